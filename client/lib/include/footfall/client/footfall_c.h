@@ -1,0 +1,84 @@
+/* footfall_c.h: the C ABI of the footfall client library, for plugins (ctypes, Maya, Blender).
+ *
+ * A session is the embedded engine or a footfalld connection. Every function returns an
+ * ff_c_status (0 = FF_C_OK, same values as ff_status in rpc/footfall.x); on failure,
+ * ffc_last_error() gives a one-line reason. No function throws, aborts or raises a signal
+ * (SIGPIPE is ignored once a session is opened). Sessions are not thread-safe: one per thread.
+ * Points are world space, 3 doubles each; normals are unit.
+ */
+#ifndef FOOTFALL_C_H_
+#define FOOTFALL_C_H_
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define FFC_ABI_VERSION 1
+
+typedef enum {
+  FF_C_OK = 0,
+  FF_C_NO_FOOTHOLD = 1,
+  FF_C_INVALID_ARGUMENT = 2,
+  FF_C_UNKNOWN_TERRAIN = 3,
+  FF_C_LIMIT_EXCEEDED = 4,
+  FF_C_IO_ERROR = 5,
+  FF_C_PARSE_ERROR = 6,
+  FF_C_ACCESS_DENIED = 7,
+  FF_C_UNAVAILABLE = 8,
+  FF_C_INTERNAL_ERROR = 9
+} ff_c_status;
+
+typedef struct ffc_session ffc_session;
+
+/* One query answer; point/normal/index are valid when status == FF_C_OK. */
+typedef struct {
+  int32_t status;
+  uint32_t index;
+  double point[3];
+  double normal[3];
+} ffc_foothold;
+
+/* FFC_ABI_VERSION of the loaded library. */
+int ffc_abi_version(void);
+
+/* Opens the in-process engine. Never NULL. */
+ffc_session* ffc_open_embedded(void);
+/* Opens a footfalld client; it connects lazily (the first call may return FF_C_UNAVAILABLE).
+ * host NULL means 127.0.0.1; timeout_s <= 0 means 10 s per call. NULL only on bad arguments. */
+ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s);
+void ffc_close(ffc_session* session);
+/* The reason for the session's last failed call; valid until the next call. Never NULL. */
+const char* ffc_last_error(const ffc_session* session);
+/* A stable name for a status, e.g. "no_foothold". */
+const char* ffc_status_name(int32_t status);
+
+/* Loads a terrain file read on this machine (points, meshes, height maps); separation > 0
+ * resamples meshes. */
+int32_t ffc_load_file(ffc_session* s, const char* path, double separation, uint32_t* terrain);
+/* Loads a file under the server's data root (RPC), or a local path (embedded). */
+int32_t ffc_load_server_file(ffc_session* s, const char* path, double separation,
+                             uint32_t* terrain);
+/* Loads `count` samples given as 6 doubles each: x y z nx ny nz. */
+int32_t ffc_load_samples(ffc_session* s, const double* samples, size_t count, const char* name,
+                         uint32_t* terrain);
+int32_t ffc_unload(ffc_session* s, uint32_t terrain);
+/* Sample count and world bounds (min xyz, max xyz) of a terrain. */
+int32_t ffc_info(ffc_session* s, uint32_t terrain, uint64_t* samples, double bounds[6]);
+
+/* Batch queries: points are 3 doubles each; steps are 6 doubles each (foot xyz, direction xyz).
+ * out[i] answers item i. tolerance <= 0: the candidate radius is the step length. */
+int32_t ffc_snap(ffc_session* s, uint32_t terrain, const double* points, size_t count,
+                 ffc_foothold* out);
+int32_t ffc_normal(ffc_session* s, uint32_t terrain, const double* points, size_t count,
+                   ffc_foothold* out);
+int32_t ffc_next(ffc_session* s, uint32_t terrain, const double* steps, size_t count,
+                 double tolerance, ffc_foothold* out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* FOOTFALL_C_H_ */

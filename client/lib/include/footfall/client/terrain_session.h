@@ -1,0 +1,90 @@
+// TerrainSession: one interface for terrain queries, with two backends: the embedded engine
+// (in-process, the default) and footfalld over ONC RPC. Both give identical answers.
+//
+// Batch calls take any number of queries (the RPC backend splits them into protocol-sized
+// calls). A call returns kOk when it was carried out; each Foothold then carries its own status
+// (kOk, kNoFoothold or kInvalidArgument). Any other return status means the call failed as a
+// whole, and last_error() says why in one line. No call throws.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "footfall/import/terrain_loader.h"
+#include "footfall/terrain/grid.h"
+
+namespace footfall {
+
+// Names a loaded terrain within a session (and, over RPC, within the server).
+using TerrainHandle = uint32_t;
+
+struct TerrainInfo {
+  std::string name;
+  GridStats stats;  // bytes, occupied cells and grid sizes as the serving engine built them
+};
+
+class TerrainSession {
+ public:
+  virtual ~TerrainSession() = default;
+  TerrainSession(const TerrainSession&) = delete;
+  TerrainSession& operator=(const TerrainSession&) = delete;
+
+  // Reads a terrain file on this machine (any format of terrain_loader.h) and loads it.
+  virtual Status LoadFile(const std::string& path, const TerrainLoadOptions& options,
+                          TerrainHandle* out);
+  // Loads a file that the serving engine reads itself: a path under footfalld's data root
+  // (RPC), or a local path (embedded). `separation` resamples meshes. [Units: wu]
+  virtual Status LoadServerFile(const std::string& path, double separation,
+                                TerrainHandle* out) = 0;
+  // Loads samples held by the caller; `name` labels the terrain in logs and info.
+  virtual Status LoadSamples(const RawSamples& samples, const std::string& name,
+                             TerrainHandle* out) = 0;
+  virtual Status Info(TerrainHandle terrain, TerrainInfo* out) = 0;
+  virtual Status Unload(TerrainHandle terrain) = 0;
+
+  // out[i] answers points[i] / queries[i]; see TerrainGrid for the exact semantics.
+  virtual Status Snap(TerrainHandle terrain, const Vec3* points, size_t count, Foothold* out) = 0;
+  virtual Status Normal(TerrainHandle terrain, const Vec3* points, size_t count,
+                        Foothold* out) = 0;
+  virtual Status Next(TerrainHandle terrain, const StepQuery* queries, size_t count,
+                      double tolerance, Foothold* out) = 0;
+
+  // Single-query conveniences over the batch calls.
+  Foothold Snap(TerrainHandle terrain, const Vec3& point);
+  Foothold Next(TerrainHandle terrain, const StepQuery& query, double tolerance = 0);
+
+  // "embedded" or "rpc HOST:PORT".
+  virtual std::string Describe() const = 0;
+  // The reason for the last failed call, one line.
+  const std::string& last_error() const { return last_error_; }
+
+ protected:
+  TerrainSession() = default;
+  Status Fail(Status status, std::string message) {
+    last_error_ = std::move(message);
+    return status;
+  }
+  std::string last_error_;
+};
+
+// The in-process engine. `threads` > 1 splits large batches across threads.
+std::unique_ptr<TerrainSession> MakeEmbeddedSession(int threads = 1);
+
+struct RpcOptions {
+  std::string host = "127.0.0.1";
+  int port = 7407;                 // footfalld's default port
+  double call_timeout_s = 10;      // [Units: s] per call
+  double connect_timeout_s = 2;    // [Units: s] per connection attempt
+};
+
+// A client of footfalld. It connects lazily, reports kUnavailable when the server is gone or
+// does not answer within the timeouts, and reconnects on the next call once the server is back;
+// it then loads its terrains again on the new server (from the same file or the samples it
+// kept), so handles stay valid across a server restart.
+std::unique_ptr<TerrainSession> MakeRpcSession(const RpcOptions& options);
+
+// Parses "HOST:PORT" (or ":PORT", or "PORT") into options->host and options->port.
+Status ParseHostPort(const std::string& text, RpcOptions* options, std::string* error);
+
+}  // namespace footfall

@@ -1,0 +1,192 @@
+// The C ABI over TerrainSession. Nothing may throw across it: every entry point catches.
+#include "footfall/client/footfall_c.h"
+
+#include <csignal>
+#include <memory>
+#include <new>
+#include <string>
+#include <vector>
+
+#include "footfall/client/terrain_session.h"
+
+struct ffc_session {
+  std::unique_ptr<footfall::TerrainSession> session;
+  std::string error;
+};
+
+namespace {
+
+using footfall::Foothold;
+using footfall::Status;
+
+int32_t Result(ffc_session* s, Status status) {
+  if (status != Status::kOk) s->error = s->session->last_error();
+  return static_cast<int32_t>(status);
+}
+
+int32_t BadArgument(ffc_session* s, const char* what) {
+  if (s) s->error = what;
+  return FF_C_INVALID_ARGUMENT;
+}
+
+void Copy(const Foothold& f, ffc_foothold* out) {
+  out->status = static_cast<int32_t>(f.status);
+  out->index = f.index;
+  out->point[0] = f.point.x, out->point[1] = f.point.y, out->point[2] = f.point.z;
+  out->normal[0] = f.normal.x, out->normal[1] = f.normal.y, out->normal[2] = f.normal.z;
+}
+
+template <typename Fn>
+int32_t Guard(ffc_session* s, Fn&& fn) {
+  if (!s) return FF_C_INVALID_ARGUMENT;
+  try {
+    return fn();
+  } catch (const std::bad_alloc&) {
+    s->error = "out of memory";
+    return FF_C_LIMIT_EXCEEDED;
+  } catch (const std::exception& e) {
+    s->error = std::string("internal error: ") + e.what();
+    return FF_C_INTERNAL_ERROR;
+  } catch (...) {
+    s->error = "internal error";
+    return FF_C_INTERNAL_ERROR;
+  }
+}
+
+int32_t PointQuery(ffc_session* s, uint32_t terrain, const double* points, size_t count,
+                   ffc_foothold* out, bool normal) {
+  return Guard(s, [&]() -> int32_t {
+    if (count && (!points || !out)) return BadArgument(s, "points and out must not be NULL");
+    std::vector<footfall::Vec3> q(count);
+    for (size_t i = 0; i < count; ++i) q[i] = {points[3 * i], points[3 * i + 1], points[3 * i + 2]};
+    std::vector<Foothold> answers(count);
+    const Status status = normal ? s->session->Normal(terrain, q.data(), count, answers.data())
+                                 : s->session->Snap(terrain, q.data(), count, answers.data());
+    if (status == Status::kOk)
+      for (size_t i = 0; i < count; ++i) Copy(answers[i], &out[i]);
+    return Result(s, status);
+  });
+}
+
+}  // namespace
+
+extern "C" {
+
+int ffc_abi_version(void) { return FFC_ABI_VERSION; }
+
+ffc_session* ffc_open_embedded(void) {
+  std::signal(SIGPIPE, SIG_IGN);
+  try {
+    auto* s = new ffc_session;
+    s->session = footfall::MakeEmbeddedSession();
+    return s;
+  } catch (...) {
+    return nullptr;
+  }
+}
+
+ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s) {
+  std::signal(SIGPIPE, SIG_IGN);
+  if (port < 1 || port > 65535) return nullptr;
+  try {
+    footfall::RpcOptions options;
+    if (host && *host) options.host = host;
+    options.port = port;
+    if (timeout_s > 0) options.call_timeout_s = timeout_s;
+    auto* s = new ffc_session;
+    s->session = footfall::MakeRpcSession(options);
+    return s;
+  } catch (...) {
+    return nullptr;
+  }
+}
+
+void ffc_close(ffc_session* session) { delete session; }
+
+const char* ffc_last_error(const ffc_session* session) {
+  return session ? session->error.c_str() : "no session";
+}
+
+const char* ffc_status_name(int32_t status) {
+  return footfall::StatusName(static_cast<Status>(status));
+}
+
+int32_t ffc_load_file(ffc_session* s, const char* path, double separation, uint32_t* terrain) {
+  return Guard(s, [&]() -> int32_t {
+    if (!path || !terrain) return BadArgument(s, "path and terrain must not be NULL");
+    footfall::TerrainLoadOptions options;
+    options.separation = separation > 0 ? separation : 0;
+    return Result(s, s->session->LoadFile(path, options, terrain));
+  });
+}
+
+int32_t ffc_load_server_file(ffc_session* s, const char* path, double separation,
+                             uint32_t* terrain) {
+  return Guard(s, [&]() -> int32_t {
+    if (!path || !terrain) return BadArgument(s, "path and terrain must not be NULL");
+    return Result(s, s->session->LoadServerFile(path, separation > 0 ? separation : 0, terrain));
+  });
+}
+
+int32_t ffc_load_samples(ffc_session* s, const double* samples, size_t count, const char* name,
+                         uint32_t* terrain) {
+  return Guard(s, [&]() -> int32_t {
+    if ((count && !samples) || !terrain) return BadArgument(s, "samples and terrain must not be NULL");
+    footfall::RawSamples raw;
+    raw.points.reserve(count), raw.normals.reserve(count);
+    for (size_t i = 0; i < count; ++i) {
+      const double* v = samples + 6 * i;
+      raw.push_back({v[0], v[1], v[2]}, {v[3], v[4], v[5]});
+    }
+    return Result(s, s->session->LoadSamples(raw, name ? name : "samples", terrain));
+  });
+}
+
+int32_t ffc_unload(ffc_session* s, uint32_t terrain) {
+  return Guard(s, [&]() -> int32_t { return Result(s, s->session->Unload(terrain)); });
+}
+
+int32_t ffc_info(ffc_session* s, uint32_t terrain, uint64_t* samples, double bounds[6]) {
+  return Guard(s, [&]() -> int32_t {
+    footfall::TerrainInfo info;
+    const Status status = s->session->Info(terrain, &info);
+    if (status == Status::kOk) {
+      if (samples) *samples = info.stats.samples;
+      if (bounds) {
+        const auto &lo = info.stats.bounds_min, &hi = info.stats.bounds_max;
+        bounds[0] = lo.x, bounds[1] = lo.y, bounds[2] = lo.z;
+        bounds[3] = hi.x, bounds[4] = hi.y, bounds[5] = hi.z;
+      }
+    }
+    return Result(s, status);
+  });
+}
+
+int32_t ffc_snap(ffc_session* s, uint32_t terrain, const double* points, size_t count,
+                 ffc_foothold* out) {
+  return PointQuery(s, terrain, points, count, out, false);
+}
+
+int32_t ffc_normal(ffc_session* s, uint32_t terrain, const double* points, size_t count,
+                   ffc_foothold* out) {
+  return PointQuery(s, terrain, points, count, out, true);
+}
+
+int32_t ffc_next(ffc_session* s, uint32_t terrain, const double* steps, size_t count,
+                 double tolerance, ffc_foothold* out) {
+  return Guard(s, [&]() -> int32_t {
+    if (count && (!steps || !out)) return BadArgument(s, "steps and out must not be NULL");
+    std::vector<footfall::StepQuery> q(count);
+    for (size_t i = 0; i < count; ++i) {
+      const double* v = steps + 6 * i;
+      q[i] = {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+    }
+    std::vector<Foothold> answers(count);
+    const Status status = s->session->Next(terrain, q.data(), count, tolerance, answers.data());
+    if (status == Status::kOk)
+      for (size_t i = 0; i < count; ++i) Copy(answers[i], &out[i]);
+    return Result(s, status);
+  });
+}
+
+}  // extern "C"

@@ -1,0 +1,94 @@
+// The embedded backend: the terrain engine in this process.
+#include <map>
+
+#include "footfall/client/terrain_session.h"
+
+namespace footfall {
+namespace {
+
+class EmbeddedSession final : public TerrainSession {
+ public:
+  explicit EmbeddedSession(int threads) : threads_(threads) {}
+
+  Status LoadServerFile(const std::string& path, double separation, TerrainHandle* out) override {
+    TerrainLoadOptions options;
+    options.separation = separation;
+    return TerrainSession::LoadFile(path, options, out);
+  }
+
+  Status LoadSamples(const RawSamples& samples, const std::string& name,
+                     TerrainHandle* out) override {
+    RawSamples copy = samples;
+    std::string error;
+    Status status = ValidateAndNormalize(&copy, &error);
+    if (status != Status::kOk) return Fail(status, name + ": " + error);
+    Entry entry;
+    entry.name = name;
+    status = TerrainGrid::Build(copy, GridOptions{}, &entry.grid, &error);
+    if (status != Status::kOk) return Fail(status, name + ": " + error);
+    const TerrainHandle handle = next_handle_++;
+    terrains_.emplace(handle, std::move(entry));
+    *out = handle;
+    return Status::kOk;
+  }
+
+  Status Info(TerrainHandle terrain, TerrainInfo* out) override {
+    const Entry* e = Find(terrain);
+    if (!e) return Unknown(terrain);
+    out->name = e->name;
+    out->stats = e->grid.stats();
+    return Status::kOk;
+  }
+
+  Status Unload(TerrainHandle terrain) override {
+    if (terrains_.erase(terrain) == 0) return Unknown(terrain);
+    return Status::kOk;
+  }
+
+  Status Snap(TerrainHandle terrain, const Vec3* points, size_t count, Foothold* out) override {
+    const Entry* e = Find(terrain);
+    if (!e) return Unknown(terrain);
+    e->grid.SnapBatch(points, count, out, threads_);
+    return Status::kOk;
+  }
+
+  Status Normal(TerrainHandle terrain, const Vec3* points, size_t count, Foothold* out) override {
+    return Snap(terrain, points, count, out);
+  }
+
+  Status Next(TerrainHandle terrain, const StepQuery* queries, size_t count, double tolerance,
+              Foothold* out) override {
+    const Entry* e = Find(terrain);
+    if (!e) return Unknown(terrain);
+    if (!std::isfinite(tolerance)) return Fail(Status::kInvalidArgument, "tolerance is not finite");
+    e->grid.NextBatch(queries, count, tolerance, out, threads_);
+    return Status::kOk;
+  }
+
+  std::string Describe() const override { return "embedded"; }
+
+ private:
+  struct Entry {
+    std::string name;
+    TerrainGrid grid;
+  };
+  const Entry* Find(TerrainHandle terrain) const {
+    auto it = terrains_.find(terrain);
+    return it == terrains_.end() ? nullptr : &it->second;
+  }
+  Status Unknown(TerrainHandle terrain) {
+    return Fail(Status::kUnknownTerrain, "no terrain with handle " + std::to_string(terrain));
+  }
+
+  int threads_;
+  TerrainHandle next_handle_ = 1;
+  std::map<TerrainHandle, Entry> terrains_;
+};
+
+}  // namespace
+
+std::unique_ptr<TerrainSession> MakeEmbeddedSession(int threads) {
+  return std::make_unique<EmbeddedSession>(threads);
+}
+
+}  // namespace footfall

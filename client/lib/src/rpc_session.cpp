@@ -1,0 +1,423 @@
+// The RPC backend: a footfalld client over TCP.
+//
+// Connections are made with our own socket (non-blocking connect with a timeout), then wrapped
+// with clnt_vc_create using a send size that keeps every request in one record fragment
+// (footfalld's non-blocking transport drops multi-fragment requests). A transport failure
+// destroys the client; the next call reconnects, and reloads a terrain the server no longer
+// knows (it restarted).
+#include <fcntl.h>
+#include <netdb.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <rpc/rpc.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <csignal>
+#include <cstring>
+#include <map>
+
+#include "footfall.h"
+#include "footfall/client/terrain_session.h"
+
+namespace footfall {
+namespace {
+
+static_assert(static_cast<int>(Status::kOk) == FF_OK, "status mirrors ff_status");
+static_assert(static_cast<int>(Status::kNoFoothold) == FF_NO_FOOTHOLD, "");
+static_assert(static_cast<int>(Status::kInternalError) == FF_INTERNAL_ERROR, "");
+
+ff_vec3 ToWire(const Vec3& v) { return {v.x, v.y, v.z}; }
+Vec3 FromWire(const ff_vec3& v) { return {v.x, v.y, v.z}; }
+
+Status FromWire(ff_status s) {
+  const int v = static_cast<int>(s);
+  return v >= FF_OK && v <= FF_INTERNAL_ERROR ? static_cast<Status>(v) : Status::kInternalError;
+}
+
+Foothold FromWire(const ff_result& r) {
+  Foothold f;
+  f.status = FromWire(r.status);
+  if (f.status == Status::kOk) {
+    f.index = r.index;
+    f.point = FromWire(r.point);
+    f.normal = FromWire(r.normal);
+  }
+  return f;
+}
+
+// Frees an rpcgen reply when it goes out of scope.
+template <typename T>
+struct Reply {
+  explicit Reply(xdrproc_t proc) : proc(proc) { std::memset(&value, 0, sizeof value); }
+  ~Reply() { xdr_free(proc, reinterpret_cast<char*>(&value)); }
+  Reply(const Reply&) = delete;
+  Reply& operator=(const Reply&) = delete;
+  T value;
+  xdrproc_t proc;
+};
+
+// How a terrain was loaded, so it can be loaded again on a restarted server.
+struct TerrainSource {
+  enum Kind { kLocalFile, kServerFile, kSamples } kind = kSamples;
+  std::string path;
+  TerrainLoadOptions options;
+  RawSamples samples;
+  std::string name;
+  uint32_t server_handle = 0;
+  bool loaded = false;
+};
+
+class RpcSession final : public TerrainSession {
+ public:
+  explicit RpcSession(const RpcOptions& options) : options_(options) {
+    std::signal(SIGPIPE, SIG_IGN);
+  }
+  ~RpcSession() override { Disconnect(); }
+
+  Status LoadFile(const std::string& path, const TerrainLoadOptions& options,
+                  TerrainHandle* out) override {
+    TerrainSource source;
+    source.kind = TerrainSource::kLocalFile;
+    source.path = path, source.options = options, source.name = path;
+    return Register(std::move(source), out);
+  }
+
+  Status LoadServerFile(const std::string& path, double separation,
+                        TerrainHandle* out) override {
+    TerrainSource source;
+    source.kind = TerrainSource::kServerFile;
+    source.path = path, source.options.separation = separation, source.name = path;
+    return Register(std::move(source), out);
+  }
+
+  Status LoadSamples(const RawSamples& samples, const std::string& name,
+                     TerrainHandle* out) override {
+    TerrainSource source;
+    source.kind = TerrainSource::kSamples;
+    source.samples = samples, source.name = name;
+    std::string error;
+    const Status status = ValidateAndNormalize(&source.samples, &error);
+    if (status != Status::kOk) return Fail(status, name + ": " + error);
+    return Register(std::move(source), out);
+  }
+
+  Status Info(TerrainHandle terrain, TerrainInfo* out) override {
+    return WithTerrain(terrain, [&](uint32_t server) -> Status {
+      ff_terrain_args args{server};
+      Reply<ff_info_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_info_reply));
+      Status s = Call(ff_info_1(&args, &reply.value, client_), "info");
+      if (s != Status::kOk) return s;
+      if (reply.value.status != FF_OK) return ServerFail(reply.value.status, "info");
+      const ff_info_reply& r = reply.value;
+      out->name = r.name ? r.name : "";
+      out->stats = GridStats{};
+      out->stats.samples = r.samples;
+      out->stats.bounds_min = FromWire(r.bounds_min);
+      out->stats.bounds_max = FromWire(r.bounds_max);
+      out->stats.cells[0] = r.cells_x, out->stats.cells[1] = r.cells_y;
+      out->stats.cells[2] = r.cells_z;
+      out->stats.cell_size = r.cell_size;
+      out->stats.occupied_cells = r.occupied_cells;
+      out->stats.bytes = r.bytes;
+      return Status::kOk;
+    });
+  }
+
+  Status Unload(TerrainHandle terrain) override {
+    auto it = terrains_.find(terrain);
+    if (it == terrains_.end()) return Unknown(terrain);
+    if (it->second.loaded && client_) {
+      ff_terrain_args args{it->second.server_handle};
+      Reply<ff_status_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_status_reply));
+      Call(ff_unload_1(&args, &reply.value, client_), "unload");  // best effort
+    }
+    terrains_.erase(it);
+    return Status::kOk;
+  }
+
+  Status Snap(TerrainHandle terrain, const Vec3* points, size_t count, Foothold* out) override {
+    return PointBatch(terrain, points, count, out, false);
+  }
+
+  Status Normal(TerrainHandle terrain, const Vec3* points, size_t count, Foothold* out) override {
+    return PointBatch(terrain, points, count, out, true);
+  }
+
+  Status Next(TerrainHandle terrain, const StepQuery* queries, size_t count, double tolerance,
+              Foothold* out) override {
+    if (!std::isfinite(tolerance)) return Fail(Status::kInvalidArgument, "tolerance is not finite");
+    std::vector<ff_next_query> wire(std::min<size_t>(count, FF_MAX_BATCH));
+    for (size_t begin = 0; begin < count; begin += FF_MAX_BATCH) {
+      const size_t n = std::min<size_t>(FF_MAX_BATCH, count - begin);
+      for (size_t i = 0; i < n; ++i)
+        wire[i] = {ToWire(queries[begin + i].foot), ToWire(queries[begin + i].direction)};
+      const Status s = WithTerrain(terrain, [&](uint32_t server) -> Status {
+        ff_next_batch_args args;
+        args.terrain = server;
+        args.tolerance = tolerance;
+        args.queries.queries_len = static_cast<u_int>(n);
+        args.queries.queries_val = wire.data();
+        Reply<ff_batch_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_batch_reply));
+        const Status cs = Call(ff_next_batch_1(&args, &reply.value, client_), "next");
+        if (cs != Status::kOk) return cs;
+        return TakeBatch(reply.value, n, out + begin, "next");
+      });
+      if (s != Status::kOk) return s;
+    }
+    return Status::kOk;
+  }
+
+  std::string Describe() const override {
+    return "rpc " + options_.host + ":" + std::to_string(options_.port);
+  }
+
+ private:
+  Status PointBatch(TerrainHandle terrain, const Vec3* points, size_t count, Foothold* out,
+                    bool normal) {
+    const char* what = normal ? "normal" : "snap";
+    std::vector<ff_vec3> wire(std::min<size_t>(count, FF_MAX_BATCH));
+    for (size_t begin = 0; begin < count; begin += FF_MAX_BATCH) {
+      const size_t n = std::min<size_t>(FF_MAX_BATCH, count - begin);
+      for (size_t i = 0; i < n; ++i) wire[i] = ToWire(points[begin + i]);
+      const Status s = WithTerrain(terrain, [&](uint32_t server) -> Status {
+        ff_point_batch_args args;
+        args.terrain = server;
+        args.points.points_len = static_cast<u_int>(n);
+        args.points.points_val = wire.data();
+        Reply<ff_batch_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_batch_reply));
+        const clnt_stat cs = normal ? ff_normal_batch_1(&args, &reply.value, client_)
+                                    : ff_snap_batch_1(&args, &reply.value, client_);
+        const Status st = Call(cs, what);
+        if (st != Status::kOk) return st;
+        return TakeBatch(reply.value, n, out + begin, what);
+      });
+      if (s != Status::kOk) return s;
+    }
+    return Status::kOk;
+  }
+
+  Status TakeBatch(const ff_batch_reply& reply, size_t n, Foothold* out, const char* what) {
+    if (reply.status != FF_OK) return ServerFail(reply.status, what);
+    if (reply.results.results_len != n) {
+      return Fail(Status::kInternalError, std::string(what) + ": server sent " +
+                                              std::to_string(reply.results.results_len) +
+                                              " answers for " + std::to_string(n) + " queries");
+    }
+    for (size_t i = 0; i < n; ++i) out[i] = FromWire(reply.results.results_val[i]);
+    return Status::kOk;
+  }
+
+  // Runs fn(server handle) for a session terrain, connecting and (re)loading as needed. If the
+  // server no longer knows the terrain (it restarted), loads it again and retries once.
+  template <typename Fn>
+  Status WithTerrain(TerrainHandle terrain, Fn&& fn) {
+    auto it = terrains_.find(terrain);
+    if (it == terrains_.end()) return Unknown(terrain);
+    for (int attempt = 0; attempt < 2; ++attempt) {
+      Status s = EnsureConnected();
+      if (s != Status::kOk) return s;
+      if (!it->second.loaded) {
+        s = Upload(&it->second);
+        if (s != Status::kOk) return s;
+      }
+      s = fn(it->second.server_handle);
+      if (s == Status::kUnknownTerrain && attempt == 0) {
+        it->second.loaded = false;
+        continue;
+      }
+      return s;
+    }
+    return Status::kUnknownTerrain;
+  }
+
+  Status Register(TerrainSource source, TerrainHandle* out) {
+    if (source.kind == TerrainSource::kLocalFile) {
+      // Parse on this machine first, so file errors name this machine's file and line.
+      std::string error;
+      const Status s = LoadTerrain(source.path, source.options, &source.samples, &error);
+      if (s != Status::kOk) return Fail(s, error);
+      source.kind = TerrainSource::kSamples;
+    }
+    Status s = EnsureConnected();
+    if (s != Status::kOk) return s;
+    s = Upload(&source);
+    if (s != Status::kOk) return s;
+    const TerrainHandle handle = next_handle_++;
+    terrains_.emplace(handle, std::move(source));
+    *out = handle;
+    return Status::kOk;
+  }
+
+  Status Upload(TerrainSource* source) {
+    source->loaded = false;
+    if (source->kind == TerrainSource::kServerFile) {
+      ff_load_args args;
+      args.path = const_cast<char*>(source->path.c_str());
+      args.separation = source->options.separation;
+      Reply<ff_load_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply));
+      const Status s = Call(ff_load_1(&args, &reply.value, client_), "load");
+      if (s != Status::kOk) return s;
+      if (reply.value.status != FF_OK)
+        return Fail(FromWire(reply.value.status), reply.value.message ? reply.value.message : "load failed");
+      source->server_handle = reply.value.terrain;
+      source->loaded = true;
+      return Status::kOk;
+    }
+    const RawSamples& samples = source->samples;
+    ff_upload_begin_args begin;
+    std::string name = source->name.substr(0, FF_MAX_NAME);
+    begin.name = const_cast<char*>(name.c_str());
+    begin.total = samples.size();
+    Reply<ff_upload_reply> started(reinterpret_cast<xdrproc_t>(xdr_ff_upload_reply));
+    Status s = Call(ff_upload_begin_1(&begin, &started.value, client_), "upload");
+    if (s != Status::kOk) return s;
+    if (started.value.status != FF_OK)
+      return Fail(FromWire(started.value.status), started.value.message ? started.value.message : "upload refused");
+    const uint32_t upload = started.value.upload;
+    std::vector<ff_sample> chunk(std::min<size_t>(samples.size(), FF_MAX_CHUNK));
+    for (size_t b = 0; b < samples.size(); b += FF_MAX_CHUNK) {
+      const size_t n = std::min<size_t>(FF_MAX_CHUNK, samples.size() - b);
+      for (size_t i = 0; i < n; ++i)
+        chunk[i] = {ToWire(samples.points[b + i]), ToWire(samples.normals[b + i])};
+      ff_upload_chunk_args args;
+      args.upload = upload;
+      args.samples.samples_len = static_cast<u_int>(n);
+      args.samples.samples_val = chunk.data();
+      Reply<ff_status_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_status_reply));
+      s = Call(ff_upload_chunk_1(&args, &reply.value, client_), "upload");
+      if (s != Status::kOk) return s;
+      if (reply.value.status != FF_OK)
+        return Fail(FromWire(reply.value.status), reply.value.message ? reply.value.message : "upload failed");
+    }
+    ff_upload_args finish{upload};
+    Reply<ff_load_reply> done(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply));
+    s = Call(ff_upload_finish_1(&finish, &done.value, client_), "upload");
+    if (s != Status::kOk) return s;
+    if (done.value.status != FF_OK)
+      return Fail(FromWire(done.value.status), done.value.message ? done.value.message : "upload failed");
+    source->server_handle = done.value.terrain;
+    source->loaded = true;
+    return Status::kOk;
+  }
+
+  Status ServerFail(ff_status status, const char* what) {
+    return Fail(FromWire(status), std::string(what) + ": server answered " +
+                                      StatusName(FromWire(status)));
+  }
+
+  Status Unknown(TerrainHandle terrain) {
+    return Fail(Status::kUnknownTerrain, "no terrain with handle " + std::to_string(terrain));
+  }
+
+  // Maps an RPC call result to a status; a transport failure drops the connection.
+  Status Call(clnt_stat status, const char* what) {
+    if (status == RPC_SUCCESS) return Status::kOk;
+    const std::string reason = clnt_sperrno(status);
+    Disconnect();
+    return Fail(Status::kUnavailable, std::string(what) + ": footfalld at " + Address() + ": " +
+                                          reason);
+  }
+
+  std::string Address() const { return options_.host + ":" + std::to_string(options_.port); }
+
+  void Disconnect() {
+    if (client_) {
+      clnt_destroy(client_);  // closes the socket (CLSET_FD_CLOSE)
+      client_ = nullptr;
+      // Terrains stay marked loaded: a server that restarted answers FF_UNKNOWN_TERRAIN for
+      // them (its handles start at a random base), and WithTerrain then loads them again.
+    }
+  }
+
+  Status EnsureConnected() {
+    if (client_) return Status::kOk;
+    addrinfo hints{};
+    hints.ai_family = AF_UNSPEC;
+    hints.ai_socktype = SOCK_STREAM;
+    addrinfo* found = nullptr;
+    const std::string port = std::to_string(options_.port);
+    const int gai = getaddrinfo(options_.host.c_str(), port.c_str(), &hints, &found);
+    if (gai != 0) {
+      return Fail(Status::kUnavailable, "footfalld at " + Address() + ": cannot resolve host: " +
+                                            gai_strerror(gai));
+    }
+    std::string reason = "no address";
+    for (addrinfo* a = found; a && !client_; a = a->ai_next) {
+      const int fd = ConnectWithTimeout(a, &reason);
+      if (fd < 0) continue;
+      netbuf address;
+      address.maxlen = address.len = static_cast<unsigned>(a->ai_addrlen);
+      address.buf = a->ai_addr;
+      client_ = clnt_vc_create(fd, &address, FOOTFALL_PROG, FOOTFALL_V1, FF_MAX_REQUEST_BYTES,
+                               FF_MAX_REQUEST_BYTES);
+      if (!client_) {
+        reason = "cannot create RPC client";
+        close(fd);
+        continue;
+      }
+      int close_fd = 1;
+      clnt_control(client_, CLSET_FD_CLOSE, reinterpret_cast<char*>(&close_fd));
+      timeval timeout;
+      timeout.tv_sec = static_cast<time_t>(options_.call_timeout_s);
+      timeout.tv_usec = static_cast<suseconds_t>(
+          (options_.call_timeout_s - static_cast<double>(timeout.tv_sec)) * 1e6);
+      clnt_control(client_, CLSET_TIMEOUT, reinterpret_cast<char*>(&timeout));
+    }
+    freeaddrinfo(found);
+    if (!client_) return Fail(Status::kUnavailable, "footfalld at " + Address() + ": " + reason);
+    return Status::kOk;
+  }
+
+  int ConnectWithTimeout(const addrinfo* a, std::string* reason) {
+    const int fd = socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
+    if (fd < 0) {
+      *reason = std::strerror(errno);
+      return -1;
+    }
+    const int flags = fcntl(fd, F_GETFL, 0);
+    fcntl(fd, F_SETFL, flags | O_NONBLOCK);
+    int rc = connect(fd, a->ai_addr, a->ai_addrlen);
+    if (rc != 0 && errno == EINPROGRESS) {
+      pollfd p{fd, POLLOUT, 0};
+      const int ms = static_cast<int>(options_.connect_timeout_s * 1000);
+      rc = poll(&p, 1, std::max(1, ms));
+      if (rc == 0) {
+        *reason = "connection timed out";
+        close(fd);
+        return -1;
+      }
+      int err = 0;
+      socklen_t len = sizeof err;
+      getsockopt(fd, SOL_SOCKET, SO_ERROR, &err, &len);
+      rc = err == 0 ? 0 : -1;
+      errno = err;
+    }
+    if (rc != 0) {
+      *reason = std::strerror(errno);
+      close(fd);
+      return -1;
+    }
+    fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
+    const int one = 1;
+    setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    return fd;
+  }
+
+  RpcOptions options_;
+  CLIENT* client_ = nullptr;
+  TerrainHandle next_handle_ = 1;
+  std::map<TerrainHandle, TerrainSource> terrains_;
+};
+
+}  // namespace
+
+std::unique_ptr<TerrainSession> MakeRpcSession(const RpcOptions& options) {
+  return std::make_unique<RpcSession>(options);
+}
+
+}  // namespace footfall

@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Installs footfall's Debian dependencies when they are missing.
+# Usage: scripts/install-deps.sh [core|test|viewer|blender|all]...   (default: core)
+set -euo pipefail
+
+core=(cmake g++ make pkg-config cpp libtirpc-dev rpcsvc-proto nlohmann-json3-dev libcli11-dev
+      libopenmesh-dev libtinygltf-dev libstb-dev)
+test=(catch2 libbenchmark-dev libnanoflann-dev rpcbind valgrind nodejs npm)
+viewer=(libglfw3-dev libglm-dev libgl-dev libgl1-mesa-dri xvfb xauth)
+blender=(blender python3)
+
+wanted=()
+[ $# -eq 0 ] && set -- core
+for group in "$@"; do
+  case "$group" in
+    core) wanted+=("${core[@]}") ;;
+    test) wanted+=("${test[@]}") ;;
+    viewer) wanted+=("${viewer[@]}") ;;
+    blender) wanted+=("${blender[@]}") ;;
+    all) wanted+=("${core[@]}" "${test[@]}" "${viewer[@]}" "${blender[@]}") ;;
+    *) echo "install-deps: unknown group '$group' (core, test, viewer, blender, all)" >&2; exit 2 ;;
+  esac
+done
+
+missing=()
+for pkg in "${wanted[@]}"; do
+  dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "ok installed" || missing+=("$pkg")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "install-deps: installing ${missing[*]}"
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi

@@ -1,0 +1,33 @@
+// Synthetic terrains with exactly known geometry, for tests, benchmarks and `footfall terrain
+// make`. All are deterministic for a given seed. Sample spacing is `spacing` world units; Y is up.
+#pragma once
+
+#include <cstdint>
+
+#include "footfall/terrain/samples.h"
+
+namespace footfall {
+
+// A height field y = amplitude * smooth noise over [0, nx) x [0, nz) samples, normals from the
+// surface gradient.
+RawSamples MakeHeightField(int nx, int nz, double spacing, double amplitude, uint64_t seed);
+
+// Samples spread evenly over a sphere (Fibonacci lattice), normals pointing outwards.
+RawSamples MakeSphere(int count, const Vec3& centre, double radius);
+
+// A staircase along +Z: `steps` steps of given rise and run, `width` wide (X), treads and risers
+// sampled at `spacing`, normals +Y on treads and -Z on risers.
+RawSamples MakeStairs(int steps, double rise, double run, double width, double spacing);
+
+// A closed room: floor (normal +Y), four walls (normals inward) and a ceiling (normal -Y), size
+// (sx, sy, sz) from the origin.
+RawSamples MakeRoom(const Vec3& size, double spacing);
+
+// A flat square of n x n samples at height y, normal +Y.
+RawSamples MakeFlat(int n, double spacing, double y);
+
+// A planar ramp rising along +Z at `slope_deg` degrees, nx x nz samples (spacing along the
+// surface), normals perpendicular to it.
+RawSamples MakeRamp(int nx, int nz, double spacing, double slope_deg);
+
+}  // namespace footfall

@@ -1,0 +1,48 @@
+// RpcServer: footfalld's ONC RPC service over TCP.
+//
+// One thread drives libtirpc (its svc layer is process-global and single-threaded) over
+// non-blocking transports with a bounded record size, so a client that sends half a request or
+// never reads its replies cannot stall the others. Requests are decoded, validated and freed by
+// our own dispatcher on every path; no exception escapes a handler. One RpcServer per process.
+#pragma once
+
+#include <atomic>
+#include <string>
+
+#include "footfall/service/terrain_registry.h"
+
+namespace footfall {
+
+struct RpcServerOptions {
+  std::string listen_host = "127.0.0.1";
+  int port = 7407;             // 0 picks a free port (see RpcServer::port())
+  std::string data_root;       // confines FF_LOAD; empty refuses server-side loads
+  bool use_rpcbind = true;     // register with rpcbind when one is running
+  int batch_threads = 1;       // threads per batch query
+  RegistryLimits limits;
+};
+
+class RpcServer {
+ public:
+  explicit RpcServer(RpcServerOptions options);
+  ~RpcServer();
+  RpcServer(const RpcServer&) = delete;
+  RpcServer& operator=(const RpcServer&) = delete;
+
+  // Binds, listens and registers. On failure returns false with a message.
+  bool Start(std::string* error);
+  // The bound port (after Start).
+  int port() const { return port_; }
+  // Serves until Stop() is called (from a signal handler or another thread).
+  void Run();
+  void Stop() { stop_.store(true); }
+
+ private:
+  RpcServerOptions options_;
+  int listen_fd_ = -1;
+  int port_ = 0;
+  bool registered_rpcbind_ = false;
+  std::atomic<bool> stop_{false};
+};
+
+}  // namespace footfall

@@ -1,0 +1,88 @@
+// TerrainRegistry: the terrains footfalld serves, by handle, with the uploads in progress and a
+// ring of recently answered queries (for live viewers). Not thread-safe: the RPC loop owns it.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "footfall/import/terrain_loader.h"
+#include "footfall/terrain/grid.h"
+
+namespace footfall {
+
+struct RegistryLimits {
+  size_t max_terrains = 256;            // loaded at once
+  size_t max_total_samples = 1u << 28;  // over all terrains and uploads
+  size_t max_uploads = 32;              // in progress at once
+  double upload_idle_s = 120;           // [Units: s] an upload idle this long is dropped
+  size_t recent_capacity = 4096;        // queries kept for FF_RECENT
+};
+
+struct LoadedTerrain {
+  std::string name;
+  TerrainGrid grid;
+};
+
+// One answered query, as the live view shows it.
+struct RecentQuery {
+  uint64_t sequence = 0;
+  uint32_t terrain = 0;
+  int op = 0;  // 0 snap, 1 normal, 2 next (ff_op)
+  Vec3 point, direction;
+  double tolerance = 0;
+  Foothold result;
+};
+
+class TerrainRegistry {
+ public:
+  // `data_root` confines server-side loads; empty refuses them.
+  TerrainRegistry(std::string data_root, RegistryLimits limits);
+
+  // Loads a file under the data root. kAccessDenied for paths escaping it (.., symlinks).
+  Status LoadFile(const std::string& relative_path, double separation, uint32_t* handle,
+                  std::string* message);
+  Status BeginUpload(const std::string& name, uint64_t total, uint32_t* upload,
+                     std::string* message);
+  Status AppendUpload(uint32_t upload, const RawSamples& chunk, std::string* message);
+  Status FinishUpload(uint32_t upload, uint32_t* handle, std::string* message);
+  Status Unload(uint32_t handle);
+  const LoadedTerrain* Find(uint32_t handle) const;
+  std::vector<uint32_t> Handles() const;
+
+  // Drops uploads idle longer than the limit.
+  void ExpireUploads();
+
+  void Record(const RecentQuery& query);
+  // Queries with sequence > after, oldest first, at most `max`; *latest is the newest sequence.
+  std::vector<RecentQuery> RecentAfter(uint64_t after, size_t max, uint64_t* latest) const;
+
+ private:
+  Status Add(const std::string& name, RawSamples samples, uint32_t* handle, std::string* message);
+  size_t TotalSamples() const;
+
+  struct Upload {
+    std::string name;
+    uint64_t total = 0;
+    RawSamples samples;
+    std::chrono::steady_clock::time_point touched;
+  };
+  std::string data_root_;  // canonical, or empty
+  RegistryLimits limits_;
+  uint32_t next_handle_;
+  uint32_t next_upload_ = 1;
+  std::map<uint32_t, std::unique_ptr<LoadedTerrain>> terrains_;
+  std::map<uint32_t, Upload> uploads_;
+  std::deque<RecentQuery> recent_;
+  uint64_t sequence_ = 0;
+};
+
+// Resolves `relative` under the canonical directory `root`, refusing escapes: absolute paths,
+// "..", and symlinks leading outside. On success *resolved is the canonical path.
+Status ResolveUnderRoot(const std::string& root, const std::string& relative,
+                        std::string* resolved, std::string* message);
+
+}  // namespace footfall

@@ -1,0 +1,395 @@
+// footfalld's procedures: decode, validate, answer, free, on every path.
+#include "dispatcher.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <new>
+#include <string>
+#include <vector>
+
+#include "footfall.h"
+
+namespace footfall {
+namespace {
+
+static_assert(static_cast<int>(Status::kOk) == FF_OK, "Status mirrors ff_status");
+static_assert(static_cast<int>(Status::kNoFoothold) == FF_NO_FOOTHOLD, "");
+static_assert(static_cast<int>(Status::kInvalidArgument) == FF_INVALID_ARGUMENT, "");
+static_assert(static_cast<int>(Status::kUnknownTerrain) == FF_UNKNOWN_TERRAIN, "");
+static_assert(static_cast<int>(Status::kLimitExceeded) == FF_LIMIT_EXCEEDED, "");
+static_assert(static_cast<int>(Status::kIoError) == FF_IO_ERROR, "");
+static_assert(static_cast<int>(Status::kParseError) == FF_PARSE_ERROR, "");
+static_assert(static_cast<int>(Status::kAccessDenied) == FF_ACCESS_DENIED, "");
+static_assert(static_cast<int>(Status::kUnavailable) == FF_UNAVAILABLE, "");
+static_assert(static_cast<int>(Status::kInternalError) == FF_INTERNAL_ERROR, "");
+
+// Batches: how many queries of each batch go to the recent-query ring.
+constexpr size_t kRecordPerBatch = 16;
+
+ServiceState* g_state = nullptr;
+
+// Reply storage, reused across calls (the loop is single-threaded). Reply structs point into it.
+struct Storage {
+  std::string message;
+  std::string name;
+  std::vector<ff_result> results;
+  std::vector<Vec3> points;
+  std::vector<StepQuery> steps;
+  std::vector<Foothold> answers;
+  std::vector<uint32_t> handles;
+  std::vector<ff_recent_query> recent;
+  RawSamples chunk;
+};
+Storage g_storage;
+
+ff_status Wire(Status s) { return static_cast<ff_status>(static_cast<int>(s)); }
+Vec3 FromWire(const ff_vec3& v) { return {v.x, v.y, v.z}; }
+ff_vec3 ToWire(const Vec3& v) { return {v.x, v.y, v.z}; }
+
+ff_result ToWire(const Foothold& f) {
+  ff_result r;
+  std::memset(&r, 0, sizeof r);
+  r.status = Wire(f.status);
+  if (f.status == Status::kOk) {
+    r.index = f.index;
+    r.point = ToWire(f.point);
+    r.normal = ToWire(f.normal);
+  }
+  return r;
+}
+
+char* Message(const std::string& text) {
+  g_storage.message = text.substr(0, FF_MAX_MESSAGE);
+  return const_cast<char*>(g_storage.message.c_str());
+}
+
+void Log(const std::string& line) { std::fprintf(stderr, "footfalld: %s\n", line.c_str()); }
+
+void LogError(const char* proc, Status status, const std::string& message) {
+  Log(std::string("error: ") + proc + ": " + StatusName(status) +
+      (message.empty() ? "" : ": " + message));
+}
+
+// --- procedures -------------------------------------------------------------------------
+
+void Load(const ff_load_args& a, ff_load_reply* r) {
+  std::string message;
+  uint32_t handle = 0;
+  const std::string path = a.path ? a.path : "";
+  const Status s = g_state->registry.LoadFile(path, a.separation, &handle, &message);
+  r->status = Wire(s);
+  r->terrain = handle;
+  if (s == Status::kOk) {
+    const GridStats& st = g_state->registry.Find(handle)->grid.stats();
+    message = "loaded " + path;
+    Log("loaded terrain " + std::to_string(handle) + " from '" + path + "': " +
+        std::to_string(st.samples) + " samples, grid " + std::to_string(st.cells[0]) + "x" +
+        std::to_string(st.cells[1]) + "x" + std::to_string(st.cells[2]));
+  } else {
+    LogError("load", s, message);
+  }
+  r->message = Message(message);
+}
+
+void UploadBegin(const ff_upload_begin_args& a, ff_upload_reply* r) {
+  std::string message;
+  uint32_t upload = 0;
+  const Status s = g_state->registry.BeginUpload(a.name ? a.name : "", a.total, &upload, &message);
+  if (s != Status::kOk) LogError("upload", s, message);
+  r->status = Wire(s);
+  r->upload = upload;
+  r->message = Message(message);
+}
+
+void UploadChunk(const ff_upload_chunk_args& a, ff_status_reply* r) {
+  RawSamples& chunk = g_storage.chunk;
+  chunk.clear();
+  for (u_int i = 0; i < a.samples.samples_len; ++i)
+    chunk.push_back(FromWire(a.samples.samples_val[i].point), FromWire(a.samples.samples_val[i].normal));
+  std::string message;
+  const Status s = g_state->registry.AppendUpload(a.upload, chunk, &message);
+  if (s != Status::kOk) LogError("upload", s, message);
+  r->status = Wire(s);
+  r->message = Message(message);
+}
+
+void UploadFinish(const ff_upload_args& a, ff_load_reply* r) {
+  std::string message;
+  uint32_t handle = 0;
+  const Status s = g_state->registry.FinishUpload(a.upload, &handle, &message);
+  r->status = Wire(s);
+  r->terrain = handle;
+  if (s == Status::kOk) {
+    const LoadedTerrain* t = g_state->registry.Find(handle);
+    const GridStats& st = t->grid.stats();
+    Log("loaded terrain " + std::to_string(handle) + " '" + t->name + "' (uploaded): " +
+        std::to_string(st.samples) + " samples, grid " + std::to_string(st.cells[0]) + "x" +
+        std::to_string(st.cells[1]) + "x" + std::to_string(st.cells[2]));
+  } else {
+    LogError("upload", s, message);
+  }
+  r->message = Message(message);
+}
+
+void Info(const ff_terrain_args& a, ff_info_reply* r) {
+  const LoadedTerrain* t = g_state->registry.Find(a.terrain);
+  g_storage.name.clear();
+  r->name = const_cast<char*>(g_storage.name.c_str());
+  if (!t) {
+    r->status = FF_UNKNOWN_TERRAIN;
+    return;
+  }
+  const GridStats& st = t->grid.stats();
+  g_storage.name = t->name.substr(0, FF_MAX_NAME);
+  r->name = const_cast<char*>(g_storage.name.c_str());
+  r->status = FF_OK;
+  r->samples = st.samples;
+  r->bounds_min = ToWire(st.bounds_min);
+  r->bounds_max = ToWire(st.bounds_max);
+  r->cells_x = st.cells[0], r->cells_y = st.cells[1], r->cells_z = st.cells[2];
+  r->cell_size = st.cell_size;
+  r->occupied_cells = st.occupied_cells;
+  r->bytes = st.bytes;
+}
+
+void Unload(const ff_terrain_args& a, ff_status_reply* r) {
+  const Status s = g_state->registry.Unload(a.terrain);
+  if (s == Status::kOk) Log("unloaded terrain " + std::to_string(a.terrain));
+  r->status = Wire(s);
+  r->message = Message(s == Status::kOk ? "" : "no terrain " + std::to_string(a.terrain));
+}
+
+void List(ff_list_reply* r) {
+  g_storage.handles = g_state->registry.Handles();
+  if (g_storage.handles.size() > FF_MAX_TERRAINS) g_storage.handles.resize(FF_MAX_TERRAINS);
+  r->status = FF_OK;
+  r->terrains.terrains_len = static_cast<u_int>(g_storage.handles.size());
+  r->terrains.terrains_val = g_storage.handles.data();
+}
+
+void Record(uint32_t terrain, int op, const Vec3& point, const Vec3& direction, double tolerance,
+            const Foothold& result) {
+  RecentQuery q;
+  q.terrain = terrain, q.op = op, q.point = point, q.direction = direction;
+  q.tolerance = tolerance, q.result = result;
+  g_state->registry.Record(q);
+}
+
+void Point(const ff_point_args& a, ff_result* r, int op) {
+  const LoadedTerrain* t = g_state->registry.Find(a.terrain);
+  if (!t) {
+    r->status = FF_UNKNOWN_TERRAIN;
+    return;
+  }
+  const Vec3 q = FromWire(a.point);
+  const Foothold f = t->grid.Snap(q);
+  *r = ToWire(f);
+  Record(a.terrain, op, q, Vec3{}, 0, f);
+}
+
+void NextOne(const ff_next_args& a, ff_result* r) {
+  const LoadedTerrain* t = g_state->registry.Find(a.terrain);
+  if (!t) {
+    r->status = FF_UNKNOWN_TERRAIN;
+    return;
+  }
+  if (!std::isfinite(a.tolerance)) {
+    r->status = FF_INVALID_ARGUMENT;
+    return;
+  }
+  const StepQuery q{FromWire(a.query.foot), FromWire(a.query.direction)};
+  const Foothold f = t->grid.Next(q, a.tolerance);
+  *r = ToWire(f);
+  Record(a.terrain, FF_OP_NEXT, q.foot, q.direction, a.tolerance, f);
+}
+
+void Reply(ff_batch_reply* r) {
+  const size_t n = g_storage.answers.size();
+  g_storage.results.resize(n);
+  for (size_t i = 0; i < n; ++i) g_storage.results[i] = ToWire(g_storage.answers[i]);
+  r->status = FF_OK;
+  r->results.results_len = static_cast<u_int>(n);
+  r->results.results_val = g_storage.results.data();
+}
+
+void PointBatch(const ff_point_batch_args& a, ff_batch_reply* r, int op) {
+  const LoadedTerrain* t = g_state->registry.Find(a.terrain);
+  if (!t) {
+    r->status = FF_UNKNOWN_TERRAIN;
+    return;
+  }
+  const size_t n = a.points.points_len;
+  g_storage.points.resize(n);
+  for (size_t i = 0; i < n; ++i) g_storage.points[i] = FromWire(a.points.points_val[i]);
+  g_storage.answers.resize(n);
+  t->grid.SnapBatch(g_storage.points.data(), n, g_storage.answers.data(), g_state->batch_threads);
+  for (size_t i = 0; i < n && i < kRecordPerBatch; ++i)
+    Record(a.terrain, op, g_storage.points[i], Vec3{}, 0, g_storage.answers[i]);
+  Reply(r);
+}
+
+void NextBatch(const ff_next_batch_args& a, ff_batch_reply* r) {
+  const LoadedTerrain* t = g_state->registry.Find(a.terrain);
+  if (!t) {
+    r->status = FF_UNKNOWN_TERRAIN;
+    return;
+  }
+  if (!std::isfinite(a.tolerance)) {
+    r->status = FF_INVALID_ARGUMENT;
+    return;
+  }
+  const size_t n = a.queries.queries_len;
+  g_storage.steps.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    g_storage.steps[i] = {FromWire(a.queries.queries_val[i].foot),
+                          FromWire(a.queries.queries_val[i].direction)};
+  }
+  g_storage.answers.resize(n);
+  t->grid.NextBatch(g_storage.steps.data(), n, a.tolerance, g_storage.answers.data(),
+                    g_state->batch_threads);
+  for (size_t i = 0; i < n && i < kRecordPerBatch; ++i) {
+    Record(a.terrain, FF_OP_NEXT, g_storage.steps[i].foot, g_storage.steps[i].direction,
+           a.tolerance, g_storage.answers[i]);
+  }
+  Reply(r);
+}
+
+void Recent(const ff_recent_args& a, ff_recent_reply* r) {
+  uint64_t latest = 0;
+  const std::vector<RecentQuery> found =
+      g_state->registry.RecentAfter(a.after, FF_MAX_RECENT, &latest);
+  g_storage.recent.resize(found.size());
+  for (size_t i = 0; i < found.size(); ++i) {
+    ff_recent_query& w = g_storage.recent[i];
+    const RecentQuery& q = found[i];
+    w.sequence = q.sequence;
+    w.terrain = q.terrain;
+    w.op = static_cast<ff_op>(q.op);
+    w.point = ToWire(q.point);
+    w.direction = ToWire(q.direction);
+    w.tolerance = q.tolerance;
+    w.result = ToWire(q.result);
+  }
+  r->status = FF_OK;
+  r->latest = latest;
+  r->queries.queries_len = static_cast<u_int>(found.size());
+  r->queries.queries_val = g_storage.recent.data();
+}
+
+// Decodes the arguments, runs the handler, replies and frees the arguments, whatever happens.
+// Every reply type starts with its ff_status, which an exception turns into an error.
+template <typename Args, typename Res, typename Fn>
+void Serve(SVCXPRT* transport, xdrproc_t decode, xdrproc_t encode, const char* proc, Fn&& fn) {
+  Args args;
+  std::memset(&args, 0, sizeof args);
+  if (!svc_getargs(transport, decode, reinterpret_cast<char*>(&args))) {
+    svc_freeargs(transport, decode, reinterpret_cast<char*>(&args));
+    svcerr_decode(transport);
+    Log(std::string("error: ") + proc + ": malformed request rejected");
+    return;
+  }
+  Res res;
+  std::memset(&res, 0, sizeof res);
+  const char* failure = nullptr;
+  try {
+    fn(args, &res);
+  } catch (const std::bad_alloc&) {
+    failure = "out of memory";
+  } catch (const std::exception& e) {
+    failure = e.what();
+  } catch (...) {
+    failure = "unknown exception";
+  }
+  if (failure) {
+    Log(std::string("error: ") + proc + ": " + failure);
+    std::memset(&res, 0, sizeof res);
+    *reinterpret_cast<ff_status*>(&res) = FF_INTERNAL_ERROR;
+  }
+  // Strings may not be NULL on the wire: give unset ones an empty value.
+  if constexpr (std::is_same_v<Res, ff_status_reply> || std::is_same_v<Res, ff_load_reply> ||
+                std::is_same_v<Res, ff_upload_reply>) {
+    if (!res.message) res.message = const_cast<char*>("");
+  }
+  if constexpr (std::is_same_v<Res, ff_info_reply>) {
+    if (!res.name) res.name = const_cast<char*>("");
+  }
+  if (!svc_sendreply(transport, encode, reinterpret_cast<char*>(&res)))
+    Log(std::string("error: ") + proc + ": reply could not be sent");
+  svc_freeargs(transport, decode, reinterpret_cast<char*>(&args));
+}
+
+#define FF_XDR(name) reinterpret_cast<xdrproc_t>(xdr_##name)
+// xdr_void takes no arguments in libtirpc's declaration; go through void* to cast it.
+#define FF_XDR_VOID reinterpret_cast<xdrproc_t>(reinterpret_cast<void*>(xdr_void))
+
+void Dispatch(svc_req* request, SVCXPRT* transport) {
+  switch (request->rq_proc) {
+    case FF_NULL:
+      svc_sendreply(transport, FF_XDR_VOID, nullptr);
+      return;
+    case FF_LOAD:
+      return Serve<ff_load_args, ff_load_reply>(transport, FF_XDR(ff_load_args),
+                                                FF_XDR(ff_load_reply), "load", Load);
+    case FF_UPLOAD_BEGIN:
+      return Serve<ff_upload_begin_args, ff_upload_reply>(
+          transport, FF_XDR(ff_upload_begin_args), FF_XDR(ff_upload_reply), "upload",
+          UploadBegin);
+    case FF_UPLOAD_CHUNK:
+      return Serve<ff_upload_chunk_args, ff_status_reply>(
+          transport, FF_XDR(ff_upload_chunk_args), FF_XDR(ff_status_reply), "upload",
+          UploadChunk);
+    case FF_UPLOAD_FINISH:
+      return Serve<ff_upload_args, ff_load_reply>(transport, FF_XDR(ff_upload_args),
+                                                  FF_XDR(ff_load_reply), "upload", UploadFinish);
+    case FF_INFO:
+      return Serve<ff_terrain_args, ff_info_reply>(transport, FF_XDR(ff_terrain_args),
+                                                   FF_XDR(ff_info_reply), "info", Info);
+    case FF_UNLOAD:
+      return Serve<ff_terrain_args, ff_status_reply>(transport, FF_XDR(ff_terrain_args),
+                                                     FF_XDR(ff_status_reply), "unload", Unload);
+    case FF_LIST: {
+      struct Empty {
+        int unused;
+      };
+      return Serve<Empty, ff_list_reply>(transport, FF_XDR_VOID, FF_XDR(ff_list_reply), "list",
+                                         [](const Empty&, ff_list_reply* r) { List(r); });
+    }
+    case FF_SNAP:
+    case FF_NORMAL: {
+      const int op = request->rq_proc == FF_SNAP ? FF_OP_SNAP : FF_OP_NORMAL;
+      return Serve<ff_point_args, ff_result>(
+          transport, FF_XDR(ff_point_args), FF_XDR(ff_result), "snap",
+          [op](const ff_point_args& a, ff_result* r) { Point(a, r, op); });
+    }
+    case FF_NEXT:
+      return Serve<ff_next_args, ff_result>(transport, FF_XDR(ff_next_args), FF_XDR(ff_result),
+                                            "next", NextOne);
+    case FF_SNAP_BATCH:
+    case FF_NORMAL_BATCH: {
+      const int op = request->rq_proc == FF_SNAP_BATCH ? FF_OP_SNAP : FF_OP_NORMAL;
+      return Serve<ff_point_batch_args, ff_batch_reply>(
+          transport, FF_XDR(ff_point_batch_args), FF_XDR(ff_batch_reply), "snap batch",
+          [op](const ff_point_batch_args& a, ff_batch_reply* r) { PointBatch(a, r, op); });
+    }
+    case FF_NEXT_BATCH:
+      return Serve<ff_next_batch_args, ff_batch_reply>(transport, FF_XDR(ff_next_batch_args),
+                                                       FF_XDR(ff_batch_reply), "next batch",
+                                                       NextBatch);
+    case FF_RECENT:
+      return Serve<ff_recent_args, ff_recent_reply>(transport, FF_XDR(ff_recent_args),
+                                                    FF_XDR(ff_recent_reply), "recent", Recent);
+    default:
+      svcerr_noproc(transport);
+      return;
+  }
+}
+
+}  // namespace
+
+DispatchFn InstallDispatcher(ServiceState* state) {
+  g_state = state;
+  return Dispatch;
+}
+
+}  // namespace footfall

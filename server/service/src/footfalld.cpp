@@ -1,0 +1,85 @@
+// footfalld: the footfall terrain query server (ONC RPC over TCP).
+#include <signal.h>
+
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <fstream>
+
+#include <CLI/CLI.hpp>
+
+#include "footfall/service/rpc_server.h"
+
+namespace {
+
+footfall::RpcServer* g_server = nullptr;
+
+void OnStopSignal(int) {
+  if (g_server) g_server->Stop();
+}
+
+// "ADDR:PORT", ":PORT" or "PORT"; IPv6 addresses in brackets.
+bool ParseListen(const std::string& text, std::string* host, int* port) {
+  const size_t colon = text.rfind(':');
+  std::string h = colon == std::string::npos ? "" : text.substr(0, colon);
+  const std::string p = colon == std::string::npos ? text : text.substr(colon + 1);
+  char* end = nullptr;
+  const long value = std::strtol(p.c_str(), &end, 10);
+  if (p.empty() || *end != '\0' || value < 0 || value > 65535) return false;
+  if (h.size() >= 2 && h.front() == '[' && h.back() == ']') h = h.substr(1, h.size() - 2);
+  *host = h.empty() ? "127.0.0.1" : h;
+  *port = static_cast<int>(value);
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"footfalld: serves footfall terrain queries over ONC RPC (TCP)"};
+  std::string listen = "127.0.0.1:7407";
+  footfall::RpcServerOptions options;
+  std::string port_file;
+  bool no_rpcbind = false;
+  app.add_option("--listen", listen, "ADDR:PORT to listen on (port 0 picks a free one)");
+  app.add_option("--data-root", options.data_root,
+                 "Directory that confines server-side terrain loads (none: refused)")
+      ->check(CLI::ExistingDirectory);
+  app.add_flag("--no-rpcbind", no_rpcbind, "Do not register with rpcbind");
+  app.add_option("--threads", options.batch_threads, "Threads per batch query")
+      ->check(CLI::Range(1, 64));
+  app.add_option("--max-samples", options.limits.max_total_samples,
+                 "Samples held over all terrains and uploads");
+  app.add_option("--port-file", port_file, "Write the bound port to this file once listening");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  std::string error;
+  if (!ParseListen(listen, &options.listen_host, &options.port)) {
+    std::fprintf(stderr, "footfalld: --listen '%s': expected ADDR:PORT with a port from 0 to 65535\n",
+                 listen.c_str());
+    return 2;
+  }
+  options.use_rpcbind = !no_rpcbind;
+
+  std::signal(SIGPIPE, SIG_IGN);
+  setvbuf(stderr, nullptr, _IOLBF, 0);
+  footfall::RpcServer server(options);
+  if (!server.Start(&error)) {
+    std::fprintf(stderr, "footfalld: %s\n", error.c_str());
+    return 1;
+  }
+  if (!port_file.empty()) {
+    std::ofstream(port_file) << server.port() << "\n";
+  }
+  g_server = &server;
+  struct sigaction action {};
+  action.sa_handler = OnStopSignal;  // no SA_RESTART: poll returns EINTR at once
+  sigaction(SIGTERM, &action, nullptr);
+  sigaction(SIGINT, &action, nullptr);
+  server.Run();
+  g_server = nullptr;
+  return 0;
+}

@@ -1,0 +1,143 @@
+#include "footfall/service/rpc_server.h"
+
+#include <arpa/inet.h>
+#include <netdb.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <rpc/pmap_clnt.h>
+#include <rpc/rpc.h>
+#include <rpc/rpc_com.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <vector>
+
+#include "dispatcher.h"
+#include "footfall.h"
+
+namespace footfall {
+namespace {
+
+constexpr int kListenBacklog = 1024;  // 64 dropped SYNs in bursts of connects
+std::unique_ptr<ServiceState> g_state;
+
+// True when something accepts TCP connections on 127.0.0.1:111 (rpcbind), checked without
+// waiting on libtirpc's long timeouts.
+bool RpcbindRunning() {
+  const int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return false;
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(111);
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  const bool up = connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+  close(fd);
+  return up;
+}
+
+}  // namespace
+
+RpcServer::RpcServer(RpcServerOptions options) : options_(std::move(options)) {}
+
+RpcServer::~RpcServer() {
+  if (registered_rpcbind_) pmap_unset(FOOTFALL_PROG, FOOTFALL_V1);
+  svc_unregister(FOOTFALL_PROG, FOOTFALL_V1);
+}
+
+bool RpcServer::Start(std::string* error) {
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  hints.ai_flags = AI_PASSIVE | AI_NUMERICSERV;
+  addrinfo* found = nullptr;
+  const std::string port = std::to_string(options_.port);
+  const int gai = getaddrinfo(options_.listen_host.c_str(), port.c_str(), &hints, &found);
+  if (gai != 0) {
+    *error = "cannot resolve listen address '" + options_.listen_host + "': " + gai_strerror(gai);
+    return false;
+  }
+  std::string reason = "no address";
+  for (addrinfo* a = found; a && listen_fd_ < 0; a = a->ai_next) {
+    const int fd = socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
+    if (fd < 0) continue;
+    const int one = 1;
+    setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+    if (bind(fd, a->ai_addr, a->ai_addrlen) != 0 || listen(fd, kListenBacklog) != 0) {
+      reason = std::strerror(errno);
+      close(fd);
+      continue;
+    }
+    listen_fd_ = fd;
+  }
+  freeaddrinfo(found);
+  if (listen_fd_ < 0) {
+    *error = "cannot listen on " + options_.listen_host + ":" + port + ": " + reason;
+    return false;
+  }
+  sockaddr_storage bound{};
+  socklen_t len = sizeof bound;
+  getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&bound), &len);
+  port_ = ntohs(bound.ss_family == AF_INET6 ? reinterpret_cast<sockaddr_in6*>(&bound)->sin6_port
+                                            : reinterpret_cast<sockaddr_in*>(&bound)->sin_port);
+
+  // Non-blocking transports with a bounded record size: a half-sent request or a client that
+  // never reads cannot stall the loop. Must be set before the transport is created.
+  int max_record = FF_MAX_REQUEST_BYTES + 8192;
+  rpc_control(RPC_SVC_CONNMAXREC_SET, &max_record);
+  SVCXPRT* transport = svc_vc_create(listen_fd_, FF_MAX_REQUEST_BYTES, FF_MAX_REQUEST_BYTES + 8192);
+  if (!transport) {
+    *error = "cannot create the RPC transport";
+    return false;
+  }
+  g_state = std::make_unique<ServiceState>(
+      ServiceState{TerrainRegistry(options_.data_root, options_.limits), options_.batch_threads});
+  const DispatchFn dispatch = InstallDispatcher(g_state.get());
+  if (!svc_register(transport, FOOTFALL_PROG, FOOTFALL_V1, dispatch, 0)) {
+    *error = "cannot register the RPC program";
+    return false;
+  }
+  std::fprintf(stderr, "footfalld: listening on %s:%d (program %u version %u)\n",
+               options_.listen_host.c_str(), port_, static_cast<unsigned>(FOOTFALL_PROG),
+               static_cast<unsigned>(FOOTFALL_V1));
+  if (options_.use_rpcbind) {
+    if (RpcbindRunning()) {
+      pmap_unset(FOOTFALL_PROG, FOOTFALL_V1);
+      registered_rpcbind_ = pmap_set(FOOTFALL_PROG, FOOTFALL_V1, IPPROTO_TCP,
+                                     static_cast<unsigned short>(port_));
+      std::fprintf(stderr, registered_rpcbind_ ? "footfalld: registered with rpcbind\n"
+                                               : "footfalld: rpcbind refused the registration\n");
+    } else {
+      std::fprintf(stderr, "footfalld: rpcbind is not running; clients connect by port\n");
+    }
+  }
+  if (!options_.data_root.empty())
+    std::fprintf(stderr, "footfalld: data root %s\n", options_.data_root.c_str());
+  return true;
+}
+
+void RpcServer::Run() {
+  std::vector<pollfd> fds;
+  auto last_expiry = std::chrono::steady_clock::now();
+  while (!stop_.load()) {
+    fds.assign(svc_pollfd, svc_pollfd + svc_max_pollfd);
+    const int ready = poll(fds.data(), fds.size(), 250);
+    if (ready < 0) {
+      if (errno == EINTR) continue;
+      std::fprintf(stderr, "footfalld: error: poll: %s\n", std::strerror(errno));
+      break;
+    }
+    if (ready > 0) svc_getreq_poll(fds.data(), ready);
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_expiry > std::chrono::seconds(5)) {
+      g_state->registry.ExpireUploads();
+      last_expiry = now;
+    }
+  }
+  std::fprintf(stderr, "footfalld: stopped\n");
+}
+
+}  // namespace footfall

@@ -1,0 +1,208 @@
+#include "footfall/service/terrain_registry.h"
+
+#include <limits.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <random>
+
+namespace footfall {
+
+Status ResolveUnderRoot(const std::string& root, const std::string& relative,
+                        std::string* resolved, std::string* message) {
+  if (root.empty()) {
+    *message = "server-side loads are disabled (footfalld has no --data-root)";
+    return Status::kAccessDenied;
+  }
+  if (relative.empty() || relative[0] == '/') {
+    *message = "'" + relative + "': expected a path relative to the data root";
+    return Status::kAccessDenied;
+  }
+  const std::string joined = root + "/" + relative;
+  char buffer[PATH_MAX];
+  if (!realpath(joined.c_str(), buffer)) {
+    *message = "'" + relative + "': no such file under the data root";
+    return Status::kIoError;
+  }
+  const std::string canonical = buffer;
+  if (canonical.compare(0, root.size() + 1, root + "/") != 0) {
+    *message = "'" + relative + "': resolves outside the data root";
+    return Status::kAccessDenied;
+  }
+  *resolved = canonical;
+  return Status::kOk;
+}
+
+TerrainRegistry::TerrainRegistry(std::string data_root, RegistryLimits limits)
+    : limits_(limits) {
+  if (!data_root.empty()) {
+    char buffer[PATH_MAX];
+    if (realpath(data_root.c_str(), buffer)) data_root_ = buffer;
+  }
+  // Handles start at a random base, so a client never mistakes a restarted server's terrain
+  // for one it loaded before.
+  std::random_device device;
+  next_handle_ = (device() & 0x7FFFFFF0u) + 1;
+}
+
+size_t TerrainRegistry::TotalSamples() const {
+  size_t total = 0;
+  for (const auto& t : terrains_) total += t.second->grid.size();
+  for (const auto& u : uploads_) total += u.second.samples.size();
+  return total;
+}
+
+Status TerrainRegistry::Add(const std::string& name, RawSamples samples, uint32_t* handle,
+                            std::string* message) {
+  if (terrains_.size() >= limits_.max_terrains) {
+    *message = "too many terrains loaded (limit " + std::to_string(limits_.max_terrains) + ")";
+    return Status::kLimitExceeded;
+  }
+  if (TotalSamples() + samples.size() > limits_.max_total_samples) {
+    *message = "sample limit reached (" + std::to_string(limits_.max_total_samples) + ")";
+    return Status::kLimitExceeded;
+  }
+  Status status = ValidateAndNormalize(&samples, message);
+  if (status != Status::kOk) return status;
+  auto terrain = std::make_unique<LoadedTerrain>();
+  terrain->name = name;
+  status = TerrainGrid::Build(samples, GridOptions{}, &terrain->grid, message);
+  if (status != Status::kOk) return status;
+  uint32_t h = next_handle_++;
+  while (h == 0 || terrains_.count(h)) h = next_handle_++;
+  terrains_.emplace(h, std::move(terrain));
+  *handle = h;
+  return Status::kOk;
+}
+
+Status TerrainRegistry::LoadFile(const std::string& relative_path, double separation,
+                                 uint32_t* handle, std::string* message) {
+  std::string path;
+  Status status = ResolveUnderRoot(data_root_, relative_path, &path, message);
+  if (status != Status::kOk) return status;
+  if (!(separation >= 0)) {
+    *message = "separation must be >= 0";
+    return Status::kInvalidArgument;
+  }
+  TerrainLoadOptions options;
+  options.separation = separation;
+  RawSamples samples;
+  std::string error;
+  status = LoadTerrain(path, options, &samples, &error);
+  if (status != Status::kOk) {
+    // Report the path as the client gave it, not the server's layout.
+    const size_t at = error.find(path);
+    if (at != std::string::npos) error.replace(at, path.size(), relative_path);
+    *message = error;
+    return status;
+  }
+  return Add(relative_path, std::move(samples), handle, message);
+}
+
+Status TerrainRegistry::BeginUpload(const std::string& name, uint64_t total, uint32_t* upload,
+                                    std::string* message) {
+  ExpireUploads();
+  if (uploads_.size() >= limits_.max_uploads) {
+    *message = "too many uploads in progress (limit " + std::to_string(limits_.max_uploads) + ")";
+    return Status::kLimitExceeded;
+  }
+  if (total > limits_.max_total_samples || TotalSamples() + total > limits_.max_total_samples) {
+    *message = "upload of " + std::to_string(total) + " samples exceeds the sample limit";
+    return Status::kLimitExceeded;
+  }
+  uint32_t id = next_upload_++;
+  while (id == 0 || uploads_.count(id)) id = next_upload_++;
+  Upload& u = uploads_[id];
+  u.name = name;
+  u.total = total;
+  u.touched = std::chrono::steady_clock::now();
+  *upload = id;
+  return Status::kOk;
+}
+
+Status TerrainRegistry::AppendUpload(uint32_t upload, const RawSamples& chunk,
+                                     std::string* message) {
+  auto it = uploads_.find(upload);
+  if (it == uploads_.end()) {
+    *message = "no upload " + std::to_string(upload) + " in progress";
+    return Status::kInvalidArgument;
+  }
+  Upload& u = it->second;
+  if (u.samples.size() + chunk.size() > u.total) {
+    *message = "upload sent more samples than the " + std::to_string(u.total) + " announced";
+    uploads_.erase(it);
+    return Status::kInvalidArgument;
+  }
+  for (size_t i = 0; i < chunk.size(); ++i) {
+    if (!IsFinite(chunk.points[i]) || !IsFinite(chunk.normals[i]) || Length2(chunk.normals[i]) == 0) {
+      *message = "sample " + std::to_string(u.samples.size() + i) +
+                 ": NaN, infinite or zero-normal value";
+      uploads_.erase(it);
+      return Status::kInvalidArgument;
+    }
+  }
+  u.samples.points.insert(u.samples.points.end(), chunk.points.begin(), chunk.points.end());
+  u.samples.normals.insert(u.samples.normals.end(), chunk.normals.begin(), chunk.normals.end());
+  u.touched = std::chrono::steady_clock::now();
+  return Status::kOk;
+}
+
+Status TerrainRegistry::FinishUpload(uint32_t upload, uint32_t* handle, std::string* message) {
+  auto it = uploads_.find(upload);
+  if (it == uploads_.end()) {
+    *message = "no upload " + std::to_string(upload) + " in progress";
+    return Status::kInvalidArgument;
+  }
+  Upload u = std::move(it->second);
+  uploads_.erase(it);
+  if (u.samples.size() != u.total) {
+    *message = "upload ended after " + std::to_string(u.samples.size()) + " of " +
+               std::to_string(u.total) + " samples";
+    return Status::kInvalidArgument;
+  }
+  return Add(u.name, std::move(u.samples), handle, message);
+}
+
+Status TerrainRegistry::Unload(uint32_t handle) {
+  return terrains_.erase(handle) ? Status::kOk : Status::kUnknownTerrain;
+}
+
+const LoadedTerrain* TerrainRegistry::Find(uint32_t handle) const {
+  auto it = terrains_.find(handle);
+  return it == terrains_.end() ? nullptr : it->second.get();
+}
+
+std::vector<uint32_t> TerrainRegistry::Handles() const {
+  std::vector<uint32_t> handles;
+  for (const auto& t : terrains_) handles.push_back(t.first);
+  return handles;
+}
+
+void TerrainRegistry::ExpireUploads() {
+  const auto now = std::chrono::steady_clock::now();
+  for (auto it = uploads_.begin(); it != uploads_.end();) {
+    const double idle = std::chrono::duration<double>(now - it->second.touched).count();
+    it = idle > limits_.upload_idle_s ? uploads_.erase(it) : std::next(it);
+  }
+}
+
+void TerrainRegistry::Record(const RecentQuery& query) {
+  if (limits_.recent_capacity == 0) return;
+  if (recent_.size() >= limits_.recent_capacity) recent_.pop_front();
+  recent_.push_back(query);
+  recent_.back().sequence = ++sequence_;
+}
+
+std::vector<RecentQuery> TerrainRegistry::RecentAfter(uint64_t after, size_t max,
+                                                      uint64_t* latest) const {
+  *latest = sequence_;
+  std::vector<RecentQuery> out;
+  for (const RecentQuery& q : recent_) {
+    if (q.sequence <= after) continue;
+    if (out.size() >= max) break;
+    out.push_back(q);
+  }
+  return out;
+}
+
+}  // namespace footfall

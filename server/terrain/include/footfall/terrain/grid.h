@@ -1,0 +1,152 @@
+// TerrainGrid: terrain samples packed into a fixed uniform 3D grid, answering exact
+// nearest-sample ("snap", "normal") and foothold ("next") queries.
+//
+// The grid covers the samples' bounding box in any orientation (walls, ceilings, spheres, not
+// only height fields). Its cell size is chosen for query speed (a few samples per occupied cell)
+// under a memory cap of about one cell per sample, whatever the bounds. A few far outliers do
+// not stretch it: the grid then covers the bulk of the samples, and its border cells take the
+// outliers (border cells extend to the true bounds). Queries are exact: they return what a
+// brute-force scan over all samples returns (see brute_force.h), ties going to the lowest index.
+//
+// Samples are stored as float offsets from the grid's origin (the centre of the bulk of the
+// samples): a stored sample differs from its input by at most ~6e-8 of its distance to that
+// origin. ForEachSample() yields the stored values; every answer uses them.
+//
+// The grid is immutable, move-only, and lives in one allocation of parallel arrays:
+// positions, normals, sample indices and cell offsets. Queries are const and thread-safe.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "footfall/terrain/samples.h"
+#include "footfall/terrain/status.h"
+#include "footfall/terrain/vec3.h"
+
+namespace footfall {
+
+// The answer to one query. On kOk, index/point/normal describe the chosen sample; on
+// kNoFoothold or an error status they are zero.
+struct Foothold {
+  Status status = Status::kInvalidArgument;
+  uint32_t index = 0;  // 0-based order of the sample in its source
+  Vec3 point;          // world space
+  Vec3 normal;         // unit
+};
+
+// A "next" query: the foot at `foot` moves along `direction`, whose length is the step length.
+struct StepQuery {
+  Vec3 foot;       // world space
+  Vec3 direction;  // world space, non-zero and finite
+};
+
+// What a query examined, for debugging and the viewer. Filled only when passed.
+struct QueryTrace {
+  Vec3 ideal;                              // the query point, or foot + direction for next
+  double radius = 0;                       // next: the candidate radius; snap: 0
+  std::vector<uint32_t> cells;             // linear indices of cells whose samples were scanned
+  std::vector<uint32_t> examined_samples;  // sample indices whose distance was computed
+  std::vector<uint32_t> candidates;        // next: samples that met the candidate conditions
+};
+
+struct GridStats {
+  size_t samples = 0;
+  uint32_t cells[3] = {0, 0, 0};  // grid dimensions in x, y, z
+  double cell_size = 0;           // [Units: wu] edge length of a (cubic) cell
+  size_t occupied_cells = 0;
+  size_t bytes = 0;                // the grid's single allocation
+  Vec3 bounds_min, bounds_max;     // world-space bounds of all samples
+  Vec3 grid_min, grid_max;         // world-space box the cells divide (the bulk of the samples)
+};
+
+struct GridOptions {
+  // Target mean samples per occupied cell. [Limit: > 0]
+  double samples_per_cell = 3.0;
+  // Memory cap: total cells <= max(64, cells_per_sample * samples). [Limit: > 0]
+  double cells_per_sample = 1.0;
+};
+
+class TerrainGrid {
+ public:
+  TerrainGrid();
+  ~TerrainGrid();
+  TerrainGrid(TerrainGrid&&) noexcept;
+  TerrainGrid& operator=(TerrainGrid&&) noexcept;
+  TerrainGrid(const TerrainGrid&) = delete;
+  TerrainGrid& operator=(const TerrainGrid&) = delete;
+
+  // Packs validated samples (ValidateAndNormalize) into a grid. Returns kInvalidArgument for
+  // non-finite values or mismatched counts, kLimitExceeded beyond 2^32-2 samples. An empty
+  // sample set gives an empty grid whose queries answer kNoFoothold.
+  static Status Build(const RawSamples& samples, const GridOptions& options, TerrainGrid* out,
+                      std::string* error);
+
+  bool empty() const { return count_ == 0; }
+  size_t size() const { return count_; }
+  const GridStats& stats() const { return stats_; }
+
+  // Every stored sample, in storage order: fn(index, world point, unit normal).
+  template <typename Fn>
+  void ForEachSample(Fn&& fn) const {
+    for (size_t slot = 0; slot < count_; ++slot) {
+      const Foothold f = MakeFoothold(static_cast<uint32_t>(slot));
+      fn(f.index, f.point, f.normal);
+    }
+  }
+
+  // The sample nearest to q (world space). kInvalidArgument for non-finite q, kNoFoothold only
+  // on an empty grid.
+  Foothold Snap(const Vec3& q, QueryTrace* trace = nullptr) const;
+
+  // Same as Snap: the answer's normal is the unit normal of the nearest sample.
+  Foothold Normal(const Vec3& q, QueryTrace* trace = nullptr) const { return Snap(q, trace); }
+
+  // The foothold for a foot at q.foot moving along q.direction. Candidates are samples p ahead
+  // of the foot, dot(p - foot, direction) > 0, within `radius` of the ideal point
+  // foot + direction, where radius = tolerance if tolerance > 0 and |direction| otherwise.
+  // The answer is the candidate nearest the ideal point (ties: lowest index), or kNoFoothold.
+  // kInvalidArgument for a zero or non-finite direction, non-finite foot or tolerance.
+  Foothold Next(const StepQuery& q, double tolerance, QueryTrace* trace = nullptr) const;
+
+  // Batch forms: out[i] answers queries[i]. Thread-safe; `threads` > 1 splits the batch.
+  void SnapBatch(const Vec3* queries, size_t count, Foothold* out, int threads = 1) const;
+  void NextBatch(const StepQuery* queries, size_t count, double tolerance, Foothold* out,
+                 int threads = 1) const;
+
+  // Grid-cell geometry, for the viewer: the world-space box of linear cell `cell`, and the
+  // linear indices of cells holding samples.
+  void CellBox(uint32_t cell, Vec3* lo, Vec3* hi) const;
+  std::vector<uint32_t> OccupiedCells() const;
+
+ private:
+  friend class BruteForce;
+  // Visits cells in shells of growing Chebyshev radius around the local point `center`, skipping
+  // cells farther than scanner.limit2() or rejected by scanner.KeepCell(lo, hi); stops when no
+  // unvisited cell can hold a sample within scanner.limit2(). Calls scanner.Scan(cell, b, e).
+  template <typename Scanner>
+  void Search(const double center[3], Scanner& scanner) const;
+  uint32_t CellCoord(double local, int axis) const;
+  double CellLo(uint32_t i, int axis) const;
+  double CellHi(uint32_t i, int axis) const;
+  Foothold MakeFoothold(uint32_t slot) const;
+
+  size_t count_ = 0;
+  GridStats stats_;
+  double origin_[3] = {0, 0, 0};      // world position of local (0, 0, 0)
+  double grid_lo_[3] = {0, 0, 0};     // local corner of cell (0, 0, 0)
+  double bounds_lo_[3] = {0, 0, 0};   // local bounds of all samples
+  double bounds_hi_[3] = {0, 0, 0};
+  double cell_size_ = 1, inv_cell_size_ = 1;
+  uint32_t dims_[3] = {1, 1, 1};
+  std::unique_ptr<unsigned char[]> memory_;
+  // Views into memory_, in cell order:
+  const float* positions_ = nullptr;   // 3 floats per sample, local (relative to origin_)
+  const float* normals_ = nullptr;     // 3 floats per sample, unit
+  const uint32_t* indices_ = nullptr;  // source index per slot
+  const uint32_t* cell_start_ = nullptr;  // cells + 1 offsets into the slots
+};
+
+}  // namespace footfall

@@ -1,0 +1,39 @@
+// A double-precision 3D vector for world-space points and directions.
+#pragma once
+
+#include <cmath>
+
+namespace footfall {
+
+struct Vec3 {
+  double x = 0, y = 0, z = 0;
+};
+
+inline Vec3 operator+(const Vec3& a, const Vec3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline Vec3 operator-(const Vec3& a, const Vec3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline Vec3 operator-(const Vec3& a) { return {-a.x, -a.y, -a.z}; }
+inline Vec3 operator*(const Vec3& a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+inline Vec3 operator*(double s, const Vec3& a) { return a * s; }
+inline Vec3 operator/(const Vec3& a, double s) { return {a.x / s, a.y / s, a.z / s}; }
+inline Vec3& operator+=(Vec3& a, const Vec3& b) { return a = a + b; }
+inline Vec3& operator-=(Vec3& a, const Vec3& b) { return a = a - b; }
+inline bool operator==(const Vec3& a, const Vec3& b) {
+  return a.x == b.x && a.y == b.y && a.z == b.z;
+}
+inline bool operator!=(const Vec3& a, const Vec3& b) { return !(a == b); }
+inline double Dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Vec3 Cross(const Vec3& a, const Vec3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline double Length2(const Vec3& a) { return Dot(a, a); }
+inline double Length(const Vec3& a) { return std::sqrt(Dot(a, a)); }
+inline double Distance2(const Vec3& a, const Vec3& b) { return Length2(a - b); }
+inline double Distance(const Vec3& a, const Vec3& b) { return Length(a - b); }
+// a / |a|; a must be non-zero and finite.
+inline Vec3 Normalize(const Vec3& a) { return a / Length(a); }
+inline bool IsFinite(const Vec3& a) {
+  return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
+}
+inline Vec3 Lerp(const Vec3& a, const Vec3& b, double t) { return a + (b - a) * t; }
+
+}  // namespace footfall

@@ -1,0 +1,448 @@
+#include "footfall/terrain/grid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <thread>
+
+#include "query_math.h"
+
+namespace footfall {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr uint32_t kNoIndex = std::numeric_limits<uint32_t>::max();
+
+// Total cells for a cell size h over local extents e, saturating in double.
+double CellCount(const double e[3], double h) {
+  double total = 1;
+  for (int a = 0; a < 3; ++a) total *= std::max(1.0, std::ceil(e[a] / h));
+  return total;
+}
+
+uint32_t AxisCells(double extent, double h) {
+  return static_cast<uint32_t>(std::max(1.0, std::ceil(extent / h)));
+}
+
+// Picks the grid box per axis: the true bounds, unless a few far outliers stretch an axis to
+// more than 4 times its bulk (1st to 99th percentile of a subsample), then the bulk plus margin.
+void ChooseGridBox(const RawSamples& s, const double lo[3], const double hi[3], double glo[3],
+                   double ghi[3]) {
+  const size_t n = s.size();
+  for (int a = 0; a < 3; ++a) glo[a] = lo[a], ghi[a] = hi[a];
+  if (n < 64) return;
+  const size_t m = std::min<size_t>(n, 4096);
+  std::vector<double> v(m);
+  for (int a = 0; a < 3; ++a) {
+    for (size_t i = 0; i < m; ++i) {
+      const Vec3& p = s.points[i * n / m];
+      v[i] = a == 0 ? p.x : a == 1 ? p.y : p.z;
+    }
+    std::sort(v.begin(), v.end());
+    const double q_lo = v[(m - 1) / 100];
+    const double q_hi = v[(m - 1) - (m - 1) / 100];
+    const double bulk = q_hi - q_lo;
+    if (hi[a] - lo[a] > 4 * bulk) {
+      const double margin = 0.25 * bulk;
+      glo[a] = std::max(lo[a], q_lo - margin);
+      ghi[a] = std::min(hi[a], q_hi + margin);
+    }
+  }
+}
+
+}  // namespace
+
+const char* StatusName(Status status) {
+  switch (status) {
+    case Status::kOk: return "ok";
+    case Status::kNoFoothold: return "no_foothold";
+    case Status::kInvalidArgument: return "invalid_argument";
+    case Status::kUnknownTerrain: return "unknown_terrain";
+    case Status::kLimitExceeded: return "limit_exceeded";
+    case Status::kIoError: return "io_error";
+    case Status::kParseError: return "parse_error";
+    case Status::kAccessDenied: return "access_denied";
+    case Status::kUnavailable: return "unavailable";
+    case Status::kInternalError: return "internal_error";
+  }
+  return "unknown_status";
+}
+
+TerrainGrid::TerrainGrid() = default;
+TerrainGrid::~TerrainGrid() = default;
+TerrainGrid::TerrainGrid(TerrainGrid&&) noexcept = default;
+TerrainGrid& TerrainGrid::operator=(TerrainGrid&&) noexcept = default;
+
+Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options, TerrainGrid* out,
+                         std::string* error) {
+  const size_t n = samples.points.size();
+  if (samples.normals.size() != n) {
+    if (error) *error = "points and normals differ in count";
+    return Status::kInvalidArgument;
+  }
+  if (n > 0xFFFFFFFEull) {
+    if (error) *error = "too many samples (limit 4294967294)";
+    return Status::kLimitExceeded;
+  }
+  if (!(options.samples_per_cell > 0) || !(options.cells_per_sample > 0)) {
+    if (error) *error = "grid options must be positive";
+    return Status::kInvalidArgument;
+  }
+  TerrainGrid g;
+  g.count_ = n;
+  // 1. True bounds, checking every value.
+  double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3& p = samples.points[i];
+    if (!IsFinite(p) || !IsFinite(samples.normals[i])) {
+      if (error) *error = "sample " + std::to_string(i) + " is not finite";
+      return Status::kInvalidArgument;
+    }
+    const double c[3] = {p.x, p.y, p.z};
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], c[a]), hi[a] = std::max(hi[a], c[a]);
+  }
+  if (n == 0) {
+    for (int a = 0; a < 3; ++a) lo[a] = hi[a] = 0;
+  }
+  // 2. The box the cells divide, and the origin at its centre.
+  double glo[3], ghi[3];
+  ChooseGridBox(samples, lo, hi, glo, ghi);
+  double extent[3];
+  for (int a = 0; a < 3; ++a) {
+    g.origin_[a] = 0.5 * (glo[a] + ghi[a]);
+    g.grid_lo_[a] = glo[a] - g.origin_[a];
+    extent[a] = ghi[a] - glo[a];
+  }
+  // 3. Positions as float offsets from the origin; bounds recomputed from the stored values.
+  std::vector<float> local(3 * n);
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3& p = samples.points[i];
+    local[3 * i + 0] = static_cast<float>(p.x - g.origin_[0]);
+    local[3 * i + 1] = static_cast<float>(p.y - g.origin_[1]);
+    local[3 * i + 2] = static_cast<float>(p.z - g.origin_[2]);
+  }
+  for (int a = 0; a < 3; ++a) g.bounds_lo_[a] = kInf, g.bounds_hi_[a] = -kInf;
+  for (size_t i = 0; i < 3 * n; ++i) {
+    const int a = static_cast<int>(i % 3);
+    g.bounds_lo_[a] = std::min(g.bounds_lo_[a], static_cast<double>(local[i]));
+    g.bounds_hi_[a] = std::max(g.bounds_hi_[a], static_cast<double>(local[i]));
+  }
+  if (n == 0) {
+    for (int a = 0; a < 3; ++a) g.bounds_lo_[a] = g.bounds_hi_[a] = 0;
+  }
+  // 4. Cell size: the smallest that fits the memory cap, then grown until occupied cells hold
+  //    about options.samples_per_cell samples (a surface's occupancy falls as 1/h^2).
+  const double budget = std::max(64.0, options.cells_per_sample * static_cast<double>(n));
+  const double max_extent = std::max({extent[0], extent[1], extent[2]});
+  double h = 1;
+  if (max_extent > 0) {
+    double h_hi = max_extent, h_lo = max_extent / (budget + 1);
+    for (int it = 0; it < 100 && h_hi > h_lo * (1 + 1e-12); ++it) {
+      const double mid = std::sqrt(h_lo * h_hi);
+      (CellCount(extent, mid) <= budget ? h_hi : h_lo) = mid;
+    }
+    h = h_hi;
+    g.cell_size_ = h, g.inv_cell_size_ = 1 / h;
+    for (int a = 0; a < 3; ++a) g.dims_[a] = AxisCells(extent[a], h);
+    const size_t total = size_t{g.dims_[0]} * g.dims_[1] * g.dims_[2];
+    std::vector<bool> occupied(total, false);
+    size_t occupied_count = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const float* p = &local[3 * i];
+      const size_t cell =
+          (size_t{g.CellCoord(p[2], 2)} * g.dims_[1] + g.CellCoord(p[1], 1)) * g.dims_[0] +
+          g.CellCoord(p[0], 0);
+      if (!occupied[cell]) occupied[cell] = true, ++occupied_count;
+    }
+    const double per_cell = static_cast<double>(n) / std::max<size_t>(1, occupied_count);
+    if (per_cell < options.samples_per_cell) h *= std::sqrt(options.samples_per_cell / per_cell);
+  }
+  g.cell_size_ = h, g.inv_cell_size_ = 1 / h;
+  for (int a = 0; a < 3; ++a) g.dims_[a] = AxisCells(extent[a], h);
+  const size_t cells = size_t{g.dims_[0]} * g.dims_[1] * g.dims_[2];
+
+  // 5. Counting sort of samples by cell, stable in source index (so ties scan in index order).
+  std::vector<uint32_t> cell_of(n);
+  for (size_t i = 0; i < n; ++i) {
+    const float* p = &local[3 * i];
+    cell_of[i] = static_cast<uint32_t>(
+        (size_t{g.CellCoord(p[2], 2)} * g.dims_[1] + g.CellCoord(p[1], 1)) * g.dims_[0] +
+        g.CellCoord(p[0], 0));
+  }
+  const size_t bytes = n * (3 + 3) * sizeof(float) + n * sizeof(uint32_t) +
+                       (cells + 1) * sizeof(uint32_t);
+  g.memory_.reset(new unsigned char[std::max<size_t>(bytes, 1)]);
+  float* positions = reinterpret_cast<float*>(g.memory_.get());
+  float* normals = positions + 3 * n;
+  uint32_t* indices = reinterpret_cast<uint32_t*>(normals + 3 * n);
+  uint32_t* cell_start = indices + n;
+  std::fill(cell_start, cell_start + cells + 1, 0u);
+  for (size_t i = 0; i < n; ++i) ++cell_start[cell_of[i] + 1];
+  for (size_t c = 0; c < cells; ++c) cell_start[c + 1] += cell_start[c];
+  size_t occupied_cells = 0;
+  for (size_t c = 0; c < cells; ++c) occupied_cells += cell_start[c + 1] > cell_start[c];
+  {
+    std::vector<uint32_t> cursor(cell_start, cell_start + cells);
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t slot = cursor[cell_of[i]]++;
+      std::memcpy(&positions[3 * slot], &local[3 * i], 3 * sizeof(float));
+      const Vec3& nv = samples.normals[i];
+      const double len = Length(nv);
+      const double inv = len > 0 ? 1 / len : 0;
+      normals[3 * slot + 0] = static_cast<float>(nv.x * inv);
+      normals[3 * slot + 1] = static_cast<float>(nv.y * inv);
+      normals[3 * slot + 2] = static_cast<float>(nv.z * inv);
+      indices[slot] = static_cast<uint32_t>(i);
+    }
+  }
+  g.positions_ = positions;
+  g.normals_ = normals;
+  g.indices_ = indices;
+  g.cell_start_ = cell_start;
+
+  GridStats& st = g.stats_;
+  st.samples = n;
+  for (int a = 0; a < 3; ++a) st.cells[a] = g.dims_[a];
+  st.cell_size = h;
+  st.occupied_cells = occupied_cells;
+  st.bytes = bytes;
+  const double* o = g.origin_;
+  st.bounds_min = {o[0] + g.bounds_lo_[0], o[1] + g.bounds_lo_[1], o[2] + g.bounds_lo_[2]};
+  st.bounds_max = {o[0] + g.bounds_hi_[0], o[1] + g.bounds_hi_[1], o[2] + g.bounds_hi_[2]};
+  st.grid_min = {glo[0], glo[1], glo[2]};
+  st.grid_max = {o[0] + g.grid_lo_[0] + g.dims_[0] * h, o[1] + g.grid_lo_[1] + g.dims_[1] * h,
+                 o[2] + g.grid_lo_[2] + g.dims_[2] * h};
+  *out = std::move(g);
+  return Status::kOk;
+}
+
+uint32_t TerrainGrid::CellCoord(double local, int axis) const {
+  const double t = (local - grid_lo_[axis]) * inv_cell_size_;
+  if (!(t > 0)) return 0;
+  if (t >= static_cast<double>(dims_[axis])) return dims_[axis] - 1;
+  return static_cast<uint32_t>(t);
+}
+
+// Cell boxes, in local coordinates. Border cells reach the sample bounds, where they hold
+// samples outside the grid box.
+double TerrainGrid::CellLo(uint32_t i, int axis) const {
+  const double lo = grid_lo_[axis] + i * cell_size_;
+  return i == 0 ? std::min(lo, bounds_lo_[axis]) : lo;
+}
+
+double TerrainGrid::CellHi(uint32_t i, int axis) const {
+  const double hi = grid_lo_[axis] + (i + 1.0) * cell_size_;
+  return i + 1 == dims_[axis] ? std::max(hi, bounds_hi_[axis]) : hi;
+}
+
+template <typename Scanner>
+void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
+  if (count_ == 0) return;
+  // Boxes are padded so that rounding in cell assignment can never prune a sample.
+  const double pad = 1e-9 * (cell_size_ + std::fabs(c[0]) + std::fabs(c[1]) + std::fabs(c[2]) +
+                             (bounds_hi_[0] - bounds_lo_[0]) + (bounds_hi_[1] - bounds_lo_[1]) +
+                             (bounds_hi_[2] - bounds_lo_[2]));
+  auto gap2 = [&](double v, double lo, double hi) {
+    const double d = v < lo - pad ? lo - pad - v : v > hi + pad ? v - hi - pad : 0.0;
+    return d * d;
+  };
+  const int64_t ci[3] = {CellCoord(c[0], 0), CellCoord(c[1], 1), CellCoord(c[2], 2)};
+  const int64_t n[3] = {dims_[0], dims_[1], dims_[2]};
+  double whole_lo[3], whole_hi[3];
+  for (int a = 0; a < 3; ++a) whole_lo[a] = CellLo(0, a), whole_hi[a] = CellHi(dims_[a] - 1, a);
+  for (int64_t r = 0;; ++r) {
+    if (r > 0) {
+      // Lower bound on the distance to any cell at Chebyshev radius >= r: the nearest of the
+      // slabs beyond the shell on each side of each axis, within the whole grid box.
+      double bound2 = kInf;
+      bool any = false;
+      for (int a = 0; a < 3; ++a) {
+        double rest = 0;
+        for (int b = 0; b < 3; ++b)
+          if (b != a) rest += gap2(c[b], whole_lo[b], whole_hi[b]);
+        if (ci[a] + r <= n[a] - 1) {
+          any = true;
+          bound2 = std::min(bound2, rest + gap2(c[a], CellLo(ci[a] + r, a), whole_hi[a]));
+        }
+        if (ci[a] - r >= 0) {
+          any = true;
+          bound2 = std::min(bound2, rest + gap2(c[a], whole_lo[a], CellHi(ci[a] - r, a)));
+        }
+      }
+      if (!any || bound2 > scanner.limit2()) return;
+    }
+    const int64_t i0 = std::max<int64_t>(0, ci[0] - r), i1 = std::min(n[0] - 1, ci[0] + r);
+    const int64_t j0 = std::max<int64_t>(0, ci[1] - r), j1 = std::min(n[1] - 1, ci[1] + r);
+    const int64_t k0 = std::max<int64_t>(0, ci[2] - r), k1 = std::min(n[2] - 1, ci[2] + r);
+    for (int64_t k = k0; k <= k1; ++k) {
+      const bool kface = k == ci[2] - r || k == ci[2] + r;
+      const double dk = gap2(c[2], CellLo(k, 2), CellHi(k, 2));
+      for (int64_t j = j0; j <= j1; ++j) {
+        const bool jface = j == ci[1] - r || j == ci[1] + r;
+        const double djk = dk + gap2(c[1], CellLo(j, 1), CellHi(j, 1));
+        if (djk > scanner.limit2()) continue;
+        const size_t row = (static_cast<size_t>(k) * n[1] + j) * n[0];
+        // Inside the shell's x range only the two x faces belong to it, unless on a y/z face.
+        const int64_t step = (kface || jface) ? 1 : std::max<int64_t>(1, 2 * r);
+        for (int64_t i = (kface || jface) ? i0 : ci[0] - r; i <= i1; i += step) {
+          if (i < i0) continue;
+          const size_t cell = row + i;
+          const uint32_t b = cell_start_[cell], e = cell_start_[cell + 1];
+          if (b == e) continue;
+          const double d2 = djk + gap2(c[0], CellLo(i, 0), CellHi(i, 0));
+          if (d2 > scanner.limit2()) continue;
+          const double lo[3] = {CellLo(i, 0) - pad, CellLo(j, 1) - pad, CellLo(k, 2) - pad};
+          const double hi[3] = {CellHi(i, 0) + pad, CellHi(j, 1) + pad, CellHi(k, 2) + pad};
+          if (!scanner.KeepCell(lo, hi)) continue;
+          scanner.Scan(static_cast<uint32_t>(cell), b, e);
+        }
+      }
+    }
+  }
+}
+
+namespace {
+
+struct SnapScanner {
+  const float* positions;
+  const uint32_t* indices;
+  const double* q;
+  QueryTrace* trace;
+  double best_d2 = kInf;
+  uint32_t best_index = kNoIndex;
+  uint32_t best_slot = kNoIndex;
+
+  double limit2() const { return best_d2; }
+  bool KeepCell(const double*, const double*) const { return true; }
+  void Scan(uint32_t cell, uint32_t b, uint32_t e) {
+    if (trace) trace->cells.push_back(cell);
+    for (uint32_t s = b; s < e; ++s) {
+      const double d2 = detail::Dist2(&positions[3 * s], q);
+      if (trace) trace->examined_samples.push_back(indices[s]);
+      if (detail::Better(d2, indices[s], best_d2, best_index)) {
+        best_d2 = d2, best_index = indices[s], best_slot = s;
+      }
+    }
+  }
+};
+
+struct NextScanner {
+  const float* positions;
+  const uint32_t* indices;
+  const detail::NextFrame* f;
+  QueryTrace* trace;
+  double best_d2;
+  uint32_t best_index = kNoIndex;
+  uint32_t best_slot = kNoIndex;
+
+  double limit2() const { return best_d2; }
+  // Skips a cell lying wholly behind the foot: its farthest corner along dir is not ahead.
+  bool KeepCell(const double* lo, const double* hi) const {
+    double support = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double d = f->dir[a];
+      support += d * ((d > 0 ? hi[a] : lo[a]) - f->foot[a]);
+    }
+    return support > 0;  // the padded box absorbs rounding
+  }
+  void Scan(uint32_t cell, uint32_t b, uint32_t e) {
+    if (trace) trace->cells.push_back(cell);
+    for (uint32_t s = b; s < e; ++s) {
+      const float* p = &positions[3 * s];
+      const double d2 = detail::Dist2(p, f->ideal);
+      if (trace) trace->examined_samples.push_back(indices[s]);
+      if (d2 > f->radius2 || !detail::Ahead(p, *f)) continue;
+      if (trace) trace->candidates.push_back(indices[s]);
+      if (detail::Better(d2, indices[s], best_d2, best_index)) {
+        best_d2 = d2, best_index = indices[s], best_slot = s;
+      }
+    }
+  }
+};
+
+}  // namespace
+
+Foothold TerrainGrid::MakeFoothold(uint32_t slot) const {
+  Foothold f;
+  f.status = Status::kOk;
+  f.index = indices_[slot];
+  const float* p = &positions_[3 * slot];
+  const float* nv = &normals_[3 * slot];
+  f.point = {origin_[0] + p[0], origin_[1] + p[1], origin_[2] + p[2]};
+  f.normal = {nv[0], nv[1], nv[2]};
+  return f;
+}
+
+Foothold TerrainGrid::Snap(const Vec3& q, QueryTrace* trace) const {
+  Foothold none;
+  if (!IsFinite(q)) return none;
+  none.status = Status::kNoFoothold;
+  const double c[3] = {q.x - origin_[0], q.y - origin_[1], q.z - origin_[2]};
+  if (trace) *trace = QueryTrace{}, trace->ideal = q;
+  SnapScanner s{positions_, indices_, c, trace};
+  Search(c, s);
+  return s.best_slot == kNoIndex ? none : MakeFoothold(s.best_slot);
+}
+
+Foothold TerrainGrid::Next(const StepQuery& q, double tolerance, QueryTrace* trace) const {
+  Foothold none;
+  detail::NextFrame f;
+  if (!detail::MakeNextFrame(origin_, q, tolerance, &f)) return none;
+  none.status = Status::kNoFoothold;
+  if (trace) {
+    *trace = QueryTrace{};
+    trace->ideal = q.foot + q.direction;
+    trace->radius = std::sqrt(f.radius2);
+  }
+  NextScanner s{positions_, indices_, &f, trace, f.radius2};
+  Search(f.ideal, s);
+  return s.best_slot == kNoIndex ? none : MakeFoothold(s.best_slot);
+}
+
+namespace {
+template <typename Fn>
+void ParallelFor(size_t count, int threads, Fn&& fn) {
+  const size_t t = static_cast<size_t>(std::max(1, threads));
+  if (t == 1 || count < 2 * t) {
+    fn(0, count);
+    return;
+  }
+  std::vector<std::thread> pool;
+  const size_t chunk = (count + t - 1) / t;
+  for (size_t b = chunk; b < count; b += chunk) pool.emplace_back(fn, b, std::min(count, b + chunk));
+  fn(0, std::min(count, chunk));
+  for (auto& th : pool) th.join();
+}
+}  // namespace
+
+void TerrainGrid::SnapBatch(const Vec3* queries, size_t count, Foothold* out, int threads) const {
+  ParallelFor(count, threads, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) out[i] = Snap(queries[i]);
+  });
+}
+
+void TerrainGrid::NextBatch(const StepQuery* queries, size_t count, double tolerance,
+                            Foothold* out, int threads) const {
+  ParallelFor(count, threads, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) out[i] = Next(queries[i], tolerance);
+  });
+}
+
+void TerrainGrid::CellBox(uint32_t cell, Vec3* lo, Vec3* hi) const {
+  const uint32_t i = cell % dims_[0], j = (cell / dims_[0]) % dims_[1],
+                 k = cell / (dims_[0] * dims_[1]);
+  *lo = {origin_[0] + CellLo(i, 0), origin_[1] + CellLo(j, 1), origin_[2] + CellLo(k, 2)};
+  *hi = {origin_[0] + CellHi(i, 0), origin_[1] + CellHi(j, 1), origin_[2] + CellHi(k, 2)};
+}
+
+std::vector<uint32_t> TerrainGrid::OccupiedCells() const {
+  std::vector<uint32_t> cells;
+  if (count_ == 0) return cells;
+  const size_t total = size_t{dims_[0]} * dims_[1] * dims_[2];
+  for (size_t c = 0; c < total; ++c)
+    if (cell_start_[c + 1] > cell_start_[c]) cells.push_back(static_cast<uint32_t>(c));
+  return cells;
+}
+
+}  // namespace footfall

@@ -1,0 +1,126 @@
+#include "footfall/terrain/point_file.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <istream>
+#include <string_view>
+#include <system_error>
+
+namespace footfall {
+namespace {
+
+bool IsSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+Status Fail(const std::string& name, size_t line, const std::string& what, RawSamples* out,
+            std::string* error) {
+  out->clear();
+  if (error) *error = name + ":" + std::to_string(line) + ": " + what;
+  return Status::kParseError;
+}
+
+}  // namespace
+
+Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* out,
+                       std::string* error) {
+  out->clear();
+  std::string text;
+  size_t line_no = 0;
+  while (std::getline(in, text)) {
+    ++line_no;
+    std::string_view line(text);
+    const size_t hash = line.find('#');
+    if (hash != std::string_view::npos) line = line.substr(0, hash);
+    double v[6];
+    int count = 0;
+    size_t pos = 0;
+    while (true) {
+      while (pos < line.size() && IsSpace(line[pos])) ++pos;
+      if (pos >= line.size()) break;
+      size_t end = pos;
+      while (end < line.size() && !IsSpace(line[end])) ++end;
+      const std::string_view token = line.substr(pos, end - pos);
+      if (count < 6) {
+        const char* first = token.data();
+        const char* last = first + token.size();
+        if (*first == '+') ++first;  // from_chars rejects a leading '+'
+        double value = 0;
+        const auto [ptr, ec] = std::from_chars(first, last, value);
+        if (ec == std::errc::result_out_of_range && ptr == last) {
+          return Fail(name, line_no,
+                      "column " + std::to_string(count + 1) + ": '" + std::string(token) +
+                          "' is out of range (expected a finite number)",
+                      out, error);
+        }
+        if (ec != std::errc() || ptr != last) {
+          return Fail(name, line_no,
+                      "column " + std::to_string(count + 1) + ": '" + std::string(token) +
+                          "' is not a number (expected x y z nx ny nz)",
+                      out, error);
+        }
+        if (!std::isfinite(value)) {
+          return Fail(name, line_no,
+                      "column " + std::to_string(count + 1) + ": '" + std::string(token) +
+                          "' is NaN or infinite (expected a finite number)",
+                      out, error);
+        }
+        v[count] = value;
+      }
+      ++count;
+      pos = end;
+    }
+    if (count == 0) continue;
+    if (count != 6) {
+      return Fail(name, line_no,
+                  "expected 6 numbers (x y z nx ny nz), found " + std::to_string(count), out,
+                  error);
+    }
+    const Vec3 normal{v[3], v[4], v[5]};
+    const double len = Length(normal);
+    if (!(len > 0) || !std::isfinite(len)) {
+      return Fail(name, line_no, "normal has zero length (expected a non-zero nx ny nz)", out,
+                  error);
+    }
+    out->push_back({v[0], v[1], v[2]}, normal / len);
+  }
+  if (in.bad()) {
+    out->clear();
+    if (error) *error = name + ": read error";
+    return Status::kIoError;
+  }
+  return Status::kOk;
+}
+
+Status ReadPointFile(const std::string& path, RawSamples* out, std::string* error) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    out->clear();
+    if (error) *error = path + ": cannot open file";
+    return Status::kIoError;
+  }
+  return ReadPointStream(in, path, out, error);
+}
+
+Status WritePointFile(const std::string& path, const RawSamples& samples, std::string* error) {
+  FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f) {
+    if (error) *error = path + ": cannot write file";
+    return Status::kIoError;
+  }
+  std::fprintf(f, "# footfall terrain points: x y z nx ny nz (%zu samples)\n", samples.size());
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const Vec3& p = samples.points[i];
+    const Vec3& n = samples.normals[i];
+    std::fprintf(f, "%.12g %.12g %.12g %.8g %.8g %.8g\n", p.x, p.y, p.z, n.x, n.y, n.z);
+  }
+  const bool ok = std::fflush(f) == 0 && !std::ferror(f);
+  std::fclose(f);
+  if (!ok) {
+    if (error) *error = path + ": write failed";
+    return Status::kIoError;
+  }
+  return Status::kOk;
+}
+
+}  // namespace footfall

@@ -1,0 +1,61 @@
+// Arithmetic shared by TerrainGrid and BruteForce, so both compute bit-identical distances and
+// predicates. Everything is in the grid's local frame (world minus origin), in double.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "footfall/terrain/grid.h"
+
+namespace footfall {
+namespace detail {
+
+// Squared distance from a stored (float, local) point to a local query point.
+inline double Dist2(const float* p, const double q[3]) {
+  const double dx = static_cast<double>(p[0]) - q[0];
+  const double dy = static_cast<double>(p[1]) - q[1];
+  const double dz = static_cast<double>(p[2]) - q[2];
+  return dx * dx + dy * dy + dz * dz;
+}
+
+// True when (d2, index) beats the best so far: nearer, or as near with a lower index.
+inline bool Better(double d2, uint32_t index, double best_d2, uint32_t best_index) {
+  return d2 < best_d2 || (d2 == best_d2 && index < best_index);
+}
+
+// A next query in local coordinates.
+struct NextFrame {
+  double foot[3];
+  double dir[3];
+  double ideal[3];
+  double radius2;
+};
+
+// Fills `frame` from a world-space query; false if the query is invalid (zero or non-finite
+// direction, non-finite foot or tolerance).
+inline bool MakeNextFrame(const double origin[3], const StepQuery& q, double tolerance,
+                          NextFrame* frame) {
+  if (!IsFinite(q.foot) || !IsFinite(q.direction) || !std::isfinite(tolerance)) return false;
+  const double len2 = Length2(q.direction);
+  if (!(len2 > 0) || !std::isfinite(len2)) return false;
+  const double foot[3] = {q.foot.x, q.foot.y, q.foot.z};
+  const double dir[3] = {q.direction.x, q.direction.y, q.direction.z};
+  for (int a = 0; a < 3; ++a) {
+    frame->foot[a] = foot[a] - origin[a];
+    frame->dir[a] = dir[a];
+    frame->ideal[a] = frame->foot[a] + dir[a];
+  }
+  frame->radius2 = tolerance > 0 ? tolerance * tolerance : len2;
+  return std::isfinite(frame->radius2);
+}
+
+// True when a stored point is strictly ahead of the foot: dot(p - foot, dir) > 0.
+inline bool Ahead(const float* p, const NextFrame& f) {
+  const double ax = static_cast<double>(p[0]) - f.foot[0];
+  const double ay = static_cast<double>(p[1]) - f.foot[1];
+  const double az = static_cast<double>(p[2]) - f.foot[2];
+  return ax * f.dir[0] + ay * f.dir[1] + az * f.dir[2] > 0;
+}
+
+}  // namespace detail
+}  // namespace footfall

@@ -1,0 +1,217 @@
+// TerrainGrid against its brute-force oracle on many terrain shapes: every answer must be
+// identical (status, index, point, normal) for queries inside, on and far outside the bounds,
+// along every axis both ways.
+#include <random>
+#include <string>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include "footfall/import/terrain_generators.h"
+#include "footfall/terrain/brute_force.h"
+#include "footfall/terrain/grid.h"
+
+using namespace footfall;
+
+namespace {
+
+TerrainGrid Build(RawSamples s) {
+  std::string error;
+  REQUIRE(ValidateAndNormalize(&s, &error) == Status::kOk);
+  TerrainGrid g;
+  REQUIRE(TerrainGrid::Build(s, GridOptions{}, &g, &error) == Status::kOk);
+  return g;
+}
+
+void RequireSame(const Foothold& a, const Foothold& b, const std::string& what) {
+  INFO(what);
+  REQUIRE(StatusName(a.status) == std::string(StatusName(b.status)));
+  if (a.status != Status::kOk) return;
+  REQUIRE(a.index == b.index);
+  REQUIRE(a.point == b.point);
+  REQUIRE(a.normal == b.normal);
+}
+
+std::string Describe(const Vec3& v) {
+  return "(" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) + ")";
+}
+
+// Query points: samples themselves, jittered samples, uniform in the bounds, on the bounds'
+// faces and corners, and far outside in every direction.
+std::vector<Vec3> QueryPoints(const TerrainGrid& g, std::mt19937_64& rng, int count) {
+  const GridStats& st = g.stats();
+  const Vec3 lo = st.bounds_min, hi = st.bounds_max;
+  const Vec3 size = hi - lo;
+  const double scale = std::max({size.x, size.y, size.z, 1e-3});
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Vec3> samples;
+  g.ForEachSample([&](uint32_t, const Vec3& p, const Vec3&) { samples.push_back(p); });
+  std::vector<Vec3> q;
+  for (int i = 0; i < count; ++i) {
+    const Vec3& s = samples[rng() % samples.size()];
+    switch (i % 6) {
+      case 0: q.push_back(s); break;
+      case 1: q.push_back(s + Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5} * (0.05 * scale)); break;
+      case 2: q.push_back(lo + Vec3{u(rng) * size.x, u(rng) * size.y, u(rng) * size.z}); break;
+      case 3: {  // on a face or corner of the bounds
+        Vec3 p = lo + Vec3{u(rng) * size.x, u(rng) * size.y, u(rng) * size.z};
+        const int axis = static_cast<int>(rng() % 3);
+        const bool top = rng() % 2;
+        (axis == 0 ? p.x : axis == 1 ? p.y : p.z) =
+            axis == 0 ? (top ? hi.x : lo.x) : axis == 1 ? (top ? hi.y : lo.y) : (top ? hi.z : lo.z);
+        if (rng() % 4 == 0) p = Vec3{rng() % 2 ? hi.x : lo.x, rng() % 2 ? hi.y : lo.y, rng() % 2 ? hi.z : lo.z};
+        q.push_back(p);
+        break;
+      }
+      case 4: {  // far outside along one axis, both ways
+        Vec3 p = s;
+        const int axis = (i / 6) % 3;
+        const double far = (i / 18) % 2 ? 50 * scale : -50 * scale;
+        (axis == 0 ? p.x : axis == 1 ? p.y : p.z) += far;
+        q.push_back(p);
+        break;
+      }
+      default: {  // far outside in a random direction
+        const Vec3 d = Normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5 + 1e-9});
+        q.push_back(lo + size * 0.5 + d * (scale * (2 + 1000 * u(rng))));
+      }
+    }
+  }
+  return q;
+}
+
+// Checks snap and next against brute force; next with step directions along +-X, +-Y, +-Z and
+// random directions, at step lengths relative to the terrain's spacing and size.
+void CheckAgainstBruteForce(const TerrainGrid& g, int count, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  const BruteForce oracle(g);
+  const std::vector<Vec3> points = QueryPoints(g, rng, count);
+  const GridStats& st = g.stats();
+  const Vec3 size = st.bounds_max - st.bounds_min;
+  const double scale = std::max({size.x, size.y, size.z, 1e-3});
+  const Vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  std::uniform_real_distribution<double> u(0, 1);
+  size_t found = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Vec3& p = points[i];
+    RequireSame(g.Snap(p), oracle.Snap(p), "snap at " + Describe(p));
+    const double length = scale * (i % 3 == 0 ? 0.01 : i % 3 == 1 ? 0.1 : 0.5) * (0.5 + u(rng));
+    Vec3 dir = i % 2 ? axes[(i / 2) % 6] : Normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5 + 1e-9});
+    dir = dir * length;
+    const double tolerance = i % 5 == 0 ? length * 0.3 : 0;
+    const StepQuery q{p, dir};
+    const Foothold a = g.Next(q, tolerance);
+    found += a.status == Status::kOk;
+    RequireSame(a, oracle.Next(q, tolerance),
+                "next from " + Describe(p) + " along " + Describe(dir) + " tol " + std::to_string(tolerance));
+  }
+  // The query mix must exercise both outcomes of next.
+  CHECK(found > 0);
+}
+
+}  // namespace
+
+TEST_CASE("TerrainGrid answers exactly as brute force", "[terrain][grid]") {
+  SECTION("on a height field") { CheckAgainstBruteForce(Build(MakeHeightField(80, 60, 0.5, 3, 7)), 3000, 1); }
+  SECTION("on a sphere") { CheckAgainstBruteForce(Build(MakeSphere(5000, {1, 2, 3}, 10)), 3000, 2); }
+  SECTION("in a room with walls and a ceiling") {
+    CheckAgainstBruteForce(Build(MakeRoom({20, 8, 12}, 0.5)), 3000, 3);
+  }
+  SECTION("on stairs") { CheckAgainstBruteForce(Build(MakeStairs(12, 0.2, 0.3, 2, 0.05)), 3000, 4); }
+  SECTION("on a perfectly flat square") { CheckAgainstBruteForce(Build(MakeFlat(60, 0.25, 1.5)), 3000, 5); }
+  SECTION("on a ramp") { CheckAgainstBruteForce(Build(MakeRamp(40, 40, 0.25, 35)), 2000, 6); }
+  SECTION("on a line of samples") {
+    RawSamples s;
+    for (int i = 0; i < 2000; ++i) s.push_back({0.01 * i, 0, 0}, {0, 1, 0});
+    CheckAgainstBruteForce(Build(s), 2000, 7);
+  }
+  SECTION("on a single sample") {
+    RawSamples s;
+    s.push_back({3, -2, 5}, {0, 0, 2});
+    CheckAgainstBruteForce(Build(s), 500, 8);
+  }
+  SECTION("with duplicated samples (ties go to the lowest index)") {
+    RawSamples s = MakeFlat(20, 1, 0);
+    const size_t n = s.size();
+    for (size_t i = 0; i < n; ++i) s.push_back(s.points[i], {0, 1, 1});  // same points, new normals
+    const TerrainGrid g = Build(s);
+    CheckAgainstBruteForce(g, 2000, 9);
+    for (size_t i = 0; i < n; i += 37) REQUIRE(g.Snap(s.points[i]).index == i);
+  }
+  SECTION("with a few far outliers") {
+    RawSamples s = MakeHeightField(60, 60, 0.5, 2, 11);
+    s.push_back({1e6, 0, 0}, {0, 1, 0});
+    s.push_back({0, -5e5, 0}, {0, 1, 0});
+    s.push_back({0, 0, 3e5}, {1, 1, 0});
+    const TerrainGrid g = Build(s);
+    CheckAgainstBruteForce(g, 3000, 10);
+    // The outliers do not stretch the cells: the bulk still gets a fine grid.
+    CHECK(g.stats().cell_size < 5);
+  }
+  SECTION("with huge coordinates (near 1e5)") {
+    RawSamples s = MakeHeightField(60, 60, 0.5, 2, 12);
+    for (auto& p : s.points) p = p + Vec3{1e5, 1e5, -1e5};
+    CheckAgainstBruteForce(Build(s), 3000, 13);
+  }
+  SECTION("with tiny spacing (1e-4)") {
+    CheckAgainstBruteForce(Build(MakeHeightField(60, 60, 1e-4, 2e-4, 14)), 3000, 15);
+  }
+  SECTION("with tiny spacing at huge coordinates") {
+    RawSamples s = MakeHeightField(40, 40, 1e-3, 1e-3, 16);
+    for (auto& p : s.points) p = p + Vec3{1e5, 0, 1e5};
+    CheckAgainstBruteForce(Build(s), 2000, 17);
+  }
+}
+
+TEST_CASE("TerrainGrid next follows the candidate rules", "[terrain][grid]") {
+  const TerrainGrid g = Build(MakeFlat(21, 1, 0));  // samples at integer x, z in [0, 20]
+  SECTION("the ideal point's sample is chosen") {
+    const Foothold f = g.Next({{5, 0, 5}, {0, 0, 3}}, 0);
+    REQUIRE(f.status == Status::kOk);
+    CHECK(f.point == Vec3{5, 0, 8});
+    CHECK(f.normal == Vec3{0, 1, 0});
+  }
+  SECTION("samples behind or beside the foot are never candidates") {
+    // From the +Z edge walking on: the only samples within one step are behind or level.
+    const Foothold f = g.Next({{5, 0, 20}, {0, 0, 3}}, 0);
+    CHECK(f.status == Status::kNoFoothold);
+  }
+  SECTION("the tolerance bounds the candidate radius") {
+    // Ideal point (5, 0, 23.5) is 3.5 beyond the edge: no sample within 1, one within 4.
+    CHECK(g.Next({{5, 0, 20.5}, {0, 0, 3}}, 1).status == Status::kNoFoothold);
+    CHECK(g.Next({{5, 0, 19.5}, {0, 0, 4}}, 4).status == Status::kOk);
+  }
+  SECTION("a zero or non-finite direction is an error") {
+    CHECK(g.Next({{5, 0, 5}, {0, 0, 0}}, 0).status == Status::kInvalidArgument);
+    CHECK(g.Next({{5, 0, 5}, {0, NAN, 1}}, 0).status == Status::kInvalidArgument);
+    CHECK(g.Next({{5, 0, INFINITY}, {0, 0, 1}}, 0).status == Status::kInvalidArgument);
+    CHECK(g.Snap({NAN, 0, 0}).status == Status::kInvalidArgument);
+  }
+}
+
+TEST_CASE("TerrainGrid keeps memory bounded", "[terrain][grid]") {
+  SECTION("an empty grid answers no foothold") {
+    TerrainGrid g;
+    std::string error;
+    REQUIRE(TerrainGrid::Build(RawSamples{}, GridOptions{}, &g, &error) == Status::kOk);
+    CHECK(g.Snap({0, 0, 0}).status == Status::kNoFoothold);
+  }
+  SECTION("cells stay within about one per sample whatever the shape") {
+    for (const RawSamples& s : {MakeSphere(20000, {0, 0, 0}, 100), MakeHeightField(150, 150, 0.1, 40, 3),
+                                MakeRoom({100, 1, 100}, 0.5)}) {
+      const TerrainGrid g = Build(s);
+      const GridStats& st = g.stats();
+      const double cells = double(st.cells[0]) * st.cells[1] * st.cells[2];
+      CHECK(cells <= std::max(64.0, 1.0 * s.size()));
+      CHECK(st.bytes <= 32 * s.size() + 4 * 64 + 64);
+    }
+  }
+  SECTION("grids move but do not copy") {
+    STATIC_REQUIRE(!std::is_copy_constructible<TerrainGrid>::value);
+    STATIC_REQUIRE(std::is_nothrow_move_constructible<TerrainGrid>::value);
+    TerrainGrid a = Build(MakeFlat(10, 1, 0));
+    TerrainGrid b = std::move(a);
+    CHECK(b.size() == 100);
+    CHECK(b.Snap({3.2, 0, 4.9}).point == Vec3{3, 0, 5});
+  }
+}

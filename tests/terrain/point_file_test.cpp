@@ -1,0 +1,74 @@
+// The point file reader: valid files load with normalised normals; each kind of bad line gives
+// an error naming file, line and what was expected.
+#include <sstream>
+#include <string>
+
+#include <catch2/catch.hpp>
+
+#include "footfall/terrain/point_file.h"
+
+using namespace footfall;
+
+namespace {
+Status Read(const std::string& text, RawSamples* out, std::string* error) {
+  std::istringstream in(text);
+  return ReadPointStream(in, "t.pts", out, error);
+}
+}  // namespace
+
+TEST_CASE("ReadPointStream reads samples", "[terrain][point_file]") {
+  RawSamples s;
+  std::string error;
+  const std::string text =
+      "# a comment\r\n"
+      "\r\n"
+      "0 1 2 0 2 0   # trailing comment\r\n"
+      "\t+1.5e0  -2 3e-1 3 0 4\n"
+      "   \n"
+      "7 8 9 0 0 -1";
+  REQUIRE(Read(text, &s, &error) == Status::kOk);
+  REQUIRE(s.size() == 3);
+  CHECK(s.points[0] == Vec3{0, 1, 2});
+  CHECK(s.normals[0] == Vec3{0, 1, 0});
+  CHECK(s.points[1] == Vec3{1.5, -2, 0.3});
+  CHECK(s.normals[1].x == Approx(0.6));
+  CHECK(s.normals[1].z == Approx(0.8));
+  CHECK(s.points[2] == Vec3{7, 8, 9});
+}
+
+TEST_CASE("ReadPointStream rejects bad lines with file and line", "[terrain][point_file]") {
+  RawSamples s;
+  std::string error;
+  SECTION("wrong count") {
+    CHECK(Read("0 0 0 0 1 0\n1 2 3 4 5\n", &s, &error) == Status::kParseError);
+    CHECK(error == "t.pts:2: expected 6 numbers (x y z nx ny nz), found 5");
+    CHECK(Read("1 2 3 4 5 6 7\n", &s, &error) == Status::kParseError);
+    CHECK(error == "t.pts:1: expected 6 numbers (x y z nx ny nz), found 7");
+  }
+  SECTION("not a number") {
+    CHECK(Read("\n\n0 0 abc 0 1 0\n", &s, &error) == Status::kParseError);
+    CHECK(error == "t.pts:3: column 3: 'abc' is not a number (expected x y z nx ny nz)");
+    CHECK(Read("0 0 1.5x 0 1 0\n", &s, &error) == Status::kParseError);
+    CHECK(error.find("t.pts:1: column 3") == 0);
+  }
+  SECTION("NaN or infinite") {
+    CHECK(Read("0 0 0 0 1 0\nnan 0 0 0 1 0\n", &s, &error) == Status::kParseError);
+    CHECK(error == "t.pts:2: column 1: 'nan' is NaN or infinite (expected a finite number)");
+    CHECK(Read("0 inf 0 0 1 0\n", &s, &error) == Status::kParseError);
+    CHECK(error.find("t.pts:1: column 2: 'inf' is NaN or infinite") == 0);
+    CHECK(Read("0 1e999 0 0 1 0\n", &s, &error) == Status::kParseError);
+    CHECK(error.find("t.pts:1: column 2: '1e999' is out of range") == 0);
+  }
+  SECTION("zero normal") {
+    CHECK(Read("0 0 0 0 0 0\n", &s, &error) == Status::kParseError);
+    CHECK(error == "t.pts:1: normal has zero length (expected a non-zero nx ny nz)");
+  }
+  CHECK(s.size() == 0);
+}
+
+TEST_CASE("ReadPointFile reports a missing file", "[terrain][point_file]") {
+  RawSamples s;
+  std::string error;
+  CHECK(ReadPointFile("/nonexistent/terrain.pts", &s, &error) == Status::kIoError);
+  CHECK(error == "/nonexistent/terrain.pts: cannot open file");
+}
