@@ -77,6 +77,16 @@ int32_t ffc_normal(ffc_session* s, uint32_t terrain, const double* points, size_
 int32_t ffc_next(ffc_session* s, uint32_t terrain, const double* steps, size_t count,
                  double tolerance, ffc_foothold* out);
 
+/* Generates a walk with the step generator, exactly as `footfall generate` does.
+ * request_json: {"character": {...character file object...} or "character_file": PATH,
+ *                "start": [x,y,z], "heading": [x,y,z], "path": [[x,y,z],...], "steps": N,
+ *                "start_frame": F, "up": [x,y,z]} (keys as the command's flags).
+ * On FF_C_OK and on a walk that stopped early, *walk_json receives the walk as footfall's JSON
+ * (release it with ffc_free_string); a stopped walk also sets ffc_last_error(). */
+int32_t ffc_generate(ffc_session* s, uint32_t terrain, const char* request_json,
+                     char** walk_json);
+void ffc_free_string(char* text);
+
 #ifdef __cplusplus
 }
 #endif
