@@ -253,26 +253,63 @@ void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
   const int64_t n[3] = {dims_[0], dims_[1], dims_[2]};
   double whole_lo[3], whole_hi[3];
   for (int a = 0; a < 3; ++a) whole_lo[a] = CellLo(0, a), whole_hi[a] = CellHi(dims_[a] - 1, a);
+  // Lower bound on the squared distance to any cell at Chebyshev radius >= r: the nearest of
+  // the slabs beyond the shell on each side of each axis, within the whole grid box. Infinite
+  // when no such cell exists.
+  auto shell_bound2 = [&](int64_t r) {
+    double bound2 = kInf;
+    for (int a = 0; a < 3; ++a) {
+      double rest = 0;
+      for (int b = 0; b < 3; ++b)
+        if (b != a) rest += gap2(c[b], whole_lo[b], whole_hi[b]);
+      if (ci[a] + r <= n[a] - 1)
+        bound2 = std::min(bound2, rest + gap2(c[a], CellLo(ci[a] + r, a), whole_hi[a]));
+      if (ci[a] - r >= 0)
+        bound2 = std::min(bound2, rest + gap2(c[a], whole_lo[a], CellHi(ci[a] - r, a)));
+    }
+    return bound2;
+  };
   for (int64_t r = 0;; ++r) {
     if (r > 0) {
-      // Lower bound on the distance to any cell at Chebyshev radius >= r: the nearest of the
-      // slabs beyond the shell on each side of each axis, within the whole grid box.
-      double bound2 = kInf;
-      bool any = false;
-      for (int a = 0; a < 3; ++a) {
-        double rest = 0;
-        for (int b = 0; b < 3; ++b)
-          if (b != a) rest += gap2(c[b], whole_lo[b], whole_hi[b]);
-        if (ci[a] + r <= n[a] - 1) {
-          any = true;
-          bound2 = std::min(bound2, rest + gap2(c[a], CellLo(ci[a] + r, a), whole_hi[a]));
+      if (shell_bound2(r) > scanner.limit2()) return;
+      if (r == 1 && shell_bound2(2) > scanner.limit2()) {
+        // Fast path: only the 26 neighbours can matter; visit those whose slabs reach the
+        // ball of the current best, per axis.
+        int64_t from[3], to[3];
+        double g[3][3], lo[3][3], hi[3][3];
+        for (int a = 0; a < 3; ++a) {
+          from[a] = 1, to[a] = -1;
+          for (int64_t o = -1; o <= 1; ++o) {
+            const int64_t idx = ci[a] + o;
+            if (idx < 0 || idx >= n[a]) continue;
+            const double cl = CellLo(static_cast<uint32_t>(idx), a);
+            const double ch = CellHi(static_cast<uint32_t>(idx), a);
+            g[a][o + 1] = gap2(c[a], cl, ch);
+            lo[a][o + 1] = cl - pad, hi[a][o + 1] = ch + pad;
+            if (g[a][o + 1] > scanner.limit2()) continue;
+            from[a] = std::min(from[a], o), to[a] = std::max(to[a], o);
+          }
         }
-        if (ci[a] - r >= 0) {
-          any = true;
-          bound2 = std::min(bound2, rest + gap2(c[a], whole_lo[a], CellHi(ci[a] - r, a)));
+        for (int64_t dk = from[2]; dk <= to[2]; ++dk) {
+          for (int64_t dj = from[1]; dj <= to[1]; ++dj) {
+            for (int64_t di = from[0]; di <= to[0]; ++di) {
+              if (di == 0 && dj == 0 && dk == 0) continue;
+              if (g[0][di + 1] + g[1][dj + 1] + g[2][dk + 1] > scanner.limit2()) continue;
+              const size_t cell =
+                  (static_cast<size_t>(ci[2] + dk) * n[1] + (ci[1] + dj)) * n[0] + (ci[0] + di);
+              const uint32_t b = cell_start_[cell], e = cell_start_[cell + 1];
+              if (b == e) continue;
+              if (Scanner::kUsesBox) {
+                const double cell_lo[3] = {lo[0][di + 1], lo[1][dj + 1], lo[2][dk + 1]};
+                const double cell_hi[3] = {hi[0][di + 1], hi[1][dj + 1], hi[2][dk + 1]};
+                if (!scanner.KeepCell(cell_lo, cell_hi)) continue;
+              }
+              scanner.Scan(static_cast<uint32_t>(cell), b, e);
+            }
+          }
         }
+        return;
       }
-      if (!any || bound2 > scanner.limit2()) return;
     }
     const int64_t lo_idx[3] = {std::max<int64_t>(0, ci[0] - r), std::max<int64_t>(0, ci[1] - r),
                                std::max<int64_t>(0, ci[2] - r)};
