@@ -79,8 +79,8 @@ std::map<std::string, std::map<std::string, Channel>> Channels(const tinygltf::M
   return out;
 }
 
-void CheckPositions(const Channel& channel, const WalkTrack& track,
-                    const std::vector<size_t>& keys, double fps) {
+void CheckPositions(const Channel& channel, const WalkTrack& track, const std::vector<size_t>& keys,
+                    double fps) {
   REQUIRE(channel.times.size() == keys.size());
   REQUIRE(channel.values.size() == keys.size() * 3);
   for (size_t i = 0; i < keys.size(); ++i) {
@@ -266,8 +266,7 @@ TEST_CASE("WriteWalk dispatches on the file extension", "[export]") {
     CHECK_THAT(error, Catch::Contains(path) && Catch::Contains("'.json'") &&
                           Catch::Contains(".gltf, .glb and .mel"));
     CHECK_FALSE(IsWalkExportPath(path));
-    CHECK(WriteWalk(walk, test::ScratchPath("dir.mel/walk"), &error) ==
-          Status::kInvalidArgument);
+    CHECK(WriteWalk(walk, test::ScratchPath("dir.mel/walk"), &error) == Status::kInvalidArgument);
     CHECK_THAT(error, Catch::Contains("no extension"));
   }
   CHECK(IsWalkExportPath("a/b.Mel"));

@@ -28,10 +28,10 @@ struct MelKey {
 struct MelScript {
   std::string time_unit;
   double min_time = NAN, max_time = NAN;
-  std::vector<std::string> groups;     // createNode transform -parent names, in order
-  std::vector<std::string> locators;   // spaceLocator -n names, in order
-  std::map<std::string, std::string> parent_of;     // locator -> "$footfall_root" or group
-  std::map<std::string, std::string> track_attr;    // locator -> footfallTrack value
+  std::vector<std::string> groups;                // createNode transform -parent names, in order
+  std::vector<std::string> locators;              // spaceLocator -n names, in order
+  std::map<std::string, std::string> parent_of;   // locator -> "$footfall_root" or group
+  std::map<std::string, std::string> track_attr;  // locator -> footfallTrack value
   std::map<std::string, std::map<std::string, std::vector<MelKey>>> keys;  // loc -> attr
   std::vector<std::string> warnings;
   int braces = 0;

@@ -32,12 +32,8 @@ int main(int argc, char** argv) {
   const struct {
     const footfall::Walk* walk;
     const char* file;
-  } samples[] = {{&biped, "walk.gltf"},
-                 {&biped, "walk.glb"},
-                 {&crowd, "crowd.gltf"},
-                 {&crowd, "crowd.glb"},
-                 {&empty, "empty.gltf"},
-                 {&biped, "walk.mel"},
+  } samples[] = {{&biped, "walk.gltf"}, {&biped, "walk.glb"},   {&crowd, "crowd.gltf"},
+                 {&crowd, "crowd.glb"}, {&empty, "empty.gltf"}, {&biped, "walk.mel"},
                  {&crowd, "crowd.mel"}};
   for (const auto& sample : samples) {
     const std::string path = dir + "/" + sample.file;

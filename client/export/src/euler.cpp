@@ -51,8 +51,7 @@ Vec3 QuatToEulerXyzDegrees(const Quat& q_in) {
 
 Vec3 ClosestEulerXyzDegrees(const Vec3& euler, const Vec3& previous) {
   const Vec3 direct = UnwrapAll(euler, previous);
-  const Vec3 alternative =
-      UnwrapAll({euler.x + 180.0, 180.0 - euler.y, euler.z + 180.0}, previous);
+  const Vec3 alternative = UnwrapAll({euler.x + 180.0, 180.0 - euler.y, euler.z + 180.0}, previous);
   return L1(alternative, previous) < L1(direct, previous) ? alternative : direct;
 }
 

@@ -70,8 +70,9 @@ tinygltf::Value NodeExtras(const WalkTrack& track) {
 
 int AddAccessor(std::vector<PendingAccessor>* pending, Streams* streams, StreamId stream,
                 const std::vector<float>& values, int type, size_t count) {
-  std::vector<float>& data =
-      stream == kTimes ? streams->times : stream == kVec3 ? streams->vec3 : streams->vec4;
+  std::vector<float>& data = stream == kTimes  ? streams->times
+                             : stream == kVec3 ? streams->vec3
+                                               : streams->vec4;
   PendingAccessor entry;
   entry.stream = stream;
   entry.first_float = data.size();
@@ -134,15 +135,15 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
       Quat previous;
       for (size_t i = 0; i < count; ++i) {
         const WalkKey& key = track.keys[samples.keys[i]];
-        translations.insert(translations.end(), {static_cast<float>(key.position.x),
-                                                 static_cast<float>(key.position.y),
-                                                 static_cast<float>(key.position.z)});
+        translations.insert(translations.end(),
+                            {static_cast<float>(key.position.x), static_cast<float>(key.position.y),
+                             static_cast<float>(key.position.z)});
         if (body) {
           Quat q = walk_export::Normalized(key.rotation);
           // q and -q are the same rotation; keep neighbours in one hemisphere so that
           // interpolation takes the short way.
-          if (i > 0 && q.x * previous.x + q.y * previous.y + q.z * previous.z +
-                               q.w * previous.w < 0) {
+          if (i > 0 &&
+              q.x * previous.x + q.y * previous.y + q.z * previous.z + q.w * previous.w < 0) {
             q = {-q.x, -q.y, -q.z, -q.w};
           }
           previous = q;
@@ -153,8 +154,8 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
       node.translation = {translations[0], translations[1], translations[2]};
       if (body) node.rotation = {rotations[0], rotations[1], rotations[2], rotations[3]};
 
-      const int input = AddAccessor(&pending, &streams, kTimes, samples.times,
-                                    TINYGLTF_TYPE_SCALAR, count);
+      const int input =
+          AddAccessor(&pending, &streams, kTimes, samples.times, TINYGLTF_TYPE_SCALAR, count);
       // The validator requires min and max on animation inputs; they must equal the stored
       // float values exactly, which a double holding a float does.
       pending[input].accessor.minValues = {samples.times.front()};
@@ -173,13 +174,11 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
         channel.target_path = target_path;
         animation.channels.push_back(channel);
       };
-      add_channel(
-          AddAccessor(&pending, &streams, kVec3, translations, TINYGLTF_TYPE_VEC3, count),
-          "translation");
+      add_channel(AddAccessor(&pending, &streams, kVec3, translations, TINYGLTF_TYPE_VEC3, count),
+                  "translation");
       if (body) {
-        add_channel(
-            AddAccessor(&pending, &streams, kVec4, rotations, TINYGLTF_TYPE_VEC4, count),
-            "rotation");
+        add_channel(AddAccessor(&pending, &streams, kVec4, rotations, TINYGLTF_TYPE_VEC4, count),
+                    "rotation");
       }
     }
     scene.nodes.push_back(static_cast<int>(model.nodes.size()));

@@ -45,8 +45,8 @@ Status CheckWalk(const Walk& walk, std::string* error) {
       }
       if (what != nullptr) {
         std::ostringstream message;
-        message << "track " << t << " '" << QualifiedTrackName(track, t) << "' key " << k
-                << " has " << what;
+        message << "track " << t << " '" << QualifiedTrackName(track, t) << "' key " << k << " has "
+                << what;
         SetError(error, message.str());
         return Status::kInvalidArgument;
       }
