@@ -14,8 +14,8 @@ void OrbitCamera::Frame(const glm::vec3& lo, const glm::vec3& hi) {
   target_ = 0.5f * (lo + hi);
   radius_ = std::max(0.5f * glm::length(hi - lo), 0.5f);
   const float half_fov = glm::radians(kFovYDegrees) * 0.5f;
-  // The bounding sphere would leave a flat terrain small in the view: come closer.
-  distance_ = radius_ / std::sin(half_fov) * 0.8f;
+  // The bounding sphere just fits the vertical field of view (so all of the box does).
+  distance_ = radius_ / std::sin(half_fov) * 1.02f;
 }
 
 void OrbitCamera::LookAt(const glm::vec3& eye, const glm::vec3& target) {

@@ -118,7 +118,11 @@ void Scene::AddLive(const std::vector<RecentQuery>& queries) {
     live_.erase(live_.begin(), live_.begin() + static_cast<long>(live_.size() - kMaxLive));
 }
 
-void Scene::Finalize() { origin_ = has_bounds_ ? 0.5 * (lo_ + hi_) : Vec3{}; }
+void Scene::Finalize() {
+  origin_ = has_bounds_ ? 0.5 * (lo_ + hi_) : Vec3{};
+  // Without samples, size markers after the scene: a walk of a few metres or of a kilometre.
+  if (!has_terrain() && has_bounds_) spacing_ = std::max(Distance(lo_, hi_) / 300, 1e-3);
+}
 
 glm::vec3 Scene::ToRender(const Vec3& world) const {
   const Vec3 r = world - origin_;

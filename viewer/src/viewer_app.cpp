@@ -176,10 +176,30 @@ struct App {
     const Rgba text{230, 230, 230, 255};
     screen->Rect(0, 0, static_cast<float>(width), line + 6, Rgba{0, 0, 0, 140});
     screen->Text(6, 4, InfoText(), scale, text);
-    float y = static_cast<float>(height) - line - 6;
+    // The help line, wrapped at its item separators to fit the width.
+    std::vector<std::string> lines(1);
+    const std::string help = HelpText();
+    for (size_t begin = 0; begin < help.size();) {
+      size_t end = help.find("   ", begin);
+      if (end == std::string::npos) end = help.size();
+      const std::string item = help.substr(begin, end - begin);
+      const std::string joined = lines.back().empty() ? item : lines.back() + "   " + item;
+      if (!lines.back().empty() &&
+          DrawList::TextWidth(joined, scale) > static_cast<float>(width) - 12) {
+        lines.push_back(item);
+      } else {
+        lines.back() = joined;
+      }
+      begin = end + 3;
+    }
+    const float top = static_cast<float>(height) - static_cast<float>(lines.size()) * line - 6;
+    screen->Rect(0, top - 4, static_cast<float>(width), static_cast<float>(height),
+                 Rgba{0, 0, 0, 140});
+    for (size_t i = 0; i < lines.size(); ++i)
+      screen->Text(6, top + static_cast<float>(i) * line, lines[i], scale, text);
     if (scene.has_walk()) {
       // The timeline: a bar over the walk's frames with a marker at the current frame.
-      const float bar_y = y - line - 10;
+      const float bar_y = top - 14;
       const float x0 = 10, x1 = static_cast<float>(width) - 10;
       screen->Rect(x0, bar_y, x1, bar_y + 6, Rgba{90, 90, 100, 220});
       const double span = std::max(scene.last_frame() - scene.first_frame(), 1e-9);
@@ -192,9 +212,6 @@ struct App {
       if (!scene.walk().stopped.empty()) f << "   stopped: " << scene.walk().stopped;
       screen->Text(x0, bar_y - line - 6, f.str(), scale, text);
     }
-    screen->Rect(0, y - 4, static_cast<float>(width), static_cast<float>(height),
-                 Rgba{0, 0, 0, 140});
-    screen->Text(6, y, HelpText(), scale, text);
   }
 
   void PullLive() {
