@@ -15,9 +15,9 @@ Foothold BruteForce::Snap(const Vec3& q) const {
   double best_d2 = std::numeric_limits<double>::infinity();
   uint32_t best_index = std::numeric_limits<uint32_t>::max(), best_slot = best_index;
   for (uint32_t s = 0; s < g.count_; ++s) {
-    const double d2 = detail::Dist2(&g.positions_[3 * s], c);
-    if (detail::Better(d2, g.indices_[s], best_d2, best_index))
-      best_d2 = d2, best_index = g.indices_[s], best_slot = s;
+    const double d2 = detail::Dist2(g.samples_[s].p, c);
+    if (detail::Better(d2, g.samples_[s].index, best_d2, best_index))
+      best_d2 = d2, best_index = g.samples_[s].index, best_slot = s;
   }
   return best_slot == std::numeric_limits<uint32_t>::max() ? none : g.MakeFoothold(best_slot);
 }
@@ -31,11 +31,11 @@ Foothold BruteForce::Next(const StepQuery& q, double tolerance) const {
   double best_d2 = f.radius2;
   uint32_t best_index = std::numeric_limits<uint32_t>::max(), best_slot = best_index;
   for (uint32_t s = 0; s < g.count_; ++s) {
-    const float* p = &g.positions_[3 * s];
+    const float* p = g.samples_[s].p;
     const double d2 = detail::Dist2(p, f.ideal);
     if (d2 > f.radius2 || !detail::Ahead(p, f)) continue;
-    if (detail::Better(d2, g.indices_[s], best_d2, best_index))
-      best_d2 = d2, best_index = g.indices_[s], best_slot = s;
+    if (detail::Better(d2, g.samples_[s].index, best_d2, best_index))
+      best_d2 = d2, best_index = g.samples_[s].index, best_slot = s;
   }
   return best_slot == std::numeric_limits<uint32_t>::max() ? none : g.MakeFoothold(best_slot);
 }

@@ -170,13 +170,12 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
         (size_t{g.CellCoord(p[2], 2)} * g.dims_[1] + g.CellCoord(p[1], 1)) * g.dims_[0] +
         g.CellCoord(p[0], 0));
   }
-  const size_t bytes = n * (3 + 3) * sizeof(float) + n * sizeof(uint32_t) +
+  const size_t bytes = n * sizeof(PackedSample) + n * 3 * sizeof(float) +
                        (cells + 1) * sizeof(uint32_t);
   g.memory_.reset(new unsigned char[std::max<size_t>(bytes, 1)]);
-  float* positions = reinterpret_cast<float*>(g.memory_.get());
-  float* normals = positions + 3 * n;
-  uint32_t* indices = reinterpret_cast<uint32_t*>(normals + 3 * n);
-  uint32_t* cell_start = indices + n;
+  PackedSample* packed = reinterpret_cast<PackedSample*>(g.memory_.get());
+  float* normals = reinterpret_cast<float*>(packed + n);
+  uint32_t* cell_start = reinterpret_cast<uint32_t*>(normals + 3 * n);
   std::fill(cell_start, cell_start + cells + 1, 0u);
   for (size_t i = 0; i < n; ++i) ++cell_start[cell_of[i] + 1];
   for (size_t c = 0; c < cells; ++c) cell_start[c + 1] += cell_start[c];
@@ -186,19 +185,18 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
     std::vector<uint32_t> cursor(cell_start, cell_start + cells);
     for (size_t i = 0; i < n; ++i) {
       const uint32_t slot = cursor[cell_of[i]]++;
-      std::memcpy(&positions[3 * slot], &local[3 * i], 3 * sizeof(float));
+      std::memcpy(packed[slot].p, &local[3 * i], 3 * sizeof(float));
       const Vec3& nv = samples.normals[i];
       const double len = Length(nv);
       const double inv = len > 0 ? 1 / len : 0;
       normals[3 * slot + 0] = static_cast<float>(nv.x * inv);
       normals[3 * slot + 1] = static_cast<float>(nv.y * inv);
       normals[3 * slot + 2] = static_cast<float>(nv.z * inv);
-      indices[slot] = static_cast<uint32_t>(i);
+      packed[slot].index = static_cast<uint32_t>(i);
     }
   }
-  g.positions_ = positions;
+  g.samples_ = packed;
   g.normals_ = normals;
-  g.indices_ = indices;
   g.cell_start_ = cell_start;
 
   GridStats& st = g.stats_;
@@ -381,8 +379,7 @@ void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
 namespace {
 
 struct SnapScanner {
-  const float* positions;
-  const uint32_t* indices;
+  const TerrainGrid::PackedSample* samples;
   const double* q;
   QueryTrace* trace;
   double best_d2 = kInf;
@@ -395,18 +392,17 @@ struct SnapScanner {
   void Scan(uint32_t cell, uint32_t b, uint32_t e) {
     if (trace) trace->cells.push_back(cell);
     for (uint32_t s = b; s < e; ++s) {
-      const double d2 = detail::Dist2(&positions[3 * s], q);
-      if (trace) trace->examined_samples.push_back(indices[s]);
-      if (detail::Better(d2, indices[s], best_d2, best_index)) {
-        best_d2 = d2, best_index = indices[s], best_slot = s;
+      const double d2 = detail::Dist2(samples[s].p, q);
+      if (trace) trace->examined_samples.push_back(samples[s].index);
+      if (detail::Better(d2, samples[s].index, best_d2, best_index)) {
+        best_d2 = d2, best_index = samples[s].index, best_slot = s;
       }
     }
   }
 };
 
 struct NextScanner {
-  const float* positions;
-  const uint32_t* indices;
+  const TerrainGrid::PackedSample* samples;
   const detail::NextFrame* f;
   QueryTrace* trace;
   double best_d2;
@@ -427,13 +423,13 @@ struct NextScanner {
   void Scan(uint32_t cell, uint32_t b, uint32_t e) {
     if (trace) trace->cells.push_back(cell);
     for (uint32_t s = b; s < e; ++s) {
-      const float* p = &positions[3 * s];
+      const float* p = samples[s].p;
       const double d2 = detail::Dist2(p, f->ideal);
-      if (trace) trace->examined_samples.push_back(indices[s]);
+      if (trace) trace->examined_samples.push_back(samples[s].index);
       if (d2 > f->radius2 || !detail::Ahead(p, *f)) continue;
-      if (trace) trace->candidates.push_back(indices[s]);
-      if (detail::Better(d2, indices[s], best_d2, best_index)) {
-        best_d2 = d2, best_index = indices[s], best_slot = s;
+      if (trace) trace->candidates.push_back(samples[s].index);
+      if (detail::Better(d2, samples[s].index, best_d2, best_index)) {
+        best_d2 = d2, best_index = samples[s].index, best_slot = s;
       }
     }
   }
@@ -444,8 +440,8 @@ struct NextScanner {
 Foothold TerrainGrid::MakeFoothold(uint32_t slot) const {
   Foothold f;
   f.status = Status::kOk;
-  f.index = indices_[slot];
-  const float* p = &positions_[3 * slot];
+  f.index = samples_[slot].index;
+  const float* p = samples_[slot].p;
   const float* nv = &normals_[3 * slot];
   f.point = {origin_[0] + p[0], origin_[1] + p[1], origin_[2] + p[2]};
   f.normal = {nv[0], nv[1], nv[2]};
@@ -458,7 +454,7 @@ Foothold TerrainGrid::Snap(const Vec3& q, QueryTrace* trace) const {
   none.status = Status::kNoFoothold;
   const double c[3] = {q.x - origin_[0], q.y - origin_[1], q.z - origin_[2]};
   if (trace) *trace = QueryTrace{}, trace->ideal = q;
-  SnapScanner s{positions_, indices_, c, trace};
+  SnapScanner s{samples_, c, trace};
   Search(c, s);
   return s.best_slot == kNoIndex ? none : MakeFoothold(s.best_slot);
 }
@@ -473,7 +469,7 @@ Foothold TerrainGrid::Next(const StepQuery& q, double tolerance, QueryTrace* tra
     trace->ideal = q.foot + q.direction;
     trace->radius = std::sqrt(f.radius2);
   }
-  NextScanner s{positions_, indices_, &f, trace, f.radius2};
+  NextScanner s{samples_, &f, trace, f.radius2};
   Search(f.ideal, s);
   return s.best_slot == kNoIndex ? none : MakeFoothold(s.best_slot);
 }

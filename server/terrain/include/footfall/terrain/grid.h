@@ -13,7 +13,7 @@
 // origin. ForEachSample() yields the stored values; every answer uses them.
 //
 // The grid is immutable, move-only, and lives in one allocation of parallel arrays:
-// positions, normals, sample indices and cell offsets. Queries are const and thread-safe.
+// positions with sample indices, normals, and cell offsets. Queries are const and thread-safe.
 #pragma once
 
 #include <cstddef>
@@ -71,6 +71,13 @@ struct GridOptions {
 
 class TerrainGrid {
  public:
+  // Storage of one sample: its position relative to the grid origin and its source index,
+  // side by side so a scan reads both from one cache line.
+  struct PackedSample {
+    float p[3];
+    uint32_t index;
+  };
+
   TerrainGrid();
   ~TerrainGrid();
   TerrainGrid(TerrainGrid&&) noexcept;
@@ -146,9 +153,8 @@ class TerrainGrid {
   uint32_t dims_[3] = {1, 1, 1};
   std::unique_ptr<unsigned char[]> memory_;
   // Views into memory_, in cell order:
-  const float* positions_ = nullptr;   // 3 floats per sample, local (relative to origin_)
-  const float* normals_ = nullptr;     // 3 floats per sample, unit
-  const uint32_t* indices_ = nullptr;  // source index per slot
+  const PackedSample* samples_ = nullptr;  // local position and source index per slot
+  const float* normals_ = nullptr;         // 3 floats per slot, unit
   const uint32_t* cell_start_ = nullptr;  // cells + 1 offsets into the slots
 };
 
