@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <tuple>
 #include <vector>
 
 namespace footfall {
@@ -41,41 +42,96 @@ uint64_t CellKey(uint64_t x, uint64_t y, uint64_t z) {
   return (x << (2 * kCellBits)) | (y << kCellBits) | z;
 }
 
-// Open-addressing map from cell key to a dense cell id.
+// Open-addressing map from cell key to a dense cell id; grows to stay at most half full.
 class CellTable {
  public:
-  explicit CellTable(size_t expected) {
-    size_t capacity = 16;
-    while (capacity < 2 * expected) capacity *= 2;
-    keys_.assign(capacity, ~0ull);
-    ids_.assign(capacity, kNone);
-    mask_ = capacity - 1;
-  }
+  explicit CellTable(size_t expected) { Reset(std::max<size_t>(16, 2 * expected)); }
   // The id of `key`, inserting it with id `next` when absent.
   uint32_t Insert(uint64_t key, uint32_t next) {
+    if (2 * (size_ + 1) > entries_.size()) Grow();
     for (size_t i = Hash(key) & mask_;; i = (i + 1) & mask_) {
-      if (keys_[i] == key) return ids_[i];
-      if (keys_[i] == ~0ull) {
-        keys_[i] = key, ids_[i] = next;
+      if (entries_[i].key == key) return entries_[i].id;
+      if (entries_[i].key == kEmpty) {
+        entries_[i] = {key, next};
+        ++size_;
         return next;
       }
     }
   }
   uint32_t Find(uint64_t key) const {
     for (size_t i = Hash(key) & mask_;; i = (i + 1) & mask_) {
-      if (keys_[i] == key) return ids_[i];
-      if (keys_[i] == ~0ull) return kNone;
+      if (entries_[i].key == key) return entries_[i].id;
+      if (entries_[i].key == kEmpty) return kNone;
     }
   }
 
  private:
+  static constexpr uint64_t kEmpty = ~0ull;
+  struct Entry {
+    uint64_t key;
+    uint32_t id;
+  };
   static size_t Hash(uint64_t key) {
     key ^= key >> 33, key *= 0xff51afd7ed558ccdull, key ^= key >> 33;
     return static_cast<size_t>(key);
   }
-  std::vector<uint64_t> keys_;
-  std::vector<uint32_t> ids_;
-  size_t mask_ = 0;
+  void Reset(size_t minimum) {
+    size_t capacity = 16;
+    while (capacity < minimum) capacity *= 2;
+    entries_.assign(capacity, Entry{kEmpty, kNone});
+    mask_ = capacity - 1;
+    size_ = 0;
+  }
+  void Grow() {
+    std::vector<Entry> old;
+    old.swap(entries_);
+    Reset(old.size() * 2);
+    for (const Entry& e : old) {
+      if (e.key != kEmpty) Insert(e.key, e.id);
+    }
+  }
+  std::vector<Entry> entries_;
+  size_t mask_ = 0, size_ = 0;
+};
+
+// Map from cell coordinates to a dense cell id: a hash of 4^3-cell tiles, each a dense block,
+// so that looking up a cell's neighbours mostly stays within one cached block.
+class CellMap {
+ public:
+  explicit CellMap(size_t expected_cells) : tiles_(expected_cells / 8 + 16) {}
+  // The id of cell (x, y, z), inserting it with id `next` when absent.
+  uint32_t Insert(uint64_t x, uint64_t y, uint64_t z, uint32_t next) {
+    uint32_t* block = Block(x, y, z, true);
+    uint32_t& id = block[Local(x, y, z)];
+    if (id == kNone) id = next;
+    return id;
+  }
+  uint32_t Find(uint64_t x, uint64_t y, uint64_t z) {
+    const uint32_t* block = Block(x, y, z, false);
+    return block ? block[Local(x, y, z)] : kNone;
+  }
+
+ private:
+  static size_t Local(uint64_t x, uint64_t y, uint64_t z) {
+    return static_cast<size_t>((x & 3) << 4 | (y & 3) << 2 | (z & 3));
+  }
+  uint32_t* Block(uint64_t x, uint64_t y, uint64_t z, bool create) {
+    const uint64_t key = CellKey(x >> 2, y >> 2, z >> 2);
+    if (key != last_key_) {
+      uint32_t tile = tiles_.Find(key);
+      if (tile == kNone) {
+        if (!create) return nullptr;
+        tile = tiles_.Insert(key, static_cast<uint32_t>(blocks_.size() / 64));
+        blocks_.resize(blocks_.size() + 64, kNone);
+      }
+      last_key_ = key, last_tile_ = tile;
+    }
+    return &blocks_[static_cast<size_t>(last_tile_) * 64];
+  }
+  CellTable tiles_;
+  std::vector<uint32_t> blocks_;
+  uint64_t last_key_ = ~0ull;
+  uint32_t last_tile_ = 0;
 };
 
 Vec3 Blend(const Vec3& a, const Vec3& b, const Vec3& c, double u, double v) {
@@ -226,24 +282,61 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
 
   // Cells of side r over the bounds; each candidate's cell id.
   const size_t n = candidates.size();
-  CellTable table(n / 4 + 16);
+  CellMap table(static_cast<size_t>(predicted) + 16);
   std::vector<uint32_t> cell_of(n);
   std::vector<uint64_t> cell_keys;
+  uint64_t last_key = ~0ull;
+  uint32_t last_id = kNone;
   for (size_t c = 0; c < n; ++c) {
     const uint64_t x = static_cast<uint64_t>(std::max(0.0, candidates[c].offset[0] * inv_cell));
     const uint64_t y = static_cast<uint64_t>(std::max(0.0, candidates[c].offset[1] * inv_cell));
     const uint64_t z = static_cast<uint64_t>(std::max(0.0, candidates[c].offset[2] * inv_cell));
     const uint64_t key = CellKey(x + 1, y + 1, z + 1);  // +1: neighbours never underflow
-    const uint32_t id = table.Insert(key, static_cast<uint32_t>(cell_keys.size()));
-    if (id == cell_keys.size()) cell_keys.push_back(key);
-    cell_of[c] = id;
+    if (key != last_key) {  // neighbouring candidates mostly share a cell
+      last_id = table.Insert(x + 1, y + 1, z + 1, static_cast<uint32_t>(cell_keys.size()));
+      if (last_id == cell_keys.size()) cell_keys.push_back(key);
+      last_key = key;
+    }
+    cell_of[c] = last_id;
+  }
+  // Renumber cells by tile (8^3 cells), then phase (coordinates mod 3), so that step 3 works
+  // through one small tile at a time with its cells' data close in memory.
+  const size_t cells = cell_keys.size();
+  const uint64_t field = kCellLimit - 1;
+  auto phase_of = [&](uint64_t key) {
+    return static_cast<int>((key >> (2 * kCellBits)) % 3 * 9 + ((key >> kCellBits) & field) % 3 * 3 +
+                            (key & field) % 3);
+  };
+  auto tile_of = [&](uint64_t key) {
+    return CellKey(key >> (2 * kCellBits) >> 3, ((key >> kCellBits) & field) >> 3, (key & field) >> 3);
+  };
+  SplitMix64 rng(options.seed);
+  int phase_rank[27];
+  {
+    int phase_order[27];
+    for (int p = 0; p < 27; ++p) phase_order[p] = p;
+    for (int m = 27; m > 1; --m) std::swap(phase_order[m - 1], phase_order[rng.Below(m)]);
+    for (int p = 0; p < 27; ++p) phase_rank[phase_order[p]] = p;
+  }
+  std::vector<uint32_t> rank(cells);
+  {
+    std::vector<std::tuple<uint64_t, int, uint32_t>> sort_keys(cells);
+    for (uint32_t id = 0; id < cells; ++id) {
+      sort_keys[id] = {tile_of(cell_keys[id]), phase_rank[phase_of(cell_keys[id])], id};
+    }
+    std::sort(sort_keys.begin(), sort_keys.end());
+    std::vector<uint64_t> sorted_keys(cells);
+    for (uint32_t r = 0; r < cells; ++r) {
+      rank[std::get<2>(sort_keys[r])] = r;
+      sorted_keys[r] = cell_keys[std::get<2>(sort_keys[r])];
+    }
+    cell_keys.swap(sorted_keys);
+    for (uint32_t& id : cell_of) id = rank[id];
   }
   // The occupied neighbours of each occupied cell (itself included), as a CSR list.
-  const size_t cells = cell_keys.size();
   std::vector<uint32_t> neighbour_start(cells + 1, 0);
   std::vector<uint32_t> neighbours;
   neighbours.reserve(cells * 9);
-  const uint64_t field = kCellLimit - 1;
   for (size_t id = 0; id < cells; ++id) {
     const uint64_t key = cell_keys[id];
     const uint64_t x = key >> (2 * kCellBits), y = (key >> kCellBits) & field, z = key & field;
@@ -253,8 +346,8 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
         for (int dy = -1; dy <= 1; ++dy) {
           for (int dz = -1; dz <= 1; ++dz) {
             if (std::abs(dx) + std::abs(dy) + std::abs(dz) != ring) continue;
-            const uint32_t other = table.Find(CellKey(x + dx, y + dy, z + dz));
-            if (other != kNone) neighbours.push_back(other);
+            const uint32_t other = table.Find(x + dx, y + dy, z + dz);
+            if (other != kNone) neighbours.push_back(rank[other]);
           }
         }
       }
@@ -263,9 +356,9 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   }
 
   // 2. A seeded random order with locality (after Wei, "Parallel Poisson disk sampling", 2008):
-  // each cell's candidates are shuffled; then pass j tries the j-th candidate of every cell,
-  // cells taken by phase (cell coordinates mod 3) in a seeded phase order. Cells of one phase
-  // are at least 2r apart, so the order within a phase does not matter.
+  // each cell's candidates are shuffled; then, tile by tile, pass j tries the j-th candidate of
+  // every cell of the tile, cells taken by phase in a seeded phase order. Cells of one phase are
+  // at least 2r apart, so the order within a phase does not matter.
   std::vector<uint32_t> cell_start(cells + 1, 0);
   for (size_t c = 0; c < n; ++c) ++cell_start[cell_of[c] + 1];
   for (size_t id = 0; id < cells; ++id) cell_start[id + 1] += cell_start[id];
@@ -274,22 +367,11 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
     std::vector<uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
     for (size_t c = 0; c < n; ++c) by_cell[fill[cell_of[c]]++] = static_cast<uint32_t>(c);
   }
-  SplitMix64 rng(options.seed);
   for (size_t id = 0; id < cells; ++id) {
     uint32_t* first = &by_cell[cell_start[id]];
     for (uint32_t m = cell_start[id + 1] - cell_start[id]; m > 1; --m) {
       std::swap(first[m - 1], first[rng.Below(m)]);
     }
-  }
-  int phase_order[27];
-  for (int p = 0; p < 27; ++p) phase_order[p] = p;
-  for (int m = 27; m > 1; --m) std::swap(phase_order[m - 1], phase_order[rng.Below(m)]);
-  std::vector<std::vector<uint32_t>> phase_cells(27);
-  for (size_t id = 0; id < cells; ++id) {
-    const uint64_t key = cell_keys[id];
-    const int phase = static_cast<int>((key >> (2 * kCellBits)) % 3 * 9 +
-                                       ((key >> kCellBits) & field) % 3 * 3 + (key & field) % 3);
-    phase_cells[phase].push_back(static_cast<uint32_t>(id));
   }
 
   // 3. Accept candidates farther than r from every accepted sample. Each cell keeps the offsets
@@ -319,21 +401,24 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
     ++own.count;
     accepted.push_back(c);
   };
-  for (uint32_t pass = 0;; ++pass) {
-    bool any = false;
-    for (int p : phase_order) {
-      std::vector<uint32_t>& active = phase_cells[p];
+  std::vector<uint32_t> active;
+  for (size_t tile_begin = 0; tile_begin < cells;) {
+    size_t tile_end = tile_begin + 1;
+    const uint64_t tile = tile_of(cell_keys[tile_begin]);
+    while (tile_end < cells && tile_of(cell_keys[tile_end]) == tile) ++tile_end;
+    active.clear();
+    for (size_t id = tile_begin; id < tile_end; ++id) active.push_back(static_cast<uint32_t>(id));
+    for (uint32_t pass = 0; !active.empty(); ++pass) {
       size_t kept = 0;
-      for (uint32_t cell : active) {
+      for (uint32_t cell : active) {  // in phase order: the renumbering sorted them so
         const uint32_t at = cell_start[cell] + pass;
         if (at >= cell_start[cell + 1]) continue;  // exhausted: drop from the list
         try_candidate(by_cell[at], cell);
         active[kept++] = cell;
       }
       active.resize(kept);
-      any = any || kept > 0;
     }
-    if (!any) break;
+    tile_begin = tile_end;
   }
 
   // 4. Points and normals, in triangle order.
