@@ -51,10 +51,11 @@ std::string StripComment(const std::string& line) {
 
 }  // namespace
 
-Status CheckObjFile(const std::string& path, std::string* error) {
+Status CheckObjFile(const std::string& path, long long* faces, std::string* error) {
   std::ifstream in(path);
   std::string line;
   long long vertices = 0;
+  *faces = 0;
   for (size_t number = 1; std::getline(in, line); ++number) {
     const std::vector<std::string> t = Tokens(StripComment(line));
     if (t.empty()) continue;
@@ -72,6 +73,7 @@ Status CheckObjFile(const std::string& path, std::string* error) {
       }
       ++vertices;
     } else if (t[0] == "f") {
+      ++*faces;
       if (t.size() < 4) {
         return Fail(At(path, number),
                     "face has " + std::to_string(t.size() - 1) + " vertices, expected 3 or more",
@@ -96,7 +98,8 @@ Status CheckObjFile(const std::string& path, std::string* error) {
   return Status::kOk;
 }
 
-Status CheckOffFile(const std::string& path, std::string* error) {
+Status CheckOffFile(const std::string& path, long long* faces, std::string* error) {
+  *faces = -1;
   std::ifstream in(path);
   std::string line;
   size_t number = 0;
@@ -123,6 +126,7 @@ Status CheckOffFile(const std::string& path, std::string* error) {
   if (t.size() < 2 || !ParseInteger(t[0], &nv) || !ParseInteger(t[1], &nf) || nv < 0 || nf < 0) {
     return Fail(At(path, number), "expected counts 'VERTICES FACES EDGES'", error);
   }
+  *faces = nf;
   for (long long v = 0; v < nv; ++v) {
     if (!next(&t)) {
       return Fail(path, "truncated: header declares " + std::to_string(nv) +
@@ -160,7 +164,8 @@ Status CheckOffFile(const std::string& path, std::string* error) {
   return Status::kOk;
 }
 
-Status CheckPlyFile(const std::string& path, std::string* error) {
+Status CheckPlyFile(const std::string& path, long long* faces, std::string* error) {
+  *faces = -1;
   std::ifstream in(path, std::ios::binary);
   std::string line;
   size_t number = 0;
@@ -218,6 +223,9 @@ Status CheckPlyFile(const std::string& path, std::string* error) {
     }
   }
   if (!ended) return Fail(path, "truncated: the PLY header has no 'end_header'", error);
+  for (const Element& e : elements) {
+    if (e.name == "face") *faces = e.count;
+  }
   if (format == "ascii") {
     long long records = 0;
     for (const Element& e : elements) records += e.count;

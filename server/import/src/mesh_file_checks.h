@@ -11,10 +11,11 @@ namespace footfall::detail {
 
 // Each returns kOk or kParseError with "FILE:LINE: what was expected" (or "FILE: ..." for binary
 // data) in *error. They check counts, vertex indices and that coordinates are finite numbers;
-// they do not build the mesh.
-Status CheckObjFile(const std::string& path, std::string* error);
-Status CheckOffFile(const std::string& path, std::string* error);
-Status CheckPlyFile(const std::string& path, std::string* error);
+// they do not build the mesh. On kOk, *faces is the number of faces the file declares (-1 when
+// unknown), so that faces OpenMesh drops (repeated vertices) can be counted.
+Status CheckObjFile(const std::string& path, long long* faces, std::string* error);
+Status CheckOffFile(const std::string& path, long long* faces, std::string* error);
+Status CheckPlyFile(const std::string& path, long long* faces, std::string* error);
 Status CheckStlFile(const std::string& path, std::string* error);
 
 }  // namespace footfall::detail

@@ -108,9 +108,10 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
     }
   }
   Status status = Status::kOk;
-  if (ext == "obj") status = detail::CheckObjFile(path, error);
-  if (ext == "off") status = detail::CheckOffFile(path, error);
-  if (ext == "ply") status = detail::CheckPlyFile(path, error);
+  long long declared_faces = -1;
+  if (ext == "obj") status = detail::CheckObjFile(path, &declared_faces, error);
+  if (ext == "off") status = detail::CheckOffFile(path, &declared_faces, error);
+  if (ext == "ply") status = detail::CheckPlyFile(path, &declared_faces, error);
   if (ext == "stl") status = detail::CheckStlFile(path, error);
   if (status != Status::kOk) return status;
 
@@ -134,7 +135,11 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
     if (error) *error = path + ": a face uses a vertex that does not exist (truncated file?)";
     return Status::kParseError;
   }
+  // Faces OpenMesh dropped (repeated vertices): declared minus read where the file declares.
   size_t skipped = CountOccurrences(messages, "equal vertices");
+  if (declared_faces > static_cast<long long>(mesh.n_faces())) {
+    skipped = static_cast<size_t>(declared_faces) - mesh.n_faces();
+  }
 
   // Vertices, all finite.
   out->vertices.resize(mesh.n_vertices());
