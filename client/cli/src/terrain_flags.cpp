@@ -2,25 +2,32 @@
 
 namespace footfall::cli {
 
+void AddLoadFlags(CLI::App* command, TerrainLoadOptions* load) {
+  command->add_option("--separation", load->separation,
+                      "Meshes and height maps: resample so that no surface point is farther "
+                      "than this from a sample (world units; 0: mean edge length / cell size)")
+      ->check(CLI::NonNegativeNumber);
+  command->add_flag("!--smooth-normals,--flat-normals", load->smooth_normals,
+                    "Sample normals from faces instead of interpolated vertex normals");
+  command->add_option("--seed", load->seed, "Seed of the mesh sampler");
+  command->add_option("--up-axis", load->up_axis, "Height maps: up axis x, y or z")
+      ->check(CLI::IsMember({'x', 'y', 'z'}));
+  command->add_option("--cell-size", load->cell_size,
+                      "Height maps: cell size (default: the .asc CELLSIZE, 1 for .pgm)")
+      ->check(CLI::PositiveNumber);
+  command->add_option("--height-scale", load->height_scale,
+                      "Height maps: world height of one file unit (metre or grey level)");
+}
+
 void AddTerrainFlags(CLI::App* command, TerrainFlags* flags) {
   command->add_option("--terrain", flags->terrain,
-                      "Terrain file on this machine: points (.pts .xyz .txt)");
+                      "Terrain file on this machine: points (.pts .xyz .txt), mesh (.obj .ply .off "
+                      ".stl .om) or height map (.asc .pgm)");
   command->add_option("--server-terrain", flags->server_terrain,
                       "Terrain file under footfalld's --data-root, read by the server");
   command->add_option("--server", flags->server,
                       "footfalld HOST:PORT; without it the embedded engine answers");
-  command->add_option("--separation", flags->load.separation,
-                      "Mesh resampling distance between samples (world units)")
-      ->check(CLI::NonNegativeNumber);
-  command->add_flag("!--smooth-normals,--flat-normals", flags->load.smooth_normals,
-                    "Mesh sample normals from faces instead of interpolated vertex normals");
-  command->add_option("--seed", flags->load.seed, "Seed of the mesh sampler");
-  command->add_option("--up-axis", flags->load.up_axis, "Height maps: up axis x, y or z")
-      ->check(CLI::IsMember({'x', 'y', 'z'}));
-  command->add_option("--cell-size", flags->load.cell_size, "PGM height maps: cell size")
-      ->check(CLI::PositiveNumber);
-  command->add_option("--height-scale", flags->load.height_scale,
-                      "PGM height maps: height of one grey level");
+  AddLoadFlags(command, &flags->load);
   command->add_option("--timeout", flags->timeout_s, "RPC call timeout in seconds")
       ->check(CLI::PositiveNumber);
 }

@@ -19,6 +19,10 @@ struct TerrainFlags {
   double timeout_s = 10;
 };
 
+// Adds the options of loading meshes and height maps: --separation, --flat-normals, --seed,
+// --up-axis, --cell-size, --height-scale.
+void AddLoadFlags(CLI::App* command, TerrainLoadOptions* load);
+
 // Adds --terrain (required unless `terrain_optional`), --server-terrain, --server, --separation,
 // --flat-normals, --seed, --up-axis, --cell-size, --height-scale, --timeout.
 void AddTerrainFlags(CLI::App* command, TerrainFlags* flags);

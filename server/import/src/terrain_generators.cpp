@@ -1,6 +1,10 @@
 #include "footfall/import/terrain_generators.h"
 
+#include <algorithm>
 #include <cmath>
+
+#include "footfall/import/mesh_generators.h"
+#include "footfall/import/mesh_sampler.h"
 
 namespace footfall {
 namespace {
@@ -120,6 +124,34 @@ RawSamples MakeRamp(int nx, int nz, double spacing, double slope_deg) {
   for (int k = 0; k < nz; ++k)
     for (int i = 0; i < nx; ++i) s.push_back(Vec3{i * spacing, 0, 0} + along * (k * spacing), normal);
   return s;
+}
+
+namespace {
+
+RawSamples Sample(const TriangleMesh& mesh, double spacing, bool smooth, uint64_t seed) {
+  MeshSampleOptions options;
+  options.separation = spacing;
+  options.smooth_normals = smooth;
+  options.seed = seed;
+  RawSamples s;
+  SampleMesh(mesh, options, &s, nullptr);  // empty on a bad spacing
+  return s;
+}
+
+}  // namespace
+
+RawSamples MakeBlocks(int nx, int nz, int max_height, double spacing, uint64_t seed) {
+  return Sample(MakeBlocksMesh(nx, nz, max_height, seed), spacing, false, seed);
+}
+
+RawSamples MakeRamps(const std::vector<double>& slopes_deg, double length, double width,
+                     double spacing) {
+  return Sample(MakeRampsMesh(slopes_deg, length, width), spacing, false, 1);
+}
+
+RawSamples MakeRocks(double size, double amplitude, double spacing, uint64_t seed) {
+  const int n = std::max(1, static_cast<int>(std::ceil(size / std::min(spacing, 0.25))));
+  return Sample(MakeRocksMesh(n, size / n, amplitude, seed), spacing, true, seed);
 }
 
 }  // namespace footfall

@@ -2,7 +2,11 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 
+#include "footfall/import/height_map.h"
+#include "footfall/import/mesh_reader.h"
+#include "footfall/import/mesh_sampler.h"
 #include "footfall/terrain/point_file.h"
 
 namespace footfall {
@@ -18,22 +22,110 @@ std::string LowerExtension(const std::string& path) {
   return ext;
 }
 
+Status CheckOptions(const TerrainLoadOptions& o, std::string* error) {
+  std::string what;
+  if (!(std::isfinite(o.separation) && o.separation >= 0)) what = "separation must be >= 0";
+  if (!(std::isfinite(o.cell_size) && o.cell_size >= 0)) what = "cell size must be >= 0";
+  if (!std::isfinite(o.height_scale)) what = "height scale must be finite";
+  if (o.up_axis != 'x' && o.up_axis != 'y' && o.up_axis != 'z') what = "up axis must be x, y or z";
+  if (what.empty()) return Status::kOk;
+  if (error) *error = what;
+  return Status::kInvalidArgument;
+}
+
+void Bounds(const RawSamples& samples, Vec3* lo, Vec3* hi) {
+  *lo = *hi = samples.size() ? samples.points[0] : Vec3{};
+  for (const Vec3& p : samples.points) {
+    lo->x = std::min(lo->x, p.x), lo->y = std::min(lo->y, p.y), lo->z = std::min(lo->z, p.z);
+    hi->x = std::max(hi->x, p.x), hi->y = std::max(hi->y, p.y), hi->z = std::max(hi->z, p.z);
+  }
+}
+
+Status Resample(const std::string& path, const TriangleMesh& mesh, double default_separation,
+                const TerrainLoadOptions& options, RawSamples* out, std::string* error,
+                TerrainLoadReport* report) {
+  MeshSampleOptions sample;
+  sample.separation = options.separation > 0 ? options.separation : default_separation;
+  sample.smooth_normals = options.smooth_normals;
+  sample.seed = options.seed;
+  sample.max_samples = options.max_samples;
+  std::string why;
+  const Status status = SampleMesh(mesh, sample, out, &why);
+  if (status != Status::kOk) {
+    if (error) *error = path + ": " + why;
+    return status;
+  }
+  report->area = SurfaceArea(mesh);
+  report->separation = sample.separation;
+  return Status::kOk;
+}
+
+Status LoadAny(const std::string& path, const std::string& ext, const TerrainLoadOptions& options,
+               RawSamples* out, std::string* error, TerrainLoadReport* report) {
+  if (ext == "pts" || ext == "xyz" || ext == "txt") {
+    report->format = "points";
+    return ReadPointFile(path, out, error);
+  }
+  if (IsMeshExtension(ext)) {
+    report->format = "mesh";
+    TriangleMesh mesh;
+    MeshReadReport read;
+    const Status status = ReadMesh(path, &mesh, error, &read);
+    if (status != Status::kOk) return status;
+    report->vertices = read.vertices;
+    report->faces = read.faces;
+    report->skipped_faces = read.skipped_faces;
+    return Resample(path, mesh, DefaultSeparation(mesh), options, out, error, report);
+  }
+  if (ext == "asc" || ext == "pgm") {
+    report->format = "heightmap";
+    HeightMap map;
+    Status status = ext == "asc" ? ReadAscGrid(path, &map, error) : ReadPgm(path, &map, error);
+    if (status != Status::kOk) return status;
+    HeightMapFrame frame;
+    frame.cell_size = options.cell_size > 0 ? options.cell_size : map.cell_size;
+    frame.height_scale = options.height_scale;
+    frame.up_axis = options.up_axis;
+    TriangleMesh mesh;
+    status = HeightMapToMesh(map, frame, &mesh, error);
+    if (status != Status::kOk) return status;
+    report->vertices = mesh.vertices.size();
+    report->nodata_cells = map.heights.size() - map.ValidCount();
+    report->skipped_faces = RemoveDegenerateTriangles(&mesh);
+    report->faces = mesh.triangles.size();
+    if (mesh.triangles.empty()) {
+      if (error) *error = path + ": no square of the grid has three cells with data";
+      return Status::kParseError;
+    }
+    return Resample(path, mesh, frame.cell_size, options, out, error, report);
+  }
+  if (error) {
+    *error = path + ": unknown terrain file extension '" + ext +
+             "' (expected points .pts .xyz .txt, meshes .obj .ply .off .stl .om, height maps "
+             ".asc .pgm)";
+  }
+  return Status::kInvalidArgument;
+}
+
 }  // namespace
 
 Status LoadTerrain(const std::string& path, const TerrainLoadOptions& options, RawSamples* out,
                    std::string* error, TerrainLoadReport* report) {
-  (void)options;
-  const std::string ext = LowerExtension(path);
-  if (ext == "pts" || ext == "xyz" || ext == "txt") {
-    if (report) *report = TerrainLoadReport{}, report->format = "points";
-    return ReadPointFile(path, out, error);
-  }
   out->clear();
-  if (error) {
-    *error = path + ": unknown terrain file extension '" + ext +
-             "' (expected .pts, .xyz or .txt point files)";
+  TerrainLoadReport local;
+  if (!report) report = &local;
+  *report = TerrainLoadReport{};
+  Status status = CheckOptions(options, error);
+  if (status == Status::kOk) {
+    status = LoadAny(path, LowerExtension(path), options, out, error, report);
   }
-  return Status::kInvalidArgument;
+  if (status != Status::kOk) {
+    out->clear();
+    return status;
+  }
+  report->samples = out->size();
+  Bounds(*out, &report->bounds_min, &report->bounds_max);
+  return Status::kOk;
 }
 
 }  // namespace footfall

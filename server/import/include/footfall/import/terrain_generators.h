@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "footfall/terrain/samples.h"
 
@@ -29,5 +30,13 @@ RawSamples MakeFlat(int n, double spacing, double y);
 // A planar ramp rising along +Z at `slope_deg` degrees, nx x nz samples (spacing along the
 // surface), normals perpendicular to it.
 RawSamples MakeRamp(int nx, int nz, double spacing, double slope_deg);
+
+// The meshes of mesh_generators.h resampled at separation `spacing` (mesh_sampler.h) with the
+// given seed: blocks of unit cubes (flat normals), ramps of the given slopes joined by flat
+// landings (flat normals), rocky noise over a square `size` wu wide (smooth normals).
+RawSamples MakeBlocks(int nx, int nz, int max_height, double spacing, uint64_t seed);
+RawSamples MakeRamps(const std::vector<double>& slopes_deg, double length, double width,
+                     double spacing);
+RawSamples MakeRocks(double size, double amplitude, double spacing, uint64_t seed);
 
 }  // namespace footfall

@@ -1,6 +1,8 @@
-// Loads terrain samples from any supported file, chosen by extension:
-//   .pts .xyz .txt  the point file (footfall/terrain/point_file.h)
-// Meshes and height maps are resampled into samples with the options below.
+// Loads terrain samples from any supported file, chosen by extension (any case):
+//   .pts .xyz .txt            the point file (footfall/terrain/point_file.h), taken as it is
+//   .obj .ply .off .stl .om   polygon meshes (mesh_reader.h), resampled (mesh_sampler.h)
+//   .asc                      ESRI ASCII grids (height_map.h), resampled
+//   .pgm                      8/16-bit PGM height maps (height_map.h), resampled
 #pragma once
 
 #include <cstdint>
@@ -11,30 +13,43 @@
 namespace footfall {
 
 struct TerrainLoadOptions {
-  // Mesh resampling: distance between samples. [Units: wu] [Limit: >= 0] 0 picks a default.
+  // Meshes and height maps: the point separation s, the farthest any point of the surface may be
+  // from a sample. [Units: wu] [Limit: >= 0] 0 picks a default: the mean edge length of a mesh,
+  // the cell size of a height map.
   double separation = 0;
-  // Mesh normals: interpolated from vertex normals (true) or taken from the face (false).
+  // Meshes and height maps: normals interpolated from vertex normals (true) or taken from the
+  // face (false).
   bool smooth_normals = true;
-  // Seed of the deterministic mesh sampler.
+  // Seed of the deterministic sampler: equal seeds give equal samples.
   uint64_t seed = 1;
   // Height maps: the world axis heights go along ('x', 'y' or 'z'). [Default: 'y', as in Maya]
   char up_axis = 'y';
-  // PGM height maps: cell size [Units: wu] and height of one grey level [Units: wu].
-  double cell_size = 1;
+  // Height maps: distance between neighbouring cells. [Units: wu] [Limit: >= 0] 0: the file's
+  // CELLSIZE for .asc, 1 for .pgm.
+  double cell_size = 0;
+  // Height maps: world height of one unit of the file (a metre of .asc, a grey level of .pgm).
+  // [Units: wu]
   double height_scale = 1;
+  // Meshes and height maps: refuse (kLimitExceeded) a separation predicting more samples.
+  size_t max_samples = 20000000;
 };
 
 // What a load found, for `footfall terrain info` and server logs.
 struct TerrainLoadReport {
-  std::string format;   // "points", "mesh", "heightmap"
-  size_t vertices = 0;  // meshes
-  size_t faces = 0;
-  size_t skipped_faces = 0;
-  double area = 0;      // [Units: wu^2] meshes and height maps
+  std::string format;        // "points", "mesh" or "heightmap"
+  size_t vertices = 0;       // meshes: as stored; height maps: valid cells
+  size_t faces = 0;          // meshes: polygons read; height maps: triangles built
+  size_t skipped_faces = 0;  // meshes: degenerate faces left out
+  size_t nodata_cells = 0;   // height maps: cells left out
+  double area = 0;           // [Units: wu^2] meshes and height maps
+  double separation = 0;     // [Units: wu] the separation used (meshes and height maps)
+  size_t samples = 0;        // samples produced
+  Vec3 bounds_min, bounds_max;  // world-space bounds of the samples
 };
 
 // Loads `path` into *out. Errors: kIoError (cannot open), kParseError (malformed content,
-// message "FILE:LINE: what was expected"), kInvalidArgument (unknown extension or bad option).
+// message "FILE:LINE: what was expected" or "FILE: what is wrong"), kInvalidArgument (unknown
+// extension or bad option), kLimitExceeded (the separation would give too many samples).
 Status LoadTerrain(const std::string& path, const TerrainLoadOptions& options, RawSamples* out,
                    std::string* error, TerrainLoadReport* report = nullptr);
 

@@ -1,0 +1,208 @@
+// `footfall terrain`: convert meshes and height maps to point files, describe terrain files, and
+// make synthetic test terrain.
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "footfall/import/terrain_generators.h"
+#include "footfall/import/terrain_loader.h"
+#include "footfall/terrain/grid.h"
+#include "footfall/terrain/point_file.h"
+#include "terrain_flags.h"
+
+namespace footfall::cli {
+namespace {
+
+struct ConvertFlags {
+  std::string input, output;
+  TerrainLoadOptions load;
+};
+
+struct InfoFlags {
+  std::string input;
+  TerrainLoadOptions load;
+};
+
+struct MakeFlags {
+  std::string kind, output;
+  double spacing = 0.05;
+  uint64_t seed = 1;
+  // stairs
+  int steps = 8;
+  double rise = 0.18, run = 0.3, width = 1.5;
+  // blocks, rocks
+  int size = 12;
+  int max_height = 3;
+  double amplitude = 0.6;
+  // ramp
+  std::vector<double> slopes{10, 20, 30};
+  double length = 2;
+  // sphere
+  double radius = 3;
+};
+
+std::string Format(const Vec3& v) {
+  std::ostringstream out;
+  out << std::setprecision(6) << "(" << v.x << ", " << v.y << ", " << v.z << ")";
+  return out.str();
+}
+
+int RunConvert(const ConvertFlags& flags) {
+  RawSamples samples;
+  std::string error;
+  TerrainLoadReport report;
+  if (LoadTerrain(flags.input, flags.load, &samples, &error, &report) != Status::kOk) {
+    std::cerr << "footfall terrain convert: " << error << '\n';
+    return 1;
+  }
+  if (WritePointFile(flags.output, samples, &error) != Status::kOk) {
+    std::cerr << "footfall terrain convert: " << error << '\n';
+    return 1;
+  }
+  std::cout << "wrote " << samples.size() << " samples to " << flags.output;
+  if (report.separation > 0) std::cout << " (separation " << report.separation << ")";
+  std::cout << '\n';
+  return 0;
+}
+
+int RunInfo(const InfoFlags& flags) {
+  RawSamples samples;
+  std::string error;
+  TerrainLoadReport report;
+  if (LoadTerrain(flags.input, flags.load, &samples, &error, &report) != Status::kOk) {
+    std::cerr << "footfall terrain info: " << error << '\n';
+    return 1;
+  }
+  TerrainGrid grid;
+  if (TerrainGrid::Build(samples, GridOptions{}, &grid, &error) != Status::kOk) {
+    std::cerr << "footfall terrain info: " << flags.input << ": " << error << '\n';
+    return 1;
+  }
+  const GridStats& g = grid.stats();
+  std::cout << std::setprecision(8);
+  std::cout << "file: " << flags.input << '\n' << "format: " << report.format << '\n';
+  if (report.format == "mesh") {
+    std::cout << "vertices: " << report.vertices << '\n'
+              << "faces: " << report.faces << '\n'
+              << "skipped faces: " << report.skipped_faces << '\n';
+  } else if (report.format == "heightmap") {
+    std::cout << "cells with data: " << report.vertices << '\n'
+              << "nodata cells: " << report.nodata_cells << '\n'
+              << "triangles: " << report.faces << '\n';
+  }
+  if (report.format != "points") {
+    std::cout << "area: " << report.area << '\n' << "separation: " << report.separation << '\n';
+  }
+  std::cout << "samples: " << report.samples << '\n'
+            << "bounds: " << Format(report.bounds_min) << " to " << Format(report.bounds_max)
+            << '\n'
+            << "grid: " << g.cells[0] << " x " << g.cells[1] << " x " << g.cells[2]
+            << " cells of " << g.cell_size << ", " << g.occupied_cells << " occupied, "
+            << g.bytes << " bytes\n";
+  return 0;
+}
+
+int RunMake(const MakeFlags& f) {
+  RawSamples samples;
+  const std::string& k = f.kind;
+  if (k == "stairs") {
+    samples = MakeStairs(f.steps, f.rise, f.run, f.width, f.spacing);
+  } else if (k == "blocks") {
+    samples = MakeBlocks(f.size, f.size, f.max_height, f.spacing, f.seed);
+  } else if (k == "ramp") {
+    samples = MakeRamps(f.slopes, f.length, f.width, f.spacing);
+  } else if (k == "rocks") {
+    samples = MakeRocks(f.size, f.amplitude, f.spacing, f.seed);
+  } else if (k == "sphere") {
+    // Fibonacci lattice with about one sample per spacing^2 of surface.
+    const double area = 4 * 3.14159265358979323846 * f.radius * f.radius;
+    samples = MakeSphere(static_cast<int>(area / (f.spacing * f.spacing)) + 1,
+                         {0, f.radius, 0}, f.radius);
+  } else if (k == "flat") {
+    samples = MakeFlat(static_cast<int>(f.size / f.spacing) + 1, f.spacing, 0);
+  } else if (k == "hills") {
+    const int n = static_cast<int>(f.size / f.spacing) + 1;
+    samples = MakeHeightField(n, n, f.spacing, f.amplitude, f.seed);
+  }
+  std::string error;
+  if (samples.size() == 0) {
+    std::cerr << "footfall terrain make: " << k << ": the parameters give no samples\n";
+    return 1;
+  }
+  if (WritePointFile(f.output, samples, &error) != Status::kOk) {
+    std::cerr << "footfall terrain make: " << error << '\n';
+    return 1;
+  }
+  std::cout << "wrote " << samples.size() << " samples to " << f.output << '\n';
+  return 0;
+}
+
+}  // namespace
+
+void AddTerrainCommand(CLI::App& app, int* exit_code) {
+  CLI::App* terrain = app.add_subcommand(
+      "terrain", "Convert, describe and make terrain files (points, meshes, height maps)");
+  terrain->require_subcommand(1);
+
+  auto convert = std::make_shared<ConvertFlags>();
+  CLI::App* c = terrain->add_subcommand(
+      "convert", "Resample a mesh or height map (or copy a point file) into a point file");
+  c->add_option("input", convert->input, "Terrain file (.obj .ply .off .stl .om .asc .pgm .pts)")
+      ->required();
+  c->add_option("-o,--output", convert->output, "Point file to write (.pts)")->required();
+  AddLoadFlags(c, &convert->load);
+  c->callback([convert, exit_code] { *exit_code = RunConvert(*convert); });
+
+  auto info = std::make_shared<InfoFlags>();
+  CLI::App* i = terrain->add_subcommand(
+      "info", "Print a terrain file's counts, bounds, area and the grid it would build");
+  i->add_option("input", info->input, "Terrain file")->required();
+  AddLoadFlags(i, &info->load);
+  i->callback([info, exit_code] { *exit_code = RunInfo(*info); });
+
+  auto make = std::make_shared<MakeFlags>();
+  CLI::App* m = terrain->add_subcommand(
+      "make", "Write a synthetic terrain of known geometry (Y up, world units) as a point file");
+  m->add_option("kind", make->kind, "stairs, blocks, ramp, rocks, sphere, flat or hills")
+      ->required()
+      ->check(CLI::IsMember({"stairs", "blocks", "ramp", "rocks", "sphere", "flat", "hills"}));
+  m->add_option("-o,--output", make->output, "Point file to write (.pts)")->required();
+  m->add_option("--spacing", make->spacing, "Distance between samples")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  m->add_option("--seed", make->seed, "Seed (blocks, rocks, hills)")->capture_default_str();
+  m->add_option("--steps", make->steps, "stairs: number of steps")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  m->add_option("--rise", make->rise, "stairs: step height")->capture_default_str();
+  m->add_option("--run", make->run, "stairs: step depth")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  m->add_option("--width", make->width, "stairs, ramp: width across")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  m->add_option("--size", make->size, "blocks: columns per side; rocks, flat, hills: side length")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  m->add_option("--max-height", make->max_height, "blocks: tallest pile in unit cubes")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  m->add_option("--amplitude", make->amplitude, "rocks, hills: height of the relief")
+      ->capture_default_str();
+  m->add_option("--slope", make->slopes, "ramp: slope of each segment in degrees (repeatable)")
+      ->check(CLI::Range(-80.0, 80.0))
+      ->capture_default_str();
+  m->add_option("--length", make->length, "ramp: horizontal run of each segment and landing")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  m->add_option("--radius", make->radius, "sphere: radius (it rests on y = 0)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  m->callback([make, exit_code] { *exit_code = RunMake(*make); });
+}
+
+}  // namespace footfall::cli

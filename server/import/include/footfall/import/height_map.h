@@ -1,0 +1,51 @@
+// Height maps: regular grids of heights read from ESRI ASCII grids (.asc) and PGM images (.pgm),
+// and their triangle mesh for resampling (mesh_sampler.h).
+//
+// Grid layout: row 0 is the north (top) row, column 0 the west (left) column, as both formats
+// store them. In the mesh, cell (row, col) becomes the vertex at east = col * cell, south =
+// row * cell, so the origin is the centre of the north-west cell; the files' georeference
+// (xllcorner, yllcorner) is not applied.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "footfall/import/triangle_mesh.h"
+#include "footfall/terrain/status.h"
+
+namespace footfall {
+
+struct HeightMap {
+  int cols = 0, rows = 0;
+  double cell_size = 1;         // [Units: file units] ASC: CELLSIZE; PGM: 1
+  std::vector<double> heights;  // rows * cols, row-major from the north-west cell; file units
+  std::vector<uint8_t> valid;   // 0 where the file says NODATA
+  size_t ValidCount() const;
+};
+
+// Reads an ESRI ASCII grid: a header (ncols, nrows, xllcorner|xllcenter, yllcorner|yllcenter,
+// cellsize, optional NODATA_value; any case) then nrows * ncols numbers. Cells equal to
+// NODATA_value are marked invalid. Errors: kIoError (cannot open), kParseError with
+// "FILE:LINE: what was expected" (bad header, non-numeric value, truncated data).
+Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error);
+
+// Reads a PGM image, binary (P5, 8 or 16 bit big-endian by maxval) or ASCII (P2). Heights are
+// the grey levels; every cell is valid. Errors as ReadAscGrid.
+Status ReadPgm(const std::string& path, HeightMap* out, std::string* error);
+
+struct HeightMapFrame {
+  double cell_size = 1;     // distance between neighbouring cells [Units: wu] [Limit: > 0]
+  double height_scale = 1;  // world height of one height unit of the file [Units: wu]
+  char up_axis = 'y';       // world axis the heights go along: 'x', 'y' or 'z'
+};
+
+// Builds the height map's surface: one vertex per valid cell, two triangles per square of four
+// valid cells (split along the north-east to south-west diagonal), one where exactly three are
+// valid; every triangle faces up. World axes by up_axis (right-handed in each case):
+//   'y': (east, height, south)   'z': (east, north, height)   'x': (height, east, north)
+// kInvalidArgument for a bad frame.
+Status HeightMapToMesh(const HeightMap& map, const HeightMapFrame& frame, TriangleMesh* out,
+                       std::string* error);
+
+}  // namespace footfall

@@ -1,0 +1,35 @@
+// TriangleMesh: an indexed triangle mesh in world space, the common form of every polygon file and
+// height map before it is resampled into terrain samples (mesh_sampler.h).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "footfall/terrain/vec3.h"
+
+namespace footfall {
+
+struct TriangleMesh {
+  std::vector<Vec3> vertices;                    // world space [(x, y, z)], all finite
+  std::vector<std::array<uint32_t, 3>> triangles;  // counter-clockwise seen from the outside
+};
+
+// Twice the area of triangle t times its unit normal: Cross(b - a, c - a). [Units: wu^2]
+Vec3 TriangleCross(const TriangleMesh& mesh, size_t t);
+
+// Sum of the triangle areas. [Units: wu^2]
+double SurfaceArea(const TriangleMesh& mesh);
+
+// Per-vertex unit normals: the area-weighted mean of the incident triangles' normals. A vertex with
+// no triangle, or whose triangle normals cancel, gets (0, 0, 0).
+std::vector<Vec3> VertexNormals(const TriangleMesh& mesh);
+
+// World-space bounds of the vertices; both (0, 0, 0) for an empty mesh.
+void MeshBounds(const TriangleMesh& mesh, Vec3* lo, Vec3* hi);
+
+// Removes triangles whose area is at most `relative_epsilon` times the squared bounding-box
+// diagonal (zero-area slivers, repeated vertices). Returns how many were removed.
+size_t RemoveDegenerateTriangles(TriangleMesh* mesh, double relative_epsilon = 1e-14);
+
+}  // namespace footfall

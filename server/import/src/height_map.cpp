@@ -1,0 +1,258 @@
+#include "footfall/import/height_map.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+
+namespace footfall {
+namespace {
+
+Status Fail(const std::string& where, const std::string& what, std::string* error) {
+  if (error) *error = where + ": " + what;
+  return Status::kParseError;
+}
+
+std::string Lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+bool ParseDouble(const std::string& token, double* value) {
+  const char* begin = token.c_str();
+  char* end = nullptr;
+  *value = std::strtod(begin, &end);
+  return end != begin && *end == '\0' && std::isfinite(*value);
+}
+
+// Whitespace-separated tokens with their line numbers; '#' comments optional.
+class TokenReader {
+ public:
+  TokenReader(const std::string& text, bool comments) : text_(&text), comments_(comments) {}
+  bool Next(std::string* token) {
+    for (;;) {
+      while (pos_ < text_->size() && std::isspace(static_cast<unsigned char>((*text_)[pos_]))) {
+        if ((*text_)[pos_] == '\n') ++line_;
+        ++pos_;
+      }
+      if (comments_ && pos_ < text_->size() && (*text_)[pos_] == '#') {
+        while (pos_ < text_->size() && (*text_)[pos_] != '\n') ++pos_;
+        continue;
+      }
+      break;
+    }
+    if (pos_ >= text_->size()) return false;
+    const size_t start = pos_;
+    while (pos_ < text_->size() && !std::isspace(static_cast<unsigned char>((*text_)[pos_]))) ++pos_;
+    *token = text_->substr(start, pos_ - start);
+    return true;
+  }
+  size_t line() const { return line_; }
+  size_t pos() const { return pos_; }
+
+ private:
+  const std::string* text_;
+  bool comments_;
+  size_t pos_ = 0, line_ = 1;
+};
+
+Status ReadWhole(const std::string& path, std::string* text, std::string* error) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    if (error) *error = path + ": cannot open";
+    return Status::kIoError;
+  }
+  text->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  if (text->empty()) return Fail(path, "the file is empty, expected a height map", error);
+  return Status::kOk;
+}
+
+}  // namespace
+
+size_t HeightMap::ValidCount() const {
+  return static_cast<size_t>(std::count(valid.begin(), valid.end(), uint8_t{1}));
+}
+
+Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) {
+  *out = HeightMap{};
+  std::string text;
+  Status status = ReadWhole(path, &text, error);
+  if (status != Status::kOk) return status;
+  TokenReader reader(text, false);
+  std::string key, value;
+  double ncols = -1, nrows = -1, cellsize = -1, nodata = NAN;
+  bool has_nodata = false;
+  // Header: KEY VALUE pairs until the first token that is a number.
+  for (;;) {
+    const TokenReader before = reader;
+    if (!reader.Next(&key)) return Fail(path, "truncated: the grid header has no data", error);
+    const size_t line = reader.line();
+    double number;
+    if (ParseDouble(key, &number)) {
+      reader = before;  // the first data value
+      break;
+    }
+    if (!reader.Next(&value) || !ParseDouble(value, &number)) {
+      return Fail(path + ":" + std::to_string(line), "header '" + key + "' needs a number", error);
+    }
+    const std::string k = Lower(key);
+    if (k == "ncols") {
+      ncols = number;
+    } else if (k == "nrows") {
+      nrows = number;
+    } else if (k == "cellsize") {
+      cellsize = number;
+    } else if (k == "nodata_value") {
+      nodata = number, has_nodata = true;
+    } else if (k != "xllcorner" && k != "yllcorner" && k != "xllcenter" && k != "yllcenter") {
+      return Fail(path + ":" + std::to_string(line),
+                  "unknown header '" + key +
+                      "' (expected ncols, nrows, xllcorner, yllcorner, cellsize, NODATA_value)",
+                  error);
+    }
+  }
+  if (!(ncols >= 1 && nrows >= 1 && ncols == std::floor(ncols) && nrows == std::floor(nrows) &&
+        ncols * nrows <= 1e9)) {
+    return Fail(path, "header needs whole ncols and nrows >= 1", error);
+  }
+  if (!(cellsize > 0)) return Fail(path, "header needs cellsize > 0", error);
+  out->cols = static_cast<int>(ncols), out->rows = static_cast<int>(nrows);
+  out->cell_size = cellsize;
+  const size_t total = static_cast<size_t>(out->cols) * out->rows;
+  out->heights.resize(total);
+  out->valid.resize(total);
+  for (size_t i = 0; i < total; ++i) {
+    if (!reader.Next(&value)) {
+      return Fail(path, "truncated: expected " + std::to_string(total) + " values (" +
+                            std::to_string(out->rows) + " rows of " + std::to_string(out->cols) +
+                            "), found " + std::to_string(i), error);
+    }
+    double h;
+    if (!ParseDouble(value, &h)) {
+      return Fail(path + ":" + std::to_string(reader.line()),
+                  "value '" + value + "' is not a finite number", error);
+    }
+    out->heights[i] = h;
+    out->valid[i] = !(has_nodata && h == nodata);
+  }
+  if (reader.Next(&value)) {
+    return Fail(path + ":" + std::to_string(reader.line()),
+                "more than the " + std::to_string(total) + " values the header declares", error);
+  }
+  return Status::kOk;
+}
+
+Status ReadPgm(const std::string& path, HeightMap* out, std::string* error) {
+  *out = HeightMap{};
+  std::string text;
+  Status status = ReadWhole(path, &text, error);
+  if (status != Status::kOk) return status;
+  TokenReader reader(text, true);
+  std::string magic, token;
+  reader.Next(&magic);
+  if (magic != "P5" && magic != "P2") {
+    return Fail(path + ":1", "expected the PGM magic 'P5' (binary) or 'P2' (ASCII)", error);
+  }
+  double fields[3];
+  const char* names[3] = {"width", "height", "maxval"};
+  for (int i = 0; i < 3; ++i) {
+    if (!reader.Next(&token) || !ParseDouble(token, &fields[i]) || fields[i] < 1 ||
+        fields[i] != std::floor(fields[i])) {
+      return Fail(path + ":" + std::to_string(reader.line()),
+                  std::string("expected the PGM ") + names[i] + " as a whole number >= 1", error);
+    }
+  }
+  if (fields[2] > 65535) return Fail(path, "PGM maxval above 65535", error);
+  if (fields[0] * fields[1] > 1e9) return Fail(path, "PGM image too large", error);
+  out->cols = static_cast<int>(fields[0]), out->rows = static_cast<int>(fields[1]);
+  out->cell_size = 1;
+  const size_t total = static_cast<size_t>(out->cols) * out->rows;
+  out->heights.resize(total);
+  out->valid.assign(total, 1);
+  if (magic == "P5") {
+    const size_t bytes = fields[2] < 256 ? 1 : 2;
+    const size_t start = reader.pos() + 1;  // exactly one whitespace byte after maxval
+    const size_t available = text.size() > start ? text.size() - start : 0;
+    if (available < total * bytes) {
+      return Fail(path, "truncated: " + std::to_string(out->cols) + " x " +
+                            std::to_string(out->rows) + " pixels of " + std::to_string(bytes) +
+                            " bytes need " + std::to_string(total * bytes) +
+                            " bytes of data, the file has " + std::to_string(available), error);
+    }
+    const auto* data = reinterpret_cast<const unsigned char*>(text.data() + start);
+    for (size_t i = 0; i < total; ++i) {
+      out->heights[i] = bytes == 1 ? data[i] : (data[2 * i] << 8 | data[2 * i + 1]);
+    }
+    return Status::kOk;
+  }
+  for (size_t i = 0; i < total; ++i) {
+    double h;
+    if (!reader.Next(&token)) {
+      return Fail(path, "truncated: expected " + std::to_string(total) + " grey levels, found " +
+                            std::to_string(i), error);
+    }
+    if (!ParseDouble(token, &h) || h < 0 || h > fields[2]) {
+      return Fail(path + ":" + std::to_string(reader.line()),
+                  "grey level '" + token + "' is not a number from 0 to maxval", error);
+    }
+    out->heights[i] = h;
+  }
+  return Status::kOk;
+}
+
+Status HeightMapToMesh(const HeightMap& map, const HeightMapFrame& frame, TriangleMesh* out,
+                       std::string* error) {
+  out->vertices.clear(), out->triangles.clear();
+  if (!(std::isfinite(frame.cell_size) && frame.cell_size > 0) ||
+      !std::isfinite(frame.height_scale) ||
+      (frame.up_axis != 'x' && frame.up_axis != 'y' && frame.up_axis != 'z')) {
+    if (error) {
+      *error = "height map frame needs cell size > 0, a finite height scale and up axis x, y or z";
+    }
+    return Status::kInvalidArgument;
+  }
+  const uint32_t kNone = 0xffffffffu;
+  std::vector<uint32_t> vertex(map.heights.size(), kNone);
+  for (int r = 0; r < map.rows; ++r) {
+    for (int c = 0; c < map.cols; ++c) {
+      const size_t i = static_cast<size_t>(r) * map.cols + c;
+      if (!map.valid[i]) continue;
+      const double east = c * frame.cell_size, south = r * frame.cell_size;
+      const double h = map.heights[i] * frame.height_scale;
+      vertex[i] = static_cast<uint32_t>(out->vertices.size());
+      if (frame.up_axis == 'y') out->vertices.push_back({east, h, south});
+      if (frame.up_axis == 'z') out->vertices.push_back({east, -south, h});
+      if (frame.up_axis == 'x') out->vertices.push_back({h, east, -south});
+    }
+  }
+  Vec3 up;
+  (frame.up_axis == 'x' ? up.x : frame.up_axis == 'y' ? up.y : up.z) = 1;
+  auto add = [&](uint32_t a, uint32_t b, uint32_t c) {
+    if (a == kNone || b == kNone || c == kNone) return;
+    const Vec3 n = Cross(out->vertices[b] - out->vertices[a], out->vertices[c] - out->vertices[a]);
+    if (Dot(n, up) < 0) std::swap(b, c);
+    out->triangles.push_back({a, b, c});
+  };
+  for (int r = 0; r + 1 < map.rows; ++r) {
+    for (int c = 0; c + 1 < map.cols; ++c) {
+      const size_t i = static_cast<size_t>(r) * map.cols + c;
+      const uint32_t nw = vertex[i], ne = vertex[i + 1], sw = vertex[i + map.cols],
+                     se = vertex[i + map.cols + 1];
+      const int valid = (nw != kNone) + (ne != kNone) + (sw != kNone) + (se != kNone);
+      if (valid == 4) {
+        add(nw, sw, ne), add(ne, sw, se);
+      } else if (valid == 3) {
+        uint32_t corner[4] = {nw, ne, se, sw}, kept[3], k = 0;
+        for (uint32_t v : corner) {
+          if (v != kNone) kept[k++] = v;
+        }
+        add(kept[0], kept[1], kept[2]);
+      }
+    }
+  }
+  return Status::kOk;
+}
+
+}  // namespace footfall

@@ -1,0 +1,297 @@
+#include "mesh_file_checks.h"
+
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+namespace footfall::detail {
+namespace {
+
+Status Fail(const std::string& where, const std::string& what, std::string* error) {
+  if (error) *error = where + ": " + what;
+  return Status::kParseError;
+}
+
+std::string At(const std::string& path, size_t line) {
+  return path + ":" + std::to_string(line);
+}
+
+std::vector<std::string> Tokens(const std::string& line) {
+  std::istringstream in(line);
+  std::vector<std::string> tokens;
+  for (std::string t; in >> t;) tokens.push_back(t);
+  return tokens;
+}
+
+// True when `token` is entirely a finite decimal number.
+bool IsFiniteNumber(const std::string& token) {
+  const char* begin = token.c_str();
+  char* end = nullptr;
+  const double value = std::strtod(begin, &end);
+  return end != begin && *end == '\0' && std::isfinite(value);
+}
+
+bool ParseInteger(const std::string& token, long long* value) {
+  const char* begin = token.c_str();
+  char* end = nullptr;
+  *value = std::strtoll(begin, &end, 10);
+  return end != begin && *end == '\0';
+}
+
+std::string StripComment(const std::string& line) {
+  std::string s = line.substr(0, line.find('#'));
+  if (!s.empty() && s.back() == '\r') s.pop_back();
+  return s;
+}
+
+}  // namespace
+
+Status CheckObjFile(const std::string& path, long long* faces, std::string* error) {
+  std::ifstream in(path);
+  std::string line;
+  long long vertices = 0;
+  *faces = 0;
+  for (size_t number = 1; std::getline(in, line); ++number) {
+    const std::vector<std::string> t = Tokens(StripComment(line));
+    if (t.empty()) continue;
+    if (t[0] == "v") {
+      if (t.size() < 4) {
+        return Fail(At(path, number),
+                    "vertex has " + std::to_string(t.size() - 1) + " coordinates, expected 3",
+                    error);
+      }
+      for (int i = 1; i <= 3; ++i) {
+        if (!IsFiniteNumber(t[i])) {
+          return Fail(At(path, number),
+                      "vertex coordinate '" + t[i] + "' is not a finite number", error);
+        }
+      }
+      ++vertices;
+    } else if (t[0] == "f") {
+      ++*faces;
+      if (t.size() < 4) {
+        return Fail(At(path, number),
+                    "face has " + std::to_string(t.size() - 1) + " vertices, expected 3 or more",
+                    error);
+      }
+      for (size_t i = 1; i < t.size(); ++i) {
+        long long index = 0;
+        if (!ParseInteger(t[i].substr(0, t[i].find('/')), &index) || index == 0) {
+          return Fail(At(path, number),
+                      "face vertex '" + t[i] + "' is not a vertex index (1-based or negative)",
+                      error);
+        }
+        if (index > vertices || -index > vertices) {
+          return Fail(At(path, number),
+                      "face uses vertex " + std::to_string(index) + " but only " +
+                          std::to_string(vertices) + " vertices are defined before it",
+                      error);
+        }
+      }
+    }
+  }
+  return Status::kOk;
+}
+
+Status CheckOffFile(const std::string& path, long long* faces, std::string* error) {
+  *faces = -1;
+  std::ifstream in(path);
+  std::string line;
+  size_t number = 0;
+  // The next non-blank, comment-free line's tokens, or false at the end of the file.
+  auto next = [&](std::vector<std::string>* tokens) {
+    while (std::getline(in, line)) {
+      ++number;
+      *tokens = Tokens(StripComment(line));
+      if (!tokens->empty()) return true;
+    }
+    return false;
+  };
+  std::vector<std::string> t;
+  if (!next(&t)) return Fail(path, "empty OFF file, expected the OFF header", error);
+  if (t[0] != "OFF") {
+    if (t[0].size() >= 3 && t[0].compare(t[0].size() - 3, 3, "OFF") == 0) {
+      return Status::kOk;  // COFF, NOFF, binary ...: left to OpenMesh
+    }
+    return Fail(At(path, number), "expected the header 'OFF', found '" + t[0] + "'", error);
+  }
+  t.erase(t.begin());
+  if (t.empty() && !next(&t)) return Fail(path, "truncated: expected the OFF counts", error);
+  long long nv = 0, nf = 0;
+  if (t.size() < 2 || !ParseInteger(t[0], &nv) || !ParseInteger(t[1], &nf) || nv < 0 || nf < 0) {
+    return Fail(At(path, number), "expected counts 'VERTICES FACES EDGES'", error);
+  }
+  *faces = nf;
+  for (long long v = 0; v < nv; ++v) {
+    if (!next(&t)) {
+      return Fail(path, "truncated: header declares " + std::to_string(nv) +
+                            " vertices, found " + std::to_string(v), error);
+    }
+    if (t.size() < 3) return Fail(At(path, number), "vertex needs 3 coordinates", error);
+    for (int i = 0; i < 3; ++i) {
+      if (!IsFiniteNumber(t[i])) {
+        return Fail(At(path, number), "vertex coordinate '" + t[i] + "' is not a finite number",
+                    error);
+      }
+    }
+  }
+  for (long long f = 0; f < nf; ++f) {
+    if (!next(&t)) {
+      return Fail(path, "truncated: header declares " + std::to_string(nf) + " faces, found " +
+                            std::to_string(f), error);
+    }
+    long long n = 0;
+    if (!ParseInteger(t[0], &n) || n < 3) {
+      return Fail(At(path, number), "face must start with its vertex count (3 or more)", error);
+    }
+    if (static_cast<long long>(t.size()) < n + 1) {
+      return Fail(At(path, number), "face declares " + std::to_string(n) + " vertices, found " +
+                                        std::to_string(t.size() - 1), error);
+    }
+    for (long long i = 1; i <= n; ++i) {
+      long long index = 0;
+      if (!ParseInteger(t[i], &index) || index < 0 || index >= nv) {
+        return Fail(At(path, number), "face vertex '" + t[i] + "' is not an index below " +
+                                          std::to_string(nv), error);
+      }
+    }
+  }
+  return Status::kOk;
+}
+
+Status CheckPlyFile(const std::string& path, long long* faces, std::string* error) {
+  *faces = -1;
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  size_t number = 0;
+  if (!std::getline(in, line) || StripComment(line) != "ply") {
+    return Fail(At(path, 1), "expected the header line 'ply'", error);
+  }
+  number = 1;
+  struct Element {
+    std::string name;
+    long long count = 0;
+    long long fixed_bytes = 0;  // fixed-size properties
+    long long list_min_bytes = 0;  // list properties, counting 3 items per face list
+  };
+  std::vector<Element> elements;
+  std::string format;
+  auto type_size = [](const std::string& type) -> int {
+    if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+    if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+    if (type == "int" || type == "uint" || type == "float" || type == "int32" ||
+        type == "uint32" || type == "float32") return 4;
+    if (type == "double" || type == "float64") return 8;
+    return 0;
+  };
+  bool ended = false;
+  while (std::getline(in, line)) {
+    ++number;
+    const std::vector<std::string> t = Tokens(StripComment(line));
+    if (t.empty() || t[0] == "comment" || t[0] == "obj_info") continue;
+    if (t[0] == "end_header") {
+      ended = true;
+      break;
+    }
+    if (t[0] == "format" && t.size() >= 2) {
+      format = t[1];
+    } else if (t[0] == "element" && t.size() >= 3) {
+      Element e;
+      e.name = t[1];
+      if (!ParseInteger(t[2], &e.count) || e.count < 0) {
+        return Fail(At(path, number), "element count '" + t[2] + "' is not a count", error);
+      }
+      elements.push_back(e);
+    } else if (t[0] == "property" && !elements.empty()) {
+      Element& e = elements.back();
+      if (t.size() >= 5 && t[1] == "list") {
+        const int count_size = type_size(t[2]), item_size = type_size(t[3]);
+        if (!count_size || !item_size) {
+          return Fail(At(path, number), "unknown PLY property type", error);
+        }
+        e.list_min_bytes += count_size + (e.name == "face" ? 3 * item_size : 0);
+      } else if (t.size() >= 3) {
+        const int size = type_size(t[1]);
+        if (!size) return Fail(At(path, number), "unknown PLY type '" + t[1] + "'", error);
+        e.fixed_bytes += size;
+      }
+    }
+  }
+  if (!ended) return Fail(path, "truncated: the PLY header has no 'end_header'", error);
+  for (const Element& e : elements) {
+    if (e.name == "face") *faces = e.count;
+  }
+  if (format == "ascii") {
+    long long records = 0;
+    for (const Element& e : elements) records += e.count;
+    long long found = 0;
+    while (std::getline(in, line)) {
+      if (!Tokens(line).empty()) ++found;
+    }
+    if (found < records) {
+      return Fail(path, "truncated: the header declares " + std::to_string(records) +
+                            " data lines, found " + std::to_string(found), error);
+    }
+    return Status::kOk;
+  }
+  const std::streamoff data_start = in.tellg();
+  in.seekg(0, std::ios::end);
+  const long long data_bytes = static_cast<long long>(in.tellg() - data_start);
+  long long need = 0;
+  for (const Element& e : elements) need += e.count * (e.fixed_bytes + e.list_min_bytes);
+  if (data_bytes < need) {
+    return Fail(path, "truncated: the header's elements need at least " + std::to_string(need) +
+                          " bytes of " + format + " data, the file has " +
+                          std::to_string(data_bytes), error);
+  }
+  return Status::kOk;
+}
+
+Status CheckStlFile(const std::string& path, std::string* error) {
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(0, std::ios::end);
+  const long long size = static_cast<long long>(in.tellg());
+  in.seekg(0);
+  std::string head(std::min<long long>(size, 84), '\0');
+  in.read(&head[0], static_cast<std::streamsize>(head.size()));
+  if (size >= 84) {
+    uint32_t count = 0;
+    std::memcpy(&count, head.data() + 80, 4);  // little-endian on every platform we build for
+    if (84 + 50ll * count == size) return Status::kOk;  // a complete binary STL
+  }
+  if (head.compare(0, 5, "solid") != 0) {
+    if (size < 84) return Fail(path, "truncated: a binary STL needs an 84-byte header", error);
+    uint32_t count = 0;
+    std::memcpy(&count, head.data() + 80, 4);
+    return Fail(path, "truncated: binary STL declares " + std::to_string(count) +
+                          " triangles (" + std::to_string(84 + 50ll * count) +
+                          " bytes), the file has " + std::to_string(size) + " bytes", error);
+  }
+  // ASCII STL: finite vertices and a closing 'endsolid'.
+  in.seekg(0);
+  std::string line;
+  bool closed = false;
+  for (size_t number = 1; std::getline(in, line); ++number) {
+    const std::vector<std::string> t = Tokens(line);
+    if (t.empty()) continue;
+    if (t[0] == "endsolid") closed = true;
+    if (t[0] == "vertex") {
+      if (t.size() < 4) return Fail(At(path, number), "vertex needs 3 coordinates", error);
+      for (int i = 1; i <= 3; ++i) {
+        if (!IsFiniteNumber(t[i])) {
+          return Fail(At(path, number), "vertex coordinate '" + t[i] + "' is not a finite number",
+                      error);
+        }
+      }
+    }
+  }
+  if (!closed) return Fail(path, "truncated: ASCII STL has no closing 'endsolid'", error);
+  return Status::kOk;
+}
+
+}  // namespace footfall::detail

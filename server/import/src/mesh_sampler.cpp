@@ -1,0 +1,465 @@
+#include "footfall/import/mesh_sampler.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <tuple>
+#include <vector>
+
+namespace footfall {
+namespace {
+
+// SplitMix64: a small, fast generator whose output is fixed by the standard-free arithmetic below,
+// so a seed gives the same order everywhere.
+struct SplitMix64 {
+  explicit SplitMix64(uint64_t seed) : state(seed) {}
+  uint64_t Next() {
+    uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+  }
+  // Uniform in [0, n), n > 0 (Lemire's multiply-shift; the tiny bias is irrelevant here).
+  uint64_t Below(uint64_t n) {
+    return static_cast<uint64_t>((static_cast<unsigned __int128>(Next()) * n) >> 64);
+  }
+  double Unit() { return static_cast<double>(Next() >> 11) * (1.0 / 9007199254740992.0); }
+  uint64_t state;
+};
+
+struct Candidate {
+  float offset[3];  // position relative to the cell grid's corner, for distance tests
+  uint32_t triangle;
+  float u, v;  // barycentric weights of corners 1 and 2 of the triangle
+};
+
+constexpr int kCellBits = 21;
+constexpr uint64_t kCellLimit = 1ull << kCellBits;
+constexpr uint32_t kNone = 0xffffffffu;
+constexpr int kSlots = 8;  // points >= r apart in a cube of side r: at most its 8 corners
+
+uint64_t CellKey(uint64_t x, uint64_t y, uint64_t z) {
+  return (x << (2 * kCellBits)) | (y << kCellBits) | z;
+}
+
+// Open-addressing map from cell key to a dense cell id; grows to stay at most half full.
+class CellTable {
+ public:
+  explicit CellTable(size_t expected) { Reset(std::max<size_t>(16, 2 * expected)); }
+  // The id of `key`, inserting it with id `next` when absent.
+  uint32_t Insert(uint64_t key, uint32_t next) {
+    if (2 * (size_ + 1) > entries_.size()) Grow();
+    for (size_t i = Hash(key) & mask_;; i = (i + 1) & mask_) {
+      if (entries_[i].key == key) return entries_[i].id;
+      if (entries_[i].key == kEmpty) {
+        entries_[i] = {key, next};
+        ++size_;
+        return next;
+      }
+    }
+  }
+  uint32_t Find(uint64_t key) const {
+    for (size_t i = Hash(key) & mask_;; i = (i + 1) & mask_) {
+      if (entries_[i].key == key) return entries_[i].id;
+      if (entries_[i].key == kEmpty) return kNone;
+    }
+  }
+
+ private:
+  static constexpr uint64_t kEmpty = ~0ull;
+  struct Entry {
+    uint64_t key;
+    uint32_t id;
+  };
+  static size_t Hash(uint64_t key) {
+    key ^= key >> 33, key *= 0xff51afd7ed558ccdull, key ^= key >> 33;
+    return static_cast<size_t>(key);
+  }
+  void Reset(size_t minimum) {
+    size_t capacity = 16;
+    while (capacity < minimum) capacity *= 2;
+    entries_.assign(capacity, Entry{kEmpty, kNone});
+    mask_ = capacity - 1;
+    size_ = 0;
+  }
+  void Grow() {
+    std::vector<Entry> old;
+    old.swap(entries_);
+    Reset(old.size() * 2);
+    for (const Entry& e : old) {
+      if (e.key != kEmpty) Insert(e.key, e.id);
+    }
+  }
+  std::vector<Entry> entries_;
+  size_t mask_ = 0, size_ = 0;
+};
+
+// Map from cell coordinates to a dense cell id: a hash of 4^3-cell tiles, each a dense block,
+// so that looking up a cell's neighbours mostly stays within one cached block.
+class CellMap {
+ public:
+  explicit CellMap(size_t expected_cells) : tiles_(expected_cells / 8 + 16) {}
+  // The id of cell (x, y, z), inserting it with id `next` when absent.
+  uint32_t Insert(uint64_t x, uint64_t y, uint64_t z, uint32_t next) {
+    uint32_t* block = Block(x, y, z, true);
+    uint32_t& id = block[Local(x, y, z)];
+    if (id == kNone) id = next;
+    return id;
+  }
+  uint32_t Find(uint64_t x, uint64_t y, uint64_t z) {
+    const uint32_t* block = Block(x, y, z, false);
+    return block ? block[Local(x, y, z)] : kNone;
+  }
+
+ private:
+  static size_t Local(uint64_t x, uint64_t y, uint64_t z) {
+    return static_cast<size_t>((x & 3) << 4 | (y & 3) << 2 | (z & 3));
+  }
+  uint32_t* Block(uint64_t x, uint64_t y, uint64_t z, bool create) {
+    const uint64_t key = CellKey(x >> 2, y >> 2, z >> 2);
+    if (key != last_key_) {
+      uint32_t tile = tiles_.Find(key);
+      if (tile == kNone) {
+        if (!create) return nullptr;
+        tile = tiles_.Insert(key, static_cast<uint32_t>(blocks_.size() / 64));
+        blocks_.resize(blocks_.size() + 64, kNone);
+      }
+      last_key_ = key, last_tile_ = tile;
+    }
+    return &blocks_[static_cast<size_t>(last_tile_) * 64];
+  }
+  CellTable tiles_;
+  std::vector<uint32_t> blocks_;
+  uint64_t last_key_ = ~0ull;
+  uint32_t last_tile_ = 0;
+};
+
+Vec3 Blend(const Vec3& a, const Vec3& b, const Vec3& c, double u, double v) {
+  return a * (1 - u - v) + b * u + c * v;
+}
+
+// Step 4: the sample normal at barycentric (u, v) of triangle t.
+Vec3 SampleNormal(const TriangleMesh& mesh, const std::vector<Vec3>& vertex_normals, size_t t,
+                  double u, double v) {
+  const Vec3 face = Normalize(TriangleCross(mesh, t));
+  if (vertex_normals.empty()) return face;
+  const auto& tri = mesh.triangles[t];
+  const Vec3 n =
+      Blend(vertex_normals[tri[0]], vertex_normals[tri[1]], vertex_normals[tri[2]], u, v);
+  const double length = Length(n);
+  if (!(length > 1e-12) || Dot(n, face) <= 0) return face;
+  return n / length;
+}
+
+Vec3 SamplePoint(const TriangleMesh& mesh, size_t t, double u, double v) {
+  const auto& tri = mesh.triangles[t];
+  return Blend(mesh.vertices[tri[0]], mesh.vertices[tri[1]], mesh.vertices[tri[2]], u, v);
+}
+
+Status CheckMesh(const TriangleMesh& mesh, std::string* error) {
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    if (!IsFinite(mesh.vertices[i])) {
+      if (error) *error = "vertex " + std::to_string(i) + " is not finite";
+      return Status::kInvalidArgument;
+    }
+  }
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    for (uint32_t v : mesh.triangles[t]) {
+      if (v >= mesh.vertices.size()) {
+        if (error) *error = "triangle " + std::to_string(t) + " uses missing vertex " +
+                            std::to_string(v);
+        return Status::kInvalidArgument;
+      }
+    }
+  }
+  return Status::kOk;
+}
+
+}  // namespace
+
+double DefaultSeparation(const TriangleMesh& mesh) {
+  double sum = 0;
+  size_t n = 0;
+  for (const auto& tri : mesh.triangles) {
+    for (int e = 0; e < 3; ++e) {
+      sum += Distance(mesh.vertices[tri[e]], mesh.vertices[tri[(e + 1) % 3]]), ++n;
+    }
+  }
+  return n ? sum / n : 1.0;
+}
+
+Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, RawSamples* out,
+                  std::string* error, MeshSampleStats* stats) {
+  out->clear();
+  if (stats) *stats = MeshSampleStats{};
+  const double s = options.separation;
+  if (!(std::isfinite(s) && s > 0)) {
+    if (error) *error = "separation must be a finite number > 0, got " + std::to_string(s);
+    return Status::kInvalidArgument;
+  }
+  Status status = CheckMesh(mesh, error);
+  if (status != Status::kOk) return status;
+  const double area = SurfaceArea(mesh);
+  const double predicted = 1.6 * area / (s * s);
+  if (predicted > static_cast<double>(options.max_samples)) {
+    if (error) {
+      *error = "separation " + std::to_string(s) + " would give about " +
+               std::to_string(static_cast<uint64_t>(predicted)) + " samples (limit " +
+               std::to_string(options.max_samples) + "); choose a larger separation";
+    }
+    return Status::kLimitExceeded;
+  }
+  if (mesh.triangles.empty()) return Status::kOk;
+
+  const double h = s / 3, r = 2 * s / 3;
+  const double h2 = h * h, r2 = r * r;
+  Vec3 lo, hi;
+  MeshBounds(mesh, &lo, &hi);
+  const double inv_cell = 1 / r;
+  const Vec3 extent = hi - lo;
+  if (extent.x * inv_cell >= kCellLimit - 2 || extent.y * inv_cell >= kCellLimit - 2 ||
+      extent.z * inv_cell >= kCellLimit - 2) {
+    if (error) *error = "separation " + std::to_string(s) + " is too small for the mesh's extent";
+    return Status::kLimitExceeded;
+  }
+
+  // 1. Candidates by longest-edge bisection, one per piece at its centroid.
+  std::vector<Candidate> candidates;
+  candidates.reserve(static_cast<size_t>(predicted * 6) + mesh.triangles.size());
+  struct Piece {
+    Vec3 p[3];
+    double b[3][2];  // barycentric (u, v) of each corner in the source triangle
+    int depth;
+  };
+  std::vector<Piece> stack;
+  const size_t candidate_limit = options.max_samples * 32 + mesh.triangles.size();
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& tri = mesh.triangles[t];
+    stack.push_back({{mesh.vertices[tri[0]], mesh.vertices[tri[1]], mesh.vertices[tri[2]]},
+                     {{0, 0}, {1, 0}, {0, 1}},
+                     0});
+    while (!stack.empty()) {
+      const Piece piece = stack.back();
+      stack.pop_back();
+      const Vec3 g = (piece.p[0] + piece.p[1] + piece.p[2]) / 3;
+      const double reach = std::max({Distance2(g, piece.p[0]), Distance2(g, piece.p[1]),
+                                     Distance2(g, piece.p[2])});
+      if (reach <= h2 || piece.depth >= 60) {
+        Candidate c;
+        const Vec3 local = g - lo;
+        c.offset[0] = static_cast<float>(local.x);
+        c.offset[1] = static_cast<float>(local.y);
+        c.offset[2] = static_cast<float>(local.z);
+        c.triangle = static_cast<uint32_t>(t);
+        c.u = static_cast<float>((piece.b[0][0] + piece.b[1][0] + piece.b[2][0]) / 3);
+        c.v = static_cast<float>((piece.b[0][1] + piece.b[1][1] + piece.b[2][1]) / 3);
+        candidates.push_back(c);
+        if (candidates.size() > candidate_limit) {
+          if (error) *error = "separation " + std::to_string(s) + " needs too many candidates";
+          return Status::kLimitExceeded;
+        }
+        continue;
+      }
+      // Split the longest edge (i, j) at its midpoint; k is the opposite corner.
+      int i = 0;
+      double longest = -1;
+      for (int e = 0; e < 3; ++e) {
+        const double d = Distance2(piece.p[e], piece.p[(e + 1) % 3]);
+        if (d > longest) longest = d, i = e;
+      }
+      const int j = (i + 1) % 3;
+      Piece a = piece, b = piece;
+      const Vec3 m = (piece.p[i] + piece.p[j]) / 2;
+      const double mb[2] = {(piece.b[i][0] + piece.b[j][0]) / 2,
+                            (piece.b[i][1] + piece.b[j][1]) / 2};
+      a.p[j] = m, a.b[j][0] = mb[0], a.b[j][1] = mb[1];  // (i, m, k)
+      b.p[i] = m, b.b[i][0] = mb[0], b.b[i][1] = mb[1];  // (m, j, k)
+      a.depth = b.depth = piece.depth + 1;
+      stack.push_back(b);
+      stack.push_back(a);
+    }
+  }
+
+  // Cells of side r over the bounds; each candidate's cell id.
+  const size_t n = candidates.size();
+  CellMap table(static_cast<size_t>(predicted) + 16);
+  std::vector<uint32_t> cell_of(n);
+  std::vector<uint64_t> cell_keys;
+  uint64_t last_key = ~0ull;
+  uint32_t last_id = kNone;
+  for (size_t c = 0; c < n; ++c) {
+    const uint64_t x = static_cast<uint64_t>(std::max(0.0, candidates[c].offset[0] * inv_cell));
+    const uint64_t y = static_cast<uint64_t>(std::max(0.0, candidates[c].offset[1] * inv_cell));
+    const uint64_t z = static_cast<uint64_t>(std::max(0.0, candidates[c].offset[2] * inv_cell));
+    const uint64_t key = CellKey(x + 1, y + 1, z + 1);  // +1: neighbours never underflow
+    if (key != last_key) {  // neighbouring candidates mostly share a cell
+      last_id = table.Insert(x + 1, y + 1, z + 1, static_cast<uint32_t>(cell_keys.size()));
+      if (last_id == cell_keys.size()) cell_keys.push_back(key);
+      last_key = key;
+    }
+    cell_of[c] = last_id;
+  }
+  // Renumber cells by tile (8^3 cells), then phase (coordinates mod 3), so that step 3 works
+  // through one small tile at a time with its cells' data close in memory.
+  const size_t cells = cell_keys.size();
+  const uint64_t field = kCellLimit - 1;
+  auto phase_of = [&](uint64_t key) {
+    return static_cast<int>((key >> (2 * kCellBits)) % 3 * 9 + ((key >> kCellBits) & field) % 3 * 3 +
+                            (key & field) % 3);
+  };
+  auto tile_of = [&](uint64_t key) {
+    return CellKey(key >> (2 * kCellBits) >> 3, ((key >> kCellBits) & field) >> 3, (key & field) >> 3);
+  };
+  SplitMix64 rng(options.seed);
+  int phase_rank[27];
+  {
+    int phase_order[27];
+    for (int p = 0; p < 27; ++p) phase_order[p] = p;
+    for (int m = 27; m > 1; --m) std::swap(phase_order[m - 1], phase_order[rng.Below(m)]);
+    for (int p = 0; p < 27; ++p) phase_rank[phase_order[p]] = p;
+  }
+  std::vector<uint32_t> rank(cells);
+  {
+    std::vector<std::tuple<uint64_t, int, uint32_t>> sort_keys(cells);
+    for (uint32_t id = 0; id < cells; ++id) {
+      sort_keys[id] = {tile_of(cell_keys[id]), phase_rank[phase_of(cell_keys[id])], id};
+    }
+    std::sort(sort_keys.begin(), sort_keys.end());
+    std::vector<uint64_t> sorted_keys(cells);
+    for (uint32_t r = 0; r < cells; ++r) {
+      rank[std::get<2>(sort_keys[r])] = r;
+      sorted_keys[r] = cell_keys[std::get<2>(sort_keys[r])];
+    }
+    cell_keys.swap(sorted_keys);
+    for (uint32_t& id : cell_of) id = rank[id];
+  }
+  // The occupied neighbours of each occupied cell (itself included), as a CSR list.
+  std::vector<uint32_t> neighbour_start(cells + 1, 0);
+  std::vector<uint32_t> neighbours;
+  neighbours.reserve(cells * 9);
+  for (size_t id = 0; id < cells; ++id) {
+    const uint64_t key = cell_keys[id];
+    const uint64_t x = key >> (2 * kCellBits), y = (key >> kCellBits) & field, z = key & field;
+    // Nearest first (itself, then faces, edges, corners): most rejections end early.
+    for (int ring = 0; ring <= 3; ++ring) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dz = -1; dz <= 1; ++dz) {
+            if (std::abs(dx) + std::abs(dy) + std::abs(dz) != ring) continue;
+            const uint32_t other = table.Find(x + dx, y + dy, z + dz);
+            if (other != kNone) neighbours.push_back(rank[other]);
+          }
+        }
+      }
+    }
+    neighbour_start[id + 1] = static_cast<uint32_t>(neighbours.size());
+  }
+
+  // 2. A seeded random order with locality (after Wei, "Parallel Poisson disk sampling", 2008):
+  // each cell's candidates are shuffled; then, tile by tile, pass j tries the j-th candidate of
+  // every cell of the tile, cells taken by phase in a seeded phase order. Cells of one phase are
+  // at least 2r apart, so the order within a phase does not matter.
+  std::vector<uint32_t> cell_start(cells + 1, 0);
+  for (size_t c = 0; c < n; ++c) ++cell_start[cell_of[c] + 1];
+  for (size_t id = 0; id < cells; ++id) cell_start[id + 1] += cell_start[id];
+  std::vector<uint32_t> by_cell(n);
+  {
+    std::vector<uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
+    for (size_t c = 0; c < n; ++c) by_cell[fill[cell_of[c]]++] = static_cast<uint32_t>(c);
+  }
+  for (size_t id = 0; id < cells; ++id) {
+    uint32_t* first = &by_cell[cell_start[id]];
+    for (uint32_t m = cell_start[id + 1] - cell_start[id]; m > 1; --m) {
+      std::swap(first[m - 1], first[rng.Below(m)]);
+    }
+  }
+
+  // 3. Accept candidates farther than r from every accepted sample. Each cell keeps the offsets
+  // of its accepted samples inline, for cache-friendly tests.
+  struct Slots {
+    uint32_t count;
+    float p[kSlots][3];
+  };
+  std::vector<Slots> slots(cells);
+  for (Slots& slot : slots) slot.count = 0;
+  std::vector<uint32_t> accepted;
+  accepted.reserve(static_cast<size_t>(predicted * 1.2) + 16);
+  const float r2f = static_cast<float>(r2);
+  auto try_candidate = [&](uint32_t c, uint32_t cell) {
+    const Candidate& cand = candidates[c];
+    for (uint32_t e = neighbour_start[cell]; e < neighbour_start[cell + 1]; ++e) {
+      const Slots& slot = slots[neighbours[e]];
+      for (uint32_t q = 0; q < slot.count; ++q) {
+        const float dx = slot.p[q][0] - cand.offset[0], dy = slot.p[q][1] - cand.offset[1],
+                    dz = slot.p[q][2] - cand.offset[2];
+        if (dx * dx + dy * dy + dz * dz < r2f) return;
+      }
+    }
+    Slots& own = slots[cell];
+    if (own.count == kSlots) return;
+    for (int d = 0; d < 3; ++d) own.p[own.count][d] = cand.offset[d];
+    ++own.count;
+    accepted.push_back(c);
+  };
+  std::vector<uint32_t> active;
+  for (size_t tile_begin = 0; tile_begin < cells;) {
+    size_t tile_end = tile_begin + 1;
+    const uint64_t tile = tile_of(cell_keys[tile_begin]);
+    while (tile_end < cells && tile_of(cell_keys[tile_end]) == tile) ++tile_end;
+    active.clear();
+    for (size_t id = tile_begin; id < tile_end; ++id) active.push_back(static_cast<uint32_t>(id));
+    for (uint32_t pass = 0; !active.empty(); ++pass) {
+      size_t kept = 0;
+      for (uint32_t cell : active) {  // in phase order: the renumbering sorted them so
+        const uint32_t at = cell_start[cell] + pass;
+        if (at >= cell_start[cell + 1]) continue;  // exhausted: drop from the list
+        try_candidate(by_cell[at], cell);
+        active[kept++] = cell;
+      }
+      active.resize(kept);
+    }
+    tile_begin = tile_end;
+  }
+
+  // 4. Points and normals, in triangle order.
+  std::sort(accepted.begin(), accepted.end());
+  const std::vector<Vec3> vertex_normals =
+      options.smooth_normals ? VertexNormals(mesh) : std::vector<Vec3>{};
+  out->points.reserve(accepted.size());
+  out->normals.reserve(accepted.size());
+  for (uint32_t c : accepted) {
+    const Candidate& cand = candidates[c];
+    out->push_back(SamplePoint(mesh, cand.triangle, cand.u, cand.v),
+                   SampleNormal(mesh, vertex_normals, cand.triangle, cand.u, cand.v));
+  }
+  if (stats) stats->candidates = n, stats->samples = accepted.size();
+  return Status::kOk;
+}
+
+void SampleMeshUniform(const TriangleMesh& mesh, size_t count, bool smooth_normals, uint64_t seed,
+                       RawSamples* out) {
+  out->clear();
+  if (mesh.triangles.empty()) return;
+  std::vector<double> cumulative(mesh.triangles.size());
+  double total = 0;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    total += Length(TriangleCross(mesh, t));
+    cumulative[t] = total;
+  }
+  const std::vector<Vec3> vertex_normals =
+      smooth_normals ? VertexNormals(mesh) : std::vector<Vec3>{};
+  SplitMix64 rng(seed);
+  out->points.reserve(count);
+  out->normals.reserve(count);
+  for (size_t i = 0; i < count; ++i) {
+    const double pick = rng.Unit() * total;
+    const size_t t = std::min<size_t>(
+        std::upper_bound(cumulative.begin(), cumulative.end(), pick) - cumulative.begin(),
+        mesh.triangles.size() - 1);
+    double u = rng.Unit(), v = rng.Unit();
+    if (u + v > 1) u = 1 - u, v = 1 - v;
+    out->push_back(SamplePoint(mesh, t, u, v), SampleNormal(mesh, vertex_normals, t, u, v));
+  }
+}
+
+}  // namespace footfall

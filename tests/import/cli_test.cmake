@@ -1,0 +1,52 @@
+# Runs the built `footfall` binary on good and bad terrain files and checks exit codes and
+# messages. Usage: cmake -DFOOTFALL=path/to/footfall -DWORK=scratch-dir -P cli_test.cmake
+file(REMOVE_RECURSE "${WORK}")
+file(MAKE_DIRECTORY "${WORK}")
+
+# expect(EXIT_ZERO|EXIT_NONZERO TEXT args...): runs footfall args, checks the exit code and that
+# stdout+stderr contains TEXT.
+function(expect want text)
+  execute_process(COMMAND "${FOOTFALL}" ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                  ERROR_VARIABLE err INPUT_FILE "${WORK}/stdin.txt")
+  set(all "${out}${err}")
+  if(want STREQUAL "EXIT_ZERO" AND NOT rc EQUAL 0)
+    message(FATAL_ERROR "footfall ${ARGN}: exit ${rc}, expected 0\n${all}")
+  endif()
+  if(want STREQUAL "EXIT_NONZERO" AND rc EQUAL 0)
+    message(FATAL_ERROR "footfall ${ARGN}: exit 0, expected non-zero\n${all}")
+  endif()
+  string(FIND "${all}" "${text}" at)
+  if(at EQUAL -1)
+    message(FATAL_ERROR "footfall ${ARGN}: output lacks '${text}':\n${all}")
+  endif()
+endfunction()
+
+file(WRITE "${WORK}/stdin.txt" "snap 0.5 2 0.5\n")
+file(WRITE "${WORK}/cube.obj" "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+     "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n")
+file(WRITE "${WORK}/empty.obj" "")
+file(WRITE "${WORK}/nan.obj" "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n")
+file(WRITE "${WORK}/fin.obj" "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n")
+file(WRITE "${WORK}/cut.off" "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n")
+file(WRITE "${WORK}/terrain.dae" "<COLLADA/>")
+file(WRITE "${WORK}/hill.asc" "ncols 3\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 1 1\n1 2 1\n1 1 1\n")
+
+# Good files.
+expect(EXIT_ZERO "faces: 6" terrain info "${WORK}/cube.obj" --separation 0.1)
+expect(EXIT_ZERO "grid:" terrain info "${WORK}/cube.obj" --separation 0.1)
+expect(EXIT_ZERO "format: heightmap" terrain info "${WORK}/hill.asc")
+expect(EXIT_ZERO "wrote" terrain convert "${WORK}/cube.obj" --separation 0.1 -o "${WORK}/cube.pts")
+expect(EXIT_ZERO "format: points" terrain info "${WORK}/cube.pts")
+expect(EXIT_ZERO "wrote" terrain make blocks --size 4 --spacing 0.2 -o "${WORK}/blocks.pts")
+expect(EXIT_ZERO "\"found\":true" query --terrain "${WORK}/cube.obj" --separation 0.1)
+# Bad files: non-zero exit and a message naming the file and the problem.
+expect(EXIT_NONZERO "empty.obj: the file is empty" terrain info "${WORK}/empty.obj")
+expect(EXIT_NONZERO "nan.obj:2: vertex coordinate 'nan' is not a finite number"
+       terrain convert "${WORK}/nan.obj" -o "${WORK}/nan.pts")
+expect(EXIT_NONZERO "fin.obj: the mesh is not manifold" terrain info "${WORK}/fin.obj")
+expect(EXIT_NONZERO "cut.off: truncated: header declares 2 faces, found 1"
+       terrain info "${WORK}/cut.off")
+expect(EXIT_NONZERO "unknown terrain file extension 'dae'" terrain info "${WORK}/terrain.dae")
+expect(EXIT_NONZERO "absent.obj: cannot open" query --terrain "${WORK}/absent.obj")
+expect(EXIT_NONZERO "larger separation" terrain info "${WORK}/cube.obj" --separation 0.0001)
+file(REMOVE_RECURSE "${WORK}")

@@ -1,0 +1,125 @@
+#include "footfall/import/height_map.h"
+
+#include "footfall/import/terrain_loader.h"
+#include "test_support.h"
+
+namespace footfall {
+namespace {
+
+bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+const char* kAsc =
+    "ncols 3\nnrows 2\nxllcorner 100\nyllcorner 200\ncellsize 2\nNODATA_value -9999\n"
+    "1 2 3\n4 -9999 6\n";
+
+}  // namespace
+
+TEST_CASE("ReadAscGrid: header, values and NODATA", "[import][heightmap]") {
+  test::TempDir dir;
+  HeightMap map;
+  std::string error;
+  REQUIRE(ReadAscGrid(dir.Write("a.asc", kAsc), &map, &error) == Status::kOk);
+  CHECK(map.cols == 3);
+  CHECK(map.rows == 2);
+  CHECK(map.cell_size == 2);
+  CHECK(map.heights[5] == 6);
+  CHECK(map.ValidCount() == 5);
+  CHECK(map.valid[4] == 0);
+
+  TriangleMesh mesh;
+  REQUIRE(HeightMapToMesh(map, HeightMapFrame{2, 1, 'y'}, &mesh, &error) == Status::kOk);
+  CHECK(mesh.vertices.size() == 5);  // the NODATA cell is left out
+  CHECK(mesh.triangles.size() == 2);  // each square has three valid cells: one triangle each
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) CHECK(TriangleCross(mesh, t).y > 0);
+  CHECK(mesh.vertices[0] == Vec3{0, 1, 0});
+  CHECK(mesh.vertices[3] == Vec3{0, 4, 2});  // row 1 lies south (+z)
+}
+
+TEST_CASE("HeightMapToMesh: the up axis", "[import][heightmap]") {
+  HeightMap map;
+  map.cols = 2, map.rows = 2, map.heights = {1, 2, 3, 4}, map.valid = {1, 1, 1, 1};
+  std::string error;
+  for (char axis : {'x', 'y', 'z'}) {
+    TriangleMesh mesh;
+    REQUIRE(HeightMapToMesh(map, HeightMapFrame{1, 10, axis}, &mesh, &error) == Status::kOk);
+    const Vec3& se = mesh.vertices[3];  // row 1, col 1, height 40
+    if (axis == 'y') CHECK(se == Vec3{1, 40, 1});
+    if (axis == 'z') CHECK(se == Vec3{1, -1, 40});
+    if (axis == 'x') CHECK(se == Vec3{40, 1, -1});
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const Vec3 n = TriangleCross(mesh, t);
+      CHECK((axis == 'x' ? n.x : axis == 'y' ? n.y : n.z) > 0);
+    }
+  }
+  TriangleMesh mesh;
+  CHECK(HeightMapToMesh(map, HeightMapFrame{1, 1, 'w'}, &mesh, &error) ==
+        Status::kInvalidArgument);
+}
+
+TEST_CASE("ReadPgm: 8 and 16 bit binary and ASCII agree", "[import][heightmap]") {
+  test::TempDir dir;
+  HeightMap p5_8, p5_16, p2;
+  std::string error;
+  const std::string bytes8 = std::string("P5\n# comment\n3 2\n255\n") + '\x01' + '\x02' + '\x03' +
+                             '\x04' + '\x05' + '\xff';
+  const std::string bytes16 = std::string("P5 3 2 1000\n") + std::string("\x00\x01\x00\x02\x00\x03"
+                              "\x00\x04\x00\x05\x00\xff", 12);
+  REQUIRE(ReadPgm(dir.Write("a.pgm", bytes8), &p5_8, &error) == Status::kOk);
+  REQUIRE(ReadPgm(dir.Write("b.pgm", bytes16), &p5_16, &error) == Status::kOk);
+  REQUIRE(ReadPgm(dir.Write("c.pgm", "P2\n3 2\n300\n1 2 3\n4 5 255\n"), &p2, &error) ==
+          Status::kOk);
+  const std::vector<double> expected{1, 2, 3, 4, 5, 255};
+  CHECK(p5_8.heights == expected);
+  CHECK(p5_16.heights == expected);
+  CHECK(p2.heights == expected);
+}
+
+TEST_CASE("Height maps: bad files give clear errors", "[import][heightmap]") {
+  test::TempDir dir;
+  HeightMap map;
+  std::string error;
+  CHECK(ReadAscGrid(dir.Write("cut.asc", "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n"
+                                         "1 2 3\n4\n"), &map, &error) == Status::kParseError);
+  CHECK(Contains(error, "cut.asc: truncated: expected 6 values (2 rows of 3), found 4"));
+  CHECK(ReadAscGrid(dir.Write("bad.asc", "ncols 2\nnrows 1\ncellsize 1\n1 x\n"), &map, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error, "bad.asc:4: value 'x' is not a finite number"));
+  CHECK(ReadAscGrid(dir.Write("hdr.asc", "ncols 2\nrows 1\n1 2\n"), &map, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error, "hdr.asc:2: unknown header 'rows'"));
+  CHECK(ReadPgm(dir.Write("cut.pgm", std::string("P5 4 4 255\n") + std::string(10, 'a')), &map,
+                &error) == Status::kParseError);
+  CHECK(Contains(error, "cut.pgm: truncated: 4 x 4 pixels of 1 bytes need 16 bytes"));
+  CHECK(ReadPgm(dir.Write("magic.pgm", "P6 1 1 255\nabc"), &map, &error) == Status::kParseError);
+  CHECK(Contains(error, "magic.pgm:1: expected the PGM magic"));
+  CHECK(ReadPgm(dir.File("absent.pgm"), &map, &error) == Status::kIoError);
+}
+
+TEST_CASE("LoadTerrain: height maps with NODATA are resampled over the valid cells",
+          "[import][heightmap]") {
+  test::TempDir dir;
+  std::string asc = "ncols 10\nnrows 10\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -1\n";
+  for (int r = 0; r < 10; ++r) {
+    for (int c = 0; c < 10; ++c) asc += (c >= 5 ? "-1 " : "2 ");
+    asc += "\n";
+  }
+  TerrainLoadOptions options;
+  options.separation = 0.5;
+  RawSamples samples;
+  std::string error;
+  TerrainLoadReport report;
+  REQUIRE(LoadTerrain(dir.Write("half.asc", asc), options, &samples, &error, &report) ==
+          Status::kOk);
+  CHECK(report.format == "heightmap");
+  CHECK(report.nodata_cells == 50);
+  CHECK(report.area == Approx(4 * 9));  // columns 0..4 span 4 cells, rows 9
+  CHECK(report.bounds_max.x <= 4);
+  for (size_t i = 0; i < samples.size(); ++i) {
+    CHECK(samples.points[i].y == Approx(2));
+    CHECK(samples.normals[i].y == Approx(1));
+  }
+}
+
+}  // namespace footfall

@@ -1,0 +1,189 @@
+#include "footfall/import/mesh_reader.h"
+
+#include <cstring>
+
+#include "footfall/import/terrain_loader.h"
+#include "test_support.h"
+
+namespace footfall {
+namespace {
+
+// A unit cube as a closed quad mesh, faces outward.
+const char* kCubeObj =
+    "# cube\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+    "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+
+Status Read(const std::string& path, TriangleMesh* mesh, std::string* error,
+            MeshReadReport* report = nullptr) {
+  return ReadMesh(path, mesh, error, report);
+}
+
+bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+void CheckCube(const TriangleMesh& mesh) {
+  CHECK(mesh.triangles.size() == 12);
+  CHECK(SurfaceArea(mesh) == Approx(6));
+  // Closed and facing out: every face normal points away from the centre.
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const Vec3 c = (mesh.vertices[mesh.triangles[t][0]] + mesh.vertices[mesh.triangles[t][1]] +
+                    mesh.vertices[mesh.triangles[t][2]]) / 3;
+    CHECK(Dot(TriangleCross(mesh, t), c - Vec3{0.5, 0.5, 0.5}) > 0);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("ReadMesh: every format gives the same triangulated cube", "[import][mesh]") {
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  MeshReadReport report;
+  SECTION("OBJ with quads") {
+    REQUIRE(Read(dir.Write("cube.obj", kCubeObj), &mesh, &error, &report) == Status::kOk);
+    CHECK(report.vertices == 8);
+    CHECK(report.faces == 6);
+    CHECK(report.skipped_faces == 0);
+    CheckCube(mesh);
+  }
+  SECTION("OFF") {
+    const std::string off =
+        "OFF\n8 6 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+        "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n";
+    REQUIRE(Read(dir.Write("cube.off", off), &mesh, &error) == Status::kOk);
+    CheckCube(mesh);
+  }
+  SECTION("ASCII PLY") {
+    const std::string ply =
+        "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 6\nproperty list uchar int vertex_indices\nend_header\n"
+        "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+        "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n";
+    REQUIRE(Read(dir.Write("cube.ply", ply), &mesh, &error) == Status::kOk);
+    CheckCube(mesh);
+  }
+  SECTION("ASCII and binary STL, and OM written from the OBJ") {
+    TriangleMesh cube;
+    REQUIRE(Read(dir.Write("cube.obj", kCubeObj), &cube, &error) == Status::kOk);
+    std::string ascii = "solid cube\n", binary(80, ' ');
+    const uint32_t count = static_cast<uint32_t>(cube.triangles.size());
+    binary.append(reinterpret_cast<const char*>(&count), 4);
+    for (size_t t = 0; t < cube.triangles.size(); ++t) {
+      const Vec3 n = Normalize(TriangleCross(cube, t));
+      ascii += "facet normal " + std::to_string(n.x) + " " + std::to_string(n.y) + " " +
+               std::to_string(n.z) + "\nouter loop\n";
+      float f[12] = {static_cast<float>(n.x), static_cast<float>(n.y), static_cast<float>(n.z)};
+      for (int c = 0; c < 3; ++c) {
+        const Vec3& v = cube.vertices[cube.triangles[t][c]];
+        ascii += "vertex " + std::to_string(v.x) + " " + std::to_string(v.y) + " " +
+                 std::to_string(v.z) + "\n";
+        f[3 + 3 * c] = static_cast<float>(v.x), f[4 + 3 * c] = static_cast<float>(v.y),
+                  f[5 + 3 * c] = static_cast<float>(v.z);
+      }
+      ascii += "endloop\nendfacet\n";
+      binary.append(reinterpret_cast<const char*>(f), sizeof f);
+      binary.append(2, '\0');
+    }
+    ascii += "endsolid cube\n";
+    REQUIRE(Read(dir.Write("ascii.stl", ascii), &mesh, &error) == Status::kOk);
+    CheckCube(mesh);
+    REQUIRE(Read(dir.Write("binary.stl", binary), &mesh, &error) == Status::kOk);
+    CheckCube(mesh);
+    SECTION("a truncated binary STL is refused") {
+      CHECK(Read(dir.Write("cut.stl", binary.substr(0, binary.size() - 30)), &mesh, &error) ==
+            Status::kParseError);
+      CHECK(Contains(error, "cut.stl: truncated: binary STL declares 12 triangles"));
+    }
+  }
+}
+
+TEST_CASE("ReadMesh: degenerate faces are skipped and counted", "[import][mesh]") {
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  MeshReadReport report;
+  const std::string obj =
+      "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nv 2 0 0\n"
+      "f 1 4 3\nf 1 3 2\nf 1 2 5\nf 2 2 3\n";  // 1 2 5 is collinear, 2 2 3 repeats a vertex
+  REQUIRE(Read(dir.Write("degenerate.obj", obj), &mesh, &error, &report) == Status::kOk);
+  CHECK(mesh.triangles.size() == 2);
+  CHECK(report.skipped_faces == 2);
+  CHECK(SurfaceArea(mesh) == Approx(1));
+}
+
+TEST_CASE("ReadMesh: bad meshes give clear errors", "[import][mesh]") {
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  SECTION("empty file") {
+    CHECK(Read(dir.Write("empty.obj", ""), &mesh, &error) == Status::kParseError);
+    CHECK(Contains(error, "empty.obj: the file is empty"));
+  }
+  SECTION("vertices but no faces") {
+    CHECK(Read(dir.Write("points.obj", "v 0 0 0\nv 1 0 0\n"), &mesh, &error) ==
+          Status::kParseError);
+    CHECK(Contains(error, "no faces"));
+  }
+  SECTION("non-manifold edge") {
+    const std::string obj =
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n";
+    CHECK(Read(dir.Write("fin.obj", obj), &mesh, &error) == Status::kParseError);
+    CHECK(Contains(error, "fin.obj: the mesh is not manifold"));
+  }
+  SECTION("NaN vertex") {
+    CHECK(Read(dir.Write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"), &mesh, &error) ==
+          Status::kParseError);
+    CHECK(Contains(error, "nan.obj:2: vertex coordinate 'nan' is not a finite number"));
+    CHECK(Read(dir.Write("nan.off", "OFF\n3 1 0\n0 0 0\n1 inf 0\n0 1 0\n3 0 1 2\n"), &mesh,
+               &error) == Status::kParseError);
+    CHECK(Contains(error, "nan.off:4:"));
+  }
+  SECTION("truncated files") {
+    const std::string cube = kCubeObj;
+    CHECK(Read(dir.Write("cut.obj", cube.substr(0, cube.size() - 5)), &mesh, &error) ==
+          Status::kParseError);
+    CHECK(Contains(error, "cut.obj:15: face has 2 vertices"));
+    CHECK(Read(dir.Write("cut.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n"), &mesh,
+               &error) == Status::kParseError);
+    CHECK(Contains(error, "cut.off: truncated: header declares 2 faces, found 1"));
+    const std::string ply =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+        "property float y\nproperty float z\nelement face 1\n"
+        "property list uchar int vertex_indices\nend_header\n" + std::string(20, '\0');
+    CHECK(Read(dir.Write("cut.ply", ply), &mesh, &error) == Status::kParseError);
+    CHECK(Contains(error, "cut.ply: truncated"));
+    CHECK(Read(dir.Write("missing.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n"), &mesh, &error) ==
+          Status::kParseError);
+    CHECK(Contains(error, "missing.obj:3: face uses vertex 3 but only 2 vertices"));
+  }
+  SECTION("missing file and unknown extension") {
+    CHECK(Read(dir.File("absent.obj"), &mesh, &error) == Status::kIoError);
+    CHECK(Contains(error, "absent.obj: cannot open"));
+    RawSamples samples;
+    CHECK(LoadTerrain(dir.Write("terrain.xyzw", "1 2 3"), TerrainLoadOptions{}, &samples,
+                      &error) == Status::kInvalidArgument);
+    CHECK(Contains(error, "unknown terrain file extension 'xyzw'"));
+  }
+}
+
+TEST_CASE("LoadTerrain: meshes are resampled at the separation", "[import][mesh]") {
+  test::TempDir dir;
+  TerrainLoadOptions options;
+  options.separation = 0.1;
+  RawSamples samples;
+  std::string error;
+  TerrainLoadReport report;
+  REQUIRE(LoadTerrain(dir.Write("cube.obj", kCubeObj), options, &samples, &error, &report) ==
+          Status::kOk);
+  CHECK(report.format == "mesh");
+  CHECK(report.faces == 6);
+  CHECK(report.area == Approx(6));
+  CHECK(report.separation == 0.1);
+  CHECK(report.samples == samples.size());
+  CHECK(samples.size() > 0.9 * 6 / (0.1 * 0.1));  // fewer near the edges, where faces meet
+  CHECK(report.bounds_min.x >= 0);
+  CHECK(report.bounds_max.y <= 1);
+}
+
+}  // namespace footfall

@@ -1,0 +1,181 @@
+#include "footfall/import/mesh_sampler.h"
+
+#include <cmath>
+
+#include "footfall/import/mesh_generators.h"
+#include "footfall/terrain/grid.h"
+#include "test_support.h"
+
+namespace footfall {
+namespace {
+
+double Diagonal(const TriangleMesh& mesh) {
+  Vec3 lo, hi;
+  MeshBounds(mesh, &lo, &hi);
+  return Distance(lo, hi);
+}
+
+RawSamples Sample(const TriangleMesh& mesh, double s, bool smooth = true, uint64_t seed = 1) {
+  MeshSampleOptions o;
+  o.separation = s, o.smooth_normals = smooth, o.seed = seed;
+  RawSamples out;
+  std::string error;
+  REQUIRE(SampleMesh(mesh, o, &out, &error) == Status::kOk);
+  REQUIRE(out.size() > 0);
+  return out;
+}
+
+// Largest distance from `probes` to their nearest sample (brute force via the exact grid).
+double LargestGap(const RawSamples& samples, const RawSamples& probes) {
+  TerrainGrid grid;
+  std::string error;
+  REQUIRE(TerrainGrid::Build(samples, GridOptions{}, &grid, &error) == Status::kOk);
+  double gap = 0;
+  for (const Vec3& p : probes.points) gap = std::max(gap, Distance(p, grid.Snap(p).point));
+  return gap;
+}
+
+TriangleMesh Square(double size) {
+  TriangleMesh m;
+  m.vertices = {{0, 0, 0}, {size, 0, 0}, {size, 0, size}, {0, 0, size}};
+  m.triangles = {{0, 2, 1}, {0, 3, 2}};
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("SampleMesh: samples lie on the mesh", "[import][sampler]") {
+  const TriangleMesh meshes[] = {MakeSphereMesh({1, 2, 3}, 2.0, 3), MakeRocksMesh(20, 0.5, 1.5, 3),
+                                 MakeBlocksMesh(6, 6, 3, 5)};
+  for (const TriangleMesh& mesh : meshes) {
+    const RawSamples s = Sample(mesh, 0.3);
+    const double limit = 1e-5 * Diagonal(mesh);
+    double worst = 0;
+    for (const Vec3& p : s.points) worst = std::max(worst, test::DistanceToMesh(mesh, p));
+    CHECK(worst < limit);
+  }
+}
+
+TEST_CASE("SampleMesh: no surface point is farther than the separation from a sample",
+          "[import][sampler]") {
+  const TriangleMesh meshes[] = {MakeSphereMesh({0, 0, 0}, 2.0, 3), MakeRocksMesh(30, 0.3, 1.0, 9),
+                                 MakeBlocksMesh(5, 5, 3, 2), MakeRampsMesh({15, -30, 45}, 2, 1.5)};
+  for (const TriangleMesh& mesh : meshes) {
+    for (double s : {0.2, 0.45}) {
+      const RawSamples samples = Sample(mesh, s);
+      RawSamples probes;
+      SampleMeshUniform(mesh, 20000, true, 77, &probes);
+      // The vertices are the hardest points to reach (corners of the surface).
+      for (const Vec3& v : mesh.vertices) probes.push_back(v, {0, 1, 0});
+      CHECK(LargestGap(samples, probes) <= s * (1 + 1e-5));
+    }
+  }
+}
+
+TEST_CASE("SampleMesh: samples do not clump", "[import][sampler]") {
+  const TriangleMesh mesh = MakeRocksMesh(10, 0.4, 0.8, 4);
+  const double s = 0.25;
+  const RawSamples samples = Sample(mesh, s);
+  double closest = 1e9;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    for (size_t j = i + 1; j < samples.size(); ++j) {
+      closest = std::min(closest, Distance(samples.points[i], samples.points[j]));
+    }
+  }
+  CHECK(closest >= 2 * s / 3 * (1 - 1e-5));
+}
+
+TEST_CASE("SampleMesh: counts scale with area / s^2", "[import][sampler]") {
+  SECTION("halving the separation about quadruples the count") {
+    const TriangleMesh mesh = Square(10);
+    const size_t coarse = Sample(mesh, 0.4).size(), fine = Sample(mesh, 0.2).size();
+    const double ratio = static_cast<double>(fine) / coarse;
+    CHECK(ratio > 3.6);
+    CHECK(ratio < 4.4);
+  }
+  SECTION("doubling the area doubles the count; density is about 1.6 / s^2") {
+    const double s = 0.3;
+    const size_t one = Sample(Square(10), s).size();
+    const size_t two = Sample(Square(10 * std::sqrt(2.0)), s).size();
+    CHECK(static_cast<double>(two) / one == Approx(2).epsilon(0.08));
+    const double density = one * s * s / 100.0;
+    CHECK(density > 1.3);
+    CHECK(density < 1.9);
+  }
+  SECTION("a mesh of many tiny triangles gets as many samples as a coarse one") {
+    const size_t coarse = Sample(Square(8), 0.5).size();
+    TriangleMesh fine = MakeRocksMesh(200, 8.0 / 200, 0.0, 1);  // flat, 80,000 triangles
+    const size_t many = Sample(fine, 0.5).size();
+    CHECK(static_cast<double>(many) / coarse == Approx(1).epsilon(0.1));
+  }
+}
+
+TEST_CASE("SampleMesh: normals are unit and agree with the faces", "[import][sampler]") {
+  const TriangleMesh sphere = MakeSphereMesh({0, 0, 0}, 2.0, 2);
+  for (bool smooth : {true, false}) {
+    const RawSamples s = Sample(sphere, 0.25, smooth);
+    for (size_t i = 0; i < s.size(); ++i) {
+      CHECK(Length(s.normals[i]) == Approx(1).epsilon(1e-9));
+      size_t t = 0;
+      test::DistanceToMesh(sphere, s.points[i], &t);
+      const Vec3 face = Normalize(TriangleCross(sphere, t));
+      CHECK(Dot(s.normals[i], face) > 0.9);
+      if (!smooth) CHECK(Distance(s.normals[i], face) < 1e-12);
+    }
+  }
+}
+
+TEST_CASE("SampleMesh: smooth and flat normals differ where they should", "[import][sampler]") {
+  SECTION("on a sphere smooth normals follow the radius more closely than face normals") {
+    const TriangleMesh sphere = MakeSphereMesh({0, 0, 0}, 2.0, 2);
+    const RawSamples smooth = Sample(sphere, 0.2, true), flat = Sample(sphere, 0.2, false);
+    REQUIRE(smooth.points == flat.points);  // the normal rule does not move samples
+    double smooth_error = 0, flat_error = 0, largest_difference = 0;
+    for (size_t i = 0; i < smooth.size(); ++i) {
+      const Vec3 radial = Normalize(smooth.points[i]);
+      smooth_error += std::acos(std::min(1.0, Dot(smooth.normals[i], radial)));
+      flat_error += std::acos(std::min(1.0, Dot(flat.normals[i], radial)));
+      largest_difference = std::max(largest_difference, Distance(smooth.normals[i], flat.normals[i]));
+    }
+    CHECK(smooth_error < 0.5 * flat_error);
+    CHECK(largest_difference > 0.05);
+  }
+  SECTION("on a plane they are equal") {
+    const RawSamples smooth = Sample(Square(4), 0.3, true), flat = Sample(Square(4), 0.3, false);
+    for (size_t i = 0; i < smooth.size(); ++i) {
+      CHECK(Distance(smooth.normals[i], {0, 1, 0}) < 1e-12);
+      CHECK(Distance(flat.normals[i], {0, 1, 0}) < 1e-12);
+    }
+  }
+}
+
+TEST_CASE("SampleMesh: deterministic for a seed", "[import][sampler]") {
+  const TriangleMesh mesh = MakeRocksMesh(12, 0.5, 1.0, 2);
+  const RawSamples a = Sample(mesh, 0.3, true, 5), b = Sample(mesh, 0.3, true, 5);
+  const RawSamples c = Sample(mesh, 0.3, true, 6);
+  CHECK(a.points == b.points);
+  CHECK(a.normals == b.normals);
+  CHECK(a.points != c.points);
+}
+
+TEST_CASE("SampleMesh: bad options are refused", "[import][sampler]") {
+  const TriangleMesh mesh = Square(10);
+  MeshSampleOptions o;
+  RawSamples out;
+  std::string error;
+  o.separation = 0;
+  CHECK(SampleMesh(mesh, o, &out, &error) == Status::kInvalidArgument);
+  CHECK(error.find("separation") != std::string::npos);
+  o.separation = NAN;
+  CHECK(SampleMesh(mesh, o, &out, &error) == Status::kInvalidArgument);
+  o.separation = 1e-4;
+  CHECK(SampleMesh(mesh, o, &out, &error) == Status::kLimitExceeded);
+  CHECK(error.find("larger separation") != std::string::npos);
+  TriangleMesh bad = mesh;
+  bad.vertices[1].y = NAN;
+  o.separation = 1;
+  CHECK(SampleMesh(bad, o, &out, &error) == Status::kInvalidArgument);
+  CHECK(error.find("vertex 1") != std::string::npos);
+}
+
+}  // namespace footfall
