@@ -20,8 +20,9 @@ Character LoadShipped(const std::string& name) {
   return c;
 }
 
-Terrain LoadTerrain(const RawSamples& samples) {
+Terrain LoadTerrain(const RawSamples& samples, double spacing) {
   Terrain t;
+  t.spacing = spacing;
   t.session = MakeEmbeddedSession();
   t.samples = samples;
   REQUIRE(t.session->LoadSamples(samples, "test", &t.handle) == Status::kOk);
@@ -91,6 +92,7 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
   CHECK(off_terrain == 0);
   // Planted feet stay put; arcs clear the terrain; phases in order.
   std::vector<Vec3> arc;
+  std::vector<double> need;  // required clearance at each arc point
   for (size_t f = 0; f < c.feet.size(); ++f) {
     const auto& k = tracks[f]->keys;
     for (size_t i = 0; i + 1 < k.size(); ++i) {
@@ -98,16 +100,20 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
         REQUIRE(k[i + 1].phase == KeyPhase::kStart);
         REQUIRE(k[i + 1].position == k[i].position);
       }
-      if (k[i].phase == KeyPhase::kStart) {
-        REQUIRE(i + 2 < k.size());
-        REQUIRE(k[i + 1].phase == KeyPhase::kMid);
-        REQUIRE(k[i + 2].phase == KeyPhase::kEnd);
-        for (int j = 1; j < 10; ++j) {
-          const double s = j / 10.0;
-          arc.push_back(s <= 0.5 ? Lerp(k[i].position, k[i + 1].position, 2 * s)
-                                 : Lerp(k[i + 1].position, k[i + 2].position, 2 * s - 1));
-        }
+      if (k[i].phase != KeyPhase::kStart) continue;
+      REQUIRE(i + 2 < k.size());
+      REQUIRE(k[i + 1].phase == KeyPhase::kMid);
+      REQUIRE(k[i + 2].phase == KeyPhase::kEnd);
+      auto at = [&](double s) {
+        return s <= 0.5 ? Lerp(k[i].position, k[i + 1].position, 2 * s)
+                        : Lerp(k[i + 1].position, k[i + 2].position, 2 * s - 1);
+      };
+      for (int j = 1; j < 8; ++j) {
+        const double s = j / 8.0;
+        arc.push_back(at(s));
+        need.push_back(0.25 * c.step_height * (1 - std::fabs(2 * s - 1)) - 1e-6);
       }
+      for (int j = 1; j < 10; ++j) arc.push_back(at(j / 10.0)), need.push_back(-t.spacing - 1e-6);
     }
   }
   std::vector<Foothold> arc_snap(arc.size());
@@ -116,9 +122,10 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
   double worst = 0;
   for (size_t i = 0; i < arc.size(); ++i) {
     const double clearance = Dot(arc[i] - arc_snap[i].point, arc_snap[i].normal);
-    if (clearance < 0) ++below, worst = std::min(worst, clearance);
+    if (clearance < need[i]) ++below, worst = std::min(worst, clearance - need[i]);
   }
-  INFO("arc points below the terrain: " << below << " of " << arc.size() << ", worst " << worst);
+  INFO("arc points not clear of the terrain: " << below << " of " << arc.size() << ", worst by "
+                                               << worst);
   CHECK(below == 0);
   // The body follows the feet.
   const Vec3 world_up = Normalize(o.up);

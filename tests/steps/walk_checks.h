@@ -22,8 +22,9 @@ struct Terrain {
   std::unique_ptr<TerrainSession> session;
   TerrainHandle handle = 0;
   RawSamples samples;
+  double spacing = 0;  // distance between neighbouring samples [Units: wu]
 };
-Terrain LoadTerrain(const RawSamples& samples);
+Terrain LoadTerrain(const RawSamples& samples, double spacing);
 
 // Generates a walk (REQUIREs kOk).
 Walk Generate(Terrain& t, const Character& c, const GenerateOptions& o);
@@ -36,7 +37,9 @@ Vec3 FootAt(const WalkTrack& track, double frame);
 //  - every start and end key lies on a terrain sample (snapping it returns the same point and
 //    normal);
 //  - a planted foot does not move between its end key and its next start key;
-//  - the swing arc start-mid-end does not pass below the terrain;
+//  - the swing arc start-mid-end clears the terrain: at the generator's check points
+//    (s = 1/8 .. 7/8 of the polyline) by a quarter of the nominal clearance, and nowhere (s =
+//    0.1 .. 0.9) by more than one sample spacing below it;
 //  - every body key sits body_height along its up above the centroid of the feet at that frame,
 //    and every foot is within reach of it;
 //  - the feet step in the declared gait order, one group per step.

@@ -12,15 +12,19 @@ namespace {
 
 using namespace steps_detail;
 
-constexpr int kMaxAttempts = 3;       // foothold queries per foot and step (shorter each time)
-constexpr double kRetryScale = 0.5;   // step length factor between attempts
+// Foothold queries per foot and step: the step vector scaled by these factors in turn (shorter,
+// then longer: over a stair's riser, then shorter still).
+constexpr int kMaxAttempts = 4;
+constexpr double kAttemptScale[kMaxAttempts] = {1.0, 0.6, 1.35, 0.3};
 constexpr int kMaxRaises = 8;         // swing arc raises before giving up
 constexpr double kRaise = 0.5;        // raise per round, in step heights
-constexpr int kArcChecks = 3;         // points checked along the start-mid-end arc
-constexpr double kArcS[kArcChecks] = {0.25, 0.5, 0.75};
+constexpr int kArcChecks = 7;         // points checked along the start-mid-end arc
+constexpr double kArcS[kArcChecks] = {0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875};
 // Required clearance at each check point, as a fraction of the arc's nominal clearance there
-// (half the step height at the quarter points, the step height at the mid key).
-constexpr double kClearanceFraction = 0.5;
+// (the step height at the mid key, falling linearly to 0 at the start and end keys).
+constexpr double kClearanceFraction = 0.25;
+// A step shorter than this fraction of step_length is a step in place: no foothold query.
+constexpr double kInPlace = 0.02;
 
 std::string Point(const Vec3& p) {
   std::ostringstream o;
@@ -55,6 +59,7 @@ struct Move {
   Vec3 end, end_normal;  // the accepted foothold
   Vec3 mid, mid_normal;
   Vec3 ideal;            // the last query's ideal point
+  Vec3 step;             // the last query's step vector
 };
 
 class Generator {
@@ -316,7 +321,7 @@ Status Generator::Setup(std::string* error) {
 Status Generator::QueryFootholds(std::vector<Move>& moves, const std::vector<Vec3>& locator,
                                  const std::vector<Vec3>& locator_normal, std::string* error) {
   const size_t feet = c_.feet.size();
-  std::vector<size_t> pending;
+  std::vector<size_t> pending, queried;
   for (size_t m = 0; m < moves.size(); ++m) pending.push_back(m);
   std::vector<Vec3> new_normals(feet);
   while (!pending.empty()) {
@@ -324,6 +329,7 @@ Status Generator::QueryFootholds(std::vector<Move>& moves, const std::vector<Vec
     //    central locator (aligned to the terrain normal under it). The step vector runs from
     //    the foot to its target; slope awareness and the reach limit shorten it.
     queries_.clear();
+    queried.clear();
     for (size_t m : pending) {
       Move& mv = moves[m];
       Agent& a = agents_[mv.agent];
@@ -335,12 +341,16 @@ Status Generator::QueryFootholds(std::vector<Move>& moves, const std::vector<Vec
       const Vec3 d = c_.feet[mv.foot].rest - pair_centre_[p];
       const Vec3 target = locator[m] + l * d.x + n * d.y + f * d.z;
       const double slope = Degrees(std::asin(std::min(1.0, std::fabs(Dot(f, a.up)))));
-      double max_len = c_.step_length * mv.scale;
+      double max_len = c_.step_length;
       if (slope > c_.slope_threshold_deg) max_len *= c_.slope_step_scale;
       Vec3 v = target - a.foot[mv.foot];
       const double len = Length(v);
       if (len > max_len) v = v * (max_len / len);
-      if (Length(v) < 1e-3 * c_.step_length) v = f * (1e-3 * c_.step_length);
+      v = v * mv.scale;  // retries step shorter
+      if (Length(v) < kInPlace * c_.step_length) {
+        mv.done = true, mv.end = a.foot[mv.foot], mv.end_normal = a.foot_normal[mv.foot];
+        continue;
+      }
       // No target beyond reach of the body where the step will put it (the feet's centroid
       // moves by this foot's displacement over the number of feet).
       for (int shrink = 0; shrink < 8; ++shrink) {
@@ -349,25 +359,36 @@ Status Generator::QueryFootholds(std::vector<Move>& moves, const std::vector<Vec
         if (Distance(a.foot[mv.foot] + v, body) <= c_.reach) break;
         v = v * 0.75;
       }
-      mv.ideal = a.foot[mv.foot] + v;
+      mv.ideal = a.foot[mv.foot] + v, mv.step = v;
       queries_.push_back({a.foot[mv.foot], v});
+      queried.push_back(m);
     }
     // 8. Query the next foothold of every pending foot of every character: one batch. The
     //    answer carries the end normal; the start normal is the planted foot's.
+    if (queries_.empty()) break;
     answers_.resize(queries_.size());
     const Status s = Check(session_.Next(terrain_, queries_.data(), queries_.size(),
                                          0.5 * c_.step_length, answers_.data()),
                            "next foothold", error);
     if (s != Status::kOk) return s;
-    for (size_t q = 0; q < pending.size(); ++q) {
-      Move& mv = moves[pending[q]];
+    for (size_t q = 0; q < queried.size(); ++q) {
+      Move& mv = moves[queried[q]];
       const Agent& a = agents_[mv.agent];
       const Foothold& h = answers_[q];
       const Vec3& foot = a.foot[mv.foot];
       std::ostringstream why;
       why.precision(3);
       ++mv.attempts;
-      if (h.status != Status::kOk) {
+      // A foothold must make half the intended progress along the ground it lands on (the step
+      // vector projected onto its tangent plane), so no foot creeps sideways along a cliff's
+      // edge. Steps mostly along the foothold's normal (onto a wall ahead) are exempt.
+      double progress = 1;
+      if (h.status == Status::kOk) {
+        const Vec3 along = ProjectOnPlane(mv.step, h.normal);
+        if (Length2(along) >= 0.25 * Length2(mv.step))
+          progress = Dot(h.point - foot, along) / Length2(along);
+      }
+      if (h.status != Status::kOk || progress < 0.5) {
         why << "no foothold within " << 0.5 * c_.step_length << " of " << Point(mv.ideal)
             << " (a gap or a cliff)";
       } else {
@@ -400,6 +421,8 @@ Status Generator::QueryFootholds(std::vector<Move>& moves, const std::vector<Vec
         Vec3 centroid;
         for (const Vec3& p : feet_now) centroid += p;
         const Vec3 body = centroid / static_cast<double>(feet) + BodyUp(a, new_normals) * c_.body_height;
+        std::vector<bool> moving(feet, false);
+        for (size_t i = m; i < e; ++i) moving[moves[i].foot] = true;
         for (size_t i = m; i < e; ++i) {
           const double dist = Distance(moves[i].end, body);
           if (dist > c_.reach) {
@@ -410,6 +433,18 @@ Status Generator::QueryFootholds(std::vector<Move>& moves, const std::vector<Vec
             moves[i].done = false, moves[i].reason = why.str();
           }
         }
+        // A planted foot the body would leave beyond reach: every moving foot steps shorter.
+        for (size_t f = 0; f < feet; ++f) {
+          const double dist = Distance(feet_now[f], body);
+          if (moving[f] || dist <= c_.reach) continue;
+          std::ostringstream why;
+          why.precision(3);
+          why << "the step would leave foot " << c_.feet[f].name << " " << dist
+              << " from the body, beyond reach " << c_.reach;
+          for (size_t i = m; i < e; ++i)
+            if (moves[i].done) moves[i].done = false, moves[i].reason = why.str();
+          break;
+        }
       }
       m = e;
     }
@@ -418,7 +453,7 @@ Status Generator::QueryFootholds(std::vector<Move>& moves, const std::vector<Vec
       Move& mv = moves[m];
       if (mv.done || mv.failed) continue;
       if (mv.attempts >= kMaxAttempts) mv.failed = true;
-      else mv.scale *= kRetryScale, pending.push_back(m);
+      else mv.scale = kAttemptScale[mv.attempts], pending.push_back(m);
     }
   }
   return Status::kOk;
@@ -485,8 +520,9 @@ Status Generator::Step(int k, std::string* error) {
   // 5. Heading: turn toward the current waypoint of the path (at most max_turn_deg).
   for (Agent& a : agents_)
     if (a.walking) Steer(a);
-  // 6. Central locators: one per foot pair stepping now, lead ahead of the pair's rest centre
-  //    in the body frame, snapped to the terrain (one batch for every character).
+  // 6. Central locators: one per foot pair stepping now, `lead` ahead of the pair's rest centre
+  //    in the body frame and lead/2 above it (so that at a wall ahead the locator snaps onto the
+  //    wall, not into the corner), snapped to the terrain (one batch for every character).
   std::vector<Move> moves;
   std::vector<size_t> locator_of_move;
   points_.clear();
@@ -495,7 +531,7 @@ Status Generator::Step(int k, std::string* error) {
     if (!a.walking) continue;
     const size_t base = points_.size();
     for (int p : pairs_of_group_[group])
-      points_.push_back(Place(a, pair_centre_[p]) + a.forward * lead_);
+      points_.push_back(Place(a, pair_centre_[p]) + a.forward * lead_ + a.up * (0.5 * lead_));
     for (int f : c_.gait[group]) {
       Move mv;
       mv.agent = i, mv.foot = f;
@@ -509,10 +545,18 @@ Status Generator::Step(int k, std::string* error) {
   Status s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()),
                    "snap locators", error);
   if (s != Status::kOk) return s;
+  // A locator that snapped farther than `lead` from where it was placed hangs over a gap or a
+  // cliff: it keeps its place (the body's frame), so the foothold query looks over the void.
   std::vector<Vec3> locator(moves.size()), locator_normal(moves.size());
   for (size_t m = 0; m < moves.size(); ++m) {
     const Foothold& h = answers_[locator_of_move[m]];
-    locator[m] = h.point, locator_normal[m] = h.normal;
+    const Vec3& placed = points_[locator_of_move[m]];
+    const Agent& a = agents_[moves[m].agent];
+    if (Distance(h.point, placed) <= lead_) {
+      locator[m] = h.point, locator_normal[m] = h.normal;
+    } else {
+      locator[m] = placed - a.up * (0.5 * lead_), locator_normal[m] = a.up;
+    }
   }
   s = QueryFootholds(moves, locator, locator_normal, error);
   if (s != Status::kOk) return s;
@@ -536,6 +580,15 @@ Status Generator::Step(int k, std::string* error) {
     while (e < moves.size() && moves[e].agent == moves[m].agent) {
       if (!moves[e].done && !failed) failed = &moves[e];
       ++e;
+    }
+    bool in_place = true;
+    for (size_t i = m; i < e; ++i) in_place &= moves[i].done && moves[i].end == a.foot[moves[i].foot];
+    if (in_place && !failed) {
+      Stop(a, k + 1,
+           "no way forward from " + Point(a.ground) +
+               ": every target is where its foot already stands (a cliff, a gap or a dead end)");
+      m = e;
+      continue;
     }
     if (failed) {
       Stop(a, k + 1,
