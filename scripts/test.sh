@@ -3,6 +3,12 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh core test viewer
+# The Khronos glTF validator for the export tests, in a local npm prefix (nothing global).
+# All gltf-validator 2.x releases on npm are pre-releases, so the version is pinned exactly.
+if [ ! -f build/node/node_modules/gltf-validator/package.json ]; then
+  npm install --prefix build/node --no-audit --no-fund --loglevel=error \
+    gltf-validator@2.0.0-dev.3.10 >/dev/null
+fi
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$(nproc)"
 cd build

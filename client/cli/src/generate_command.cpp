@@ -1,5 +1,5 @@
 // `footfall generate`: places the footsteps of a character (or a crowd) on a terrain and writes
-// the keyed walk (JSON; glTF and MEL once the exporters are linked in).
+// the keyed walk as JSON, glTF (.gltf, .glb) or a Maya MEL script.
 #include <unistd.h>
 
 #include <charconv>
@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "footfall/export/walk_writer.h"
 #include "footfall/steps/generator.h"
 #include "footfall/steps/walk_json.h"
 #include "terrain_flags.h"
@@ -74,10 +75,7 @@ std::string Extension(const std::string& path) {
 Status WriteOutput(const Walk& walk, const std::string& path, std::string* error) {
   const std::string ext = Extension(path);
   if (ext == "json") return WriteWalkJson(walk, path, error);
-  if (ext == "gltf" || ext == "glb" || ext == "mel") {
-    *error = path + ": unsupported output ." + ext + " (this build writes .json only)";
-    return Status::kInvalidArgument;
-  }
+  if (IsWalkExportPath(path)) return WriteWalk(walk, path, error);
   *error = path + ": unsupported output extension (expected .json, .gltf, .glb or .mel)";
   return Status::kInvalidArgument;
 }

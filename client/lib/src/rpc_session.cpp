@@ -1,21 +1,11 @@
 // The RPC backend: a footfalld client over TCP.
 //
-// Connections are made with our own socket (non-blocking connect with a timeout), then wrapped
-// with clnt_vc_create using a send size that keeps every request in one record fragment
-// (footfalld's non-blocking transport drops multi-fragment requests). A transport failure
-// destroys the client; the next call reconnects, and reloads a terrain the server no longer
-// knows (it restarted).
-#include <fcntl.h>
-#include <netdb.h>
-#include <netinet/in.h>
-#include <netinet/tcp.h>
-#include <poll.h>
+// Connections are made by ConnectFootfalld (rpc_connect.h): a bounded connect, and every
+// request in one record fragment. A transport failure destroys the client; the next call
+// reconnects, and reloads a terrain the server no longer knows (it restarted).
 #include <rpc/rpc.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <csignal>
 #include <cstring>
@@ -23,6 +13,7 @@
 
 #include "footfall.h"
 #include "footfall/client/terrain_session.h"
+#include "rpc_connect.h"
 
 namespace footfall {
 namespace {
@@ -336,76 +327,10 @@ class RpcSession final : public TerrainSession {
 
   Status EnsureConnected() {
     if (client_) return Status::kOk;
-    addrinfo hints{};
-    hints.ai_family = AF_UNSPEC;
-    hints.ai_socktype = SOCK_STREAM;
-    addrinfo* found = nullptr;
-    const std::string port = std::to_string(options_.port);
-    const int gai = getaddrinfo(options_.host.c_str(), port.c_str(), &hints, &found);
-    if (gai != 0) {
-      return Fail(Status::kUnavailable, "footfalld at " + Address() + ": cannot resolve host: " +
-                                            gai_strerror(gai));
-    }
-    std::string reason = "no address";
-    for (addrinfo* a = found; a && !client_; a = a->ai_next) {
-      const int fd = ConnectWithTimeout(a, &reason);
-      if (fd < 0) continue;
-      netbuf address;
-      address.maxlen = address.len = static_cast<unsigned>(a->ai_addrlen);
-      address.buf = a->ai_addr;
-      client_ = clnt_vc_create(fd, &address, FOOTFALL_PROG, FOOTFALL_V1, FF_MAX_REQUEST_BYTES,
-                               FF_MAX_REQUEST_BYTES);
-      if (!client_) {
-        reason = "cannot create RPC client";
-        close(fd);
-        continue;
-      }
-      int close_fd = 1;
-      clnt_control(client_, CLSET_FD_CLOSE, reinterpret_cast<char*>(&close_fd));
-      timeval timeout;
-      timeout.tv_sec = static_cast<time_t>(options_.call_timeout_s);
-      timeout.tv_usec = static_cast<suseconds_t>(
-          (options_.call_timeout_s - static_cast<double>(timeout.tv_sec)) * 1e6);
-      clnt_control(client_, CLSET_TIMEOUT, reinterpret_cast<char*>(&timeout));
-    }
-    freeaddrinfo(found);
+    std::string reason;
+    client_ = ConnectFootfalld(options_, &reason);
     if (!client_) return Fail(Status::kUnavailable, "footfalld at " + Address() + ": " + reason);
     return Status::kOk;
-  }
-
-  int ConnectWithTimeout(const addrinfo* a, std::string* reason) {
-    const int fd = socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
-    if (fd < 0) {
-      *reason = std::strerror(errno);
-      return -1;
-    }
-    const int flags = fcntl(fd, F_GETFL, 0);
-    fcntl(fd, F_SETFL, flags | O_NONBLOCK);
-    int rc = connect(fd, a->ai_addr, a->ai_addrlen);
-    if (rc != 0 && errno == EINPROGRESS) {
-      pollfd p{fd, POLLOUT, 0};
-      const int ms = static_cast<int>(options_.connect_timeout_s * 1000);
-      rc = poll(&p, 1, std::max(1, ms));
-      if (rc == 0) {
-        *reason = "connection timed out";
-        close(fd);
-        return -1;
-      }
-      int err = 0;
-      socklen_t len = sizeof err;
-      getsockopt(fd, SOL_SOCKET, SO_ERROR, &err, &len);
-      rc = err == 0 ? 0 : -1;
-      errno = err;
-    }
-    if (rc != 0) {
-      *reason = std::strerror(errno);
-      close(fd);
-      return -1;
-    }
-    fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
-    const int one = 1;
-    setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-    return fd;
   }
 
   RpcOptions options_;

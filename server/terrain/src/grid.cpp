@@ -239,63 +239,139 @@ double TerrainGrid::CellHi(uint32_t i, int axis) const {
 template <typename Scanner>
 void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
   if (count_ == 0) return;
-  // Boxes are padded so that rounding in cell assignment can never prune a sample.
+  // Cell boxes are padded so that rounding in cell assignment can never prune a sample.
   const double pad = 1e-9 * (cell_size_ + std::fabs(c[0]) + std::fabs(c[1]) + std::fabs(c[2]) +
                              (bounds_hi_[0] - bounds_lo_[0]) + (bounds_hi_[1] - bounds_lo_[1]) +
                              (bounds_hi_[2] - bounds_lo_[2]));
-  auto gap2 = [&](double v, double lo, double hi) {
+  auto gap2 = [pad](double v, double lo, double hi) {
     const double d = v < lo - pad ? lo - pad - v : v > hi + pad ? v - hi - pad : 0.0;
     return d * d;
   };
-  const int64_t ci[3] = {CellCoord(c[0], 0), CellCoord(c[1], 1), CellCoord(c[2], 2)};
   const int64_t n[3] = {dims_[0], dims_[1], dims_[2]};
-  double whole_lo[3], whole_hi[3];
-  for (int a = 0; a < 3; ++a) whole_lo[a] = CellLo(0, a), whole_hi[a] = CellHi(dims_[a] - 1, a);
-  for (int64_t r = 0;; ++r) {
-    if (r > 0) {
-      // Lower bound on the distance to any cell at Chebyshev radius >= r: the nearest of the
-      // slabs beyond the shell on each side of each axis, within the whole grid box.
-      double bound2 = kInf;
-      bool any = false;
+  const int64_t ci[3] = {CellCoord(c[0], 0), CellCoord(c[1], 1), CellCoord(c[2], 2)};
+  // Visits one cell; lo/hi are its padded box, needed only by scanners that test boxes.
+  auto visit_cell = [&](int64_t i, int64_t j, int64_t k, const double* lo, const double* hi) {
+    const size_t cell = (static_cast<size_t>(k) * n[1] + j) * n[0] + i;
+    const uint32_t b = cell_start_[cell], e = cell_start_[cell + 1];
+    if (b == e) return;
+    if (Scanner::kUsesBox && !scanner.KeepCell(lo, hi)) return;
+    scanner.Scan(static_cast<uint32_t>(cell), b, e);
+  };
+  auto visit = [&](int64_t i, int64_t j, int64_t k) {
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    if (Scanner::kUsesBox) {
+      const int64_t idx[3] = {i, j, k};
       for (int a = 0; a < 3; ++a) {
-        double rest = 0;
-        for (int b = 0; b < 3; ++b)
-          if (b != a) rest += gap2(c[b], whole_lo[b], whole_hi[b]);
-        if (ci[a] + r <= n[a] - 1) {
-          any = true;
-          bound2 = std::min(bound2, rest + gap2(c[a], CellLo(ci[a] + r, a), whole_hi[a]));
-        }
-        if (ci[a] - r >= 0) {
-          any = true;
-          bound2 = std::min(bound2, rest + gap2(c[a], whole_lo[a], CellHi(ci[a] - r, a)));
+        lo[a] = CellLo(static_cast<uint32_t>(idx[a]), a) - pad;
+        hi[a] = CellHi(static_cast<uint32_t>(idx[a]), a) + pad;
+      }
+    }
+    visit_cell(i, j, k, lo, hi);
+  };
+
+  // 1. The query's own cell.
+  visit(ci[0], ci[1], ci[2]);
+
+  // 2. When the ball of the best distance so far (or the candidate radius) reaches few cells,
+  //    visit exactly those: the cells overlapping the ball's bounding box, pruned by distance.
+  //    If it reaches beyond the 26 neighbours, visit those first: they usually shrink the ball.
+  constexpr int64_t kMaxAxisCells = 16, kMaxBoxCells = 343;
+  double gap[3][kMaxAxisCells], box_lo[3][kMaxAxisCells], box_hi[3][kMaxAxisCells];
+  int64_t lo[3], hi[3];
+  // Fills lo/hi with the cell range the ball reaches; returns its cell count (capped).
+  auto ball_box = [&]() -> int64_t {
+    if (!(scanner.limit2() < kInf)) return kMaxBoxCells + 1;
+    const double reach = std::sqrt(scanner.limit2()) + pad;
+    int64_t cells = 1;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = CellCoord(c[a] - reach, a), hi[a] = CellCoord(c[a] + reach, a);
+      if (hi[a] - lo[a] + 1 > kMaxAxisCells) return kMaxBoxCells + 1;
+      cells *= hi[a] - lo[a] + 1;
+    }
+    return cells;
+  };
+  // Visits the box's cells farther than `skip` (Chebyshev) from the query's cell.
+  auto visit_box = [&](int64_t skip) {
+    for (int a = 0; a < 3; ++a) {
+      for (int64_t t = lo[a]; t <= hi[a]; ++t) {
+        const double cl = CellLo(static_cast<uint32_t>(t), a);
+        const double ch = CellHi(static_cast<uint32_t>(t), a);
+        gap[a][t - lo[a]] = gap2(c[a], cl, ch);
+        box_lo[a][t - lo[a]] = cl - pad, box_hi[a][t - lo[a]] = ch + pad;
+      }
+    }
+    for (int64_t k = lo[2]; k <= hi[2]; ++k) {
+      const double gk = gap[2][k - lo[2]];
+      if (gk > scanner.limit2()) continue;
+      for (int64_t j = lo[1]; j <= hi[1]; ++j) {
+        const double gjk = gk + gap[1][j - lo[1]];
+        if (gjk > scanner.limit2()) continue;
+        const bool inner = std::abs(k - ci[2]) <= skip && std::abs(j - ci[1]) <= skip;
+        for (int64_t i = lo[0]; i <= hi[0]; ++i) {
+          if (inner && std::abs(i - ci[0]) <= skip) continue;
+          if (gjk + gap[0][i - lo[0]] > scanner.limit2()) continue;
+          const double cell_lo[3] = {box_lo[0][i - lo[0]], box_lo[1][j - lo[1]], box_lo[2][k - lo[2]]};
+          const double cell_hi[3] = {box_hi[0][i - lo[0]], box_hi[1][j - lo[1]], box_hi[2][k - lo[2]]};
+          visit_cell(i, j, k, cell_lo, cell_hi);
         }
       }
-      if (!any || bound2 > scanner.limit2()) return;
     }
-    const int64_t i0 = std::max<int64_t>(0, ci[0] - r), i1 = std::min(n[0] - 1, ci[0] + r);
-    const int64_t j0 = std::max<int64_t>(0, ci[1] - r), j1 = std::min(n[1] - 1, ci[1] + r);
-    const int64_t k0 = std::max<int64_t>(0, ci[2] - r), k1 = std::min(n[2] - 1, ci[2] + r);
-    for (int64_t k = k0; k <= k1; ++k) {
+  };
+  int64_t done = 0;  // cells within this Chebyshev radius of ci are visited
+  int64_t cells = ball_box();
+  if (cells > 27) {
+    for (int a = 0; a < 3; ++a)
+      lo[a] = std::max<int64_t>(0, ci[a] - 1), hi[a] = std::min(n[a] - 1, ci[a] + 1);
+    visit_box(0);
+    done = 1;
+    cells = ball_box();
+  }
+  if (cells <= kMaxBoxCells) {
+    visit_box(done);
+    return;
+  }
+
+  // 3. Otherwise, shells of growing Chebyshev radius until no unvisited cell can matter.
+  double whole_lo[3], whole_hi[3];
+  for (int a = 0; a < 3; ++a) whole_lo[a] = CellLo(0, a), whole_hi[a] = CellHi(dims_[a] - 1, a);
+  thread_local std::vector<double> axis_gap[3];
+  for (int64_t r = done + 1;; ++r) {
+    // Lower bound on the distance to any cell at radius >= r: the nearest of the slabs beyond
+    // the shell on each side of each axis, within the whole grid box.
+    double bound2 = kInf;
+    for (int a = 0; a < 3; ++a) {
+      double rest = 0;
+      for (int b = 0; b < 3; ++b)
+        if (b != a) rest += gap2(c[b], whole_lo[b], whole_hi[b]);
+      if (ci[a] + r <= n[a] - 1)
+        bound2 = std::min(bound2, rest + gap2(c[a], CellLo(static_cast<uint32_t>(ci[a] + r), a), whole_hi[a]));
+      if (ci[a] - r >= 0)
+        bound2 = std::min(bound2, rest + gap2(c[a], whole_lo[a], CellHi(static_cast<uint32_t>(ci[a] - r), a)));
+    }
+    if (bound2 > scanner.limit2()) return;  // also when no cell is left (bound2 infinite)
+    int64_t lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::max<int64_t>(0, ci[a] - r), hi[a] = std::min(n[a] - 1, ci[a] + r);
+      axis_gap[a].resize(static_cast<size_t>(hi[a] - lo[a] + 1));
+      for (int64_t t = lo[a]; t <= hi[a]; ++t) {
+        axis_gap[a][t - lo[a]] = gap2(c[a], CellLo(static_cast<uint32_t>(t), a),
+                                      CellHi(static_cast<uint32_t>(t), a));
+      }
+    }
+    for (int64_t k = lo[2]; k <= hi[2]; ++k) {
       const bool kface = k == ci[2] - r || k == ci[2] + r;
-      const double dk = gap2(c[2], CellLo(k, 2), CellHi(k, 2));
-      for (int64_t j = j0; j <= j1; ++j) {
+      const double gk = axis_gap[2][k - lo[2]];
+      if (gk > scanner.limit2()) continue;
+      for (int64_t j = lo[1]; j <= hi[1]; ++j) {
         const bool jface = j == ci[1] - r || j == ci[1] + r;
-        const double djk = dk + gap2(c[1], CellLo(j, 1), CellHi(j, 1));
-        if (djk > scanner.limit2()) continue;
-        const size_t row = (static_cast<size_t>(k) * n[1] + j) * n[0];
-        // Inside the shell's x range only the two x faces belong to it, unless on a y/z face.
-        const int64_t step = (kface || jface) ? 1 : std::max<int64_t>(1, 2 * r);
-        for (int64_t i = (kface || jface) ? i0 : ci[0] - r; i <= i1; i += step) {
-          if (i < i0) continue;
-          const size_t cell = row + i;
-          const uint32_t b = cell_start_[cell], e = cell_start_[cell + 1];
-          if (b == e) continue;
-          const double d2 = djk + gap2(c[0], CellLo(i, 0), CellHi(i, 0));
-          if (d2 > scanner.limit2()) continue;
-          const double lo[3] = {CellLo(i, 0) - pad, CellLo(j, 1) - pad, CellLo(k, 2) - pad};
-          const double hi[3] = {CellHi(i, 0) + pad, CellHi(j, 1) + pad, CellHi(k, 2) + pad};
-          if (!scanner.KeepCell(lo, hi)) continue;
-          scanner.Scan(static_cast<uint32_t>(cell), b, e);
+        const double gjk = gk + axis_gap[1][j - lo[1]];
+        if (gjk > scanner.limit2()) continue;
+        // Off the y and z faces, only the two x faces belong to the shell.
+        const int64_t step = (kface || jface) ? 1 : 2 * r;
+        for (int64_t i = (kface || jface) ? lo[0] : ci[0] - r; i <= hi[0]; i += step) {
+          if (i < lo[0]) continue;
+          if (gjk + axis_gap[0][i - lo[0]] > scanner.limit2()) continue;
+          visit(i, j, k);
         }
       }
     }
@@ -313,6 +389,7 @@ struct SnapScanner {
   uint32_t best_index = kNoIndex;
   uint32_t best_slot = kNoIndex;
 
+  static constexpr bool kUsesBox = false;
   double limit2() const { return best_d2; }
   bool KeepCell(const double*, const double*) const { return true; }
   void Scan(uint32_t cell, uint32_t b, uint32_t e) {
@@ -336,6 +413,7 @@ struct NextScanner {
   uint32_t best_index = kNoIndex;
   uint32_t best_slot = kNoIndex;
 
+  static constexpr bool kUsesBox = true;
   double limit2() const { return best_d2; }
   // Skips a cell lying wholly behind the foot: its farthest corner along dir is not ahead.
   bool KeepCell(const double* lo, const double* hi) const {

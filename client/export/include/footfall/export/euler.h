@@ -1,0 +1,20 @@
+// Quaternion to Euler angle conversion for DCC tools that key rotations as Euler angles (Maya).
+#pragma once
+
+#include "footfall/steps/walk.h"
+#include "footfall/terrain/vec3.h"
+
+namespace footfall {
+
+// Euler angles in degrees for Maya's default rotate order XYZ: rotating by x about the X axis,
+// then y about Y, then z about Z (all about the parent's axes) gives the rotation of `q`.
+// `q` need not be unit length but must be non-zero. y is in [-90, 90]; x and z in [-180, 180].
+// At gimbal lock (y = +-90) x is 0.
+Vec3 QuatToEulerXyzDegrees(const Quat& q);
+
+// The Euler triple equivalent to `euler` (degrees, XYZ order) that is closest to `previous`:
+// adds multiples of 360 per angle and also tries the alternative solution (x+180, 180-y, z+180),
+// so keyed rotations do not spin the long way round between keys.
+Vec3 ClosestEulerXyzDegrees(const Vec3& euler, const Vec3& previous);
+
+}  // namespace footfall

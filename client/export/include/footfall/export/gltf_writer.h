@@ -1,0 +1,36 @@
+// glTF 2.0 export of a walk: one node per track (foot IK targets and bodies), animated by one
+// animation named "walk" with LINEAR samplers. Passes the Khronos glTF validator.
+#pragma once
+
+#include <string>
+
+#include "footfall/steps/walk.h"
+#include "footfall/terrain/status.h"
+
+namespace footfall {
+
+struct GltfOptions {
+  // true: .glb (one binary container, the animation data in its BIN chunk).
+  // false: .gltf JSON with the buffer embedded as a base64 data URI, so the file is
+  // self-contained (no side .bin to lose when the file is moved).
+  bool binary = false;
+};
+
+// Writes `walk` to `path` as glTF 2.0.
+// - Nodes: one per track, in track order, all roots of the single scene. Names are the track
+//   name, or "character/name" for crowd tracks; a repeated name gets a "_2", "_3"... suffix.
+//   Each node's rest translation (and rotation for bodies) is its first key.
+// - Channels: feet animate translation; bodies translation and rotation (normalised
+//   quaternions). Times in seconds = frame / fps. glTF needs strictly increasing times: keys are
+//   ordered by frame (stable) and of several keys on the same frame only the last one is kept.
+// - Node extras hold {"kind", "character", "track"}; the animation's extras hold {"fps"} and
+//   {"stopped"} when the walk stopped early. World units are written unchanged (glTF metres).
+// Returns kInvalidArgument (with `*error` set) for fps <= 0, a negative frame, NaN/Inf values or
+// a zero quaternion; kIoError naming `path` when the file cannot be written. `error` may be null.
+Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& options,
+                 std::string* error);
+
+// As above, binary when `path` ends in ".glb" (any case), JSON otherwise.
+Status WriteGltf(const Walk& walk, const std::string& path, std::string* error);
+
+}  // namespace footfall

@@ -1,0 +1,29 @@
+// Maya MEL export of a walk: `source walk.mel` creates one locator per track under a root group
+// and keys it, so an animator can constrain IK handles and the body to the locators.
+#pragma once
+
+#include <string>
+
+#include "footfall/steps/walk.h"
+#include "footfall/terrain/status.h"
+
+namespace footfall {
+
+// Writes `walk` to `path` as a MEL script that, when sourced:
+// 1. sets the scene time unit to the walk's fps when Maya has a unit for it (15 game, 24 film,
+//    25 pal, 30 ntsc, 48 show, 50 palf, 60 ntscf, other whole rates Maya 2017+ knows as
+//    "<fps>fps"); otherwise it prints a MEL warning and keeps the scene's unit. Sets the
+//    playback range to the walk's frames;
+// 2. creates a root transform "footfall_walk" and, for crowd walks, one transform per character
+//    under it;
+// 3. per track, creates a locator (`spaceLocator -n`), parents it, and keys translateX/Y/Z at
+//    every key frame (bodies also rotateX/Y/Z: the quaternion as Euler XYZ degrees, unwrapped so
+//    consecutive keys take the shortest turn). Frames are written as they are in the walk.
+// Node names are sanitised to Maya names ([A-Za-z_][A-Za-z0-9_]*; other characters become '_')
+// and made unique in the file. The script uses the names Maya returns, so it still works when
+// the scene already holds nodes of the same names. Keys on the same frame: the last one wins.
+// Returns kInvalidArgument (with `*error` set) for fps <= 0, NaN/Inf values or a zero quaternion;
+// kIoError naming `path` when the file cannot be written. `error` may be null.
+Status WriteMel(const Walk& walk, const std::string& path, std::string* error);
+
+}  // namespace footfall

@@ -1,0 +1,58 @@
+#include "footfall/export/euler.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace footfall {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegrees = 180.0 / kPi;
+
+// `angle` plus the multiple of 360 that brings it closest to `target` (degrees).
+double Unwrap(double angle, double target) {
+  return angle + 360.0 * std::round((target - angle) / 360.0);
+}
+
+Vec3 UnwrapAll(const Vec3& euler, const Vec3& target) {
+  return {Unwrap(euler.x, target.x), Unwrap(euler.y, target.y), Unwrap(euler.z, target.z)};
+}
+
+double L1(const Vec3& a, const Vec3& b) {
+  return std::abs(a.x - b.x) + std::abs(a.y - b.y) + std::abs(a.z - b.z);
+}
+
+}  // namespace
+
+Vec3 QuatToEulerXyzDegrees(const Quat& q_in) {
+  const double n = std::sqrt(q_in.x * q_in.x + q_in.y * q_in.y + q_in.z * q_in.z + q_in.w * q_in.w);
+  const double x = q_in.x / n, y = q_in.y / n, z = q_in.z / n, w = q_in.w / n;
+  // Rotation matrix entries (column vectors) needed for R = Rz(c) * Ry(b) * Rx(a).
+  const double m00 = 1 - 2 * (y * y + z * z);
+  const double m01 = 2 * (x * y - z * w);
+  const double m10 = 2 * (x * y + z * w);
+  const double m11 = 1 - 2 * (x * x + z * z);
+  const double m20 = 2 * (x * z - y * w);
+  const double m21 = 2 * (y * z + x * w);
+  const double m22 = 1 - 2 * (x * x + y * y);
+  const double sin_b = std::clamp(-m20, -1.0, 1.0);
+  const double b = std::asin(sin_b);
+  double a, c;
+  if (std::abs(sin_b) > 1 - 1e-12) {
+    // Gimbal lock: X and Z turn about the same axis; put it all in Z.
+    a = 0;
+    c = std::atan2(-m01, m11);
+  } else {
+    a = std::atan2(m21, m22);
+    c = std::atan2(m10, m00);
+  }
+  return {a * kDegrees, b * kDegrees, c * kDegrees};
+}
+
+Vec3 ClosestEulerXyzDegrees(const Vec3& euler, const Vec3& previous) {
+  const Vec3 direct = UnwrapAll(euler, previous);
+  const Vec3 alternative = UnwrapAll({euler.x + 180.0, 180.0 - euler.y, euler.z + 180.0}, previous);
+  return L1(alternative, previous) < L1(direct, previous) ? alternative : direct;
+}
+
+}  // namespace footfall

@@ -1,0 +1,237 @@
+#include "footfall/export/gltf_writer.h"
+
+#include <tiny_gltf.h>
+
+#include <cctype>
+#include <cstring>
+#include <sstream>
+#include <vector>
+
+#include "file_output.h"
+#include "walk_prep.h"
+
+namespace footfall {
+namespace {
+
+using walk_export::SetError;
+
+// Animation data grouped by element type, one buffer view each: all time inputs, all VEC3
+// outputs, all VEC4 outputs. Accessors point into them with 4-byte aligned offsets.
+struct Streams {
+  std::vector<float> times;
+  std::vector<float> vec3;
+  std::vector<float> vec4;
+};
+
+enum StreamId { kTimes, kVec3, kVec4, kStreamCount };
+
+struct PendingAccessor {
+  StreamId stream;
+  size_t first_float;  // offset into the stream, in floats
+  tinygltf::Accessor accessor;
+};
+
+// Keys of one track as glTF samples: ascending float times (seconds), duplicates dropped.
+struct Samples {
+  std::vector<float> times;
+  std::vector<size_t> keys;  // index into track.keys for each time
+};
+
+Status TrackSamples(const WalkTrack& track, size_t track_index, double fps, Samples* samples,
+                    std::string* error) {
+  for (size_t index : walk_export::KeyOrder(track)) {
+    const WalkKey& key = track.keys[index];
+    if (key.frame < 0) {
+      std::ostringstream message;
+      message << "glTF animation times must be >= 0 but track " << track_index << " '"
+              << walk_export::QualifiedTrackName(track, track_index) << "' key " << index
+              << " is at frame " << key.frame << "; start the walk at frame 0 or later";
+      SetError(error, message.str());
+      return Status::kInvalidArgument;
+    }
+    const float time = static_cast<float>(key.frame / fps);
+    if (!samples->times.empty() && time <= samples->times.back()) {
+      samples->keys.back() = index;  // the same time once rounded to float: the later key wins
+      continue;
+    }
+    samples->times.push_back(time);
+    samples->keys.push_back(index);
+  }
+  return Status::kOk;
+}
+
+tinygltf::Value NodeExtras(const WalkTrack& track) {
+  tinygltf::Value::Object extras;
+  extras["kind"] = tinygltf::Value(std::string(track.kind == TrackKind::kBody ? "body" : "foot"));
+  extras["character"] = tinygltf::Value(track.character);
+  extras["track"] = tinygltf::Value(track.name);
+  return tinygltf::Value(std::move(extras));
+}
+
+int AddAccessor(std::vector<PendingAccessor>* pending, Streams* streams, StreamId stream,
+                const std::vector<float>& values, int type, size_t count) {
+  std::vector<float>& data = stream == kTimes  ? streams->times
+                             : stream == kVec3 ? streams->vec3
+                                               : streams->vec4;
+  PendingAccessor entry;
+  entry.stream = stream;
+  entry.first_float = data.size();
+  data.insert(data.end(), values.begin(), values.end());
+  entry.accessor.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+  entry.accessor.type = type;
+  entry.accessor.count = count;
+  pending->push_back(std::move(entry));
+  return static_cast<int>(pending->size() - 1);
+}
+
+bool EndsWithGlb(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string ext = path.substr(path.size() - 4);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".glb";
+}
+
+}  // namespace
+
+Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& options,
+                 std::string* error) {
+  Status status = walk_export::CheckWalk(walk, error);
+  if (status != Status::kOk) return status;
+
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "footfall " FOOTFALL_VERSION " (tinygltf)";
+
+  std::vector<std::string> names;
+  names.reserve(walk.tracks.size());
+  for (size_t t = 0; t < walk.tracks.size(); ++t) {
+    names.push_back(walk_export::QualifiedTrackName(walk.tracks[t], t));
+  }
+  names = walk_export::UniqueNames(names);
+
+  Streams streams;
+  std::vector<PendingAccessor> pending;
+  tinygltf::Animation animation;
+  animation.name = "walk";
+  tinygltf::Scene scene;
+  scene.name = "walk";
+
+  for (size_t t = 0; t < walk.tracks.size(); ++t) {
+    const WalkTrack& track = walk.tracks[t];
+    const bool body = track.kind == TrackKind::kBody;
+    tinygltf::Node node;
+    node.name = names[t];
+    node.extras = NodeExtras(track);
+
+    Samples samples;
+    status = TrackSamples(track, t, walk.fps, &samples, error);
+    if (status != Status::kOk) return status;
+
+    if (!samples.keys.empty()) {
+      const size_t count = samples.keys.size();
+      std::vector<float> translations;
+      std::vector<float> rotations;
+      translations.reserve(count * 3);
+      Quat previous;
+      for (size_t i = 0; i < count; ++i) {
+        const WalkKey& key = track.keys[samples.keys[i]];
+        translations.insert(translations.end(),
+                            {static_cast<float>(key.position.x), static_cast<float>(key.position.y),
+                             static_cast<float>(key.position.z)});
+        if (body) {
+          Quat q = walk_export::Normalized(key.rotation);
+          // q and -q are the same rotation; keep neighbours in one hemisphere so that
+          // interpolation takes the short way.
+          if (i > 0 &&
+              q.x * previous.x + q.y * previous.y + q.z * previous.z + q.w * previous.w < 0) {
+            q = {-q.x, -q.y, -q.z, -q.w};
+          }
+          previous = q;
+          rotations.insert(rotations.end(), {static_cast<float>(q.x), static_cast<float>(q.y),
+                                             static_cast<float>(q.z), static_cast<float>(q.w)});
+        }
+      }
+      node.translation = {translations[0], translations[1], translations[2]};
+      if (body) node.rotation = {rotations[0], rotations[1], rotations[2], rotations[3]};
+
+      const int input =
+          AddAccessor(&pending, &streams, kTimes, samples.times, TINYGLTF_TYPE_SCALAR, count);
+      // The validator requires min and max on animation inputs; they must equal the stored
+      // float values exactly, which a double holding a float does.
+      pending[input].accessor.minValues = {samples.times.front()};
+      pending[input].accessor.maxValues = {samples.times.back()};
+
+      const int node_index = static_cast<int>(model.nodes.size());
+      auto add_channel = [&](int output, const char* target_path) {
+        tinygltf::AnimationSampler sampler;
+        sampler.input = input;
+        sampler.output = output;
+        sampler.interpolation = "LINEAR";
+        animation.samplers.push_back(sampler);
+        tinygltf::AnimationChannel channel;
+        channel.sampler = static_cast<int>(animation.samplers.size() - 1);
+        channel.target_node = node_index;
+        channel.target_path = target_path;
+        animation.channels.push_back(channel);
+      };
+      add_channel(AddAccessor(&pending, &streams, kVec3, translations, TINYGLTF_TYPE_VEC3, count),
+                  "translation");
+      if (body) {
+        add_channel(AddAccessor(&pending, &streams, kVec4, rotations, TINYGLTF_TYPE_VEC4, count),
+                    "rotation");
+      }
+    }
+    scene.nodes.push_back(static_cast<int>(model.nodes.size()));
+    model.nodes.push_back(std::move(node));
+  }
+
+  // One buffer holding the three streams back to back, one buffer view per non-empty stream.
+  const std::vector<float>* stream_data[kStreamCount] = {&streams.times, &streams.vec3,
+                                                         &streams.vec4};
+  int view_of[kStreamCount] = {-1, -1, -1};
+  tinygltf::Buffer buffer;
+  for (int s = 0; s < kStreamCount; ++s) {
+    const std::vector<float>& data = *stream_data[s];
+    if (data.empty()) continue;
+    tinygltf::BufferView view;
+    view.buffer = 0;
+    view.byteOffset = buffer.data.size();
+    view.byteLength = data.size() * sizeof(float);
+    const size_t at = buffer.data.size();
+    buffer.data.resize(at + view.byteLength);
+    std::memcpy(buffer.data.data() + at, data.data(), view.byteLength);
+    view_of[s] = static_cast<int>(model.bufferViews.size());
+    model.bufferViews.push_back(view);
+  }
+  if (!buffer.data.empty()) model.buffers.push_back(std::move(buffer));
+  for (PendingAccessor& entry : pending) {
+    entry.accessor.bufferView = view_of[entry.stream];
+    entry.accessor.byteOffset = entry.first_float * sizeof(float);
+    model.accessors.push_back(std::move(entry.accessor));
+  }
+
+  tinygltf::Value::Object animation_extras;
+  animation_extras["fps"] = tinygltf::Value(walk.fps);
+  if (!walk.stopped.empty()) animation_extras["stopped"] = tinygltf::Value(walk.stopped);
+  animation.extras = tinygltf::Value(std::move(animation_extras));
+  // An animation needs at least one channel; a walk without keys has none.
+  if (!animation.channels.empty()) model.animations.push_back(std::move(animation));
+  model.scenes.push_back(std::move(scene));
+  model.defaultScene = 0;
+
+  std::ostringstream out;
+  tinygltf::TinyGLTF gltf;
+  if (!gltf.WriteGltfSceneToStream(&model, out, /*prettyPrint=*/true, options.binary)) {
+    SetError(error, "tinygltf could not serialise the walk for '" + path + "'");
+    return Status::kInternalError;
+  }
+  return walk_export::WriteFileBytes(path, out.str(), error);
+}
+
+Status WriteGltf(const Walk& walk, const std::string& path, std::string* error) {
+  GltfOptions options;
+  options.binary = EndsWithGlb(path);
+  return WriteGltf(walk, path, options, error);
+}
+
+}  // namespace footfall

@@ -1,0 +1,106 @@
+#include "walk_prep.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <set>
+#include <sstream>
+
+namespace footfall {
+namespace walk_export {
+namespace {
+
+bool Finite(const Quat& q) {
+  return std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) && std::isfinite(q.w);
+}
+
+double Norm2(const Quat& q) { return q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w; }
+
+}  // namespace
+
+void SetError(std::string* error, const std::string& message) {
+  if (error != nullptr) *error = message;
+}
+
+Status CheckWalk(const Walk& walk, std::string* error) {
+  if (!std::isfinite(walk.fps) || walk.fps <= 0) {
+    std::ostringstream message;
+    message << "walk fps must be finite and > 0, got " << walk.fps;
+    SetError(error, message.str());
+    return Status::kInvalidArgument;
+  }
+  for (size_t t = 0; t < walk.tracks.size(); ++t) {
+    const WalkTrack& track = walk.tracks[t];
+    for (size_t k = 0; k < track.keys.size(); ++k) {
+      const WalkKey& key = track.keys[k];
+      const char* what = nullptr;
+      if (!std::isfinite(key.frame)) {
+        what = "a non-finite frame";
+      } else if (!IsFinite(key.position)) {
+        what = "a non-finite position";
+      } else if (track.kind == TrackKind::kBody && !Finite(key.rotation)) {
+        what = "a non-finite rotation";
+      } else if (track.kind == TrackKind::kBody && !(Norm2(key.rotation) > 1e-24)) {
+        what = "a zero rotation quaternion";
+      }
+      if (what != nullptr) {
+        std::ostringstream message;
+        message << "track " << t << " '" << QualifiedTrackName(track, t) << "' key " << k << " has "
+                << what;
+        SetError(error, message.str());
+        return Status::kInvalidArgument;
+      }
+    }
+  }
+  return Status::kOk;
+}
+
+std::vector<size_t> KeyOrder(const WalkTrack& track) {
+  std::vector<size_t> order(track.keys.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&track](size_t a, size_t b) {
+    return track.keys[a].frame < track.keys[b].frame;
+  });
+  std::vector<size_t> kept;
+  kept.reserve(order.size());
+  for (size_t index : order) {
+    if (!kept.empty() && track.keys[kept.back()].frame == track.keys[index].frame) {
+      kept.back() = index;  // same frame: the later key wins
+    } else {
+      kept.push_back(index);
+    }
+  }
+  return kept;
+}
+
+std::string QualifiedTrackName(const WalkTrack& track, size_t index) {
+  std::string name = track.name.empty() ? "track" + std::to_string(index) : track.name;
+  return track.character.empty() ? name : track.character + "/" + name;
+}
+
+std::vector<std::string> UniqueNames(const std::vector<std::string>& names) {
+  std::set<std::string> taken(names.begin(), names.end());
+  std::set<std::string> used;
+  std::vector<std::string> unique;
+  unique.reserve(names.size());
+  for (const std::string& name : names) {
+    // A suffixed name never takes a name that another track carries as its own.
+    std::string candidate = name;
+    for (int suffix = 2;
+         used.count(candidate) != 0 || (candidate != name && taken.count(candidate) != 0);
+         ++suffix) {
+      candidate = name + "_" + std::to_string(suffix);
+    }
+    used.insert(candidate);
+    unique.push_back(candidate);
+  }
+  return unique;
+}
+
+Quat Normalized(const Quat& q) {
+  const double n = std::sqrt(Norm2(q));
+  return {q.x / n, q.y / n, q.z / n, q.w / n};
+}
+
+}  // namespace walk_export
+}  // namespace footfall

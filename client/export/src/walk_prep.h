@@ -1,0 +1,37 @@
+// Preparing a walk for export, shared by the glTF and MEL writers: input checks, the order in
+// which a track's keys are written, and unique node names.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "footfall/steps/walk.h"
+#include "footfall/terrain/status.h"
+
+namespace footfall {
+namespace walk_export {
+
+// Sets *error to `message` when error is non-null.
+void SetError(std::string* error, const std::string& message);
+
+// kOk when fps is finite and > 0 and every key has a finite frame and position, and every body
+// key a finite, non-zero quaternion; otherwise kInvalidArgument with the track and key named.
+Status CheckWalk(const Walk& walk, std::string* error);
+
+// Indices into track.keys in ascending frame order (stable); of keys sharing a frame only the
+// last (in track order) is listed.
+std::vector<size_t> KeyOrder(const WalkTrack& track);
+
+// "name" for a single character, "character/name" for a crowd track; "track<i>" when the track
+// has no name.
+std::string QualifiedTrackName(const WalkTrack& track, size_t index);
+
+// `names` with repeats renamed "<name>_2", "<name>_3"... (never colliding with another name).
+std::vector<std::string> UniqueNames(const std::vector<std::string>& names);
+
+// q / |q|; q must be finite and non-zero (CheckWalk).
+Quat Normalized(const Quat& q);
+
+}  // namespace walk_export
+}  // namespace footfall

@@ -1,0 +1,273 @@
+// The glTF writer: files read back with tinygltf hold one node per track, the keys as LINEAR
+// samplers with times frame / fps, and bad input or unwritable paths give clear errors.
+#include <tiny_gltf.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include "footfall/export/gltf_writer.h"
+#include "footfall/export/walk_writer.h"
+#include "walk_fixtures.h"
+
+using namespace footfall;
+
+namespace {
+
+tinygltf::Model Load(const std::string& path, bool binary) {
+  tinygltf::TinyGLTF loader;
+  tinygltf::Model model;
+  std::string error, warning;
+  const bool ok = binary ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
+                         : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+  INFO(error << warning);
+  REQUIRE(ok);
+  return model;
+}
+
+std::string ReadBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// The floats of an accessor (FLOAT components, tightly packed).
+std::vector<float> Floats(const tinygltf::Model& model, int accessor_index) {
+  const tinygltf::Accessor& accessor = model.accessors.at(accessor_index);
+  REQUIRE(accessor.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT);
+  const tinygltf::BufferView& view = model.bufferViews.at(accessor.bufferView);
+  const tinygltf::Buffer& buffer = model.buffers.at(view.buffer);
+  const size_t components = static_cast<size_t>(tinygltf::GetNumComponentsInType(accessor.type));
+  std::vector<float> values(accessor.count * components);
+  const size_t offset = view.byteOffset + accessor.byteOffset;
+  REQUIRE(offset + values.size() * sizeof(float) <= view.byteOffset + view.byteLength);
+  std::memcpy(values.data(), buffer.data.data() + offset, values.size() * sizeof(float));
+  return values;
+}
+
+struct Channel {
+  std::vector<float> times;
+  std::vector<float> values;
+  std::string interpolation;
+};
+
+// node name -> path ("translation", "rotation") -> the channel's sampled data.
+std::map<std::string, std::map<std::string, Channel>> Channels(const tinygltf::Model& model) {
+  std::map<std::string, std::map<std::string, Channel>> out;
+  REQUIRE(model.animations.size() == 1);
+  const tinygltf::Animation& animation = model.animations[0];
+  for (const tinygltf::AnimationChannel& channel : animation.channels) {
+    const tinygltf::AnimationSampler& sampler = animation.samplers.at(channel.sampler);
+    const std::string& node = model.nodes.at(channel.target_node).name;
+    REQUIRE(out[node].count(channel.target_path) == 0);
+    Channel& c = out[node][channel.target_path];
+    c.times = Floats(model, sampler.input);
+    c.values = Floats(model, sampler.output);
+    c.interpolation = sampler.interpolation;
+    const tinygltf::Accessor& input = model.accessors.at(sampler.input);
+    REQUIRE(input.minValues.size() == 1);
+    REQUIRE(input.maxValues.size() == 1);
+    CHECK(input.minValues[0] == c.times.front());
+    CHECK(input.maxValues[0] == c.times.back());
+  }
+  return out;
+}
+
+void CheckPositions(const Channel& channel, const WalkTrack& track, const std::vector<size_t>& keys,
+                    double fps) {
+  REQUIRE(channel.times.size() == keys.size());
+  REQUIRE(channel.values.size() == keys.size() * 3);
+  for (size_t i = 0; i < keys.size(); ++i) {
+    const WalkKey& key = track.keys[keys[i]];
+    CHECK(channel.times[i] == static_cast<float>(key.frame / fps));
+    if (i > 0) CHECK(channel.times[i] > channel.times[i - 1]);
+    CHECK(channel.values[3 * i] == static_cast<float>(key.position.x));
+    CHECK(channel.values[3 * i + 1] == static_cast<float>(key.position.y));
+    CHECK(channel.values[3 * i + 2] == static_cast<float>(key.position.z));
+  }
+}
+
+}  // namespace
+
+TEST_CASE("WriteGltf writes a node per track with keyed channels", "[export][gltf]") {
+  const Walk walk = test::BipedWalk();
+  const bool binary = GENERATE(false, true);
+  const std::string path = test::ScratchPath(binary ? "biped.glb" : "biped.gltf");
+  std::string error;
+  REQUIRE(WriteGltf(walk, path, &error) == Status::kOk);
+  INFO(path);
+
+  const std::string bytes = ReadBytes(path);
+  if (binary) {
+    REQUIRE(bytes.compare(0, 4, "glTF") == 0);
+  } else {
+    REQUIRE(bytes.front() == '{');
+    CHECK(bytes.find("\"uri\": \"data:application/octet-stream;base64,") != std::string::npos);
+  }
+
+  const tinygltf::Model model = Load(path, binary);
+  CHECK(model.asset.version == "2.0");
+  CHECK(model.asset.generator.rfind("footfall ", 0) == 0);
+  REQUIRE(model.nodes.size() == 3);
+  CHECK(model.nodes[0].name == "L");
+  CHECK(model.nodes[1].name == "R");
+  CHECK(model.nodes[2].name == "body");
+  CHECK(model.nodes[2].extras.Get("kind").Get<std::string>() == "body");
+  CHECK(model.nodes[0].extras.Get("kind").Get<std::string>() == "foot");
+  REQUIRE(model.scenes.size() == 1);
+  CHECK(model.defaultScene == 0);
+  CHECK(model.scenes[0].nodes == std::vector<int>{0, 1, 2});
+  CHECK(model.animations[0].name == "walk");
+  CHECK(model.animations[0].extras.Get("fps").GetNumberAsDouble() == 24);
+
+  auto channels = Channels(model);
+  SECTION("feet animate translation only, with every key at frame / fps seconds") {
+    REQUIRE(channels["L"].size() == 1);
+    CheckPositions(channels["L"]["translation"], walk.tracks[0], {0, 1, 2, 3, 4, 5}, 24);
+    CHECK(channels["L"]["translation"].interpolation == "LINEAR");
+    CHECK(channels["L"]["translation"].times.front() == static_cast<float>(1.0 / 24));
+    // Rest pose: the first key.
+    CHECK(model.nodes[0].translation == std::vector<double>{static_cast<float>(-0.1), 0, 0});
+  }
+  SECTION("two keys on one frame keep the later key once") {
+    REQUIRE(channels["R"].size() == 1);
+    CheckPositions(channels["R"]["translation"], walk.tracks[1], {0, 1, 3, 4, 5}, 24);
+  }
+  SECTION("bodies animate translation and unit rotations kept in one hemisphere") {
+    REQUIRE(channels["body"].size() == 2);
+    CheckPositions(channels["body"]["translation"], walk.tracks[2], {0, 1, 2, 3, 4}, 24);
+    const Channel& rotation = channels["body"]["rotation"];
+    CHECK(rotation.interpolation == "LINEAR");
+    CHECK(rotation.times == channels["body"]["translation"].times);
+    REQUIRE(rotation.values.size() == 5 * 4);
+    const double yaw[] = {0, 60, 150, 170, 190};
+    for (size_t i = 0; i < 5; ++i) {
+      const float* q = &rotation.values[4 * i];
+      const Quat expected = test::YawQuat(yaw[i]);
+      CHECK(std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]) ==
+            Approx(1).margin(1e-6));
+      // Same rotation (up to sign) as the key.
+      const double dot =
+          q[0] * expected.x + q[1] * expected.y + q[2] * expected.z + q[3] * expected.w;
+      CHECK(std::abs(dot) == Approx(1).margin(1e-6));
+      if (i > 0) {
+        const float* p = &rotation.values[4 * (i - 1)];
+        CHECK(p[0] * q[0] + p[1] * q[1] + p[2] * q[2] + p[3] * q[3] > 0);
+      }
+    }
+  }
+  std::remove(path.c_str());
+}
+
+TEST_CASE("WriteGltf names crowd nodes character/track", "[export][gltf]") {
+  const Walk walk = test::CrowdWalk();
+  const std::string path = test::ScratchPath("crowd.glb");
+  std::string error;
+  REQUIRE(WriteGltf(walk, path, &error) == Status::kOk);
+  const tinygltf::Model model = Load(path, true);
+  std::vector<std::string> names;
+  for (const tinygltf::Node& node : model.nodes) names.push_back(node.name);
+  CHECK(names == std::vector<std::string>{"ant 1/L1", "ant 1/R1", "ant 1/body", "ant-2/L1",
+                                          "ant-2/R1", "ant-2/body"});
+  CHECK(model.nodes[3].extras.Get("character").Get<std::string>() == "ant-2");
+  CHECK(model.nodes[3].extras.Get("track").Get<std::string>() == "L1");
+  auto channels = Channels(model);
+  CHECK(channels.size() == 6);
+  CheckPositions(channels["ant-2/R1"]["translation"], walk.tracks[4], {0, 1, 2}, 30);
+  CHECK(channels["ant-2/body"].count("rotation") == 1);
+  std::remove(path.c_str());
+}
+
+TEST_CASE("WriteGltf makes repeated and empty track names unique", "[export][gltf]") {
+  Walk walk = test::BipedWalk();
+  walk.tracks[1].name = "L";
+  walk.tracks.push_back(walk.tracks[0]);
+  walk.tracks.back().name = "L_2";
+  walk.tracks.push_back(walk.tracks[0]);
+  walk.tracks.back().name = "";
+  walk.tracks.back().keys.clear();  // a track without keys: a node, no channel
+  const std::string path = test::ScratchPath("names.gltf");
+  std::string error;
+  REQUIRE(WriteGltf(walk, path, &error) == Status::kOk);
+  const tinygltf::Model model = Load(path, false);
+  std::vector<std::string> names;
+  for (const tinygltf::Node& node : model.nodes) names.push_back(node.name);
+  CHECK(names == std::vector<std::string>{"L", "L_3", "body", "L_2", "track4"});
+  CHECK(Channels(model).count("track4") == 0);
+  std::remove(path.c_str());
+}
+
+TEST_CASE("WriteGltf rejects walks glTF cannot hold", "[export][gltf]") {
+  const std::string path = test::ScratchPath("bad.gltf");
+  std::string error;
+  Walk walk = test::BipedWalk();
+  SECTION("a negative frame") {
+    walk.tracks[1].keys[0].frame = -2;
+    CHECK(WriteGltf(walk, path, &error) == Status::kInvalidArgument);
+    CHECK_THAT(error, Catch::Contains("track 1 'R' key 0 is at frame -2"));
+  }
+  SECTION("fps not above zero") {
+    walk.fps = 0;
+    CHECK(WriteGltf(walk, path, &error) == Status::kInvalidArgument);
+    CHECK_THAT(error, Catch::Contains("fps"));
+  }
+  SECTION("a NaN position") {
+    walk.tracks[0].keys[2].position.y = std::nan("");
+    CHECK(WriteGltf(walk, path, &error) == Status::kInvalidArgument);
+    CHECK_THAT(error, Catch::Contains("track 0 'L' key 2 has a non-finite position"));
+  }
+  SECTION("a zero body quaternion") {
+    walk.tracks[2].keys[1].rotation = {0, 0, 0, 0};
+    CHECK(WriteGltf(walk, path, &error) == Status::kInvalidArgument);
+    CHECK_THAT(error, Catch::Contains("track 2 'body' key 1 has a zero rotation quaternion"));
+  }
+  std::ifstream written(path);
+  CHECK_FALSE(written.good());  // nothing written
+}
+
+TEST_CASE("WriteGltf reports unwritable paths as I/O errors", "[export][gltf]") {
+  const std::string path = test::ScratchPath("no-such-dir") + "/walk.glb";
+  std::string error;
+  CHECK(WriteGltf(test::BipedWalk(), path, &error) == Status::kIoError);
+  CHECK_THAT(error, Catch::Contains(path));
+  CHECK(WriteGltf(test::BipedWalk(), path, nullptr) == Status::kIoError);
+}
+
+TEST_CASE("WriteWalk dispatches on the file extension", "[export]") {
+  const Walk walk = test::BipedWalk();
+  std::string error;
+  SECTION("glTF binary for .GLB in any case") {
+    const std::string path = test::ScratchPath("upper.GLB");
+    REQUIRE(WriteWalk(walk, path, &error) == Status::kOk);
+    CHECK(ReadBytes(path).compare(0, 4, "glTF") == 0);
+    std::remove(path.c_str());
+  }
+  SECTION("glTF JSON for .gltf") {
+    const std::string path = test::ScratchPath("walk.gltf");
+    REQUIRE(WriteWalk(walk, path, &error) == Status::kOk);
+    CHECK(ReadBytes(path).front() == '{');
+    std::remove(path.c_str());
+  }
+  SECTION("MEL for .mel") {
+    const std::string path = test::ScratchPath("walk.mel");
+    REQUIRE(WriteWalk(walk, path, &error) == Status::kOk);
+    CHECK(ReadBytes(path).find("spaceLocator") != std::string::npos);
+    std::remove(path.c_str());
+  }
+  SECTION("an unknown extension is an invalid argument naming the path") {
+    const std::string path = test::ScratchPath("walk.json");
+    CHECK(WriteWalk(walk, path, &error) == Status::kInvalidArgument);
+    CHECK_THAT(error, Catch::Contains(path) && Catch::Contains("'.json'") &&
+                          Catch::Contains(".gltf, .glb and .mel"));
+    CHECK_FALSE(IsWalkExportPath(path));
+    CHECK(WriteWalk(walk, test::ScratchPath("dir.mel/walk"), &error) == Status::kInvalidArgument);
+    CHECK_THAT(error, Catch::Contains("no extension"));
+  }
+  CHECK(IsWalkExportPath("a/b.Mel"));
+}

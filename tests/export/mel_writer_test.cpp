@@ -1,0 +1,216 @@
+// The MEL writer: the script, parsed back, creates the expected locators and groups and keys
+// each attribute once per distinct frame with the walk's values.
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include "footfall/export/euler.h"
+#include "footfall/export/mel_writer.h"
+#include "walk_fixtures.h"
+
+using namespace footfall;
+
+namespace {
+
+struct MelKey {
+  double frame;
+  double value;
+};
+
+// What a MEL walk script does, recovered line by line.
+struct MelScript {
+  std::string time_unit;
+  double min_time = NAN, max_time = NAN;
+  std::vector<std::string> groups;                // createNode transform -parent names, in order
+  std::vector<std::string> locators;              // spaceLocator -n names, in order
+  std::map<std::string, std::string> parent_of;   // locator -> "$footfall_root" or group
+  std::map<std::string, std::string> track_attr;  // locator -> footfallTrack value
+  std::map<std::string, std::map<std::string, std::vector<MelKey>>> keys;  // loc -> attr
+  std::vector<std::string> warnings;
+  int braces = 0;
+};
+
+MelScript ParseMel(const std::string& path) {
+  std::ifstream in(path);
+  REQUIRE(in.good());
+  static const std::regex unit(R"re(^currentUnit -time "([^"]+)";$)re");
+  static const std::regex playback(R"re(^playbackOptions -minTime (\S+) -maxTime (\S+) .*;$)re");
+  static const std::regex group(
+      R"re(^\$footfall_groups\[(\d+)\] = `createNode transform -name "(\w+)" -parent \$footfall_root`;$)re");
+  static const std::regex locator(R"re(^\$footfall_node = `spaceLocator -n "(\w+)"`;$)re");
+  static const std::regex parent(
+      R"re(^\$footfall_node = `parent \$footfall_node\[0\] (\$footfall_root|\$footfall_groups\[(\d+)\])`;$)re");
+  static const std::regex track(
+      R"re(^setAttr -type "string" \(\$footfall_node\[0\] \+ ".footfallTrack"\) "(.*)";$)re");
+  static const std::regex key(
+      R"re(^setKeyframe -t (-?[0-9.]+) -at (translate[XYZ]|rotate[XYZ]) -v (-?[0-9.]+) \$footfall_node\[0\];$)re");
+  MelScript script;
+  std::string line, current;
+  std::smatch m;
+  while (std::getline(in, line)) {
+    if (line == "{") ++script.braces;
+    if (line == "}") --script.braces;
+    if (std::regex_match(line, m, unit)) {
+      script.time_unit = m[1];
+    } else if (std::regex_match(line, m, playback)) {
+      script.min_time = std::stod(m[1]);
+      script.max_time = std::stod(m[2]);
+    } else if (std::regex_match(line, m, group)) {
+      REQUIRE(std::stoul(m[1]) == script.groups.size());
+      script.groups.push_back(m[2]);
+    } else if (std::regex_match(line, m, locator)) {
+      current = m[1];
+      script.locators.push_back(current);
+    } else if (std::regex_match(line, m, parent)) {
+      REQUIRE(!current.empty());
+      script.parent_of[current] = m[2].matched ? script.groups.at(std::stoul(m[2])) : m[1].str();
+    } else if (std::regex_match(line, m, track)) {
+      script.track_attr[current] = m[1];
+    } else if (std::regex_match(line, m, key)) {
+      REQUIRE(!current.empty());
+      script.keys[current][m[2]].push_back({std::stod(m[1]), std::stod(m[3])});
+    } else if (line.rfind("warning ", 0) == 0) {
+      script.warnings.push_back(line);
+    } else if (line.rfind("setKeyframe", 0) == 0) {
+      FAIL("unexpected setKeyframe line: " << line);
+    }
+  }
+  return script;
+}
+
+std::string WriteAndKeep(const Walk& walk, const std::string& name) {
+  const std::string path = test::ScratchPath(name);
+  std::string error;
+  REQUIRE(WriteMel(walk, path, &error) == Status::kOk);
+  return path;
+}
+
+// The rotation matrix R = Rz * Ry * Rx of Euler XYZ degrees applied to `v`.
+Vec3 RotateEuler(const Vec3& euler_deg, const Vec3& v) {
+  const double k = 3.14159265358979323846 / 180;
+  const double cx = std::cos(euler_deg.x * k), sx = std::sin(euler_deg.x * k);
+  const double cy = std::cos(euler_deg.y * k), sy = std::sin(euler_deg.y * k);
+  const double cz = std::cos(euler_deg.z * k), sz = std::sin(euler_deg.z * k);
+  Vec3 a{v.x, cx * v.y - sx * v.z, sx * v.y + cx * v.z};
+  Vec3 b{cy * a.x + sy * a.z, a.y, -sy * a.x + cy * a.z};
+  return {cz * b.x - sz * b.y, sz * b.x + cz * b.y, b.z};
+}
+
+}  // namespace
+
+TEST_CASE("WriteMel keys a locator per track", "[export][mel]") {
+  const Walk walk = test::BipedWalk();
+  const std::string path = WriteAndKeep(walk, "biped.mel");
+  const MelScript script = ParseMel(path);
+  CHECK(script.braces == 0);
+  CHECK(script.time_unit == "film");
+  CHECK(script.min_time == 1);
+  CHECK(script.max_time == 37);
+  CHECK(script.groups.empty());
+  REQUIRE(script.locators == std::vector<std::string>{"L", "R", "body"});
+  for (const std::string& name : script.locators) {
+    CHECK(script.parent_of.at(name) == "$footfall_root");
+    CHECK(script.track_attr.at(name) == name);
+  }
+
+  SECTION("feet: translate keys only, one per distinct frame, with the key values") {
+    const auto& left = script.keys.at("L");
+    CHECK(left.size() == 3);
+    const auto& right = script.keys.at("R");
+    CHECK(right.size() == 3);
+    const char* axes[] = {"translateX", "translateY", "translateZ"};
+    for (int axis = 0; axis < 3; ++axis) {
+      REQUIRE(left.at(axes[axis]).size() == 6);
+      REQUIRE(right.at(axes[axis]).size() == 5);  // frame 25 keyed once
+      for (size_t i = 0; i < 6; ++i) {
+        const WalkKey& key = walk.tracks[0].keys[i];
+        const double expected[] = {key.position.x, key.position.y, key.position.z};
+        CHECK(left.at(axes[axis])[i].frame == key.frame);
+        CHECK(left.at(axes[axis])[i].value == Approx(expected[axis]).margin(1e-6));
+      }
+    }
+    // The later of the two frame-25 keys is the one kept.
+    CHECK(right.at("translateY")[2].frame == 25);
+    CHECK(right.at("translateY")[2].value == Approx(0.01));
+  }
+  SECTION("body: translate and rotate keys; Euler angles reproduce the quaternions") {
+    const auto& body = script.keys.at("body");
+    REQUIRE(body.size() == 6);
+    for (const auto& entry : body) CHECK(entry.second.size() == 5);
+    const double yaw[] = {0, 60, 150, 170, 190};
+    for (size_t i = 0; i < 5; ++i) {
+      const Vec3 euler{body.at("rotateX")[i].value, body.at("rotateY")[i].value,
+                       body.at("rotateZ")[i].value};
+      // Rotating the forward axis by the Euler angles matches yawing it.
+      const Vec3 forward = RotateEuler(euler, {0, 0, 1});
+      const double k = 3.14159265358979323846 / 180;
+      CHECK(forward.x == Approx(std::sin(yaw[i] * k)).margin(1e-5));
+      CHECK(forward.z == Approx(std::cos(yaw[i] * k)).margin(1e-5));
+      CHECK(body.at("translateY")[i].value == Approx(walk.tracks[2].keys[i].position.y));
+    }
+    // Unwrapped: no key turns more than 180 degrees from the previous one.
+    for (size_t i = 1; i < 5; ++i) {
+      CHECK(std::abs(body.at("rotateY")[i].value - body.at("rotateY")[i - 1].value) < 180);
+    }
+  }
+  std::remove(path.c_str());
+}
+
+TEST_CASE("WriteMel groups crowd characters and sanitises names", "[export][mel]") {
+  Walk walk = test::CrowdWalk();
+  walk.tracks[0].name = "3rd leg|x";
+  const std::string path = WriteAndKeep(walk, "crowd.mel");
+  const MelScript script = ParseMel(path);
+  CHECK(script.time_unit == "ntsc");
+  CHECK(script.groups == std::vector<std::string>{"ant_1", "ant_2"});
+  CHECK(script.locators == std::vector<std::string>{"ant_1_3rd_leg_x", "ant_1_R1", "ant_1_body",
+                                                    "ant_2_L1", "ant_2_R1", "ant_2_body"});
+  CHECK(script.parent_of.at("ant_1_body") == "ant_1");
+  CHECK(script.parent_of.at("ant_2_L1") == "ant_2");
+  CHECK(script.track_attr.at("ant_1_3rd_leg_x") == "ant 1/3rd leg|x");
+  for (const std::string& name : script.locators) {
+    CHECK(script.keys.at(name).at("translateX").size() == 3);
+  }
+  CHECK(script.keys.at("ant_2_body").at("rotateY").size() == 3);
+  CHECK(script.keys.at("ant_2_L1").count("rotateY") == 0);
+  CHECK(script.keys.at("ant_2_L1").at("translateX")[2].value == Approx(1.9));
+  std::remove(path.c_str());
+}
+
+TEST_CASE("WriteMel names without a Maya time unit and special characters", "[export][mel]") {
+  Walk walk = test::BipedWalk();
+  walk.fps = 23;
+  walk.tracks[0].name = "9";
+  walk.tracks[1].name = "a\"b\nc";
+  walk.stopped = "cliff at step 3\nposition (1, 2, 3)";
+  const std::string path = WriteAndKeep(walk, "odd.mel");
+  const MelScript script = ParseMel(path);
+  CHECK(script.time_unit.empty());
+  REQUIRE(script.warnings.size() == 1);
+  CHECK_THAT(script.warnings[0], Catch::Contains("no time unit for 23 fps"));
+  CHECK(script.locators == std::vector<std::string>{"_9", "a_b_c", "body"});
+  CHECK(script.track_attr.at("a_b_c") == "a\\\"b\\nc");  // escaped in the MEL string
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  CHECK_THAT(text.str(), Catch::Contains("// The walk stopped early: cliff at step 3 position"));
+  std::remove(path.c_str());
+}
+
+TEST_CASE("WriteMel reports bad walks and unwritable paths", "[export][mel]") {
+  std::string error;
+  Walk walk = test::BipedWalk();
+  const std::string unwritable = test::ScratchPath("no-such-dir") + "/walk.mel";
+  CHECK(WriteMel(walk, unwritable, &error) == Status::kIoError);
+  CHECK_THAT(error, Catch::Contains(unwritable));
+  walk.tracks[2].keys[0].rotation.w = INFINITY;
+  CHECK(WriteMel(walk, test::ScratchPath("bad.mel"), &error) == Status::kInvalidArgument);
+  CHECK_THAT(error, Catch::Contains("track 2 'body' key 0 has a non-finite rotation"));
+}

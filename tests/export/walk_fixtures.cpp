@@ -1,0 +1,103 @@
+#include "walk_fixtures.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+
+namespace footfall {
+namespace test {
+namespace {
+
+WalkKey FootKey(double frame, KeyPhase phase, Vec3 position) {
+  WalkKey key;
+  key.frame = frame;
+  key.phase = phase;
+  key.position = position;
+  return key;
+}
+
+WalkKey BodyKey(double frame, Vec3 position, Quat rotation) {
+  WalkKey key;
+  key.frame = frame;
+  key.position = position;
+  key.rotation = rotation;
+  return key;
+}
+
+WalkTrack Track(const std::string& name, const std::string& character, TrackKind kind) {
+  WalkTrack track;
+  track.name = name;
+  track.character = character;
+  track.kind = kind;
+  return track;
+}
+
+}  // namespace
+
+Quat YawQuat(double degrees) {
+  const double half = degrees * 3.14159265358979323846 / 360.0;
+  return {0, std::sin(half), 0, std::cos(half)};
+}
+
+Walk BipedWalk() {
+  Walk walk;
+  walk.fps = 24;
+  WalkTrack left = Track("L", "", TrackKind::kFoot);
+  left.keys = {FootKey(1, KeyPhase::kStart, {-0.1, 0, 0}),
+               FootKey(7, KeyPhase::kMid, {-0.1, 0.15, 0.25}),
+               FootKey(13, KeyPhase::kEnd, {-0.1, 0.02, 0.5}),
+               FootKey(25, KeyPhase::kStart, {-0.1, 0.02, 0.5}),
+               FootKey(31, KeyPhase::kMid, {-0.1, 0.2, 0.75}),
+               FootKey(37, KeyPhase::kEnd, {-0.1, 0.05, 1.0})};
+  WalkTrack right = Track("R", "", TrackKind::kFoot);
+  right.keys = {FootKey(13, KeyPhase::kStart, {0.1, 0, 0}),
+                FootKey(19, KeyPhase::kMid, {0.1, 0.15, 0.25}),
+                FootKey(25, KeyPhase::kEnd, {0.1, 0.01, 0.5}),
+                FootKey(25, KeyPhase::kStart, {0.1, 0.01, 0.5}),
+                FootKey(31, KeyPhase::kMid, {0.1, 0.18, 0.75}),
+                FootKey(37, KeyPhase::kEnd, {0.1, 0.03, 1.0})};
+  WalkTrack body = Track("body", "", TrackKind::kBody);
+  Quat q60 = YawQuat(60);
+  q60 = {q60.x * 2, q60.y * 2, q60.z * 2, q60.w * 2};
+  Quat q170 = YawQuat(170);
+  q170 = {-q170.x, -q170.y, -q170.z, -q170.w};
+  body.keys = {BodyKey(1, {0, 0.9, 0}, YawQuat(0)), BodyKey(13, {0, 0.91, 0.25}, q60),
+               BodyKey(25, {0, 0.92, 0.5}, YawQuat(150)), BodyKey(31, {0, 0.93, 0.6}, q170),
+               BodyKey(37, {0, 0.94, 0.75}, YawQuat(190))};
+  walk.tracks = {left, right, body};
+  return walk;
+}
+
+Walk CrowdWalk() {
+  Walk walk;
+  walk.fps = 30;
+  const char* characters[] = {"ant 1", "ant-2"};
+  for (int c = 0; c < 2; ++c) {
+    const double x = 2.0 * c;
+    WalkTrack l1 = Track("L1", characters[c], TrackKind::kFoot);
+    l1.keys = {FootKey(1, KeyPhase::kStart, {x - 0.1, 0, 0}),
+               FootKey(5, KeyPhase::kMid, {x - 0.1, 0.1, 0.1}),
+               FootKey(9, KeyPhase::kEnd, {x - 0.1, 0, 0.2})};
+    WalkTrack r1 = Track("R1", characters[c], TrackKind::kFoot);
+    r1.keys = {FootKey(9, KeyPhase::kStart, {x + 0.1, 0, 0}),
+               FootKey(13, KeyPhase::kMid, {x + 0.1, 0.1, 0.1}),
+               FootKey(17, KeyPhase::kEnd, {x + 0.1, 0, 0.2})};
+    WalkTrack body = Track("body", characters[c], TrackKind::kBody);
+    body.keys = {BodyKey(1, {x, 0.3, 0}, YawQuat(0)), BodyKey(9, {x, 0.3, 0.05}, YawQuat(10)),
+                 BodyKey(17, {x, 0.3, 0.1}, YawQuat(20))};
+    walk.tracks.push_back(l1);
+    walk.tracks.push_back(r1);
+    walk.tracks.push_back(body);
+  }
+  return walk;
+}
+
+std::string ScratchPath(const std::string& name) {
+  return (std::filesystem::temp_directory_path() /
+          ("footfall_export_" + std::to_string(::getpid()) + "_" + name))
+      .string();
+}
+
+}  // namespace test
+}  // namespace footfall

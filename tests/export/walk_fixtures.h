@@ -1,0 +1,29 @@
+// Walks built in code for the exporter tests: a biped with start/mid/end foot keys and a turning
+// body, and a two-character crowd. Frames start at 1, as in Maya.
+#pragma once
+
+#include <string>
+
+#include "footfall/steps/walk.h"
+
+namespace footfall {
+namespace test {
+
+// A rotation of `degrees` about +Y (Maya's up), as a unit quaternion.
+Quat YawQuat(double degrees);
+
+// fps 24. Tracks: foot "L" (2 steps, 6 keys at frames 1..37), foot "R" (2 steps; its first end
+// and second start share frame 25, so 5 distinct frames), "body" (5 keys turning 0, 60, 150,
+// 170, 190 degrees about +Y; the 60-degree key is not unit length and the 170-degree key has
+// its sign flipped).
+Walk BipedWalk();
+
+// fps 30. Characters "ant 1" and "ant-2", each with feet "L1", "R1" and a "body" (3 keys each),
+// offset 2 units apart along X.
+Walk CrowdWalk();
+
+// A scratch file path unique to this process: <tmp>/footfall_export_<pid>_<name>.
+std::string ScratchPath(const std::string& name);
+
+}  // namespace test
+}  // namespace footfall

@@ -1,0 +1,407 @@
+// footfall-view, run headless on a private Xvfb: screenshots of queries and walks checked
+// pixel by pixel, a live server followed, and bad inputs.
+#include <catch2/catch.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <thread>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <nlohmann/json.hpp>
+
+#define STB_IMAGE_IMPLEMENTATION
+#include <stb/stb_image.h>
+
+#include "footfall/import/terrain_loader.h"
+#include "footfall/terrain/brute_force.h"
+#include "footfall/terrain/grid.h"
+#include "footfall/viewer/query_view.h"
+#include "footfall/viewer/walk_pose.h"
+#include "footfall/viewer/walk_reader.h"
+#include "process.h"
+
+namespace footfall {
+namespace {
+
+using nlohmann::json;
+using test::Run;
+using test::RunResult;
+
+const std::string kView = FOOTFALL_VIEW;
+const std::string kTerrain = std::string(FOOTFALL_DATA_DIR) + "/terrain/hills.pts";
+constexpr double kTimeout = 60;  // [Units: s] generous: llvmpipe on a loaded 2-core machine
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<unsigned char> rgb;
+  glm::ivec3 At(int x, int y) const {
+    const size_t i = (static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x)) * 3;
+    return {rgb[i], rgb[i + 1], rgb[i + 2]};
+  }
+};
+
+Image ReadPng(const std::string& path) {
+  Image image;
+  int channels = 0;
+  unsigned char* data = stbi_load(path.c_str(), &image.width, &image.height, &channels, 3);
+  INFO("reading " << path);
+  REQUIRE(data != nullptr);
+  image.rgb.assign(data, data + static_cast<size_t>(image.width) * image.height * 3);
+  stbi_image_free(data);
+  return image;
+}
+
+bool Near(const glm::ivec3& a, const glm::ivec3& b, int tolerance = 8) {
+  return std::abs(a.x - b.x) <= tolerance && std::abs(a.y - b.y) <= tolerance &&
+         std::abs(a.z - b.z) <= tolerance;
+}
+
+// How many pixels within `radius` of `pixel` have colour `color`.
+int CountColorNear(const Image& image, glm::vec2 pixel, int radius, glm::ivec3 color) {
+  int count = 0;
+  for (int y = static_cast<int>(pixel.y) - radius; y <= static_cast<int>(pixel.y) + radius; ++y) {
+    for (int x = static_cast<int>(pixel.x) - radius; x <= static_cast<int>(pixel.x) + radius; ++x) {
+      if (x >= 0 && y >= 0 && x < image.width && y < image.height && Near(image.At(x, y), color))
+        ++count;
+    }
+  }
+  return count;
+}
+
+int CountColor(const Image& image, glm::ivec3 color) {
+  return CountColorNear(image, {image.width / 2.0f, image.height / 2.0f},
+                        std::max(image.width, image.height), color);
+}
+
+// The test's own projection (not the viewer's camera code): y up, 45 degree vertical FOV,
+// pixels from the top-left corner.
+glm::vec2 Project(const glm::dvec3& eye, const glm::dvec3& target, int width, int height,
+                  const glm::dvec3& p) {
+  const glm::dmat4 view = glm::lookAt(eye, target, glm::dvec3(0, 1, 0));
+  const glm::dmat4 proj =
+      glm::perspective(glm::radians(45.0), static_cast<double>(width) / height, 0.1, 1000.0);
+  const glm::dvec4 clip = proj * view * glm::dvec4(p, 1);
+  return {static_cast<float>((clip.x / clip.w * 0.5 + 0.5) * width),
+          static_cast<float>((0.5 - clip.y / clip.w * 0.5) * height)};
+}
+
+RunResult View(std::vector<std::string> args) {
+  args.insert(args.begin(), kView);
+  RunResult r = Run(args, {test::XDisplay()}, kTimeout);
+  INFO("footfall-view stderr: " << r.err);
+  REQUIRE_FALSE(r.timed_out);
+  return r;
+}
+
+const glm::ivec3 kChosen(255, 0, 255);
+
+// The port footfalld writes to its --port-file once listening ("" after 10 s).
+std::string WaitForPort(const std::string& path) {
+  std::string port;
+  for (int i = 0; i < 500 && port.empty(); ++i) {
+    port = test::ReadFile(path);
+    while (!port.empty() && (port.back() == '\n' || port.back() == ' ')) port.pop_back();
+    if (port.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return port;
+}
+
+TEST_CASE("screenshot of a next query shows the chosen sample where it projects",
+          "[viewer][screenshot]") {
+  const std::string dir = test::TempDir();
+  const glm::dvec3 eye(10, 14, -6), target(14, 0, 14);
+  const int width = 800, height = 500;
+  const StepQuery query{{10, 1, 10}, {1.2, 0, 0.3}};
+  const RunResult r = View({"--terrain", kTerrain, "--query", "next 10 1 10 1.2 0 0.3",
+                            "--camera", "10 14 -6 14 0 14", "--size", "800x500", "--screenshot",
+                            dir + "/shot.png", "--dump-state", dir + "/state.json"});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+
+  // The oracle: brute force over the same terrain.
+  RawSamples samples;
+  std::string error;
+  REQUIRE(LoadTerrain(kTerrain, {}, &samples, &error) == Status::kOk);
+  REQUIRE(ValidateAndNormalize(&samples, &error) == Status::kOk);
+  TerrainGrid grid;
+  REQUIRE(TerrainGrid::Build(samples, {}, &grid, &error) == Status::kOk);
+  const Foothold expected = BruteForce(grid).Next(query, 0);
+  REQUIRE(expected.status == Status::kOk);
+
+  const json state = json::parse(test::ReadFile(dir + "/state.json"));
+  REQUIRE(state["queries"].size() == 1);
+  CHECK(state["queries"][0]["index"] == expected.index);
+  CHECK(state["queries"][0]["candidates"].get<int>() > 0);
+
+  const Image image = ReadPng(dir + "/shot.png");
+  REQUIRE(image.width == width);
+  REQUIRE(image.height == height);
+  const glm::vec2 pixel = Project(eye, target, width, height,
+                                  {expected.point.x, expected.point.y, expected.point.z});
+  INFO("chosen sample projects to " << pixel.x << ", " << pixel.y);
+  const glm::vec2 dumped(state["queries"][0]["pixel"][0].get<float>(),
+                         state["queries"][0]["pixel"][1].get<float>());
+  CHECK(glm::length(dumped - pixel) < 2.0f);
+  // The chosen sample is a 15 px magenta square centred on its projection.
+  CHECK(CountColorNear(image, pixel, 4, kChosen) >= 40);
+  CHECK(CountColor(image, kChosen) < 600);  // and nowhere else to speak of
+
+  // Terrain coloured by normal: mostly-up normals are green-dominant.
+  int terrain = 0;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const glm::ivec3 c = image.At(x, y);
+      if (c.y > c.x + 40 && c.y > c.z + 40) ++terrain;
+    }
+  }
+  const double share = static_cast<double>(terrain) / (width * height);
+  INFO("terrain share " << share);
+  CHECK(share > 0.25);
+  CHECK(share < 0.98);
+}
+
+TEST_CASE("height colouring and grid cells change the picture", "[viewer][screenshot]") {
+  const std::string dir = test::TempDir();
+  REQUIRE(View({"--terrain", kTerrain, "--height-colors", "--cells", "--size", "320x200",
+                "--screenshot", dir + "/h.png"})
+              .exit_code == 0);
+  const Image image = ReadPng(dir + "/h.png");
+  REQUIRE(image.width == 320);
+  // No green-dominant normal colours now; the height ramp's blues and sands instead.
+  int normal_green = 0, other = 0;
+  for (int y = 30; y < 170; ++y) {
+    for (int x = 0; x < 320; ++x) {
+      const glm::ivec3 c = image.At(x, y);
+      if (c.x == 128 && c.y > 240 && c.z == 128) ++normal_green;
+      if (!Near(c, {28, 30, 36}, 3)) ++other;
+    }
+  }
+  CHECK(normal_green < 50);
+  CHECK(other > 320 * 140 / 5);
+}
+
+std::string WalkJson() {
+  // L1 steps from (2, 0, 2) over an arc to (4, 0, 2) during frames 1-13; R1 from (2, 0, 0)
+  // to (4, 0, 0) during frames 13-25. The body moves along x between them.
+  return R"({"fps": 24, "tracks": [
+    {"name": "L1", "kind": "foot", "keys": [
+      {"frame": 1, "phase": "start", "position": [2, 0, 2], "normal": [0, 1, 0]},
+      {"frame": 7, "phase": "mid", "position": [3, 0.5, 2], "normal": [0, 1, 0]},
+      {"frame": 13, "phase": "end", "position": [4, 0, 2], "normal": [0, 1, 0]}]},
+    {"name": "R1", "kind": "foot", "keys": [
+      {"frame": 13, "phase": "start", "position": [2, 0, 0], "normal": [0, 1, 0]},
+      {"frame": 19, "phase": "mid", "position": [3, 0.5, 0], "normal": [0, 1, 0]},
+      {"frame": 25, "phase": "end", "position": [4, 0, 0], "normal": [0, 1, 0]}]},
+    {"name": "body", "kind": "body", "keys": [
+      {"frame": 1, "position": [2, 1, 1], "rotation": [0, 0, 0, 1]},
+      {"frame": 25, "position": [4, 1, 1], "rotation": [0, 0, 0, 1]}]}]})";
+}
+
+TEST_CASE("screenshot of a walk shows the feet where the JSON puts them at that frame",
+          "[viewer][walk]") {
+  const std::string dir = test::TempDir();
+  test::WriteFile(dir + "/walk.json", WalkJson());
+  const glm::dvec3 eye(3, 6, 7), target(3, 0, 1);
+  const glm::ivec3 left(255, 80, 40), right(40, 130, 255);  // foot tracks 0 and 1
+  struct Case {
+    int frame;
+    glm::dvec3 l1, r1;
+  };
+  for (const Case& c : {Case{13, {4, 0, 2}, {2, 0, 0}}, Case{7, {3, 0.5, 2}, {2, 0, 0}},
+                        Case{25, {4, 0, 2}, {4, 0, 0}}}) {
+    SECTION("frame " + std::to_string(c.frame)) {
+      const std::string shot = dir + "/walk" + std::to_string(c.frame) + ".png";
+      const RunResult r =
+          View({"--walk", dir + "/walk.json", "--frame", std::to_string(c.frame), "--camera",
+                "3 6 7 3 0 1", "--size", "640x480", "--screenshot", shot, "--dump-state",
+                dir + "/state.json"});
+      REQUIRE(r.exit_code == 0);
+      const Image image = ReadPng(shot);
+      REQUIRE(image.width == 640);
+      const glm::vec2 l = Project(eye, target, 640, 480, c.l1);
+      const glm::vec2 rr = Project(eye, target, 640, 480, c.r1);
+      INFO("L1 at " << l.x << "," << l.y << "  R1 at " << rr.x << "," << rr.y);
+      CHECK(CountColorNear(image, l, 4, left) >= 40);
+      CHECK(CountColorNear(image, rr, 4, right) >= 40);
+      const json state = json::parse(test::ReadFile(dir + "/state.json"));
+      CHECK(state["walk"]["frame"] == c.frame);
+      CHECK(state["walk"]["tracks"][0]["name"] == "L1");
+      CHECK(state["walk"]["tracks"][0]["position"][0].get<double>() == Approx(c.l1.x));
+      CHECK(state["walk"]["tracks"][0]["position"][1].get<double>() == Approx(c.l1.y));
+    }
+  }
+}
+
+TEST_CASE("live: the viewer shows a query another client sends to footfalld", "[viewer][live]") {
+  const std::string dir = test::TempDir();
+  test::Child server({FOOTFALLD, "--listen", "127.0.0.1:0", "--port-file", dir + "/port",
+                      "--no-rpcbind"},
+                     {});
+  const std::string port = WaitForPort(dir + "/port");
+  INFO("footfalld stderr: " << server.Err());
+  REQUIRE_FALSE(port.empty());
+  const std::string address = "127.0.0.1:" + port;
+
+  test::Child viewer({kView, "--terrain", kTerrain, "--server", address, "--live",
+                      "--live-wait", "1", "--timeout", "30", "--size", "640x400",
+                      "--screenshot", dir + "/live.png", "--dump-state", dir + "/state.json"},
+                     {test::XDisplay()});
+  INFO("viewer stderr: " << viewer.Err());
+  REQUIRE(viewer.WaitForOutput("live: following footfalld at " + address, kTimeout));
+
+  const RunResult client = Run({FOOTFALL_CLI, "query", "--terrain", kTerrain, "--server", address},
+                               {}, kTimeout, "next 10 1 10 1.2 0 0.3\n");
+  INFO("footfall query: " << client.out << client.err);
+  REQUIRE(client.exit_code == 0);
+  const json answer = json::parse(client.out.substr(0, client.out.find('\n')));
+  REQUIRE(answer["found"] == true);
+
+  int code = -1;
+  REQUIRE(viewer.Wait(kTimeout, &code));
+  REQUIRE(code == 0);
+  const json state = json::parse(test::ReadFile(dir + "/state.json"));
+  REQUIRE(state["live"]["received"].get<int>() >= 1);
+  const json& q = state["live"]["queries"][0];
+  CHECK(q["op"] == "next");
+  CHECK(q["index"] == answer["index"]);
+  CHECK(q["traced"] == true);  // re-traced on the local copy of the terrain
+  REQUIRE(q["visible"] == true);
+  const Image image = ReadPng(dir + "/live.png");
+  const glm::vec2 pixel(q["pixel"][0].get<float>(), q["pixel"][1].get<float>());
+  CHECK(CountColorNear(image, pixel, 4, kChosen) >= 40);
+}
+
+TEST_CASE("live: a server that never sees a query ends the wait with a message",
+          "[viewer][live]") {
+  const std::string dir = test::TempDir();
+  test::Child server({FOOTFALLD, "--listen", "127.0.0.1:0", "--port-file", dir + "/port",
+                      "--no-rpcbind"},
+                     {});
+  const std::string port = WaitForPort(dir + "/port");
+  REQUIRE_FALSE(port.empty());
+  const RunResult r = View({"--server", "127.0.0.1:" + port, "--live", "--live-wait", "1",
+                            "--timeout", "1", "--screenshot", dir + "/x.png"});
+  CHECK(r.exit_code == 1);
+  CHECK_THAT(r.err, Catch::Contains("received 0 of 1 queries"));
+}
+
+TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][errors]") {
+  const std::string dir = test::TempDir();
+  const std::string shot = dir + "/x.png";
+  SECTION("missing terrain file") {
+    const RunResult r = View({"--terrain", dir + "/missing.pts", "--screenshot", shot});
+    CHECK(r.exit_code == 1);
+    CHECK_THAT(r.err, Catch::Contains(dir + "/missing.pts") && Catch::Contains("cannot open"));
+  }
+  SECTION("malformed query strings") {
+    RunResult r = View({"--terrain", kTerrain, "--query", "next 1 2 3", "--screenshot", shot});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("next: expected 6 numbers (X Y Z DX DY DZ), found 3"));
+    r = View({"--terrain", kTerrain, "--query", "jump 1 2 3", "--screenshot", shot});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("unknown query 'jump'"));
+    r = View({"--terrain", kTerrain, "--query", "snap 1 nan 3", "--screenshot", shot});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("argument 2 'nan' is not a finite number"));
+    r = View({"--terrain", kTerrain, "--query", "next 1 2 3 0 0 0", "--screenshot", shot});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("direction DX DY DZ must be non-zero"));
+  }
+  SECTION("unreachable server") {
+    const RunResult r = View({"--server", "127.0.0.1:1", "--live", "--screenshot", shot});
+    CHECK(r.exit_code == 1);
+    CHECK_THAT(r.err, Catch::Contains("footfalld at 127.0.0.1:1"));
+  }
+  SECTION("missing and malformed walk files") {
+    RunResult r = View({"--walk", dir + "/none.json", "--screenshot", shot});
+    CHECK(r.exit_code == 1);
+    CHECK_THAT(r.err, Catch::Contains(dir + "/none.json: cannot open walk file"));
+    test::WriteFile(dir + "/broken.json", "{\"fps\": 24,\n \"tracks\": [\n");
+    r = View({"--walk", dir + "/broken.json", "--screenshot", shot});
+    CHECK(r.exit_code == 1);
+    CHECK_THAT(r.err, Catch::Contains(dir + "/broken.json:3:1: malformed JSON"));
+    test::WriteFile(dir + "/shape.json",
+                    R"({"tracks": [{"name": "L1", "keys": [{"frame": 1, "position": [1, 2]}]}]})");
+    r = View({"--walk", dir + "/shape.json", "--screenshot", shot});
+    CHECK(r.exit_code == 1);
+    CHECK_THAT(r.err, Catch::Contains("tracks[0].keys[0].position: expected an array of 3"));
+  }
+  SECTION("bad sizes and missing content") {
+    RunResult r = View({"--terrain", kTerrain, "--size", "12by4", "--screenshot", shot});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("--size \"12by4\": expected WIDTHxHEIGHT"));
+    r = View({"--screenshot", shot});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("nothing to show"));
+  }
+  SECTION("no display") {
+    const RunResult r =
+        Run({kView, "--terrain", kTerrain, "--screenshot", shot}, {"DISPLAY="}, kTimeout);
+    CHECK(r.exit_code == 1);
+    CHECK_THAT(r.err, Catch::Contains("cannot open a display"));
+  }
+  std::ifstream none(shot);
+  CHECK_FALSE(none.good());  // no failed run leaves a screenshot
+}
+
+TEST_CASE("query strings parse into queries", "[viewer][query]") {
+  viewer::QuerySpec spec;
+  std::string error;
+  REQUIRE(viewer::ParseQuerySpec("next 1 2 3 0.5,0,-0.5", &spec, &error));
+  CHECK(spec.op == QueryOp::kNext);
+  CHECK(spec.direction.z == -0.5);
+  CHECK(viewer::FormatQuerySpec(spec) == "next 1 2 3 0.5 0 -0.5");
+  REQUIRE(viewer::ParseQuerySpec("  normal 1 2 3 ", &spec, &error));
+  CHECK(spec.op == QueryOp::kNormal);
+  CHECK_FALSE(viewer::ParseQuerySpec("", &spec, &error));
+  CHECK_THAT(error, Catch::Contains("empty query"));
+  CHECK_FALSE(viewer::ParseQuerySpec("snap 1 2 3 4", &spec, &error));
+  CHECK(error == "snap: expected 3 numbers (X Y Z), found 4");
+}
+
+TEST_CASE("walk poses follow keys and swing arcs", "[viewer][walk]") {
+  const std::string dir = test::TempDir();
+  test::WriteFile(dir + "/walk.json", WalkJson());
+  Walk walk;
+  std::string error;
+  REQUIRE(viewer::ReadWalkJson(dir + "/walk.json", &walk, &error) == Status::kOk);
+  REQUIRE(walk.tracks.size() == 3);
+  CHECK(walk.tracks[2].kind == TrackKind::kBody);
+  const WalkTrack& l1 = walk.tracks[0];
+  SECTION("keys are hit exactly and the foot holds outside its keys") {
+    CHECK(viewer::PoseAt(l1, 1).position == Vec3{2, 0, 2});
+    CHECK(viewer::PoseAt(l1, 7).position.y == Approx(0.5));
+    CHECK(viewer::PoseAt(l1, 13).position == Vec3{4, 0, 2});
+    CHECK(viewer::PoseAt(l1, 0).position == Vec3{2, 0, 2});
+    CHECK(viewer::PoseAt(l1, 99).position == Vec3{4, 0, 2});
+  }
+  SECTION("the swing is a smooth arc, above the straight line and swinging") {
+    const viewer::TrackPose p = viewer::PoseAt(l1, 4);
+    CHECK(p.swinging);
+    CHECK(p.position.y > 0.3);
+    CHECK(p.position.y < 0.5);
+    CHECK(p.position.x == Approx(2.5));
+  }
+  SECTION("the body interpolates linearly") {
+    CHECK(viewer::PoseAt(walk.tracks[2], 13).position.x == Approx(3));
+  }
+  double first = 0, last = 0;
+  viewer::FrameRange(walk, &first, &last);
+  CHECK(first == 1);
+  CHECK(last == 25);
+}
+
+TEST_CASE("walk files with descending frames are refused", "[viewer][walk]") {
+  const std::string dir = test::TempDir();
+  test::WriteFile(dir + "/w.json", R"({"fps": 24, "tracks": [{"name": "L1", "keys": [
+      {"frame": 5, "position": [0, 0, 0]}, {"frame": 2, "position": [1, 0, 0]}]}]})");
+  Walk walk;
+  std::string error;
+  CHECK(viewer::ReadWalkJson(dir + "/w.json", &walk, &error) == Status::kParseError);
+  CHECK_THAT(error, Catch::Contains("tracks[0].keys[1].frame: frames must ascend"));
+}
+
+}  // namespace
+}  // namespace footfall

@@ -1,0 +1,110 @@
+// Scene: everything the viewer shows, without GL: the terrain samples and their grid, the
+// queries (command line and live), and a walk. It turns itself into DrawLists for a frame and
+// describes what it drew as JSON (the state dump used by tests).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "footfall/client/recent_queries.h"
+#include "footfall/import/terrain_loader.h"
+#include "footfall/steps/walk.h"
+#include "footfall/terrain/grid.h"
+#include "footfall/viewer/camera.h"
+#include "footfall/viewer/draw_list.h"
+#include "footfall/viewer/query_view.h"
+
+namespace footfall::viewer {
+
+enum class ColorMode { kNormal, kHeight };
+
+// What the user toggles while viewing.
+struct ViewState {
+  double frame = 0;  // walk playback frame
+  ColorMode color = ColorMode::kNormal;
+  bool show_cells = false;  // occupied grid cells as wireframe boxes
+};
+
+// The colours the viewer uses, so tests and docs can name them.
+namespace colors {
+constexpr Rgba kBackground{28, 30, 36, 255};
+constexpr Rgba kChosen{255, 0, 255, 255};     // the sample a query chose
+constexpr Rgba kCandidate{255, 214, 0, 255};  // next: samples meeting the conditions
+constexpr Rgba kExamined{150, 150, 170, 255};
+constexpr Rgba kFoot{0, 200, 255, 255};       // the query point / foot
+constexpr Rgba kIdeal{255, 255, 255, 255};    // foot + direction
+constexpr Rgba kArrow{255, 140, 0, 255};
+constexpr Rgba kCell{110, 110, 130, 255};
+constexpr Rgba kQueryCell{230, 230, 90, 160};
+constexpr Rgba kBody{240, 240, 240, 255};
+}  // namespace colors
+
+// The colour of foot track `i` of a walk (cycles through a palette free of the query colours).
+Rgba FootColor(size_t track_index);
+
+class Scene {
+ public:
+  // Loads a terrain file (any format of terrain_loader.h) and builds its grid.
+  Status LoadTerrain(const std::string& path, const TerrainLoadOptions& options,
+                     std::string* error);
+  // Answers a query on the terrain's grid and keeps it for drawing. kInvalidArgument without
+  // a terrain.
+  Status AddQuery(const QuerySpec& spec, std::string* error);
+  // Reads a walk JSON file (walk_reader.h).
+  Status LoadWalk(const std::string& path, std::string* error);
+  // Adds queries received from footfalld, traced on the local grid when there is one. Keeps
+  // the newest `kMaxLive`.
+  void AddLive(const std::vector<RecentQuery>& queries);
+  static constexpr size_t kMaxLive = 256;
+
+  // Fixes the render-space origin at the centre of what is loaded. Call once after loading.
+  void Finalize();
+
+  bool has_terrain() const { return !terrain_path_.empty(); }
+  bool has_walk() const { return !walk_path_.empty(); }
+  const TerrainGrid& grid() const { return grid_; }
+  const Walk& walk() const { return walk_; }
+  double first_frame() const { return first_frame_; }
+  double last_frame() const { return last_frame_; }
+  size_t live_received() const { return live_received_; }
+  const std::vector<QueryView>& queries() const { return queries_; }
+  const std::vector<QueryView>& live() const { return live_; }
+
+  // World space to render space (world minus the origin), and the render-space bounds of
+  // everything loaded (a unit box when nothing is).
+  glm::vec3 ToRender(const Vec3& world) const;
+  Vec3 ToWorld(const glm::vec3& render) const;
+  void RenderBounds(glm::vec3* lo, glm::vec3* hi) const;
+
+  // The terrain samples as world-sized points in render space, coloured by `mode`.
+  std::vector<DrawVertex> TerrainPoints(ColorMode mode) const;
+  // Terrain splat size. [Units: wu]
+  double SampleSpacing() const { return spacing_; }
+
+  // Fills `depth_tested` (grid cells) and `on_top` (queries, walk) for one frame.
+  void Draw(const ViewState& view, DrawList* depth_tested, DrawList* on_top) const;
+
+  // What a frame shows, with pixel positions for a width x height image seen by `camera`.
+  nlohmann::ordered_json Describe(const ViewState& view, const OrbitCamera& camera, int width,
+                                  int height) const;
+
+ private:
+  void DrawQuery(const QueryView& q, bool latest, DrawList* depth_tested, DrawList* on_top) const;
+  void DrawWalk(const ViewState& view, DrawList* on_top) const;
+
+  std::string terrain_path_, walk_path_;
+  RawSamples samples_;
+  TerrainGrid grid_;
+  double spacing_ = 0.1;
+  std::vector<QueryView> queries_, live_;
+  size_t live_received_ = 0;
+  Walk walk_;
+  double first_frame_ = 0, last_frame_ = 0;
+  Vec3 origin_;
+  Vec3 lo_, hi_;
+  bool has_bounds_ = false;
+};
+
+}  // namespace footfall::viewer

@@ -1,0 +1,28 @@
+// Where a walk's feet and body are at a given frame, for drawing and playback.
+#pragma once
+
+#include "footfall/steps/walk.h"
+
+namespace footfall::viewer {
+
+struct TrackPose {
+  Vec3 position;       // world space
+  Vec3 normal{0, 1, 0};
+  Quat rotation;       // body tracks
+  bool swinging = false;  // feet: between a start and an end key
+};
+
+// The pose of `track` at `frame` (animation frames, may be fractional). A swing from a start
+// key through a mid key to an end key follows the quadratic arc through those three points;
+// elsewhere positions are interpolated linearly (a planted foot keeps its place) and body
+// rotations spherically. Before the first key and after the last the track holds still.
+// The track must have at least one key.
+TrackPose PoseAt(const WalkTrack& track, double frame);
+
+// A point of the quadratic arc through start (t = 0), mid (t = 0.5) and end (t = 1).
+Vec3 ArcPoint(const Vec3& start, const Vec3& mid, const Vec3& end, double t);
+
+// The first and last key frames over all tracks; {0, 0} for a walk without keys.
+void FrameRange(const Walk& walk, double* first, double* last);
+
+}  // namespace footfall::viewer

@@ -1,0 +1,100 @@
+// footfall-view: the debug viewer of terrains, queries, walks and live servers.
+#include <charconv>
+#include <cmath>
+#include <csignal>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+
+#include "footfall/viewer/viewer_app.h"
+
+namespace {
+
+bool ParseNumbers(const std::string& text, size_t count, std::vector<double>* out) {
+  std::string spaced = text;
+  for (char& c : spaced) {
+    if (c == ',') c = ' ';
+  }
+  std::istringstream in(spaced);
+  out->clear();
+  for (std::string t; in >> t;) {
+    double v = 0;
+    const auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+    if (ec != std::errc() || ptr != t.data() + t.size() || !std::isfinite(v)) return false;
+    out->push_back(v);
+  }
+  return out->size() == count;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::signal(SIGPIPE, SIG_IGN);
+  footfall::viewer::ViewerOptions o;
+  CLI::App app{
+      "footfall-view: draws terrain samples, queries (foot, direction, cells, candidates, chosen "
+      "sample), walks and the queries of a live footfalld. Keys: drag orbit, right-drag pan, "
+      "wheel zoom, F frame all, C colour, G grid cells, space play, left/right frame, Esc quit."};
+  std::string size, camera;
+  double frame = 0;
+  app.add_option("--terrain", o.terrain, "Terrain file (.pts/.xyz/.txt or any loader format)");
+  app.add_option("--separation", o.load.separation, "Mesh resampling distance (wu)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--up-axis", o.load.up_axis, "Height maps: up axis x, y or z");
+  app.add_option("--query", o.queries,
+                 "A query to draw, repeatable: \"next X Y Z DX DY DZ\", \"snap X Y Z\", "
+                 "\"normal X Y Z\"");
+  app.add_option("--tolerance", o.tolerance,
+                 "next: candidate radius around the ideal point (default: the step length)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--walk", o.walk, "Walk JSON file from the step generator");
+  app.add_option("--server", o.server, "footfalld HOST:PORT, with --live");
+  app.add_flag("--live", o.live, "Draw the queries the server answers, as they arrive");
+  app.add_option("--live-wait", o.live_wait,
+                 "With --screenshot: wait for this many live queries before rendering")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--timeout", o.timeout_s, "Bound on waits for the server (s)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--screenshot", o.screenshot, "Render one frame off screen to this PNG and exit");
+  app.add_option("--size", size, "Window or image size WxH (default 1280x800)");
+  auto* frame_opt = app.add_option("--frame", frame, "Walk frame to show");
+  app.add_option("--dump-state", o.dump_state,
+                 "Write what is drawn (pixel positions of chosen samples and feet, live "
+                 "queries) as JSON");
+  app.add_flag("--height-colors", o.height_colors, "Colour samples by height, not by normal");
+  app.add_flag("--cells", o.show_cells, "Draw the occupied grid cells");
+  app.add_option("--camera", camera,
+                 "Camera \"EX EY EZ TX TY TZ\": eye and target in world space (y up, 45 degree "
+                 "vertical field of view); default frames everything");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  if (!size.empty()) {
+    const size_t x = size.find_first_of("xX");
+    std::vector<double> wh;
+    if (x == std::string::npos ||
+        !ParseNumbers(size.substr(0, x) + " " + size.substr(x + 1), 2, &wh) ||
+        wh[0] != std::floor(wh[0]) || wh[1] != std::floor(wh[1]) || wh[0] < 1 || wh[1] < 1 ||
+        wh[0] > 16384 || wh[1] > 16384) {
+      std::cerr << "footfall-view: --size \"" << size
+                << "\": expected WIDTHxHEIGHT in pixels, e.g. 1280x800\n";
+      return 2;
+    }
+    o.width = static_cast<int>(wh[0]), o.height = static_cast<int>(wh[1]);
+  }
+  if (!camera.empty()) {
+    std::vector<double> v;
+    if (!ParseNumbers(camera, 6, &v) ||
+        (v[0] == v[3] && v[1] == v[4] && v[2] == v[5])) {
+      std::cerr << "footfall-view: --camera \"" << camera
+                << "\": expected 6 finite numbers EX EY EZ TX TY TZ, eye != target\n";
+      return 2;
+    }
+    o.has_camera = true;
+    o.eye = {v[0], v[1], v[2]}, o.target = {v[3], v[4], v[5]};
+  }
+  if (frame_opt->count() > 0) o.has_frame = true, o.frame = frame;
+  return footfall::viewer::RunViewer(o);
+}

@@ -1,0 +1,356 @@
+#include "footfall/viewer/scene.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "footfall/viewer/walk_pose.h"
+#include "footfall/viewer/walk_reader.h"
+
+namespace footfall::viewer {
+namespace {
+
+using nlohmann::ordered_json;
+
+uint8_t Byte(double v) { return static_cast<uint8_t>(std::clamp(v, 0.0, 1.0) * 255.0 + 0.5); }
+
+Rgba NormalColor(const Vec3& n) {
+  return {Byte(n.x * 0.5 + 0.5), Byte(n.y * 0.5 + 0.5), Byte(n.z * 0.5 + 0.5), 255};
+}
+
+// A blue - teal - green - sand - white ramp over t in [0, 1].
+Rgba HeightColor(double t) {
+  static const double kStops[5][3] = {
+      {0.15, 0.25, 0.65}, {0.10, 0.60, 0.60}, {0.30, 0.70, 0.25}, {0.80, 0.70, 0.40},
+      {0.97, 0.97, 0.97}};
+  t = std::clamp(t, 0.0, 1.0) * 4;
+  const int i = std::min(static_cast<int>(t), 3);
+  const double f = t - i;
+  return {Byte(kStops[i][0] + (kStops[i + 1][0] - kStops[i][0]) * f),
+          Byte(kStops[i][1] + (kStops[i + 1][1] - kStops[i][1]) * f),
+          Byte(kStops[i][2] + (kStops[i + 1][2] - kStops[i][2]) * f), 255};
+}
+
+// A world-space direction as a render-space vector (directions need no origin shift).
+glm::vec3 Direction(const Vec3& v) {
+  return glm::vec3(static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z));
+}
+
+ordered_json Json(const Vec3& v) { return ordered_json::array({v.x, v.y, v.z}); }
+ordered_json Json(const glm::vec2& v) { return ordered_json::array({v.x, v.y}); }
+
+void Grow(const Vec3& p, Vec3* lo, Vec3* hi, bool* any) {
+  if (!*any) {
+    *lo = *hi = p;
+    *any = true;
+    return;
+  }
+  lo->x = std::min(lo->x, p.x), lo->y = std::min(lo->y, p.y), lo->z = std::min(lo->z, p.z);
+  hi->x = std::max(hi->x, p.x), hi->y = std::max(hi->y, p.y), hi->z = std::max(hi->z, p.z);
+}
+
+}  // namespace
+
+Rgba FootColor(size_t track_index) {
+  static const Rgba kPalette[] = {{255, 80, 40, 255},  {40, 130, 255, 255}, {60, 220, 60, 255},
+                                  {255, 150, 200, 255}, {150, 100, 255, 255}, {0, 230, 230, 255}};
+  return kPalette[track_index % (sizeof kPalette / sizeof kPalette[0])];
+}
+
+Status Scene::LoadTerrain(const std::string& path, const TerrainLoadOptions& options,
+                          std::string* error) {
+  RawSamples samples;
+  Status s = footfall::LoadTerrain(path, options, &samples, error);
+  if (s != Status::kOk) return s;
+  s = ValidateAndNormalize(&samples, error);
+  if (s != Status::kOk) {
+    *error = path + ": " + *error;
+    return s;
+  }
+  TerrainGrid grid;
+  s = TerrainGrid::Build(samples, GridOptions{}, &grid, error);
+  if (s != Status::kOk) {
+    *error = path + ": " + *error;
+    return s;
+  }
+  samples_ = std::move(samples);
+  grid_ = std::move(grid);
+  terrain_path_ = path;
+  const GridStats& st = grid_.stats();
+  if (st.samples > 0 && st.occupied_cells > 0) {
+    spacing_ = st.cell_size *
+               std::sqrt(static_cast<double>(st.occupied_cells) / static_cast<double>(st.samples));
+  }
+  for (const Vec3& p : samples_.points) Grow(p, &lo_, &hi_, &has_bounds_);
+  return Status::kOk;
+}
+
+Status Scene::AddQuery(const QuerySpec& spec, std::string* error) {
+  if (!has_terrain()) {
+    *error = "a query needs a terrain (--terrain FILE)";
+    return Status::kInvalidArgument;
+  }
+  queries_.push_back(RunQuery(grid_, spec));
+  const QueryView& q = queries_.back();
+  Grow(q.spec.point, &lo_, &hi_, &has_bounds_);
+  Grow(q.trace.ideal, &lo_, &hi_, &has_bounds_);
+  return Status::kOk;
+}
+
+Status Scene::LoadWalk(const std::string& path, std::string* error) {
+  Walk walk;
+  const Status s = ReadWalkJson(path, &walk, error);
+  if (s != Status::kOk) return s;
+  walk_ = std::move(walk);
+  walk_path_ = path;
+  FrameRange(walk_, &first_frame_, &last_frame_);
+  for (const WalkTrack& t : walk_.tracks) {
+    for (const WalkKey& k : t.keys) Grow(k.position, &lo_, &hi_, &has_bounds_);
+  }
+  return Status::kOk;
+}
+
+void Scene::AddLive(const std::vector<RecentQuery>& queries) {
+  for (const RecentQuery& q : queries) {
+    live_.push_back(FromRecent(q, has_terrain() ? &grid_ : nullptr));
+    ++live_received_;
+  }
+  if (live_.size() > kMaxLive)
+    live_.erase(live_.begin(), live_.begin() + static_cast<long>(live_.size() - kMaxLive));
+}
+
+void Scene::Finalize() {
+  origin_ = has_bounds_ ? 0.5 * (lo_ + hi_) : Vec3{};
+  // Without samples, size markers after the scene: a walk of a few metres or of a kilometre.
+  if (!has_terrain() && has_bounds_) spacing_ = std::max(Distance(lo_, hi_) / 300, 1e-3);
+}
+
+glm::vec3 Scene::ToRender(const Vec3& world) const {
+  const Vec3 r = world - origin_;
+  return glm::vec3(static_cast<float>(r.x), static_cast<float>(r.y), static_cast<float>(r.z));
+}
+
+Vec3 Scene::ToWorld(const glm::vec3& render) const {
+  return origin_ + Vec3{render.x, render.y, render.z};
+}
+
+void Scene::RenderBounds(glm::vec3* lo, glm::vec3* hi) const {
+  if (!has_bounds_) {
+    *lo = glm::vec3(-0.5f), *hi = glm::vec3(0.5f);
+    return;
+  }
+  *lo = ToRender(lo_), *hi = ToRender(hi_);
+}
+
+std::vector<DrawVertex> Scene::TerrainPoints(ColorMode mode) const {
+  std::vector<DrawVertex> out;
+  out.reserve(samples_.size());
+  const double h0 = lo_.y, h1 = hi_.y;
+  const float size = -static_cast<float>(spacing_ * 1.6);  // world-sized splats
+  for (size_t i = 0; i < samples_.size(); ++i) {
+    const Vec3& p = samples_.points[i];
+    const Rgba c = mode == ColorMode::kNormal
+                       ? NormalColor(samples_.normals[i])
+                       : HeightColor(h1 > h0 ? (p.y - h0) / (h1 - h0) : 0.5);
+    out.push_back({ToRender(p), c, size});
+  }
+  return out;
+}
+
+void Scene::DrawQuery(const QueryView& q, bool latest, DrawList* depth_tested,
+                      DrawList* on_top) const {
+  const float unit = static_cast<float>(spacing_);
+  if (q.traced) {
+    for (uint32_t cell : q.trace.cells) {
+      Vec3 lo, hi;
+      grid_.CellBox(cell, &lo, &hi);
+      depth_tested->Box(ToRender(lo), ToRender(hi), colors::kQueryCell);
+    }
+    for (uint32_t i : q.trace.examined_samples) {
+      if (i < samples_.size()) on_top->Point(ToRender(samples_.points[i]), colors::kExamined, 3);
+    }
+    for (uint32_t i : q.trace.candidates) {
+      if (i < samples_.size())
+        on_top->Point(ToRender(samples_.points[i]), colors::kCandidate, 5);
+    }
+  }
+  const glm::vec3 foot = ToRender(q.spec.point);
+  const float marker = latest ? 1.0f : 0.6f;
+  on_top->Point(foot, colors::kFoot, 11 * marker);
+  on_top->Cross(foot, unit * 2, colors::kFoot);
+  if (q.spec.op == QueryOp::kNext) {
+    const glm::vec3 ideal = ToRender(q.spec.point + q.spec.direction);
+    const float step = static_cast<float>(Length(q.spec.direction));
+    on_top->Arrow(foot, ideal, std::max(step * 0.15f, unit), colors::kArrow);
+    on_top->Point(ideal, colors::kIdeal, 8 * marker);
+    // The candidate radius, as a ring in the horizontal plane around the ideal point.
+    const float radius = static_cast<float>(q.trace.radius > 0 ? q.trace.radius
+                                            : q.spec.tolerance > 0 ? q.spec.tolerance
+                                                                   : step);
+    const int kSegments = 48;
+    for (int i = 0; i < kSegments; ++i) {
+      const float a0 = 6.2831853f * static_cast<float>(i) / kSegments;
+      const float a1 = 6.2831853f * static_cast<float>(i + 1) / kSegments;
+      on_top->Line(ideal + radius * glm::vec3(std::cos(a0), 0, std::sin(a0)),
+                   ideal + radius * glm::vec3(std::cos(a1), 0, std::sin(a1)),
+                   Rgba{255, 255, 255, 90});
+    }
+  }
+  if (q.result.status == Status::kOk) {
+    const glm::vec3 chosen = ToRender(q.result.point);
+    const glm::vec3 from =
+        q.spec.op == QueryOp::kNext ? ToRender(q.spec.point + q.spec.direction) : foot;
+    on_top->Line(from, chosen, colors::kChosen);
+    on_top->Line(chosen, chosen + (unit * 4) * Direction(q.result.normal), colors::kChosen);
+    on_top->Point(chosen, colors::kChosen, 15 * marker);
+  }
+}
+
+void Scene::DrawWalk(const ViewState& view, DrawList* on_top) const {
+  size_t foot_index = 0;
+  std::vector<glm::vec3> body_path;
+  const float unit = static_cast<float>(std::max(spacing_, 0.02));
+  for (const WalkTrack& track : walk_.tracks) {
+    if (track.keys.empty()) continue;
+    if (track.kind == TrackKind::kBody) {
+      for (const WalkKey& k : track.keys) body_path.push_back(ToRender(k.position));
+      for (size_t i = 1; i < body_path.size(); ++i)
+        on_top->Line(body_path[i - 1], body_path[i], Rgba{200, 200, 200, 160});
+      body_path.clear();
+      const TrackPose pose = PoseAt(track, view.frame);
+      const glm::vec3 p = ToRender(pose.position);
+      on_top->Point(p, colors::kBody, 12);
+      // The body's axes: x red, y green, z blue.
+      const Quat& q = pose.rotation;
+      const glm::vec3 axes[3] = {
+          {1 - 2 * (q.y * q.y + q.z * q.z), 2 * (q.x * q.y + q.w * q.z), 2 * (q.x * q.z - q.w * q.y)},
+          {2 * (q.x * q.y - q.w * q.z), 1 - 2 * (q.x * q.x + q.z * q.z), 2 * (q.y * q.z + q.w * q.x)},
+          {2 * (q.x * q.z + q.w * q.y), 2 * (q.y * q.z - q.w * q.x), 1 - 2 * (q.x * q.x + q.y * q.y)}};
+      const Rgba axis_colors[3] = {{255, 60, 60, 255}, {60, 255, 60, 255}, {60, 60, 255, 255}};
+      for (int a = 0; a < 3; ++a) on_top->Line(p, p + axes[a] * (unit * 8), axis_colors[a]);
+      continue;
+    }
+    const Rgba color = FootColor(foot_index++);
+    const Rgba dim{static_cast<uint8_t>(color.r / 2 + 40), static_cast<uint8_t>(color.g / 2 + 40),
+                   static_cast<uint8_t>(color.b / 2 + 40), 255};
+    const std::vector<WalkKey>& keys = track.keys;
+    for (size_t i = 0; i < keys.size(); ++i) {
+      const WalkKey& k = keys[i];
+      if (k.phase == KeyPhase::kEnd || k.phase == KeyPhase::kStart || k.phase == KeyPhase::kNone)
+        on_top->Point(ToRender(k.position), dim, 7);  // a foothold
+      if (k.phase == KeyPhase::kStart && i + 2 < keys.size() &&
+          keys[i + 1].phase == KeyPhase::kMid && keys[i + 2].phase == KeyPhase::kEnd) {
+        const int kSegments = 16;
+        glm::vec3 prev = ToRender(k.position);
+        for (int s = 1; s <= kSegments; ++s) {
+          const glm::vec3 next = ToRender(ArcPoint(k.position, keys[i + 1].position,
+                                                   keys[i + 2].position,
+                                                   static_cast<double>(s) / kSegments));
+          on_top->Line(prev, next, dim);
+          prev = next;
+        }
+        on_top->Point(ToRender(keys[i + 1].position), dim, 4);
+      }
+    }
+    const TrackPose pose = PoseAt(track, view.frame);
+    const glm::vec3 p = ToRender(pose.position);
+    on_top->Line(p, p + Direction(pose.normal) * (unit * 6), color);
+    on_top->Point(p, color, 16);
+  }
+}
+
+void Scene::Draw(const ViewState& view, DrawList* depth_tested, DrawList* on_top) const {
+  if (view.show_cells && has_terrain()) {
+    for (uint32_t cell : grid_.OccupiedCells()) {
+      Vec3 lo, hi;
+      grid_.CellBox(cell, &lo, &hi);
+      depth_tested->Box(ToRender(lo), ToRender(hi), colors::kCell);
+    }
+  }
+  for (size_t i = 0; i < live_.size(); ++i)
+    DrawQuery(live_[i], i + 1 == live_.size(), depth_tested, on_top);
+  for (const QueryView& q : queries_) DrawQuery(q, true, depth_tested, on_top);
+  if (has_walk()) DrawWalk(view, on_top);
+}
+
+ordered_json Scene::Describe(const ViewState& view, const OrbitCamera& camera, int width,
+                             int height) const {
+  auto pixel = [&](const Vec3& world, ordered_json* j) {
+    glm::vec2 px(0, 0);
+    const bool front = camera.Project(ToRender(world), width, height, &px);
+    (*j)["pixel"] = Json(px);
+    (*j)["visible"] = front && px.x >= 0 && px.y >= 0 && px.x < static_cast<float>(width) &&
+                      px.y < static_cast<float>(height);
+  };
+  auto query_json = [&](const QueryView& q) {
+    ordered_json j;
+    j["query"] = FormatQuerySpec(q.spec);
+    j["op"] = QueryOpName(q.spec.op);
+    if (q.live) j["sequence"] = q.sequence;
+    j["status"] = StatusName(q.result.status);
+    j["found"] = q.result.status == Status::kOk;
+    if (q.result.status == Status::kOk) {
+      j["index"] = q.result.index;
+      j["point"] = Json(q.result.point);
+      pixel(q.result.point, &j);
+    }
+    j["traced"] = q.traced;
+    if (q.traced) {
+      j["cells"] = q.trace.cells.size();
+      j["examined"] = q.trace.examined_samples.size();
+      j["candidates"] = q.trace.candidates.size();
+    }
+    return j;
+  };
+  ordered_json root;
+  root["image"] = {{"width", width}, {"height", height}};
+  root["camera"] = {{"eye", Json(ToWorld(camera.Eye()))},
+                    {"target", Json(ToWorld(camera.target()))},
+                    {"fov_y_degrees", OrbitCamera::kFovYDegrees}};
+  root["color_mode"] = view.color == ColorMode::kNormal ? "normal" : "height";
+  root["show_cells"] = view.show_cells;
+  if (has_terrain()) {
+    const GridStats& st = grid_.stats();
+    root["terrain"] = {{"path", terrain_path_},
+                       {"samples", st.samples},
+                       {"bounds_min", Json(st.bounds_min)},
+                       {"bounds_max", Json(st.bounds_max)},
+                       {"occupied_cells", st.occupied_cells}};
+  } else {
+    root["terrain"] = nullptr;
+  }
+  root["queries"] = ordered_json::array();
+  for (const QueryView& q : queries_) root["queries"].push_back(query_json(q));
+  root["live"] = {{"received", live_received_}, {"queries", ordered_json::array()}};
+  for (const QueryView& q : live_) root["live"]["queries"].push_back(query_json(q));
+  if (has_walk()) {
+    ordered_json w;
+    w["path"] = walk_path_;
+    w["fps"] = walk_.fps;
+    w["frame"] = view.frame;
+    w["first_frame"] = first_frame_;
+    w["last_frame"] = last_frame_;
+    w["tracks"] = ordered_json::array();
+    size_t foot_index = 0;
+    for (const WalkTrack& t : walk_.tracks) {
+      if (t.keys.empty()) continue;
+      const TrackPose pose = PoseAt(t, view.frame);
+      ordered_json j;
+      j["name"] = t.name;
+      j["kind"] = t.kind == TrackKind::kFoot ? "foot" : "body";
+      j["position"] = Json(pose.position);
+      pixel(pose.position, &j);
+      if (t.kind == TrackKind::kFoot) {
+        const Rgba c = FootColor(foot_index++);
+        j["color"] = ordered_json::array({c.r, c.g, c.b});
+        j["swinging"] = pose.swinging;
+      }
+      w["tracks"].push_back(j);
+    }
+    root["walk"] = w;
+  } else {
+    root["walk"] = nullptr;
+  }
+  return root;
+}
+
+}  // namespace footfall::viewer

@@ -1,0 +1,454 @@
+// footfall-view's window, input and frame loop (GLFW), headless screenshots and live mode.
+#define GLFW_INCLUDE_NONE
+#include "footfall/viewer/viewer_app.h"
+
+#include <GLFW/glfw3.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <fstream>
+#include <iostream>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "footfall/client/recent_queries.h"
+#include "footfall/viewer/png_writer.h"
+#include "footfall/viewer/renderer.h"
+#include "footfall/viewer/scene.h"
+
+namespace footfall::viewer {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+int Fail(const std::string& message, int code = 1) {
+  std::cerr << "footfall-view: " << message << '\n';
+  return code;
+}
+
+std::string g_glfw_error;  // the last GLFW error, for messages
+
+void OnGlfwError(int, const char* description) { g_glfw_error = description ? description : ""; }
+
+// Polls footfalld on its own thread so a slow or vanished server never stalls drawing.
+class LiveFollower {
+ public:
+  explicit LiveFollower(const RpcOptions& options) : feed_(options) {}
+  ~LiveFollower() { Stop(); }
+
+  // Connects and skips past queries; false (see error()) when the server cannot be reached.
+  bool Start() {
+    if (feed_.Start() != Status::kOk) {
+      error_ = feed_.last_error();
+      return false;
+    }
+    start_after_ = feed_.after();
+    thread_ = std::thread([this] { Run(); });
+    return true;
+  }
+
+  void Stop() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+
+  // Moves the queries received since the last call into *out.
+  void Take(std::vector<RecentQuery>* out) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    out->insert(out->end(), pending_.begin(), pending_.end());
+    pending_.clear();
+  }
+
+  std::string status() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return status_;
+  }
+  const std::string& error() const { return error_; }
+  uint64_t start_after() const { return start_after_; }
+  std::string Address() const { return feed_.Address(); }
+
+ private:
+  void Run() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (!stop_) {
+      lock.unlock();
+      std::vector<RecentQuery> got;
+      const Status s = feed_.Poll(&got);
+      lock.lock();
+      pending_.insert(pending_.end(), got.begin(), got.end());
+      status_ = s == Status::kOk ? "connected" : "disconnected: " + feed_.last_error();
+      wake_.wait_for(lock, std::chrono::milliseconds(s == Status::kOk ? 100 : 500),
+                     [this] { return stop_; });
+    }
+  }
+
+  RecentQueryFeed feed_;
+  std::thread thread_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stop_ = false;
+  std::vector<RecentQuery> pending_;
+  std::string status_ = "connected";
+  std::string error_;
+  uint64_t start_after_ = 0;
+};
+
+struct App {
+  const ViewerOptions& options;
+  Scene scene;
+  ViewState view;
+  OrbitCamera camera;
+  std::unique_ptr<Renderer> renderer;  // lives while the GL context does
+  std::unique_ptr<LiveFollower> live;
+  GLFWwindow* window = nullptr;
+  bool playing = false;
+  bool terrain_dirty = true;
+  // Mouse drag state.
+  bool rotating = false, panning = false;
+  double last_x = 0, last_y = 0;
+
+  explicit App(const ViewerOptions& o) : options(o) {}
+
+  void FrameAll() {
+    glm::vec3 lo, hi;
+    scene.RenderBounds(&lo, &hi);
+    camera.Frame(lo, hi);
+  }
+
+  void SetFrame(double frame) {
+    view.frame = std::clamp(frame, scene.first_frame(), scene.last_frame());
+  }
+
+  std::string HelpText() const {
+    std::ostringstream s;
+    s << "drag: orbit   right-drag: pan   wheel: zoom   F: frame all   C: colour ("
+      << (view.color == ColorMode::kNormal ? "normal" : "height") << ")   G: cells ("
+      << (view.show_cells ? "on" : "off") << ")";
+    if (scene.has_walk()) s << "   space: play   left/right: frame";
+    s << "   Esc: quit";
+    return s.str();
+  }
+
+  std::string InfoText() {
+    std::ostringstream s;
+    if (scene.has_terrain())
+      s << "terrain " << options.terrain << " (" << scene.grid().size() << " samples)   ";
+    if (!scene.queries().empty()) s << "queries " << scene.queries().size() << "   ";
+    if (live) {
+      s << "live " << live->Address() << ": " << scene.live_received() << " received ("
+        << live->status() << ")   ";
+    }
+    if (scene.has_walk()) s << "walk " << options.walk;
+    return s.str();
+  }
+
+  // Draws one frame into the bound framebuffer.
+  void Render(int width, int height) {
+    if (terrain_dirty) {
+      renderer->SetTerrain(scene.TerrainPoints(view.color));
+      terrain_dirty = false;
+    }
+    const float aspect = static_cast<float>(width) / static_cast<float>(std::max(height, 1));
+    const glm::mat4 projection = camera.Projection(aspect);
+    const glm::mat4 view_projection = projection * camera.View();
+    const float point_scale = static_cast<float>(height) * projection[1][1] * 0.5f;
+    renderer->Begin(width, height, colors::kBackground);
+    renderer->DrawTerrain(view_projection, point_scale);
+    DrawList depth_tested, on_top, screen;
+    scene.Draw(view, &depth_tested, &on_top);
+    renderer->DrawScene(depth_tested, view_projection, point_scale, true);
+    renderer->DrawScene(on_top, view_projection, point_scale, false);
+    DrawOverlay(width, height, &screen);
+    renderer->DrawScreen(screen, width, height);
+  }
+
+  void DrawOverlay(int width, int height, DrawList* screen) {
+    const float scale = width >= 900 ? 1.5f : 1.0f;
+    const float line = 12 * scale;
+    const Rgba text{230, 230, 230, 255};
+    screen->Rect(0, 0, static_cast<float>(width), line + 6, Rgba{0, 0, 0, 140});
+    screen->Text(6, 4, InfoText(), scale, text);
+    // The help line, wrapped at its item separators to fit the width.
+    std::vector<std::string> lines(1);
+    const std::string help = HelpText();
+    for (size_t begin = 0; begin < help.size();) {
+      size_t end = help.find("   ", begin);
+      if (end == std::string::npos) end = help.size();
+      const std::string item = help.substr(begin, end - begin);
+      const std::string joined = lines.back().empty() ? item : lines.back() + "   " + item;
+      if (!lines.back().empty() &&
+          DrawList::TextWidth(joined, scale) > static_cast<float>(width) - 12) {
+        lines.push_back(item);
+      } else {
+        lines.back() = joined;
+      }
+      begin = end + 3;
+    }
+    const float top = static_cast<float>(height) - static_cast<float>(lines.size()) * line - 6;
+    screen->Rect(0, top - 4, static_cast<float>(width), static_cast<float>(height),
+                 Rgba{0, 0, 0, 140});
+    for (size_t i = 0; i < lines.size(); ++i)
+      screen->Text(6, top + static_cast<float>(i) * line, lines[i], scale, text);
+    if (scene.has_walk()) {
+      // The timeline: a bar over the walk's frames with a marker at the current frame.
+      const float bar_y = top - 14;
+      const float x0 = 10, x1 = static_cast<float>(width) - 10;
+      screen->Rect(x0, bar_y, x1, bar_y + 6, Rgba{90, 90, 100, 220});
+      const double span = std::max(scene.last_frame() - scene.first_frame(), 1e-9);
+      const float t = static_cast<float>((view.frame - scene.first_frame()) / span);
+      const float mx = x0 + (x1 - x0) * std::clamp(t, 0.0f, 1.0f);
+      screen->Rect(mx - 3, bar_y - 5, mx + 3, bar_y + 11, Rgba{255, 255, 255, 255});
+      std::ostringstream f;
+      f << "frame " << view.frame << " of " << scene.first_frame() << "-" << scene.last_frame()
+        << " at " << scene.walk().fps << " fps" << (playing ? "  (playing)" : "");
+      if (!scene.walk().stopped.empty()) f << "   stopped: " << scene.walk().stopped;
+      screen->Text(x0, bar_y - line - 6, f.str(), scale, text);
+    }
+  }
+
+  void PullLive() {
+    if (!live) return;
+    std::vector<RecentQuery> got;
+    live->Take(&got);
+    if (!got.empty()) scene.AddLive(got);
+  }
+
+  bool WriteDump(int width, int height) {
+    if (options.dump_state.empty()) return true;
+    nlohmann::ordered_json j = scene.Describe(view, camera, width, height);
+    if (live) {
+      j["live"]["server"] = live->Address();
+      j["live"]["after"] = live->start_after();
+    }
+    std::ofstream out(options.dump_state);
+    out << j.dump(2) << '\n';
+    out.flush();
+    if (!out) {
+      Fail(options.dump_state + ": cannot write the state dump");
+      return false;
+    }
+    return true;
+  }
+
+  static App* From(GLFWwindow* w) { return static_cast<App*>(glfwGetWindowUserPointer(w)); }
+
+  static void OnKey(GLFWwindow* w, int key, int, int action, int) {
+    if (action != GLFW_PRESS && action != GLFW_REPEAT) return;
+    App* app = From(w);
+    switch (key) {
+      case GLFW_KEY_ESCAPE:
+      case GLFW_KEY_Q: glfwSetWindowShouldClose(w, GLFW_TRUE); break;
+      case GLFW_KEY_F: app->FrameAll(); break;
+      case GLFW_KEY_C:
+        app->view.color =
+            app->view.color == ColorMode::kNormal ? ColorMode::kHeight : ColorMode::kNormal;
+        app->terrain_dirty = true;
+        break;
+      case GLFW_KEY_G: app->view.show_cells = !app->view.show_cells; break;
+      case GLFW_KEY_SPACE: app->playing = !app->playing; break;
+      case GLFW_KEY_RIGHT:
+        app->playing = false;
+        app->SetFrame(std::floor(app->view.frame) + 1);
+        break;
+      case GLFW_KEY_LEFT:
+        app->playing = false;
+        app->SetFrame(std::ceil(app->view.frame) - 1);
+        break;
+      case GLFW_KEY_HOME: app->SetFrame(app->scene.first_frame()); break;
+      case GLFW_KEY_END: app->SetFrame(app->scene.last_frame()); break;
+      default: break;
+    }
+  }
+
+  static void OnButton(GLFWwindow* w, int button, int action, int) {
+    App* app = From(w);
+    glfwGetCursorPos(w, &app->last_x, &app->last_y);
+    if (button == GLFW_MOUSE_BUTTON_LEFT) app->rotating = action == GLFW_PRESS;
+    if (button == GLFW_MOUSE_BUTTON_RIGHT || button == GLFW_MOUSE_BUTTON_MIDDLE)
+      app->panning = action == GLFW_PRESS;
+  }
+
+  static void OnCursor(GLFWwindow* w, double x, double y) {
+    App* app = From(w);
+    const float dx = static_cast<float>(x - app->last_x);
+    const float dy = static_cast<float>(y - app->last_y);
+    app->last_x = x, app->last_y = y;
+    int width = 1, height = 1;
+    glfwGetWindowSize(w, &width, &height);
+    if (app->rotating) app->camera.Orbit(-dx * 0.01f, dy * 0.01f);
+    if (app->panning)
+      app->camera.Pan(dx / static_cast<float>(std::max(height, 1)),
+                      dy / static_cast<float>(std::max(height, 1)));
+  }
+
+  static void OnScroll(GLFWwindow* w, double, double dy) {
+    From(w)->camera.Zoom(std::pow(0.9f, static_cast<float>(dy)));
+  }
+
+  int Interactive() {
+    glfwSetWindowUserPointer(window, this);
+    glfwSetKeyCallback(window, OnKey);
+    glfwSetMouseButtonCallback(window, OnButton);
+    glfwSetCursorPosCallback(window, OnCursor);
+    glfwSetScrollCallback(window, OnScroll);
+    glfwSwapInterval(1);
+    Clock::time_point last = Clock::now();
+    while (!glfwWindowShouldClose(window)) {
+      glfwPollEvents();
+      const Clock::time_point now = Clock::now();
+      const double dt = std::chrono::duration<double>(now - last).count();
+      last = now;
+      if (playing && scene.has_walk()) {
+        double f = view.frame + dt * scene.walk().fps;
+        if (f > scene.last_frame()) f = scene.first_frame();  // loop
+        view.frame = f;
+      }
+      PullLive();
+      int width = 0, height = 0;
+      glfwGetFramebufferSize(window, &width, &height);
+      if (width > 0 && height > 0) Render(width, height);
+      glfwSwapBuffers(window);
+    }
+    int width = 0, height = 0;
+    glfwGetFramebufferSize(window, &width, &height);
+    return WriteDump(width, height) ? 0 : 1;
+  }
+
+  int Screenshot() {
+    std::string error;
+    OffscreenTarget target;
+    if (!target.Create(options.width, options.height, &error)) return Fail(error);
+    if (live && options.live_wait > 0) {
+      const Clock::time_point deadline =
+          Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                             std::chrono::duration<double>(options.timeout_s));
+      while (scene.live_received() < static_cast<size_t>(options.live_wait)) {
+        if (Clock::now() >= deadline) {
+          return Fail("live: received " + std::to_string(scene.live_received()) + " of " +
+                      std::to_string(options.live_wait) + " queries from " + live->Address() +
+                      " within " + std::to_string(options.timeout_s) + " s (" + live->status() +
+                      ")");
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        PullLive();
+      }
+    }
+    PullLive();
+    Render(options.width, options.height);
+    std::vector<uint8_t> rgba;
+    target.Read(&rgba);
+    if (!WritePng(options.screenshot, options.width, options.height, rgba, &error))
+      return Fail(error);
+    return WriteDump(options.width, options.height) ? 0 : 1;
+  }
+};
+
+}  // namespace
+
+int RunViewer(const ViewerOptions& options) {
+  // 1. Check the options and parse every query before opening anything.
+  if (options.terrain.empty() && options.walk.empty() && !options.live)
+    return Fail("nothing to show: give --terrain FILE, --walk FILE or --server HOST:PORT --live",
+                2);
+  if (options.live && options.server.empty()) return Fail("--live needs --server HOST:PORT", 2);
+  if (!options.server.empty() && !options.live)
+    return Fail("--server is used only with --live (the viewer follows a server's queries)", 2);
+  if (!options.queries.empty() && options.terrain.empty())
+    return Fail("--query needs --terrain FILE (queries run on the local terrain)", 2);
+  if (options.live_wait > 0 && options.screenshot.empty())
+    return Fail("--live-wait is for --screenshot", 2);
+  if (options.width <= 0 || options.height <= 0 || options.width > 16384 ||
+      options.height > 16384)
+    return Fail("--size: width and height must be within 1..16384", 2);
+  std::vector<QuerySpec> specs;
+  for (const std::string& text : options.queries) {
+    QuerySpec spec;
+    std::string error;
+    if (!ParseQuerySpec(text, &spec, &error))
+      return Fail("--query \"" + text + "\": " + error, 2);
+    spec.tolerance = options.tolerance;
+    specs.push_back(spec);
+  }
+  RpcOptions rpc;
+  if (options.live) {
+    std::string error;
+    if (ParseHostPort(options.server, &rpc, &error) != Status::kOk)
+      return Fail("--server: " + error, 2);
+    rpc.connect_timeout_s = std::min(2.0, options.timeout_s);
+    rpc.call_timeout_s = std::min(5.0, options.timeout_s);
+  }
+
+  // 2. Load the terrain, answer the queries, read the walk.
+  App app(options);
+  std::string error;
+  if (!options.terrain.empty() &&
+      app.scene.LoadTerrain(options.terrain, options.load, &error) != Status::kOk)
+    return Fail(error);
+  for (const QuerySpec& spec : specs) {
+    if (app.scene.AddQuery(spec, &error) != Status::kOk) return Fail(error);
+  }
+  if (!options.walk.empty() && app.scene.LoadWalk(options.walk, &error) != Status::kOk)
+    return Fail(error);
+  app.scene.Finalize();
+  app.view.color = options.height_colors ? ColorMode::kHeight : ColorMode::kNormal;
+  app.view.show_cells = options.show_cells;
+  app.SetFrame(options.has_frame ? options.frame : app.scene.first_frame());
+  if (options.has_frame && app.scene.has_walk() &&
+      (options.frame < app.scene.first_frame() || options.frame > app.scene.last_frame())) {
+    std::cerr << "footfall-view: note: --frame " << options.frame << " is outside the walk's "
+              << app.scene.first_frame() << "-" << app.scene.last_frame() << "; showing "
+              << app.view.frame << '\n';
+  }
+  app.FrameAll();
+  if (options.has_camera) app.camera.LookAt(app.scene.ToRender(options.eye),
+                                            app.scene.ToRender(options.target));
+
+  // 3. Open a window (hidden for screenshots) with an OpenGL 3.3 core context.
+  glfwSetErrorCallback(OnGlfwError);
+  if (!glfwInit()) {
+    return Fail("cannot open a display: " + g_glfw_error +
+                " (for headless use: xvfb-run -a footfall-view ... --screenshot out.png)");
+  }
+  // GL objects go before the context, the context before GLFW.
+  struct GlfwGuard {
+    App* app;
+    ~GlfwGuard() {
+      app->renderer.reset();
+      glfwTerminate();
+    }
+  } guard{&app};
+  const bool headless = !options.screenshot.empty();
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  glfwWindowHint(GLFW_VISIBLE, headless ? GLFW_FALSE : GLFW_TRUE);
+  app.window = glfwCreateWindow(headless ? 64 : options.width, headless ? 64 : options.height,
+                                "footfall-view", nullptr, nullptr);
+  if (!app.window)
+    return Fail("cannot create an OpenGL 3.3 core context: " + g_glfw_error);
+  glfwMakeContextCurrent(app.window);
+  app.renderer = std::make_unique<Renderer>();
+  if (!app.renderer->Init(&error)) return Fail(error);
+
+  // 4. Follow the server, then draw.
+  if (options.live) {
+    app.live = std::make_unique<LiveFollower>(rpc);
+    if (!app.live->Start()) return Fail(app.live->error());
+    std::cout << "footfall-view: live: following footfalld at " << app.live->Address()
+              << " after query " << app.live->start_after() << std::endl;
+  }
+  const int code = headless ? app.Screenshot() : app.Interactive();
+  if (app.live) app.live->Stop();
+  return code;
+}
+
+}  // namespace footfall::viewer

@@ -1,0 +1,98 @@
+#include "footfall/viewer/walk_pose.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace footfall::viewer {
+namespace {
+
+Quat Slerp(Quat a, const Quat& b, double t) {
+  double d = a.x * b.x + a.y * b.y + a.z * b.z + a.w * b.w;
+  if (d < 0) a = {-a.x, -a.y, -a.z, -a.w}, d = -d;
+  double wa = 1 - t, wb = t;
+  if (d < 0.9995) {
+    const double angle = std::acos(std::min(1.0, d));
+    const double s = std::sin(angle);
+    wa = std::sin((1 - t) * angle) / s;
+    wb = std::sin(t * angle) / s;
+  }
+  Quat q{wa * a.x + wb * b.x, wa * a.y + wb * b.y, wa * a.z + wb * b.z, wa * a.w + wb * b.w};
+  const double n = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+  return {q.x / n, q.y / n, q.z / n, q.w / n};
+}
+
+TrackPose FromKey(const WalkKey& k) {
+  TrackPose p;
+  p.position = k.position;
+  p.normal = k.normal;
+  p.rotation = k.rotation;
+  return p;
+}
+
+}  // namespace
+
+Vec3 ArcPoint(const Vec3& start, const Vec3& mid, const Vec3& end, double t) {
+  // Quadratic Bezier whose t = 0.5 point is `mid`.
+  const Vec3 control = 2.0 * mid - 0.5 * (start + end);
+  const double u = 1 - t;
+  return u * u * start + 2 * u * t * control + t * t * end;
+}
+
+TrackPose PoseAt(const WalkTrack& track, double frame) {
+  const std::vector<WalkKey>& keys = track.keys;
+  if (keys.empty()) return TrackPose{};
+  if (frame <= keys.front().frame) return FromKey(keys.front());
+  if (frame >= keys.back().frame) return FromKey(keys.back());
+  // The last key at or before `frame`.
+  size_t i = static_cast<size_t>(
+      std::upper_bound(keys.begin(), keys.end(), frame,
+                       [](double f, const WalkKey& k) { return f < k.frame; }) -
+      keys.begin() - 1);
+  const WalkKey& a = keys[i];
+  const WalkKey& b = keys[i + 1];
+  TrackPose pose;
+  if (track.kind == TrackKind::kFoot) {
+    // A start, mid, end triple around `frame` makes a swing arc.
+    size_t s = keys.size();
+    if (a.phase == KeyPhase::kStart && b.phase == KeyPhase::kMid && i + 2 < keys.size() &&
+        keys[i + 2].phase == KeyPhase::kEnd) {
+      s = i;
+    } else if (a.phase == KeyPhase::kMid && b.phase == KeyPhase::kEnd && i >= 1 &&
+               keys[i - 1].phase == KeyPhase::kStart) {
+      s = i - 1;
+    }
+    if (s < keys.size()) {
+      const WalkKey& k0 = keys[s];
+      const WalkKey& km = keys[s + 1];
+      const WalkKey& k1 = keys[s + 2];
+      const double span = k1.frame - k0.frame;
+      const double t = span > 0 ? (frame - k0.frame) / span : 1.0;
+      pose.position = ArcPoint(k0.position, km.position, k1.position, t);
+      const Vec3 n = Lerp(k0.normal, k1.normal, t);
+      pose.normal = Length2(n) > 0 ? Normalize(n) : k0.normal;
+      pose.swinging = true;
+      return pose;
+    }
+  }
+  const double span = b.frame - a.frame;
+  const double t = span > 0 ? (frame - a.frame) / span : 1.0;
+  pose.position = Lerp(a.position, b.position, t);
+  const Vec3 n = Lerp(a.normal, b.normal, t);
+  pose.normal = Length2(n) > 0 ? Normalize(n) : a.normal;
+  pose.rotation = Slerp(a.rotation, b.rotation, t);
+  pose.swinging = a.phase == KeyPhase::kStart || a.phase == KeyPhase::kMid;
+  return pose;
+}
+
+void FrameRange(const Walk& walk, double* first, double* last) {
+  bool any = false;
+  *first = *last = 0;
+  for (const WalkTrack& t : walk.tracks) {
+    if (t.keys.empty()) continue;
+    if (!any || t.keys.front().frame < *first) *first = t.keys.front().frame;
+    if (!any || t.keys.back().frame > *last) *last = t.keys.back().frame;
+    any = true;
+  }
+}
+
+}  // namespace footfall::viewer
