@@ -621,11 +621,11 @@ Status Generator::Step(int k, std::string* error) {
 Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Character& character,
                     const GenerateOptions& options, Walk* out, std::string* error) {
   if (!(Length2(options.up) > 0) || !IsFinite(options.up)) {
-    *error = "--up must be a non-zero finite vector";
+    *error = "up must be a non-zero finite vector";
     return Status::kInvalidArgument;
   }
   if (!(Length2(options.heading) > 0) || !IsFinite(options.heading)) {
-    *error = "--heading must be a non-zero finite vector";
+    *error = "heading must be a non-zero finite vector";
     return Status::kInvalidArgument;
   }
   if (!IsFinite(options.start) || !std::isfinite(options.start_frame) || !(options.fps > 0) ||
