@@ -323,7 +323,8 @@ Status Generator::QueryFootholds(std::vector<Move>& moves, const std::vector<Vec
   const size_t feet = c_.feet.size();
   std::vector<size_t> pending, queried;
   for (size_t m = 0; m < moves.size(); ++m) pending.push_back(m);
-  std::vector<Vec3> new_normals(feet);
+  std::vector<Vec3> new_normals(feet), feet_now(feet);
+  std::vector<char> moving(feet);
   while (!pending.empty()) {
     // 7. Target locators: the foot's rest offset from its pair's centre, in the frame of the
     //    central locator (aligned to the terrain normal under it). The step vector runs from
@@ -376,8 +377,6 @@ Status Generator::QueryFootholds(std::vector<Move>& moves, const std::vector<Vec
       const Agent& a = agents_[mv.agent];
       const Foothold& h = answers_[q];
       const Vec3& foot = a.foot[mv.foot];
-      std::ostringstream why;
-      why.precision(3);
       ++mv.attempts;
       // A foothold must make half the intended progress along the ground it lands on (the step
       // vector projected onto its tangent plane), so no foot creeps sideways along a cliff's
@@ -388,23 +387,26 @@ Status Generator::QueryFootholds(std::vector<Move>& moves, const std::vector<Vec
         if (Length2(along) >= 0.25 * Length2(mv.step))
           progress = Dot(h.point - foot, along) / Length2(along);
       }
-      if (h.status != Status::kOk || progress < 0.5) {
+      const bool found = h.status == Status::kOk && progress >= 0.5;
+      const double rise = found ? Dot(h.point - foot, a.up) : 0;
+      const double slope = found ? Degrees(AngleBetween(h.normal, a.up)) : 0;
+      if (found && std::fabs(rise) <= c_.max_rise && slope <= c_.max_slope_deg) {
+        mv.done = true, mv.end = h.point, mv.end_normal = h.normal;
+        continue;
+      }
+      std::ostringstream why;  // refused: say why (only built on this rare path)
+      why.precision(3);
+      if (!found) {
         why << "no foothold within " << 0.5 * c_.step_length << " of " << Point(mv.ideal)
             << " (a gap or a cliff)";
+      } else if (std::fabs(rise) > c_.max_rise) {
+        why << "the foothold at " << Point(h.point) << (rise > 0 ? " rises " : " drops ")
+            << std::fabs(rise) << ", more than max_rise " << c_.max_rise << " (a cliff)";
       } else {
-        const double rise = Dot(h.point - foot, a.up);
-        const double slope = Degrees(AngleBetween(h.normal, a.up));
-        if (std::fabs(rise) > c_.max_rise) {
-          why << "the foothold at " << Point(h.point) << (rise > 0 ? " rises " : " drops ")
-              << std::fabs(rise) << ", more than max_rise " << c_.max_rise << " (a cliff)";
-        } else if (slope > c_.max_slope_deg) {
-          why << "the foothold at " << Point(h.point) << " leans " << slope
-              << " deg, more than max_slope_deg " << c_.max_slope_deg << " (too steep)";
-        } else {
-          mv.done = true, mv.end = h.point, mv.end_normal = h.normal;
-        }
+        why << "the foothold at " << Point(h.point) << " leans " << slope
+            << " deg, more than max_slope_deg " << c_.max_slope_deg << " (too steep)";
       }
-      if (!mv.done) mv.reason = why.str();
+      mv.reason = why.str();
     }
     // The reach limit on the body where the accepted footholds put it; feet beyond it retry.
     for (size_t m = 0; m < moves.size();) {
@@ -414,15 +416,15 @@ Status Generator::QueryFootholds(std::vector<Move>& moves, const std::vector<Vec
       while (e < moves.size() && moves[e].agent == agent) all_done &= moves[e].done, ++e;
       if (all_done) {
         const Agent& a = agents_[agent];
-        std::vector<Vec3> feet_now = a.foot;
-        new_normals = a.foot_normal;
+        feet_now.assign(a.foot.begin(), a.foot.end());
+        new_normals.assign(a.foot_normal.begin(), a.foot_normal.end());
         for (size_t i = m; i < e; ++i)
           feet_now[moves[i].foot] = moves[i].end, new_normals[moves[i].foot] = moves[i].end_normal;
         Vec3 centroid;
         for (const Vec3& p : feet_now) centroid += p;
         const Vec3 body = centroid / static_cast<double>(feet) + BodyUp(a, new_normals) * c_.body_height;
-        std::vector<bool> moving(feet, false);
-        for (size_t i = m; i < e; ++i) moving[moves[i].foot] = true;
+        moving.assign(feet, 0);
+        for (size_t i = m; i < e; ++i) moving[moves[i].foot] = 1;
         for (size_t i = m; i < e; ++i) {
           const double dist = Distance(moves[i].end, body);
           if (dist > c_.reach) {
@@ -466,6 +468,7 @@ Status Generator::ClearArcs(std::vector<Move>& moves, std::string* error) {
   std::vector<size_t> pending;
   for (size_t m = 0; m < moves.size(); ++m) {
     Move& mv = moves[m];
+    if (!mv.done) continue;
     const Agent& a = agents_[mv.agent];
     mv.mid_normal = NormalizeOr(a.foot_normal[mv.foot] + mv.end_normal, a.up);
     mv.mid = (a.foot[mv.foot] + mv.end) * 0.5 + mv.mid_normal * c_.step_height;
@@ -560,16 +563,8 @@ Status Generator::Step(int k, std::string* error) {
   }
   s = QueryFootholds(moves, locator, locator_normal, error);
   if (s != Status::kOk) return s;
-  {  // Arcs only for feet whose foothold was accepted.
-    std::vector<Move> accepted;
-    for (const Move& mv : moves)
-      if (mv.done) accepted.push_back(mv);
-    s = ClearArcs(accepted, error);
-    if (s != Status::kOk) return s;
-    size_t j = 0;
-    for (Move& mv : moves)
-      if (mv.done) mv = accepted[j++];
-  }
+  s = ClearArcs(moves, error);  // only the feet whose foothold was accepted
+  if (s != Status::kOk) return s;
   // 10. Key each foot (start, mid, end) and plant it; 11. move the body to the feet's centroid,
   //     raised along its up (multipeds: the averaged foot normal), heading carried along, and
   //     key it at touch-down. A character with a refused foot stops before this step's keys.
