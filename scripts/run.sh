@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job on bundled data, with the embedded engine (no server needed): builds footfall
-# (installing its Debian dependencies when missing) and answers sample queries on a bundled
-# terrain. Extra arguments go to `footfall query`.
+# (installing its Debian dependencies when missing) and generates a biped's walk across the
+# bundled hills, written as JSON (the interchange), glTF and a Maya MEL script under out/.
+# Extra arguments go to `footfall generate` (e.g. --steps 40, --path "10,0,10 30,0,30").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh core
@@ -9,10 +10,7 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DFOOTFALL_BUILD_TESTS=OFF \
   -DFOOTFALL_BUILD_BENCH=OFF -DFOOTFALL_BUILD_VIEWER=OFF >/dev/null
 cmake --build build -j"$(nproc)" --target footfall >/dev/null
 mkdir -p out
-build/client/cli/footfall query --terrain data/terrain/hills.pts "$@" <<'QUERIES' | tee out/queries.jsonl
-snap 10 5 10
-normal 10 5 10
-next 10 0 10 0 0 0.8
-next 10 0 10 0.8 0 0
-QUERIES
-echo "answers written to out/queries.jsonl" >&2
+build/client/cli/footfall generate --terrain data/terrain/hills.pts \
+  --character data/characters/biped.json --start 8,0,8 --path "8,0,30 30,0,30" \
+  --out out/walk.json --out out/walk.gltf --out out/walk.mel "$@"
+echo "walk written to out/walk.json (also out/walk.gltf, out/walk.mel)" >&2

@@ -8,5 +8,6 @@ namespace footfall::cli {
 
 void AddQueryCommand(CLI::App& app, int* exit_code);
 void AddTerrainCommand(CLI::App& app, int* exit_code);
+void AddGenerateCommand(CLI::App& app, int* exit_code);
 
 }  // namespace footfall::cli

@@ -1,0 +1,138 @@
+// The character file and walk JSON readers (round trips, each kind of bad input named), and the
+// C ABI's ffc_generate against GenerateWalk.
+#include <cstdlib>
+#include <string>
+
+#include <catch2/catch.hpp>
+
+#include "footfall/client/footfall_c.h"
+#include "footfall/import/terrain_generators.h"
+#include "footfall/steps/walk_json.h"
+#include "walk_checks.h"
+
+using namespace footfall;
+using namespace footfall::test;
+
+namespace {
+
+std::string Biped(const std::string& replace_from = "", const std::string& replace_to = "") {
+  std::string text = R"({"format": "footfall-character", "version": 1, "name": "b",
+    "feet": [{"name": "L", "rest": [0.1, 0, 0]}, {"name": "R", "rest": [-0.1, 0, 0]}],
+    "gait": [["L"], ["R"]], "pairs": [["L", "R"]], "step_length": 0.6, "step_height": 0.1,
+    "body_height": 0.9, "frames_per_step": 10, "align_to_normal": false, "reach": 1.1})";
+  if (!replace_from.empty()) {
+    const size_t at = text.find(replace_from);
+    REQUIRE(at != std::string::npos);
+    text.replace(at, replace_from.size(), replace_to);
+  }
+  return text;
+}
+
+}  // namespace
+
+TEST_CASE("Character files parse, and bad ones are named", "[steps][character]") {
+  Character c;
+  std::string error;
+  REQUIRE(ParseCharacter(Biped(), "b.json", &c, &error) == Status::kOk);
+  CHECK(c.feet.size() == 2);
+  CHECK(c.gait.size() == 2);
+  CHECK(c.frames_per_step == 10);
+  CHECK(c.max_slope_deg == 50);  // default
+  for (const std::string& name : ShippedCharacters()) LoadShipped(name);
+  const std::pair<std::pair<std::string, std::string>, std::string> bad[] = {
+      {{"\"version\": 1", "\"version\": 2"}, "b.json: 'version' 2 is not supported"},
+      {{"\"step_length\": 0.6", "\"step_length\": -1"}, "b.json: 'step_length' = -1 is out of range"},
+      {{"[[\"L\"], [\"R\"]]", "[[\"L\"], [\"X\"]]"}, "b.json: 'gait'[1]: no foot named 'X'"},
+      {{"[[\"L\"], [\"R\"]]", "[[\"L\"]]"}, "b.json: 'gait': foot 'R' is in no group"},
+      {{"[[\"L\"], [\"R\"]]", "[[\"L\", \"L\"], [\"R\"]]"}, "foot 'L' is listed twice"},
+      {{"\"reach\": 1.1", "\"reach\": 0.5"}, "'reach' = 0.5 must exceed foot 'L''s rest distance"},
+      {{"\"name\": \"b\"", "\"nmae\": \"b\""}, "b.json: unknown field 'nmae'"},
+      {{"\"frames_per_step\": 10", "\"frames_per_step\": 2.5"}, "'frames_per_step': expected an integer"},
+      {{"\"align_to_normal\": false", "\"align_to_normal\": 1"}, "'align_to_normal': expected true"},
+      {{"[0.1, 0, 0]", "[0.1, 0]"}, "'feet'[0].rest: expected [x, y, z]"},
+      {{"\"body_height\": 0.9,", ""}, "missing field 'body_height'"},
+  };
+  for (const auto& [edit, message] : bad) {
+    INFO(message);
+    CHECK(ParseCharacter(Biped(edit.first, edit.second), "b.json", &c, &error) != Status::kOk);
+    CHECK_THAT(error, Catch::Contains(message));
+  }
+  CHECK(ParseCharacter("{", "b.json", &c, &error) == Status::kParseError);
+  CHECK(LoadCharacter("/nonexistent/c.json", &c, &error) == Status::kIoError);
+  CHECK_THAT(error, Catch::Contains("/nonexistent/c.json: cannot open"));
+}
+
+TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]") {
+  const Character c = LoadShipped("hexapod");
+  Terrain t = LoadTerrain(MakeHeightField(150, 150, 0.012, 0.01, 3), 0.012);
+  GenerateOptions o;
+  o.steps = 6;
+  o.crowd = 2;
+  o.crowd_spacing = 0.6;
+  const Walk w = Generate(t, c, o);
+  const std::string text = WalkToJson(w);
+  Walk back;
+  std::string error;
+  REQUIRE(ParseWalkJson(text, "w.json", &back, &error) == Status::kOk);
+  CHECK(WalkToJson(back) == text);
+  REQUIRE(back.tracks.size() == w.tracks.size());
+  CHECK(back.tracks[0].character == "c1");
+  CHECK(back.tracks[0].keys[1].phase == KeyPhase::kMid);
+  CHECK(back.tracks[0].keys[1].position == w.tracks[0].keys[1].position);
+  CHECK(std::string(PhaseName(KeyPhase::kStart)) == "start");
+  CHECK(std::string(PhaseName(KeyPhase::kNone)).empty());
+  const std::pair<std::string, std::string> bad[] = {
+      {R"({"format":"footfall-walk","version":9,"fps":24,"tracks":[]})", "w.json: version: expected 1"},
+      {R"({"format":"footfall-walk","version":1,"fps":0,"tracks":[]})", "w.json: fps: expected a positive number"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"arm","keys":[]}]})", "tracks[0].kind: expected \"foot\" or \"body\""},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","keys":[{"frame":1,"phase":"up","position":[0,0,0]}]}]})", "tracks[0].keys[0].phase: expected"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","keys":[{"frame":1,"phase":"end","position":[0,0]}]}]})", "tracks[0].keys[0].position: expected an array of 3 numbers"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"b","kind":"body","keys":[{"frame":2,"position":[0,0,0]},{"frame":1,"position":[0,0,0]}]}]})", "tracks[0].keys[1].frame: frames must increase"},
+      {"[1, 2]", "w.json: not a JSON object"},
+  };
+  for (const auto& [input, message] : bad) {
+    INFO(message);
+    CHECK(ParseWalkJson(input, "w.json", &back, &error) == Status::kParseError);
+    CHECK_THAT(error, Catch::Contains(message));
+  }
+}
+
+TEST_CASE("ffc_generate gives the walk GenerateWalk gives", "[steps][c_api]") {
+  const RawSamples ground = MakeHeightField(200, 200, 0.05, 0.05, 5);
+  std::vector<double> flat;
+  for (size_t i = 0; i < ground.size(); ++i) {
+    const Vec3 &p = ground.points[i], &n = ground.normals[i];
+    flat.insert(flat.end(), {p.x, p.y, p.z, n.x, n.y, n.z});
+  }
+  ffc_session* s = ffc_open_embedded();
+  REQUIRE(s);
+  uint32_t terrain = 0;
+  REQUIRE(ffc_load_samples(s, flat.data(), ground.size(), "hf", &terrain) == FF_C_OK);
+  const std::string file = std::string(FOOTFALL_SOURCE_DIR) + "/data/characters/biped.json";
+  const std::string request = R"({"character_file": ")" + file +
+                              R"(", "start": [5, 0, 5], "heading": [1, 0, 0], "steps": 6, "start_frame": 10})";
+  char* json = nullptr;
+  REQUIRE(ffc_generate(s, terrain, request.c_str(), &json) == FF_C_OK);
+  REQUIRE(json);
+  Terrain t = LoadTerrain(ground, 0.05);
+  GenerateOptions o;
+  o.has_start = true, o.start = {5, 0, 5}, o.heading = {1, 0, 0}, o.steps = 6, o.start_frame = 10;
+  CHECK(std::string(json) == WalkToJson(Generate(t, LoadShipped("biped"), o)));
+  ffc_free_string(json);
+  // Bad requests: a status and a message, no walk.
+  json = nullptr;
+  CHECK(ffc_generate(s, terrain, R"({"steps": 3})", &json) == FF_C_INVALID_ARGUMENT);
+  CHECK_THAT(ffc_last_error(s), Catch::Contains("'character'"));
+  CHECK(json == nullptr);
+  CHECK(ffc_generate(s, terrain, "{", &json) == FF_C_PARSE_ERROR);
+  CHECK(ffc_generate(s, terrain, nullptr, &json) == FF_C_INVALID_ARGUMENT);
+  // A walk stopped early: FF_C_NO_FOOTHOLD, the keys so far, and why in ffc_last_error.
+  const std::string cliff = R"({"character_file": ")" + file +
+                            R"(", "start": [5, 0, 5], "heading": [1, 0, 0], "steps": 200})";
+  REQUIRE(ffc_generate(s, terrain, cliff.c_str(), &json) == FF_C_NO_FOOTHOLD);
+  REQUIRE(json);
+  CHECK_THAT(std::string(json), Catch::Contains("\"phase\":\"end\""));
+  CHECK_THAT(ffc_last_error(s), Catch::StartsWith("step "));
+  ffc_free_string(json);
+  ffc_close(s);
+}

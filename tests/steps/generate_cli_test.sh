@@ -1,0 +1,92 @@
+#!/usr/bin/env bash
+# `footfall generate` end to end: identical walks from the embedded engine and a real footfalld
+# (single characters, a path, a crowd, a walk that stops at a cliff), every output format, the
+# exit status of a stopped walk, and the messages of bad flags.
+# Usage: generate_cli_test.sh FOOTFALL FOOTFALLD SOURCE_DIR
+set -u
+footfall=$1
+footfalld=$2
+src=$3
+work=$(mktemp -d)
+server_pid=""
+trap '[ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null; rm -rf "$work"' EXIT
+failures=0
+passes=0
+check() {  # check NAME CONDITION...
+  local name=$1; shift
+  if "$@"; then passes=$((passes + 1)); else echo "FAILED: $name" >&2; failures=$((failures + 1)); fi
+}
+chars=$src/data/characters
+hills=$src/data/terrain/hills.pts
+
+# A fine flat floor for insects (2.4 x 2.4 m, 1.2 cm spacing), and a plateau ending in a cliff
+# at z = 6 (the ground below is 20 m lower).
+awk 'BEGIN { for (k = 0; k < 200; k++) for (i = 0; i < 200; i++) printf "%.3f 0 %.3f 0 1 0\n", i * 0.012, k * 0.012 }' > "$work/floor.pts"
+awk 'BEGIN { for (k = 0; k < 160; k++) for (i = 0; i < 100; i++) printf "%.2f %d %.2f 0 1 0\n", i * 0.05, (k * 0.05 < 6 ? 0 : -20), k * 0.05 }' > "$work/cliff.pts"
+
+"$footfalld" --listen 127.0.0.1:0 --port-file "$work/port" --no-rpcbind 2> "$work/server.log" &
+server_pid=$!
+for _ in $(seq 100); do [ -s "$work/port" ] && break; sleep 0.05; done
+server=127.0.0.1:$(cat "$work/port")
+
+both() {  # both NAME EXPECTED_EXIT ARGS...: embedded and RPC runs give identical JSON
+  local name=$1 want=$2; shift 2
+  "$footfall" generate "$@" --out "$work/$name-embedded.json" 2> "$work/$name-embedded.err"
+  local rc_e=$?
+  "$footfall" generate "$@" --server "$server" --out "$work/$name-rpc.json" 2> "$work/$name-rpc.err"
+  local rc_r=$?
+  check "$name: embedded exit $want" [ "$rc_e" -eq "$want" ]
+  check "$name: rpc exit $want" [ "$rc_r" -eq "$want" ]
+  check "$name: walk written" [ -s "$work/$name-embedded.json" ]
+  check "$name: embedded and --server walks identical" cmp -s "$work/$name-embedded.json" "$work/$name-rpc.json"
+}
+
+# 1. Embedded and RPC give the same walk, byte for byte.
+both biped-hills 0 --terrain "$hills" --character "$chars/biped.json" --steps 16
+both biped-path 0 --terrain "$hills" --character "$chars/biped.json" --start 10,0,10 \
+  --path "10,0,16 16,0,16"
+both quadruped-hills 0 --terrain "$hills" --character "$chars/quadruped.json" --steps 16 --heading 1,0,1
+both hexapod-crowd 0 --terrain "$work/floor.pts" --character "$chars/hexapod.json" --steps 12 \
+  --crowd 9 --crowd-spacing 0.6 --start 1.2,0,0.8
+both octopod-floor 0 --terrain "$work/floor.pts" --character "$chars/octopod.json" --steps 10 \
+  --start 1.2,0,0.6 --start-frame 101
+both biped-cliff 2 --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
+  --steps 100
+check "path: reaches the goal without stopping" grep -q '"stopped":""' "$work/biped-path-embedded.json"
+check "crowd: nine characters" [ "$(grep -o '"name":"body","character":"c[0-9]*"' "$work/hexapod-crowd-embedded.json" | wc -l)" -eq 9 ]
+check "start frame" grep -q '{"frame":101,"phase":"start"' "$work/octopod-floor-embedded.json"
+
+# 2. A walk stopped at a cliff: the message names the step and the position; the keys so far
+#    are written; exit 2.
+check "cliff: message on stderr" grep -qE 'stopped early: step [0-9]+: foot [LR] at \([0-9.]+, [0-9.-]+, [0-9.]+\): .*cliff' "$work/biped-cliff-embedded.err"
+check "cliff: message in the walk" grep -qE '"stopped":"step [0-9]+: foot' "$work/biped-cliff-embedded.json"
+check "cliff: keys kept" [ "$(grep -c '"phase":"end"' "$work/biped-cliff-embedded.json")" -gt 8 ]
+
+# 3. Every output format at once; a stopped walk still writes them all.
+"$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
+  --steps 100 --out "$work/all.json" --out "$work/all.gltf" --out "$work/all.glb" --out "$work/all.mel" 2>/dev/null
+check "formats: exit 2 for a stopped walk" [ $? -eq 2 ]
+for f in all.json all.gltf all.glb all.mel; do check "formats: $f written" [ -s "$work/$f" ]; done
+check "formats: MEL keys the feet" grep -q 'setKeyframe' "$work/all.mel"
+
+# 4. Bad flags: a message naming the flag, exit 1, no output.
+bad() {  # bad NAME EXPECTED_MESSAGE ARGS...
+  local name=$1 want=$2; shift 2
+  local err
+  err=$("$footfall" generate "$@" 2>&1 >/dev/null)
+  check "$name: exit 1" [ $? -eq 1 ]
+  check "$name: message '$want'" grep -qF -- "$want" <<< "$err"
+}
+bad start "--start '1,2': expected X,Y,Z" --terrain "$hills" --character "$chars/biped.json" --start 1,2 --out "$work/x.json"
+bad heading "--heading 'a,0,1': 'a' is not a finite number" --terrain "$hills" --character "$chars/biped.json" --heading a,0,1 --out "$work/x.json"
+bad path "--path '3,4': expected X,Y,Z" --terrain "$hills" --character "$chars/biped.json" --path "1,0,1 3,4" --out "$work/x.json"
+bad extension "unsupported output extension" --terrain "$hills" --character "$chars/biped.json" --out "$work/x.txt"
+bad character "$work/none.json: cannot open character file" --terrain "$hills" --character "$work/none.json" --out "$work/x.json"
+printf '{"format": "footfall-character", "version": 1, "feet": []}' > "$work/bad.json"
+bad character-content "$work/bad.json: 'feet': expected a non-empty array" --terrain "$hills" --character "$work/bad.json" --out "$work/x.json"
+bad zero-heading "heading must be a non-zero finite vector" --terrain "$hills" --character "$chars/biped.json" --heading 0,0,0 --out "$work/x.json"
+check "bad flags: no output written" [ ! -e "$work/x.json" ]
+
+kill "$server_pid"; wait "$server_pid" 2>/dev/null; server_pid=""
+echo "$passes passed, $failures failed"
+[ "$failures" -eq 0 ]
