@@ -21,8 +21,11 @@ from .session import (
     WalkStopped,
 )
 from .server import LocalServer, ServerError, find_footfalld
+from .connection import Connection
+from . import character
 
 __all__ = [
+    "Connection",
     "FootfallError",
     "Foothold",
     "LibraryNotFound",

@@ -20,7 +20,12 @@ def find_footfalld():
     for path in filter(None, [env, os.path.join(here, "footfalld"),
                               os.path.join(repo, "build", "server", "service", "footfalld")]):
         tried.append(path)
-        if os.path.isfile(path) and os.access(path, os.X_OK):
+        if os.path.isfile(path):
+            if not os.access(path, os.X_OK):
+                try:  # unpacked from a zip (Blender's add-on installer drops the mode bits)
+                    os.chmod(path, 0o755)
+                except OSError:
+                    continue
             return path
     found = shutil.which("footfalld")
     if found:
