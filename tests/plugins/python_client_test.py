@@ -75,6 +75,53 @@ class EmbeddedTest(unittest.TestCase):
         self.assertIn("closed", e.exception.message)
 
 
+class SharedLogicTest(unittest.TestCase):
+    """The pure-Python parts both plugins use: mesh resampling and character files."""
+
+    def test_square_resampled_in_halves(self):
+        pts = [(0, 0, 0), (1, 0, 0), (1, 0, 1), (0, 0, 1)]
+        tris = [(0, 2, 1), (0, 3, 2)]  # counter-clockwise seen from +Y
+        samples = ff.sampling.sample_triangles(pts, tris, 0.75)  # diagonal 1.41: halves
+        self.assertEqual(sorted(s[:3] for s in samples),
+                         sorted((x / 2, 0.0, z / 2) for x in range(3) for z in range(3)))
+        for s in samples:
+            self.assertEqual(s[3:], (0.0, 1.0, 0.0))
+        with ff.Session.embedded() as s:
+            t = s.load_samples(samples, "square")
+            self.assertEqual(s.info(t)[0], 9)
+
+    def test_point_file_round_trips_exactly(self):
+        samples = ff.sampling.sample_triangles([(0, 0.1, 0), (0.3, 0.7, 0), (0, 0.2, 0.9)],
+                                               [(0, 2, 1)], 0.1)
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "t.pts")
+            ff.sampling.write_point_file(path, samples)
+            with ff.Session.embedded() as s:
+                a, b = s.load_file(path), s.load_samples(samples)
+                probe = [p[:3] for p in samples[::7]]
+                self.assertEqual(s.snap(a, probe), s.snap(b, probe))
+
+    def test_separation_must_be_positive(self):
+        with self.assertRaises(ValueError):
+            ff.sampling.sample_triangles([(0, 0, 0)] * 3, [(0, 1, 2)], 0)
+
+    def test_character_pairs_and_overrides(self):
+        data = ff.character.parse(json.dumps({
+            "feet": [{"name": "L", "rest": [0.1, 0, 0]}, {"name": "R", "rest": [-0.1, 0, 0]},
+                     {"name": "T", "rest": [0, 0, -0.5]}],
+            "step_length": 0.6, "frames_per_step": 12}))
+        self.assertEqual(ff.character.pairs(data), [("L_R", ["L", "R"]), ("T", ["T"])])
+        data["pairs"] = [["L"], ["R", "T"]]
+        self.assertEqual(ff.character.pairs(data), [("L", ["L"]), ("R_T", ["R", "T"])])
+        out = ff.character.with_overrides(data, step_length=0.8, step_height=0, frames_per_step=9)
+        self.assertEqual((out["step_length"], out["frames_per_step"]), (0.8, 9))
+        self.assertNotIn("step_height", out)
+        self.assertEqual(data["step_length"], 0.6)
+        with self.assertRaises(ff.FootfallError) as e:
+            ff.character.parse('{"feet": [{"name": "L"}]}', "bad.json")
+        self.assertIn("bad.json: feet[0]", e.exception.message)
+
+
 class RpcTest(unittest.TestCase):
     def setUp(self):
         self.server = ff.LocalServer().start()

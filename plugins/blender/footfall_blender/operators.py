@@ -11,7 +11,7 @@ from bpy.props import EnumProperty, IntProperty, StringProperty
 from bpy_extras.io_utils import ImportHelper
 from mathutils import Matrix, Vector
 
-from . import keying, sampling
+from . import keying
 from .axes import from_ff, to_ff
 from .props import preferences
 
@@ -20,6 +20,7 @@ try:  # inside the add-on zip
 except ImportError:  # the source tree: plugins/python on sys.path
     import footfall_client as ffc
 character = ffc.character
+sampling = ffc.sampling
 
 _connection = ffc.Connection()
 TERRAIN = "scene"
