@@ -184,19 +184,20 @@ class BlenderAddonTest(unittest.TestCase):
     # -- the scene ------------------------------------------------------------------------------
 
     def test_1_terrain_setup(self):
-        bpy.ops.mesh.primitive_grid_add(x_subdivisions=60, y_subdivisions=60, size=30)
+        # 10 x 10 m of hills, resampled every 5 cm (the hexapod's feet are 12 cm apart).
+        bpy.ops.mesh.primitive_grid_add(x_subdivisions=50, y_subdivisions=50, size=10)
         terrain = bpy.context.active_object
         terrain.name = "terrain"
         for v in terrain.data.vertices:
             x, y = v.co.x, v.co.y
-            v.co.z = 0.7 * math.sin(0.35 * x) * math.cos(0.25 * y) + 0.03 * x
+            v.co.z = 0.3 * math.sin(0.9 * x) * math.cos(0.7 * y) + 0.03 * x
         self.select([terrain], terrain)
         scene = bpy.context.scene.footfall
-        scene.terrain_source, scene.separation = "MESH", 0.25
+        scene.terrain_source, scene.separation = "MESH", 0.05
         self.assertEqual(bpy.ops.footfall.terrain_setup(save_points=self.pts), {"FINISHED"})
         self.samples_tree()
         self.assertEqual(scene.sample_count, self._count)
-        self.assertGreater(scene.sample_count, 10000)
+        self.assertGreater(scene.sample_count, 200 * 200)
         self.assertEqual(scene.terrain_name, "terrain")
 
     def test_2_bad_selection_is_a_report(self):
@@ -206,7 +207,7 @@ class BlenderAddonTest(unittest.TestCase):
         self.assertIn("select a mesh", str(e.exception))
 
     def test_3_hexapod_setup_creates_empties(self):
-        bpy.context.scene.cursor.location = (-4.0, 4.0, 0.0)
+        bpy.context.scene.cursor.location = (-3.0, 3.0, 0.0)
         result = bpy.ops.footfall.character_setup(
             character_file=os.path.join(CHARACTERS, "hexapod.json"), mode="CREATE", name="hexapod")
         self.assertEqual(result, {"FINISHED"})
@@ -231,18 +232,18 @@ class BlenderAddonTest(unittest.TestCase):
     def test_4_biped_setup_picks_ik_targets(self):
         with open(os.path.join(CHARACTERS, "biped.json")) as f:
             names = [foot["name"] for foot in json.load(f)["feet"]]
-        bpy.ops.object.armature_add(location=(5.0, -2.0, 1.0))
+        bpy.ops.object.armature_add(location=(0.0, 3.0, 1.0))
         arm = bpy.context.active_object
         arm.name = "biped_armature"
         body = bpy.data.objects.new("biped_body", None)
         bpy.context.scene.collection.objects.link(body)
-        body.location = (5.0, -2.0, 1.0)
+        body.location = (0.0, 3.0, 1.0)
         body.rotation_euler = (0.0, 0.0, math.radians(30))  # faces 30 degrees off -Y
         empties = []
         for i, name in enumerate(names):
             e = bpy.data.objects.new("biped_IK_" + name, None)
             bpy.context.scene.collection.objects.link(e)
-            e.location = (5.0 + (0.2 if i == 0 else -0.2), -2.0, 0.0)
+            e.location = (0.2 if i == 0 else -0.2, 3.0, 0.0)
             empties.append(e)
         ik = arm.pose.bones[0].constraints.new("IK")
         ik.target = empties[0]
