@@ -447,9 +447,15 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
                     key["rotation"] = list(quat_to_ff([curves[("rotation_quaternion", i)]
                                                        .evaluate(f) for i in range(4)]))
                 keys.append(key)
-            kind = "body" if obj.name.split(".")[0] == "body" or "rotation_quaternion" in \
-                {p for p, _ in curves} else "foot"
-            tracks.append({"name": obj.name.split(".")[0], "kind": kind, "keys": keys})
+            # footfall's glTF names each node's track and kind in its extras (custom properties
+            # once imported); a glTF from elsewhere falls back to the node name.
+            name = str(obj.get("track") or obj.name.split(".")[0])
+            kind = str(obj.get("kind") or ("body" if ("rotation_quaternion", 0) in curves
+                                           else "foot"))
+            if kind == "foot":
+                for key in keys:
+                    key.pop("rotation", None)
+            tracks.append({"name": name, "kind": kind, "keys": keys})
         for obj in made:
             bpy.data.objects.remove(obj)
         for action in set(bpy.data.actions) - actions_before:
