@@ -7,5 +7,6 @@
 namespace footfall::cli {
 
 void AddQueryCommand(CLI::App& app, int* exit_code);
+void AddGenerateCommand(CLI::App& app, int* exit_code);
 
 }  // namespace footfall::cli

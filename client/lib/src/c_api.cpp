@@ -2,12 +2,17 @@
 #include "footfall/client/footfall_c.h"
 
 #include <csignal>
+#include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <new>
 #include <string>
 #include <vector>
 
 #include "footfall/client/terrain_session.h"
+#include "footfall/steps/generate_request.h"
+#include "footfall/steps/generator.h"
+#include "footfall/steps/walk_json.h"
 
 struct ffc_session {
   std::unique_ptr<footfall::TerrainSession> session;
@@ -188,5 +193,39 @@ int32_t ffc_next(ffc_session* s, uint32_t terrain, const double* steps, size_t c
     return Result(s, status);
   });
 }
+
+int32_t ffc_generate(ffc_session* s, uint32_t terrain, const char* request_json,
+                     char** walk_json) {
+  return Guard(s, [&]() -> int32_t {
+    if (!request_json || !walk_json) return BadArgument(s, "request_json and walk_json must not be NULL");
+    *walk_json = nullptr;
+    footfall::Character character;
+    footfall::GenerateOptions options;
+    footfall::Walk walk;
+    std::string error;
+    Status status = footfall::ParseGenerateRequest(request_json, &character, &options, &error);
+    if (status == Status::kOk)
+      status = footfall::GenerateWalk(*s->session, terrain, character, options, &walk, &error);
+    if (status != Status::kOk) {
+      s->error = error;
+      return static_cast<int32_t>(status);
+    }
+    const std::string text = footfall::WalkToJson(walk);
+    char* copy = static_cast<char*>(std::malloc(text.size() + 1));
+    if (!copy) {
+      s->error = "out of memory";
+      return FF_C_LIMIT_EXCEEDED;
+    }
+    std::memcpy(copy, text.c_str(), text.size() + 1);
+    *walk_json = copy;
+    if (!walk.stopped.empty()) {  // the keys so far are in *walk_json
+      s->error = walk.stopped;
+      return FF_C_NO_FOOTHOLD;
+    }
+    return FF_C_OK;
+  });
+}
+
+void ffc_free_string(char* text) { std::free(text); }
 
 }  // extern "C"

@@ -1,0 +1,218 @@
+// `footfall generate`: places the footsteps of a character (or a crowd) on a terrain and writes
+// the keyed walk (JSON; glTF and MEL once the exporters are linked in).
+#include <unistd.h>
+
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "footfall/steps/generator.h"
+#include "footfall/steps/walk_json.h"
+#include "terrain_flags.h"
+
+namespace footfall::cli {
+namespace {
+
+struct GenerateFlags {
+  TerrainFlags terrain;
+  std::string character;
+  std::string start, heading, path, up;
+  int steps = -1;
+  double start_frame = 1;
+  double fps = 24;
+  int crowd = 1;
+  double crowd_spacing = 0;
+  bool progress = false;
+  std::vector<std::string> out;
+};
+
+bool ParseNumber(const std::string& token, double* value) {
+  const char* first = token.data();
+  const char* last = first + token.size();
+  if (first != last && *first == '+') ++first;
+  const auto [ptr, ec] = std::from_chars(first, last, *value);
+  return ec == std::errc() && ptr == last && std::isfinite(*value);
+}
+
+// "X,Y,Z" into *out; false with a message naming the flag.
+bool ParseVec(const std::string& text, const std::string& flag, Vec3* out, std::string* error) {
+  std::vector<double> v;
+  std::string token;
+  std::istringstream in(text);
+  while (std::getline(in, token, ',')) {
+    double x;
+    if (!ParseNumber(token, &x)) {
+      *error = flag + " '" + text + "': '" + token + "' is not a finite number (expected X,Y,Z)";
+      return false;
+    }
+    v.push_back(x);
+  }
+  if (v.size() != 3) {
+    *error = flag + " '" + text + "': expected X,Y,Z (three numbers separated by commas)";
+    return false;
+  }
+  *out = {v[0], v[1], v[2]};
+  return true;
+}
+
+std::string Extension(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  const size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string ext = path.substr(dot + 1);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+// Writes one output, chosen by its extension.
+Status WriteOutput(const Walk& walk, const std::string& path, std::string* error) {
+  const std::string ext = Extension(path);
+  if (ext == "json") return WriteWalkJson(walk, path, error);
+  if (ext == "gltf" || ext == "glb" || ext == "mel") {
+    *error = path + ": unsupported output ." + ext + " (this build writes .json only)";
+    return Status::kInvalidArgument;
+  }
+  *error = path + ": unsupported output extension (expected .json, .gltf, .glb or .mel)";
+  return Status::kInvalidArgument;
+}
+
+// A one-line progress bar on stderr, redrawn at most 10 times a second.
+class ProgressBar {
+ public:
+  void Update(int done, int total) {
+    const auto now = std::chrono::steady_clock::now();
+    if (done < total && now - last_ < std::chrono::milliseconds(100)) return;
+    last_ = now;
+    const int width = 40;
+    const int filled = total > 0 ? static_cast<int>(static_cast<double>(done) * width / total) : width;
+    std::fprintf(stderr, "\r[%s%s] step %d/%d", std::string(filled, '#').c_str(),
+                 std::string(width - filled, '.').c_str(), done, total);
+    std::fflush(stderr);
+    shown_ = true;
+  }
+  void Finish() {
+    if (shown_) std::fputc('\n', stderr);
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_{};
+  bool shown_ = false;
+};
+
+int RunGenerate(const GenerateFlags& flags) {
+  std::string error;
+  GenerateOptions options;
+  // Flags first, so a typo fails before the terrain loads.
+  if (!flags.start.empty()) {
+    if (!ParseVec(flags.start, "--start", &options.start, &error)) goto bad_flag;
+    options.has_start = true;
+  }
+  if (!flags.heading.empty() && !ParseVec(flags.heading, "--heading", &options.heading, &error))
+    goto bad_flag;
+  if (!flags.up.empty() && !ParseVec(flags.up, "--up", &options.up, &error)) goto bad_flag;
+  {
+    std::istringstream in(flags.path);
+    for (std::string point; in >> point;) {
+      Vec3 p;
+      if (!ParseVec(point, "--path", &p, &error)) goto bad_flag;
+      options.path.push_back(p);
+    }
+  }
+  for (const std::string& out : flags.out) {
+    const std::string ext = Extension(out);
+    if (ext != "json" && ext != "gltf" && ext != "glb" && ext != "mel") {
+      error = "--out " + out + ": unsupported output extension (expected .json, .gltf, .glb or .mel)";
+      goto bad_flag;
+    }
+  }
+  options.steps = flags.steps;
+  options.start_frame = flags.start_frame;
+  options.fps = flags.fps;
+  options.crowd = flags.crowd;
+  options.crowd_spacing = flags.crowd_spacing;
+  {
+    Character character;
+    if (LoadCharacter(flags.character, &character, &error) != Status::kOk) goto bad_flag;
+    std::unique_ptr<TerrainSession> session;
+    TerrainHandle terrain = 0;
+    if (OpenTerrain(flags.terrain, &session, &terrain, &error) != Status::kOk) goto bad_flag;
+    ProgressBar bar;
+    const bool long_run = static_cast<long long>(flags.crowd) *
+                              (flags.steps < 0 ? 8 : flags.steps) >= 20000;
+    if (flags.progress || (long_run && isatty(STDERR_FILENO)))
+      options.progress = [&bar](int done, int total) { bar.Update(done, total); };
+    Walk walk;
+    const Status status = GenerateWalk(*session, terrain, character, options, &walk, &error);
+    bar.Finish();
+    if (status != Status::kOk) {
+      std::cerr << "footfall generate: " << error << '\n';
+      return 1;
+    }
+    int code = 0;
+    for (const std::string& out : flags.out) {
+      if (WriteOutput(walk, out, &error) != Status::kOk) {
+        std::cerr << "footfall generate: " << error << '\n';
+        code = 1;
+      }
+    }
+    if (!walk.stopped.empty()) {
+      std::cerr << "footfall generate: stopped early: " << walk.stopped << '\n';
+      return 2;
+    }
+    return code;
+  }
+bad_flag:
+  std::cerr << "footfall generate: " << error << '\n';
+  return 1;
+}
+
+}  // namespace
+
+void AddGenerateCommand(CLI::App& app, int* exit_code) {
+  auto flags = std::make_shared<GenerateFlags>();
+  CLI::App* cmd = app.add_subcommand(
+      "generate",
+      "Place every footstep of a character on a terrain and key the walk (foot IK targets and "
+      "body) into JSON, glTF or MEL files");
+  AddTerrainFlags(cmd, &flags->terrain);
+  cmd->add_option("--character", flags->character, "Character file (JSON, see the README)")
+      ->required();
+  cmd->add_option("--start", flags->start,
+                  "X,Y,Z where the character starts (default: the sample nearest the centre of "
+                  "the top of the terrain's bounds)");
+  cmd->add_option("--heading", flags->heading,
+                  "DX,DY,DZ facing direction, projected onto the ground (default 0,0,1)");
+  cmd->add_option("--path", flags->path,
+                  "Waypoints \"X,Y,Z X,Y,Z ...\" to follow (one point: a goal); the walk ends "
+                  "at the last one");
+  cmd->add_option("--steps", flags->steps,
+                  "Steps per character, one gait group each (default 8; with --path, until "
+                  "the goal)")
+      ->check(CLI::Range(0, 1000000));
+  cmd->add_option("--start-frame", flags->start_frame, "Frame of the first keys (default 1)");
+  cmd->add_option("--fps", flags->fps, "Frames per second of the walk (default 24)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--up", flags->up, "X,Y,Z world up of bipeds (default 0,1,0, as in Maya)");
+  cmd->add_option("--crowd", flags->crowd,
+                  "Generate this many characters at once on a grid around --start")
+      ->check(CLI::Range(1, 1000000));
+  cmd->add_option("--crowd-spacing", flags->crowd_spacing,
+                  "Distance between crowd characters (default: twice the character's reach)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--progress", flags->progress,
+                "Show a progress bar on stderr (shown anyway for long runs on a terminal)");
+  cmd->add_option("--out", flags->out, "Output file: .json, .gltf, .glb or .mel (repeatable)")
+      ->required();
+  cmd->footer(
+      "Exit status: 0 when every step was generated, 2 when the walk stopped early (at a cliff, "
+      "a gap, a wall too steep; the outputs then hold every key up to that step), 1 on errors.");
+  cmd->callback([flags, exit_code] { *exit_code = RunGenerate(*flags); });
+}
+
+}  // namespace footfall::cli

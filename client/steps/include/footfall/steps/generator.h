@@ -1,0 +1,53 @@
+// The step generator: places every footstep of one or many characters on a terrain and keys the
+// walk (foot IK targets and the body). The algorithm is listed as numbered steps in
+// client/steps/README.md; generator.cpp repeats the numbers in comments.
+//
+// It asks the terrain only through a TerrainSession, so the embedded engine and footfalld give
+// the same walk. Each round of queries of a step is one batch call for all characters (crowds
+// included); the RPC backend splits it into protocol-sized calls.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "footfall/client/terrain_session.h"
+#include "footfall/steps/character.h"
+#include "footfall/steps/walk.h"
+
+namespace footfall {
+
+struct GenerateOptions {
+  // Where the (first) character stands, snapped to the terrain. World space. Unset: the sample
+  // nearest the centre of the top of the terrain's bounds (top along `up`).
+  bool has_start = false;
+  Vec3 start;
+  // Facing direction, projected onto the start's tangent plane. World space, non-zero.
+  Vec3 heading{0, 0, 1};
+  // Waypoints to follow, in order (one point: a goal). World space. The heading turns toward
+  // the current waypoint; the walk ends when the last one is reached (within half a step).
+  std::vector<Vec3> path;
+  // Steps per character; one step moves one gait group. < 0: 8 without a path, up to 10000
+  // (until the goal) with one.
+  int steps = -1;
+  double start_frame = 1;  // frame of the first keys
+  double fps = 24;         // frames per second of the walk [Limit: > 0]
+  // World up for bipeds (characters with align_to_normal false). Non-zero; normalised.
+  Vec3 up{0, 1, 0};
+  // Crowd: this many characters on a square grid around `start` (spacing `crowd_spacing`, or
+  // 2 * reach when <= 0), each following the path shifted by its offset. Tracks then carry the
+  // character id "c1".."cN".
+  int crowd = 1;
+  double crowd_spacing = 0;
+  // Called after every step with (steps done, steps requested); may be empty.
+  std::function<void(int, int)> progress;
+};
+
+// Generates the walk into *out (replacing it). Returns kOk when the walk was generated, even if
+// it stopped early: then out->stopped says at which step and position, and every key up to that
+// step is kept. Other statuses: kInvalidArgument (bad options, message in *error), or the
+// session's failure (kUnavailable, kUnknownTerrain ...; *error from last_error()).
+Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Character& character,
+                    const GenerateOptions& options, Walk* out, std::string* error);
+
+}  // namespace footfall

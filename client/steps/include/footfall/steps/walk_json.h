@@ -1,0 +1,34 @@
+// The walk as JSON, footfall's canonical interchange (read by the viewer and the Blender
+// plugin). Format "footfall-walk", version 1, documented in client/steps/README.md:
+//   {"format": "footfall-walk", "version": 1, "fps": 24, "stopped": "",
+//    "tracks": [{"name": "L1", "kind": "foot", "keys": [{"frame": 1, "phase": "start",
+//                "position": [x, y, z], "normal": [nx, ny, nz]}, ...]},
+//               {"name": "body", "kind": "body", "keys": [{"frame": 1, "position": [x, y, z],
+//                "rotation": [qx, qy, qz, qw]}, ...]}]}
+// Crowd tracks add "character": "c1". Numbers are written so they read back exactly.
+#pragma once
+
+#include <string>
+
+#include "footfall/steps/walk.h"
+#include "footfall/terrain/status.h"
+
+namespace footfall {
+
+constexpr int kWalkFormatVersion = 1;
+
+// The walk as JSON text (one line per key, ending in a newline).
+std::string WalkToJson(const Walk& walk);
+
+// Writes WalkToJson(walk) to `path`. kIoError with a message naming the file on failure.
+Status WriteWalkJson(const Walk& walk, const std::string& path, std::string* error);
+
+// Parses walk JSON. `source` names it in errors ("SOURCE: tracks[2].keys[5].position: expected
+// [x, y, z]"). kParseError for malformed or unsupported input.
+Status ParseWalkJson(const std::string& text, const std::string& source, Walk* out,
+                     std::string* error);
+
+// Reads and parses a walk file. kIoError when it cannot be read.
+Status ReadWalkJson(const std::string& path, Walk* out, std::string* error);
+
+}  // namespace footfall

@@ -1,0 +1,221 @@
+#include "footfall/steps/character.h"
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace footfall {
+namespace {
+
+using nlohmann::json;
+
+// Collects the first error while reading fields; every reader returns false once it fails.
+struct Reader {
+  std::string source;
+  std::string error;
+  Status status = Status::kOk;
+
+  bool Fail(Status s, const std::string& what) {
+    if (status == Status::kOk) status = s, error = source + ": " + what;
+    return false;
+  }
+  bool Number(const json& j, const char* key, bool required, double* out) {
+    auto it = j.find(key);
+    if (it == j.end()) return required ? Fail(Status::kParseError, std::string("missing field '") + key + "' (a number)") : true;
+    if (!it->is_number() || !std::isfinite(it->get<double>()))
+      return Fail(Status::kParseError, std::string("'") + key + "': expected a finite number");
+    *out = it->get<double>();
+    return true;
+  }
+  bool Vector(const json& j, const std::string& where, Vec3* out) {
+    if (!j.is_array() || j.size() != 3)
+      return Fail(Status::kParseError, where + ": expected [x, y, z]");
+    double v[3];
+    for (int i = 0; i < 3; ++i) {
+      if (!j[i].is_number() || !std::isfinite(j[i].get<double>()))
+        return Fail(Status::kParseError, where + ": expected finite numbers");
+      v[i] = j[i].get<double>();
+    }
+    *out = {v[0], v[1], v[2]};
+    return true;
+  }
+  bool Range(double v, double lo, double hi, bool lo_open, bool hi_open, const char* key) {
+    const bool ok = (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
+    if (ok) return true;
+    std::ostringstream m;
+    m << "'" << key << "' = " << v << " is out of range " << (lo_open ? "(" : "[") << lo << ", "
+      << hi << (hi_open ? ")" : "]");
+    return Fail(Status::kInvalidArgument, m.str());
+  }
+  // A list of groups of foot names, each name used exactly once over all groups.
+  bool Groups(const json& j, const char* key, const std::map<std::string, int>& feet,
+              size_t max_group, std::vector<std::vector<int>>* out) {
+    const std::string k = std::string("'") + key + "'";
+    if (!j.is_array() || j.empty())
+      return Fail(Status::kParseError, k + ": expected a non-empty array of arrays of foot names");
+    std::set<int> seen;
+    for (size_t g = 0; g < j.size(); ++g) {
+      const std::string where = k + "[" + std::to_string(g) + "]";
+      if (!j[g].is_array() || j[g].empty() || j[g].size() > max_group)
+        return Fail(Status::kParseError, where + ": expected an array of 1 to " +
+                                             std::to_string(max_group) + " foot names");
+      std::vector<int> group;
+      for (const json& name : j[g]) {
+        if (!name.is_string()) return Fail(Status::kParseError, where + ": expected foot names");
+        auto it = feet.find(name.get<std::string>());
+        if (it == feet.end())
+          return Fail(Status::kInvalidArgument, where + ": no foot named '" + name.get<std::string>() + "'");
+        if (!seen.insert(it->second).second)
+          return Fail(Status::kInvalidArgument, where + ": foot '" + it->first + "' is listed twice");
+        group.push_back(it->second);
+      }
+      out->push_back(group);
+    }
+    if (seen.size() != feet.size()) {
+      for (const auto& [name, index] : feet)
+        if (!seen.count(index))
+          return Fail(Status::kInvalidArgument, k + ": foot '" + name + "' is in no group");
+    }
+    return true;
+  }
+};
+
+}  // namespace
+
+Status ParseCharacter(const std::string& text, const std::string& source, Character* out,
+                      std::string* error) {
+  Reader r;
+  r.source = source;
+  json j = json::parse(text, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) {
+    *error = source + ": not a JSON object (expected a footfall character file)";
+    return Status::kParseError;
+  }
+  static const std::set<std::string> kKnown = {
+      "format", "version", "name", "feet", "gait", "pairs", "step_length", "step_height",
+      "body_height", "frames_per_step", "align_to_normal", "slope_threshold_deg",
+      "slope_step_scale", "max_slope_deg", "max_rise", "reach", "max_turn_deg", "comment"};
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (!kKnown.count(it.key())) {
+      r.Fail(Status::kParseError, "unknown field '" + it.key() + "'");
+      break;
+    }
+  }
+  Character c;
+  if (r.status == Status::kOk) {
+    if (j.value("format", std::string()) != "footfall-character")
+      r.Fail(Status::kParseError, "'format': expected \"footfall-character\"");
+    else if (!j.contains("version") || !j["version"].is_number_integer())
+      r.Fail(Status::kParseError, "'version': expected an integer");
+    else if (j["version"].get<int>() != kCharacterFormatVersion)
+      r.Fail(Status::kParseError, "'version' " + j["version"].dump() + " is not supported (this build reads version " + std::to_string(kCharacterFormatVersion) + ")");
+  }
+  if (r.status == Status::kOk && j.contains("name")) {
+    if (!j["name"].is_string()) r.Fail(Status::kParseError, "'name': expected a string");
+    else c.name = j["name"].get<std::string>();
+  }
+  std::map<std::string, int> foot_index;
+  if (r.status == Status::kOk) {
+    const json* feet = j.contains("feet") ? &j["feet"] : nullptr;
+    if (!feet || !feet->is_array() || feet->empty()) {
+      r.Fail(Status::kParseError, "'feet': expected a non-empty array of {\"name\", \"rest\"}");
+    } else {
+      for (size_t i = 0; i < feet->size() && r.status == Status::kOk; ++i) {
+        const json& f = (*feet)[i];
+        const std::string where = "'feet'[" + std::to_string(i) + "]";
+        FootSpec spec;
+        if (!f.is_object() || !f.contains("name") || !f["name"].is_string() ||
+            f["name"].get<std::string>().empty() || !f.contains("rest")) {
+          r.Fail(Status::kParseError, where + ": expected {\"name\": STRING, \"rest\": [x, y, z]}");
+          break;
+        }
+        spec.name = f["name"].get<std::string>();
+        if (!r.Vector(f["rest"], where + ".rest", &spec.rest)) break;
+        if (!foot_index.emplace(spec.name, static_cast<int>(i)).second) {
+          r.Fail(Status::kInvalidArgument, where + ": foot name '" + spec.name + "' is used twice");
+          break;
+        }
+        c.feet.push_back(spec);
+      }
+    }
+  }
+  if (r.status == Status::kOk) {
+    if (!j.contains("gait")) r.Fail(Status::kParseError, "missing field 'gait' (groups of foot names)");
+    else r.Groups(j["gait"], "gait", foot_index, c.feet.size(), &c.gait);
+  }
+  if (r.status == Status::kOk) {
+    if (j.contains("pairs")) {
+      r.Groups(j["pairs"], "pairs", foot_index, 2, &c.pairs);
+    } else {
+      for (size_t i = 0; i < c.feet.size(); ++i) c.pairs.push_back({static_cast<int>(i)});
+    }
+  }
+  double fps = c.frames_per_step;
+  if (r.status == Status::kOk) {
+    r.Number(j, "step_length", true, &c.step_length) &&
+        r.Number(j, "step_height", true, &c.step_height) &&
+        r.Number(j, "body_height", true, &c.body_height) &&
+        r.Number(j, "frames_per_step", true, &fps) &&
+        r.Number(j, "slope_threshold_deg", false, &c.slope_threshold_deg) &&
+        r.Number(j, "slope_step_scale", false, &c.slope_step_scale) &&
+        r.Number(j, "max_slope_deg", false, &c.max_slope_deg) &&
+        r.Number(j, "max_rise", false, &c.max_rise) && r.Number(j, "reach", true, &c.reach) &&
+        r.Number(j, "max_turn_deg", false, &c.max_turn_deg);
+  }
+  if (r.status == Status::kOk) {
+    if (!j.contains("align_to_normal") || !j["align_to_normal"].is_boolean())
+      r.Fail(Status::kParseError, "'align_to_normal': expected true (multipeds) or false (bipeds)");
+    else c.align_to_normal = j["align_to_normal"].get<bool>();
+  }
+  if (r.status == Status::kOk) {
+    if (fps != std::floor(fps)) r.Fail(Status::kParseError, "'frames_per_step': expected an integer");
+    c.frames_per_step = static_cast<int>(std::min(fps, 1e6));
+  }
+  if (r.status == Status::kOk) {
+    r.Range(c.step_length, 0, 1e9, true, false, "step_length") &&
+        r.Range(c.step_height, 0, 1e9, true, false, "step_height") &&
+        r.Range(c.body_height, 0, 1e9, false, false, "body_height") &&
+        r.Range(fps, 2, 1e6, false, false, "frames_per_step") &&
+        r.Range(c.slope_threshold_deg, 0, 90, false, false, "slope_threshold_deg") &&
+        r.Range(c.slope_step_scale, 0, 1, true, false, "slope_step_scale") &&
+        r.Range(c.max_slope_deg, 0, 180, true, true, "max_slope_deg") &&
+        r.Range(c.max_rise, 0, 1e9, true, false, "max_rise") &&
+        r.Range(c.reach, 0, 1e9, true, false, "reach") &&
+        r.Range(c.max_turn_deg, 0, 180, true, false, "max_turn_deg");
+  }
+  if (r.status == Status::kOk) {
+    for (const FootSpec& f : c.feet) {
+      const double rest = Length(f.rest + Vec3{0, -c.body_height, 0});
+      if (rest >= c.reach) {
+        std::ostringstream m;
+        m << "'reach' = " << c.reach << " must exceed foot '" << f.name
+          << "''s rest distance from the body (" << rest << ")";
+        r.Fail(Status::kInvalidArgument, m.str());
+        break;
+      }
+    }
+  }
+  if (r.status != Status::kOk) {
+    *error = r.error;
+    return r.status;
+  }
+  *out = std::move(c);
+  return Status::kOk;
+}
+
+Status LoadCharacter(const std::string& path, Character* out, std::string* error) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    *error = path + ": cannot open character file";
+    return Status::kIoError;
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  return ParseCharacter(text.str(), path, out, error);
+}
+
+}  // namespace footfall

@@ -1,0 +1,94 @@
+// Small vector and rotation helpers of the step generator. World space; angles in radians.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include "footfall/steps/walk.h"
+#include "footfall/terrain/vec3.h"
+
+namespace footfall::steps_detail {
+
+constexpr double kPi = 3.14159265358979323846;
+inline double Radians(double deg) { return deg * kPi / 180; }
+inline double Degrees(double rad) { return rad * 180 / kPi; }
+
+// v without its component along the unit normal n.
+inline Vec3 ProjectOnPlane(const Vec3& v, const Vec3& n) { return v - n * Dot(v, n); }
+
+// v / |v|, or `fallback` when v is (nearly) zero.
+inline Vec3 NormalizeOr(const Vec3& v, const Vec3& fallback) {
+  const double len = Length(v);
+  return len > 1e-12 ? v / len : fallback;
+}
+
+// Angle between two unit vectors.
+inline double AngleBetween(const Vec3& a, const Vec3& b) {
+  return std::acos(std::clamp(Dot(a, b), -1.0, 1.0));
+}
+
+// A unit vector perpendicular to the unit vector n.
+inline Vec3 AnyPerpendicular(const Vec3& n) {
+  const Vec3 axis = std::fabs(n.x) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 0, 1};
+  return Normalize(Cross(n, axis));
+}
+
+// v rotated by `angle` around the unit axis (right-handed).
+inline Vec3 RotateAround(const Vec3& v, const Vec3& axis, double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  return v * c + Cross(axis, v) * s + axis * (Dot(axis, v) * (1 - c));
+}
+
+// v carried by the smallest rotation that takes unit vector `from` to unit vector `to`.
+inline Vec3 Transport(const Vec3& v, const Vec3& from, const Vec3& to) {
+  const Vec3 axis = Cross(from, to);
+  const double s = Length(axis), c = Dot(from, to);
+  if (s < 1e-12) return c > 0 ? v : RotateAround(v, AnyPerpendicular(from), kPi);
+  return RotateAround(v, axis / s, std::atan2(s, c));
+}
+
+// A unit forward direction in the plane of unit normal `up`: `want` projected onto it, or
+// `previous` carried onto it when `want` is (nearly) along `up`.
+inline Vec3 TangentForward(const Vec3& want, const Vec3& previous, const Vec3& previous_up,
+                           const Vec3& up) {
+  const Vec3 p = ProjectOnPlane(want, up);
+  if (Length2(p) > 1e-8 * Length2(want)) return Normalize(p);
+  const Vec3 carried = ProjectOnPlane(Transport(previous, previous_up, up), up);
+  return NormalizeOr(carried, AnyPerpendicular(up));
+}
+
+// The rotation whose columns are the character axes in world space: X = left, Y = up,
+// Z = forward (orthonormal, right-handed).
+inline Quat QuatFromBasis(const Vec3& x, const Vec3& y, const Vec3& z) {
+  const double m00 = x.x, m10 = x.y, m20 = x.z;
+  const double m01 = y.x, m11 = y.y, m21 = y.z;
+  const double m02 = z.x, m12 = z.y, m22 = z.z;
+  Quat q;
+  const double trace = m00 + m11 + m22;
+  if (trace > 0) {
+    const double s = 0.5 / std::sqrt(trace + 1);
+    q.w = 0.25 / s, q.x = (m21 - m12) * s, q.y = (m02 - m20) * s, q.z = (m10 - m01) * s;
+  } else if (m00 > m11 && m00 > m22) {
+    const double s = 2 * std::sqrt(1 + m00 - m11 - m22);
+    q.w = (m21 - m12) / s, q.x = 0.25 * s, q.y = (m01 + m10) / s, q.z = (m02 + m20) / s;
+  } else if (m11 > m22) {
+    const double s = 2 * std::sqrt(1 + m11 - m00 - m22);
+    q.w = (m02 - m20) / s, q.x = (m01 + m10) / s, q.y = 0.25 * s, q.z = (m12 + m21) / s;
+  } else {
+    const double s = 2 * std::sqrt(1 + m22 - m00 - m11);
+    q.w = (m10 - m01) / s, q.x = (m02 + m20) / s, q.y = (m12 + m21) / s, q.z = 0.25 * s;
+  }
+  const double n = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+  q.x /= n, q.y /= n, q.z /= n, q.w /= n;
+  if (q.w < 0) q.x = -q.x, q.y = -q.y, q.z = -q.z, q.w = -q.w;  // one sign, for stable output
+  return q;
+}
+
+// v rotated by the unit quaternion q.
+inline Vec3 Rotate(const Quat& q, const Vec3& v) {
+  const Vec3 u{q.x, q.y, q.z};
+  const Vec3 t = Cross(u, v) * 2;
+  return v + t * q.w + Cross(u, t);
+}
+
+}  // namespace footfall::steps_detail

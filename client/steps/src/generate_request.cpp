@@ -1,0 +1,114 @@
+#include "footfall/steps/generate_request.h"
+
+#include <cmath>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+namespace footfall {
+namespace {
+
+using nlohmann::json;
+
+bool ReadVec(const json& j, const char* key, Vec3* out, std::string* error) {
+  if (!j.is_array() || j.size() != 3) {
+    *error = std::string("request: '") + key + "': expected [x, y, z]";
+    return false;
+  }
+  double v[3];
+  for (int i = 0; i < 3; ++i) {
+    if (!j[i].is_number() || !std::isfinite(j[i].get<double>())) {
+      *error = std::string("request: '") + key + "': expected finite numbers";
+      return false;
+    }
+    v[i] = j[i].get<double>();
+  }
+  *out = {v[0], v[1], v[2]};
+  return true;
+}
+
+bool ReadNumber(const json& j, const char* key, double* out, std::string* error) {
+  if (!j.is_number() || !std::isfinite(j.get<double>())) {
+    *error = std::string("request: '") + key + "': expected a finite number";
+    return false;
+  }
+  *out = j.get<double>();
+  return true;
+}
+
+}  // namespace
+
+Status ParseGenerateRequest(const std::string& text, Character* character,
+                            GenerateOptions* options, std::string* error) {
+  const json j = json::parse(text, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) {
+    *error = "request: not a JSON object";
+    return Status::kParseError;
+  }
+  static const std::set<std::string> kKnown = {"character", "character_file", "start", "heading",
+                                               "path", "steps", "start_frame", "up", "fps",
+                                               "crowd"};
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (!kKnown.count(it.key())) {
+      *error = "request: unknown field '" + it.key() + "'";
+      return Status::kParseError;
+    }
+  }
+  GenerateOptions o;
+  Status s;
+  if (j.contains("character") == j.contains("character_file")) {
+    *error = "request: give exactly one of 'character' (an object) or 'character_file' (a path)";
+    return Status::kInvalidArgument;
+  }
+  if (j.contains("character")) {
+    if (!j["character"].is_object()) {
+      *error = "request: 'character': expected a character file's object";
+      return Status::kParseError;
+    }
+    s = ParseCharacter(j["character"].dump(), "request character", character, error);
+  } else {
+    if (!j["character_file"].is_string()) {
+      *error = "request: 'character_file': expected a path";
+      return Status::kParseError;
+    }
+    s = LoadCharacter(j["character_file"].get<std::string>(), character, error);
+  }
+  if (s != Status::kOk) return s;
+  bool ok = true;
+  if (ok && j.contains("start")) ok = ReadVec(j["start"], "start", &o.start, error), o.has_start = true;
+  if (ok && j.contains("heading")) ok = ReadVec(j["heading"], "heading", &o.heading, error);
+  if (ok && j.contains("up")) ok = ReadVec(j["up"], "up", &o.up, error);
+  if (ok && j.contains("start_frame")) ok = ReadNumber(j["start_frame"], "start_frame", &o.start_frame, error);
+  if (ok && j.contains("fps")) ok = ReadNumber(j["fps"], "fps", &o.fps, error);
+  for (const char* key : {"steps", "crowd"}) {
+    if (!ok || !j.contains(key)) continue;
+    if (!j[key].is_number_integer()) {
+      *error = std::string("request: '") + key + "': expected an integer";
+      ok = false;
+    } else {
+      const long long v = j[key].get<long long>();
+      if (v < -1 || v > 1000000) {
+        *error = std::string("request: '") + key + "': out of range";
+        ok = false;
+      } else {
+        (std::string(key) == "steps" ? o.steps : o.crowd) = static_cast<int>(v);
+      }
+    }
+  }
+  if (ok && j.contains("path")) {
+    if (!j["path"].is_array()) {
+      *error = "request: 'path': expected an array of [x, y, z]";
+      ok = false;
+    }
+    for (size_t i = 0; ok && i < j["path"].size(); ++i) {
+      Vec3 p;
+      ok = ReadVec(j["path"][i], "path", &p, error);
+      o.path.push_back(p);
+    }
+  }
+  if (!ok) return Status::kParseError;
+  *options = std::move(o);
+  return Status::kOk;
+}
+
+}  // namespace footfall

@@ -1,0 +1,610 @@
+// The step generator. The numbered comments match the numbered list in client/steps/README.md.
+#include "footfall/steps/generator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "frame_math.h"
+
+namespace footfall {
+namespace {
+
+using namespace steps_detail;
+
+constexpr int kMaxAttempts = 3;       // foothold queries per foot and step (shorter each time)
+constexpr double kRetryScale = 0.5;   // step length factor between attempts
+constexpr int kMaxRaises = 8;         // swing arc raises before giving up
+constexpr double kRaise = 0.5;        // raise per round, in step heights
+constexpr int kArcChecks = 3;         // points checked along the start-mid-end arc
+constexpr double kArcS[kArcChecks] = {0.25, 0.5, 0.75};
+// Required clearance at each check point, as a fraction of the arc's nominal clearance there
+// (half the step height at the quarter points, the step height at the mid key).
+constexpr double kClearanceFraction = 0.5;
+
+std::string Point(const Vec3& p) {
+  std::ostringstream o;
+  o.precision(4);
+  o << std::fixed << "(" << p.x << ", " << p.y << ", " << p.z << ")";
+  return o.str();
+}
+
+// One walking character.
+struct Agent {
+  std::string id;      // "" for a single character, else "c1".."cN"
+  Vec3 ground;         // the body's ground point: centroid of the planted feet
+  Vec3 up;             // the body's up (world up for bipeds)
+  Vec3 forward;        // the body's heading, unit, perpendicular to up
+  std::vector<Vec3> foot, foot_normal;  // planted feet
+  std::vector<Vec3> path;
+  size_t waypoint = 0;
+  bool walking = true;   // false once stopped or arrived
+  std::string stopped;   // why it stopped early ("" when it did not)
+  size_t first_track = 0;
+};
+
+// One foot of one agent in the current step.
+struct Move {
+  size_t agent;
+  int foot;
+  double scale = 1;      // step length factor (retries shorten it)
+  int attempts = 0;
+  bool done = false;
+  bool failed = false;
+  std::string reason;    // why the last attempt was refused
+  Vec3 end, end_normal;  // the accepted foothold
+  Vec3 mid, mid_normal;
+  Vec3 ideal;            // the last query's ideal point
+};
+
+class Generator {
+ public:
+  Generator(TerrainSession& session, TerrainHandle terrain, const Character& c,
+            const GenerateOptions& o, Walk* walk)
+      : session_(session), terrain_(terrain), c_(c), o_(o), walk_(*walk) {}
+
+  Status Run(std::string* error);
+
+ private:
+  Status Setup(std::string* error);
+  Status Step(int k, std::string* error);
+  Status QueryFootholds(std::vector<Move>& moves, const std::vector<Vec3>& locator,
+                        const std::vector<Vec3>& locator_normal, std::string* error);
+  Status ClearArcs(std::vector<Move>& moves, std::string* error);
+  void Steer(Agent& a) const;
+  Vec3 Left(const Agent& a) const { return Cross(a.up, a.forward); }
+  Vec3 Place(const Agent& a, const Vec3& rest) const {
+    return a.ground + Left(a) * rest.x + a.up * rest.y + a.forward * rest.z;
+  }
+  Vec3 BodyUp(const Agent& a, const std::vector<Vec3>& normals) const;
+  void KeyFoot(const Agent& a, int foot, double frame, KeyPhase phase, const Vec3& p,
+               const Vec3& n);
+  void KeyBody(const Agent& a, double frame);
+  void Stop(Agent& a, int step, const std::string& why);
+  // A failed batch call: the session's status, and its message prefixed with `what`.
+  Status Check(Status status, const char* what, std::string* error) {
+    if (status != Status::kOk) *error = std::string(what) + ": " + session_.last_error();
+    return status;
+  }
+
+  TerrainSession& session_;
+  TerrainHandle terrain_;
+  const Character& c_;
+  const GenerateOptions& o_;
+  Walk& walk_;
+  Vec3 world_up_;
+  int steps_ = 0;
+  double lead_ = 0;
+  std::vector<Agent> agents_;
+  std::vector<int> pair_of_foot_;
+  std::vector<Vec3> pair_centre_;                 // rest centre of each pair, character space
+  std::vector<std::vector<int>> pairs_of_group_;  // pairs with a foot in each gait group
+  // Batch buffers, reused every step.
+  std::vector<Vec3> points_;
+  std::vector<StepQuery> queries_;
+  std::vector<Foothold> answers_;
+};
+
+Vec3 Generator::BodyUp(const Agent& a, const std::vector<Vec3>& normals) const {
+  if (!c_.align_to_normal) return world_up_;
+  Vec3 sum;
+  for (const Vec3& n : normals) sum += n;
+  return NormalizeOr(sum, a.up);
+}
+
+void Generator::KeyFoot(const Agent& a, int foot, double frame, KeyPhase phase, const Vec3& p,
+                        const Vec3& n) {
+  std::vector<WalkKey>& keys = walk_.tracks[a.first_track + foot].keys;
+  if (!keys.empty() && keys.back().frame == frame) keys.pop_back();  // lift-off replaces plant
+  WalkKey key;
+  key.frame = frame, key.phase = phase, key.position = p, key.normal = n;
+  keys.push_back(key);
+}
+
+void Generator::KeyBody(const Agent& a, double frame) {
+  WalkKey key;
+  key.frame = frame;
+  key.position = a.ground + a.up * c_.body_height;
+  key.normal = a.up;
+  key.rotation = QuatFromBasis(Left(a), a.up, a.forward);
+  walk_.tracks[a.first_track + c_.feet.size()].keys.push_back(key);
+}
+
+void Generator::Stop(Agent& a, int step, const std::string& why) {
+  a.walking = false;
+  std::ostringstream m;
+  m << "step " << step;
+  if (!a.id.empty()) m << " of " << a.id;
+  m << ": " << why << "; walk stopped, keys up to step " << step - 1 << " kept";
+  a.stopped = m.str();
+}
+
+// Turns the heading toward the current waypoint, at most max_turn_deg per step; marks the
+// agent arrived at the last waypoint.
+void Generator::Steer(Agent& a) const {
+  if (a.path.empty()) return;
+  while (a.waypoint < a.path.size()) {
+    const Vec3 to = ProjectOnPlane(a.path[a.waypoint] - a.ground, a.up);
+    const bool last = a.waypoint + 1 == a.path.size();
+    if (Length(to) > (last ? 0.5 : 1.0) * c_.step_length) break;
+    ++a.waypoint;
+  }
+  if (a.waypoint == a.path.size()) {
+    a.walking = false;  // arrived: not an early stop
+    return;
+  }
+  const Vec3 to = ProjectOnPlane(a.path[a.waypoint] - a.ground, a.up);
+  if (Length2(to) < 1e-18) return;
+  const Vec3 want = Normalize(to);
+  const double angle = std::atan2(Dot(Cross(a.forward, want), a.up), Dot(a.forward, want));
+  const double max_turn = Radians(c_.max_turn_deg);
+  a.forward = Normalize(RotateAround(a.forward, a.up, std::clamp(angle, -max_turn, max_turn)));
+}
+
+Status Generator::Run(std::string* error) {
+  world_up_ = Normalize(o_.up);
+  const int groups = static_cast<int>(c_.gait.size());
+  steps_ = o_.steps >= 0 ? o_.steps : (o_.path.empty() ? 8 : 10000);
+  // The target locator's lead over the foot's rest position: with the body at the feet's
+  // centroid, L * (G + 1) / (2G) makes every foot travel exactly L per step once walking
+  // (half a step ahead for G -> infinity; 3/4 of a step for two gait groups).
+  lead_ = c_.step_length * (groups + 1) / (2.0 * groups);
+  pair_of_foot_.assign(c_.feet.size(), 0);
+  for (size_t p = 0; p < c_.pairs.size(); ++p) {
+    Vec3 centre;
+    for (int f : c_.pairs[p]) pair_of_foot_[f] = static_cast<int>(p), centre += c_.feet[f].rest;
+    pair_centre_.push_back(centre / static_cast<double>(c_.pairs[p].size()));
+  }
+  pairs_of_group_.assign(groups, {});
+  for (int g = 0; g < groups; ++g) {
+    for (int f : c_.gait[g]) {
+      auto& list = pairs_of_group_[g];
+      if (std::find(list.begin(), list.end(), pair_of_foot_[f]) == list.end())
+        list.push_back(pair_of_foot_[f]);
+    }
+  }
+  Status s = Setup(error);
+  if (s != Status::kOk) return s;
+  for (int k = 0; k < steps_; ++k) {
+    bool any = false;
+    for (const Agent& a : agents_) any = any || a.walking;
+    if (!any) break;
+    s = Step(k, error);
+    if (s != Status::kOk) return s;
+    if (o_.progress) o_.progress(k + 1, steps_);
+  }
+  // The walk's stop message: the first agent's, and how many others stopped.
+  size_t stopped = 0;
+  for (const Agent& a : agents_) {
+    if (a.stopped.empty()) continue;
+    if (stopped++ == 0) walk_.stopped = a.stopped;
+  }
+  if (stopped > 1)
+    walk_.stopped += " (and " + std::to_string(stopped - 1) + " more characters stopped)";
+  return Status::kOk;
+}
+
+Status Generator::Setup(std::string* error) {
+  const size_t feet = c_.feet.size();
+  // 1. The start: --start, or the sample nearest the centre of the top of the bounds.
+  Vec3 start = o_.start;
+  if (!o_.has_start) {
+    TerrainInfo info;
+    const Status s = Check(session_.Info(terrain_, &info), "terrain info", error);
+    if (s != Status::kOk) return s;
+    const Vec3 lo = info.stats.bounds_min, hi = info.stats.bounds_max;
+    const Vec3 centre = (lo + hi) * 0.5;
+    double top = 0;
+    for (int i = 0; i < 8; ++i) {
+      const Vec3 corner{i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z};
+      top = std::max(top, Dot(corner - centre, world_up_));
+    }
+    start = centre + world_up_ * top;
+  }
+  Foothold first;
+  Status s = Check(session_.Snap(terrain_, &start, 1, &first), "snap start", error);
+  if (s != Status::kOk) return s;
+  if (first.status != Status::kOk) {
+    *error = "the terrain is empty: no sample to start on";
+    return Status::kInvalidArgument;
+  }
+  // 2. The start frame: up (terrain normal for multipeds, world up for bipeds) and the heading
+  //    projected onto the plane perpendicular to it. Crowds stand on a grid in that plane.
+  const Vec3 up0 = c_.align_to_normal ? first.normal : world_up_;
+  const Vec3 fwd0 = TangentForward(o_.heading, AnyPerpendicular(world_up_), world_up_, up0);
+  const Vec3 left0 = Cross(up0, fwd0);
+  const int n = std::max(1, o_.crowd);
+  const int cols = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n))));
+  const int rows = (n + cols - 1) / cols;
+  const double spacing = o_.crowd_spacing > 0 ? o_.crowd_spacing : 2 * c_.reach;
+  std::vector<Vec3> offsets(n);
+  points_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const double x = (i % cols - (cols - 1) / 2.0) * spacing;
+    const double z = (i / cols - (rows - 1) / 2.0) * spacing;
+    offsets[i] = n == 1 ? Vec3{} : left0 * x + fwd0 * z;
+    points_[i] = first.point + offsets[i];
+  }
+  answers_.resize(n);
+  s = Check(session_.Snap(terrain_, points_.data(), n, answers_.data()), "snap start", error);
+  if (s != Status::kOk) return s;
+  agents_.resize(n);
+  walk_.tracks.clear();
+  walk_.tracks.reserve(n * (feet + 1));
+  const size_t groups = c_.gait.size();
+  for (int i = 0; i < n; ++i) {
+    Agent& a = agents_[i];
+    if (n > 1) a.id = "c" + std::to_string(i + 1);
+    a.ground = answers_[i].point;
+    a.up = c_.align_to_normal ? answers_[i].normal : world_up_;
+    a.forward = TangentForward(o_.heading, fwd0, up0, a.up);
+    for (const Vec3& p : o_.path) a.path.push_back(p + offsets[i]);
+    if (!a.path.empty()) {
+      const Vec3 to = ProjectOnPlane(a.path[0] - a.ground, a.up);
+      if (Length2(to) > 1e-18) a.forward = Normalize(to);
+    }
+    a.first_track = walk_.tracks.size();
+    for (size_t f = 0; f <= feet; ++f) {
+      WalkTrack t;
+      t.name = f < feet ? c_.feet[f].name : "body";
+      t.character = a.id;
+      t.kind = f < feet ? TrackKind::kFoot : TrackKind::kBody;
+      const size_t steps_of_foot = static_cast<size_t>(steps_) / groups + 1;
+      t.keys.reserve(std::min<size_t>(f < feet ? 3 * steps_of_foot + 1 : steps_ + 1, 4096));
+      walk_.tracks.push_back(std::move(t));
+    }
+  }
+  // 3. Snap the feet at their rest positions around each start.
+  points_.resize(n * feet);
+  for (int i = 0; i < n; ++i)
+    for (size_t f = 0; f < feet; ++f) points_[i * feet + f] = Place(agents_[i], c_.feet[f].rest);
+  answers_.resize(points_.size());
+  s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()),
+            "snap feet", error);
+  if (s != Status::kOk) return s;
+  // 4. The body at the feet's centroid, raised by body_height along its up (multipeds: the
+  //    averaged foot normal); every foot and the body keyed planted at the start frame.
+  for (int i = 0; i < n; ++i) {
+    Agent& a = agents_[i];
+    a.foot.resize(feet), a.foot_normal.resize(feet);
+    Vec3 centroid;
+    for (size_t f = 0; f < feet; ++f) {
+      a.foot[f] = answers_[i * feet + f].point;
+      a.foot_normal[f] = answers_[i * feet + f].normal;
+      centroid += a.foot[f];
+    }
+    const Vec3 old_up = a.up;
+    a.up = BodyUp(a, a.foot_normal);
+    a.forward = TangentForward(a.forward, a.forward, old_up, a.up);
+    a.ground = centroid / static_cast<double>(feet);
+    for (size_t f = 0; f < feet; ++f) {
+      KeyFoot(a, static_cast<int>(f), o_.start_frame, KeyPhase::kEnd, a.foot[f], a.foot_normal[f]);
+      const double slope = Degrees(AngleBetween(a.foot_normal[f], a.up));
+      if (a.walking && slope > c_.max_slope_deg) {
+        std::ostringstream m;
+        m.precision(3);
+        m << "foot " << c_.feet[f].name << " cannot stand at " << Point(a.foot[f])
+          << ": ground leans " << slope << " deg, more than max_slope_deg " << c_.max_slope_deg;
+        Stop(a, 1, m.str());
+      }
+    }
+    KeyBody(a, o_.start_frame);
+  }
+  return Status::kOk;
+}
+
+Status Generator::QueryFootholds(std::vector<Move>& moves, const std::vector<Vec3>& locator,
+                                 const std::vector<Vec3>& locator_normal, std::string* error) {
+  const size_t feet = c_.feet.size();
+  std::vector<size_t> pending;
+  for (size_t m = 0; m < moves.size(); ++m) pending.push_back(m);
+  std::vector<Vec3> new_normals(feet);
+  while (!pending.empty()) {
+    // 7. Target locators: the foot's rest offset from its pair's centre, in the frame of the
+    //    central locator (aligned to the terrain normal under it). The step vector runs from
+    //    the foot to its target; slope awareness and the reach limit shorten it.
+    queries_.clear();
+    for (size_t m : pending) {
+      Move& mv = moves[m];
+      Agent& a = agents_[mv.agent];
+      const int p = pair_of_foot_[mv.foot];
+      Vec3 n = locator_normal[m];
+      if (Degrees(AngleBetween(n, a.up)) > c_.max_slope_deg) n = a.up;  // an edge, not ground
+      const Vec3 f = TangentForward(a.forward, a.forward, a.up, n);
+      const Vec3 l = Cross(n, f);
+      const Vec3 d = c_.feet[mv.foot].rest - pair_centre_[p];
+      const Vec3 target = locator[m] + l * d.x + n * d.y + f * d.z;
+      const double slope = Degrees(std::asin(std::min(1.0, std::fabs(Dot(f, a.up)))));
+      double max_len = c_.step_length * mv.scale;
+      if (slope > c_.slope_threshold_deg) max_len *= c_.slope_step_scale;
+      Vec3 v = target - a.foot[mv.foot];
+      const double len = Length(v);
+      if (len > max_len) v = v * (max_len / len);
+      if (Length(v) < 1e-3 * c_.step_length) v = f * (1e-3 * c_.step_length);
+      // No target beyond reach of the body where the step will put it (the feet's centroid
+      // moves by this foot's displacement over the number of feet).
+      for (int shrink = 0; shrink < 8; ++shrink) {
+        const Vec3 ground = a.ground + v / static_cast<double>(feet);
+        const Vec3 body = ground + a.up * c_.body_height;
+        if (Distance(a.foot[mv.foot] + v, body) <= c_.reach) break;
+        v = v * 0.75;
+      }
+      mv.ideal = a.foot[mv.foot] + v;
+      queries_.push_back({a.foot[mv.foot], v});
+    }
+    // 8. Query the next foothold of every pending foot of every character: one batch. The
+    //    answer carries the end normal; the start normal is the planted foot's.
+    answers_.resize(queries_.size());
+    const Status s = Check(session_.Next(terrain_, queries_.data(), queries_.size(),
+                                         0.5 * c_.step_length, answers_.data()),
+                           "next foothold", error);
+    if (s != Status::kOk) return s;
+    for (size_t q = 0; q < pending.size(); ++q) {
+      Move& mv = moves[pending[q]];
+      const Agent& a = agents_[mv.agent];
+      const Foothold& h = answers_[q];
+      const Vec3& foot = a.foot[mv.foot];
+      std::ostringstream why;
+      why.precision(3);
+      ++mv.attempts;
+      if (h.status != Status::kOk) {
+        why << "no foothold within " << 0.5 * c_.step_length << " of " << Point(mv.ideal)
+            << " (a gap or a cliff)";
+      } else {
+        const double rise = Dot(h.point - foot, a.up);
+        const double slope = Degrees(AngleBetween(h.normal, a.up));
+        if (std::fabs(rise) > c_.max_rise) {
+          why << "the foothold at " << Point(h.point) << (rise > 0 ? " rises " : " drops ")
+              << std::fabs(rise) << ", more than max_rise " << c_.max_rise << " (a cliff)";
+        } else if (slope > c_.max_slope_deg) {
+          why << "the foothold at " << Point(h.point) << " leans " << slope
+              << " deg, more than max_slope_deg " << c_.max_slope_deg << " (too steep)";
+        } else {
+          mv.done = true, mv.end = h.point, mv.end_normal = h.normal;
+        }
+      }
+      if (!mv.done) mv.reason = why.str();
+    }
+    // The reach limit on the body where the accepted footholds put it; feet beyond it retry.
+    for (size_t m = 0; m < moves.size();) {
+      const size_t agent = moves[m].agent;
+      size_t e = m;
+      bool all_done = true;
+      while (e < moves.size() && moves[e].agent == agent) all_done &= moves[e].done, ++e;
+      if (all_done) {
+        const Agent& a = agents_[agent];
+        std::vector<Vec3> feet_now = a.foot;
+        new_normals = a.foot_normal;
+        for (size_t i = m; i < e; ++i)
+          feet_now[moves[i].foot] = moves[i].end, new_normals[moves[i].foot] = moves[i].end_normal;
+        Vec3 centroid;
+        for (const Vec3& p : feet_now) centroid += p;
+        const Vec3 body = centroid / static_cast<double>(feet) + BodyUp(a, new_normals) * c_.body_height;
+        for (size_t i = m; i < e; ++i) {
+          const double dist = Distance(moves[i].end, body);
+          if (dist > c_.reach) {
+            std::ostringstream why;
+            why.precision(3);
+            why << "the foothold at " << Point(moves[i].end) << " is " << dist
+                << " from the body, beyond reach " << c_.reach;
+            moves[i].done = false, moves[i].reason = why.str();
+          }
+        }
+      }
+      m = e;
+    }
+    pending.clear();
+    for (size_t m = 0; m < moves.size(); ++m) {
+      Move& mv = moves[m];
+      if (mv.done || mv.failed) continue;
+      if (mv.attempts >= kMaxAttempts) mv.failed = true;
+      else mv.scale *= kRetryScale, pending.push_back(m);
+    }
+  }
+  return Status::kOk;
+}
+
+Status Generator::ClearArcs(std::vector<Move>& moves, std::string* error) {
+  // 9. Swing arcs: the mid key is the midpoint of start and end raised along the averaged
+  //    normal by step_height. Points along the start-mid-end arc are snapped to the terrain; an
+  //    arc passing below it (or too close) raises the mid key, round after round.
+  std::vector<size_t> pending;
+  for (size_t m = 0; m < moves.size(); ++m) {
+    Move& mv = moves[m];
+    const Agent& a = agents_[mv.agent];
+    mv.mid_normal = NormalizeOr(a.foot_normal[mv.foot] + mv.end_normal, a.up);
+    mv.mid = (a.foot[mv.foot] + mv.end) * 0.5 + mv.mid_normal * c_.step_height;
+    pending.push_back(m);
+  }
+  for (int round = 0; !pending.empty(); ++round) {
+    points_.clear();
+    for (size_t m : pending) {
+      const Move& mv = moves[m];
+      const Vec3& start = agents_[mv.agent].foot[mv.foot];
+      for (double s : kArcS)
+        points_.push_back(s <= 0.5 ? Lerp(start, mv.mid, 2 * s) : Lerp(mv.mid, mv.end, 2 * s - 1));
+    }
+    answers_.resize(points_.size());
+    const Status s = Check(session_.Snap(terrain_, points_.data(), points_.size(),
+                                         answers_.data()),
+                           "snap swing arc", error);
+    if (s != Status::kOk) return s;
+    std::vector<size_t> still;
+    for (size_t i = 0; i < pending.size(); ++i) {
+      Move& mv = moves[pending[i]];
+      bool clear = true;
+      for (int j = 0; j < kArcChecks; ++j) {
+        const Foothold& h = answers_[i * kArcChecks + j];
+        const double nominal = c_.step_height * (1 - std::fabs(2 * kArcS[j] - 1));
+        if (h.status == Status::kOk &&
+            Dot(points_[i * kArcChecks + j] - h.point, h.normal) < kClearanceFraction * nominal)
+          clear = false;
+      }
+      if (clear) continue;
+      if (round + 1 >= kMaxRaises) {
+        std::ostringstream why;
+        why.precision(3);
+        why << "the swing arc to " << Point(mv.end) << " cannot clear the terrain (mid key raised "
+            << kMaxRaises * kRaise << " step heights)";
+        mv.failed = true, mv.done = false, mv.reason = why.str();
+        continue;
+      }
+      mv.mid += mv.mid_normal * (kRaise * c_.step_height);
+      still.push_back(pending[i]);
+    }
+    pending.swap(still);
+  }
+  return Status::kOk;
+}
+
+Status Generator::Step(int k, std::string* error) {
+  const int group = k % static_cast<int>(c_.gait.size());
+  const double f0 = o_.start_frame + static_cast<double>(k) * c_.frames_per_step;
+  const double f_mid = f0 + 0.5 * c_.frames_per_step;
+  const double f1 = f0 + c_.frames_per_step;
+  // 5. Heading: turn toward the current waypoint of the path (at most max_turn_deg).
+  for (Agent& a : agents_)
+    if (a.walking) Steer(a);
+  // 6. Central locators: one per foot pair stepping now, lead ahead of the pair's rest centre
+  //    in the body frame, snapped to the terrain (one batch for every character).
+  std::vector<Move> moves;
+  std::vector<size_t> locator_of_move;
+  points_.clear();
+  for (size_t i = 0; i < agents_.size(); ++i) {
+    const Agent& a = agents_[i];
+    if (!a.walking) continue;
+    const size_t base = points_.size();
+    for (int p : pairs_of_group_[group])
+      points_.push_back(Place(a, pair_centre_[p]) + a.forward * lead_);
+    for (int f : c_.gait[group]) {
+      Move mv;
+      mv.agent = i, mv.foot = f;
+      moves.push_back(mv);
+      const auto& list = pairs_of_group_[group];
+      locator_of_move.push_back(base + (std::find(list.begin(), list.end(), pair_of_foot_[f]) - list.begin()));
+    }
+  }
+  if (moves.empty()) return Status::kOk;
+  answers_.resize(points_.size());
+  Status s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()),
+                   "snap locators", error);
+  if (s != Status::kOk) return s;
+  std::vector<Vec3> locator(moves.size()), locator_normal(moves.size());
+  for (size_t m = 0; m < moves.size(); ++m) {
+    const Foothold& h = answers_[locator_of_move[m]];
+    locator[m] = h.point, locator_normal[m] = h.normal;
+  }
+  s = QueryFootholds(moves, locator, locator_normal, error);
+  if (s != Status::kOk) return s;
+  {  // Arcs only for feet whose foothold was accepted.
+    std::vector<Move> accepted;
+    for (const Move& mv : moves)
+      if (mv.done) accepted.push_back(mv);
+    s = ClearArcs(accepted, error);
+    if (s != Status::kOk) return s;
+    size_t j = 0;
+    for (Move& mv : moves)
+      if (mv.done) mv = accepted[j++];
+  }
+  // 10. Key each foot (start, mid, end) and plant it; 11. move the body to the feet's centroid,
+  //     raised along its up (multipeds: the averaged foot normal), heading carried along, and
+  //     key it at touch-down. A character with a refused foot stops before this step's keys.
+  for (size_t m = 0; m < moves.size();) {
+    Agent& a = agents_[moves[m].agent];
+    size_t e = m;
+    const Move* failed = nullptr;
+    while (e < moves.size() && moves[e].agent == moves[m].agent) {
+      if (!moves[e].done && !failed) failed = &moves[e];
+      ++e;
+    }
+    if (failed) {
+      Stop(a, k + 1,
+           "foot " + c_.feet[failed->foot].name + " at " + Point(a.foot[failed->foot]) + ": " +
+               failed->reason);
+      m = e;
+      continue;
+    }
+    for (size_t i = m; i < e; ++i) {
+      const Move& mv = moves[i];
+      KeyFoot(a, mv.foot, f0, KeyPhase::kStart, a.foot[mv.foot], a.foot_normal[mv.foot]);
+      KeyFoot(a, mv.foot, f_mid, KeyPhase::kMid, mv.mid, mv.mid_normal);
+      KeyFoot(a, mv.foot, f1, KeyPhase::kEnd, mv.end, mv.end_normal);
+      a.foot[mv.foot] = mv.end, a.foot_normal[mv.foot] = mv.end_normal;
+    }
+    Vec3 centroid;
+    for (const Vec3& p : a.foot) centroid += p;
+    a.ground = centroid / static_cast<double>(a.foot.size());
+    const Vec3 old_up = a.up;
+    a.up = BodyUp(a, a.foot_normal);
+    a.forward = TangentForward(a.forward, a.forward, old_up, a.up);
+    KeyBody(a, f1);
+    m = e;
+  }
+  return Status::kOk;
+}
+
+}  // namespace
+
+Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Character& character,
+                    const GenerateOptions& options, Walk* out, std::string* error) {
+  if (!(Length2(options.up) > 0) || !IsFinite(options.up)) {
+    *error = "--up must be a non-zero finite vector";
+    return Status::kInvalidArgument;
+  }
+  if (!(Length2(options.heading) > 0) || !IsFinite(options.heading)) {
+    *error = "--heading must be a non-zero finite vector";
+    return Status::kInvalidArgument;
+  }
+  if (!IsFinite(options.start) || !std::isfinite(options.start_frame) || !(options.fps > 0) ||
+      !std::isfinite(options.fps)) {
+    *error = "start, start frame and fps must be finite (fps > 0)";
+    return Status::kInvalidArgument;
+  }
+  for (const Vec3& p : options.path) {
+    if (!IsFinite(p)) {
+      *error = "path waypoints must be finite";
+      return Status::kInvalidArgument;
+    }
+  }
+  if (options.crowd < 1 || options.crowd > 1000000) {
+    *error = "crowd must be from 1 to 1000000 characters";
+    return Status::kInvalidArgument;
+  }
+  if (options.steps > 1000000) {
+    *error = "steps must be at most 1000000";
+    return Status::kInvalidArgument;
+  }
+  if (character.feet.empty() || character.gait.empty()) {
+    *error = "the character has no feet or no gait";
+    return Status::kInvalidArgument;
+  }
+  Walk walk;
+  walk.fps = options.fps;
+  Generator g(session, terrain, character, options, &walk);
+  const Status s = g.Run(error);
+  if (s != Status::kOk) return s;
+  *out = std::move(walk);
+  return Status::kOk;
+}
+
+}  // namespace footfall

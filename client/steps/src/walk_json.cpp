@@ -1,0 +1,241 @@
+#include "footfall/steps/walk_json.h"
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace footfall {
+namespace {
+
+using nlohmann::json;
+
+// Shortest text that reads back as the same double; JSON has no NaN/Inf, so those write null
+// (the generator never produces them).
+void Number(std::string& out, double v) {
+  if (!std::isfinite(v)) {
+    out += "null";
+    return;
+  }
+  if (v == 0) v = 0;  // no "-0"
+  char buffer[32];
+  const auto r = std::to_chars(buffer, buffer + sizeof buffer, v);
+  out.append(buffer, r.ptr);
+}
+
+void Vector(std::string& out, const Vec3& v) {
+  out += '[';
+  Number(out, v.x), out += ',', Number(out, v.y), out += ',', Number(out, v.z);
+  out += ']';
+}
+
+void String(std::string& out, const std::string& s) { out += json(s).dump(); }
+
+const char* KindName(TrackKind kind) { return kind == TrackKind::kFoot ? "foot" : "body"; }
+
+struct Reader {
+  std::string source;
+  std::string error;
+  bool Fail(const std::string& where, const std::string& what) {
+    if (error.empty()) error = source + ": " + where + ": " + what;
+    return false;
+  }
+  bool Finite(const json& j, const std::string& where, double* out) {
+    if (!j.is_number() || !std::isfinite(j.get<double>())) return Fail(where, "expected a finite number");
+    *out = j.get<double>();
+    return true;
+  }
+  bool Array(const json& j, size_t n, const std::string& where, double* out) {
+    if (!j.is_array() || j.size() != n)
+      return Fail(where, "expected an array of " + std::to_string(n) + " numbers");
+    for (size_t i = 0; i < n; ++i)
+      if (!Finite(j[i], where + "[" + std::to_string(i) + "]", &out[i])) return false;
+    return true;
+  }
+  bool Vec(const json& j, const std::string& where, Vec3* out) {
+    double v[3];
+    if (!Array(j, 3, where, v)) return false;
+    *out = {v[0], v[1], v[2]};
+    return true;
+  }
+};
+
+}  // namespace
+
+std::string WalkToJson(const Walk& walk) {
+  std::string out;
+  size_t keys = 0;
+  for (const WalkTrack& t : walk.tracks) keys += t.keys.size();
+  out.reserve(256 + keys * 140);
+  out += "{\"format\":\"footfall-walk\",\"version\":";
+  out += std::to_string(kWalkFormatVersion);
+  out += ",\"fps\":";
+  Number(out, walk.fps);
+  out += ",\"stopped\":";
+  String(out, walk.stopped);
+  out += ",\"tracks\":[";
+  for (size_t ti = 0; ti < walk.tracks.size(); ++ti) {
+    const WalkTrack& t = walk.tracks[ti];
+    out += ti ? ",\n" : "\n";
+    out += "{\"name\":";
+    String(out, t.name);
+    if (!t.character.empty()) out += ",\"character\":", String(out, t.character);
+    out += ",\"kind\":\"";
+    out += KindName(t.kind);
+    out += "\",\"keys\":[";
+    for (size_t ki = 0; ki < t.keys.size(); ++ki) {
+      const WalkKey& k = t.keys[ki];
+      out += ki ? ",\n " : "\n ";
+      out += "{\"frame\":";
+      Number(out, k.frame);
+      if (t.kind == TrackKind::kFoot) {
+        out += ",\"phase\":\"";
+        out += PhaseName(k.phase);
+        out += "\",\"position\":";
+        Vector(out, k.position);
+        out += ",\"normal\":";
+        Vector(out, k.normal);
+      } else {
+        out += ",\"position\":";
+        Vector(out, k.position);
+        out += ",\"rotation\":[";
+        Number(out, k.rotation.x), out += ',', Number(out, k.rotation.y), out += ',';
+        Number(out, k.rotation.z), out += ',', Number(out, k.rotation.w);
+        out += ']';
+      }
+      out += '}';
+    }
+    out += "]}";
+  }
+  out += "\n]}\n";
+  return out;
+}
+
+Status WriteWalkJson(const Walk& walk, const std::string& path, std::string* error) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) {
+    *error = path + ": cannot open for writing";
+    return Status::kIoError;
+  }
+  const std::string text = WalkToJson(walk);
+  out.write(text.data(), static_cast<std::streamsize>(text.size()));
+  out.close();
+  if (!out) {
+    *error = path + ": write failed";
+    return Status::kIoError;
+  }
+  return Status::kOk;
+}
+
+Status ParseWalkJson(const std::string& text, const std::string& source, Walk* out,
+                     std::string* error) {
+  json j = json::parse(text, nullptr, false);
+  Reader r;
+  r.source = source;
+  Walk walk;
+  if (j.is_discarded() || !j.is_object()) {
+    *error = source + ": not a JSON object (expected a footfall walk)";
+    return Status::kParseError;
+  }
+  if (j.value("format", std::string()) != "footfall-walk") {
+    r.Fail("format", "expected \"footfall-walk\"");
+  } else if (!j.contains("version") || !j["version"].is_number_integer() ||
+             j["version"].get<int>() != kWalkFormatVersion) {
+    r.Fail("version", "expected " + std::to_string(kWalkFormatVersion));
+  } else if (!j.contains("fps") || !r.Finite(j["fps"], "fps", &walk.fps)) {
+    r.Fail("fps", "expected a positive number");
+  } else if (!(walk.fps > 0)) {
+    r.Fail("fps", "expected a positive number");
+  } else if (j.contains("stopped") && !j["stopped"].is_string()) {
+    r.Fail("stopped", "expected a string");
+  } else if (!j.contains("tracks") || !j["tracks"].is_array()) {
+    r.Fail("tracks", "expected an array");
+  }
+  if (r.error.empty()) {
+    walk.stopped = j.value("stopped", std::string());
+    const json& tracks = j["tracks"];
+    for (size_t ti = 0; ti < tracks.size() && r.error.empty(); ++ti) {
+      const json& t = tracks[ti];
+      const std::string tw = "tracks[" + std::to_string(ti) + "]";
+      WalkTrack track;
+      if (!t.is_object() || !t.contains("name") || !t["name"].is_string()) {
+        r.Fail(tw, "expected {\"name\": STRING, \"kind\": \"foot\"|\"body\", \"keys\": [...]}");
+        break;
+      }
+      track.name = t["name"].get<std::string>();
+      if (t.contains("character")) {
+        if (!t["character"].is_string()) {
+          r.Fail(tw + ".character", "expected a string");
+          break;
+        }
+        track.character = t["character"].get<std::string>();
+      }
+      const std::string kind = t.contains("kind") && t["kind"].is_string() ? t["kind"].get<std::string>() : "";
+      if (kind == "foot") track.kind = TrackKind::kFoot;
+      else if (kind == "body") track.kind = TrackKind::kBody;
+      else {
+        r.Fail(tw + ".kind", "expected \"foot\" or \"body\"");
+        break;
+      }
+      if (!t.contains("keys") || !t["keys"].is_array()) {
+        r.Fail(tw + ".keys", "expected an array");
+        break;
+      }
+      const json& keys = t["keys"];
+      track.keys.reserve(keys.size());
+      for (size_t ki = 0; ki < keys.size(); ++ki) {
+        const json& k = keys[ki];
+        const std::string kw = tw + ".keys[" + std::to_string(ki) + "]";
+        WalkKey key;
+        if (!k.is_object() || !k.contains("frame") || !k.contains("position")) {
+          r.Fail(kw, "expected an object with frame and position");
+          break;
+        }
+        if (!r.Finite(k["frame"], kw + ".frame", &key.frame)) break;
+        if (!track.keys.empty() && !(key.frame > track.keys.back().frame)) {
+          r.Fail(kw + ".frame", "frames must increase along a track");
+          break;
+        }
+        if (!r.Vec(k["position"], kw + ".position", &key.position)) break;
+        if (track.kind == TrackKind::kFoot) {
+          const std::string phase = k.contains("phase") && k["phase"].is_string() ? k["phase"].get<std::string>() : "?";
+          if (phase == "start") key.phase = KeyPhase::kStart;
+          else if (phase == "mid") key.phase = KeyPhase::kMid;
+          else if (phase == "end") key.phase = KeyPhase::kEnd;
+          else {
+            r.Fail(kw + ".phase", "expected \"start\", \"mid\" or \"end\"");
+            break;
+          }
+          if (k.contains("normal") && !r.Vec(k["normal"], kw + ".normal", &key.normal)) break;
+        } else {
+          double q[4] = {0, 0, 0, 1};
+          if (k.contains("rotation") && !r.Array(k["rotation"], 4, kw + ".rotation", q)) break;
+          key.rotation = {q[0], q[1], q[2], q[3]};
+        }
+        track.keys.push_back(key);
+      }
+      walk.tracks.push_back(std::move(track));
+    }
+  }
+  if (!r.error.empty()) {
+    *error = r.error;
+    return Status::kParseError;
+  }
+  *out = std::move(walk);
+  return Status::kOk;
+}
+
+Status ReadWalkJson(const std::string& path, Walk* out, std::string* error) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    *error = path + ": cannot open walk file";
+    return Status::kIoError;
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  return ParseWalkJson(text.str(), path, out, error);
+}
+
+}  // namespace footfall

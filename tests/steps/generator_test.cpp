@@ -1,0 +1,433 @@
+// The step generator on generated terrain, for every shipped character: slopes, stairs, a
+// sphere, a wall, a path with a 90-degree turn, a cliff, crowds. Every walk is checked against
+// the invariants of walk_checks.h.
+#include <cmath>
+#include <string>
+
+#include <catch2/catch.hpp>
+
+#include "footfall/import/terrain_generators.h"
+#include "walk_checks.h"
+
+using namespace footfall;
+using namespace footfall::test;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Terrain sizes follow the character: a biped's terrain is ~6 times an insect's.
+double Scale(const Character& c) { return c.step_length / 0.7; }
+
+Vec3 BodyForward(const WalkKey& k) {
+  const Quat& q = k.rotation;
+  return {2 * (q.x * q.z + q.w * q.y), 2 * (q.y * q.z - q.w * q.x), 1 - 2 * (q.x * q.x + q.y * q.y)};
+}
+
+Vec3 BodyUp(const WalkKey& k) {
+  const Quat& q = k.rotation;
+  return {2 * (q.x * q.y - q.w * q.z), 1 - 2 * (q.x * q.x + q.z * q.z), 2 * (q.y * q.z + q.w * q.x)};
+}
+
+size_t StepsDone(const Walk& w) {
+  for (const WalkTrack& t : w.tracks)
+    if (t.kind == TrackKind::kBody) return t.keys.size() - 1;
+  return 0;
+}
+
+const WalkTrack& Body(const Walk& w) {
+  for (const WalkTrack& t : w.tracks)
+    if (t.kind == TrackKind::kBody) return t;
+  FAIL("no body track");
+  return w.tracks.front();
+}
+
+}  // namespace
+
+TEST_CASE("Walks up and down a 20-degree ramp", "[steps][generator]") {
+  for (const std::string& name : ShippedCharacters()) {
+    const Character c = LoadShipped(name);
+    const double s = Scale(c), spacing = 0.05 * s, width = 8 * c.reach;
+    const double slope = 20 * kPi / 180;
+    const int nx = static_cast<int>(width / spacing), nz = static_cast<int>((14 * c.step_length + 6 * c.reach) / spacing);
+    Terrain t = LoadTerrain(MakeRamp(nx, nz, spacing, 20));
+    const double length = nz * spacing;
+    for (bool uphill : {true, false}) {
+      INFO(name << (uphill ? " uphill" : " downhill"));
+      GenerateOptions o;
+      const double d = uphill ? 2 * c.reach : length - 2 * c.reach;
+      o.has_start = true;
+      o.start = {width / 2, std::sin(slope) * d, std::cos(slope) * d};
+      o.heading = {0, 0, uphill ? 1.0 : -1.0};
+      o.steps = 12;
+      const Walk w = Generate(t, c, o);
+      INFO(w.stopped);
+      CHECK(w.stopped.empty());
+      CHECK(StepsDone(w) == 12);
+      CheckWalk(t, c, o, w);
+      const auto& body = Body(w).keys;
+      const double climbed = body.back().position.y - body.front().position.y;
+      CHECK((uphill ? climbed : -climbed) > 2 * c.step_length * std::sin(slope));
+    }
+  }
+}
+
+TEST_CASE("Steps are shorter on a slope past the threshold", "[steps][generator]") {
+  const Character c = LoadShipped("biped");
+  const double spacing = 0.05;
+  auto stride = [&](double slope_deg) {
+    Terrain t = LoadTerrain(MakeRamp(120, 300, spacing, slope_deg));
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {3, std::sin(slope_deg * kPi / 180) * 2, std::cos(slope_deg * kPi / 180) * 2};
+    o.steps = 10;
+    const Walk w = Generate(t, c, o);
+    REQUIRE(w.stopped.empty());
+    CheckWalk(t, c, o, w);
+    // The longest foot travel over the last 4 steps.
+    double longest = 0;
+    for (const WalkTrack& tr : w.tracks) {
+      if (tr.kind != TrackKind::kFoot) continue;
+      for (size_t i = tr.keys.size() > 6 ? tr.keys.size() - 6 : 0; i + 2 < tr.keys.size(); ++i)
+        if (tr.keys[i].phase == KeyPhase::kStart)
+          longest = std::max(longest, Distance(tr.keys[i].position, tr.keys[i + 2].position));
+    }
+    return longest;
+  };
+  const double flat = stride(0), steep = stride(25);
+  CHECK(flat > 0.9 * c.step_length);
+  CHECK(flat <= c.step_length + 1e-9);
+  CHECK(steep <= c.slope_step_scale * c.step_length + 2 * spacing);
+  CHECK(steep < 0.8 * flat);
+}
+
+TEST_CASE("Climbs stairs", "[steps][generator]") {
+  for (const std::string& name : ShippedCharacters()) {
+    const Character c = LoadShipped(name);
+    const double s = Scale(c);
+    const double rise = 0.15 * s, run = 0.35 * s;
+    Terrain t = LoadTerrain(MakeStairs(24, rise, run, 8 * c.reach, 0.025 * s));
+    INFO(name);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {4 * c.reach, 0, c.reach};
+    o.steps = 12;
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    CHECK(w.stopped.empty());
+    CHECK(StepsDone(w) == 12);
+    CheckWalk(t, c, o, w);
+    const auto& body = Body(w).keys;
+    CHECK(body.back().position.y - body.front().position.y > 3 * rise);
+  }
+}
+
+TEST_CASE("Multipeds walk around a sphere; bipeds stop where it gets too steep",
+          "[steps][generator]") {
+  for (const std::string& name : ShippedCharacters()) {
+    const Character c = LoadShipped(name);
+    const double radius = 3 * c.reach, spacing = c.step_length / 10;
+    const int count = static_cast<int>(4 * kPi * radius * radius / (spacing * spacing));
+    Terrain t = LoadTerrain(MakeSphere(count, {0, 0, 0}, radius));
+    INFO(name);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {0, radius, 0};
+    o.steps = static_cast<int>(1.3 * kPi * radius / (c.step_length / 2));
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    CheckWalk(t, c, o, w);
+    if (c.align_to_normal) {
+      CHECK(w.stopped.empty());
+      // Past the bottom: the body went around, its up turned upside down.
+      double lowest = 0, most_down = 1;
+      for (const WalkKey& k : Body(w).keys) {
+        lowest = std::min(lowest, k.position.y);
+        most_down = std::min(most_down, BodyUp(k).y);
+      }
+      CHECK(lowest < -0.8 * radius);
+      CHECK(most_down < -0.8);
+    } else {
+      CHECK_THAT(w.stopped, Catch::Contains("step ") && Catch::Contains("max_slope_deg"));
+      CHECK(StepsDone(w) > 2);
+    }
+  }
+}
+
+TEST_CASE("Multipeds climb a wall; others stop at it", "[steps][generator]") {
+  for (const std::string& name : ShippedCharacters()) {
+    const Character c = LoadShipped(name);
+    const double spacing = c.step_length / 10;
+    const Vec3 size{8 * c.reach, 4 * c.reach, 8 * c.reach};
+    Terrain t = LoadTerrain(MakeRoom(size, spacing));
+    INFO(name);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {size.x / 2, 0, 5 * c.reach};
+    o.steps = static_cast<int>((3 * c.reach + 2 * c.reach) / (c.step_length / 2)) + 4;
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    CheckWalk(t, c, o, w);
+    double highest_foot = 0;
+    bool on_wall = false;
+    for (const WalkTrack& tr : w.tracks)
+      for (const WalkKey& k : tr.keys)
+        if (tr.kind == TrackKind::kFoot && k.phase == KeyPhase::kEnd) {
+          highest_foot = std::max(highest_foot, k.position.y);
+          on_wall |= k.normal.z < -0.99;
+        }
+    if (name == "hexapod" || name == "octopod") {
+      CHECK(w.stopped.empty());
+      CHECK(on_wall);
+      CHECK(highest_foot > c.reach);
+      CHECK(Body(w).keys.back().position.y > c.reach);
+    } else {
+      CHECK_THAT(w.stopped, Catch::Contains("step "));
+      CHECK_FALSE(on_wall);
+    }
+  }
+}
+
+TEST_CASE("Multipeds start on a wall or a ceiling", "[steps][generator]") {
+  const Character c = LoadShipped("hexapod");
+  const Vec3 size{2, 2, 2};
+  Terrain t = LoadTerrain(MakeRoom(size, 0.012));
+  SECTION("on the wall z = 0, facing up it") {
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {1, 0.8, 0};
+    o.heading = {0, 1, 0};
+    o.steps = 10;
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    CHECK(w.stopped.empty());
+    CheckWalk(t, c, o, w);
+    const auto& body = Body(w).keys;
+    CHECK(body.back().position.y - body.front().position.y > 3 * c.step_length);
+    CHECK(BodyUp(body.back()).z > 0.99);
+    CHECK(body.back().position.z == Approx(c.body_height).margin(1e-6));
+  }
+  SECTION("on the ceiling, facing +X") {
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {0.6, 2, 1};
+    o.heading = {1, 0, 0};
+    o.steps = 10;
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    CHECK(w.stopped.empty());
+    CheckWalk(t, c, o, w);
+    const auto& body = Body(w).keys;
+    CHECK(body.back().position.x - body.front().position.x > 3 * c.step_length);
+    CHECK(BodyUp(body.back()).y < -0.99);
+    CHECK(body.back().position.y == Approx(2 - c.body_height).margin(1e-6));
+  }
+}
+
+TEST_CASE("Any heading, not only +Z", "[steps][generator]") {
+  const Character c = LoadShipped("biped");
+  Terrain t = LoadTerrain(MakeFlat(200, 0.05, 0));
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {3, 0, 3};
+  o.heading = {1, 0.5, -1};  // projected onto the ground: (1, 0, -1)
+  o.steps = 8;
+  const Walk w = Generate(t, c, o);
+  REQUIRE(w.stopped.empty());
+  CheckWalk(t, c, o, w);
+  const auto& body = Body(w).keys;
+  const Vec3 moved = body.back().position - body.front().position;
+  const Vec3 want = Normalize(Vec3{1, 0, -1});
+  CHECK(Dot(Normalize(moved), want) > 0.99);
+  CHECK(Dot(BodyForward(body.back()), want) > 0.999);
+}
+
+TEST_CASE("The heading follows a path with a 90-degree turn", "[steps][generator]") {
+  for (const std::string& name : ShippedCharacters()) {
+    const Character c = LoadShipped(name);
+    const double leg = 10 * c.step_length, margin = 4 * c.reach, spacing = c.step_length / 10;
+    const int n = static_cast<int>((leg + 2 * margin) / spacing);
+    Terrain t = LoadTerrain(MakeFlat(n, spacing, 0));
+    INFO(name);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {margin, 0, margin};
+    o.heading = {0, 0, 1};
+    const Vec3 corner{margin, 0, margin + leg}, goal{margin + leg, 0, margin + leg};
+    o.path = {corner, goal};
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    REQUIRE(w.stopped.empty());
+    CheckWalk(t, c, o, w);
+    const auto& body = Body(w).keys;
+    const Vec3 ground_end = body.back().position - Vec3{0, c.body_height, 0};
+    CHECK(Distance(ground_end, goal) <= c.step_length);
+    bool faced_z = false, faced_x = false;
+    double nearest_corner = 1e9;
+    for (const WalkKey& k : body) {
+      const Vec3 f = BodyForward(k);
+      faced_z |= f.z > 0.99;
+      faced_x |= f.x > 0.99;
+      nearest_corner = std::min(nearest_corner, Distance(k.position - Vec3{0, c.body_height, 0}, corner));
+      // Before the corner it walks +Z; after, +X; never back.
+      CHECK(f.x > -1e-9);
+      CHECK(f.z > -1e-9);
+    }
+    CHECK(faced_z);
+    CHECK(faced_x);
+    CHECK(BodyForward(body.back()).x > 0.99);
+    CHECK(nearest_corner < 2 * c.step_length);
+  }
+}
+
+TEST_CASE("A cliff stops the walk with the step, the position and the keys so far",
+          "[steps][generator]") {
+  for (const std::string& name : ShippedCharacters()) {
+    const Character c = LoadShipped(name);
+    const double spacing = c.step_length / 10, edge = 8 * c.reach;
+    RawSamples s;
+    const int n = static_cast<int>(10 * c.reach / spacing);
+    for (int k = 0; k < n; ++k)
+      for (int i = 0; i < n; ++i) {
+        const double x = i * spacing, z = k * spacing;
+        s.push_back({x, z < edge ? 0 : -20 * c.reach, z}, {0, 1, 0});
+      }
+    Terrain t = LoadTerrain(s);
+    INFO(name);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {5 * c.reach, 0, 3 * c.reach};
+    o.steps = 200;
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    REQUIRE_FALSE(w.stopped.empty());
+    const size_t done = StepsDone(w);
+    CHECK(done > 4);
+    CHECK_THAT(w.stopped, Catch::StartsWith("step " + std::to_string(done + 1) + ": foot "));
+    CHECK_THAT(w.stopped, Catch::Contains("cliff"));
+    CHECK_THAT(w.stopped, Catch::Contains("keys up to step " + std::to_string(done) + " kept"));
+    CheckWalk(t, c, o, w);
+    // Nothing lost: every foot ends planted at the edge side, with all its steps keyed.
+    for (const WalkTrack& tr : w.tracks) {
+      if (tr.kind != TrackKind::kFoot) continue;
+      CHECK(tr.keys.back().phase == KeyPhase::kEnd);
+      CHECK(tr.keys.back().position.z < edge);
+      CHECK(tr.keys.back().position.y == 0);
+    }
+  }
+}
+
+TEST_CASE("The default start is the sample nearest the top centre of the bounds",
+          "[steps][generator]") {
+  const Character c = LoadShipped("biped");
+  Terrain t = LoadTerrain(MakeFlat(100, 0.05, 2));
+  GenerateOptions o;
+  o.steps = 2;
+  const Walk w = Generate(t, c, o);
+  const WalkKey& b = Body(w).keys.front();
+  CHECK(b.position.x == Approx(2.475).margin(0.05));
+  CHECK(b.position.z == Approx(2.475).margin(0.05));
+  CHECK(b.position.y == Approx(2 + c.body_height));
+}
+
+namespace {
+
+// A real embedded session that counts the batch calls it serves.
+class CountingSession final : public TerrainSession {
+ public:
+  CountingSession() : inner_(MakeEmbeddedSession()) {}
+  Status LoadServerFile(const std::string& p, double s, TerrainHandle* out) override {
+    return inner_->LoadServerFile(p, s, out);
+  }
+  Status LoadSamples(const RawSamples& s, const std::string& n, TerrainHandle* out) override {
+    return inner_->LoadSamples(s, n, out);
+  }
+  Status Info(TerrainHandle t, TerrainInfo* out) override { return inner_->Info(t, out); }
+  Status Unload(TerrainHandle t) override { return inner_->Unload(t); }
+  Status Snap(TerrainHandle t, const Vec3* p, size_t n, Foothold* out) override {
+    ++snaps;
+    return inner_->Snap(t, p, n, out);
+  }
+  Status Normal(TerrainHandle t, const Vec3* p, size_t n, Foothold* out) override {
+    ++snaps;
+    return inner_->Normal(t, p, n, out);
+  }
+  Status Next(TerrainHandle t, const StepQuery* q, size_t n, double tol, Foothold* out) override {
+    ++nexts, next_queries += n;
+    return inner_->Next(t, q, n, tol, out);
+  }
+  std::string Describe() const override { return "counting " + inner_->Describe(); }
+  size_t snaps = 0, nexts = 0, next_queries = 0;
+
+ private:
+  std::unique_ptr<TerrainSession> inner_;
+};
+
+}  // namespace
+
+TEST_CASE("A crowd batches every character's queries into one call per round",
+          "[steps][generator][crowd]") {
+  const Character c = LoadShipped("hexapod");
+  const RawSamples ground = MakeFlat(300, 0.012, 0);
+  auto run = [&](int crowd, CountingSession* session, Walk* w) {
+    TerrainHandle h;
+    REQUIRE(session->LoadSamples(ground, "flat", &h) == Status::kOk);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {1.8, 0, 1.2};
+    o.steps = 10;
+    o.crowd = crowd;
+    o.crowd_spacing = 0.5;
+    std::string error;
+    REQUIRE(GenerateWalk(*session, h, c, o, w, &error) == Status::kOk);
+    Terrain t;
+    t.session = MakeEmbeddedSession();
+    REQUIRE(t.session->LoadSamples(ground, "flat", &t.handle) == Status::kOk);
+    CheckWalk(t, c, o, *w);
+  };
+  CountingSession one, many;
+  Walk w1, w9;
+  run(1, &one, &w1);
+  run(9, &many, &w9);
+  CHECK(w9.stopped.empty());
+  CHECK(many.next_queries == 9 * one.next_queries);
+  CHECK(many.nexts == one.nexts);
+  CHECK(many.snaps == one.snaps);
+  CHECK(one.nexts == 10);  // flat ground: one Next batch per step, no retries
+  // Tracks are named per character.
+  CHECK(w9.tracks.size() == 9 * (c.feet.size() + 1));
+  CHECK(w9.tracks.front().character == "c1");
+  CHECK(w9.tracks.back().character == "c9");
+}
+
+TEST_CASE("Generation is deterministic", "[steps][generator]") {
+  const Character c = LoadShipped("quadruped");
+  Terrain t = LoadTerrain(MakeHeightField(200, 200, 0.04, 0.1, 7));
+  GenerateOptions o;
+  o.steps = 16;
+  const Walk a = Generate(t, c, o), b = Generate(t, c, o);
+  REQUIRE(a.tracks.size() == b.tracks.size());
+  for (size_t i = 0; i < a.tracks.size(); ++i) {
+    REQUIRE(a.tracks[i].keys.size() == b.tracks[i].keys.size());
+    for (size_t k = 0; k < a.tracks[i].keys.size(); ++k)
+      CHECK(a.tracks[i].keys[k].position == b.tracks[i].keys[k].position);
+  }
+}
+
+TEST_CASE("Bad options are refused with a message", "[steps][generator]") {
+  const Character c = LoadShipped("biped");
+  Terrain t = LoadTerrain(MakeFlat(10, 0.1, 0));
+  Walk w;
+  std::string error;
+  GenerateOptions o;
+  o.heading = {0, 0, 0};
+  CHECK(GenerateWalk(*t.session, t.handle, c, o, &w, &error) == Status::kInvalidArgument);
+  CHECK_THAT(error, Catch::Contains("heading"));
+  o = GenerateOptions{};
+  o.up = {0, std::nan(""), 0};
+  CHECK(GenerateWalk(*t.session, t.handle, c, o, &w, &error) == Status::kInvalidArgument);
+  CHECK_THAT(error, Catch::Contains("up"));
+  o = GenerateOptions{};
+  CHECK(GenerateWalk(*t.session, t.handle + 99, c, o, &w, &error) == Status::kUnknownTerrain);
+  CHECK_THAT(error, Catch::Contains("handle"));
+}

@@ -1,0 +1,164 @@
+#include "walk_checks.h"
+
+#include <cmath>
+
+#include <catch2/catch.hpp>
+
+namespace footfall::test {
+
+const std::vector<std::string>& ShippedCharacters() {
+  static const std::vector<std::string> names = {"biped", "quadruped", "hexapod", "octopod"};
+  return names;
+}
+
+Character LoadShipped(const std::string& name) {
+  Character c;
+  std::string error;
+  const std::string path = std::string(FOOTFALL_SOURCE_DIR) + "/data/characters/" + name + ".json";
+  INFO(error);
+  REQUIRE(LoadCharacter(path, &c, &error) == Status::kOk);
+  return c;
+}
+
+Terrain LoadTerrain(const RawSamples& samples) {
+  Terrain t;
+  t.session = MakeEmbeddedSession();
+  t.samples = samples;
+  REQUIRE(t.session->LoadSamples(samples, "test", &t.handle) == Status::kOk);
+  return t;
+}
+
+Walk Generate(Terrain& t, const Character& c, const GenerateOptions& o) {
+  Walk w;
+  std::string error;
+  const Status s = GenerateWalk(*t.session, t.handle, c, o, &w, &error);
+  INFO(error);
+  REQUIRE(s == Status::kOk);
+  return w;
+}
+
+Vec3 FootAt(const WalkTrack& track, double frame) {
+  const auto& k = track.keys;
+  if (frame <= k.front().frame) return k.front().position;
+  for (size_t i = 1; i < k.size(); ++i) {
+    if (frame <= k[i].frame) {
+      const double t = (frame - k[i - 1].frame) / (k[i].frame - k[i - 1].frame);
+      return Lerp(k[i - 1].position, k[i].position, t);
+    }
+  }
+  return k.back().position;
+}
+
+std::vector<const WalkTrack*> TracksOf(const Walk& w, const std::string& character) {
+  std::vector<const WalkTrack*> out;
+  for (const WalkTrack& t : w.tracks)
+    if (t.character == character) out.push_back(&t);
+  return out;
+}
+
+namespace {
+
+Vec3 QuatAxisY(const Quat& q) {
+  return {2 * (q.x * q.y - q.w * q.z), 1 - 2 * (q.x * q.x + q.z * q.z), 2 * (q.y * q.z + q.w * q.x)};
+}
+
+void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, const Walk& w,
+                    const std::string& id) {
+  INFO("character '" << id << "'");
+  const auto tracks = TracksOf(w, id);
+  REQUIRE(tracks.size() == c.feet.size() + 1);
+  const WalkTrack& body = *tracks.back();
+  REQUIRE(body.kind == TrackKind::kBody);
+  for (size_t f = 0; f < c.feet.size(); ++f) {
+    REQUIRE(tracks[f]->name == c.feet[f].name);
+    REQUIRE(tracks[f]->kind == TrackKind::kFoot);
+  }
+  for (const WalkTrack* tr : tracks) {
+    REQUIRE_FALSE(tr->keys.empty());
+    for (size_t i = 1; i < tr->keys.size(); ++i) REQUIRE(tr->keys[i].frame > tr->keys[i - 1].frame);
+  }
+  // Start and end keys on terrain samples, exactly.
+  std::vector<Vec3> planted;
+  std::vector<Vec3> normals;
+  for (size_t f = 0; f < c.feet.size(); ++f)
+    for (const WalkKey& k : tracks[f]->keys)
+      if (k.phase != KeyPhase::kMid) planted.push_back(k.position), normals.push_back(k.normal);
+  std::vector<Foothold> snapped(planted.size());
+  REQUIRE(t.session->Snap(t.handle, planted.data(), planted.size(), snapped.data()) == Status::kOk);
+  size_t off_terrain = 0;
+  for (size_t i = 0; i < planted.size(); ++i)
+    off_terrain += !(snapped[i].point == planted[i] && snapped[i].normal == normals[i]);
+  CHECK(off_terrain == 0);
+  // Planted feet stay put; arcs clear the terrain; phases in order.
+  std::vector<Vec3> arc;
+  for (size_t f = 0; f < c.feet.size(); ++f) {
+    const auto& k = tracks[f]->keys;
+    for (size_t i = 0; i + 1 < k.size(); ++i) {
+      if (k[i].phase == KeyPhase::kEnd) {
+        REQUIRE(k[i + 1].phase == KeyPhase::kStart);
+        REQUIRE(k[i + 1].position == k[i].position);
+      }
+      if (k[i].phase == KeyPhase::kStart) {
+        REQUIRE(i + 2 < k.size());
+        REQUIRE(k[i + 1].phase == KeyPhase::kMid);
+        REQUIRE(k[i + 2].phase == KeyPhase::kEnd);
+        for (int j = 1; j < 10; ++j) {
+          const double s = j / 10.0;
+          arc.push_back(s <= 0.5 ? Lerp(k[i].position, k[i + 1].position, 2 * s)
+                                 : Lerp(k[i + 1].position, k[i + 2].position, 2 * s - 1));
+        }
+      }
+    }
+  }
+  std::vector<Foothold> arc_snap(arc.size());
+  REQUIRE(t.session->Snap(t.handle, arc.data(), arc.size(), arc_snap.data()) == Status::kOk);
+  size_t below = 0;
+  double worst = 0;
+  for (size_t i = 0; i < arc.size(); ++i) {
+    const double clearance = Dot(arc[i] - arc_snap[i].point, arc_snap[i].normal);
+    if (clearance < 0) ++below, worst = std::min(worst, clearance);
+  }
+  INFO("arc points below the terrain: " << below << " of " << arc.size() << ", worst " << worst);
+  CHECK(below == 0);
+  // The body follows the feet.
+  const Vec3 world_up = Normalize(o.up);
+  for (const WalkKey& b : body.keys) {
+    Vec3 centroid;
+    for (size_t f = 0; f < c.feet.size(); ++f) {
+      const Vec3 p = FootAt(*tracks[f], b.frame);
+      centroid += p;
+      CHECK(Distance(p, b.position) <= c.reach + 1e-9);
+    }
+    centroid = centroid / static_cast<double>(c.feet.size());
+    const Vec3 up = c.align_to_normal ? QuatAxisY(b.rotation) : world_up;
+    const Vec3 expected = centroid + up * c.body_height;
+    CHECK(Distance(expected, b.position) < 1e-6);
+  }
+  // Gait order: step k moves exactly group k % G, at frames start_frame + k * frames_per_step.
+  const size_t steps = body.keys.size() - 1;
+  const int groups = static_cast<int>(c.gait.size());
+  for (size_t k = 0; k < steps; ++k) {
+    const double f0 = o.start_frame + static_cast<double>(k) * c.frames_per_step;
+    const auto& group = c.gait[k % groups];
+    for (size_t f = 0; f < c.feet.size(); ++f) {
+      bool lifts = false;
+      for (const WalkKey& key : tracks[f]->keys) lifts |= key.phase == KeyPhase::kStart && key.frame == f0;
+      const bool in_group = std::find(group.begin(), group.end(), static_cast<int>(f)) != group.end();
+      INFO("step " << k + 1 << " foot " << c.feet[f].name);
+      CHECK(lifts == in_group);
+    }
+    CHECK(body.keys[k + 1].frame == f0 + c.frames_per_step);
+  }
+}
+
+}  // namespace
+
+void CheckWalk(Terrain& t, const Character& c, const GenerateOptions& o, const Walk& w) {
+  std::vector<std::string> ids;
+  for (const WalkTrack& tr : w.tracks)
+    if (tr.kind == TrackKind::kBody) ids.push_back(tr.character);
+  REQUIRE(ids.size() == static_cast<size_t>(std::max(1, o.crowd)));
+  for (const std::string& id : ids) CheckCharacter(t, c, o, w, id);
+}
+
+}  // namespace footfall::test

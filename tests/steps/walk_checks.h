@@ -1,0 +1,48 @@
+// Shared helpers of the step generator tests: shipped characters, terrains scaled to a
+// character, and the invariants every generated walk must satisfy.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "footfall/client/terrain_session.h"
+#include "footfall/steps/character.h"
+#include "footfall/steps/generator.h"
+#include "footfall/steps/walk.h"
+
+namespace footfall::test {
+
+const std::vector<std::string>& ShippedCharacters();  // "biped", "quadruped", ...
+Character LoadShipped(const std::string& name);        // from data/characters (REQUIREs success)
+
+// A terrain loaded into a fresh embedded session.
+struct Terrain {
+  std::unique_ptr<TerrainSession> session;
+  TerrainHandle handle = 0;
+  RawSamples samples;
+};
+Terrain LoadTerrain(const RawSamples& samples);
+
+// Generates a walk (REQUIREs kOk).
+Walk Generate(Terrain& t, const Character& c, const GenerateOptions& o);
+
+// The foot position of a track at `frame` (held between keys, linear between a step's keys).
+Vec3 FootAt(const WalkTrack& track, double frame);
+
+// Checks every invariant with Catch assertions:
+//  - frames increase along every track, and every track has keys;
+//  - every start and end key lies on a terrain sample (snapping it returns the same point and
+//    normal);
+//  - a planted foot does not move between its end key and its next start key;
+//  - the swing arc start-mid-end does not pass below the terrain;
+//  - every body key sits body_height along its up above the centroid of the feet at that frame,
+//    and every foot is within reach of it;
+//  - the feet step in the declared gait order, one group per step.
+void CheckWalk(Terrain& t, const Character& c, const GenerateOptions& o, const Walk& w);
+
+// Tracks of one character ("" for a single one): feet in file order, then the body.
+std::vector<const WalkTrack*> TracksOf(const Walk& w, const std::string& character);
+
+}  // namespace footfall::test
