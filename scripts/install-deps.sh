@@ -22,8 +22,18 @@ for group in "$@"; do
   esac
 done
 
+# Packages whose command may come from elsewhere (a newer Node.js ships its own npm).
+provided_by_command() {
+  case "$1" in
+    nodejs) command -v node >/dev/null ;;
+    npm) command -v npm >/dev/null ;;
+    *) return 1 ;;
+  esac
+}
+
 missing=()
 for pkg in "${wanted[@]}"; do
+  provided_by_command "$pkg" && continue
   dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "ok installed" || missing+=("$pkg")
 done
 if [ ${#missing[@]} -gt 0 ]; then

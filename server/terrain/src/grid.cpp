@@ -247,54 +247,115 @@ void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
     const double d = v < lo - pad ? lo - pad - v : v > hi + pad ? v - hi - pad : 0.0;
     return d * d;
   };
+  // Per-thread scratch for the per-axis tables below (grows only for very wide shells).
+  thread_local std::vector<double> axis_gap_[3], axis_lo_[3], axis_hi_[3];
   const int64_t ci[3] = {CellCoord(c[0], 0), CellCoord(c[1], 1), CellCoord(c[2], 2)};
   const int64_t n[3] = {dims_[0], dims_[1], dims_[2]};
   double whole_lo[3], whole_hi[3];
   for (int a = 0; a < 3; ++a) whole_lo[a] = CellLo(0, a), whole_hi[a] = CellHi(dims_[a] - 1, a);
+  // Lower bound on the squared distance to any cell at Chebyshev radius >= r: the nearest of
+  // the slabs beyond the shell on each side of each axis, within the whole grid box. Infinite
+  // when no such cell exists.
+  auto shell_bound2 = [&](int64_t r) {
+    double bound2 = kInf;
+    for (int a = 0; a < 3; ++a) {
+      double rest = 0;
+      for (int b = 0; b < 3; ++b)
+        if (b != a) rest += gap2(c[b], whole_lo[b], whole_hi[b]);
+      if (ci[a] + r <= n[a] - 1)
+        bound2 = std::min(bound2, rest + gap2(c[a], CellLo(ci[a] + r, a), whole_hi[a]));
+      if (ci[a] - r >= 0)
+        bound2 = std::min(bound2, rest + gap2(c[a], whole_lo[a], CellHi(ci[a] - r, a)));
+    }
+    return bound2;
+  };
   for (int64_t r = 0;; ++r) {
     if (r > 0) {
-      // Lower bound on the distance to any cell at Chebyshev radius >= r: the nearest of the
-      // slabs beyond the shell on each side of each axis, within the whole grid box.
-      double bound2 = kInf;
-      bool any = false;
-      for (int a = 0; a < 3; ++a) {
-        double rest = 0;
-        for (int b = 0; b < 3; ++b)
-          if (b != a) rest += gap2(c[b], whole_lo[b], whole_hi[b]);
-        if (ci[a] + r <= n[a] - 1) {
-          any = true;
-          bound2 = std::min(bound2, rest + gap2(c[a], CellLo(ci[a] + r, a), whole_hi[a]));
+      if (shell_bound2(r) > scanner.limit2()) return;
+      if (r == 1 && shell_bound2(2) > scanner.limit2()) {
+        // Fast path: only the 26 neighbours can matter; visit those whose slabs reach the
+        // ball of the current best, per axis.
+        int64_t from[3], to[3];
+        double g[3][3], lo[3][3], hi[3][3];
+        for (int a = 0; a < 3; ++a) {
+          from[a] = 1, to[a] = -1;
+          for (int64_t o = -1; o <= 1; ++o) {
+            const int64_t idx = ci[a] + o;
+            if (idx < 0 || idx >= n[a]) continue;
+            const double cl = CellLo(static_cast<uint32_t>(idx), a);
+            const double ch = CellHi(static_cast<uint32_t>(idx), a);
+            g[a][o + 1] = gap2(c[a], cl, ch);
+            lo[a][o + 1] = cl - pad, hi[a][o + 1] = ch + pad;
+            if (g[a][o + 1] > scanner.limit2()) continue;
+            from[a] = std::min(from[a], o), to[a] = std::max(to[a], o);
+          }
         }
-        if (ci[a] - r >= 0) {
-          any = true;
-          bound2 = std::min(bound2, rest + gap2(c[a], whole_lo[a], CellHi(ci[a] - r, a)));
+        for (int64_t dk = from[2]; dk <= to[2]; ++dk) {
+          for (int64_t dj = from[1]; dj <= to[1]; ++dj) {
+            for (int64_t di = from[0]; di <= to[0]; ++di) {
+              if (di == 0 && dj == 0 && dk == 0) continue;
+              if (g[0][di + 1] + g[1][dj + 1] + g[2][dk + 1] > scanner.limit2()) continue;
+              const size_t cell =
+                  (static_cast<size_t>(ci[2] + dk) * n[1] + (ci[1] + dj)) * n[0] + (ci[0] + di);
+              const uint32_t b = cell_start_[cell], e = cell_start_[cell + 1];
+              if (b == e) continue;
+              if (Scanner::kUsesBox) {
+                const double cell_lo[3] = {lo[0][di + 1], lo[1][dj + 1], lo[2][dk + 1]};
+                const double cell_hi[3] = {hi[0][di + 1], hi[1][dj + 1], hi[2][dk + 1]};
+                if (!scanner.KeepCell(cell_lo, cell_hi)) continue;
+              }
+              scanner.Scan(static_cast<uint32_t>(cell), b, e);
+            }
+          }
         }
+        return;
       }
-      if (!any || bound2 > scanner.limit2()) return;
     }
-    const int64_t i0 = std::max<int64_t>(0, ci[0] - r), i1 = std::min(n[0] - 1, ci[0] + r);
-    const int64_t j0 = std::max<int64_t>(0, ci[1] - r), j1 = std::min(n[1] - 1, ci[1] + r);
-    const int64_t k0 = std::max<int64_t>(0, ci[2] - r), k1 = std::min(n[2] - 1, ci[2] + r);
-    for (int64_t k = k0; k <= k1; ++k) {
+    const int64_t lo_idx[3] = {std::max<int64_t>(0, ci[0] - r), std::max<int64_t>(0, ci[1] - r),
+                               std::max<int64_t>(0, ci[2] - r)};
+    const int64_t hi_idx[3] = {std::min(n[0] - 1, ci[0] + r), std::min(n[1] - 1, ci[1] + r),
+                               std::min(n[2] - 1, ci[2] + r)};
+    // Per-axis squared gaps from the query to each cell slab of this shell, and the padded
+    // slab bounds, computed once per shell.
+    for (int a = 0; a < 3; ++a) {
+      const int64_t count = hi_idx[a] - lo_idx[a] + 1;
+      if (static_cast<size_t>(count) > axis_gap_[a].size()) {
+        axis_gap_[a].resize(count), axis_lo_[a].resize(count), axis_hi_[a].resize(count);
+      }
+      for (int64_t t = 0; t < count; ++t) {
+        const uint32_t idx = static_cast<uint32_t>(lo_idx[a] + t);
+        const double lo = CellLo(idx, a), hi = CellHi(idx, a);
+        axis_gap_[a][t] = gap2(c[a], lo, hi);
+        axis_lo_[a][t] = lo - pad;
+        axis_hi_[a][t] = hi + pad;
+      }
+    }
+    const double* gx = axis_gap_[0].data();
+    const double* gy = axis_gap_[1].data();
+    const double* gz = axis_gap_[2].data();
+    for (int64_t k = lo_idx[2]; k <= hi_idx[2]; ++k) {
       const bool kface = k == ci[2] - r || k == ci[2] + r;
-      const double dk = gap2(c[2], CellLo(k, 2), CellHi(k, 2));
-      for (int64_t j = j0; j <= j1; ++j) {
+      const double dk = gz[k - lo_idx[2]];
+      if (dk > scanner.limit2()) continue;
+      for (int64_t j = lo_idx[1]; j <= hi_idx[1]; ++j) {
         const bool jface = j == ci[1] - r || j == ci[1] + r;
-        const double djk = dk + gap2(c[1], CellLo(j, 1), CellHi(j, 1));
+        const double djk = dk + gy[j - lo_idx[1]];
         if (djk > scanner.limit2()) continue;
         const size_t row = (static_cast<size_t>(k) * n[1] + j) * n[0];
         // Inside the shell's x range only the two x faces belong to it, unless on a y/z face.
         const int64_t step = (kface || jface) ? 1 : std::max<int64_t>(1, 2 * r);
-        for (int64_t i = (kface || jface) ? i0 : ci[0] - r; i <= i1; i += step) {
-          if (i < i0) continue;
+        for (int64_t i = (kface || jface) ? lo_idx[0] : ci[0] - r; i <= hi_idx[0]; i += step) {
+          if (i < lo_idx[0]) continue;
+          const int64_t ti = i - lo_idx[0];
+          if (djk + gx[ti] > scanner.limit2()) continue;
           const size_t cell = row + i;
           const uint32_t b = cell_start_[cell], e = cell_start_[cell + 1];
           if (b == e) continue;
-          const double d2 = djk + gap2(c[0], CellLo(i, 0), CellHi(i, 0));
-          if (d2 > scanner.limit2()) continue;
-          const double lo[3] = {CellLo(i, 0) - pad, CellLo(j, 1) - pad, CellLo(k, 2) - pad};
-          const double hi[3] = {CellHi(i, 0) + pad, CellHi(j, 1) + pad, CellHi(k, 2) + pad};
-          if (!scanner.KeepCell(lo, hi)) continue;
+          if (Scanner::kUsesBox) {
+            const double lo[3] = {axis_lo_[0][ti], axis_lo_[1][j - lo_idx[1]], axis_lo_[2][k - lo_idx[2]]};
+            const double hi[3] = {axis_hi_[0][ti], axis_hi_[1][j - lo_idx[1]], axis_hi_[2][k - lo_idx[2]]};
+            if (!scanner.KeepCell(lo, hi)) continue;
+          }
           scanner.Scan(static_cast<uint32_t>(cell), b, e);
         }
       }
@@ -313,6 +374,7 @@ struct SnapScanner {
   uint32_t best_index = kNoIndex;
   uint32_t best_slot = kNoIndex;
 
+  static constexpr bool kUsesBox = false;
   double limit2() const { return best_d2; }
   bool KeepCell(const double*, const double*) const { return true; }
   void Scan(uint32_t cell, uint32_t b, uint32_t e) {
@@ -336,6 +398,7 @@ struct NextScanner {
   uint32_t best_index = kNoIndex;
   uint32_t best_slot = kNoIndex;
 
+  static constexpr bool kUsesBox = true;
   double limit2() const { return best_d2; }
   // Skips a cell lying wholly behind the foot: its farthest corner along dir is not ahead.
   bool KeepCell(const double* lo, const double* hi) const {

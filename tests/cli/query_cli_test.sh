@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# `footfall query` end to end: answers, per-line errors, bad terrain files, and identical answers
+# from the embedded engine and a real footfalld.
+# Usage: query_cli_test.sh FOOTFALL FOOTFALLD
+set -u
+footfall=$1
+footfalld=$2
+work=$(mktemp -d)
+server_pid=""
+trap '[ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null; rm -rf "$work"' EXIT
+failures=0
+passes=0
+check() {  # check NAME CONDITION...
+  local name=$1; shift
+  if "$@"; then passes=$((passes + 1)); else echo "FAILED: $name" >&2; failures=$((failures + 1)); fi
+}
+
+# A 5 x 5 flat terrain at y = 0, samples at integer x, z.
+for z in 0 1 2 3 4; do for x in 0 1 2 3 4; do echo "$x 0 $z 0 1 0"; done; done > "$work/flat.pts"
+
+# 1. Answers, in order, one JSON object per line.
+printf 'snap 1.2 3 2.9\nnormal 4 4 4\nnext 1 0 1 0 0 2\nnext 1 0 4 0 0 2\n' |
+  "$footfall" query --terrain "$work/flat.pts" > "$work/out.jsonl"
+rc=$?
+check "valid queries exit 0" [ "$rc" -eq 0 ]
+check "snap answer" grep -qx '{"op":"snap","found":true,"index":16,"point":\[1.0,0.0,3.0\],"normal":\[0.0,1.0,0.0\]}' <(sed -n 1p "$work/out.jsonl")
+check "normal answer" grep -q '"op":"normal","found":true,"index":24' <(sed -n 2p "$work/out.jsonl")
+check "next answer" grep -qx '{"op":"next","found":true,"index":16,"point":\[1.0,0.0,3.0\],"normal":\[0.0,1.0,0.0\]}' <(sed -n 3p "$work/out.jsonl")
+check "no foothold" grep -qx '{"op":"next","found":false}' <(sed -n 4p "$work/out.jsonl")
+
+# 2. Malformed lines give an error object with the line number; the run goes on; exit non-zero.
+printf 'snap 1 0 1\nsnap 1 x 1\n\njump 1 2 3\nnext 0 0 0 0 0 0\nsnap 2 0 2\n' |
+  "$footfall" query --terrain "$work/flat.pts" > "$work/out.jsonl"
+rc=$?
+check "malformed lines exit 1" [ "$rc" -eq 1 ]
+check "six lines give five answers" [ "$(wc -l < "$work/out.jsonl")" -eq 5 ]
+check "bad number" grep -q '{"op":"error","line":2,"message":"snap: argument 2 '"'"'x'"'"' is not a finite number"}' "$work/out.jsonl"
+check "unknown command" grep -q '"line":4,"message":"unknown command '"'"'jump'"'"'' "$work/out.jsonl"
+check "zero direction" grep -q '"line":5,"message":"next: direction DX DY DZ must be non-zero"' "$work/out.jsonl"
+check "answers after errors" grep -q '"op":"snap","found":true,"index":12' <(sed -n 5p "$work/out.jsonl")
+
+# 3. Bad terrain files: the documented message and a non-zero exit, never a crash.
+bad() {  # bad NAME CONTENT EXPECTED_MESSAGE
+  printf "$2" > "$work/$1.pts"
+  local err rc
+  err=$(echo "snap 0 0 0" | "$footfall" query --terrain "$work/$1.pts" 2>&1 >/dev/null)
+  rc=$?
+  check "$1: exit 1" [ "$rc" -eq 1 ]
+  check "$1: message '$3'" grep -qF "$3" <<< "$err"
+}
+bad count '0 0 0 0 1 0\n1 2 3\n' "$work/count.pts:2: expected 6 numbers (x y z nx ny nz), found 3"
+bad nan '# header\n0 0 nan 0 1 0\n' "$work/nan.pts:2: column 3: 'nan' is NaN or infinite"
+bad inf '0 0 0 0 1 0\n0 -inf 0 0 1 0\n' "$work/inf.pts:2: column 2: '-inf' is NaN or infinite"
+bad word '0 0 0 0 1 0\n\n0 0 0 up 1 0\n' "$work/word.pts:3: column 4: 'up' is not a number"
+bad zero '0 0 0 0 0 0\n' "$work/zero.pts:1: normal has zero length"
+err=$(echo "snap 0 0 0" | "$footfall" query --terrain "$work/missing.pts" 2>&1 >/dev/null)
+check "missing file: exit 1" [ $? -eq 1 ]
+check "missing file: message" grep -qF "$work/missing.pts: cannot open file" <<< "$err"
+
+# 4. The same answers over RPC from a real footfalld, by upload and by server-side path.
+"$footfalld" --listen 127.0.0.1:0 --port-file "$work/port" --no-rpcbind --data-root "$work" 2> "$work/server.log" &
+server_pid=$!
+for _ in $(seq 100); do [ -s "$work/port" ] && break; sleep 0.05; done
+port=$(cat "$work/port")
+{ for i in $(seq 0 200); do echo "snap $((i % 7)).3 0.$i $((i % 5)).6"; echo "next $((i % 5)) 0 $((i % 4)) 0.$i 0 1.$i"; done; } > "$work/queries"
+"$footfall" query --terrain "$work/flat.pts" < "$work/queries" > "$work/embedded.jsonl"
+"$footfall" query --terrain "$work/flat.pts" --server "127.0.0.1:$port" < "$work/queries" > "$work/rpc.jsonl"
+"$footfall" query --server-terrain flat.pts --server "127.0.0.1:$port" < "$work/queries" > "$work/rpc-path.jsonl"
+check "RPC upload answers equal embedded" cmp -s "$work/embedded.jsonl" "$work/rpc.jsonl"
+check "RPC server-side load answers equal embedded" cmp -s "$work/embedded.jsonl" "$work/rpc-path.jsonl"
+check "402 answers" [ "$(wc -l < "$work/rpc.jsonl")" -eq 402 ]
+err=$(echo "snap 0 0 0" | "$footfall" query --server-terrain ../../etc/passwd --server "127.0.0.1:$port" 2>&1 >/dev/null)
+check "escape refused: exit 1" [ $? -eq 1 ]
+check "escape refused: message" grep -qF "resolves outside the data root" <<< "$err"
+check "server logs loads" grep -q "loaded terrain" "$work/server.log"
+kill "$server_pid"; wait "$server_pid" 2>/dev/null; server_pid=""
+err=$(echo "snap 0 0 0" | "$footfall" query --terrain "$work/flat.pts" --server "127.0.0.1:$port" 2>&1 >/dev/null)
+check "server gone: exit 1" [ $? -eq 1 ]
+check "server gone: message" grep -qF "footfalld at 127.0.0.1:$port" <<< "$err"
+
+echo "$passes passed, $failures failed"
+[ "$failures" -eq 0 ]

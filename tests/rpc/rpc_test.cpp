@@ -1,0 +1,384 @@
+// footfalld over loopback: RPC answers equal the embedded engine's; misbehaving clients do not
+// stop others from being served nor grow the server's memory; clients report a dead server and
+// recover after a restart; rpcbind registration answers rpcinfo.
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include "footfall.h"
+#include "footfall/client/terrain_session.h"
+#include "footfall/import/terrain_generators.h"
+#include "server_process.h"
+
+using namespace footfall;
+using footfall::test::ServerProcess;
+
+namespace {
+
+RawSamples TestTerrain() {
+  RawSamples s = MakeHeightField(120, 100, 0.25, 1.5, 42);
+  const RawSamples ball = MakeSphere(3000, {15, 3, 12}, 2);
+  for (size_t i = 0; i < ball.size(); ++i) s.push_back(ball.points[i], ball.normals[i]);
+  return s;
+}
+
+std::unique_ptr<TerrainSession> Connect(int port, double timeout_s = 5) {
+  RpcOptions o;
+  o.port = port;
+  o.call_timeout_s = timeout_s;
+  return MakeRpcSession(o);
+}
+
+void RequireSame(const Foothold& a, const Foothold& b) {
+  REQUIRE(static_cast<int>(a.status) == static_cast<int>(b.status));
+  REQUIRE(a.index == b.index);
+  REQUIRE(a.point == b.point);
+  REQUIRE(a.normal == b.normal);
+}
+
+// Random queries around the test terrain, in and far outside its bounds.
+void MakeQueries(size_t n, std::vector<Vec3>* points, std::vector<StepQuery>* steps) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> x(-5, 35), y(-3, 6), z(-5, 30), d(-1, 1);
+  for (size_t i = 0; i < n; ++i) {
+    Vec3 p{x(rng), y(rng), z(rng)};
+    if (i % 50 == 0) p = p * 1000.0;
+    points->push_back(p);
+    Vec3 dir{d(rng), d(rng) * 0.2, d(rng)};
+    if (i % 97 == 0) dir = Vec3{};  // invalid: answered per item
+    steps->push_back({p, dir});
+  }
+}
+
+// --- raw ONC RPC messages, for misbehaving clients ------------------------------------------
+
+void Put32(std::vector<unsigned char>* b, uint32_t v) {
+  for (int s = 24; s >= 0; s -= 8) b->push_back(static_cast<unsigned char>(v >> s));
+}
+
+void PutDouble(std::vector<unsigned char>* b, double v) {
+  uint64_t bits;
+  std::memcpy(&bits, &v, 8);
+  Put32(b, static_cast<uint32_t>(bits >> 32));
+  Put32(b, static_cast<uint32_t>(bits));
+}
+
+// A complete one-fragment call record for `proc` with already encoded arguments.
+std::vector<unsigned char> CallRecord(uint32_t xid, uint32_t proc, const std::vector<unsigned char>& args) {
+  std::vector<unsigned char> body;
+  Put32(&body, xid);
+  Put32(&body, 0);  // CALL
+  Put32(&body, 2);  // RPC version
+  Put32(&body, FOOTFALL_PROG);
+  Put32(&body, FOOTFALL_V1);
+  Put32(&body, proc);
+  Put32(&body, 0), Put32(&body, 0);  // AUTH_NONE credentials
+  Put32(&body, 0), Put32(&body, 0);  // AUTH_NONE verifier
+  body.insert(body.end(), args.begin(), args.end());
+  std::vector<unsigned char> record;
+  Put32(&record, 0x80000000u | static_cast<uint32_t>(body.size()));
+  record.insert(record.end(), body.begin(), body.end());
+  return record;
+}
+
+int RawConnect(int port) {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<uint16_t>(port));
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  REQUIRE(connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0);
+  return fd;
+}
+
+// Sends what fits without blocking; returns bytes sent.
+size_t SendSome(int fd, const std::vector<unsigned char>& bytes) {
+  const int flags = fcntl(fd, F_GETFL, 0);
+  fcntl(fd, F_SETFL, flags | O_NONBLOCK);
+  size_t sent = 0;
+  while (sent < bytes.size()) {
+    const ssize_t n = send(fd, bytes.data() + sent, bytes.size() - sent, MSG_NOSIGNAL);
+    if (n <= 0) break;
+    sent += static_cast<size_t>(n);
+  }
+  fcntl(fd, F_SETFL, flags);
+  return sent;
+}
+
+// A well-behaved client still gets correct answers.
+void RequireServed(int port) {
+  auto rpc = Connect(port, 5);
+  TerrainHandle remote = 0;
+  REQUIRE(rpc->LoadSamples(MakeFlat(10, 1, 0), "probe", &remote) == Status::kOk);
+  const Foothold f = rpc->Snap(remote, Vec3{3.2, 1, 4.7});
+  REQUIRE(f.status == Status::kOk);
+  CHECK(f.point == Vec3{3, 0, 5});
+}
+
+}  // namespace
+
+TEST_CASE("RPC answers equal the embedded engine", "[rpc]") {
+  ServerProcess server;
+  auto rpc = Connect(server.port());
+  auto embedded = MakeEmbeddedSession();
+  const RawSamples terrain = TestTerrain();
+  TerrainHandle remote = 0, local = 0;
+  REQUIRE(rpc->LoadSamples(terrain, "test", &remote) == Status::kOk);
+  REQUIRE(embedded->LoadSamples(terrain, "test", &local) == Status::kOk);
+
+  std::vector<Vec3> points;
+  std::vector<StepQuery> steps;
+  MakeQueries(10000, &points, &steps);  // more than one protocol batch
+  const size_t n = points.size();
+  std::vector<Foothold> a(n), b(n);
+
+  SECTION("snap and normal batches") {
+    REQUIRE(rpc->Snap(remote, points.data(), n, a.data()) == Status::kOk);
+    REQUIRE(embedded->Snap(local, points.data(), n, b.data()) == Status::kOk);
+    for (size_t i = 0; i < n; ++i) RequireSame(a[i], b[i]);
+    REQUIRE(rpc->Normal(remote, points.data(), n, a.data()) == Status::kOk);
+    for (size_t i = 0; i < n; ++i) RequireSame(a[i], b[i]);
+  }
+  SECTION("next batches, with and without tolerance") {
+    for (double tolerance : {0.0, 0.2}) {
+      REQUIRE(rpc->Next(remote, steps.data(), n, tolerance, a.data()) == Status::kOk);
+      REQUIRE(embedded->Next(local, steps.data(), n, tolerance, b.data()) == Status::kOk);
+      size_t found = 0, invalid = 0;
+      for (size_t i = 0; i < n; ++i) {
+        RequireSame(a[i], b[i]);
+        found += a[i].status == Status::kOk;
+        invalid += a[i].status == Status::kInvalidArgument;
+      }
+      CHECK(found > 100);
+      CHECK(invalid > 0);
+    }
+  }
+  SECTION("terrain info") {
+    TerrainInfo ri, li;
+    REQUIRE(rpc->Info(remote, &ri) == Status::kOk);
+    REQUIRE(embedded->Info(local, &li) == Status::kOk);
+    CHECK(ri.name == "test");
+    CHECK(ri.stats.samples == terrain.size());
+    CHECK(ri.stats.bounds_min == li.stats.bounds_min);
+    CHECK(ri.stats.bounds_max == li.stats.bounds_max);
+    CHECK(ri.stats.cells[0] == li.stats.cells[0]);
+    CHECK(ri.stats.bytes == li.stats.bytes);
+  }
+  SECTION("unload and unknown terrains") {
+    REQUIRE(rpc->Unload(remote) == Status::kOk);
+    CHECK(rpc->Snap(remote, Vec3{}).status == Status::kUnknownTerrain);
+  }
+  SECTION("the single-query procedures") {
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons(static_cast<uint16_t>(server.port()));
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    int sock = RPC_ANYSOCK;
+    CLIENT* c = clnttcp_create(&addr, FOOTFALL_PROG, FOOTFALL_V1, &sock, 0, 0);
+    REQUIRE(c != nullptr);
+    // The session's handle is its own; find the server's through FF_LIST.
+    ff_list_reply list{};
+    REQUIRE(ff_list_1(nullptr, &list, c) == RPC_SUCCESS);
+    REQUIRE(list.terrains.terrains_len == 1);
+    const unsigned server_handle = list.terrains.terrains_val[0];
+    xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_list_reply), reinterpret_cast<char*>(&list));
+    for (size_t i = 0; i < 300; ++i) {
+      ff_point_args pa{server_handle, {points[i].x, points[i].y, points[i].z}};
+      ff_result r{};
+      REQUIRE(ff_snap_1(&pa, &r, c) == RPC_SUCCESS);
+      Foothold f;
+      f.status = static_cast<Status>(r.status);
+      f.index = r.index;
+      f.point = {r.point.x, r.point.y, r.point.z};
+      f.normal = {r.normal.x, r.normal.y, r.normal.z};
+      RequireSame(f, embedded->Snap(local, points[i]));
+      ff_next_args na{server_handle, 0, {{steps[i].foot.x, steps[i].foot.y, steps[i].foot.z},
+                                         {steps[i].direction.x, steps[i].direction.y, steps[i].direction.z}}};
+      REQUIRE(ff_next_1(&na, &r, c) == RPC_SUCCESS);
+      const Foothold e = embedded->Next(local, steps[i]);
+      REQUIRE(static_cast<int>(r.status) == static_cast<int>(e.status));
+      if (e.status == Status::kOk) CHECK(r.index == e.index);
+    }
+    // Recently answered queries are published for live viewers.
+    ff_recent_args ra{0};
+    ff_recent_reply rr{};
+    REQUIRE(ff_recent_1(&ra, &rr, c) == RPC_SUCCESS);
+    CHECK(rr.status == FF_OK);
+    CHECK(rr.queries.queries_len > 0);
+    CHECK(rr.latest >= 600);
+    xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_recent_reply), reinterpret_cast<char*>(&rr));
+    clnt_destroy(c);
+  }
+}
+
+TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
+  char tmpl[] = "/tmp/footfall-root-XXXXXX";
+  REQUIRE(mkdtemp(tmpl));
+  const std::string root = tmpl;
+  {
+    std::ofstream(root + "/ok.pts") << "0 0 0 0 1 0\n1 0 0 0 1 0\n";
+    std::ofstream(root + "/bad.pts") << "0 0 0 0 1 0\n1 0 zero 0 1 0\n";
+    std::ofstream("/tmp/footfall-outside.pts") << "0 0 0 0 1 0\n";
+    REQUIRE(symlink("/tmp/footfall-outside.pts", (root + "/link.pts").c_str()) == 0);
+  }
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", root});
+  auto rpc = Connect(server.port());
+  TerrainHandle t = 0;
+  CHECK(rpc->LoadServerFile("ok.pts", 0, &t) == Status::kOk);
+  CHECK(rpc->Snap(t, Vec3{0.9, 0, 0}).index == 1);
+  CHECK(rpc->LoadServerFile("../footfall-outside.pts", 0, &t) == Status::kAccessDenied);
+  CHECK(rpc->LoadServerFile("link.pts", 0, &t) == Status::kAccessDenied);
+  CHECK(rpc->LoadServerFile("/etc/passwd", 0, &t) == Status::kAccessDenied);
+  CHECK(rpc->LoadServerFile("missing.pts", 0, &t) == Status::kIoError);
+  REQUIRE(rpc->LoadServerFile("bad.pts", 0, &t) == Status::kParseError);
+  CHECK(rpc->last_error() == "bad.pts:2: column 3: 'zero' is not a number (expected x y z nx ny nz)");
+  CHECK(server.Log().find("error: load") != std::string::npos);
+  std::system(("rm -rf '" + root + "' /tmp/footfall-outside.pts").c_str());
+}
+
+TEST_CASE("misbehaving clients leave others served and memory flat", "[rpc][robustness]") {
+  ServerProcess server;
+  auto loader = Connect(server.port());
+  TerrainHandle remote = 0;
+  REQUIRE(loader->LoadSamples(TestTerrain(), "test", &remote) == Status::kOk);
+
+  SECTION("a half-sent request") {
+    const int fd = RawConnect(server.port());
+    std::vector<unsigned char> partial;
+    Put32(&partial, 0x80000000u | 1000);  // announces 1000 bytes, sends 12
+    Put32(&partial, 1), Put32(&partial, 0), Put32(&partial, 2);
+    SendSome(fd, partial);
+    RequireServed(server.port());
+    close(fd);
+  }
+  SECTION("a client that never reads its replies") {
+    const int fd = RawConnect(server.port());
+    // Full snap batches on the real terrain: 64 large replies nobody reads.
+    std::vector<unsigned char> batch;
+    Put32(&batch, remote);
+    Put32(&batch, FF_MAX_BATCH);
+    for (int i = 0; i < FF_MAX_BATCH; ++i) PutDouble(&batch, i), PutDouble(&batch, 0), PutDouble(&batch, 0);
+    std::vector<unsigned char> stream;
+    for (uint32_t xid = 1; xid <= 64; ++xid) {
+      const auto rec = CallRecord(xid, FF_SNAP_BATCH, batch);
+      stream.insert(stream.end(), rec.begin(), rec.end());
+    }
+    SendSome(fd, stream);
+    RequireServed(server.port());
+    close(fd);
+  }
+  SECTION("garbage bytes") {
+    std::mt19937 rng(3);
+    for (int round = 0; round < 20; ++round) {
+      const int fd = RawConnect(server.port());
+      std::vector<unsigned char> junk(4096 + round * 1000);
+      for (auto& c : junk) c = static_cast<unsigned char>(rng());
+      if (round % 2) junk[0] = 0x80;  // a plausible record mark with a huge length
+      SendSome(fd, junk);
+      close(fd);
+    }
+    RequireServed(server.port());
+  }
+  SECTION("batches claiming more items than they carry") {
+    std::vector<unsigned char> args;
+    Put32(&args, remote);
+    Put32(&args, FF_MAX_BATCH);  // claims 4096 points...
+    for (int i = 0; i < 10; ++i) PutDouble(&args, i), PutDouble(&args, 0), PutDouble(&args, 0);
+    auto hammer = [&](int count) {
+      for (int i = 0; i < count; ++i) {
+        const int fd = RawConnect(server.port());
+        const auto rec = CallRecord(static_cast<uint32_t>(i + 1), FF_SNAP_BATCH, args);
+        SendSome(fd, rec);
+        unsigned char reply[256];
+        const ssize_t got = recv(fd, reply, sizeof reply, 0);  // a GARBAGE_ARGS reply
+        CHECK(got > 0);
+        close(fd);
+      }
+    };
+    hammer(100);  // warm up allocator pools
+    const long before = server.RssKiB();
+    hammer(400);  // a leak of the 96 KiB array would add ~38 MiB
+    const long after = server.RssKiB();
+    INFO("RSS before " << before << " KiB, after " << after << " KiB");
+    CHECK(after - before < 4096);
+    RequireServed(server.port());
+  }
+  // The loader's terrain is still there and answers.
+  CHECK(loader->Snap(remote, Vec3{1, 0, 1}).status == Status::kOk);
+}
+
+TEST_CASE("clients report a dead server and recover after a restart", "[rpc][robustness]") {
+  const RawSamples terrain = TestTerrain();
+  auto server = std::make_unique<ServerProcess>();
+  const int port = server->port();
+  auto rpc = Connect(port, 2);
+  TerrainHandle t = 0;
+  REQUIRE(rpc->LoadSamples(terrain, "test", &t) == Status::kOk);
+  const Foothold before = rpc->Snap(t, Vec3{5, 1, 5});
+  REQUIRE(before.status == Status::kOk);
+
+  SECTION("killed and restarted") {
+    server->Kill();
+    const Foothold dead = rpc->Snap(t, Vec3{5, 1, 5});
+    CHECK(dead.status == Status::kUnavailable);
+    CHECK(rpc->last_error().find("footfalld at 127.0.0.1:" + std::to_string(port)) != std::string::npos);
+    CHECK(rpc->Snap(t, Vec3{5, 1, 5}).status == Status::kUnavailable);  // still down: same answer
+    server = std::make_unique<ServerProcess>(port);
+    // The session reconnects and loads its terrain on the new server by itself.
+    const Foothold again = rpc->Snap(t, Vec3{5, 1, 5});
+    REQUIRE(again.status == Status::kOk);
+    RequireSame(again, before);
+  }
+  SECTION("a server that stops answering times out") {
+    kill(server->pid(), SIGSTOP);
+    const Foothold stuck = rpc->Snap(t, Vec3{5, 1, 5});
+    kill(server->pid(), SIGCONT);
+    CHECK(stuck.status == Status::kUnavailable);
+    INFO(rpc->last_error());
+    CHECK(rpc->last_error().find("Timed out") != std::string::npos);
+    const Foothold back = rpc->Snap(t, Vec3{5, 1, 5});
+    REQUIRE(back.status == Status::kOk);
+    RequireSame(back, before);
+  }
+  SECTION("nothing listening") {
+    auto nobody = Connect(1, 1);  // port 1: refused at once
+    TerrainHandle h = 0;
+    CHECK(nobody->LoadSamples(terrain, "x", &h) == Status::kUnavailable);
+    CHECK(nobody->last_error().find("Connection refused") != std::string::npos);
+  }
+}
+
+TEST_CASE("footfalld registers with rpcbind and answers rpcinfo", "[rpc][rpcbind]") {
+  // rpcbind is a test dependency (scripts/install-deps.sh test): start it when not running.
+  if (std::system("rpcinfo -p 127.0.0.1 >/dev/null 2>&1") != 0) {
+    REQUIRE(std::system("rpcbind -w >/dev/null 2>&1 || rpcbind >/dev/null 2>&1") == 0);
+    for (int i = 0; i < 100 && std::system("rpcinfo -p 127.0.0.1 >/dev/null 2>&1") != 0; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ServerProcess server(0, {});
+  CHECK(server.Log().find("registered with rpcbind") != std::string::npos);
+  const std::string command =
+      "rpcinfo -t 127.0.0.1 " + std::to_string(FOOTFALL_PROG) + " 1 2>&1";
+  FILE* p = popen(command.c_str(), "r");
+  REQUIRE(p);
+  char buffer[512] = {0};
+  const size_t n = fread(buffer, 1, sizeof buffer - 1, p);
+  const int rc = pclose(p);
+  const std::string out(buffer, n);
+  INFO(out);
+  CHECK(rc == 0);
+  CHECK(out.find("ready and waiting") != std::string::npos);
+}

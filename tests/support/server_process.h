@@ -1,0 +1,36 @@
+// ServerProcess: a real footfalld started for a test on loopback, stopped (SIGTERM, then
+// SIGKILL) when the object goes away.
+#pragma once
+
+#include <sys/types.h>
+
+#include <string>
+#include <vector>
+
+namespace footfall::test {
+
+class ServerProcess {
+ public:
+  // Starts footfalld with --listen 127.0.0.1:PORT (0: any free port) and extra arguments, and
+  // waits until it listens. Throws std::runtime_error if it does not start within 10 s.
+  explicit ServerProcess(int port = 0, std::vector<std::string> extra_args = {"--no-rpcbind"});
+  ~ServerProcess();
+  ServerProcess(const ServerProcess&) = delete;
+  ServerProcess& operator=(const ServerProcess&) = delete;
+
+  int port() const { return port_; }
+  pid_t pid() const { return pid_; }
+  // Sends SIGKILL and reaps the process.
+  void Kill();
+  // Resident memory of the server process, in KiB.
+  long RssKiB() const;
+  // Everything the server wrote to stderr so far.
+  std::string Log() const;
+
+ private:
+  pid_t pid_ = -1;
+  int port_ = 0;
+  std::string dir_;
+};
+
+}  // namespace footfall::test
