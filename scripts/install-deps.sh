@@ -7,7 +7,7 @@ core=(cmake g++ make pkg-config cpp libtirpc-dev rpcsvc-proto nlohmann-json3-dev
       libopenmesh-dev libtinygltf-dev libstb-dev)
 test=(catch2 libbenchmark-dev libnanoflann-dev rpcbind valgrind nodejs npm)
 viewer=(libglfw3-dev libglm-dev libgl-dev libgl1-mesa-dri xvfb xauth)
-blender=(blender python3)
+blender=(blender python3 python3-numpy)
 
 wanted=()
 [ $# -eq 0 ] && set -- core

@@ -2,7 +2,7 @@
 # Builds footfall and runs its whole test suite. Installs what it needs on Debian first.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/install-deps.sh core test viewer
+scripts/install-deps.sh core test viewer blender
 # The Khronos glTF validator for the export tests, in a local npm prefix (nothing global).
 # All gltf-validator 2.x releases on npm are pre-releases, so the version is pinned exactly.
 if [ ! -f build/node/node_modules/gltf-validator/package.json ]; then

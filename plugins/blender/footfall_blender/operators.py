@@ -1,0 +1,467 @@
+"""The add-on's operators: Terrain Setup, Character Setup, Generate Walk, Import Walk. Every
+failure is a Blender report; nothing here may raise into Blender."""
+
+import json
+import math
+import os
+import tempfile
+
+import bpy
+from bpy.props import EnumProperty, IntProperty, StringProperty
+from bpy_extras.io_utils import ImportHelper
+from mathutils import Matrix, Vector
+
+from . import keying
+from .axes import from_ff, to_ff
+from .props import preferences
+
+try:  # inside the add-on zip
+    from . import footfall_client as ffc
+except ImportError:  # the source tree: plugins/python on sys.path
+    import footfall_client as ffc
+character = ffc.character
+sampling = ffc.sampling
+
+_connection = ffc.Connection()
+TERRAIN = "scene"
+# Called after each chunk of Generate Walk with (operator, steps done); tests use it to stop the
+# server in the middle of a walk.
+chunk_hook = None
+
+
+def shutdown():
+    """Closes the connection and stops a footfalld the add-on started."""
+    _connection.shutdown()
+
+
+def session(context):
+    prefs = preferences(context)
+    if prefs is None:
+        return _connection.get()
+    return _connection.get(prefs.host, prefs.port, prefs.start_local,
+                           bpy.path.abspath(prefs.footfalld) if prefs.footfalld else None,
+                           prefs.timeout)
+
+
+def describe_connection():
+    return _connection.describe()
+
+
+def _fail(op, message):
+    op.report({"ERROR"}, message)
+    return {"CANCELLED"}
+
+
+def _error_text(e):
+    if isinstance(e, ffc.FootfallError):
+        return "footfall: %s (%s)" % (e.message, e.status_name)
+    return "footfall: %s" % e
+
+
+def _status(context, text):
+    try:
+        if context.workspace is not None:
+            context.workspace.status_text_set(text)
+    except Exception:
+        pass
+
+
+# -- Terrain Setup ------------------------------------------------------------------------------
+
+def mesh_samples(context, obj, separation):
+    """The evaluated mesh of `obj` resampled at `separation`, in footfall's frame."""
+    depsgraph = context.evaluated_depsgraph_get()
+    evaluated = obj.evaluated_get(depsgraph)
+    mesh = evaluated.to_mesh()
+    try:
+        mesh.calc_loop_triangles()
+        mw = obj.matrix_world
+        nm = mw.to_3x3().inverted_safe().transposed()
+        points = [to_ff(mw @ v.co) for v in mesh.vertices]
+        normals = [to_ff((nm @ v.normal).normalized()) for v in mesh.vertices]
+        tris = [tuple(t.vertices) for t in mesh.loop_triangles]
+    finally:
+        evaluated.to_mesh_clear()
+    if not tris:
+        raise ValueError("%s has no faces" % obj.name)
+    if mw.determinant() < 0:  # mirrored: keep the winding counter-clockwise
+        tris = [(a, c, b) for a, b, c in tris]
+    return sampling.sample_triangles(points, tris, separation, normals)
+
+
+class FOOTFALL_OT_terrain_setup(bpy.types.Operator):
+    """Send the selected mesh (resampled at the point separation) or a point file to footfalld"""
+    bl_idname = "footfall.terrain_setup"
+    bl_label = "Terrain Setup"
+    bl_options = {"REGISTER"}
+
+    save_points: StringProperty(name="Save samples", subtype="FILE_PATH", default="",
+                                description="Also write the samples sent as a point file")
+
+    def execute(self, context):
+        settings = context.scene.footfall
+        try:
+            s = session(context)
+            if settings.terrain_source == "FILE":
+                path = bpy.path.abspath(settings.terrain_file)
+                if not path:
+                    return _fail(self, "footfall: choose a terrain file first")
+                terrain = _connection.load_file(TERRAIN, path, settings.separation)
+                name = os.path.basename(path)
+            else:
+                obj = context.active_object
+                if obj is None or obj.type != "MESH":
+                    return _fail(self, "footfall: select a mesh for the terrain")
+                samples = mesh_samples(context, obj, settings.separation)
+                if self.save_points:
+                    sampling.write_point_file(bpy.path.abspath(self.save_points), samples,
+                                              "footfall terrain points from Blender " + obj.name)
+                terrain = _connection.load_samples(TERRAIN, samples)
+                name = obj.name
+            count, _ = s.info(terrain)
+        except (ffc.FootfallError, ValueError, OSError) as e:
+            return _fail(self, _error_text(e))
+        settings.terrain_name = name
+        settings.sample_count = count
+        self.report({"INFO"}, "footfall: terrain %s, %d samples on %s"
+                    % (name, count, _connection.describe()))
+        return {"FINISHED"}
+
+
+# -- Character Setup ----------------------------------------------------------------------------
+
+def _empty(context, name, display="PLAIN_AXES", size=0.2, parent=None):
+    obj = bpy.data.objects.new(name, None)
+    obj.empty_display_type = display
+    obj.empty_display_size = size
+    context.scene.collection.objects.link(obj)
+    if parent is not None:
+        obj.parent = parent
+    return obj
+
+
+def _frame(up, forward):
+    """A world rotation (Blender) with Z along `up` and -Y along `forward` projected."""
+    z = up.normalized()
+    f = forward - z * forward.dot(z)
+    if f.length < 1e-9:
+        f = z.orthogonal()
+    y = -f.normalized()
+    x = y.cross(z).normalized()
+    return Matrix((x, y, z)).transposed()
+
+
+def _snap(s, terrain, point):
+    hold = s.snap(terrain, [to_ff(point)])[0]
+    if not hold.ok:
+        raise ffc.FootfallError(hold.status, "no terrain near %s" % tuple(round(c, 3) for c in point),
+                                "ffc_snap")
+    return Vector(from_ff(hold.point)), Vector(from_ff(hold.normal))
+
+
+class FOOTFALL_OT_character_setup(bpy.types.Operator):
+    """Set up a character on the terrain: pick its body and foot IK targets (selected objects
+    named after the feet, the active one the body) or create empties; adds target and central
+    locators"""
+    bl_idname = "footfall.character_setup"
+    bl_label = "Character Setup"
+    bl_options = {"REGISTER", "UNDO"}
+
+    character_file: StringProperty(name="Character file", subtype="FILE_PATH")
+    mode: EnumProperty(name="Rig", items=[
+        ("CREATE", "Create empties", "Create a body and foot IK target empties at the 3D cursor"),
+        ("PICK", "Pick selected", "Use the active object as body and selected objects named "
+                                  "after the feet as IK targets")], default="CREATE")
+    name: StringProperty(name="Name", default="", description="Rig name (default: the file's)")
+
+    def execute(self, context):
+        try:
+            data = character.load(bpy.path.abspath(self.character_file))
+            feet = character.feet(data, self.character_file)
+            s = session(context)
+            terrain = _connection.terrain(TERRAIN)
+            return self._setup(context, s, terrain, data, feet)
+        except (ffc.FootfallError, ValueError, OSError) as e:
+            return _fail(self, _error_text(e))
+
+    def _pick(self, context, feet):
+        body = context.active_object
+        if body is None:
+            raise ValueError("select the body (active) and the foot IK targets")
+        chosen = {}
+        candidates = [o for o in context.selected_objects if o is not body]
+        for name, _ in feet:
+            for o in candidates:
+                n = o.name
+                if n == name or n.endswith(("_" + name, "." + name, "-" + name, ":" + name)):
+                    chosen[name] = o
+                    break
+        missing = [n for n, _ in feet if n not in chosen]
+        if missing:
+            raise ValueError("no selected object named after foot %s" % ", ".join(missing))
+        return body, chosen
+
+    def _setup(self, context, s, terrain, data, feet):
+        rig_name = self.name or data.get("name") or os.path.splitext(
+            os.path.basename(self.character_file))[0]
+        height = character.body_height(data)
+        step = character.number(data, "step_length", 0.5)
+        if self.mode == "PICK":
+            body, targets = self._pick(context, feet)
+            origin = body.matrix_world.translation.copy()
+            forward = body.matrix_world.to_3x3() @ Vector((0, -1, 0))
+        else:
+            body, targets = None, {}
+            origin = context.scene.cursor.location.copy()
+            forward = context.scene.cursor.matrix.to_3x3() @ Vector((0, -1, 0))
+        ground, normal = _snap(s, terrain, origin)
+        multiped = not character.is_biped(data)
+        up = normal if multiped else Vector((0, 0, 1))
+        rot = _frame(up, forward)
+
+        root = _empty(context, rig_name + "_rig", "ARROWS", 0.5)
+        root.matrix_world = Matrix.Translation(ground) @ rot.to_4x4()
+        rig = root.footfall_rig
+        rig.is_rig = True
+        rig.character_path = self.character_file
+        rig.character_json = json.dumps(data)
+        if body is None:
+            body = _empty(context, rig_name + "_body", "CUBE", 0.3 * height)
+        body.rotation_mode = "QUATERNION"
+        body.matrix_world = Matrix.Translation(ground + up.normalized() * height) @ rot.to_4x4()
+        rig.body = body
+
+        # Feet: on the terrain below their offset from the body (character space: +X left,
+        # +Z forward; Blender: -X ... see axes.py), targets half a step in front of each foot.
+        placed = {}
+        for name, offset in feet:
+            local = Vector(from_ff((offset[0], 0.0, offset[2])))
+            foot_point, foot_normal = _snap(s, terrain, ground + rot @ local)
+            obj = targets.get(name) or _empty(context, "%s_%s" % (rig_name, name), "SPHERE", 0.08)
+            m = obj.matrix_world.copy()
+            m.translation = foot_point
+            obj.matrix_world = m
+            placed[name] = (obj, foot_point)
+            item = rig.feet.add()
+            item.name = name
+            item.target = obj
+        fwd = rot @ Vector((0, -1, 0))
+        for pair_name, members in character.pairs(data):
+            centre = sum((placed[m][1] for m in members), Vector()) / len(members)
+            point, normal = _snap(s, terrain, centre)
+            central = _empty(context, "%s_%s_center" % (rig_name, pair_name), "CIRCLE", 0.3,
+                             parent=root)
+            central.matrix_world = Matrix.Translation(point) @ _frame(normal, fwd).to_4x4()
+            for m in members:
+                target = _empty(context, "%s_%s_target" % (rig_name, m), "CONE", 0.06,
+                                parent=central)
+                target.matrix_world = Matrix.Translation(
+                    placed[m][1] + _frame(normal, fwd) @ Vector((0, -step / 2, 0)))
+        context.scene.footfall.rig = root
+        context.view_layer.update()
+        self.report({"INFO"}, "footfall: %s set up with %d feet" % (rig_name, len(feet)))
+        return {"FINISHED"}
+
+
+# -- Generate Walk ------------------------------------------------------------------------------
+
+def walk_request(context, rig_obj, steps, start_frame):
+    """The ffc_generate request for the rig and the scene's walk settings, and the character."""
+    settings = context.scene.footfall
+    rig = rig_obj.footfall_rig
+    data = character.parse(rig.character_json, rig.character_path or rig_obj.name)
+    data = character.with_overrides(data, step_length=settings.step_length,
+                                    step_height=settings.step_height,
+                                    frames_per_step=settings.frames_per_step)
+    mw = rig_obj.matrix_world
+    request = {"character": data,
+               "start": list(to_ff(mw.translation)),
+               "heading": list(to_ff(mw.to_3x3() @ Vector((0, -1, 0)))),
+               "steps": int(steps), "start_frame": int(start_frame)}
+    if settings.path is not None:
+        request["path"] = [list(to_ff(p)) for p in curve_points(context, settings.path)]
+    return request
+
+
+def curve_points(context, obj):
+    """World points of a curve (evaluated, as a mesh of its segments)."""
+    evaluated = obj.evaluated_get(context.evaluated_depsgraph_get())
+    mesh = evaluated.to_mesh()
+    try:
+        pts = [obj.matrix_world @ v.co for v in mesh.vertices]
+    finally:
+        evaluated.to_mesh_clear()
+    if len(pts) < 2:
+        raise ValueError("path %s has fewer than 2 points" % obj.name)
+    return pts
+
+
+def rig_targets(rig_obj):
+    rig = rig_obj.footfall_rig
+    feet = {f.name: f.target for f in rig.feet if f.target is not None}
+    return feet, rig.body
+
+
+def active_rig(context):
+    obj = context.scene.footfall.rig
+    if obj is not None and obj.footfall_rig.is_rig:
+        return obj
+    obj = context.active_object
+    while obj is not None:
+        if obj.footfall_rig.is_rig:
+            return obj
+        obj = obj.parent
+    return None
+
+
+class FOOTFALL_OT_generate_walk(bpy.types.Operator):
+    """Generate a walk with footfall and key the rig's IK targets and body"""
+    bl_idname = "footfall.generate_walk"
+    bl_label = "Generate Walk"
+    bl_options = {"REGISTER", "UNDO"}
+
+    chunk_steps: IntProperty(name="Steps per call", default=0, min=0,
+                             description="Steps asked for per server call, keyed as they come "
+                                         "(0: about a tenth of the walk)")
+
+    def execute(self, context):
+        settings = context.scene.footfall
+        rig_obj = active_rig(context)
+        if rig_obj is None:
+            return _fail(self, "footfall: no rig: run Character Setup first")
+        feet, body = rig_targets(rig_obj)
+        if not feet:
+            return _fail(self, "footfall: rig %s has no foot IK targets" % rig_obj.name)
+        total = settings.steps
+        chunk = self.chunk_steps or max(1, int(math.ceil(total / 10.0)))
+        wm = context.window_manager
+        keyed = 0
+        walk_text = None
+        try:
+            s = session(context)
+            terrain = _connection.terrain(TERRAIN)
+            wm.progress_begin(0, total)
+            done = 0
+            while done < total:
+                done = min(total, done + chunk)
+                _status(context, "footfall: generating step %d of %d" % (done, total))
+                request = walk_request(context, rig_obj, done, settings.start_frame)
+                status, walk_text_new, message = s.generate_json(terrain, request)
+                if walk_text_new is not None:
+                    walk = json.loads(walk_text_new)
+                    keying.clear_keys(list(feet.values()) + [body], settings.start_frame)
+                    keyed = keying.key_walk(walk, feet, body)
+                    walk_text = walk_text_new
+                    stopped = walk.get("stopped")
+                else:
+                    stopped = None
+                if status != 0 or stopped:
+                    raise ffc.FootfallError(status if status else 1, message or stopped,
+                                            "ffc_generate")
+                wm.progress_update(done)
+                if chunk_hook is not None:
+                    chunk_hook(self, done)
+        except (ffc.FootfallError, ValueError, OSError) as e:
+            self.report({"ERROR"}, "%s; %d keys made before it were kept" % (_error_text(e), keyed))
+            return {"FINISHED"} if keyed else {"CANCELLED"}
+        finally:
+            if walk_text is not None:
+                keying.store_walk_text("footfall_walk.json", walk_text)
+            try:
+                wm.progress_end()
+            except Exception:
+                pass
+            _status(context, None)
+        self.report({"INFO"}, "footfall: %d steps, %d keys on %s" % (total, keyed, rig_obj.name))
+        return {"FINISHED"}
+
+
+# -- Import Walk --------------------------------------------------------------------------------
+
+class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
+    """Import a footfall walk (JSON or glTF) onto the active rig (or onto new empties)"""
+    bl_idname = "footfall.import_walk"
+    bl_label = "Import footfall Walk"
+    bl_options = {"REGISTER", "UNDO"}
+
+    filter_glob: StringProperty(default="*.json;*.gltf;*.glb", options={"HIDDEN"})
+
+    def execute(self, context):
+        path = self.filepath
+        try:
+            if path.lower().endswith((".gltf", ".glb")):
+                walk = self._walk_from_gltf(context, path)
+            else:
+                with open(path) as f:
+                    walk = json.load(f)
+            if not isinstance(walk, dict) or not isinstance(walk.get("tracks"), list):
+                raise ValueError("%s: expected footfall walk JSON with a \"tracks\" list" % path)
+            rig_obj = active_rig(context)
+            if rig_obj is not None:
+                feet, body = rig_targets(rig_obj)
+            else:
+                feet, body = self._empties(context, walk, os.path.splitext(os.path.basename(path))[0])
+            first = min((k["frame"] for t in walk["tracks"] for k in t.get("keys", [])), default=0)
+            keying.clear_keys(list(feet.values()) + [body], first)
+            count = keying.key_walk(walk, feet, body)
+        except (OSError, ValueError, KeyError, TypeError) as e:
+            return _fail(self, "footfall: cannot import %s: %s" % (path, e))
+        if count == 0:
+            return _fail(self, "footfall: %s has no track for this rig's feet or body" % path)
+        self.report({"INFO"}, "footfall: %d keys imported from %s" % (count, os.path.basename(path)))
+        return {"FINISHED"}
+
+    def _empties(self, context, walk, name):
+        feet, body = {}, None
+        for track in walk["tracks"]:
+            if track.get("kind") == "body":
+                body = _empty(context, "%s_body" % name, "CUBE", 0.3)
+            else:
+                feet[track["name"]] = _empty(context, "%s_%s" % (name, track["name"]), "SPHERE", 0.08)
+        return feet, body
+
+    def _walk_from_gltf(self, context, path):
+        """Imports the glTF with Blender's importer and reads its node animation back as a
+        walk dict (positions converted back to footfall's frame), then removes what it made."""
+        before = set(bpy.data.objects)
+        actions_before = set(bpy.data.actions)
+        result = bpy.ops.import_scene.gltf(filepath=path)
+        if "FINISHED" not in result:
+            raise ValueError("Blender's glTF importer failed")
+        made = [o for o in bpy.data.objects if o not in before]
+        tracks = []
+        for obj in made:
+            action = obj.animation_data.action if obj.animation_data else None
+            if action is None:
+                continue
+            curves = {(fc.data_path, fc.array_index): fc for fc in action.fcurves}
+            frames = sorted({kp.co[0] for fc in action.fcurves for kp in fc.keyframe_points})
+            keys = []
+            for f in frames:
+                key = {"frame": f}
+                if ("location", 0) in curves:
+                    key["position"] = list(to_ff([curves[("location", i)].evaluate(f)
+                                                  for i in range(3)]))
+                if ("rotation_quaternion", 0) in curves:
+                    from .axes import quat_to_ff
+                    key["rotation"] = list(quat_to_ff([curves[("rotation_quaternion", i)]
+                                                       .evaluate(f) for i in range(4)]))
+                keys.append(key)
+            # footfall's glTF names each node's track and kind in its extras (custom properties
+            # once imported); a glTF from elsewhere falls back to the node name.
+            name = str(obj.get("track") or obj.name.split(".")[0])
+            kind = str(obj.get("kind") or ("body" if ("rotation_quaternion", 0) in curves
+                                           else "foot"))
+            if kind == "foot":
+                for key in keys:
+                    key.pop("rotation", None)
+            tracks.append({"name": name, "kind": kind, "keys": keys})
+        for obj in made:
+            bpy.data.objects.remove(obj)
+        for action in set(bpy.data.actions) - actions_before:
+            bpy.data.actions.remove(action)
+        return {"tracks": tracks}
+
+
+classes = [FOOTFALL_OT_terrain_setup, FOOTFALL_OT_character_setup, FOOTFALL_OT_generate_walk,
+           FOOTFALL_OT_import_walk]

@@ -1,0 +1,92 @@
+"""Add-on preferences (server), scene settings (terrain, walk) and the rig data on objects."""
+
+import bpy
+from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty,
+                       IntProperty, PointerProperty, StringProperty)
+
+ADDON = __package__
+
+
+class FootfallPreferences(bpy.types.AddonPreferences):
+    bl_idname = ADDON
+
+    host: StringProperty(name="Host", default="127.0.0.1",
+                         description="footfalld host to connect to")
+    port: IntProperty(name="Port", default=7407, min=1, max=65535,
+                      description="footfalld port (7407 by default)")
+    start_local: BoolProperty(name="Start a local footfalld", default=True,
+                              description="When no server answers at host:port, start footfalld "
+                                          "on this machine on a free port")
+    footfalld: StringProperty(name="footfalld", subtype="FILE_PATH", default="",
+                              description="footfalld to start (empty: the bundled one, "
+                                          "$FOOTFALLD or PATH)")
+    timeout: FloatProperty(name="Timeout (s)", default=10.0, min=0.5, max=600.0,
+                           description="Seconds per server call")
+
+    def draw(self, context):
+        col = self.layout.column()
+        row = col.row()
+        row.prop(self, "host")
+        row.prop(self, "port")
+        col.prop(self, "start_local")
+        col.prop(self, "footfalld")
+        col.prop(self, "timeout")
+
+
+def preferences(context):
+    addon = context.preferences.addons.get(ADDON)
+    return addon.preferences if addon else None
+
+
+class FootfallFoot(bpy.types.PropertyGroup):
+    # name: the foot's name in the character file (PropertyGroup.name)
+    target: PointerProperty(type=bpy.types.Object, name="IK target",
+                            description="Object keyed as this foot's IK target")
+
+
+class FootfallRig(bpy.types.PropertyGroup):
+    """On the rig's root empty: which character, which body and which foot targets."""
+    is_rig: BoolProperty(default=False)
+    character_path: StringProperty(name="Character file", subtype="FILE_PATH")
+    character_json: StringProperty(name="Character", description="The character file's JSON")
+    body: PointerProperty(type=bpy.types.Object, name="Body")
+    feet: CollectionProperty(type=FootfallFoot)
+
+
+class FootfallScene(bpy.types.PropertyGroup):
+    # Terrain Setup
+    terrain_source: EnumProperty(name="Source", items=[
+        ("MESH", "Selected mesh", "Resample the selected mesh at the point separation"),
+        ("FILE", "Point file", "Load a terrain file (.pts)")], default="MESH")
+    separation: FloatProperty(name="Point separation", default=0.25, min=0.001, soft_max=5.0,
+                              unit="LENGTH", description="Distance between terrain samples")
+    terrain_file: StringProperty(name="Terrain file", subtype="FILE_PATH")
+    terrain_name: StringProperty(name="Terrain", default="")
+    sample_count: IntProperty(name="Samples", default=0)
+    # Character Setup / Generate Walk
+    rig: PointerProperty(type=bpy.types.Object, name="Rig",
+                         poll=lambda self, obj: obj.footfall_rig.is_rig)
+    steps: IntProperty(name="Steps", default=8, min=1, max=100000)
+    start_frame: IntProperty(name="Start frame", default=1)
+    frames_per_step: IntProperty(name="Frames per step", default=0, min=0,
+                                 description="0: the character file's value")
+    step_length: FloatProperty(name="Step length", default=0.0, min=0.0, unit="LENGTH",
+                               description="0: the character file's value")
+    step_height: FloatProperty(name="Step height", default=0.0, min=0.0, unit="LENGTH",
+                               description="0: the character file's value")
+    path: PointerProperty(type=bpy.types.Object, name="Path",
+                          poll=lambda self, obj: obj.type == "CURVE",
+                          description="Optional curve the walk follows")
+
+
+classes = [FootfallPreferences, FootfallFoot, FootfallRig, FootfallScene]
+
+
+def attach():
+    bpy.types.Scene.footfall = PointerProperty(type=FootfallScene)
+    bpy.types.Object.footfall_rig = PointerProperty(type=FootfallRig)
+
+
+def detach():
+    del bpy.types.Object.footfall_rig
+    del bpy.types.Scene.footfall

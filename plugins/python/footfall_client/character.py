@@ -1,0 +1,113 @@
+"""Character files (data/characters/*.json) as the plugins need them: foot names and offsets,
+the foot pairs that share a central locator, and the walk settings a panel may override.
+Pure Python; footfall's frame (Y up, the character facing +Z, +X its left)."""
+
+import json
+import math
+
+from .session import INVALID_ARGUMENT, FootfallError
+
+# Walk settings a panel can override: panel name -> character file key.
+OVERRIDES = {"step_length": "step_length", "step_height": "step_height",
+             "frames_per_step": "frames_per_step"}
+
+
+def load(path):
+    """The character file at `path` as a dict; FootfallError (io_error/parse_error) otherwise."""
+    try:
+        with open(path) as f:
+            text = f.read()
+    except OSError as e:
+        raise FootfallError(5, "%s: %s" % (path, e.strerror or e), "character") from None
+    return parse(text, path)
+
+
+def parse(text, name="character"):
+    try:
+        data = json.loads(text)
+    except ValueError as e:
+        raise FootfallError(6, "%s: %s" % (name, e), "character") from None
+    feet(data, name)  # validates
+    return data
+
+
+def _vec(value):
+    if isinstance(value, dict):
+        value = [value.get(k, 0.0) for k in "xyz"]
+    return tuple(float(v) for v in value)
+
+
+def feet(data, name="character"):
+    """[(foot name, (x, y, z) rest position)] in file order: relative to the body's ground
+    point, character space (+Z forward, +Y up, +X left)."""
+    raw = data.get("feet") if isinstance(data, dict) else None
+    if not isinstance(raw, list) or not raw:
+        raise FootfallError(INVALID_ARGUMENT, "%s: expected a non-empty \"feet\" list" % name,
+                            "character")
+    out = []
+    for i, foot in enumerate(raw):
+        try:
+            pos = foot.get("rest", foot.get("position"))
+            out.append((str(foot["name"]), _vec(pos)))
+        except (AttributeError, KeyError, TypeError, ValueError):
+            raise FootfallError(INVALID_ARGUMENT, "%s: feet[%d]: expected {\"name\": ..., "
+                                "\"rest\": [x, y, z]}" % (name, i), "character") from None
+    return out
+
+
+def number(data, key, default):
+    try:
+        return float(data.get(key, default))
+    except (TypeError, ValueError):
+        return default
+
+
+def body_height(data):
+    """Height of the body above the feet [world units] (the generator's default 0.9)."""
+    return number(data, "body_height", 0.9)
+
+
+def is_biped(data):
+    """Bipeds stay upright; multipeds (align_to_normal) take the terrain normal as up."""
+    return not bool(data.get("align_to_normal", False))
+
+
+def pairs(data):
+    """Foot pairs that share a central locator: the file's "pairs" (groups of foot names), or
+    else each left foot (x > 0) with the right foot (x < 0) nearest to its mirror; a foot left
+    over stands alone. [(name, [foot names])]"""
+    given = data.get("pairs")
+    if isinstance(given, list) and given:
+        return [("_".join(str(n) for n in group), [str(n) for n in group]) for group in given]
+    fs = feet(data)
+    left = [f for f in fs if f[1][0] > 0]
+    right = [f for f in fs if f[1][0] <= 0]
+    out, used = [], set()
+    for name, p in left:
+        best = None
+        for rname, q in right:
+            if rname in used:
+                continue
+            d = math.hypot(p[0] + q[0], p[2] - q[2])
+            if best is None or d < best[0]:
+                best = (d, rname)
+        if best is None:
+            out.append((name, [name]))
+        else:
+            used.add(best[1])
+            out.append(("%s_%s" % (name, best[1]), [name, best[1]]))
+    for rname, _ in right:
+        if rname not in used:
+            out.append((rname, [rname]))
+    return out
+
+
+def with_overrides(data, **values):
+    """A copy of `data` with the walk settings in `values` (see OVERRIDES) replaced where the
+    value is > 0; zero or None keeps the file's value."""
+    out = json.loads(json.dumps(data))
+    for panel_name, value in values.items():
+        key = OVERRIDES[panel_name]
+        if value is not None and value > 0:
+            out[key] = int(value) if key == "frames_per_step" else float(value)
+    return out

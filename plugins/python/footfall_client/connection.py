@@ -1,0 +1,108 @@
+"""Connection: what a DCC plugin keeps between its commands. One Session to the configured
+footfalld (starting a local footfalld when none answers, if allowed) and the terrains loaded
+through it, uploaded again when the session changes (a new local server)."""
+
+from .server import LocalServer, ServerError
+from .session import UNAVAILABLE, UNKNOWN_TERRAIN, FootfallError, Session
+
+
+class Connection:
+    def __init__(self):
+        self.session = None
+        self.local = None          # LocalServer this connection started, if any
+        self._target = None        # (host, port) the session talks to
+        self._terrains = {}        # name -> [source, terrain id, session]
+
+    def describe(self):
+        if self.session is None:
+            return "not connected"
+        own = " (started by footfall)" if self.local and self.local.running() else ""
+        return self.session.description + own
+
+    def get(self, host="127.0.0.1", port=7407, start_local=True, footfalld=None, timeout=10.0):
+        """A Session that answers. Tries host:port (or the local server started earlier); when
+        nothing answers and start_local is set, starts footfalld on a free loopback port.
+        Raises FootfallError('unavailable') with what to do when no server can be had."""
+        target = (host or "127.0.0.1", int(port))
+        if self.local is not None and self.local.running():
+            target = ("127.0.0.1", self.local.port)
+        if self.session is None or self._target != target:
+            self._open(target, timeout)
+        if self.session.ping():
+            return self.session
+        if not start_local:
+            raise FootfallError(UNAVAILABLE, "no footfalld answers at %s:%d: start one there or "
+                                "allow starting a local footfalld" % target, "connect")
+        if self.local is not None:
+            self.local.stop()
+        try:
+            self.local = LocalServer(executable=footfalld or None).start()
+        except ServerError as e:
+            self.local = None
+            raise FootfallError(UNAVAILABLE, "no footfalld answers at %s:%d and a local one "
+                                "could not be started: %s" % (target + (e,)), "connect") from None
+        self._open(("127.0.0.1", self.local.port), timeout)
+        if not self.session.ping():
+            raise FootfallError(UNAVAILABLE, "the local footfalld on port %d does not answer"
+                                % self.local.port, "connect")
+        return self.session
+
+    def _open(self, target, timeout):
+        if self.session is not None:
+            self.session.close()
+        self.session = Session.rpc(target[0], target[1], timeout)
+        self._target = target
+
+    # -- terrains -----------------------------------------------------------------------------
+
+    def load_samples(self, name, samples):
+        """Loads samples on the current session as terrain `name` (replacing an older one)."""
+        return self._load(name, ("samples", samples))
+
+    def load_file(self, name, path, separation=0.0):
+        """Loads a terrain file read on this machine as terrain `name`."""
+        return self._load(name, ("file", path, separation))
+
+    def _load(self, name, source):
+        if self.session is None:
+            raise FootfallError(UNAVAILABLE, "not connected", "load")
+        old = self._terrains.pop(name, None)
+        if old and old[2] is self.session:
+            try:
+                self.session.unload(old[1])
+            except FootfallError:
+                pass
+        terrain = self._upload(source)
+        self._terrains[name] = [source, terrain, self.session]
+        return terrain
+
+    def _upload(self, source):
+        if source[0] == "samples":
+            return self.session.load_samples(source[1], "blender")
+        return self.session.load_file(source[1], source[2])
+
+    def terrain(self, name):
+        """The id of terrain `name` on the current session, uploading it again if the session
+        changed since it was loaded."""
+        entry = self._terrains.get(name)
+        if entry is None:
+            raise FootfallError(UNKNOWN_TERRAIN, "no terrain '%s' loaded in this session: run "
+                                "Terrain Setup first" % name, "terrain")
+        if entry[2] is not self.session:
+            entry[1] = self._upload(entry[0])
+            entry[2] = self.session
+        return entry[1]
+
+    def has_terrain(self, name):
+        return name in self._terrains
+
+    def shutdown(self):
+        """Closes the session and stops a server this connection started."""
+        if self.session is not None:
+            self.session.close()
+            self.session = None
+        if self.local is not None:
+            self.local.stop()
+            self.local = None
+        self._terrains.clear()
+        self._target = None

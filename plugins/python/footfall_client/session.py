@@ -1,0 +1,283 @@
+"""Session: one embedded engine or footfalld connection, with Pythonic errors."""
+
+import ctypes
+import json
+from array import array
+from collections import namedtuple
+
+from .library import FfcFoothold, load_library
+
+# ff_status values (footfall_c.h, rpc/footfall.x), by number.
+STATUS_NAMES = {
+    0: "ok",
+    1: "no_foothold",
+    2: "invalid_argument",
+    3: "unknown_terrain",
+    4: "limit_exceeded",
+    5: "io_error",
+    6: "parse_error",
+    7: "access_denied",
+    8: "unavailable",
+    9: "internal_error",
+}
+OK, NO_FOOTHOLD, INVALID_ARGUMENT, UNKNOWN_TERRAIN, UNAVAILABLE = 0, 1, 2, 3, 8
+
+
+class FootfallError(Exception):
+    """A failed footfall call: `status` (int), `status_name` ("unavailable", ...), `message`
+    (the library's one-line reason) and `call` (the C function that failed)."""
+
+    def __init__(self, status, message, call=""):
+        self.status = status
+        self.status_name = STATUS_NAMES.get(status, "status_%d" % status)
+        self.message = message
+        self.call = call
+        super().__init__("%s: %s" % (self.status_name, message))
+
+
+class WalkStopped(FootfallError):
+    """generate() stopped before every step was made (a cliff, the server gone). `walk` holds
+    the keys made up to that point (footfall's walk JSON as a dict), or None."""
+
+    def __init__(self, status, message, walk, call="ffc_generate"):
+        super().__init__(status, message, call)
+        self.walk = walk
+
+
+# One answer of snap/normal/next. point and normal are world-space 3-tuples (None unless ok).
+Foothold = namedtuple("Foothold", "status status_name index point normal")
+Foothold.ok = property(lambda self: self.status == OK)
+
+
+def _flat(rows, width, what):
+    """rows: a sequence of `width`-tuples, or an already flat sequence of floats -> array('d')."""
+    flat = array("d")
+    try:
+        for row in rows:
+            if isinstance(row, (int, float)):
+                flat.append(float(row))
+            else:
+                if len(row) != width:
+                    raise ValueError
+                flat.extend(float(v) for v in row)
+    except (TypeError, ValueError):
+        raise FootfallError(INVALID_ARGUMENT, "%s: expected %d numbers per item" % (what, width),
+                            "python") from None
+    if len(flat) % width:
+        raise FootfallError(INVALID_ARGUMENT, "%s: %d numbers is not a multiple of %d"
+                            % (what, len(flat), width), "python")
+    return flat
+
+
+def _pointer(flat):
+    if not flat:
+        return ctypes.POINTER(ctypes.c_double)()
+    return (ctypes.c_double * len(flat)).from_buffer(flat)
+
+
+class Session:
+    """A footfall session. Open with Session.rpc(...) or Session.embedded(); close() or use
+    `with`. Not thread-safe: one session per thread. Methods raise FootfallError on failure."""
+
+    def __init__(self, handle, library, description):
+        self._h = handle
+        self._lib = library
+        self.description = description
+
+    @classmethod
+    def rpc(cls, host="127.0.0.1", port=7407, timeout=10.0, library=None):
+        """A footfalld client at host:port; it connects lazily (the first call may raise
+        FootfallError 'unavailable'). `timeout` is per call in seconds."""
+        lib = load_library(library)
+        if not isinstance(port, int) or not 1 <= port <= 65535:
+            raise FootfallError(INVALID_ARGUMENT, "port %r: expected 1 to 65535" % (port,), "ffc_open_rpc")
+        handle = lib.lib.ffc_open_rpc((host or "").encode(), port, float(timeout))
+        if not handle:
+            raise FootfallError(INVALID_ARGUMENT, "cannot open a client for %s:%d" % (host, port),
+                                "ffc_open_rpc")
+        return cls(handle, lib, "rpc %s:%d" % (host or "127.0.0.1", port))
+
+    @classmethod
+    def embedded(cls, library=None):
+        """The in-process engine of libfootfall.so."""
+        lib = load_library(library)
+        handle = lib.lib.ffc_open_embedded()
+        if not handle:
+            raise FootfallError(INTERNAL_ERROR, "cannot open the embedded engine", "ffc_open_embedded")
+        return cls(handle, lib, "embedded")
+
+    def close(self):
+        if self._h:
+            self._lib.lib.ffc_close(self._h)
+            self._h = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown: the library may be gone already
+            pass
+
+    def __repr__(self):
+        return "<footfall_client.Session %s%s>" % (self.description, "" if self._h else " closed")
+
+    # -- internals --------------------------------------------------------------------------
+
+    def _handle(self, call):
+        if not self._h:
+            raise FootfallError(INVALID_ARGUMENT, "the session is closed", call)
+        return self._h
+
+    def last_error(self):
+        if not self._h:
+            return "the session is closed"
+        return self._lib.lib.ffc_last_error(self._h).decode("utf-8", "replace")
+
+    def _check(self, status, call):
+        if status != OK:
+            raise FootfallError(status, self.last_error() or STATUS_NAMES.get(status, ""), call)
+
+    def _answers(self, out, count):
+        result = []
+        for i in range(count):
+            h = out[i]
+            if h.status == OK:
+                result.append(Foothold(h.status, "ok", h.index, tuple(h.point), tuple(h.normal)))
+            else:
+                result.append(Foothold(h.status, STATUS_NAMES.get(h.status, str(h.status)), h.index,
+                                       None, None))
+        return result
+
+    # -- terrains -----------------------------------------------------------------------------
+
+    def load_file(self, path, separation=0.0):
+        """Reads a terrain file on this machine and loads it; returns the terrain id.
+        separation [world units] resamples meshes (0: the library's default)."""
+        h = self._handle("ffc_load_file")
+        out = ctypes.c_uint32()
+        self._check(self._lib.lib.ffc_load_file(h, str(path).encode(), float(separation),
+                                                ctypes.byref(out)), "ffc_load_file")
+        return out.value
+
+    def load_server_file(self, path, separation=0.0):
+        """Loads a file under footfalld's data root (RPC) or a local path (embedded)."""
+        h = self._handle("ffc_load_server_file")
+        out = ctypes.c_uint32()
+        self._check(self._lib.lib.ffc_load_server_file(h, str(path).encode(), float(separation),
+                                                       ctypes.byref(out)), "ffc_load_server_file")
+        return out.value
+
+    def load_samples(self, samples, name="samples"):
+        """Loads samples (x, y, z, nx, ny, nz) given as 6-tuples or one flat sequence; returns
+        the terrain id."""
+        h = self._handle("ffc_load_samples")
+        flat = _flat(samples, 6, "samples")
+        out = ctypes.c_uint32()
+        self._check(self._lib.lib.ffc_load_samples(h, _pointer(flat), len(flat) // 6,
+                                                   name.encode(), ctypes.byref(out)),
+                    "ffc_load_samples")
+        return out.value
+
+    def unload(self, terrain):
+        self._check(self._lib.lib.ffc_unload(self._handle("ffc_unload"), terrain), "ffc_unload")
+
+    def info(self, terrain):
+        """(sample count, (min x, min y, min z, max x, max y, max z)) of a terrain."""
+        h = self._handle("ffc_info")
+        count = ctypes.c_uint64()
+        bounds = (ctypes.c_double * 6)()
+        self._check(self._lib.lib.ffc_info(h, terrain, ctypes.byref(count), bounds), "ffc_info")
+        return count.value, tuple(bounds)
+
+    def ping(self):
+        """True when the server answers (any reply), False when it is unavailable. Makes one
+        round trip (loads and unloads a one-sample terrain); never raises for a missing server."""
+        try:
+            t = self.load_samples([(0.0, 0.0, 0.0, 0.0, 1.0, 0.0)], "ping")
+        except FootfallError as e:
+            return e.status != UNAVAILABLE
+        try:
+            self.unload(t)
+        except FootfallError:
+            pass
+        return True
+
+    # -- queries ------------------------------------------------------------------------------
+
+    def _points(self, fn_name, terrain, points):
+        h = self._handle(fn_name)
+        flat = _flat(points, 3, "points")
+        n = len(flat) // 3
+        out = (FfcFoothold * max(n, 1))()
+        self._check(getattr(self._lib.lib, fn_name)(h, terrain, _pointer(flat), n, out), fn_name)
+        return self._answers(out, n)
+
+    def snap(self, terrain, points):
+        """The nearest terrain sample to each point: a list of Foothold."""
+        return self._points("ffc_snap", terrain, points)
+
+    def normal(self, terrain, points):
+        """The terrain normal at each point: a list of Foothold."""
+        return self._points("ffc_normal", terrain, points)
+
+    def next(self, terrain, steps, tolerance=0.0):
+        """The next foothold for each step (foot x, y, z, direction x, y, z): a list of
+        Foothold. tolerance <= 0: the candidate radius is the step length."""
+        h = self._handle("ffc_next")
+        flat = _flat(steps, 6, "steps")
+        n = len(flat) // 6
+        out = (FfcFoothold * max(n, 1))()
+        self._check(self._lib.lib.ffc_next(h, terrain, _pointer(flat), n, float(tolerance), out),
+                    "ffc_next")
+        return self._answers(out, n)
+
+    # -- walks --------------------------------------------------------------------------------
+
+    def generate_json(self, terrain, request):
+        """Runs the step generator (as `footfall generate` does) and returns (status, walk JSON
+        text or None, message). request: a dict or JSON text (keys of footfall_c.h)."""
+        h = self._handle("ffc_generate")
+        if not self._lib.has("ffc_generate"):
+            raise FootfallError(INTERNAL_ERROR, "%s has no ffc_generate (an older library)"
+                                % self._lib.path, "ffc_generate")
+        text = request if isinstance(request, str) else json.dumps(request)
+        out = ctypes.c_void_p()
+        status = self._lib.lib.ffc_generate(h, terrain, text.encode(), ctypes.byref(out))
+        walk = None
+        if out.value:
+            try:
+                walk = ctypes.string_at(out.value).decode("utf-8")
+            finally:
+                self._lib.lib.ffc_free_string(out.value)
+        message = self.last_error() if (status != OK or walk is None) else ""
+        return status, walk, message
+
+    def generate(self, terrain, request):
+        """The walk as a dict (footfall's walk JSON). Raises WalkStopped (with .walk holding the
+        keys made so far) when the walk stopped early, FootfallError when nothing was made."""
+        status, text, message = self.generate_json(terrain, request)
+        walk = None
+        if text is not None:
+            try:
+                walk = json.loads(text)
+            except ValueError as e:
+                raise FootfallError(INTERNAL_ERROR, "walk JSON from the library: %s" % e,
+                                    "ffc_generate") from None
+        stopped = walk.get("stopped") if isinstance(walk, dict) else None
+        if status != OK:
+            if walk is not None:
+                raise WalkStopped(status, message or stopped or "walk stopped", walk)
+            raise FootfallError(status, message, "ffc_generate")
+        if walk is None:
+            raise FootfallError(INTERNAL_ERROR, "ffc_generate gave no walk", "ffc_generate")
+        if stopped:
+            raise WalkStopped(NO_FOOTHOLD, message or stopped, walk)
+        return walk
+
+
+INTERNAL_ERROR = 9

@@ -1,0 +1,221 @@
+"""Tests of the shared plugin package footfall_client (plain python3, unittest) against a real
+libfootfall.so and a real footfalld started here on a free loopback port.
+
+Run: FOOTFALL_LIB=build/client/lib/libfootfall.so FOOTFALLD=build/server/service/footfalld \
+     PYTHONPATH=plugins/python python3 -m unittest tests/plugins/python_client_test.py
+"""
+
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(REPO, "plugins", "python"))
+
+import footfall_client as ff  # noqa: E402
+
+HILLS = os.path.join(REPO, "data", "terrain", "hills.pts")
+CHARACTERS = os.environ.get("FOOTFALL_CHARACTERS") or os.path.join(REPO, "data", "characters")
+
+
+def flat_grid(n=21, spacing=0.5, height=0.0):
+    """n x n samples on the plane y = height, normal +Y, as 6-tuples."""
+    return [(i * spacing, height, j * spacing, 0.0, 1.0, 0.0) for i in range(n) for j in range(n)]
+
+
+class EmbeddedTest(unittest.TestCase):
+    def setUp(self):
+        self.s = ff.Session.embedded()
+
+    def tearDown(self):
+        self.s.close()
+
+    def test_samples_load_and_snap(self):
+        t = self.s.load_samples(flat_grid(), "flat")
+        count, bounds = self.s.info(t)
+        self.assertEqual(count, 21 * 21)
+        self.assertEqual(bounds, (0.0, 0.0, 0.0, 10.0, 0.0, 10.0))
+        hold = self.s.snap(t, [(1.1, 3.0, 2.4)])[0]
+        self.assertTrue(hold.ok)
+        self.assertEqual(hold.point, (1.0, 0.0, 2.5))
+        self.assertEqual(hold.normal, (0.0, 1.0, 0.0))
+        # A flat sequence of floats is accepted as well as tuples.
+        self.assertEqual(self.s.snap(t, [1.1, 3.0, 2.4])[0], hold)
+
+    def test_next_steps_forward(self):
+        t = self.s.load_samples(flat_grid(), "flat")
+        hold = self.s.next(t, [(2.0, 0.0, 2.0, 0.0, 0.0, 1.0)])[0]
+        self.assertTrue(hold.ok, hold)
+        self.assertAlmostEqual(hold.point[0], 2.0)
+        self.assertAlmostEqual(hold.point[2], 3.0)
+
+    def test_bad_input_raises_with_status_and_message(self):
+        with self.assertRaises(ff.FootfallError) as e:
+            self.s.load_file(os.path.join(tempfile.gettempdir(), "no-such-terrain.pts"))
+        self.assertEqual(e.exception.status_name, "io_error")
+        self.assertIn("no-such-terrain.pts", e.exception.message)
+        self.assertEqual(e.exception.call, "ffc_load_file")
+        with self.assertRaises(ff.FootfallError) as e:
+            self.s.load_samples([(1, 2, 3)])
+        self.assertEqual(e.exception.status_name, "invalid_argument")
+        with self.assertRaises(ff.FootfallError) as e:
+            self.s.snap(12345, [(0, 0, 0)])
+        self.assertEqual(e.exception.status_name, "unknown_terrain")
+        self.assertTrue(e.exception.message)
+
+    def test_closed_session_raises_instead_of_crashing(self):
+        self.s.close()
+        with self.assertRaises(ff.FootfallError) as e:
+            self.s.snap(0, [(0, 0, 0)])
+        self.assertIn("closed", e.exception.message)
+
+
+class SharedLogicTest(unittest.TestCase):
+    """The pure-Python parts both plugins use: mesh resampling and character files."""
+
+    def test_square_resampled_in_halves(self):
+        pts = [(0, 0, 0), (1, 0, 0), (1, 0, 1), (0, 0, 1)]
+        tris = [(0, 2, 1), (0, 3, 2)]  # counter-clockwise seen from +Y
+        samples = ff.sampling.sample_triangles(pts, tris, 0.75)  # diagonal 1.41: halves
+        self.assertEqual(sorted(s[:3] for s in samples),
+                         sorted((x / 2, 0.0, z / 2) for x in range(3) for z in range(3)))
+        for s in samples:
+            self.assertEqual(s[3:], (0.0, 1.0, 0.0))
+        with ff.Session.embedded() as s:
+            t = s.load_samples(samples, "square")
+            self.assertEqual(s.info(t)[0], 9)
+
+    def test_point_file_round_trips_exactly(self):
+        samples = ff.sampling.sample_triangles([(0, 0.1, 0), (0.3, 0.7, 0), (0, 0.2, 0.9)],
+                                               [(0, 2, 1)], 0.1)
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "t.pts")
+            ff.sampling.write_point_file(path, samples)
+            with ff.Session.embedded() as s:
+                a, b = s.load_file(path), s.load_samples(samples)
+                probe = [p[:3] for p in samples[::7]]
+                self.assertEqual(s.snap(a, probe), s.snap(b, probe))
+
+    def test_separation_must_be_positive(self):
+        with self.assertRaises(ValueError):
+            ff.sampling.sample_triangles([(0, 0, 0)] * 3, [(0, 1, 2)], 0)
+
+    def test_character_pairs_and_overrides(self):
+        data = ff.character.parse(json.dumps({
+            "feet": [{"name": "L", "rest": [0.1, 0, 0]}, {"name": "R", "rest": [-0.1, 0, 0]},
+                     {"name": "T", "rest": [0, 0, -0.5]}],
+            "step_length": 0.6, "frames_per_step": 12}))
+        self.assertEqual(ff.character.pairs(data), [("L_R", ["L", "R"]), ("T", ["T"])])
+        data["pairs"] = [["L"], ["R", "T"]]
+        self.assertEqual(ff.character.pairs(data), [("L", ["L"]), ("R_T", ["R", "T"])])
+        out = ff.character.with_overrides(data, step_length=0.8, step_height=0, frames_per_step=9)
+        self.assertEqual((out["step_length"], out["frames_per_step"]), (0.8, 9))
+        self.assertNotIn("step_height", out)
+        self.assertEqual(data["step_length"], 0.6)
+        with self.assertRaises(ff.FootfallError) as e:
+            ff.character.parse('{"feet": [{"name": "L"}]}', "bad.json")
+        self.assertIn("bad.json: feet[0]", e.exception.message)
+
+
+class RpcTest(unittest.TestCase):
+    def setUp(self):
+        self.server = ff.LocalServer().start()
+        self.s = ff.Session.rpc("127.0.0.1", self.server.port, timeout=5.0)
+
+    def tearDown(self):
+        self.s.close()
+        self.server.stop()
+
+    def test_rpc_answers_equal_embedded(self):
+        t = self.s.load_file(HILLS)
+        with ff.Session.embedded() as local:
+            lt = local.load_file(HILLS)
+            self.assertEqual(self.s.info(t), local.info(lt))
+            points = [(x * 0.7 + 1, 5.0, x * 0.9 + 2) for x in range(40)]
+            self.assertEqual(self.s.snap(t, points), local.snap(lt, points))
+            self.assertEqual(self.s.normal(t, points), local.normal(lt, points))
+            steps = [(p[0], 0.5, p[2], 1.0, 0.0, 0.0) for p in points]
+            self.assertEqual(self.s.next(t, steps, 0.3), local.next(lt, steps, 0.3))
+
+    def test_server_killed_then_restarted(self):
+        t = self.s.load_samples(flat_grid(), "flat")
+        self.assertTrue(self.s.ping())
+        self.assertTrue(self.s.snap(t, [(1, 1, 1)])[0].ok)
+        self.server.kill()
+        for _ in range(3):  # repeated calls on a dead server keep failing cleanly
+            with self.assertRaises(ff.FootfallError) as e:
+                self.s.snap(t, [(1, 1, 1)])
+            self.assertEqual(e.exception.status_name, "unavailable")
+            self.assertIn(str(self.server.port), e.exception.message)
+        self.assertFalse(self.s.ping())
+        self.server.restart()
+        self.assertTrue(self.s.ping())
+        # The same session works again; its terrain is uploaded again by the client library.
+        hold = self.s.snap(t, [(1.1, 1, 2.4)])[0]
+        self.assertTrue(hold.ok, hold)
+        self.assertEqual(hold.point, (1.0, 0.0, 2.5))
+
+    def test_no_server_is_a_clear_error(self):
+        port = self.server.port
+        self.server.stop()
+        with ff.Session.rpc("127.0.0.1", port, timeout=2.0) as s:
+            with self.assertRaises(ff.FootfallError) as e:
+                s.load_samples(flat_grid(3), "flat")
+            self.assertEqual(e.exception.status_name, "unavailable")
+            self.assertFalse(s.ping())
+
+    def test_bad_port_is_rejected(self):
+        with self.assertRaises(ff.FootfallError):
+            ff.Session.rpc("127.0.0.1", 70000)
+
+
+class GenerateTest(unittest.TestCase):
+    """ffc_generate over RPC gives the same walk JSON as `footfall generate`."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.cli = os.environ.get("FOOTFALL_CLI") or os.path.join(REPO, "build", "client", "cli",
+                                                                   "footfall")
+        cls.server = ff.LocalServer().start()
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.server.stop()
+
+    def test_generate_matches_cli(self):
+        character = os.path.join(CHARACTERS, "biped.json")  # hills: 0.25 m samples
+        self.assertTrue(os.path.isfile(character), character)
+        with ff.Session.rpc("127.0.0.1", self.server.port) as s:
+            t = s.load_file(HILLS)
+            request = {"character_file": character, "start": [20.0, 0.0, 12.0],
+                       "heading": [0.0, 0.0, 1.0], "steps": 6, "start_frame": 1}
+            walk = s.generate(t, request)
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "walk.json")
+            subprocess.run([self.cli, "generate", "--terrain", HILLS, "--character", character,
+                            "--start", "20,0,12", "--heading", "0,0,1", "--steps", "6",
+                            "--start-frame", "1", "--out", out], check=True)
+            with open(out) as f:
+                expected = json.load(f)
+        self.assertEqual(walk, expected)
+        feet = [tr for tr in walk["tracks"] if tr["kind"] == "foot"]
+        self.assertEqual(len(feet), 2)
+        for track in feet:
+            for key in track["keys"]:
+                self.assertTrue(all(math.isfinite(v) for v in key["position"]))
+
+    def test_generate_bad_request_raises(self):
+        with ff.Session.rpc("127.0.0.1", self.server.port) as s:
+            t = s.load_file(HILLS)
+            with self.assertRaises(ff.FootfallError) as e:
+                s.generate(t, "{not json")
+            self.assertIn(e.exception.status_name, ("invalid_argument", "parse_error"))
+
+
+if __name__ == "__main__":
+    unittest.main()
