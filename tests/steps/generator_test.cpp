@@ -2,11 +2,14 @@
 // sphere, a wall, a path with a 90-degree turn, a cliff, crowds. Every walk is checked against
 // the invariants of walk_checks.h.
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
 #include <string>
 
 #include <catch2/catch.hpp>
 
 #include "footfall/import/terrain_generators.h"
+#include "footfall/import/terrain_loader.h"
 #include "walk_checks.h"
 
 using namespace footfall;
@@ -428,4 +431,40 @@ TEST_CASE("Bad options are refused with a message", "[steps][generator]") {
   o = GenerateOptions{};
   CHECK(GenerateWalk(*t.session, t.handle + 99, c, o, &w, &error) == Status::kUnknownTerrain);
   CHECK_THAT(error, Catch::Contains("handle"));
+}
+
+TEST_CASE("A multiped walks over the Spot mesh, a closed surface with overhangs",
+          "[steps][generator][shared-data]") {
+  // Real data from ../shared/data: Keenan Crane's Spot (public domain), resampled by
+  // footfall::import and scaled by 2 to a 3.4 m cow for a 30 cm insect.
+  const std::string path = FOOTFALL_SOURCE_DIR "/../shared/data/terrain/mesh_spot_triangulated.obj";
+  std::ifstream probe(path);
+  if (!probe) {
+    if (std::getenv("CI")) FAIL("shared data missing in CI: " << path);
+    WARN("skipped: shared data not found at " << path << " (CI is unset)");
+    return;
+  }
+  const Character c = LoadShipped("hexapod");
+  constexpr double kScale = 2;
+  const double spacing = c.step_length / 10;
+  TerrainLoadOptions load;
+  load.separation = spacing / kScale;
+  RawSamples samples;
+  std::string error;
+  REQUIRE(footfall::LoadTerrain(path, load, &samples, &error) == Status::kOk);
+  for (Vec3& p : samples.points) p = p * kScale;
+  Terrain t = test::LoadTerrain(samples, spacing);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {0, 1.4, -0.2};  // on the back
+  o.heading = {0, 0, -1};    // toward the tail, over it and under the belly
+  o.steps = 60;
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CheckWalk(t, c, o, w);
+  CHECK(StepsDone(w) >= 30);
+  // It went over the rump: the body turned past vertical at some point.
+  double most_down = 1;
+  for (const WalkKey& k : Body(w).keys) most_down = std::min(most_down, BodyUp(k).y);
+  CHECK(most_down < 0);
 }
