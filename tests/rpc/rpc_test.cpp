@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <netinet/in.h>
 #include <signal.h>
+#include <sys/wait.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -380,6 +381,21 @@ TEST_CASE("clients report a dead server and recover after a restart", "[rpc][rob
     CHECK(nobody->LoadSamples(terrain, "x", &h) == Status::kUnavailable);
     CHECK(nobody->last_error().find("Connection refused") != std::string::npos);
   }
+}
+
+TEST_CASE("footfalld stops cleanly on SIGTERM, also with clients connected", "[rpc]") {
+  ServerProcess server;
+  auto rpc = Connect(server.port());
+  TerrainHandle t = 0;
+  REQUIRE(rpc->LoadSamples(MakeFlat(10, 1, 0), "flat", &t) == Status::kOk);
+  const int idle = RawConnect(server.port());  // a connection that stays open
+  const int status = server.Terminate();
+  close(idle);
+  REQUIRE(status != -1);
+  CHECK(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 0);
+  CHECK(server.Log().find("footfalld: stopped") != std::string::npos);
+  CHECK(rpc->Snap(t, Vec3{1, 0, 1}).status == Status::kUnavailable);
 }
 
 TEST_CASE("footfalld registers with rpcbind and answers rpcinfo", "[rpc][rpcbind]") {

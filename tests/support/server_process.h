@@ -22,6 +22,8 @@ class ServerProcess {
   pid_t pid() const { return pid_; }
   // Sends SIGKILL and reaps the process.
   void Kill();
+  // Sends SIGTERM and waits up to 5 s; returns the wait status, or -1 if it did not exit.
+  int Terminate();
   // Resident memory of the server process, in KiB.
   long RssKiB() const;
   // Everything the server wrote to stderr so far.
