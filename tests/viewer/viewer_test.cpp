@@ -309,10 +309,11 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
   SECTION("malformed query strings") {
     RunResult r = View({"--terrain", kTerrain, "--query", "next 1 2 3", "--screenshot", shot});
     CHECK(r.exit_code == 2);
-    CHECK_THAT(r.err, Catch::Contains("next: expected 6 numbers (X Y Z DX DY DZ), found 3"));
+    CHECK_THAT(r.err, Catch::Contains("--query \"next 1 2 3\": next: expected 6 numbers, found 3"));
     r = View({"--terrain", kTerrain, "--query", "jump 1 2 3", "--screenshot", shot});
     CHECK(r.exit_code == 2);
-    CHECK_THAT(r.err, Catch::Contains("unknown query 'jump'"));
+    CHECK_THAT(r.err, Catch::Contains("unknown command 'jump' (expected snap X Y Z, normal X Y Z "
+                                      "or next X Y Z DX DY DZ)"));
     r = View({"--terrain", kTerrain, "--query", "snap 1 nan 3", "--screenshot", shot});
     CHECK(r.exit_code == 2);
     CHECK_THAT(r.err, Catch::Contains("argument 2 'nan' is not a finite number"));
@@ -369,19 +370,17 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
   CHECK_FALSE(none.good());  // no failed run leaves a screenshot
 }
 
-TEST_CASE("query strings parse into queries", "[viewer][query]") {
-  viewer::QuerySpec spec;
-  std::string error;
-  REQUIRE(viewer::ParseQuerySpec("next 1 2 3 0.5,0,-0.5", &spec, &error));
-  CHECK(spec.op == QueryOp::kNext);
-  CHECK(spec.direction.z == -0.5);
-  CHECK(viewer::FormatQuerySpec(spec) == "next 1 2 3 0.5 0 -0.5");
-  REQUIRE(viewer::ParseQuerySpec("  normal 1 2 3 ", &spec, &error));
-  CHECK(spec.op == QueryOp::kNormal);
-  CHECK_FALSE(viewer::ParseQuerySpec("", &spec, &error));
-  CHECK_THAT(error, Catch::Contains("empty query"));
-  CHECK_FALSE(viewer::ParseQuerySpec("snap 1 2 3 4", &spec, &error));
-  CHECK(error == "snap: expected 3 numbers (X Y Z), found 4");
+TEST_CASE("comma-separated --query numbers are drawn like spaced ones", "[viewer][query]") {
+  const std::string dir = test::TempDir();
+  const RunResult r = View({"--terrain", kTerrain, "--query", "next 10,1,10 1.2,0,0.3",
+                            "--size", "160x100", "--screenshot", dir + "/shot.png",
+                            "--dump-state", dir + "/state.json"});
+  REQUIRE(r.exit_code == 0);
+  const json state = json::parse(test::ReadFile(dir + "/state.json"));
+  REQUIRE(state["queries"].size() == 1);
+  CHECK(state["queries"][0]["query"] == "next 10 1 10 1.2 0 0.3");
+  CHECK(state["queries"][0]["op"] == "next");
+  CHECK(state["queries"][0]["candidates"].get<int>() > 0);
 }
 
 TEST_CASE("walk poses follow keys and swing arcs", "[viewer][walk]") {

@@ -291,7 +291,7 @@ ordered_json Scene::Describe(const ViewState& view, const OrbitCamera& camera, i
   };
   auto query_json = [&](const QueryView& q) {
     ordered_json j;
-    j["query"] = FormatQuerySpec(q.spec);
+    j["query"] = FormatQueryText(q.spec);
     j["op"] = QueryOpName(q.spec.op);
     if (q.live) j["sequence"] = q.sequence;
     j["status"] = StatusName(q.result.status);
