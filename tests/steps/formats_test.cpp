@@ -92,7 +92,8 @@ TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]")
       {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"b","kind":"body","keys":[{"frame":1,"position":[0,0,0],"rotation":[0,0,0,0]}]}]})", "w.json: tracks[0].keys[0].rotation: expected a non-zero quaternion"},
       {"[1, 2]", "w.json: not a JSON object"},
       {"{\"format\": \"footfall-walk\",\n \"tracks\": [\n", "w.json:3:1: malformed JSON: syntax error"},
-      {"{\"format\": \"footfall-walk\",\n \"fps\": 24 24}", "w.json:2:12: malformed JSON: syntax error"},
+      // The position is the last character the parser read: the end of the unexpected "24".
+      {"{\"format\": \"footfall-walk\",\n \"fps\": 24 24}", "w.json:2:13: malformed JSON: syntax error"},
   };
   for (const auto& [input, message] : bad) {
     INFO(message);
