@@ -77,6 +77,20 @@ TEST_CASE("malformed query lines say what was expected", "[client][query_text]")
   }
 }
 
+TEST_CASE("number tokens are whole finite decimals", "[client][query_text]") {
+  double v = 7;
+  CHECK(ParseFiniteNumber("-2.5e-1", &v));
+  CHECK(v == -0.25);
+  CHECK(ParseFiniteNumber("+3", &v));
+  CHECK(v == 3);
+  for (const char* bad : {"", "+", "x", "3x", " 3", "++3", "nan", "inf", "-inf", "1e999", "0x10"}) {
+    INFO("'" << bad << "'");
+    v = 7;
+    CHECK_FALSE(ParseFiniteNumber(bad, &v));
+    CHECK(v == 7);  // left alone
+  }
+}
+
 TEST_CASE("query ops have stable names", "[client][query_text]") {
   CHECK(std::string(QueryOpName(QueryOp::kSnap)) == "snap");
   CHECK(std::string(QueryOpName(QueryOp::kNormal)) == "normal");

@@ -10,15 +10,18 @@ namespace {
 
 constexpr const char* kForms = "snap X Y Z, normal X Y Z or next X Y Z DX DY DZ";
 
-bool ParseNumber(const std::string& token, double* value) {
+}  // namespace
+
+bool ParseFiniteNumber(const std::string& token, double* value) {
   const char* first = token.data();
   const char* last = first + token.size();
   if (first != last && *first == '+') ++first;
-  const auto [ptr, ec] = std::from_chars(first, last, *value);
-  return ec == std::errc() && ptr == last && std::isfinite(*value);
+  double v = 0;
+  const auto [ptr, ec] = std::from_chars(first, last, v);
+  if (ec != std::errc() || ptr != last || !std::isfinite(v)) return false;
+  *value = v;
+  return true;
 }
-
-}  // namespace
 
 const char* QueryOpName(QueryOp op) {
   switch (op) {
@@ -61,7 +64,7 @@ bool ParseQueryText(const std::string& text, QueryText* out, std::string* error)
   }
   double v[6] = {0, 0, 0, 0, 0, 0};
   for (size_t i = 0; i < want; ++i) {
-    if (!ParseNumber(tokens[i + 1], &v[i])) {
+    if (!ParseFiniteNumber(tokens[i + 1], &v[i])) {
       *error = op + ": argument " + std::to_string(i + 1) + " '" + tokens[i + 1] +
                "' is not a finite number";
       return false;

@@ -21,6 +21,10 @@ struct QueryText {
   Vec3 direction;  // world space, next only: non-zero, its length is the step length
 };
 
+// Parses one whole token as a finite decimal number ("1.5", "-2", "+3e1"): false for anything
+// else, including "nan", "inf", out-of-range values and trailing characters.
+bool ParseFiniteNumber(const std::string& token, double* value);
+
 // Parses one query line (no comments: callers strip them). Numbers are finite decimals, with an
 // optional leading '+'. On failure returns false, leaves *out alone and sets *error to one line
 // saying what was expected, e.g. "normal: expected 3 numbers, found 2",
