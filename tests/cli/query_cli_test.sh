@@ -29,15 +29,17 @@ check "next answer" grep -qx '{"op":"next","found":true,"index":16,"point":\[1.0
 check "no foothold" grep -qx '{"op":"next","found":false}' <(sed -n 4p "$work/out.jsonl")
 
 # 2. Malformed lines give an error object with the line number; the run goes on; exit non-zero.
-printf 'snap 1 0 1\nsnap 1 x 1\n\njump 1 2 3\nnext 0 0 0 0 0 0\nsnap 2 0 2\n' |
+printf 'snap 1 0 1\nsnap 1 x 1\n\njump 1 2 3\nnext 0 0 0 0 0 0\nsnap 2 0 2\nnormal 4 4 # short\nsnap 2,0, 2\n' |
   "$footfall" query --terrain "$work/flat.pts" > "$work/out.jsonl"
 rc=$?
 check "malformed lines exit 1" [ "$rc" -eq 1 ]
-check "six lines give five answers" [ "$(wc -l < "$work/out.jsonl")" -eq 5 ]
+check "eight lines give seven answers" [ "$(wc -l < "$work/out.jsonl")" -eq 7 ]
 check "bad number" grep -q '{"op":"error","line":2,"message":"snap: argument 2 '"'"'x'"'"' is not a finite number"}' "$work/out.jsonl"
-check "unknown command" grep -q '"line":4,"message":"unknown command '"'"'jump'"'"'' "$work/out.jsonl"
+check "unknown command" grep -qF '"line":4,"message":"unknown command '"'"'jump'"'"' (expected snap X Y Z, normal X Y Z or next X Y Z DX DY DZ)"}' "$work/out.jsonl"
 check "zero direction" grep -q '"line":5,"message":"next: direction DX DY DZ must be non-zero"' "$work/out.jsonl"
 check "answers after errors" grep -q '"op":"snap","found":true,"index":12' <(sed -n 5p "$work/out.jsonl")
+check "count" grep -qF '{"op":"error","line":7,"message":"normal: expected 3 numbers, found 2"}' <(sed -n 6p "$work/out.jsonl")
+check "commas separate numbers" grep -q '"op":"snap","found":true,"index":12' <(sed -n 7p "$work/out.jsonl")
 
 # 3. Bad terrain files: the documented message and a non-zero exit, never a crash.
 bad() {  # bad NAME CONTENT EXPECTED_MESSAGE

@@ -88,7 +88,12 @@ TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]")
       {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","keys":[{"frame":1,"phase":"up","position":[0,0,0]}]}]})", "tracks[0].keys[0].phase: expected"},
       {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","keys":[{"frame":1,"phase":"end","position":[0,0]}]}]})", "tracks[0].keys[0].position: expected an array of 3 numbers"},
       {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"b","kind":"body","keys":[{"frame":2,"position":[0,0,0]},{"frame":1,"position":[0,0,0]}]}]})", "tracks[0].keys[1].frame: frames must increase"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"b","kind":"body","keys":[{"frame":1,"position":[0,0,0]},{"frame":1,"position":[1,0,0]}]}]})", "tracks[0].keys[1].frame: frames must increase"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"b","kind":"body","keys":[{"frame":1,"position":[0,0,0],"rotation":[0,0,0,0]}]}]})", "w.json: tracks[0].keys[0].rotation: expected a non-zero quaternion"},
       {"[1, 2]", "w.json: not a JSON object"},
+      {"{\"format\": \"footfall-walk\",\n \"tracks\": [\n", "w.json:3:1: malformed JSON: syntax error"},
+      // The position is the last character the parser read: the end of the unexpected "24".
+      {"{\"format\": \"footfall-walk\",\n \"fps\": 24 24}", "w.json:2:13: malformed JSON: syntax error"},
   };
   for (const auto& [input, message] : bad) {
     INFO(message);

@@ -15,11 +15,11 @@
 #include <stb/stb_image.h>
 
 #include "footfall/import/terrain_loader.h"
+#include "footfall/steps/walk_json.h"
 #include "footfall/terrain/brute_force.h"
 #include "footfall/terrain/grid.h"
 #include "footfall/viewer/query_view.h"
 #include "footfall/viewer/walk_pose.h"
-#include "footfall/viewer/walk_reader.h"
 #include "process.h"
 
 namespace footfall {
@@ -185,7 +185,7 @@ TEST_CASE("height colouring and grid cells change the picture", "[viewer][screen
 std::string WalkJson() {
   // L1 steps from (2, 0, 2) over an arc to (4, 0, 2) during frames 1-13; R1 from (2, 0, 0)
   // to (4, 0, 0) during frames 13-25. The body moves along x between them.
-  return R"({"fps": 24, "tracks": [
+  return R"({"format": "footfall-walk", "version": 1, "fps": 24, "tracks": [
     {"name": "L1", "kind": "foot", "keys": [
       {"frame": 1, "phase": "start", "position": [2, 0, 2], "normal": [0, 1, 0]},
       {"frame": 7, "phase": "mid", "position": [3, 0.5, 2], "normal": [0, 1, 0]},
@@ -196,7 +196,15 @@ std::string WalkJson() {
       {"frame": 25, "phase": "end", "position": [4, 0, 0], "normal": [0, 1, 0]}]},
     {"name": "body", "kind": "body", "keys": [
       {"frame": 1, "position": [2, 1, 1], "rotation": [0, 0, 0, 1]},
-      {"frame": 25, "position": [4, 1, 1], "rotation": [0, 0, 0, 1]}]}]})";
+      {"frame": 25, "position": [4, 1, 1], "rotation": [0, 0, 0, 2]}]}]})";
+}
+
+// A valid walk but for L1's second key, which comes before its first.
+std::string DescendingWalkJson() {
+  return R"({"format": "footfall-walk", "version": 1, "fps": 24, "tracks": [
+    {"name": "L1", "kind": "foot", "keys": [
+      {"frame": 5, "phase": "start", "position": [0, 0, 0]},
+      {"frame": 2, "phase": "end", "position": [1, 0, 0]}]}]})";
 }
 
 TEST_CASE("screenshot of a walk shows the feet where the JSON puts them at that frame",
@@ -230,6 +238,9 @@ TEST_CASE("screenshot of a walk shows the feet where the JSON puts them at that 
       CHECK(state["walk"]["tracks"][0]["name"] == "L1");
       CHECK(state["walk"]["tracks"][0]["position"][0].get<double>() == Approx(c.l1.x));
       CHECK(state["walk"]["tracks"][0]["position"][1].get<double>() == Approx(c.l1.y));
+      // The file's last body rotation is [0, 0, 0, 2]: drawn as the unit quaternion.
+      CHECK(state["walk"]["tracks"][2]["kind"] == "body");
+      CHECK(state["walk"]["tracks"][2]["rotation"][3].get<double>() == Approx(1));
     }
   }
 }
@@ -298,10 +309,11 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
   SECTION("malformed query strings") {
     RunResult r = View({"--terrain", kTerrain, "--query", "next 1 2 3", "--screenshot", shot});
     CHECK(r.exit_code == 2);
-    CHECK_THAT(r.err, Catch::Contains("next: expected 6 numbers (X Y Z DX DY DZ), found 3"));
+    CHECK_THAT(r.err, Catch::Contains("--query \"next 1 2 3\": next: expected 6 numbers, found 3"));
     r = View({"--terrain", kTerrain, "--query", "jump 1 2 3", "--screenshot", shot});
     CHECK(r.exit_code == 2);
-    CHECK_THAT(r.err, Catch::Contains("unknown query 'jump'"));
+    CHECK_THAT(r.err, Catch::Contains("unknown command 'jump' (expected snap X Y Z, normal X Y Z "
+                                      "or next X Y Z DX DY DZ)"));
     r = View({"--terrain", kTerrain, "--query", "snap 1 nan 3", "--screenshot", shot});
     CHECK(r.exit_code == 2);
     CHECK_THAT(r.err, Catch::Contains("argument 2 'nan' is not a finite number"));
@@ -318,15 +330,27 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     RunResult r = View({"--walk", dir + "/none.json", "--screenshot", shot});
     CHECK(r.exit_code == 1);
     CHECK_THAT(r.err, Catch::Contains(dir + "/none.json: cannot open walk file"));
-    test::WriteFile(dir + "/broken.json", "{\"fps\": 24,\n \"tracks\": [\n");
+    test::WriteFile(dir + "/broken.json",
+                    "{\"format\": \"footfall-walk\", \"version\": 1, \"fps\": 24,\n \"tracks\": [\n");
     r = View({"--walk", dir + "/broken.json", "--screenshot", shot});
     CHECK(r.exit_code == 1);
-    CHECK_THAT(r.err, Catch::Contains(dir + "/broken.json:3:1: malformed JSON"));
-    test::WriteFile(dir + "/shape.json",
-                    R"({"tracks": [{"name": "L1", "keys": [{"frame": 1, "position": [1, 2]}]}]})");
+    CHECK_THAT(r.err, Catch::Contains(dir + "/broken.json:3:1: malformed JSON: syntax error"));
+    test::WriteFile(dir + "/shape.json", R"({"format": "footfall-walk", "version": 1, "fps": 24,
+        "tracks": [{"name": "L1", "kind": "foot", "keys": [
+          {"frame": 1, "phase": "start", "position": [1, 2]}]}]})");
     r = View({"--walk", dir + "/shape.json", "--screenshot", shot});
     CHECK(r.exit_code == 1);
-    CHECK_THAT(r.err, Catch::Contains("tracks[0].keys[0].position: expected an array of 3"));
+    CHECK_THAT(r.err, Catch::Contains(dir + "/shape.json: tracks[0].keys[0].position: "
+                                      "expected an array of 3 numbers"));
+    test::WriteFile(dir + "/plain.json", R"({"fps": 24, "tracks": []})");
+    r = View({"--walk", dir + "/plain.json", "--screenshot", shot});
+    CHECK(r.exit_code == 1);
+    CHECK_THAT(r.err, Catch::Contains(dir + "/plain.json: format: expected \"footfall-walk\""));
+    test::WriteFile(dir + "/descending.json", DescendingWalkJson());
+    r = View({"--walk", dir + "/descending.json", "--screenshot", shot});
+    CHECK(r.exit_code == 1);
+    CHECK_THAT(r.err, Catch::Contains(dir + "/descending.json: tracks[0].keys[1].frame: "
+                                      "frames must increase along a track"));
   }
   SECTION("bad sizes and missing content") {
     RunResult r = View({"--terrain", kTerrain, "--size", "12by4", "--screenshot", shot});
@@ -346,19 +370,17 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
   CHECK_FALSE(none.good());  // no failed run leaves a screenshot
 }
 
-TEST_CASE("query strings parse into queries", "[viewer][query]") {
-  viewer::QuerySpec spec;
-  std::string error;
-  REQUIRE(viewer::ParseQuerySpec("next 1 2 3 0.5,0,-0.5", &spec, &error));
-  CHECK(spec.op == QueryOp::kNext);
-  CHECK(spec.direction.z == -0.5);
-  CHECK(viewer::FormatQuerySpec(spec) == "next 1 2 3 0.5 0 -0.5");
-  REQUIRE(viewer::ParseQuerySpec("  normal 1 2 3 ", &spec, &error));
-  CHECK(spec.op == QueryOp::kNormal);
-  CHECK_FALSE(viewer::ParseQuerySpec("", &spec, &error));
-  CHECK_THAT(error, Catch::Contains("empty query"));
-  CHECK_FALSE(viewer::ParseQuerySpec("snap 1 2 3 4", &spec, &error));
-  CHECK(error == "snap: expected 3 numbers (X Y Z), found 4");
+TEST_CASE("comma-separated --query numbers are drawn like spaced ones", "[viewer][query]") {
+  const std::string dir = test::TempDir();
+  const RunResult r = View({"--terrain", kTerrain, "--query", "next 10,1,10 1.2,0,0.3",
+                            "--size", "160x100", "--screenshot", dir + "/shot.png",
+                            "--dump-state", dir + "/state.json"});
+  REQUIRE(r.exit_code == 0);
+  const json state = json::parse(test::ReadFile(dir + "/state.json"));
+  REQUIRE(state["queries"].size() == 1);
+  CHECK(state["queries"][0]["query"] == "next 10 1 10 1.2 0 0.3");
+  CHECK(state["queries"][0]["op"] == "next");
+  CHECK(state["queries"][0]["candidates"].get<int>() > 0);
 }
 
 TEST_CASE("walk poses follow keys and swing arcs", "[viewer][walk]") {
@@ -366,9 +388,10 @@ TEST_CASE("walk poses follow keys and swing arcs", "[viewer][walk]") {
   test::WriteFile(dir + "/walk.json", WalkJson());
   Walk walk;
   std::string error;
-  REQUIRE(viewer::ReadWalkJson(dir + "/walk.json", &walk, &error) == Status::kOk);
+  REQUIRE(ReadWalkJson(dir + "/walk.json", &walk, &error) == Status::kOk);
   REQUIRE(walk.tracks.size() == 3);
   CHECK(walk.tracks[2].kind == TrackKind::kBody);
+  CHECK(walk.tracks[2].keys[1].rotation.w == 2);  // the reader keeps rotations as written
   const WalkTrack& l1 = walk.tracks[0];
   SECTION("keys are hit exactly and the foot holds outside its keys") {
     CHECK(viewer::PoseAt(l1, 1).position == Vec3{2, 0, 2});
@@ -395,12 +418,11 @@ TEST_CASE("walk poses follow keys and swing arcs", "[viewer][walk]") {
 
 TEST_CASE("walk files with descending frames are refused", "[viewer][walk]") {
   const std::string dir = test::TempDir();
-  test::WriteFile(dir + "/w.json", R"({"fps": 24, "tracks": [{"name": "L1", "keys": [
-      {"frame": 5, "position": [0, 0, 0]}, {"frame": 2, "position": [1, 0, 0]}]}]})");
+  test::WriteFile(dir + "/w.json", DescendingWalkJson());
   Walk walk;
   std::string error;
-  CHECK(viewer::ReadWalkJson(dir + "/w.json", &walk, &error) == Status::kParseError);
-  CHECK_THAT(error, Catch::Contains("tracks[0].keys[1].frame: frames must ascend"));
+  CHECK(ReadWalkJson(dir + "/w.json", &walk, &error) == Status::kParseError);
+  CHECK(error == dir + "/w.json: tracks[0].keys[1].frame: frames must increase along a track");
 }
 
 }  // namespace

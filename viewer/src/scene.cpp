@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "footfall/steps/walk_json.h"
 #include "footfall/viewer/walk_pose.h"
-#include "footfall/viewer/walk_reader.h"
 
 namespace footfall::viewer {
 namespace {
@@ -100,6 +100,14 @@ Status Scene::LoadWalk(const std::string& path, std::string* error) {
   Walk walk;
   const Status s = ReadWalkJson(path, &walk, error);
   if (s != Status::kOk) return s;
+  // The reader keeps rotations as written (non-zero); poses and axes want unit quaternions.
+  for (WalkTrack& t : walk.tracks) {
+    for (WalkKey& k : t.keys) {
+      Quat& q = k.rotation;
+      const double n = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+      q = {q.x / n, q.y / n, q.z / n, q.w / n};
+    }
+  }
   walk_ = std::move(walk);
   walk_path_ = path;
   FrameRange(walk_, &first_frame_, &last_frame_);
@@ -283,7 +291,7 @@ ordered_json Scene::Describe(const ViewState& view, const OrbitCamera& camera, i
   };
   auto query_json = [&](const QueryView& q) {
     ordered_json j;
-    j["query"] = FormatQuerySpec(q.spec);
+    j["query"] = FormatQueryText(q.spec);
     j["op"] = QueryOpName(q.spec.op);
     if (q.live) j["sequence"] = q.sequence;
     j["status"] = StatusName(q.result.status);
@@ -343,6 +351,9 @@ ordered_json Scene::Describe(const ViewState& view, const OrbitCamera& camera, i
         const Rgba c = FootColor(foot_index++);
         j["color"] = ordered_json::array({c.r, c.g, c.b});
         j["swinging"] = pose.swinging;
+      } else {
+        const Quat& q = pose.rotation;
+        j["rotation"] = ordered_json::array({q.x, q.y, q.z, q.w});
       }
       w["tracks"].push_back(j);
     }

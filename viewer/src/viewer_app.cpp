@@ -372,7 +372,7 @@ int RunViewer(const ViewerOptions& options) {
   for (const std::string& text : options.queries) {
     QuerySpec spec;
     std::string error;
-    if (!ParseQuerySpec(text, &spec, &error))
+    if (!ParseQueryText(text, &spec, &error))
       return Fail("--query \"" + text + "\": " + error, 2);
     spec.tolerance = options.tolerance;
     specs.push_back(spec);

@@ -2,7 +2,6 @@
 // the keyed walk as JSON, glTF (.gltf, .glb) or a Maya MEL script.
 #include <unistd.h>
 
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +11,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "footfall/client/query_text.h"
 #include "footfall/export/walk_writer.h"
 #include "footfall/steps/generator.h"
 #include "footfall/steps/walk_json.h"
@@ -33,14 +33,6 @@ struct GenerateFlags {
   std::vector<std::string> out;
 };
 
-bool ParseNumber(const std::string& token, double* value) {
-  const char* first = token.data();
-  const char* last = first + token.size();
-  if (first != last && *first == '+') ++first;
-  const auto [ptr, ec] = std::from_chars(first, last, *value);
-  return ec == std::errc() && ptr == last && std::isfinite(*value);
-}
-
 // "X,Y,Z" into *out; false with a message naming the flag.
 bool ParseVec(const std::string& text, const std::string& flag, Vec3* out, std::string* error) {
   std::vector<double> v;
@@ -48,7 +40,7 @@ bool ParseVec(const std::string& text, const std::string& flag, Vec3* out, std::
   std::istringstream in(text);
   while (std::getline(in, token, ',')) {
     double x;
-    if (!ParseNumber(token, &x)) {
+    if (!ParseFiniteNumber(token, &x)) {
       *error = flag + " '" + text + "': '" + token + "' is not a finite number (expected X,Y,Z)";
       return false;
     }

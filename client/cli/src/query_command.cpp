@@ -2,79 +2,33 @@
 #include <poll.h>
 #include <unistd.h>
 
-#include <charconv>
 #include <iostream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "footfall/client/query_text.h"
 #include "terrain_flags.h"
 
 namespace footfall::cli {
 namespace {
 
-enum class Op { kSnap, kNormal, kNext };
-
+// One stdin line that holds a command.
 struct Command {
   size_t line = 0;
-  Op op = Op::kSnap;
-  Vec3 a, b;
+  QueryText query;
   std::string error;  // non-empty: the line was malformed
 };
 
-const char* OpName(Op op) {
-  return op == Op::kSnap ? "snap" : op == Op::kNormal ? "normal" : "next";
-}
-
-bool ParseNumber(const std::string& token, double* value) {
-  const char* first = token.data();
-  const char* last = first + token.size();
-  if (first != last && *first == '+') ++first;
-  const auto [ptr, ec] = std::from_chars(first, last, *value);
-  return ec == std::errc() && ptr == last && std::isfinite(*value);
-}
-
 // Parses one command line; returns false for blank and comment lines.
 bool ParseCommand(const std::string& text, size_t line, Command* out) {
-  std::istringstream in(text.substr(0, text.find('#')));
-  std::vector<std::string> tokens;
-  for (std::string t; in >> t;) tokens.push_back(t);
-  if (tokens.empty()) return false;
+  const std::string command = text.substr(0, text.find('#'));
+  if (command.find_first_not_of(" \t\r\v\f") == std::string::npos) return false;
   *out = Command{};
   out->line = line;
-  const std::string& op = tokens[0];
-  size_t want;
-  if (op == "snap") {
-    out->op = Op::kSnap, want = 3;
-  } else if (op == "normal") {
-    out->op = Op::kNormal, want = 3;
-  } else if (op == "next") {
-    out->op = Op::kNext, want = 6;
-  } else {
-    out->error = "unknown command '" + op + "' (expected snap X Y Z, normal X Y Z or next X Y Z DX DY DZ)";
-    return true;
-  }
-  if (tokens.size() - 1 != want) {
-    out->error = op + ": expected " + std::to_string(want) + " numbers, found " +
-                 std::to_string(tokens.size() - 1);
-    return true;
-  }
-  double v[6];
-  for (size_t i = 0; i < want; ++i) {
-    if (!ParseNumber(tokens[i + 1], &v[i])) {
-      out->error = op + ": argument " + std::to_string(i + 1) + " '" + tokens[i + 1] +
-                   "' is not a finite number";
-      return true;
-    }
-  }
-  out->a = {v[0], v[1], v[2]};
-  if (want == 6) {
-    out->b = {v[3], v[4], v[5]};
-    if (Length2(out->b) == 0) out->error = "next: direction DX DY DZ must be non-zero";
-  }
+  ParseQueryText(command, &out->query, &out->error);
   return true;
 }
 
@@ -92,8 +46,8 @@ bool RunBlock(TerrainSession& session, TerrainHandle terrain, double tolerance,
   std::vector<StepQuery> steps;
   for (const Command& c : block) {
     if (!c.error.empty()) continue;
-    if (c.op == Op::kNext) steps.push_back({c.a, c.b});
-    else points.push_back(c.a);
+    if (c.query.op == QueryOp::kNext) steps.push_back({c.query.point, c.query.direction});
+    else points.push_back(c.query.point);
   }
   std::vector<Foothold> point_answers(points.size()), step_answers(steps.size());
   Status ps = points.empty() ? Status::kOk
@@ -112,20 +66,20 @@ bool RunBlock(TerrainSession& session, TerrainHandle terrain, double tolerance,
       j = {{"op", "error"}, {"line", c.line}, {"message", c.error}};
       ok = false;
     } else {
-      const bool next = c.op == Op::kNext;
+      const bool next = c.query.op == QueryOp::kNext;
       const Status call = next ? ss : ps;
       const Foothold& f = next ? step_answers[si++] : point_answers[pi++];
       if (call != Status::kOk) {
         j = {{"op", "error"}, {"line", c.line}, {"message", next ? serr : perr}};
         ok = false;
       } else if (f.status == Status::kOk) {
-        j = {{"op", OpName(c.op)}, {"found", true}, {"index", f.index}, {"point", Vec(f.point)},
+        j = {{"op", QueryOpName(c.query.op)}, {"found", true}, {"index", f.index}, {"point", Vec(f.point)},
              {"normal", Vec(f.normal)}};
       } else if (f.status == Status::kNoFoothold) {
-        j = {{"op", OpName(c.op)}, {"found", false}};
+        j = {{"op", QueryOpName(c.query.op)}, {"found", false}};
       } else {
         j = {{"op", "error"}, {"line", c.line},
-             {"message", std::string(OpName(c.op)) + ": " + StatusName(f.status)}};
+             {"message", std::string(QueryOpName(c.query.op)) + ": " + StatusName(f.status)}};
         ok = false;
       }
     }

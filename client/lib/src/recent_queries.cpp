@@ -21,15 +21,6 @@ Status FromWire(ff_status s) {
 
 }  // namespace
 
-const char* QueryOpName(QueryOp op) {
-  switch (op) {
-    case QueryOp::kSnap: return "snap";
-    case QueryOp::kNormal: return "normal";
-    case QueryOp::kNext: return "next";
-  }
-  return "unknown";
-}
-
 struct RecentQueryFeed::Connection {
   CLIENT* client = nullptr;
 };

@@ -1,5 +1,6 @@
 #include "footfall/steps/walk_json.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -61,6 +62,26 @@ struct Reader {
     return true;
   }
 };
+
+// "SOURCE:LINE:COLUMN: malformed JSON: WHAT", the position of the byte the parser stopped at.
+std::string MalformedJson(const std::string& text, const std::string& source,
+                          const json::parse_error& e) {
+  size_t line = 1, column = 1;
+  const size_t end = std::min(text.size(), e.byte > 0 ? static_cast<size_t>(e.byte - 1) : 0);
+  for (size_t i = 0; i < end; ++i) {
+    if (text[i] == '\n') ++line, column = 1;
+    else ++column;
+  }
+  // e.what() is "[json.exception.parse_error.101] parse error at line L, column C: WHAT".
+  std::string what = e.what();
+  const size_t at = what.find("parse error");
+  if (at != std::string::npos) {
+    const size_t colon = what.find(": ", at);
+    what = colon != std::string::npos ? what.substr(colon + 2) : what.substr(at);
+  }
+  return source + ":" + std::to_string(line) + ":" + std::to_string(column) +
+         ": malformed JSON: " + what;
+}
 
 }  // namespace
 
@@ -131,11 +152,17 @@ Status WriteWalkJson(const Walk& walk, const std::string& path, std::string* err
 
 Status ParseWalkJson(const std::string& text, const std::string& source, Walk* out,
                      std::string* error) {
-  json j = json::parse(text, nullptr, false);
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    *error = MalformedJson(text, source, e);
+    return Status::kParseError;
+  }
   Reader r;
   r.source = source;
   Walk walk;
-  if (j.is_discarded() || !j.is_object()) {
+  if (!j.is_object()) {
     *error = source + ": not a JSON object (expected a footfall walk)";
     return Status::kParseError;
   }
@@ -212,6 +239,10 @@ Status ParseWalkJson(const std::string& text, const std::string& source, Walk* o
         } else {
           double q[4] = {0, 0, 0, 1};
           if (k.contains("rotation") && !r.Array(k["rotation"], 4, kw + ".rotation", q)) break;
+          if (!(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] > 1e-18)) {
+            r.Fail(kw + ".rotation", "expected a non-zero quaternion [qx, qy, qz, qw]");
+            break;
+          }
           key.rotation = {q[0], q[1], q[2], q[3]};
         }
         track.keys.push_back(key);

@@ -6,25 +6,17 @@
 #include <cstdint>
 #include <string>
 
+#include "footfall/client/query_text.h"
 #include "footfall/client/recent_queries.h"
 #include "footfall/terrain/grid.h"
 
 namespace footfall::viewer {
 
-// One query as the user wrote it: "snap X Y Z", "normal X Y Z" or "next X Y Z DX DY DZ".
-struct QuerySpec {
-  QueryOp op = QueryOp::kSnap;
-  Vec3 point;      // world space: the query point, or the foot for next
-  Vec3 direction;  // world space, next only; non-zero, its length is the step length
+// One query to draw: as the user wrote it (ParseQueryText, query_text.h) or as footfalld
+// received it, with the candidate radius it is answered with.
+struct QuerySpec : QueryText {
   double tolerance = 0;  // [Units: wu] next only; <= 0 means one step length
 };
-
-// Parses `text` (numbers separated by spaces or commas). On failure returns false and sets
-// *error to what was expected, e.g. "next: expected 6 numbers (X Y Z DX DY DZ), found 4".
-bool ParseQuerySpec(const std::string& text, QuerySpec* out, std::string* error);
-
-// "next 1 0 2 0.5 0 0": a query in the syntax ParseQuerySpec reads.
-std::string FormatQuerySpec(const QuerySpec& spec);
 
 // A query with its answer and, when a grid was at hand, what the grid examined.
 struct QueryView {

@@ -52,7 +52,8 @@ class Scene {
   // Answers a query on the terrain's grid and keeps it for drawing. kInvalidArgument without
   // a terrain.
   Status AddQuery(const QuerySpec& spec, std::string* error);
-  // Reads a walk JSON file (walk_reader.h).
+  // Reads a footfall-walk JSON file (footfall/steps/walk_json.h); body rotations are
+  // normalised for drawing.
   Status LoadWalk(const std::string& path, std::string* error);
   // Adds queries received from footfalld, traced on the local grid when there is one. Keeps
   // the newest `kMaxLive`.

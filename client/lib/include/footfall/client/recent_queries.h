@@ -10,14 +10,10 @@
 #include <string>
 #include <vector>
 
+#include "footfall/client/query_text.h"
 #include "footfall/client/terrain_session.h"
 
 namespace footfall {
-
-enum class QueryOp { kSnap, kNormal, kNext };
-
-// A short stable name: "snap", "normal", "next".
-const char* QueryOpName(QueryOp op);
 
 // One query the server answered.
 struct RecentQuery {

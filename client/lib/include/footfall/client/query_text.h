@@ -1,0 +1,39 @@
+// Terrain queries as one line of text, the syntax of `footfall query` (stdin) and
+// `footfall-view --query`: "snap X Y Z", "normal X Y Z" or "next X Y Z DX DY DZ", the numbers
+// separated by spaces, tabs or commas ("next 1 2 3 0.5,0,-0.5").
+#pragma once
+
+#include <string>
+
+#include "footfall/terrain/vec3.h"
+
+namespace footfall {
+
+enum class QueryOp { kSnap, kNormal, kNext };
+
+// A short stable name: "snap", "normal", "next".
+const char* QueryOpName(QueryOp op);
+
+// One query as written.
+struct QueryText {
+  QueryOp op = QueryOp::kSnap;
+  Vec3 point;      // world space: the query point, or the foot for next
+  Vec3 direction;  // world space, next only: non-zero, its length is the step length
+};
+
+// Parses one whole token as a finite decimal number ("1.5", "-2", "+3e1"): false for anything
+// else, including "nan", "inf", out-of-range values and trailing characters.
+bool ParseFiniteNumber(const std::string& token, double* value);
+
+// Parses one query line (no comments: callers strip them). Numbers are finite decimals, with an
+// optional leading '+'. On failure returns false, leaves *out alone and sets *error to one line
+// saying what was expected, e.g. "normal: expected 3 numbers, found 2",
+// "snap: argument 2 'x' is not a finite number", "next: direction DX DY DZ must be non-zero",
+// "unknown command 'jump' (expected snap X Y Z, normal X Y Z or next X Y Z DX DY DZ)".
+bool ParseQueryText(const std::string& text, QueryText* out, std::string* error);
+
+// "next 1 0 2 0.5 0 0": the query in the syntax ParseQueryText reads (numbers to 6 significant
+// digits).
+std::string FormatQueryText(const QueryText& query);
+
+}  // namespace footfall

@@ -1,0 +1,92 @@
+#include "footfall/client/query_text.h"
+
+#include <charconv>
+#include <cmath>
+#include <sstream>
+#include <vector>
+
+namespace footfall {
+namespace {
+
+constexpr const char* kForms = "snap X Y Z, normal X Y Z or next X Y Z DX DY DZ";
+
+}  // namespace
+
+bool ParseFiniteNumber(const std::string& token, double* value) {
+  const char* first = token.data();
+  const char* last = first + token.size();
+  if (first != last && *first == '+') ++first;
+  double v = 0;
+  const auto [ptr, ec] = std::from_chars(first, last, v);
+  if (ec != std::errc() || ptr != last || !std::isfinite(v)) return false;
+  *value = v;
+  return true;
+}
+
+const char* QueryOpName(QueryOp op) {
+  switch (op) {
+    case QueryOp::kSnap: return "snap";
+    case QueryOp::kNormal: return "normal";
+    case QueryOp::kNext: return "next";
+  }
+  return "unknown";
+}
+
+bool ParseQueryText(const std::string& text, QueryText* out, std::string* error) {
+  std::string spaced = text;
+  for (char& c : spaced) {
+    if (c == ',') c = ' ';
+  }
+  std::istringstream in(spaced);
+  std::vector<std::string> tokens;
+  for (std::string t; in >> t;) tokens.push_back(t);
+  if (tokens.empty()) {
+    *error = std::string("empty query (expected ") + kForms + ")";
+    return false;
+  }
+  QueryText query;
+  const std::string& op = tokens[0];
+  size_t want = 3;
+  if (op == "snap") {
+    query.op = QueryOp::kSnap;
+  } else if (op == "normal") {
+    query.op = QueryOp::kNormal;
+  } else if (op == "next") {
+    query.op = QueryOp::kNext, want = 6;
+  } else {
+    *error = "unknown command '" + op + "' (expected " + kForms + ")";
+    return false;
+  }
+  if (tokens.size() - 1 != want) {
+    *error = op + ": expected " + std::to_string(want) + " numbers, found " +
+             std::to_string(tokens.size() - 1);
+    return false;
+  }
+  double v[6] = {0, 0, 0, 0, 0, 0};
+  for (size_t i = 0; i < want; ++i) {
+    if (!ParseFiniteNumber(tokens[i + 1], &v[i])) {
+      *error = op + ": argument " + std::to_string(i + 1) + " '" + tokens[i + 1] +
+               "' is not a finite number";
+      return false;
+    }
+  }
+  query.point = {v[0], v[1], v[2]};
+  query.direction = {v[3], v[4], v[5]};
+  if (query.op == QueryOp::kNext && Length2(query.direction) == 0) {
+    *error = "next: direction DX DY DZ must be non-zero";
+    return false;
+  }
+  *out = query;
+  return true;
+}
+
+std::string FormatQueryText(const QueryText& query) {
+  std::ostringstream out;
+  out << QueryOpName(query.op) << ' ' << query.point.x << ' ' << query.point.y << ' '
+      << query.point.z;
+  if (query.op == QueryOp::kNext)
+    out << ' ' << query.direction.x << ' ' << query.direction.y << ' ' << query.direction.z;
+  return out.str();
+}
+
+}  // namespace footfall
