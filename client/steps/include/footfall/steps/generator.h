@@ -39,6 +39,9 @@ struct GenerateOptions {
   // character id "c1".."cN".
   int crowd = 1;
   double crowd_spacing = 0;
+  // Threads for the generator's own per-character work (large crowds only; the session splits
+  // its batches by itself). The walk is the same whatever the count. [Limit: >= 1]
+  int threads = 1;
   // Called after every step with (steps done, steps requested); may be empty.
   std::function<void(int, int)> progress;
 };
