@@ -415,7 +415,8 @@ TEST_CASE("Generation is deterministic", "[steps][generator]") {
   }
 }
 
-TEST_CASE("A large crowd's walk is the same on one thread and on two", "[steps][generator][crowd]") {
+TEST_CASE("A large crowd's walk is the same on one thread and on two",
+          "[steps][generator][crowd]") {
   // 2,100 hexapods: enough for the generator and the engine to split their work.
   const Character c = LoadShipped("hexapod");
   const RawSamples ground = MakeHeightField(500, 500, 0.03, 0.01, 3);
@@ -448,10 +449,10 @@ TEST_CASE("A large crowd's walk is the same on one thread and on two", "[steps][
     for (size_t k = 0; k < one.tracks[i].keys.size(); ++k) {
       const WalkKey &a = one.tracks[i].keys[k], &b = two.tracks[i].keys[k];
       ++keys;
-      differ += !(a.frame == b.frame && a.phase == b.phase && a.position == b.position &&
-                  a.normal == b.normal && a.rotation.x == b.rotation.x &&
-                  a.rotation.y == b.rotation.y && a.rotation.z == b.rotation.z &&
-                  a.rotation.w == b.rotation.w);
+      differ +=
+          !(a.frame == b.frame && a.phase == b.phase && a.position == b.position &&
+            a.normal == b.normal && a.rotation.x == b.rotation.x && a.rotation.y == b.rotation.y &&
+            a.rotation.z == b.rotation.z && a.rotation.w == b.rotation.w);
     }
   }
   CHECK(keys > 2100 * 10);
