@@ -1,6 +1,7 @@
 // Walk generation: 10,000 hexapods x 100 steps (one crowd, every round of queries one batch),
 // with the embedded engine and over RPC against a real footfalld on loopback. The baseline in the
-// same run is one hexapod x 100 steps: compare the per_char_step_us counters.
+// same run is one hexapod x 100 steps: compare the per_char_step_us counters. Two threads: the
+// embedded engine's batches and the generator's own per-character work (footfalld: --threads 2).
 #include <benchmark/benchmark.h>
 
 #include <memory>
@@ -76,6 +77,7 @@ void Walks(benchmark::State& state, Backend& (*backend)()) {
   o.crowd = static_cast<int>(state.range(0));
   o.crowd_spacing = 0.5;
   o.steps = static_cast<int>(state.range(1));
+  o.threads = 2;
   size_t keys = 0;
   for (auto _ : state) {
     Walk w;

@@ -52,6 +52,9 @@ both octopod-floor 0 --terrain "$work/floor.pts" --character "$chars/octopod.jso
   --start 1.2,0,0.6 --start-frame 101
 both biped-cliff 2 --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
   --steps 100
+"$footfall" generate --terrain "$work/floor.pts" --character "$chars/hexapod.json" --steps 12 \
+  --crowd 9 --crowd-spacing 0.6 --start 1.2,0,0.8 --threads 1 --out "$work/hexapod-crowd-1.json" 2> /dev/null
+check "crowd: --threads 1 gives the same walk" cmp -s "$work/hexapod-crowd-1.json" "$work/hexapod-crowd-embedded.json"
 check "path: reaches the goal without stopping" grep -q '"stopped":""' "$work/biped-path-embedded.json"
 check "crowd: nine characters" [ "$(grep -o '"name":"body","character":"c[0-9]*"' "$work/hexapod-crowd-embedded.json" | wc -l)" -eq 9 ]
 check "start frame" grep -q '{"frame":101,"phase":"start"' "$work/octopod-floor-embedded.json"

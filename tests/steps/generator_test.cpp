@@ -415,6 +415,57 @@ TEST_CASE("Generation is deterministic", "[steps][generator]") {
   }
 }
 
+TEST_CASE("A large crowd's walk is the same on one thread and on two",
+          "[steps][generator][crowd]") {
+  // 2,100 hexapods: enough for the generator and the engine to split their work.
+  const Character c = LoadShipped("hexapod");
+  const RawSamples ground = MakeHeightField(500, 500, 0.03, 0.01, 3);
+  auto run = [&](int threads) {
+    auto session = MakeEmbeddedSession(threads);
+    TerrainHandle h;
+    REQUIRE(session->LoadSamples(ground, "bumps", &h) == Status::kOk);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {7.5, 0, 7};
+    o.steps = 4;
+    o.crowd = 2100;
+    o.crowd_spacing = 0.3;
+    o.threads = threads;
+    Walk w;
+    std::string error;
+    INFO(error);
+    REQUIRE(GenerateWalk(*session, h, c, o, &w, &error) == Status::kOk);
+    return w;
+  };
+  const Walk one = run(1), two = run(2);
+  CHECK(one.stopped == two.stopped);
+  REQUIRE(one.tracks.size() == two.tracks.size());
+  REQUIRE(one.tracks.size() == 2100 * (c.feet.size() + 1));
+  size_t keys = 0, differ = 0;
+  for (size_t i = 0; i < one.tracks.size(); ++i) {
+    REQUIRE(one.tracks[i].name == two.tracks[i].name);
+    REQUIRE(one.tracks[i].character == two.tracks[i].character);
+    REQUIRE(one.tracks[i].keys.size() == two.tracks[i].keys.size());
+    for (size_t k = 0; k < one.tracks[i].keys.size(); ++k) {
+      const WalkKey &a = one.tracks[i].keys[k], &b = two.tracks[i].keys[k];
+      ++keys;
+      differ +=
+          !(a.frame == b.frame && a.phase == b.phase && a.position == b.position &&
+            a.normal == b.normal && a.rotation.x == b.rotation.x && a.rotation.y == b.rotation.y &&
+            a.rotation.z == b.rotation.z && a.rotation.w == b.rotation.w);
+    }
+  }
+  CHECK(keys > 2100 * 10);
+  CHECK(differ == 0);
+  GenerateOptions bad;
+  bad.threads = 0;
+  Terrain t = LoadTerrain(MakeFlat(10, 0.1, 0), 0.1);
+  Walk w;
+  std::string error;
+  CHECK(GenerateWalk(*t.session, t.handle, c, bad, &w, &error) == Status::kInvalidArgument);
+  CHECK_THAT(error, Catch::Contains("threads"));
+}
+
 TEST_CASE("Bad options are refused with a message", "[steps][generator]") {
   const Character c = LoadShipped("biped");
   Terrain t = LoadTerrain(MakeFlat(10, 0.1, 0), 0.1);

@@ -2,11 +2,13 @@
 // the keyed walk as JSON, glTF (.gltf, .glb) or a Maya MEL script.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <sstream>
+#include <thread>
 #include <string>
 #include <vector>
 
@@ -30,6 +32,7 @@ struct GenerateFlags {
   int crowd = 1;
   double crowd_spacing = 0;
   bool progress = false;
+  int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::vector<std::string> out;
 };
 
@@ -126,12 +129,15 @@ int RunGenerate(const GenerateFlags& flags) {
   options.fps = flags.fps;
   options.crowd = flags.crowd;
   options.crowd_spacing = flags.crowd_spacing;
+  options.threads = flags.threads;
   {
     Character character;
     if (LoadCharacter(flags.character, &character, &error) != Status::kOk) goto bad_flag;
     std::unique_ptr<TerrainSession> session;
     TerrainHandle terrain = 0;
-    if (OpenTerrain(flags.terrain, &session, &terrain, &error) != Status::kOk) goto bad_flag;
+    TerrainFlags terrain_flags = flags.terrain;
+    terrain_flags.threads = flags.threads;
+    if (OpenTerrain(terrain_flags, &session, &terrain, &error) != Status::kOk) goto bad_flag;
     ProgressBar bar;
     const bool long_run = static_cast<long long>(flags.crowd) *
                               (flags.steps < 0 ? 8 : flags.steps) >= 20000;
@@ -195,6 +201,10 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
   cmd->add_option("--crowd-spacing", flags->crowd_spacing,
                   "Distance between crowd characters (default: twice the character's reach)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--threads", flags->threads,
+                  "Threads for the embedded engine's queries and the generator's own work "
+                  "(default: the hardware's; the walk is the same whatever the count)")
+      ->check(CLI::Range(1, 256));
   cmd->add_flag("--progress", flags->progress,
                 "Show a progress bar on stderr (shown anyway for long runs on a terminal)");
   cmd->add_option("--out", flags->out, "Output file: .json, .gltf, .glb or .mel (repeatable)")

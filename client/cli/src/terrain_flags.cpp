@@ -43,7 +43,7 @@ Status OpenTerrain(const TerrainFlags& flags, std::unique_ptr<TerrainSession>* s
     return Status::kInvalidArgument;
   }
   if (flags.server.empty()) {
-    *session = MakeEmbeddedSession();
+    *session = MakeEmbeddedSession(flags.threads);
   } else {
     RpcOptions options;
     options.call_timeout_s = flags.timeout_s;

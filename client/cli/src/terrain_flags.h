@@ -17,6 +17,7 @@ struct TerrainFlags {
   std::string server;          // HOST:PORT; empty: embedded engine
   TerrainLoadOptions load;
   double timeout_s = 10;
+  int threads = 1;  // threads of the embedded engine's batch queries (unused with --server)
 };
 
 // Adds the options of loading meshes and height maps: --separation, --flat-normals, --seed,

@@ -1,9 +1,11 @@
-// The step generator. The numbered comments match the numbered list in client/steps/README.md.
+// The step generator. The numbered comments match the numbered list of "The algorithm" in the
+// top-level README.md.
 #include "footfall/steps/generator.h"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <thread>
 
 #include "frame_math.h"
 
@@ -25,6 +27,24 @@ constexpr double kArcS[kArcChecks] = {0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.87
 constexpr double kClearanceFraction = 0.25;
 // A step shorter than this fraction of step_length is a step in place: no foothold query.
 constexpr double kInPlace = 0.02;
+// Per-character loops split across threads only from this many items (threads cost ~20 us).
+constexpr size_t kMinParallel = 2048;
+
+// fn(begin, end) over 0..count-1 in `threads` contiguous chunks; returns when all are done.
+template <typename Fn>
+void ForChunks(size_t count, int threads, Fn&& fn) {
+  const size_t t = static_cast<size_t>(std::max(1, threads));
+  if (t == 1 || count < kMinParallel) {
+    fn(size_t{0}, count);
+    return;
+  }
+  const size_t chunk = (count + t - 1) / t;
+  std::vector<std::thread> pool;
+  for (size_t b = chunk; b < count; b += chunk)
+    pool.emplace_back([&fn, b, chunk, count] { fn(b, std::min(count, b + chunk)); });
+  fn(size_t{0}, std::min(count, chunk));
+  for (std::thread& th : pool) th.join();
+}
 
 std::string Point(const Vec3& p) {
   std::ostringstream o;
@@ -73,9 +93,12 @@ class Generator {
  private:
   Status Setup(std::string* error);
   Status Step(int k, std::string* error);
-  Status QueryFootholds(std::vector<Move>& moves, const std::vector<Vec3>& locator,
-                        const std::vector<Vec3>& locator_normal, std::string* error);
-  Status ClearArcs(std::vector<Move>& moves, std::string* error);
+  Status QueryFootholds(std::string* error);
+  Status ClearArcs(std::string* error);
+  template <typename Fn>
+  void Parallel(size_t count, Fn&& fn) const {
+    ForChunks(count, o_.threads, std::forward<Fn>(fn));
+  }
   void Steer(Agent& a) const;
   Vec3 Left(const Agent& a) const { return Cross(a.up, a.forward); }
   Vec3 Place(const Agent& a, const Vec3& rest) const {
@@ -104,7 +127,15 @@ class Generator {
   std::vector<int> pair_of_foot_;
   std::vector<Vec3> pair_centre_;                 // rest centre of each pair, character space
   std::vector<std::vector<int>> pairs_of_group_;  // pairs with a foot in each gait group
-  // Batch buffers, reused every step.
+  // slot_of_foot_[g][j]: index in pairs_of_group_[g] of the pair of foot gait[g][j]
+  std::vector<std::vector<size_t>> slot_of_foot_;
+  // Buffers reused every step. The moves of the w-th walking character of a step are
+  // moves_[w * G .. (w + 1) * G) for G feet in the stepping group.
+  std::vector<size_t> walking_;  // agents walking this step
+  std::vector<Move> moves_;
+  std::vector<Vec3> locator_, locator_normal_;  // per move
+  std::vector<size_t> pending_, queried_, still_;
+  std::vector<char> verdict_;
   std::vector<Vec3> points_;
   std::vector<StepQuery> queries_;
   std::vector<Foothold> answers_;
@@ -181,11 +212,13 @@ Status Generator::Run(std::string* error) {
     pair_centre_.push_back(centre / static_cast<double>(c_.pairs[p].size()));
   }
   pairs_of_group_.assign(groups, {});
+  slot_of_foot_.assign(groups, {});
   for (int g = 0; g < groups; ++g) {
+    auto& list = pairs_of_group_[g];
     for (int f : c_.gait[g]) {
-      auto& list = pairs_of_group_[g];
-      if (std::find(list.begin(), list.end(), pair_of_foot_[f]) == list.end())
-        list.push_back(pair_of_foot_[f]);
+      auto it = std::find(list.begin(), list.end(), pair_of_foot_[f]);
+      if (it == list.end()) it = list.insert(list.end(), pair_of_foot_[f]);
+      slot_of_foot_[g].push_back(static_cast<size_t>(it - list.begin()));
     }
   }
   Status s = Setup(error);
@@ -318,51 +351,55 @@ Status Generator::Setup(std::string* error) {
   return Status::kOk;
 }
 
-Status Generator::QueryFootholds(std::vector<Move>& moves, const std::vector<Vec3>& locator,
-                                 const std::vector<Vec3>& locator_normal, std::string* error) {
+Status Generator::QueryFootholds(std::string* error) {
   const size_t feet = c_.feet.size();
-  std::vector<size_t> pending, queried;
-  for (size_t m = 0; m < moves.size(); ++m) pending.push_back(m);
-  std::vector<Vec3> new_normals(feet), feet_now(feet);
-  std::vector<char> moving(feet);
-  while (!pending.empty()) {
+  std::vector<Move>& moves = moves_;
+  const size_t per_agent = walking_.empty() ? 0 : moves.size() / walking_.size();
+  pending_.resize(moves.size());
+  for (size_t m = 0; m < moves.size(); ++m) pending_[m] = m;
+  while (!pending_.empty()) {
     // 7. Target locators: the foot's rest offset from its pair's centre, in the frame of the
     //    central locator (aligned to the terrain normal under it). The step vector runs from
     //    the foot to its target; slope awareness and the reach limit shorten it.
+    Parallel(pending_.size(), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        Move& mv = moves[pending_[i]];
+        const Agent& a = agents_[mv.agent];
+        const int p = pair_of_foot_[mv.foot];
+        Vec3 n = locator_normal_[pending_[i]];
+        if (Degrees(AngleBetween(n, a.up)) > c_.max_slope_deg) n = a.up;  // an edge, not ground
+        const Vec3 f = TangentForward(a.forward, a.forward, a.up, n);
+        const Vec3 l = Cross(n, f);
+        const Vec3 d = c_.feet[mv.foot].rest - pair_centre_[p];
+        const Vec3 target = locator_[pending_[i]] + l * d.x + n * d.y + f * d.z;
+        const double slope = Degrees(std::asin(std::min(1.0, std::fabs(Dot(f, a.up)))));
+        double max_len = c_.step_length;
+        if (slope > c_.slope_threshold_deg) max_len *= c_.slope_step_scale;
+        Vec3 v = target - a.foot[mv.foot];
+        const double len = Length(v);
+        if (len > max_len) v = v * (max_len / len);
+        v = v * mv.scale;  // retries step shorter
+        if (Length(v) < kInPlace * c_.step_length) {
+          mv.done = true, mv.end = a.foot[mv.foot], mv.end_normal = a.foot_normal[mv.foot];
+          continue;
+        }
+        // No target beyond reach of the body where the step will put it (the feet's centroid
+        // moves by this foot's displacement over the number of feet).
+        for (int shrink = 0; shrink < 8; ++shrink) {
+          const Vec3 ground = a.ground + v / static_cast<double>(feet);
+          const Vec3 body = ground + a.up * c_.body_height;
+          if (Distance(a.foot[mv.foot] + v, body) <= c_.reach) break;
+          v = v * 0.75;
+        }
+        mv.ideal = a.foot[mv.foot] + v, mv.step = v;
+      }
+    });
     queries_.clear();
-    queried.clear();
-    for (size_t m : pending) {
-      Move& mv = moves[m];
-      Agent& a = agents_[mv.agent];
-      const int p = pair_of_foot_[mv.foot];
-      Vec3 n = locator_normal[m];
-      if (Degrees(AngleBetween(n, a.up)) > c_.max_slope_deg) n = a.up;  // an edge, not ground
-      const Vec3 f = TangentForward(a.forward, a.forward, a.up, n);
-      const Vec3 l = Cross(n, f);
-      const Vec3 d = c_.feet[mv.foot].rest - pair_centre_[p];
-      const Vec3 target = locator[m] + l * d.x + n * d.y + f * d.z;
-      const double slope = Degrees(std::asin(std::min(1.0, std::fabs(Dot(f, a.up)))));
-      double max_len = c_.step_length;
-      if (slope > c_.slope_threshold_deg) max_len *= c_.slope_step_scale;
-      Vec3 v = target - a.foot[mv.foot];
-      const double len = Length(v);
-      if (len > max_len) v = v * (max_len / len);
-      v = v * mv.scale;  // retries step shorter
-      if (Length(v) < kInPlace * c_.step_length) {
-        mv.done = true, mv.end = a.foot[mv.foot], mv.end_normal = a.foot_normal[mv.foot];
-        continue;
-      }
-      // No target beyond reach of the body where the step will put it (the feet's centroid
-      // moves by this foot's displacement over the number of feet).
-      for (int shrink = 0; shrink < 8; ++shrink) {
-        const Vec3 ground = a.ground + v / static_cast<double>(feet);
-        const Vec3 body = ground + a.up * c_.body_height;
-        if (Distance(a.foot[mv.foot] + v, body) <= c_.reach) break;
-        v = v * 0.75;
-      }
-      mv.ideal = a.foot[mv.foot] + v, mv.step = v;
-      queries_.push_back({a.foot[mv.foot], v});
-      queried.push_back(m);
+    queried_.clear();
+    for (size_t m : pending_) {
+      if (moves[m].done) continue;  // a step in place
+      queries_.push_back({agents_[moves[m].agent].foot[moves[m].foot], moves[m].step});
+      queried_.push_back(m);
     }
     // 8. Query the next foothold of every pending foot of every character: one batch. The
     //    answer carries the end normal; the start normal is the planted foot's.
@@ -372,57 +409,62 @@ Status Generator::QueryFootholds(std::vector<Move>& moves, const std::vector<Vec
                                          0.5 * c_.step_length, answers_.data()),
                            "next foothold", error);
     if (s != Status::kOk) return s;
-    for (size_t q = 0; q < queried.size(); ++q) {
-      Move& mv = moves[queried[q]];
-      const Agent& a = agents_[mv.agent];
-      const Foothold& h = answers_[q];
-      const Vec3& foot = a.foot[mv.foot];
-      ++mv.attempts;
-      // A foothold must make half the intended progress along the ground it lands on (the step
-      // vector projected onto its tangent plane), so no foot creeps sideways along a cliff's
-      // edge. Steps mostly along the foothold's normal (onto a wall ahead) are exempt.
-      double progress = 1;
-      if (h.status == Status::kOk) {
-        const Vec3 along = ProjectOnPlane(mv.step, h.normal);
-        if (Length2(along) >= 0.25 * Length2(mv.step))
-          progress = Dot(h.point - foot, along) / Length2(along);
+    Parallel(queried_.size(), [&](size_t b, size_t e) {
+      for (size_t q = b; q < e; ++q) {
+        Move& mv = moves[queried_[q]];
+        const Agent& a = agents_[mv.agent];
+        const Foothold& h = answers_[q];
+        const Vec3& foot = a.foot[mv.foot];
+        ++mv.attempts;
+        // A foothold must make half the intended progress along the ground it lands on (the
+        // step vector projected onto its tangent plane), so no foot creeps sideways along a
+        // cliff's edge. Steps mostly along the foothold's normal (onto a wall ahead) are exempt.
+        double progress = 1;
+        if (h.status == Status::kOk) {
+          const Vec3 along = ProjectOnPlane(mv.step, h.normal);
+          if (Length2(along) >= 0.25 * Length2(mv.step))
+            progress = Dot(h.point - foot, along) / Length2(along);
+        }
+        const bool found = h.status == Status::kOk && progress >= 0.5;
+        const double rise = found ? Dot(h.point - foot, a.up) : 0;
+        const double slope = found ? Degrees(AngleBetween(h.normal, a.up)) : 0;
+        if (found && std::fabs(rise) <= c_.max_rise && slope <= c_.max_slope_deg) {
+          mv.done = true, mv.end = h.point, mv.end_normal = h.normal;
+          continue;
+        }
+        std::ostringstream why;  // refused: say why (only built on this rare path)
+        why.precision(3);
+        if (!found) {
+          why << "no foothold within " << 0.5 * c_.step_length << " of " << Point(mv.ideal)
+              << " (a gap or a cliff)";
+        } else if (std::fabs(rise) > c_.max_rise) {
+          why << "the foothold at " << Point(h.point) << (rise > 0 ? " rises " : " drops ")
+              << std::fabs(rise) << ", more than max_rise " << c_.max_rise << " (a cliff)";
+        } else {
+          why << "the foothold at " << Point(h.point) << " leans " << slope
+              << " deg, more than max_slope_deg " << c_.max_slope_deg << " (too steep)";
+        }
+        mv.reason = why.str();
       }
-      const bool found = h.status == Status::kOk && progress >= 0.5;
-      const double rise = found ? Dot(h.point - foot, a.up) : 0;
-      const double slope = found ? Degrees(AngleBetween(h.normal, a.up)) : 0;
-      if (found && std::fabs(rise) <= c_.max_rise && slope <= c_.max_slope_deg) {
-        mv.done = true, mv.end = h.point, mv.end_normal = h.normal;
-        continue;
-      }
-      std::ostringstream why;  // refused: say why (only built on this rare path)
-      why.precision(3);
-      if (!found) {
-        why << "no foothold within " << 0.5 * c_.step_length << " of " << Point(mv.ideal)
-            << " (a gap or a cliff)";
-      } else if (std::fabs(rise) > c_.max_rise) {
-        why << "the foothold at " << Point(h.point) << (rise > 0 ? " rises " : " drops ")
-            << std::fabs(rise) << ", more than max_rise " << c_.max_rise << " (a cliff)";
-      } else {
-        why << "the foothold at " << Point(h.point) << " leans " << slope
-            << " deg, more than max_slope_deg " << c_.max_slope_deg << " (too steep)";
-      }
-      mv.reason = why.str();
-    }
+    });
     // The reach limit on the body where the accepted footholds put it; feet beyond it retry.
-    for (size_t m = 0; m < moves.size();) {
-      const size_t agent = moves[m].agent;
-      size_t e = m;
-      bool all_done = true;
-      while (e < moves.size() && moves[e].agent == agent) all_done &= moves[e].done, ++e;
-      if (all_done) {
-        const Agent& a = agents_[agent];
+    Parallel(walking_.size(), [&](size_t wb, size_t we) {
+      std::vector<Vec3> new_normals(feet), feet_now(feet);
+      std::vector<char> moving(feet);
+      for (size_t w = wb; w < we; ++w) {
+        const size_t m = w * per_agent, e = m + per_agent;
+        bool all_done = true;
+        for (size_t i = m; i < e; ++i) all_done &= moves[i].done;
+        if (!all_done) continue;
+        const Agent& a = agents_[moves[m].agent];
         feet_now.assign(a.foot.begin(), a.foot.end());
         new_normals.assign(a.foot_normal.begin(), a.foot_normal.end());
         for (size_t i = m; i < e; ++i)
           feet_now[moves[i].foot] = moves[i].end, new_normals[moves[i].foot] = moves[i].end_normal;
         Vec3 centroid;
         for (const Vec3& p : feet_now) centroid += p;
-        const Vec3 body = centroid / static_cast<double>(feet) + BodyUp(a, new_normals) * c_.body_height;
+        const Vec3 body =
+            centroid / static_cast<double>(feet) + BodyUp(a, new_normals) * c_.body_height;
         moving.assign(feet, 0);
         for (size_t i = m; i < e; ++i) moving[moves[i].foot] = 1;
         for (size_t i = m; i < e; ++i) {
@@ -448,69 +490,80 @@ Status Generator::QueryFootholds(std::vector<Move>& moves, const std::vector<Vec
           break;
         }
       }
-      m = e;
-    }
-    pending.clear();
+    });
+    pending_.clear();
     for (size_t m = 0; m < moves.size(); ++m) {
       Move& mv = moves[m];
       if (mv.done || mv.failed) continue;
       if (mv.attempts >= kMaxAttempts) mv.failed = true;
-      else mv.scale = kAttemptScale[mv.attempts], pending.push_back(m);
+      else mv.scale = kAttemptScale[mv.attempts], pending_.push_back(m);
     }
   }
   return Status::kOk;
 }
 
-Status Generator::ClearArcs(std::vector<Move>& moves, std::string* error) {
+Status Generator::ClearArcs(std::string* error) {
   // 9. Swing arcs: the mid key is the midpoint of start and end raised along the averaged
   //    normal by step_height. Points along the start-mid-end arc are snapped to the terrain; an
   //    arc passing below it (or too close) raises the mid key, round after round.
-  std::vector<size_t> pending;
+  std::vector<Move>& moves = moves_;
+  pending_.clear();
   for (size_t m = 0; m < moves.size(); ++m) {
     Move& mv = moves[m];
     if (!mv.done) continue;
     const Agent& a = agents_[mv.agent];
     mv.mid_normal = NormalizeOr(a.foot_normal[mv.foot] + mv.end_normal, a.up);
     mv.mid = (a.foot[mv.foot] + mv.end) * 0.5 + mv.mid_normal * c_.step_height;
-    pending.push_back(m);
+    pending_.push_back(m);
   }
-  for (int round = 0; !pending.empty(); ++round) {
-    points_.clear();
-    for (size_t m : pending) {
-      const Move& mv = moves[m];
-      const Vec3& start = agents_[mv.agent].foot[mv.foot];
-      for (double s : kArcS)
-        points_.push_back(s <= 0.5 ? Lerp(start, mv.mid, 2 * s) : Lerp(mv.mid, mv.end, 2 * s - 1));
-    }
+  for (int round = 0; !pending_.empty(); ++round) {
+    points_.resize(pending_.size() * kArcChecks);
+    Parallel(pending_.size(), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        const Move& mv = moves[pending_[i]];
+        const Vec3& start = agents_[mv.agent].foot[mv.foot];
+        for (int j = 0; j < kArcChecks; ++j) {
+          const double s = kArcS[j];
+          points_[i * kArcChecks + j] =
+              s <= 0.5 ? Lerp(start, mv.mid, 2 * s) : Lerp(mv.mid, mv.end, 2 * s - 1);
+        }
+      }
+    });
     answers_.resize(points_.size());
     const Status s = Check(session_.Snap(terrain_, points_.data(), points_.size(),
                                          answers_.data()),
                            "snap swing arc", error);
     if (s != Status::kOk) return s;
-    std::vector<size_t> still;
-    for (size_t i = 0; i < pending.size(); ++i) {
-      Move& mv = moves[pending[i]];
-      bool clear = true;
-      for (int j = 0; j < kArcChecks; ++j) {
-        const Foothold& h = answers_[i * kArcChecks + j];
-        const double nominal = c_.step_height * (1 - std::fabs(2 * kArcS[j] - 1));
-        if (h.status == Status::kOk &&
-            Dot(points_[i * kArcChecks + j] - h.point, h.normal) < kClearanceFraction * nominal)
-          clear = false;
+    verdict_.assign(pending_.size(), 0);  // 1: raise and check again
+    Parallel(pending_.size(), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        Move& mv = moves[pending_[i]];
+        bool clear = true;
+        for (int j = 0; j < kArcChecks; ++j) {
+          const Foothold& h = answers_[i * kArcChecks + j];
+          const double nominal = c_.step_height * (1 - std::fabs(2 * kArcS[j] - 1));
+          if (h.status == Status::kOk &&
+              Dot(points_[i * kArcChecks + j] - h.point, h.normal) < kClearanceFraction * nominal)
+            clear = false;
+        }
+        if (clear) continue;
+        if (round + 1 >= kMaxRaises) {
+          std::ostringstream why;
+          why.precision(3);
+          why << "the swing arc to " << Point(mv.end)
+              << " cannot clear the terrain (mid key raised " << kMaxRaises * kRaise
+              << " step heights)";
+          mv.failed = true, mv.done = false, mv.reason = why.str();
+          continue;
+        }
+        mv.mid += mv.mid_normal * (kRaise * c_.step_height);
+        verdict_[i] = 1;
       }
-      if (clear) continue;
-      if (round + 1 >= kMaxRaises) {
-        std::ostringstream why;
-        why.precision(3);
-        why << "the swing arc to " << Point(mv.end) << " cannot clear the terrain (mid key raised "
-            << kMaxRaises * kRaise << " step heights)";
-        mv.failed = true, mv.done = false, mv.reason = why.str();
-        continue;
-      }
-      mv.mid += mv.mid_normal * (kRaise * c_.step_height);
-      still.push_back(pending[i]);
-    }
-    pending.swap(still);
+    });
+    still_.clear();
+    for (size_t i = 0; i < pending_.size(); ++i)
+      if (verdict_[i]) still_.push_back(pending_[i]);
+    pending_.swap(still_);
   }
   return Status::kOk;
 }
@@ -521,93 +574,100 @@ Status Generator::Step(int k, std::string* error) {
   const double f_mid = f0 + 0.5 * c_.frames_per_step;
   const double f1 = f0 + c_.frames_per_step;
   // 5. Heading: turn toward the current waypoint of the path (at most max_turn_deg).
-  for (Agent& a : agents_)
-    if (a.walking) Steer(a);
+  Parallel(agents_.size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i)
+      if (agents_[i].walking) Steer(agents_[i]);
+  });
   // 6. Central locators: one per foot pair stepping now, `lead` ahead of the pair's rest centre
   //    in the body frame and lead/2 above it (so that at a wall ahead the locator snaps onto the
   //    wall, not into the corner), snapped to the terrain (one batch for every character).
-  std::vector<Move> moves;
-  std::vector<size_t> locator_of_move;
-  points_.clear();
-  for (size_t i = 0; i < agents_.size(); ++i) {
-    const Agent& a = agents_[i];
-    if (!a.walking) continue;
-    const size_t base = points_.size();
-    for (int p : pairs_of_group_[group])
-      points_.push_back(Place(a, pair_centre_[p]) + a.forward * lead_ + a.up * (0.5 * lead_));
-    for (int f : c_.gait[group]) {
-      Move mv;
-      mv.agent = i, mv.foot = f;
-      moves.push_back(mv);
-      const auto& list = pairs_of_group_[group];
-      locator_of_move.push_back(base + (std::find(list.begin(), list.end(), pair_of_foot_[f]) - list.begin()));
+  walking_.clear();
+  for (size_t i = 0; i < agents_.size(); ++i)
+    if (agents_[i].walking) walking_.push_back(i);
+  if (walking_.empty()) return Status::kOk;
+  const std::vector<int>& stepping = c_.gait[group];
+  const std::vector<int>& pairs = pairs_of_group_[group];
+  const std::vector<size_t>& slot = slot_of_foot_[group];
+  const size_t per_agent = stepping.size(), locators = pairs.size();
+  if (per_agent == 0) return Status::kOk;
+  moves_.assign(walking_.size() * per_agent, Move{});
+  points_.resize(walking_.size() * locators);
+  Parallel(walking_.size(), [&](size_t b, size_t e) {
+    for (size_t w = b; w < e; ++w) {
+      const Agent& a = agents_[walking_[w]];
+      for (size_t p = 0; p < locators; ++p)
+        points_[w * locators + p] =
+            Place(a, pair_centre_[pairs[p]]) + a.forward * lead_ + a.up * (0.5 * lead_);
+      for (size_t j = 0; j < per_agent; ++j)
+        moves_[w * per_agent + j].agent = walking_[w], moves_[w * per_agent + j].foot = stepping[j];
     }
-  }
-  if (moves.empty()) return Status::kOk;
+  });
   answers_.resize(points_.size());
   Status s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()),
                    "snap locators", error);
   if (s != Status::kOk) return s;
   // A locator that snapped farther than `lead` from where it was placed hangs over a gap or a
   // cliff: it keeps its place (the body's frame), so the foothold query looks over the void.
-  std::vector<Vec3> locator(moves.size()), locator_normal(moves.size());
-  for (size_t m = 0; m < moves.size(); ++m) {
-    const Foothold& h = answers_[locator_of_move[m]];
-    const Vec3& placed = points_[locator_of_move[m]];
-    const Agent& a = agents_[moves[m].agent];
-    if (Distance(h.point, placed) <= lead_) {
-      locator[m] = h.point, locator_normal[m] = h.normal;
-    } else {
-      locator[m] = placed - a.up * (0.5 * lead_), locator_normal[m] = a.up;
+  locator_.resize(moves_.size()), locator_normal_.resize(moves_.size());
+  Parallel(moves_.size(), [&](size_t b, size_t e) {
+    for (size_t m = b; m < e; ++m) {
+      const size_t l = (m / per_agent) * locators + slot[m % per_agent];
+      const Foothold& h = answers_[l];
+      const Vec3& placed = points_[l];
+      const Agent& a = agents_[moves_[m].agent];
+      if (Distance(h.point, placed) <= lead_) {
+        locator_[m] = h.point, locator_normal_[m] = h.normal;
+      } else {
+        locator_[m] = placed - a.up * (0.5 * lead_), locator_normal_[m] = a.up;
+      }
     }
-  }
-  s = QueryFootholds(moves, locator, locator_normal, error);
+  });
+  s = QueryFootholds(error);
   if (s != Status::kOk) return s;
-  s = ClearArcs(moves, error);  // only the feet whose foothold was accepted
+  s = ClearArcs(error);  // only the feet whose foothold was accepted
   if (s != Status::kOk) return s;
   // 10. Key each foot (start, mid, end) and plant it; 11. move the body to the feet's centroid,
   //     raised along its up (multipeds: the averaged foot normal), heading carried along, and
   //     key it at touch-down. A character with a refused foot stops before this step's keys.
-  for (size_t m = 0; m < moves.size();) {
-    Agent& a = agents_[moves[m].agent];
-    size_t e = m;
-    const Move* failed = nullptr;
-    while (e < moves.size() && moves[e].agent == moves[m].agent) {
-      if (!moves[e].done && !failed) failed = &moves[e];
-      ++e;
+  Parallel(walking_.size(), [&](size_t wb, size_t we) {
+    for (size_t w = wb; w < we; ++w) {
+      const size_t m = w * per_agent, e = m + per_agent;
+      Agent& a = agents_[walking_[w]];
+      const Move* failed = nullptr;
+      for (size_t i = m; i < e && !failed; ++i)
+        if (!moves_[i].done) failed = &moves_[i];
+      bool in_place = true;
+      for (size_t i = m; i < e; ++i)
+        in_place &= moves_[i].done && moves_[i].end == a.foot[moves_[i].foot];
+      if (in_place && !failed) {
+        Stop(a, k + 1,
+             "no way forward from " + Point(a.ground) +
+                 ": every target is where its foot already stands (a cliff, a gap or a dead "
+                 "end)");
+        continue;
+      }
+      if (failed) {
+        Stop(a, k + 1,
+             "foot " + c_.feet[failed->foot].name + " at " + Point(a.foot[failed->foot]) + ": " +
+                 failed->reason);
+        continue;
+      }
+      for (size_t i = m; i < e; ++i) {
+        const Move& mv = moves_[i];
+        KeyFoot(a, mv.foot, f0, KeyPhase::kStart, a.foot[mv.foot], a.foot_normal[mv.foot]);
+        KeyFoot(a, mv.foot, f_mid, KeyPhase::kMid, mv.mid, mv.mid_normal);
+        KeyFoot(a, mv.foot, f1, KeyPhase::kEnd, mv.end, mv.end_normal);
+        a.foot[mv.foot] = mv.end, a.foot_normal[mv.foot] = mv.end_normal;
+      }
+      Vec3 centroid;
+      for (const Vec3& p : a.foot) centroid += p;
+      a.ground = centroid / static_cast<double>(a.foot.size());
+      const Vec3 old_up = a.up;
+      a.up = BodyUp(a, a.foot_normal);
+      a.forward = TangentForward(a.forward, a.forward, old_up, a.up);
+      KeyBody(a, f1);
     }
-    bool in_place = true;
-    for (size_t i = m; i < e; ++i) in_place &= moves[i].done && moves[i].end == a.foot[moves[i].foot];
-    if (in_place && !failed) {
-      Stop(a, k + 1,
-           "no way forward from " + Point(a.ground) +
-               ": every target is where its foot already stands (a cliff, a gap or a dead end)");
-      m = e;
-      continue;
-    }
-    if (failed) {
-      Stop(a, k + 1,
-           "foot " + c_.feet[failed->foot].name + " at " + Point(a.foot[failed->foot]) + ": " +
-               failed->reason);
-      m = e;
-      continue;
-    }
-    for (size_t i = m; i < e; ++i) {
-      const Move& mv = moves[i];
-      KeyFoot(a, mv.foot, f0, KeyPhase::kStart, a.foot[mv.foot], a.foot_normal[mv.foot]);
-      KeyFoot(a, mv.foot, f_mid, KeyPhase::kMid, mv.mid, mv.mid_normal);
-      KeyFoot(a, mv.foot, f1, KeyPhase::kEnd, mv.end, mv.end_normal);
-      a.foot[mv.foot] = mv.end, a.foot_normal[mv.foot] = mv.end_normal;
-    }
-    Vec3 centroid;
-    for (const Vec3& p : a.foot) centroid += p;
-    a.ground = centroid / static_cast<double>(a.foot.size());
-    const Vec3 old_up = a.up;
-    a.up = BodyUp(a, a.foot_normal);
-    a.forward = TangentForward(a.forward, a.forward, old_up, a.up);
-    KeyBody(a, f1);
-    m = e;
-  }
+  });
   return Status::kOk;
 }
 
@@ -640,6 +700,10 @@ Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Charac
   }
   if (options.steps > 1000000) {
     *error = "steps must be at most 1000000";
+    return Status::kInvalidArgument;
+  }
+  if (options.threads < 1) {
+    *error = "threads must be at least 1";
     return Status::kInvalidArgument;
   }
   if (character.feet.empty() || character.gait.empty()) {

@@ -490,39 +490,16 @@ void ParallelFor(size_t count, int threads, Fn&& fn) {
 }
 }  // namespace
 
-std::vector<uint32_t> TerrainGrid::SpatialOrder(const Vec3* points, size_t count,
-                                                size_t stride_bytes) const {
-  // Queries answered in cell order touch memory coherently: sort by the cell they fall in.
-  std::vector<std::pair<uint64_t, uint32_t>> keyed(count);
-  const auto* bytes = reinterpret_cast<const unsigned char*>(points);
-  for (size_t i = 0; i < count; ++i) {
-    const Vec3& p = *reinterpret_cast<const Vec3*>(bytes + i * stride_bytes);
-    uint64_t key = ~uint64_t{0};  // invalid queries last
-    if (IsFinite(p)) {
-      key = (uint64_t{CellCoord(p.z - origin_[2], 2)} * dims_[1] +
-             CellCoord(p.y - origin_[1], 1)) * dims_[0] + CellCoord(p.x - origin_[0], 0);
-    }
-    keyed[i] = {key, static_cast<uint32_t>(i)};
-  }
-  std::sort(keyed.begin(), keyed.end());
-  std::vector<uint32_t> order(count);
-  for (size_t i = 0; i < count; ++i) order[i] = keyed[i].second;
-  return order;
-}
-
 void TerrainGrid::SnapBatch(const Vec3* queries, size_t count, Foothold* out, int threads) const {
-  const std::vector<uint32_t> order = SpatialOrder(queries, count, sizeof(Vec3));
   ParallelFor(count, threads, [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) out[order[i]] = Snap(queries[order[i]]);
+    for (size_t i = b; i < e; ++i) out[i] = Snap(queries[i]);
   });
 }
 
 void TerrainGrid::NextBatch(const StepQuery* queries, size_t count, double tolerance,
                             Foothold* out, int threads) const {
-  // Ordered by foot position: the ideal points of nearby feet are near one another too.
-  const std::vector<uint32_t> order = SpatialOrder(&queries[0].foot, count, sizeof(StepQuery));
   ParallelFor(count, threads, [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) out[order[i]] = Next(queries[order[i]], tolerance);
+    for (size_t i = b; i < e; ++i) out[i] = Next(queries[i], tolerance);
   });
 }
 

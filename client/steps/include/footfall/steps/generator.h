@@ -1,6 +1,6 @@
 // The step generator: places every footstep of one or many characters on a terrain and keys the
-// walk (foot IK targets and the body). The algorithm is listed as numbered steps in
-// client/steps/README.md; generator.cpp repeats the numbers in comments.
+// walk (foot IK targets and the body). The algorithm is listed as numbered steps in the
+// top-level README.md ("The algorithm"); generator.cpp repeats the numbers in comments.
 //
 // It asks the terrain only through a TerrainSession, so the embedded engine and footfalld give
 // the same walk. Each round of queries of a step is one batch call for all characters (crowds
@@ -39,6 +39,9 @@ struct GenerateOptions {
   // character id "c1".."cN".
   int crowd = 1;
   double crowd_spacing = 0;
+  // Threads for the generator's own per-character work (large crowds only; the session splits
+  // its batches by itself). The walk is the same whatever the count. [Limit: >= 1]
+  int threads = 1;
   // Called after every step with (steps done, steps requested); may be empty.
   std::function<void(int, int)> progress;
 };

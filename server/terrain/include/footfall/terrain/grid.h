@@ -118,8 +118,7 @@ class TerrainGrid {
   // kInvalidArgument for a zero or non-finite direction, non-finite foot or tolerance.
   Foothold Next(const StepQuery& q, double tolerance, QueryTrace* trace = nullptr) const;
 
-  // Batch forms: out[i] answers queries[i]. Thread-safe; `threads` > 1 splits the batch. The
-  // queries are answered in grid-cell order, which keeps memory access coherent.
+  // Batch forms: out[i] answers queries[i]. Thread-safe; `threads` > 1 splits the batch.
   void SnapBatch(const Vec3* queries, size_t count, Foothold* out, int threads = 1) const;
   void NextBatch(const StepQuery* queries, size_t count, double tolerance, Foothold* out,
                  int threads = 1) const;
@@ -137,8 +136,6 @@ class TerrainGrid {
   template <typename Scanner>
   void Search(const double center[3], Scanner& scanner) const;
   uint32_t CellCoord(double local, int axis) const;
-  // Indices 0..count-1 ordered by the grid cell of each point (points `stride_bytes` apart).
-  std::vector<uint32_t> SpatialOrder(const Vec3* points, size_t count, size_t stride_bytes) const;
   double CellLo(uint32_t i, int axis) const;
   double CellHi(uint32_t i, int axis) const;
   Foothold MakeFoothold(uint32_t slot) const;
