@@ -64,7 +64,7 @@ struct GridStats {
 
 struct GridOptions {
   // Target mean samples per occupied cell. [Limit: > 0]
-  double samples_per_cell = 3.0;
+  double samples_per_cell = 8;
   // Memory cap: total cells <= max(64, cells_per_sample * samples). [Limit: > 0]
   double cells_per_sample = 1.0;
 };
