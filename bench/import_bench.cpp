@@ -54,12 +54,12 @@ void BM_VertexExtraction(benchmark::State& state) {
   for (auto _ : state) {
     const std::vector<footfall::Vec3> normals = footfall::VertexNormals(mesh);
     samples.clear();
-    for (size_t v = 0; v < mesh.vertices.size(); ++v) samples.push_back(mesh.vertices[v], normals[v]);
+    for (size_t v = 0; v < mesh.vertices.size(); ++v)
+      samples.push_back(mesh.vertices[v], normals[v]);
     benchmark::DoNotOptimize(samples.points.data());
   }
-  state.counters["samples_per_s"] =
-      benchmark::Counter(static_cast<double>(mesh.vertices.size()) * state.iterations(),
-                         benchmark::Counter::kIsRate);
+  state.counters["samples_per_s"] = benchmark::Counter(
+      static_cast<double>(mesh.vertices.size()) * state.iterations(), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_VertexExtraction)->Unit(benchmark::kMillisecond);
 

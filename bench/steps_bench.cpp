@@ -98,21 +98,34 @@ void Walks(benchmark::State& state, Backend& (*backend)()) {
   state.counters["keys"] = static_cast<double>(keys);
   state.counters["char_steps_per_s"] =
       benchmark::Counter(char_steps, benchmark::Counter::kIsIterationInvariantRate);
-  state.counters["per_char_step_us"] = benchmark::Counter(
-      char_steps * 1e-6, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["per_char_step_us"] =
+      benchmark::Counter(char_steps * 1e-6, benchmark::Counter::kIsIterationInvariantRate |
+                                                benchmark::Counter::kInvert);
 }
 
 void BM_WalkEmbedded(benchmark::State& state) { Walks(state, Embedded); }
 void BM_WalkRpc(benchmark::State& state) { Walks(state, Rpc); }
 
-BENCHMARK(BM_WalkEmbedded)->ArgNames({"hexapods", "steps"})->Args({1, 100})
+BENCHMARK(BM_WalkEmbedded)
+    ->ArgNames({"hexapods", "steps"})
+    ->Args({1, 100})
     ->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_WalkEmbedded)->ArgNames({"hexapods", "steps"})->Args({10000, 100})
-    ->Unit(benchmark::kMillisecond)->Iterations(3)->UseRealTime();
-BENCHMARK(BM_WalkRpc)->ArgNames({"hexapods", "steps"})->Args({1, 100})
+BENCHMARK(BM_WalkEmbedded)
+    ->ArgNames({"hexapods", "steps"})
+    ->Args({10000, 100})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3)
+    ->UseRealTime();
+BENCHMARK(BM_WalkRpc)
+    ->ArgNames({"hexapods", "steps"})
+    ->Args({1, 100})
     ->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_WalkRpc)->ArgNames({"hexapods", "steps"})->Args({10000, 100})
-    ->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+BENCHMARK(BM_WalkRpc)
+    ->ArgNames({"hexapods", "steps"})
+    ->Args({10000, 100})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace footfall

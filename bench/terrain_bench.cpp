@@ -25,8 +25,8 @@ using namespace footfall;
 
 namespace {
 
-constexpr int kSide = 1000;         // 1000 x 1000 = 1M samples
-constexpr double kSpacing = 0.1;    // 100 m x 100 m
+constexpr int kSide = 1000;       // 1000 x 1000 = 1M samples
+constexpr double kSpacing = 0.1;  // 100 m x 100 m
 constexpr size_t kQueries = 1 << 16;
 
 const RawSamples& Samples() {
@@ -81,7 +81,9 @@ std::vector<StepQuery> StepsFrom(const std::vector<Vec3>& points) {
   return steps;
 }
 
-const std::vector<Vec3>& Points(int order) { return order == 0 ? RandomPoints() : CoherentPoints(); }
+const std::vector<Vec3>& Points(int order) {
+  return order == 0 ? RandomPoints() : CoherentPoints();
+}
 const char* OrderName(int order) { return order == 0 ? "random" : "coherent"; }
 
 // --- the grid --------------------------------------------------------------------------------
@@ -150,7 +152,9 @@ struct Cloud {
     return dim == 0 ? p.x : dim == 1 ? p.y : p.z;
   }
   template <class Box>
-  bool kdtree_get_bbox(Box&) const { return false; }
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
 };
 using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>,
                                                    Cloud, 3, uint32_t>;
@@ -225,7 +229,8 @@ void BatchBench(benchmark::State& state, bool rpc, bool next) {
     if (st != Status::kOk) state.SkipWithError(s.last_error().c_str());
     offset = (offset + kBatch) % (kQueries - kBatch);
   }
-  state.SetLabel(std::string(rpc ? "rpc" : "embedded") + (next ? " next" : " snap") + " batch of 4096");
+  state.SetLabel(std::string(rpc ? "rpc" : "embedded") + (next ? " next" : " snap") +
+                 " batch of 4096");
   state.SetItemsProcessed(state.iterations() * kBatch);
 }
 

@@ -30,7 +30,7 @@ TEST_CASE("ReadAscGrid: header, values and NODATA", "[import][heightmap]") {
 
   TriangleMesh mesh;
   REQUIRE(HeightMapToMesh(map, HeightMapFrame{2, 1, 'y'}, &mesh, &error) == Status::kOk);
-  CHECK(mesh.vertices.size() == 5);  // the NODATA cell is left out
+  CHECK(mesh.vertices.size() == 5);   // the NODATA cell is left out
   CHECK(mesh.triangles.size() == 2);  // each square has three valid cells: one triangle each
   for (size_t t = 0; t < mesh.triangles.size(); ++t) CHECK(TriangleCross(mesh, t).y > 0);
   CHECK(mesh.vertices[0] == Vec3{0, 1, 0});
@@ -54,8 +54,7 @@ TEST_CASE("HeightMapToMesh: the up axis", "[import][heightmap]") {
     }
   }
   TriangleMesh mesh;
-  CHECK(HeightMapToMesh(map, HeightMapFrame{1, 1, 'w'}, &mesh, &error) ==
-        Status::kInvalidArgument);
+  CHECK(HeightMapToMesh(map, HeightMapFrame{1, 1, 'w'}, &mesh, &error) == Status::kInvalidArgument);
 }
 
 TEST_CASE("ReadPgm: 8 and 16 bit binary and ASCII agree", "[import][heightmap]") {
@@ -64,8 +63,10 @@ TEST_CASE("ReadPgm: 8 and 16 bit binary and ASCII agree", "[import][heightmap]")
   std::string error;
   const std::string bytes8 = std::string("P5\n# comment\n3 2\n255\n") + '\x01' + '\x02' + '\x03' +
                              '\x04' + '\x05' + '\xff';
-  const std::string bytes16 = std::string("P5 3 2 1000\n") + std::string("\x00\x01\x00\x02\x00\x03"
-                              "\x00\x04\x00\x05\x00\xff", 12);
+  const std::string bytes16 = std::string("P5 3 2 1000\n") + std::string(
+                                                                 "\x00\x01\x00\x02\x00\x03"
+                                                                 "\x00\x04\x00\x05\x00\xff",
+                                                                 12);
   REQUIRE(ReadPgm(dir.Write("a.pgm", bytes8), &p5_8, &error) == Status::kOk);
   REQUIRE(ReadPgm(dir.Write("b.pgm", bytes16), &p5_16, &error) == Status::kOk);
   REQUIRE(ReadPgm(dir.Write("c.pgm", "P2\n3 2\n300\n1 2 3\n4 5 255\n"), &p2, &error) ==
@@ -80,8 +81,10 @@ TEST_CASE("Height maps: bad files give clear errors", "[import][heightmap]") {
   test::TempDir dir;
   HeightMap map;
   std::string error;
-  CHECK(ReadAscGrid(dir.Write("cut.asc", "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n"
-                                         "1 2 3\n4\n"), &map, &error) == Status::kParseError);
+  CHECK(ReadAscGrid(dir.Write("cut.asc",
+                              "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n"
+                              "1 2 3\n4\n"),
+                    &map, &error) == Status::kParseError);
   CHECK(Contains(error, "cut.asc: truncated: expected 6 values (2 rows of 3), found 4"));
   CHECK(ReadAscGrid(dir.Write("bad.asc", "ncols 2\nnrows 1\ncellsize 1\n1 x\n"), &map, &error) ==
         Status::kParseError);

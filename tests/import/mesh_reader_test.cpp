@@ -28,7 +28,8 @@ void CheckCube(const TriangleMesh& mesh) {
   // Closed and facing out: every face normal points away from the centre.
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     const Vec3 c = (mesh.vertices[mesh.triangles[t][0]] + mesh.vertices[mesh.triangles[t][1]] +
-                    mesh.vertices[mesh.triangles[t][2]]) / 3;
+                    mesh.vertices[mesh.triangles[t][2]]) /
+                   3;
     CHECK(Dot(TriangleCross(mesh, t), c - Vec3{0.5, 0.5, 0.5}) > 0);
   }
 }
@@ -150,7 +151,8 @@ TEST_CASE("ReadMesh: bad meshes give clear errors", "[import][mesh]") {
     const std::string ply =
         "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
         "property float y\nproperty float z\nelement face 1\n"
-        "property list uchar int vertex_indices\nend_header\n" + std::string(20, '\0');
+        "property list uchar int vertex_indices\nend_header\n" +
+        std::string(20, '\0');
     CHECK(Read(dir.Write("cut.ply", ply), &mesh, &error) == Status::kParseError);
     CHECK(Contains(error, "cut.ply: truncated"));
     CHECK(Read(dir.Write("missing.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n"), &mesh, &error) ==
@@ -161,8 +163,8 @@ TEST_CASE("ReadMesh: bad meshes give clear errors", "[import][mesh]") {
     CHECK(Read(dir.File("absent.obj"), &mesh, &error) == Status::kIoError);
     CHECK(Contains(error, "absent.obj: cannot open"));
     RawSamples samples;
-    CHECK(LoadTerrain(dir.Write("terrain.xyzw", "1 2 3"), TerrainLoadOptions{}, &samples,
-                      &error) == Status::kInvalidArgument);
+    CHECK(LoadTerrain(dir.Write("terrain.xyzw", "1 2 3"), TerrainLoadOptions{}, &samples, &error) ==
+          Status::kInvalidArgument);
     CHECK(Contains(error, "unknown terrain file extension 'xyzw'"));
   }
 }

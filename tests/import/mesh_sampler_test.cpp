@@ -135,7 +135,8 @@ TEST_CASE("SampleMesh: smooth and flat normals differ where they should", "[impo
       const Vec3 radial = Normalize(smooth.points[i]);
       smooth_error += std::acos(std::min(1.0, Dot(smooth.normals[i], radial)));
       flat_error += std::acos(std::min(1.0, Dot(flat.normals[i], radial)));
-      largest_difference = std::max(largest_difference, Distance(smooth.normals[i], flat.normals[i]));
+      largest_difference =
+          std::max(largest_difference, Distance(smooth.normals[i], flat.normals[i]));
     }
     CHECK(smooth_error < 0.5 * flat_error);
     CHECK(largest_difference > 0.05);

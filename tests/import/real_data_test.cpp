@@ -60,8 +60,7 @@ TEST_CASE("SRTM tile: the ASC grid and the 16-bit PGM give the same samples", "[
   options.separation = 60;
   TerrainLoadReport asc_report, pgm_report;
   const RawSamples asc = Load(dir + "/terrain_srtm_boulder_144x144.asc", options, &asc_report);
-  const RawSamples pgm =
-      Load(dir + "/terrain_srtm_boulder_144x144_u16.pgm", options, &pgm_report);
+  const RawSamples pgm = Load(dir + "/terrain_srtm_boulder_144x144_u16.pgm", options, &pgm_report);
   CHECK(asc_report.vertices == 144 * 144);
   CHECK(asc.points == pgm.points);
   CHECK(asc.normals == pgm.normals);

@@ -10,7 +10,8 @@
 namespace footfall::test {
 
 TempDir::TempDir() {
-  std::string pattern = (std::filesystem::temp_directory_path() / "footfall-import-XXXXXX").string();
+  std::string pattern =
+      (std::filesystem::temp_directory_path() / "footfall-import-XXXXXX").string();
   REQUIRE(mkdtemp(&pattern[0]) != nullptr);
   path_ = pattern;
 }

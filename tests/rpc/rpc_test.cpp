@@ -5,8 +5,8 @@
 #include <fcntl.h>
 #include <netinet/in.h>
 #include <signal.h>
-#include <sys/wait.h>
 #include <sys/socket.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -79,7 +79,8 @@ void PutDouble(std::vector<unsigned char>* b, double v) {
 }
 
 // A complete one-fragment call record for `proc` with already encoded arguments.
-std::vector<unsigned char> CallRecord(uint32_t xid, uint32_t proc, const std::vector<unsigned char>& args) {
+std::vector<unsigned char> CallRecord(uint32_t xid, uint32_t proc,
+                                      const std::vector<unsigned char>& args) {
   std::vector<unsigned char> body;
   Put32(&body, xid);
   Put32(&body, 0);  // CALL
@@ -207,8 +208,10 @@ TEST_CASE("RPC answers equal the embedded engine", "[rpc]") {
       f.point = {r.point.x, r.point.y, r.point.z};
       f.normal = {r.normal.x, r.normal.y, r.normal.z};
       RequireSame(f, embedded->Snap(local, points[i]));
-      ff_next_args na{server_handle, 0, {{steps[i].foot.x, steps[i].foot.y, steps[i].foot.z},
-                                         {steps[i].direction.x, steps[i].direction.y, steps[i].direction.z}}};
+      ff_next_args na{server_handle,
+                      0,
+                      {{steps[i].foot.x, steps[i].foot.y, steps[i].foot.z},
+                       {steps[i].direction.x, steps[i].direction.y, steps[i].direction.z}}};
       REQUIRE(ff_next_1(&na, &r, c) == RPC_SUCCESS);
       const Foothold e = embedded->Next(local, steps[i]);
       REQUIRE(static_cast<int>(r.status) == static_cast<int>(e.status));
@@ -246,7 +249,8 @@ TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
   CHECK(rpc->LoadServerFile("/etc/passwd", 0, &t) == Status::kAccessDenied);
   CHECK(rpc->LoadServerFile("missing.pts", 0, &t) == Status::kIoError);
   REQUIRE(rpc->LoadServerFile("bad.pts", 0, &t) == Status::kParseError);
-  CHECK(rpc->last_error() == "bad.pts:2: column 3: 'zero' is not a number (expected x y z nx ny nz)");
+  CHECK(rpc->last_error() ==
+        "bad.pts:2: column 3: 'zero' is not a number (expected x y z nx ny nz)");
   CHECK(server.Log().find("error: load") != std::string::npos);
   std::system(("rm -rf '" + root + "' /tmp/footfall-outside.pts").c_str());
 }
@@ -268,15 +272,17 @@ TEST_CASE("misbehaving clients leave others served and memory flat", "[rpc][robu
   };
   SECTION("half-sent requests") {
     std::vector<int> held;
-    flat([&] {
-      const int fd = RawConnect(server.port());
-      std::vector<unsigned char> partial;
-      Put32(&partial, 0x80000000u | 1000);  // announces 1000 bytes, sends 12
-      Put32(&partial, 1), Put32(&partial, 0), Put32(&partial, 2);
-      SendSome(fd, partial);
-      held.push_back(fd);
-      if (held.size() > 20) close(held.front()), held.erase(held.begin());
-    }, 100);
+    flat(
+        [&] {
+          const int fd = RawConnect(server.port());
+          std::vector<unsigned char> partial;
+          Put32(&partial, 0x80000000u | 1000);  // announces 1000 bytes, sends 12
+          Put32(&partial, 1), Put32(&partial, 0), Put32(&partial, 2);
+          SendSome(fd, partial);
+          held.push_back(fd);
+          if (held.size() > 20) close(held.front()), held.erase(held.begin());
+        },
+        100);
     RequireServed(server.port());
     for (int fd : held) close(fd);
   }
@@ -285,33 +291,38 @@ TEST_CASE("misbehaving clients leave others served and memory flat", "[rpc][robu
     std::vector<unsigned char> batch;
     Put32(&batch, remote);
     Put32(&batch, FF_MAX_BATCH);
-    for (int i = 0; i < FF_MAX_BATCH; ++i) PutDouble(&batch, i % 30), PutDouble(&batch, 0), PutDouble(&batch, 0);
+    for (int i = 0; i < FF_MAX_BATCH; ++i)
+      PutDouble(&batch, i % 30), PutDouble(&batch, 0), PutDouble(&batch, 0);
     std::vector<unsigned char> stream;
     for (uint32_t xid = 1; xid <= 64; ++xid) {
       const auto rec = CallRecord(xid, FF_SNAP_BATCH, batch);
       stream.insert(stream.end(), rec.begin(), rec.end());
     }
     std::vector<int> held;
-    flat([&] {
-      const int fd = RawConnect(server.port());
-      SendSome(fd, stream);
-      held.push_back(fd);
-      if (held.size() > 4) close(held.front()), held.erase(held.begin());
-    }, 8);
+    flat(
+        [&] {
+          const int fd = RawConnect(server.port());
+          SendSome(fd, stream);
+          held.push_back(fd);
+          if (held.size() > 4) close(held.front()), held.erase(held.begin());
+        },
+        8);
     RequireServed(server.port());
     for (int fd : held) close(fd);
   }
   SECTION("garbage bytes") {
     std::mt19937 rng(3);
     int round = 0;
-    flat([&] {
-      const int fd = RawConnect(server.port());
-      std::vector<unsigned char> junk(4096 + (round++ % 10) * 1000);
-      for (auto& c : junk) c = static_cast<unsigned char>(rng());
-      if (round % 2) junk[0] = 0x80;  // a plausible record mark with a huge length
-      SendSome(fd, junk);
-      close(fd);
-    }, 100);
+    flat(
+        [&] {
+          const int fd = RawConnect(server.port());
+          std::vector<unsigned char> junk(4096 + (round++ % 10) * 1000);
+          for (auto& c : junk) c = static_cast<unsigned char>(rng());
+          if (round % 2) junk[0] = 0x80;  // a plausible record mark with a huge length
+          SendSome(fd, junk);
+          close(fd);
+        },
+        100);
     RequireServed(server.port());
   }
   SECTION("batches claiming more items than they carry") {
@@ -356,7 +367,8 @@ TEST_CASE("clients report a dead server and recover after a restart", "[rpc][rob
     server->Kill();
     const Foothold dead = rpc->Snap(t, Vec3{5, 1, 5});
     CHECK(dead.status == Status::kUnavailable);
-    CHECK(rpc->last_error().find("footfalld at 127.0.0.1:" + std::to_string(port)) != std::string::npos);
+    CHECK(rpc->last_error().find("footfalld at 127.0.0.1:" + std::to_string(port)) !=
+          std::string::npos);
     CHECK(rpc->Snap(t, Vec3{5, 1, 5}).status == Status::kUnavailable);  // still down: same answer
     server = std::make_unique<ServerProcess>(port);
     // The session reconnects and loads its terrain on the new server by itself.
@@ -407,8 +419,7 @@ TEST_CASE("footfalld registers with rpcbind and answers rpcinfo", "[rpc][rpcbind
   }
   ServerProcess server(0, {});
   CHECK(server.Log().find("registered with rpcbind") != std::string::npos);
-  const std::string command =
-      "rpcinfo -t 127.0.0.1 " + std::to_string(FOOTFALL_PROG) + " 1 2>&1";
+  const std::string command = "rpcinfo -t 127.0.0.1 " + std::to_string(FOOTFALL_PROG) + " 1 2>&1";
   FILE* p = popen(command.c_str(), "r");
   REQUIRE(p);
   char buffer[512] = {0};

@@ -41,14 +41,17 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
   for (const std::string& name : ShippedCharacters()) LoadShipped(name);
   const std::pair<std::pair<std::string, std::string>, std::string> bad[] = {
       {{"\"version\": 1", "\"version\": 2"}, "b.json: 'version' 2 is not supported"},
-      {{"\"step_length\": 0.6", "\"step_length\": -1"}, "b.json: 'step_length' = -1 is out of range"},
+      {{"\"step_length\": 0.6", "\"step_length\": -1"},
+       "b.json: 'step_length' = -1 is out of range"},
       {{"[[\"L\"], [\"R\"]]", "[[\"L\"], [\"X\"]]"}, "b.json: 'gait'[1]: no foot named 'X'"},
       {{"[[\"L\"], [\"R\"]]", "[[\"L\"]]"}, "b.json: 'gait': foot 'R' is in no group"},
       {{"[[\"L\"], [\"R\"]]", "[[\"L\", \"L\"], [\"R\"]]"}, "foot 'L' is listed twice"},
       {{"\"reach\": 1.1", "\"reach\": 0.5"}, "'reach' = 0.5 must exceed foot 'L''s rest distance"},
       {{"\"name\": \"b\"", "\"nmae\": \"b\""}, "b.json: unknown field 'nmae'"},
-      {{"\"frames_per_step\": 10", "\"frames_per_step\": 2.5"}, "'frames_per_step': expected an integer"},
-      {{"\"align_to_normal\": false", "\"align_to_normal\": 1"}, "'align_to_normal': expected true"},
+      {{"\"frames_per_step\": 10", "\"frames_per_step\": 2.5"},
+       "'frames_per_step': expected an integer"},
+      {{"\"align_to_normal\": false", "\"align_to_normal\": 1"},
+       "'align_to_normal': expected true"},
       {{"[0.1, 0, 0]", "[0.1, 0]"}, "'feet'[0].rest: expected [x, y, z]"},
       {{"\"body_height\": 0.9,", ""}, "missing field 'body_height'"},
   };
@@ -82,18 +85,28 @@ TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]")
   CHECK(std::string(PhaseName(KeyPhase::kStart)) == "start");
   CHECK(std::string(PhaseName(KeyPhase::kNone)).empty());
   const std::pair<std::string, std::string> bad[] = {
-      {R"({"format":"footfall-walk","version":9,"fps":24,"tracks":[]})", "w.json: version: expected 1"},
-      {R"({"format":"footfall-walk","version":1,"fps":0,"tracks":[]})", "w.json: fps: expected a positive number"},
-      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"arm","keys":[]}]})", "tracks[0].kind: expected \"foot\" or \"body\""},
-      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","keys":[{"frame":1,"phase":"up","position":[0,0,0]}]}]})", "tracks[0].keys[0].phase: expected"},
-      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","keys":[{"frame":1,"phase":"end","position":[0,0]}]}]})", "tracks[0].keys[0].position: expected an array of 3 numbers"},
-      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"b","kind":"body","keys":[{"frame":2,"position":[0,0,0]},{"frame":1,"position":[0,0,0]}]}]})", "tracks[0].keys[1].frame: frames must increase"},
-      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"b","kind":"body","keys":[{"frame":1,"position":[0,0,0]},{"frame":1,"position":[1,0,0]}]}]})", "tracks[0].keys[1].frame: frames must increase"},
-      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"b","kind":"body","keys":[{"frame":1,"position":[0,0,0],"rotation":[0,0,0,0]}]}]})", "w.json: tracks[0].keys[0].rotation: expected a non-zero quaternion"},
+      {R"({"format":"footfall-walk","version":9,"fps":24,"tracks":[]})",
+       "w.json: version: expected 1"},
+      {R"({"format":"footfall-walk","version":1,"fps":0,"tracks":[]})",
+       "w.json: fps: expected a positive number"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"arm","keys":[]}]})",
+       "tracks[0].kind: expected \"foot\" or \"body\""},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","keys":[{"frame":1,"phase":"up","position":[0,0,0]}]}]})",
+       "tracks[0].keys[0].phase: expected"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","keys":[{"frame":1,"phase":"end","position":[0,0]}]}]})",
+       "tracks[0].keys[0].position: expected an array of 3 numbers"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"b","kind":"body","keys":[{"frame":2,"position":[0,0,0]},{"frame":1,"position":[0,0,0]}]}]})",
+       "tracks[0].keys[1].frame: frames must increase"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"b","kind":"body","keys":[{"frame":1,"position":[0,0,0]},{"frame":1,"position":[1,0,0]}]}]})",
+       "tracks[0].keys[1].frame: frames must increase"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"b","kind":"body","keys":[{"frame":1,"position":[0,0,0],"rotation":[0,0,0,0]}]}]})",
+       "w.json: tracks[0].keys[0].rotation: expected a non-zero quaternion"},
       {"[1, 2]", "w.json: not a JSON object"},
-      {"{\"format\": \"footfall-walk\",\n \"tracks\": [\n", "w.json:3:1: malformed JSON: syntax error"},
+      {"{\"format\": \"footfall-walk\",\n \"tracks\": [\n",
+       "w.json:3:1: malformed JSON: syntax error"},
       // The position is the last character the parser read: the end of the unexpected "24".
-      {"{\"format\": \"footfall-walk\",\n \"fps\": 24 24}", "w.json:2:13: malformed JSON: syntax error"},
+      {"{\"format\": \"footfall-walk\",\n \"fps\": 24 24}",
+       "w.json:2:13: malformed JSON: syntax error"},
   };
   for (const auto& [input, message] : bad) {
     INFO(message);
@@ -114,8 +127,9 @@ TEST_CASE("ffc_generate gives the walk GenerateWalk gives", "[steps][c_api]") {
   uint32_t terrain = 0;
   REQUIRE(ffc_load_samples(s, flat.data(), ground.size(), "hf", &terrain) == FF_C_OK);
   const std::string file = std::string(FOOTFALL_SOURCE_DIR) + "/data/characters/biped.json";
-  const std::string request = R"({"character_file": ")" + file +
-                              R"(", "start": [5, 0, 5], "heading": [1, 0, 0], "steps": 6, "start_frame": 10})";
+  const std::string request =
+      R"({"character_file": ")" + file +
+      R"(", "start": [5, 0, 5], "heading": [1, 0, 0], "steps": 6, "start_frame": 10})";
   char* json = nullptr;
   REQUIRE(ffc_generate(s, terrain, request.c_str(), &json) == FF_C_OK);
   REQUIRE(json);

@@ -24,12 +24,14 @@ double Scale(const Character& c) { return c.step_length / 0.7; }
 
 Vec3 BodyForward(const WalkKey& k) {
   const Quat& q = k.rotation;
-  return {2 * (q.x * q.z + q.w * q.y), 2 * (q.y * q.z - q.w * q.x), 1 - 2 * (q.x * q.x + q.y * q.y)};
+  return {2 * (q.x * q.z + q.w * q.y), 2 * (q.y * q.z - q.w * q.x),
+          1 - 2 * (q.x * q.x + q.y * q.y)};
 }
 
 Vec3 BodyUp(const WalkKey& k) {
   const Quat& q = k.rotation;
-  return {2 * (q.x * q.y - q.w * q.z), 1 - 2 * (q.x * q.x + q.z * q.z), 2 * (q.y * q.z + q.w * q.x)};
+  return {2 * (q.x * q.y - q.w * q.z), 1 - 2 * (q.x * q.x + q.z * q.z),
+          2 * (q.y * q.z + q.w * q.x)};
 }
 
 size_t StepsDone(const Walk& w) {
@@ -52,7 +54,8 @@ TEST_CASE("Walks up and down a 20-degree ramp", "[steps][generator]") {
     const Character c = LoadShipped(name);
     const double s = Scale(c), spacing = 0.05 * s, width = 8 * c.reach;
     const double slope = 20 * kPi / 180;
-    const int nx = static_cast<int>(width / spacing), nz = static_cast<int>((14 * c.step_length + 6 * c.reach) / spacing);
+    const int nx = static_cast<int>(width / spacing),
+              nz = static_cast<int>((14 * c.step_length + 6 * c.reach) / spacing);
     Terrain t = LoadTerrain(MakeRamp(nx, nz, spacing, 20), spacing);
     const double length = nz * spacing;
     for (bool uphill : {true, false}) {
@@ -271,7 +274,8 @@ TEST_CASE("The heading follows a path with a 90-degree turn", "[steps][generator
       const Vec3 f = BodyForward(k);
       faced_z |= f.z > 0.99;
       faced_x |= f.x > 0.99;
-      nearest_corner = std::min(nearest_corner, Distance(k.position - Vec3{0, c.body_height, 0}, corner));
+      nearest_corner =
+          std::min(nearest_corner, Distance(k.position - Vec3{0, c.body_height, 0}, corner));
       // Before the corner it walks +Z; after, +X; never back (small corrections aside).
       CHECK(f.x > -0.1);
       CHECK(f.z > -0.1);

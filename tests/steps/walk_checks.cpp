@@ -60,7 +60,8 @@ std::vector<const WalkTrack*> TracksOf(const Walk& w, const std::string& charact
 namespace {
 
 Vec3 QuatAxisY(const Quat& q) {
-  return {2 * (q.x * q.y - q.w * q.z), 1 - 2 * (q.x * q.x + q.z * q.z), 2 * (q.y * q.z + q.w * q.x)};
+  return {2 * (q.x * q.y - q.w * q.z), 1 - 2 * (q.x * q.x + q.z * q.z),
+          2 * (q.y * q.z + q.w * q.x)};
 }
 
 void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, const Walk& w,
@@ -149,8 +150,10 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
     const auto& group = c.gait[k % groups];
     for (size_t f = 0; f < c.feet.size(); ++f) {
       bool lifts = false;
-      for (const WalkKey& key : tracks[f]->keys) lifts |= key.phase == KeyPhase::kStart && key.frame == f0;
-      const bool in_group = std::find(group.begin(), group.end(), static_cast<int>(f)) != group.end();
+      for (const WalkKey& key : tracks[f]->keys)
+        lifts |= key.phase == KeyPhase::kStart && key.frame == f0;
+      const bool in_group =
+          std::find(group.begin(), group.end(), static_cast<int>(f)) != group.end();
       INFO("step " << k + 1 << " foot " << c.feet[f].name);
       CHECK(lifts == in_group);
     }

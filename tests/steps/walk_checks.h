@@ -15,7 +15,7 @@
 namespace footfall::test {
 
 const std::vector<std::string>& ShippedCharacters();  // "biped", "quadruped", ...
-Character LoadShipped(const std::string& name);        // from data/characters (REQUIREs success)
+Character LoadShipped(const std::string& name);       // from data/characters (REQUIREs success)
 
 // A terrain loaded into a fresh embedded session.
 struct Terrain {

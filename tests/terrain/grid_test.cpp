@@ -50,16 +50,26 @@ std::vector<Vec3> QueryPoints(const TerrainGrid& g, std::mt19937_64& rng, int co
   for (int i = 0; i < count; ++i) {
     const Vec3& s = samples[rng() % samples.size()];
     switch (i % 6) {
-      case 0: q.push_back(s); break;
-      case 1: q.push_back(s + Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5} * (0.05 * scale)); break;
-      case 2: q.push_back(lo + Vec3{u(rng) * size.x, u(rng) * size.y, u(rng) * size.z}); break;
+      case 0:
+        q.push_back(s);
+        break;
+      case 1:
+        q.push_back(s + Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5} * (0.05 * scale));
+        break;
+      case 2:
+        q.push_back(lo + Vec3{u(rng) * size.x, u(rng) * size.y, u(rng) * size.z});
+        break;
       case 3: {  // on a face or corner of the bounds
         Vec3 p = lo + Vec3{u(rng) * size.x, u(rng) * size.y, u(rng) * size.z};
         const int axis = static_cast<int>(rng() % 3);
         const bool top = rng() % 2;
-        (axis == 0 ? p.x : axis == 1 ? p.y : p.z) =
-            axis == 0 ? (top ? hi.x : lo.x) : axis == 1 ? (top ? hi.y : lo.y) : (top ? hi.z : lo.z);
-        if (rng() % 4 == 0) p = Vec3{rng() % 2 ? hi.x : lo.x, rng() % 2 ? hi.y : lo.y, rng() % 2 ? hi.z : lo.z};
+        (axis == 0   ? p.x
+         : axis == 1 ? p.y
+                     : p.z) = axis == 0   ? (top ? hi.x : lo.x)
+                              : axis == 1 ? (top ? hi.y : lo.y)
+                                          : (top ? hi.z : lo.z);
+        if (rng() % 4 == 0)
+          p = Vec3{rng() % 2 ? hi.x : lo.x, rng() % 2 ? hi.y : lo.y, rng() % 2 ? hi.z : lo.z};
         q.push_back(p);
         break;
       }
@@ -96,14 +106,16 @@ void CheckAgainstBruteForce(const TerrainGrid& g, int count, uint64_t seed) {
     const Vec3& p = points[i];
     RequireSame(g.Snap(p), oracle.Snap(p), "snap at " + Describe(p));
     const double length = scale * (i % 3 == 0 ? 0.01 : i % 3 == 1 ? 0.1 : 0.5) * (0.5 + u(rng));
-    Vec3 dir = i % 2 ? axes[(i / 2) % 6] : Normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5 + 1e-9});
+    Vec3 dir = i % 2 ? axes[(i / 2) % 6]
+                     : Normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5 + 1e-9});
     dir = dir * length;
     const double tolerance = i % 5 == 0 ? length * 0.3 : 0;
     const StepQuery q{p, dir};
     const Foothold a = g.Next(q, tolerance);
     found += a.status == Status::kOk;
     RequireSame(a, oracle.Next(q, tolerance),
-                "next from " + Describe(p) + " along " + Describe(dir) + " tol " + std::to_string(tolerance));
+                "next from " + Describe(p) + " along " + Describe(dir) + " tol " +
+                    std::to_string(tolerance));
   }
   // The query mix must exercise both outcomes of next.
   CHECK(found > 0);
@@ -112,13 +124,21 @@ void CheckAgainstBruteForce(const TerrainGrid& g, int count, uint64_t seed) {
 }  // namespace
 
 TEST_CASE("TerrainGrid answers exactly as brute force", "[terrain][grid]") {
-  SECTION("on a height field") { CheckAgainstBruteForce(Build(MakeHeightField(80, 60, 0.5, 3, 7)), 3000, 1); }
-  SECTION("on a sphere") { CheckAgainstBruteForce(Build(MakeSphere(5000, {1, 2, 3}, 10)), 3000, 2); }
+  SECTION("on a height field") {
+    CheckAgainstBruteForce(Build(MakeHeightField(80, 60, 0.5, 3, 7)), 3000, 1);
+  }
+  SECTION("on a sphere") {
+    CheckAgainstBruteForce(Build(MakeSphere(5000, {1, 2, 3}, 10)), 3000, 2);
+  }
   SECTION("in a room with walls and a ceiling") {
     CheckAgainstBruteForce(Build(MakeRoom({20, 8, 12}, 0.5)), 3000, 3);
   }
-  SECTION("on stairs") { CheckAgainstBruteForce(Build(MakeStairs(12, 0.2, 0.3, 2, 0.05)), 3000, 4); }
-  SECTION("on a perfectly flat square") { CheckAgainstBruteForce(Build(MakeFlat(60, 0.25, 1.5)), 3000, 5); }
+  SECTION("on stairs") {
+    CheckAgainstBruteForce(Build(MakeStairs(12, 0.2, 0.3, 2, 0.05)), 3000, 4);
+  }
+  SECTION("on a perfectly flat square") {
+    CheckAgainstBruteForce(Build(MakeFlat(60, 0.25, 1.5)), 3000, 5);
+  }
   SECTION("on a ramp") { CheckAgainstBruteForce(Build(MakeRamp(40, 40, 0.25, 35)), 2000, 6); }
   SECTION("on a line of samples") {
     RawSamples s;
@@ -197,8 +217,9 @@ TEST_CASE("TerrainGrid keeps memory bounded", "[terrain][grid]") {
     CHECK(g.Snap({0, 0, 0}).status == Status::kNoFoothold);
   }
   SECTION("cells stay within about one per sample whatever the shape") {
-    for (const RawSamples& s : {MakeSphere(20000, {0, 0, 0}, 100), MakeHeightField(150, 150, 0.1, 40, 3),
-                                MakeRoom({100, 1, 100}, 0.5)}) {
+    for (const RawSamples& s :
+         {MakeSphere(20000, {0, 0, 0}, 100), MakeHeightField(150, 150, 0.1, 40, 3),
+          MakeRoom({100, 1, 100}, 0.5)}) {
       const TerrainGrid g = Build(s);
       const GridStats& st = g.stats();
       const double cells = double(st.cells[0]) * st.cells[1] * st.cells[2];

@@ -27,8 +27,10 @@ using Clock = std::chrono::steady_clock;
   for (const std::string& e : env) {
     const size_t eq = e.find('=');
     const std::string name = e.substr(0, eq), value = e.substr(eq + 1);
-    if (value.empty()) unsetenv(name.c_str());
-    else setenv(name.c_str(), value.c_str(), 1);
+    if (value.empty())
+      unsetenv(name.c_str());
+    else
+      setenv(name.c_str(), value.c_str(), 1);
   }
   if (in_fd >= 0) dup2(in_fd, 0);
   if (out_fd >= 0) dup2(out_fd, 1);
@@ -176,8 +178,8 @@ std::string XDisplay() {
   if (pid == 0) {
     close(fds[0]);
     const int null = open("/dev/null", O_RDWR);
-    Exec({"Xvfb", "-displayfd", std::to_string(fds[1]), "-screen", "0", "1280x1024x24",
-          "-nolisten", "tcp"},
+    Exec({"Xvfb", "-displayfd", std::to_string(fds[1]), "-screen", "0", "1280x1024x24", "-nolisten",
+          "tcp"},
          {}, null, null, null);
   }
   close(fds[1]);

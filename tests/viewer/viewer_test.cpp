@@ -37,7 +37,8 @@ struct Image {
   int width = 0, height = 0;
   std::vector<unsigned char> rgb;
   glm::ivec3 At(int x, int y) const {
-    const size_t i = (static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x)) * 3;
+    const size_t i =
+        (static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x)) * 3;
     return {rgb[i], rgb[i + 1], rgb[i + 2]};
   }
 };
@@ -114,8 +115,8 @@ TEST_CASE("screenshot of a next query shows the chosen sample where it projects"
   const glm::dvec3 eye(10, 14, -6), target(14, 0, 14);
   const int width = 800, height = 500;
   const StepQuery query{{10, 1, 10}, {1.2, 0, 0.3}};
-  const RunResult r = View({"--terrain", kTerrain, "--query", "next 10 1 10 1.2 0 0.3",
-                            "--camera", "10 14 -6 14 0 14", "--size", "800x500", "--screenshot",
+  const RunResult r = View({"--terrain", kTerrain, "--query", "next 10 1 10 1.2 0 0.3", "--camera",
+                            "10 14 -6 14 0 14", "--size", "800x500", "--screenshot",
                             dir + "/shot.png", "--dump-state", dir + "/state.json"});
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
@@ -138,8 +139,8 @@ TEST_CASE("screenshot of a next query shows the chosen sample where it projects"
   const Image image = ReadPng(dir + "/shot.png");
   REQUIRE(image.width == width);
   REQUIRE(image.height == height);
-  const glm::vec2 pixel = Project(eye, target, width, height,
-                                  {expected.point.x, expected.point.y, expected.point.z});
+  const glm::vec2 pixel =
+      Project(eye, target, width, height, {expected.point.x, expected.point.y, expected.point.z});
   INFO("chosen sample projects to " << pixel.x << ", " << pixel.y);
   const glm::vec2 dumped(state["queries"][0]["pixel"][0].get<float>(),
                          state["queries"][0]["pixel"][1].get<float>());
@@ -221,10 +222,9 @@ TEST_CASE("screenshot of a walk shows the feet where the JSON puts them at that 
                         Case{25, {4, 0, 2}, {4, 0, 0}}}) {
     SECTION("frame " + std::to_string(c.frame)) {
       const std::string shot = dir + "/walk" + std::to_string(c.frame) + ".png";
-      const RunResult r =
-          View({"--walk", dir + "/walk.json", "--frame", std::to_string(c.frame), "--camera",
-                "3 6 7 3 0 1", "--size", "640x480", "--screenshot", shot, "--dump-state",
-                dir + "/state.json"});
+      const RunResult r = View({"--walk", dir + "/walk.json", "--frame", std::to_string(c.frame),
+                                "--camera", "3 6 7 3 0 1", "--size", "640x480", "--screenshot",
+                                shot, "--dump-state", dir + "/state.json"});
       REQUIRE(r.exit_code == 0);
       const Image image = ReadPng(shot);
       REQUIRE(image.width == 640);
@@ -247,17 +247,16 @@ TEST_CASE("screenshot of a walk shows the feet where the JSON puts them at that 
 
 TEST_CASE("live: the viewer shows a query another client sends to footfalld", "[viewer][live]") {
   const std::string dir = test::TempDir();
-  test::Child server({FOOTFALLD, "--listen", "127.0.0.1:0", "--port-file", dir + "/port",
-                      "--no-rpcbind"},
-                     {});
+  test::Child server(
+      {FOOTFALLD, "--listen", "127.0.0.1:0", "--port-file", dir + "/port", "--no-rpcbind"}, {});
   const std::string port = WaitForPort(dir + "/port");
   INFO("footfalld stderr: " << server.Err());
   REQUIRE_FALSE(port.empty());
   const std::string address = "127.0.0.1:" + port;
 
-  test::Child viewer({kView, "--terrain", kTerrain, "--server", address, "--live",
-                      "--live-wait", "1", "--timeout", "30", "--size", "640x400",
-                      "--screenshot", dir + "/live.png", "--dump-state", dir + "/state.json"},
+  test::Child viewer({kView, "--terrain", kTerrain, "--server", address, "--live", "--live-wait",
+                      "1", "--timeout", "30", "--size", "640x400", "--screenshot",
+                      dir + "/live.png", "--dump-state", dir + "/state.json"},
                      {test::XDisplay()});
   INFO("viewer stderr: " << viewer.Err());
   REQUIRE(viewer.WaitForOutput("live: following footfalld at " + address, kTimeout));
@@ -284,12 +283,10 @@ TEST_CASE("live: the viewer shows a query another client sends to footfalld", "[
   CHECK(CountColorNear(image, pixel, 4, kChosen) >= 40);
 }
 
-TEST_CASE("live: a server that never sees a query ends the wait with a message",
-          "[viewer][live]") {
+TEST_CASE("live: a server that never sees a query ends the wait with a message", "[viewer][live]") {
   const std::string dir = test::TempDir();
-  test::Child server({FOOTFALLD, "--listen", "127.0.0.1:0", "--port-file", dir + "/port",
-                      "--no-rpcbind"},
-                     {});
+  test::Child server(
+      {FOOTFALLD, "--listen", "127.0.0.1:0", "--port-file", dir + "/port", "--no-rpcbind"}, {});
   const std::string port = WaitForPort(dir + "/port");
   REQUIRE_FALSE(port.empty());
   const RunResult r = View({"--server", "127.0.0.1:" + port, "--live", "--live-wait", "1",
@@ -330,8 +327,9 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     RunResult r = View({"--walk", dir + "/none.json", "--screenshot", shot});
     CHECK(r.exit_code == 1);
     CHECK_THAT(r.err, Catch::Contains(dir + "/none.json: cannot open walk file"));
-    test::WriteFile(dir + "/broken.json",
-                    "{\"format\": \"footfall-walk\", \"version\": 1, \"fps\": 24,\n \"tracks\": [\n");
+    test::WriteFile(
+        dir + "/broken.json",
+        "{\"format\": \"footfall-walk\", \"version\": 1, \"fps\": 24,\n \"tracks\": [\n");
     r = View({"--walk", dir + "/broken.json", "--screenshot", shot});
     CHECK(r.exit_code == 1);
     CHECK_THAT(r.err, Catch::Contains(dir + "/broken.json:3:1: malformed JSON: syntax error"));
@@ -341,7 +339,7 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     r = View({"--walk", dir + "/shape.json", "--screenshot", shot});
     CHECK(r.exit_code == 1);
     CHECK_THAT(r.err, Catch::Contains(dir + "/shape.json: tracks[0].keys[0].position: "
-                                      "expected an array of 3 numbers"));
+                                            "expected an array of 3 numbers"));
     test::WriteFile(dir + "/plain.json", R"({"fps": 24, "tracks": []})");
     r = View({"--walk", dir + "/plain.json", "--screenshot", shot});
     CHECK(r.exit_code == 1);
@@ -350,7 +348,7 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     r = View({"--walk", dir + "/descending.json", "--screenshot", shot});
     CHECK(r.exit_code == 1);
     CHECK_THAT(r.err, Catch::Contains(dir + "/descending.json: tracks[0].keys[1].frame: "
-                                      "frames must increase along a track"));
+                                            "frames must increase along a track"));
   }
   SECTION("bad sizes and missing content") {
     RunResult r = View({"--terrain", kTerrain, "--size", "12by4", "--screenshot", shot});
@@ -372,9 +370,9 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
 
 TEST_CASE("comma-separated --query numbers are drawn like spaced ones", "[viewer][query]") {
   const std::string dir = test::TempDir();
-  const RunResult r = View({"--terrain", kTerrain, "--query", "next 10,1,10 1.2,0,0.3",
-                            "--size", "160x100", "--screenshot", dir + "/shot.png",
-                            "--dump-state", dir + "/state.json"});
+  const RunResult r =
+      View({"--terrain", kTerrain, "--query", "next 10,1,10 1.2,0,0.3", "--size", "160x100",
+            "--screenshot", dir + "/shot.png", "--dump-state", dir + "/state.json"});
   REQUIRE(r.exit_code == 0);
   const json state = json::parse(test::ReadFile(dir + "/state.json"));
   REQUIRE(state["queries"].size() == 1);

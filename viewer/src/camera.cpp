@@ -22,8 +22,7 @@ void OrbitCamera::LookAt(const glm::vec3& eye, const glm::vec3& target) {
   target_ = target;
   const glm::vec3 d = eye - target;
   distance_ = std::max(glm::length(d), 1e-4f);
-  pitch_ = std::clamp(std::asin(std::clamp(d.y / distance_, -1.0f, 1.0f)), -kMaxPitch,
-                      kMaxPitch);
+  pitch_ = std::clamp(std::asin(std::clamp(d.y / distance_, -1.0f, 1.0f)), -kMaxPitch, kMaxPitch);
   yaw_ = std::atan2(d.x, d.z);
   radius_ = std::max(radius_, distance_);
 }
@@ -58,8 +57,8 @@ glm::mat4 OrbitCamera::Projection(float aspect) const {
 }
 
 bool OrbitCamera::Project(const glm::vec3& p, int width, int height, glm::vec2* pixel) const {
-  const glm::vec4 clip = Projection(static_cast<float>(width) / static_cast<float>(height)) *
-                         View() * glm::vec4(p, 1);
+  const glm::vec4 clip =
+      Projection(static_cast<float>(width) / static_cast<float>(height)) * View() * glm::vec4(p, 1);
   if (clip.w <= 0) return false;
   const glm::vec2 ndc(clip.x / clip.w, clip.y / clip.w);
   *pixel = glm::vec2((ndc.x * 0.5f + 0.5f) * static_cast<float>(width),

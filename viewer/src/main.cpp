@@ -86,8 +86,7 @@ int main(int argc, char** argv) {
   }
   if (!camera.empty()) {
     std::vector<double> v;
-    if (!ParseNumbers(camera, 6, &v) ||
-        (v[0] == v[3] && v[1] == v[4] && v[2] == v[5])) {
+    if (!ParseNumbers(camera, 6, &v) || (v[0] == v[3] && v[1] == v[4] && v[2] == v[5])) {
       std::cerr << "footfall-view: --camera \"" << camera
                 << "\": expected 6 finite numbers EX EY EZ TX TY TZ, eye != target\n";
       return 2;

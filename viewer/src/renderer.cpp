@@ -76,8 +76,8 @@ struct Renderer::Gl {
   void Draw(GLenum mode, const std::vector<DrawVertex>& v) {
     if (v.empty()) return;
     Attributes(stream);
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(v.size() * sizeof(DrawVertex)),
-                 v.data(), GL_STREAM_DRAW);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(v.size() * sizeof(DrawVertex)), v.data(),
+                 GL_STREAM_DRAW);
     glDrawArrays(mode, 0, static_cast<GLsizei>(v.size()));
   }
 
@@ -146,8 +146,8 @@ void Renderer::DrawTerrain(const glm::mat4& view_projection, float point_scale) 
   glDrawArrays(GL_POINTS, 0, gl_->terrain_count);
 }
 
-void Renderer::DrawScene(const DrawList& list, const glm::mat4& view_projection,
-                         float point_scale, bool depth_test) {
+void Renderer::DrawScene(const DrawList& list, const glm::mat4& view_projection, float point_scale,
+                         bool depth_test) {
   if (depth_test) {
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LEQUAL);
@@ -162,8 +162,8 @@ void Renderer::DrawScene(const DrawList& list, const glm::mat4& view_projection,
 
 void Renderer::DrawScreen(const DrawList& list, int width, int height) {
   glDisable(GL_DEPTH_TEST);
-  const glm::mat4 pixels = glm::ortho(0.0f, static_cast<float>(width),
-                                      static_cast<float>(height), 0.0f, -1.0f, 1.0f);
+  const glm::mat4 pixels =
+      glm::ortho(0.0f, static_cast<float>(width), static_cast<float>(height), 0.0f, -1.0f, 1.0f);
   gl_->Use(pixels, 1);
   gl_->Draw(GL_TRIANGLES, list.triangles());
   gl_->Draw(GL_LINES, list.lines());

@@ -19,9 +19,11 @@ Rgba NormalColor(const Vec3& n) {
 
 // A blue - teal - green - sand - white ramp over t in [0, 1].
 Rgba HeightColor(double t) {
-  static const double kStops[5][3] = {
-      {0.15, 0.25, 0.65}, {0.10, 0.60, 0.60}, {0.30, 0.70, 0.25}, {0.80, 0.70, 0.40},
-      {0.97, 0.97, 0.97}};
+  static const double kStops[5][3] = {{0.15, 0.25, 0.65},
+                                      {0.10, 0.60, 0.60},
+                                      {0.30, 0.70, 0.25},
+                                      {0.80, 0.70, 0.40},
+                                      {0.97, 0.97, 0.97}};
   t = std::clamp(t, 0.0, 1.0) * 4;
   const int i = std::min(static_cast<int>(t), 3);
   const double f = t - i;
@@ -51,7 +53,7 @@ void Grow(const Vec3& p, Vec3* lo, Vec3* hi, bool* any) {
 }  // namespace
 
 Rgba FootColor(size_t track_index) {
-  static const Rgba kPalette[] = {{255, 80, 40, 255},  {40, 130, 255, 255}, {60, 220, 60, 255},
+  static const Rgba kPalette[] = {{255, 80, 40, 255},   {40, 130, 255, 255},  {60, 220, 60, 255},
                                   {255, 150, 200, 255}, {150, 100, 255, 255}, {0, 230, 230, 255}};
   return kPalette[track_index % (sizeof kPalette / sizeof kPalette[0])];
 }
@@ -156,9 +158,8 @@ std::vector<DrawVertex> Scene::TerrainPoints(ColorMode mode) const {
   const float size = -static_cast<float>(spacing_ * 1.6);  // world-sized splats
   for (size_t i = 0; i < samples_.size(); ++i) {
     const Vec3& p = samples_.points[i];
-    const Rgba c = mode == ColorMode::kNormal
-                       ? NormalColor(samples_.normals[i])
-                       : HeightColor(h1 > h0 ? (p.y - h0) / (h1 - h0) : 0.5);
+    const Rgba c = mode == ColorMode::kNormal ? NormalColor(samples_.normals[i])
+                                              : HeightColor(h1 > h0 ? (p.y - h0) / (h1 - h0) : 0.5);
     out.push_back({ToRender(p), c, size});
   }
   return out;
@@ -177,8 +178,7 @@ void Scene::DrawQuery(const QueryView& q, bool latest, DrawList* depth_tested,
       if (i < samples_.size()) on_top->Point(ToRender(samples_.points[i]), colors::kExamined, 3);
     }
     for (uint32_t i : q.trace.candidates) {
-      if (i < samples_.size())
-        on_top->Point(ToRender(samples_.points[i]), colors::kCandidate, 5);
+      if (i < samples_.size()) on_top->Point(ToRender(samples_.points[i]), colors::kCandidate, 5);
     }
   }
   const glm::vec3 foot = ToRender(q.spec.point);
@@ -191,7 +191,7 @@ void Scene::DrawQuery(const QueryView& q, bool latest, DrawList* depth_tested,
     on_top->Arrow(foot, ideal, std::max(step * 0.15f, unit), colors::kArrow);
     on_top->Point(ideal, colors::kIdeal, 8 * marker);
     // The candidate radius, as a ring in the horizontal plane around the ideal point.
-    const float radius = static_cast<float>(q.trace.radius > 0 ? q.trace.radius
+    const float radius = static_cast<float>(q.trace.radius > 0     ? q.trace.radius
                                             : q.spec.tolerance > 0 ? q.spec.tolerance
                                                                    : step);
     const int kSegments = 48;
@@ -229,10 +229,12 @@ void Scene::DrawWalk(const ViewState& view, DrawList* on_top) const {
       on_top->Point(p, colors::kBody, 12);
       // The body's axes: x red, y green, z blue.
       const Quat& q = pose.rotation;
-      const glm::vec3 axes[3] = {
-          {1 - 2 * (q.y * q.y + q.z * q.z), 2 * (q.x * q.y + q.w * q.z), 2 * (q.x * q.z - q.w * q.y)},
-          {2 * (q.x * q.y - q.w * q.z), 1 - 2 * (q.x * q.x + q.z * q.z), 2 * (q.y * q.z + q.w * q.x)},
-          {2 * (q.x * q.z + q.w * q.y), 2 * (q.y * q.z - q.w * q.x), 1 - 2 * (q.x * q.x + q.y * q.y)}};
+      const glm::vec3 axes[3] = {{1 - 2 * (q.y * q.y + q.z * q.z), 2 * (q.x * q.y + q.w * q.z),
+                                  2 * (q.x * q.z - q.w * q.y)},
+                                 {2 * (q.x * q.y - q.w * q.z), 1 - 2 * (q.x * q.x + q.z * q.z),
+                                  2 * (q.y * q.z + q.w * q.x)},
+                                 {2 * (q.x * q.z + q.w * q.y), 2 * (q.y * q.z - q.w * q.x),
+                                  1 - 2 * (q.x * q.x + q.y * q.y)}};
       const Rgba axis_colors[3] = {{255, 60, 60, 255}, {60, 255, 60, 255}, {60, 60, 255, 255}};
       for (int a = 0; a < 3; ++a) on_top->Line(p, p + axes[a] * (unit * 8), axis_colors[a]);
       continue;
@@ -250,9 +252,9 @@ void Scene::DrawWalk(const ViewState& view, DrawList* on_top) const {
         const int kSegments = 16;
         glm::vec3 prev = ToRender(k.position);
         for (int s = 1; s <= kSegments; ++s) {
-          const glm::vec3 next = ToRender(ArcPoint(k.position, keys[i + 1].position,
-                                                   keys[i + 2].position,
-                                                   static_cast<double>(s) / kSegments));
+          const glm::vec3 next =
+              ToRender(ArcPoint(k.position, keys[i + 1].position, keys[i + 2].position,
+                                static_cast<double>(s) / kSegments));
           on_top->Line(prev, next, dim);
           prev = next;
         }

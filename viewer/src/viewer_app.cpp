@@ -245,15 +245,23 @@ struct App {
     App* app = From(w);
     switch (key) {
       case GLFW_KEY_ESCAPE:
-      case GLFW_KEY_Q: glfwSetWindowShouldClose(w, GLFW_TRUE); break;
-      case GLFW_KEY_F: app->FrameAll(); break;
+      case GLFW_KEY_Q:
+        glfwSetWindowShouldClose(w, GLFW_TRUE);
+        break;
+      case GLFW_KEY_F:
+        app->FrameAll();
+        break;
       case GLFW_KEY_C:
         app->view.color =
             app->view.color == ColorMode::kNormal ? ColorMode::kHeight : ColorMode::kNormal;
         app->terrain_dirty = true;
         break;
-      case GLFW_KEY_G: app->view.show_cells = !app->view.show_cells; break;
-      case GLFW_KEY_SPACE: app->playing = !app->playing; break;
+      case GLFW_KEY_G:
+        app->view.show_cells = !app->view.show_cells;
+        break;
+      case GLFW_KEY_SPACE:
+        app->playing = !app->playing;
+        break;
       case GLFW_KEY_RIGHT:
         app->playing = false;
         app->SetFrame(std::floor(app->view.frame) + 1);
@@ -262,9 +270,14 @@ struct App {
         app->playing = false;
         app->SetFrame(std::ceil(app->view.frame) - 1);
         break;
-      case GLFW_KEY_HOME: app->SetFrame(app->scene.first_frame()); break;
-      case GLFW_KEY_END: app->SetFrame(app->scene.last_frame()); break;
-      default: break;
+      case GLFW_KEY_HOME:
+        app->SetFrame(app->scene.first_frame());
+        break;
+      case GLFW_KEY_END:
+        app->SetFrame(app->scene.last_frame());
+        break;
+      default:
+        break;
     }
   }
 
@@ -365,15 +378,13 @@ int RunViewer(const ViewerOptions& options) {
     return Fail("--query needs --terrain FILE (queries run on the local terrain)", 2);
   if (options.live_wait > 0 && options.screenshot.empty())
     return Fail("--live-wait is for --screenshot", 2);
-  if (options.width <= 0 || options.height <= 0 || options.width > 16384 ||
-      options.height > 16384)
+  if (options.width <= 0 || options.height <= 0 || options.width > 16384 || options.height > 16384)
     return Fail("--size: width and height must be within 1..16384", 2);
   std::vector<QuerySpec> specs;
   for (const std::string& text : options.queries) {
     QuerySpec spec;
     std::string error;
-    if (!ParseQueryText(text, &spec, &error))
-      return Fail("--query \"" + text + "\": " + error, 2);
+    if (!ParseQueryText(text, &spec, &error)) return Fail("--query \"" + text + "\": " + error, 2);
     spec.tolerance = options.tolerance;
     specs.push_back(spec);
   }
@@ -408,8 +419,8 @@ int RunViewer(const ViewerOptions& options) {
               << app.view.frame << '\n';
   }
   app.FrameAll();
-  if (options.has_camera) app.camera.LookAt(app.scene.ToRender(options.eye),
-                                            app.scene.ToRender(options.target));
+  if (options.has_camera)
+    app.camera.LookAt(app.scene.ToRender(options.eye), app.scene.ToRender(options.target));
 
   // 3. Open a window (hidden for screenshots) with an OpenGL 3.3 core context.
   glfwSetErrorCallback(OnGlfwError);
@@ -433,8 +444,7 @@ int RunViewer(const ViewerOptions& options) {
   glfwWindowHint(GLFW_VISIBLE, headless ? GLFW_FALSE : GLFW_TRUE);
   app.window = glfwCreateWindow(headless ? 64 : options.width, headless ? 64 : options.height,
                                 "footfall-view", nullptr, nullptr);
-  if (!app.window)
-    return Fail("cannot create an OpenGL 3.3 core context: " + g_glfw_error);
+  if (!app.window) return Fail("cannot create an OpenGL 3.3 core context: " + g_glfw_error);
   glfwMakeContextCurrent(app.window);
   app.renderer = std::make_unique<Renderer>();
   if (!app.renderer->Init(&error)) return Fail(error);

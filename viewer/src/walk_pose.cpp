@@ -44,10 +44,10 @@ TrackPose PoseAt(const WalkTrack& track, double frame) {
   if (frame <= keys.front().frame) return FromKey(keys.front());
   if (frame >= keys.back().frame) return FromKey(keys.back());
   // The last key at or before `frame`.
-  size_t i = static_cast<size_t>(
-      std::upper_bound(keys.begin(), keys.end(), frame,
-                       [](double f, const WalkKey& k) { return f < k.frame; }) -
-      keys.begin() - 1);
+  size_t i =
+      static_cast<size_t>(std::upper_bound(keys.begin(), keys.end(), frame,
+                                           [](double f, const WalkKey& k) { return f < k.frame; }) -
+                          keys.begin() - 1);
   const WalkKey& a = keys[i];
   const WalkKey& b = keys[i + 1];
   TrackPose pose;

@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <iostream>
 #include <sstream>
-#include <thread>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "commands.h"
@@ -83,7 +83,8 @@ class ProgressBar {
     if (done < total && now - last_ < std::chrono::milliseconds(100)) return;
     last_ = now;
     const int width = 40;
-    const int filled = total > 0 ? static_cast<int>(static_cast<double>(done) * width / total) : width;
+    const int filled =
+        total > 0 ? static_cast<int>(static_cast<double>(done) * width / total) : width;
     std::fprintf(stderr, "\r[%s%s] step %d/%d", std::string(filled, '#').c_str(),
                  std::string(width - filled, '.').c_str(), done, total);
     std::fflush(stderr);
@@ -120,7 +121,8 @@ int RunGenerate(const GenerateFlags& flags) {
   for (const std::string& out : flags.out) {
     const std::string ext = Extension(out);
     if (ext != "json" && ext != "gltf" && ext != "glb" && ext != "mel") {
-      error = "--out " + out + ": unsupported output extension (expected .json, .gltf, .glb or .mel)";
+      error =
+          "--out " + out + ": unsupported output extension (expected .json, .gltf, .glb or .mel)";
       goto bad_flag;
     }
   }
@@ -139,8 +141,8 @@ int RunGenerate(const GenerateFlags& flags) {
     terrain_flags.threads = flags.threads;
     if (OpenTerrain(terrain_flags, &session, &terrain, &error) != Status::kOk) goto bad_flag;
     ProgressBar bar;
-    const bool long_run = static_cast<long long>(flags.crowd) *
-                              (flags.steps < 0 ? 8 : flags.steps) >= 20000;
+    const bool long_run =
+        static_cast<long long>(flags.crowd) * (flags.steps < 0 ? 8 : flags.steps) >= 20000;
     if (flags.progress || (long_run && isatty(STDERR_FILENO)))
       options.progress = [&bar](int done, int total) { bar.Update(done, total); };
     Walk walk;

@@ -46,13 +46,15 @@ bool RunBlock(TerrainSession& session, TerrainHandle terrain, double tolerance,
   std::vector<StepQuery> steps;
   for (const Command& c : block) {
     if (!c.error.empty()) continue;
-    if (c.query.op == QueryOp::kNext) steps.push_back({c.query.point, c.query.direction});
-    else points.push_back(c.query.point);
+    if (c.query.op == QueryOp::kNext)
+      steps.push_back({c.query.point, c.query.direction});
+    else
+      points.push_back(c.query.point);
   }
   std::vector<Foothold> point_answers(points.size()), step_answers(steps.size());
-  Status ps = points.empty() ? Status::kOk
-                             : session.Snap(terrain, points.data(), points.size(),
-                                            point_answers.data());
+  Status ps = points.empty()
+                  ? Status::kOk
+                  : session.Snap(terrain, points.data(), points.size(), point_answers.data());
   std::string perr = session.last_error();
   Status ss = steps.empty() ? Status::kOk
                             : session.Next(terrain, steps.data(), steps.size(), tolerance,
@@ -73,12 +75,16 @@ bool RunBlock(TerrainSession& session, TerrainHandle terrain, double tolerance,
         j = {{"op", "error"}, {"line", c.line}, {"message", next ? serr : perr}};
         ok = false;
       } else if (f.status == Status::kOk) {
-        j = {{"op", QueryOpName(c.query.op)}, {"found", true}, {"index", f.index}, {"point", Vec(f.point)},
+        j = {{"op", QueryOpName(c.query.op)},
+             {"found", true},
+             {"index", f.index},
+             {"point", Vec(f.point)},
              {"normal", Vec(f.normal)}};
       } else if (f.status == Status::kNoFoothold) {
         j = {{"op", QueryOpName(c.query.op)}, {"found", false}};
       } else {
-        j = {{"op", "error"}, {"line", c.line},
+        j = {{"op", "error"},
+             {"line", c.line},
              {"message", std::string(QueryOpName(c.query.op)) + ": " + StatusName(f.status)}};
         ok = false;
       }

@@ -100,9 +100,8 @@ int RunInfo(const InfoFlags& flags) {
   std::cout << "samples: " << report.samples << '\n'
             << "bounds: " << Format(report.bounds_min) << " to " << Format(report.bounds_max)
             << '\n'
-            << "grid: " << g.cells[0] << " x " << g.cells[1] << " x " << g.cells[2]
-            << " cells of " << g.cell_size << ", " << g.occupied_cells << " occupied, "
-            << g.bytes << " bytes\n";
+            << "grid: " << g.cells[0] << " x " << g.cells[1] << " x " << g.cells[2] << " cells of "
+            << g.cell_size << ", " << g.occupied_cells << " occupied, " << g.bytes << " bytes\n";
   return 0;
 }
 
@@ -120,8 +119,8 @@ int RunMake(const MakeFlags& f) {
   } else if (k == "sphere") {
     // Fibonacci lattice with about one sample per spacing^2 of surface.
     const double area = 4 * 3.14159265358979323846 * f.radius * f.radius;
-    samples = MakeSphere(static_cast<int>(area / (f.spacing * f.spacing)) + 1,
-                         {0, f.radius, 0}, f.radius);
+    samples = MakeSphere(static_cast<int>(area / (f.spacing * f.spacing)) + 1, {0, f.radius, 0},
+                         f.radius);
   } else if (k == "flat") {
     samples = MakeFlat(static_cast<int>(f.size / f.spacing) + 1, f.spacing, 0);
   } else if (k == "hills") {

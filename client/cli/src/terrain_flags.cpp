@@ -3,17 +3,19 @@
 namespace footfall::cli {
 
 void AddLoadFlags(CLI::App* command, TerrainLoadOptions* load) {
-  command->add_option("--separation", load->separation,
-                      "Meshes and height maps: resample so that no surface point is farther "
-                      "than this from a sample (world units; 0: mean edge length / cell size)")
+  command
+      ->add_option("--separation", load->separation,
+                   "Meshes and height maps: resample so that no surface point is farther "
+                   "than this from a sample (world units; 0: mean edge length / cell size)")
       ->check(CLI::NonNegativeNumber);
   command->add_flag("!--smooth-normals,--flat-normals", load->smooth_normals,
                     "Sample normals from faces instead of interpolated vertex normals");
   command->add_option("--seed", load->seed, "Seed of the mesh sampler");
   command->add_option("--up-axis", load->up_axis, "Height maps: up axis x, y or z")
       ->check(CLI::IsMember({'x', 'y', 'z'}));
-  command->add_option("--cell-size", load->cell_size,
-                      "Height maps: cell size (default: the .asc CELLSIZE, 1 for .pgm)")
+  command
+      ->add_option("--cell-size", load->cell_size,
+                   "Height maps: cell size (default: the .asc CELLSIZE, 1 for .pgm)")
       ->check(CLI::PositiveNumber);
   command->add_option("--height-scale", load->height_scale,
                       "Height maps: world height of one file unit (metre or grey level)");
@@ -51,10 +53,10 @@ Status OpenTerrain(const TerrainFlags& flags, std::unique_ptr<TerrainSession>* s
     if (status != Status::kOk) return status;
     *session = MakeRpcSession(options);
   }
-  const Status status = flags.terrain.empty()
-                            ? (*session)->LoadServerFile(flags.server_terrain,
-                                                         flags.load.separation, terrain)
-                            : (*session)->LoadFile(flags.terrain, flags.load, terrain);
+  const Status status =
+      flags.terrain.empty()
+          ? (*session)->LoadServerFile(flags.server_terrain, flags.load.separation, terrain)
+          : (*session)->LoadFile(flags.terrain, flags.load, terrain);
   if (status != Status::kOk) *error = (*session)->last_error();
   return status;
 }

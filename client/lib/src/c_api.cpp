@@ -136,7 +136,8 @@ int32_t ffc_load_server_file(ffc_session* s, const char* path, double separation
 int32_t ffc_load_samples(ffc_session* s, const double* samples, size_t count, const char* name,
                          uint32_t* terrain) {
   return Guard(s, [&]() -> int32_t {
-    if ((count && !samples) || !terrain) return BadArgument(s, "samples and terrain must not be NULL");
+    if ((count && !samples) || !terrain)
+      return BadArgument(s, "samples and terrain must not be NULL");
     footfall::RawSamples raw;
     raw.points.reserve(count), raw.normals.reserve(count);
     for (size_t i = 0; i < count; ++i) {
@@ -194,10 +195,10 @@ int32_t ffc_next(ffc_session* s, uint32_t terrain, const double* steps, size_t c
   });
 }
 
-int32_t ffc_generate(ffc_session* s, uint32_t terrain, const char* request_json,
-                     char** walk_json) {
+int32_t ffc_generate(ffc_session* s, uint32_t terrain, const char* request_json, char** walk_json) {
   return Guard(s, [&]() -> int32_t {
-    if (!request_json || !walk_json) return BadArgument(s, "request_json and walk_json must not be NULL");
+    if (!request_json || !walk_json)
+      return BadArgument(s, "request_json and walk_json must not be NULL");
     *walk_json = nullptr;
     footfall::Character character;
     footfall::GenerateOptions options;

@@ -25,9 +25,12 @@ bool ParseFiniteNumber(const std::string& token, double* value) {
 
 const char* QueryOpName(QueryOp op) {
   switch (op) {
-    case QueryOp::kSnap: return "snap";
-    case QueryOp::kNormal: return "normal";
-    case QueryOp::kNext: return "next";
+    case QueryOp::kSnap:
+      return "snap";
+    case QueryOp::kNormal:
+      return "normal";
+    case QueryOp::kNext:
+      return "next";
   }
   return "unknown";
 }

@@ -77,7 +77,7 @@ Status RecentQueryFeed::Fetch(std::vector<RecentQuery>* out, uint64_t* latest) {
       RecentQuery q;
       q.sequence = w.sequence;
       q.terrain = w.terrain;
-      q.op = w.op == FF_OP_NEXT ? QueryOp::kNext
+      q.op = w.op == FF_OP_NEXT     ? QueryOp::kNext
              : w.op == FF_OP_NORMAL ? QueryOp::kNormal
                                     : QueryOp::kSnap;
       q.point = FromWire(w.point);
@@ -96,8 +96,8 @@ Status RecentQueryFeed::Fetch(std::vector<RecentQuery>* out, uint64_t* latest) {
     }
   }
   xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_recent_reply), reinterpret_cast<char*>(&reply));
-  if (s != Status::kOk) return Fail(s, "recent: footfalld at " + Address() + " answered " +
-                                           StatusName(s));
+  if (s != Status::kOk)
+    return Fail(s, "recent: footfalld at " + Address() + " answered " + StatusName(s));
   return Status::kOk;
 }
 

@@ -78,8 +78,7 @@ class RpcSession final : public TerrainSession {
     return Register(std::move(source), out);
   }
 
-  Status LoadServerFile(const std::string& path, double separation,
-                        TerrainHandle* out) override {
+  Status LoadServerFile(const std::string& path, double separation, TerrainHandle* out) override {
     TerrainSource source;
     source.kind = TerrainSource::kServerFile;
     source.path = path, source.options.separation = separation, source.name = path;
@@ -254,7 +253,8 @@ class RpcSession final : public TerrainSession {
       const Status s = Call(ff_load_1(&args, &reply.value, client_), "load");
       if (s != Status::kOk) return s;
       if (reply.value.status != FF_OK)
-        return Fail(FromWire(reply.value.status), reply.value.message ? reply.value.message : "load failed");
+        return Fail(FromWire(reply.value.status),
+                    reply.value.message ? reply.value.message : "load failed");
       source->server_handle = reply.value.terrain;
       source->loaded = true;
       return Status::kOk;
@@ -268,7 +268,8 @@ class RpcSession final : public TerrainSession {
     Status s = Call(ff_upload_begin_1(&begin, &started.value, client_), "upload");
     if (s != Status::kOk) return s;
     if (started.value.status != FF_OK)
-      return Fail(FromWire(started.value.status), started.value.message ? started.value.message : "upload refused");
+      return Fail(FromWire(started.value.status),
+                  started.value.message ? started.value.message : "upload refused");
     const uint32_t upload = started.value.upload;
     std::vector<ff_sample> chunk(std::min<size_t>(samples.size(), FF_MAX_CHUNK));
     for (size_t b = 0; b < samples.size(); b += FF_MAX_CHUNK) {
@@ -283,22 +284,24 @@ class RpcSession final : public TerrainSession {
       s = Call(ff_upload_chunk_1(&args, &reply.value, client_), "upload");
       if (s != Status::kOk) return s;
       if (reply.value.status != FF_OK)
-        return Fail(FromWire(reply.value.status), reply.value.message ? reply.value.message : "upload failed");
+        return Fail(FromWire(reply.value.status),
+                    reply.value.message ? reply.value.message : "upload failed");
     }
     ff_upload_args finish{upload};
     Reply<ff_load_reply> done(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply));
     s = Call(ff_upload_finish_1(&finish, &done.value, client_), "upload");
     if (s != Status::kOk) return s;
     if (done.value.status != FF_OK)
-      return Fail(FromWire(done.value.status), done.value.message ? done.value.message : "upload failed");
+      return Fail(FromWire(done.value.status),
+                  done.value.message ? done.value.message : "upload failed");
     source->server_handle = done.value.terrain;
     source->loaded = true;
     return Status::kOk;
   }
 
   Status ServerFail(ff_status status, const char* what) {
-    return Fail(FromWire(status), std::string(what) + ": server answered " +
-                                      StatusName(FromWire(status)));
+    return Fail(FromWire(status),
+                std::string(what) + ": server answered " + StatusName(FromWire(status)));
   }
 
   Status Unknown(TerrainHandle terrain) {
@@ -310,8 +313,8 @@ class RpcSession final : public TerrainSession {
     if (status == RPC_SUCCESS) return Status::kOk;
     const std::string reason = clnt_sperrno(status);
     Disconnect();
-    return Fail(Status::kUnavailable, std::string(what) + ": footfalld at " + Address() + ": " +
-                                          reason);
+    return Fail(Status::kUnavailable,
+                std::string(what) + ": footfalld at " + Address() + ": " + reason);
   }
 
   std::string Address() const { return options_.host + ":" + std::to_string(options_.port); }

@@ -25,7 +25,10 @@ struct Reader {
   }
   bool Number(const json& j, const char* key, bool required, double* out) {
     auto it = j.find(key);
-    if (it == j.end()) return required ? Fail(Status::kParseError, std::string("missing field '") + key + "' (a number)") : true;
+    if (it == j.end())
+      return required
+                 ? Fail(Status::kParseError, std::string("missing field '") + key + "' (a number)")
+                 : true;
     if (!it->is_number() || !std::isfinite(it->get<double>()))
       return Fail(Status::kParseError, std::string("'") + key + "': expected a finite number");
     *out = it->get<double>();
@@ -68,9 +71,11 @@ struct Reader {
         if (!name.is_string()) return Fail(Status::kParseError, where + ": expected foot names");
         auto it = feet.find(name.get<std::string>());
         if (it == feet.end())
-          return Fail(Status::kInvalidArgument, where + ": no foot named '" + name.get<std::string>() + "'");
+          return Fail(Status::kInvalidArgument,
+                      where + ": no foot named '" + name.get<std::string>() + "'");
         if (!seen.insert(it->second).second)
-          return Fail(Status::kInvalidArgument, where + ": foot '" + it->first + "' is listed twice");
+          return Fail(Status::kInvalidArgument,
+                      where + ": foot '" + it->first + "' is listed twice");
         group.push_back(it->second);
       }
       out->push_back(group);
@@ -95,10 +100,24 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
     *error = source + ": not a JSON object (expected a footfall character file)";
     return Status::kParseError;
   }
-  static const std::set<std::string> kKnown = {
-      "format", "version", "name", "feet", "gait", "pairs", "step_length", "step_height",
-      "body_height", "frames_per_step", "align_to_normal", "slope_threshold_deg",
-      "slope_step_scale", "max_slope_deg", "max_rise", "reach", "max_turn_deg", "comment"};
+  static const std::set<std::string> kKnown = {"format",
+                                               "version",
+                                               "name",
+                                               "feet",
+                                               "gait",
+                                               "pairs",
+                                               "step_length",
+                                               "step_height",
+                                               "body_height",
+                                               "frames_per_step",
+                                               "align_to_normal",
+                                               "slope_threshold_deg",
+                                               "slope_step_scale",
+                                               "max_slope_deg",
+                                               "max_rise",
+                                               "reach",
+                                               "max_turn_deg",
+                                               "comment"};
   for (auto it = j.begin(); it != j.end(); ++it) {
     if (!kKnown.count(it.key())) {
       r.Fail(Status::kParseError, "unknown field '" + it.key() + "'");
@@ -112,11 +131,15 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
     else if (!j.contains("version") || !j["version"].is_number_integer())
       r.Fail(Status::kParseError, "'version': expected an integer");
     else if (j["version"].get<int>() != kCharacterFormatVersion)
-      r.Fail(Status::kParseError, "'version' " + j["version"].dump() + " is not supported (this build reads version " + std::to_string(kCharacterFormatVersion) + ")");
+      r.Fail(Status::kParseError, "'version' " + j["version"].dump() +
+                                      " is not supported (this build reads version " +
+                                      std::to_string(kCharacterFormatVersion) + ")");
   }
   if (r.status == Status::kOk && j.contains("name")) {
-    if (!j["name"].is_string()) r.Fail(Status::kParseError, "'name': expected a string");
-    else c.name = j["name"].get<std::string>();
+    if (!j["name"].is_string())
+      r.Fail(Status::kParseError, "'name': expected a string");
+    else
+      c.name = j["name"].get<std::string>();
   }
   std::map<std::string, int> foot_index;
   if (r.status == Status::kOk) {
@@ -144,8 +167,10 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
     }
   }
   if (r.status == Status::kOk) {
-    if (!j.contains("gait")) r.Fail(Status::kParseError, "missing field 'gait' (groups of foot names)");
-    else r.Groups(j["gait"], "gait", foot_index, c.feet.size(), &c.gait);
+    if (!j.contains("gait"))
+      r.Fail(Status::kParseError, "missing field 'gait' (groups of foot names)");
+    else
+      r.Groups(j["gait"], "gait", foot_index, c.feet.size(), &c.gait);
   }
   if (r.status == Status::kOk) {
     if (j.contains("pairs")) {
@@ -169,10 +194,12 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
   if (r.status == Status::kOk) {
     if (!j.contains("align_to_normal") || !j["align_to_normal"].is_boolean())
       r.Fail(Status::kParseError, "'align_to_normal': expected true (multipeds) or false (bipeds)");
-    else c.align_to_normal = j["align_to_normal"].get<bool>();
+    else
+      c.align_to_normal = j["align_to_normal"].get<bool>();
   }
   if (r.status == Status::kOk) {
-    if (fps != std::floor(fps)) r.Fail(Status::kParseError, "'frames_per_step': expected an integer");
+    if (fps != std::floor(fps))
+      r.Fail(Status::kParseError, "'frames_per_step': expected an integer");
     c.frames_per_step = static_cast<int>(std::min(fps, 1e6));
   }
   if (r.status == Status::kOk) {

@@ -38,16 +38,16 @@ bool ReadNumber(const json& j, const char* key, double* out, std::string* error)
 
 }  // namespace
 
-Status ParseGenerateRequest(const std::string& text, Character* character,
-                            GenerateOptions* options, std::string* error) {
+Status ParseGenerateRequest(const std::string& text, Character* character, GenerateOptions* options,
+                            std::string* error) {
   const json j = json::parse(text, nullptr, false);
   if (j.is_discarded() || !j.is_object()) {
     *error = "request: not a JSON object";
     return Status::kParseError;
   }
-  static const std::set<std::string> kKnown = {"character", "character_file", "start", "heading",
-                                               "path", "steps", "start_frame", "up", "fps",
-                                               "crowd"};
+  static const std::set<std::string> kKnown = {
+      "character", "character_file", "start", "heading", "path",
+      "steps",     "start_frame",    "up",    "fps",     "crowd"};
   for (auto it = j.begin(); it != j.end(); ++it) {
     if (!kKnown.count(it.key())) {
       *error = "request: unknown field '" + it.key() + "'";
@@ -75,10 +75,12 @@ Status ParseGenerateRequest(const std::string& text, Character* character,
   }
   if (s != Status::kOk) return s;
   bool ok = true;
-  if (ok && j.contains("start")) ok = ReadVec(j["start"], "start", &o.start, error), o.has_start = true;
+  if (ok && j.contains("start"))
+    ok = ReadVec(j["start"], "start", &o.start, error), o.has_start = true;
   if (ok && j.contains("heading")) ok = ReadVec(j["heading"], "heading", &o.heading, error);
   if (ok && j.contains("up")) ok = ReadVec(j["up"], "up", &o.up, error);
-  if (ok && j.contains("start_frame")) ok = ReadNumber(j["start_frame"], "start_frame", &o.start_frame, error);
+  if (ok && j.contains("start_frame"))
+    ok = ReadNumber(j["start_frame"], "start_frame", &o.start_frame, error);
   if (ok && j.contains("fps")) ok = ReadNumber(j["fps"], "fps", &o.fps, error);
   for (const char* key : {"steps", "crowd"}) {
     if (!ok || !j.contains(key)) continue;

@@ -18,9 +18,9 @@ using namespace steps_detail;
 // then longer: over a stair's riser, then shorter still).
 constexpr int kMaxAttempts = 4;
 constexpr double kAttemptScale[kMaxAttempts] = {1.0, 0.6, 1.35, 0.3};
-constexpr int kMaxRaises = 8;         // swing arc raises before giving up
-constexpr double kRaise = 0.5;        // raise per round, in step heights
-constexpr int kArcChecks = 7;         // points checked along the start-mid-end arc
+constexpr int kMaxRaises = 8;   // swing arc raises before giving up
+constexpr double kRaise = 0.5;  // raise per round, in step heights
+constexpr int kArcChecks = 7;   // points checked along the start-mid-end arc
 constexpr double kArcS[kArcChecks] = {0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875};
 // Required clearance at each check point, as a fraction of the arc's nominal clearance there
 // (the step height at the mid key, falling linearly to 0 at the start and end keys).
@@ -55,15 +55,15 @@ std::string Point(const Vec3& p) {
 
 // One walking character.
 struct Agent {
-  std::string id;      // "" for a single character, else "c1".."cN"
-  Vec3 ground;         // the body's ground point: centroid of the planted feet
-  Vec3 up;             // the body's up (world up for bipeds)
-  Vec3 forward;        // the body's heading, unit, perpendicular to up
+  std::string id;                       // "" for a single character, else "c1".."cN"
+  Vec3 ground;                          // the body's ground point: centroid of the planted feet
+  Vec3 up;                              // the body's up (world up for bipeds)
+  Vec3 forward;                         // the body's heading, unit, perpendicular to up
   std::vector<Vec3> foot, foot_normal;  // planted feet
   std::vector<Vec3> path;
   size_t waypoint = 0;
-  bool walking = true;   // false once stopped or arrived
-  std::string stopped;   // why it stopped early ("" when it did not)
+  bool walking = true;  // false once stopped or arrived
+  std::string stopped;  // why it stopped early ("" when it did not)
   size_t first_track = 0;
 };
 
@@ -71,15 +71,15 @@ struct Agent {
 struct Move {
   size_t agent;
   int foot;
-  double scale = 1;      // step length factor (retries shorten it)
+  double scale = 1;  // step length factor (retries shorten it)
   int attempts = 0;
   bool done = false;
   bool failed = false;
   std::string reason;    // why the last attempt was refused
   Vec3 end, end_normal;  // the accepted foothold
   Vec3 mid, mid_normal;
-  Vec3 ideal;            // the last query's ideal point
-  Vec3 step;             // the last query's step vector
+  Vec3 ideal;  // the last query's ideal point
+  Vec3 step;   // the last query's step vector
 };
 
 class Generator {
@@ -317,8 +317,8 @@ Status Generator::Setup(std::string* error) {
   for (int i = 0; i < n; ++i)
     for (size_t f = 0; f < feet; ++f) points_[i * feet + f] = Place(agents_[i], c_.feet[f].rest);
   answers_.resize(points_.size());
-  s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()),
-            "snap feet", error);
+  s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()), "snap feet",
+            error);
   if (s != Status::kOk) return s;
   // 4. The body at the feet's centroid, raised by body_height along its up (multipeds: the
   //    averaged foot normal); every foot and the body keyed planted at the start frame.
@@ -495,8 +495,10 @@ Status Generator::QueryFootholds(std::string* error) {
     for (size_t m = 0; m < moves.size(); ++m) {
       Move& mv = moves[m];
       if (mv.done || mv.failed) continue;
-      if (mv.attempts >= kMaxAttempts) mv.failed = true;
-      else mv.scale = kAttemptScale[mv.attempts], pending_.push_back(m);
+      if (mv.attempts >= kMaxAttempts)
+        mv.failed = true;
+      else
+        mv.scale = kAttemptScale[mv.attempts], pending_.push_back(m);
     }
   }
   return Status::kOk;
@@ -530,8 +532,7 @@ Status Generator::ClearArcs(std::string* error) {
       }
     });
     answers_.resize(points_.size());
-    const Status s = Check(session_.Snap(terrain_, points_.data(), points_.size(),
-                                         answers_.data()),
+    const Status s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()),
                            "snap swing arc", error);
     if (s != Status::kOk) return s;
     verdict_.assign(pending_.size(), 0);  // 1: raise and check again

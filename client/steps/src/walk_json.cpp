@@ -44,7 +44,8 @@ struct Reader {
     return false;
   }
   bool Finite(const json& j, const std::string& where, double* out) {
-    if (!j.is_number() || !std::isfinite(j.get<double>())) return Fail(where, "expected a finite number");
+    if (!j.is_number() || !std::isfinite(j.get<double>()))
+      return Fail(where, "expected a finite number");
     *out = j.get<double>();
     return true;
   }
@@ -69,8 +70,10 @@ std::string MalformedJson(const std::string& text, const std::string& source,
   size_t line = 1, column = 1;
   const size_t end = std::min(text.size(), e.byte > 0 ? static_cast<size_t>(e.byte - 1) : 0);
   for (size_t i = 0; i < end; ++i) {
-    if (text[i] == '\n') ++line, column = 1;
-    else ++column;
+    if (text[i] == '\n')
+      ++line, column = 1;
+    else
+      ++column;
   }
   // e.what() is "[json.exception.parse_error.101] parse error at line L, column C: WHAT".
   std::string what = e.what();
@@ -199,9 +202,12 @@ Status ParseWalkJson(const std::string& text, const std::string& source, Walk* o
         }
         track.character = t["character"].get<std::string>();
       }
-      const std::string kind = t.contains("kind") && t["kind"].is_string() ? t["kind"].get<std::string>() : "";
-      if (kind == "foot") track.kind = TrackKind::kFoot;
-      else if (kind == "body") track.kind = TrackKind::kBody;
+      const std::string kind =
+          t.contains("kind") && t["kind"].is_string() ? t["kind"].get<std::string>() : "";
+      if (kind == "foot")
+        track.kind = TrackKind::kFoot;
+      else if (kind == "body")
+        track.kind = TrackKind::kBody;
       else {
         r.Fail(tw + ".kind", "expected \"foot\" or \"body\"");
         break;
@@ -227,10 +233,14 @@ Status ParseWalkJson(const std::string& text, const std::string& source, Walk* o
         }
         if (!r.Vec(k["position"], kw + ".position", &key.position)) break;
         if (track.kind == TrackKind::kFoot) {
-          const std::string phase = k.contains("phase") && k["phase"].is_string() ? k["phase"].get<std::string>() : "?";
-          if (phase == "start") key.phase = KeyPhase::kStart;
-          else if (phase == "mid") key.phase = KeyPhase::kMid;
-          else if (phase == "end") key.phase = KeyPhase::kEnd;
+          const std::string phase =
+              k.contains("phase") && k["phase"].is_string() ? k["phase"].get<std::string>() : "?";
+          if (phase == "start")
+            key.phase = KeyPhase::kStart;
+          else if (phase == "mid")
+            key.phase = KeyPhase::kMid;
+          else if (phase == "end")
+            key.phase = KeyPhase::kEnd;
           else {
             r.Fail(kw + ".phase", "expected \"start\", \"mid\" or \"end\"");
             break;

@@ -45,7 +45,8 @@ class TokenReader {
     }
     if (pos_ >= text_->size()) return false;
     const size_t start = pos_;
-    while (pos_ < text_->size() && !std::isspace(static_cast<unsigned char>((*text_)[pos_]))) ++pos_;
+    while (pos_ < text_->size() && !std::isspace(static_cast<unsigned char>((*text_)[pos_])))
+      ++pos_;
     *token = text_->substr(start, pos_ - start);
     return true;
   }
@@ -125,9 +126,11 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
   out->valid.resize(total);
   for (size_t i = 0; i < total; ++i) {
     if (!reader.Next(&value)) {
-      return Fail(path, "truncated: expected " + std::to_string(total) + " values (" +
-                            std::to_string(out->rows) + " rows of " + std::to_string(out->cols) +
-                            "), found " + std::to_string(i), error);
+      return Fail(path,
+                  "truncated: expected " + std::to_string(total) + " values (" +
+                      std::to_string(out->rows) + " rows of " + std::to_string(out->cols) +
+                      "), found " + std::to_string(i),
+                  error);
     }
     double h;
     if (!ParseDouble(value, &h)) {
@@ -176,10 +179,12 @@ Status ReadPgm(const std::string& path, HeightMap* out, std::string* error) {
     const size_t start = reader.pos() + 1;  // exactly one whitespace byte after maxval
     const size_t available = text.size() > start ? text.size() - start : 0;
     if (available < total * bytes) {
-      return Fail(path, "truncated: " + std::to_string(out->cols) + " x " +
-                            std::to_string(out->rows) + " pixels of " + std::to_string(bytes) +
-                            " bytes need " + std::to_string(total * bytes) +
-                            " bytes of data, the file has " + std::to_string(available), error);
+      return Fail(path,
+                  "truncated: " + std::to_string(out->cols) + " x " + std::to_string(out->rows) +
+                      " pixels of " + std::to_string(bytes) + " bytes need " +
+                      std::to_string(total * bytes) + " bytes of data, the file has " +
+                      std::to_string(available),
+                  error);
     }
     const auto* data = reinterpret_cast<const unsigned char*>(text.data() + start);
     for (size_t i = 0; i < total; ++i) {
@@ -190,8 +195,10 @@ Status ReadPgm(const std::string& path, HeightMap* out, std::string* error) {
   for (size_t i = 0; i < total; ++i) {
     double h;
     if (!reader.Next(&token)) {
-      return Fail(path, "truncated: expected " + std::to_string(total) + " grey levels, found " +
-                            std::to_string(i), error);
+      return Fail(path,
+                  "truncated: expected " + std::to_string(total) + " grey levels, found " +
+                      std::to_string(i),
+                  error);
     }
     if (!ParseDouble(token, &h) || h < 0 || h > fields[2]) {
       return Fail(path + ":" + std::to_string(reader.line()),

@@ -1,9 +1,9 @@
 #include "mesh_file_checks.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
-#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -17,9 +17,7 @@ Status Fail(const std::string& where, const std::string& what, std::string* erro
   return Status::kParseError;
 }
 
-std::string At(const std::string& path, size_t line) {
-  return path + ":" + std::to_string(line);
-}
+std::string At(const std::string& path, size_t line) { return path + ":" + std::to_string(line); }
 
 std::vector<std::string> Tokens(const std::string& line) {
   std::istringstream in(line);
@@ -67,8 +65,8 @@ Status CheckObjFile(const std::string& path, long long* faces, std::string* erro
       }
       for (int i = 1; i <= 3; ++i) {
         if (!IsFiniteNumber(t[i])) {
-          return Fail(At(path, number),
-                      "vertex coordinate '" + t[i] + "' is not a finite number", error);
+          return Fail(At(path, number), "vertex coordinate '" + t[i] + "' is not a finite number",
+                      error);
         }
       }
       ++vertices;
@@ -129,8 +127,10 @@ Status CheckOffFile(const std::string& path, long long* faces, std::string* erro
   *faces = nf;
   for (long long v = 0; v < nv; ++v) {
     if (!next(&t)) {
-      return Fail(path, "truncated: header declares " + std::to_string(nv) +
-                            " vertices, found " + std::to_string(v), error);
+      return Fail(path,
+                  "truncated: header declares " + std::to_string(nv) + " vertices, found " +
+                      std::to_string(v),
+                  error);
     }
     if (t.size() < 3) return Fail(At(path, number), "vertex needs 3 coordinates", error);
     for (int i = 0; i < 3; ++i) {
@@ -142,22 +142,27 @@ Status CheckOffFile(const std::string& path, long long* faces, std::string* erro
   }
   for (long long f = 0; f < nf; ++f) {
     if (!next(&t)) {
-      return Fail(path, "truncated: header declares " + std::to_string(nf) + " faces, found " +
-                            std::to_string(f), error);
+      return Fail(
+          path,
+          "truncated: header declares " + std::to_string(nf) + " faces, found " + std::to_string(f),
+          error);
     }
     long long n = 0;
     if (!ParseInteger(t[0], &n) || n < 3) {
       return Fail(At(path, number), "face must start with its vertex count (3 or more)", error);
     }
     if (static_cast<long long>(t.size()) < n + 1) {
-      return Fail(At(path, number), "face declares " + std::to_string(n) + " vertices, found " +
-                                        std::to_string(t.size() - 1), error);
+      return Fail(
+          At(path, number),
+          "face declares " + std::to_string(n) + " vertices, found " + std::to_string(t.size() - 1),
+          error);
     }
     for (long long i = 1; i <= n; ++i) {
       long long index = 0;
       if (!ParseInteger(t[i], &index) || index < 0 || index >= nv) {
-        return Fail(At(path, number), "face vertex '" + t[i] + "' is not an index below " +
-                                          std::to_string(nv), error);
+        return Fail(At(path, number),
+                    "face vertex '" + t[i] + "' is not an index below " + std::to_string(nv),
+                    error);
       }
     }
   }
@@ -176,7 +181,7 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
   struct Element {
     std::string name;
     long long count = 0;
-    long long fixed_bytes = 0;  // fixed-size properties
+    long long fixed_bytes = 0;     // fixed-size properties
     long long list_min_bytes = 0;  // list properties, counting 3 items per face list
   };
   std::vector<Element> elements;
@@ -184,8 +189,9 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
   auto type_size = [](const std::string& type) -> int {
     if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
     if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
-    if (type == "int" || type == "uint" || type == "float" || type == "int32" ||
-        type == "uint32" || type == "float32") return 4;
+    if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" ||
+        type == "float32")
+      return 4;
     if (type == "double" || type == "float64") return 8;
     return 0;
   };
@@ -234,8 +240,10 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
       if (!Tokens(line).empty()) ++found;
     }
     if (found < records) {
-      return Fail(path, "truncated: the header declares " + std::to_string(records) +
-                            " data lines, found " + std::to_string(found), error);
+      return Fail(path,
+                  "truncated: the header declares " + std::to_string(records) +
+                      " data lines, found " + std::to_string(found),
+                  error);
     }
     return Status::kOk;
   }
@@ -245,9 +253,10 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
   long long need = 0;
   for (const Element& e : elements) need += e.count * (e.fixed_bytes + e.list_min_bytes);
   if (data_bytes < need) {
-    return Fail(path, "truncated: the header's elements need at least " + std::to_string(need) +
-                          " bytes of " + format + " data, the file has " +
-                          std::to_string(data_bytes), error);
+    return Fail(path,
+                "truncated: the header's elements need at least " + std::to_string(need) +
+                    " bytes of " + format + " data, the file has " + std::to_string(data_bytes),
+                error);
   }
   return Status::kOk;
 }
@@ -268,9 +277,11 @@ Status CheckStlFile(const std::string& path, std::string* error) {
     if (size < 84) return Fail(path, "truncated: a binary STL needs an 84-byte header", error);
     uint32_t count = 0;
     std::memcpy(&count, head.data() + 80, 4);
-    return Fail(path, "truncated: binary STL declares " + std::to_string(count) +
-                          " triangles (" + std::to_string(84 + 50ll * count) +
-                          " bytes), the file has " + std::to_string(size) + " bytes", error);
+    return Fail(path,
+                "truncated: binary STL declares " + std::to_string(count) + " triangles (" +
+                    std::to_string(84 + 50ll * count) + " bytes), the file has " +
+                    std::to_string(size) + " bytes",
+                error);
   }
   // ASCII STL: finite vertices and a closing 'endsolid'.
   in.seekg(0);

@@ -55,9 +55,8 @@ TriangleMesh MakeBlocksMesh(int nx, int nz, int max_height, uint64_t seed) {
     for (int i = 0; i < nx; ++i) {
       // Piles: noise on a coarse lattice, sharpened, so heights cluster.
       const double n = ValueNoise(i / 3.0, k / 3.0, seed);
-      height[static_cast<size_t>(k) * nx + i] =
-          std::clamp(static_cast<int>(std::floor((n * 1.6 - 0.4) * (max_height + 1))), 0,
-                     max_height);
+      height[static_cast<size_t>(k) * nx + i] = std::clamp(
+          static_cast<int>(std::floor((n * 1.6 - 0.4) * (max_height + 1))), 0, max_height);
     }
   }
   auto at = [&](int i, int k) {
@@ -111,8 +110,8 @@ TriangleMesh MakeRocksMesh(int n, double cell, double amplitude, uint64_t seed) 
       const double x = i * cell, z = k * cell;
       double h = 0, weight = 1, total = 0, frequency = 1 / 3.0;
       for (int octave = 0; octave < 4; ++octave) {
-        const double ridge = 1 - std::abs(2 * ValueNoise(x * frequency, z * frequency,
-                                                         seed + octave) - 1);
+        const double ridge =
+            1 - std::abs(2 * ValueNoise(x * frequency, z * frequency, seed + octave) - 1);
         h += weight * ridge * ridge, total += weight;
         weight *= 0.5, frequency *= 2.1;
       }
@@ -131,14 +130,14 @@ TriangleMesh MakeRocksMesh(int n, double cell, double amplitude, uint64_t seed) 
 
 TriangleMesh MakeSphereMesh(const Vec3& centre, double radius, int subdivisions) {
   const double t = (1 + std::sqrt(5.0)) / 2;
-  std::vector<Vec3> unit = {{-1, t, 0}, {1, t, 0},  {-1, -t, 0}, {1, -t, 0},
-                            {0, -1, t}, {0, 1, t},  {0, -1, -t}, {0, 1, -t},
-                            {t, 0, -1}, {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<Vec3> unit = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
+                            {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
+                            {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
   for (Vec3& v : unit) v = Normalize(v);
   std::vector<std::array<uint32_t, 3>> faces = {
-      {0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+      {0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
       {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-      {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+      {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   for (int level = 0; level < subdivisions; ++level) {
     std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints;
     auto middle = [&](uint32_t a, uint32_t b) {

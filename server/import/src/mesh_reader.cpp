@@ -147,8 +147,8 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
     const auto& p = mesh.point(vh);
     const Vec3 v{p[0], p[1], p[2]};
     if (!IsFinite(v)) {
-      if (error) *error = path + ": vertex " + std::to_string(vh.idx() + 1) +
-                          " has a non-finite coordinate";
+      if (error)
+        *error = path + ": vertex " + std::to_string(vh.idx() + 1) + " has a non-finite coordinate";
       return Status::kParseError;
     }
     out->vertices[vh.idx()] = v;
@@ -158,8 +158,9 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
     return Status::kParseError;
   }
   if (mesh.n_faces() == 0) {
-    if (error) *error = path + ": " + std::to_string(mesh.n_vertices()) +
-                        " vertices but no faces: expected a polygon mesh";
+    if (error)
+      *error = path + ": " + std::to_string(mesh.n_vertices()) +
+               " vertices but no faces: expected a polygon mesh";
     return Status::kParseError;
   }
 

@@ -166,8 +166,8 @@ Status CheckMesh(const TriangleMesh& mesh, std::string* error) {
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     for (uint32_t v : mesh.triangles[t]) {
       if (v >= mesh.vertices.size()) {
-        if (error) *error = "triangle " + std::to_string(t) + " uses missing vertex " +
-                            std::to_string(v);
+        if (error)
+          *error = "triangle " + std::to_string(t) + " uses missing vertex " + std::to_string(v);
         return Status::kInvalidArgument;
       }
     }
@@ -242,8 +242,8 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
       const Piece piece = stack.back();
       stack.pop_back();
       const Vec3 g = (piece.p[0] + piece.p[1] + piece.p[2]) / 3;
-      const double reach = std::max({Distance2(g, piece.p[0]), Distance2(g, piece.p[1]),
-                                     Distance2(g, piece.p[2])});
+      const double reach =
+          std::max({Distance2(g, piece.p[0]), Distance2(g, piece.p[1]), Distance2(g, piece.p[2])});
       if (reach <= h2 || piece.depth >= 60) {
         Candidate c;
         const Vec3 local = g - lo;
@@ -304,11 +304,12 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   const size_t cells = cell_keys.size();
   const uint64_t field = kCellLimit - 1;
   auto phase_of = [&](uint64_t key) {
-    return static_cast<int>((key >> (2 * kCellBits)) % 3 * 9 + ((key >> kCellBits) & field) % 3 * 3 +
-                            (key & field) % 3);
+    return static_cast<int>((key >> (2 * kCellBits)) % 3 * 9 +
+                            ((key >> kCellBits) & field) % 3 * 3 + (key & field) % 3);
   };
   auto tile_of = [&](uint64_t key) {
-    return CellKey(key >> (2 * kCellBits) >> 3, ((key >> kCellBits) & field) >> 3, (key & field) >> 3);
+    return CellKey(key >> (2 * kCellBits) >> 3, ((key >> kCellBits) & field) >> 3,
+                   (key & field) >> 3);
   };
   SplitMix64 rng(options.seed);
   int phase_rank[27];

@@ -84,7 +84,9 @@ RawSamples MakeStairs(int steps, double rise, double run, double width, double s
 
 RawSamples MakeRoom(const Vec3& size, double spacing) {
   RawSamples s;
-  auto count = [spacing](double len) { return std::max(1, static_cast<int>(std::round(len / spacing))); };
+  auto count = [spacing](double len) {
+    return std::max(1, static_cast<int>(std::round(len / spacing)));
+  };
   const int nx = count(size.x), ny = count(size.y), nz = count(size.z);
   for (int i = 0; i <= nx; ++i) {
     for (int k = 0; k <= nz; ++k) {
@@ -122,7 +124,8 @@ RawSamples MakeRamp(int nx, int nz, double spacing, double slope_deg) {
   const Vec3 along{0, std::sin(a), std::cos(a)};
   const Vec3 normal{0, std::cos(a), -std::sin(a)};
   for (int k = 0; k < nz; ++k)
-    for (int i = 0; i < nx; ++i) s.push_back(Vec3{i * spacing, 0, 0} + along * (k * spacing), normal);
+    for (int i = 0; i < nx; ++i)
+      s.push_back(Vec3{i * spacing, 0, 0} + along * (k * spacing), normal);
   return s;
 }
 

@@ -83,8 +83,8 @@ void Load(const ff_load_args& a, ff_load_reply* r) {
   if (s == Status::kOk) {
     const GridStats& st = g_state->registry.Find(handle)->grid.stats();
     message = "loaded " + path;
-    Log("loaded terrain " + std::to_string(handle) + " from '" + path + "': " +
-        std::to_string(st.samples) + " samples, grid " + std::to_string(st.cells[0]) + "x" +
+    Log("loaded terrain " + std::to_string(handle) + " from '" + path +
+        "': " + std::to_string(st.samples) + " samples, grid " + std::to_string(st.cells[0]) + "x" +
         std::to_string(st.cells[1]) + "x" + std::to_string(st.cells[2]));
   } else {
     LogError("load", s, message);
@@ -106,7 +106,8 @@ void UploadChunk(const ff_upload_chunk_args& a, ff_status_reply* r) {
   RawSamples& chunk = g_storage.chunk;
   chunk.clear();
   for (u_int i = 0; i < a.samples.samples_len; ++i)
-    chunk.push_back(FromWire(a.samples.samples_val[i].point), FromWire(a.samples.samples_val[i].normal));
+    chunk.push_back(FromWire(a.samples.samples_val[i].point),
+                    FromWire(a.samples.samples_val[i].normal));
   std::string message;
   const Status s = g_state->registry.AppendUpload(a.upload, chunk, &message);
   if (s != Status::kOk) LogError("upload", s, message);
@@ -333,12 +334,10 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
                                                 FF_XDR(ff_load_reply), "load", Load);
     case FF_UPLOAD_BEGIN:
       return Serve<ff_upload_begin_args, ff_upload_reply>(
-          transport, FF_XDR(ff_upload_begin_args), FF_XDR(ff_upload_reply), "upload",
-          UploadBegin);
+          transport, FF_XDR(ff_upload_begin_args), FF_XDR(ff_upload_reply), "upload", UploadBegin);
     case FF_UPLOAD_CHUNK:
       return Serve<ff_upload_chunk_args, ff_status_reply>(
-          transport, FF_XDR(ff_upload_chunk_args), FF_XDR(ff_status_reply), "upload",
-          UploadChunk);
+          transport, FF_XDR(ff_upload_chunk_args), FF_XDR(ff_status_reply), "upload", UploadChunk);
     case FF_UPLOAD_FINISH:
       return Serve<ff_upload_args, ff_load_reply>(transport, FF_XDR(ff_upload_args),
                                                   FF_XDR(ff_load_reply), "upload", UploadFinish);
@@ -373,9 +372,8 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
           [op](const ff_point_batch_args& a, ff_batch_reply* r) { PointBatch(a, r, op); });
     }
     case FF_NEXT_BATCH:
-      return Serve<ff_next_batch_args, ff_batch_reply>(transport, FF_XDR(ff_next_batch_args),
-                                                       FF_XDR(ff_batch_reply), "next batch",
-                                                       NextBatch);
+      return Serve<ff_next_batch_args, ff_batch_reply>(
+          transport, FF_XDR(ff_next_batch_args), FF_XDR(ff_batch_reply), "next batch", NextBatch);
     case FF_RECENT:
       return Serve<ff_recent_args, ff_recent_reply>(transport, FF_XDR(ff_recent_args),
                                                     FF_XDR(ff_recent_reply), "recent", Recent);

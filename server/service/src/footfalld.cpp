@@ -4,8 +4,8 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
-#include <string>
 #include <fstream>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
@@ -58,7 +58,8 @@ int main(int argc, char** argv) {
   }
   std::string error;
   if (!ParseListen(listen, &options.listen_host, &options.port)) {
-    std::fprintf(stderr, "footfalld: --listen '%s': expected ADDR:PORT with a port from 0 to 65535\n",
+    std::fprintf(stderr,
+                 "footfalld: --listen '%s': expected ADDR:PORT with a port from 0 to 65535\n",
                  listen.c_str());
     return 2;
   }

@@ -106,8 +106,8 @@ bool RpcServer::Start(std::string* error) {
   if (options_.use_rpcbind) {
     if (RpcbindRunning()) {
       pmap_unset(FOOTFALL_PROG, FOOTFALL_V1);
-      registered_rpcbind_ = pmap_set(FOOTFALL_PROG, FOOTFALL_V1, IPPROTO_TCP,
-                                     static_cast<unsigned short>(port_));
+      registered_rpcbind_ =
+          pmap_set(FOOTFALL_PROG, FOOTFALL_V1, IPPROTO_TCP, static_cast<unsigned short>(port_));
       std::fprintf(stderr, registered_rpcbind_ ? "footfalld: registered with rpcbind\n"
                                                : "footfalld: rpcbind refused the registration\n");
     } else {

@@ -8,8 +8,8 @@
 
 namespace footfall {
 
-Status ResolveUnderRoot(const std::string& root, const std::string& relative,
-                        std::string* resolved, std::string* message) {
+Status ResolveUnderRoot(const std::string& root, const std::string& relative, std::string* resolved,
+                        std::string* message) {
   if (root.empty()) {
     *message = "server-side loads are disabled (footfalld has no --data-root)";
     return Status::kAccessDenied;
@@ -33,8 +33,7 @@ Status ResolveUnderRoot(const std::string& root, const std::string& relative,
   return Status::kOk;
 }
 
-TerrainRegistry::TerrainRegistry(std::string data_root, RegistryLimits limits)
-    : limits_(limits) {
+TerrainRegistry::TerrainRegistry(std::string data_root, RegistryLimits limits) : limits_(limits) {
   if (!data_root.empty()) {
     char buffer[PATH_MAX];
     if (realpath(data_root.c_str(), buffer)) data_root_ = buffer;
@@ -134,9 +133,10 @@ Status TerrainRegistry::AppendUpload(uint32_t upload, const RawSamples& chunk,
     return Status::kInvalidArgument;
   }
   for (size_t i = 0; i < chunk.size(); ++i) {
-    if (!IsFinite(chunk.points[i]) || !IsFinite(chunk.normals[i]) || Length2(chunk.normals[i]) == 0) {
-      *message = "sample " + std::to_string(u.samples.size() + i) +
-                 ": NaN, infinite or zero-normal value";
+    if (!IsFinite(chunk.points[i]) || !IsFinite(chunk.normals[i]) ||
+        Length2(chunk.normals[i]) == 0) {
+      *message =
+          "sample " + std::to_string(u.samples.size() + i) + ": NaN, infinite or zero-normal value";
       uploads_.erase(it);
       return Status::kInvalidArgument;
     }

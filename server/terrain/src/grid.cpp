@@ -55,16 +55,26 @@ void ChooseGridBox(const RawSamples& s, const double lo[3], const double hi[3], 
 
 const char* StatusName(Status status) {
   switch (status) {
-    case Status::kOk: return "ok";
-    case Status::kNoFoothold: return "no_foothold";
-    case Status::kInvalidArgument: return "invalid_argument";
-    case Status::kUnknownTerrain: return "unknown_terrain";
-    case Status::kLimitExceeded: return "limit_exceeded";
-    case Status::kIoError: return "io_error";
-    case Status::kParseError: return "parse_error";
-    case Status::kAccessDenied: return "access_denied";
-    case Status::kUnavailable: return "unavailable";
-    case Status::kInternalError: return "internal_error";
+    case Status::kOk:
+      return "ok";
+    case Status::kNoFoothold:
+      return "no_foothold";
+    case Status::kInvalidArgument:
+      return "invalid_argument";
+    case Status::kUnknownTerrain:
+      return "unknown_terrain";
+    case Status::kLimitExceeded:
+      return "limit_exceeded";
+    case Status::kIoError:
+      return "io_error";
+    case Status::kParseError:
+      return "parse_error";
+    case Status::kAccessDenied:
+      return "access_denied";
+    case Status::kUnavailable:
+      return "unavailable";
+    case Status::kInternalError:
+      return "internal_error";
   }
   return "unknown_status";
 }
@@ -75,7 +85,7 @@ TerrainGrid::TerrainGrid(TerrainGrid&&) noexcept = default;
 TerrainGrid& TerrainGrid::operator=(TerrainGrid&&) noexcept = default;
 
 Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options, TerrainGrid* out,
-                         std::string* error) {
+                          std::string* error) {
   const size_t n = samples.points.size();
   if (samples.normals.size() != n) {
     if (error) *error = "points and normals differ in count";
@@ -170,8 +180,8 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
         (size_t{g.CellCoord(p[2], 2)} * g.dims_[1] + g.CellCoord(p[1], 1)) * g.dims_[0] +
         g.CellCoord(p[0], 0));
   }
-  const size_t bytes = n * sizeof(PackedSample) + n * 3 * sizeof(float) +
-                       (cells + 1) * sizeof(uint32_t);
+  const size_t bytes =
+      n * sizeof(PackedSample) + n * 3 * sizeof(float) + (cells + 1) * sizeof(uint32_t);
   g.memory_.reset(new unsigned char[std::max<size_t>(bytes, 1)]);
   PackedSample* packed = reinterpret_cast<PackedSample*>(g.memory_.get());
   float* normals = reinterpret_cast<float*>(packed + n);
@@ -308,8 +318,10 @@ void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
         for (int64_t i = lo[0]; i <= hi[0]; ++i) {
           if (inner && std::abs(i - ci[0]) <= skip) continue;
           if (gjk + gap[0][i - lo[0]] > scanner.limit2()) continue;
-          const double cell_lo[3] = {box_lo[0][i - lo[0]], box_lo[1][j - lo[1]], box_lo[2][k - lo[2]]};
-          const double cell_hi[3] = {box_hi[0][i - lo[0]], box_hi[1][j - lo[1]], box_hi[2][k - lo[2]]};
+          const double cell_lo[3] = {box_lo[0][i - lo[0]], box_lo[1][j - lo[1]],
+                                     box_lo[2][k - lo[2]]};
+          const double cell_hi[3] = {box_hi[0][i - lo[0]], box_hi[1][j - lo[1]],
+                                     box_hi[2][k - lo[2]]};
           visit_cell(i, j, k, cell_lo, cell_hi);
         }
       }
@@ -342,9 +354,11 @@ void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
       for (int b = 0; b < 3; ++b)
         if (b != a) rest += gap2(c[b], whole_lo[b], whole_hi[b]);
       if (ci[a] + r <= n[a] - 1)
-        bound2 = std::min(bound2, rest + gap2(c[a], CellLo(static_cast<uint32_t>(ci[a] + r), a), whole_hi[a]));
+        bound2 = std::min(
+            bound2, rest + gap2(c[a], CellLo(static_cast<uint32_t>(ci[a] + r), a), whole_hi[a]));
       if (ci[a] - r >= 0)
-        bound2 = std::min(bound2, rest + gap2(c[a], whole_lo[a], CellHi(static_cast<uint32_t>(ci[a] - r), a)));
+        bound2 = std::min(
+            bound2, rest + gap2(c[a], whole_lo[a], CellHi(static_cast<uint32_t>(ci[a] - r), a)));
     }
     if (bound2 > scanner.limit2()) return;  // also when no cell is left (bound2 infinite)
     int64_t lo[3], hi[3];
@@ -352,8 +366,8 @@ void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
       lo[a] = std::max<int64_t>(0, ci[a] - r), hi[a] = std::min(n[a] - 1, ci[a] + r);
       axis_gap[a].resize(static_cast<size_t>(hi[a] - lo[a] + 1));
       for (int64_t t = lo[a]; t <= hi[a]; ++t) {
-        axis_gap[a][t - lo[a]] = gap2(c[a], CellLo(static_cast<uint32_t>(t), a),
-                                      CellHi(static_cast<uint32_t>(t), a));
+        axis_gap[a][t - lo[a]] =
+            gap2(c[a], CellLo(static_cast<uint32_t>(t), a), CellHi(static_cast<uint32_t>(t), a));
       }
     }
     for (int64_t k = lo[2]; k <= hi[2]; ++k) {
@@ -484,7 +498,8 @@ void ParallelFor(size_t count, int threads, Fn&& fn) {
   }
   std::vector<std::thread> pool;
   const size_t chunk = (count + t - 1) / t;
-  for (size_t b = chunk; b < count; b += chunk) pool.emplace_back(fn, b, std::min(count, b + chunk));
+  for (size_t b = chunk; b < count; b += chunk)
+    pool.emplace_back(fn, b, std::min(count, b + chunk));
   fn(0, std::min(count, chunk));
   for (auto& th : pool) th.join();
 }
@@ -496,8 +511,8 @@ void TerrainGrid::SnapBatch(const Vec3* queries, size_t count, Foothold* out, in
   });
 }
 
-void TerrainGrid::NextBatch(const StepQuery* queries, size_t count, double tolerance,
-                            Foothold* out, int threads) const {
+void TerrainGrid::NextBatch(const StepQuery* queries, size_t count, double tolerance, Foothold* out,
+                            int threads) const {
   ParallelFor(count, threads, [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) out[i] = Next(queries[i], tolerance);
   });

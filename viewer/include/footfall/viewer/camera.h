@@ -38,9 +38,9 @@ class OrbitCamera {
  private:
   glm::vec3 target_{0, 0, 0};
   float distance_ = 10;
-  float yaw_ = 0.6f;     // [Units: radians] around +y, 0 looks along -z
-  float pitch_ = 0.6f;   // [Units: radians] above the horizon
-  float radius_ = 1;     // the framed box's half diagonal, for the clip planes
+  float yaw_ = 0.6f;    // [Units: radians] around +y, 0 looks along -z
+  float pitch_ = 0.6f;  // [Units: radians] above the horizon
+  float radius_ = 1;    // the framed box's half diagonal, for the clip planes
 };
 
 }  // namespace footfall::viewer

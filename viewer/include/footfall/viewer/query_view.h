@@ -21,8 +21,8 @@ struct QuerySpec : QueryText {
 // A query with its answer and, when a grid was at hand, what the grid examined.
 struct QueryView {
   QuerySpec spec;
-  Foothold result;        // the answer drawn as the chosen sample
-  QueryTrace trace;       // valid when `traced`
+  Foothold result;   // the answer drawn as the chosen sample
+  QueryTrace trace;  // valid when `traced`
   bool traced = false;
   bool live = false;      // received from footfalld rather than given on the command line
   uint64_t sequence = 0;  // live: the server's query sequence

@@ -33,8 +33,8 @@ constexpr Rgba kBackground{28, 30, 36, 255};
 constexpr Rgba kChosen{255, 0, 255, 255};     // the sample a query chose
 constexpr Rgba kCandidate{255, 214, 0, 255};  // next: samples meeting the conditions
 constexpr Rgba kExamined{150, 150, 170, 255};
-constexpr Rgba kFoot{0, 200, 255, 255};       // the query point / foot
-constexpr Rgba kIdeal{255, 255, 255, 255};    // foot + direction
+constexpr Rgba kFoot{0, 200, 255, 255};     // the query point / foot
+constexpr Rgba kIdeal{255, 255, 255, 255};  // foot + direction
 constexpr Rgba kArrow{255, 140, 0, 255};
 constexpr Rgba kCell{110, 110, 130, 255};
 constexpr Rgba kQueryCell{230, 230, 90, 160};

@@ -6,9 +6,9 @@
 namespace footfall::viewer {
 
 struct TrackPose {
-  Vec3 position;       // world space
+  Vec3 position;  // world space
   Vec3 normal{0, 1, 0};
-  Quat rotation;       // body tracks
+  Quat rotation;          // body tracks
   bool swinging = false;  // feet: between a start and an end key
 };
 

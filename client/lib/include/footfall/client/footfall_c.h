@@ -84,8 +84,7 @@ int32_t ffc_next(ffc_session* s, uint32_t terrain, const double* steps, size_t c
  * On FF_C_OK and on a walk that stopped early, *walk_json receives the walk as footfall's JSON
  * (release it with ffc_free_string); a walk that stopped early returns FF_C_NO_FOOTHOLD,
  * still fills *walk_json with the keys so far, and sets ffc_last_error() to why it stopped. */
-int32_t ffc_generate(ffc_session* s, uint32_t terrain, const char* request_json,
-                     char** walk_json);
+int32_t ffc_generate(ffc_session* s, uint32_t terrain, const char* request_json, char** walk_json);
 void ffc_free_string(char* text);
 
 #ifdef __cplusplus

@@ -17,13 +17,13 @@ namespace footfall {
 
 // One query the server answered.
 struct RecentQuery {
-  uint64_t sequence = 0;     // the server's running count of recorded queries, from 1
-  uint32_t terrain = 0;      // the server's terrain handle (not a session handle)
+  uint64_t sequence = 0;  // the server's running count of recorded queries, from 1
+  uint32_t terrain = 0;   // the server's terrain handle (not a session handle)
   QueryOp op = QueryOp::kSnap;
-  Vec3 point;                // world space: the query point, or the foot for kNext
-  Vec3 direction;            // world space, kNext only: its length is the step length
-  double tolerance = 0;      // [Units: wu] kNext only; <= 0 means one step length
-  Foothold result;           // the answer the server gave
+  Vec3 point;            // world space: the query point, or the foot for kNext
+  Vec3 direction;        // world space, kNext only: its length is the step length
+  double tolerance = 0;  // [Units: wu] kNext only; <= 0 means one step length
+  Foothold result;       // the answer the server gave
 };
 
 class RecentQueryFeed {

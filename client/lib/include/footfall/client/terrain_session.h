@@ -35,8 +35,7 @@ class TerrainSession {
                           TerrainHandle* out);
   // Loads a file that the serving engine reads itself: a path under footfalld's data root
   // (RPC), or a local path (embedded). `separation` resamples meshes. [Units: wu]
-  virtual Status LoadServerFile(const std::string& path, double separation,
-                                TerrainHandle* out) = 0;
+  virtual Status LoadServerFile(const std::string& path, double separation, TerrainHandle* out) = 0;
   // Loads samples held by the caller; `name` labels the terrain in logs and info.
   virtual Status LoadSamples(const RawSamples& samples, const std::string& name,
                              TerrainHandle* out) = 0;
@@ -45,8 +44,7 @@ class TerrainSession {
 
   // out[i] answers points[i] / queries[i]; see TerrainGrid for the exact semantics.
   virtual Status Snap(TerrainHandle terrain, const Vec3* points, size_t count, Foothold* out) = 0;
-  virtual Status Normal(TerrainHandle terrain, const Vec3* points, size_t count,
-                        Foothold* out) = 0;
+  virtual Status Normal(TerrainHandle terrain, const Vec3* points, size_t count, Foothold* out) = 0;
   virtual Status Next(TerrainHandle terrain, const StepQuery* queries, size_t count,
                       double tolerance, Foothold* out) = 0;
 
@@ -73,9 +71,9 @@ std::unique_ptr<TerrainSession> MakeEmbeddedSession(int threads = 1);
 
 struct RpcOptions {
   std::string host = "127.0.0.1";
-  int port = 7407;                 // footfalld's default port
-  double call_timeout_s = 10;      // [Units: s] per call
-  double connect_timeout_s = 2;    // [Units: s] per connection attempt
+  int port = 7407;               // footfalld's default port
+  double call_timeout_s = 10;    // [Units: s] per call
+  double connect_timeout_s = 2;  // [Units: s] per connection attempt
 };
 
 // A client of footfalld. It connects lazily, reports kUnavailable when the server is gone or

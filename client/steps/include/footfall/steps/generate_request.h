@@ -15,7 +15,7 @@ namespace footfall {
 
 // Fills *character and *options from the request. kParseError / kInvalidArgument with a
 // message naming the field; kIoError when character_file cannot be read.
-Status ParseGenerateRequest(const std::string& text, Character* character,
-                            GenerateOptions* options, std::string* error);
+Status ParseGenerateRequest(const std::string& text, Character* character, GenerateOptions* options,
+                            std::string* error);
 
 }  // namespace footfall

@@ -21,9 +21,9 @@ enum class KeyPhase { kNone, kStart, kMid, kEnd };
 struct WalkKey {
   double frame = 0;
   KeyPhase phase = KeyPhase::kNone;
-  Vec3 position;        // world space
-  Vec3 normal{0, 1, 0}; // feet: unit terrain normal at the key (mid: the averaged normal)
-  Quat rotation;        // body: world orientation
+  Vec3 position;         // world space
+  Vec3 normal{0, 1, 0};  // feet: unit terrain normal at the key (mid: the averaged normal)
+  Quat rotation;         // body: world orientation
 };
 
 enum class TrackKind { kFoot, kBody };

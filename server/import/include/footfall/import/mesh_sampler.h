@@ -30,7 +30,8 @@
 namespace footfall {
 
 struct MeshSampleOptions {
-  // Point separation s: the farthest any surface point may be from a sample. [Units: wu] [Limit: > 0]
+  // Point separation s: the farthest any surface point may be from a sample. [Units: wu] [Limit: >
+  // 0]
   double separation = 1;
   // Normals interpolated from vertex normals (true) or the face's (false).
   bool smooth_normals = true;

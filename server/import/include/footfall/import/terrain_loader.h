@@ -36,14 +36,14 @@ struct TerrainLoadOptions {
 
 // What a load found, for `footfall terrain info` and server logs.
 struct TerrainLoadReport {
-  std::string format;        // "points", "mesh" or "heightmap"
-  size_t vertices = 0;       // meshes: as stored; height maps: valid cells
-  size_t faces = 0;          // meshes: polygons read; height maps: triangles built
-  size_t skipped_faces = 0;  // meshes: degenerate faces left out
-  size_t nodata_cells = 0;   // height maps: cells left out
-  double area = 0;           // [Units: wu^2] meshes and height maps
-  double separation = 0;     // [Units: wu] the separation used (meshes and height maps)
-  size_t samples = 0;        // samples produced
+  std::string format;           // "points", "mesh" or "heightmap"
+  size_t vertices = 0;          // meshes: as stored; height maps: valid cells
+  size_t faces = 0;             // meshes: polygons read; height maps: triangles built
+  size_t skipped_faces = 0;     // meshes: degenerate faces left out
+  size_t nodata_cells = 0;      // height maps: cells left out
+  double area = 0;              // [Units: wu^2] meshes and height maps
+  double separation = 0;        // [Units: wu] the separation used (meshes and height maps)
+  size_t samples = 0;           // samples produced
   Vec3 bounds_min, bounds_max;  // world-space bounds of the samples
 };
 

@@ -11,7 +11,7 @@
 namespace footfall {
 
 struct TriangleMesh {
-  std::vector<Vec3> vertices;                    // world space [(x, y, z)], all finite
+  std::vector<Vec3> vertices;                      // world space [(x, y, z)], all finite
   std::vector<std::array<uint32_t, 3>> triangles;  // counter-clockwise seen from the outside
 };
 

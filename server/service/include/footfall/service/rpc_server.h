@@ -15,10 +15,10 @@ namespace footfall {
 
 struct RpcServerOptions {
   std::string listen_host = "127.0.0.1";
-  int port = 7407;             // 0 picks a free port (see RpcServer::port())
-  std::string data_root;       // confines FF_LOAD; empty refuses server-side loads
-  bool use_rpcbind = true;     // register with rpcbind when one is running
-  int batch_threads = 1;       // threads per batch query
+  int port = 7407;          // 0 picks a free port (see RpcServer::port())
+  std::string data_root;    // confines FF_LOAD; empty refuses server-side loads
+  bool use_rpcbind = true;  // register with rpcbind when one is running
+  int batch_threads = 1;    // threads per batch query
   RegistryLimits limits;
 };
 

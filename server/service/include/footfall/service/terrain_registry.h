@@ -82,7 +82,7 @@ class TerrainRegistry {
 
 // Resolves `relative` under the canonical directory `root`, refusing escapes: absolute paths,
 // "..", and symlinks leading outside. On success *resolved is the canonical path.
-Status ResolveUnderRoot(const std::string& root, const std::string& relative,
-                        std::string* resolved, std::string* message);
+Status ResolveUnderRoot(const std::string& root, const std::string& relative, std::string* resolved,
+                        std::string* message);
 
 }  // namespace footfall

@@ -57,9 +57,9 @@ struct GridStats {
   uint32_t cells[3] = {0, 0, 0};  // grid dimensions in x, y, z
   double cell_size = 0;           // [Units: wu] edge length of a (cubic) cell
   size_t occupied_cells = 0;
-  size_t bytes = 0;                // the grid's single allocation
-  Vec3 bounds_min, bounds_max;     // world-space bounds of all samples
-  Vec3 grid_min, grid_max;         // world-space box the cells divide (the bulk of the samples)
+  size_t bytes = 0;             // the grid's single allocation
+  Vec3 bounds_min, bounds_max;  // world-space bounds of all samples
+  Vec3 grid_min, grid_max;      // world-space box the cells divide (the bulk of the samples)
 };
 
 struct GridOptions {
@@ -142,9 +142,9 @@ class TerrainGrid {
 
   size_t count_ = 0;
   GridStats stats_;
-  double origin_[3] = {0, 0, 0};      // world position of local (0, 0, 0)
-  double grid_lo_[3] = {0, 0, 0};     // local corner of cell (0, 0, 0)
-  double bounds_lo_[3] = {0, 0, 0};   // local bounds of all samples
+  double origin_[3] = {0, 0, 0};     // world position of local (0, 0, 0)
+  double grid_lo_[3] = {0, 0, 0};    // local corner of cell (0, 0, 0)
+  double bounds_lo_[3] = {0, 0, 0};  // local bounds of all samples
   double bounds_hi_[3] = {0, 0, 0};
   double cell_size_ = 1, inv_cell_size_ = 1;
   uint32_t dims_[3] = {1, 1, 1};
@@ -152,7 +152,7 @@ class TerrainGrid {
   // Views into memory_, in cell order:
   const PackedSample* samples_ = nullptr;  // local position and source index per slot
   const float* normals_ = nullptr;         // 3 floats per slot, unit
-  const uint32_t* cell_start_ = nullptr;  // cells + 1 offsets into the slots
+  const uint32_t* cell_start_ = nullptr;   // cells + 1 offsets into the slots
 };
 
 }  // namespace footfall
