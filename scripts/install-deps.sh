@@ -5,7 +5,7 @@ set -euo pipefail
 
 core=(cmake g++ make pkg-config cpp libtirpc-dev rpcsvc-proto nlohmann-json3-dev libcli11-dev
       libopenmesh-dev libtinygltf-dev libstb-dev)
-test=(catch2 libbenchmark-dev libnanoflann-dev rpcbind valgrind nodejs npm)
+test=(catch2 libbenchmark-dev libnanoflann-dev rpcbind nodejs npm clang-format git)
 viewer=(libglfw3-dev libglm-dev libgl-dev libgl1-mesa-dri xvfb xauth)
 blender=(blender python3 python3-numpy)
 
