@@ -1,7 +1,9 @@
 // TerrainGrid against its brute-force oracle on many terrain shapes: every answer must be
 // identical (status, index, point, normal) for queries inside, on and far outside the bounds,
 // along every axis both ways.
+#include <algorithm>
 #include <random>
+#include <tuple>
 #include <string>
 #include <vector>
 
@@ -119,6 +121,20 @@ void CheckAgainstBruteForce(const TerrainGrid& g, int count, uint64_t seed) {
   }
   // The query mix must exercise both outcomes of next.
   CHECK(found > 0);
+  // Batches give the same answers, in the given order and in a spatially sorted order (where
+  // each search starts from the previous answer), on one and two threads.
+  std::vector<Vec3> sorted = points;
+  std::sort(sorted.begin(), sorted.end(), [](const Vec3& a, const Vec3& b) {
+    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+  });
+  for (const std::vector<Vec3>* batch : {&points, static_cast<const std::vector<Vec3>*>(&sorted)}) {
+    for (int threads : {1, 2}) {
+      std::vector<Foothold> answers(batch->size());
+      g.SnapBatch(batch->data(), batch->size(), answers.data(), threads);
+      for (size_t i = 0; i < batch->size(); ++i)
+        RequireSame(answers[i], oracle.Snap((*batch)[i]), "batch snap at " + Describe((*batch)[i]));
+    }
+  }
 }
 
 }  // namespace
