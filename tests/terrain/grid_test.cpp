@@ -3,8 +3,8 @@
 // along every axis both ways.
 #include <algorithm>
 #include <random>
-#include <tuple>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <catch2/catch.hpp>

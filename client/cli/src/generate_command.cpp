@@ -17,6 +17,7 @@
 #include "footfall/export/walk_writer.h"
 #include "footfall/steps/generator.h"
 #include "footfall/steps/walk_json.h"
+#include "footfall/terrain/file_extension.h"
 #include "terrain_flags.h"
 
 namespace footfall::cli {
@@ -57,18 +58,9 @@ bool ParseVec(const std::string& text, const std::string& flag, Vec3* out, std::
   return true;
 }
 
-std::string Extension(const std::string& path) {
-  const size_t slash = path.find_last_of('/');
-  const size_t dot = path.find_last_of('.');
-  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-  std::string ext = path.substr(dot + 1);
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-
 // Writes one output, chosen by its extension.
 Status WriteOutput(const Walk& walk, const std::string& path, std::string* error) {
-  const std::string ext = Extension(path);
+  const std::string ext = FileExtension(path);
   if (ext == "json") return WriteWalkJson(walk, path, error);
   if (IsWalkExportPath(path)) return WriteWalk(walk, path, error);
   *error = path + ": unsupported output extension (expected .json, .gltf, .glb or .mel)";
@@ -119,7 +111,7 @@ int RunGenerate(const GenerateFlags& flags) {
     }
   }
   for (const std::string& out : flags.out) {
-    const std::string ext = Extension(out);
+    const std::string ext = FileExtension(out);
     if (ext != "json" && ext != "gltf" && ext != "glb" && ext != "mel") {
       error =
           "--out " + out + ": unsupported output extension (expected .json, .gltf, .glb or .mel)";

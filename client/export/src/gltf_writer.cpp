@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "file_output.h"
+#include "footfall/terrain/file_extension.h"
 #include "walk_prep.h"
 
 namespace footfall {
@@ -84,12 +85,7 @@ int AddAccessor(std::vector<PendingAccessor>* pending, Streams* streams, StreamI
   return static_cast<int>(pending->size() - 1);
 }
 
-bool EndsWithGlb(const std::string& path) {
-  if (path.size() < 4) return false;
-  std::string ext = path.substr(path.size() - 4);
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".glb";
-}
+bool EndsWithGlb(const std::string& path) { return FileExtension(path) == "glb"; }
 
 }  // namespace
 

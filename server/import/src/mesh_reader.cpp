@@ -7,6 +7,7 @@
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 
+#include "footfall/terrain/file_extension.h"
 #include "mesh_file_checks.h"
 
 namespace footfall {
@@ -16,15 +17,6 @@ struct DoubleTraits : public OpenMesh::DefaultTraits {
   typedef OpenMesh::Vec3d Point;
 };
 using PolyMesh = OpenMesh::PolyMesh_ArrayKernelT<DoubleTraits>;
-
-std::string Extension(const std::string& path) {
-  const size_t slash = path.find_last_of('/');
-  const size_t dot = path.find_last_of('.');
-  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-  std::string ext = path.substr(dot + 1);
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
 
 // OpenMesh reports problems on its global streams omerr/omlog/omout. While reading we send
 // them to a buffer (counting its messages) instead of the process's stderr; a mutex keeps
@@ -91,7 +83,7 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
                 MeshReadReport* report) {
   out->vertices.clear(), out->triangles.clear();
   if (report) *report = MeshReadReport{};
-  const std::string ext = Extension(path);
+  const std::string ext = FileExtension(path);
   if (!IsMeshExtension(ext)) {
     if (error) *error = path + ": not a mesh extension '" + ext + "' (obj, ply, off, stl, om)";
     return Status::kInvalidArgument;

@@ -7,20 +7,11 @@
 #include "footfall/import/height_map.h"
 #include "footfall/import/mesh_reader.h"
 #include "footfall/import/mesh_sampler.h"
+#include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/point_file.h"
 
 namespace footfall {
 namespace {
-
-std::string LowerExtension(const std::string& path) {
-  const size_t slash = path.find_last_of('/');
-  const size_t dot = path.find_last_of('.');
-  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-  std::string ext = path.substr(dot + 1);
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
 
 Status CheckOptions(const TerrainLoadOptions& o, std::string* error) {
   std::string what;
@@ -117,7 +108,7 @@ Status LoadTerrain(const std::string& path, const TerrainLoadOptions& options, R
   *report = TerrainLoadReport{};
   Status status = CheckOptions(options, error);
   if (status == Status::kOk) {
-    status = LoadAny(path, LowerExtension(path), options, out, error, report);
+    status = LoadAny(path, FileExtension(path), options, out, error, report);
   }
   if (status != Status::kOk) {
     out->clear();

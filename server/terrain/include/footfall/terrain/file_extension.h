@@ -1,0 +1,19 @@
+// The extension of a file name, lower-cased, which every reader and writer dispatches on.
+#pragma once
+
+#include <cctype>
+#include <string>
+
+namespace footfall {
+
+// "dir/Walk.GLB" -> "glb"; "" when the last path component has no dot.
+inline std::string FileExtension(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  const size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string ext = path.substr(dot + 1);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+}  // namespace footfall
