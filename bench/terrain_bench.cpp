@@ -132,6 +132,39 @@ void BM_GridNext(benchmark::State& state) {
 }
 BENCHMARK(BM_GridNext)->Arg(0)->Arg(1)->Threads(1)->Threads(2)->UseRealTime();
 
+// Batches of 4096 queries, which prefetch ahead (TerrainGrid::SnapBatch / NextBatch).
+void BM_GridSnapBatch(benchmark::State& state) {
+  const TerrainGrid& g = Grid();
+  const std::vector<Vec3>& q = Points(static_cast<int>(state.range(0)));
+  std::vector<Foothold> out(4096);
+  size_t offset = 0;
+  for (auto _ : state) {
+    g.SnapBatch(&q[offset], out.size(), out.data(), 1);
+    benchmark::DoNotOptimize(out.data());
+    offset = (offset + out.size()) % (kQueries - out.size());
+  }
+  state.SetLabel(OrderName(static_cast<int>(state.range(0))));
+  state.SetItemsProcessed(state.iterations() * out.size());
+}
+BENCHMARK(BM_GridSnapBatch)->Arg(0)->Arg(1)->UseRealTime();
+
+void BM_GridNextBatch(benchmark::State& state) {
+  const TerrainGrid& g = Grid();
+  static const std::vector<StepQuery> random = StepsFrom(RandomPoints());
+  static const std::vector<StepQuery> coherent = StepsFrom(CoherentPoints());
+  const std::vector<StepQuery>& q = state.range(0) == 0 ? random : coherent;
+  std::vector<Foothold> out(4096);
+  size_t offset = 0;
+  for (auto _ : state) {
+    g.NextBatch(&q[offset], out.size(), 0, out.data(), 1);
+    benchmark::DoNotOptimize(out.data());
+    offset = (offset + out.size()) % (kQueries - out.size());
+  }
+  state.SetLabel(OrderName(static_cast<int>(state.range(0))));
+  state.SetItemsProcessed(state.iterations() * out.size());
+}
+BENCHMARK(BM_GridNextBatch)->Arg(0)->Arg(1)->UseRealTime();
+
 // --- baselines: brute force and a k-d tree -------------------------------------------------
 
 void BM_BruteForceSnap(benchmark::State& state) {
