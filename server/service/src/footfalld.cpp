@@ -1,11 +1,13 @@
 // footfalld: the footfall terrain query server (ONC RPC over TCP).
 #include <signal.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <string>
+#include <thread>
 
 #include <CLI/CLI.hpp>
 
@@ -46,7 +48,9 @@ int main(int argc, char** argv) {
                  "Directory that confines server-side terrain loads (none: refused)")
       ->check(CLI::ExistingDirectory);
   app.add_flag("--no-rpcbind", no_rpcbind, "Do not register with rpcbind");
-  app.add_option("--threads", options.batch_threads, "Threads per batch query")
+  options.batch_threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  app.add_option("--threads", options.batch_threads,
+                 "Threads per batch query (default: the hardware's cores)")
       ->check(CLI::Range(1, 64));
   app.add_option("--max-samples", options.limits.max_total_samples,
                  "Samples held over all terrains and uploads");
