@@ -36,6 +36,16 @@ TEST_CASE("ReadPointStream reads samples", "[terrain][point_file]") {
   CHECK(s.points[2] == Vec3{7, 8, 9});
 }
 
+TEST_CASE("ReadPointStream accepts a UTF-8 byte order mark and bare decimal points",
+          "[terrain][point_file]") {
+  RawSamples s;
+  std::string error;
+  REQUIRE(Read("\xEF\xBB\xBF.5 5. 1E1 0 1 0\r\n-0 +2 3e-2\t0 0 1\n", &s, &error) == Status::kOk);
+  REQUIRE(s.size() == 2);
+  CHECK(s.points[0] == Vec3{0.5, 5, 10});
+  CHECK(s.points[1] == Vec3{0, 2, 0.03});
+}
+
 TEST_CASE("ReadPointStream rejects bad lines with file and line", "[terrain][point_file]") {
   RawSamples s;
   std::string error;

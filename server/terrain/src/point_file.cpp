@@ -30,6 +30,7 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
   while (std::getline(in, text)) {
     ++line_no;
     std::string_view line(text);
+    if (line_no == 1 && line.substr(0, 3) == "\xEF\xBB\xBF") line.remove_prefix(3);  // UTF-8 BOM
     const size_t hash = line.find('#');
     if (hash != std::string_view::npos) line = line.substr(0, hash);
     double v[6];
