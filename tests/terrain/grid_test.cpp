@@ -199,6 +199,27 @@ TEST_CASE("TerrainGrid answers exactly as brute force", "[terrain][grid]") {
   }
 }
 
+TEST_CASE("TerrainGrid answers very far queries exactly, and refuses absurd ones",
+          "[terrain][grid]") {
+  const TerrainGrid g = Build(MakeHeightField(120, 120, 0.1, 0.3, 21));
+  const BruteForce oracle(g);
+  std::mt19937_64 rng(22);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (double distance : {1e4, 1e6, 1e9, 1e12, 1e14}) {
+    for (int i = 0; i < 40; ++i) {
+      const Vec3 q = Normalize(Vec3{u(rng), u(rng), u(rng)}) * distance;
+      RequireSame(g.Snap(q), oracle.Snap(q), "snap at " + Describe(q));
+      const StepQuery step{q, Vec3{u(rng), u(rng), u(rng)} * distance};
+      RequireSame(g.Next(step, 0), oracle.Next(step, 0), "next from " + Describe(q));
+    }
+  }
+  for (const Vec3& q : {Vec3{2e15, 0, 0}, Vec3{0, -1e300, 0}, Vec3{1e308, 1e308, 1e308}}) {
+    CHECK(g.Snap(q).status == Status::kInvalidArgument);
+    CHECK(oracle.Snap(q).status == Status::kInvalidArgument);
+    CHECK(g.Next({Vec3{}, q}, 0).status == Status::kInvalidArgument);
+  }
+}
+
 TEST_CASE("TerrainGrid next follows the candidate rules", "[terrain][grid]") {
   const TerrainGrid g = Build(MakeFlat(21, 1, 0));  // samples at integer x, z in [0, 20]
   SECTION("the ideal point's sample is chosen") {

@@ -9,9 +9,10 @@ namespace footfall {
 Foothold BruteForce::Snap(const Vec3& q) const {
   Foothold none;
   if (!IsFinite(q)) return none;
-  none.status = Status::kNoFoothold;
   const TerrainGrid& g = grid_;
   const double c[3] = {q.x - g.origin_[0], q.y - g.origin_[1], q.z - g.origin_[2]};
+  if (!detail::InQueryRange(c)) return none;
+  none.status = Status::kNoFoothold;
   double best_d2 = std::numeric_limits<double>::infinity();
   uint32_t best_index = std::numeric_limits<uint32_t>::max(), best_slot = best_index;
   for (uint32_t s = 0; s < g.count_; ++s) {

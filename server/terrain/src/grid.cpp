@@ -13,6 +13,8 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr uint32_t kNoIndex = std::numeric_limits<uint32_t>::max();
+// Cells per axis of a block, the coarse level used for queries far from the grid.
+constexpr uint32_t kBlockCells = 8;
 
 // Total cells for a cell size h over local extents e, saturating in double.
 double CellCount(const double e[3], double h) {
@@ -180,12 +182,15 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
         (size_t{g.CellCoord(p[2], 2)} * g.dims_[1] + g.CellCoord(p[1], 1)) * g.dims_[0] +
         g.CellCoord(p[0], 0));
   }
-  const size_t bytes =
-      n * sizeof(PackedSample) + n * 3 * sizeof(float) + (cells + 1) * sizeof(uint32_t);
+  for (int a = 0; a < 3; ++a) g.block_dims_[a] = (g.dims_[a] + kBlockCells - 1) / kBlockCells;
+  const size_t blocks = size_t{g.block_dims_[0]} * g.block_dims_[1] * g.block_dims_[2];
+  const size_t bytes = n * sizeof(PackedSample) + n * 3 * sizeof(float) +
+                       (cells + 1) * sizeof(uint32_t) + blocks * 6 * sizeof(float);
   g.memory_.reset(new unsigned char[std::max<size_t>(bytes, 1)]);
   PackedSample* packed = reinterpret_cast<PackedSample*>(g.memory_.get());
   float* normals = reinterpret_cast<float*>(packed + n);
   uint32_t* cell_start = reinterpret_cast<uint32_t*>(normals + 3 * n);
+  float* block_bounds = reinterpret_cast<float*>(cell_start + cells + 1);
   std::fill(cell_start, cell_start + cells + 1, 0u);
   for (size_t i = 0; i < n; ++i) ++cell_start[cell_of[i] + 1];
   for (size_t c = 0; c < cells; ++c) cell_start[c + 1] += cell_start[c];
@@ -208,6 +213,25 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
   g.samples_ = packed;
   g.normals_ = normals;
   g.cell_start_ = cell_start;
+  // 6. Tight bounds of the samples of each block of cells, for queries far from the grid.
+  for (size_t b = 0; b < blocks; ++b) {
+    for (int a = 0; a < 3; ++a) {
+      block_bounds[6 * b + a] = std::numeric_limits<float>::infinity();
+      block_bounds[6 * b + 3 + a] = -std::numeric_limits<float>::infinity();
+    }
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const float* p = &local[3 * i];
+    const size_t b = (size_t{g.CellCoord(p[2], 2) / kBlockCells} * g.block_dims_[1] +
+                      g.CellCoord(p[1], 1) / kBlockCells) *
+                         g.block_dims_[0] +
+                     g.CellCoord(p[0], 0) / kBlockCells;
+    for (int a = 0; a < 3; ++a) {
+      block_bounds[6 * b + a] = std::min(block_bounds[6 * b + a], p[a]);
+      block_bounds[6 * b + 3 + a] = std::max(block_bounds[6 * b + 3 + a], p[a]);
+    }
+  }
+  g.block_bounds_ = block_bounds;
 
   GridStats& st = g.stats_;
   st.samples = n;
@@ -248,9 +272,11 @@ template <typename Scanner>
 void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
   if (count_ == 0) return;
   // Cell boxes are padded so that rounding in cell assignment can never prune a sample.
-  const double pad = 1e-9 * (cell_size_ + std::fabs(c[0]) + std::fabs(c[1]) + std::fabs(c[2]) +
-                             (bounds_hi_[0] - bounds_lo_[0]) + (bounds_hi_[1] - bounds_lo_[1]) +
-                             (bounds_hi_[2] - bounds_lo_[2]));
+  // The pad covers rounding in cell assignment (relative to the grid's extent) and in the
+  // distance arithmetic (relative to the query's distance, ~1e-15 of it).
+  const double pad = 1e-9 * (cell_size_ + (bounds_hi_[0] - bounds_lo_[0]) +
+                             (bounds_hi_[1] - bounds_lo_[1]) + (bounds_hi_[2] - bounds_lo_[2])) +
+                     1e-13 * (std::fabs(c[0]) + std::fabs(c[1]) + std::fabs(c[2]));
   auto gap2 = [pad](double v, double lo, double hi) {
     const double d = v < lo - pad ? lo - pad - v : v > hi + pad ? v - hi - pad : 0.0;
     return d * d;
@@ -341,26 +367,80 @@ void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
     return;
   }
 
-  // 3. Otherwise, shells of growing Chebyshev radius until no unvisited cell can matter.
   double whole_lo[3], whole_hi[3];
-  for (int a = 0; a < 3; ++a) whole_lo[a] = CellLo(0, a), whole_hi[a] = CellHi(dims_[a] - 1, a);
+  double outside2 = 0;
+  for (int a = 0; a < 3; ++a) {
+    whole_lo[a] = CellLo(0, a), whole_hi[a] = CellHi(dims_[a] - 1, a);
+    outside2 += gap2(c[a], whole_lo[a], whole_hi[a]);
+  }
+
+  // 3. Far from the grid, shells would sweep every cell: visit blocks of cells instead, nearest
+  //    first by the tight bounds of their samples, until the next block is farther than the best.
+  if (outside2 > 16 * cell_size_ * cell_size_) {
+    thread_local std::vector<std::pair<double, uint32_t>> order;
+    order.clear();
+    const size_t blocks = size_t{block_dims_[0]} * block_dims_[1] * block_dims_[2];
+    for (size_t b = 0; b < blocks; ++b) {
+      const float* bb = &block_bounds_[6 * b];
+      if (!(bb[0] <= bb[3])) continue;  // empty
+      const double d2 =
+          gap2(c[0], bb[0], bb[3]) + gap2(c[1], bb[1], bb[4]) + gap2(c[2], bb[2], bb[5]);
+      if (d2 <= scanner.limit2()) order.emplace_back(d2, static_cast<uint32_t>(b));
+    }
+    std::sort(order.begin(), order.end());
+    for (const auto& [d2, b] : order) {
+      if (d2 > scanner.limit2()) break;
+      const int64_t bi = b % block_dims_[0], bj = (b / block_dims_[0]) % block_dims_[1],
+                    bk = b / (size_t{block_dims_[0]} * block_dims_[1]);
+      for (int64_t k = bk * kBlockCells; k < std::min<int64_t>(n[2], (bk + 1) * kBlockCells); ++k) {
+        const double gk =
+            gap2(c[2], CellLo(static_cast<uint32_t>(k), 2), CellHi(static_cast<uint32_t>(k), 2));
+        if (gk > scanner.limit2()) continue;
+        for (int64_t j = bj * kBlockCells; j < std::min<int64_t>(n[1], (bj + 1) * kBlockCells);
+             ++j) {
+          const double gjk = gk + gap2(c[1], CellLo(static_cast<uint32_t>(j), 1),
+                                       CellHi(static_cast<uint32_t>(j), 1));
+          if (gjk > scanner.limit2()) continue;
+          for (int64_t i = bi * kBlockCells; i < std::min<int64_t>(n[0], (bi + 1) * kBlockCells);
+               ++i) {
+            if (gjk + gap2(c[0], CellLo(static_cast<uint32_t>(i), 0),
+                           CellHi(static_cast<uint32_t>(i), 0)) >
+                scanner.limit2())
+              continue;
+            visit(i, j, k);  // a cell visited before is scanned again: harmless, never better
+          }
+        }
+      }
+    }
+    return;
+  }
+
+  // 4. Otherwise, shells of growing Chebyshev radius until no unvisited cell can matter.
   thread_local std::vector<double> axis_gap[3];
   for (int64_t r = done + 1;; ++r) {
     // Lower bound on the distance to any cell at radius >= r: the nearest of the slabs beyond
     // the shell on each side of each axis, within the whole grid box.
     double bound2 = kInf;
+    bool any = false;
     for (int a = 0; a < 3; ++a) {
       double rest = 0;
       for (int b = 0; b < 3; ++b)
         if (b != a) rest += gap2(c[b], whole_lo[b], whole_hi[b]);
-      if (ci[a] + r <= n[a] - 1)
+      if (ci[a] + r <= n[a] - 1) {
+        any = true;
         bound2 = std::min(
             bound2, rest + gap2(c[a], CellLo(static_cast<uint32_t>(ci[a] + r), a), whole_hi[a]));
-      if (ci[a] - r >= 0)
+      }
+      if (ci[a] - r >= 0) {
+        any = true;
         bound2 = std::min(
             bound2, rest + gap2(c[a], whole_lo[a], CellHi(static_cast<uint32_t>(ci[a] - r), a)));
+      }
     }
-    if (bound2 > scanner.limit2()) return;  // also when no cell is left (bound2 infinite)
+    // Done when no cell is left, or none can hold a better sample. (Squared distances of
+    // queries near the limits of double overflow to infinity: then only running out of cells
+    // ends the search, and every sample ties.)
+    if (!any || bound2 > scanner.limit2()) return;
     int64_t lo[3], hi[3];
     for (int a = 0; a < 3; ++a) {
       lo[a] = std::max<int64_t>(0, ci[a] - r), hi[a] = std::min(n[a] - 1, ci[a] + r);
@@ -465,8 +545,9 @@ Foothold TerrainGrid::MakeFoothold(uint32_t slot) const {
 Foothold TerrainGrid::Snap(const Vec3& q, QueryTrace* trace) const {
   Foothold none;
   if (!IsFinite(q)) return none;
-  none.status = Status::kNoFoothold;
   const double c[3] = {q.x - origin_[0], q.y - origin_[1], q.z - origin_[2]};
+  if (!detail::InQueryRange(c)) return none;
+  none.status = Status::kNoFoothold;
   if (trace) *trace = QueryTrace{}, trace->ideal = q;
   SnapScanner s{samples_, c, trace};
   Search(c, s);

@@ -23,6 +23,16 @@ inline bool Better(double d2, uint32_t index, double best_d2, uint32_t best_inde
   return d2 < best_d2 || (d2 == best_d2 && index < best_index);
 }
 
+// Queries farther than this from the grid's origin are refused: there, squared distances keep
+// no precision to tell samples apart. [Units: wu]
+constexpr double kMaxQueryDistance = 1e15;
+
+// True when a local query point is within kMaxQueryDistance of the origin along every axis.
+inline bool InQueryRange(const double c[3]) {
+  return std::fabs(c[0]) <= kMaxQueryDistance && std::fabs(c[1]) <= kMaxQueryDistance &&
+         std::fabs(c[2]) <= kMaxQueryDistance;
+}
+
 // A next query in local coordinates.
 struct NextFrame {
   double foot[3];
@@ -46,7 +56,7 @@ inline bool MakeNextFrame(const double origin[3], const StepQuery& q, double tol
     frame->ideal[a] = frame->foot[a] + dir[a];
   }
   frame->radius2 = tolerance > 0 ? tolerance * tolerance : len2;
-  return std::isfinite(frame->radius2);
+  return std::isfinite(frame->radius2) && InQueryRange(frame->foot) && InQueryRange(frame->ideal);
 }
 
 // True when a stored point is strictly ahead of the foot: dot(p - foot, dir) > 0.

@@ -153,6 +153,8 @@ class TerrainGrid {
   const PackedSample* samples_ = nullptr;  // local position and source index per slot
   const float* normals_ = nullptr;         // 3 floats per slot, unit
   const uint32_t* cell_start_ = nullptr;   // cells + 1 offsets into the slots
+  const float* block_bounds_ = nullptr;    // per block of 8^3 cells: local min xyz, max xyz
+  uint32_t block_dims_[3] = {1, 1, 1};
 };
 
 }  // namespace footfall
