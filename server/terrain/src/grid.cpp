@@ -306,6 +306,45 @@ void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
   // 1. The query's own cell.
   visit(ci[0], ci[1], ci[2]);
 
+  // 1b. The common case, cheaply: the best ball reaches at most the direct neighbours. Per
+  //     axis, a neighbour is visited only if the ball crosses the face it shares with ci.
+  if (scanner.limit2() < kInf) {
+    const double limit = scanner.limit2();
+    double gap[3][3];
+    int64_t from[3], to[3];
+    bool simple = true;
+    for (int a = 0; a < 3 && simple; ++a) {
+      const double face = grid_lo_[a] + static_cast<double>(ci[a]) * cell_size_;
+      const double dlo = c[a] - face - pad;               // to the face with cell ci - 1
+      const double dhi = face + cell_size_ - c[a] - pad;  // to the face with cell ci + 1
+      const double beyond_lo = dlo + cell_size_, beyond_hi = dhi + cell_size_;
+      if ((ci[a] >= 2 && (beyond_lo <= 0 || beyond_lo * beyond_lo <= limit)) ||
+          (ci[a] <= n[a] - 3 && (beyond_hi <= 0 || beyond_hi * beyond_hi <= limit))) {
+        simple = false;  // the ball may reach two cells away
+        break;
+      }
+      gap[a][0] = dlo > 0 ? dlo * dlo : 0;
+      gap[a][1] = 0;
+      gap[a][2] = dhi > 0 ? dhi * dhi : 0;
+      from[a] = ci[a] >= 1 && gap[a][0] <= limit ? -1 : 0;
+      to[a] = ci[a] <= n[a] - 2 && gap[a][2] <= limit ? 1 : 0;
+    }
+    if (simple) {
+      for (int64_t dk = from[2]; dk <= to[2]; ++dk) {
+        for (int64_t dj = from[1]; dj <= to[1]; ++dj) {
+          const double gjk = gap[2][dk + 1] + gap[1][dj + 1];
+          if (gjk > scanner.limit2()) continue;
+          for (int64_t di = from[0]; di <= to[0]; ++di) {
+            if ((di | dj | dk) == 0) continue;
+            if (gjk + gap[0][di + 1] > scanner.limit2()) continue;
+            visit(ci[0] + di, ci[1] + dj, ci[2] + dk);
+          }
+        }
+      }
+      return;
+    }
+  }
+
   // 2. When the ball of the best distance so far (or the candidate radius) reaches few cells,
   //    visit exactly those: the cells overlapping the ball's bounding box, pruned by distance.
   //    If it reaches beyond the 26 neighbours, visit those first: they usually shrink the ball.
@@ -472,6 +511,8 @@ void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
 
 namespace {
 
+// Scanners come in a traced and an untraced flavour, so the untraced scan loop has no test.
+template <bool kTraced>
 struct SnapScanner {
   const TerrainGrid::PackedSample* samples;
   const double* q;
@@ -484,17 +525,18 @@ struct SnapScanner {
   double limit2() const { return best_d2; }
   bool KeepCell(const double*, const double*) const { return true; }
   void Scan(uint32_t cell, uint32_t b, uint32_t e) {
-    if (trace) trace->cells.push_back(cell);
+    if (kTraced) trace->cells.push_back(cell);
     for (uint32_t s = b; s < e; ++s) {
       const double d2 = detail::Dist2(samples[s].p, q);
-      if (trace) trace->examined_samples.push_back(samples[s].index);
-      if (detail::Better(d2, samples[s].index, best_d2, best_index)) {
+      if (kTraced) trace->examined_samples.push_back(samples[s].index);
+      if (d2 <= best_d2 && detail::Better(d2, samples[s].index, best_d2, best_index)) {
         best_d2 = d2, best_index = samples[s].index, best_slot = s;
       }
     }
   }
 };
 
+template <bool kTraced>
 struct NextScanner {
   const TerrainGrid::PackedSample* samples;
   const detail::NextFrame* f;
@@ -515,13 +557,13 @@ struct NextScanner {
     return support > 0;  // the padded box absorbs rounding
   }
   void Scan(uint32_t cell, uint32_t b, uint32_t e) {
-    if (trace) trace->cells.push_back(cell);
+    if (kTraced) trace->cells.push_back(cell);
     for (uint32_t s = b; s < e; ++s) {
       const float* p = samples[s].p;
       const double d2 = detail::Dist2(p, f->ideal);
-      if (trace) trace->examined_samples.push_back(samples[s].index);
+      if (kTraced) trace->examined_samples.push_back(samples[s].index);
       if (d2 > f->radius2 || !detail::Ahead(p, *f)) continue;
-      if (trace) trace->candidates.push_back(samples[s].index);
+      if (kTraced) trace->candidates.push_back(samples[s].index);
       if (detail::Better(d2, samples[s].index, best_d2, best_index)) {
         best_d2 = d2, best_index = samples[s].index, best_slot = s;
       }
@@ -549,9 +591,17 @@ Foothold TerrainGrid::Snap(const Vec3& q, QueryTrace* trace) const {
   if (!detail::InQueryRange(c)) return none;
   none.status = Status::kNoFoothold;
   if (trace) *trace = QueryTrace{}, trace->ideal = q;
-  SnapScanner s{samples_, c, trace};
-  Search(c, s);
-  return s.best_slot == kNoIndex ? none : MakeFoothold(s.best_slot);
+  uint32_t best_slot;
+  if (trace) {
+    SnapScanner<true> s{samples_, c, trace};
+    Search(c, s);
+    best_slot = s.best_slot;
+  } else {
+    SnapScanner<false> s{samples_, c, nullptr};
+    Search(c, s);
+    best_slot = s.best_slot;
+  }
+  return best_slot == kNoIndex ? none : MakeFoothold(best_slot);
 }
 
 Foothold TerrainGrid::Next(const StepQuery& q, double tolerance, QueryTrace* trace) const {
@@ -564,9 +614,24 @@ Foothold TerrainGrid::Next(const StepQuery& q, double tolerance, QueryTrace* tra
     trace->ideal = q.foot + q.direction;
     trace->radius = std::sqrt(f.radius2);
   }
-  NextScanner s{samples_, &f, trace, f.radius2};
-  Search(f.ideal, s);
-  return s.best_slot == kNoIndex ? none : MakeFoothold(s.best_slot);
+  uint32_t best_slot;
+  if (trace) {
+    NextScanner<true> s{samples_, &f, trace, f.radius2};
+    Search(f.ideal, s);
+    best_slot = s.best_slot;
+  } else {
+    // The sample nearest the ideal point, if it is a candidate, is the nearest candidate (same
+    // distances, same tie order); if it is beyond the radius, no sample is a candidate. Only
+    // when it lies behind the foot does the candidate search run.
+    SnapScanner<false> nearest{samples_, f.ideal, nullptr};
+    Search(f.ideal, nearest);
+    if (nearest.best_slot == kNoIndex || nearest.best_d2 > f.radius2) return none;
+    if (detail::Ahead(samples_[nearest.best_slot].p, f)) return MakeFoothold(nearest.best_slot);
+    NextScanner<false> s{samples_, &f, nullptr, f.radius2};
+    Search(f.ideal, s);
+    best_slot = s.best_slot;
+  }
+  return best_slot == kNoIndex ? none : MakeFoothold(best_slot);
 }
 
 namespace {
