@@ -248,12 +248,17 @@ Backends& TheBackends() {
   return b;
 }
 
+// Batches of FF_MAX_BATCH queries through a TerrainSession, embedded or over RPC, in random
+// (Arg 0) or coherent (Arg 1) order.
 void BatchBench(benchmark::State& state, bool rpc, bool next) {
   Backends& b = TheBackends();
   TerrainSession& s = rpc ? *b.rpc : *b.embedded;
   const TerrainHandle t = rpc ? b.rpc_terrain : b.embedded_terrain;
-  static const std::vector<StepQuery> steps = StepsFrom(RandomPoints());
-  const std::vector<Vec3>& points = RandomPoints();
+  const int order = static_cast<int>(state.range(0));
+  static const std::vector<StepQuery> random_steps = StepsFrom(RandomPoints());
+  static const std::vector<StepQuery> coherent_steps = StepsFrom(CoherentPoints());
+  const std::vector<StepQuery>& steps = order == 0 ? random_steps : coherent_steps;
+  const std::vector<Vec3>& points = Points(order);
   std::vector<Foothold> out(kBatch);
   size_t offset = 0;
   for (auto _ : state) {
@@ -263,7 +268,7 @@ void BatchBench(benchmark::State& state, bool rpc, bool next) {
     offset = (offset + kBatch) % (kQueries - kBatch);
   }
   state.SetLabel(std::string(rpc ? "rpc" : "embedded") + (next ? " next" : " snap") +
-                 " batch of 4096");
+                 " batch of 4096, " + OrderName(order));
   state.SetItemsProcessed(state.iterations() * kBatch);
 }
 
@@ -271,10 +276,10 @@ void BM_EmbeddedSnapBatch(benchmark::State& state) { BatchBench(state, false, fa
 void BM_RpcSnapBatch(benchmark::State& state) { BatchBench(state, true, false); }
 void BM_EmbeddedNextBatch(benchmark::State& state) { BatchBench(state, false, true); }
 void BM_RpcNextBatch(benchmark::State& state) { BatchBench(state, true, true); }
-BENCHMARK(BM_EmbeddedSnapBatch)->Unit(benchmark::kMicrosecond)->UseRealTime();
-BENCHMARK(BM_RpcSnapBatch)->Unit(benchmark::kMicrosecond)->UseRealTime();
-BENCHMARK(BM_EmbeddedNextBatch)->Unit(benchmark::kMicrosecond)->UseRealTime();
-BENCHMARK(BM_RpcNextBatch)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_EmbeddedSnapBatch)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_RpcSnapBatch)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_EmbeddedNextBatch)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_RpcNextBatch)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 }  // namespace
 

@@ -13,6 +13,7 @@
 
 #include "footfall.h"
 #include "footfall/client/terrain_session.h"
+#include "footfall/rpc/batch_xdr.h"
 #include "rpc_connect.h"
 
 namespace footfall {
@@ -25,21 +26,12 @@ static_assert(static_cast<int>(Status::kInternalError) == FF_INTERNAL_ERROR, "")
 ff_vec3 ToWire(const Vec3& v) { return {v.x, v.y, v.z}; }
 Vec3 FromWire(const ff_vec3& v) { return {v.x, v.y, v.z}; }
 
-Status FromWire(ff_status s) {
-  const int v = static_cast<int>(s);
+// A wire status (any 32-bit value) as a Status; values the protocol does not know become
+// kInternalError.
+Status StatusFromWire(int v) {
   return v >= FF_OK && v <= FF_INTERNAL_ERROR ? static_cast<Status>(v) : Status::kInternalError;
 }
-
-Foothold FromWire(const ff_result& r) {
-  Foothold f;
-  f.status = FromWire(r.status);
-  if (f.status == Status::kOk) {
-    f.index = r.index;
-    f.point = FromWire(r.point);
-    f.normal = FromWire(r.normal);
-  }
-  return f;
-}
+Status FromWire(ff_status s) { return StatusFromWire(static_cast<int>(s)); }
 
 // Frees an rpcgen reply when it goes out of scope.
 template <typename T>
@@ -141,21 +133,23 @@ class RpcSession final : public TerrainSession {
   Status Next(TerrainHandle terrain, const StepQuery* queries, size_t count, double tolerance,
               Foothold* out) override {
     if (!std::isfinite(tolerance)) return Fail(Status::kInvalidArgument, "tolerance is not finite");
-    std::vector<ff_next_query> wire(std::min<size_t>(count, FF_MAX_BATCH));
     for (size_t begin = 0; begin < count; begin += FF_MAX_BATCH) {
       const size_t n = std::min<size_t>(FF_MAX_BATCH, count - begin);
-      for (size_t i = 0; i < n; ++i)
-        wire[i] = {ToWire(queries[begin + i].foot), ToWire(queries[begin + i].direction)};
       const Status s = WithTerrain(terrain, [&](uint32_t server) -> Status {
-        ff_next_batch_args args;
+        // Encoded straight from the caller's queries, answers decoded straight into `out`.
+        NextBatchView<StepQuery> args;
         args.terrain = server;
         args.tolerance = tolerance;
-        args.queries.queries_len = static_cast<u_int>(n);
-        args.queries.queries_val = wire.data();
-        Reply<ff_batch_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_batch_reply));
-        const Status cs = Call(ff_next_batch_1(&args, &reply.value, client_), "next");
+        args.count = args.capacity = static_cast<u_int>(n);
+        args.queries = const_cast<StepQuery*>(queries + begin);  // only read: encoded
+        BatchReplyView<Foothold> reply;
+        reply.results = out + begin;
+        reply.capacity = static_cast<u_int>(n);
+        const Status cs = Call(CallBatch(FF_NEXT_BATCH, AsXdrProc(XdrNextBatchView<StepQuery>),
+                                         &args, &reply),
+                               "next");
         if (cs != Status::kOk) return cs;
-        return TakeBatch(reply.value, n, out + begin, "next");
+        return TakeBatch(reply, n, out + begin, "next");
       });
       if (s != Status::kOk) return s;
     }
@@ -170,35 +164,57 @@ class RpcSession final : public TerrainSession {
   Status PointBatch(TerrainHandle terrain, const Vec3* points, size_t count, Foothold* out,
                     bool normal) {
     const char* what = normal ? "normal" : "snap";
-    std::vector<ff_vec3> wire(std::min<size_t>(count, FF_MAX_BATCH));
     for (size_t begin = 0; begin < count; begin += FF_MAX_BATCH) {
       const size_t n = std::min<size_t>(FF_MAX_BATCH, count - begin);
-      for (size_t i = 0; i < n; ++i) wire[i] = ToWire(points[begin + i]);
       const Status s = WithTerrain(terrain, [&](uint32_t server) -> Status {
-        ff_point_batch_args args;
+        PointBatchView<Vec3> args;
         args.terrain = server;
-        args.points.points_len = static_cast<u_int>(n);
-        args.points.points_val = wire.data();
-        Reply<ff_batch_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_batch_reply));
-        const clnt_stat cs = normal ? ff_normal_batch_1(&args, &reply.value, client_)
-                                    : ff_snap_batch_1(&args, &reply.value, client_);
-        const Status st = Call(cs, what);
+        args.count = args.capacity = static_cast<u_int>(n);
+        args.points = const_cast<Vec3*>(points + begin);  // only read: encoded
+        BatchReplyView<Foothold> reply;
+        reply.results = out + begin;
+        reply.capacity = static_cast<u_int>(n);
+        const Status st =
+            Call(CallBatch(normal ? FF_NORMAL_BATCH : FF_SNAP_BATCH,
+                           AsXdrProc(XdrPointBatchView<Vec3>), &args, &reply),
+                 what);
         if (st != Status::kOk) return st;
-        return TakeBatch(reply.value, n, out + begin, what);
+        return TakeBatch(reply, n, out + begin, what);
       });
       if (s != Status::kOk) return s;
     }
     return Status::kOk;
   }
 
-  Status TakeBatch(const ff_batch_reply& reply, size_t n, Foothold* out, const char* what) {
+  // One batch call with the fast filters; the answers land in reply->results.
+  template <typename Args>
+  clnt_stat CallBatch(rpcproc_t proc, xdrproc_t encode, Args* args,
+                      BatchReplyView<Foothold>* reply) {
+    // The client's CLSET_TIMEOUT governs; a zero timeout here would mean "do not wait".
+    timeval timeout{};
+    timeout.tv_sec = static_cast<time_t>(std::max(1.0, options_.call_timeout_s));
+    return clnt_call(client_, proc, encode, reinterpret_cast<char*>(args),
+                     AsXdrProc(XdrBatchReplyView<Foothold>), reinterpret_cast<char*>(reply),
+                     timeout);
+  }
+
+  // Checks a decoded batch reply whose results were written to out[0, n): its status, its
+  // count, and each answer's status (an unknown one becomes kInternalError; a failed answer
+  // carries no index, point or normal).
+  Status TakeBatch(const BatchReplyView<Foothold>& reply, size_t n, Foothold* out,
+                   const char* what) {
     if (reply.status != FF_OK) return ServerFail(reply.status, what);
-    if (reply.results.results_len != n) {
+    if (reply.count != n) {
       return Fail(Status::kInternalError, std::string(what) + ": server sent " +
-                                              std::to_string(reply.results.results_len) +
-                                              " answers for " + std::to_string(n) + " queries");
+                                              std::to_string(reply.count) + " answers for " +
+                                              std::to_string(n) + " queries");
     }
-    for (size_t i = 0; i < n; ++i) out[i] = FromWire(reply.results.results_val[i]);
+    for (size_t i = 0; i < n; ++i) {
+      if (out[i].status == Status::kOk) continue;
+      Foothold failed;
+      failed.status = StatusFromWire(static_cast<int>(out[i].status));
+      out[i] = failed;
+    }
     return Status::kOk;
   }
 

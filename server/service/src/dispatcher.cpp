@@ -4,11 +4,14 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <new>
 #include <string>
 #include <vector>
 
+#include "batch_pool.h"
 #include "footfall.h"
+#include "footfall/rpc/batch_xdr.h"
 
 namespace footfall {
 namespace {
@@ -26,14 +29,18 @@ static_assert(static_cast<int>(Status::kInternalError) == FF_INTERNAL_ERROR, "")
 
 // Batches: how many queries of each batch go to the recent-query ring.
 constexpr size_t kRecordPerBatch = 16;
+// Batches: queries per chunk that the batch threads take in turn (about 0.1 ms of snaps).
+constexpr size_t kBatchChunk = 256;
 
 ServiceState* g_state = nullptr;
+std::unique_ptr<BatchPool> g_pool;
 
-// Reply storage, reused across calls (the loop is single-threaded). Reply structs point into it.
+// Request and reply storage, reused across calls (the loop is single-threaded). Batch requests
+// are decoded straight into points / steps (FF_MAX_BATCH each), and replies encoded straight from
+// answers; reply structs point into this storage.
 struct Storage {
   std::string message;
   std::string name;
-  std::vector<ff_result> results;
   std::vector<Vec3> points;
   std::vector<StepQuery> steps;
   std::vector<Foothold> answers;
@@ -205,32 +212,44 @@ void NextOne(const ff_next_args& a, ff_result* r) {
   Record(a.terrain, FF_OP_NEXT, q.foot, q.direction, a.tolerance, f);
 }
 
-void Reply(ff_batch_reply* r) {
-  const size_t n = g_storage.answers.size();
-  g_storage.results.resize(n);
-  for (size_t i = 0; i < n; ++i) g_storage.results[i] = ToWire(g_storage.answers[i]);
-  r->status = FF_OK;
-  r->results.results_len = static_cast<u_int>(n);
-  r->results.results_val = g_storage.results.data();
+// On the wire a failed answer carries no index, point or normal.
+void ClearFailed(Foothold* f) {
+  if (f->status == Status::kOk) return;
+  Foothold cleared;
+  cleared.status = f->status;
+  *f = cleared;
 }
 
-void PointBatch(const ff_point_batch_args& a, ff_batch_reply* r, int op) {
+// Answers queries [0, n) of a batch into g_storage.answers on the batch threads; `answer(b, e)`
+// fills answers [b, e).
+template <typename Fn>
+void RunBatch(size_t n, BatchReplyView<Foothold>* r, Fn&& answer) {
+  Foothold* answers = g_storage.answers.data();
+  g_pool->Run(n, kBatchChunk, [&](size_t b, size_t e) {
+    answer(b, e, answers);
+    for (size_t i = b; i < e; ++i) ClearFailed(&answers[i]);
+  });
+  r->status = FF_OK;
+  r->count = r->capacity = static_cast<u_int>(n);
+  r->results = answers;
+}
+
+void PointBatch(const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r, int op) {
   const LoadedTerrain* t = g_state->registry.Find(a.terrain);
   if (!t) {
     r->status = FF_UNKNOWN_TERRAIN;
     return;
   }
-  const size_t n = a.points.points_len;
-  g_storage.points.resize(n);
-  for (size_t i = 0; i < n; ++i) g_storage.points[i] = FromWire(a.points.points_val[i]);
-  g_storage.answers.resize(n);
-  t->grid.SnapBatch(g_storage.points.data(), n, g_storage.answers.data(), g_state->batch_threads);
+  const size_t n = a.count;
+  const Vec3* points = a.points;
+  RunBatch(n, r, [&](size_t b, size_t e, Foothold* out) {
+    t->grid.SnapBatch(points + b, e - b, out + b, 1);
+  });
   for (size_t i = 0; i < n && i < kRecordPerBatch; ++i)
-    Record(a.terrain, op, g_storage.points[i], Vec3{}, 0, g_storage.answers[i]);
-  Reply(r);
+    Record(a.terrain, op, points[i], Vec3{}, 0, r->results[i]);
 }
 
-void NextBatch(const ff_next_batch_args& a, ff_batch_reply* r) {
+void NextBatch(const NextBatchView<StepQuery>& a, BatchReplyView<Foothold>* r) {
   const LoadedTerrain* t = g_state->registry.Find(a.terrain);
   if (!t) {
     r->status = FF_UNKNOWN_TERRAIN;
@@ -240,20 +259,14 @@ void NextBatch(const ff_next_batch_args& a, ff_batch_reply* r) {
     r->status = FF_INVALID_ARGUMENT;
     return;
   }
-  const size_t n = a.queries.queries_len;
-  g_storage.steps.resize(n);
-  for (size_t i = 0; i < n; ++i) {
-    g_storage.steps[i] = {FromWire(a.queries.queries_val[i].foot),
-                          FromWire(a.queries.queries_val[i].direction)};
-  }
-  g_storage.answers.resize(n);
-  t->grid.NextBatch(g_storage.steps.data(), n, a.tolerance, g_storage.answers.data(),
-                    g_state->batch_threads);
-  for (size_t i = 0; i < n && i < kRecordPerBatch; ++i) {
-    Record(a.terrain, FF_OP_NEXT, g_storage.steps[i].foot, g_storage.steps[i].direction,
-           a.tolerance, g_storage.answers[i]);
-  }
-  Reply(r);
+  const size_t n = a.count;
+  const StepQuery* steps = a.queries;
+  const double tolerance = a.tolerance;
+  RunBatch(n, r, [&](size_t b, size_t e, Foothold* out) {
+    t->grid.NextBatch(steps + b, e - b, tolerance, out + b, 1);
+  });
+  for (size_t i = 0; i < n && i < kRecordPerBatch; ++i)
+    Record(a.terrain, FF_OP_NEXT, steps[i].foot, steps[i].direction, tolerance, r->results[i]);
 }
 
 void Recent(const ff_recent_args& a, ff_recent_reply* r) {
@@ -278,20 +291,19 @@ void Recent(const ff_recent_args& a, ff_recent_reply* r) {
   r->queries.queries_val = g_storage.recent.data();
 }
 
-// Decodes the arguments, runs the handler, replies and frees the arguments, whatever happens.
-// Every reply type starts with its ff_status, which an exception turns into an error.
+// Decodes the arguments into `args` (set up by the caller: empty, or pointing at storage),
+// runs the handler, replies and frees the arguments, whatever happens. Every reply type starts
+// with its ff_status, which an exception turns into an error.
 template <typename Args, typename Res, typename Fn>
-void Serve(SVCXPRT* transport, xdrproc_t decode, xdrproc_t encode, const char* proc, Fn&& fn) {
-  Args args;
-  std::memset(&args, 0, sizeof args);
+void ServeWith(SVCXPRT* transport, xdrproc_t decode, Args& args, xdrproc_t encode,
+               const char* proc, Fn&& fn) {
   if (!svc_getargs(transport, decode, reinterpret_cast<char*>(&args))) {
     svc_freeargs(transport, decode, reinterpret_cast<char*>(&args));
     svcerr_decode(transport);
     Log(std::string("error: ") + proc + ": malformed request rejected");
     return;
   }
-  Res res;
-  std::memset(&res, 0, sizeof res);
+  Res res{};
   const char* failure = nullptr;
   try {
     fn(args, &res);
@@ -304,7 +316,7 @@ void Serve(SVCXPRT* transport, xdrproc_t decode, xdrproc_t encode, const char* p
   }
   if (failure) {
     Log(std::string("error: ") + proc + ": " + failure);
-    std::memset(&res, 0, sizeof res);
+    res = Res{};
     *reinterpret_cast<ff_status*>(&res) = FF_INTERNAL_ERROR;
   }
   // Strings may not be NULL on the wire: give unset ones an empty value.
@@ -318,6 +330,13 @@ void Serve(SVCXPRT* transport, xdrproc_t decode, xdrproc_t encode, const char* p
   if (!svc_sendreply(transport, encode, reinterpret_cast<char*>(&res)))
     Log(std::string("error: ") + proc + ": reply could not be sent");
   svc_freeargs(transport, decode, reinterpret_cast<char*>(&args));
+}
+
+// ServeWith for rpcgen argument types, decoded into zeroed structs.
+template <typename Args, typename Res, typename Fn>
+void Serve(SVCXPRT* transport, xdrproc_t decode, xdrproc_t encode, const char* proc, Fn&& fn) {
+  Args args{};
+  ServeWith<Args, Res>(transport, decode, args, encode, proc, std::forward<Fn>(fn));
 }
 
 #define FF_XDR(name) reinterpret_cast<xdrproc_t>(xdr_##name)
@@ -367,13 +386,24 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
     case FF_SNAP_BATCH:
     case FF_NORMAL_BATCH: {
       const int op = request->rq_proc == FF_SNAP_BATCH ? FF_OP_SNAP : FF_OP_NORMAL;
-      return Serve<ff_point_batch_args, ff_batch_reply>(
-          transport, FF_XDR(ff_point_batch_args), FF_XDR(ff_batch_reply), "snap batch",
-          [op](const ff_point_batch_args& a, ff_batch_reply* r) { PointBatch(a, r, op); });
+      PointBatchView<Vec3> args;
+      args.points = g_storage.points.data();
+      args.capacity = FF_MAX_BATCH;
+      return ServeWith<PointBatchView<Vec3>, BatchReplyView<Foothold>>(
+          transport, AsXdrProc(XdrPointBatchView<Vec3>), args,
+          AsXdrProc(XdrBatchReplyView<Foothold>), "snap batch",
+          [op](const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r) {
+            PointBatch(a, r, op);
+          });
     }
-    case FF_NEXT_BATCH:
-      return Serve<ff_next_batch_args, ff_batch_reply>(
-          transport, FF_XDR(ff_next_batch_args), FF_XDR(ff_batch_reply), "next batch", NextBatch);
+    case FF_NEXT_BATCH: {
+      NextBatchView<StepQuery> args;
+      args.queries = g_storage.steps.data();
+      args.capacity = FF_MAX_BATCH;
+      return ServeWith<NextBatchView<StepQuery>, BatchReplyView<Foothold>>(
+          transport, AsXdrProc(XdrNextBatchView<StepQuery>), args,
+          AsXdrProc(XdrBatchReplyView<Foothold>), "next batch", NextBatch);
+    }
     case FF_RECENT:
       return Serve<ff_recent_args, ff_recent_reply>(transport, FF_XDR(ff_recent_args),
                                                     FF_XDR(ff_recent_reply), "recent", Recent);
@@ -387,6 +417,10 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
 
 DispatchFn InstallDispatcher(ServiceState* state) {
   g_state = state;
+  g_pool = std::make_unique<BatchPool>(state->batch_threads);
+  g_storage.points.resize(FF_MAX_BATCH);
+  g_storage.steps.resize(FF_MAX_BATCH);
+  g_storage.answers.resize(FF_MAX_BATCH);
   return Dispatch;
 }
 
