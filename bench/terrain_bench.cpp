@@ -281,6 +281,28 @@ BENCHMARK(BM_RpcSnapBatch)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->UseRe
 BENCHMARK(BM_EmbeddedNextBatch)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK(BM_RpcNextBatch)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
+// The floor of the batch path: snap batches of non-finite points, which the engine refuses at
+// once (each answer kInvalidArgument), on the benchmark terrain. The RPC figure is the
+// transport's own ceiling (client and server coding, copies, system calls, wake-ups), the
+// embedded one the cost of the session call.
+void FloorBench(benchmark::State& state, bool rpc) {
+  Backends& b = TheBackends();
+  TerrainSession& s = rpc ? *b.rpc : *b.embedded;
+  const TerrainHandle t = rpc ? b.rpc_terrain : b.embedded_terrain;
+  const std::vector<Vec3> points(kBatch, Vec3{std::nan(""), 0, 0});
+  std::vector<Foothold> out(kBatch);
+  for (auto _ : state) {
+    const Status st = s.Snap(t, points.data(), kBatch, out.data());
+    if (st != Status::kOk) state.SkipWithError(s.last_error().c_str());
+  }
+  state.SetLabel(std::string(rpc ? "rpc" : "embedded") + " snap batch of 4096 refused points");
+  state.SetItemsProcessed(state.iterations() * kBatch);
+}
+void BM_EmbeddedBatchFloor(benchmark::State& state) { FloorBench(state, false); }
+void BM_RpcBatchFloor(benchmark::State& state) { FloorBench(state, true); }
+BENCHMARK(BM_EmbeddedBatchFloor)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_RpcBatchFloor)->Unit(benchmark::kMicrosecond)->UseRealTime();
+
 }  // namespace
 
 BENCHMARK_MAIN();

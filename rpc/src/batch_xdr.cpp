@@ -43,8 +43,8 @@ bool_t FastXdrPointBatchArgs(XDR* xdrs, ff_point_batch_args* args) {
 
 bool_t FastXdrNextBatchArgs(XDR* xdrs, ff_next_batch_args* args) {
   return xdr_u_int(xdrs, &args->terrain) && xdr_double(xdrs, &args->tolerance) &&
-         Array<xdr_detail::StepCodec>(xdrs, &args->queries.queries_val,
-                                      &args->queries.queries_len, FF_MAX_BATCH);
+         Array<xdr_detail::StepCodec>(xdrs, &args->queries.queries_val, &args->queries.queries_len,
+                                      FF_MAX_BATCH);
 }
 
 bool_t FastXdrBatchReply(XDR* xdrs, ff_batch_reply* reply) {

@@ -302,8 +302,7 @@ TEST_CASE("fast batch filters decode what rpcgen encoded", "[rpc][xdr]") {
         REQUIRE(fast.terrain == b.args.terrain);
         REQUIRE(SameBits(fast.tolerance, b.args.tolerance));
         REQUIRE(fast.queries.queries_len == n);
-        for (size_t i = 0; i < n; ++i)
-          REQUIRE(SameBits(fast.queries.queries_val[i], b.queries[i]));
+        for (size_t i = 0; i < n; ++i) REQUIRE(SameBits(fast.queries.queries_val[i], b.queries[i]));
         Free(xdr_ff_next_batch_args, &fast);
 
         std::vector<StepQuery> steps(FF_MAX_BATCH);
@@ -322,7 +321,8 @@ TEST_CASE("fast batch filters decode what rpcgen encoded", "[rpc][xdr]") {
         REQUIRE(Decode(FastXdrBatchReply, wire.bytes, &fast, misalign));
         REQUIRE(fast.status == b.reply.status);
         REQUIRE(fast.results.results_len == n);
-        for (size_t i = 0; i < n; ++i) REQUIRE(SameResult(b.results[i], fast.results.results_val[i]));
+        for (size_t i = 0; i < n; ++i)
+          REQUIRE(SameResult(b.results[i], fast.results.results_val[i]));
         Free(xdr_ff_batch_reply, &fast);
 
         std::vector<Foothold> results(FF_MAX_BATCH);

@@ -145,9 +145,9 @@ class RpcSession final : public TerrainSession {
         BatchReplyView<Foothold> reply;
         reply.results = out + begin;
         reply.capacity = static_cast<u_int>(n);
-        const Status cs = Call(CallBatch(FF_NEXT_BATCH, AsXdrProc(XdrNextBatchView<StepQuery>),
-                                         &args, &reply),
-                               "next");
+        const Status cs =
+            Call(CallBatch(FF_NEXT_BATCH, AsXdrProc(XdrNextBatchView<StepQuery>), &args, &reply),
+                 "next");
         if (cs != Status::kOk) return cs;
         return TakeBatch(reply, n, out + begin, "next");
       });
@@ -174,10 +174,9 @@ class RpcSession final : public TerrainSession {
         BatchReplyView<Foothold> reply;
         reply.results = out + begin;
         reply.capacity = static_cast<u_int>(n);
-        const Status st =
-            Call(CallBatch(normal ? FF_NORMAL_BATCH : FF_SNAP_BATCH,
-                           AsXdrProc(XdrPointBatchView<Vec3>), &args, &reply),
-                 what);
+        const Status st = Call(CallBatch(normal ? FF_NORMAL_BATCH : FF_SNAP_BATCH,
+                                         AsXdrProc(XdrPointBatchView<Vec3>), &args, &reply),
+                               what);
         if (st != Status::kOk) return st;
         return TakeBatch(reply, n, out + begin, what);
       });

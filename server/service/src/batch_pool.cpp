@@ -1,10 +1,20 @@
 #include "batch_pool.h"
 
 #include <algorithm>
+#include <chrono>
 
 namespace footfall {
+namespace {
 
-BatchPool::BatchPool(int threads) {
+inline void CpuRelax() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#endif
+}
+
+}  // namespace
+
+BatchPool::BatchPool(int threads, int caller_spin_us) : caller_spin_us_(caller_spin_us) {
   for (int i = 1; i < threads; ++i) workers_.emplace_back([this] { Work(); });
 }
 
@@ -15,6 +25,19 @@ BatchPool::~BatchPool() {
   }
   work_.notify_all();
   for (auto& t : workers_) t.join();
+}
+
+template <typename Done>
+bool BatchPool::Spin(int us, Done&& done) {
+  if (us <= 0) return done();
+  const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(us);
+  for (;;) {
+    for (int i = 0; i < 64; ++i) {
+      if (done()) return true;
+      CpuRelax();
+    }
+    if (std::chrono::steady_clock::now() >= until) return done();
+  }
 }
 
 void BatchPool::Drain(std::unique_lock<std::mutex>& lock) {
@@ -31,16 +54,19 @@ void BatchPool::Drain(std::unique_lock<std::mutex>& lock) {
     }
     lock.lock();
     if (error && !error_) error_ = error;
-    finished_ += end - begin;
-    if (finished_ == count_) done_.notify_all();
+    const size_t finished = finished_.load(std::memory_order_relaxed) + (end - begin);
+    finished_.store(finished, std::memory_order_release);
+    if (finished == count_ && caller_sleeping_) done_.notify_one();
   }
 }
 
 void BatchPool::Work() {
+  uint64_t seen = 0;
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {
-    work_.wait(lock, [this] { return stop_ || next_ < count_; });
+    work_.wait(lock, [&] { return stop_ || posted_ != seen; });
     if (stop_) return;
+    seen = posted_;
     Drain(lock);
   }
 }
@@ -53,15 +79,27 @@ void BatchPool::Run(size_t count, size_t chunk, const std::function<void(size_t,
   }
   std::unique_lock<std::mutex> lock(mutex_);
   fn_ = &fn;
-  count_ = count, chunk_ = chunk, next_ = 0, finished_ = 0;
+  count_ = count, chunk_ = chunk, next_ = 0;
+  finished_.store(0);
   error_ = nullptr;
+  ++posted_;
   lock.unlock();
   work_.notify_all();
   lock.lock();
   Drain(lock);
-  done_.wait(lock, [this] { return finished_ == count_; });
-  // Nothing left to take: workers go back to sleep.
-  count_ = next_ = finished_ = 0;
+  // The workers' last chunks: poll for a while, then sleep until the last one wakes us.
+  lock.unlock();
+  const bool done =
+      Spin(caller_spin_us_, [&] { return finished_.load(std::memory_order_acquire) == count; });
+  lock.lock();
+  if (!done) {
+    caller_sleeping_ = true;
+    done_.wait(lock, [&] { return finished_.load() == count_; });
+    caller_sleeping_ = false;
+  }
+  // Nothing left to take: a worker that wakes now finds no chunk.
+  count_ = next_ = 0;
+  finished_.store(0);
   fn_ = nullptr;
   std::exception_ptr error = error_;
   error_ = nullptr;

@@ -29,8 +29,8 @@ static_assert(static_cast<int>(Status::kInternalError) == FF_INTERNAL_ERROR, "")
 
 // Batches: how many queries of each batch go to the recent-query ring.
 constexpr size_t kRecordPerBatch = 16;
-// Batches: queries per chunk that the batch threads take in turn (about 0.1 ms of snaps).
-constexpr size_t kBatchChunk = 256;
+// Batches: queries per chunk that the batch threads take in turn (about 50 us of snaps).
+constexpr size_t kBatchChunk = 128;
 
 ServiceState* g_state = nullptr;
 std::unique_ptr<BatchPool> g_pool;
@@ -295,8 +295,8 @@ void Recent(const ff_recent_args& a, ff_recent_reply* r) {
 // runs the handler, replies and frees the arguments, whatever happens. Every reply type starts
 // with its ff_status, which an exception turns into an error.
 template <typename Args, typename Res, typename Fn>
-void ServeWith(SVCXPRT* transport, xdrproc_t decode, Args& args, xdrproc_t encode,
-               const char* proc, Fn&& fn) {
+void ServeWith(SVCXPRT* transport, xdrproc_t decode, Args& args, xdrproc_t encode, const char* proc,
+               Fn&& fn) {
   if (!svc_getargs(transport, decode, reinterpret_cast<char*>(&args))) {
     svc_freeargs(transport, decode, reinterpret_cast<char*>(&args));
     svcerr_decode(transport);

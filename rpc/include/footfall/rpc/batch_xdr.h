@@ -42,9 +42,9 @@ bool_t FastXdrBatchReply(XDR* xdrs, ff_batch_reply* reply);
 template <typename Vec>
 struct PointBatchView {
   u_int terrain = 0;
-  u_int count = 0;       // items in use
+  u_int count = 0;  // items in use
   Vec* points = nullptr;
-  u_int capacity = 0;    // items `points` holds; decoding refuses more
+  u_int capacity = 0;  // items `points` holds; decoding refuses more
 };
 
 // ff_next_batch_args with its queries (fields foot, direction) in a caller-owned array.
@@ -240,9 +240,8 @@ bool_t ViewArray(XDR* xdrs, T* items, u_int* count, u_int capacity) {
 template <typename Vec>
 bool_t XdrPointBatchView(XDR* xdrs, PointBatchView<Vec>* view) {
   if (xdrs->x_op == XDR_FREE) return TRUE;
-  return xdr_u_int(xdrs, &view->terrain) &&
-         xdr_detail::ViewArray<xdr_detail::VecCodec>(xdrs, view->points, &view->count,
-                                                     view->capacity);
+  return xdr_u_int(xdrs, &view->terrain) && xdr_detail::ViewArray<xdr_detail::VecCodec>(
+                                                xdrs, view->points, &view->count, view->capacity);
 }
 
 template <typename Step>
