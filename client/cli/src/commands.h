@@ -9,5 +9,6 @@ namespace footfall::cli {
 void AddQueryCommand(CLI::App& app, int* exit_code);
 void AddTerrainCommand(CLI::App& app, int* exit_code);
 void AddGenerateCommand(CLI::App& app, int* exit_code);
+void AddBenchCommand(CLI::App& app, int* exit_code);
 
 }  // namespace footfall::cli

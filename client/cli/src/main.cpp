@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   footfall::cli::AddQueryCommand(app, &exit_code);
   footfall::cli::AddTerrainCommand(app, &exit_code);
   footfall::cli::AddGenerateCommand(app, &exit_code);
+  footfall::cli::AddBenchCommand(app, &exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -148,7 +148,10 @@ class TerrainGrid {
   double bounds_hi_[3] = {0, 0, 0};
   double cell_size_ = 1, inv_cell_size_ = 1;
   uint32_t dims_[3] = {1, 1, 1};
-  std::unique_ptr<unsigned char[]> memory_;
+  struct FreeMemory {
+    void operator()(unsigned char* p) const;
+  };
+  std::unique_ptr<unsigned char[], FreeMemory> memory_;
   // Views into memory_, in cell order:
   const PackedSample* samples_ = nullptr;  // local position and source index per slot
   const float* normals_ = nullptr;         // 3 floats per slot, unit

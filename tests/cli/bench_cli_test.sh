@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# `footfall bench` end to end: the figures it reports, embedded and against a real footfalld,
+# and the errors of bad input. Figures are checked for presence and sense, never for speed.
+# Usage: bench_cli_test.sh FOOTFALL FOOTFALLD SOURCE_DIR
+set -u
+footfall=$1
+footfalld=$2
+source_dir=$3
+work=$(mktemp -d)
+server_pid=""
+trap '[ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null; rm -rf "$work"' EXIT
+failures=0
+passes=0
+check() {  # check NAME CONDITION...
+  local name=$1; shift
+  if "$@"; then passes=$((passes + 1)); else echo "FAILED: $name" >&2; failures=$((failures + 1)); fi
+}
+hills=$source_dir/data/terrain/hills.pts
+
+# Checks a JSON report: the terrain's figures, and every query figure positive, with the
+# baseline expected ("brute force" or "embedded") beside the figures that have one.
+check_report() {  # check_report NAME FILE BATCH_BASELINE
+  python3 - "$2" "$3" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+batch_base = sys.argv[2]
+assert r["samples"] == 25921, r["samples"]
+assert 0 < r["bytes_per_sample"] <= 64, r["bytes_per_sample"]
+assert r["load_s"] > 0 and r["queries"] == 3000
+names = [f["name"] for f in r["figures"]]
+for op in ("snap", "next"):
+    for order in ("random", "coherent"):
+        assert f"{op} {order}, one per call" in names, names
+        assert f"{op} {order}, batches of 1000" in names, names
+for f in r["figures"]:
+    assert f["ns_per_query"] > 0 and f["queries_per_s"] > 0, f
+    if f["name"].endswith("one per call"):
+        assert f["baseline"] == "brute force" and f["baseline_ns_per_query"] > 0, f
+    elif batch_base:
+        assert f["baseline"] == batch_base and f["ratio"] > 0, f
+    else:
+        assert "baseline" not in f, f
+PY
+}
+
+# 1. Embedded: every figure, brute force beside single queries.
+"$footfall" bench --terrain "$hills" --queries 3000 --batch 1000 --min-time 0.02 --json \
+  > "$work/embedded.json" 2> "$work/err"
+check "embedded bench exits 0" [ $? -eq 0 ]
+check "embedded report" check_report embedded "$work/embedded.json" ""
+"$footfall" bench --terrain "$hills" --queries 3000 --batch 1000 --min-time 0.02 > "$work/text"
+check "text report names the backend" grep -q '^backend: embedded$' "$work/text"
+check "text report has a line per figure" [ "$(grep -c 'ns/query' "$work/text")" -eq 8 ]
+
+# 2. Over RPC against a real footfalld: the embedded engine is the batches' baseline.
+"$footfalld" --listen 127.0.0.1:0 --port-file "$work/port" --no-rpcbind 2> "$work/server.log" &
+server_pid=$!
+for _ in $(seq 100); do [ -s "$work/port" ] && break; sleep 0.05; done
+server=127.0.0.1:$(cat "$work/port")
+"$footfall" bench --terrain "$hills" --server "$server" --queries 3000 --batch 1000 \
+  --min-time 0.02 --json > "$work/rpc.json" 2> "$work/err"
+check "rpc bench exits 0" [ $? -eq 0 ]
+check "rpc report" check_report rpc "$work/rpc.json" embedded
+check "rpc backend named" grep -q "\"backend\": \"rpc $server\"" "$work/rpc.json"
+
+# 3. Bad input: a clear message and a non-zero exit.
+printf '0 0 0 0 1 0\n1 2 3\n' > "$work/bad.pts"
+err=$("$footfall" bench --terrain "$work/bad.pts" 2>&1 >/dev/null)
+check "bad terrain: exit 1" [ $? -eq 1 ]
+check "bad terrain: file and line" grep -qF "$work/bad.pts:2: expected 6 numbers" <<< "$err"
+err=$("$footfall" bench --terrain "$hills" --queries 0 2>&1 >/dev/null)
+check "zero queries refused" [ $? -ne 0 ]
+kill "$server_pid"; wait "$server_pid" 2>/dev/null; server_pid=""
+err=$("$footfall" bench --terrain "$hills" --server "$server" --timeout 2 2>&1 >/dev/null)
+check "no server: exit 1" [ $? -eq 1 ]
+check "no server: says so" grep -qi "footfall bench: .*$server" <<< "$err"
+
+echo "$passes checks passed, $failures failed"
+[ "$failures" -eq 0 ]
