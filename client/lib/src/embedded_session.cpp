@@ -1,14 +1,18 @@
 // The embedded backend: the terrain engine in this process.
 #include <map>
+#include <memory>
 
 #include "footfall/client/terrain_session.h"
+#include "footfall/terrain/batch_pool.h"
 
 namespace footfall {
 namespace {
 
 class EmbeddedSession final : public TerrainSession {
  public:
-  explicit EmbeddedSession(int threads) : threads_(threads) {}
+  // Batches are shared with threads - 1 persistent workers, started once per session.
+  explicit EmbeddedSession(int threads)
+      : pool_(threads > 1 ? std::make_unique<BatchPool>(threads) : nullptr) {}
 
   Status LoadServerFile(const std::string& path, double separation, TerrainHandle* out) override {
     TerrainLoadOptions options;
@@ -48,7 +52,7 @@ class EmbeddedSession final : public TerrainSession {
   Status Snap(TerrainHandle terrain, const Vec3* points, size_t count, Foothold* out) override {
     const Entry* e = Find(terrain);
     if (!e) return Unknown(terrain);
-    e->grid.SnapBatch(points, count, out, threads_);
+    Share(count, [&](size_t b, size_t end) { e->grid.SnapBatch(points + b, end - b, out + b); });
     return Status::kOk;
   }
 
@@ -61,13 +65,25 @@ class EmbeddedSession final : public TerrainSession {
     const Entry* e = Find(terrain);
     if (!e) return Unknown(terrain);
     if (!std::isfinite(tolerance)) return Fail(Status::kInvalidArgument, "tolerance is not finite");
-    e->grid.NextBatch(queries, count, tolerance, out, threads_);
+    Share(count, [&](size_t b, size_t end) {
+      e->grid.NextBatch(queries + b, end - b, tolerance, out + b);
+    });
     return Status::kOk;
   }
 
   std::string Describe() const override { return "embedded"; }
 
  private:
+  // Runs fn(begin, end) over [0, count), on the pool's threads when there is one.
+  template <typename Fn>
+  void Share(size_t count, Fn&& fn) {
+    constexpr size_t kChunk = 128;  // queries a thread takes at a time
+    if (pool_)
+      pool_->Run(count, kChunk, fn);
+    else
+      fn(0, count);
+  }
+
   struct Entry {
     std::string name;
     TerrainGrid grid;
@@ -80,7 +96,7 @@ class EmbeddedSession final : public TerrainSession {
     return Fail(Status::kUnknownTerrain, "no terrain with handle " + std::to_string(terrain));
   }
 
-  int threads_;
+  std::unique_ptr<BatchPool> pool_;
   TerrainHandle next_handle_ = 1;
   std::map<TerrainHandle, Entry> terrains_;
 };

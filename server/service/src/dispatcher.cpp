@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "batch_pool.h"
+#include "footfall/terrain/batch_pool.h"
 #include "footfall.h"
 #include "footfall/rpc/batch_xdr.h"
 

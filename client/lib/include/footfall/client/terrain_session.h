@@ -66,7 +66,8 @@ class TerrainSession {
   std::string last_error_;
 };
 
-// The in-process engine. `threads` > 1 splits large batches across threads.
+// The in-process engine. With `threads` > 1, batches are shared with threads - 1 persistent
+// workers started here.
 std::unique_ptr<TerrainSession> MakeEmbeddedSession(int threads = 1);
 
 struct RpcOptions {

@@ -1,4 +1,4 @@
-#include "batch_pool.h"
+#include "footfall/terrain/batch_pool.h"
 
 #include <algorithm>
 #include <chrono>

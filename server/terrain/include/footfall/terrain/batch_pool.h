@@ -1,5 +1,5 @@
-// BatchPool: persistent threads that share a batch query with the thread that asks for it.
-// Internal to footfall::service.
+// BatchPool: persistent threads that share a batch query with the thread that asks for it
+// (footfalld's batch procedures, the embedded session's batches).
 //
 // The batch is cut into chunks that the caller and the workers take in turn, so a worker that
 // wakes late (its core busy elsewhere) takes fewer chunks instead of holding the caller up, and

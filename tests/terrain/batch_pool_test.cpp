@@ -1,4 +1,4 @@
-// footfalld's batch threads (server/service/src/batch_pool.h): every query of a batch answered
+// The batch threads (footfall/terrain/batch_pool.h): every query of a batch answered
 // exactly once whatever the threads and chunk sizes, exceptions carried back to the caller, and
 // the pool still serving after one.
 #include <algorithm>
@@ -8,11 +8,11 @@
 
 #include <catch2/catch.hpp>
 
-#include "batch_pool.h"
+#include "footfall/terrain/batch_pool.h"
 
 using footfall::BatchPool;
 
-TEST_CASE("batch threads answer every item exactly once", "[rpc][pool]") {
+TEST_CASE("batch threads answer every item exactly once", "[pool]") {
   for (const int threads : {1, 2, 4}) {
     BatchPool pool(threads);
     for (const size_t count : {size_t{0}, size_t{1}, size_t{127}, size_t{128}, size_t{129},
@@ -39,7 +39,7 @@ TEST_CASE("batch threads answer every item exactly once", "[rpc][pool]") {
   }
 }
 
-TEST_CASE("batch threads carry an exception back and keep serving", "[rpc][pool]") {
+TEST_CASE("batch threads carry an exception back and keep serving", "[pool]") {
   BatchPool pool(2);
   for (int round = 0; round < 20; ++round) {
     std::atomic<size_t> done{0};
