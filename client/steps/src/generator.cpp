@@ -27,6 +27,8 @@ constexpr double kArcS[kArcChecks] = {0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.87
 constexpr double kClearanceFraction = 0.25;
 // A step shorter than this fraction of step_length is a step in place: no foothold query.
 constexpr double kInPlace = 0.02;
+// Move::query of a move not asked this round.
+constexpr size_t kNoQuery = ~size_t{0};
 // Per-character loops split across threads only from this many items (threads cost ~20 us).
 constexpr size_t kMinParallel = 2048;
 
@@ -78,8 +80,9 @@ struct Move {
   std::string reason;    // why the last attempt was refused
   Vec3 end, end_normal;  // the accepted foothold
   Vec3 mid, mid_normal;
-  Vec3 ideal;  // the last query's ideal point
-  Vec3 step;   // the last query's step vector
+  Vec3 ideal;               // the last query's ideal point
+  Vec3 step;                // the last query's step vector
+  size_t query = kNoQuery;  // index of this round's foothold answer, or kNoQuery
 };
 
 class Generator {
@@ -94,7 +97,15 @@ class Generator {
   Status Setup(std::string* error);
   Status Step(int k, std::string* error);
   Status QueryFootholds(std::string* error);
-  Status ClearArcs(std::string* error);
+  // Accepts the answer h to mv's foothold query, or records why it is refused.
+  void Judge(Move& mv, const Foothold& h) const;
+  // The reach limit for one character whose moves moves_[m, e) all have a foothold: refuses
+  // the footholds beyond reach of the body they lead to, or all of them when a planted foot
+  // would be left beyond reach.
+  void CheckReach(size_t m, size_t e);
+  Status ClearArcs(int k, std::string* error);
+  // Keys (or stops) the w-th walking character at step k once its moves are final.
+  void Finish(size_t w, int k);
   template <typename Fn>
   void Parallel(size_t count, Fn&& fn) const {
     ForChunks(count, o_.threads, std::forward<Fn>(fn));
@@ -134,8 +145,14 @@ class Generator {
   std::vector<size_t> walking_;  // agents walking this step
   std::vector<Move> moves_;
   std::vector<Vec3> locator_, locator_normal_;  // per move
-  std::vector<size_t> pending_, queried_, still_;
-  std::vector<char> verdict_;
+  std::vector<size_t> pending_, still_;
+  std::vector<char> verdict_, raised_;
+  // A character in a round of arc checks: the w-th walking one, its arcs pending_[begin, end).
+  struct ArcAgent {
+    size_t walking, begin, end;
+  };
+  std::vector<ArcAgent> arc_agents_, next_agents_;
+  int group_ = 0;  // the gait group stepping now
   std::vector<Vec3> points_;
   std::vector<StepQuery> queries_;
   std::vector<Foothold> answers_;
@@ -355,9 +372,11 @@ Status Generator::QueryFootholds(std::string* error) {
   const size_t feet = c_.feet.size();
   std::vector<Move>& moves = moves_;
   const size_t per_agent = walking_.empty() ? 0 : moves.size() / walking_.size();
+  const size_t locators = pairs_of_group_[group_].size();
+  const std::vector<size_t>& slot = slot_of_foot_[group_];
   pending_.resize(moves.size());
   for (size_t m = 0; m < moves.size(); ++m) pending_[m] = m;
-  while (!pending_.empty()) {
+  for (int round = 0; !pending_.empty(); ++round) {
     // 7. Target locators: the foot's rest offset from its pair's centre, in the frame of the
     //    central locator (aligned to the terrain normal under it). The step vector runs from
     //    the foot to its target; slope awareness and the reach limit shorten it.
@@ -365,6 +384,20 @@ Status Generator::QueryFootholds(std::string* error) {
       for (size_t i = b; i < e; ++i) {
         Move& mv = moves[pending_[i]];
         const Agent& a = agents_[mv.agent];
+        if (round == 0) {
+          // 6 (end). A locator that snapped farther than `lead` from where it was placed hangs
+          // over a gap or a cliff: it keeps its place (the body's frame), so the foothold query
+          // looks over the void. Round 0 holds every move, and answers_ the locator snaps.
+          const size_t m = pending_[i];
+          const size_t l = (m / per_agent) * locators + slot[m % per_agent];
+          const Foothold& h = answers_[l];
+          const Vec3& placed = points_[l];
+          if (Distance(h.point, placed) <= lead_) {
+            locator_[m] = h.point, locator_normal_[m] = h.normal;
+          } else {
+            locator_[m] = placed - a.up * (0.5 * lead_), locator_normal_[m] = a.up;
+          }
+        }
         const int p = pair_of_foot_[mv.foot];
         Vec3 n = locator_normal_[pending_[i]];
         if (Degrees(AngleBetween(n, a.up)) > c_.max_slope_deg) n = a.up;  // an edge, not ground
@@ -395,11 +428,10 @@ Status Generator::QueryFootholds(std::string* error) {
       }
     });
     queries_.clear();
-    queried_.clear();
     for (size_t m : pending_) {
       if (moves[m].done) continue;  // a step in place
+      moves[m].query = queries_.size();
       queries_.push_back({agents_[moves[m].agent].foot[moves[m].foot], moves[m].step});
-      queried_.push_back(m);
     }
     // 8. Query the next foothold of every pending foot of every character: one batch. The
     //    answer carries the end normal; the start normal is the planted foot's.
@@ -409,86 +441,18 @@ Status Generator::QueryFootholds(std::string* error) {
                                          0.5 * c_.step_length, answers_.data()),
                            "next foothold", error);
     if (s != Status::kOk) return s;
-    Parallel(queried_.size(), [&](size_t b, size_t e) {
-      for (size_t q = b; q < e; ++q) {
-        Move& mv = moves[queried_[q]];
-        const Agent& a = agents_[mv.agent];
-        const Foothold& h = answers_[q];
-        const Vec3& foot = a.foot[mv.foot];
-        ++mv.attempts;
-        // A foothold must make half the intended progress along the ground it lands on (the
-        // step vector projected onto its tangent plane), so no foot creeps sideways along a
-        // cliff's edge. Steps mostly along the foothold's normal (onto a wall ahead) are exempt.
-        double progress = 1;
-        if (h.status == Status::kOk) {
-          const Vec3 along = ProjectOnPlane(mv.step, h.normal);
-          if (Length2(along) >= 0.25 * Length2(mv.step))
-            progress = Dot(h.point - foot, along) / Length2(along);
-        }
-        const bool found = h.status == Status::kOk && progress >= 0.5;
-        const double rise = found ? Dot(h.point - foot, a.up) : 0;
-        const double slope = found ? Degrees(AngleBetween(h.normal, a.up)) : 0;
-        if (found && std::fabs(rise) <= c_.max_rise && slope <= c_.max_slope_deg) {
-          mv.done = true, mv.end = h.point, mv.end_normal = h.normal;
-          continue;
-        }
-        std::ostringstream why;  // refused: say why (only built on this rare path)
-        why.precision(3);
-        if (!found) {
-          why << "no foothold within " << 0.5 * c_.step_length << " of " << Point(mv.ideal)
-              << " (a gap or a cliff)";
-        } else if (std::fabs(rise) > c_.max_rise) {
-          why << "the foothold at " << Point(h.point) << (rise > 0 ? " rises " : " drops ")
-              << std::fabs(rise) << ", more than max_rise " << c_.max_rise << " (a cliff)";
-        } else {
-          why << "the foothold at " << Point(h.point) << " leans " << slope
-              << " deg, more than max_slope_deg " << c_.max_slope_deg << " (too steep)";
-        }
-        mv.reason = why.str();
-      }
-    });
-    // The reach limit on the body where the accepted footholds put it; feet beyond it retry.
+    // Per character (its moves are contiguous): accept or refuse each answered foot, then the
+    // reach limit on the body where the accepted footholds put it; feet beyond it retry.
     Parallel(walking_.size(), [&](size_t wb, size_t we) {
-      std::vector<Vec3> new_normals(feet), feet_now(feet);
-      std::vector<char> moving(feet);
       for (size_t w = wb; w < we; ++w) {
         const size_t m = w * per_agent, e = m + per_agent;
         bool all_done = true;
-        for (size_t i = m; i < e; ++i) all_done &= moves[i].done;
-        if (!all_done) continue;
-        const Agent& a = agents_[moves[m].agent];
-        feet_now.assign(a.foot.begin(), a.foot.end());
-        new_normals.assign(a.foot_normal.begin(), a.foot_normal.end());
-        for (size_t i = m; i < e; ++i)
-          feet_now[moves[i].foot] = moves[i].end, new_normals[moves[i].foot] = moves[i].end_normal;
-        Vec3 centroid;
-        for (const Vec3& p : feet_now) centroid += p;
-        const Vec3 body =
-            centroid / static_cast<double>(feet) + BodyUp(a, new_normals) * c_.body_height;
-        moving.assign(feet, 0);
-        for (size_t i = m; i < e; ++i) moving[moves[i].foot] = 1;
         for (size_t i = m; i < e; ++i) {
-          const double dist = Distance(moves[i].end, body);
-          if (dist > c_.reach) {
-            std::ostringstream why;
-            why.precision(3);
-            why << "the foothold at " << Point(moves[i].end) << " is " << dist
-                << " from the body, beyond reach " << c_.reach;
-            moves[i].done = false, moves[i].reason = why.str();
-          }
+          if (moves[i].query != kNoQuery)
+            Judge(moves[i], answers_[moves[i].query]), moves[i].query = kNoQuery;
+          all_done &= moves[i].done;
         }
-        // A planted foot the body would leave beyond reach: every moving foot steps shorter.
-        for (size_t f = 0; f < feet; ++f) {
-          const double dist = Distance(feet_now[f], body);
-          if (moving[f] || dist <= c_.reach) continue;
-          std::ostringstream why;
-          why.precision(3);
-          why << "the step would leave foot " << c_.feet[f].name << " " << dist
-              << " from the body, beyond reach " << c_.reach;
-          for (size_t i = m; i < e; ++i)
-            if (moves[i].done) moves[i].done = false, moves[i].reason = why.str();
-          break;
-        }
+        if (all_done) CheckReach(m, e);
       }
     });
     pending_.clear();
@@ -504,26 +468,108 @@ Status Generator::QueryFootholds(std::string* error) {
   return Status::kOk;
 }
 
-Status Generator::ClearArcs(std::string* error) {
+void Generator::Judge(Move& mv, const Foothold& h) const {
+  const Agent& a = agents_[mv.agent];
+  const Vec3& foot = a.foot[mv.foot];
+  ++mv.attempts;
+  // A foothold must make half the intended progress along the ground it lands on (the step
+  // vector projected onto its tangent plane), so no foot creeps sideways along a cliff's edge.
+  // Steps mostly along the foothold's normal (onto a wall ahead) are exempt.
+  double progress = 1;
+  if (h.status == Status::kOk) {
+    const Vec3 along = ProjectOnPlane(mv.step, h.normal);
+    if (Length2(along) >= 0.25 * Length2(mv.step))
+      progress = Dot(h.point - foot, along) / Length2(along);
+  }
+  const bool found = h.status == Status::kOk && progress >= 0.5;
+  const double rise = found ? Dot(h.point - foot, a.up) : 0;
+  const double slope = found ? Degrees(AngleBetween(h.normal, a.up)) : 0;
+  if (found && std::fabs(rise) <= c_.max_rise && slope <= c_.max_slope_deg) {
+    mv.done = true, mv.end = h.point, mv.end_normal = h.normal;
+    return;
+  }
+  std::ostringstream why;  // refused: say why (only built on this rare path)
+  why.precision(3);
+  if (!found) {
+    why << "no foothold within " << 0.5 * c_.step_length << " of " << Point(mv.ideal)
+        << " (a gap or a cliff)";
+  } else if (std::fabs(rise) > c_.max_rise) {
+    why << "the foothold at " << Point(h.point) << (rise > 0 ? " rises " : " drops ")
+        << std::fabs(rise) << ", more than max_rise " << c_.max_rise << " (a cliff)";
+  } else {
+    why << "the foothold at " << Point(h.point) << " leans " << slope
+        << " deg, more than max_slope_deg " << c_.max_slope_deg << " (too steep)";
+  }
+  mv.reason = why.str();
+}
+
+void Generator::CheckReach(size_t m, size_t e) {
+  std::vector<Move>& moves = moves_;
+  const size_t feet = c_.feet.size();
+  const Agent& a = agents_[moves[m].agent];
+  // Where foot f stands after this step: its move's foothold, or where it is planted.
+  auto after = [&](size_t f, bool normal) -> const Vec3& {
+    for (size_t i = m; i < e; ++i)
+      if (moves[i].foot == static_cast<int>(f)) return normal ? moves[i].end_normal : moves[i].end;
+    return normal ? a.foot_normal[f] : a.foot[f];
+  };
+  Vec3 centroid, normal_sum;
+  for (size_t f = 0; f < feet; ++f) centroid += after(f, false), normal_sum += after(f, true);
+  const Vec3 up = c_.align_to_normal ? NormalizeOr(normal_sum, a.up) : world_up_;
+  const Vec3 body = centroid / static_cast<double>(feet) + up * c_.body_height;
+  for (size_t i = m; i < e; ++i) {
+    const double dist = Distance(moves[i].end, body);
+    if (dist > c_.reach) {
+      std::ostringstream why;
+      why.precision(3);
+      why << "the foothold at " << Point(moves[i].end) << " is " << dist
+          << " from the body, beyond reach " << c_.reach;
+      moves[i].done = false, moves[i].reason = why.str();
+    }
+  }
+  // A planted foot the body would leave beyond reach: every moving foot steps shorter.
+  for (size_t f = 0; f < feet; ++f) {
+    bool moving = false;
+    for (size_t i = m; i < e; ++i) moving |= moves[i].foot == static_cast<int>(f);
+    const double dist = Distance(a.foot[f], body);
+    if (moving || dist <= c_.reach) continue;
+    std::ostringstream why;
+    why.precision(3);
+    why << "the step would leave foot " << c_.feet[f].name << " " << dist
+        << " from the body, beyond reach " << c_.reach;
+    for (size_t i = m; i < e; ++i)
+      if (moves[i].done) moves[i].done = false, moves[i].reason = why.str();
+    break;
+  }
+}
+
+Status Generator::ClearArcs(int k, std::string* error) {
   // 9. Swing arcs: the mid key is the midpoint of start and end raised along the averaged
   //    normal by step_height. Points along the start-mid-end arc are snapped to the terrain; an
-  //    arc passing below it (or too close) raises the mid key, round after round.
+  //    arc passing below it (or too close) raises the mid key, round after round. A character
+  //    is finished (10-11) in the round where none of its arcs was raised.
   std::vector<Move>& moves = moves_;
+  const size_t per_agent = walking_.empty() ? 0 : moves.size() / walking_.size();
+  // Round 0: every walking character, with the moves whose foothold was accepted.
   pending_.clear();
-  for (size_t m = 0; m < moves.size(); ++m) {
-    Move& mv = moves[m];
-    if (!mv.done) continue;
-    const Agent& a = agents_[mv.agent];
-    mv.mid_normal = NormalizeOr(a.foot_normal[mv.foot] + mv.end_normal, a.up);
-    mv.mid = (a.foot[mv.foot] + mv.end) * 0.5 + mv.mid_normal * c_.step_height;
-    pending_.push_back(m);
+  arc_agents_.clear();
+  for (size_t w = 0; w < walking_.size(); ++w) {
+    const size_t begin = pending_.size();
+    for (size_t m = w * per_agent; m < (w + 1) * per_agent; ++m)
+      if (moves[m].done) pending_.push_back(m);
+    arc_agents_.push_back({w, begin, pending_.size()});
   }
-  for (int round = 0; !pending_.empty(); ++round) {
+  for (int round = 0; !arc_agents_.empty(); ++round) {
     points_.resize(pending_.size() * kArcChecks);
     Parallel(pending_.size(), [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {
-        const Move& mv = moves[pending_[i]];
-        const Vec3& start = agents_[mv.agent].foot[mv.foot];
+        Move& mv = moves[pending_[i]];
+        const Agent& a = agents_[mv.agent];
+        const Vec3& start = a.foot[mv.foot];
+        if (round == 0) {
+          mv.mid_normal = NormalizeOr(a.foot_normal[mv.foot] + mv.end_normal, a.up);
+          mv.mid = (start + mv.end) * 0.5 + mv.mid_normal * c_.step_height;
+        }
         for (int j = 0; j < kArcChecks; ++j) {
           const double s = kArcS[j];
           points_[i * kArcChecks + j] =
@@ -531,145 +577,146 @@ Status Generator::ClearArcs(std::string* error) {
         }
       }
     });
-    answers_.resize(points_.size());
-    const Status s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()),
-                           "snap swing arc", error);
-    if (s != Status::kOk) return s;
+    if (!pending_.empty()) {
+      answers_.resize(points_.size());
+      const Status s =
+          Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()),
+                "snap swing arc", error);
+      if (s != Status::kOk) return s;
+    }
     verdict_.assign(pending_.size(), 0);  // 1: raise and check again
-    Parallel(pending_.size(), [&](size_t b, size_t e) {
-      for (size_t i = b; i < e; ++i) {
-        Move& mv = moves[pending_[i]];
-        bool clear = true;
-        for (int j = 0; j < kArcChecks; ++j) {
-          const Foothold& h = answers_[i * kArcChecks + j];
-          const double nominal = c_.step_height * (1 - std::fabs(2 * kArcS[j] - 1));
-          if (h.status == Status::kOk &&
-              Dot(points_[i * kArcChecks + j] - h.point, h.normal) < kClearanceFraction * nominal)
-            clear = false;
+    raised_.assign(arc_agents_.size(), 0);
+    Parallel(arc_agents_.size(), [&](size_t b, size_t e) {
+      for (size_t g = b; g < e; ++g) {
+        const ArcAgent& aa = arc_agents_[g];
+        for (size_t i = aa.begin; i < aa.end; ++i) {
+          Move& mv = moves[pending_[i]];
+          bool clear = true;
+          for (int j = 0; j < kArcChecks; ++j) {
+            const Foothold& h = answers_[i * kArcChecks + j];
+            const double nominal = c_.step_height * (1 - std::fabs(2 * kArcS[j] - 1));
+            if (h.status == Status::kOk &&
+                Dot(points_[i * kArcChecks + j] - h.point, h.normal) < kClearanceFraction * nominal)
+              clear = false;
+          }
+          if (clear) continue;
+          if (round + 1 >= kMaxRaises) {
+            std::ostringstream why;
+            why.precision(3);
+            why << "the swing arc to " << Point(mv.end)
+                << " cannot clear the terrain (mid key raised " << kMaxRaises * kRaise
+                << " step heights)";
+            mv.failed = true, mv.done = false, mv.reason = why.str();
+            continue;
+          }
+          mv.mid += mv.mid_normal * (kRaise * c_.step_height);
+          verdict_[i] = 1, raised_[g] = 1;
         }
-        if (clear) continue;
-        if (round + 1 >= kMaxRaises) {
-          std::ostringstream why;
-          why.precision(3);
-          why << "the swing arc to " << Point(mv.end)
-              << " cannot clear the terrain (mid key raised " << kMaxRaises * kRaise
-              << " step heights)";
-          mv.failed = true, mv.done = false, mv.reason = why.str();
-          continue;
-        }
-        mv.mid += mv.mid_normal * (kRaise * c_.step_height);
-        verdict_[i] = 1;
+        if (!raised_[g]) Finish(aa.walking, k);
       }
     });
+    // The next round: the characters with a raised arc, and only those arcs.
     still_.clear();
-    for (size_t i = 0; i < pending_.size(); ++i)
-      if (verdict_[i]) still_.push_back(pending_[i]);
+    next_agents_.clear();
+    for (size_t g = 0; g < arc_agents_.size(); ++g) {
+      if (!raised_[g]) continue;
+      const size_t begin = still_.size();
+      for (size_t i = arc_agents_[g].begin; i < arc_agents_[g].end; ++i)
+        if (verdict_[i]) still_.push_back(pending_[i]);
+      next_agents_.push_back({arc_agents_[g].walking, begin, still_.size()});
+    }
     pending_.swap(still_);
+    arc_agents_.swap(next_agents_);
   }
   return Status::kOk;
 }
 
-Status Generator::Step(int k, std::string* error) {
-  const int group = k % static_cast<int>(c_.gait.size());
+// 10. Key each foot (start, mid, end) and plant it; 11. move the body to the feet's centroid,
+//     raised along its up (multipeds: the averaged foot normal), heading carried along, and key
+//     it at touch-down. A character with a refused foot stops before this step's keys.
+void Generator::Finish(size_t w, int k) {
+  const size_t per_agent = moves_.size() / walking_.size();
   const double f0 = o_.start_frame + static_cast<double>(k) * c_.frames_per_step;
   const double f_mid = f0 + 0.5 * c_.frames_per_step;
   const double f1 = f0 + c_.frames_per_step;
+  const size_t m = w * per_agent, e = m + per_agent;
+  Agent& a = agents_[walking_[w]];
+  const Move* failed = nullptr;
+  for (size_t i = m; i < e && !failed; ++i)
+    if (!moves_[i].done) failed = &moves_[i];
+  bool in_place = true;
+  for (size_t i = m; i < e; ++i)
+    in_place &= moves_[i].done && moves_[i].end == a.foot[moves_[i].foot];
+  if (in_place && !failed) {
+    Stop(a, k + 1,
+         "no way forward from " + Point(a.ground) +
+             ": every target is where its foot already stands (a cliff, a gap or a dead end)");
+    return;
+  }
+  if (failed) {
+    Stop(a, k + 1,
+         "foot " + c_.feet[failed->foot].name + " at " + Point(a.foot[failed->foot]) + ": " +
+             failed->reason);
+    return;
+  }
+  for (size_t i = m; i < e; ++i) {
+    const Move& mv = moves_[i];
+    KeyFoot(a, mv.foot, f0, KeyPhase::kStart, a.foot[mv.foot], a.foot_normal[mv.foot]);
+    KeyFoot(a, mv.foot, f_mid, KeyPhase::kMid, mv.mid, mv.mid_normal);
+    KeyFoot(a, mv.foot, f1, KeyPhase::kEnd, mv.end, mv.end_normal);
+    a.foot[mv.foot] = mv.end, a.foot_normal[mv.foot] = mv.end_normal;
+  }
+  Vec3 centroid;
+  for (const Vec3& p : a.foot) centroid += p;
+  a.ground = centroid / static_cast<double>(a.foot.size());
+  const Vec3 old_up = a.up;
+  a.up = BodyUp(a, a.foot_normal);
+  a.forward = TangentForward(a.forward, a.forward, old_up, a.up);
+  KeyBody(a, f1);
+}
+
+Status Generator::Step(int k, std::string* error) {
+  group_ = k % static_cast<int>(c_.gait.size());
   // 5. Heading: turn toward the current waypoint of the path (at most max_turn_deg).
-  Parallel(agents_.size(), [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i)
-      if (agents_[i].walking) Steer(agents_[i]);
-  });
+  walking_.clear();
+  for (size_t i = 0; i < agents_.size(); ++i) {
+    if (!agents_[i].walking) continue;
+    Steer(agents_[i]);
+    if (agents_[i].walking) walking_.push_back(i);
+  }
   // 6. Central locators: one per foot pair stepping now, `lead` ahead of the pair's rest centre
   //    in the body frame and lead/2 above it (so that at a wall ahead the locator snaps onto the
   //    wall, not into the corner), snapped to the terrain (one batch for every character).
-  walking_.clear();
-  for (size_t i = 0; i < agents_.size(); ++i)
-    if (agents_[i].walking) walking_.push_back(i);
   if (walking_.empty()) return Status::kOk;
-  const std::vector<int>& stepping = c_.gait[group];
-  const std::vector<int>& pairs = pairs_of_group_[group];
-  const std::vector<size_t>& slot = slot_of_foot_[group];
+  const std::vector<int>& stepping = c_.gait[group_];
+  const std::vector<int>& pairs = pairs_of_group_[group_];
   const size_t per_agent = stepping.size(), locators = pairs.size();
   if (per_agent == 0) return Status::kOk;
-  moves_.assign(walking_.size() * per_agent, Move{});
+  moves_.resize(walking_.size() * per_agent);
   points_.resize(walking_.size() * locators);
+  locator_.resize(moves_.size()), locator_normal_.resize(moves_.size());
   Parallel(walking_.size(), [&](size_t b, size_t e) {
     for (size_t w = b; w < e; ++w) {
       const Agent& a = agents_[walking_[w]];
       for (size_t p = 0; p < locators; ++p)
         points_[w * locators + p] =
             Place(a, pair_centre_[pairs[p]]) + a.forward * lead_ + a.up * (0.5 * lead_);
-      for (size_t j = 0; j < per_agent; ++j)
-        moves_[w * per_agent + j].agent = walking_[w], moves_[w * per_agent + j].foot = stepping[j];
+      for (size_t j = 0; j < per_agent; ++j) {
+        Move& mv = moves_[w * per_agent + j];
+        mv = Move{};
+        mv.agent = walking_[w], mv.foot = stepping[j];
+      }
     }
   });
   answers_.resize(points_.size());
-  Status s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()),
-                   "snap locators", error);
+  const Status s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()),
+                         "snap locators", error);
   if (s != Status::kOk) return s;
-  // A locator that snapped farther than `lead` from where it was placed hangs over a gap or a
-  // cliff: it keeps its place (the body's frame), so the foothold query looks over the void.
-  locator_.resize(moves_.size()), locator_normal_.resize(moves_.size());
-  Parallel(moves_.size(), [&](size_t b, size_t e) {
-    for (size_t m = b; m < e; ++m) {
-      const size_t l = (m / per_agent) * locators + slot[m % per_agent];
-      const Foothold& h = answers_[l];
-      const Vec3& placed = points_[l];
-      const Agent& a = agents_[moves_[m].agent];
-      if (Distance(h.point, placed) <= lead_) {
-        locator_[m] = h.point, locator_normal_[m] = h.normal;
-      } else {
-        locator_[m] = placed - a.up * (0.5 * lead_), locator_normal_[m] = a.up;
-      }
-    }
-  });
-  s = QueryFootholds(error);
-  if (s != Status::kOk) return s;
-  s = ClearArcs(error);  // only the feet whose foothold was accepted
-  if (s != Status::kOk) return s;
-  // 10. Key each foot (start, mid, end) and plant it; 11. move the body to the feet's centroid,
-  //     raised along its up (multipeds: the averaged foot normal), heading carried along, and
-  //     key it at touch-down. A character with a refused foot stops before this step's keys.
-  Parallel(walking_.size(), [&](size_t wb, size_t we) {
-    for (size_t w = wb; w < we; ++w) {
-      const size_t m = w * per_agent, e = m + per_agent;
-      Agent& a = agents_[walking_[w]];
-      const Move* failed = nullptr;
-      for (size_t i = m; i < e && !failed; ++i)
-        if (!moves_[i].done) failed = &moves_[i];
-      bool in_place = true;
-      for (size_t i = m; i < e; ++i)
-        in_place &= moves_[i].done && moves_[i].end == a.foot[moves_[i].foot];
-      if (in_place && !failed) {
-        Stop(a, k + 1,
-             "no way forward from " + Point(a.ground) +
-                 ": every target is where its foot already stands (a cliff, a gap or a dead "
-                 "end)");
-        continue;
-      }
-      if (failed) {
-        Stop(a, k + 1,
-             "foot " + c_.feet[failed->foot].name + " at " + Point(a.foot[failed->foot]) + ": " +
-                 failed->reason);
-        continue;
-      }
-      for (size_t i = m; i < e; ++i) {
-        const Move& mv = moves_[i];
-        KeyFoot(a, mv.foot, f0, KeyPhase::kStart, a.foot[mv.foot], a.foot_normal[mv.foot]);
-        KeyFoot(a, mv.foot, f_mid, KeyPhase::kMid, mv.mid, mv.mid_normal);
-        KeyFoot(a, mv.foot, f1, KeyPhase::kEnd, mv.end, mv.end_normal);
-        a.foot[mv.foot] = mv.end, a.foot_normal[mv.foot] = mv.end_normal;
-      }
-      Vec3 centroid;
-      for (const Vec3& p : a.foot) centroid += p;
-      a.ground = centroid / static_cast<double>(a.foot.size());
-      const Vec3 old_up = a.up;
-      a.up = BodyUp(a, a.foot_normal);
-      a.forward = TangentForward(a.forward, a.forward, old_up, a.up);
-      KeyBody(a, f1);
-    }
-  });
-  return Status::kOk;
+  // 6 (end) and 7-8 in QueryFootholds; 9 (only the feet whose foothold was accepted) and 10-11
+  // in ClearArcs.
+  const Status f = QueryFootholds(error);
+  if (f != Status::kOk) return f;
+  return ClearArcs(k, error);
 }
 
 }  // namespace
