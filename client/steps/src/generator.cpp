@@ -153,9 +153,11 @@ class Generator {
   };
   std::vector<ArcAgent> arc_agents_, next_agents_;
   int group_ = 0;  // the gait group stepping now
-  std::vector<Vec3> points_;
+  // Query points and answers of each round, one buffer per kind of round so that their sizes
+  // stay the same from step to step (no refill on resize).
+  std::vector<Vec3> points_, arc_points_;  // setup and locators; arc check points
   std::vector<StepQuery> queries_;
-  std::vector<Foothold> answers_;
+  std::vector<Foothold> answers_, next_answers_, arc_answers_;
 };
 
 Vec3 Generator::BodyUp(const Agent& a, const std::vector<Vec3>& normals) const {
@@ -436,9 +438,9 @@ Status Generator::QueryFootholds(std::string* error) {
     // 8. Query the next foothold of every pending foot of every character: one batch. The
     //    answer carries the end normal; the start normal is the planted foot's.
     if (queries_.empty()) break;
-    answers_.resize(queries_.size());
+    next_answers_.resize(queries_.size());
     const Status s = Check(session_.Next(terrain_, queries_.data(), queries_.size(),
-                                         0.5 * c_.step_length, answers_.data()),
+                                         0.5 * c_.step_length, next_answers_.data()),
                            "next foothold", error);
     if (s != Status::kOk) return s;
     // Per character (its moves are contiguous): accept or refuse each answered foot, then the
@@ -449,7 +451,7 @@ Status Generator::QueryFootholds(std::string* error) {
         bool all_done = true;
         for (size_t i = m; i < e; ++i) {
           if (moves[i].query != kNoQuery)
-            Judge(moves[i], answers_[moves[i].query]), moves[i].query = kNoQuery;
+            Judge(moves[i], next_answers_[moves[i].query]), moves[i].query = kNoQuery;
           all_done &= moves[i].done;
         }
         if (all_done) CheckReach(m, e);
@@ -560,7 +562,7 @@ Status Generator::ClearArcs(int k, std::string* error) {
     arc_agents_.push_back({w, begin, pending_.size()});
   }
   for (int round = 0; !arc_agents_.empty(); ++round) {
-    points_.resize(pending_.size() * kArcChecks);
+    arc_points_.resize(pending_.size() * kArcChecks);
     Parallel(pending_.size(), [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {
         Move& mv = moves[pending_[i]];
@@ -572,16 +574,16 @@ Status Generator::ClearArcs(int k, std::string* error) {
         }
         for (int j = 0; j < kArcChecks; ++j) {
           const double s = kArcS[j];
-          points_[i * kArcChecks + j] =
+          arc_points_[i * kArcChecks + j] =
               s <= 0.5 ? Lerp(start, mv.mid, 2 * s) : Lerp(mv.mid, mv.end, 2 * s - 1);
         }
       }
     });
     if (!pending_.empty()) {
-      answers_.resize(points_.size());
-      const Status s =
-          Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()),
-                "snap swing arc", error);
+      arc_answers_.resize(arc_points_.size());
+      const Status s = Check(
+          session_.Snap(terrain_, arc_points_.data(), arc_points_.size(), arc_answers_.data()),
+          "snap swing arc", error);
       if (s != Status::kOk) return s;
     }
     verdict_.assign(pending_.size(), 0);  // 1: raise and check again
@@ -593,10 +595,10 @@ Status Generator::ClearArcs(int k, std::string* error) {
           Move& mv = moves[pending_[i]];
           bool clear = true;
           for (int j = 0; j < kArcChecks; ++j) {
-            const Foothold& h = answers_[i * kArcChecks + j];
+            const Foothold& h = arc_answers_[i * kArcChecks + j];
             const double nominal = c_.step_height * (1 - std::fabs(2 * kArcS[j] - 1));
-            if (h.status == Status::kOk &&
-                Dot(points_[i * kArcChecks + j] - h.point, h.normal) < kClearanceFraction * nominal)
+            if (h.status == Status::kOk && Dot(arc_points_[i * kArcChecks + j] - h.point,
+                                               h.normal) < kClearanceFraction * nominal)
               clear = false;
           }
           if (clear) continue;
