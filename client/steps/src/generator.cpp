@@ -4,10 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <sstream>
-#include <thread>
 
 #include "frame_math.h"
+#include "worker_pool.h"
 
 namespace footfall {
 namespace {
@@ -29,24 +30,9 @@ constexpr double kClearanceFraction = 0.25;
 constexpr double kInPlace = 0.02;
 // Move::query of a move not asked this round.
 constexpr size_t kNoQuery = ~size_t{0};
-// Per-character loops split across threads only from this many items (threads cost ~20 us).
-constexpr size_t kMinParallel = 2048;
-
-// fn(begin, end) over 0..count-1 in `threads` contiguous chunks; returns when all are done.
-template <typename Fn>
-void ForChunks(size_t count, int threads, Fn&& fn) {
-  const size_t t = static_cast<size_t>(std::max(1, threads));
-  if (t == 1 || count < kMinParallel) {
-    fn(size_t{0}, count);
-    return;
-  }
-  const size_t chunk = (count + t - 1) / t;
-  std::vector<std::thread> pool;
-  for (size_t b = chunk; b < count; b += chunk)
-    pool.emplace_back([&fn, b, chunk, count] { fn(b, std::min(count, b + chunk)); });
-  fn(size_t{0}, std::min(count, chunk));
-  for (std::thread& th : pool) th.join();
-}
+// Per-character loops split across threads only from this many items (a hand-over costs
+// ~20 us).
+constexpr size_t kMinParallel = 512;
 
 std::string Point(const Vec3& p) {
   std::ostringstream o;
@@ -106,9 +92,13 @@ class Generator {
   Status ClearArcs(int k, std::string* error);
   // Keys (or stops) the w-th walking character at step k once its moves are final.
   void Finish(size_t w, int k);
+  // fn(begin, end) over [0, count), split across the pool's threads for large counts. Each
+  // item's result must not depend on the split.
   template <typename Fn>
-  void Parallel(size_t count, Fn&& fn) const {
-    ForChunks(count, o_.threads, std::forward<Fn>(fn));
+  void Parallel(size_t count, Fn&& fn) {
+    if (o_.threads <= 1 || count < kMinParallel) return fn(size_t{0}, count);
+    if (!pool_) pool_ = std::make_unique<WorkerPool>(o_.threads);  // started on first use
+    pool_->Run(count, fn);
   }
   void Steer(Agent& a) const;
   Vec3 Left(const Agent& a) const { return Cross(a.up, a.forward); }
@@ -135,6 +125,7 @@ class Generator {
   int steps_ = 0;
   double lead_ = 0;
   std::vector<Agent> agents_;
+  std::unique_ptr<WorkerPool> pool_;
   std::vector<int> pair_of_foot_;
   std::vector<Vec3> pair_centre_;                 // rest centre of each pair, character space
   std::vector<std::vector<int>> pairs_of_group_;  // pairs with a foot in each gait group
