@@ -21,7 +21,13 @@ constexpr int kMaxAttempts = 4;
 constexpr double kAttemptScale[kMaxAttempts] = {1.0, 0.6, 1.35, 0.3};
 constexpr int kMaxRaises = 8;   // swing arc raises before giving up
 constexpr double kRaise = 0.5;  // raise per round, in step heights
-constexpr int kArcChecks = 7;   // points checked along the start-mid-end arc
+// Points checked along the start-mid-end arc. Each is snapped: its clearance is measured along
+// the normal of its nearest sample, and a Snap answer elsewhere proves only that no sample lies
+// closer to that point than the answer, which bounds neither which sample is nearest here nor
+// its normal. (A point between two points of the same straight half that share a nearest sample
+// shares it too, Voronoi cells being convex; but measured on the bench's ground, samples a third
+// of a step apart, that would spare at most one query in seven, for an extra round of queries.)
+constexpr int kArcChecks = 7;
 constexpr double kArcS[kArcChecks] = {0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875};
 // Required clearance at each check point, as a fraction of the arc's nominal clearance there
 // (the step height at the mid key, falling linearly to 0 at the start and end keys).
