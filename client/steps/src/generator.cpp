@@ -137,6 +137,9 @@ class Generator {
   std::vector<std::vector<int>> pairs_of_group_;  // pairs with a foot in each gait group
   // slot_of_foot_[g][j]: index in pairs_of_group_[g] of the pair of foot gait[g][j]
   std::vector<std::vector<size_t>> slot_of_foot_;
+  // move_of_foot_[g][f]: j when foot f is gait[g][j] (its move is the j-th of its character's
+  // moves in a step of group g), else -1
+  std::vector<std::vector<int>> move_of_foot_;
   // Buffers reused every step. The moves of the w-th walking character of a step are
   // moves_[w * G .. (w + 1) * G) for G feet in the stepping group.
   std::vector<size_t> walking_;  // agents walking this step
@@ -229,7 +232,10 @@ Status Generator::Run(std::string* error) {
   }
   pairs_of_group_.assign(groups, {});
   slot_of_foot_.assign(groups, {});
+  move_of_foot_.assign(groups, std::vector<int>(c_.feet.size(), -1));
   for (int g = 0; g < groups; ++g) {
+    for (size_t j = 0; j < c_.gait[g].size(); ++j)
+      move_of_foot_[g][c_.gait[g][j]] = static_cast<int>(j);
     auto& list = pairs_of_group_[g];
     for (int f : c_.gait[g]) {
       auto it = std::find(list.begin(), list.end(), pair_of_foot_[f]);
@@ -506,14 +512,14 @@ void Generator::CheckReach(size_t m, size_t e) {
   std::vector<Move>& moves = moves_;
   const size_t feet = c_.feet.size();
   const Agent& a = agents_[moves[m].agent];
-  // Where foot f stands after this step: its move's foothold, or where it is planted.
-  auto after = [&](size_t f, bool normal) -> const Vec3& {
-    for (size_t i = m; i < e; ++i)
-      if (moves[i].foot == static_cast<int>(f)) return normal ? moves[i].end_normal : moves[i].end;
-    return normal ? a.foot_normal[f] : a.foot[f];
-  };
+  const std::vector<int>& slot = move_of_foot_[group_];  // foot -> its move's offset, or -1
+  // The feet and normals after this step: each moving foot at its foothold.
   Vec3 centroid, normal_sum;
-  for (size_t f = 0; f < feet; ++f) centroid += after(f, false), normal_sum += after(f, true);
+  for (size_t f = 0; f < feet; ++f) {
+    const bool moving = slot[f] >= 0;
+    centroid += moving ? moves[m + slot[f]].end : a.foot[f];
+    normal_sum += moving ? moves[m + slot[f]].end_normal : a.foot_normal[f];
+  }
   const Vec3 up = c_.align_to_normal ? NormalizeOr(normal_sum, a.up) : world_up_;
   const Vec3 body = centroid / static_cast<double>(feet) + up * c_.body_height;
   for (size_t i = m; i < e; ++i) {
@@ -528,10 +534,8 @@ void Generator::CheckReach(size_t m, size_t e) {
   }
   // A planted foot the body would leave beyond reach: every moving foot steps shorter.
   for (size_t f = 0; f < feet; ++f) {
-    bool moving = false;
-    for (size_t i = m; i < e; ++i) moving |= moves[i].foot == static_cast<int>(f);
     const double dist = Distance(a.foot[f], body);
-    if (moving || dist <= c_.reach) continue;
+    if (slot[f] >= 0 || dist <= c_.reach) continue;
     std::ostringstream why;
     why.precision(3);
     why << "the step would leave foot " << c_.feet[f].name << " " << dist
