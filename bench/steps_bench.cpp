@@ -112,6 +112,11 @@ BENCHMARK(BM_WalkEmbedded)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_WalkEmbedded)
     ->ArgNames({"hexapods", "steps"})
+    ->Args({1000, 100})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_WalkEmbedded)
+    ->ArgNames({"hexapods", "steps"})
     ->Args({10000, 100})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3)

@@ -470,6 +470,50 @@ TEST_CASE("A large crowd's walk is the same on one thread and on two",
   CHECK_THAT(error, Catch::Contains("threads"));
 }
 
+TEST_CASE(
+    "A crowd on rocks (raised arcs, refused footholds, stops) is the same on one thread "
+    "and on two",
+    "[steps][generator][crowd]") {
+  // 600 hexapods 5 cm apart on data/terrain/rocks.pts (8 cm samples): enough characters for the
+  // per-character passes to split; some arcs need raising (their characters finish in a later
+  // round of arc checks) and some characters stop.
+  const Character c = LoadShipped("hexapod");
+  RawSamples rocks;
+  std::string error;
+  REQUIRE(footfall::LoadTerrain(FOOTFALL_SOURCE_DIR "/data/terrain/rocks.pts", TerrainLoadOptions{},
+                                &rocks, &error) == Status::kOk);
+  GenerateOptions o;
+  o.steps = 30;
+  o.crowd = 600;
+  o.crowd_spacing = 0.05;
+  auto run = [&](int threads) {
+    Terrain t = LoadTerrain(rocks, 0.08);
+    o.threads = threads;
+    return Generate(t, c, o);
+  };
+  const Walk one = run(1), two = run(2);
+  CHECK_THAT(one.stopped, Catch::Contains("more characters stopped"));
+  CHECK(one.stopped == two.stopped);
+  REQUIRE(one.tracks.size() == two.tracks.size());
+  size_t differ = 0, raised = 0;
+  for (size_t i = 0; i < one.tracks.size(); ++i) {
+    const auto &ka = one.tracks[i].keys, &kb = two.tracks[i].keys;
+    REQUIRE(ka.size() == kb.size());
+    for (size_t k = 0; k < ka.size(); ++k) {
+      differ += !(ka[k].frame == kb[k].frame && ka[k].phase == kb[k].phase &&
+                  ka[k].position == kb[k].position && ka[k].normal == kb[k].normal);
+      // A raised arc: its mid key more than step_height above the chord's midpoint.
+      if (ka[k].phase == KeyPhase::kMid)
+        raised += Distance(ka[k].position, (ka[k - 1].position + ka[k + 1].position) * 0.5) >
+                  1.01 * c.step_height;
+    }
+  }
+  CHECK(differ == 0);
+  CHECK(raised > 0);
+  Terrain t = LoadTerrain(rocks, 0.08);
+  CheckWalk(t, c, o, two);
+}
+
 TEST_CASE("Bad options are refused with a message", "[steps][generator]") {
   const Character c = LoadShipped("biped");
   Terrain t = LoadTerrain(MakeFlat(10, 0.1, 0), 0.1);

@@ -4,10 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <sstream>
-#include <thread>
 
 #include "frame_math.h"
+#include "worker_pool.h"
 
 namespace footfall {
 namespace {
@@ -20,31 +21,24 @@ constexpr int kMaxAttempts = 4;
 constexpr double kAttemptScale[kMaxAttempts] = {1.0, 0.6, 1.35, 0.3};
 constexpr int kMaxRaises = 8;   // swing arc raises before giving up
 constexpr double kRaise = 0.5;  // raise per round, in step heights
-constexpr int kArcChecks = 7;   // points checked along the start-mid-end arc
+// Points checked along the start-mid-end arc. Each is snapped: its clearance is measured along
+// the normal of its nearest sample, and a Snap answer elsewhere proves only that no sample lies
+// closer to that point than the answer, which bounds neither which sample is nearest here nor
+// its normal. (A point between two points of the same straight half that share a nearest sample
+// shares it too, Voronoi cells being convex; but measured on the bench's ground, samples a third
+// of a step apart, that would spare at most one query in seven, for an extra round of queries.)
+constexpr int kArcChecks = 7;
 constexpr double kArcS[kArcChecks] = {0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875};
 // Required clearance at each check point, as a fraction of the arc's nominal clearance there
 // (the step height at the mid key, falling linearly to 0 at the start and end keys).
 constexpr double kClearanceFraction = 0.25;
 // A step shorter than this fraction of step_length is a step in place: no foothold query.
 constexpr double kInPlace = 0.02;
-// Per-character loops split across threads only from this many items (threads cost ~20 us).
-constexpr size_t kMinParallel = 2048;
-
-// fn(begin, end) over 0..count-1 in `threads` contiguous chunks; returns when all are done.
-template <typename Fn>
-void ForChunks(size_t count, int threads, Fn&& fn) {
-  const size_t t = static_cast<size_t>(std::max(1, threads));
-  if (t == 1 || count < kMinParallel) {
-    fn(size_t{0}, count);
-    return;
-  }
-  const size_t chunk = (count + t - 1) / t;
-  std::vector<std::thread> pool;
-  for (size_t b = chunk; b < count; b += chunk)
-    pool.emplace_back([&fn, b, chunk, count] { fn(b, std::min(count, b + chunk)); });
-  fn(size_t{0}, std::min(count, chunk));
-  for (std::thread& th : pool) th.join();
-}
+// Move::query of a move not asked this round.
+constexpr size_t kNoQuery = ~size_t{0};
+// Per-character loops split across threads only from this many items (a hand-over costs
+// ~20 us).
+constexpr size_t kMinParallel = 512;
 
 std::string Point(const Vec3& p) {
   std::ostringstream o;
@@ -78,8 +72,9 @@ struct Move {
   std::string reason;    // why the last attempt was refused
   Vec3 end, end_normal;  // the accepted foothold
   Vec3 mid, mid_normal;
-  Vec3 ideal;  // the last query's ideal point
-  Vec3 step;   // the last query's step vector
+  Vec3 ideal;               // the last query's ideal point
+  Vec3 step;                // the last query's step vector
+  size_t query = kNoQuery;  // index of this round's foothold answer, or kNoQuery
 };
 
 class Generator {
@@ -94,10 +89,22 @@ class Generator {
   Status Setup(std::string* error);
   Status Step(int k, std::string* error);
   Status QueryFootholds(std::string* error);
-  Status ClearArcs(std::string* error);
+  // Accepts the answer h to mv's foothold query, or records why it is refused.
+  void Judge(Move& mv, const Foothold& h) const;
+  // The reach limit for one character whose moves moves_[m, e) all have a foothold: refuses
+  // the footholds beyond reach of the body they lead to, or all of them when a planted foot
+  // would be left beyond reach.
+  void CheckReach(size_t m, size_t e);
+  Status ClearArcs(int k, std::string* error);
+  // Keys (or stops) the w-th walking character at step k once its moves are final.
+  void Finish(size_t w, int k);
+  // fn(begin, end) over [0, count), split across the pool's threads for large counts. Each
+  // item's result must not depend on the split.
   template <typename Fn>
-  void Parallel(size_t count, Fn&& fn) const {
-    ForChunks(count, o_.threads, std::forward<Fn>(fn));
+  void Parallel(size_t count, Fn&& fn) {
+    if (o_.threads <= 1 || count < kMinParallel) return fn(size_t{0}, count);
+    if (!pool_) pool_ = std::make_unique<WorkerPool>(o_.threads);  // started on first use
+    pool_->Run(count, fn);
   }
   void Steer(Agent& a) const;
   Vec3 Left(const Agent& a) const { return Cross(a.up, a.forward); }
@@ -124,21 +131,33 @@ class Generator {
   int steps_ = 0;
   double lead_ = 0;
   std::vector<Agent> agents_;
+  std::unique_ptr<WorkerPool> pool_;
   std::vector<int> pair_of_foot_;
   std::vector<Vec3> pair_centre_;                 // rest centre of each pair, character space
   std::vector<std::vector<int>> pairs_of_group_;  // pairs with a foot in each gait group
   // slot_of_foot_[g][j]: index in pairs_of_group_[g] of the pair of foot gait[g][j]
   std::vector<std::vector<size_t>> slot_of_foot_;
+  // move_of_foot_[g][f]: j when foot f is gait[g][j] (its move is the j-th of its character's
+  // moves in a step of group g), else -1
+  std::vector<std::vector<int>> move_of_foot_;
   // Buffers reused every step. The moves of the w-th walking character of a step are
   // moves_[w * G .. (w + 1) * G) for G feet in the stepping group.
   std::vector<size_t> walking_;  // agents walking this step
   std::vector<Move> moves_;
   std::vector<Vec3> locator_, locator_normal_;  // per move
-  std::vector<size_t> pending_, queried_, still_;
-  std::vector<char> verdict_;
-  std::vector<Vec3> points_;
+  std::vector<size_t> pending_, still_;
+  std::vector<char> verdict_, raised_;
+  // A character in a round of arc checks: the w-th walking one, its arcs pending_[begin, end).
+  struct ArcAgent {
+    size_t walking, begin, end;
+  };
+  std::vector<ArcAgent> arc_agents_, next_agents_;
+  int group_ = 0;  // the gait group stepping now
+  // Query points and answers of each round, one buffer per kind of round so that their sizes
+  // stay the same from step to step (no refill on resize).
+  std::vector<Vec3> points_, arc_points_;  // setup and locators; arc check points
   std::vector<StepQuery> queries_;
-  std::vector<Foothold> answers_;
+  std::vector<Foothold> answers_, next_answers_, arc_answers_;
 };
 
 Vec3 Generator::BodyUp(const Agent& a, const std::vector<Vec3>& normals) const {
@@ -213,7 +232,10 @@ Status Generator::Run(std::string* error) {
   }
   pairs_of_group_.assign(groups, {});
   slot_of_foot_.assign(groups, {});
+  move_of_foot_.assign(groups, std::vector<int>(c_.feet.size(), -1));
   for (int g = 0; g < groups; ++g) {
+    for (size_t j = 0; j < c_.gait[g].size(); ++j)
+      move_of_foot_[g][c_.gait[g][j]] = static_cast<int>(j);
     auto& list = pairs_of_group_[g];
     for (int f : c_.gait[g]) {
       auto it = std::find(list.begin(), list.end(), pair_of_foot_[f]);
@@ -355,9 +377,11 @@ Status Generator::QueryFootholds(std::string* error) {
   const size_t feet = c_.feet.size();
   std::vector<Move>& moves = moves_;
   const size_t per_agent = walking_.empty() ? 0 : moves.size() / walking_.size();
+  const size_t locators = pairs_of_group_[group_].size();
+  const std::vector<size_t>& slot = slot_of_foot_[group_];
   pending_.resize(moves.size());
   for (size_t m = 0; m < moves.size(); ++m) pending_[m] = m;
-  while (!pending_.empty()) {
+  for (int round = 0; !pending_.empty(); ++round) {
     // 7. Target locators: the foot's rest offset from its pair's centre, in the frame of the
     //    central locator (aligned to the terrain normal under it). The step vector runs from
     //    the foot to its target; slope awareness and the reach limit shorten it.
@@ -365,6 +389,20 @@ Status Generator::QueryFootholds(std::string* error) {
       for (size_t i = b; i < e; ++i) {
         Move& mv = moves[pending_[i]];
         const Agent& a = agents_[mv.agent];
+        if (round == 0) {
+          // 6 (end). A locator that snapped farther than `lead` from where it was placed hangs
+          // over a gap or a cliff: it keeps its place (the body's frame), so the foothold query
+          // looks over the void. Round 0 holds every move, and answers_ the locator snaps.
+          const size_t m = pending_[i];
+          const size_t l = (m / per_agent) * locators + slot[m % per_agent];
+          const Foothold& h = answers_[l];
+          const Vec3& placed = points_[l];
+          if (Distance(h.point, placed) <= lead_) {
+            locator_[m] = h.point, locator_normal_[m] = h.normal;
+          } else {
+            locator_[m] = placed - a.up * (0.5 * lead_), locator_normal_[m] = a.up;
+          }
+        }
         const int p = pair_of_foot_[mv.foot];
         Vec3 n = locator_normal_[pending_[i]];
         if (Degrees(AngleBetween(n, a.up)) > c_.max_slope_deg) n = a.up;  // an edge, not ground
@@ -395,100 +433,31 @@ Status Generator::QueryFootholds(std::string* error) {
       }
     });
     queries_.clear();
-    queried_.clear();
     for (size_t m : pending_) {
       if (moves[m].done) continue;  // a step in place
+      moves[m].query = queries_.size();
       queries_.push_back({agents_[moves[m].agent].foot[moves[m].foot], moves[m].step});
-      queried_.push_back(m);
     }
     // 8. Query the next foothold of every pending foot of every character: one batch. The
     //    answer carries the end normal; the start normal is the planted foot's.
     if (queries_.empty()) break;
-    answers_.resize(queries_.size());
+    next_answers_.resize(queries_.size());
     const Status s = Check(session_.Next(terrain_, queries_.data(), queries_.size(),
-                                         0.5 * c_.step_length, answers_.data()),
+                                         0.5 * c_.step_length, next_answers_.data()),
                            "next foothold", error);
     if (s != Status::kOk) return s;
-    Parallel(queried_.size(), [&](size_t b, size_t e) {
-      for (size_t q = b; q < e; ++q) {
-        Move& mv = moves[queried_[q]];
-        const Agent& a = agents_[mv.agent];
-        const Foothold& h = answers_[q];
-        const Vec3& foot = a.foot[mv.foot];
-        ++mv.attempts;
-        // A foothold must make half the intended progress along the ground it lands on (the
-        // step vector projected onto its tangent plane), so no foot creeps sideways along a
-        // cliff's edge. Steps mostly along the foothold's normal (onto a wall ahead) are exempt.
-        double progress = 1;
-        if (h.status == Status::kOk) {
-          const Vec3 along = ProjectOnPlane(mv.step, h.normal);
-          if (Length2(along) >= 0.25 * Length2(mv.step))
-            progress = Dot(h.point - foot, along) / Length2(along);
-        }
-        const bool found = h.status == Status::kOk && progress >= 0.5;
-        const double rise = found ? Dot(h.point - foot, a.up) : 0;
-        const double slope = found ? Degrees(AngleBetween(h.normal, a.up)) : 0;
-        if (found && std::fabs(rise) <= c_.max_rise && slope <= c_.max_slope_deg) {
-          mv.done = true, mv.end = h.point, mv.end_normal = h.normal;
-          continue;
-        }
-        std::ostringstream why;  // refused: say why (only built on this rare path)
-        why.precision(3);
-        if (!found) {
-          why << "no foothold within " << 0.5 * c_.step_length << " of " << Point(mv.ideal)
-              << " (a gap or a cliff)";
-        } else if (std::fabs(rise) > c_.max_rise) {
-          why << "the foothold at " << Point(h.point) << (rise > 0 ? " rises " : " drops ")
-              << std::fabs(rise) << ", more than max_rise " << c_.max_rise << " (a cliff)";
-        } else {
-          why << "the foothold at " << Point(h.point) << " leans " << slope
-              << " deg, more than max_slope_deg " << c_.max_slope_deg << " (too steep)";
-        }
-        mv.reason = why.str();
-      }
-    });
-    // The reach limit on the body where the accepted footholds put it; feet beyond it retry.
+    // Per character (its moves are contiguous): accept or refuse each answered foot, then the
+    // reach limit on the body where the accepted footholds put it; feet beyond it retry.
     Parallel(walking_.size(), [&](size_t wb, size_t we) {
-      std::vector<Vec3> new_normals(feet), feet_now(feet);
-      std::vector<char> moving(feet);
       for (size_t w = wb; w < we; ++w) {
         const size_t m = w * per_agent, e = m + per_agent;
         bool all_done = true;
-        for (size_t i = m; i < e; ++i) all_done &= moves[i].done;
-        if (!all_done) continue;
-        const Agent& a = agents_[moves[m].agent];
-        feet_now.assign(a.foot.begin(), a.foot.end());
-        new_normals.assign(a.foot_normal.begin(), a.foot_normal.end());
-        for (size_t i = m; i < e; ++i)
-          feet_now[moves[i].foot] = moves[i].end, new_normals[moves[i].foot] = moves[i].end_normal;
-        Vec3 centroid;
-        for (const Vec3& p : feet_now) centroid += p;
-        const Vec3 body =
-            centroid / static_cast<double>(feet) + BodyUp(a, new_normals) * c_.body_height;
-        moving.assign(feet, 0);
-        for (size_t i = m; i < e; ++i) moving[moves[i].foot] = 1;
         for (size_t i = m; i < e; ++i) {
-          const double dist = Distance(moves[i].end, body);
-          if (dist > c_.reach) {
-            std::ostringstream why;
-            why.precision(3);
-            why << "the foothold at " << Point(moves[i].end) << " is " << dist
-                << " from the body, beyond reach " << c_.reach;
-            moves[i].done = false, moves[i].reason = why.str();
-          }
+          if (moves[i].query != kNoQuery)
+            Judge(moves[i], next_answers_[moves[i].query]), moves[i].query = kNoQuery;
+          all_done &= moves[i].done;
         }
-        // A planted foot the body would leave beyond reach: every moving foot steps shorter.
-        for (size_t f = 0; f < feet; ++f) {
-          const double dist = Distance(feet_now[f], body);
-          if (moving[f] || dist <= c_.reach) continue;
-          std::ostringstream why;
-          why.precision(3);
-          why << "the step would leave foot " << c_.feet[f].name << " " << dist
-              << " from the body, beyond reach " << c_.reach;
-          for (size_t i = m; i < e; ++i)
-            if (moves[i].done) moves[i].done = false, moves[i].reason = why.str();
-          break;
-        }
+        if (all_done) CheckReach(m, e);
       }
     });
     pending_.clear();
@@ -504,172 +473,253 @@ Status Generator::QueryFootholds(std::string* error) {
   return Status::kOk;
 }
 
-Status Generator::ClearArcs(std::string* error) {
+void Generator::Judge(Move& mv, const Foothold& h) const {
+  const Agent& a = agents_[mv.agent];
+  const Vec3& foot = a.foot[mv.foot];
+  ++mv.attempts;
+  // A foothold must make half the intended progress along the ground it lands on (the step
+  // vector projected onto its tangent plane), so no foot creeps sideways along a cliff's edge.
+  // Steps mostly along the foothold's normal (onto a wall ahead) are exempt.
+  double progress = 1;
+  if (h.status == Status::kOk) {
+    const Vec3 along = ProjectOnPlane(mv.step, h.normal);
+    if (Length2(along) >= 0.25 * Length2(mv.step))
+      progress = Dot(h.point - foot, along) / Length2(along);
+  }
+  const bool found = h.status == Status::kOk && progress >= 0.5;
+  const double rise = found ? Dot(h.point - foot, a.up) : 0;
+  const double slope = found ? Degrees(AngleBetween(h.normal, a.up)) : 0;
+  if (found && std::fabs(rise) <= c_.max_rise && slope <= c_.max_slope_deg) {
+    mv.done = true, mv.end = h.point, mv.end_normal = h.normal;
+    return;
+  }
+  std::ostringstream why;  // refused: say why (only built on this rare path)
+  why.precision(3);
+  if (!found) {
+    why << "no foothold within " << 0.5 * c_.step_length << " of " << Point(mv.ideal)
+        << " (a gap or a cliff)";
+  } else if (std::fabs(rise) > c_.max_rise) {
+    why << "the foothold at " << Point(h.point) << (rise > 0 ? " rises " : " drops ")
+        << std::fabs(rise) << ", more than max_rise " << c_.max_rise << " (a cliff)";
+  } else {
+    why << "the foothold at " << Point(h.point) << " leans " << slope
+        << " deg, more than max_slope_deg " << c_.max_slope_deg << " (too steep)";
+  }
+  mv.reason = why.str();
+}
+
+void Generator::CheckReach(size_t m, size_t e) {
+  std::vector<Move>& moves = moves_;
+  const size_t feet = c_.feet.size();
+  const Agent& a = agents_[moves[m].agent];
+  const std::vector<int>& slot = move_of_foot_[group_];  // foot -> its move's offset, or -1
+  // The feet and normals after this step: each moving foot at its foothold.
+  Vec3 centroid, normal_sum;
+  for (size_t f = 0; f < feet; ++f) {
+    const bool moving = slot[f] >= 0;
+    centroid += moving ? moves[m + slot[f]].end : a.foot[f];
+    normal_sum += moving ? moves[m + slot[f]].end_normal : a.foot_normal[f];
+  }
+  const Vec3 up = c_.align_to_normal ? NormalizeOr(normal_sum, a.up) : world_up_;
+  const Vec3 body = centroid / static_cast<double>(feet) + up * c_.body_height;
+  for (size_t i = m; i < e; ++i) {
+    const double dist = Distance(moves[i].end, body);
+    if (dist > c_.reach) {
+      std::ostringstream why;
+      why.precision(3);
+      why << "the foothold at " << Point(moves[i].end) << " is " << dist
+          << " from the body, beyond reach " << c_.reach;
+      moves[i].done = false, moves[i].reason = why.str();
+    }
+  }
+  // A planted foot the body would leave beyond reach: every moving foot steps shorter.
+  for (size_t f = 0; f < feet; ++f) {
+    const double dist = Distance(a.foot[f], body);
+    if (slot[f] >= 0 || dist <= c_.reach) continue;
+    std::ostringstream why;
+    why.precision(3);
+    why << "the step would leave foot " << c_.feet[f].name << " " << dist
+        << " from the body, beyond reach " << c_.reach;
+    for (size_t i = m; i < e; ++i)
+      if (moves[i].done) moves[i].done = false, moves[i].reason = why.str();
+    break;
+  }
+}
+
+Status Generator::ClearArcs(int k, std::string* error) {
   // 9. Swing arcs: the mid key is the midpoint of start and end raised along the averaged
   //    normal by step_height. Points along the start-mid-end arc are snapped to the terrain; an
-  //    arc passing below it (or too close) raises the mid key, round after round.
+  //    arc passing below it (or too close) raises the mid key, round after round. A character
+  //    is finished (10-11) in the round where none of its arcs was raised.
   std::vector<Move>& moves = moves_;
+  const size_t per_agent = walking_.empty() ? 0 : moves.size() / walking_.size();
+  // Round 0: every walking character, with the moves whose foothold was accepted.
   pending_.clear();
-  for (size_t m = 0; m < moves.size(); ++m) {
-    Move& mv = moves[m];
-    if (!mv.done) continue;
-    const Agent& a = agents_[mv.agent];
-    mv.mid_normal = NormalizeOr(a.foot_normal[mv.foot] + mv.end_normal, a.up);
-    mv.mid = (a.foot[mv.foot] + mv.end) * 0.5 + mv.mid_normal * c_.step_height;
-    pending_.push_back(m);
+  arc_agents_.clear();
+  for (size_t w = 0; w < walking_.size(); ++w) {
+    const size_t begin = pending_.size();
+    for (size_t m = w * per_agent; m < (w + 1) * per_agent; ++m)
+      if (moves[m].done) pending_.push_back(m);
+    arc_agents_.push_back({w, begin, pending_.size()});
   }
-  for (int round = 0; !pending_.empty(); ++round) {
-    points_.resize(pending_.size() * kArcChecks);
+  for (int round = 0; !arc_agents_.empty(); ++round) {
+    arc_points_.resize(pending_.size() * kArcChecks);
     Parallel(pending_.size(), [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {
-        const Move& mv = moves[pending_[i]];
-        const Vec3& start = agents_[mv.agent].foot[mv.foot];
+        Move& mv = moves[pending_[i]];
+        const Agent& a = agents_[mv.agent];
+        const Vec3& start = a.foot[mv.foot];
+        if (round == 0) {
+          mv.mid_normal = NormalizeOr(a.foot_normal[mv.foot] + mv.end_normal, a.up);
+          mv.mid = (start + mv.end) * 0.5 + mv.mid_normal * c_.step_height;
+        }
         for (int j = 0; j < kArcChecks; ++j) {
           const double s = kArcS[j];
-          points_[i * kArcChecks + j] =
+          arc_points_[i * kArcChecks + j] =
               s <= 0.5 ? Lerp(start, mv.mid, 2 * s) : Lerp(mv.mid, mv.end, 2 * s - 1);
         }
       }
     });
-    answers_.resize(points_.size());
-    const Status s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()),
-                           "snap swing arc", error);
-    if (s != Status::kOk) return s;
+    if (!pending_.empty()) {
+      arc_answers_.resize(arc_points_.size());
+      const Status s = Check(
+          session_.Snap(terrain_, arc_points_.data(), arc_points_.size(), arc_answers_.data()),
+          "snap swing arc", error);
+      if (s != Status::kOk) return s;
+    }
     verdict_.assign(pending_.size(), 0);  // 1: raise and check again
-    Parallel(pending_.size(), [&](size_t b, size_t e) {
-      for (size_t i = b; i < e; ++i) {
-        Move& mv = moves[pending_[i]];
-        bool clear = true;
-        for (int j = 0; j < kArcChecks; ++j) {
-          const Foothold& h = answers_[i * kArcChecks + j];
-          const double nominal = c_.step_height * (1 - std::fabs(2 * kArcS[j] - 1));
-          if (h.status == Status::kOk &&
-              Dot(points_[i * kArcChecks + j] - h.point, h.normal) < kClearanceFraction * nominal)
-            clear = false;
+    raised_.assign(arc_agents_.size(), 0);
+    Parallel(arc_agents_.size(), [&](size_t b, size_t e) {
+      for (size_t g = b; g < e; ++g) {
+        const ArcAgent& aa = arc_agents_[g];
+        for (size_t i = aa.begin; i < aa.end; ++i) {
+          Move& mv = moves[pending_[i]];
+          bool clear = true;
+          for (int j = 0; j < kArcChecks; ++j) {
+            const Foothold& h = arc_answers_[i * kArcChecks + j];
+            const double nominal = c_.step_height * (1 - std::fabs(2 * kArcS[j] - 1));
+            if (h.status == Status::kOk && Dot(arc_points_[i * kArcChecks + j] - h.point,
+                                               h.normal) < kClearanceFraction * nominal)
+              clear = false;
+          }
+          if (clear) continue;
+          if (round + 1 >= kMaxRaises) {
+            std::ostringstream why;
+            why.precision(3);
+            why << "the swing arc to " << Point(mv.end)
+                << " cannot clear the terrain (mid key raised " << kMaxRaises * kRaise
+                << " step heights)";
+            mv.failed = true, mv.done = false, mv.reason = why.str();
+            continue;
+          }
+          mv.mid += mv.mid_normal * (kRaise * c_.step_height);
+          verdict_[i] = 1, raised_[g] = 1;
         }
-        if (clear) continue;
-        if (round + 1 >= kMaxRaises) {
-          std::ostringstream why;
-          why.precision(3);
-          why << "the swing arc to " << Point(mv.end)
-              << " cannot clear the terrain (mid key raised " << kMaxRaises * kRaise
-              << " step heights)";
-          mv.failed = true, mv.done = false, mv.reason = why.str();
-          continue;
-        }
-        mv.mid += mv.mid_normal * (kRaise * c_.step_height);
-        verdict_[i] = 1;
+        if (!raised_[g]) Finish(aa.walking, k);
       }
     });
+    // The next round: the characters with a raised arc, and only those arcs.
     still_.clear();
-    for (size_t i = 0; i < pending_.size(); ++i)
-      if (verdict_[i]) still_.push_back(pending_[i]);
+    next_agents_.clear();
+    for (size_t g = 0; g < arc_agents_.size(); ++g) {
+      if (!raised_[g]) continue;
+      const size_t begin = still_.size();
+      for (size_t i = arc_agents_[g].begin; i < arc_agents_[g].end; ++i)
+        if (verdict_[i]) still_.push_back(pending_[i]);
+      next_agents_.push_back({arc_agents_[g].walking, begin, still_.size()});
+    }
     pending_.swap(still_);
+    arc_agents_.swap(next_agents_);
   }
   return Status::kOk;
 }
 
-Status Generator::Step(int k, std::string* error) {
-  const int group = k % static_cast<int>(c_.gait.size());
+// 10. Key each foot (start, mid, end) and plant it; 11. move the body to the feet's centroid,
+//     raised along its up (multipeds: the averaged foot normal), heading carried along, and key
+//     it at touch-down. A character with a refused foot stops before this step's keys.
+void Generator::Finish(size_t w, int k) {
+  const size_t per_agent = moves_.size() / walking_.size();
   const double f0 = o_.start_frame + static_cast<double>(k) * c_.frames_per_step;
   const double f_mid = f0 + 0.5 * c_.frames_per_step;
   const double f1 = f0 + c_.frames_per_step;
+  const size_t m = w * per_agent, e = m + per_agent;
+  Agent& a = agents_[walking_[w]];
+  const Move* failed = nullptr;
+  for (size_t i = m; i < e && !failed; ++i)
+    if (!moves_[i].done) failed = &moves_[i];
+  bool in_place = true;
+  for (size_t i = m; i < e; ++i)
+    in_place &= moves_[i].done && moves_[i].end == a.foot[moves_[i].foot];
+  if (in_place && !failed) {
+    Stop(a, k + 1,
+         "no way forward from " + Point(a.ground) +
+             ": every target is where its foot already stands (a cliff, a gap or a dead end)");
+    return;
+  }
+  if (failed) {
+    Stop(a, k + 1,
+         "foot " + c_.feet[failed->foot].name + " at " + Point(a.foot[failed->foot]) + ": " +
+             failed->reason);
+    return;
+  }
+  for (size_t i = m; i < e; ++i) {
+    const Move& mv = moves_[i];
+    KeyFoot(a, mv.foot, f0, KeyPhase::kStart, a.foot[mv.foot], a.foot_normal[mv.foot]);
+    KeyFoot(a, mv.foot, f_mid, KeyPhase::kMid, mv.mid, mv.mid_normal);
+    KeyFoot(a, mv.foot, f1, KeyPhase::kEnd, mv.end, mv.end_normal);
+    a.foot[mv.foot] = mv.end, a.foot_normal[mv.foot] = mv.end_normal;
+  }
+  Vec3 centroid;
+  for (const Vec3& p : a.foot) centroid += p;
+  a.ground = centroid / static_cast<double>(a.foot.size());
+  const Vec3 old_up = a.up;
+  a.up = BodyUp(a, a.foot_normal);
+  a.forward = TangentForward(a.forward, a.forward, old_up, a.up);
+  KeyBody(a, f1);
+}
+
+Status Generator::Step(int k, std::string* error) {
+  group_ = k % static_cast<int>(c_.gait.size());
   // 5. Heading: turn toward the current waypoint of the path (at most max_turn_deg).
-  Parallel(agents_.size(), [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i)
-      if (agents_[i].walking) Steer(agents_[i]);
-  });
+  walking_.clear();
+  for (size_t i = 0; i < agents_.size(); ++i) {
+    if (!agents_[i].walking) continue;
+    Steer(agents_[i]);
+    if (agents_[i].walking) walking_.push_back(i);
+  }
   // 6. Central locators: one per foot pair stepping now, `lead` ahead of the pair's rest centre
   //    in the body frame and lead/2 above it (so that at a wall ahead the locator snaps onto the
   //    wall, not into the corner), snapped to the terrain (one batch for every character).
-  walking_.clear();
-  for (size_t i = 0; i < agents_.size(); ++i)
-    if (agents_[i].walking) walking_.push_back(i);
   if (walking_.empty()) return Status::kOk;
-  const std::vector<int>& stepping = c_.gait[group];
-  const std::vector<int>& pairs = pairs_of_group_[group];
-  const std::vector<size_t>& slot = slot_of_foot_[group];
+  const std::vector<int>& stepping = c_.gait[group_];
+  const std::vector<int>& pairs = pairs_of_group_[group_];
   const size_t per_agent = stepping.size(), locators = pairs.size();
   if (per_agent == 0) return Status::kOk;
-  moves_.assign(walking_.size() * per_agent, Move{});
+  moves_.resize(walking_.size() * per_agent);
   points_.resize(walking_.size() * locators);
+  locator_.resize(moves_.size()), locator_normal_.resize(moves_.size());
   Parallel(walking_.size(), [&](size_t b, size_t e) {
     for (size_t w = b; w < e; ++w) {
       const Agent& a = agents_[walking_[w]];
       for (size_t p = 0; p < locators; ++p)
         points_[w * locators + p] =
             Place(a, pair_centre_[pairs[p]]) + a.forward * lead_ + a.up * (0.5 * lead_);
-      for (size_t j = 0; j < per_agent; ++j)
-        moves_[w * per_agent + j].agent = walking_[w], moves_[w * per_agent + j].foot = stepping[j];
+      for (size_t j = 0; j < per_agent; ++j) {
+        Move& mv = moves_[w * per_agent + j];
+        mv = Move{};
+        mv.agent = walking_[w], mv.foot = stepping[j];
+      }
     }
   });
   answers_.resize(points_.size());
-  Status s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()),
-                   "snap locators", error);
+  const Status s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()),
+                         "snap locators", error);
   if (s != Status::kOk) return s;
-  // A locator that snapped farther than `lead` from where it was placed hangs over a gap or a
-  // cliff: it keeps its place (the body's frame), so the foothold query looks over the void.
-  locator_.resize(moves_.size()), locator_normal_.resize(moves_.size());
-  Parallel(moves_.size(), [&](size_t b, size_t e) {
-    for (size_t m = b; m < e; ++m) {
-      const size_t l = (m / per_agent) * locators + slot[m % per_agent];
-      const Foothold& h = answers_[l];
-      const Vec3& placed = points_[l];
-      const Agent& a = agents_[moves_[m].agent];
-      if (Distance(h.point, placed) <= lead_) {
-        locator_[m] = h.point, locator_normal_[m] = h.normal;
-      } else {
-        locator_[m] = placed - a.up * (0.5 * lead_), locator_normal_[m] = a.up;
-      }
-    }
-  });
-  s = QueryFootholds(error);
-  if (s != Status::kOk) return s;
-  s = ClearArcs(error);  // only the feet whose foothold was accepted
-  if (s != Status::kOk) return s;
-  // 10. Key each foot (start, mid, end) and plant it; 11. move the body to the feet's centroid,
-  //     raised along its up (multipeds: the averaged foot normal), heading carried along, and
-  //     key it at touch-down. A character with a refused foot stops before this step's keys.
-  Parallel(walking_.size(), [&](size_t wb, size_t we) {
-    for (size_t w = wb; w < we; ++w) {
-      const size_t m = w * per_agent, e = m + per_agent;
-      Agent& a = agents_[walking_[w]];
-      const Move* failed = nullptr;
-      for (size_t i = m; i < e && !failed; ++i)
-        if (!moves_[i].done) failed = &moves_[i];
-      bool in_place = true;
-      for (size_t i = m; i < e; ++i)
-        in_place &= moves_[i].done && moves_[i].end == a.foot[moves_[i].foot];
-      if (in_place && !failed) {
-        Stop(a, k + 1,
-             "no way forward from " + Point(a.ground) +
-                 ": every target is where its foot already stands (a cliff, a gap or a dead "
-                 "end)");
-        continue;
-      }
-      if (failed) {
-        Stop(a, k + 1,
-             "foot " + c_.feet[failed->foot].name + " at " + Point(a.foot[failed->foot]) + ": " +
-                 failed->reason);
-        continue;
-      }
-      for (size_t i = m; i < e; ++i) {
-        const Move& mv = moves_[i];
-        KeyFoot(a, mv.foot, f0, KeyPhase::kStart, a.foot[mv.foot], a.foot_normal[mv.foot]);
-        KeyFoot(a, mv.foot, f_mid, KeyPhase::kMid, mv.mid, mv.mid_normal);
-        KeyFoot(a, mv.foot, f1, KeyPhase::kEnd, mv.end, mv.end_normal);
-        a.foot[mv.foot] = mv.end, a.foot_normal[mv.foot] = mv.end_normal;
-      }
-      Vec3 centroid;
-      for (const Vec3& p : a.foot) centroid += p;
-      a.ground = centroid / static_cast<double>(a.foot.size());
-      const Vec3 old_up = a.up;
-      a.up = BodyUp(a, a.foot_normal);
-      a.forward = TangentForward(a.forward, a.forward, old_up, a.up);
-      KeyBody(a, f1);
-    }
-  });
-  return Status::kOk;
+  // 6 (end) and 7-8 in QueryFootholds; 9 (only the feet whose foothold was accepted) and 10-11
+  // in ClearArcs.
+  const Status f = QueryFootholds(error);
+  if (f != Status::kOk) return f;
+  return ClearArcs(k, error);
 }
 
 }  // namespace
