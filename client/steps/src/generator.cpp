@@ -1,6 +1,7 @@
 // The step generator. The numbered comments match the numbered list of "The algorithm" in the
 // top-level README.md.
 #include "footfall/steps/generator.h"
+#include "footfall/terrain/batch_pool.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +9,6 @@
 #include <sstream>
 
 #include "frame_math.h"
-#include "worker_pool.h"
 
 namespace footfall {
 namespace {
@@ -103,8 +103,11 @@ class Generator {
   template <typename Fn>
   void Parallel(size_t count, Fn&& fn) {
     if (o_.threads <= 1 || count < kMinParallel) return fn(size_t{0}, count);
-    if (!pool_) pool_ = std::make_unique<WorkerPool>(o_.threads);  // started on first use
-    pool_->Run(count, fn);
+    if (!pool_) pool_ = std::make_unique<BatchPool>(o_.threads);  // started on first use
+    // Chunks of about count / (8 threads), taken in turn: a thread the system holds up delays
+    // the others little.
+    const size_t chunk = std::max<size_t>(1, count / (8 * static_cast<size_t>(o_.threads)));
+    pool_->Run(count, chunk, fn);
   }
   void Steer(Agent& a) const;
   Vec3 Left(const Agent& a) const { return Cross(a.up, a.forward); }
@@ -131,7 +134,7 @@ class Generator {
   int steps_ = 0;
   double lead_ = 0;
   std::vector<Agent> agents_;
-  std::unique_ptr<WorkerPool> pool_;
+  std::unique_ptr<BatchPool> pool_;
   std::vector<int> pair_of_foot_;
   std::vector<Vec3> pair_centre_;                 // rest centre of each pair, character space
   std::vector<std::vector<int>> pairs_of_group_;  // pairs with a foot in each gait group

@@ -10,9 +10,9 @@
 #include <utility>
 #include <vector>
 
-#include "footfall/terrain/batch_pool.h"
 #include "footfall.h"
 #include "footfall/rpc/batch_xdr.h"
+#include "footfall/terrain/batch_pool.h"
 
 namespace footfall {
 namespace {
