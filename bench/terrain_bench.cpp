@@ -240,7 +240,9 @@ Backends& TheBackends() {
     o.port = x.server->port();
     o.call_timeout_s = 60;
     x.rpc = MakeRpcSession(o);
-    x.embedded = MakeEmbeddedSession();
+    // As many threads as footfalld answers batches with (its default: every core).
+    x.embedded =
+        MakeEmbeddedSession(static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
     x.rpc->LoadSamples(Samples(), "bench", &x.rpc_terrain);
     x.embedded->LoadSamples(Samples(), "bench", &x.embedded_terrain);
     return x;
