@@ -6,15 +6,7 @@ set -u
 footfall=$1
 footfalld=$2
 source_dir=$3
-work=$(mktemp -d)
-server_pid=""
-trap '[ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null; rm -rf "$work"' EXIT
-failures=0
-passes=0
-check() {  # check NAME CONDITION...
-  local name=$1; shift
-  if "$@"; then passes=$((passes + 1)); else echo "FAILED: $name" >&2; failures=$((failures + 1)); fi
-}
+source "$(dirname "$0")/../support/cli_checks.sh"
 hills=$source_dir/data/terrain/hills.pts
 
 # Checks a JSON report: the terrain's figures, and every query figure positive, with the
@@ -53,10 +45,7 @@ check "text report names the backend" grep -q '^backend: embedded$' "$work/text"
 check "text report has a line per figure" [ "$(grep -c 'ns/query' "$work/text")" -eq 8 ]
 
 # 2. Over RPC against a real footfalld: the embedded engine is the batches' baseline.
-"$footfalld" --listen 127.0.0.1:0 --port-file "$work/port" --no-rpcbind 2> "$work/server.log" &
-server_pid=$!
-for _ in $(seq 100); do [ -s "$work/port" ] && break; sleep 0.05; done
-server=127.0.0.1:$(cat "$work/port")
+start_server "$footfalld"
 "$footfall" bench --terrain "$hills" --server "$server" --queries 3000 --batch 1000 \
   --min-time 0.02 --json > "$work/rpc.json" 2> "$work/err"
 check "rpc bench exits 0" [ $? -eq 0 ]
@@ -70,10 +59,9 @@ check "bad terrain: exit 1" [ $? -eq 1 ]
 check "bad terrain: file and line" grep -qF "$work/bad.pts:2: expected 6 numbers" <<< "$err"
 err=$("$footfall" bench --terrain "$hills" --queries 0 2>&1 >/dev/null)
 check "zero queries refused" [ $? -ne 0 ]
-kill "$server_pid"; wait "$server_pid" 2>/dev/null; server_pid=""
+stop_server
 err=$("$footfall" bench --terrain "$hills" --server "$server" --timeout 2 2>&1 >/dev/null)
 check "no server: exit 1" [ $? -eq 1 ]
 check "no server: says so" grep -qi "footfall bench: .*$server" <<< "$err"
 
-echo "$passes checks passed, $failures failed"
-[ "$failures" -eq 0 ]
+finish

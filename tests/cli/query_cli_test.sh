@@ -5,15 +5,7 @@
 set -u
 footfall=$1
 footfalld=$2
-work=$(mktemp -d)
-server_pid=""
-trap '[ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null; rm -rf "$work"' EXIT
-failures=0
-passes=0
-check() {  # check NAME CONDITION...
-  local name=$1; shift
-  if "$@"; then passes=$((passes + 1)); else echo "FAILED: $name" >&2; failures=$((failures + 1)); fi
-}
+source "$(dirname "$0")/../support/cli_checks.sh"
 
 # A 5 x 5 flat terrain at y = 0, samples at integer x, z.
 for z in 0 1 2 3 4; do for x in 0 1 2 3 4; do echo "$x 0 $z 0 1 0"; done; done > "$work/flat.pts"
@@ -60,10 +52,7 @@ check "missing file: exit 1" [ $? -eq 1 ]
 check "missing file: message" grep -qF "$work/missing.pts: cannot open file" <<< "$err"
 
 # 4. The same answers over RPC from a real footfalld, by upload and by server-side path.
-"$footfalld" --listen 127.0.0.1:0 --port-file "$work/port" --no-rpcbind --data-root "$work" 2> "$work/server.log" &
-server_pid=$!
-for _ in $(seq 100); do [ -s "$work/port" ] && break; sleep 0.05; done
-port=$(cat "$work/port")
+start_server "$footfalld" --data-root "$work"
 { for i in $(seq 0 200); do echo "snap $((i % 7)).3 0.$i $((i % 5)).6"; echo "next $((i % 5)) 0 $((i % 4)) 0.$i 0 1.$i"; done; } > "$work/queries"
 "$footfall" query --terrain "$work/flat.pts" < "$work/queries" > "$work/embedded.jsonl"
 "$footfall" query --terrain "$work/flat.pts" --server "127.0.0.1:$port" < "$work/queries" > "$work/rpc.jsonl"
@@ -75,10 +64,9 @@ err=$(echo "snap 0 0 0" | "$footfall" query --server-terrain ../../etc/passwd --
 check "escape refused: exit 1" [ $? -eq 1 ]
 check "escape refused: message" grep -qF "resolves outside the data root" <<< "$err"
 check "server logs loads" grep -q "loaded terrain" "$work/server.log"
-kill "$server_pid"; wait "$server_pid" 2>/dev/null; server_pid=""
+stop_server
 err=$(echo "snap 0 0 0" | "$footfall" query --terrain "$work/flat.pts" --server "127.0.0.1:$port" 2>&1 >/dev/null)
 check "server gone: exit 1" [ $? -eq 1 ]
 check "server gone: message" grep -qF "footfalld at 127.0.0.1:$port" <<< "$err"
 
-echo "$passes passed, $failures failed"
-[ "$failures" -eq 0 ]
+finish

@@ -7,15 +7,7 @@ set -u
 footfall=$1
 footfalld=$2
 src=$3
-work=$(mktemp -d)
-server_pid=""
-trap '[ -n "$server_pid" ] && kill "$server_pid" 2>/dev/null; rm -rf "$work"' EXIT
-failures=0
-passes=0
-check() {  # check NAME CONDITION...
-  local name=$1; shift
-  if "$@"; then passes=$((passes + 1)); else echo "FAILED: $name" >&2; failures=$((failures + 1)); fi
-}
+source "$(dirname "$0")/../support/cli_checks.sh"
 chars=$src/data/characters
 hills=$src/data/terrain/hills.pts
 
@@ -24,10 +16,7 @@ hills=$src/data/terrain/hills.pts
 awk 'BEGIN { for (k = 0; k < 200; k++) for (i = 0; i < 200; i++) printf "%.3f 0 %.3f 0 1 0\n", i * 0.012, k * 0.012 }' > "$work/floor.pts"
 awk 'BEGIN { for (k = 0; k < 160; k++) for (i = 0; i < 100; i++) printf "%.2f %d %.2f 0 1 0\n", i * 0.05, (k * 0.05 < 6 ? 0 : -20), k * 0.05 }' > "$work/cliff.pts"
 
-"$footfalld" --listen 127.0.0.1:0 --port-file "$work/port" --no-rpcbind 2> "$work/server.log" &
-server_pid=$!
-for _ in $(seq 100); do [ -s "$work/port" ] && break; sleep 0.05; done
-server=127.0.0.1:$(cat "$work/port")
+start_server "$footfalld"
 
 both() {  # both NAME EXPECTED_EXIT ARGS...: embedded and RPC runs give identical JSON
   local name=$1 want=$2; shift 2
@@ -90,6 +79,5 @@ bad character-content "$work/bad.json: 'feet': expected a non-empty array" --ter
 bad zero-heading "heading must be a non-zero finite vector" --terrain "$hills" --character "$chars/biped.json" --heading 0,0,0 --out "$work/x.json"
 check "bad flags: no output written" [ ! -e "$work/x.json" ]
 
-kill "$server_pid"; wait "$server_pid" 2>/dev/null; server_pid=""
-echo "$passes passed, $failures failed"
-[ "$failures" -eq 0 ]
+stop_server
+finish
