@@ -157,7 +157,7 @@ int RunBench(const BenchFlags& flags) {
   }
   const GridStats& st = info.stats;
   if (st.samples == 0) {
-    std::cerr << who << "the terrain has no samples\n";
+    std::cerr << who << info.name << ": the terrain has no samples\n";
     return 1;
   }
   const double jitter = flags.jitter > 0 ? flags.jitter : 0.25 * st.cell_size;
