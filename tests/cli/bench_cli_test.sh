@@ -57,6 +57,10 @@ printf '0 0 0 0 1 0\n1 2 3\n' > "$work/bad.pts"
 err=$("$footfall" bench --terrain "$work/bad.pts" 2>&1 >/dev/null)
 check "bad terrain: exit 1" [ $? -eq 1 ]
 check "bad terrain: file and line" grep -qF "$work/bad.pts:2: expected 6 numbers" <<< "$err"
+printf '# no samples\n' > "$work/empty.pts"
+err=$("$footfall" bench --terrain "$work/empty.pts" 2>&1 >/dev/null)
+check "empty terrain: exit 1" [ $? -eq 1 ]
+check "empty terrain: message" grep -qF "$work/empty.pts: the terrain has no samples" <<< "$err"
 err=$("$footfall" bench --terrain "$hills" --queries 0 2>&1 >/dev/null)
 check "zero queries refused" [ $? -ne 0 ]
 stop_server
