@@ -22,6 +22,13 @@ constexpr uint32_t kNoIndex = std::numeric_limits<uint32_t>::max();
 // Cells per axis of a block, the coarse level used for queries far from the grid.
 constexpr uint32_t kBlockCells = 8;
 
+// The 26 neighbours of a cell as offsets: faces, then edges, then corners.
+constexpr int kNeighbourOrder[26][3] = {
+    {-1, 0, 0},  {1, 0, 0},   {0, -1, 0}, {0, 1, 0},   {0, 0, -1},   {0, 0, 1},   {-1, -1, 0},
+    {1, -1, 0},  {-1, 1, 0},  {1, 1, 0},  {-1, 0, -1}, {1, 0, -1},   {-1, 0, 1},  {1, 0, 1},
+    {0, -1, -1}, {0, 1, -1},  {0, -1, 1}, {0, 1, 1},   {-1, -1, -1}, {1, -1, -1}, {-1, 1, -1},
+    {1, 1, -1},  {-1, -1, 1}, {1, -1, 1}, {-1, 1, 1},  {1, 1, 1}};
+
 // Total cells for a cell size h over local extents e, saturating in double.
 double CellCount(const double e[3], double h) {
   double total = 1;
@@ -420,12 +427,35 @@ void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
       }
     }
   };
+  // The 26 neighbours, the 6 sharing a face first, then the 12 sharing an edge, then the 8
+  // corners: the nearer classes usually shrink the ball enough to skip most of the others.
+  auto visit_neighbours = [&]() {
+    double g[3][3], box_lo[3][3], box_hi[3][3];
+    bool has[3][3];
+    for (int a = 0; a < 3; ++a) {
+      for (int d = 0; d < 3; ++d) {
+        const int64_t t = ci[a] + d - 1;
+        has[a][d] = t >= 0 && t < n[a];
+        if (!has[a][d]) continue;
+        const double cl = CellLo(static_cast<uint32_t>(t), a);
+        const double ch = CellHi(static_cast<uint32_t>(t), a);
+        g[a][d] = gap2(c[a], cl, ch);
+        box_lo[a][d] = cl - pad, box_hi[a][d] = ch + pad;
+      }
+    }
+    for (const auto& o : kNeighbourOrder) {
+      const int i = o[0] + 1, j = o[1] + 1, k = o[2] + 1;
+      if (!has[0][i] || !has[1][j] || !has[2][k]) continue;
+      if (g[0][i] + g[1][j] + g[2][k] > scanner.limit2()) continue;
+      const double cell_lo[3] = {box_lo[0][i], box_lo[1][j], box_lo[2][k]};
+      const double cell_hi[3] = {box_hi[0][i], box_hi[1][j], box_hi[2][k]};
+      visit_cell(ci[0] + o[0], ci[1] + o[1], ci[2] + o[2], cell_lo, cell_hi);
+    }
+  };
   int64_t done = 0;  // cells within this Chebyshev radius of ci are visited
   int64_t cells = ball_box();
   if (cells > 27) {
-    for (int a = 0; a < 3; ++a)
-      lo[a] = std::max<int64_t>(0, ci[a] - 1), hi[a] = std::min(n[a] - 1, ci[a] + 1);
-    visit_box(0);
+    visit_neighbours();
     done = 1;
     cells = ball_box();
   }
