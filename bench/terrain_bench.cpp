@@ -165,6 +165,19 @@ void BM_GridNextBatch(benchmark::State& state) {
 }
 BENCHMARK(BM_GridNextBatch)->Arg(0)->Arg(1)->UseRealTime();
 
+// A malicious or careless next query: off the terrain's edge, outward, with a tolerance far
+// larger than the terrain, so that no sample is a candidate. Baseline: brute force.
+void BM_GridNextNoCandidate(benchmark::State& state) {
+  const TerrainGrid& g = Grid();
+  const GridStats& st = g.stats();
+  const StepQuery q{{st.bounds_max.x, 0, 0.5 * (st.bounds_min.z + st.bounds_max.z)}, {0.6, 0, 0}};
+  const bool brute = state.range(0) == 1;
+  static const BruteForce oracle(Grid());
+  for (auto _ : state) benchmark::DoNotOptimize(brute ? oracle.Next(q, 1e6) : g.Next(q, 1e6));
+  state.SetLabel(brute ? "brute force" : "grid");
+}
+BENCHMARK(BM_GridNextNoCandidate)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
 // --- baselines: brute force and a k-d tree -------------------------------------------------
 
 void BM_BruteForceSnap(benchmark::State& state) {

@@ -246,6 +246,43 @@ TEST_CASE("TerrainGrid next follows the candidate rules", "[terrain][grid]") {
   }
 }
 
+TEST_CASE("TerrainGrid next with a tolerance as large as the terrain", "[terrain][grid]") {
+  // 200 x 200 samples, 0.1 apart: steps from every edge outward and inward, from inside and
+  // from beyond the bounds, with tolerances from a step to far beyond the terrain.
+  const TerrainGrid g = Build(MakeHeightField(200, 200, 0.1, 0.3, 31));
+  const BruteForce oracle(g);
+  const GridStats& st = g.stats();
+  const Vec3 lo = st.bounds_min, hi = st.bounds_max, mid = (lo + hi) * 0.5;
+  std::vector<StepQuery> steps;
+  for (double along : {-0.5, 0.0, 0.5}) {
+    for (double t : {-1.0, -0.2, 0.0, 0.3, 1.0, 2.0}) {
+      const Vec3 x_edge{hi.x + t, mid.y, mid.z + along * (hi.z - lo.z)};
+      const Vec3 z_edge{mid.x + along * (hi.x - lo.x), mid.y, lo.z - t};
+      for (double sign : {1.0, -1.0}) {
+        steps.push_back({x_edge, {0.6 * sign, 0, 0}});
+        steps.push_back({z_edge, {0, 0.1 * sign, -0.6 * sign}});
+      }
+    }
+  }
+  for (const StepQuery& q : steps) {
+    for (double tolerance : {0.0, 1.0, 10.0, 1e3, 1e6}) {
+      RequireSame(g.Next(q, tolerance), oracle.Next(q, tolerance),
+                  "next from " + Describe(q.foot) + " along " + Describe(q.direction) +
+                      " tolerance " + std::to_string(tolerance));
+    }
+  }
+  // Walking off the +X edge with a huge tolerance: every sample is behind the foot, and only the
+  // cells the foot's plane crosses are scanned. (How long the search takes is measured by
+  // bench/terrain_bench, BM_GridNextNoCandidate.)
+  QueryTrace trace;
+  const Foothold f = g.Next({{hi.x, mid.y, mid.z}, {0.6, 0, 0}}, 1e6, &trace);
+  CHECK(f.status == Status::kNoFoothold);
+  const size_t cells = size_t{st.cells[0]} * st.cells[1] * st.cells[2];
+  INFO("cells scanned " << trace.cells.size() << " of " << cells);
+  CHECK(trace.cells.size() * 10 < cells);
+  CHECK(trace.candidates.empty());
+}
+
 TEST_CASE("TerrainGrid keeps memory bounded", "[terrain][grid]") {
   SECTION("an empty grid answers no foothold") {
     TerrainGrid g;

@@ -473,7 +473,10 @@ void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
 
   // 3. Far from the grid, shells would sweep every cell: visit blocks of cells instead, nearest
   //    first by the tight bounds of their samples, until the next block is farther than the best.
-  if (outside2 > 16 * cell_size_ * cell_size_) {
+  //    Scanners that test boxes (next's candidates) always take this path for large balls: a
+  //    block lying wholly behind the foot is skipped whole, so a large tolerance with no
+  //    candidate costs a pass over the blocks, not over every cell.
+  if (Scanner::kUsesBox || outside2 > 16 * cell_size_ * cell_size_) {
     thread_local std::vector<std::pair<double, uint32_t>> order;
     order.clear();
     const size_t blocks = size_t{block_dims_[0]} * block_dims_[1] * block_dims_[2];
@@ -482,7 +485,13 @@ void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
       if (!(bb[0] <= bb[3])) continue;  // empty
       const double d2 =
           gap2(c[0], bb[0], bb[3]) + gap2(c[1], bb[1], bb[4]) + gap2(c[2], bb[2], bb[5]);
-      if (d2 <= scanner.limit2()) order.emplace_back(d2, static_cast<uint32_t>(b));
+      if (d2 > scanner.limit2()) continue;
+      if (Scanner::kUsesBox) {
+        const double lo[3] = {bb[0] - pad, bb[1] - pad, bb[2] - pad};
+        const double hi[3] = {bb[3] + pad, bb[4] + pad, bb[5] + pad};
+        if (!scanner.KeepCell(lo, hi)) continue;
+      }
+      order.emplace_back(d2, static_cast<uint32_t>(b));
     }
     std::sort(order.begin(), order.end());
     for (const auto& [d2, b] : order) {
