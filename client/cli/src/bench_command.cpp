@@ -323,8 +323,11 @@ int RunBench(const BenchFlags& flags) {
             << " x " << st.cells[2] << " cells of " << st.cell_size << " (" << st.occupied_cells
             << " occupied), " << std::fixed << std::setprecision(1) << bytes_per_sample
             << " bytes per sample\n"
-            << "load (read, build" << (rpc ? ", upload" : "") << "): " << std::setprecision(3)
-            << load_s << " s\n"
+            << "load ("
+            << (!rpc                            ? "read, build"
+                : flags.terrain.terrain.empty() ? "footfalld reads, builds"
+                                                : "read, upload, build")
+            << "): " << std::setprecision(3) << load_s << " s\n"
             << "queries: " << n << " foot-like points (jitter " << std::defaultfloat << jitter
             << "), steps of " << step << '\n';
   for (const Figure& f : figures) {
