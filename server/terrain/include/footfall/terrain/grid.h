@@ -3,7 +3,7 @@
 //
 // The grid covers the samples' bounding box in any orientation (walls, ceilings, spheres, not
 // only height fields). Its cell size is chosen for query speed (a few samples per occupied cell)
-// under a memory cap of about one cell per sample, whatever the bounds. A few far outliers do
+// under a memory cap of 0.95 cells per sample, whatever the bounds. A few far outliers do
 // not stretch it: the grid then covers the bulk of the samples, and its border cells take the
 // outliers (border cells extend to the true bounds). Queries are exact: they return what a
 // brute-force scan over all samples returns (see brute_force.h), ties going to the lowest index.
@@ -65,8 +65,9 @@ struct GridStats {
 struct GridOptions {
   // Target mean samples per occupied cell. [Limit: > 0]
   double samples_per_cell = 8;
-  // Memory cap: total cells <= max(64, cells_per_sample * samples). [Limit: > 0]
-  double cells_per_sample = 1.0;
+  // Memory cap: total cells <= max(64, cells_per_sample * samples). [Limit: > 0] The default
+  // keeps a grid within 32 bytes per sample: 28 for the sample and its normal, 4 per cell.
+  double cells_per_sample = 0.95;
 };
 
 class TerrainGrid {
