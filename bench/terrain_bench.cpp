@@ -139,7 +139,7 @@ void BM_GridSnapBatch(benchmark::State& state) {
   std::vector<Foothold> out(4096);
   size_t offset = 0;
   for (auto _ : state) {
-    g.SnapBatch(&q[offset], out.size(), out.data(), 1);
+    g.SnapBatch(&q[offset], out.size(), out.data());
     benchmark::DoNotOptimize(out.data());
     offset = (offset + out.size()) % (kQueries - out.size());
   }
@@ -156,7 +156,7 @@ void BM_GridNextBatch(benchmark::State& state) {
   std::vector<Foothold> out(4096);
   size_t offset = 0;
   for (auto _ : state) {
-    g.NextBatch(&q[offset], out.size(), 0, out.data(), 1);
+    g.NextBatch(&q[offset], out.size(), 0, out.data());
     benchmark::DoNotOptimize(out.data());
     offset = (offset + out.size()) % (kQueries - out.size());
   }

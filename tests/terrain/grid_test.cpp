@@ -10,6 +10,7 @@
 #include <catch2/catch.hpp>
 
 #include "footfall/import/terrain_generators.h"
+#include "footfall/terrain/batch_pool.h"
 #include "footfall/terrain/brute_force.h"
 #include "footfall/terrain/grid.h"
 
@@ -129,8 +130,9 @@ void CheckAgainstBruteForce(const TerrainGrid& g, int count, uint64_t seed) {
   });
   for (const std::vector<Vec3>* batch : {&points, static_cast<const std::vector<Vec3>*>(&sorted)}) {
     for (int threads : {1, 2}) {
+      BatchPool pool(threads);
       std::vector<Foothold> answers(batch->size());
-      g.SnapBatch(batch->data(), batch->size(), answers.data(), threads);
+      g.SnapBatch(batch->data(), batch->size(), answers.data(), threads > 1 ? &pool : nullptr);
       for (size_t i = 0; i < batch->size(); ++i)
         RequireSame(answers[i], oracle.Snap((*batch)[i]), "batch snap at " + Describe((*batch)[i]));
     }

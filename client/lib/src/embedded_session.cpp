@@ -52,7 +52,7 @@ class EmbeddedSession final : public TerrainSession {
   Status Snap(TerrainHandle terrain, const Vec3* points, size_t count, Foothold* out) override {
     const Entry* e = Find(terrain);
     if (!e) return Unknown(terrain);
-    Share(count, [&](size_t b, size_t end) { e->grid.SnapBatch(points + b, end - b, out + b); });
+    e->grid.SnapBatch(points, count, out, pool_.get());
     return Status::kOk;
   }
 
@@ -65,25 +65,13 @@ class EmbeddedSession final : public TerrainSession {
     const Entry* e = Find(terrain);
     if (!e) return Unknown(terrain);
     if (!std::isfinite(tolerance)) return Fail(Status::kInvalidArgument, "tolerance is not finite");
-    Share(count, [&](size_t b, size_t end) {
-      e->grid.NextBatch(queries + b, end - b, tolerance, out + b);
-    });
+    e->grid.NextBatch(queries, count, tolerance, out, pool_.get());
     return Status::kOk;
   }
 
   std::string Describe() const override { return "embedded"; }
 
  private:
-  // Runs fn(begin, end) over [0, count), on the pool's threads when there is one.
-  template <typename Fn>
-  void Share(size_t count, Fn&& fn) {
-    constexpr size_t kChunk = 128;  // queries a thread takes at a time
-    if (pool_)
-      pool_->Run(count, kChunk, fn);
-    else
-      fn(0, count);
-  }
-
   struct Entry {
     std::string name;
     TerrainGrid grid;

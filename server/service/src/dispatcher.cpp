@@ -30,8 +30,6 @@ static_assert(static_cast<int>(Status::kInternalError) == FF_INTERNAL_ERROR, "")
 
 // Batches: how many queries of each batch go to the recent-query ring.
 constexpr size_t kRecordPerBatch = 16;
-// Batches: queries per chunk that the batch threads take in turn (about 50 us of snaps).
-constexpr size_t kBatchChunk = 128;
 
 ServiceState* g_state = nullptr;
 std::unique_ptr<BatchPool> g_pool;
@@ -226,7 +224,7 @@ void ClearFailed(Foothold* f) {
 template <typename Fn>
 void RunBatch(size_t n, BatchReplyView<Foothold>* r, Fn&& answer) {
   Foothold* answers = g_storage.answers.data();
-  g_pool->Run(n, kBatchChunk, [&](size_t b, size_t e) {
+  g_pool->Run(n, BatchPool::kQueryChunk, [&](size_t b, size_t e) {
     answer(b, e, answers);
     for (size_t i = b; i < e; ++i) ClearFailed(&answers[i]);
   });
@@ -244,7 +242,7 @@ void PointBatch(const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r, int 
   const size_t n = a.count;
   const Vec3* points = a.points;
   RunBatch(n, r, [&](size_t b, size_t e, Foothold* out) {
-    t->grid.SnapBatch(points + b, e - b, out + b, 1);
+    t->grid.SnapBatch(points + b, e - b, out + b);
   });
   for (size_t i = 0; i < n && i < kRecordPerBatch; ++i)
     Record(a.terrain, op, points[i], Vec3{}, 0, r->results[i]);
@@ -264,7 +262,7 @@ void NextBatch(const NextBatchView<StepQuery>& a, BatchReplyView<Foothold>* r) {
   const StepQuery* steps = a.queries;
   const double tolerance = a.tolerance;
   RunBatch(n, r, [&](size_t b, size_t e, Foothold* out) {
-    t->grid.NextBatch(steps + b, e - b, tolerance, out + b, 1);
+    t->grid.NextBatch(steps + b, e - b, tolerance, out + b);
   });
   for (size_t i = 0; i < n && i < kRecordPerBatch; ++i)
     Record(a.terrain, FF_OP_NEXT, steps[i].foot, steps[i].direction, tolerance, r->results[i]);

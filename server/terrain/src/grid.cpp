@@ -6,12 +6,12 @@
 #include <cstring>
 #include <limits>
 #include <new>
-#include <thread>
 
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
 
+#include "footfall/terrain/batch_pool.h"
 #include "query_math.h"
 
 namespace footfall {
@@ -706,34 +706,26 @@ Foothold TerrainGrid::Next(const StepQuery& q, double tolerance, QueryTrace* tra
   return best_slot == kNoIndex ? none : MakeFoothold(best_slot);
 }
 
-namespace {
-template <typename Fn>
-void ParallelFor(size_t count, int threads, Fn&& fn) {
-  const size_t t = static_cast<size_t>(std::max(1, threads));
-  if (t == 1 || count < 2 * t) {
-    fn(0, count);
-    return;
-  }
-  std::vector<std::thread> pool;
-  const size_t chunk = (count + t - 1) / t;
-  for (size_t b = chunk; b < count; b += chunk)
-    pool.emplace_back(fn, b, std::min(count, b + chunk));
-  fn(0, std::min(count, chunk));
-  for (auto& th : pool) th.join();
-}
-}  // namespace
-
-void TerrainGrid::SnapBatch(const Vec3* queries, size_t count, Foothold* out, int threads) const {
-  ParallelFor(count, threads, [&](size_t b, size_t e) {
+void TerrainGrid::SnapBatch(const Vec3* queries, size_t count, Foothold* out,
+                            BatchPool* pool) const {
+  auto answer = [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) out[i] = Snap(queries[i]);
-  });
+  };
+  if (pool)
+    pool->Run(count, BatchPool::kQueryChunk, answer);
+  else
+    answer(0, count);
 }
 
 void TerrainGrid::NextBatch(const StepQuery* queries, size_t count, double tolerance, Foothold* out,
-                            int threads) const {
-  ParallelFor(count, threads, [&](size_t b, size_t e) {
+                            BatchPool* pool) const {
+  auto answer = [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) out[i] = Next(queries[i], tolerance);
-  });
+  };
+  if (pool)
+    pool->Run(count, BatchPool::kQueryChunk, answer);
+  else
+    answer(0, count);
 }
 
 void TerrainGrid::CellBox(uint32_t cell, Vec3* lo, Vec3* hi) const {

@@ -26,6 +26,9 @@ class BatchPool {
   // `threads` counts the caller: threads - 1 workers are started (none for 1 or less).
   // [Units: us] `caller_spin_us`: how long Run polls for the workers' last chunks before it
   // sleeps.
+  // Queries per chunk for batches of terrain queries (about 50 us of snaps).
+  static constexpr size_t kQueryChunk = 128;
+
   explicit BatchPool(int threads, int caller_spin_us = 100);
   ~BatchPool();
   BatchPool(const BatchPool&) = delete;

@@ -28,6 +28,8 @@
 
 namespace footfall {
 
+class BatchPool;
+
 // The answer to one query. On kOk, index/point/normal describe the chosen sample; on
 // kNoFoothold or an error status they are zero.
 struct Foothold {
@@ -119,10 +121,11 @@ class TerrainGrid {
   // kInvalidArgument for a zero or non-finite direction, non-finite foot or tolerance.
   Foothold Next(const StepQuery& q, double tolerance, QueryTrace* trace = nullptr) const;
 
-  // Batch forms: out[i] answers queries[i]. Thread-safe; `threads` > 1 splits the batch.
-  void SnapBatch(const Vec3* queries, size_t count, Foothold* out, int threads = 1) const;
+  // Batch forms: out[i] answers queries[i]. Thread-safe. With a pool, the batch is shared with
+  // its threads, BatchPool::kQueryChunk queries at a time; without, it runs on the caller.
+  void SnapBatch(const Vec3* queries, size_t count, Foothold* out, BatchPool* pool = nullptr) const;
   void NextBatch(const StepQuery* queries, size_t count, double tolerance, Foothold* out,
-                 int threads = 1) const;
+                 BatchPool* pool = nullptr) const;
 
   // Grid-cell geometry, for the viewer: the world-space box of linear cell `cell`, and the
   // linear indices of cells holding samples.
