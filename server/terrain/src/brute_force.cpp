@@ -15,12 +15,18 @@ Foothold BruteForce::Snap(const Vec3& q) const {
   none.status = Status::kNoFoothold;
   double best_d2 = std::numeric_limits<double>::infinity();
   uint32_t best_index = std::numeric_limits<uint32_t>::max(), best_slot = best_index;
-  for (uint32_t s = 0; s < g.count_; ++s) {
-    const double d2 = detail::Dist2(g.samples_[s].p, c);
-    if (detail::Better(d2, g.samples_[s].index, best_d2, best_index))
-      best_d2 = d2, best_index = g.samples_[s].index, best_slot = s;
+  uint32_t best_cell = 0;
+  for (uint32_t cell = 0; g.count_ > 0 && cell < g.cells_; ++cell) {
+    for (uint32_t s = g.cell_start_[cell]; s < g.cell_start_[cell + 1]; ++s) {
+      float p[3];
+      g.LocalPoint(cell, s, p);
+      const double d2 = detail::Dist2(p, c);
+      if (detail::Better(d2, g.answers_[s].index, best_d2, best_index))
+        best_d2 = d2, best_index = g.answers_[s].index, best_cell = cell, best_slot = s;
+    }
   }
-  return best_slot == std::numeric_limits<uint32_t>::max() ? none : g.MakeFoothold(best_slot);
+  return best_slot == std::numeric_limits<uint32_t>::max() ? none
+                                                            : g.MakeFoothold(best_cell, best_slot);
 }
 
 Foothold BruteForce::Next(const StepQuery& q, double tolerance) const {
@@ -31,14 +37,19 @@ Foothold BruteForce::Next(const StepQuery& q, double tolerance) const {
   none.status = Status::kNoFoothold;
   double best_d2 = f.radius2;
   uint32_t best_index = std::numeric_limits<uint32_t>::max(), best_slot = best_index;
-  for (uint32_t s = 0; s < g.count_; ++s) {
-    const float* p = g.samples_[s].p;
-    const double d2 = detail::Dist2(p, f.ideal);
-    if (d2 > f.radius2 || !detail::Ahead(p, f)) continue;
-    if (detail::Better(d2, g.samples_[s].index, best_d2, best_index))
-      best_d2 = d2, best_index = g.samples_[s].index, best_slot = s;
+  uint32_t best_cell = 0;
+  for (uint32_t cell = 0; g.count_ > 0 && cell < g.cells_; ++cell) {
+    for (uint32_t s = g.cell_start_[cell]; s < g.cell_start_[cell + 1]; ++s) {
+      float p[3];
+      g.LocalPoint(cell, s, p);
+      const double d2 = detail::Dist2(p, f.ideal);
+      if (d2 > f.radius2 || !detail::Ahead(p, f)) continue;
+      if (detail::Better(d2, g.answers_[s].index, best_d2, best_index))
+        best_d2 = d2, best_index = g.answers_[s].index, best_cell = cell, best_slot = s;
+    }
   }
-  return best_slot == std::numeric_limits<uint32_t>::max() ? none : g.MakeFoothold(best_slot);
+  return best_slot == std::numeric_limits<uint32_t>::max() ? none
+                                                            : g.MakeFoothold(best_cell, best_slot);
 }
 
 }  // namespace footfall

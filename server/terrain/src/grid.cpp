@@ -11,6 +11,7 @@
 #include <sys/mman.h>
 #endif
 
+#include "cell_scan.h"
 #include "footfall/terrain/batch_pool.h"
 #include "query_math.h"
 
@@ -207,7 +208,13 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
   }
   g.cell_size_ = h, g.inv_cell_size_ = 1 / h;
   for (int a = 0; a < 3; ++a) g.dims_[a] = AxisCells(extent[a], h);
+  for (int a = 0; a < 3; ++a) g.last_cell_[a] = g.dims_[a] - 1.0;
   const size_t cells = size_t{g.dims_[0]} * g.dims_[1] * g.dims_[2];
+  g.cells_ = cells;
+  // Cell boxes are padded so that rounding can never prune a sample: in cell assignment
+  // (relative to the grid's extent) and in distances (relative to the query's, added per query).
+  g.pad_ = 1e-9 * (h + (g.bounds_hi_[0] - g.bounds_lo_[0]) + (g.bounds_hi_[1] - g.bounds_lo_[1]) +
+                   (g.bounds_hi_[2] - g.bounds_lo_[2]));
 
   // 5. Counting sort of samples by cell, stable in source index (so ties scan in index order).
   std::vector<uint32_t> cell_of(n);
@@ -219,13 +226,15 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
   }
   for (int a = 0; a < 3; ++a) g.block_dims_[a] = (g.dims_[a] + kBlockCells - 1) / kBlockCells;
   const size_t blocks = size_t{g.block_dims_[0]} * g.block_dims_[1] * g.block_dims_[2];
-  const size_t bytes = n * sizeof(PackedSample) + n * 3 * sizeof(float) +
-                       (cells + 1) * sizeof(uint32_t) + blocks * 6 * sizeof(float);
+  // Positions end with 4 spare floats: a cell scan loads 4 samples at a time.
+  const size_t position_floats = 3 * n + 4;
+  const size_t bytes = n * sizeof(SampleAnswer) + (cells + 1) * sizeof(uint32_t) +
+                       blocks * 6 * sizeof(float) + position_floats * sizeof(float);
   g.memory_.reset(AllocateGridMemory(bytes));
-  PackedSample* packed = reinterpret_cast<PackedSample*>(g.memory_.get());
-  float* normals = reinterpret_cast<float*>(packed + n);
-  uint32_t* cell_start = reinterpret_cast<uint32_t*>(normals + 3 * n);
+  SampleAnswer* answers = reinterpret_cast<SampleAnswer*>(g.memory_.get());
+  uint32_t* cell_start = reinterpret_cast<uint32_t*>(answers + n);
   float* block_bounds = reinterpret_cast<float*>(cell_start + cells + 1);
+  float* positions = block_bounds + blocks * 6;
   std::fill(cell_start, cell_start + cells + 1, 0u);
   for (size_t i = 0; i < n; ++i) ++cell_start[cell_of[i] + 1];
   for (size_t c = 0; c < cells; ++c) cell_start[c + 1] += cell_start[c];
@@ -234,19 +243,23 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
   {
     std::vector<uint32_t> cursor(cell_start, cell_start + cells);
     for (size_t i = 0; i < n; ++i) {
-      const uint32_t slot = cursor[cell_of[i]]++;
-      std::memcpy(packed[slot].p, &local[3 * i], 3 * sizeof(float));
+      const uint32_t cell = cell_of[i];
+      const uint32_t first = cell_start[cell], count = cell_start[cell + 1] - first;
+      const uint32_t slot = cursor[cell]++;
+      float* x = positions + 3 * size_t{first} + (slot - first);
+      x[0] = local[3 * i], x[count] = local[3 * i + 1], x[2 * size_t{count}] = local[3 * i + 2];
       const Vec3& nv = samples.normals[i];
       const double len = Length(nv);
       const double inv = len > 0 ? 1 / len : 0;
-      normals[3 * slot + 0] = static_cast<float>(nv.x * inv);
-      normals[3 * slot + 1] = static_cast<float>(nv.y * inv);
-      normals[3 * slot + 2] = static_cast<float>(nv.z * inv);
-      packed[slot].index = static_cast<uint32_t>(i);
+      answers[slot].normal[0] = static_cast<float>(nv.x * inv);
+      answers[slot].normal[1] = static_cast<float>(nv.y * inv);
+      answers[slot].normal[2] = static_cast<float>(nv.z * inv);
+      answers[slot].index = static_cast<uint32_t>(i);
     }
+    std::fill(positions + 3 * n, positions + position_floats, 0.0f);
   }
-  g.samples_ = packed;
-  g.normals_ = normals;
+  g.positions_ = positions;
+  g.answers_ = answers;
   g.cell_start_ = cell_start;
   // 6. Tight bounds of the samples of each block of cells, for queries far from the grid.
   for (size_t b = 0; b < blocks; ++b) {
@@ -306,12 +319,9 @@ double TerrainGrid::CellHi(uint32_t i, int axis) const {
 template <typename Scanner>
 void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
   if (count_ == 0) return;
-  // Cell boxes are padded so that rounding in cell assignment can never prune a sample.
-  // The pad covers rounding in cell assignment (relative to the grid's extent) and in the
-  // distance arithmetic (relative to the query's distance, ~1e-15 of it).
-  const double pad = 1e-9 * (cell_size_ + (bounds_hi_[0] - bounds_lo_[0]) +
-                             (bounds_hi_[1] - bounds_lo_[1]) + (bounds_hi_[2] - bounds_lo_[2])) +
-                     1e-13 * (std::fabs(c[0]) + std::fabs(c[1]) + std::fabs(c[2]));
+  // The cell-box pad (see Build), plus rounding in the distance arithmetic (~1e-15 of the
+  // query's distance).
+  const double pad = pad_ + 1e-13 * (std::fabs(c[0]) + std::fabs(c[1]) + std::fabs(c[2]));
   auto gap2 = [pad](double v, double lo, double hi) {
     const double d = v < lo - pad ? lo - pad - v : v > hi + pad ? v - hi - pad : 0.0;
     return d * d;
@@ -576,45 +586,42 @@ void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
   }
 }
 
-namespace {
-
 // Scanners come in a traced and an untraced flavour, so the untraced scan loop has no test.
 template <bool kTraced>
-struct SnapScanner {
-  const TerrainGrid::PackedSample* samples;
-  const float* normals;
+struct TerrainGrid::SnapScanner {
+  const TerrainGrid& grid;
   const double* q;
   QueryTrace* trace;
   double best_d2 = kInf;
-  uint32_t best_index = kNoIndex;
+  uint32_t best_cell = kNoIndex;
   uint32_t best_slot = kNoIndex;
 
   static constexpr bool kUsesBox = false;
   double limit2() const { return best_d2; }
   bool KeepCell(const double*, const double*) const { return true; }
   void Scan(uint32_t cell, uint32_t b, uint32_t e) {
-    if (kTraced) trace->cells.push_back(cell);
-    const uint32_t before = best_slot;
-    for (uint32_t s = b; s < e; ++s) {
-      const double d2 = detail::Dist2(samples[s].p, q);
-      if (kTraced) trace->examined_samples.push_back(samples[s].index);
-      if (d2 <= best_d2 && detail::Better(d2, samples[s].index, best_d2, best_index)) {
-        best_d2 = d2, best_index = samples[s].index, best_slot = s;
-      }
+    if (kTraced) {
+      trace->cells.push_back(cell);
+      for (uint32_t s = b; s < e; ++s) trace->examined_samples.push_back(grid.answers_[s].index);
     }
-    // The answer carries its sample's normal, stored apart: start loading it while the search
-    // goes on (usually the first cell's best is the answer).
-    if (best_slot != before) __builtin_prefetch(&normals[3 * best_slot]);
+    const uint32_t before = best_slot;
+    detail::ScanCellNearest(
+        grid.positions_ + 3 * size_t{b}, b, e - b, q,
+        [this](uint32_t s) { return grid.answers_[s].index; }, &best_d2, &best_slot);
+    // The answer's normal and index are stored apart: start loading them while the search goes
+    // on (usually the first cell's best is the answer).
+    if (best_slot != before) best_cell = cell, __builtin_prefetch(&grid.answers_[best_slot]);
   }
 };
 
 template <bool kTraced>
-struct NextScanner {
-  const TerrainGrid::PackedSample* samples;
+struct TerrainGrid::NextScanner {
+  const TerrainGrid& grid;
   const detail::NextFrame* f;
   QueryTrace* trace;
   double best_d2;
   uint32_t best_index = kNoIndex;
+  uint32_t best_cell = kNoIndex;
   uint32_t best_slot = kNoIndex;
 
   static constexpr bool kUsesBox = true;
@@ -630,30 +637,98 @@ struct NextScanner {
   }
   void Scan(uint32_t cell, uint32_t b, uint32_t e) {
     if (kTraced) trace->cells.push_back(cell);
-    for (uint32_t s = b; s < e; ++s) {
-      const float* p = samples[s].p;
+    const float* x = grid.positions_ + 3 * size_t{b};
+    const uint32_t count = e - b;
+    for (uint32_t i = 0; i < count; ++i) {
+      const float p[3] = {x[i], x[count + i], x[2 * size_t{count} + i]};
+      const uint32_t index = grid.answers_[b + i].index;
       const double d2 = detail::Dist2(p, f->ideal);
-      if (kTraced) trace->examined_samples.push_back(samples[s].index);
+      if (kTraced) trace->examined_samples.push_back(index);
       if (d2 > f->radius2 || !detail::Ahead(p, *f)) continue;
-      if (kTraced) trace->candidates.push_back(samples[s].index);
-      if (detail::Better(d2, samples[s].index, best_d2, best_index)) {
-        best_d2 = d2, best_index = samples[s].index, best_slot = s;
-      }
+      if (kTraced) trace->candidates.push_back(index);
+      if (detail::Better(d2, index, best_d2, best_index))
+        best_d2 = d2, best_index = index, best_cell = cell, best_slot = b + i;
     }
   }
 };
 
-}  // namespace
-
-Foothold TerrainGrid::MakeFoothold(uint32_t slot) const {
+Foothold TerrainGrid::MakeFoothold(uint32_t cell, uint32_t slot) const {
   Foothold f;
   f.status = Status::kOk;
-  f.index = samples_[slot].index;
-  const float* p = samples_[slot].p;
-  const float* nv = &normals_[3 * slot];
+  f.index = answers_[slot].index;
+  float p[3];
+  LocalPoint(cell, slot, p);
+  const float* nv = answers_[slot].normal;
   f.point = {origin_[0] + p[0], origin_[1] + p[1], origin_[2] + p[2]};
   f.normal = {nv[0], nv[1], nv[2]};
   return f;
+}
+
+// Compiled for AVX2 as well where the compiler can, chosen at load time: the cell scans then
+// take four samples per instruction.
+#if defined(__x86_64__) && defined(__GNUC__) && defined(__has_attribute)
+#if __has_attribute(target_clones)
+__attribute__((target_clones("avx2", "default")))
+#endif
+#endif
+bool TerrainGrid::NearestNearby(const double c[3], uint32_t* cell_out, uint32_t* slot_out) const {
+  if (count_ == 0) return false;
+  int64_t ci[3];
+  for (int a = 0; a < 3; ++a) {
+    double t = (c[a] - grid_lo_[a]) * inv_cell_size_;
+    t = t > 0 ? t : 0;
+    t = t < last_cell_[a] ? t : last_cell_[a];
+    ci[a] = static_cast<int64_t>(t);
+  }
+  const int64_t stride[3] = {1, dims_[0], int64_t{dims_[0]} * dims_[1]};
+  const int64_t cell = ci[0] + ci[1] * stride[1] + ci[2] * stride[2];
+  double best = kInf;
+  uint32_t best_slot = kNoIndex;
+  int64_t best_cell = cell;
+  auto index_of = [this](uint32_t s) { return answers_[s].index; };
+  auto scan = [&](int64_t at) {
+    const uint32_t b = cell_start_[at], e = cell_start_[at + 1];
+    const uint32_t before = best_slot;
+    detail::ScanCellNearest(positions_ + 3 * size_t{b}, b, e - b, c, index_of, &best, &best_slot);
+    if (best_slot != before) best_cell = at, __builtin_prefetch(&answers_[best_slot]);
+  };
+  scan(cell);
+  if (best_slot == kNoIndex || !(best < kInf)) return false;
+  // Per axis, the squared gaps to the lower and upper neighbours the ball reaches (padded as in
+  // Search). A ball reaching two cells away is left to Search.
+  const double pad = pad_ + 1e-13 * (std::fabs(c[0]) + std::fabs(c[1]) + std::fabs(c[2]));
+  double gap[3][2];
+  int64_t step[3][2];
+  int sides[3];
+  for (int a = 0; a < 3; ++a) {
+    const double face = grid_lo_[a] + static_cast<double>(ci[a]) * cell_size_;
+    const double dlo = c[a] - face - pad, dhi = face + cell_size_ - c[a] - pad;
+    const double far_lo = dlo + cell_size_, far_hi = dhi + cell_size_;
+    if (ci[a] >= 2 && (far_lo <= 0 || far_lo * far_lo <= best)) return false;
+    if (ci[a] + 2 < dims_[a] && (far_hi <= 0 || far_hi * far_hi <= best)) return false;
+    sides[a] = 0;
+    const double glo = dlo > 0 ? dlo * dlo : 0, ghi = dhi > 0 ? dhi * dhi : 0;
+    if (ci[a] >= 1 && glo <= best) gap[a][sides[a]] = glo, step[a][sides[a]++] = -stride[a];
+    if (ci[a] + 1 < dims_[a] && ghi <= best) gap[a][sides[a]] = ghi, step[a][sides[a]++] = stride[a];
+  }
+  // Faces, then edges, then corners: the nearer neighbours usually shrink the ball first.
+  for (int a = 0; a < 3; ++a)
+    for (int s = 0; s < sides[a]; ++s)
+      if (gap[a][s] <= best) scan(cell + step[a][s]);
+  for (int a = 0; a < 3; ++a) {
+    const int b = a == 2 ? 0 : a + 1;
+    for (int s = 0; s < sides[a]; ++s)
+      for (int t = 0; t < sides[b]; ++t)
+        if (gap[a][s] + gap[b][t] <= best) scan(cell + step[a][s] + step[b][t]);
+  }
+  for (int s = 0; s < sides[0]; ++s)
+    for (int t = 0; t < sides[1]; ++t)
+      for (int u = 0; u < sides[2]; ++u)
+        if (gap[0][s] + gap[1][t] + gap[2][u] <= best)
+          scan(cell + step[0][s] + step[1][t] + step[2][u]);
+  *cell_out = static_cast<uint32_t>(best_cell);
+  *slot_out = best_slot;
+  return true;
 }
 
 Foothold TerrainGrid::Snap(const Vec3& q, QueryTrace* trace) const {
@@ -662,18 +737,18 @@ Foothold TerrainGrid::Snap(const Vec3& q, QueryTrace* trace) const {
   const double c[3] = {q.x - origin_[0], q.y - origin_[1], q.z - origin_[2]};
   if (!detail::InQueryRange(c)) return none;
   none.status = Status::kNoFoothold;
-  if (trace) *trace = QueryTrace{}, trace->ideal = q;
-  uint32_t best_slot;
+  uint32_t cell = kNoIndex, slot = kNoIndex;
   if (trace) {
-    SnapScanner<true> s{samples_, normals_, c, trace};
+    *trace = QueryTrace{}, trace->ideal = q;
+    SnapScanner<true> s{*this, c, trace};
     Search(c, s);
-    best_slot = s.best_slot;
-  } else {
-    SnapScanner<false> s{samples_, normals_, c, nullptr};
+    cell = s.best_cell, slot = s.best_slot;
+  } else if (!NearestNearby(c, &cell, &slot)) {
+    SnapScanner<false> s{*this, c, nullptr};
     Search(c, s);
-    best_slot = s.best_slot;
+    cell = s.best_cell, slot = s.best_slot;
   }
-  return best_slot == kNoIndex ? none : MakeFoothold(best_slot);
+  return slot == kNoIndex ? none : MakeFoothold(cell, slot);
 }
 
 Foothold TerrainGrid::Next(const StepQuery& q, double tolerance, QueryTrace* trace) const {
@@ -681,29 +756,33 @@ Foothold TerrainGrid::Next(const StepQuery& q, double tolerance, QueryTrace* tra
   detail::NextFrame f;
   if (!detail::MakeNextFrame(origin_, q, tolerance, &f)) return none;
   none.status = Status::kNoFoothold;
+  uint32_t cell = kNoIndex, slot = kNoIndex;
   if (trace) {
     *trace = QueryTrace{};
     trace->ideal = q.foot + q.direction;
     trace->radius = std::sqrt(f.radius2);
-  }
-  uint32_t best_slot;
-  if (trace) {
-    NextScanner<true> s{samples_, &f, trace, f.radius2};
+    NextScanner<true> s{*this, &f, trace, f.radius2};
     Search(f.ideal, s);
-    best_slot = s.best_slot;
+    cell = s.best_cell, slot = s.best_slot;
   } else {
     // The sample nearest the ideal point, if it is a candidate, is the nearest candidate (same
     // distances, same tie order); if it is beyond the radius, no sample is a candidate. Only
     // when it lies behind the foot does the candidate search run.
-    SnapScanner<false> nearest{samples_, normals_, f.ideal, nullptr};
-    Search(f.ideal, nearest);
-    if (nearest.best_slot == kNoIndex || nearest.best_d2 > f.radius2) return none;
-    if (detail::Ahead(samples_[nearest.best_slot].p, f)) return MakeFoothold(nearest.best_slot);
-    NextScanner<false> s{samples_, &f, nullptr, f.radius2};
+    if (!NearestNearby(f.ideal, &cell, &slot)) {
+      SnapScanner<false> s{*this, f.ideal, nullptr};
+      Search(f.ideal, s);
+      cell = s.best_cell, slot = s.best_slot;
+    }
+    if (slot == kNoIndex) return none;
+    float p[3];
+    LocalPoint(cell, slot, p);
+    if (detail::Dist2(p, f.ideal) > f.radius2) return none;
+    if (detail::Ahead(p, f)) return MakeFoothold(cell, slot);
+    NextScanner<false> s{*this, &f, nullptr, f.radius2};
     Search(f.ideal, s);
-    best_slot = s.best_slot;
+    cell = s.best_cell, slot = s.best_slot;
   }
-  return best_slot == kNoIndex ? none : MakeFoothold(best_slot);
+  return slot == kNoIndex ? none : MakeFoothold(cell, slot);
 }
 
 void TerrainGrid::SnapBatch(const Vec3* queries, size_t count, Foothold* out,

@@ -12,8 +12,10 @@
 // samples): a stored sample differs from its input by at most ~6e-8 of its distance to that
 // origin. ForEachSample() yields the stored values; every answer uses them.
 //
-// The grid is immutable, move-only, and lives in one allocation of parallel arrays:
-// positions with sample indices, normals, and cell offsets. Queries are const and thread-safe.
+// The grid is immutable, move-only, and lives in one allocation of parallel arrays: positions
+// (each cell's samples as a run of x, then y, then z, so one cell is one contiguous span that a
+// query scans several samples at a time), each sample's normal with its source index (read only
+// for the answer), and cell offsets. Queries are const and thread-safe.
 #pragma once
 
 #include <cstddef>
@@ -74,13 +76,6 @@ struct GridOptions {
 
 class TerrainGrid {
  public:
-  // Storage of one sample: its position relative to the grid origin and its source index,
-  // side by side so a scan reads both from one cache line.
-  struct PackedSample {
-    float p[3];
-    uint32_t index;
-  };
-
   TerrainGrid();
   ~TerrainGrid();
   TerrainGrid(TerrainGrid&&) noexcept;
@@ -101,9 +96,11 @@ class TerrainGrid {
   // Every stored sample, in storage order: fn(index, world point, unit normal).
   template <typename Fn>
   void ForEachSample(Fn&& fn) const {
-    for (size_t slot = 0; slot < count_; ++slot) {
-      const Foothold f = MakeFoothold(static_cast<uint32_t>(slot));
-      fn(f.index, f.point, f.normal);
+    for (uint32_t cell = 0; count_ > 0 && cell < cells_; ++cell) {
+      for (uint32_t slot = cell_start_[cell]; slot < cell_start_[cell + 1]; ++slot) {
+        const Foothold f = MakeFoothold(cell, slot);
+        fn(f.index, f.point, f.normal);
+      }
     }
   }
 
@@ -134,6 +131,27 @@ class TerrainGrid {
 
  private:
   friend class BruteForce;
+  // What a query reads of a sample only once it is the answer.
+  struct SampleAnswer {
+    float normal[3];  // unit
+    uint32_t index;   // 0-based order of the sample in its source
+  };
+  // The local position of a stored sample: slot `slot` of cell `cell`.
+  void LocalPoint(uint32_t cell, uint32_t slot, float p[3]) const {
+    const uint32_t first = cell_start_[cell], count = cell_start_[cell + 1] - first;
+    const float* x = positions_ + 3 * size_t{first} + (slot - first);
+    p[0] = x[0], p[1] = x[count], p[2] = x[2 * size_t{count}];
+  }
+  // The common case of a nearest-sample search, in few instructions: the query's own cell holds
+  // samples and the ball of the nearest of them reaches at most its direct neighbours. Then sets
+  // *cell and *slot to the nearest sample and returns true; otherwise returns false, and Search
+  // must answer.
+  bool NearestNearby(const double c[3], uint32_t* cell, uint32_t* slot) const;
+  // Search's visitors for nearest-sample and candidate scans (grid.cpp).
+  template <bool kTraced>
+  struct SnapScanner;
+  template <bool kTraced>
+  struct NextScanner;
   // Visits cells in shells of growing Chebyshev radius around the local point `center`, skipping
   // cells farther than scanner.limit2() or rejected by scanner.KeepCell(lo, hi); stops when no
   // unvisited cell can hold a sample within scanner.limit2(). Calls scanner.Scan(cell, b, e).
@@ -142,7 +160,7 @@ class TerrainGrid {
   uint32_t CellCoord(double local, int axis) const;
   double CellLo(uint32_t i, int axis) const;
   double CellHi(uint32_t i, int axis) const;
-  Foothold MakeFoothold(uint32_t slot) const;
+  Foothold MakeFoothold(uint32_t cell, uint32_t slot) const;
 
   size_t count_ = 0;
   GridStats stats_;
@@ -151,14 +169,17 @@ class TerrainGrid {
   double bounds_lo_[3] = {0, 0, 0};  // local bounds of all samples
   double bounds_hi_[3] = {0, 0, 0};
   double cell_size_ = 1, inv_cell_size_ = 1;
+  double pad_ = 0;                   // the query-independent part of the cell-box pad
   uint32_t dims_[3] = {1, 1, 1};
+  double last_cell_[3] = {0, 0, 0};  // dims_ - 1, as doubles
+  size_t cells_ = 0;                 // dims_[0] * dims_[1] * dims_[2]
   struct FreeMemory {
     void operator()(unsigned char* p) const;
   };
   std::unique_ptr<unsigned char[], FreeMemory> memory_;
   // Views into memory_, in cell order:
-  const PackedSample* samples_ = nullptr;  // local position and source index per slot
-  const float* normals_ = nullptr;         // 3 floats per slot, unit
+  const float* positions_ = nullptr;       // per cell from 3 * its first slot: x..., y..., z...
+  const SampleAnswer* answers_ = nullptr;  // per slot
   const uint32_t* cell_start_ = nullptr;   // cells + 1 offsets into the slots
   const float* block_bounds_ = nullptr;    // per block of 8^3 cells: local min xyz, max xyz
   uint32_t block_dims_[3] = {1, 1, 1};
