@@ -26,7 +26,7 @@ Foothold BruteForce::Snap(const Vec3& q) const {
     }
   }
   return best_slot == std::numeric_limits<uint32_t>::max() ? none
-                                                            : g.MakeFoothold(best_cell, best_slot);
+                                                           : g.MakeFoothold(best_cell, best_slot);
 }
 
 Foothold BruteForce::Next(const StepQuery& q, double tolerance) const {
@@ -49,7 +49,7 @@ Foothold BruteForce::Next(const StepQuery& q, double tolerance) const {
     }
   }
   return best_slot == std::numeric_limits<uint32_t>::max() ? none
-                                                            : g.MakeFoothold(best_cell, best_slot);
+                                                           : g.MakeFoothold(best_cell, best_slot);
 }
 
 }  // namespace footfall

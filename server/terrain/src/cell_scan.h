@@ -52,8 +52,8 @@ inline void ScanCellNearest(const float* xyz, uint32_t first, uint32_t count, co
       const uint32_t s = first + i + l;
       if (d < best) {
         best = d, slot = s;
-      } else if (d == best && (slot == std::numeric_limits<uint32_t>::max() ||
-                               index_of(s) < index_of(slot))) {
+      } else if (d == best &&
+                 (slot == std::numeric_limits<uint32_t>::max() || index_of(s) < index_of(slot))) {
         slot = s;  // an exact tie: the lower source index wins
       }
     }

@@ -620,7 +620,6 @@ struct TerrainGrid::NextScanner {
   const detail::NextFrame* f;
   QueryTrace* trace;
   double best_d2;
-  uint32_t best_index = kNoIndex;
   uint32_t best_cell = kNoIndex;
   uint32_t best_slot = kNoIndex;
 
@@ -641,13 +640,16 @@ struct TerrainGrid::NextScanner {
     const uint32_t count = e - b;
     for (uint32_t i = 0; i < count; ++i) {
       const float p[3] = {x[i], x[count + i], x[2 * size_t{count} + i]};
-      const uint32_t index = grid.answers_[b + i].index;
+      const uint32_t slot = b + i;
       const double d2 = detail::Dist2(p, f->ideal);
-      if (kTraced) trace->examined_samples.push_back(index);
+      if (kTraced) trace->examined_samples.push_back(grid.answers_[slot].index);
       if (d2 > f->radius2 || !detail::Ahead(p, *f)) continue;
-      if (kTraced) trace->candidates.push_back(index);
-      if (detail::Better(d2, index, best_d2, best_index))
-        best_d2 = d2, best_index = index, best_cell = cell, best_slot = b + i;
+      if (kTraced) trace->candidates.push_back(grid.answers_[slot].index);
+      // Source indices are read only on an exact tie.
+      if (d2 < best_d2 ||
+          (d2 == best_d2 &&
+           (best_slot == kNoIndex || grid.answers_[slot].index < grid.answers_[best_slot].index)))
+        best_d2 = d2, best_cell = cell, best_slot = slot;
     }
   }
 };
@@ -709,7 +711,8 @@ bool TerrainGrid::NearestNearby(const double c[3], uint32_t* cell_out, uint32_t*
     sides[a] = 0;
     const double glo = dlo > 0 ? dlo * dlo : 0, ghi = dhi > 0 ? dhi * dhi : 0;
     if (ci[a] >= 1 && glo <= best) gap[a][sides[a]] = glo, step[a][sides[a]++] = -stride[a];
-    if (ci[a] + 1 < dims_[a] && ghi <= best) gap[a][sides[a]] = ghi, step[a][sides[a]++] = stride[a];
+    if (ci[a] + 1 < dims_[a] && ghi <= best)
+      gap[a][sides[a]] = ghi, step[a][sides[a]++] = stride[a];
   }
   // Faces, then edges, then corners: the nearer neighbours usually shrink the ball first.
   for (int a = 0; a < 3; ++a)

@@ -169,7 +169,7 @@ class TerrainGrid {
   double bounds_lo_[3] = {0, 0, 0};  // local bounds of all samples
   double bounds_hi_[3] = {0, 0, 0};
   double cell_size_ = 1, inv_cell_size_ = 1;
-  double pad_ = 0;                   // the query-independent part of the cell-box pad
+  double pad_ = 0;  // the query-independent part of the cell-box pad
   uint32_t dims_[3] = {1, 1, 1};
   double last_cell_[3] = {0, 0, 0};  // dims_ - 1, as doubles
   size_t cells_ = 0;                 // dims_[0] * dims_[1] * dims_[2]
