@@ -2,6 +2,7 @@
 // identical (status, index, point, normal) for queries inside, on and far outside the bounds,
 // along every axis both ways.
 #include <algorithm>
+#include <limits>
 #include <random>
 #include <string>
 #include <tuple>
@@ -105,6 +106,7 @@ void CheckAgainstBruteForce(const TerrainGrid& g, int count, uint64_t seed) {
   const Vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
   std::uniform_real_distribution<double> u(0, 1);
   size_t found = 0;
+  std::vector<StepQuery> steps;  // the next queries, for the batch check
   for (size_t i = 0; i < points.size(); ++i) {
     const Vec3& p = points[i];
     RequireSame(g.Snap(p), oracle.Snap(p), "snap at " + Describe(p));
@@ -114,6 +116,7 @@ void CheckAgainstBruteForce(const TerrainGrid& g, int count, uint64_t seed) {
     dir = dir * length;
     const double tolerance = i % 5 == 0 ? length * 0.3 : 0;
     const StepQuery q{p, dir};
+    steps.push_back(q);
     const Foothold a = g.Next(q, tolerance);
     found += a.status == Status::kOk;
     RequireSame(a, oracle.Next(q, tolerance),
@@ -122,13 +125,31 @@ void CheckAgainstBruteForce(const TerrainGrid& g, int count, uint64_t seed) {
   }
   // The query mix must exercise both outcomes of next.
   CHECK(found > 0);
-  // Batches give the same answers, in the given order and in a spatially sorted order (where
-  // each search starts from the previous answer), on one and two threads.
+  // Batches give the same answers, in the given order and in a spatially sorted order, on one
+  // and two threads, with invalid queries among valid ones.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (size_t i = 0; i < steps.size(); i += 97) steps[i].direction = {0, 0, 0};
+  for (size_t i = 50; i < steps.size(); i += 89) steps[i].foot.y = nan;
+  for (int threads : {1, 2}) {
+    BatchPool pool(threads);
+    std::vector<Foothold> answers(steps.size());
+    g.NextBatch(steps.data(), steps.size(), 0, answers.data(), threads > 1 ? &pool : nullptr);
+    for (size_t i = 0; i < steps.size(); ++i)
+      RequireSame(
+          answers[i], oracle.Next(steps[i], 0),
+          "batch next from " + Describe(steps[i].foot) + " along " + Describe(steps[i].direction));
+  }
+  const std::vector<Vec3> points_with_invalid = [&] {
+    std::vector<Vec3> v = points;
+    for (size_t i = 30; i < v.size(); i += 83) v[i].z = nan;
+    return v;
+  }();
   std::vector<Vec3> sorted = points;
   std::sort(sorted.begin(), sorted.end(), [](const Vec3& a, const Vec3& b) {
     return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
   });
-  for (const std::vector<Vec3>* batch : {&points, static_cast<const std::vector<Vec3>*>(&sorted)}) {
+  for (const std::vector<Vec3>* batch :
+       {&points_with_invalid, static_cast<const std::vector<Vec3>*>(&sorted)}) {
     for (int threads : {1, 2}) {
       BatchPool pool(threads);
       std::vector<Foothold> answers(batch->size());

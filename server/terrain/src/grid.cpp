@@ -20,6 +20,12 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr uint32_t kNoIndex = std::numeric_limits<uint32_t>::max();
+// Batches start loading a query's cell offsets this many queries ahead, then its samples half
+// as far ahead.
+constexpr size_t kPrefetchDistance = 6;
+// Batches find the answers of this many queries before reading their normals and indices, which
+// were prefetched meanwhile.
+constexpr size_t kAnswerLag = 8;
 // Cells per axis of a block, the coarse level used for queries far from the grid.
 constexpr uint32_t kBlockCells = 8;
 
@@ -734,64 +740,114 @@ bool TerrainGrid::NearestNearby(const double c[3], uint32_t* cell_out, uint32_t*
   return true;
 }
 
-Foothold TerrainGrid::Snap(const Vec3& q, QueryTrace* trace) const {
-  Foothold none;
-  if (!IsFinite(q)) return none;
+TerrainGrid::Located TerrainGrid::LocateSnap(const Vec3& q, QueryTrace* trace) const {
+  Located found;  // kInvalidArgument
+  if (!IsFinite(q)) return found;
   const double c[3] = {q.x - origin_[0], q.y - origin_[1], q.z - origin_[2]};
-  if (!detail::InQueryRange(c)) return none;
-  none.status = Status::kNoFoothold;
-  uint32_t cell = kNoIndex, slot = kNoIndex;
+  if (!detail::InQueryRange(c)) return found;
+  found.status = Status::kNoFoothold;
   if (trace) {
     *trace = QueryTrace{}, trace->ideal = q;
     SnapScanner<true> s{*this, c, trace};
     Search(c, s);
-    cell = s.best_cell, slot = s.best_slot;
-  } else if (!NearestNearby(c, &cell, &slot)) {
+    found.cell = s.best_cell, found.slot = s.best_slot;
+  } else if (!NearestNearby(c, &found.cell, &found.slot)) {
     SnapScanner<false> s{*this, c, nullptr};
     Search(c, s);
-    cell = s.best_cell, slot = s.best_slot;
+    found.cell = s.best_cell, found.slot = s.best_slot;
   }
-  return slot == kNoIndex ? none : MakeFoothold(cell, slot);
+  if (found.slot != kNoIndex) found.status = Status::kOk;
+  return found;
 }
 
-Foothold TerrainGrid::Next(const StepQuery& q, double tolerance, QueryTrace* trace) const {
-  Foothold none;
+TerrainGrid::Located TerrainGrid::LocateNext(const StepQuery& q, double tolerance,
+                                             QueryTrace* trace) const {
+  Located found;  // kInvalidArgument
   detail::NextFrame f;
-  if (!detail::MakeNextFrame(origin_, q, tolerance, &f)) return none;
-  none.status = Status::kNoFoothold;
-  uint32_t cell = kNoIndex, slot = kNoIndex;
+  if (!detail::MakeNextFrame(origin_, q, tolerance, &f)) return found;
+  found.status = Status::kNoFoothold;
   if (trace) {
     *trace = QueryTrace{};
     trace->ideal = q.foot + q.direction;
     trace->radius = std::sqrt(f.radius2);
     NextScanner<true> s{*this, &f, trace, f.radius2};
     Search(f.ideal, s);
-    cell = s.best_cell, slot = s.best_slot;
+    found.cell = s.best_cell, found.slot = s.best_slot;
   } else {
     // The sample nearest the ideal point, if it is a candidate, is the nearest candidate (same
     // distances, same tie order); if it is beyond the radius, no sample is a candidate. Only
     // when it lies behind the foot does the candidate search run.
-    if (!NearestNearby(f.ideal, &cell, &slot)) {
+    if (!NearestNearby(f.ideal, &found.cell, &found.slot)) {
       SnapScanner<false> s{*this, f.ideal, nullptr};
       Search(f.ideal, s);
-      cell = s.best_cell, slot = s.best_slot;
+      found.cell = s.best_cell, found.slot = s.best_slot;
     }
-    if (slot == kNoIndex) return none;
+    if (found.slot == kNoIndex) return found;
     float p[3];
-    LocalPoint(cell, slot, p);
-    if (detail::Dist2(p, f.ideal) > f.radius2) return none;
-    if (detail::Ahead(p, f)) return MakeFoothold(cell, slot);
-    NextScanner<false> s{*this, &f, nullptr, f.radius2};
-    Search(f.ideal, s);
-    cell = s.best_cell, slot = s.best_slot;
+    LocalPoint(found.cell, found.slot, p);
+    if (detail::Dist2(p, f.ideal) > f.radius2) {
+      found.slot = kNoIndex;
+      return found;
+    }
+    if (!detail::Ahead(p, f)) {
+      NextScanner<false> s{*this, &f, nullptr, f.radius2};
+      Search(f.ideal, s);
+      found.cell = s.best_cell, found.slot = s.best_slot;
+    }
   }
-  return slot == kNoIndex ? none : MakeFoothold(cell, slot);
+  if (found.slot != kNoIndex) found.status = Status::kOk;
+  return found;
+}
+
+Foothold TerrainGrid::Answer(const Located& found) const {
+  if (found.status != Status::kOk) {
+    Foothold none;
+    none.status = found.status;
+    return none;
+  }
+  return MakeFoothold(found.cell, found.slot);
+}
+
+Foothold TerrainGrid::Snap(const Vec3& q, QueryTrace* trace) const {
+  return Answer(LocateSnap(q, trace));
+}
+
+Foothold TerrainGrid::Next(const StepQuery& q, double tolerance, QueryTrace* trace) const {
+  return Answer(LocateNext(q, tolerance, trace));
+}
+
+void TerrainGrid::Prefetch(const Vec3& q, bool samples) const {
+  const double c[3] = {q.x - origin_[0], q.y - origin_[1], q.z - origin_[2]};
+  const int64_t stride[3] = {1, dims_[0], int64_t{dims_[0]} * dims_[1]};
+  int64_t cell = 0;
+  for (int a = 0; a < 3; ++a) {
+    double t = (c[a] - grid_lo_[a]) * inv_cell_size_;
+    t = t > 0 ? t : 0;  // NaN too
+    t = t < last_cell_[a] ? t : last_cell_[a];
+    cell += static_cast<int64_t>(t) * stride[a];
+  }
+  if (!samples) {
+    __builtin_prefetch(&cell_start_[cell]);
+    return;
+  }
+  const size_t b = cell_start_[cell], e = cell_start_[cell + 1];
+  __builtin_prefetch(positions_ + 3 * b);
+  if (e > b) __builtin_prefetch(positions_ + 3 * e - 1);  // the run's last line
 }
 
 void TerrainGrid::SnapBatch(const Vec3* queries, size_t count, Foothold* out,
                             BatchPool* pool) const {
   auto answer = [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) out[i] = Snap(queries[i]);
+    Located found[kAnswerLag];
+    for (size_t g = b; g < e; g += kAnswerLag) {
+      const size_t n = std::min(kAnswerLag, e - g);
+      for (size_t i = g; i < g + n; ++i) {
+        if (i + 2 * kPrefetchDistance < e) Prefetch(queries[i + 2 * kPrefetchDistance], false);
+        if (i + kPrefetchDistance < e) Prefetch(queries[i + kPrefetchDistance], true);
+        found[i - g] = LocateSnap(queries[i], nullptr);
+      }
+      for (size_t i = 0; i < n; ++i) out[g + i] = Answer(found[i]);
+    }
   };
   if (pool)
     pool->Run(count, BatchPool::kQueryChunk, answer);
@@ -802,7 +858,22 @@ void TerrainGrid::SnapBatch(const Vec3* queries, size_t count, Foothold* out,
 void TerrainGrid::NextBatch(const StepQuery* queries, size_t count, double tolerance, Foothold* out,
                             BatchPool* pool) const {
   auto answer = [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) out[i] = Next(queries[i], tolerance);
+    Located found[kAnswerLag];
+    for (size_t g = b; g < e; g += kAnswerLag) {
+      const size_t n = std::min(kAnswerLag, e - g);
+      for (size_t i = g; i < g + n; ++i) {
+        if (i + 2 * kPrefetchDistance < e) {
+          const StepQuery& ahead = queries[i + 2 * kPrefetchDistance];
+          Prefetch(ahead.foot + ahead.direction, false);
+        }
+        if (i + kPrefetchDistance < e) {
+          const StepQuery& ahead = queries[i + kPrefetchDistance];
+          Prefetch(ahead.foot + ahead.direction, true);
+        }
+        found[i - g] = LocateNext(queries[i], tolerance, nullptr);
+      }
+      for (size_t i = 0; i < n; ++i) out[g + i] = Answer(found[i]);
+    }
   };
   if (pool)
     pool->Run(count, BatchPool::kQueryChunk, answer);

@@ -157,10 +157,22 @@ class TerrainGrid {
   // unvisited cell can hold a sample within scanner.limit2(). Calls scanner.Scan(cell, b, e).
   template <typename Scanner>
   void Search(const double center[3], Scanner& scanner) const;
+  // Starts loading what a query at q reads first: its cell's offsets, or (once those have
+  // arrived) its cell's samples. Any q is safe.
+  void Prefetch(const Vec3& q, bool samples) const;
   uint32_t CellCoord(double local, int axis) const;
   double CellLo(uint32_t i, int axis) const;
   double CellHi(uint32_t i, int axis) const;
   Foothold MakeFoothold(uint32_t cell, uint32_t slot) const;
+  // A query's outcome before its answer is read: on kOk, the answer's cell and slot.
+  struct Located {
+    Status status = Status::kInvalidArgument;
+    uint32_t cell = 0xFFFFFFFFu;
+    uint32_t slot = 0xFFFFFFFFu;
+  };
+  Located LocateSnap(const Vec3& q, QueryTrace* trace) const;
+  Located LocateNext(const StepQuery& q, double tolerance, QueryTrace* trace) const;
+  Foothold Answer(const Located& found) const;
 
   size_t count_ = 0;
   GridStats stats_;
