@@ -47,6 +47,12 @@ check "crowd: --threads 1 gives the same walk" cmp -s "$work/hexapod-crowd-1.jso
 check "path: reaches the goal without stopping" grep -q '"stopped":""' "$work/biped-path-embedded.json"
 check "crowd: nine characters" [ "$(grep -o '"name":"body","character":"c[0-9]*"' "$work/hexapod-crowd-embedded.json" | wc -l)" -eq 9 ]
 check "start frame" grep -q '{"frame":101,"phase":"start"' "$work/octopod-floor-embedded.json"
+# A crowd larger than one embedded pass (1000 characters): the embedded run walks it in two
+# passes, the RPC run all at once; same walk. --progress draws the bar to the end.
+both big-crowd 0 --terrain "$work/floor.pts" --character "$chars/hexapod.json" --steps 4 \
+  --crowd 1100 --crowd-spacing 0.04 --start 1.2,0,1.2 --progress
+check "big crowd: 1100 characters" [ "$(grep -o '"name":"body","character":"c[0-9]*"' "$work/big-crowd-embedded.json" | wc -l)" -eq 1100 ]
+check "big crowd: progress bar reaches 100%" grep -q '100%' "$work/big-crowd-embedded.err"
 
 # 2. A walk stopped at a cliff: the message names the step and the position; the keys so far
 #    are written; exit 2.

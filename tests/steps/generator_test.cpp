@@ -471,8 +471,8 @@ TEST_CASE("A large crowd's walk is the same on one thread and on two",
 }
 
 TEST_CASE(
-    "A crowd on rocks (raised arcs, refused footholds, stops) is the same on one thread "
-    "and on two",
+    "A crowd on rocks (raised arcs, refused footholds, stops) is the same on one thread, "
+    "on two, and walked in passes",
     "[steps][generator][crowd]") {
   // 600 hexapods 5 cm apart on data/terrain/rocks.pts (8 cm samples): enough characters for the
   // per-character passes to split; some arcs need raising (their characters finish in a later
@@ -486,32 +486,47 @@ TEST_CASE(
   o.steps = 30;
   o.crowd = 600;
   o.crowd_spacing = 0.05;
-  auto run = [&](int threads) {
+  std::vector<std::pair<int, int>> progress;
+  auto run = [&](int threads, int per_pass) {
     Terrain t = LoadTerrain(rocks, 0.08);
     o.threads = threads;
+    o.characters_per_pass = per_pass;
+    progress.clear();
+    o.progress = [&progress](int done, int total) { progress.emplace_back(done, total); };
     return Generate(t, c, o);
   };
-  const Walk one = run(1), two = run(2);
+  const Walk one = run(1, 0), two = run(2, 0);
+  // 5 passes of 128 characters, the last one short; a pass ends early once all its characters
+  // have stopped.
+  const Walk passes = run(2, 128);
+  REQUIRE(!progress.empty());
+  CHECK(progress.back().first == progress.back().second);
+  CHECK(progress.back().second == 5 * o.steps);
+  for (size_t i = 1; i < progress.size(); ++i) CHECK(progress[i].first >= progress[i - 1].first);
   CHECK_THAT(one.stopped, Catch::Contains("more characters stopped"));
-  CHECK(one.stopped == two.stopped);
-  REQUIRE(one.tracks.size() == two.tracks.size());
-  size_t differ = 0, raised = 0;
-  for (size_t i = 0; i < one.tracks.size(); ++i) {
-    const auto &ka = one.tracks[i].keys, &kb = two.tracks[i].keys;
-    REQUIRE(ka.size() == kb.size());
-    for (size_t k = 0; k < ka.size(); ++k) {
-      differ += !(ka[k].frame == kb[k].frame && ka[k].phase == kb[k].phase &&
-                  ka[k].position == kb[k].position && ka[k].normal == kb[k].normal);
-      // A raised arc: its mid key more than step_height above the chord's midpoint.
-      if (ka[k].phase == KeyPhase::kMid)
-        raised += Distance(ka[k].position, (ka[k - 1].position + ka[k + 1].position) * 0.5) >
-                  1.01 * c.step_height;
+  size_t raised = 0;
+  for (const Walk* other : {&two, &passes}) {
+    CHECK(one.stopped == other->stopped);
+    REQUIRE(one.tracks.size() == other->tracks.size());
+    size_t differ = 0;
+    for (size_t i = 0; i < one.tracks.size(); ++i) {
+      const auto &ka = one.tracks[i].keys, &kb = other->tracks[i].keys;
+      REQUIRE(ka.size() == kb.size());
+      for (size_t k = 0; k < ka.size(); ++k) {
+        differ += !(ka[k].frame == kb[k].frame && ka[k].phase == kb[k].phase &&
+                    ka[k].position == kb[k].position && ka[k].normal == kb[k].normal &&
+                    ka[k].rotation.x == kb[k].rotation.x && ka[k].rotation.w == kb[k].rotation.w);
+        // A raised arc: its mid key more than step_height above the chord's midpoint.
+        if (ka[k].phase == KeyPhase::kMid)
+          raised += Distance(ka[k].position, (ka[k - 1].position + ka[k + 1].position) * 0.5) >
+                    1.01 * c.step_height;
+      }
     }
+    CHECK(differ == 0);
   }
-  CHECK(differ == 0);
   CHECK(raised > 0);
   Terrain t = LoadTerrain(rocks, 0.08);
-  CheckWalk(t, c, o, two);
+  CheckWalk(t, c, o, passes);
 }
 
 TEST_CASE("Bad options are refused with a message", "[steps][generator]") {

@@ -67,6 +67,9 @@ Status WriteOutput(const Walk& walk, const std::string& path, std::string* error
   return Status::kInvalidArgument;
 }
 
+// Characters walked together by the embedded engine (GenerateOptions::characters_per_pass).
+constexpr int kEmbeddedCharactersPerPass = 1000;
+
 // A one-line progress bar on stderr, redrawn at most 10 times a second.
 class ProgressBar {
  public:
@@ -77,8 +80,9 @@ class ProgressBar {
     const int width = 40;
     const int filled =
         total > 0 ? static_cast<int>(static_cast<double>(done) * width / total) : width;
-    std::fprintf(stderr, "\r[%s%s] step %d/%d", std::string(filled, '#').c_str(),
-                 std::string(width - filled, '.').c_str(), done, total);
+    std::fprintf(stderr, "\r[%s%s] %3d%%", std::string(filled, '#').c_str(),
+                 std::string(width - filled, '.').c_str(),
+                 total > 0 ? static_cast<int>(100.0 * done / total) : 100);
     std::fflush(stderr);
     shown_ = true;
   }
@@ -124,6 +128,9 @@ int RunGenerate(const GenerateFlags& flags) {
   options.crowd = flags.crowd;
   options.crowd_spacing = flags.crowd_spacing;
   options.threads = flags.threads;
+  // Embedded, crowds walk a few hundred characters at a time (their terrain stays in the
+  // caches); over RPC, all at once (one call per round of queries).
+  options.characters_per_pass = flags.terrain.server.empty() ? kEmbeddedCharactersPerPass : 0;
   {
     Character character;
     if (LoadCharacter(flags.character, &character, &error) != Status::kOk) goto bad_flag;

@@ -134,6 +134,7 @@ class Generator {
   int steps_ = 0;
   double lead_ = 0;
   std::vector<Agent> agents_;
+  size_t pass_begin_ = 0, pass_end_ = 0;  // the agents walking in this pass
   std::unique_ptr<BatchPool> pool_;
   std::vector<int> pair_of_foot_;
   std::vector<Vec3> pair_centre_;                 // rest centre of each pair, character space
@@ -248,13 +249,22 @@ Status Generator::Run(std::string* error) {
   }
   Status s = Setup(error);
   if (s != Status::kOk) return s;
-  for (int k = 0; k < steps_; ++k) {
-    bool any = false;
-    for (const Agent& a : agents_) any = any || a.walking;
-    if (!any) break;
-    s = Step(k, error);
-    if (s != Status::kOk) return s;
-    if (o_.progress) o_.progress(k + 1, steps_);
+  // Passes: the characters walk every step in groups of characters_per_pass (all at once by
+  // default), so that a group's terrain stays in the caches from one step to the next.
+  const size_t n = agents_.size();
+  const size_t per_pass = o_.characters_per_pass > 0 ? o_.characters_per_pass : n;
+  const int passes = static_cast<int>((n + per_pass - 1) / per_pass);
+  for (int pass = 0; pass < passes; ++pass) {
+    pass_begin_ = pass * per_pass, pass_end_ = std::min(n, pass_begin_ + per_pass);
+    for (int k = 0; k < steps_; ++k) {
+      bool any = false;
+      for (size_t i = pass_begin_; i < pass_end_ && !any; ++i) any = agents_[i].walking;
+      if (!any) break;
+      s = Step(k, error);
+      if (s != Status::kOk) return s;
+      if (o_.progress) o_.progress(pass * steps_ + k + 1, passes * steps_);
+    }
+    if (o_.progress) o_.progress((pass + 1) * steps_, passes * steps_);
   }
   // The walk's stop message: the first agent's, and how many others stopped.
   size_t stopped = 0;
@@ -685,7 +695,7 @@ Status Generator::Step(int k, std::string* error) {
   group_ = k % static_cast<int>(c_.gait.size());
   // 5. Heading: turn toward the current waypoint of the path (at most max_turn_deg).
   walking_.clear();
-  for (size_t i = 0; i < agents_.size(); ++i) {
+  for (size_t i = pass_begin_; i < pass_end_; ++i) {
     if (!agents_[i].walking) continue;
     Steer(agents_[i]);
     if (agents_[i].walking) walking_.push_back(i);

@@ -42,7 +42,14 @@ struct GenerateOptions {
   // Threads for the generator's own per-character work (large crowds only; the session splits
   // its batches by itself). The walk is the same whatever the count. [Limit: >= 1]
   int threads = 1;
-  // Called after every step with (steps done, steps requested); may be empty.
+  // Characters walked together: the crowd walks every step in groups of this many characters,
+  // one group after the other, so that each group's stretch of terrain stays in the caches
+  // (embedded engine). <= 0: all at once, which makes every round of queries of a step one
+  // batch call for the whole crowd (the right choice over RPC). The walk is the same whatever
+  // the value.
+  int characters_per_pass = 0;
+  // Called as the walk advances with (work done, total work), in steps times passes; may be
+  // empty.
   std::function<void(int, int)> progress;
 };
 
