@@ -184,6 +184,38 @@ TEST_CASE("TerrainGrid answers exactly as brute force", "[terrain][grid]") {
     for (int i = 0; i < 2000; ++i) s.push_back({0.01 * i, 0, 0}, {0, 1, 0});
     CheckAgainstBruteForce(Build(s), 2000, 7);
   }
+  SECTION("in a cloud of random points (sparse cells: nearest samples one to three cells away)") {
+    std::mt19937_64 rng(10);
+    std::uniform_real_distribution<double> u(-5, 5);
+    RawSamples s;
+    for (int i = 0; i < 3000; ++i) s.push_back({u(rng), 0.3 * u(rng), u(rng)}, {0, 1, 0});
+    CheckAgainstBruteForce(Build(s), 3000, 11);
+  }
+  SECTION("through the volume around a height field (nearest samples cells away)") {
+    // Points well above and below the surface: the ball of the query's own cell often reaches
+    // two or more cells away, and sometimes the answer lies there. The field is turned to face
+    // each axis in turn, so that those cells lie along every axis.
+    const RawSamples field = MakeHeightField(80, 60, 0.5, 3, 7);
+    for (int up = 0; up < 3; ++up) {
+      RawSamples s;
+      auto turn = [up](const Vec3& v) {
+        return up == 0 ? Vec3{v.y, v.z, v.x} : up == 1 ? v : Vec3{v.x, v.z, v.y};
+      };
+      for (size_t i = 0; i < field.size(); ++i)
+        s.push_back(turn(field.points[i]), turn(field.normals[i]));
+      const TerrainGrid g = Build(s);
+      const BruteForce oracle(g);
+      const GridStats& st = g.stats();
+      std::mt19937_64 rng(12 + up);
+      std::uniform_real_distribution<double> u(-0.1, 1.1);
+      for (int i = 0; i < 30000; ++i) {
+        const Vec3& lo = st.bounds_min;
+        const Vec3 size = st.bounds_max - st.bounds_min;
+        const Vec3 p{lo.x + size.x * u(rng), lo.y + size.y * u(rng), lo.z + size.z * u(rng)};
+        RequireSame(g.Snap(p), oracle.Snap(p), "snap at " + Describe(p));
+      }
+    }
+  }
   SECTION("on a single sample") {
     RawSamples s;
     s.push_back({3, -2, 5}, {0, 0, 2});
