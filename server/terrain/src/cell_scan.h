@@ -28,6 +28,7 @@ inline void ScanCellNearest(const float* xyz, uint32_t first, uint32_t count, co
   const Double4 qz = {q[2], q[2], q[2], q[2]};
   const Double4 lane = {0, 1, 2, 3};
   const Double4 inf = {kInf, kInf, kInf, kInf};
+  const Double4 four = {4, 4, 4, 4};
   double best = *best_d2;
   uint32_t slot = *best_slot;
   for (uint32_t i = 0; i < count; i += 4) {
@@ -45,16 +46,22 @@ inline void ScanCellNearest(const float* xyz, uint32_t first, uint32_t count, co
     const Double4 pair_min = d2 < half ? d2 : half;
     const Double4 swap = __builtin_shufflevector(pair_min, pair_min, 1, 0, 3, 2);
     const Double4 all_min = pair_min < swap ? pair_min : swap;
-    if (!(all_min[0] <= best)) continue;
-    const uint32_t lanes = count - i < 4 ? count - i : 4;
-    for (uint32_t l = 0; l < lanes; ++l) {
-      const double d = d2[l];
-      const uint32_t s = first + i + l;
-      if (d < best) {
-        best = d, slot = s;
-      } else if (d == best &&
-                 (slot == std::numeric_limits<uint32_t>::max() || index_of(s) < index_of(slot))) {
-        slot = s;  // an exact tie: the lower source index wins
+    if (all_min[0] < best) {
+      // The first lane holding the minimum: within a cell, slots ascend with source index.
+      const Double4 at = d2 == all_min ? lane : four;
+      const Double4 at_half = __builtin_shufflevector(at, at, 2, 3, 0, 1);
+      const Double4 at_pair = at < at_half ? at : at_half;
+      const double first_lane = at_pair[0] < at_pair[1] ? at_pair[0] : at_pair[1];
+      best = all_min[0], slot = first + i + static_cast<uint32_t>(first_lane);
+    } else if (all_min[0] == best) {
+      // An exact tie with the best so far (another cell's, or an earlier group's): the lower
+      // source index wins.
+      const uint32_t lanes = count - i < 4 ? count - i : 4;
+      for (uint32_t l = 0; l < lanes; ++l) {
+        const uint32_t s = first + i + l;
+        if (d2[l] == best &&
+            (slot == std::numeric_limits<uint32_t>::max() || index_of(s) < index_of(slot)))
+          slot = s;
       }
     }
   }
