@@ -672,9 +672,9 @@ Foothold TerrainGrid::MakeFoothold(uint32_t cell, uint32_t slot) const {
   return f;
 }
 
-// Compiled for AVX2 as well where the compiler and the loader can (GNU ifuncs: x86-64 Linux),
+// Compiled for AVX2 as well where the compiler and the loader can (GNU ifuncs: x86-64 glibc),
 // chosen at load time: the cell scans then take four samples per instruction.
-#if defined(__x86_64__) && defined(__linux__) && defined(__GNUC__) && defined(__has_attribute)
+#if defined(__x86_64__) && defined(__GLIBC__) && defined(__GNUC__) && defined(__has_attribute)
 #if __has_attribute(target_clones)
 __attribute__((target_clones("avx2", "default")))
 #endif
