@@ -68,7 +68,7 @@ struct GridStats {
 
 struct GridOptions {
   // Target mean samples per occupied cell. [Limit: > 0]
-  double samples_per_cell = 8;
+  double samples_per_cell = 12;
   // Memory cap: total cells <= max(64, cells_per_sample * samples). [Limit: > 0] The default
   // keeps a grid within 32 bytes per sample: 28 for the sample and its normal, 4 per cell.
   double cells_per_sample = 0.95;
