@@ -303,6 +303,16 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
   return Status::kOk;
 }
 
+int64_t TerrainGrid::ClampedCell(const double c[3], int64_t ci[3]) const {
+  for (int a = 0; a < 3; ++a) {
+    double t = (c[a] - grid_lo_[a]) * inv_cell_size_;
+    t = t > 0 ? t : 0;  // NaN too
+    t = t < last_cell_[a] ? t : last_cell_[a];
+    ci[a] = static_cast<int64_t>(t);
+  }
+  return ci[0] + (ci[1] + ci[2] * int64_t{dims_[1]}) * dims_[0];
+}
+
 uint32_t TerrainGrid::CellCoord(double local, int axis) const {
   const double t = (local - grid_lo_[axis]) * inv_cell_size_;
   if (!(t > 0)) return 0;
@@ -682,14 +692,8 @@ __attribute__((target_clones("avx2", "default")))
 bool TerrainGrid::NearestNearby(const double c[3], uint32_t* cell_out, uint32_t* slot_out) const {
   if (count_ == 0) return false;
   int64_t ci[3];
-  for (int a = 0; a < 3; ++a) {
-    double t = (c[a] - grid_lo_[a]) * inv_cell_size_;
-    t = t > 0 ? t : 0;
-    t = t < last_cell_[a] ? t : last_cell_[a];
-    ci[a] = static_cast<int64_t>(t);
-  }
+  const int64_t cell = ClampedCell(c, ci);
   const int64_t stride[3] = {1, dims_[0], int64_t{dims_[0]} * dims_[1]};
-  const int64_t cell = ci[0] + ci[1] * stride[1] + ci[2] * stride[2];
   double best = kInf;
   uint32_t best_slot = kNoIndex;
   int64_t best_cell = cell;
@@ -818,14 +822,8 @@ Foothold TerrainGrid::Next(const StepQuery& q, double tolerance, QueryTrace* tra
 
 void TerrainGrid::Prefetch(const Vec3& q, bool samples) const {
   const double c[3] = {q.x - origin_[0], q.y - origin_[1], q.z - origin_[2]};
-  const int64_t stride[3] = {1, dims_[0], int64_t{dims_[0]} * dims_[1]};
-  int64_t cell = 0;
-  for (int a = 0; a < 3; ++a) {
-    double t = (c[a] - grid_lo_[a]) * inv_cell_size_;
-    t = t > 0 ? t : 0;  // NaN too
-    t = t < last_cell_[a] ? t : last_cell_[a];
-    cell += static_cast<int64_t>(t) * stride[a];
-  }
+  int64_t ci[3];
+  const int64_t cell = ClampedCell(c, ci);
   if (!samples) {
     __builtin_prefetch(&cell_start_[cell]);
     return;

@@ -160,6 +160,9 @@ class TerrainGrid {
   // Starts loading what a query at q reads first: its cell's offsets, or (once those have
   // arrived) its cell's samples. Any q is safe.
   void Prefetch(const Vec3& q, bool samples) const;
+  // The linear index of the cell holding local point c, clamped into the grid (NaN counts as
+  // below); ci receives its coordinates. Same cell as CellCoord per axis.
+  int64_t ClampedCell(const double c[3], int64_t ci[3]) const;
   uint32_t CellCoord(double local, int axis) const;
   double CellLo(uint32_t i, int axis) const;
   double CellHi(uint32_t i, int axis) const;
