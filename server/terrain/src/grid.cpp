@@ -705,25 +705,35 @@ bool TerrainGrid::NearestNearby(const double c[3], uint32_t* cell_out, uint32_t*
     if (best_slot != before) best_cell = at, __builtin_prefetch(&answers_[best_slot]);
   };
   scan(cell);
-  if (best_slot == kNoIndex || !(best < kInf)) return false;
+  // An empty own cell: every neighbour is visited, and the ball is checked afterwards.
+  const bool own_empty = best_slot == kNoIndex;
+  if (!own_empty && !(best < kInf)) return false;
   // Per axis, the squared gaps to the lower and upper neighbours the ball reaches (padded as in
   // Search). A ball reaching two cells away is left to Search.
   const double pad = pad_ + 1e-13 * (std::fabs(c[0]) + std::fabs(c[1]) + std::fabs(c[2]));
-  double gap[3][2];
+  double gap[3][2], far[3][2];
   int64_t step[3][2];
   int sides[3];
+  auto reaches_two_away = [&]() {
+    for (int a = 0; a < 3; ++a) {
+      if (ci[a] >= 2 && (far[a][0] <= 0 || far[a][0] * far[a][0] <= best)) return true;
+      if (ci[a] + 2 < dims_[a] && (far[a][1] <= 0 || far[a][1] * far[a][1] <= best)) return true;
+    }
+    return false;
+  };
   for (int a = 0; a < 3; ++a) {
     const double face = grid_lo_[a] + static_cast<double>(ci[a]) * cell_size_;
     const double dlo = c[a] - face - pad, dhi = face + cell_size_ - c[a] - pad;
-    const double far_lo = dlo + cell_size_, far_hi = dhi + cell_size_;
-    if (ci[a] >= 2 && (far_lo <= 0 || far_lo * far_lo <= best)) return false;
-    if (ci[a] + 2 < dims_[a] && (far_hi <= 0 || far_hi * far_hi <= best)) return false;
+    far[a][0] = dlo + cell_size_, far[a][1] = dhi + cell_size_;
     sides[a] = 0;
     const double glo = dlo > 0 ? dlo * dlo : 0, ghi = dhi > 0 ? dhi * dhi : 0;
     if (ci[a] >= 1 && glo <= best) gap[a][sides[a]] = glo, step[a][sides[a]++] = -stride[a];
     if (ci[a] + 1 < dims_[a] && ghi <= best)
       gap[a][sides[a]] = ghi, step[a][sides[a]++] = stride[a];
   }
+  // The ball of the own cell's nearest bounds the search: when it reaches two cells away, so
+  // might the answer.
+  if (!own_empty && reaches_two_away()) return false;
   // Faces, then edges, then corners: the nearer neighbours usually shrink the ball first.
   for (int a = 0; a < 3; ++a)
     for (int s = 0; s < sides[a]; ++s)
@@ -739,6 +749,7 @@ bool TerrainGrid::NearestNearby(const double c[3], uint32_t* cell_out, uint32_t*
       for (int u = 0; u < sides[2]; ++u)
         if (gap[0][s] + gap[1][t] + gap[2][u] <= best)
           scan(cell + step[0][s] + step[1][t] + step[2][u]);
+  if (own_empty && (best_slot == kNoIndex || !(best < kInf) || reaches_two_away())) return false;
   *cell_out = static_cast<uint32_t>(best_cell);
   *slot_out = best_slot;
   return true;

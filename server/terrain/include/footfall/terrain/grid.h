@@ -142,10 +142,10 @@ class TerrainGrid {
     const float* x = positions_ + 3 * size_t{first} + (slot - first);
     p[0] = x[0], p[1] = x[count], p[2] = x[2 * size_t{count}];
   }
-  // The common case of a nearest-sample search, in few instructions: the query's own cell holds
-  // samples and the ball of the nearest of them reaches at most its direct neighbours. Then sets
-  // *cell and *slot to the nearest sample and returns true; otherwise returns false, and Search
-  // must answer.
+  // The common case of a nearest-sample search, in few instructions: the ball around the query
+  // of the nearest sample in its cell (or, when that cell is empty, in its direct neighbours)
+  // reaches no cell two away. Then sets *cell and *slot to the nearest sample and returns true;
+  // otherwise returns false, and Search must answer.
   bool NearestNearby(const double c[3], uint32_t* cell, uint32_t* slot) const;
   // Search's visitors for nearest-sample and candidate scans (grid.cpp).
   template <bool kTraced>
