@@ -19,11 +19,11 @@ using namespace footfall;
 
 namespace {
 
-TerrainGrid Build(RawSamples s) {
+TerrainGrid Build(RawSamples s, const GridOptions& options = GridOptions{}) {
   std::string error;
   REQUIRE(ValidateAndNormalize(&s, &error) == Status::kOk);
   TerrainGrid g;
-  REQUIRE(TerrainGrid::Build(s, GridOptions{}, &g, &error) == Status::kOk);
+  REQUIRE(TerrainGrid::Build(s, options, &g, &error) == Status::kOk);
   return g;
 }
 
@@ -251,6 +251,33 @@ TEST_CASE("TerrainGrid answers exactly as brute force", "[terrain][grid]") {
     RawSamples s = MakeHeightField(40, 40, 1e-3, 1e-3, 16);
     for (auto& p : s.points) p = p + Vec3{1e5, 0, 1e5};
     CheckAgainstBruteForce(Build(s), 2000, 17);
+  }
+}
+
+TEST_CASE("The portable cell scan answers as the AVX2 one and as brute force", "[terrain][grid]") {
+  // Grids scan with AVX2 when the CPU has it; the portable path serves every other CPU.
+  if (!CpuHasAvx2()) WARN("this CPU has no AVX2: both grids below take the portable path");
+  GridOptions portable;
+  portable.use_avx2 = false;
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> u(-5, 5);
+  RawSamples cloud;
+  for (int i = 0; i < 3000; ++i) cloud.push_back({u(rng), 0.3 * u(rng), u(rng)}, {0, 1, 0});
+  int seed = 30;
+  for (const RawSamples& s : {MakeHeightField(80, 60, 0.5, 3, 7), MakeSphere(5000, {1, 2, 3}, 10),
+                              MakeStairs(12, 0.2, 0.3, 2, 0.05), cloud}) {
+    const TerrainGrid g = Build(s, portable), fast = Build(s);
+    CheckAgainstBruteForce(g, 2000, ++seed);
+    const GridStats& st = g.stats();
+    const Vec3 size = st.bounds_max - st.bounds_min;
+    std::uniform_real_distribution<double> t(-0.2, 1.2);
+    for (int i = 0; i < 20000; ++i) {
+      const Vec3 p{st.bounds_min.x + size.x * t(rng), st.bounds_min.y + size.y * t(rng),
+                   st.bounds_min.z + size.z * t(rng)};
+      RequireSame(g.Snap(p), fast.Snap(p), "snap at " + Describe(p));
+      const StepQuery q{p, Vec3{t(rng) - 0.5, t(rng) - 0.5, t(rng) - 0.5} * size.x};
+      RequireSame(g.Next(q, 0), fast.Next(q, 0), "next from " + Describe(p));
+    }
   }
 }
 

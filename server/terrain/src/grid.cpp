@@ -217,6 +217,7 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
   for (int a = 0; a < 3; ++a) g.last_cell_[a] = g.dims_[a] - 1.0;
   const size_t cells = size_t{g.dims_[0]} * g.dims_[1] * g.dims_[2];
   g.cells_ = cells;
+  g.avx2_ = options.use_avx2 && CpuHasAvx2();
   // Cell boxes are padded so that rounding can never prune a sample: in cell assignment
   // (relative to the grid's extent) and in distances (relative to the query's, added per query).
   g.pad_ = 1e-9 * (h + (g.bounds_hi_[0] - g.bounds_lo_[0]) + (g.bounds_hi_[1] - g.bounds_lo_[1]) +
@@ -682,77 +683,111 @@ Foothold TerrainGrid::MakeFoothold(uint32_t cell, uint32_t slot) const {
   return f;
 }
 
-// Compiled for AVX2 as well where the compiler and the loader can (GNU ifuncs: x86-64 glibc),
-// chosen at load time: the cell scans then take four samples per instruction.
-#if defined(__x86_64__) && defined(__GLIBC__) && defined(__GNUC__) && defined(__has_attribute)
-#if __has_attribute(target_clones)
-__attribute__((target_clones("avx2", "default")))
+// The body of TerrainGrid::NearestNearby, compiled twice: portable, and for AVX2 where the
+// compiler offers it (the cell scans then take four samples per instruction).
+struct NearbySearch {
+#if defined(__GNUC__)
+  __attribute__((always_inline))
 #endif
-#endif
-bool TerrainGrid::NearestNearby(const double c[3], uint32_t* cell_out, uint32_t* slot_out) const {
-  if (count_ == 0) return false;
-  int64_t ci[3];
-  const int64_t cell = ClampedCell(c, ci);
-  const int64_t stride[3] = {1, dims_[0], int64_t{dims_[0]} * dims_[1]};
-  double best = kInf;
-  uint32_t best_slot = kNoIndex;
-  int64_t best_cell = cell;
-  auto index_of = [this](uint32_t s) { return answers_[s].index; };
-  auto scan = [&](int64_t at) {
-    const uint32_t b = cell_start_[at], e = cell_start_[at + 1];
-    const uint32_t before = best_slot;
-    detail::ScanCellNearest(positions_ + 3 * size_t{b}, b, e - b, c, index_of, &best, &best_slot);
-    if (best_slot != before) best_cell = at, __builtin_prefetch(&answers_[best_slot]);
-  };
-  scan(cell);
-  // An empty own cell: every neighbour is visited, and the ball is checked afterwards.
-  const bool own_empty = best_slot == kNoIndex;
-  if (!own_empty && !(best < kInf)) return false;
-  // Per axis, the squared gaps to the lower and upper neighbours the ball reaches (padded as in
-  // Search). A ball reaching two cells away is left to Search.
-  const double pad = pad_ + 1e-13 * (std::fabs(c[0]) + std::fabs(c[1]) + std::fabs(c[2]));
-  double gap[3][2], far[3][2];
-  int64_t step[3][2];
-  int sides[3];
-  auto reaches_two_away = [&]() {
+  static inline bool
+  Run(const TerrainGrid& g, const double c[3], uint32_t* cell_out, uint32_t* slot_out) {
+    if (g.count_ == 0) return false;
+    int64_t ci[3];
+    const int64_t cell = g.ClampedCell(c, ci);
+    const int64_t stride[3] = {1, g.dims_[0], int64_t{g.dims_[0]} * g.dims_[1]};
+    double best = kInf;
+    uint32_t best_slot = kNoIndex;
+    int64_t best_cell = cell;
+    auto index_of = [&g](uint32_t s) { return g.answers_[s].index; };
+    auto scan = [&](int64_t at) {
+      const uint32_t b = g.cell_start_[at], e = g.cell_start_[at + 1];
+      const uint32_t before = best_slot;
+      detail::ScanCellNearest(g.positions_ + 3 * size_t{b}, b, e - b, c, index_of, &best,
+                              &best_slot);
+      if (best_slot != before) best_cell = at, __builtin_prefetch(&g.answers_[best_slot]);
+    };
+    scan(cell);
+    // An empty own cell: every neighbour is visited, and the ball is checked afterwards.
+    const bool own_empty = best_slot == kNoIndex;
+    if (!own_empty && !(best < kInf)) return false;
+    // Per axis, the squared gaps to the lower and upper neighbours the ball reaches (padded as in
+    // Search). A ball reaching two cells away is left to Search.
+    const double pad = g.pad_ + 1e-13 * (std::fabs(c[0]) + std::fabs(c[1]) + std::fabs(c[2]));
+    double gap[3][2], far[3][2];
+    int64_t step[3][2];
+    int sides[3];
+    auto reaches_two_away = [&]() {
+      for (int a = 0; a < 3; ++a) {
+        if (ci[a] >= 2 && (far[a][0] <= 0 || far[a][0] * far[a][0] <= best)) return true;
+        if (ci[a] + 2 < g.dims_[a] && (far[a][1] <= 0 || far[a][1] * far[a][1] <= best))
+          return true;
+      }
+      return false;
+    };
     for (int a = 0; a < 3; ++a) {
-      if (ci[a] >= 2 && (far[a][0] <= 0 || far[a][0] * far[a][0] <= best)) return true;
-      if (ci[a] + 2 < dims_[a] && (far[a][1] <= 0 || far[a][1] * far[a][1] <= best)) return true;
+      const double face = g.grid_lo_[a] + static_cast<double>(ci[a]) * g.cell_size_;
+      const double dlo = c[a] - face - pad, dhi = face + g.cell_size_ - c[a] - pad;
+      far[a][0] = dlo + g.cell_size_, far[a][1] = dhi + g.cell_size_;
+      sides[a] = 0;
+      const double glo = dlo > 0 ? dlo * dlo : 0, ghi = dhi > 0 ? dhi * dhi : 0;
+      if (ci[a] >= 1 && glo <= best) gap[a][sides[a]] = glo, step[a][sides[a]++] = -stride[a];
+      if (ci[a] + 1 < g.dims_[a] && ghi <= best)
+        gap[a][sides[a]] = ghi, step[a][sides[a]++] = stride[a];
     }
-    return false;
-  };
-  for (int a = 0; a < 3; ++a) {
-    const double face = grid_lo_[a] + static_cast<double>(ci[a]) * cell_size_;
-    const double dlo = c[a] - face - pad, dhi = face + cell_size_ - c[a] - pad;
-    far[a][0] = dlo + cell_size_, far[a][1] = dhi + cell_size_;
-    sides[a] = 0;
-    const double glo = dlo > 0 ? dlo * dlo : 0, ghi = dhi > 0 ? dhi * dhi : 0;
-    if (ci[a] >= 1 && glo <= best) gap[a][sides[a]] = glo, step[a][sides[a]++] = -stride[a];
-    if (ci[a] + 1 < dims_[a] && ghi <= best)
-      gap[a][sides[a]] = ghi, step[a][sides[a]++] = stride[a];
+    // The ball of the own cell's nearest bounds the search: when it reaches two cells away, so
+    // might the answer.
+    if (!own_empty && reaches_two_away()) return false;
+    // Faces, then edges, then corners: the nearer neighbours usually shrink the ball first.
+    for (int a = 0; a < 3; ++a)
+      for (int s = 0; s < sides[a]; ++s)
+        if (gap[a][s] <= best) scan(cell + step[a][s]);
+    for (int a = 0; a < 3; ++a) {
+      const int b = a == 2 ? 0 : a + 1;
+      for (int s = 0; s < sides[a]; ++s)
+        for (int t = 0; t < sides[b]; ++t)
+          if (gap[a][s] + gap[b][t] <= best) scan(cell + step[a][s] + step[b][t]);
+    }
+    for (int s = 0; s < sides[0]; ++s)
+      for (int t = 0; t < sides[1]; ++t)
+        for (int u = 0; u < sides[2]; ++u)
+          if (gap[0][s] + gap[1][t] + gap[2][u] <= best)
+            scan(cell + step[0][s] + step[1][t] + step[2][u]);
+    if (own_empty && (best_slot == kNoIndex || !(best < kInf) || reaches_two_away())) return false;
+    *cell_out = static_cast<uint32_t>(best_cell);
+    *slot_out = best_slot;
+    return true;
   }
-  // The ball of the own cell's nearest bounds the search: when it reaches two cells away, so
-  // might the answer.
-  if (!own_empty && reaches_two_away()) return false;
-  // Faces, then edges, then corners: the nearer neighbours usually shrink the ball first.
-  for (int a = 0; a < 3; ++a)
-    for (int s = 0; s < sides[a]; ++s)
-      if (gap[a][s] <= best) scan(cell + step[a][s]);
-  for (int a = 0; a < 3; ++a) {
-    const int b = a == 2 ? 0 : a + 1;
-    for (int s = 0; s < sides[a]; ++s)
-      for (int t = 0; t < sides[b]; ++t)
-        if (gap[a][s] + gap[b][t] <= best) scan(cell + step[a][s] + step[b][t]);
-  }
-  for (int s = 0; s < sides[0]; ++s)
-    for (int t = 0; t < sides[1]; ++t)
-      for (int u = 0; u < sides[2]; ++u)
-        if (gap[0][s] + gap[1][t] + gap[2][u] <= best)
-          scan(cell + step[0][s] + step[1][t] + step[2][u]);
-  if (own_empty && (best_slot == kNoIndex || !(best < kInf) || reaches_two_away())) return false;
-  *cell_out = static_cast<uint32_t>(best_cell);
-  *slot_out = best_slot;
-  return true;
+};
+
+namespace {
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#define FOOTFALL_AVX2_SCAN 1
+__attribute__((target("avx2"))) bool NearbyAvx2(const TerrainGrid& g, const double c[3],
+                                                uint32_t* cell, uint32_t* slot) {
+  return NearbySearch::Run(g, c, cell, slot);
+}
+#endif
+
+bool NearbyPortable(const TerrainGrid& g, const double c[3], uint32_t* cell, uint32_t* slot) {
+  return NearbySearch::Run(g, c, cell, slot);
+}
+
+}  // namespace
+
+bool CpuHasAvx2() {
+#ifdef FOOTFALL_AVX2_SCAN
+  return __builtin_cpu_supports("avx2");
+#else
+  return false;
+#endif
+}
+
+bool TerrainGrid::NearestNearby(const double c[3], uint32_t* cell, uint32_t* slot) const {
+#ifdef FOOTFALL_AVX2_SCAN
+  if (avx2_) return NearbyAvx2(*this, c, cell, slot);
+#endif
+  return NearbyPortable(*this, c, cell, slot);
 }
 
 TerrainGrid::Located TerrainGrid::LocateSnap(const Vec3& q, QueryTrace* trace) const {

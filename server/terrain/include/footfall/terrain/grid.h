@@ -72,7 +72,13 @@ struct GridOptions {
   // Memory cap: total cells <= max(64, cells_per_sample * samples). [Limit: > 0] The default
   // keeps a grid within 32 bytes per sample: 28 for the sample and its normal, 4 per cell.
   double cells_per_sample = 0.95;
+  // Scan cells with AVX2 when the CPU has it (x86-64 builds with GCC or Clang); false: the
+  // portable code, same answers.
+  bool use_avx2 = true;
 };
+
+// True when this build can scan with AVX2 and the CPU has it.
+bool CpuHasAvx2();
 
 class TerrainGrid {
  public:
@@ -131,6 +137,7 @@ class TerrainGrid {
 
  private:
   friend class BruteForce;
+  friend struct NearbySearch;
   // What a query reads of a sample only once it is the answer.
   struct SampleAnswer {
     float normal[3];  // unit
@@ -188,6 +195,7 @@ class TerrainGrid {
   uint32_t dims_[3] = {1, 1, 1};
   double last_cell_[3] = {0, 0, 0};  // dims_ - 1, as doubles
   size_t cells_ = 0;                 // dims_[0] * dims_[1] * dims_[2]
+  bool avx2_ = false;                // cells scanned with AVX2 (GridOptions::use_avx2)
   struct FreeMemory {
     void operator()(unsigned char* p) const;
   };
