@@ -4,6 +4,7 @@
 #include "footfall/terrain/batch_pool.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <memory>
 #include <sstream>
@@ -254,6 +255,12 @@ Status Generator::Run(std::string* error) {
   const size_t n = agents_.size();
   const size_t per_pass = o_.characters_per_pass > 0 ? o_.characters_per_pass : n;
   const int passes = static_cast<int>((n + per_pass - 1) / per_pass);
+  // Progress in steps times passes, scaled down if that overflows an int.
+  const int64_t total = int64_t{passes} * steps_;
+  const double scale = total > INT_MAX ? static_cast<double>(INT_MAX) / total : 1.0;
+  auto report = [&](int64_t done) {
+    if (o_.progress) o_.progress(static_cast<int>(done * scale), static_cast<int>(total * scale));
+  };
   for (int pass = 0; pass < passes; ++pass) {
     pass_begin_ = pass * per_pass, pass_end_ = std::min(n, pass_begin_ + per_pass);
     for (int k = 0; k < steps_; ++k) {
@@ -262,9 +269,9 @@ Status Generator::Run(std::string* error) {
       if (!any) break;
       s = Step(k, error);
       if (s != Status::kOk) return s;
-      if (o_.progress) o_.progress(pass * steps_ + k + 1, passes * steps_);
+      report(int64_t{pass} * steps_ + k + 1);
     }
-    if (o_.progress) o_.progress((pass + 1) * steps_, passes * steps_);
+    report(int64_t{pass + 1} * steps_);
   }
   // The walk's stop message: the first agent's, and how many others stopped.
   size_t stopped = 0;
