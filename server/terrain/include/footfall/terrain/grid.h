@@ -170,7 +170,13 @@ class TerrainGrid {
   // The linear index of the cell holding local point c, clamped into the grid (NaN counts as
   // below); ci receives its coordinates. Same cell as CellCoord per axis.
   int64_t ClampedCell(const double c[3], int64_t ci[3]) const;
-  uint32_t CellCoord(double local, int axis) const;
+  // The cell coordinate along `axis` of a local coordinate, clamped into the grid.
+  uint32_t CellCoord(double local, int axis) const {
+    const double t = (local - grid_lo_[axis]) * inv_cell_size_;
+    if (!(t > 0)) return 0;
+    if (t >= static_cast<double>(dims_[axis])) return dims_[axis] - 1;
+    return static_cast<uint32_t>(t);
+  }
   double CellLo(uint32_t i, int axis) const;
   double CellHi(uint32_t i, int axis) const;
   Foothold MakeFoothold(uint32_t cell, uint32_t slot) const;

@@ -1,0 +1,266 @@
+// TerrainGrid::Build: bounds, the grid box, the cell size, and the single allocation the samples
+// are packed into (see grid.h for the layout).
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <new>
+#include <vector>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
+#include "footfall/terrain/grid.h"
+#include "grid_layout.h"
+
+namespace footfall {
+namespace {
+
+using detail::kBlockCells;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Total cells for a cell size h over local extents e, saturating in double.
+double CellCount(const double e[3], double h) {
+  double total = 1;
+  for (int a = 0; a < 3; ++a) total *= std::max(1.0, std::ceil(e[a] / h));
+  return total;
+}
+
+uint32_t AxisCells(double extent, double h) {
+  return static_cast<uint32_t>(std::max(1.0, std::ceil(extent / h)));
+}
+
+// Picks the grid box per axis: the true bounds, unless a few far outliers stretch an axis to
+// more than 4 times its bulk (1st to 99th percentile of a subsample), then the bulk plus margin.
+void ChooseGridBox(const RawSamples& s, const double lo[3], const double hi[3], double glo[3],
+                   double ghi[3]) {
+  const size_t n = s.size();
+  for (int a = 0; a < 3; ++a) glo[a] = lo[a], ghi[a] = hi[a];
+  if (n < 64) return;
+  const size_t m = std::min<size_t>(n, 4096);
+  std::vector<double> v(m);
+  for (int a = 0; a < 3; ++a) {
+    for (size_t i = 0; i < m; ++i) {
+      const Vec3& p = s.points[i * n / m];
+      v[i] = a == 0 ? p.x : a == 1 ? p.y : p.z;
+    }
+    std::sort(v.begin(), v.end());
+    const double q_lo = v[(m - 1) / 100];
+    const double q_hi = v[(m - 1) - (m - 1) / 100];
+    const double bulk = q_hi - q_lo;
+    if (hi[a] - lo[a] > 4 * bulk) {
+      const double margin = 0.25 * bulk;
+      glo[a] = std::max(lo[a], q_lo - margin);
+      ghi[a] = std::min(hi[a], q_hi + margin);
+    }
+  }
+}
+
+// The grid's single allocation. Large grids are aligned to 2 MiB and marked for transparent
+// huge pages where the system offers them (Linux, madvise mode): random queries over a grid of
+// tens of megabytes otherwise spend much of their time in TLB misses. Throws std::bad_alloc.
+unsigned char* AllocateGridMemory(size_t bytes) {
+  constexpr size_t kHugePage = size_t{2} << 20;
+  bytes = std::max<size_t>(bytes, 1);
+  void* p = nullptr;
+  if (bytes < kHugePage) {
+    p = std::malloc(bytes);
+  } else {
+    const size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+    p = std::aligned_alloc(kHugePage, rounded);
+#ifdef MADV_HUGEPAGE
+    if (p) madvise(p, rounded, MADV_HUGEPAGE);
+#endif
+  }
+  if (!p) throw std::bad_alloc();
+  return static_cast<unsigned char*>(p);
+}
+
+}  // namespace
+
+void TerrainGrid::FreeMemory::operator()(unsigned char* p) const { std::free(p); }
+
+TerrainGrid::TerrainGrid() = default;
+TerrainGrid::~TerrainGrid() = default;
+TerrainGrid::TerrainGrid(TerrainGrid&&) noexcept = default;
+TerrainGrid& TerrainGrid::operator=(TerrainGrid&&) noexcept = default;
+
+Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options, TerrainGrid* out,
+                          std::string* error) {
+  const size_t n = samples.points.size();
+  if (samples.normals.size() != n) {
+    if (error) *error = "points and normals differ in count";
+    return Status::kInvalidArgument;
+  }
+  if (n > 0xFFFFFFFEull) {
+    if (error) *error = "too many samples (limit 4294967294)";
+    return Status::kLimitExceeded;
+  }
+  if (!(options.samples_per_cell > 0) || !(options.cells_per_sample > 0)) {
+    if (error) *error = "grid options must be positive";
+    return Status::kInvalidArgument;
+  }
+  TerrainGrid g;
+  g.count_ = n;
+  // 1. True bounds, checking every value.
+  double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3& p = samples.points[i];
+    if (!IsFinite(p) || !IsFinite(samples.normals[i])) {
+      if (error) *error = "sample " + std::to_string(i) + " is not finite";
+      return Status::kInvalidArgument;
+    }
+    const double c[3] = {p.x, p.y, p.z};
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], c[a]), hi[a] = std::max(hi[a], c[a]);
+  }
+  if (n == 0) {
+    for (int a = 0; a < 3; ++a) lo[a] = hi[a] = 0;
+  }
+  // 2. The box the cells divide, and the origin at its centre.
+  double glo[3], ghi[3];
+  ChooseGridBox(samples, lo, hi, glo, ghi);
+  double extent[3];
+  for (int a = 0; a < 3; ++a) {
+    g.origin_[a] = 0.5 * (glo[a] + ghi[a]);
+    g.grid_lo_[a] = glo[a] - g.origin_[a];
+    extent[a] = ghi[a] - glo[a];
+  }
+  // 3. Positions as float offsets from the origin; bounds recomputed from the stored values.
+  std::vector<float> local(3 * n);
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3& p = samples.points[i];
+    local[3 * i + 0] = static_cast<float>(p.x - g.origin_[0]);
+    local[3 * i + 1] = static_cast<float>(p.y - g.origin_[1]);
+    local[3 * i + 2] = static_cast<float>(p.z - g.origin_[2]);
+  }
+  for (int a = 0; a < 3; ++a) g.bounds_lo_[a] = kInf, g.bounds_hi_[a] = -kInf;
+  for (size_t i = 0; i < 3 * n; ++i) {
+    const int a = static_cast<int>(i % 3);
+    g.bounds_lo_[a] = std::min(g.bounds_lo_[a], static_cast<double>(local[i]));
+    g.bounds_hi_[a] = std::max(g.bounds_hi_[a], static_cast<double>(local[i]));
+  }
+  if (n == 0) {
+    for (int a = 0; a < 3; ++a) g.bounds_lo_[a] = g.bounds_hi_[a] = 0;
+  }
+  // 4. Cell size: the smallest that fits the memory cap, then grown until occupied cells hold
+  //    about options.samples_per_cell samples (a surface's occupancy falls as 1/h^2).
+  const double budget = std::max(64.0, options.cells_per_sample * static_cast<double>(n));
+  const double max_extent = std::max({extent[0], extent[1], extent[2]});
+  double h = 1;
+  if (max_extent > 0) {
+    double h_hi = max_extent, h_lo = max_extent / (budget + 1);
+    for (int it = 0; it < 100 && h_hi > h_lo * (1 + 1e-12); ++it) {
+      const double mid = std::sqrt(h_lo * h_hi);
+      (CellCount(extent, mid) <= budget ? h_hi : h_lo) = mid;
+    }
+    h = h_hi;
+    g.cell_size_ = h, g.inv_cell_size_ = 1 / h;
+    for (int a = 0; a < 3; ++a) g.dims_[a] = AxisCells(extent[a], h);
+    const size_t total = size_t{g.dims_[0]} * g.dims_[1] * g.dims_[2];
+    std::vector<bool> occupied(total, false);
+    size_t occupied_count = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const float* p = &local[3 * i];
+      const size_t cell =
+          (size_t{g.CellCoord(p[2], 2)} * g.dims_[1] + g.CellCoord(p[1], 1)) * g.dims_[0] +
+          g.CellCoord(p[0], 0);
+      if (!occupied[cell]) occupied[cell] = true, ++occupied_count;
+    }
+    const double per_cell = static_cast<double>(n) / std::max<size_t>(1, occupied_count);
+    if (per_cell < options.samples_per_cell) h *= std::sqrt(options.samples_per_cell / per_cell);
+  }
+  g.cell_size_ = h, g.inv_cell_size_ = 1 / h;
+  for (int a = 0; a < 3; ++a) g.dims_[a] = AxisCells(extent[a], h);
+  for (int a = 0; a < 3; ++a) g.last_cell_[a] = g.dims_[a] - 1.0;
+  const size_t cells = size_t{g.dims_[0]} * g.dims_[1] * g.dims_[2];
+  g.cells_ = cells;
+  g.avx2_ = options.use_avx2 && CpuHasAvx2();
+  // Cell boxes are padded so that rounding can never prune a sample: in cell assignment
+  // (relative to the grid's extent) and in distances (relative to the query's, added per query).
+  g.pad_ = 1e-9 * (h + (g.bounds_hi_[0] - g.bounds_lo_[0]) + (g.bounds_hi_[1] - g.bounds_lo_[1]) +
+                   (g.bounds_hi_[2] - g.bounds_lo_[2]));
+
+  // 5. Counting sort of samples by cell, stable in source index (so ties scan in index order).
+  std::vector<uint32_t> cell_of(n);
+  for (size_t i = 0; i < n; ++i) {
+    const float* p = &local[3 * i];
+    cell_of[i] = static_cast<uint32_t>(
+        (size_t{g.CellCoord(p[2], 2)} * g.dims_[1] + g.CellCoord(p[1], 1)) * g.dims_[0] +
+        g.CellCoord(p[0], 0));
+  }
+  for (int a = 0; a < 3; ++a) g.block_dims_[a] = (g.dims_[a] + kBlockCells - 1) / kBlockCells;
+  const size_t blocks = size_t{g.block_dims_[0]} * g.block_dims_[1] * g.block_dims_[2];
+  // Positions end with 4 spare floats: a cell scan loads 4 samples at a time.
+  const size_t position_floats = 3 * n + 4;
+  const size_t bytes = n * sizeof(SampleAnswer) + (cells + 1) * sizeof(uint32_t) +
+                       blocks * 6 * sizeof(float) + position_floats * sizeof(float);
+  g.memory_.reset(AllocateGridMemory(bytes));
+  SampleAnswer* answers = reinterpret_cast<SampleAnswer*>(g.memory_.get());
+  uint32_t* cell_start = reinterpret_cast<uint32_t*>(answers + n);
+  float* block_bounds = reinterpret_cast<float*>(cell_start + cells + 1);
+  float* positions = block_bounds + blocks * 6;
+  std::fill(cell_start, cell_start + cells + 1, 0u);
+  for (size_t i = 0; i < n; ++i) ++cell_start[cell_of[i] + 1];
+  for (size_t c = 0; c < cells; ++c) cell_start[c + 1] += cell_start[c];
+  size_t occupied_cells = 0;
+  for (size_t c = 0; c < cells; ++c) occupied_cells += cell_start[c + 1] > cell_start[c];
+  {
+    std::vector<uint32_t> cursor(cell_start, cell_start + cells);
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t cell = cell_of[i];
+      const uint32_t first = cell_start[cell], count = cell_start[cell + 1] - first;
+      const uint32_t slot = cursor[cell]++;
+      float* x = positions + 3 * size_t{first} + (slot - first);
+      x[0] = local[3 * i], x[count] = local[3 * i + 1], x[2 * size_t{count}] = local[3 * i + 2];
+      const Vec3& nv = samples.normals[i];
+      const double len = Length(nv);
+      const double inv = len > 0 ? 1 / len : 0;
+      answers[slot].normal[0] = static_cast<float>(nv.x * inv);
+      answers[slot].normal[1] = static_cast<float>(nv.y * inv);
+      answers[slot].normal[2] = static_cast<float>(nv.z * inv);
+      answers[slot].index = static_cast<uint32_t>(i);
+    }
+    std::fill(positions + 3 * n, positions + position_floats, 0.0f);
+  }
+  g.positions_ = positions;
+  g.answers_ = answers;
+  g.cell_start_ = cell_start;
+  // 6. Tight bounds of the samples of each block of cells, for queries far from the grid.
+  for (size_t b = 0; b < blocks; ++b) {
+    for (int a = 0; a < 3; ++a) {
+      block_bounds[6 * b + a] = std::numeric_limits<float>::infinity();
+      block_bounds[6 * b + 3 + a] = -std::numeric_limits<float>::infinity();
+    }
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const float* p = &local[3 * i];
+    const size_t b = (size_t{g.CellCoord(p[2], 2) / kBlockCells} * g.block_dims_[1] +
+                      g.CellCoord(p[1], 1) / kBlockCells) *
+                         g.block_dims_[0] +
+                     g.CellCoord(p[0], 0) / kBlockCells;
+    for (int a = 0; a < 3; ++a) {
+      block_bounds[6 * b + a] = std::min(block_bounds[6 * b + a], p[a]);
+      block_bounds[6 * b + 3 + a] = std::max(block_bounds[6 * b + 3 + a], p[a]);
+    }
+  }
+  g.block_bounds_ = block_bounds;
+
+  GridStats& st = g.stats_;
+  st.samples = n;
+  for (int a = 0; a < 3; ++a) st.cells[a] = g.dims_[a];
+  st.cell_size = h;
+  st.occupied_cells = occupied_cells;
+  st.bytes = bytes;
+  const double* o = g.origin_;
+  st.bounds_min = {o[0] + g.bounds_lo_[0], o[1] + g.bounds_lo_[1], o[2] + g.bounds_lo_[2]};
+  st.bounds_max = {o[0] + g.bounds_hi_[0], o[1] + g.bounds_hi_[1], o[2] + g.bounds_hi_[2]};
+  st.grid_min = {glo[0], glo[1], glo[2]};
+  st.grid_max = {o[0] + g.grid_lo_[0] + g.dims_[0] * h, o[1] + g.grid_lo_[1] + g.dims_[1] * h,
+                 o[2] + g.grid_lo_[2] + g.dims_[2] * h};
+  *out = std::move(g);
+  return Status::kOk;
+}
+
+}  // namespace footfall
