@@ -117,6 +117,12 @@ void CheckAgainstBruteForce(const TerrainGrid& g, int count, uint64_t seed) {
     const double tolerance = i % 5 == 0 ? length * 0.3 : 0;
     const StepQuery q{p, dir};
     steps.push_back(q);
+    if (i % 5 == 0) {  // a traced query (the viewer's) takes the general search: same answers
+      QueryTrace trace;
+      RequireSame(g.Snap(p, &trace), g.Snap(p), "traced snap at " + Describe(p));
+      RequireSame(g.Next(q, tolerance, &trace), g.Next(q, tolerance),
+                  "traced next from " + Describe(p));
+    }
     const Foothold a = g.Next(q, tolerance);
     found += a.status == Status::kOk;
     RequireSame(a, oracle.Next(q, tolerance),

@@ -91,45 +91,6 @@ void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
   // 1. The query's own cell.
   visit(ci[0], ci[1], ci[2]);
 
-  // 1b. The common case, cheaply: the best ball reaches at most the direct neighbours. Per
-  //     axis, a neighbour is visited only if the ball crosses the face it shares with ci.
-  if (scanner.limit2() < kInf) {
-    const double limit = scanner.limit2();
-    double gap[3][3];
-    int64_t from[3], to[3];
-    bool simple = true;
-    for (int a = 0; a < 3 && simple; ++a) {
-      const double face = grid_lo_[a] + static_cast<double>(ci[a]) * cell_size_;
-      const double dlo = c[a] - face - pad;               // to the face with cell ci - 1
-      const double dhi = face + cell_size_ - c[a] - pad;  // to the face with cell ci + 1
-      const double beyond_lo = dlo + cell_size_, beyond_hi = dhi + cell_size_;
-      if ((ci[a] >= 2 && (beyond_lo <= 0 || beyond_lo * beyond_lo <= limit)) ||
-          (ci[a] <= n[a] - 3 && (beyond_hi <= 0 || beyond_hi * beyond_hi <= limit))) {
-        simple = false;  // the ball may reach two cells away
-        break;
-      }
-      gap[a][0] = dlo > 0 ? dlo * dlo : 0;
-      gap[a][1] = 0;
-      gap[a][2] = dhi > 0 ? dhi * dhi : 0;
-      from[a] = ci[a] >= 1 && gap[a][0] <= limit ? -1 : 0;
-      to[a] = ci[a] <= n[a] - 2 && gap[a][2] <= limit ? 1 : 0;
-    }
-    if (simple) {
-      for (int64_t dk = from[2]; dk <= to[2]; ++dk) {
-        for (int64_t dj = from[1]; dj <= to[1]; ++dj) {
-          const double gjk = gap[2][dk + 1] + gap[1][dj + 1];
-          if (gjk > scanner.limit2()) continue;
-          for (int64_t di = from[0]; di <= to[0]; ++di) {
-            if ((di | dj | dk) == 0) continue;
-            if (gjk + gap[0][di + 1] > scanner.limit2()) continue;
-            visit(ci[0] + di, ci[1] + dj, ci[2] + dk);
-          }
-        }
-      }
-      return;
-    }
-  }
-
   // 2. When the ball of the best distance so far (or the candidate radius) reaches few cells,
   //    visit exactly those: the cells overlapping the ball's bounding box, pruned by distance.
   //    If it reaches beyond the 26 neighbours, visit those first: they usually shrink the ball.
