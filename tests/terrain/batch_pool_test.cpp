@@ -1,9 +1,10 @@
 // The batch threads (footfall/terrain/batch_pool.h): every query of a batch answered
-// exactly once whatever the threads and chunk sizes, exceptions carried back to the caller, and
-// the pool still serving after one.
+// exactly once whatever the threads and chunk sizes, exceptions carried back to the caller, the
+// pool still serving after one, and a pool shared by callers on several threads.
 #include <algorithm>
 #include <atomic>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include <catch2/catch.hpp>
@@ -11,6 +12,7 @@
 #include "footfall/terrain/batch_pool.h"
 
 using footfall::BatchPool;
+using footfall::SharedBatchPool;
 
 TEST_CASE("batch threads answer every item exactly once", "[pool]") {
   for (const int threads : {1, 2, 4}) {
@@ -55,4 +57,31 @@ TEST_CASE("batch threads carry an exception back and keep serving", "[pool]") {
     pool.Run(1000, 10, [&](size_t b, size_t e) { after += e - b; });
     REQUIRE(after.load() == 1000);
   }
+}
+
+TEST_CASE("a shared pool serves callers on several threads at once", "[pool]") {
+  CHECK(SharedBatchPool(1) == nullptr);
+  const std::shared_ptr<BatchPool> pool = SharedBatchPool(2);
+  REQUIRE(pool != nullptr);
+  CHECK(SharedBatchPool(2) == pool);  // one pool per thread count while it is held
+  CHECK(SharedBatchPool(3) != pool);
+  // Three callers, each running batches on the same pool: a caller that finds the pool busy runs
+  // its batch on its own thread. Every item of every batch is answered exactly once.
+  std::atomic<size_t> wrong{0};
+  std::vector<std::thread> callers;
+  for (int t = 0; t < 3; ++t) {
+    callers.emplace_back([&pool, &wrong, t] {
+      for (int round = 0; round < 300; ++round) {
+        const size_t count = 100 + static_cast<size_t>((round * 37 + t * 11) % 900);
+        std::vector<std::atomic<int>> hits(count);
+        for (auto& h : hits) h = 0;
+        pool->Run(count, 16, [&](size_t b, size_t e) {
+          for (size_t i = b; i < e; ++i) ++hits[i];
+        });
+        for (auto& h : hits) wrong += h.load() != 1;
+      }
+    });
+  }
+  for (auto& c : callers) c.join();
+  CHECK(wrong.load() == 0);
 }

@@ -11,8 +11,7 @@ namespace {
 class EmbeddedSession final : public TerrainSession {
  public:
   // Batches are shared with threads - 1 persistent workers, started once per session.
-  explicit EmbeddedSession(int threads)
-      : pool_(threads > 1 ? std::make_unique<BatchPool>(threads) : nullptr) {}
+  explicit EmbeddedSession(int threads) : pool_(SharedBatchPool(threads)) {}
 
   Status LoadServerFile(const std::string& path, double separation, TerrainHandle* out) override {
     TerrainLoadOptions options;
@@ -84,7 +83,7 @@ class EmbeddedSession final : public TerrainSession {
     return Fail(Status::kUnknownTerrain, "no terrain with handle " + std::to_string(terrain));
   }
 
-  std::unique_ptr<BatchPool> pool_;
+  std::shared_ptr<BatchPool> pool_;  // the process's shared pool (null: one thread)
   TerrainHandle next_handle_ = 1;
   std::map<TerrainHandle, Entry> terrains_;
 };

@@ -104,7 +104,7 @@ class Generator {
   template <typename Fn>
   void Parallel(size_t count, Fn&& fn) {
     if (o_.threads <= 1 || count < kMinParallel) return fn(size_t{0}, count);
-    if (!pool_) pool_ = std::make_unique<BatchPool>(o_.threads);  // started on first use
+    if (!pool_) pool_ = SharedBatchPool(o_.threads);  // the engine's threads, on first use
     // Chunks of about count / (8 threads), taken in turn: a thread the system holds up delays
     // the others little.
     const size_t chunk = std::max<size_t>(1, count / (8 * static_cast<size_t>(o_.threads)));
@@ -136,7 +136,7 @@ class Generator {
   double lead_ = 0;
   std::vector<Agent> agents_;
   size_t pass_begin_ = 0, pass_end_ = 0;  // the agents walking in this pass
-  std::unique_ptr<BatchPool> pool_;
+  std::shared_ptr<BatchPool> pool_;
   std::vector<int> pair_of_foot_;
   std::vector<Vec3> pair_centre_;                 // rest centre of each pair, character space
   std::vector<std::vector<int>> pairs_of_group_;  // pairs with a foot in each gait group

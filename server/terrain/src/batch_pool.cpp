@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 
 namespace footfall {
 namespace {
@@ -14,7 +15,8 @@ inline void CpuRelax() {
 
 }  // namespace
 
-BatchPool::BatchPool(int threads, int caller_spin_us) : caller_spin_us_(caller_spin_us) {
+BatchPool::BatchPool(int threads, int caller_spin_us, int worker_spin_us)
+    : caller_spin_us_(caller_spin_us), worker_spin_us_(worker_spin_us) {
   for (int i = 1; i < threads; ++i) workers_.emplace_back([this] { Work(); });
 }
 
@@ -64,6 +66,11 @@ void BatchPool::Work() {
   uint64_t seen = 0;
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {
+    if (worker_spin_us_ > 0 && !stop_ && posted_ == seen) {
+      lock.unlock();
+      Spin(worker_spin_us_, [&] { return posted_.load(std::memory_order_acquire) != seen; });
+      lock.lock();
+    }
     work_.wait(lock, [&] { return stop_ || posted_ != seen; });
     if (stop_) return;
     seen = posted_;
@@ -73,7 +80,8 @@ void BatchPool::Work() {
 
 void BatchPool::Run(size_t count, size_t chunk, const std::function<void(size_t, size_t)>& fn) {
   chunk = std::max<size_t>(1, chunk);
-  if (workers_.empty() || count <= chunk) {
+  std::unique_lock<std::mutex> run(run_mutex_, std::defer_lock);
+  if (workers_.empty() || count <= chunk || !run.try_lock()) {
     if (count > 0) fn(0, count);
     return;
   }
@@ -105,6 +113,19 @@ void BatchPool::Run(size_t count, size_t chunk, const std::function<void(size_t,
   error_ = nullptr;
   lock.unlock();
   if (error) std::rethrow_exception(error);
+}
+
+std::shared_ptr<BatchPool> SharedBatchPool(int threads) {
+  if (threads <= 1) return nullptr;
+  static std::mutex mutex;
+  static std::map<int, std::weak_ptr<BatchPool>> pools;
+  std::lock_guard<std::mutex> lock(mutex);
+  std::shared_ptr<BatchPool> pool = pools[threads].lock();
+  if (!pool) {
+    pool = std::make_shared<BatchPool>(threads, 100, 200);
+    pools[threads] = pool;
+  }
+  return pool;
 }
 
 }  // namespace footfall
