@@ -128,8 +128,8 @@ int RunGenerate(const GenerateFlags& flags) {
   options.crowd = flags.crowd;
   options.crowd_spacing = flags.crowd_spacing;
   options.threads = flags.threads;
-  // Embedded, crowds walk a few hundred characters at a time (their terrain stays in the
-  // caches); over RPC, all at once (one call per round of queries).
+  // Embedded, crowds walk 1000 characters at a time (their terrain stays in the caches); over
+  // RPC, all at once (one call per round of queries).
   options.characters_per_pass = flags.terrain.server.empty() ? kEmbeddedCharactersPerPass : 0;
   {
     Character character;

@@ -10,7 +10,7 @@ namespace {
 
 class EmbeddedSession final : public TerrainSession {
  public:
-  // Batches are shared with threads - 1 persistent workers, started once per session.
+  // Batches are shared with the threads - 1 persistent workers of the process's shared pool.
   explicit EmbeddedSession(int threads) : pool_(SharedBatchPool(threads)) {}
 
   Status LoadServerFile(const std::string& path, double separation, TerrainHandle* out) override {
