@@ -563,16 +563,17 @@ void TerrainGrid::Prefetch(const Vec3& q, bool samples) const {
   if (e > b) __builtin_prefetch(positions_ + 3 * e - 1);  // the run's last line
 }
 
-void TerrainGrid::SnapBatch(const Vec3* queries, size_t count, Foothold* out,
-                            BatchPool* pool) const {
+template <typename Ideal, typename Locate>
+void TerrainGrid::AnswerBatch(size_t count, Foothold* out, BatchPool* pool, const Ideal& ideal,
+                              const Locate& locate) const {
   auto answer = [&](size_t b, size_t e) {
     Located found[kAnswerLag];
     for (size_t g = b; g < e; g += kAnswerLag) {
       const size_t n = std::min(kAnswerLag, e - g);
       for (size_t i = g; i < g + n; ++i) {
-        if (i + 2 * kPrefetchDistance < e) Prefetch(queries[i + 2 * kPrefetchDistance], false);
-        if (i + kPrefetchDistance < e) Prefetch(queries[i + kPrefetchDistance], true);
-        found[i - g] = LocateSnap(queries[i], nullptr);
+        if (i + 2 * kPrefetchDistance < e) Prefetch(ideal(i + 2 * kPrefetchDistance), false);
+        if (i + kPrefetchDistance < e) Prefetch(ideal(i + kPrefetchDistance), true);
+        found[i - g] = locate(i);
       }
       for (size_t i = 0; i < n; ++i) out[g + i] = Answer(found[i]);
     }
@@ -583,30 +584,18 @@ void TerrainGrid::SnapBatch(const Vec3* queries, size_t count, Foothold* out,
     answer(0, count);
 }
 
+void TerrainGrid::SnapBatch(const Vec3* queries, size_t count, Foothold* out,
+                            BatchPool* pool) const {
+  AnswerBatch(
+      count, out, pool, [&](size_t i) { return queries[i]; },
+      [&](size_t i) { return LocateSnap(queries[i], nullptr); });
+}
+
 void TerrainGrid::NextBatch(const StepQuery* queries, size_t count, double tolerance, Foothold* out,
                             BatchPool* pool) const {
-  auto answer = [&](size_t b, size_t e) {
-    Located found[kAnswerLag];
-    for (size_t g = b; g < e; g += kAnswerLag) {
-      const size_t n = std::min(kAnswerLag, e - g);
-      for (size_t i = g; i < g + n; ++i) {
-        if (i + 2 * kPrefetchDistance < e) {
-          const StepQuery& ahead = queries[i + 2 * kPrefetchDistance];
-          Prefetch(ahead.foot + ahead.direction, false);
-        }
-        if (i + kPrefetchDistance < e) {
-          const StepQuery& ahead = queries[i + kPrefetchDistance];
-          Prefetch(ahead.foot + ahead.direction, true);
-        }
-        found[i - g] = LocateNext(queries[i], tolerance, nullptr);
-      }
-      for (size_t i = 0; i < n; ++i) out[g + i] = Answer(found[i]);
-    }
-  };
-  if (pool)
-    pool->Run(count, BatchPool::kQueryChunk, answer);
-  else
-    answer(0, count);
+  AnswerBatch(
+      count, out, pool, [&](size_t i) { return queries[i].foot + queries[i].direction; },
+      [&](size_t i) { return LocateNext(queries[i], tolerance, nullptr); });
 }
 
 void TerrainGrid::CellBox(uint32_t cell, Vec3* lo, Vec3* hi) const {

@@ -189,6 +189,11 @@ class TerrainGrid {
   Located LocateSnap(const Vec3& q, QueryTrace* trace) const;
   Located LocateNext(const StepQuery& q, double tolerance, QueryTrace* trace) const;
   Foothold Answer(const Located& found) const;
+  // The batch loop shared by SnapBatch and NextBatch: ideal(i) is where query i searches (for
+  // prefetching), locate(i) finds its answer.
+  template <typename Ideal, typename Locate>
+  void AnswerBatch(size_t count, Foothold* out, BatchPool* pool, const Ideal& ideal,
+                   const Locate& locate) const;
 
   size_t count_ = 0;
   GridStats stats_;
