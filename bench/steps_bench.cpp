@@ -69,9 +69,9 @@ Backend& Rpc() {
   return b;
 }
 
-// per_pass: GenerateOptions::characters_per_pass, as `footfall generate` sets it (embedded:
-// 1000 characters at a time; RPC: the whole crowd, one call per round of queries).
-void Walks(benchmark::State& state, Backend& (*backend)(), int per_pass) {
+// The crowd walks in passes as GenerateOptions sets them by default (embedded: 1000 characters
+// at a time; RPC: the whole crowd, one call per round of queries).
+void Walks(benchmark::State& state, Backend& (*backend)()) {
   Backend& b = backend();
   GenerateOptions o;
   o.has_start = true;
@@ -80,7 +80,6 @@ void Walks(benchmark::State& state, Backend& (*backend)(), int per_pass) {
   o.crowd_spacing = 0.5;
   o.steps = static_cast<int>(state.range(1));
   o.threads = 2;
-  o.characters_per_pass = per_pass;
   size_t keys = 0;
   for (auto _ : state) {
     Walk w;
@@ -106,8 +105,8 @@ void Walks(benchmark::State& state, Backend& (*backend)(), int per_pass) {
                                                 benchmark::Counter::kInvert);
 }
 
-void BM_WalkEmbedded(benchmark::State& state) { Walks(state, Embedded, 1000); }
-void BM_WalkRpc(benchmark::State& state) { Walks(state, Rpc, 0); }
+void BM_WalkEmbedded(benchmark::State& state) { Walks(state, Embedded); }
+void BM_WalkRpc(benchmark::State& state) { Walks(state, Rpc); }
 
 BENCHMARK(BM_WalkEmbedded)
     ->ArgNames({"hexapods", "steps"})

@@ -364,7 +364,9 @@ class CountingSession final : public TerrainSession {
     return inner_->Next(t, q, n, tol, out);
   }
   std::string Describe() const override { return "counting " + inner_->Describe(); }
+  bool InProcess() const override { return !remote && inner_->InProcess(); }
   size_t snaps = 0, nexts = 0, next_queries = 0;
+  bool remote = false;  // says it answers out of process, as an RPC session does
 
  private:
   std::unique_ptr<TerrainSession> inner_;
@@ -403,6 +405,45 @@ TEST_CASE("A crowd batches every character's queries into one call per round",
   CHECK(w9.tracks.size() == 9 * (c.feet.size() + 1));
   CHECK(w9.tracks.front().character == "c1");
   CHECK(w9.tracks.back().character == "c9");
+}
+
+TEST_CASE("By default a crowd walks in passes in process and all at once out of process",
+          "[steps][generator][crowd]") {
+  const Character c = LoadShipped("hexapod");
+  const RawSamples ground = MakeFlat(400, 0.012, 0);  // 4.8 m square
+  const int crowd = kInProcessCharactersPerPass + 1, steps = 2;
+  auto run = [&](CountingSession* session, int* passes) {
+    TerrainHandle h;
+    REQUIRE(session->LoadSamples(ground, "flat", &h) == Status::kOk);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {2.4, 0, 2.2};
+    o.steps = steps;
+    o.crowd = crowd;
+    o.crowd_spacing = 0.1;
+    o.progress = [passes, steps](int, int total) { *passes = total / steps; };
+    Walk w;
+    std::string error;
+    REQUIRE(GenerateWalk(*session, h, c, o, &w, &error) == Status::kOk);
+    CHECK(w.stopped.empty());
+    return w;
+  };
+  CountingSession local, remote;
+  remote.remote = true;
+  int local_passes = 0, remote_passes = 0;
+  const Walk a = run(&local, &local_passes), b = run(&remote, &remote_passes);
+  CHECK(local_passes == 2);
+  CHECK(remote_passes == 1);
+  CHECK(local.nexts == 2 * remote.nexts);
+  CHECK(local.next_queries == remote.next_queries);
+  REQUIRE(a.tracks.size() == b.tracks.size());
+  size_t differ = 0;
+  for (size_t i = 0; i < a.tracks.size(); ++i) {
+    REQUIRE(a.tracks[i].keys.size() == b.tracks[i].keys.size());
+    for (size_t k = 0; k < a.tracks[i].keys.size(); ++k)
+      differ += !(a.tracks[i].keys[k].position == b.tracks[i].keys[k].position);
+  }
+  CHECK(differ == 0);
 }
 
 TEST_CASE("Generation is deterministic", "[steps][generator]") {
@@ -495,7 +536,7 @@ TEST_CASE(
     o.progress = [&progress](int done, int total) { progress.emplace_back(done, total); };
     return Generate(t, c, o);
   };
-  const Walk one = run(1, 0), two = run(2, 0);
+  const Walk one = run(1, -1), two = run(2, -1);
   // 5 passes of 128 characters, the last one short; a pass ends early once all its characters
   // have stopped.
   const Walk passes = run(2, 128);

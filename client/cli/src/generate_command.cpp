@@ -67,9 +67,6 @@ Status WriteOutput(const Walk& walk, const std::string& path, std::string* error
   return Status::kInvalidArgument;
 }
 
-// Characters walked together by the embedded engine (GenerateOptions::characters_per_pass).
-constexpr int kEmbeddedCharactersPerPass = 1000;
-
 // A one-line progress bar on stderr, redrawn at most 10 times a second.
 class ProgressBar {
  public:
@@ -128,9 +125,6 @@ int RunGenerate(const GenerateFlags& flags) {
   options.crowd = flags.crowd;
   options.crowd_spacing = flags.crowd_spacing;
   options.threads = flags.threads;
-  // Embedded, crowds walk 1000 characters at a time (their terrain stays in the caches); over
-  // RPC, all at once (one call per round of queries).
-  options.characters_per_pass = flags.terrain.server.empty() ? kEmbeddedCharactersPerPass : 0;
   {
     Character character;
     if (LoadCharacter(flags.character, &character, &error) != Status::kOk) goto bad_flag;

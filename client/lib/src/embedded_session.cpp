@@ -69,6 +69,7 @@ class EmbeddedSession final : public TerrainSession {
   }
 
   std::string Describe() const override { return "embedded"; }
+  bool InProcess() const override { return true; }
 
  private:
   struct Entry {

@@ -159,6 +159,7 @@ class RpcSession final : public TerrainSession {
   std::string Describe() const override {
     return "rpc " + options_.host + ":" + std::to_string(options_.port);
   }
+  bool InProcess() const override { return false; }
 
  private:
   Status PointBatch(TerrainHandle terrain, const Vec3* points, size_t count, Foothold* out,

@@ -250,10 +250,13 @@ Status Generator::Run(std::string* error) {
   }
   Status s = Setup(error);
   if (s != Status::kOk) return s;
-  // Passes: the characters walk every step in groups of characters_per_pass (all at once by
-  // default), so that a group's terrain stays in the caches from one step to the next.
+  // Passes: the characters walk every step in groups of characters_per_pass, so that a group's
+  // terrain stays in the caches from one step to the next.
   const size_t n = agents_.size();
-  const size_t per_pass = o_.characters_per_pass > 0 ? o_.characters_per_pass : n;
+  int per_pass_option = o_.characters_per_pass;
+  if (per_pass_option == 0)
+    per_pass_option = session_.InProcess() ? kInProcessCharactersPerPass : -1;
+  const size_t per_pass = per_pass_option > 0 ? static_cast<size_t>(per_pass_option) : n;
   const int passes = static_cast<int>((n + per_pass - 1) / per_pass);
   // Progress in steps times passes, scaled down if that overflows an int.
   const int64_t total = int64_t{passes} * steps_;

@@ -54,6 +54,9 @@ class TerrainSession {
 
   // "embedded" or "rpc HOST:PORT".
   virtual std::string Describe() const = 0;
+  // True when queries are answered in this process (no round trip per call): callers may then
+  // prefer several smaller batches that stay in the caches to one large one.
+  virtual bool InProcess() const = 0;
   // The reason for the last failed call, one line.
   const std::string& last_error() const { return last_error_; }
 

@@ -17,6 +17,10 @@
 
 namespace footfall {
 
+// Characters walked together by default when the session answers in process: their stretch of
+// terrain and their keys stay in the caches from one step to the next.
+constexpr int kInProcessCharactersPerPass = 1000;
+
 struct GenerateOptions {
   // Where the (first) character stands, snapped to the terrain. World space. Unset: the sample
   // nearest the centre of the top of the terrain's bounds (top along `up`).
@@ -43,10 +47,11 @@ struct GenerateOptions {
   // its batches by itself). The walk is the same whatever the count. [Limit: >= 1]
   int threads = 1;
   // Characters walked together: the crowd walks every step in groups of this many characters,
-  // one group after the other, so that each group's stretch of terrain stays in the caches
-  // (embedded engine). <= 0: all at once, which makes every round of queries of a step one
-  // batch call for the whole crowd (the right choice over RPC). The walk is the same whatever
-  // the value.
+  // one group after the other, so that each group's stretch of terrain stays in the caches.
+  // < 0: all at once, which makes every round of queries of a step one batch call for the
+  // whole crowd (the right choice over RPC). 0: chosen by the session,
+  // kInProcessCharactersPerPass when it answers in process, else all at once. The walk is the
+  // same whatever the value.
   int characters_per_pass = 0;
   // Called as the walk advances with (work done, total work), in steps times passes; may be
   // empty.
