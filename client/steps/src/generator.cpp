@@ -134,6 +134,8 @@ class Generator {
   Vec3 world_up_;
   int steps_ = 0;
   double lead_ = 0;
+  // cos(max_slope_deg), sin(slope_threshold_deg): slope tests on dot products of unit vectors.
+  double cos_max_slope_ = -1, sin_slope_threshold_ = 1;
   std::vector<Agent> agents_;
   size_t pass_begin_ = 0, pass_end_ = 0;  // the agents walking in this pass
   std::shared_ptr<BatchPool> pool_;
@@ -229,6 +231,11 @@ Status Generator::Run(std::string* error) {
   // centroid, L * (G + 1) / (2G) makes every foot travel exactly L per step once walking
   // (half a step ahead for G -> infinity; 3/4 of a step for two gait groups).
   lead_ = c_.step_length * (groups + 1) / (2.0 * groups);
+  // (Past the ends of their ranges the tests hold or fail whatever the rounding of the dots.)
+  cos_max_slope_ =
+      c_.max_slope_deg >= 180 ? -2.0 : std::cos(Radians(std::max(c_.max_slope_deg, 0.0)));
+  sin_slope_threshold_ =
+      c_.slope_threshold_deg >= 90 ? 2.0 : std::sin(Radians(std::max(c_.slope_threshold_deg, 0.0)));
   pair_of_foot_.assign(c_.feet.size(), 0);
   for (size_t p = 0; p < c_.pairs.size(); ++p) {
     Vec3 centre;
@@ -428,14 +435,13 @@ Status Generator::QueryFootholds(std::string* error) {
         }
         const int p = pair_of_foot_[mv.foot];
         Vec3 n = locator_normal_[pending_[i]];
-        if (Degrees(AngleBetween(n, a.up)) > c_.max_slope_deg) n = a.up;  // an edge, not ground
+        if (Dot(n, a.up) < cos_max_slope_) n = a.up;  // leans past max_slope_deg: an edge
         const Vec3 f = TangentForward(a.forward, a.forward, a.up, n);
         const Vec3 l = Cross(n, f);
         const Vec3 d = c_.feet[mv.foot].rest - pair_centre_[p];
         const Vec3 target = locator_[pending_[i]] + l * d.x + n * d.y + f * d.z;
-        const double slope = Degrees(std::asin(std::min(1.0, std::fabs(Dot(f, a.up)))));
-        double max_len = c_.step_length;
-        if (slope > c_.slope_threshold_deg) max_len *= c_.slope_step_scale;
+        double max_len = c_.step_length;  // shorter where the heading climbs or falls steeply
+        if (std::fabs(Dot(f, a.up)) > sin_slope_threshold_) max_len *= c_.slope_step_scale;
         Vec3 v = target - a.foot[mv.foot];
         const double len = Length(v);
         if (len > max_len) v = v * (max_len / len);
@@ -511,8 +517,7 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
   }
   const bool found = h.status == Status::kOk && progress >= 0.5;
   const double rise = found ? Dot(h.point - foot, a.up) : 0;
-  const double slope = found ? Degrees(AngleBetween(h.normal, a.up)) : 0;
-  if (found && std::fabs(rise) <= c_.max_rise && slope <= c_.max_slope_deg) {
+  if (found && std::fabs(rise) <= c_.max_rise && Dot(h.normal, a.up) >= cos_max_slope_) {
     mv.done = true, mv.end = h.point, mv.end_normal = h.normal;
     return;
   }
@@ -525,8 +530,9 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
     why << "the foothold at " << Point(h.point) << (rise > 0 ? " rises " : " drops ")
         << std::fabs(rise) << ", more than max_rise " << c_.max_rise << " (a cliff)";
   } else {
-    why << "the foothold at " << Point(h.point) << " leans " << slope
-        << " deg, more than max_slope_deg " << c_.max_slope_deg << " (too steep)";
+    why << "the foothold at " << Point(h.point) << " leans "
+        << Degrees(AngleBetween(h.normal, a.up)) << " deg, more than max_slope_deg "
+        << c_.max_slope_deg << " (too steep)";
   }
   mv.reason = why.str();
 }
