@@ -223,9 +223,14 @@ TEST_CASE("WriteGltf rejects walks glTF cannot hold", "[export][gltf]") {
     CHECK_THAT(error, Catch::Contains("track 0 'L' key 2 has a non-finite position"));
   }
   SECTION("a zero body quaternion") {
-    walk.tracks[2].keys[1].rotation = {0, 0, 0, 0};
+    walk.tracks[2].rotations[1] = {0, 0, 0, 0};
     CHECK(WriteGltf(walk, path, &error) == Status::kInvalidArgument);
     CHECK_THAT(error, Catch::Contains("track 2 'body' key 1 has a zero rotation quaternion"));
+  }
+  SECTION("a body key without its rotation") {
+    walk.tracks[2].rotations.pop_back();
+    CHECK(WriteGltf(walk, path, &error) == Status::kInvalidArgument);
+    CHECK_THAT(error, Catch::Contains("track 2 'body' has 4 rotations for 5 keys"));
   }
   std::ifstream written(path);
   CHECK_FALSE(written.good());  // nothing written

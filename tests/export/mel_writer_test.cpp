@@ -210,7 +210,7 @@ TEST_CASE("WriteMel reports bad walks and unwritable paths", "[export][mel]") {
   const std::string unwritable = test::ScratchPath("no-such-dir") + "/walk.mel";
   CHECK(WriteMel(walk, unwritable, &error) == Status::kIoError);
   CHECK_THAT(error, Catch::Contains(unwritable));
-  walk.tracks[2].keys[0].rotation.w = INFINITY;
+  walk.tracks[2].rotations[0].w = INFINITY;
   CHECK(WriteMel(walk, test::ScratchPath("bad.mel"), &error) == Status::kInvalidArgument);
   CHECK_THAT(error, Catch::Contains("track 2 'body' key 0 has a non-finite rotation"));
 }

@@ -17,12 +17,12 @@ WalkKey FootKey(double frame, KeyPhase phase, Vec3 position) {
   return key;
 }
 
-WalkKey BodyKey(double frame, Vec3 position, Quat rotation) {
+void AddBodyKey(WalkTrack* body, double frame, Vec3 position, Quat rotation) {
   WalkKey key;
   key.frame = frame;
   key.position = position;
-  key.rotation = rotation;
-  return key;
+  body->keys.push_back(key);
+  body->rotations.push_back(rotation);
 }
 
 WalkTrack Track(const std::string& name, const std::string& character, TrackKind kind) {
@@ -62,9 +62,11 @@ Walk BipedWalk() {
   q60 = {q60.x * 2, q60.y * 2, q60.z * 2, q60.w * 2};
   Quat q170 = YawQuat(170);
   q170 = {-q170.x, -q170.y, -q170.z, -q170.w};
-  body.keys = {BodyKey(1, {0, 0.9, 0}, YawQuat(0)), BodyKey(13, {0, 0.91, 0.25}, q60),
-               BodyKey(25, {0, 0.92, 0.5}, YawQuat(150)), BodyKey(31, {0, 0.93, 0.6}, q170),
-               BodyKey(37, {0, 0.94, 0.75}, YawQuat(190))};
+  AddBodyKey(&body, 1, {0, 0.9, 0}, YawQuat(0));
+  AddBodyKey(&body, 13, {0, 0.91, 0.25}, q60);
+  AddBodyKey(&body, 25, {0, 0.92, 0.5}, YawQuat(150));
+  AddBodyKey(&body, 31, {0, 0.93, 0.6}, q170);
+  AddBodyKey(&body, 37, {0, 0.94, 0.75}, YawQuat(190));
   walk.tracks = {left, right, body};
   return walk;
 }
@@ -84,8 +86,9 @@ Walk CrowdWalk() {
                FootKey(13, KeyPhase::kMid, {x + 0.1, 0.1, 0.1}),
                FootKey(17, KeyPhase::kEnd, {x + 0.1, 0, 0.2})};
     WalkTrack body = Track("body", characters[c], TrackKind::kBody);
-    body.keys = {BodyKey(1, {x, 0.3, 0}, YawQuat(0)), BodyKey(9, {x, 0.3, 0.05}, YawQuat(10)),
-                 BodyKey(17, {x, 0.3, 0.1}, YawQuat(20))};
+    AddBodyKey(&body, 1, {x, 0.3, 0}, YawQuat(0));
+    AddBodyKey(&body, 9, {x, 0.3, 0.05}, YawQuat(10));
+    AddBodyKey(&body, 17, {x, 0.3, 0.1}, YawQuat(20));
     walk.tracks.push_back(l1);
     walk.tracks.push_back(r1);
     walk.tracks.push_back(body);

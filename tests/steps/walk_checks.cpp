@@ -71,9 +71,11 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
   REQUIRE(tracks.size() == c.feet.size() + 1);
   const WalkTrack& body = *tracks.back();
   REQUIRE(body.kind == TrackKind::kBody);
+  REQUIRE(body.rotations.size() == body.keys.size());
   for (size_t f = 0; f < c.feet.size(); ++f) {
     REQUIRE(tracks[f]->name == c.feet[f].name);
     REQUIRE(tracks[f]->kind == TrackKind::kFoot);
+    REQUIRE(tracks[f]->rotations.empty());
   }
   for (const WalkTrack* tr : tracks) {
     REQUIRE_FALSE(tr->keys.empty());
@@ -130,7 +132,8 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
   CHECK(below == 0);
   // The body follows the feet.
   const Vec3 world_up = Normalize(o.up);
-  for (const WalkKey& b : body.keys) {
+  for (size_t i = 0; i < body.keys.size(); ++i) {
+    const WalkKey& b = body.keys[i];
     Vec3 centroid;
     for (size_t f = 0; f < c.feet.size(); ++f) {
       const Vec3 p = FootAt(*tracks[f], b.frame);
@@ -138,7 +141,7 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
       CHECK(Distance(p, b.position) <= c.reach + 1e-9);
     }
     centroid = centroid / static_cast<double>(c.feet.size());
-    const Vec3 up = c.align_to_normal ? QuatAxisY(b.rotation) : world_up;
+    const Vec3 up = c.align_to_normal ? QuatAxisY(body.rotations[i]) : world_up;
     const Vec3 expected = centroid + up * c.body_height;
     CHECK(Distance(expected, b.position) < 1e-6);
   }

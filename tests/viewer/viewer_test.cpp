@@ -389,7 +389,7 @@ TEST_CASE("walk poses follow keys and swing arcs", "[viewer][walk]") {
   REQUIRE(ReadWalkJson(dir + "/walk.json", &walk, &error) == Status::kOk);
   REQUIRE(walk.tracks.size() == 3);
   CHECK(walk.tracks[2].kind == TrackKind::kBody);
-  CHECK(walk.tracks[2].keys[1].rotation.w == 2);  // the reader keeps rotations as written
+  CHECK(walk.tracks[2].rotations[1].w == 2);  // the reader keeps rotations as written
   const WalkTrack& l1 = walk.tracks[0];
   SECTION("keys are hit exactly and the foot holds outside its keys") {
     CHECK(viewer::PoseAt(l1, 1).position == Vec3{2, 0, 2});

@@ -104,8 +104,7 @@ Status Scene::LoadWalk(const std::string& path, std::string* error) {
   if (s != Status::kOk) return s;
   // The reader keeps rotations as written (non-zero); poses and axes want unit quaternions.
   for (WalkTrack& t : walk.tracks) {
-    for (WalkKey& k : t.keys) {
-      Quat& q = k.rotation;
+    for (Quat& q : t.rotations) {
       const double n = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
       q = {q.x / n, q.y / n, q.z / n, q.w / n};
     }

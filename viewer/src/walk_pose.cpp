@@ -21,11 +21,11 @@ Quat Slerp(Quat a, const Quat& b, double t) {
   return {q.x / n, q.y / n, q.z / n, q.w / n};
 }
 
-TrackPose FromKey(const WalkKey& k) {
+TrackPose FromKey(const WalkTrack& track, size_t i) {
   TrackPose p;
-  p.position = k.position;
-  p.normal = k.normal;
-  p.rotation = k.rotation;
+  p.position = track.keys[i].position;
+  p.normal = track.keys[i].normal;
+  p.rotation = track.Rotation(i);
   return p;
 }
 
@@ -41,8 +41,8 @@ Vec3 ArcPoint(const Vec3& start, const Vec3& mid, const Vec3& end, double t) {
 TrackPose PoseAt(const WalkTrack& track, double frame) {
   const std::vector<WalkKey>& keys = track.keys;
   if (keys.empty()) return TrackPose{};
-  if (frame <= keys.front().frame) return FromKey(keys.front());
-  if (frame >= keys.back().frame) return FromKey(keys.back());
+  if (frame <= keys.front().frame) return FromKey(track, 0);
+  if (frame >= keys.back().frame) return FromKey(track, keys.size() - 1);
   // The last key at or before `frame`.
   size_t i =
       static_cast<size_t>(std::upper_bound(keys.begin(), keys.end(), frame,
@@ -79,7 +79,7 @@ TrackPose PoseAt(const WalkTrack& track, double frame) {
   pose.position = Lerp(a.position, b.position, t);
   const Vec3 n = Lerp(a.normal, b.normal, t);
   pose.normal = Length2(n) > 0 ? Normalize(n) : a.normal;
-  pose.rotation = Slerp(a.rotation, b.rotation, t);
+  pose.rotation = Slerp(track.Rotation(i), track.Rotation(i + 1), t);
   pose.swinging = a.phase == KeyPhase::kStart || a.phase == KeyPhase::kMid;
   return pose;
 }

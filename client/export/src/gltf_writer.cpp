@@ -135,7 +135,7 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
                             {static_cast<float>(key.position.x), static_cast<float>(key.position.y),
                              static_cast<float>(key.position.z)});
         if (body) {
-          Quat q = walk_export::Normalized(key.rotation);
+          Quat q = walk_export::Normalized(track.Rotation(samples.keys[i]));
           // q and -q are the same rotation; keep neighbours in one hemisphere so that
           // interpolation takes the short way.
           if (i > 0 &&

@@ -190,7 +190,7 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
                " $footfall_node[0];\n";
       }
       if (body) {
-        Vec3 euler = QuatToEulerXyzDegrees(key.rotation);
+        Vec3 euler = QuatToEulerXyzDegrees(track.Rotation(index));
         if (!first) euler = ClosestEulerXyzDegrees(euler, previous_euler);
         previous_euler = euler;
         const double rotate[] = {euler.x, euler.y, euler.z};

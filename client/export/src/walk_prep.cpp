@@ -31,6 +31,14 @@ Status CheckWalk(const Walk& walk, std::string* error) {
   }
   for (size_t t = 0; t < walk.tracks.size(); ++t) {
     const WalkTrack& track = walk.tracks[t];
+    if (track.kind == TrackKind::kBody && track.rotations.size() != track.keys.size()) {
+      std::ostringstream message;
+      message << "track " << t << " '" << QualifiedTrackName(track, t) << "' has "
+              << track.rotations.size() << " rotations for " << track.keys.size()
+              << " keys (expected one per key)";
+      SetError(error, message.str());
+      return Status::kInvalidArgument;
+    }
     for (size_t k = 0; k < track.keys.size(); ++k) {
       const WalkKey& key = track.keys[k];
       const char* what = nullptr;
@@ -38,9 +46,9 @@ Status CheckWalk(const Walk& walk, std::string* error) {
         what = "a non-finite frame";
       } else if (!IsFinite(key.position)) {
         what = "a non-finite position";
-      } else if (track.kind == TrackKind::kBody && !Finite(key.rotation)) {
+      } else if (track.kind == TrackKind::kBody && !Finite(track.rotations[k])) {
         what = "a non-finite rotation";
-      } else if (track.kind == TrackKind::kBody && !(Norm2(key.rotation) > 1e-24)) {
+      } else if (track.kind == TrackKind::kBody && !(Norm2(track.rotations[k]) > 1e-24)) {
         what = "a zero rotation quaternion";
       }
       if (what != nullptr) {

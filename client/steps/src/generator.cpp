@@ -188,8 +188,9 @@ void Generator::KeyBody(const Agent& a, double frame) {
   key.frame = frame;
   key.position = a.ground + a.up * c_.body_height;
   key.normal = a.up;
-  key.rotation = QuatFromBasis(Left(a), a.up, a.forward);
-  walk_.tracks[a.first_track + c_.feet.size()].keys.push_back(key);
+  WalkTrack& track = walk_.tracks[a.first_track + c_.feet.size()];
+  track.keys.push_back(key);
+  track.rotations.push_back(QuatFromBasis(Left(a), a.up, a.forward));
 }
 
 void Generator::Stop(Agent& a, int step, const std::string& why) {
@@ -361,6 +362,7 @@ Status Generator::Setup(std::string* error) {
       t.kind = f < feet ? TrackKind::kFoot : TrackKind::kBody;
       const size_t steps_of_foot = static_cast<size_t>(steps_) / groups + 1;
       t.keys.reserve(std::min<size_t>(f < feet ? 3 * steps_of_foot + 1 : steps_ + 1, 4096));
+      if (f == feet) t.rotations.reserve(t.keys.capacity());
       walk_.tracks.push_back(std::move(t));
     }
   }

@@ -125,8 +125,9 @@ std::string WalkToJson(const Walk& walk) {
         out += ",\"position\":";
         Vector(out, k.position);
         out += ",\"rotation\":[";
-        Number(out, k.rotation.x), out += ',', Number(out, k.rotation.y), out += ',';
-        Number(out, k.rotation.z), out += ',', Number(out, k.rotation.w);
+        const Quat q = t.Rotation(ki);
+        Number(out, q.x), out += ',', Number(out, q.y), out += ',';
+        Number(out, q.z), out += ',', Number(out, q.w);
         out += ']';
       }
       out += '}';
@@ -253,7 +254,7 @@ Status ParseWalkJson(const std::string& text, const std::string& source, Walk* o
             r.Fail(kw + ".rotation", "expected a non-zero quaternion [qx, qy, qz, qw]");
             break;
           }
-          key.rotation = {q[0], q[1], q[2], q[3]};
+          track.rotations.push_back({q[0], q[1], q[2], q[3]});
         }
         track.keys.push_back(key);
       }

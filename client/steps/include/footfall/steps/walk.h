@@ -2,6 +2,7 @@
 // glTF, MEL) and of the viewer. World space throughout; frames are animation frames at `fps`.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -16,15 +17,18 @@ struct Quat {
 
 // Where a foot key sits in its step: lift-off, top of the swing arc, touch-down. Body keys
 // have no phase.
-enum class KeyPhase { kNone, kStart, kMid, kEnd };
+enum class KeyPhase : uint8_t { kNone, kStart, kMid, kEnd };
 
+// One key of a track: 64 bytes, as a crowd's walk holds millions of them. A body's orientation
+// is kept beside its keys (WalkTrack::rotations).
 struct WalkKey {
   double frame = 0;
-  KeyPhase phase = KeyPhase::kNone;
   Vec3 position;         // world space
-  Vec3 normal{0, 1, 0};  // feet: unit terrain normal at the key (mid: the averaged normal)
-  Quat rotation;         // body: world orientation
+  Vec3 normal{0, 1, 0};  // feet: unit terrain normal at the key (mid: the averaged normal);
+                         // body: its up
+  KeyPhase phase = KeyPhase::kNone;
 };
+static_assert(sizeof(WalkKey) == 64, "WalkKey is one cache line's worth");
 
 enum class TrackKind { kFoot, kBody };
 
@@ -34,6 +38,12 @@ struct WalkTrack {
   std::string character;  // crowd runs: which character ("" for a single character)
   TrackKind kind = TrackKind::kFoot;
   std::vector<WalkKey> keys;  // ascending frames
+  // Body tracks: the body's world orientation at each key (rotations[i] at keys[i]). Empty for
+  // feet.
+  std::vector<Quat> rotations;
+
+  // The orientation at keys[i]: rotations[i], or the identity where there is none.
+  Quat Rotation(size_t i) const { return i < rotations.size() ? rotations[i] : Quat{}; }
 };
 
 struct Walk {
