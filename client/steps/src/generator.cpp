@@ -16,12 +16,19 @@ namespace {
 
 using namespace steps_detail;
 
-// Foothold queries per foot and step: the step vector scaled by these factors in turn (shorter,
-// then longer: over a stair's riser, then shorter still).
-constexpr int kMaxAttempts = 4;
-constexpr double kAttemptScale[kMaxAttempts] = {1.0, 0.6, 1.35, 0.3};
-constexpr int kMaxRaises = 8;   // swing arc raises before giving up
-constexpr double kRaise = 0.5;  // raise per round, in step heights
+// Foothold queries per foot and step, in turn: the step vector scaled (shorter, then longer:
+// over a stair's riser, then shorter still), then aimed down by `drop` times max_rise along the
+// body's up (down a stair's nose, or over a convex edge onto the face below it).
+struct Attempt {
+  double scale, drop;
+};
+constexpr int kMaxAttempts = 7;
+constexpr Attempt kAttempts[kMaxAttempts] = {{1.0, 0},   {0.6, 0},   {1.35, 0}, {0.3, 0},
+                                             {1.0, 0.5}, {0.6, 0.5}, {0.3, 0.5}};
+constexpr int kMaxRaises = 8;         // swing arc raises before giving up
+constexpr double kRaise = 0.5;        // raise per round, in step heights
+constexpr double kSlide = 0.25;       // slide per round toward a blocked half's end (of the way)
+constexpr double kAlikeCos = 0.7071;  // footholds whose normals are within 45 deg face alike
 // Points checked along the start-mid-end arc. Each is snapped: its clearance is measured along
 // the normal of its nearest sample, and a Snap answer elsewhere proves only that no sample lies
 // closer to that point than the answer, which bounds neither which sample is nearest here nor
@@ -66,7 +73,7 @@ struct Agent {
 struct Move {
   size_t agent;
   int foot;
-  double scale = 1;  // step length factor (retries shorten it)
+  Attempt attempt = kAttempts[0];  // how this round aims the step (retries change it)
   int attempts = 0;
   bool done = false;
   bool failed = false;
@@ -447,9 +454,13 @@ Status Generator::QueryFootholds(std::string* error) {
         Vec3 v = target - a.foot[mv.foot];
         const double len = Length(v);
         if (len > max_len) v = v * (max_len / len);
-        v = v * mv.scale;  // retries step shorter
+        v = v * mv.attempt.scale;  // retries step shorter or longer
         if (Length(v) < kInPlace * c_.step_length) {
-          mv.done = true, mv.end = a.foot[mv.foot], mv.end_normal = a.foot_normal[mv.foot];
+          if (mv.attempt.drop > 0) {
+            mv.failed = true;  // nothing ahead to aim down at: the last refusal stands
+          } else {
+            mv.done = true, mv.end = a.foot[mv.foot], mv.end_normal = a.foot_normal[mv.foot];
+          }
           continue;
         }
         // No target beyond reach of the body where the step will put it (the feet's centroid
@@ -460,12 +471,13 @@ Status Generator::QueryFootholds(std::string* error) {
           if (Distance(a.foot[mv.foot] + v, body) <= c_.reach) break;
           v = v * 0.75;
         }
+        v -= a.up * (mv.attempt.drop * c_.max_rise);  // the last retries aim down
         mv.ideal = a.foot[mv.foot] + v, mv.step = v;
       }
     });
     queries_.clear();
     for (size_t m : pending_) {
-      if (moves[m].done) continue;  // a step in place
+      if (moves[m].done || moves[m].failed) continue;  // a step in place; nothing to aim at
       moves[m].query = queries_.size();
       queries_.push_back({agents_[moves[m].agent].foot[moves[m].foot], moves[m].step});
     }
@@ -498,7 +510,7 @@ Status Generator::QueryFootholds(std::string* error) {
       if (mv.attempts >= kMaxAttempts)
         mv.failed = true;
       else
-        mv.scale = kAttemptScale[mv.attempts], pending_.push_back(m);
+        mv.attempt = kAttempts[mv.attempts], pending_.push_back(m);
     }
   }
   return Status::kOk;
@@ -511,10 +523,12 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
   // A foothold must make half the intended progress along the ground it lands on (the step
   // vector projected onto its tangent plane), so no foot creeps sideways along a cliff's edge.
   // Steps mostly along the foothold's normal (onto a wall ahead) are exempt.
+  // A step aimed down is judged on the progress it was aimed to make.
+  const Vec3 intended = mv.step + a.up * (mv.attempt.drop * c_.max_rise);
   double progress = 1;
   if (h.status == Status::kOk) {
-    const Vec3 along = ProjectOnPlane(mv.step, h.normal);
-    if (Length2(along) >= 0.25 * Length2(mv.step))
+    const Vec3 along = ProjectOnPlane(intended, h.normal);
+    if (Length2(along) >= 0.25 * Length2(intended))
       progress = Dot(h.point - foot, along) / Length2(along);
   }
   const bool found = h.status == Status::kOk && progress >= 0.5;
@@ -625,15 +639,15 @@ Status Generator::ClearArcs(int k, std::string* error) {
         const ArcAgent& aa = arc_agents_[g];
         for (size_t i = aa.begin; i < aa.end; ++i) {
           Move& mv = moves[pending_[i]];
-          bool clear = true;
+          bool low[2] = {false, false};  // a check point too low in the first, second half
           for (int j = 0; j < kArcChecks; ++j) {
             const Foothold& h = arc_answers_[i * kArcChecks + j];
             const double nominal = c_.step_height * (1 - std::fabs(2 * kArcS[j] - 1));
             if (h.status == Status::kOk && Dot(arc_points_[i * kArcChecks + j] - h.point,
                                                h.normal) < kClearanceFraction * nominal)
-              clear = false;
+              low[kArcS[j] > 0.5] = true;
           }
-          if (clear) continue;
+          if (!low[0] && !low[1]) continue;
           if (round + 1 >= kMaxRaises) {
             std::ostringstream why;
             why.precision(3);
@@ -644,6 +658,15 @@ Status Generator::ClearArcs(int k, std::string* error) {
             continue;
           }
           mv.mid += mv.mid_normal * (kRaise * c_.step_height);
+          // Low in one half only, between footholds that face alike (a riser just ahead of
+          // the lifting foot, a nose just behind the landing one): the mid key also slides
+          // toward that half's end, so the foot lifts before it travels, or travels before it
+          // lands. (Over an edge between faces, raising alone is what clears it.)
+          if (low[0] != low[1] &&
+              Dot(agents_[mv.agent].foot_normal[mv.foot], mv.end_normal) >= kAlikeCos) {
+            const Vec3& end = low[0] ? agents_[mv.agent].foot[mv.foot] : mv.end;
+            mv.mid += ProjectOnPlane(end - mv.mid, mv.mid_normal) * kSlide;
+          }
           verdict_[i] = 1, raised_[g] = 1;
         }
         if (!raised_[g]) Finish(aa.walking, k);
