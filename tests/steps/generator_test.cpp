@@ -8,6 +8,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "footfall/import/mesh_generators.h"
+#include "footfall/import/mesh_sampler.h"
 #include "footfall/import/terrain_generators.h"
 #include "footfall/import/terrain_loader.h"
 #include "walk_checks.h"
@@ -180,6 +182,33 @@ TEST_CASE("The shipped quadruped climbs the shipped stairs; the insects walk dow
     }
     CHECK_THAT(w.stopped, Catch::Contains("(a gap or a cliff)"));
   }
+}
+
+TEST_CASE("Swing arcs clear a resampled stair mesh, whose riser tops lie beside the noses",
+          "[steps][generator]") {
+  // Poisson-disk samples with flat normals: above a nose, the nearest sample is often the top of
+  // the riser below it, facing -z, so an arc point high above the nose lies only a little in
+  // front of that sample's plane. Its clearance is its distance to the sample, not its height
+  // along that normal, or the arc is raised in vain and the walk stops. The quadruped's reach
+  // is raised to 1 m so that reach does not stop it on stairs this steep first.
+  RawSamples stairs;
+  MeshSampleOptions mo;
+  mo.separation = 0.03;
+  mo.smooth_normals = false;
+  REQUIRE(SampleMesh(MakeStairsMesh(8, 0.18, 0.3, 1.5), mo, &stairs, nullptr) == Status::kOk);
+  Terrain t = LoadTerrain(stairs, mo.separation);
+  Character c = LoadShipped("quadruped");
+  c.reach = 1.0;
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {0.75, 0, -0.6};
+  o.steps = 24;
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CheckWalk(t, c, o, w);
+  // Up seven of the eight steps at least (a toe planted right against the last riser cannot
+  // lift without moving back, which arcs do not do).
+  CHECK(Body(w).keys.back().position.y > 7 * 0.18);
 }
 
 TEST_CASE("Multipeds walk around a sphere; bipeds stop where it gets too steep",
@@ -365,6 +394,9 @@ TEST_CASE("A cliff stops the walk with the step, the position and the keys so fa
     CHECK(done > 4);
     CHECK_THAT(w.stopped, Catch::StartsWith("step " + std::to_string(done + 1) + ": foot "));
     CHECK_THAT(w.stopped, Catch::Contains("cliff"));
+    // The first refusal (the step as meant), then how many other tries failed too.
+    CHECK_THAT(w.stopped,
+               Catch::Contains("(6 more tries, shorter, longer or aimed down, refused too)"));
     CHECK_THAT(w.stopped, Catch::Contains("keys up to step " + std::to_string(done) + " kept"));
     CheckWalk(t, c, o, w);
     // Nothing lost: every foot ends planted at the edge side, with all its steps keyed.

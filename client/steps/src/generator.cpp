@@ -55,6 +55,17 @@ std::string Point(const Vec3& p) {
   return o.str();
 }
 
+// How far p is above the terrain, from h, the sample nearest to it: its height along h's
+// normal (negative: below the terrain), or, where p lies farther out along h's face than above
+// it (above a stair's nose, seen from the riser's top sample), its distance to h over sqrt(2),
+// which is the same where the two meet.
+double Clearance(const Vec3& p, const Foothold& h) {
+  const Vec3 v = p - h.point;
+  const double height = Dot(v, h.normal), d2 = Length2(v);
+  if (height <= 0 || d2 <= 2 * height * height) return height;
+  return std::sqrt(0.5 * d2);
+}
+
 // One walking character.
 struct Agent {
   std::string id;                       // "" for a single character, else "c1".."cN"
@@ -77,7 +88,7 @@ struct Move {
   int attempts = 0;
   bool done = false;
   bool failed = false;
-  std::string reason;    // why the last attempt was refused
+  std::string reason;    // why the first refused attempt was refused (or the arc, why not)
   Vec3 end, end_normal;  // the accepted foothold
   Vec3 mid, mid_normal;
   Vec3 ideal;               // the last query's ideal point
@@ -103,6 +114,8 @@ class Generator {
   // the footholds beyond reach of the body they lead to, or all of them when a planted foot
   // would be left beyond reach.
   void CheckReach(size_t m, size_t e);
+  // Gives up on mv's foothold after its last try; its reason says how many were refused.
+  static void Fail(Move& mv);
   Status ClearArcs(int k, std::string* error);
   // Keys (or stops) the w-th walking character at step k once its moves are final.
   void Finish(size_t w, int k);
@@ -457,7 +470,7 @@ Status Generator::QueryFootholds(std::string* error) {
         v = v * mv.attempt.scale;  // retries step shorter or longer
         if (Length(v) < kInPlace * c_.step_length) {
           if (mv.attempt.drop > 0) {
-            mv.failed = true;  // nothing ahead to aim down at: the last refusal stands
+            Fail(mv);  // nothing ahead to aim down at
           } else {
             mv.done = true, mv.end = a.foot[mv.foot], mv.end_normal = a.foot_normal[mv.foot];
           }
@@ -508,7 +521,7 @@ Status Generator::QueryFootholds(std::string* error) {
       Move& mv = moves[m];
       if (mv.done || mv.failed) continue;
       if (mv.attempts >= kMaxAttempts)
-        mv.failed = true;
+        Fail(mv);
       else
         mv.attempt = kAttempts[mv.attempts], pending_.push_back(m);
     }
@@ -537,7 +550,8 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
     mv.done = true, mv.end = h.point, mv.end_normal = h.normal;
     return;
   }
-  std::ostringstream why;  // refused: say why (only built on this rare path)
+  if (!mv.reason.empty()) return;  // the first refusal says why: the step as meant
+  std::ostringstream why;          // refused: say why (only built on this rare path)
   why.precision(3);
   if (!found) {
     why << "no foothold within " << 0.5 * c_.step_length << " of " << Point(mv.ideal)
@@ -551,6 +565,13 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
         << c_.max_slope_deg << " (too steep)";
   }
   mv.reason = why.str();
+}
+
+void Generator::Fail(Move& mv) {
+  mv.failed = true;
+  if (mv.attempts > 1)
+    mv.reason += " (" + std::to_string(mv.attempts - 1) +
+                 " more tries, shorter, longer or aimed down, refused too)";
 }
 
 void Generator::CheckReach(size_t m, size_t e) {
@@ -574,7 +595,8 @@ void Generator::CheckReach(size_t m, size_t e) {
       why.precision(3);
       why << "the foothold at " << Point(moves[i].end) << " is " << dist
           << " from the body, beyond reach " << c_.reach;
-      moves[i].done = false, moves[i].reason = why.str();
+      moves[i].done = false;
+      if (moves[i].reason.empty()) moves[i].reason = why.str();
     }
   }
   // A planted foot the body would leave beyond reach: every moving foot steps shorter.
@@ -585,8 +607,11 @@ void Generator::CheckReach(size_t m, size_t e) {
     why.precision(3);
     why << "the step would leave foot " << c_.feet[f].name << " " << dist
         << " from the body, beyond reach " << c_.reach;
-    for (size_t i = m; i < e; ++i)
-      if (moves[i].done) moves[i].done = false, moves[i].reason = why.str();
+    for (size_t i = m; i < e; ++i) {
+      if (!moves[i].done) continue;
+      moves[i].done = false;
+      if (moves[i].reason.empty()) moves[i].reason = why.str();
+    }
     break;
   }
 }
@@ -643,8 +668,8 @@ Status Generator::ClearArcs(int k, std::string* error) {
           for (int j = 0; j < kArcChecks; ++j) {
             const Foothold& h = arc_answers_[i * kArcChecks + j];
             const double nominal = c_.step_height * (1 - std::fabs(2 * kArcS[j] - 1));
-            if (h.status == Status::kOk && Dot(arc_points_[i * kArcChecks + j] - h.point,
-                                               h.normal) < kClearanceFraction * nominal)
+            if (h.status == Status::kOk &&
+                Clearance(arc_points_[i * kArcChecks + j], h) < kClearanceFraction * nominal)
               low[kArcS[j] > 0.5] = true;
           }
           if (!low[0] && !low[1]) continue;
@@ -658,12 +683,11 @@ Status Generator::ClearArcs(int k, std::string* error) {
             continue;
           }
           mv.mid += mv.mid_normal * (kRaise * c_.step_height);
-          // Low in one half only, between footholds that face alike (a riser just ahead of
-          // the lifting foot, a nose just behind the landing one): the mid key also slides
-          // toward that half's end, so the foot lifts before it travels, or travels before it
-          // lands. (Over an edge between faces, raising alone is what clears it.)
-          if (low[0] != low[1] &&
-              Dot(agents_[mv.agent].foot_normal[mv.foot], mv.end_normal) >= kAlikeCos) {
+          // Between footholds that face alike, the mid key also slides toward the start when
+          // the first half is low (a riser just ahead of the lifting foot: it lifts before it
+          // travels), else toward the end (a nose just behind the landing foot: it travels
+          // before it lands). (Over an edge between faces, raising alone is what clears it.)
+          if (Dot(agents_[mv.agent].foot_normal[mv.foot], mv.end_normal) >= kAlikeCos) {
             const Vec3& end = low[0] ? agents_[mv.agent].foot[mv.foot] : mv.end;
             mv.mid += ProjectOnPlane(end - mv.mid, mv.mid_normal) * kSlide;
           }

@@ -48,6 +48,18 @@ void AddQuad(TriangleMesh* mesh, const Vec3& a, const Vec3& b, const Vec3& c, co
 
 }  // namespace
 
+TriangleMesh MakeStairsMesh(int steps, double rise, double run, double width) {
+  TriangleMesh mesh;
+  const Vec3 up{0, 1, 0}, back{0, 0, -1};
+  AddQuad(&mesh, {0, 0, -3 * run}, {width, 0, -3 * run}, {width, 0, 0}, {0, 0, 0}, up);
+  for (int k = 0; k < steps; ++k) {
+    const double y0 = k * rise, y1 = y0 + rise, z0 = k * run, z1 = z0 + run;
+    AddQuad(&mesh, {0, y0, z0}, {width, y0, z0}, {width, y1, z0}, {0, y1, z0}, back);
+    AddQuad(&mesh, {0, y1, z0}, {width, y1, z0}, {width, y1, z1}, {0, y1, z1}, up);
+  }
+  return mesh;
+}
+
 TriangleMesh MakeBlocksMesh(int nx, int nz, int max_height, uint64_t seed) {
   TriangleMesh mesh;
   std::vector<int> height(static_cast<size_t>(std::max(nx, 0)) * std::max(nz, 0));

@@ -25,6 +25,12 @@ TriangleMesh MakeRampsMesh(const std::vector<double>& slopes_deg, double length,
 // multi-octave value noise of peak-to-trough height about `amplitude`.
 TriangleMesh MakeRocksMesh(int n, double cell, double amplitude, uint64_t seed);
 
+// A flight of `steps` stairs rising along +z, `width` across (x in [0, width]): a floor at
+// y = 0 from z = -3 * run to 0, then treads (facing +y) `rise` above each other and `run` deep,
+// with risers (facing -z) between them. Every face has its own vertices, so smooth normals stay
+// flat and a stair's nose is a sharp edge; the sides are open.
+TriangleMesh MakeStairsMesh(int steps, double rise, double run, double width);
+
 // A sphere of `radius` about `centre`: an icosahedron subdivided `subdivisions` times
 // (20 * 4^subdivisions triangles), vertices on the sphere, faces outward.
 TriangleMesh MakeSphereMesh(const Vec3& centre, double radius, int subdivisions);
