@@ -83,6 +83,7 @@ bad character "$work/none.json: cannot open character file" --terrain "$hills" -
 printf '{"format": "footfall-character", "version": 1, "feet": []}' > "$work/bad.json"
 bad character-content "$work/bad.json: 'feet': expected a non-empty array" --terrain "$hills" --character "$work/bad.json" --out "$work/x.json"
 bad zero-heading "heading must be a non-zero finite vector" --terrain "$hills" --character "$chars/biped.json" --heading 0,0,0 --out "$work/x.json"
+bad far-start "the start is too far from the terrain to snap" --terrain "$hills" --character "$chars/biped.json" --start 1e20,0,0 --out "$work/x.json"
 check "bad flags: no output written" [ ! -e "$work/x.json" ]
 
 stop_server

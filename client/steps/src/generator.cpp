@@ -336,7 +336,9 @@ Status Generator::Setup(std::string* error) {
   Status s = Check(session_.Snap(terrain_, &start, 1, &first), "snap start", error);
   if (s != Status::kOk) return s;
   if (first.status != Status::kOk) {
-    *error = "the terrain is empty: no sample to start on";
+    *error = first.status == Status::kInvalidArgument
+                 ? "the start is too far from the terrain to snap (queries reach 1e15 from it)"
+                 : "the terrain is empty: no sample to start on";
     return Status::kInvalidArgument;
   }
   // 2. The start frame: up (terrain normal for multipeds, world up for bipeds) and the heading
