@@ -6,6 +6,8 @@
 #include <netinet/in.h>
 #include <signal.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -253,6 +255,34 @@ TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
         "bad.pts:2: column 3: 'zero' is not a number (expected x y z nx ny nz)");
   CHECK(server.Log().find("error: load") != std::string::npos);
   std::system(("rm -rf '" + root + "' /tmp/footfall-outside.pts").c_str());
+}
+
+TEST_CASE("footfalld refuses files that are not regular and keeps serving", "[rpc][robustness]") {
+  char tmpl[] = "/tmp/footfall-root-XXXXXX";
+  REQUIRE(mkdtemp(tmpl));
+  const std::string root = tmpl;
+  REQUIRE(mkfifo((root + "/fifo.pts").c_str(), 0600) == 0);  // open() for reading would block
+  REQUIRE(mkdir((root + "/dir.pts").c_str(), 0700) == 0);
+  const int unix_socket = socket(AF_UNIX, SOCK_STREAM, 0);
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  std::snprintf(address.sun_path, sizeof address.sun_path, "%s/socket.pts", root.c_str());
+  REQUIRE(bind(unix_socket, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0);
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", root});
+  // A generous timeout: a server stuck opening the FIFO would answer nobody within it.
+  auto rpc = Connect(server.port(), 20);
+  const std::pair<const char*, const char*> cases[] = {
+      {"fifo.pts", "'fifo.pts' is a FIFO: expected a regular terrain file"},
+      {"dir.pts", "'dir.pts' is a directory: expected a regular terrain file"},
+      {"socket.pts", "'socket.pts' is a socket: expected a regular terrain file"}};
+  for (const auto& c : cases) {
+    TerrainHandle t = 0;
+    CHECK(rpc->LoadServerFile(c.first, 0, &t) == Status::kInvalidArgument);
+    CHECK(rpc->last_error() == c.second);
+  }
+  RequireServed(server.port());  // another client is answered afterwards
+  close(unix_socket);
+  std::system(("rm -rf '" + root + "'").c_str());
 }
 
 TEST_CASE("misbehaving clients leave others served and memory flat", "[rpc][robustness]") {

@@ -1,7 +1,9 @@
 #include "footfall/service/terrain_registry.h"
 
+#include <fcntl.h>
 #include <limits.h>
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <random>
@@ -30,6 +32,45 @@ Status ResolveUnderRoot(const std::string& root, const std::string& relative, st
     return Status::kAccessDenied;
   }
   *resolved = canonical;
+  return Status::kOk;
+}
+
+namespace {
+
+// What a file type is, for messages about files that are not regular.
+const char* FileKind(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  return "not a regular file";
+}
+
+}  // namespace
+
+Status CheckRegularFile(const std::string& path, const std::string& shown, std::string* message) {
+  struct stat before {};
+  if (stat(path.c_str(), &before) != 0) {
+    *message = "'" + shown + "': no such file under the data root";
+    return Status::kIoError;
+  }
+  auto refuse = [&](mode_t mode) {
+    *message = "'" + shown + "' is " + FileKind(mode) + ": expected a regular terrain file";
+    return Status::kInvalidArgument;
+  };
+  if (!S_ISREG(before.st_mode)) return refuse(before.st_mode);
+  // Opened without blocking, in case it was replaced since, and checked again through the fd.
+  const int fd = open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+  if (fd < 0) {
+    *message = "'" + shown + "': cannot open";
+    return Status::kIoError;
+  }
+  struct stat opened {};
+  const bool same =
+      fstat(fd, &opened) == 0 && opened.st_dev == before.st_dev && opened.st_ino == before.st_ino;
+  close(fd);
+  if (!same || !S_ISREG(opened.st_mode)) return refuse(opened.st_mode);
   return Status::kOk;
 }
 
@@ -78,6 +119,8 @@ Status TerrainRegistry::LoadFile(const std::string& relative_path, double separa
                                  uint32_t* handle, std::string* message) {
   std::string path;
   Status status = ResolveUnderRoot(data_root_, relative_path, &path, message);
+  if (status != Status::kOk) return status;
+  status = CheckRegularFile(path, relative_path, message);
   if (status != Status::kOk) return status;
   if (!(separation >= 0)) {
     *message = "separation must be >= 0";

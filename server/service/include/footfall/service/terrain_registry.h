@@ -85,4 +85,9 @@ class TerrainRegistry {
 Status ResolveUnderRoot(const std::string& root, const std::string& relative, std::string* resolved,
                         std::string* message);
 
+// Refuses (kInvalidArgument) anything at `path` but a regular file: FIFOs, devices, sockets and
+// directories, whose reading could block the server or never end. Never blocks; messages name
+// the file as `shown`.
+Status CheckRegularFile(const std::string& path, const std::string& shown, std::string* message);
+
 }  // namespace footfall
