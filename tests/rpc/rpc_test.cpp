@@ -231,30 +231,80 @@ TEST_CASE("RPC answers equal the embedded engine", "[rpc]") {
   }
 }
 
+// FF_LOAD's arguments encoded as xdr_string would, but from a std::string that may hold NUL
+// bytes (rpcgen's stub sends a C string).
+struct RawLoadArgs {
+  std::string path;
+  double separation = 0;
+};
+
+bool_t EncodeRawLoad(XDR* xdrs, RawLoadArgs* a) {
+  char* bytes = a->path.data();
+  u_int length = static_cast<u_int>(a->path.size());
+  return xdr_bytes(xdrs, &bytes, &length, FF_MAX_PATH) && xdr_double(xdrs, &a->separation);
+}
+
 TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
   char tmpl[] = "/tmp/footfall-root-XXXXXX";
   REQUIRE(mkdtemp(tmpl));
   const std::string root = tmpl;
+  const std::string outside = root + "-outside";  // a folder beside the root
   {
+    REQUIRE(mkdir(outside.c_str(), 0700) == 0);
     std::ofstream(root + "/ok.pts") << "0 0 0 0 1 0\n1 0 0 0 1 0\n";
     std::ofstream(root + "/bad.pts") << "0 0 0 0 1 0\n1 0 zero 0 1 0\n";
-    std::ofstream("/tmp/footfall-outside.pts") << "0 0 0 0 1 0\n";
-    REQUIRE(symlink("/tmp/footfall-outside.pts", (root + "/link.pts").c_str()) == 0);
+    std::ofstream(outside + "/there.pts") << "0 0 0 0 1 0\n";
+    REQUIRE(symlink((outside + "/there.pts").c_str(), (root + "/link.pts").c_str()) == 0);
+    REQUIRE(symlink((outside + "/gone.pts").c_str(), (root + "/dangling.pts").c_str()) == 0);
+    REQUIRE(symlink(outside.c_str(), (root + "/out").c_str()) == 0);
   }
   ServerProcess server(0, {"--no-rpcbind", "--data-root", root});
   auto rpc = Connect(server.port());
   TerrainHandle t = 0;
   CHECK(rpc->LoadServerFile("ok.pts", 0, &t) == Status::kOk);
   CHECK(rpc->Snap(t, Vec3{0.9, 0, 0}).index == 1);
-  CHECK(rpc->LoadServerFile("../footfall-outside.pts", 0, &t) == Status::kAccessDenied);
-  CHECK(rpc->LoadServerFile("link.pts", 0, &t) == Status::kAccessDenied);
   CHECK(rpc->LoadServerFile("/etc/passwd", 0, &t) == Status::kAccessDenied);
   CHECK(rpc->LoadServerFile("missing.pts", 0, &t) == Status::kIoError);
+  CHECK(rpc->LoadServerFile("nowhere/missing.pts", 0, &t) == Status::kIoError);
   REQUIRE(rpc->LoadServerFile("bad.pts", 0, &t) == Status::kParseError);
   CHECK(rpc->last_error() ==
         "bad.pts:2: column 3: 'zero' is not a number (expected x y z nx ny nz)");
   CHECK(server.Log().find("error: load") != std::string::npos);
-  std::system(("rm -rf '" + root + "' /tmp/footfall-outside.pts").c_str());
+
+  SECTION("paths leaving the root get one answer, whether their targets exist or not") {
+    const std::string base = root.substr(root.rfind('/') + 1) + "-outside/";
+    for (const std::string& path :
+         std::vector<std::string>{"../" + base + "there.pts", "../" + base + "gone.pts",
+                                  "sub/../../" + base + "there.pts", "link.pts", "dangling.pts",
+                                  "out/there.pts", "out/gone.pts", "out/no/such/dir.pts"}) {
+      INFO(path);
+      CHECK(rpc->LoadServerFile(path, 0, &t) == Status::kAccessDenied);
+      CHECK(rpc->last_error() == "'" + path + "' leads outside the data root");
+    }
+  }
+  SECTION("a path with a NUL byte is refused, not cut short") {
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons(static_cast<uint16_t>(server.port()));
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    int sock = RPC_ANYSOCK;
+    CLIENT* c = clnttcp_create(&addr, FOOTFALL_PROG, FOOTFALL_V1, &sock, 0, 0);
+    REQUIRE(c != nullptr);
+    RawLoadArgs args;
+    args.path = std::string("ok.pts\0../x", 11);
+    ff_load_reply reply{};
+    const timeval timeout{10, 0};
+    REQUIRE(clnt_call(c, FF_LOAD, reinterpret_cast<xdrproc_t>(EncodeRawLoad),
+                      reinterpret_cast<char*>(&args),
+                      reinterpret_cast<xdrproc_t>(xdr_ff_load_reply),
+                      reinterpret_cast<char*>(&reply), timeout) == RPC_SUCCESS);
+    CHECK(reply.status == FF_INVALID_ARGUMENT);
+    CHECK(std::string(reply.message) ==
+          "path has a NUL byte at offset 6: expected a path without NUL bytes");
+    xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&reply));
+    clnt_destroy(c);
+  }
+  std::system(("rm -rf '" + root + "' '" + outside + "'").c_str());
 }
 
 TEST_CASE("footfalld refuses files that are not regular and keeps serving", "[rpc][robustness]") {

@@ -79,10 +79,22 @@ void LogError(const char* proc, Status status, const std::string& message) {
 
 // --- procedures -------------------------------------------------------------------------
 
-void Load(const ff_load_args& a, ff_load_reply* r) {
+// ff_load_args decoded with the path's length kept (the same bytes as xdr_string): a C string
+// would end the path at a NUL byte inside it, and load another file than the one named.
+struct LoadArgs {
+  char* path = nullptr;
+  u_int path_len = 0;
+  double separation = 0;
+};
+
+bool_t XdrLoadArgs(XDR* xdrs, LoadArgs* a) {
+  return xdr_bytes(xdrs, &a->path, &a->path_len, FF_MAX_PATH) && xdr_double(xdrs, &a->separation);
+}
+
+void Load(const LoadArgs& a, ff_load_reply* r) {
   std::string message;
   uint32_t handle = 0;
-  const std::string path = a.path ? a.path : "";
+  const std::string path = a.path ? std::string(a.path, a.path_len) : "";
   const Status s = g_state->registry.LoadFile(path, a.separation, &handle, &message);
   r->status = Wire(s);
   r->terrain = handle;
@@ -348,8 +360,8 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
       svc_sendreply(transport, FF_XDR_VOID, nullptr);
       return;
     case FF_LOAD:
-      return Serve<ff_load_args, ff_load_reply>(transport, FF_XDR(ff_load_args),
-                                                FF_XDR(ff_load_reply), "load", Load);
+      return Serve<LoadArgs, ff_load_reply>(transport, AsXdrProc(XdrLoadArgs),
+                                            FF_XDR(ff_load_reply), "load", Load);
     case FF_UPLOAD_BEGIN:
       return Serve<ff_upload_begin_args, ff_upload_reply>(
           transport, FF_XDR(ff_upload_begin_args), FF_XDR(ff_upload_reply), "upload", UploadBegin);

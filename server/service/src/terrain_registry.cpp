@@ -6,36 +6,61 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <random>
+#include <vector>
 
 namespace footfall {
 
-Status ResolveUnderRoot(const std::string& root, const std::string& relative, std::string* resolved,
-                        std::string* message) {
-  if (root.empty()) {
-    *message = "server-side loads are disabled (footfalld has no --data-root)";
-    return Status::kAccessDenied;
-  }
-  if (relative.empty() || relative[0] == '/') {
-    *message = "'" + relative + "': expected a path relative to the data root";
-    return Status::kAccessDenied;
-  }
-  const std::string joined = root + "/" + relative;
-  char buffer[PATH_MAX];
-  if (!realpath(joined.c_str(), buffer)) {
-    *message = "'" + relative + "': no such file under the data root";
-    return Status::kIoError;
-  }
-  const std::string canonical = buffer;
-  if (canonical.compare(0, root.size() + 1, root + "/") != 0) {
-    *message = "'" + relative + "': resolves outside the data root";
-    return Status::kAccessDenied;
-  }
-  *resolved = canonical;
-  return Status::kOk;
+namespace {
+
+// True when canonical `path` is `root` or below it.
+bool Inside(const std::string& root, const std::string& path) {
+  return root == "/" || path == root || path.compare(0, root.size() + 1, root + "/") == 0;
 }
 
-namespace {
+// True when canonical `path` is an ancestor of `root` (a walk from "/" passes it on the way in).
+bool AboveRoot(const std::string& root, const std::string& path) {
+  return path == "/" || root.compare(0, path.size() + 1, path + "/") == 0;
+}
+
+std::vector<std::string> Components(const std::string& path) {
+  std::vector<std::string> parts;
+  size_t begin = 0;
+  while (begin <= path.size()) {
+    const size_t end = std::min(path.find('/', begin), path.size());
+    if (end > begin) parts.push_back(path.substr(begin, end - begin));
+    begin = end + 1;
+  }
+  return parts;
+}
+
+// For an absolute path that realpath cannot resolve: true when resolving it leaves `root` before
+// it fails (a prefix resolves outside, or the part that fails is a link whose target leads out).
+// Decided without looking at anything outside the root that the path names, so the answer does
+// not reveal whether such things exist.
+bool LeadsOutside(const std::string& root, const std::string& path, int depth) {
+  if (depth > 16) return true;  // a loop of links
+  const std::vector<std::string> parts = Components(path);
+  std::string at = "/";  // canonical, inside the root or above it
+  for (size_t i = 0; i < parts.size(); ++i) {
+    const std::string next = (at == "/" ? "" : at) + "/" + parts[i];
+    char buffer[PATH_MAX];
+    if (realpath(next.c_str(), buffer)) {
+      at = buffer;
+      if (!Inside(root, at) && !AboveRoot(root, at)) return true;
+      continue;
+    }
+    if (!Inside(root, at)) return true;
+    const ssize_t n = readlink(next.c_str(), buffer, sizeof buffer - 1);
+    if (n < 0) return false;  // missing below a directory of the root
+    buffer[n] = '\0';
+    std::string rest = buffer[0] == '/' ? std::string(buffer) : at + "/" + buffer;
+    for (size_t j = i + 1; j < parts.size(); ++j) rest += "/" + parts[j];
+    return LeadsOutside(root, rest, depth + 1);
+  }
+  return !Inside(root, at);
+}
 
 // What a file type is, for messages about files that are not regular.
 const char* FileKind(mode_t mode) {
@@ -48,6 +73,49 @@ const char* FileKind(mode_t mode) {
 }
 
 }  // namespace
+
+Status ResolveUnderRoot(const std::string& root, const std::string& relative, std::string* resolved,
+                        std::string* message) {
+  if (root.empty()) {
+    *message = "server-side loads are disabled (footfalld has no --data-root)";
+    return Status::kAccessDenied;
+  }
+  const size_t nul = relative.find('\0');
+  if (nul != std::string::npos) {
+    *message = "path has a NUL byte at offset " + std::to_string(nul) +
+               ": expected a path without NUL bytes";
+    return Status::kInvalidArgument;
+  }
+  if (relative.empty() || relative[0] == '/') {
+    *message = "'" + relative + "': expected a path relative to the data root";
+    return Status::kAccessDenied;
+  }
+  // Every path that leaves the root gets this one answer, whether or not its target exists.
+  const std::string outside = "'" + relative + "' leads outside the data root";
+  for (const std::string& part : Components(relative)) {
+    if (part == "..") {
+      *message = outside;
+      return Status::kAccessDenied;
+    }
+  }
+  const std::string joined = root + "/" + relative;
+  char buffer[PATH_MAX];
+  if (!realpath(joined.c_str(), buffer)) {
+    if (LeadsOutside(root, joined, 0)) {
+      *message = outside;
+      return Status::kAccessDenied;
+    }
+    *message = "'" + relative + "': no such file under the data root";
+    return Status::kIoError;
+  }
+  const std::string canonical = buffer;
+  if (!Inside(root, canonical)) {
+    *message = outside;
+    return Status::kAccessDenied;
+  }
+  *resolved = canonical;
+  return Status::kOk;
+}
 
 Status CheckRegularFile(const std::string& path, const std::string& shown, std::string* message) {
   struct stat before {};
