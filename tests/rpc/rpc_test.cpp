@@ -16,6 +16,7 @@
 #include <fstream>
 #include <functional>
 #include <random>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -332,6 +333,32 @@ TEST_CASE("footfalld refuses files that are not regular and keeps serving", "[rp
   }
   RequireServed(server.port());  // another client is answered afterwards
   close(unix_socket);
+  std::system(("rm -rf '" + root + "'").c_str());
+}
+
+TEST_CASE("footfalld escapes control characters from clients in its log", "[rpc][robustness]") {
+  char tmpl[] = "/tmp/footfall-root-XXXXXX";
+  REQUIRE(mkdtemp(tmpl));
+  const std::string root = tmpl;
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", root});
+  auto rpc = Connect(server.port());
+  TerrainHandle t = 0;
+  const std::string forged = "\nfootfalld: forged line\r\x1b[2J\\n";
+  REQUIRE(rpc->LoadSamples(MakeFlat(4, 1, 0), "name" + forged, &t) == Status::kOk);
+  CHECK(rpc->LoadServerFile("path" + forged, 0, &t) == Status::kIoError);
+  const std::string log = server.Log();
+  INFO(log);
+  CHECK(log.find("'name\\nfootfalld: forged line\\r\\x1b[2J\\\\n' (uploaded)") !=
+        std::string::npos);
+  CHECK(log.find("'path\\nfootfalld: forged line\\r\\x1b[2J\\\\n': no such file") !=
+        std::string::npos);
+  CHECK(log.find('\r') == std::string::npos);
+  CHECK(log.find('\x1b') == std::string::npos);
+  std::istringstream lines(log);
+  for (std::string line; std::getline(lines, line);) {
+    CHECK(line.rfind("footfalld: ", 0) == 0);
+    CHECK(line.rfind("footfalld: forged", 0) != 0);
+  }
   std::system(("rm -rf '" + root + "'").c_str());
 }
 

@@ -70,7 +70,37 @@ char* Message(const std::string& text) {
   return const_cast<char*>(g_storage.message.c_str());
 }
 
-void Log(const std::string& line) { std::fprintf(stderr, "footfalld: %s\n", line.c_str()); }
+// `text` with backslashes and control characters escaped (\\n, \\t, \\xHH), so text from a client
+// cannot start a log line of its own nor send terminal escapes.
+std::string EscapeControl(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    if (c == '\\') {
+      out += "\\\\";
+    } else if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\r') {
+      out += "\\r";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (u < 0x20 || u == 0x7F) {
+      static const char kHex[] = "0123456789abcdef";
+      out += "\\x";
+      out += kHex[u >> 4];
+      out += kHex[u & 15];
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+// One log line; every line may hold text from a client (paths, names, messages quoting them).
+void Log(const std::string& line) {
+  std::fprintf(stderr, "footfalld: %s\n", EscapeControl(line).c_str());
+}
 
 void LogError(const char* proc, Status status, const std::string& message) {
   Log(std::string("error: ") + proc + ": " + StatusName(status) +
