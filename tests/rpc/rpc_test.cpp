@@ -134,6 +134,47 @@ void RequireServed(int port) {
   CHECK(f.point == Vec3{3, 0, 5});
 }
 
+// A raw rpcgen client of footfalld on loopback (rpcgen's stubs, no session logic).
+CLIENT* RawClient(int port) {
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  int sock = RPC_ANYSOCK;
+  CLIENT* c = clnttcp_create(&addr, FOOTFALL_PROG, FOOTFALL_V1, &sock, 0, 0);
+  REQUIRE(c != nullptr);
+  return c;
+}
+
+// FF_UPLOAD_BEGIN from a raw client; returns the status, the upload id in *upload.
+ff_status BeginUpload(CLIENT* c, uint64_t total, uint32_t* upload, std::string* message) {
+  ff_upload_begin_args args;
+  args.name = const_cast<char*>("raw");
+  args.total = total;
+  ff_upload_reply reply{};
+  REQUIRE(ff_upload_begin_1(&args, &reply, c) == RPC_SUCCESS);
+  *upload = reply.upload;
+  *message = reply.message ? reply.message : "";
+  const ff_status status = reply.status;
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_upload_reply), reinterpret_cast<char*>(&reply));
+  return status;
+}
+
+// FF_UPLOAD_CHUNK from a raw client.
+ff_status SendChunk(CLIENT* c, uint32_t upload, std::vector<ff_sample> samples,
+                    std::string* message) {
+  ff_upload_chunk_args args;
+  args.upload = upload;
+  args.samples.samples_len = static_cast<u_int>(samples.size());
+  args.samples.samples_val = samples.data();
+  ff_status_reply reply{};
+  REQUIRE(ff_upload_chunk_1(&args, &reply, c) == RPC_SUCCESS);
+  *message = reply.message ? reply.message : "";
+  const ff_status status = reply.status;
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_status_reply), reinterpret_cast<char*>(&reply));
+  return status;
+}
+
 }  // namespace
 
 TEST_CASE("RPC answers equal the embedded engine", "[rpc]") {
@@ -358,6 +399,51 @@ TEST_CASE("footfalld escapes control characters from clients in its log", "[rpc]
   for (std::string line; std::getline(lines, line);) {
     CHECK(line.rfind("footfalld: ", 0) == 0);
     CHECK(line.rfind("footfalld: forged", 0) != 0);
+  }
+  std::system(("rm -rf '" + root + "'").c_str());
+}
+
+TEST_CASE("footfalld holds --max-samples over parallel uploads and mesh loads", "[rpc]") {
+  char tmpl[] = "/tmp/footfall-root-XXXXXX";
+  REQUIRE(mkdtemp(tmpl));
+  const std::string root = tmpl;
+  std::ofstream(root + "/square.obj")  // 10 x 10: 100 square units
+      << "v 0 0 0\nv 10 0 0\nv 10 0 10\nv 0 0 10\nf 1 3 2\nf 1 4 3\n";
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", root, "--max-samples", "2000"});
+  std::string message;
+
+  SECTION("uploads reserve their announced totals until they end") {
+    CLIENT* a = RawClient(server.port());
+    CLIENT* b = RawClient(server.port());
+    uint32_t upload_a = 0, upload_b = 0;
+    REQUIRE(BeginUpload(a, 1500, &upload_a, &message) == FF_OK);
+    CHECK(BeginUpload(b, 1000, &upload_b, &message) == FF_LIMIT_EXCEEDED);
+    CHECK(message ==
+          "an upload of 1000 samples does not fit in the sample budget (--max-samples 2000, "
+          "1500 in use by loaded terrains and uploads in progress)");
+    // Another connection cannot add to a's upload.
+    CHECK(SendChunk(b, upload_a, {ff_sample{{0, 0, 0}, {0, 1, 0}}}, &message) ==
+          FF_INVALID_ARGUMENT);
+    CHECK(message == "no upload " + std::to_string(upload_a) + " in progress on this connection");
+    // A client that goes away releases its reservation.
+    clnt_destroy(a);
+    REQUIRE(ff_null_1(nullptr, nullptr, b) == RPC_SUCCESS);  // the server has seen a close
+    CHECK(BeginUpload(b, 1000, &upload_b, &message) == FF_OK);
+    // A failed chunk ends the upload and releases it too.
+    CHECK(SendChunk(b, upload_b, {ff_sample{{0, 0, 0}, {0, 0, 0}}}, &message) ==
+          FF_INVALID_ARGUMENT);
+    CHECK(BeginUpload(b, 2000, &upload_b, &message) == FF_OK);
+    clnt_destroy(b);
+  }
+  SECTION("meshes are refused on the sampler's estimate, naming a separation that fits") {
+    auto rpc = Connect(server.port());
+    TerrainHandle t = 0;
+    CHECK(rpc->LoadServerFile("square.obj", 0.05, &t) == Status::kLimitExceeded);
+    CHECK(rpc->last_error() ==
+          "square.obj: separation 0.05 would give about 64000 samples (limit 2000); choose a "
+          "separation of at least 0.283 (the limit is what is left of the sample budget "
+          "(--max-samples 2000, 0 in use by loaded terrains and uploads in progress))");
+    CHECK(rpc->LoadServerFile("square.obj", 0.283, &t) == Status::kOk);
   }
   std::system(("rm -rf '" + root + "'").c_str());
 }

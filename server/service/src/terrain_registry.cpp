@@ -153,11 +153,16 @@ TerrainRegistry::TerrainRegistry(std::string data_root, RegistryLimits limits) :
   next_handle_ = (device() & 0x7FFFFFF0u) + 1;
 }
 
-size_t TerrainRegistry::TotalSamples() const {
-  size_t total = 0;
+uint64_t TerrainRegistry::TotalSamples() const {
+  uint64_t total = 0;
   for (const auto& t : terrains_) total += t.second->grid.size();
-  for (const auto& u : uploads_) total += u.second.samples.size();
+  for (const auto& u : uploads_) total += u.second.total;
   return total;
+}
+
+std::string TerrainRegistry::Budget() const {
+  return "the sample budget (--max-samples " + std::to_string(limits_.max_total_samples) + ", " +
+         std::to_string(TotalSamples()) + " in use by loaded terrains and uploads in progress)";
 }
 
 Status TerrainRegistry::Add(const std::string& name, RawSamples samples, uint32_t* handle,
@@ -167,7 +172,7 @@ Status TerrainRegistry::Add(const std::string& name, RawSamples samples, uint32_
     return Status::kLimitExceeded;
   }
   if (TotalSamples() + samples.size() > limits_.max_total_samples) {
-    *message = "sample limit reached (" + std::to_string(limits_.max_total_samples) + ")";
+    *message = std::to_string(samples.size()) + " samples do not fit in " + Budget();
     return Status::kLimitExceeded;
   }
   Status status = ValidateAndNormalize(&samples, message);
@@ -196,6 +201,9 @@ Status TerrainRegistry::LoadFile(const std::string& relative_path, double separa
   }
   TerrainLoadOptions options;
   options.separation = separation;
+  // Meshes are refused on the sampler's estimate, before any sampling.
+  const uint64_t used = TotalSamples();
+  options.max_samples = used < limits_.max_total_samples ? limits_.max_total_samples - used : 0;
   RawSamples samples;
   std::string error;
   status = LoadTerrain(path, options, &samples, &error);
@@ -204,37 +212,40 @@ Status TerrainRegistry::LoadFile(const std::string& relative_path, double separa
     const size_t at = error.find(path);
     if (at != std::string::npos) error.replace(at, path.size(), relative_path);
     *message = error;
+    if (status == Status::kLimitExceeded)
+      *message += " (the limit is what is left of " + Budget() + ")";
     return status;
   }
   return Add(relative_path, std::move(samples), handle, message);
 }
 
-Status TerrainRegistry::BeginUpload(const std::string& name, uint64_t total, uint32_t* upload,
-                                    std::string* message) {
+Status TerrainRegistry::BeginUpload(const std::string& name, uint64_t total, uint64_t owner,
+                                    uint32_t* upload, std::string* message) {
   ExpireUploads();
   if (uploads_.size() >= limits_.max_uploads) {
     *message = "too many uploads in progress (limit " + std::to_string(limits_.max_uploads) + ")";
     return Status::kLimitExceeded;
   }
   if (total > limits_.max_total_samples || TotalSamples() + total > limits_.max_total_samples) {
-    *message = "upload of " + std::to_string(total) + " samples exceeds the sample limit";
+    *message = "an upload of " + std::to_string(total) + " samples does not fit in " + Budget();
     return Status::kLimitExceeded;
   }
   uint32_t id = next_upload_++;
   while (id == 0 || uploads_.count(id)) id = next_upload_++;
   Upload& u = uploads_[id];
   u.name = name;
+  u.owner = owner;
   u.total = total;
   u.touched = std::chrono::steady_clock::now();
   *upload = id;
   return Status::kOk;
 }
 
-Status TerrainRegistry::AppendUpload(uint32_t upload, const RawSamples& chunk,
+Status TerrainRegistry::AppendUpload(uint32_t upload, uint64_t owner, const RawSamples& chunk,
                                      std::string* message) {
   auto it = uploads_.find(upload);
-  if (it == uploads_.end()) {
-    *message = "no upload " + std::to_string(upload) + " in progress";
+  if (it == uploads_.end() || it->second.owner != owner) {
+    *message = "no upload " + std::to_string(upload) + " in progress on this connection";
     return Status::kInvalidArgument;
   }
   Upload& u = it->second;
@@ -258,10 +269,11 @@ Status TerrainRegistry::AppendUpload(uint32_t upload, const RawSamples& chunk,
   return Status::kOk;
 }
 
-Status TerrainRegistry::FinishUpload(uint32_t upload, uint32_t* handle, std::string* message) {
+Status TerrainRegistry::FinishUpload(uint32_t upload, uint64_t owner, uint32_t* handle,
+                                     std::string* message) {
   auto it = uploads_.find(upload);
-  if (it == uploads_.end()) {
-    *message = "no upload " + std::to_string(upload) + " in progress";
+  if (it == uploads_.end() || it->second.owner != owner) {
+    *message = "no upload " + std::to_string(upload) + " in progress on this connection";
     return Status::kInvalidArgument;
   }
   Upload u = std::move(it->second);
@@ -287,6 +299,11 @@ std::vector<uint32_t> TerrainRegistry::Handles() const {
   std::vector<uint32_t> handles;
   for (const auto& t : terrains_) handles.push_back(t.first);
   return handles;
+}
+
+void TerrainRegistry::DropClient(uint64_t owner) {
+  for (auto it = uploads_.begin(); it != uploads_.end();)
+    it = it->second.owner == owner ? uploads_.erase(it) : std::next(it);
 }
 
 void TerrainRegistry::ExpireUploads() {
