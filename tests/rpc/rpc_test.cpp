@@ -11,6 +11,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -446,6 +447,58 @@ TEST_CASE("footfalld holds --max-samples over parallel uploads and mesh loads", 
     CHECK(rpc->LoadServerFile("square.obj", 0.283, &t) == Status::kOk);
   }
   std::system(("rm -rf '" + root + "'").c_str());
+}
+
+TEST_CASE("footfalld refuses uploaded samples out of range, per chunk", "[rpc]") {
+  ServerProcess server;
+  CLIENT* c = RawClient(server.port());
+  std::string message;
+  uint32_t upload = 0;
+  auto refused = [&](const ff_sample& bad) {
+    REQUIRE(BeginUpload(c, 2, &upload, &message) == FF_OK);
+    CHECK(SendChunk(c, upload, {ff_sample{{0, 0, 0}, {0, 1, 0}}, bad}, &message) ==
+          FF_INVALID_ARGUMENT);
+    return message;
+  };
+  CHECK(refused({{1e308, 0, 0}, {0, 1, 0}}) ==
+        "sample 1: point (1e+308, 0, 0) is out of range (expected coordinates within +-1e+38)");
+  CHECK(refused({{0, -4e38, 0}, {0, 1, 0}}) ==
+        "sample 1: point (0, -4e+38, 0) is out of range (expected coordinates within +-1e+38)");
+  CHECK(refused({{0, 0, 0}, {0, 0, 0}}) ==
+        "sample 1: normal (0, 0, 0) has zero length (expected a non-zero nx ny nz)");
+
+  // Huge finite normals are normalised without overflowing; coordinates at the limit answer.
+  auto load = [&](const std::vector<ff_sample>& samples) {
+    REQUIRE(BeginUpload(c, samples.size(), &upload, &message) == FF_OK);
+    REQUIRE(SendChunk(c, upload, samples, &message) == FF_OK);
+    ff_upload_args finish{upload};
+    ff_load_reply loaded{};
+    REQUIRE(ff_upload_finish_1(&finish, &loaded, c) == RPC_SUCCESS);
+    INFO(loaded.message);
+    REQUIRE(loaded.status == FF_OK);
+    const unsigned terrain = loaded.terrain;
+    xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&loaded));
+    return terrain;
+  };
+  auto snap = [&](unsigned terrain, const ff_vec3& p) {
+    ff_point_args at{terrain, p};
+    ff_result r{};
+    REQUIRE(ff_snap_1(&at, &r, c) == RPC_SUCCESS);
+    return r;
+  };
+  const unsigned tilted = load({{{0, 0, 0}, {1e300, 1e300, 0}}, {{5, 0, 0}, {0, 1, 0}}});
+  ff_result r = snap(tilted, {0.1, 0, 0});
+  REQUIRE(r.status == FF_OK);
+  CHECK(r.normal.x == Approx(std::sqrt(0.5)));
+  CHECK(r.normal.y == Approx(std::sqrt(0.5)));
+  CHECK(r.normal.z == 0);
+  const unsigned far = load({{{1e38, 0, 0}, {0, 1, 0}}, {{1e38, 1, 0}, {0, 1, 0}}});
+  r = snap(far, {1e38, 0.9, 0});
+  REQUIRE(r.status == FF_OK);
+  CHECK(r.index == 1);
+  CHECK(r.point.x == 1e38);
+  CHECK(r.point.y == Approx(1));
+  clnt_destroy(c);
 }
 
 TEST_CASE("misbehaving clients leave others served and memory flat", "[rpc][robustness]") {

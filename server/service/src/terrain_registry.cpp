@@ -255,10 +255,9 @@ Status TerrainRegistry::AppendUpload(uint32_t upload, uint64_t owner, const RawS
     return Status::kInvalidArgument;
   }
   for (size_t i = 0; i < chunk.size(); ++i) {
-    if (!IsFinite(chunk.points[i]) || !IsFinite(chunk.normals[i]) ||
-        Length2(chunk.normals[i]) == 0) {
-      *message =
-          "sample " + std::to_string(u.samples.size() + i) + ": NaN, infinite or zero-normal value";
+    std::string what;
+    if (CheckSample(chunk.points[i], chunk.normals[i], &what) != Status::kOk) {
+      *message = "sample " + std::to_string(u.samples.size() + i) + ": " + what;
       uploads_.erase(it);
       return Status::kInvalidArgument;
     }
