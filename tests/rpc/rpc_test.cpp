@@ -501,6 +501,71 @@ TEST_CASE("footfalld refuses uploaded samples out of range, per chunk", "[rpc]")
   clnt_destroy(c);
 }
 
+TEST_CASE("batch items with NaN or infinite inputs answer FF_INVALID_ARGUMENT", "[rpc]") {
+  ServerProcess server;
+  auto rpc = Connect(server.port());
+  TerrainHandle t = 0;
+  REQUIRE(rpc->LoadSamples(MakeFlat(10, 1, 0), "flat", &t) == Status::kOk);
+  CLIENT* c = RawClient(server.port());
+  ff_list_reply list{};
+  REQUIRE(ff_list_1(nullptr, &list, c) == RPC_SUCCESS);
+  REQUIRE(list.terrains.terrains_len == 1);
+  const unsigned terrain = list.terrains.terrains_val[0];
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_list_reply), reinterpret_cast<char*>(&list));
+  const double nan = std::nan(""), inf = HUGE_VAL;
+  std::vector<ff_vec3> points = {{1, 0, 1}, {nan, 0, 1}, {1, inf, 1}, {2, 0, -inf}, {2, 0, 2}};
+  const ff_status expected[] = {FF_OK, FF_INVALID_ARGUMENT, FF_INVALID_ARGUMENT,
+                                FF_INVALID_ARGUMENT, FF_OK};
+  for (const u_int proc : {FF_SNAP_BATCH, FF_NORMAL_BATCH}) {
+    ff_point_batch_args args;
+    args.terrain = terrain;
+    args.points.points_len = static_cast<u_int>(points.size());
+    args.points.points_val = points.data();
+    ff_batch_reply reply{};
+    const timeval timeout{10, 0};
+    REQUIRE(clnt_call(c, proc, reinterpret_cast<xdrproc_t>(xdr_ff_point_batch_args),
+                      reinterpret_cast<char*>(&args),
+                      reinterpret_cast<xdrproc_t>(xdr_ff_batch_reply),
+                      reinterpret_cast<char*>(&reply), timeout) == RPC_SUCCESS);
+    CHECK(reply.status == FF_OK);
+    REQUIRE(reply.results.results_len == points.size());
+    for (size_t i = 0; i < points.size(); ++i) {
+      INFO("proc " << proc << " item " << i);
+      CHECK(reply.results.results_val[i].status == expected[i]);
+    }
+    xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_batch_reply), reinterpret_cast<char*>(&reply));
+  }
+  std::vector<ff_next_query> steps = {{{1, 0, 1}, {1, 0, 0}},
+                                      {{nan, 0, 1}, {1, 0, 0}},
+                                      {{1, 0, 1}, {inf, 0, 0}},
+                                      {{1, 0, 1}, {0, 0, nan}},
+                                      {{1, 0, 1}, {0, 0, 1}}};
+  ff_next_batch_args next;
+  next.terrain = terrain;
+  next.tolerance = 0;
+  next.queries.queries_len = static_cast<u_int>(steps.size());
+  next.queries.queries_val = steps.data();
+  ff_batch_reply reply{};
+  REQUIRE(ff_next_batch_1(&next, &reply, c) == RPC_SUCCESS);
+  CHECK(reply.status == FF_OK);
+  REQUIRE(reply.results.results_len == steps.size());
+  for (size_t i = 0; i < steps.size(); ++i) {
+    INFO("next item " << i);
+    CHECK(reply.results.results_val[i].status == expected[i]);
+  }
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_batch_reply), reinterpret_cast<char*>(&reply));
+  clnt_destroy(c);
+  // Through the client library (the fast batch filters on both sides), in a large batch.
+  std::vector<Vec3> many(3000, Vec3{1, 0, 1});
+  for (size_t i = 7; i < many.size(); i += 101) many[i].y = nan;
+  std::vector<Foothold> answers(many.size());
+  REQUIRE(rpc->Snap(t, many.data(), many.size(), answers.data()) == Status::kOk);
+  for (size_t i = 0; i < many.size(); ++i) {
+    INFO("item " << i);
+    CHECK(answers[i].status == (std::isnan(many[i].y) ? Status::kInvalidArgument : Status::kOk));
+  }
+}
+
 TEST_CASE("misbehaving clients leave others served and memory flat", "[rpc][robustness]") {
   ServerProcess server;
   auto loader = Connect(server.port());
