@@ -62,7 +62,7 @@ check "RPC server-side load answers equal embedded" cmp -s "$work/embedded.jsonl
 check "402 answers" [ "$(wc -l < "$work/rpc.jsonl")" -eq 402 ]
 err=$(echo "snap 0 0 0" | "$footfall" query --server-terrain ../../etc/passwd --server "127.0.0.1:$port" 2>&1 >/dev/null)
 check "escape refused: exit 1" [ $? -eq 1 ]
-check "escape refused: message" grep -qF "resolves outside the data root" <<< "$err"
+check "escape refused: message" grep -qF "'../../etc/passwd' leads outside the data root" <<< "$err"
 check "server logs loads" grep -q "loaded terrain" "$work/server.log"
 stop_server
 err=$(echo "snap 0 0 0" | "$footfall" query --terrain "$work/flat.pts" --server "127.0.0.1:$port" 2>&1 >/dev/null)

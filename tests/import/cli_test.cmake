@@ -48,5 +48,5 @@ expect(EXIT_NONZERO "cut.off: truncated: header declares 2 faces, found 1"
        terrain info "${WORK}/cut.off")
 expect(EXIT_NONZERO "unknown terrain file extension 'dae'" terrain info "${WORK}/terrain.dae")
 expect(EXIT_NONZERO "absent.obj: cannot open" query --terrain "${WORK}/absent.obj")
-expect(EXIT_NONZERO "larger separation" terrain info "${WORK}/cube.obj" --separation 0.0001)
+expect(EXIT_NONZERO "choose a separation of at least" terrain info "${WORK}/cube.obj" --separation 0.0001)
 file(REMOVE_RECURSE "${WORK}")

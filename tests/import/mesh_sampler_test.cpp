@@ -171,7 +171,18 @@ TEST_CASE("SampleMesh: bad options are refused", "[import][sampler]") {
   CHECK(SampleMesh(mesh, o, &out, &error) == Status::kInvalidArgument);
   o.separation = 1e-4;
   CHECK(SampleMesh(mesh, o, &out, &error) == Status::kLimitExceeded);
-  CHECK(error.find("larger separation") != std::string::npos);
+  CHECK(error ==
+        "separation 0.0001 would give about 16000000000 samples (limit 20000000); choose a "
+        "separation of at least 0.00283");
+  // The separation suggested fits: sqrt(1.6 * 100 / 2000) = 0.28284 rounds up to 0.283.
+  o.max_samples = 2000;
+  o.separation = 0.05;
+  CHECK(SampleMesh(mesh, o, &out, &error) == Status::kLimitExceeded);
+  CHECK(error.find("about 64000 samples (limit 2000); choose a separation of at least 0.283") !=
+        std::string::npos);
+  o.separation = 0.283;
+  CHECK(SampleMesh(mesh, o, &out, &error) == Status::kOk);
+  o.max_samples = 20000000;
   TriangleMesh bad = mesh;
   bad.vertices[1].y = NAN;
   o.separation = 1;

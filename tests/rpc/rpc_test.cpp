@@ -6,14 +6,18 @@
 #include <netinet/in.h>
 #include <signal.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <functional>
 #include <random>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -131,6 +135,47 @@ void RequireServed(int port) {
   CHECK(f.point == Vec3{3, 0, 5});
 }
 
+// A raw rpcgen client of footfalld on loopback (rpcgen's stubs, no session logic).
+CLIENT* RawClient(int port) {
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  int sock = RPC_ANYSOCK;
+  CLIENT* c = clnttcp_create(&addr, FOOTFALL_PROG, FOOTFALL_V1, &sock, 0, 0);
+  REQUIRE(c != nullptr);
+  return c;
+}
+
+// FF_UPLOAD_BEGIN from a raw client; returns the status, the upload id in *upload.
+ff_status BeginUpload(CLIENT* c, uint64_t total, uint32_t* upload, std::string* message) {
+  ff_upload_begin_args args;
+  args.name = const_cast<char*>("raw");
+  args.total = total;
+  ff_upload_reply reply{};
+  REQUIRE(ff_upload_begin_1(&args, &reply, c) == RPC_SUCCESS);
+  *upload = reply.upload;
+  *message = reply.message ? reply.message : "";
+  const ff_status status = reply.status;
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_upload_reply), reinterpret_cast<char*>(&reply));
+  return status;
+}
+
+// FF_UPLOAD_CHUNK from a raw client.
+ff_status SendChunk(CLIENT* c, uint32_t upload, std::vector<ff_sample> samples,
+                    std::string* message) {
+  ff_upload_chunk_args args;
+  args.upload = upload;
+  args.samples.samples_len = static_cast<u_int>(samples.size());
+  args.samples.samples_val = samples.data();
+  ff_status_reply reply{};
+  REQUIRE(ff_upload_chunk_1(&args, &reply, c) == RPC_SUCCESS);
+  *message = reply.message ? reply.message : "";
+  const ff_status status = reply.status;
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_status_reply), reinterpret_cast<char*>(&reply));
+  return status;
+}
+
 }  // namespace
 
 TEST_CASE("RPC answers equal the embedded engine", "[rpc]") {
@@ -229,30 +274,296 @@ TEST_CASE("RPC answers equal the embedded engine", "[rpc]") {
   }
 }
 
+// FF_LOAD's arguments encoded as xdr_string would, but from a std::string that may hold NUL
+// bytes (rpcgen's stub sends a C string).
+struct RawLoadArgs {
+  std::string path;
+  double separation = 0;
+};
+
+bool_t EncodeRawLoad(XDR* xdrs, RawLoadArgs* a) {
+  char* bytes = a->path.data();
+  u_int length = static_cast<u_int>(a->path.size());
+  return xdr_bytes(xdrs, &bytes, &length, FF_MAX_PATH) && xdr_double(xdrs, &a->separation);
+}
+
 TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
   char tmpl[] = "/tmp/footfall-root-XXXXXX";
   REQUIRE(mkdtemp(tmpl));
   const std::string root = tmpl;
+  const std::string outside = root + "-outside";  // a folder beside the root
   {
+    REQUIRE(mkdir(outside.c_str(), 0700) == 0);
     std::ofstream(root + "/ok.pts") << "0 0 0 0 1 0\n1 0 0 0 1 0\n";
     std::ofstream(root + "/bad.pts") << "0 0 0 0 1 0\n1 0 zero 0 1 0\n";
-    std::ofstream("/tmp/footfall-outside.pts") << "0 0 0 0 1 0\n";
-    REQUIRE(symlink("/tmp/footfall-outside.pts", (root + "/link.pts").c_str()) == 0);
+    std::ofstream(outside + "/there.pts") << "0 0 0 0 1 0\n";
+    REQUIRE(symlink((outside + "/there.pts").c_str(), (root + "/link.pts").c_str()) == 0);
+    REQUIRE(symlink((outside + "/gone.pts").c_str(), (root + "/dangling.pts").c_str()) == 0);
+    REQUIRE(symlink(outside.c_str(), (root + "/out").c_str()) == 0);
   }
   ServerProcess server(0, {"--no-rpcbind", "--data-root", root});
   auto rpc = Connect(server.port());
   TerrainHandle t = 0;
   CHECK(rpc->LoadServerFile("ok.pts", 0, &t) == Status::kOk);
   CHECK(rpc->Snap(t, Vec3{0.9, 0, 0}).index == 1);
-  CHECK(rpc->LoadServerFile("../footfall-outside.pts", 0, &t) == Status::kAccessDenied);
-  CHECK(rpc->LoadServerFile("link.pts", 0, &t) == Status::kAccessDenied);
   CHECK(rpc->LoadServerFile("/etc/passwd", 0, &t) == Status::kAccessDenied);
   CHECK(rpc->LoadServerFile("missing.pts", 0, &t) == Status::kIoError);
+  CHECK(rpc->LoadServerFile("nowhere/missing.pts", 0, &t) == Status::kIoError);
   REQUIRE(rpc->LoadServerFile("bad.pts", 0, &t) == Status::kParseError);
   CHECK(rpc->last_error() ==
         "bad.pts:2: column 3: 'zero' is not a number (expected x y z nx ny nz)");
   CHECK(server.Log().find("error: load") != std::string::npos);
-  std::system(("rm -rf '" + root + "' /tmp/footfall-outside.pts").c_str());
+
+  SECTION("paths leaving the root get one answer, whether their targets exist or not") {
+    const std::string base = root.substr(root.rfind('/') + 1) + "-outside/";
+    for (const std::string& path :
+         std::vector<std::string>{"../" + base + "there.pts", "../" + base + "gone.pts",
+                                  "sub/../../" + base + "there.pts", "link.pts", "dangling.pts",
+                                  "out/there.pts", "out/gone.pts", "out/no/such/dir.pts"}) {
+      INFO(path);
+      CHECK(rpc->LoadServerFile(path, 0, &t) == Status::kAccessDenied);
+      CHECK(rpc->last_error() == "'" + path + "' leads outside the data root");
+    }
+  }
+  SECTION("a path with a NUL byte is refused, not cut short") {
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons(static_cast<uint16_t>(server.port()));
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    int sock = RPC_ANYSOCK;
+    CLIENT* c = clnttcp_create(&addr, FOOTFALL_PROG, FOOTFALL_V1, &sock, 0, 0);
+    REQUIRE(c != nullptr);
+    RawLoadArgs args;
+    args.path = std::string("ok.pts\0../x", 11);
+    ff_load_reply reply{};
+    const timeval timeout{10, 0};
+    REQUIRE(clnt_call(c, FF_LOAD, reinterpret_cast<xdrproc_t>(EncodeRawLoad),
+                      reinterpret_cast<char*>(&args),
+                      reinterpret_cast<xdrproc_t>(xdr_ff_load_reply),
+                      reinterpret_cast<char*>(&reply), timeout) == RPC_SUCCESS);
+    CHECK(reply.status == FF_INVALID_ARGUMENT);
+    CHECK(std::string(reply.message) ==
+          "path has a NUL byte at offset 6: expected a path without NUL bytes");
+    xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&reply));
+    clnt_destroy(c);
+  }
+  std::system(("rm -rf '" + root + "' '" + outside + "'").c_str());
+}
+
+TEST_CASE("footfalld refuses files that are not regular and keeps serving", "[rpc][robustness]") {
+  char tmpl[] = "/tmp/footfall-root-XXXXXX";
+  REQUIRE(mkdtemp(tmpl));
+  const std::string root = tmpl;
+  REQUIRE(mkfifo((root + "/fifo.pts").c_str(), 0600) == 0);  // open() for reading would block
+  REQUIRE(mkdir((root + "/dir.pts").c_str(), 0700) == 0);
+  const int unix_socket = socket(AF_UNIX, SOCK_STREAM, 0);
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  std::snprintf(address.sun_path, sizeof address.sun_path, "%s/socket.pts", root.c_str());
+  REQUIRE(bind(unix_socket, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0);
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", root});
+  // A generous timeout: a server stuck opening the FIFO would answer nobody within it.
+  auto rpc = Connect(server.port(), 20);
+  const std::pair<const char*, const char*> cases[] = {
+      {"fifo.pts", "'fifo.pts' is a FIFO: expected a regular terrain file"},
+      {"dir.pts", "'dir.pts' is a directory: expected a regular terrain file"},
+      {"socket.pts", "'socket.pts' is a socket: expected a regular terrain file"}};
+  for (const auto& c : cases) {
+    TerrainHandle t = 0;
+    CHECK(rpc->LoadServerFile(c.first, 0, &t) == Status::kInvalidArgument);
+    CHECK(rpc->last_error() == c.second);
+  }
+  RequireServed(server.port());  // another client is answered afterwards
+  close(unix_socket);
+  std::system(("rm -rf '" + root + "'").c_str());
+}
+
+TEST_CASE("footfalld escapes control characters from clients in its log", "[rpc][robustness]") {
+  char tmpl[] = "/tmp/footfall-root-XXXXXX";
+  REQUIRE(mkdtemp(tmpl));
+  const std::string root = tmpl;
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", root});
+  auto rpc = Connect(server.port());
+  TerrainHandle t = 0;
+  const std::string forged = "\nfootfalld: forged line\r\x1b[2J\\n";
+  REQUIRE(rpc->LoadSamples(MakeFlat(4, 1, 0), "name" + forged, &t) == Status::kOk);
+  CHECK(rpc->LoadServerFile("path" + forged, 0, &t) == Status::kIoError);
+  const std::string log = server.Log();
+  INFO(log);
+  CHECK(log.find("'name\\nfootfalld: forged line\\r\\x1b[2J\\\\n' (uploaded)") !=
+        std::string::npos);
+  CHECK(log.find("'path\\nfootfalld: forged line\\r\\x1b[2J\\\\n': no such file") !=
+        std::string::npos);
+  CHECK(log.find('\r') == std::string::npos);
+  CHECK(log.find('\x1b') == std::string::npos);
+  std::istringstream lines(log);
+  for (std::string line; std::getline(lines, line);) {
+    CHECK(line.rfind("footfalld: ", 0) == 0);
+    CHECK(line.rfind("footfalld: forged", 0) != 0);
+  }
+  std::system(("rm -rf '" + root + "'").c_str());
+}
+
+TEST_CASE("footfalld holds --max-samples over parallel uploads and mesh loads", "[rpc]") {
+  char tmpl[] = "/tmp/footfall-root-XXXXXX";
+  REQUIRE(mkdtemp(tmpl));
+  const std::string root = tmpl;
+  std::ofstream(root + "/square.obj")  // 10 x 10: 100 square units
+      << "v 0 0 0\nv 10 0 0\nv 10 0 10\nv 0 0 10\nf 1 3 2\nf 1 4 3\n";
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", root, "--max-samples", "2000"});
+  std::string message;
+
+  SECTION("uploads reserve their announced totals until they end") {
+    CLIENT* a = RawClient(server.port());
+    CLIENT* b = RawClient(server.port());
+    uint32_t upload_a = 0, upload_b = 0;
+    REQUIRE(BeginUpload(a, 1500, &upload_a, &message) == FF_OK);
+    CHECK(BeginUpload(b, 1000, &upload_b, &message) == FF_LIMIT_EXCEEDED);
+    CHECK(message ==
+          "an upload of 1000 samples does not fit in the sample budget (--max-samples 2000, "
+          "1500 in use by loaded terrains and uploads in progress)");
+    // Another connection cannot add to a's upload.
+    CHECK(SendChunk(b, upload_a, {ff_sample{{0, 0, 0}, {0, 1, 0}}}, &message) ==
+          FF_INVALID_ARGUMENT);
+    CHECK(message == "no upload " + std::to_string(upload_a) + " in progress on this connection");
+    // A client that goes away releases its reservation.
+    clnt_destroy(a);
+    REQUIRE(ff_null_1(nullptr, nullptr, b) == RPC_SUCCESS);  // the server has seen a close
+    CHECK(BeginUpload(b, 1000, &upload_b, &message) == FF_OK);
+    // A failed chunk ends the upload and releases it too.
+    CHECK(SendChunk(b, upload_b, {ff_sample{{0, 0, 0}, {0, 0, 0}}}, &message) ==
+          FF_INVALID_ARGUMENT);
+    CHECK(BeginUpload(b, 2000, &upload_b, &message) == FF_OK);
+    clnt_destroy(b);
+  }
+  SECTION("meshes are refused on the sampler's estimate, naming a separation that fits") {
+    auto rpc = Connect(server.port());
+    TerrainHandle t = 0;
+    CHECK(rpc->LoadServerFile("square.obj", 0.05, &t) == Status::kLimitExceeded);
+    CHECK(rpc->last_error() ==
+          "square.obj: separation 0.05 would give about 64000 samples (limit 2000); choose a "
+          "separation of at least 0.283 (the limit is what is left of the sample budget "
+          "(--max-samples 2000, 0 in use by loaded terrains and uploads in progress))");
+    CHECK(rpc->LoadServerFile("square.obj", 0.283, &t) == Status::kOk);
+  }
+  std::system(("rm -rf '" + root + "'").c_str());
+}
+
+TEST_CASE("footfalld refuses uploaded samples out of range, per chunk", "[rpc]") {
+  ServerProcess server;
+  CLIENT* c = RawClient(server.port());
+  std::string message;
+  uint32_t upload = 0;
+  auto refused = [&](const ff_sample& bad) {
+    REQUIRE(BeginUpload(c, 2, &upload, &message) == FF_OK);
+    CHECK(SendChunk(c, upload, {ff_sample{{0, 0, 0}, {0, 1, 0}}, bad}, &message) ==
+          FF_INVALID_ARGUMENT);
+    return message;
+  };
+  CHECK(refused({{1e308, 0, 0}, {0, 1, 0}}) ==
+        "sample 1: point (1e+308, 0, 0) is out of range (expected coordinates within +-1e+38)");
+  CHECK(refused({{0, -4e38, 0}, {0, 1, 0}}) ==
+        "sample 1: point (0, -4e+38, 0) is out of range (expected coordinates within +-1e+38)");
+  CHECK(refused({{0, 0, 0}, {0, 0, 0}}) ==
+        "sample 1: normal (0, 0, 0) has zero length (expected a non-zero nx ny nz)");
+
+  // Huge finite normals are normalised without overflowing; coordinates at the limit answer.
+  auto load = [&](const std::vector<ff_sample>& samples) {
+    REQUIRE(BeginUpload(c, samples.size(), &upload, &message) == FF_OK);
+    REQUIRE(SendChunk(c, upload, samples, &message) == FF_OK);
+    ff_upload_args finish{upload};
+    ff_load_reply loaded{};
+    REQUIRE(ff_upload_finish_1(&finish, &loaded, c) == RPC_SUCCESS);
+    INFO(loaded.message);
+    REQUIRE(loaded.status == FF_OK);
+    const unsigned terrain = loaded.terrain;
+    xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&loaded));
+    return terrain;
+  };
+  auto snap = [&](unsigned terrain, const ff_vec3& p) {
+    ff_point_args at{terrain, p};
+    ff_result r{};
+    REQUIRE(ff_snap_1(&at, &r, c) == RPC_SUCCESS);
+    return r;
+  };
+  const unsigned tilted = load({{{0, 0, 0}, {1e300, 1e300, 0}}, {{5, 0, 0}, {0, 1, 0}}});
+  ff_result r = snap(tilted, {0.1, 0, 0});
+  REQUIRE(r.status == FF_OK);
+  CHECK(r.normal.x == Approx(std::sqrt(0.5)));
+  CHECK(r.normal.y == Approx(std::sqrt(0.5)));
+  CHECK(r.normal.z == 0);
+  const unsigned far = load({{{1e38, 0, 0}, {0, 1, 0}}, {{1e38, 1, 0}, {0, 1, 0}}});
+  r = snap(far, {1e38, 0.9, 0});
+  REQUIRE(r.status == FF_OK);
+  CHECK(r.index == 1);
+  CHECK(r.point.x == 1e38);
+  CHECK(r.point.y == Approx(1));
+  clnt_destroy(c);
+}
+
+TEST_CASE("batch items with NaN or infinite inputs answer FF_INVALID_ARGUMENT", "[rpc]") {
+  ServerProcess server;
+  auto rpc = Connect(server.port());
+  TerrainHandle t = 0;
+  REQUIRE(rpc->LoadSamples(MakeFlat(10, 1, 0), "flat", &t) == Status::kOk);
+  CLIENT* c = RawClient(server.port());
+  ff_list_reply list{};
+  REQUIRE(ff_list_1(nullptr, &list, c) == RPC_SUCCESS);
+  REQUIRE(list.terrains.terrains_len == 1);
+  const unsigned terrain = list.terrains.terrains_val[0];
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_list_reply), reinterpret_cast<char*>(&list));
+  const double nan = std::nan(""), inf = HUGE_VAL;
+  std::vector<ff_vec3> points = {{1, 0, 1}, {nan, 0, 1}, {1, inf, 1}, {2, 0, -inf}, {2, 0, 2}};
+  const ff_status expected[] = {FF_OK, FF_INVALID_ARGUMENT, FF_INVALID_ARGUMENT,
+                                FF_INVALID_ARGUMENT, FF_OK};
+  for (const u_int proc : {FF_SNAP_BATCH, FF_NORMAL_BATCH}) {
+    ff_point_batch_args args;
+    args.terrain = terrain;
+    args.points.points_len = static_cast<u_int>(points.size());
+    args.points.points_val = points.data();
+    ff_batch_reply reply{};
+    const timeval timeout{10, 0};
+    REQUIRE(clnt_call(c, proc, reinterpret_cast<xdrproc_t>(xdr_ff_point_batch_args),
+                      reinterpret_cast<char*>(&args),
+                      reinterpret_cast<xdrproc_t>(xdr_ff_batch_reply),
+                      reinterpret_cast<char*>(&reply), timeout) == RPC_SUCCESS);
+    CHECK(reply.status == FF_OK);
+    REQUIRE(reply.results.results_len == points.size());
+    for (size_t i = 0; i < points.size(); ++i) {
+      INFO("proc " << proc << " item " << i);
+      CHECK(reply.results.results_val[i].status == expected[i]);
+    }
+    xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_batch_reply), reinterpret_cast<char*>(&reply));
+  }
+  std::vector<ff_next_query> steps = {{{1, 0, 1}, {1, 0, 0}},
+                                      {{nan, 0, 1}, {1, 0, 0}},
+                                      {{1, 0, 1}, {inf, 0, 0}},
+                                      {{1, 0, 1}, {0, 0, nan}},
+                                      {{1, 0, 1}, {0, 0, 1}}};
+  ff_next_batch_args next;
+  next.terrain = terrain;
+  next.tolerance = 0;
+  next.queries.queries_len = static_cast<u_int>(steps.size());
+  next.queries.queries_val = steps.data();
+  ff_batch_reply reply{};
+  REQUIRE(ff_next_batch_1(&next, &reply, c) == RPC_SUCCESS);
+  CHECK(reply.status == FF_OK);
+  REQUIRE(reply.results.results_len == steps.size());
+  for (size_t i = 0; i < steps.size(); ++i) {
+    INFO("next item " << i);
+    CHECK(reply.results.results_val[i].status == expected[i]);
+  }
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_batch_reply), reinterpret_cast<char*>(&reply));
+  clnt_destroy(c);
+  // Through the client library (the fast batch filters on both sides), in a large batch.
+  std::vector<Vec3> many(3000, Vec3{1, 0, 1});
+  for (size_t i = 7; i < many.size(); i += 101) many[i].y = nan;
+  std::vector<Foothold> answers(many.size());
+  REQUIRE(rpc->Snap(t, many.data(), many.size(), answers.data()) == Status::kOk);
+  for (size_t i = 0; i < many.size(); ++i) {
+    INFO("item " << i);
+    CHECK(answers[i].status == (std::isnan(many[i].y) ? Status::kInvalidArgument : Status::kOk));
+  }
 }
 
 TEST_CASE("misbehaving clients leave others served and memory flat", "[rpc][robustness]") {

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -175,6 +177,19 @@ Status CheckMesh(const TriangleMesh& mesh, std::string* error) {
   return Status::kOk;
 }
 
+// `x` with 3 significant digits ("0.283", "1.5e-05").
+std::string Format3(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", x);
+  return text;
+}
+
+// The smallest value of 3 significant digits >= x (x > 0), so the value shown is enough.
+double RoundUp3(double x) {
+  const double step = std::pow(10.0, std::floor(std::log10(x)) - 2);
+  return std::ceil(x / step) * step;
+}
+
 }  // namespace
 
 double DefaultSeparation(const TriangleMesh& mesh) {
@@ -203,9 +218,12 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   const double predicted = 1.6 * area / (s * s);
   if (predicted > static_cast<double>(options.max_samples)) {
     if (error) {
-      *error = "separation " + std::to_string(s) + " would give about " +
-               std::to_string(static_cast<uint64_t>(predicted)) + " samples (limit " +
-               std::to_string(options.max_samples) + "); choose a larger separation";
+      // The smallest separation whose estimate fits, rounded up to 3 significant digits.
+      const double fits = std::sqrt(1.6 * area / std::max<double>(1, options.max_samples));
+      *error = "separation " + Format3(s) + " would give about " +
+               std::to_string(std::llround(predicted)) + " samples (limit " +
+               std::to_string(options.max_samples) + "); choose a separation of at least " +
+               Format3(RoundUp3(fits));
     }
     return Status::kLimitExceeded;
   }

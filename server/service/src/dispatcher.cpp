@@ -1,11 +1,14 @@
 // footfalld's procedures: decode, validate, answer, free, on every path.
 #include "dispatcher.h"
 
+#include <poll.h>
+
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <memory>
 #include <new>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -70,19 +73,79 @@ char* Message(const std::string& text) {
   return const_cast<char*>(g_storage.message.c_str());
 }
 
-void Log(const std::string& line) { std::fprintf(stderr, "footfalld: %s\n", line.c_str()); }
+// `text` with backslashes and control characters escaped (\\n, \\t, \\xHH), so text from a client
+// cannot start a log line of its own nor send terminal escapes.
+std::string EscapeControl(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    if (c == '\\') {
+      out += "\\\\";
+    } else if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\r') {
+      out += "\\r";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (u < 0x20 || u == 0x7F) {
+      static const char kHex[] = "0123456789abcdef";
+      out += "\\x";
+      out += kHex[u >> 4];
+      out += kHex[u & 15];
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+// One log line; every line may hold text from a client (paths, names, messages quoting them).
+void Log(const std::string& line) {
+  std::fprintf(stderr, "footfalld: %s\n", EscapeControl(line).c_str());
+}
 
 void LogError(const char* proc, Status status, const std::string& message) {
   Log(std::string("error: ") + proc + ": " + StatusName(status) +
       (message.empty() ? "" : ": " + message));
 }
 
+// The connection a request came on, registered on its first request.
+uint64_t ConnectionOf(SVCXPRT* transport) {
+  const netbuf& address = transport->xp_rtaddr;
+  const std::string peer =
+      address.buf ? std::string(static_cast<const char*>(address.buf), address.len) : std::string();
+  auto it = g_state->connections.find(transport->xp_fd);
+  if (it != g_state->connections.end() && it->second.peer != peer) {
+    g_state->registry.DropClient(it->second.id);  // the socket number was reused
+    g_state->connections.erase(it);
+    it = g_state->connections.end();
+  }
+  if (it == g_state->connections.end())
+    it =
+        g_state->connections.emplace(transport->xp_fd, Connection{g_state->next_connection++, peer})
+            .first;
+  return it->second.id;
+}
+
 // --- procedures -------------------------------------------------------------------------
 
-void Load(const ff_load_args& a, ff_load_reply* r) {
+// ff_load_args decoded with the path's length kept (the same bytes as xdr_string): a C string
+// would end the path at a NUL byte inside it, and load another file than the one named.
+struct LoadArgs {
+  char* path = nullptr;
+  u_int path_len = 0;
+  double separation = 0;
+};
+
+bool_t XdrLoadArgs(XDR* xdrs, LoadArgs* a) {
+  return xdr_bytes(xdrs, &a->path, &a->path_len, FF_MAX_PATH) && xdr_double(xdrs, &a->separation);
+}
+
+void Load(const LoadArgs& a, ff_load_reply* r) {
   std::string message;
   uint32_t handle = 0;
-  const std::string path = a.path ? a.path : "";
+  const std::string path = a.path ? std::string(a.path, a.path_len) : "";
   const Status s = g_state->registry.LoadFile(path, a.separation, &handle, &message);
   r->status = Wire(s);
   r->terrain = handle;
@@ -98,33 +161,34 @@ void Load(const ff_load_args& a, ff_load_reply* r) {
   r->message = Message(message);
 }
 
-void UploadBegin(const ff_upload_begin_args& a, ff_upload_reply* r) {
+void UploadBegin(const ff_upload_begin_args& a, uint64_t client, ff_upload_reply* r) {
   std::string message;
   uint32_t upload = 0;
-  const Status s = g_state->registry.BeginUpload(a.name ? a.name : "", a.total, &upload, &message);
+  const Status s =
+      g_state->registry.BeginUpload(a.name ? a.name : "", a.total, client, &upload, &message);
   if (s != Status::kOk) LogError("upload", s, message);
   r->status = Wire(s);
   r->upload = upload;
   r->message = Message(message);
 }
 
-void UploadChunk(const ff_upload_chunk_args& a, ff_status_reply* r) {
+void UploadChunk(const ff_upload_chunk_args& a, uint64_t client, ff_status_reply* r) {
   RawSamples& chunk = g_storage.chunk;
   chunk.clear();
   for (u_int i = 0; i < a.samples.samples_len; ++i)
     chunk.push_back(FromWire(a.samples.samples_val[i].point),
                     FromWire(a.samples.samples_val[i].normal));
   std::string message;
-  const Status s = g_state->registry.AppendUpload(a.upload, chunk, &message);
+  const Status s = g_state->registry.AppendUpload(a.upload, client, chunk, &message);
   if (s != Status::kOk) LogError("upload", s, message);
   r->status = Wire(s);
   r->message = Message(message);
 }
 
-void UploadFinish(const ff_upload_args& a, ff_load_reply* r) {
+void UploadFinish(const ff_upload_args& a, uint64_t client, ff_load_reply* r) {
   std::string message;
   uint32_t handle = 0;
-  const Status s = g_state->registry.FinishUpload(a.upload, &handle, &message);
+  const Status s = g_state->registry.FinishUpload(a.upload, client, &handle, &message);
   r->status = Wire(s);
   r->terrain = handle;
   if (s == Status::kOk) {
@@ -343,22 +407,30 @@ void Serve(SVCXPRT* transport, xdrproc_t decode, xdrproc_t encode, const char* p
 #define FF_XDR_VOID reinterpret_cast<xdrproc_t>(reinterpret_cast<void*>(xdr_void))
 
 void Dispatch(svc_req* request, SVCXPRT* transport) {
+  const uint64_t client = ConnectionOf(transport);
   switch (request->rq_proc) {
     case FF_NULL:
       svc_sendreply(transport, FF_XDR_VOID, nullptr);
       return;
     case FF_LOAD:
-      return Serve<ff_load_args, ff_load_reply>(transport, FF_XDR(ff_load_args),
-                                                FF_XDR(ff_load_reply), "load", Load);
+      return Serve<LoadArgs, ff_load_reply>(transport, AsXdrProc(XdrLoadArgs),
+                                            FF_XDR(ff_load_reply), "load", Load);
     case FF_UPLOAD_BEGIN:
       return Serve<ff_upload_begin_args, ff_upload_reply>(
-          transport, FF_XDR(ff_upload_begin_args), FF_XDR(ff_upload_reply), "upload", UploadBegin);
+          transport, FF_XDR(ff_upload_begin_args), FF_XDR(ff_upload_reply), "upload",
+          [client](const ff_upload_begin_args& a, ff_upload_reply* r) {
+            UploadBegin(a, client, r);
+          });
     case FF_UPLOAD_CHUNK:
       return Serve<ff_upload_chunk_args, ff_status_reply>(
-          transport, FF_XDR(ff_upload_chunk_args), FF_XDR(ff_status_reply), "upload", UploadChunk);
+          transport, FF_XDR(ff_upload_chunk_args), FF_XDR(ff_status_reply), "upload",
+          [client](const ff_upload_chunk_args& a, ff_status_reply* r) {
+            UploadChunk(a, client, r);
+          });
     case FF_UPLOAD_FINISH:
-      return Serve<ff_upload_args, ff_load_reply>(transport, FF_XDR(ff_upload_args),
-                                                  FF_XDR(ff_load_reply), "upload", UploadFinish);
+      return Serve<ff_upload_args, ff_load_reply>(
+          transport, FF_XDR(ff_upload_args), FF_XDR(ff_load_reply), "upload",
+          [client](const ff_upload_args& a, ff_load_reply* r) { UploadFinish(a, client, r); });
     case FF_INFO:
       return Serve<ff_terrain_args, ff_info_reply>(transport, FF_XDR(ff_terrain_args),
                                                    FF_XDR(ff_info_reply), "info", Info);
@@ -413,6 +485,21 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
 }
 
 }  // namespace
+
+void ReapConnections() {
+  if (!g_state || g_state->connections.empty()) return;
+  std::set<int> open;
+  for (int i = 0; i < svc_max_pollfd; ++i)
+    if (svc_pollfd[i].fd >= 0) open.insert(svc_pollfd[i].fd);
+  for (auto it = g_state->connections.begin(); it != g_state->connections.end();) {
+    if (open.count(it->first)) {
+      ++it;
+      continue;
+    }
+    g_state->registry.DropClient(it->second.id);
+    it = g_state->connections.erase(it);
+  }
+}
 
 DispatchFn InstallDispatcher(ServiceState* state) {
   g_state = state;

@@ -3,13 +3,26 @@
 
 #include <rpc/rpc.h>
 
+#include <cstdint>
+#include <map>
+#include <string>
+
 #include "footfall/service/terrain_registry.h"
 
 namespace footfall {
 
+// A client connection as the dispatcher knows it: an id that is never reused, and the peer
+// address it was first seen with (a new connection on a recycled fd has another).
+struct Connection {
+  uint64_t id = 0;
+  std::string peer;
+};
+
 struct ServiceState {
   TerrainRegistry registry;
   int batch_threads = 1;
+  std::map<int, Connection> connections;  // by socket
+  uint64_t next_connection = 1;
 };
 
 using DispatchFn = void (*)(svc_req*, SVCXPRT*);
@@ -17,5 +30,9 @@ using DispatchFn = void (*)(svc_req*, SVCXPRT*);
 // Makes `state` the one the dispatcher serves, and returns the function to register with
 // svc_register. One state per process (libtirpc's svc layer is process-global).
 DispatchFn InstallDispatcher(ServiceState* state);
+
+// Forgets the connections libtirpc has closed, ending their uploads. Call after every
+// svc_getreq_poll, so a closed socket is noticed before its number can be reused.
+void ReapConnections();
 
 }  // namespace footfall

@@ -93,8 +93,8 @@ bool RpcServer::Start(std::string* error) {
     *error = "cannot create the RPC transport";
     return false;
   }
-  g_state = std::make_unique<ServiceState>(
-      ServiceState{TerrainRegistry(options_.data_root, options_.limits), options_.batch_threads});
+  g_state = std::make_unique<ServiceState>(ServiceState{
+      TerrainRegistry(options_.data_root, options_.limits), options_.batch_threads, {}, 1});
   const DispatchFn dispatch = InstallDispatcher(g_state.get());
   if (!svc_register(transport, FOOTFALL_PROG, FOOTFALL_V1, dispatch, 0)) {
     *error = "cannot register the RPC program";
@@ -130,7 +130,10 @@ void RpcServer::Run() {
       std::fprintf(stderr, "footfalld: error: poll: %s\n", std::strerror(errno));
       break;
     }
-    if (ready > 0) svc_getreq_poll(fds.data(), ready);
+    if (ready > 0) {
+      svc_getreq_poll(fds.data(), ready);
+      ReapConnections();
+    }
     const auto now = std::chrono::steady_clock::now();
     if (now - last_expiry > std::chrono::seconds(5)) {
       g_state->registry.ExpireUploads();

@@ -1,12 +1,78 @@
 #include "footfall/service/terrain_registry.h"
 
+#include <fcntl.h>
 #include <limits.h>
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <random>
+#include <vector>
 
 namespace footfall {
+
+namespace {
+
+// True when canonical `path` is `root` or below it.
+bool Inside(const std::string& root, const std::string& path) {
+  return root == "/" || path == root || path.compare(0, root.size() + 1, root + "/") == 0;
+}
+
+// True when canonical `path` is an ancestor of `root` (a walk from "/" passes it on the way in).
+bool AboveRoot(const std::string& root, const std::string& path) {
+  return path == "/" || root.compare(0, path.size() + 1, path + "/") == 0;
+}
+
+std::vector<std::string> Components(const std::string& path) {
+  std::vector<std::string> parts;
+  size_t begin = 0;
+  while (begin <= path.size()) {
+    const size_t end = std::min(path.find('/', begin), path.size());
+    if (end > begin) parts.push_back(path.substr(begin, end - begin));
+    begin = end + 1;
+  }
+  return parts;
+}
+
+// For an absolute path that realpath cannot resolve: true when resolving it leaves `root` before
+// it fails (a prefix resolves outside, or the part that fails is a link whose target leads out).
+// Decided without looking at anything outside the root that the path names, so the answer does
+// not reveal whether such things exist.
+bool LeadsOutside(const std::string& root, const std::string& path, int depth) {
+  if (depth > 16) return true;  // a loop of links
+  const std::vector<std::string> parts = Components(path);
+  std::string at = "/";  // canonical, inside the root or above it
+  for (size_t i = 0; i < parts.size(); ++i) {
+    const std::string next = (at == "/" ? "" : at) + "/" + parts[i];
+    char buffer[PATH_MAX];
+    if (realpath(next.c_str(), buffer)) {
+      at = buffer;
+      if (!Inside(root, at) && !AboveRoot(root, at)) return true;
+      continue;
+    }
+    if (!Inside(root, at)) return true;
+    const ssize_t n = readlink(next.c_str(), buffer, sizeof buffer - 1);
+    if (n < 0) return false;  // missing below a directory of the root
+    buffer[n] = '\0';
+    std::string rest = buffer[0] == '/' ? std::string(buffer) : at + "/" + buffer;
+    for (size_t j = i + 1; j < parts.size(); ++j) rest += "/" + parts[j];
+    return LeadsOutside(root, rest, depth + 1);
+  }
+  return !Inside(root, at);
+}
+
+// What a file type is, for messages about files that are not regular.
+const char* FileKind(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  return "not a regular file";
+}
+
+}  // namespace
 
 Status ResolveUnderRoot(const std::string& root, const std::string& relative, std::string* resolved,
                         std::string* message) {
@@ -14,22 +80,65 @@ Status ResolveUnderRoot(const std::string& root, const std::string& relative, st
     *message = "server-side loads are disabled (footfalld has no --data-root)";
     return Status::kAccessDenied;
   }
+  const size_t nul = relative.find('\0');
+  if (nul != std::string::npos) {
+    *message = "path has a NUL byte at offset " + std::to_string(nul) +
+               ": expected a path without NUL bytes";
+    return Status::kInvalidArgument;
+  }
   if (relative.empty() || relative[0] == '/') {
     *message = "'" + relative + "': expected a path relative to the data root";
     return Status::kAccessDenied;
   }
+  // Every path that leaves the root gets this one answer, whether or not its target exists.
+  const std::string outside = "'" + relative + "' leads outside the data root";
+  for (const std::string& part : Components(relative)) {
+    if (part == "..") {
+      *message = outside;
+      return Status::kAccessDenied;
+    }
+  }
   const std::string joined = root + "/" + relative;
   char buffer[PATH_MAX];
   if (!realpath(joined.c_str(), buffer)) {
+    if (LeadsOutside(root, joined, 0)) {
+      *message = outside;
+      return Status::kAccessDenied;
+    }
     *message = "'" + relative + "': no such file under the data root";
     return Status::kIoError;
   }
   const std::string canonical = buffer;
-  if (canonical.compare(0, root.size() + 1, root + "/") != 0) {
-    *message = "'" + relative + "': resolves outside the data root";
+  if (!Inside(root, canonical)) {
+    *message = outside;
     return Status::kAccessDenied;
   }
   *resolved = canonical;
+  return Status::kOk;
+}
+
+Status CheckRegularFile(const std::string& path, const std::string& shown, std::string* message) {
+  struct stat before {};
+  if (stat(path.c_str(), &before) != 0) {
+    *message = "'" + shown + "': no such file under the data root";
+    return Status::kIoError;
+  }
+  auto refuse = [&](mode_t mode) {
+    *message = "'" + shown + "' is " + FileKind(mode) + ": expected a regular terrain file";
+    return Status::kInvalidArgument;
+  };
+  if (!S_ISREG(before.st_mode)) return refuse(before.st_mode);
+  // Opened without blocking, in case it was replaced since, and checked again through the fd.
+  const int fd = open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+  if (fd < 0) {
+    *message = "'" + shown + "': cannot open";
+    return Status::kIoError;
+  }
+  struct stat opened {};
+  const bool same =
+      fstat(fd, &opened) == 0 && opened.st_dev == before.st_dev && opened.st_ino == before.st_ino;
+  close(fd);
+  if (!same || !S_ISREG(opened.st_mode)) return refuse(opened.st_mode);
   return Status::kOk;
 }
 
@@ -44,11 +153,16 @@ TerrainRegistry::TerrainRegistry(std::string data_root, RegistryLimits limits) :
   next_handle_ = (device() & 0x7FFFFFF0u) + 1;
 }
 
-size_t TerrainRegistry::TotalSamples() const {
-  size_t total = 0;
+uint64_t TerrainRegistry::TotalSamples() const {
+  uint64_t total = 0;
   for (const auto& t : terrains_) total += t.second->grid.size();
-  for (const auto& u : uploads_) total += u.second.samples.size();
+  for (const auto& u : uploads_) total += u.second.total;
   return total;
+}
+
+std::string TerrainRegistry::Budget() const {
+  return "the sample budget (--max-samples " + std::to_string(limits_.max_total_samples) + ", " +
+         std::to_string(TotalSamples()) + " in use by loaded terrains and uploads in progress)";
 }
 
 Status TerrainRegistry::Add(const std::string& name, RawSamples samples, uint32_t* handle,
@@ -58,7 +172,7 @@ Status TerrainRegistry::Add(const std::string& name, RawSamples samples, uint32_
     return Status::kLimitExceeded;
   }
   if (TotalSamples() + samples.size() > limits_.max_total_samples) {
-    *message = "sample limit reached (" + std::to_string(limits_.max_total_samples) + ")";
+    *message = std::to_string(samples.size()) + " samples do not fit in " + Budget();
     return Status::kLimitExceeded;
   }
   Status status = ValidateAndNormalize(&samples, message);
@@ -79,12 +193,17 @@ Status TerrainRegistry::LoadFile(const std::string& relative_path, double separa
   std::string path;
   Status status = ResolveUnderRoot(data_root_, relative_path, &path, message);
   if (status != Status::kOk) return status;
+  status = CheckRegularFile(path, relative_path, message);
+  if (status != Status::kOk) return status;
   if (!(separation >= 0)) {
     *message = "separation must be >= 0";
     return Status::kInvalidArgument;
   }
   TerrainLoadOptions options;
   options.separation = separation;
+  // Meshes are refused on the sampler's estimate, before any sampling.
+  const uint64_t used = TotalSamples();
+  options.max_samples = used < limits_.max_total_samples ? limits_.max_total_samples - used : 0;
   RawSamples samples;
   std::string error;
   status = LoadTerrain(path, options, &samples, &error);
@@ -93,37 +212,40 @@ Status TerrainRegistry::LoadFile(const std::string& relative_path, double separa
     const size_t at = error.find(path);
     if (at != std::string::npos) error.replace(at, path.size(), relative_path);
     *message = error;
+    if (status == Status::kLimitExceeded)
+      *message += " (the limit is what is left of " + Budget() + ")";
     return status;
   }
   return Add(relative_path, std::move(samples), handle, message);
 }
 
-Status TerrainRegistry::BeginUpload(const std::string& name, uint64_t total, uint32_t* upload,
-                                    std::string* message) {
+Status TerrainRegistry::BeginUpload(const std::string& name, uint64_t total, uint64_t owner,
+                                    uint32_t* upload, std::string* message) {
   ExpireUploads();
   if (uploads_.size() >= limits_.max_uploads) {
     *message = "too many uploads in progress (limit " + std::to_string(limits_.max_uploads) + ")";
     return Status::kLimitExceeded;
   }
   if (total > limits_.max_total_samples || TotalSamples() + total > limits_.max_total_samples) {
-    *message = "upload of " + std::to_string(total) + " samples exceeds the sample limit";
+    *message = "an upload of " + std::to_string(total) + " samples does not fit in " + Budget();
     return Status::kLimitExceeded;
   }
   uint32_t id = next_upload_++;
   while (id == 0 || uploads_.count(id)) id = next_upload_++;
   Upload& u = uploads_[id];
   u.name = name;
+  u.owner = owner;
   u.total = total;
   u.touched = std::chrono::steady_clock::now();
   *upload = id;
   return Status::kOk;
 }
 
-Status TerrainRegistry::AppendUpload(uint32_t upload, const RawSamples& chunk,
+Status TerrainRegistry::AppendUpload(uint32_t upload, uint64_t owner, const RawSamples& chunk,
                                      std::string* message) {
   auto it = uploads_.find(upload);
-  if (it == uploads_.end()) {
-    *message = "no upload " + std::to_string(upload) + " in progress";
+  if (it == uploads_.end() || it->second.owner != owner) {
+    *message = "no upload " + std::to_string(upload) + " in progress on this connection";
     return Status::kInvalidArgument;
   }
   Upload& u = it->second;
@@ -133,10 +255,9 @@ Status TerrainRegistry::AppendUpload(uint32_t upload, const RawSamples& chunk,
     return Status::kInvalidArgument;
   }
   for (size_t i = 0; i < chunk.size(); ++i) {
-    if (!IsFinite(chunk.points[i]) || !IsFinite(chunk.normals[i]) ||
-        Length2(chunk.normals[i]) == 0) {
-      *message =
-          "sample " + std::to_string(u.samples.size() + i) + ": NaN, infinite or zero-normal value";
+    std::string what;
+    if (CheckSample(chunk.points[i], chunk.normals[i], &what) != Status::kOk) {
+      *message = "sample " + std::to_string(u.samples.size() + i) + ": " + what;
       uploads_.erase(it);
       return Status::kInvalidArgument;
     }
@@ -147,10 +268,11 @@ Status TerrainRegistry::AppendUpload(uint32_t upload, const RawSamples& chunk,
   return Status::kOk;
 }
 
-Status TerrainRegistry::FinishUpload(uint32_t upload, uint32_t* handle, std::string* message) {
+Status TerrainRegistry::FinishUpload(uint32_t upload, uint64_t owner, uint32_t* handle,
+                                     std::string* message) {
   auto it = uploads_.find(upload);
-  if (it == uploads_.end()) {
-    *message = "no upload " + std::to_string(upload) + " in progress";
+  if (it == uploads_.end() || it->second.owner != owner) {
+    *message = "no upload " + std::to_string(upload) + " in progress on this connection";
     return Status::kInvalidArgument;
   }
   Upload u = std::move(it->second);
@@ -176,6 +298,11 @@ std::vector<uint32_t> TerrainRegistry::Handles() const {
   std::vector<uint32_t> handles;
   for (const auto& t : terrains_) handles.push_back(t.first);
   return handles;
+}
+
+void TerrainRegistry::DropClient(uint64_t owner) {
+  for (auto it = uploads_.begin(); it != uploads_.end();)
+    it = it->second.owner == owner ? uploads_.erase(it) : std::next(it);
 }
 
 void TerrainRegistry::ExpireUploads() {

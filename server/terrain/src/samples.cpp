@@ -1,8 +1,53 @@
 #include "footfall/terrain/samples.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace footfall {
+namespace {
+
+std::string Format(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", x);
+  return text;
+}
+
+std::string Format(const Vec3& v) {
+  return "(" + Format(v.x) + ", " + Format(v.y) + ", " + Format(v.z) + ")";
+}
+
+}  // namespace
+
+bool NormalizeSafely(const Vec3& v, Vec3* unit) {
+  if (!IsFinite(v)) return false;
+  const double largest = std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)});
+  if (!(largest > 0)) return false;
+  const Vec3 scaled = v / largest;  // largest component +-1: the length is in [1, sqrt(3)]
+  *unit = scaled / Length(scaled);
+  return true;
+}
+
+Status CheckSample(const Vec3& point, const Vec3& normal, std::string* what) {
+  std::string why;
+  Vec3 unit;
+  if (!IsFinite(point)) {
+    why = "point " + Format(point) + " is not finite (expected finite x y z)";
+  } else if (std::fabs(point.x) > terrain::kMaxCoordinate ||
+             std::fabs(point.y) > terrain::kMaxCoordinate ||
+             std::fabs(point.z) > terrain::kMaxCoordinate) {
+    why = "point " + Format(point) + " is out of range (expected coordinates within +-" +
+          Format(terrain::kMaxCoordinate) + ")";
+  } else if (!IsFinite(normal)) {
+    why = "normal " + Format(normal) + " is not finite (expected finite nx ny nz)";
+  } else if (!NormalizeSafely(normal, &unit)) {
+    why = "normal " + Format(normal) + " has zero length (expected a non-zero nx ny nz)";
+  } else {
+    return Status::kOk;
+  }
+  if (what) *what = why;
+  return Status::kInvalidArgument;
+}
 
 Status ValidateAndNormalize(RawSamples* samples, std::string* error) {
   if (samples->points.size() != samples->normals.size()) {
@@ -10,18 +55,12 @@ Status ValidateAndNormalize(RawSamples* samples, std::string* error) {
     return Status::kInvalidArgument;
   }
   for (size_t i = 0; i < samples->size(); ++i) {
-    const Vec3& p = samples->points[i];
-    Vec3& n = samples->normals[i];
-    if (!IsFinite(p) || !IsFinite(n)) {
-      if (error) *error = "sample " + std::to_string(i) + ": value is NaN or infinite";
+    std::string what;
+    if (CheckSample(samples->points[i], samples->normals[i], &what) != Status::kOk) {
+      if (error) *error = "sample " + std::to_string(i) + ": " + what;
       return Status::kInvalidArgument;
     }
-    const double len = Length(n);
-    if (!(len > 0) || !std::isfinite(len)) {
-      if (error) *error = "sample " + std::to_string(i) + ": normal has zero length";
-      return Status::kInvalidArgument;
-    }
-    n = n / len;
+    NormalizeSafely(samples->normals[i], &samples->normals[i]);
   }
   return Status::kOk;
 }

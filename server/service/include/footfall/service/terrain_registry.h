@@ -43,12 +43,21 @@ class TerrainRegistry {
   TerrainRegistry(std::string data_root, RegistryLimits limits);
 
   // Loads a file under the data root. kAccessDenied for paths escaping it (.., symlinks).
+  // Meshes and height maps are refused before sampling when the sampler's estimate exceeds the
+  // samples left in the budget (RegistryLimits::max_total_samples).
   Status LoadFile(const std::string& relative_path, double separation, uint32_t* handle,
                   std::string* message);
-  Status BeginUpload(const std::string& name, uint64_t total, uint32_t* upload,
+  // Starts an upload for client `owner` (a connection), reserving its announced total against
+  // the sample budget until it finishes, fails, expires or DropClient(owner). kLimitExceeded
+  // when the budget cannot hold it.
+  Status BeginUpload(const std::string& name, uint64_t total, uint64_t owner, uint32_t* upload,
                      std::string* message);
-  Status AppendUpload(uint32_t upload, const RawSamples& chunk, std::string* message);
-  Status FinishUpload(uint32_t upload, uint32_t* handle, std::string* message);
+  // Appends a chunk to `owner`'s upload; a bad chunk ends the upload.
+  Status AppendUpload(uint32_t upload, uint64_t owner, const RawSamples& chunk,
+                      std::string* message);
+  Status FinishUpload(uint32_t upload, uint64_t owner, uint32_t* handle, std::string* message);
+  // Ends the uploads of a client that went away, releasing their reservations.
+  void DropClient(uint64_t owner);
   Status Unload(uint32_t handle);
   const LoadedTerrain* Find(uint32_t handle) const;
   std::vector<uint32_t> Handles() const;
@@ -62,11 +71,15 @@ class TerrainRegistry {
 
  private:
   Status Add(const std::string& name, RawSamples samples, uint32_t* handle, std::string* message);
-  size_t TotalSamples() const;
+  // Samples held by loaded terrains plus those reserved by uploads in progress.
+  uint64_t TotalSamples() const;
+  // "the sample budget (--max-samples N, M in use)", for messages.
+  std::string Budget() const;
 
   struct Upload {
     std::string name;
-    uint64_t total = 0;
+    uint64_t owner = 0;
+    uint64_t total = 0;  // announced, and reserved
     RawSamples samples;
     std::chrono::steady_clock::time_point touched;
   };
@@ -84,5 +97,10 @@ class TerrainRegistry {
 // "..", and symlinks leading outside. On success *resolved is the canonical path.
 Status ResolveUnderRoot(const std::string& root, const std::string& relative, std::string* resolved,
                         std::string* message);
+
+// Refuses (kInvalidArgument) anything at `path` but a regular file: FIFOs, devices, sockets and
+// directories, whose reading could block the server or never end. Never blocks; messages name
+// the file as `shown`.
+Status CheckRegularFile(const std::string& path, const std::string& shown, std::string* message);
 
 }  // namespace footfall
