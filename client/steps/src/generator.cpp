@@ -170,6 +170,8 @@ class Generator {
   // Buffers reused every step. The moves of the w-th walking character of a step are
   // moves_[w * G .. (w + 1) * G) for G feet in the stepping group.
   std::vector<size_t> walking_;  // agents walking this step
+  std::vector<size_t> walkers_;  // indices in walking_ of the characters placing feet this pass
+  std::vector<char> retry_;      // per walking character: a foot to place again
   std::vector<Move> moves_;
   std::vector<Vec3> locator_, locator_normal_;  // per move
   std::vector<size_t> pending_, still_;
@@ -433,8 +435,11 @@ Status Generator::QueryFootholds(std::string* error) {
   const size_t per_agent = walking_.empty() ? 0 : moves.size() / walking_.size();
   const size_t locators = pairs_of_group_[group_].size();
   const std::vector<size_t>& slot = slot_of_foot_[group_];
-  pending_.resize(moves.size());
-  for (size_t m = 0; m < moves.size(); ++m) pending_[m] = m;
+  // The moves of this pass's characters still without a foothold (all of them in the first pass).
+  pending_.clear();
+  for (size_t w : walkers_)
+    for (size_t m = w * per_agent; m < (w + 1) * per_agent; ++m)
+      if (!moves[m].done && !moves[m].failed) pending_.push_back(m);
   for (int round = 0; !pending_.empty(); ++round) {
     // 7. Target locators: the foot's rest offset from its pair's centre, in the frame of the
     //    central locator (aligned to the terrain normal under it). The step vector runs from
@@ -506,26 +511,28 @@ Status Generator::QueryFootholds(std::string* error) {
     if (s != Status::kOk) return s;
     // Per character (its moves are contiguous): accept or refuse each answered foot, then the
     // reach limit on the body where the accepted footholds put it; feet beyond it retry.
-    Parallel(walking_.size(), [&](size_t wb, size_t we) {
-      for (size_t w = wb; w < we; ++w) {
-        const size_t m = w * per_agent, e = m + per_agent;
+    Parallel(walkers_.size(), [&](size_t wb, size_t we) {
+      for (size_t i = wb; i < we; ++i) {
+        const size_t m = walkers_[i] * per_agent, e = m + per_agent;
         bool all_done = true;
-        for (size_t i = m; i < e; ++i) {
-          if (moves[i].query != kNoQuery)
-            Judge(moves[i], next_answers_[moves[i].query]), moves[i].query = kNoQuery;
-          all_done &= moves[i].done;
+        for (size_t j = m; j < e; ++j) {
+          if (moves[j].query != kNoQuery)
+            Judge(moves[j], next_answers_[moves[j].query]), moves[j].query = kNoQuery;
+          all_done &= moves[j].done;
         }
         if (all_done) CheckReach(m, e);
       }
     });
     pending_.clear();
-    for (size_t m = 0; m < moves.size(); ++m) {
-      Move& mv = moves[m];
-      if (mv.done || mv.failed) continue;
-      if (mv.attempts >= kMaxAttempts)
-        Fail(mv);
-      else
-        mv.attempt = kAttempts[mv.attempts], pending_.push_back(m);
+    for (size_t w : walkers_) {
+      for (size_t m = w * per_agent; m < (w + 1) * per_agent; ++m) {
+        Move& mv = moves[m];
+        if (mv.done || mv.failed) continue;
+        if (mv.attempts >= kMaxAttempts)
+          Fail(mv);
+        else
+          mv.attempt = kAttempts[mv.attempts], pending_.push_back(m);
+      }
     }
   }
   return Status::kOk;
@@ -625,10 +632,11 @@ Status Generator::ClearArcs(int k, std::string* error) {
   //    is finished (10-11) in the round where none of its arcs was raised.
   std::vector<Move>& moves = moves_;
   const size_t per_agent = walking_.empty() ? 0 : moves.size() / walking_.size();
-  // Round 0: every walking character, with the moves whose foothold was accepted.
+  // Round 0: this pass's characters, with the moves whose foothold was accepted.
   pending_.clear();
   arc_agents_.clear();
-  for (size_t w = 0; w < walking_.size(); ++w) {
+  retry_.assign(walking_.size(), 0);
+  for (size_t w : walkers_) {
     const size_t begin = pending_.size();
     for (size_t m = w * per_agent; m < (w + 1) * per_agent; ++m)
       if (moves[m].done) pending_.push_back(m);
@@ -676,12 +684,22 @@ Status Generator::ClearArcs(int k, std::string* error) {
           }
           if (!low[0] && !low[1]) continue;
           if (round + 1 >= kMaxRaises) {
-            std::ostringstream why;
-            why.precision(3);
-            why << "the swing arc to " << Point(mv.end)
-                << " cannot clear the terrain (mid key raised " << kMaxRaises * kRaise
-                << " step heights)";
-            mv.failed = true, mv.done = false, mv.reason = why.str();
+            // The foot asks for another foothold (its next try), or gives up after the last.
+            if (mv.reason.empty()) {
+              std::ostringstream why;
+              why.precision(3);
+              why << "the swing arc to " << Point(mv.end)
+                  << " cannot clear the terrain (mid key raised " << kMaxRaises * kRaise
+                  << " step heights)";
+              mv.reason = why.str();
+            }
+            mv.done = false;
+            if (mv.attempts >= kMaxAttempts) {
+              Fail(mv);
+            } else {
+              mv.attempt = kAttempts[mv.attempts];
+              retry_[aa.walking] = 1;
+            }
             continue;
           }
           mv.mid += mv.mid_normal * (kRaise * c_.step_height);
@@ -695,7 +713,7 @@ Status Generator::ClearArcs(int k, std::string* error) {
           }
           verdict_[i] = 1, raised_[g] = 1;
         }
-        if (!raised_[g]) Finish(aa.walking, k);
+        if (!raised_[g] && !retry_[aa.walking]) Finish(aa.walking, k);
       }
     });
     // The next round: the characters with a raised arc, and only those arcs.
@@ -711,6 +729,10 @@ Status Generator::ClearArcs(int k, std::string* error) {
     pending_.swap(still_);
     arc_agents_.swap(next_agents_);
   }
+  // The next pass: the characters with a foot to place again.
+  walkers_.clear();
+  for (size_t w = 0; w < retry_.size(); ++w)
+    if (retry_[w]) walkers_.push_back(w);
   return Status::kOk;
 }
 
@@ -796,10 +818,16 @@ Status Generator::Step(int k, std::string* error) {
                          "snap locators", error);
   if (s != Status::kOk) return s;
   // 6 (end) and 7-8 in QueryFootholds; 9 (only the feet whose foothold was accepted) and 10-11
-  // in ClearArcs.
-  const Status f = QueryFootholds(error);
-  if (f != Status::kOk) return f;
-  return ClearArcs(k, error);
+  // in ClearArcs. A foot whose arc cannot clear asks for its next foothold: its character goes
+  // through both again.
+  walkers_.resize(walking_.size());
+  for (size_t w = 0; w < walking_.size(); ++w) walkers_[w] = w;
+  while (!walkers_.empty()) {
+    Status st = QueryFootholds(error);
+    if (st == Status::kOk) st = ClearArcs(k, error);
+    if (st != Status::kOk) return st;
+  }
+  return Status::kOk;
 }
 
 }  // namespace
