@@ -230,13 +230,7 @@ TEST_CASE("RPC answers equal the embedded engine", "[rpc]") {
     CHECK(rpc->Snap(remote, Vec3{}).status == Status::kUnknownTerrain);
   }
   SECTION("the single-query procedures") {
-    sockaddr_in addr{};
-    addr.sin_family = AF_INET;
-    addr.sin_port = htons(static_cast<uint16_t>(server.port()));
-    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    int sock = RPC_ANYSOCK;
-    CLIENT* c = clnttcp_create(&addr, FOOTFALL_PROG, FOOTFALL_V1, &sock, 0, 0);
-    REQUIRE(c != nullptr);
+    CLIENT* c = RawClient(server.port());
     // The session's handle is its own; find the server's through FF_LIST.
     ff_list_reply list{};
     REQUIRE(ff_list_1(nullptr, &list, c) == RPC_SUCCESS);
@@ -326,13 +320,7 @@ TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
     }
   }
   SECTION("a path with a NUL byte is refused, not cut short") {
-    sockaddr_in addr{};
-    addr.sin_family = AF_INET;
-    addr.sin_port = htons(static_cast<uint16_t>(server.port()));
-    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    int sock = RPC_ANYSOCK;
-    CLIENT* c = clnttcp_create(&addr, FOOTFALL_PROG, FOOTFALL_V1, &sock, 0, 0);
-    REQUIRE(c != nullptr);
+    CLIENT* c = RawClient(server.port());
     RawLoadArgs args;
     args.path = std::string("ok.pts\0../x", 11);
     ff_load_reply reply{};

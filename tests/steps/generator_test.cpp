@@ -47,6 +47,29 @@ const WalkTrack& Body(const Walk& w) {
   return w.tracks.front();
 }
 
+// Walks 12 steps from `start` along +Z (`forward`) or -Z and checks the walk: no stop, every
+// invariant of CheckWalk, and the body rising by more than `rise` (a negative `rise`: falling by
+// more than -rise).
+void WalkTwelveSteps(Terrain& t, const Character& c, const Vec3& start, bool forward, double rise) {
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = start;
+  o.heading = {0, 0, forward ? 1.0 : -1.0};
+  o.steps = 12;
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CHECK(w.stopped.empty());
+  CHECK(StepsDone(w) == 12);
+  CheckWalk(t, c, o, w);
+  const auto& body = Body(w).keys;
+  const double climbed = body.back().position.y - body.front().position.y;
+  if (rise >= 0) {
+    CHECK(climbed > rise);
+  } else {
+    CHECK(climbed < rise);
+  }
+}
+
 }  // namespace
 
 TEST_CASE("Walks up and down a 20-degree ramp", "[steps][generator]") {
@@ -60,20 +83,10 @@ TEST_CASE("Walks up and down a 20-degree ramp", "[steps][generator]") {
     const double length = nz * spacing;
     for (bool uphill : {true, false}) {
       INFO(name << (uphill ? " uphill" : " downhill"));
-      GenerateOptions o;
       const double d = uphill ? 2 * c.reach : length - 2 * c.reach;
-      o.has_start = true;
-      o.start = {width / 2, std::sin(slope) * d, std::cos(slope) * d};
-      o.heading = {0, 0, uphill ? 1.0 : -1.0};
-      o.steps = 12;
-      const Walk w = Generate(t, c, o);
-      INFO(w.stopped);
-      CHECK(w.stopped.empty());
-      CHECK(StepsDone(w) == 12);
-      CheckWalk(t, c, o, w);
-      const auto& body = Body(w).keys;
-      const double climbed = body.back().position.y - body.front().position.y;
-      CHECK((uphill ? climbed : -climbed) > 2 * c.step_length * std::sin(slope));
+      const double climb = 2 * c.step_length * std::sin(slope);
+      WalkTwelveSteps(t, c, {width / 2, std::sin(slope) * d, std::cos(slope) * d}, uphill,
+                      uphill ? climb : -climb);
     }
   }
 }
@@ -107,49 +120,20 @@ TEST_CASE("Steps are shorter on a slope past the threshold", "[steps][generator]
   CHECK(steep < 0.8 * flat);
 }
 
-TEST_CASE("Climbs stairs", "[steps][generator]") {
-  for (const std::string& name : ShippedCharacters()) {
-    const Character c = LoadShipped(name);
-    const double s = Scale(c);
-    const double rise = 0.15 * s, run = 0.35 * s;
-    Terrain t = LoadTerrain(MakeStairs(24, rise, run, 8 * c.reach, 0.025 * s), 0.025 * s);
-    INFO(name);
-    GenerateOptions o;
-    o.has_start = true;
-    o.start = {4 * c.reach, 0, c.reach};
-    o.steps = 12;
-    const Walk w = Generate(t, c, o);
-    INFO(w.stopped);
-    CHECK(w.stopped.empty());
-    CHECK(StepsDone(w) == 12);
-    CheckWalk(t, c, o, w);
-    const auto& body = Body(w).keys;
-    CHECK(body.back().position.y - body.front().position.y > 3 * rise);
-  }
-}
-
-TEST_CASE("Walks down stairs", "[steps][generator]") {
-  // Every foot reaches past a nose: a biped onto the tread below; a quadruped aims down when
-  // its target hangs over the nose; insects wrap over the nose onto the riser, then down.
+TEST_CASE("Walks up and down stairs", "[steps][generator]") {
+  // Down, every foot reaches past a nose: a biped onto the tread below; a quadruped aims down
+  // when its target hangs over the nose; insects wrap over the nose onto the riser, then down.
   for (const std::string& name : ShippedCharacters()) {
     const Character c = LoadShipped(name);
     const double s = Scale(c);
     const double rise = 0.15 * s, run = 0.35 * s;
     const int steps = 24;
     Terrain t = LoadTerrain(MakeStairs(steps, rise, run, 8 * c.reach, 0.025 * s), 0.025 * s);
-    INFO(name);
-    GenerateOptions o;
-    o.has_start = true;
-    o.start = {4 * c.reach, rise * (steps - 1), run * steps - c.reach};
-    o.heading = {0, 0, -1};
-    o.steps = 12;
-    const Walk w = Generate(t, c, o);
-    INFO(w.stopped);
-    CHECK(w.stopped.empty());
-    CHECK(StepsDone(w) == 12);
-    CheckWalk(t, c, o, w);
-    const auto& body = Body(w).keys;
-    CHECK(body.front().position.y - body.back().position.y > 2 * rise);
+    INFO(name << " up");
+    WalkTwelveSteps(t, c, {4 * c.reach, 0, c.reach}, true, 3 * rise);
+    INFO(name << " down");
+    WalkTwelveSteps(t, c, {4 * c.reach, rise * (steps - 1), run * steps - c.reach}, false,
+                    -2 * rise);
   }
 }
 
