@@ -54,6 +54,12 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
        "'align_to_normal': expected true"},
       {{"[0.1, 0, 0]", "[0.1, 0]"}, "'feet'[0].rest: expected [x, y, z]"},
       {{"\"body_height\": 0.9,", ""}, "missing field 'body_height'"},
+      // Fields of the wrong JSON type are named with the type found, never thrown.
+      {{"\"footfall-character\"", "5"}, "b.json: 'format' must be a string, found number"},
+      {{"\"format\": \"footfall-character\",", ""}, "b.json: missing field 'format'"},
+      {{"\"name\": \"b\"", "\"name\": [1]"}, "b.json: 'name' must be a string, found array"},
+      {{"\"step_length\": 0.6", "\"step_length\": \"0.6\""},
+       "b.json: 'step_length' must be a number, found string"},
   };
   for (const auto& [edit, message] : bad) {
     INFO(message);
@@ -101,6 +107,10 @@ TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]")
        "tracks[0].keys[1].frame: frames must increase"},
       {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"b","kind":"body","keys":[{"frame":1,"position":[0,0,0],"rotation":[0,0,0,0]}]}]})",
        "w.json: tracks[0].keys[0].rotation: expected a non-zero quaternion"},
+      {R"({"format":5,"version":1,"fps":24,"tracks":[]})",
+       "w.json: format: must be a string, found number"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"stopped":7,"tracks":[]})",
+       "w.json: stopped: expected a string"},
       {"[1, 2]", "w.json: not a JSON object"},
       {"{\"format\": \"footfall-walk\",\n \"tracks\": [\n",
        "w.json:3:1: malformed JSON: syntax error"},

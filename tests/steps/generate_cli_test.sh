@@ -82,6 +82,9 @@ bad extension "unsupported output extension" --terrain "$hills" --character "$ch
 bad character "$work/none.json: cannot open character file" --terrain "$hills" --character "$work/none.json" --out "$work/x.json"
 printf '{"format": "footfall-character", "version": 1, "feet": []}' > "$work/bad.json"
 bad character-content "$work/bad.json: 'feet': expected a non-empty array" --terrain "$hills" --character "$work/bad.json" --out "$work/x.json"
+# A field of the wrong JSON type is a message, not an abort.
+sed 's/"footfall-character"/5/' "$chars/biped.json" > "$work/format5.json"
+bad character-type "$work/format5.json: 'format' must be a string, found number" --terrain "$hills" --character "$work/format5.json" --out "$work/x.json"
 bad zero-heading "heading must be a non-zero finite vector" --terrain "$hills" --character "$chars/biped.json" --heading 0,0,0 --out "$work/x.json"
 check "bad flags: no output written" [ ! -e "$work/x.json" ]
 

@@ -23,13 +23,19 @@ struct Reader {
     if (status == Status::kOk) status = s, error = source + ": " + what;
     return false;
   }
+  // "'KEY' must be EXPECTED, found TYPE" for a field of the wrong JSON type.
+  bool Mistyped(const std::string& key, const char* expected, const json& found) {
+    return Fail(Status::kParseError,
+                "'" + key + "' must be " + expected + ", found " + found.type_name());
+  }
   bool Number(const json& j, const char* key, bool required, double* out) {
     auto it = j.find(key);
     if (it == j.end())
       return required
                  ? Fail(Status::kParseError, std::string("missing field '") + key + "' (a number)")
                  : true;
-    if (!it->is_number() || !std::isfinite(it->get<double>()))
+    if (!it->is_number()) return Mistyped(key, "a number", *it);
+    if (!std::isfinite(it->get<double>()))
       return Fail(Status::kParseError, std::string("'") + key + "': expected a finite number");
     *out = it->get<double>();
     return true;
@@ -126,7 +132,11 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
   }
   Character c;
   if (r.status == Status::kOk) {
-    if (j.value("format", std::string()) != "footfall-character")
+    if (!j.contains("format"))
+      r.Fail(Status::kParseError, "missing field 'format' (expected \"footfall-character\")");
+    else if (!j["format"].is_string())
+      r.Mistyped("format", "a string", j["format"]);
+    else if (j["format"].get<std::string>() != "footfall-character")
       r.Fail(Status::kParseError, "'format': expected \"footfall-character\"");
     else if (!j.contains("version") || !j["version"].is_number_integer())
       r.Fail(Status::kParseError, "'version': expected an integer");
@@ -137,7 +147,7 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
   }
   if (r.status == Status::kOk && j.contains("name")) {
     if (!j["name"].is_string())
-      r.Fail(Status::kParseError, "'name': expected a string");
+      r.Mistyped("name", "a string", j["name"]);
     else
       c.name = j["name"].get<std::string>();
   }
