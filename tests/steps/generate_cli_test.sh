@@ -85,6 +85,8 @@ bad character-content "$work/bad.json: 'feet': expected a non-empty array" --ter
 # A field of the wrong JSON type is a message, not an abort.
 sed 's/"footfall-character"/5/' "$chars/biped.json" > "$work/format5.json"
 bad character-type "$work/format5.json: 'format' must be a string, found number" --terrain "$hills" --character "$work/format5.json" --out "$work/x.json"
+sed 's/"version": 1/"version": 4294967297/' "$chars/biped.json" > "$work/version.json"
+bad character-version "$work/version.json: 'version' 4294967297 is not supported" --terrain "$hills" --character "$work/version.json" --out "$work/x.json"
 bad zero-heading "heading must be a non-zero finite vector" --terrain "$hills" --character "$chars/biped.json" --heading 0,0,0 --out "$work/x.json"
 check "bad flags: no output written" [ ! -e "$work/x.json" ]
 

@@ -8,6 +8,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "json_input.h"
+
 namespace footfall {
 namespace {
 
@@ -101,8 +103,9 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
                       std::string* error) {
   Reader r;
   r.source = source;
-  json j = json::parse(text, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) {
+  json j;
+  if (!detail::ParseJsonText(text, source, &j, error)) return Status::kParseError;
+  if (!j.is_object()) {
     *error = source + ": not a JSON object (expected a footfall character file)";
     return Status::kParseError;
   }
@@ -124,12 +127,10 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
                                                "reach",
                                                "max_turn_deg",
                                                "comment"};
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    if (!kKnown.count(it.key())) {
-      r.Fail(Status::kParseError, "unknown field '" + it.key() + "'");
-      break;
-    }
-  }
+  static const std::set<std::string> kKnownFoot = {"name", "rest"};
+  std::string unknown;
+  if (detail::FindUnknownKey(j, kKnown, &unknown))
+    r.Fail(Status::kParseError, detail::UnknownFieldMessage(unknown, kKnown));
   Character c;
   if (r.status == Status::kOk) {
     if (!j.contains("format"))
@@ -140,7 +141,7 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
       r.Fail(Status::kParseError, "'format': expected \"footfall-character\"");
     else if (!j.contains("version") || !j["version"].is_number_integer())
       r.Fail(Status::kParseError, "'version': expected an integer");
-    else if (j["version"].get<int>() != kCharacterFormatVersion)
+    else if (!detail::IsInteger(j["version"], kCharacterFormatVersion))
       r.Fail(Status::kParseError, "'version' " + j["version"].dump() +
                                       " is not supported (this build reads version " +
                                       std::to_string(kCharacterFormatVersion) + ")");
@@ -164,6 +165,11 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
         if (!f.is_object() || !f.contains("name") || !f["name"].is_string() ||
             f["name"].get<std::string>().empty() || !f.contains("rest")) {
           r.Fail(Status::kParseError, where + ": expected {\"name\": STRING, \"rest\": [x, y, z]}");
+          break;
+        }
+        if (detail::FindUnknownKey(f, kKnownFoot, &unknown)) {
+          r.Fail(Status::kParseError,
+                 where + ": " + detail::UnknownFieldMessage(unknown, kKnownFoot));
           break;
         }
         spec.name = f["name"].get<std::string>();
