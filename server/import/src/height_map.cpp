@@ -6,6 +6,9 @@
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <sstream>
+
+#include "footfall/terrain/samples.h"
 
 namespace footfall {
 namespace {
@@ -25,6 +28,13 @@ bool ParseDouble(const std::string& token, double* value) {
   char* end = nullptr;
   *value = std::strtod(begin, &end);
   return end != begin && *end == '\0' && std::isfinite(*value);
+}
+
+// A number as people write it: "5e+14", "0.25".
+std::string Number(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
 }
 
 // Whitespace-separated tokens with their line numbers; '#' comments optional.
@@ -184,6 +194,12 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
     }
     out->heights[i] = h;
     out->valid[i] = !(has_nodata && h == nodata);
+    if (out->valid[i] && std::fabs(h) > terrain::kMaxCoordinate) {
+      return Fail(path + ":" + std::to_string(reader.line()),
+                  "value " + value + " is out of range (expected |height| <= " +
+                      Number(terrain::kMaxCoordinate) + ")",
+                  error);
+    }
   }
   if (reader.Next(&value)) {
     return Fail(path + ":" + std::to_string(reader.line()),
@@ -287,6 +303,27 @@ Status HeightMapToMesh(const HeightMap& map, const HeightMapFrame& frame, Triang
       *error = "height map frame needs cell size > 0, a finite height scale and up axis x, y or z";
     }
     return Status::kInvalidArgument;
+  }
+  const double extent = std::max(map.cols - 1, map.rows - 1) * frame.cell_size;
+  if (extent > terrain::kMaxCoordinate) {
+    if (error) {
+      *error = "the grid spans " + Number(extent) + " (" + std::to_string(map.cols) + " x " +
+               std::to_string(map.rows) + " cells of " + Number(frame.cell_size) +
+               "), out of range (expected at most " + Number(terrain::kMaxCoordinate) + ")";
+    }
+    return Status::kInvalidArgument;
+  }
+  for (size_t i = 0; i < map.heights.size(); ++i) {
+    const double h = map.heights[i] * frame.height_scale;
+    if (map.valid[i] && !(std::fabs(h) <= terrain::kMaxCoordinate)) {
+      if (error) {
+        *error = "cell (row " + std::to_string(i / map.cols) + ", column " +
+                 std::to_string(i % map.cols) + "): height " + Number(map.heights[i]) + " x " +
+                 Number(frame.height_scale) +
+                 " is out of range (expected |height| <= " + Number(terrain::kMaxCoordinate) + ")";
+      }
+      return Status::kInvalidArgument;
+    }
   }
   const uint32_t kNone = 0xffffffffu;
   std::vector<uint32_t> vertex(map.heights.size(), kNone);

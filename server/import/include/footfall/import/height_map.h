@@ -50,7 +50,8 @@ struct HeightMapFrame {
 // valid cells (split along the north-east to south-west diagonal), one where exactly three are
 // valid; every triangle faces up. World axes by up_axis (right-handed in each case):
 //   'y': (east, height, south)   'z': (east, north, height)   'x': (height, east, north)
-// kInvalidArgument for a bad frame.
+// kInvalidArgument for a bad frame, or a vertex beyond +-terrain::kMaxCoordinate (the message
+// names the cell).
 Status HeightMapToMesh(const HeightMap& map, const HeightMapFrame& frame, TriangleMesh* out,
                        std::string* error);
 

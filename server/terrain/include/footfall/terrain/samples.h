@@ -26,3 +26,15 @@ struct RawSamples {
 Status ValidateAndNormalize(RawSamples* samples, std::string* error);
 
 }  // namespace footfall
+
+namespace footfall::terrain {
+
+// The largest |x|, |y| or |z| a terrain sample may have. [Units: wu] The grid stores samples as
+// float offsets from its origin, a point inside the samples' bounds, and refuses queries farther
+// than 1e15 from that origin (kMaxQueryDistance, query_math.h), where squared distances in double
+// can no longer tell samples apart. Within +-5e14 every sample is at most 1e15 from any origin
+// inside the bounds, so every sample stays reachable by a query (float offsets, which overflow
+// near 3.4e38, are far from their limit). Terrain readers refuse larger coordinates at load.
+constexpr double kMaxCoordinate = 5e14;
+
+}  // namespace footfall::terrain
