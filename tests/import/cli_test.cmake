@@ -49,6 +49,24 @@ expect(EXIT_NONZERO "nan.obj:2: vertex coordinate 'nan' is not a finite number"
 expect(EXIT_NONZERO "fin.obj: the mesh is not manifold" terrain info "${WORK}/fin.obj")
 expect(EXIT_NONZERO "cut.off: truncated: header declares 2 faces, found 1"
        terrain info "${WORK}/cut.off")
+# terrain make: every number finite, and a cap on the samples before anything is allocated.
+expect(EXIT_NONZERO "--amplitude: 'nan' is not a finite number"
+       terrain make hills --amplitude nan -o "${WORK}/x.pts")
+expect(EXIT_NONZERO "--amplitude: 'inf' is not a finite number"
+       terrain make rocks --amplitude inf -o "${WORK}/x.pts")
+expect(EXIT_NONZERO "--spacing: 'nan' is not a finite number > 0"
+       terrain make flat --spacing nan -o "${WORK}/x.pts")
+expect(EXIT_NONZERO "--slope: '1e300' is not a finite number from -80 to 80"
+       terrain make ramp --slope 1e300 -o "${WORK}/x.pts")
+expect(EXIT_NONZERO "hills: these sizes at --spacing 0.05 give about 4e+12 samples, more than the 20000000 allowed"
+       terrain make hills --size 100000 -o "${WORK}/x.pts")
+expect(EXIT_NONZERO "flat: these sizes at --spacing 0.001 give about 4e+24 samples"
+       terrain make flat --size 2000000000 --spacing 0.001 -o "${WORK}/x.pts")
+expect(EXIT_NONZERO "--height-scale: 'nan' is not a finite number"
+       terrain info "${WORK}/hill.asc" --height-scale nan)
+if(EXISTS "${WORK}/x.pts")
+  message(FATAL_ERROR "terrain make wrote a file for bad flags")
+endif()
 # A point file without samples is refused by every command that loads it.
 foreach(command "terrain;info" "query;--terrain" "generate;--character;${SOURCE_DIR}/data/characters/biped.json;--out;${WORK}/x.json;--terrain")
   expect(EXIT_NONZERO "empty.pts: no samples (expected at least one line x y z nx ny nz)"
