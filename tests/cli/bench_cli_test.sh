@@ -60,7 +60,10 @@ check "bad terrain: file and line" grep -qF "$work/bad.pts:2: expected 6 numbers
 printf '# no samples\n' > "$work/empty.pts"
 err=$("$footfall" bench --terrain "$work/empty.pts" 2>&1 >/dev/null)
 check "empty terrain: exit 1" [ $? -eq 1 ]
-check "empty terrain: message" grep -qF "$work/empty.pts: the terrain has no samples" <<< "$err"
+check "empty terrain: message" grep -qF "$work/empty.pts: no samples (expected at least one line x y z nx ny nz)" <<< "$err"
+err=$("$footfall" bench --terrain "$hills" --jitter nan 2>&1 >/dev/null)
+check "nan jitter refused" [ $? -ne 0 ]
+check "nan jitter: message" grep -qF -- "--jitter: 'nan' is not a finite number >= 0" <<< "$err"
 err=$("$footfall" bench --terrain "$hills" --queries 0 2>&1 >/dev/null)
 check "zero queries refused" [ $? -ne 0 ]
 stop_server

@@ -42,6 +42,9 @@ bad() {  # bad NAME CONTENT EXPECTED_MESSAGE
   check "$1: exit 1" [ "$rc" -eq 1 ]
   check "$1: message '$3'" grep -qF "$3" <<< "$err"
 }
+err=$(echo "snap 0 0 0" | "$footfall" query --terrain "$work/flat.pts" --tolerance nan 2>&1 >/dev/null)
+check "nan tolerance refused" [ $? -ne 0 ]
+check "nan tolerance: message" grep -qF -- "--tolerance: 'nan' is not a finite number >= 0" <<< "$err"
 bad count '0 0 0 0 1 0\n1 2 3\n' "$work/count.pts:2: expected 6 numbers (x y z nx ny nz), found 3"
 bad nan '# header\n0 0 nan 0 1 0\n' "$work/nan.pts:2: column 3: 'nan' is NaN or infinite"
 bad inf '0 0 0 0 1 0\n0 -inf 0 0 1 0\n' "$work/inf.pts:2: column 2: '-inf' is NaN or infinite"

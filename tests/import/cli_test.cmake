@@ -29,6 +29,9 @@ file(WRITE "${WORK}/nan.obj" "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n")
 file(WRITE "${WORK}/fin.obj" "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n")
 file(WRITE "${WORK}/cut.off" "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n")
 file(WRITE "${WORK}/terrain.dae" "<COLLADA/>")
+file(WRITE "${WORK}/empty.pts" "# no samples\n\n")
+file(WRITE "${WORK}/far.pts" "0 0 0 0 1 0\n1e308 0 0 0 1 0\n")
+file(WRITE "${WORK}/tall.asc" "ncols 2\nnrows 2\ncellsize 1\nNODATA_value -3.4e38\n1 -3.4e38\n1e20 2\n")
 file(WRITE "${WORK}/hill.asc" "ncols 3\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 1 1\n1 2 1\n1 1 1\n")
 
 # Good files.
@@ -46,6 +49,38 @@ expect(EXIT_NONZERO "nan.obj:2: vertex coordinate 'nan' is not a finite number"
 expect(EXIT_NONZERO "fin.obj: the mesh is not manifold" terrain info "${WORK}/fin.obj")
 expect(EXIT_NONZERO "cut.off: truncated: header declares 2 faces, found 1"
        terrain info "${WORK}/cut.off")
+# terrain make: every number finite, and a cap on the samples before anything is allocated.
+expect(EXIT_NONZERO "--amplitude: 'nan' is not a finite number"
+       terrain make hills --amplitude nan -o "${WORK}/x.pts")
+expect(EXIT_NONZERO "--amplitude: 'inf' is not a finite number"
+       terrain make rocks --amplitude inf -o "${WORK}/x.pts")
+expect(EXIT_NONZERO "--spacing: 'nan' is not a finite number > 0"
+       terrain make flat --spacing nan -o "${WORK}/x.pts")
+expect(EXIT_NONZERO "--slope: '1e300' is not a finite number from -80 to 80"
+       terrain make ramp --slope 1e300 -o "${WORK}/x.pts")
+expect(EXIT_NONZERO "hills: these sizes at --spacing 0.05 give about 4e+12 samples, more than the 20000000 allowed"
+       terrain make hills --size 100000 -o "${WORK}/x.pts")
+expect(EXIT_NONZERO "flat: these sizes at --spacing 0.001 give about 4e+24 samples"
+       terrain make flat --size 2000000000 --spacing 0.001 -o "${WORK}/x.pts")
+expect(EXIT_NONZERO "--height-scale: 'nan' is not a finite number"
+       terrain info "${WORK}/hill.asc" --height-scale nan)
+if(EXISTS "${WORK}/x.pts")
+  message(FATAL_ERROR "terrain make wrote a file for bad flags")
+endif()
+# A point file without samples is refused by every command that loads it.
+foreach(command "terrain;info" "query;--terrain" "generate;--character;${SOURCE_DIR}/data/characters/biped.json;--out;${WORK}/x.json;--terrain")
+  expect(EXIT_NONZERO "empty.pts: no samples (expected at least one line x y z nx ny nz)"
+         ${command} "${WORK}/empty.pts")
+endforeach()
+expect(EXIT_NONZERO "far.pts:2: column 1: 1e308 is out of range (expected |x| <= 5e+14)"
+       terrain info "${WORK}/far.pts")
+# NODATA may be huge; a valid height beyond the grid's range is refused with its line.
+expect(EXIT_NONZERO "tall.asc:6: value 1e20 is out of range (expected |height| <= 5e+14)"
+       terrain info "${WORK}/tall.asc")
+expect(EXIT_NONZERO "hill.asc: cell (row 0, column 0): height 1 x 1e+15 is out of range (expected |height| <= 5e+14)"
+       terrain info "${WORK}/hill.asc" --height-scale 1e15)
+expect(EXIT_NONZERO "hill.asc: the grid spans 2e+15"
+       terrain info "${WORK}/hill.asc" --cell-size 1e15)
 expect(EXIT_NONZERO "unknown terrain file extension 'dae'" terrain info "${WORK}/terrain.dae")
 expect(EXIT_NONZERO "absent.obj: cannot open" query --terrain "${WORK}/absent.obj")
 expect(EXIT_NONZERO "choose a separation of at least" terrain info "${WORK}/cube.obj" --separation 0.0001)

@@ -85,7 +85,7 @@ TEST_CASE("Height maps: bad files give clear errors", "[import][heightmap]") {
                               "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n"
                               "1 2 3\n4\n"),
                     &map, &error) == Status::kParseError);
-  CHECK(Contains(error, "cut.asc: truncated: expected 6 values (2 rows of 3), found 4"));
+  CHECK(Contains(error, "cut.asc:7: truncated: expected 6 values (2 rows of 3), found 4"));
   CHECK(ReadAscGrid(dir.Write("bad.asc", "ncols 2\nnrows 1\ncellsize 1\n1 x\n"), &map, &error) ==
         Status::kParseError);
   CHECK(Contains(error, "bad.asc:4: value 'x' is not a finite number"));
@@ -98,6 +98,52 @@ TEST_CASE("Height maps: bad files give clear errors", "[import][heightmap]") {
   CHECK(ReadPgm(dir.Write("magic.pgm", "P6 1 1 255\nabc"), &map, &error) == Status::kParseError);
   CHECK(Contains(error, "magic.pgm:1: expected the PGM magic"));
   CHECK(ReadPgm(dir.File("absent.pgm"), &map, &error) == Status::kIoError);
+}
+
+TEST_CASE("Height maps: headers are checked against the data before anything is allocated",
+          "[import][heightmap]") {
+  test::TempDir dir;
+  HeightMap map;
+  std::string error;
+  // A billion cells declared, three values present: refused at once (no 9 GB allocation).
+  CHECK(ReadAscGrid(dir.Write("big.asc",
+                              "ncols 1000000000\nnrows 1\nxllcorner 0\nyllcorner 0\n"
+                              "cellsize 1\n1 2 3\n"),
+                    &map, &error) == Status::kParseError);
+  CHECK(Contains(
+      error, "big.asc:6: truncated: expected 1000000000 values (1 rows of 1000000000), found 3"));
+  CHECK(map.heights.capacity() == 0);
+  CHECK(ReadPgm(dir.Write("big.pgm", "P5\n100000 100000\n255\nabc"), &map, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error,
+                 "big.pgm: truncated: 100000 x 100000 pixels of 1 bytes need 10000000000 bytes of "
+                 "data, the file has 3"));
+  CHECK(ReadPgm(dir.Write("big2.pgm", "P2\n# big\n100000 100000\n255\n1 2 3\n"), &map, &error) ==
+        Status::kParseError);
+  CHECK(Contains(
+      error,
+      "big2.pgm:5: truncated: expected 10000000000 grey levels (100000 x 100000 pixels), found 3"));
+  // P5 pixels above maxval are refused like P2 grey levels.
+  CHECK(ReadPgm(dir.Write("over.pgm",
+                          std::string("P5\n2 2\n100\n") + '\x01' + '\x02' + '\xff' + '\x04'),
+                &map, &error) == Status::kParseError);
+  CHECK(
+      Contains(error, "over.pgm: pixel 2 (row 1, column 0, byte 13) is 255, above the maxval 100"));
+  CHECK(ReadPgm(dir.Write("over16.pgm", std::string("P5 1 1 1000\n") + '\x03' + '\xe9'), &map,
+                &error) == Status::kParseError);
+  CHECK(Contains(error, "is 1001, above the maxval 1000"));
+}
+
+TEST_CASE("Height maps: a UTF-8 byte order mark is skipped", "[import][heightmap]") {
+  test::TempDir dir;
+  HeightMap map;
+  std::string error;
+  REQUIRE(ReadAscGrid(dir.Write("bom.asc", std::string("\xEF\xBB\xBF") + kAsc), &map, &error) ==
+          Status::kOk);
+  CHECK(map.heights[5] == 6);
+  REQUIRE(ReadPgm(dir.Write("bom.pgm", "\xEF\xBB\xBFP2\n2 1\n9\n1 2\n"), &map, &error) ==
+          Status::kOk);
+  CHECK(map.heights[1] == 2);
 }
 
 TEST_CASE("LoadTerrain: height maps with NODATA are resampled over the valid cells",

@@ -189,3 +189,41 @@ TEST_CASE("LoadTerrain: meshes are resampled at the separation", "[import][mesh]
 }
 
 }  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("ReadMesh: OBJ and OFF meshes keep double-precision coordinates far from the origin",
+          "[import][mesh]") {
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  // In float, 300000.01 and 300000.02 are the same number (float spacing there is 0.03).
+  const std::string obj = "v 300000.01 0 0\nv 300000.02 0 1\nv 300001.03 0 0\nf 1 2 3\n";
+  const std::string off = "OFF\n3 1 0\n300000.01 0 0\n300000.02 0 1\n300001.03 0 0\n3 0 1 2\n";
+  // PLY, STL and OM go through OpenMesh's float parsing (see the README).
+  for (const auto& [name, text] :
+       {std::pair<std::string, std::string>{"far.obj", obj}, {"far.off", off}}) {
+    INFO(name);
+    REQUIRE(Read(dir.Write(name, text), &mesh, &error) == Status::kOk);
+    CHECK(mesh.vertices[0].x == 300000.01);
+    CHECK(mesh.vertices[1].x == 300000.02);
+    CHECK(mesh.vertices[2].x == 300001.03);
+  }
+}
+
+TEST_CASE("ReadMesh: coordinates beyond kMaxCoordinate are refused with file and line",
+          "[import][mesh]") {
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  CHECK(Read(dir.Write("huge.obj", "v 1 0 0\nv 0 0 1\nv 0 -1e300 0\nf 1 2 3\n"), &mesh, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error,
+                 "huge.obj:3: vertex coordinate -1e300 is out of range (expected "
+                 "|coordinate| <= 5e+14)"));
+  CHECK(Read(dir.Write("huge.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 0 6e14\n3 0 1 2\n"), &mesh,
+             &error) == Status::kParseError);
+  CHECK(Contains(error, "huge.off:5: vertex coordinate 6e14 is out of range"));
+}
+
+}  // namespace footfall

@@ -449,9 +449,11 @@ TEST_CASE("footfalld refuses uploaded samples out of range, per chunk", "[rpc]")
     return message;
   };
   CHECK(refused({{1e308, 0, 0}, {0, 1, 0}}) ==
-        "sample 1: point (1e+308, 0, 0) is out of range (expected coordinates within +-1e+38)");
+        "sample 1: point (1e+308, 0, 0) is out of range (expected coordinates within +-5e+14)");
   CHECK(refused({{0, -4e38, 0}, {0, 1, 0}}) ==
-        "sample 1: point (0, -4e+38, 0) is out of range (expected coordinates within +-1e+38)");
+        "sample 1: point (0, -4e+38, 0) is out of range (expected coordinates within +-5e+14)");
+  CHECK(refused({{0, 0, 5.0001e14}, {0, 1, 0}}) ==
+        "sample 1: point (0, 0, 5.0001e+14) is out of range (expected coordinates within +-5e+14)");
   CHECK(refused({{0, 0, 0}, {0, 0, 0}}) ==
         "sample 1: normal (0, 0, 0) has zero length (expected a non-zero nx ny nz)");
 
@@ -480,11 +482,11 @@ TEST_CASE("footfalld refuses uploaded samples out of range, per chunk", "[rpc]")
   CHECK(r.normal.x == Approx(std::sqrt(0.5)));
   CHECK(r.normal.y == Approx(std::sqrt(0.5)));
   CHECK(r.normal.z == 0);
-  const unsigned far = load({{{1e38, 0, 0}, {0, 1, 0}}, {{1e38, 1, 0}, {0, 1, 0}}});
-  r = snap(far, {1e38, 0.9, 0});
+  const unsigned far = load({{{5e14, 0, 0}, {0, 1, 0}}, {{5e14, 1, 0}, {0, 1, 0}}});
+  r = snap(far, {5e14, 0.9, 0});
   REQUIRE(r.status == FF_OK);
   CHECK(r.index == 1);
-  CHECK(r.point.x == 1e38);
+  CHECK(r.point.x == 5e14);
   CHECK(r.point.y == Approx(1));
   clnt_destroy(c);
 }

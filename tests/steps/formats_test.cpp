@@ -47,13 +47,27 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
       {{"[[\"L\"], [\"R\"]]", "[[\"L\"]]"}, "b.json: 'gait': foot 'R' is in no group"},
       {{"[[\"L\"], [\"R\"]]", "[[\"L\", \"L\"], [\"R\"]]"}, "foot 'L' is listed twice"},
       {{"\"reach\": 1.1", "\"reach\": 0.5"}, "'reach' = 0.5 must exceed foot 'L''s rest distance"},
-      {{"\"name\": \"b\"", "\"nmae\": \"b\""}, "b.json: unknown field 'nmae'"},
+      {{"\"name\": \"b\"", "\"nmae\": \"b\""},
+       "b.json: unknown field 'nmae' (known fields: align_to_normal, body_height, comment,"},
+      {{"[0.1, 0, 0]}", "[0.1, 0, 0], \"size\": 1}"},
+       "b.json: 'feet'[0]: unknown field 'size' (known fields: name, rest)"},
+      // The version is compared exactly: 2^32 + 1 does not wrap to 1.
+      {{"\"version\": 1", "\"version\": 4294967297"},
+       "b.json: 'version' 4294967297 is not supported"},
+      {{"\"version\": 1", "\"version\": -4294967295"}, "'version' -4294967295 is not supported"},
+      {{"\"version\": 1", "\"version\": 18446744073709551615"}, "is not supported"},
       {{"\"frames_per_step\": 10", "\"frames_per_step\": 2.5"},
        "'frames_per_step': expected an integer"},
       {{"\"align_to_normal\": false", "\"align_to_normal\": 1"},
        "'align_to_normal': expected true"},
       {{"[0.1, 0, 0]", "[0.1, 0]"}, "'feet'[0].rest: expected [x, y, z]"},
       {{"\"body_height\": 0.9,", ""}, "missing field 'body_height'"},
+      // Fields of the wrong JSON type are named with the type found, never thrown.
+      {{"\"footfall-character\"", "5"}, "b.json: 'format' must be a string, found number"},
+      {{"\"format\": \"footfall-character\",", ""}, "b.json: missing field 'format'"},
+      {{"\"name\": \"b\"", "\"name\": [1]"}, "b.json: 'name' must be a string, found array"},
+      {{"\"step_length\": 0.6", "\"step_length\": \"0.6\""},
+       "b.json: 'step_length' must be a number, found string"},
   };
   for (const auto& [edit, message] : bad) {
     INFO(message);
@@ -61,6 +75,12 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
     CHECK_THAT(error, Catch::Contains(message));
   }
   CHECK(ParseCharacter("{", "b.json", &c, &error) == Status::kParseError);
+  // Syntax errors say where: line 3, column 16 is the '}' after the missing value.
+  CHECK(ParseCharacter("{\"format\": \"footfall-character\",\n\"version\": 1,\n\"step_length\": }",
+                       "b.json", &c, &error) == Status::kParseError);
+  CHECK_THAT(error, Catch::StartsWith("b.json:3:16: malformed JSON: syntax error"));
+  // A UTF-8 byte order mark is skipped.
+  CHECK(ParseCharacter("\xEF\xBB\xBF" + Biped(), "b.json", &c, &error) == Status::kOk);
   CHECK(LoadCharacter("/nonexistent/c.json", &c, &error) == Status::kIoError);
   CHECK_THAT(error, Catch::Contains("/nonexistent/c.json: cannot open"));
 }
@@ -87,6 +107,8 @@ TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]")
   const std::pair<std::string, std::string> bad[] = {
       {R"({"format":"footfall-walk","version":9,"fps":24,"tracks":[]})",
        "w.json: version: expected 1"},
+      {R"({"format":"footfall-walk","version":4294967297,"fps":24,"tracks":[]})",
+       "w.json: version: expected 1"},
       {R"({"format":"footfall-walk","version":1,"fps":0,"tracks":[]})",
        "w.json: fps: expected a positive number"},
       {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"arm","keys":[]}]})",
@@ -101,6 +123,10 @@ TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]")
        "tracks[0].keys[1].frame: frames must increase"},
       {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"b","kind":"body","keys":[{"frame":1,"position":[0,0,0],"rotation":[0,0,0,0]}]}]})",
        "w.json: tracks[0].keys[0].rotation: expected a non-zero quaternion"},
+      {R"({"format":5,"version":1,"fps":24,"tracks":[]})",
+       "w.json: format: must be a string, found number"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"stopped":7,"tracks":[]})",
+       "w.json: stopped: expected a string"},
       {"[1, 2]", "w.json: not a JSON object"},
       {"{\"format\": \"footfall-walk\",\n \"tracks\": [\n",
        "w.json:3:1: malformed JSON: syntax error"},

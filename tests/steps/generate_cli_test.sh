@@ -54,6 +54,11 @@ both big-crowd 0 --terrain "$work/floor.pts" --character "$chars/hexapod.json" -
 check "big crowd: 1100 characters" [ "$(grep -o '"name":"body","character":"c[0-9]*"' "$work/big-crowd-embedded.json" | wc -l)" -eq 1100 ]
 check "big crowd: progress bar reaches 100%" grep -q '100%' "$work/big-crowd-embedded.err"
 
+# Directions with huge components are normalised without overflow: the same walk as 1,0,1.
+"$footfall" generate --terrain "$hills" --character "$chars/quadruped.json" --steps 16 \
+  --heading 1e300,0,1e300 --up 0,1e300,0 --out "$work/huge-heading.json" 2> /dev/null
+check "heading 1e300,0,1e300: the walk of 1,0,1" cmp -s "$work/huge-heading.json" "$work/quadruped-hills-embedded.json"
+
 # 2. A walk stopped at a cliff: the message names the step and the position; the keys so far
 #    are written; exit 2.
 check "cliff: message on stderr" grep -qE 'stopped early: step [0-9]+: foot [LR] at \([0-9.]+, [0-9.-]+, [0-9.]+\): .*cliff' "$work/biped-cliff-embedded.err"
@@ -68,11 +73,12 @@ for f in all.json all.gltf all.glb all.mel; do check "formats: $f written" [ -s 
 check "formats: MEL keys the feet" grep -q 'setKeyframe' "$work/all.mel"
 
 # 4. Bad flags: a message naming the flag, exit 1, no output.
-bad() {  # bad NAME EXPECTED_MESSAGE ARGS...
+bad() {  # bad NAME EXPECTED_MESSAGE ARGS...: exit 1 (or CLI11's 105 for a flag's own check)
   local name=$1 want=$2; shift 2
   local err
   err=$("$footfall" generate "$@" 2>&1 >/dev/null)
-  check "$name: exit 1" [ $? -eq 1 ]
+  local rc=$?
+  check "$name: exit 1" [ "$rc" -eq 1 -o "$rc" -eq 105 ]
   check "$name: message '$want'" grep -qF -- "$want" <<< "$err"
 }
 bad start "--start '1,2': expected X,Y,Z" --terrain "$hills" --character "$chars/biped.json" --start 1,2 --out "$work/x.json"
@@ -82,8 +88,17 @@ bad extension "unsupported output extension" --terrain "$hills" --character "$ch
 bad character "$work/none.json: cannot open character file" --terrain "$hills" --character "$work/none.json" --out "$work/x.json"
 printf '{"format": "footfall-character", "version": 1, "feet": []}' > "$work/bad.json"
 bad character-content "$work/bad.json: 'feet': expected a non-empty array" --terrain "$hills" --character "$work/bad.json" --out "$work/x.json"
+# A field of the wrong JSON type is a message, not an abort.
+sed 's/"footfall-character"/5/' "$chars/biped.json" > "$work/format5.json"
+bad character-type "$work/format5.json: 'format' must be a string, found number" --terrain "$hills" --character "$work/format5.json" --out "$work/x.json"
+sed 's/"version": 1/"version": 4294967297/' "$chars/biped.json" > "$work/version.json"
+bad character-version "$work/version.json: 'version' 4294967297 is not supported" --terrain "$hills" --character "$work/version.json" --out "$work/x.json"
 bad zero-heading "heading must be a non-zero finite vector" --terrain "$hills" --character "$chars/biped.json" --heading 0,0,0 --out "$work/x.json"
 bad far-start "the start is too far from the terrain to snap" --terrain "$hills" --character "$chars/biped.json" --start 1e20,0,0 --out "$work/x.json"
+# Numbers: finite, within readable bounds, one check for every float flag.
+bad fps-tiny "--fps: '1e-300' is not a finite number from 0.001 to 1e+06" --terrain "$hills" --character "$chars/biped.json" --fps 1e-300 --out "$work/x.json"
+bad start-frame "--start-frame: '-1e300' is not a finite number from -1e+09 to 1e+09" --terrain "$hills" --character "$chars/biped.json" --start-frame -1e300 --out "$work/x.json"
+bad crowd-spacing "--crowd-spacing: 'nan' is not a finite number from 0 to 1e+06" --terrain "$hills" --character "$chars/biped.json" --crowd-spacing nan --out "$work/x.json"
 check "bad flags: no output written" [ ! -e "$work/x.json" ]
 
 stop_server

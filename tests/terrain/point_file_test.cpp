@@ -69,6 +69,20 @@ TEST_CASE("ReadPointStream rejects bad lines with file and line", "[terrain][poi
     CHECK(Read("0 1e999 0 0 1 0\n", &s, &error) == Status::kParseError);
     CHECK(error.find("t.pts:1: column 2: '1e999' is out of range") == 0);
   }
+  SECTION("beyond the grid's range") {
+    // The grid stores float offsets from its origin and answers within 1e15 of it: coordinates
+    // beyond terrain::kMaxCoordinate would answer garbage or infinities.
+    CHECK(Read("0 0 0 0 1 0\n1e308 0 0 0 1 0\n", &s, &error) == Status::kParseError);
+    CHECK(error == "t.pts:2: column 1: 1e308 is out of range (expected |x| <= 5e+14)");
+    CHECK(Read("0 0 -1e39 0 1 0\n", &s, &error) == Status::kParseError);
+    CHECK(error == "t.pts:1: column 3: -1e39 is out of range (expected |z| <= 5e+14)");
+    CHECK(terrain::kMaxCoordinate == 5e14);
+    std::string text = "0 -5e14 0 0 1 0\n";
+    REQUIRE(Read(text, &s, &error) == Status::kOk);  // the limit itself is accepted
+    // Normals are directions: any finite size is fine.
+    REQUIRE(Read("0 0 0 0 1e300 0\n", &s, &error) == Status::kOk);
+    s.clear();
+  }
   SECTION("zero normal") {
     CHECK(Read("0 0 0 0 0 0\n", &s, &error) == Status::kParseError);
     CHECK(error == "t.pts:1: normal has zero length (expected a non-zero nx ny nz)");

@@ -19,6 +19,7 @@
 #include "commands.h"
 #include "footfall/import/terrain_loader.h"
 #include "footfall/terrain/brute_force.h"
+#include "number_checks.h"
 #include "terrain_flags.h"
 
 namespace footfall::cli {
@@ -358,11 +359,11 @@ void AddBenchCommand(CLI::App& app, int* exit_code) {
       ->check(CLI::Range(size_t{1}, size_t{1} << 20));
   cmd->add_option("--jitter", flags->jitter,
                   "how far query points lie off the terrain, per axis (default: a quarter cell)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(FiniteAtLeast(0));
   cmd->add_option("--step", flags->step, "step length of next queries (default: two cells)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(FiniteAtLeast(0));
   cmd->add_option("--min-time", flags->min_time, "seconds each figure is measured for at least")
-      ->check(CLI::PositiveNumber);
+      ->check(FiniteRange(0.001, 3600));
   cmd->add_option("--query-seed", flags->seed, "seed of the query points");
   cmd->add_flag("--json", flags->json, "write the figures as one JSON object");
   cmd->callback([flags, exit_code] { *exit_code = RunBench(*flags); });

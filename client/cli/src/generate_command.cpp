@@ -18,6 +18,7 @@
 #include "footfall/steps/generator.h"
 #include "footfall/steps/walk_json.h"
 #include "footfall/terrain/file_extension.h"
+#include "number_checks.h"
 #include "terrain_flags.h"
 
 namespace footfall::cli {
@@ -186,16 +187,17 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
                   "Steps per character, one gait group each (default 8; with --path, until "
                   "the goal)")
       ->check(CLI::Range(0, 1000000));
-  cmd->add_option("--start-frame", flags->start_frame, "Frame of the first keys (default 1)");
+  cmd->add_option("--start-frame", flags->start_frame, "Frame of the first keys (default 1)")
+      ->check(FiniteRange(-1e9, 1e9));
   cmd->add_option("--fps", flags->fps, "Frames per second of the walk (default 24)")
-      ->check(CLI::PositiveNumber);
+      ->check(FiniteRange(0.001, 1e6));
   cmd->add_option("--up", flags->up, "X,Y,Z world up of bipeds (default 0,1,0, as in Maya)");
   cmd->add_option("--crowd", flags->crowd,
                   "Generate this many characters at once on a grid around --start")
       ->check(CLI::Range(1, 1000000));
   cmd->add_option("--crowd-spacing", flags->crowd_spacing,
                   "Distance between crowd characters (default: twice the character's reach)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(FiniteRange(0, 1e6));
   cmd->add_option("--threads", flags->threads,
                   "Threads for the embedded engine's queries and the generator's own work "
                   "(default: the hardware's; the walk is the same whatever the count)")

@@ -1,5 +1,8 @@
 // footfall: footstep placement on uneven terrain, from the command line.
 #include <csignal>
+#include <exception>
+#include <iostream>
+#include <new>
 
 #include <CLI/CLI.hpp>
 
@@ -18,6 +21,14 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const std::bad_alloc&) {
+    std::cerr << "footfall: out of memory\n";
+    return 1;
+  } catch (const std::exception& e) {
+    // A last resort: every reader reports bad input as a message of its own; whatever escapes
+    // them still ends in a message and exit status 1, never an abort.
+    std::cerr << "footfall: " << e.what() << '\n';
+    return 1;
   }
   return exit_code;
 }

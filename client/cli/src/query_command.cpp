@@ -10,6 +10,7 @@
 
 #include "commands.h"
 #include "footfall/client/query_text.h"
+#include "number_checks.h"
 #include "terrain_flags.h"
 
 namespace footfall::cli {
@@ -144,7 +145,7 @@ void AddQueryCommand(CLI::App& app, int* exit_code) {
   AddTerrainFlags(cmd, &flags->terrain);
   cmd->add_option("--tolerance", flags->tolerance,
                   "next: candidate radius around the ideal point (default: the step length)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(FiniteAtLeast(0));
   cmd->callback([flags, exit_code] { *exit_code = RunQuery(*flags); });
 }
 

@@ -1,5 +1,7 @@
 // `footfall terrain`: convert meshes and height maps to point files, describe terrain files, and
 // make synthetic test terrain.
+#include <algorithm>
+#include <cmath>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -12,6 +14,7 @@
 #include "footfall/import/terrain_loader.h"
 #include "footfall/terrain/grid.h"
 #include "footfall/terrain/point_file.h"
+#include "number_checks.h"
 #include "terrain_flags.h"
 
 namespace footfall::cli {
@@ -105,9 +108,39 @@ int RunInfo(const InfoFlags& flags) {
   return 0;
 }
 
+// The most samples `terrain make` writes (about 1 GB of point file).
+constexpr double kMaxMadeSamples = 20000000;
+
+// About how many samples `make` would write, in double so that no flag can overflow it.
+double EstimateSamples(const MakeFlags& f) {
+  const double per_area = 1 / (f.spacing * f.spacing);
+  const std::string& k = f.kind;
+  if (k == "stairs") return f.steps * (f.run + std::fabs(f.rise)) * f.width * per_area;
+  if (k == "blocks")
+    return static_cast<double>(f.size) * f.size * (1 + 4.0 * f.max_height) * per_area;
+  if (k == "ramp") {
+    double run = f.length;  // the landing
+    for (double slope : f.slopes) run += f.length / std::cos(slope * 3.14159265358979323846 / 180);
+    return run * f.width * per_area;
+  }
+  if (k == "sphere") return 4 * 3.14159265358979323846 * f.radius * f.radius * per_area;
+  const double side = f.size / f.spacing + 1;  // rocks, flat, hills
+  return side * side;
+}
+
 int RunMake(const MakeFlags& f) {
   RawSamples samples;
   const std::string& k = f.kind;
+  const double estimate = EstimateSamples(f);
+  if (!(estimate <= kMaxMadeSamples)) {
+    std::ostringstream m;
+    m << "footfall terrain make: " << k << ": these sizes at --spacing " << f.spacing
+      << " give about " << std::setprecision(3) << estimate << " samples, more than the "
+      << std::setprecision(10) << kMaxMadeSamples
+      << " allowed (raise --spacing or make it smaller)";
+    std::cerr << m.str() << '\n';
+    return 1;
+  }
   if (k == "stairs") {
     samples = MakeStairs(f.steps, f.rise, f.run, f.width, f.spacing);
   } else if (k == "blocks") {
@@ -131,6 +164,14 @@ int RunMake(const MakeFlags& f) {
   if (samples.size() == 0) {
     std::cerr << "footfall terrain make: " << k << ": the parameters give no samples\n";
     return 1;
+  }
+  for (const Vec3& p : samples.points) {
+    const double m = std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+    if (!(m <= terrain::kMaxCoordinate)) {
+      std::cerr << "footfall terrain make: " << k << ": the parameters give coordinates beyond "
+                << terrain::kMaxCoordinate << " (" << m << "), out of the grid's range\n";
+      return 1;
+    }
   }
   if (WritePointFile(f.output, samples, &error) != Status::kOk) {
     std::cerr << "footfall terrain make: " << error << '\n';
@@ -171,18 +212,20 @@ void AddTerrainCommand(CLI::App& app, int* exit_code) {
       ->check(CLI::IsMember({"stairs", "blocks", "ramp", "rocks", "sphere", "flat", "hills"}));
   m->add_option("-o,--output", make->output, "Point file to write (.pts)")->required();
   m->add_option("--spacing", make->spacing, "Distance between samples")
-      ->check(CLI::PositiveNumber)
+      ->check(FiniteAbove(0))
       ->capture_default_str();
   m->add_option("--seed", make->seed, "Seed (blocks, rocks, hills)")->capture_default_str();
   m->add_option("--steps", make->steps, "stairs: number of steps")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  m->add_option("--rise", make->rise, "stairs: step height")->capture_default_str();
+  m->add_option("--rise", make->rise, "stairs: step height")
+      ->check(Finite())
+      ->capture_default_str();
   m->add_option("--run", make->run, "stairs: step depth")
-      ->check(CLI::PositiveNumber)
+      ->check(FiniteAbove(0))
       ->capture_default_str();
   m->add_option("--width", make->width, "stairs, ramp: width across")
-      ->check(CLI::PositiveNumber)
+      ->check(FiniteAbove(0))
       ->capture_default_str();
   m->add_option("--size", make->size, "blocks: columns per side; rocks, flat, hills: side length")
       ->check(CLI::PositiveNumber)
@@ -191,15 +234,16 @@ void AddTerrainCommand(CLI::App& app, int* exit_code) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   m->add_option("--amplitude", make->amplitude, "rocks, hills: height of the relief")
+      ->check(Finite())
       ->capture_default_str();
   m->add_option("--slope", make->slopes, "ramp: slope of each segment in degrees (repeatable)")
-      ->check(CLI::Range(-80.0, 80.0))
+      ->check(FiniteRange(-80, 80))
       ->capture_default_str();
   m->add_option("--length", make->length, "ramp: horizontal run of each segment and landing")
-      ->check(CLI::PositiveNumber)
+      ->check(FiniteAbove(0))
       ->capture_default_str();
   m->add_option("--radius", make->radius, "sphere: radius (it rests on y = 0)")
-      ->check(CLI::PositiveNumber)
+      ->check(FiniteAbove(0))
       ->capture_default_str();
   m->callback([make, exit_code] { *exit_code = RunMake(*make); });
 }

@@ -1,5 +1,7 @@
 #include "terrain_flags.h"
 
+#include "number_checks.h"
+
 namespace footfall::cli {
 
 void AddLoadFlags(CLI::App* command, TerrainLoadOptions* load) {
@@ -7,7 +9,7 @@ void AddLoadFlags(CLI::App* command, TerrainLoadOptions* load) {
       ->add_option("--separation", load->separation,
                    "Meshes and height maps: resample so that no surface point is farther "
                    "than this from a sample (world units; 0: mean edge length / cell size)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(FiniteAtLeast(0));
   command->add_flag("!--smooth-normals,--flat-normals", load->smooth_normals,
                     "Sample normals from faces instead of interpolated vertex normals");
   command->add_option("--seed", load->seed, "Seed of the mesh sampler");
@@ -16,9 +18,11 @@ void AddLoadFlags(CLI::App* command, TerrainLoadOptions* load) {
   command
       ->add_option("--cell-size", load->cell_size,
                    "Height maps: cell size (default: the .asc CELLSIZE, 1 for .pgm)")
-      ->check(CLI::PositiveNumber);
-  command->add_option("--height-scale", load->height_scale,
-                      "Height maps: world height of one file unit (metre or grey level)");
+      ->check(FiniteAbove(0));
+  command
+      ->add_option("--height-scale", load->height_scale,
+                   "Height maps: world height of one file unit (metre or grey level)")
+      ->check(Finite());
 }
 
 void AddTerrainFlags(CLI::App* command, TerrainFlags* flags) {
@@ -31,7 +35,7 @@ void AddTerrainFlags(CLI::App* command, TerrainFlags* flags) {
                       "footfalld HOST:PORT; without it the embedded engine answers");
   AddLoadFlags(command, &flags->load);
   command->add_option("--timeout", flags->timeout_s, "RPC call timeout in seconds")
-      ->check(CLI::PositiveNumber);
+      ->check(FiniteRange(0.001, 1e6));
 }
 
 Status OpenTerrain(const TerrainFlags& flags, std::unique_ptr<TerrainSession>* session,

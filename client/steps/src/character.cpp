@@ -8,6 +8,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "json_input.h"
+
 namespace footfall {
 namespace {
 
@@ -23,13 +25,19 @@ struct Reader {
     if (status == Status::kOk) status = s, error = source + ": " + what;
     return false;
   }
+  // "'KEY' must be EXPECTED, found TYPE" for a field of the wrong JSON type.
+  bool Mistyped(const std::string& key, const char* expected, const json& found) {
+    return Fail(Status::kParseError,
+                "'" + key + "' must be " + expected + ", found " + found.type_name());
+  }
   bool Number(const json& j, const char* key, bool required, double* out) {
     auto it = j.find(key);
     if (it == j.end())
       return required
                  ? Fail(Status::kParseError, std::string("missing field '") + key + "' (a number)")
                  : true;
-    if (!it->is_number() || !std::isfinite(it->get<double>()))
+    if (!it->is_number()) return Mistyped(key, "a number", *it);
+    if (!std::isfinite(it->get<double>()))
       return Fail(Status::kParseError, std::string("'") + key + "': expected a finite number");
     *out = it->get<double>();
     return true;
@@ -95,8 +103,9 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
                       std::string* error) {
   Reader r;
   r.source = source;
-  json j = json::parse(text, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) {
+  json j;
+  if (!detail::ParseJsonText(text, source, &j, error)) return Status::kParseError;
+  if (!j.is_object()) {
     *error = source + ": not a JSON object (expected a footfall character file)";
     return Status::kParseError;
   }
@@ -118,26 +127,28 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
                                                "reach",
                                                "max_turn_deg",
                                                "comment"};
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    if (!kKnown.count(it.key())) {
-      r.Fail(Status::kParseError, "unknown field '" + it.key() + "'");
-      break;
-    }
-  }
+  static const std::set<std::string> kKnownFoot = {"name", "rest"};
+  std::string unknown;
+  if (detail::FindUnknownKey(j, kKnown, &unknown))
+    r.Fail(Status::kParseError, detail::UnknownFieldMessage(unknown, kKnown));
   Character c;
   if (r.status == Status::kOk) {
-    if (j.value("format", std::string()) != "footfall-character")
+    if (!j.contains("format"))
+      r.Fail(Status::kParseError, "missing field 'format' (expected \"footfall-character\")");
+    else if (!j["format"].is_string())
+      r.Mistyped("format", "a string", j["format"]);
+    else if (j["format"].get<std::string>() != "footfall-character")
       r.Fail(Status::kParseError, "'format': expected \"footfall-character\"");
     else if (!j.contains("version") || !j["version"].is_number_integer())
       r.Fail(Status::kParseError, "'version': expected an integer");
-    else if (j["version"].get<int>() != kCharacterFormatVersion)
+    else if (!detail::IsInteger(j["version"], kCharacterFormatVersion))
       r.Fail(Status::kParseError, "'version' " + j["version"].dump() +
                                       " is not supported (this build reads version " +
                                       std::to_string(kCharacterFormatVersion) + ")");
   }
   if (r.status == Status::kOk && j.contains("name")) {
     if (!j["name"].is_string())
-      r.Fail(Status::kParseError, "'name': expected a string");
+      r.Mistyped("name", "a string", j["name"]);
     else
       c.name = j["name"].get<std::string>();
   }
@@ -154,6 +165,11 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
         if (!f.is_object() || !f.contains("name") || !f["name"].is_string() ||
             f["name"].get<std::string>().empty() || !f.contains("rest")) {
           r.Fail(Status::kParseError, where + ": expected {\"name\": STRING, \"rest\": [x, y, z]}");
+          break;
+        }
+        if (detail::FindUnknownKey(f, kKnownFoot, &unknown)) {
+          r.Fail(Status::kParseError,
+                 where + ": " + detail::UnknownFieldMessage(unknown, kKnownFoot));
           break;
         }
         spec.name = f["name"].get<std::string>();

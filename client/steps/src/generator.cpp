@@ -833,12 +833,17 @@ Status Generator::Step(int k, std::string* error) {
 }  // namespace
 
 Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Character& character,
-                    const GenerateOptions& options, Walk* out, std::string* error) {
-  if (!(Length2(options.up) > 0) || !IsFinite(options.up)) {
+                    const GenerateOptions& given, Walk* out, std::string* error) {
+  // Directions are normalised here, exactly even for components near 1e300 (their squares
+  // would overflow).
+  GenerateOptions options = given;
+  options.up = SafeNormalize(given.up);
+  options.heading = SafeNormalize(given.heading);
+  if (options.up == Vec3{}) {
     *error = "up must be a non-zero finite vector";
     return Status::kInvalidArgument;
   }
-  if (!(Length2(options.heading) > 0) || !IsFinite(options.heading)) {
+  if (options.heading == Vec3{}) {
     *error = "heading must be a non-zero finite vector";
     return Status::kInvalidArgument;
   }

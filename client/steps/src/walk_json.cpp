@@ -8,6 +8,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "json_input.h"
+
 namespace footfall {
 namespace {
 
@@ -63,28 +65,6 @@ struct Reader {
     return true;
   }
 };
-
-// "SOURCE:LINE:COLUMN: malformed JSON: WHAT", the position of the byte the parser stopped at.
-std::string MalformedJson(const std::string& text, const std::string& source,
-                          const json::parse_error& e) {
-  size_t line = 1, column = 1;
-  const size_t end = std::min(text.size(), e.byte > 0 ? static_cast<size_t>(e.byte - 1) : 0);
-  for (size_t i = 0; i < end; ++i) {
-    if (text[i] == '\n')
-      ++line, column = 1;
-    else
-      ++column;
-  }
-  // e.what() is "[json.exception.parse_error.101] parse error at line L, column C: WHAT".
-  std::string what = e.what();
-  const size_t at = what.find("parse error");
-  if (at != std::string::npos) {
-    const size_t colon = what.find(": ", at);
-    what = colon != std::string::npos ? what.substr(colon + 2) : what.substr(at);
-  }
-  return source + ":" + std::to_string(line) + ":" + std::to_string(column) +
-         ": malformed JSON: " + what;
-}
 
 }  // namespace
 
@@ -157,12 +137,7 @@ Status WriteWalkJson(const Walk& walk, const std::string& path, std::string* err
 Status ParseWalkJson(const std::string& text, const std::string& source, Walk* out,
                      std::string* error) {
   json j;
-  try {
-    j = json::parse(text);
-  } catch (const json::parse_error& e) {
-    *error = MalformedJson(text, source, e);
-    return Status::kParseError;
-  }
+  if (!detail::ParseJsonText(text, source, &j, error)) return Status::kParseError;
   Reader r;
   r.source = source;
   Walk walk;
@@ -170,10 +145,12 @@ Status ParseWalkJson(const std::string& text, const std::string& source, Walk* o
     *error = source + ": not a JSON object (expected a footfall walk)";
     return Status::kParseError;
   }
-  if (j.value("format", std::string()) != "footfall-walk") {
+  if (j.contains("format") && !j["format"].is_string()) {
+    r.Fail("format", std::string("must be a string, found ") + j["format"].type_name());
+  } else if (j.value("format", std::string()) != "footfall-walk") {
     r.Fail("format", "expected \"footfall-walk\"");
   } else if (!j.contains("version") || !j["version"].is_number_integer() ||
-             j["version"].get<int>() != kWalkFormatVersion) {
+             !detail::IsInteger(j["version"], kWalkFormatVersion)) {
     r.Fail("version", "expected " + std::to_string(kWalkFormatVersion));
   } else if (!j.contains("fps") || !r.Finite(j["fps"], "fps", &walk.fps)) {
     r.Fail("fps", "expected a positive number");

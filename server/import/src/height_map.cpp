@@ -6,6 +6,9 @@
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <sstream>
+
+#include "footfall/terrain/samples.h"
 
 namespace footfall {
 namespace {
@@ -25,6 +28,13 @@ bool ParseDouble(const std::string& token, double* value) {
   char* end = nullptr;
   *value = std::strtod(begin, &end);
   return end != begin && *end == '\0' && std::isfinite(*value);
+}
+
+// A number as people write it: "5e+14", "0.25".
+std::string Number(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
 }
 
 // Whitespace-separated tokens with their line numbers; '#' comments optional.
@@ -66,7 +76,44 @@ Status ReadWhole(const std::string& path, std::string* text, std::string* error)
     return Status::kIoError;
   }
   text->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  if (text->compare(0, 3, "\xEF\xBB\xBF") == 0) text->erase(0, 3);  // UTF-8 byte order mark
   if (text->empty()) return Fail(path, "the file is empty, expected a height map", error);
+  return Status::kOk;
+}
+
+// A whole number of the header as text ("1000000000", not "1e+09").
+std::string Count(double n) { return std::to_string(static_cast<long long>(n)); }
+
+// Counts the tokens `reader` has left, up to one more than a height map may have, and the line
+// of the last one counted.
+size_t CountValues(TokenReader reader, double declared, size_t* last_line) {
+  const double limit = std::min(declared, static_cast<double>(kMaxHeightMapCells) + 1);
+  size_t count = 0;
+  std::string token;
+  *last_line = reader.line();
+  while (static_cast<double>(count) < limit && reader.Next(&token)) {
+    ++count, *last_line = reader.line();
+  }
+  return count;
+}
+
+// Checks a header's grid of `cells` cells before anything is allocated for it: against the data
+// the file holds (`present` values, the last on `last_line`; see CountValues) and against
+// kMaxHeightMapCells. `declared` says what the header asked for ("6 values (2 rows of 3)"),
+// `header` where ("FILE:2").
+Status CheckGridSize(const std::string& path, const std::string& header, double cells,
+                     const std::string& declared, size_t present, size_t last_line,
+                     std::string* error) {
+  if (static_cast<double>(present) < cells && present <= kMaxHeightMapCells) {
+    return Fail(path + ":" + std::to_string(last_line),
+                "truncated: expected " + declared + ", found " + std::to_string(present), error);
+  }
+  if (cells > static_cast<double>(kMaxHeightMapCells)) {
+    return Fail(header,
+                "the header declares " + declared + ", more than the " +
+                    std::to_string(kMaxHeightMapCells) + " cells a height map may have",
+                error);
+  }
   return Status::kOk;
 }
 
@@ -85,6 +132,7 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
   std::string key, value;
   double ncols = -1, nrows = -1, cellsize = -1, nodata = NAN;
   bool has_nodata = false;
+  size_t size_line = 1;  // the line of ncols or nrows, whichever comes last
   // Header: KEY VALUE pairs until the first token that is a number.
   for (;;) {
     const TokenReader before = reader;
@@ -100,9 +148,9 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
     }
     const std::string k = Lower(key);
     if (k == "ncols") {
-      ncols = number;
+      ncols = number, size_line = line;
     } else if (k == "nrows") {
-      nrows = number;
+      nrows = number, size_line = line;
     } else if (k == "cellsize") {
       cellsize = number;
     } else if (k == "nodata_value") {
@@ -114,11 +162,18 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
                   error);
     }
   }
-  if (!(ncols >= 1 && nrows >= 1 && ncols == std::floor(ncols) && nrows == std::floor(nrows) &&
-        ncols * nrows <= 1e9)) {
+  if (!(ncols >= 1 && nrows >= 1 && ncols == std::floor(ncols) && nrows == std::floor(nrows))) {
     return Fail(path, "header needs whole ncols and nrows >= 1", error);
   }
   if (!(cellsize > 0)) return Fail(path, "header needs cellsize > 0", error);
+  const double cells = ncols * nrows;
+  size_t last_line;
+  const size_t present = CountValues(reader, cells, &last_line);
+  status =
+      CheckGridSize(path, path + ":" + std::to_string(size_line), cells,
+                    Count(cells) + " values (" + Count(nrows) + " rows of " + Count(ncols) + ")",
+                    present, last_line, error);
+  if (status != Status::kOk) return status;
   out->cols = static_cast<int>(ncols), out->rows = static_cast<int>(nrows);
   out->cell_size = cellsize;
   const size_t total = static_cast<size_t>(out->cols) * out->rows;
@@ -139,6 +194,12 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
     }
     out->heights[i] = h;
     out->valid[i] = !(has_nodata && h == nodata);
+    if (out->valid[i] && std::fabs(h) > terrain::kMaxCoordinate) {
+      return Fail(path + ":" + std::to_string(reader.line()),
+                  "value " + value + " is out of range (expected |height| <= " +
+                      Number(terrain::kMaxCoordinate) + ")",
+                  error);
+    }
   }
   if (reader.Next(&value)) {
     return Fail(path + ":" + std::to_string(reader.line()),
@@ -159,6 +220,7 @@ Status ReadPgm(const std::string& path, HeightMap* out, std::string* error) {
     return Fail(path + ":1", "expected the PGM magic 'P5' (binary) or 'P2' (ASCII)", error);
   }
   double fields[3];
+  size_t size_line = 1;
   const char* names[3] = {"width", "height", "maxval"};
   for (int i = 0; i < 3; ++i) {
     if (!reader.Next(&token) || !ParseDouble(token, &fields[i]) || fields[i] < 1 ||
@@ -166,29 +228,51 @@ Status ReadPgm(const std::string& path, HeightMap* out, std::string* error) {
       return Fail(path + ":" + std::to_string(reader.line()),
                   std::string("expected the PGM ") + names[i] + " as a whole number >= 1", error);
     }
+    if (i == 1) size_line = reader.line();
   }
   if (fields[2] > 65535) return Fail(path, "PGM maxval above 65535", error);
-  if (fields[0] * fields[1] > 1e9) return Fail(path, "PGM image too large", error);
+  const double cells = fields[0] * fields[1];
+  const std::string header = path + ":" + std::to_string(size_line);
+  const size_t bytes = fields[2] < 256 ? 1 : 2;  // per P5 pixel
+  const size_t start = reader.pos() + 1;         // P5: exactly one whitespace byte after maxval
+  if (magic == "P5") {
+    const size_t available = text.size() > start ? text.size() - start : 0;
+    const std::string declared = Count(fields[0]) + " x " + Count(fields[1]) + " pixels";
+    if (static_cast<double>(available) < cells * bytes) {
+      return Fail(path,
+                  "truncated: " + declared + " of " + std::to_string(bytes) + " bytes need " +
+                      Count(cells * bytes) + " bytes of data, the file has " +
+                      std::to_string(available),
+                  error);
+    }
+    status = CheckGridSize(path, header, cells, declared, available / bytes, 0, error);
+  } else {
+    size_t last_line;
+    const size_t present = CountValues(reader, cells, &last_line);
+    status = CheckGridSize(
+        path, header, cells,
+        Count(cells) + " grey levels (" + Count(fields[0]) + " x " + Count(fields[1]) + " pixels)",
+        present, last_line, error);
+  }
+  if (status != Status::kOk) return status;
   out->cols = static_cast<int>(fields[0]), out->rows = static_cast<int>(fields[1]);
   out->cell_size = 1;
   const size_t total = static_cast<size_t>(out->cols) * out->rows;
   out->heights.resize(total);
   out->valid.assign(total, 1);
   if (magic == "P5") {
-    const size_t bytes = fields[2] < 256 ? 1 : 2;
-    const size_t start = reader.pos() + 1;  // exactly one whitespace byte after maxval
-    const size_t available = text.size() > start ? text.size() - start : 0;
-    if (available < total * bytes) {
-      return Fail(path,
-                  "truncated: " + std::to_string(out->cols) + " x " + std::to_string(out->rows) +
-                      " pixels of " + std::to_string(bytes) + " bytes need " +
-                      std::to_string(total * bytes) + " bytes of data, the file has " +
-                      std::to_string(available),
-                  error);
-    }
     const auto* data = reinterpret_cast<const unsigned char*>(text.data() + start);
     for (size_t i = 0; i < total; ++i) {
-      out->heights[i] = bytes == 1 ? data[i] : (data[2 * i] << 8 | data[2 * i + 1]);
+      const int grey = bytes == 1 ? data[i] : (data[2 * i] << 8 | data[2 * i + 1]);
+      if (grey > fields[2]) {
+        return Fail(path,
+                    "pixel " + std::to_string(i) + " (row " + std::to_string(i / out->cols) +
+                        ", column " + std::to_string(i % out->cols) + ", byte " +
+                        std::to_string(start + i * bytes) + ") is " + std::to_string(grey) +
+                        ", above the maxval " + std::to_string(static_cast<int>(fields[2])),
+                    error);
+      }
+      out->heights[i] = grey;
     }
     return Status::kOk;
   }
@@ -219,6 +303,27 @@ Status HeightMapToMesh(const HeightMap& map, const HeightMapFrame& frame, Triang
       *error = "height map frame needs cell size > 0, a finite height scale and up axis x, y or z";
     }
     return Status::kInvalidArgument;
+  }
+  const double extent = std::max(map.cols - 1, map.rows - 1) * frame.cell_size;
+  if (extent > terrain::kMaxCoordinate) {
+    if (error) {
+      *error = "the grid spans " + Number(extent) + " (" + std::to_string(map.cols) + " x " +
+               std::to_string(map.rows) + " cells of " + Number(frame.cell_size) +
+               "), out of range (expected at most " + Number(terrain::kMaxCoordinate) + ")";
+    }
+    return Status::kInvalidArgument;
+  }
+  for (size_t i = 0; i < map.heights.size(); ++i) {
+    const double h = map.heights[i] * frame.height_scale;
+    if (map.valid[i] && !(std::fabs(h) <= terrain::kMaxCoordinate)) {
+      if (error) {
+        *error = "cell (row " + std::to_string(i / map.cols) + ", column " +
+                 std::to_string(i % map.cols) + "): height " + Number(map.heights[i]) + " x " +
+                 Number(frame.height_scale) +
+                 " is out of range (expected |height| <= " + Number(terrain::kMaxCoordinate) + ")";
+      }
+      return Status::kInvalidArgument;
+    }
   }
   const uint32_t kNone = 0xffffffffu;
   std::vector<uint32_t> vertex(map.heights.size(), kNone);

@@ -9,6 +9,8 @@
 #include <sstream>
 #include <vector>
 
+#include "footfall/terrain/samples.h"
+
 namespace footfall::detail {
 namespace {
 
@@ -26,12 +28,23 @@ std::vector<std::string> Tokens(const std::string& line) {
   return tokens;
 }
 
-// True when `token` is entirely a finite decimal number.
-bool IsFiniteNumber(const std::string& token) {
+// kOk and *value when `token` is entirely a finite decimal number within
+// +-terrain::kMaxCoordinate; otherwise kParseError with "WHERE: what was expected".
+Status CheckCoordinate(const std::string& where, const std::string& token, double* value_out,
+                       std::string* error) {
   const char* begin = token.c_str();
   char* end = nullptr;
   const double value = std::strtod(begin, &end);
-  return end != begin && *end == '\0' && std::isfinite(value);
+  *value_out = value;
+  if (end == begin || *end != '\0' || !std::isfinite(value))
+    return Fail(where, "vertex coordinate '" + token + "' is not a finite number", error);
+  if (std::fabs(value) > terrain::kMaxCoordinate) {
+    std::ostringstream m;
+    m << "vertex coordinate " << token
+      << " is out of range (expected |coordinate| <= " << terrain::kMaxCoordinate << ")";
+    return Fail(where, m.str(), error);
+  }
+  return Status::kOk;
 }
 
 bool ParseInteger(const std::string& token, long long* value) {
@@ -49,7 +62,8 @@ std::string StripComment(const std::string& line) {
 
 }  // namespace
 
-Status CheckObjFile(const std::string& path, long long* faces, std::string* error) {
+Status CheckObjFile(const std::string& path, long long* faces, std::vector<Vec3>* coordinates,
+                    std::string* error) {
   std::ifstream in(path);
   std::string line;
   long long vertices = 0;
@@ -63,12 +77,12 @@ Status CheckObjFile(const std::string& path, long long* faces, std::string* erro
                     "vertex has " + std::to_string(t.size() - 1) + " coordinates, expected 3",
                     error);
       }
+      double c[3];
       for (int i = 1; i <= 3; ++i) {
-        if (!IsFiniteNumber(t[i])) {
-          return Fail(At(path, number), "vertex coordinate '" + t[i] + "' is not a finite number",
-                      error);
-        }
+        const Status s = CheckCoordinate(At(path, number), t[i], &c[i - 1], error);
+        if (s != Status::kOk) return s;
       }
+      coordinates->push_back({c[0], c[1], c[2]});
       ++vertices;
     } else if (t[0] == "f") {
       ++*faces;
@@ -96,7 +110,8 @@ Status CheckObjFile(const std::string& path, long long* faces, std::string* erro
   return Status::kOk;
 }
 
-Status CheckOffFile(const std::string& path, long long* faces, std::string* error) {
+Status CheckOffFile(const std::string& path, long long* faces, std::vector<Vec3>* coordinates,
+                    std::string* error) {
   *faces = -1;
   std::ifstream in(path);
   std::string line;
@@ -133,12 +148,12 @@ Status CheckOffFile(const std::string& path, long long* faces, std::string* erro
                   error);
     }
     if (t.size() < 3) return Fail(At(path, number), "vertex needs 3 coordinates", error);
+    double c[3];
     for (int i = 0; i < 3; ++i) {
-      if (!IsFiniteNumber(t[i])) {
-        return Fail(At(path, number), "vertex coordinate '" + t[i] + "' is not a finite number",
-                    error);
-      }
+      const Status s = CheckCoordinate(At(path, number), t[i], &c[i], error);
+      if (s != Status::kOk) return s;
     }
+    coordinates->push_back({c[0], c[1], c[2]});
   }
   for (long long f = 0; f < nf; ++f) {
     if (!next(&t)) {
@@ -294,10 +309,9 @@ Status CheckStlFile(const std::string& path, std::string* error) {
     if (t[0] == "vertex") {
       if (t.size() < 4) return Fail(At(path, number), "vertex needs 3 coordinates", error);
       for (int i = 1; i <= 3; ++i) {
-        if (!IsFiniteNumber(t[i])) {
-          return Fail(At(path, number), "vertex coordinate '" + t[i] + "' is not a finite number",
-                      error);
-        }
+        double c;
+        const Status s = CheckCoordinate(At(path, number), t[i], &c, error);
+        if (s != Status::kOk) return s;
       }
     }
   }

@@ -1,5 +1,6 @@
 #include "footfall/import/mesh_reader.h"
 
+#include <cmath>
 #include <fstream>
 #include <mutex>
 #include <sstream>
@@ -8,6 +9,7 @@
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 
 #include "footfall/terrain/file_extension.h"
+#include "footfall/terrain/samples.h"
 #include "mesh_file_checks.h"
 
 namespace footfall {
@@ -101,8 +103,9 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
   }
   Status status = Status::kOk;
   long long declared_faces = -1;
-  if (ext == "obj") status = detail::CheckObjFile(path, &declared_faces, error);
-  if (ext == "off") status = detail::CheckOffFile(path, &declared_faces, error);
+  std::vector<Vec3> exact;  // OBJ, OFF: the coordinates in double, in file order
+  if (ext == "obj") status = detail::CheckObjFile(path, &declared_faces, &exact, error);
+  if (ext == "off") status = detail::CheckOffFile(path, &declared_faces, &exact, error);
   if (ext == "ply") status = detail::CheckPlyFile(path, &declared_faces, error);
   if (ext == "stl") status = detail::CheckStlFile(path, error);
   if (status != Status::kOk) return status;
@@ -133,14 +136,26 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
     skipped = static_cast<size_t>(declared_faces) - mesh.n_faces();
   }
 
-  // Vertices, all finite.
+  // Vertices, all finite. OpenMesh parses text coordinates as float; where the file's own
+  // double-precision coordinates match its vertices one to one, they are used instead.
+  const bool use_exact = exact.size() == mesh.n_vertices();
   out->vertices.resize(mesh.n_vertices());
   for (const auto vh : mesh.vertices()) {
     const auto& p = mesh.point(vh);
-    const Vec3 v{p[0], p[1], p[2]};
+    const Vec3 v = use_exact ? exact[vh.idx()] : Vec3{p[0], p[1], p[2]};
     if (!IsFinite(v)) {
       if (error)
         *error = path + ": vertex " + std::to_string(vh.idx() + 1) + " has a non-finite coordinate";
+      return Status::kParseError;
+    }
+    const double limit = terrain::kMaxCoordinate;
+    if (std::fabs(v.x) > limit || std::fabs(v.y) > limit || std::fabs(v.z) > limit) {
+      if (error) {
+        std::ostringstream m;
+        m << path << ": vertex " << vh.idx() + 1 << " (" << v.x << ", " << v.y << ", " << v.z
+          << ") is out of range (expected |coordinate| <= " << limit << ")";
+        *error = m.str();
+      }
       return Status::kParseError;
     }
     out->vertices[vh.idx()] = v;

@@ -55,7 +55,12 @@ Status LoadAny(const std::string& path, const std::string& ext, const TerrainLoa
                RawSamples* out, std::string* error, TerrainLoadReport* report) {
   if (ext == "pts" || ext == "xyz" || ext == "txt") {
     report->format = "points";
-    return ReadPointFile(path, out, error);
+    const Status status = ReadPointFile(path, out, error);
+    if (status == Status::kOk && out->size() == 0) {
+      if (error) *error = path + ": no samples (expected at least one line x y z nx ny nz)";
+      return Status::kParseError;
+    }
+    return status;
   }
   if (IsMeshExtension(ext)) {
     report->format = "mesh";
@@ -78,8 +83,12 @@ Status LoadAny(const std::string& path, const std::string& ext, const TerrainLoa
     frame.height_scale = options.height_scale;
     frame.up_axis = options.up_axis;
     TriangleMesh mesh;
-    status = HeightMapToMesh(map, frame, &mesh, error);
-    if (status != Status::kOk) return status;
+    std::string why;
+    status = HeightMapToMesh(map, frame, &mesh, &why);
+    if (status != Status::kOk) {
+      if (error) *error = path + ": " + why;
+      return status;
+    }
     report->vertices = mesh.vertices.size();
     report->nodata_cells = map.heights.size() - map.ValidCount();
     report->skipped_faces = RemoveDegenerateTriangles(&mesh);

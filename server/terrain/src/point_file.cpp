@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <istream>
+#include <sstream>
 #include <string_view>
 #include <system_error>
 
@@ -66,6 +67,12 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
                           "' is NaN or infinite (expected a finite number)",
                       out, error);
         }
+        if (count < 3 && std::fabs(value) > terrain::kMaxCoordinate) {
+          std::ostringstream m;
+          m << "column " << count + 1 << ": " << token << " is out of range (expected |"
+            << "xyz"[count] << "| <= " << terrain::kMaxCoordinate << ")";
+          return Fail(name, line_no, m.str(), out, error);
+        }
         v[count] = value;
       }
       ++count;
@@ -77,13 +84,12 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
                   "expected 6 numbers (x y z nx ny nz), found " + std::to_string(count), out,
                   error);
     }
-    const Vec3 normal{v[3], v[4], v[5]};
-    const double len = Length(normal);
-    if (!(len > 0) || !std::isfinite(len)) {
+    const Vec3 normal = SafeNormalize({v[3], v[4], v[5]});
+    if (normal == Vec3{}) {
       return Fail(name, line_no, "normal has zero length (expected a non-zero nx ny nz)", out,
                   error);
     }
-    out->push_back({v[0], v[1], v[2]}, normal / len);
+    out->push_back({v[0], v[1], v[2]}, normal);
   }
   if (in.bad()) {
     out->clear();

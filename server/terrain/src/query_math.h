@@ -26,6 +26,9 @@ inline bool Better(double d2, uint32_t index, double best_d2, uint32_t best_inde
 // Queries farther than this from the grid's origin are refused: there, squared distances keep
 // no precision to tell samples apart. [Units: wu]
 constexpr double kMaxQueryDistance = 1e15;
+static_assert(
+    2 * terrain::kMaxCoordinate <= kMaxQueryDistance,
+    "a sample at +-kMaxCoordinate must be within query range of any origin in the bounds");
 
 // True when a local query point is within kMaxQueryDistance of the origin along every axis.
 inline bool InQueryRange(const double c[3]) {

@@ -19,18 +19,8 @@ std::string Format(const Vec3& v) {
 
 }  // namespace
 
-bool NormalizeSafely(const Vec3& v, Vec3* unit) {
-  if (!IsFinite(v)) return false;
-  const double largest = std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)});
-  if (!(largest > 0)) return false;
-  const Vec3 scaled = v / largest;  // largest component +-1: the length is in [1, sqrt(3)]
-  *unit = scaled / Length(scaled);
-  return true;
-}
-
 Status CheckSample(const Vec3& point, const Vec3& normal, std::string* what) {
   std::string why;
-  Vec3 unit;
   if (!IsFinite(point)) {
     why = "point " + Format(point) + " is not finite (expected finite x y z)";
   } else if (std::fabs(point.x) > terrain::kMaxCoordinate ||
@@ -40,7 +30,7 @@ Status CheckSample(const Vec3& point, const Vec3& normal, std::string* what) {
           Format(terrain::kMaxCoordinate) + ")";
   } else if (!IsFinite(normal)) {
     why = "normal " + Format(normal) + " is not finite (expected finite nx ny nz)";
-  } else if (!NormalizeSafely(normal, &unit)) {
+  } else if (Length2(SafeNormalize(normal)) == 0) {
     why = "normal " + Format(normal) + " has zero length (expected a non-zero nx ny nz)";
   } else {
     return Status::kOk;
@@ -60,7 +50,7 @@ Status ValidateAndNormalize(RawSamples* samples, std::string* error) {
       if (error) *error = "sample " + std::to_string(i) + ": " + what;
       return Status::kInvalidArgument;
     }
-    NormalizeSafely(samples->normals[i], &samples->normals[i]);
+    samples->normals[i] = SafeNormalize(samples->normals[i]);
   }
   return Status::kOk;
 }

@@ -55,8 +55,10 @@ struct Character {
 };
 
 // Parses a character file's text. `source` names it in errors ("FILE: field: what was
-// expected"). Returns kParseError for malformed JSON or a missing/mistyped field,
-// kInvalidArgument for values out of range or inconsistent gait/pairs.
+// expected", "FILE:LINE:COLUMN: malformed JSON: ..."). Returns kParseError for malformed JSON,
+// an unknown field (at the top level or in a foot), a missing or mistyped field or a version
+// other than kCharacterFormatVersion; kInvalidArgument for values out of range or inconsistent
+// gait/pairs.
 Status ParseCharacter(const std::string& text, const std::string& source, Character* out,
                       std::string* error);
 

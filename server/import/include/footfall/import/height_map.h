@@ -7,6 +7,7 @@
 // (xllcorner, yllcorner) is not applied.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -15,6 +16,10 @@
 #include "footfall/terrain/status.h"
 
 namespace footfall {
+
+// The most cells a height map may have (a 10000 x 10000 grid): larger headers are refused before
+// anything is allocated, as are headers declaring more cells than the file holds values.
+constexpr size_t kMaxHeightMapCells = 100000000;
 
 struct HeightMap {
   int cols = 0, rows = 0;
@@ -26,12 +31,13 @@ struct HeightMap {
 
 // Reads an ESRI ASCII grid: a header (ncols, nrows, xllcorner|xllcenter, yllcorner|yllcenter,
 // cellsize, optional NODATA_value; any case) then nrows * ncols numbers. Cells equal to
-// NODATA_value are marked invalid. Errors: kIoError (cannot open), kParseError with
-// "FILE:LINE: what was expected" (bad header, non-numeric value, truncated data).
+// NODATA_value are marked invalid. A leading UTF-8 byte order mark is skipped. Errors: kIoError
+// (cannot open), kParseError with "FILE:LINE: what was expected" (bad header, more cells than
+// kMaxHeightMapCells or than the file has data for, non-numeric value, truncated data).
 Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error);
 
 // Reads a PGM image, binary (P5, 8 or 16 bit big-endian by maxval) or ASCII (P2). Heights are
-// the grey levels; every cell is valid. Errors as ReadAscGrid.
+// the grey levels, each at most maxval; every cell is valid. Errors as ReadAscGrid.
 Status ReadPgm(const std::string& path, HeightMap* out, std::string* error);
 
 struct HeightMapFrame {
@@ -44,7 +50,8 @@ struct HeightMapFrame {
 // valid cells (split along the north-east to south-west diagonal), one where exactly three are
 // valid; every triangle faces up. World axes by up_axis (right-handed in each case):
 //   'y': (east, height, south)   'z': (east, north, height)   'x': (height, east, north)
-// kInvalidArgument for a bad frame.
+// kInvalidArgument for a bad frame, or a vertex beyond +-terrain::kMaxCoordinate (the message
+// names the cell).
 Status HeightMapToMesh(const HeightMap& map, const HeightMapFrame& frame, TriangleMesh* out,
                        std::string* error);
 

@@ -23,24 +23,20 @@ struct RawSamples {
 
 namespace terrain {
 
-// The largest magnitude of a sample coordinate. [Units: wu] The grid stores each point as a
-// float offset from the centre of the samples' box (grid_build.cpp): with every coordinate
-// within +-1e38, offsets stay within +-1e38, below FLT_MAX (3.4e38), and the box's extent (at
-// most 2e38) and squared distances stay finite in double. Beyond it, a point could become an
-// infinite float and queries answer inf. (Queries themselves must lie within 1e15 of the grid's
-// origin: detail::kMaxQueryDistance.)
-constexpr double kMaxCoordinate = 1e38;
+// The largest |x|, |y| or |z| a terrain sample may have. [Units: wu] The grid stores samples as
+// float offsets from its origin, a point inside the samples' bounds, and refuses queries farther
+// than 1e15 from that origin (kMaxQueryDistance, query_math.h), where squared distances in double
+// can no longer tell samples apart. Within +-5e14 every sample is at most 1e15 from any origin
+// inside the bounds, so every sample stays reachable by a query (float offsets, which overflow
+// near 3.4e38, are far from their limit). Terrain readers refuse larger coordinates at load.
+constexpr double kMaxCoordinate = 5e14;
 
 }  // namespace terrain
 
 // Checks one sample: coordinates finite and within +-terrain::kMaxCoordinate, normal finite and
-// non-zero (any finite length: see NormalizeSafely). On failure returns kInvalidArgument and says
-// in *what what is wrong and what was expected.
+// non-zero (any finite length: see SafeNormalize in vec3.h). On failure returns kInvalidArgument
+// and says in *what what is wrong and what was expected.
 Status CheckSample(const Vec3& point, const Vec3& normal, std::string* what);
-
-// The unit vector along `v`, scaled by its largest component first so that no finite vector
-// overflows or underflows on the way. False when `v` is zero or not finite.
-bool NormalizeSafely(const Vec3& v, Vec3* unit);
 
 // Checks that counts match and every sample passes CheckSample, then normalises the normals. On
 // failure returns kInvalidArgument and names the first bad sample in *error ("sample 3: ...").

@@ -35,5 +35,13 @@ inline bool IsFinite(const Vec3& a) {
   return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
 }
 inline Vec3 Lerp(const Vec3& a, const Vec3& b, double t) { return a + (b - a) * t; }
+// a / |a| for any finite non-zero a, even with components near 1e300 whose squares overflow
+// (a is first scaled by its largest |component|); {0, 0, 0} when a is zero or not finite.
+inline Vec3 SafeNormalize(const Vec3& a) {
+  if (!IsFinite(a)) return {};
+  const double scale = std::fmax(std::fabs(a.x), std::fmax(std::fabs(a.y), std::fabs(a.z)));
+  if (!(scale > 0)) return {};
+  return Normalize(a / scale);
+}
 
 }  // namespace footfall

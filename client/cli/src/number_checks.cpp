@@ -1,0 +1,48 @@
+#include "number_checks.h"
+
+#include <sstream>
+#include <string>
+
+#include "footfall/client/query_text.h"
+
+namespace footfall::cli {
+namespace {
+
+std::string Text(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+// A validator accepting finite numbers x with ok(x); `expected` describes them.
+template <typename Ok>
+CLI::Validator Make(const std::string& expected, Ok ok) {
+  return CLI::Validator(
+      [expected, ok](std::string& input) -> std::string {
+        double x;
+        if (!ParseFiniteNumber(input, &x) || !ok(x)) return "'" + input + "' is not " + expected;
+        return "";
+      },
+      expected);
+}
+
+}  // namespace
+
+CLI::Validator Finite() {
+  return Make("a finite number", [](double) { return true; });
+}
+
+CLI::Validator FiniteAtLeast(double lo) {
+  return Make("a finite number >= " + Text(lo), [lo](double x) { return x >= lo; });
+}
+
+CLI::Validator FiniteAbove(double lo) {
+  return Make("a finite number > " + Text(lo), [lo](double x) { return x > lo; });
+}
+
+CLI::Validator FiniteRange(double lo, double hi) {
+  return Make("a finite number from " + Text(lo) + " to " + Text(hi),
+              [lo, hi](double x) { return x >= lo && x <= hi; });
+}
+
+}  // namespace footfall::cli

@@ -1,0 +1,29 @@
+// Reading footfall's JSON files (character files, walks): syntax errors with their line and
+// column, JSON type names for messages, exact version numbers and unknown fields. Private to
+// footfall::steps.
+#pragma once
+
+#include <cstdint>
+#include <set>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace footfall::detail {
+
+// Parses `text` (a leading UTF-8 byte order mark is skipped) into *out. On malformed JSON returns
+// false with "SOURCE:LINE:COLUMN: malformed JSON: WHAT" in *error, LINE and COLUMN (1-based,
+// column in bytes) locating the last byte the parser read.
+bool ParseJsonText(const std::string& text, const std::string& source, nlohmann::json* out,
+                   std::string* error);
+
+// True when `j` is an integer equal to `expected`, with no wrap-around (4294967297 is not 1).
+bool IsInteger(const nlohmann::json& j, int64_t expected);
+
+// True when object `j` has a key not in `known`; *key is then the first such key.
+bool FindUnknownKey(const nlohmann::json& j, const std::set<std::string>& known, std::string* key);
+
+// "unknown field 'KEY' (known fields: a, b, c)", with the known fields in sorted order.
+std::string UnknownFieldMessage(const std::string& key, const std::set<std::string>& known);
+
+}  // namespace footfall::detail
