@@ -47,6 +47,14 @@ expect(EXIT_NONZERO "empty.obj: the file is empty" terrain info "${WORK}/empty.o
 expect(EXIT_NONZERO "nan.obj:2: vertex coordinate 'nan' is not a finite number"
        terrain convert "${WORK}/nan.obj" -o "${WORK}/nan.pts")
 expect(EXIT_NONZERO "fin.obj: the mesh is not manifold" terrain info "${WORK}/fin.obj")
+# Terrain is written as points: an output named like a mesh is refused, nothing written.
+expect(EXIT_NONZERO "expected a point file name (.pts .xyz .txt)"
+       terrain convert "${WORK}/cube.obj" --separation 0.1 -o "${WORK}/cube-out.obj")
+expect(EXIT_NONZERO "expected a point file name (.pts .xyz .txt)"
+       terrain make flat -o "${WORK}/flat.ply")
+if(EXISTS "${WORK}/cube-out.obj" OR EXISTS "${WORK}/flat.ply")
+  message(FATAL_ERROR "a terrain was written under a mesh file name")
+endif()
 expect(EXIT_NONZERO "cut.off: truncated: header declares 2 faces, found 1"
        terrain info "${WORK}/cut.off")
 # terrain make: every number finite, and a cap on the samples before anything is allocated.

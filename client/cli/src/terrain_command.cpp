@@ -12,6 +12,7 @@
 #include "commands.h"
 #include "footfall/import/terrain_generators.h"
 #include "footfall/import/terrain_loader.h"
+#include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/grid.h"
 #include "footfall/terrain/point_file.h"
 #include "number_checks.h"
@@ -181,6 +182,18 @@ int RunMake(const MakeFlags& f) {
   return 0;
 }
 
+// -o of convert and make: terrain is written as a point file only, so its name must say so
+// (.pts .xyz .txt), or `-o walls.obj` would write points into a file that every reader takes
+// for a mesh.
+const CLI::Validator kPointFileOutput(
+    [](std::string& path) {
+      if (IsPointFileExtension(FileExtension(path))) return std::string();
+      return "'" + path +
+             "': expected a point file name (.pts .xyz .txt): terrain is written as "
+             "points";
+    },
+    "FILE.pts");
+
 }  // namespace
 
 void AddTerrainCommand(CLI::App& app, int* exit_code) {
@@ -193,7 +206,9 @@ void AddTerrainCommand(CLI::App& app, int* exit_code) {
       "convert", "Resample a mesh or height map (or copy a point file) into a point file");
   c->add_option("input", convert->input, "Terrain file (.obj .ply .off .stl .om .asc .pgm .pts)")
       ->required();
-  c->add_option("-o,--output", convert->output, "Point file to write (.pts)")->required();
+  c->add_option("-o,--output", convert->output, "Point file to write (.pts .xyz .txt)")
+      ->required()
+      ->check(kPointFileOutput);
   AddLoadFlags(c, &convert->load);
   c->callback([convert, exit_code] { *exit_code = RunConvert(*convert); });
 
@@ -210,7 +225,9 @@ void AddTerrainCommand(CLI::App& app, int* exit_code) {
   m->add_option("kind", make->kind, "stairs, blocks, ramp, rocks, sphere, flat or hills")
       ->required()
       ->check(CLI::IsMember({"stairs", "blocks", "ramp", "rocks", "sphere", "flat", "hills"}));
-  m->add_option("-o,--output", make->output, "Point file to write (.pts)")->required();
+  m->add_option("-o,--output", make->output, "Point file to write (.pts .xyz .txt)")
+      ->required()
+      ->check(kPointFileOutput);
   m->add_option("--spacing", make->spacing, "Distance between samples")
       ->check(FiniteAbove(0))
       ->capture_default_str();

@@ -11,6 +11,11 @@
 #include "footfall/terrain/point_file.h"
 
 namespace footfall {
+
+bool IsPointFileExtension(const std::string& lower_extension) {
+  return lower_extension == "pts" || lower_extension == "xyz" || lower_extension == "txt";
+}
+
 namespace {
 
 Status CheckOptions(const TerrainLoadOptions& o, std::string* error) {
@@ -53,7 +58,7 @@ Status Resample(const std::string& path, const TriangleMesh& mesh, double defaul
 
 Status LoadAny(const std::string& path, const std::string& ext, const TerrainLoadOptions& options,
                RawSamples* out, std::string* error, TerrainLoadReport* report) {
-  if (ext == "pts" || ext == "xyz" || ext == "txt") {
+  if (IsPointFileExtension(ext)) {
     report->format = "points";
     const Status status = ReadPointFile(path, out, error);
     if (status == Status::kOk && out->size() == 0) {

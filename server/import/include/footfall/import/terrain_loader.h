@@ -12,6 +12,9 @@
 
 namespace footfall {
 
+// True for the extensions of the point file: pts, xyz, txt (lower case, without the dot).
+bool IsPointFileExtension(const std::string& lower_extension);
+
 struct TerrainLoadOptions {
   // Meshes and height maps: the point separation s, the farthest any point of the surface may be
   // from a sample. [Units: wu] [Limit: >= 0] 0 picks a default: the mean edge length of a mesh,
