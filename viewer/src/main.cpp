@@ -2,6 +2,8 @@
 #include <charconv>
 #include <cmath>
 #include <csignal>
+#include <exception>
+#include <iostream>
 #include <sstream>
 
 #include <CLI/CLI.hpp>
@@ -95,5 +97,12 @@ int main(int argc, char** argv) {
     o.eye = {v[0], v[1], v[2]}, o.target = {v[3], v[4], v[5]};
   }
   if (frame_opt->count() > 0) o.has_frame = true, o.frame = frame;
-  return footfall::viewer::RunViewer(o);
+  try {
+    return footfall::viewer::RunViewer(o);
+  } catch (const std::exception& e) {
+    // A last resort, as in `footfall`: every reader reports bad input itself; whatever escapes
+    // still ends in a message and exit status 1, never an abort.
+    std::cerr << "footfall-view: " << e.what() << '\n';
+    return 1;
+  }
 }
