@@ -137,7 +137,7 @@ TEST_CASE("Walks up and down stairs", "[steps][generator]") {
   }
 }
 
-TEST_CASE("The shipped quadruped climbs the shipped stairs; the insects walk down them",
+TEST_CASE("The shipped quadruped climbs the shipped stairs, the insects walk down them",
           "[steps][generator]") {
   // data/terrain/stairs.pts: 8 steps of 0.18 x 0.3 m along +Z, 1.5 m wide, top tread at 1.26.
   // The quadruped's toes start close to each riser, so its swing lifts before it travels.
@@ -227,7 +227,7 @@ TEST_CASE("A foot whose swing arc cannot clear takes its next foothold instead",
   CHECK(Body(w).keys.back().position.y > 1.26);
 }
 
-TEST_CASE("Multipeds walk around a sphere; bipeds stop where it gets too steep",
+TEST_CASE("Multipeds walk around a sphere, bipeds stop where it gets too steep",
           "[steps][generator]") {
   for (const std::string& name : ShippedCharacters()) {
     const Character c = LoadShipped(name);
@@ -257,7 +257,7 @@ TEST_CASE("Multipeds walk around a sphere; bipeds stop where it gets too steep",
   }
 }
 
-TEST_CASE("Multipeds climb a wall; others stop at it", "[steps][generator]") {
+TEST_CASE("Multipeds climb a wall, others stop at it", "[steps][generator]") {
   for (const std::string& name : ShippedCharacters()) {
     const Character c = LoadShipped(name);
     const double spacing = c.step_length / 10;
