@@ -88,7 +88,11 @@ struct Move {
   int attempts = 0;
   bool done = false;
   bool failed = false;
-  std::string reason;    // why the first refused attempt was refused (or the arc, why not)
+  // Why the foot was refused: the first foothold refused (the step as meant), or, when every
+  // foothold before was a gap, the first one found but refused (steep, high, out of reach, an
+  // arc that cannot clear), which says more.
+  std::string reason;
+  bool reason_is_gap = false;
   Vec3 end, end_normal;  // the accepted foothold
   Vec3 mid, mid_normal;
   Vec3 ideal;               // the last query's ideal point
@@ -114,6 +118,10 @@ class Generator {
   // the footholds beyond reach of the body they lead to, or all of them when a planted foot
   // would be left beyond reach.
   void CheckReach(size_t m, size_t e);
+  // Whether a refusal (a gap or not) becomes mv's reason (see Move::reason).
+  static bool KeepsReason(const Move& mv, bool gap) {
+    return mv.reason.empty() || (mv.reason_is_gap && !gap);
+  }
   // Gives up on mv's foothold after its last try; its reason says how many were refused.
   static void Fail(Move& mv);
   Status ClearArcs(int k, std::string* error);
@@ -559,8 +567,8 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
     mv.done = true, mv.end = h.point, mv.end_normal = h.normal;
     return;
   }
-  if (!mv.reason.empty()) return;  // the first refusal says why: the step as meant
-  std::ostringstream why;          // refused: say why (only built on this rare path)
+  if (!KeepsReason(mv, !found)) return;  // mv already has a better reason
+  std::ostringstream why;                // refused: say why (only built on this rare path)
   why.precision(3);
   if (!found) {
     why << "no foothold within " << 0.5 * c_.step_length << " of " << Point(mv.ideal)
@@ -573,7 +581,7 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
         << Degrees(AngleBetween(h.normal, a.up)) << " deg, more than max_slope_deg "
         << c_.max_slope_deg << " (too steep)";
   }
-  mv.reason = why.str();
+  mv.reason = why.str(), mv.reason_is_gap = !found;
 }
 
 void Generator::Fail(Move& mv) {
@@ -605,7 +613,7 @@ void Generator::CheckReach(size_t m, size_t e) {
       why << "the foothold at " << Point(moves[i].end) << " is " << dist
           << " from the body, beyond reach " << c_.reach;
       moves[i].done = false;
-      if (moves[i].reason.empty()) moves[i].reason = why.str();
+      if (KeepsReason(moves[i], false)) moves[i].reason = why.str(), moves[i].reason_is_gap = false;
     }
   }
   // A planted foot the body would leave beyond reach: every moving foot steps shorter.
@@ -619,7 +627,7 @@ void Generator::CheckReach(size_t m, size_t e) {
     for (size_t i = m; i < e; ++i) {
       if (!moves[i].done) continue;
       moves[i].done = false;
-      if (moves[i].reason.empty()) moves[i].reason = why.str();
+      if (KeepsReason(moves[i], false)) moves[i].reason = why.str(), moves[i].reason_is_gap = false;
     }
     break;
   }
@@ -685,13 +693,13 @@ Status Generator::ClearArcs(int k, std::string* error) {
           if (!low[0] && !low[1]) continue;
           if (round + 1 >= kMaxRaises) {
             // The foot asks for another foothold (its next try), or gives up after the last.
-            if (mv.reason.empty()) {
+            if (KeepsReason(mv, false)) {
               std::ostringstream why;
               why.precision(3);
               why << "the swing arc to " << Point(mv.end)
                   << " cannot clear the terrain (mid key raised " << kMaxRaises * kRaise
                   << " step heights)";
-              mv.reason = why.str();
+              mv.reason = why.str(), mv.reason_is_gap = false;
             }
             mv.done = false;
             if (mv.attempts >= kMaxAttempts) {
