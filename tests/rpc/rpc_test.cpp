@@ -192,6 +192,35 @@ uint32_t OnlyServerTerrain(int port) {
   return handle;
 }
 
+// FF_INFO from a raw client; returns the status.
+ff_status RawInfo(CLIENT* c, uint32_t terrain) {
+  ff_terrain_args args{terrain};
+  ff_info_reply reply{};
+  REQUIRE(ff_info_1(&args, &reply, c) == RPC_SUCCESS);
+  const ff_status status = reply.status;
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_info_reply), reinterpret_cast<char*>(&reply));
+  return status;
+}
+
+// FF_UNLOAD from a raw client; returns the status, the message in *message.
+ff_status RawUnload(CLIENT* c, uint32_t terrain, std::string* message) {
+  ff_terrain_args args{terrain};
+  ff_status_reply reply{};
+  REQUIRE(ff_unload_1(&args, &reply, c) == RPC_SUCCESS);
+  *message = reply.message ? reply.message : "";
+  const ff_status status = reply.status;
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_status_reply), reinterpret_cast<char*>(&reply));
+  return status;
+}
+
+// FF_SNAP from a raw client; returns the status.
+ff_status RawSnap(CLIENT* c, uint32_t terrain) {
+  ff_point_args args{terrain, {1, 0, 1}};
+  ff_result reply{};
+  REQUIRE(ff_snap_1(&args, &reply, c) == RPC_SUCCESS);
+  return reply.status;
+}
+
 // Full snap batch calls on `terrain` (FF_MAX_BATCH points), whose replies are the largest.
 std::vector<unsigned char> FullBatchCall(uint32_t terrain) {
   std::vector<unsigned char> batch;
@@ -810,6 +839,70 @@ TEST_CASE("footfalld closes a connection whose replies go unread past --unread-t
   CHECK(log.find("its replies went unread for 1 s") != std::string::npos);
   RequireServed(server.port());
   CHECK(loader->Snap(t, Vec3{1, 0, 1}).status == Status::kOk);
+}
+
+TEST_CASE("only the connection that loaded a terrain may unload it", "[rpc]") {
+  ServerProcess server;
+  auto owner = Connect(server.port());
+  TerrainHandle t = 0;
+  REQUIRE(owner->LoadSamples(MakeFlat(10, 1, 0), "flat", &t) == Status::kOk);
+  const uint32_t handle = OnlyServerTerrain(server.port());
+  CLIENT* other = RawClient(server.port());
+  std::string message;
+  CHECK(RawUnload(other, handle, &message) == FF_ACCESS_DENIED);
+  CHECK(message == "terrain " + std::to_string(handle) +
+                       " was loaded by another connection: only that connection may unload it");
+  // Others may still query and describe it.
+  CHECK(RawSnap(other, handle) == FF_OK);
+  CHECK(RawInfo(other, handle) == FF_OK);
+  CHECK(RawUnload(other, handle + 1, &message) == FF_UNKNOWN_TERRAIN);
+  CHECK(owner->Unload(t) == Status::kOk);
+  CHECK(RawInfo(other, handle) == FF_UNKNOWN_TERRAIN);
+  clnt_destroy(other);
+}
+
+TEST_CASE("a closed connection's terrains are freed once unqueried for --orphan-timeout", "[rpc]") {
+  ServerProcess server(0, {"--no-rpcbind", "--orphan-timeout", "2"});
+  auto owner = Connect(server.port());
+  TerrainHandle t = 0;
+  REQUIRE(owner->LoadSamples(MakeFlat(10, 1, 0), "flat", &t) == Status::kOk);
+  const uint32_t handle = OnlyServerTerrain(server.port());
+  CLIENT* other = RawClient(server.port());
+  owner.reset();  // its connection closes: the terrain is orphaned
+  // Queried by another client for twice the timeout, it stays.
+  for (int i = 0; i < 20; ++i) {
+    REQUIRE(RawSnap(other, handle) == FF_OK);
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  std::string message;
+  CHECK(RawUnload(other, handle, &message) == FF_ACCESS_DENIED);
+  CHECK(message.find("was loaded by a connection that has closed") != std::string::npos);
+  // Unqueried, it goes (FF_INFO is not a query: it does not keep it).
+  CHECK(WaitFor([&] { return RawInfo(other, handle) == FF_UNKNOWN_TERRAIN; }));
+  const std::string log = server.Log();
+  INFO(log);
+  CHECK(log.find("terrain " + std::to_string(handle) + " orphaned") != std::string::npos);
+  CHECK(log.find("freed orphaned terrain " + std::to_string(handle) + " after 2 s") !=
+        std::string::npos);
+  clnt_destroy(other);
+  RequireServed(server.port());
+}
+
+TEST_CASE("footfalld holds each connection to --max-client-terrains", "[rpc]") {
+  ServerProcess server(0, {"--no-rpcbind", "--max-client-terrains", "2"});
+  auto first = Connect(server.port());
+  TerrainHandle a = 0, b = 0, c = 0;
+  REQUIRE(first->LoadSamples(MakeFlat(10, 1, 0), "a", &a) == Status::kOk);
+  REQUIRE(first->LoadSamples(MakeFlat(10, 1, 0), "b", &b) == Status::kOk);
+  CHECK(first->LoadSamples(MakeFlat(10, 1, 0), "c", &c) == Status::kLimitExceeded);
+  CHECK(first->last_error() ==
+        "this connection holds 2 terrains, the most one connection may hold "
+        "(--max-client-terrains 2): unload one first");
+  // Another connection has its own quota; an unload makes room.
+  auto second = Connect(server.port());
+  CHECK(second->LoadSamples(MakeFlat(10, 1, 0), "d", &c) == Status::kOk);
+  REQUIRE(first->Unload(a) == Status::kOk);
+  CHECK(first->LoadSamples(MakeFlat(10, 1, 0), "c", &c) == Status::kOk);
 }
 
 TEST_CASE("clients report a dead server and recover after a restart", "[rpc][robustness]") {

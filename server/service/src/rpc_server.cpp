@@ -154,8 +154,8 @@ void RpcServer::Run() {
       ReapConnections();
     }
     const auto now = std::chrono::steady_clock::now();
-    if (now - last_expiry > std::chrono::seconds(5)) {
-      g_state->registry.ExpireUploads();
+    if (now - last_expiry >= std::chrono::seconds(1)) {
+      ExpireIdle();
       last_expiry = now;
     }
   }
