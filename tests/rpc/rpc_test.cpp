@@ -782,7 +782,7 @@ TEST_CASE("misbehaving clients leave others served and memory flat", "[rpc][robu
   CHECK(loader->Snap(remote, Vec3{1, 0, 1}).status == Status::kOk);
 }
 
-TEST_CASE("clients that never read their replies are held back; the others are served",
+TEST_CASE("clients that never read their replies are held back while others are served",
           "[rpc][robustness]") {
   ServerProcess server;
   auto loader = Connect(server.port());
