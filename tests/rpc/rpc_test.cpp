@@ -11,6 +11,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -174,6 +177,121 @@ ff_status SendChunk(CLIENT* c, uint32_t upload, std::vector<ff_sample> samples,
   const ff_status status = reply.status;
   xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_status_reply), reinterpret_cast<char*>(&reply));
   return status;
+}
+
+// The handle footfalld gave the one terrain it holds, for raw calls (sessions number their
+// terrains themselves).
+uint32_t OnlyServerTerrain(int port) {
+  CLIENT* c = RawClient(port);
+  ff_list_reply reply{};
+  REQUIRE(ff_list_1(nullptr, &reply, c) == RPC_SUCCESS);
+  REQUIRE(reply.terrains.terrains_len == 1);
+  const uint32_t handle = reply.terrains.terrains_val[0];
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_list_reply), reinterpret_cast<char*>(&reply));
+  clnt_destroy(c);
+  return handle;
+}
+
+// FF_INFO from a raw client; returns the status.
+ff_status RawInfo(CLIENT* c, uint32_t terrain) {
+  ff_terrain_args args{terrain};
+  ff_info_reply reply{};
+  REQUIRE(ff_info_1(&args, &reply, c) == RPC_SUCCESS);
+  const ff_status status = reply.status;
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_info_reply), reinterpret_cast<char*>(&reply));
+  return status;
+}
+
+// FF_UNLOAD from a raw client; returns the status, the message in *message.
+ff_status RawUnload(CLIENT* c, uint32_t terrain, std::string* message) {
+  ff_terrain_args args{terrain};
+  ff_status_reply reply{};
+  REQUIRE(ff_unload_1(&args, &reply, c) == RPC_SUCCESS);
+  *message = reply.message ? reply.message : "";
+  const ff_status status = reply.status;
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_status_reply), reinterpret_cast<char*>(&reply));
+  return status;
+}
+
+// FF_SNAP from a raw client; returns the status.
+ff_status RawSnap(CLIENT* c, uint32_t terrain) {
+  ff_point_args args{terrain, {1, 0, 1}};
+  ff_result reply{};
+  REQUIRE(ff_snap_1(&args, &reply, c) == RPC_SUCCESS);
+  return reply.status;
+}
+
+// Full snap batch calls on `terrain` (FF_MAX_BATCH points), whose replies are the largest.
+std::vector<unsigned char> FullBatchCall(uint32_t terrain) {
+  std::vector<unsigned char> batch;
+  Put32(&batch, terrain);
+  Put32(&batch, FF_MAX_BATCH);
+  for (int i = 0; i < FF_MAX_BATCH; ++i)
+    PutDouble(&batch, i % 30), PutDouble(&batch, 0), PutDouble(&batch, 0);
+  return CallRecord(1, FF_SNAP_BATCH, batch);
+}
+
+// A client on its own thread that sends `record` again and again and never reads a reply, until
+// destroyed; when the server drops it, it counts the drop and connects again. No Catch2
+// assertions on this thread: the test reads the counters.
+class Flooder {
+ public:
+  Flooder(int port, std::vector<unsigned char> record)
+      : port_(port), record_(std::move(record)), thread_([this] { Run(); }) {}
+  ~Flooder() {
+    stop_ = true;
+    thread_.join();
+  }
+  int drops() const { return drops_; }
+  int blocked() const { return blocked_; }  // sends that waited 100 ms on a full socket
+
+ private:
+  void Run() {
+    int fd = -1;
+    size_t at = 0;
+    while (!stop_) {
+      if (fd < 0) {
+        fd = socket(AF_INET, SOCK_STREAM, 0);
+        sockaddr_in a{};
+        a.sin_family = AF_INET;
+        a.sin_port = htons(static_cast<uint16_t>(port_));
+        a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        const timeval wait{0, 100000};
+        setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &wait, sizeof wait);
+        if (connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
+          close(fd), fd = -1;
+          std::this_thread::sleep_for(std::chrono::milliseconds(10));
+          continue;
+        }
+        at = 0;
+      }
+      const ssize_t n = send(fd, record_.data() + at, record_.size() - at, MSG_NOSIGNAL);
+      if (n > 0) {
+        at = (at + static_cast<size_t>(n)) % record_.size();
+      } else if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)) {
+        ++blocked_;
+      } else {
+        close(fd), fd = -1;
+        ++drops_;
+      }
+    }
+    if (fd >= 0) close(fd);
+  }
+  const int port_;
+  const std::vector<unsigned char> record_;
+  std::atomic<bool> stop_{false};
+  std::atomic<int> drops_{0}, blocked_{0};
+  std::thread thread_;
+};
+
+// Waits up to 10 s for `done`.
+bool WaitFor(const std::function<bool()>& done) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return true;
 }
 
 }  // namespace
@@ -590,7 +708,7 @@ TEST_CASE("misbehaving clients leave others served and memory flat", "[rpc][robu
   SECTION("clients that never read their replies") {
     // Full snap batches on the real terrain: 64 large replies nobody reads, per client.
     std::vector<unsigned char> batch;
-    Put32(&batch, remote);
+    Put32(&batch, OnlyServerTerrain(server.port()));
     Put32(&batch, FF_MAX_BATCH);
     for (int i = 0; i < FF_MAX_BATCH; ++i)
       PutDouble(&batch, i % 30), PutDouble(&batch, 0), PutDouble(&batch, 0);
@@ -652,6 +770,129 @@ TEST_CASE("misbehaving clients leave others served and memory flat", "[rpc][robu
   }
   // The loader's terrain is still there and answers.
   CHECK(loader->Snap(remote, Vec3{1, 0, 1}).status == Status::kOk);
+}
+
+TEST_CASE("clients that never read their replies are held back while others are served",
+          "[rpc][robustness]") {
+  ServerProcess server;
+  auto loader = Connect(server.port());
+  TerrainHandle t = 0;
+  REQUIRE(loader->LoadSamples(MakeFlat(30, 1, 0), "flat", &t) == Status::kOk);
+  const std::vector<unsigned char> call = FullBatchCall(OnlyServerTerrain(server.port()));
+  Flooder first(server.port(), call), second(server.port(), call);
+  // Both fill their sockets: the server no longer takes their requests.
+  REQUIRE(WaitFor([&] { return first.blocked() > 0 && second.blocked() > 0; }));
+
+  const double cpu_before = server.CpuSeconds();
+  const auto start = std::chrono::steady_clock::now();
+  // A new client: connects, uploads its own terrain and queries it.
+  auto rpc = Connect(server.port(), 10);
+  TerrainHandle own = 0;
+  REQUIRE(rpc->LoadSamples(MakeFlat(10, 1, 0), "own", &own) == Status::kOk);
+  const int calls = 20;
+  int answered = 0;
+  // Bounded, so that a server that stalls on them ends the test in time: it takes 0.5 s here.
+  const auto give_up = start + std::chrono::seconds(10);
+  for (int i = 0; i < calls && std::chrono::steady_clock::now() < give_up; ++i) {
+    const Foothold f = rpc->Snap(own, Vec3{3.2, 1, 4.7});
+    INFO(rpc->last_error());
+    CHECK(f.status == Status::kOk);
+    CHECK(f.point == Vec3{3, 0, 5});
+    answered += f.status == Status::kOk;
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  }
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double cpu = server.CpuSeconds() - cpu_before;
+  CHECK(answered == calls);
+  INFO("server CPU " << cpu << " s over " << wall << " s");
+  CHECK(cpu < 0.5 * wall);  // waiting connections do not make it spin
+  // Held back, not dropped (the limit is --unread-timeout, 30 s).
+  CHECK(first.drops() == 0);
+  CHECK(second.drops() == 0);
+  CHECK(loader->Snap(t, Vec3{1, 0, 1}).status == Status::kOk);
+}
+
+TEST_CASE("footfalld closes a connection whose replies go unread past --unread-timeout",
+          "[rpc][robustness]") {
+  ServerProcess server(0, {"--no-rpcbind", "--unread-timeout", "1"});
+  auto loader = Connect(server.port());
+  TerrainHandle t = 0;
+  REQUIRE(loader->LoadSamples(MakeFlat(30, 1, 0), "flat", &t) == Status::kOk);
+  {
+    Flooder flooder(server.port(), FullBatchCall(OnlyServerTerrain(server.port())));
+    REQUIRE(WaitFor([&] { return flooder.drops() > 0; }));
+  }
+  const std::string log = server.Log();
+  INFO(log);
+  CHECK(log.find("closing the connection from 127.0.0.1:") != std::string::npos);
+  CHECK(log.find("its replies went unread for 1 s") != std::string::npos);
+  RequireServed(server.port());
+  CHECK(loader->Snap(t, Vec3{1, 0, 1}).status == Status::kOk);
+}
+
+TEST_CASE("only the connection that loaded a terrain may unload it", "[rpc]") {
+  ServerProcess server;
+  auto owner = Connect(server.port());
+  TerrainHandle t = 0;
+  REQUIRE(owner->LoadSamples(MakeFlat(10, 1, 0), "flat", &t) == Status::kOk);
+  const uint32_t handle = OnlyServerTerrain(server.port());
+  CLIENT* other = RawClient(server.port());
+  std::string message;
+  CHECK(RawUnload(other, handle, &message) == FF_ACCESS_DENIED);
+  CHECK(message == "terrain " + std::to_string(handle) +
+                       " was loaded by another connection: only that connection may unload it");
+  // Others may still query and describe it.
+  CHECK(RawSnap(other, handle) == FF_OK);
+  CHECK(RawInfo(other, handle) == FF_OK);
+  CHECK(RawUnload(other, handle + 1, &message) == FF_UNKNOWN_TERRAIN);
+  CHECK(owner->Unload(t) == Status::kOk);
+  CHECK(RawInfo(other, handle) == FF_UNKNOWN_TERRAIN);
+  clnt_destroy(other);
+}
+
+TEST_CASE("a closed connection's terrains are freed once unqueried for --orphan-timeout", "[rpc]") {
+  ServerProcess server(0, {"--no-rpcbind", "--orphan-timeout", "2"});
+  auto owner = Connect(server.port());
+  TerrainHandle t = 0;
+  REQUIRE(owner->LoadSamples(MakeFlat(10, 1, 0), "flat", &t) == Status::kOk);
+  const uint32_t handle = OnlyServerTerrain(server.port());
+  CLIENT* other = RawClient(server.port());
+  owner.reset();  // its connection closes: the terrain is orphaned
+  // Queried by another client for twice the timeout, it stays.
+  for (int i = 0; i < 20; ++i) {
+    REQUIRE(RawSnap(other, handle) == FF_OK);
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  std::string message;
+  CHECK(RawUnload(other, handle, &message) == FF_ACCESS_DENIED);
+  CHECK(message.find("was loaded by a connection that has closed") != std::string::npos);
+  // Unqueried, it goes (FF_INFO is not a query: it does not keep it).
+  CHECK(WaitFor([&] { return RawInfo(other, handle) == FF_UNKNOWN_TERRAIN; }));
+  const std::string log = server.Log();
+  INFO(log);
+  CHECK(log.find("terrain " + std::to_string(handle) + " orphaned") != std::string::npos);
+  CHECK(log.find("freed orphaned terrain " + std::to_string(handle) + " after 2 s") !=
+        std::string::npos);
+  clnt_destroy(other);
+  RequireServed(server.port());
+}
+
+TEST_CASE("footfalld holds each connection to --max-client-terrains", "[rpc]") {
+  ServerProcess server(0, {"--no-rpcbind", "--max-client-terrains", "2"});
+  auto first = Connect(server.port());
+  TerrainHandle a = 0, b = 0, c = 0;
+  REQUIRE(first->LoadSamples(MakeFlat(10, 1, 0), "a", &a) == Status::kOk);
+  REQUIRE(first->LoadSamples(MakeFlat(10, 1, 0), "b", &b) == Status::kOk);
+  CHECK(first->LoadSamples(MakeFlat(10, 1, 0), "c", &c) == Status::kLimitExceeded);
+  CHECK(first->last_error() ==
+        "this connection holds 2 terrains, the most one connection may hold "
+        "(--max-client-terrains 2): unload one first");
+  // Another connection has its own quota; an unload makes room.
+  auto second = Connect(server.port());
+  CHECK(second->LoadSamples(MakeFlat(10, 1, 0), "d", &c) == Status::kOk);
+  REQUIRE(first->Unload(a) == Status::kOk);
+  CHECK(first->LoadSamples(MakeFlat(10, 1, 0), "c", &c) == Status::kOk);
 }
 
 TEST_CASE("clients report a dead server and recover after a restart", "[rpc][robustness]") {

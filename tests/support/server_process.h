@@ -26,6 +26,8 @@ class ServerProcess {
   int Terminate();
   // Resident memory of the server process, in KiB.
   long RssKiB() const;
+  // CPU time the server process has used so far (user and system, all threads) [Units: s].
+  double CpuSeconds() const;
   // Everything the server wrote to stderr so far.
   std::string Log() const;
 

@@ -110,6 +110,21 @@ void LogError(const char* proc, Status status, const std::string& message) {
       (message.empty() ? "" : ": " + message));
 }
 
+// "N s", with decimals only when needed.
+std::string SecondsText(double seconds) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g s", seconds);
+  return text;
+}
+
+// Forgets a client that went away: ends its uploads and orphans its terrains.
+void DropClient(const Connection& connection) {
+  for (const uint32_t handle : g_state->registry.DropClient(connection.id))
+    Log("terrain " + std::to_string(handle) +
+        " orphaned: the connection that loaded it closed; it is freed after " +
+        SecondsText(g_state->registry.limits().orphan_idle_s) + " without queries");
+}
+
 // The connection a request came on, registered on its first request.
 uint64_t ConnectionOf(SVCXPRT* transport) {
   const netbuf& address = transport->xp_rtaddr;
@@ -117,7 +132,7 @@ uint64_t ConnectionOf(SVCXPRT* transport) {
       address.buf ? std::string(static_cast<const char*>(address.buf), address.len) : std::string();
   auto it = g_state->connections.find(transport->xp_fd);
   if (it != g_state->connections.end() && it->second.peer != peer) {
-    g_state->registry.DropClient(it->second.id);  // the socket number was reused
+    DropClient(it->second);  // the socket number was reused
     g_state->connections.erase(it);
     it = g_state->connections.end();
   }
@@ -142,11 +157,11 @@ bool_t XdrLoadArgs(XDR* xdrs, LoadArgs* a) {
   return xdr_bytes(xdrs, &a->path, &a->path_len, FF_MAX_PATH) && xdr_double(xdrs, &a->separation);
 }
 
-void Load(const LoadArgs& a, ff_load_reply* r) {
+void Load(const LoadArgs& a, uint64_t client, ff_load_reply* r) {
   std::string message;
   uint32_t handle = 0;
   const std::string path = a.path ? std::string(a.path, a.path_len) : "";
-  const Status s = g_state->registry.LoadFile(path, a.separation, &handle, &message);
+  const Status s = g_state->registry.LoadFile(path, a.separation, client, &handle, &message);
   r->status = Wire(s);
   r->terrain = handle;
   if (s == Status::kOk) {
@@ -224,11 +239,13 @@ void Info(const ff_terrain_args& a, ff_info_reply* r) {
   r->bytes = st.bytes;
 }
 
-void Unload(const ff_terrain_args& a, ff_status_reply* r) {
-  const Status s = g_state->registry.Unload(a.terrain);
+void Unload(const ff_terrain_args& a, uint64_t client, ff_status_reply* r) {
+  std::string message;
+  const Status s = g_state->registry.Unload(a.terrain, client, &message);
   if (s == Status::kOk) Log("unloaded terrain " + std::to_string(a.terrain));
+  if (s == Status::kAccessDenied) LogError("unload", s, message);
   r->status = Wire(s);
-  r->message = Message(s == Status::kOk ? "" : "no terrain " + std::to_string(a.terrain));
+  r->message = Message(s == Status::kOk ? "" : message);
 }
 
 void List(ff_list_reply* r) {
@@ -248,7 +265,7 @@ void Record(uint32_t terrain, int op, const Vec3& point, const Vec3& direction, 
 }
 
 void Point(const ff_point_args& a, ff_result* r, int op) {
-  const LoadedTerrain* t = g_state->registry.Find(a.terrain);
+  const LoadedTerrain* t = g_state->registry.Use(a.terrain);
   if (!t) {
     r->status = FF_UNKNOWN_TERRAIN;
     return;
@@ -260,7 +277,7 @@ void Point(const ff_point_args& a, ff_result* r, int op) {
 }
 
 void NextOne(const ff_next_args& a, ff_result* r) {
-  const LoadedTerrain* t = g_state->registry.Find(a.terrain);
+  const LoadedTerrain* t = g_state->registry.Use(a.terrain);
   if (!t) {
     r->status = FF_UNKNOWN_TERRAIN;
     return;
@@ -298,7 +315,7 @@ void RunBatch(size_t n, BatchReplyView<Foothold>* r, Fn&& answer) {
 }
 
 void PointBatch(const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r, int op) {
-  const LoadedTerrain* t = g_state->registry.Find(a.terrain);
+  const LoadedTerrain* t = g_state->registry.Use(a.terrain);
   if (!t) {
     r->status = FF_UNKNOWN_TERRAIN;
     return;
@@ -313,7 +330,7 @@ void PointBatch(const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r, int 
 }
 
 void NextBatch(const NextBatchView<StepQuery>& a, BatchReplyView<Foothold>* r) {
-  const LoadedTerrain* t = g_state->registry.Find(a.terrain);
+  const LoadedTerrain* t = g_state->registry.Use(a.terrain);
   if (!t) {
     r->status = FF_UNKNOWN_TERRAIN;
     return;
@@ -413,8 +430,9 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
       svc_sendreply(transport, FF_XDR_VOID, nullptr);
       return;
     case FF_LOAD:
-      return Serve<LoadArgs, ff_load_reply>(transport, AsXdrProc(XdrLoadArgs),
-                                            FF_XDR(ff_load_reply), "load", Load);
+      return Serve<LoadArgs, ff_load_reply>(
+          transport, AsXdrProc(XdrLoadArgs), FF_XDR(ff_load_reply), "load",
+          [client](const LoadArgs& a, ff_load_reply* r) { Load(a, client, r); });
     case FF_UPLOAD_BEGIN:
       return Serve<ff_upload_begin_args, ff_upload_reply>(
           transport, FF_XDR(ff_upload_begin_args), FF_XDR(ff_upload_reply), "upload",
@@ -435,8 +453,9 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
       return Serve<ff_terrain_args, ff_info_reply>(transport, FF_XDR(ff_terrain_args),
                                                    FF_XDR(ff_info_reply), "info", Info);
     case FF_UNLOAD:
-      return Serve<ff_terrain_args, ff_status_reply>(transport, FF_XDR(ff_terrain_args),
-                                                     FF_XDR(ff_status_reply), "unload", Unload);
+      return Serve<ff_terrain_args, ff_status_reply>(
+          transport, FF_XDR(ff_terrain_args), FF_XDR(ff_status_reply), "unload",
+          [client](const ff_terrain_args& a, ff_status_reply* r) { Unload(a, client, r); });
     case FF_LIST: {
       struct Empty {
         int unused;
@@ -496,9 +515,17 @@ void ReapConnections() {
       ++it;
       continue;
     }
-    g_state->registry.DropClient(it->second.id);
+    DropClient(it->second);
     it = g_state->connections.erase(it);
   }
+}
+
+void ExpireIdle() {
+  if (!g_state) return;
+  g_state->registry.ExpireUploads();
+  for (const uint32_t handle : g_state->registry.ExpireOrphans())
+    Log("freed orphaned terrain " + std::to_string(handle) + " after " +
+        SecondsText(g_state->registry.limits().orphan_idle_s) + " without queries");
 }
 
 DispatchFn InstallDispatcher(ServiceState* state) {

@@ -31,8 +31,13 @@ using DispatchFn = void (*)(svc_req*, SVCXPRT*);
 // svc_register. One state per process (libtirpc's svc layer is process-global).
 DispatchFn InstallDispatcher(ServiceState* state);
 
-// Forgets the connections libtirpc has closed, ending their uploads. Call after every
-// svc_getreq_poll, so a closed socket is noticed before its number can be reused.
+// Forgets the connections libtirpc has closed, ending their uploads and orphaning their
+// terrains. Call after every svc_getreq_poll, so a closed socket is noticed before its number
+// can be reused.
 void ReapConnections();
+
+// Drops idle uploads and frees orphaned terrains left unqueried past their grace period, with a
+// log line each. Call about once a second.
+void ExpireIdle();
 
 }  // namespace footfall

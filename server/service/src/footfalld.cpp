@@ -54,6 +54,17 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 64));
   app.add_option("--max-samples", options.limits.max_total_samples,
                  "Samples held over all terrains and uploads");
+  app.add_option("--orphan-timeout", options.limits.orphan_idle_s,
+                 "Seconds without queries after which a terrain whose connection has closed is "
+                 "freed (default 600)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--max-client-terrains", options.limits.max_client_terrains,
+                 "Terrains one connection may hold loaded at once (default 64)")
+      ->check(CLI::Range(1, 256));
+  app.add_option("--unread-timeout", options.unread_timeout_s,
+                 "Seconds a client may leave its replies unread, with no room for another, "
+                 "before its connection is closed")
+      ->check(CLI::PositiveNumber);
   app.add_option("--port-file", port_file, "Write the bound port to this file once listening");
   try {
     app.parse(argc, argv);

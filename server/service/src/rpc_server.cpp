@@ -18,6 +18,7 @@
 
 #include "dispatcher.h"
 #include "footfall.h"
+#include "read_gate.h"
 
 namespace footfall {
 namespace {
@@ -66,6 +67,10 @@ bool RpcServer::Start(std::string* error) {
     if (fd < 0) continue;
     const int one = 1;
     setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+    // Accepted connections inherit the send buffer: room for a largest reply beside another
+    // (the kernel doubles the value, and caps it at net.core.wmem_max).
+    const int send_buffer = static_cast<int>(kReplyRoomBytes);
+    setsockopt(fd, SOL_SOCKET, SO_SNDBUF, &send_buffer, sizeof send_buffer);
     if (bind(fd, a->ai_addr, a->ai_addrlen) != 0 || listen(fd, kListenBacklog) != 0) {
       reason = std::strerror(errno);
       close(fd);
@@ -83,9 +88,19 @@ bool RpcServer::Start(std::string* error) {
   getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&bound), &len);
   port_ = ntohs(bound.ss_family == AF_INET6 ? reinterpret_cast<sockaddr_in6*>(&bound)->sin6_port
                                             : reinterpret_cast<sockaddr_in*>(&bound)->sin_port);
+  int send_buffer = 0;
+  len = sizeof send_buffer;
+  getsockopt(listen_fd_, SOL_SOCKET, SO_SNDBUF, &send_buffer, &len);
+  send_buffer_ = static_cast<size_t>(send_buffer);
+  if (send_buffer_ < kReplyRoomBytes)
+    std::fprintf(stderr,
+                 "footfalld: warning: the socket send buffer is %zu bytes, less than a full batch "
+                 "reply needs (%zu): raise net.core.wmem_max\n",
+                 send_buffer_, kReplyRoomBytes);
 
-  // Non-blocking transports with a bounded record size: a half-sent request or a client that
-  // never reads cannot stall the loop. Must be set before the transport is created.
+  // Non-blocking transports with a bounded record size: a half-sent request cannot stall the
+  // loop (ReadGate holds back clients that never read). Must be set before the transport is
+  // created.
   int max_record = FF_MAX_REQUEST_BYTES + 8192;
   rpc_control(RPC_SVC_CONNMAXREC_SET, &max_record);
   SVCXPRT* transport = svc_vc_create(listen_fd_, FF_MAX_REQUEST_BYTES, FF_MAX_REQUEST_BYTES + 8192);
@@ -120,23 +135,27 @@ bool RpcServer::Start(std::string* error) {
 }
 
 void RpcServer::Run() {
-  std::vector<pollfd> fds;
+  ReadGate gate(send_buffer_, options_.unread_timeout_s);
+  std::vector<pollfd> fds, readable;
   auto last_expiry = std::chrono::steady_clock::now();
   while (!stop_.load()) {
-    fds.assign(svc_pollfd, svc_pollfd + svc_max_pollfd);
-    const int ready = poll(fds.data(), fds.size(), 250);
+    const int timeout_ms = gate.Prepare(&fds, 250);
+    const int ready = poll(fds.data(), fds.size(), timeout_ms);
     if (ready < 0) {
       if (errno == EINTR) continue;
       std::fprintf(stderr, "footfalld: error: poll: %s\n", std::strerror(errno));
       break;
     }
     if (ready > 0) {
-      svc_getreq_poll(fds.data(), ready);
+      // svc_getreq_poll serves the first `count` entries with revents set, reading a request
+      // from each: hand it only those whose reply fits.
+      gate.Collect(fds, &readable);
+      if (!readable.empty()) svc_getreq_poll(readable.data(), static_cast<int>(readable.size()));
       ReapConnections();
     }
     const auto now = std::chrono::steady_clock::now();
-    if (now - last_expiry > std::chrono::seconds(5)) {
-      g_state->registry.ExpireUploads();
+    if (now - last_expiry >= std::chrono::seconds(1)) {
+      ExpireIdle();
       last_expiry = now;
     }
   }

@@ -165,8 +165,20 @@ std::string TerrainRegistry::Budget() const {
          std::to_string(TotalSamples()) + " in use by loaded terrains and uploads in progress)";
 }
 
-Status TerrainRegistry::Add(const std::string& name, RawSamples samples, uint32_t* handle,
-                            std::string* message) {
+Status TerrainRegistry::CheckQuota(uint64_t owner, std::string* message) const {
+  size_t held = 0;
+  for (const auto& t : terrains_) held += t.second->owner == owner;
+  if (held < limits_.max_client_terrains) return Status::kOk;
+  *message = "this connection holds " + std::to_string(held) +
+             " terrains, the most one connection may hold (--max-client-terrains " +
+             std::to_string(limits_.max_client_terrains) + "): unload one first";
+  return Status::kLimitExceeded;
+}
+
+Status TerrainRegistry::Add(const std::string& name, RawSamples samples, uint64_t owner,
+                            uint32_t* handle, std::string* message) {
+  Status status = CheckQuota(owner, message);
+  if (status != Status::kOk) return status;
   if (terrains_.size() >= limits_.max_terrains) {
     *message = "too many terrains loaded (limit " + std::to_string(limits_.max_terrains) + ")";
     return Status::kLimitExceeded;
@@ -175,10 +187,12 @@ Status TerrainRegistry::Add(const std::string& name, RawSamples samples, uint32_
     *message = std::to_string(samples.size()) + " samples do not fit in " + Budget();
     return Status::kLimitExceeded;
   }
-  Status status = ValidateAndNormalize(&samples, message);
+  status = ValidateAndNormalize(&samples, message);
   if (status != Status::kOk) return status;
   auto terrain = std::make_unique<LoadedTerrain>();
   terrain->name = name;
+  terrain->owner = owner;
+  terrain->used = std::chrono::steady_clock::now();
   status = TerrainGrid::Build(samples, GridOptions{}, &terrain->grid, message);
   if (status != Status::kOk) return status;
   uint32_t h = next_handle_++;
@@ -189,9 +203,11 @@ Status TerrainRegistry::Add(const std::string& name, RawSamples samples, uint32_
 }
 
 Status TerrainRegistry::LoadFile(const std::string& relative_path, double separation,
-                                 uint32_t* handle, std::string* message) {
+                                 uint64_t owner, uint32_t* handle, std::string* message) {
+  Status status = CheckQuota(owner, message);  // before reading or sampling anything
+  if (status != Status::kOk) return status;
   std::string path;
-  Status status = ResolveUnderRoot(data_root_, relative_path, &path, message);
+  status = ResolveUnderRoot(data_root_, relative_path, &path, message);
   if (status != Status::kOk) return status;
   status = CheckRegularFile(path, relative_path, message);
   if (status != Status::kOk) return status;
@@ -216,12 +232,14 @@ Status TerrainRegistry::LoadFile(const std::string& relative_path, double separa
       *message += " (the limit is what is left of " + Budget() + ")";
     return status;
   }
-  return Add(relative_path, std::move(samples), handle, message);
+  return Add(relative_path, std::move(samples), owner, handle, message);
 }
 
 Status TerrainRegistry::BeginUpload(const std::string& name, uint64_t total, uint64_t owner,
                                     uint32_t* upload, std::string* message) {
   ExpireUploads();
+  const Status quota = CheckQuota(owner, message);
+  if (quota != Status::kOk) return quota;
   if (uploads_.size() >= limits_.max_uploads) {
     *message = "too many uploads in progress (limit " + std::to_string(limits_.max_uploads) + ")";
     return Status::kLimitExceeded;
@@ -282,16 +300,36 @@ Status TerrainRegistry::FinishUpload(uint32_t upload, uint64_t owner, uint32_t* 
                std::to_string(u.total) + " samples";
     return Status::kInvalidArgument;
   }
-  return Add(u.name, std::move(u.samples), handle, message);
+  return Add(u.name, std::move(u.samples), owner, handle, message);
 }
 
-Status TerrainRegistry::Unload(uint32_t handle) {
-  return terrains_.erase(handle) ? Status::kOk : Status::kUnknownTerrain;
+Status TerrainRegistry::Unload(uint32_t handle, uint64_t requester, std::string* message) {
+  auto it = terrains_.find(handle);
+  if (it == terrains_.end()) {
+    *message = "no terrain " + std::to_string(handle);
+    return Status::kUnknownTerrain;
+  }
+  if (it->second->owner != requester) {
+    *message = "terrain " + std::to_string(handle) +
+               (it->second->owner == 0
+                    ? " was loaded by a connection that has closed: it is freed once unused"
+                    : " was loaded by another connection: only that connection may unload it");
+    return Status::kAccessDenied;
+  }
+  terrains_.erase(it);
+  return Status::kOk;
 }
 
 const LoadedTerrain* TerrainRegistry::Find(uint32_t handle) const {
   auto it = terrains_.find(handle);
   return it == terrains_.end() ? nullptr : it->second.get();
+}
+
+const LoadedTerrain* TerrainRegistry::Use(uint32_t handle) {
+  auto it = terrains_.find(handle);
+  if (it == terrains_.end()) return nullptr;
+  it->second->used = std::chrono::steady_clock::now();
+  return it->second.get();
 }
 
 std::vector<uint32_t> TerrainRegistry::Handles() const {
@@ -300,9 +338,34 @@ std::vector<uint32_t> TerrainRegistry::Handles() const {
   return handles;
 }
 
-void TerrainRegistry::DropClient(uint64_t owner) {
+std::vector<uint32_t> TerrainRegistry::DropClient(uint64_t owner) {
   for (auto it = uploads_.begin(); it != uploads_.end();)
     it = it->second.owner == owner ? uploads_.erase(it) : std::next(it);
+  std::vector<uint32_t> orphaned;
+  const auto now = std::chrono::steady_clock::now();
+  for (auto& t : terrains_) {
+    if (owner == 0 || t.second->owner != owner) continue;
+    t.second->owner = 0;
+    t.second->used = std::max(t.second->used, now);
+    orphaned.push_back(t.first);
+  }
+  return orphaned;
+}
+
+std::vector<uint32_t> TerrainRegistry::ExpireOrphans() {
+  const auto now = std::chrono::steady_clock::now();
+  std::vector<uint32_t> freed;
+  for (auto it = terrains_.begin(); it != terrains_.end();) {
+    const LoadedTerrain& t = *it->second;
+    const double idle_s = std::chrono::duration<double>(now - t.used).count();
+    if (t.owner == 0 && idle_s >= limits_.orphan_idle_s) {
+      freed.push_back(it->first);
+      it = terrains_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  return freed;
 }
 
 void TerrainRegistry::ExpireUploads() {

@@ -1,12 +1,15 @@
 // RpcServer: footfalld's ONC RPC service over TCP.
 //
 // One thread drives libtirpc (its svc layer is process-global and single-threaded) over
-// non-blocking transports with a bounded record size, so a client that sends half a request or
-// never reads its replies cannot stall the others. Requests are decoded, validated and freed by
-// our own dispatcher on every path; no exception escapes a handler. One RpcServer per process.
+// non-blocking transports with a bounded record size, so a client that sends half a request
+// cannot stall the others; a request is read from a connection only while its socket has room
+// for the reply, so one that never reads its replies cannot either (see read_gate.h). Requests are
+// decoded, validated and freed by our own dispatcher on every path; no exception escapes a handler.
+// One RpcServer per process.
 #pragma once
 
 #include <atomic>
+#include <cstddef>
 #include <string>
 
 #include "footfall/service/terrain_registry.h"
@@ -19,6 +22,8 @@ struct RpcServerOptions {
   std::string data_root;    // confines FF_LOAD; empty refuses server-side loads
   bool use_rpcbind = true;  // register with rpcbind when one is running
   int batch_threads = 1;    // threads per batch query
+  // [Units: s] A connection whose unread replies leave no room for another this long is closed.
+  double unread_timeout_s = 30;
   RegistryLimits limits;
 };
 
@@ -41,6 +46,7 @@ class RpcServer {
   RpcServerOptions options_;
   int listen_fd_ = -1;
   int port_ = 0;
+  size_t send_buffer_ = 0;  // [Units: bytes] of every connection, as the kernel reports it
   bool registered_rpcbind_ = false;
   std::atomic<bool> stop_{false};
 };

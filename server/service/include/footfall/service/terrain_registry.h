@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "footfall/import/terrain_loader.h"
 #include "footfall/terrain/grid.h"
@@ -15,7 +16,9 @@
 namespace footfall {
 
 struct RegistryLimits {
-  size_t max_terrains = 256;            // loaded at once
+  size_t max_terrains = 256;        // loaded at once
+  size_t max_client_terrains = 64;  // loaded at once by one client (connection)
+  double orphan_idle_s = 600;  // [Units: s] an orphaned terrain without queries this long is freed
   size_t max_total_samples = 1u << 28;  // over all terrains and uploads
   size_t max_uploads = 32;              // in progress at once
   double upload_idle_s = 120;           // [Units: s] an upload idle this long is dropped
@@ -25,6 +28,11 @@ struct RegistryLimits {
 struct LoadedTerrain {
   std::string name;
   TerrainGrid grid;
+  // The client (connection) that loaded it, the only one that may unload it; 0 once that client
+  // has gone (the terrain is orphaned).
+  uint64_t owner = 0;
+  // The last query on it from any client, or when it was orphaned if later.
+  std::chrono::steady_clock::time_point used;
 };
 
 // One answered query, as the live view shows it.
@@ -45,32 +53,49 @@ class TerrainRegistry {
   // Loads a file under the data root. kAccessDenied for paths escaping it (.., symlinks).
   // Meshes and height maps are refused before sampling when the sampler's estimate exceeds the
   // samples left in the budget (RegistryLimits::max_total_samples).
-  Status LoadFile(const std::string& relative_path, double separation, uint32_t* handle,
-                  std::string* message);
+  // The terrain belongs to client `owner`; kLimitExceeded when that client already holds
+  // RegistryLimits::max_client_terrains.
+  Status LoadFile(const std::string& relative_path, double separation, uint64_t owner,
+                  uint32_t* handle, std::string* message);
   // Starts an upload for client `owner` (a connection), reserving its announced total against
   // the sample budget until it finishes, fails, expires or DropClient(owner). kLimitExceeded
-  // when the budget cannot hold it.
+  // when the budget cannot hold it, or when `owner` already holds its quota of terrains.
   Status BeginUpload(const std::string& name, uint64_t total, uint64_t owner, uint32_t* upload,
                      std::string* message);
   // Appends a chunk to `owner`'s upload; a bad chunk ends the upload.
   Status AppendUpload(uint32_t upload, uint64_t owner, const RawSamples& chunk,
                       std::string* message);
+  // Makes the upload a terrain belonging to `owner`.
   Status FinishUpload(uint32_t upload, uint64_t owner, uint32_t* handle, std::string* message);
-  // Ends the uploads of a client that went away, releasing their reservations.
-  void DropClient(uint64_t owner);
-  Status Unload(uint32_t handle);
+  // Ends the uploads of a client that went away, releasing their reservations, and orphans its
+  // terrains (they stay queryable until RegistryLimits::orphan_idle_s pass without a query).
+  // Returns the handles orphaned.
+  std::vector<uint32_t> DropClient(uint64_t owner);
+  // Unloads a terrain of client `requester`: kAccessDenied for another client's terrain or an
+  // orphan, kUnknownTerrain for no terrain.
+  Status Unload(uint32_t handle, uint64_t requester, std::string* message);
+  // The terrain, for reading its description (not a query); nullptr if there is none.
   const LoadedTerrain* Find(uint32_t handle) const;
+  // The terrain, for a query: marks it used now, which keeps an orphan alive.
+  const LoadedTerrain* Use(uint32_t handle);
   std::vector<uint32_t> Handles() const;
+  const RegistryLimits& limits() const { return limits_; }
 
   // Drops uploads idle longer than the limit.
   void ExpireUploads();
+  // Frees orphaned terrains without a query for RegistryLimits::orphan_idle_s; returns their
+  // handles.
+  std::vector<uint32_t> ExpireOrphans();
 
   void Record(const RecentQuery& query);
   // Queries with sequence > after, oldest first, at most `max`; *latest is the newest sequence.
   std::vector<RecentQuery> RecentAfter(uint64_t after, size_t max, uint64_t* latest) const;
 
  private:
-  Status Add(const std::string& name, RawSamples samples, uint32_t* handle, std::string* message);
+  Status Add(const std::string& name, RawSamples samples, uint64_t owner, uint32_t* handle,
+             std::string* message);
+  // kLimitExceeded, with a message, when `owner` holds its quota of terrains.
+  Status CheckQuota(uint64_t owner, std::string* message) const;
   // Samples held by loaded terrains plus those reserved by uploads in progress.
   uint64_t TotalSamples() const;
   // "the sample budget (--max-samples N, M in use)", for messages.

@@ -1,0 +1,97 @@
+#include "read_gate.h"
+
+#include <arpa/inet.h>
+#include <linux/sockios.h>
+#include <netinet/in.h>
+#include <rpc/rpc.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+
+#include <cstdio>
+#include <string>
+
+namespace footfall {
+namespace {
+
+// [Units: ms] How often connections without room are checked again while any waits.
+constexpr int kRecheckMs = 10;
+
+constexpr short kReadEvents = POLLIN | POLLPRI | POLLRDNORM | POLLRDBAND;
+
+// "ADDR:PORT" of the peer of `fd`, or "an unknown peer".
+std::string PeerOf(int fd) {
+  sockaddr_storage address{};
+  socklen_t len = sizeof address;
+  if (getpeername(fd, reinterpret_cast<sockaddr*>(&address), &len) != 0) return "an unknown peer";
+  char host[INET6_ADDRSTRLEN] = "";
+  int port = 0;
+  if (address.ss_family == AF_INET6) {
+    const auto* a = reinterpret_cast<const sockaddr_in6*>(&address);
+    inet_ntop(AF_INET6, &a->sin6_addr, host, sizeof host);
+    port = ntohs(a->sin6_port);
+    return std::string("[") + host + "]:" + std::to_string(port);
+  }
+  const auto* a = reinterpret_cast<const sockaddr_in*>(&address);
+  inet_ntop(AF_INET, &a->sin_addr, host, sizeof host);
+  port = ntohs(a->sin_port);
+  return std::string(host) + ":" + std::to_string(port);
+}
+
+}  // namespace
+
+ReadGate::ReadGate(size_t send_buffer, double stuck_limit_s)
+    : max_queued_(send_buffer > kReplyRoomBytes ? send_buffer - kReplyRoomBytes : 0),
+      stuck_limit_s_(stuck_limit_s) {}
+
+int ReadGate::Prepare(std::vector<pollfd>* fds, int idle_ms) {
+  fds->assign(svc_pollfd, svc_pollfd + svc_max_pollfd);
+  const auto now = std::chrono::steady_clock::now();
+  bool any_waiting = false;
+  for (pollfd& p : *fds) {
+    p.revents = 0;
+    if (p.fd < 0) continue;
+    // The listening socket answers EINVAL, and is always read (accept).
+    int queued = 0;
+    if (ioctl(p.fd, SIOCOUTQ, &queued) != 0 || static_cast<size_t>(queued) <= max_queued_) {
+      waiting_.erase(p.fd);
+      continue;
+    }
+    Waiting& w = waiting_.emplace(p.fd, Waiting{now}).first->second;
+    if (w.closing) continue;  // shut down: its replies fail at once, so it may be read
+    const double waited_s = std::chrono::duration<double>(now - w.since).count();
+    if (waited_s >= stuck_limit_s_) {
+      Close(p.fd, waited_s);
+      w.closing = true;
+      continue;
+    }
+    p.events = w.writable ? 0 : POLLOUT;
+    any_waiting = true;
+  }
+  return any_waiting ? kRecheckMs : idle_ms;
+}
+
+void ReadGate::Collect(const std::vector<pollfd>& fds, std::vector<pollfd>* readable) {
+  readable->clear();
+  for (const pollfd& p : fds) {
+    if (p.revents == 0) continue;
+    if ((p.events & kReadEvents) || (p.revents & (POLLERR | POLLHUP | POLLNVAL))) {
+      readable->push_back(p);
+    } else if (p.revents & POLLOUT) {
+      // The kernel calls a socket writable at a third free, which may be less than a reply:
+      // stop polling it for POLLOUT (it would spin) and only recheck it in Prepare.
+      auto it = waiting_.find(p.fd);
+      if (it != waiting_.end()) it->second.writable = true;
+    }
+  }
+}
+
+void ReadGate::Close(int fd, double waited_s) {
+  std::fprintf(stderr,
+               "footfalld: closing the connection from %s: its replies went unread for %.0f s\n",
+               PeerOf(fd).c_str(), waited_s);
+  const linger reset{1, 0};
+  setsockopt(fd, SOL_SOCKET, SO_LINGER, &reset, sizeof reset);
+  shutdown(fd, SHUT_RDWR);
+}
+
+}  // namespace footfall
