@@ -172,27 +172,35 @@ TEST_CASE("Swing arcs clear a resampled stair mesh, whose riser tops lie beside 
           "[steps][generator]") {
   // Poisson-disk samples with flat normals: above a nose, the nearest sample is often the top of
   // the riser below it, facing -z, so an arc point high above the nose lies only a little in
-  // front of that sample's plane. Its clearance is its distance to the sample, not its height
-  // along that normal, or the arc is raised in vain and the walk stops. The quadruped's reach
-  // is raised to 1 m so that reach does not stop it on stairs this steep first.
-  RawSamples stairs;
-  MeshSampleOptions mo;
-  mo.separation = 0.03;
-  mo.smooth_normals = false;
-  REQUIRE(SampleMesh(MakeStairsMesh(8, 0.18, 0.3, 1.5), mo, &stairs, nullptr) == Status::kOk);
-  Terrain t = LoadTerrain(stairs, mo.separation);
+  // front of that sample's plane. Its clearance is its distance to the sample (less the gap the
+  // sampling leaves), not its height along that normal, or the arc is raised in vain and the
+  // walk stops. The quadruped's reach is raised to 1 m so that reach does not stop it on stairs
+  // this steep first. Nine samplings (three separations, three seeds): measured along the
+  // riser's normal, one walk of the nine reached the top; some still stop where a toe is
+  // planted against a riser (README, "What it does not do").
   Character c = LoadShipped("quadruped");
   c.reach = 1.0;
-  GenerateOptions o;
-  o.has_start = true;
-  o.start = {0.75, 0, -0.6};
-  o.steps = 24;
-  const Walk w = Generate(t, c, o);
-  INFO(w.stopped);
-  CheckWalk(t, c, o, w);
-  // Up seven of the eight steps at least (a toe planted right against the last riser cannot
-  // lift without moving back, which arcs do not do).
-  CHECK(Body(w).keys.back().position.y > 7 * 0.18);
+  int to_the_top = 0;
+  for (const double separation : {0.025, 0.03, 0.04}) {
+    for (const uint64_t seed : {1, 2, 3}) {
+      RawSamples stairs;
+      MeshSampleOptions mo;
+      mo.separation = separation;
+      mo.smooth_normals = false;
+      mo.seed = seed;
+      REQUIRE(SampleMesh(MakeStairsMesh(8, 0.18, 0.3, 1.5), mo, &stairs, nullptr) == Status::kOk);
+      Terrain t = LoadTerrain(stairs, separation);
+      GenerateOptions o;
+      o.has_start = true;
+      o.start = {0.75, 0, -0.6};
+      o.steps = 30;
+      const Walk w = Generate(t, c, o);
+      INFO(separation << " " << seed << ": " << w.stopped);
+      CheckWalk(t, c, o, w);
+      to_the_top += Body(w).keys.back().position.y > 8 * 0.18;
+    }
+  }
+  CHECK(to_the_top >= 4);
 }
 
 TEST_CASE("A foot whose swing arc cannot clear takes its next foothold instead",

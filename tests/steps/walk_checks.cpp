@@ -1,5 +1,6 @@
 #include "walk_checks.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <catch2/catch.hpp>
@@ -124,12 +125,11 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
   size_t below = 0;
   double worst = 0;
   for (size_t i = 0; i < arc.size(); ++i) {
-    // Along the nearest sample's normal, or, beyond its face (farther out along it than
-    // above it), the distance to it over sqrt(2).
+    // Along the nearest sample's normal, or, when larger, the distance to it less twice the
+    // spacing (no surface is nearer than that).
     const Vec3 v = arc[i] - arc_snap[i].point;
     double clearance = Dot(v, arc_snap[i].normal);
-    if (clearance > 0 && Length2(v) > 2 * clearance * clearance)
-      clearance = std::sqrt(0.5 * Length2(v));
+    if (clearance > 0) clearance = std::max(clearance, Length(v) - 2 * t.spacing);
     if (clearance < need[i]) ++below, worst = std::min(worst, clearance - need[i]);
   }
   INFO("arc points not clear of the terrain: " << below << " of " << arc.size() << ", worst by "

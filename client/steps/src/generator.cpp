@@ -56,14 +56,15 @@ std::string Point(const Vec3& p) {
 }
 
 // How far p is above the terrain, from h, the sample nearest to it: its height along h's
-// normal (negative: below the terrain), or, where p lies farther out along h's face than above
-// it (above a stair's nose, seen from the riser's top sample), its distance to h over sqrt(2),
-// which is the same where the two meet.
-double Clearance(const Vec3& p, const Foothold& h) {
+// normal (negative: below the terrain), or, when larger, its distance to h less `gap`, the
+// farthest the surface may be from its nearest sample. No sample is nearer than h, so no
+// surface is nearer than that: above a stair's nose, whose nearest sample may be the riser's
+// top, a point high up is in the clear although it lies little in front of the riser's plane.
+double Clearance(const Vec3& p, const Foothold& h, double gap) {
   const Vec3 v = p - h.point;
-  const double height = Dot(v, h.normal), d2 = Length2(v);
-  if (height <= 0 || d2 <= 2 * height * height) return height;
-  return std::sqrt(0.5 * d2);
+  const double height = Dot(v, h.normal);
+  if (height <= 0) return height;
+  return std::max(height, Length(v) - gap);
 }
 
 // One walking character.
@@ -162,6 +163,9 @@ class Generator {
   Vec3 world_up_;
   int steps_ = 0;
   double lead_ = 0;
+  // The farthest a point of the surface may be from its nearest sample, estimated from the
+  // grid: twice the mean spacing, cell_size / sqrt(samples per occupied cell). [Units: wu]
+  double gap_ = 0;
   // cos(max_slope_deg), sin(slope_threshold_deg): slope tests on dot products of unit vectors.
   double cos_max_slope_ = -1, sin_slope_threshold_ = 1;
   std::vector<Agent> agents_;
@@ -327,12 +331,17 @@ Status Generator::Run(std::string* error) {
 
 Status Generator::Setup(std::string* error) {
   const size_t feet = c_.feet.size();
+  TerrainInfo info;
+  Status s = Check(session_.Info(terrain_, &info), "terrain info", error);
+  if (s != Status::kOk) return s;
+  const GridStats& g = info.stats;
+  gap_ = g.samples > 0
+             ? 2 * g.cell_size *
+                   std::sqrt(static_cast<double>(g.occupied_cells) / static_cast<double>(g.samples))
+             : 0;
   // 1. The start: --start, or the sample nearest the centre of the top of the bounds.
   Vec3 start = o_.start;
   if (!o_.has_start) {
-    TerrainInfo info;
-    const Status s = Check(session_.Info(terrain_, &info), "terrain info", error);
-    if (s != Status::kOk) return s;
     const Vec3 lo = info.stats.bounds_min, hi = info.stats.bounds_max;
     const Vec3 centre = (lo + hi) * 0.5;
     double top = 0;
@@ -343,7 +352,7 @@ Status Generator::Setup(std::string* error) {
     start = centre + world_up_ * top;
   }
   Foothold first;
-  Status s = Check(session_.Snap(terrain_, &start, 1, &first), "snap start", error);
+  s = Check(session_.Snap(terrain_, &start, 1, &first), "snap start", error);
   if (s != Status::kOk) return s;
   if (first.status != Status::kOk) {
     *error = first.status == Status::kInvalidArgument
@@ -687,7 +696,7 @@ Status Generator::ClearArcs(int k, std::string* error) {
             const Foothold& h = arc_answers_[i * kArcChecks + j];
             const double nominal = c_.step_height * (1 - std::fabs(2 * kArcS[j] - 1));
             if (h.status == Status::kOk &&
-                Clearance(arc_points_[i * kArcChecks + j], h) < kClearanceFraction * nominal)
+                Clearance(arc_points_[i * kArcChecks + j], h, gap_) < kClearanceFraction * nominal)
               low[kArcS[j] > 0.5] = true;
           }
           if (!low[0] && !low[1]) continue;
