@@ -71,5 +71,11 @@ stop_server
 err=$(echo "snap 0 0 0" | "$footfall" query --terrain "$work/flat.pts" --server "127.0.0.1:$port" 2>&1 >/dev/null)
 check "server gone: exit 1" [ $? -eq 1 ]
 check "server gone: message" grep -qF "footfalld at 127.0.0.1:$port" <<< "$err"
+# footfalld's own flags: timeouts are finite numbers of seconds (NaN used to pass).
+for flag in "--orphan-timeout nan" "--unread-timeout inf" "--unread-timeout 0"; do
+  err=$(timeout 5 "$footfalld" --listen 127.0.0.1:0 --no-rpcbind $flag 2>&1)
+  check "footfalld $flag: exit non-zero" [ $? -ne 0 ]
+  check "footfalld $flag: message" grep -qE "is not a number of seconds (from|above) 0 to 1e\+09" <<< "$err"
+done
 
 finish

@@ -2,6 +2,7 @@
 #include <signal.h>
 
 #include <algorithm>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -35,6 +36,22 @@ bool ParseListen(const std::string& text, std::string* host, int* port) {
   return true;
 }
 
+// A timeout flag's check: a finite number of seconds from `lo` (exclusive unless `zero_ok`) to
+// 1e9. CLI11's own number checks let NaN through, and print the limits of double in full.
+CLI::Validator Seconds(bool zero_ok) {
+  const std::string expected =
+      std::string("a number of seconds ") + (zero_ok ? "from 0" : "above 0") + " to 1e+09";
+  return CLI::Validator(
+      [expected, zero_ok](std::string& input) -> std::string {
+        char* end = nullptr;
+        const double x = std::strtod(input.c_str(), &end);
+        const bool ok = !input.empty() && *end == '\0' && std::isfinite(x) && x <= 1e9 &&
+                        (zero_ok ? x >= 0 : x > 0);
+        return ok ? std::string() : "'" + input + "' is not " + expected;
+      },
+      "SECONDS");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -57,14 +74,14 @@ int main(int argc, char** argv) {
   app.add_option("--orphan-timeout", options.limits.orphan_idle_s,
                  "Seconds without queries after which a terrain whose connection has closed is "
                  "freed (default 600)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(Seconds(true));
   app.add_option("--max-client-terrains", options.limits.max_client_terrains,
                  "Terrains one connection may hold loaded at once (default 64)")
       ->check(CLI::Range(1, 256));
   app.add_option("--unread-timeout", options.unread_timeout_s,
                  "Seconds a client may leave its replies unread, with no room for another, "
                  "before its connection is closed")
-      ->check(CLI::PositiveNumber);
+      ->check(Seconds(false));
   app.add_option("--port-file", port_file, "Write the bound port to this file once listening");
   try {
     app.parse(argc, argv);
