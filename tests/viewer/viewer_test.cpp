@@ -357,6 +357,13 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     r = View({"--screenshot", shot});
     CHECK(r.exit_code == 2);
     CHECK_THAT(r.err, Catch::Contains("nothing to show"));
+    r = View({"--terrain", kTerrain, "--frame", "nan", "--screenshot", shot});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err,
+               Catch::Contains("--frame: 'nan' is not a finite number from -1e+09 to 1e+09"));
+    r = View({"--terrain", kTerrain, "--tolerance", "nan", "--screenshot", shot});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("--tolerance: 'nan' is not a finite number >= 0"));
   }
   SECTION("no display") {
     const RunResult r =

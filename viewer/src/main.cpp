@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "footfall/cli/number_checks.h"
 #include "footfall/viewer/viewer_app.h"
 
 namespace {
@@ -48,7 +49,7 @@ int main(int argc, char** argv) {
                  "\"normal X Y Z\"");
   app.add_option("--tolerance", o.tolerance,
                  "next: candidate radius around the ideal point (default: the step length)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(footfall::cli::FiniteAtLeast(0));
   app.add_option("--walk", o.walk, "Walk JSON file from the step generator");
   app.add_option("--server", o.server, "footfalld HOST:PORT, with --live");
   app.add_flag("--live", o.live, "Draw the queries the server answers, as they arrive");
@@ -56,10 +57,11 @@ int main(int argc, char** argv) {
                  "With --screenshot: wait for this many live queries before rendering")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--timeout", o.timeout_s, "Bound on waits for the server (s)")
-      ->check(CLI::PositiveNumber);
+      ->check(footfall::cli::FiniteRange(0.001, 1e6));
   app.add_option("--screenshot", o.screenshot, "Render one frame off screen to this PNG and exit");
   app.add_option("--size", size, "Window or image size WxH (default 1280x800)");
-  auto* frame_opt = app.add_option("--frame", frame, "Walk frame to show");
+  auto* frame_opt = app.add_option("--frame", frame, "Walk frame to show")
+                        ->check(footfall::cli::FiniteRange(-1e9, 1e9));
   app.add_option("--dump-state", o.dump_state,
                  "Write what is drawn (pixel positions of chosen samples and feet, live "
                  "queries) as JSON");
@@ -71,7 +73,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    return app.exit(e) == 0 ? 0 : 2;  // a refused flag: 2, as for --size and --camera
   }
   if (!size.empty()) {
     const size_t x = size.find_first_of("xX");

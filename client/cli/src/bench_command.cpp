@@ -17,9 +17,9 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "footfall/cli/number_checks.h"
 #include "footfall/import/terrain_loader.h"
 #include "footfall/terrain/brute_force.h"
-#include "number_checks.h"
 #include "terrain_flags.h"
 
 namespace footfall::cli {

@@ -13,12 +13,12 @@
 #include <vector>
 
 #include "commands.h"
+#include "footfall/cli/number_checks.h"
 #include "footfall/client/query_text.h"
 #include "footfall/export/walk_writer.h"
 #include "footfall/steps/generator.h"
 #include "footfall/steps/walk_json.h"
 #include "footfall/terrain/file_extension.h"
-#include "number_checks.h"
 #include "terrain_flags.h"
 
 namespace footfall::cli {

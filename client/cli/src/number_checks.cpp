@@ -1,4 +1,4 @@
-#include "number_checks.h"
+#include "footfall/cli/number_checks.h"
 
 #include <sstream>
 #include <string>

@@ -9,8 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "footfall/cli/number_checks.h"
 #include "footfall/client/query_text.h"
-#include "number_checks.h"
 #include "terrain_flags.h"
 
 namespace footfall::cli {

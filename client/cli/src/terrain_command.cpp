@@ -10,12 +10,12 @@
 #include <vector>
 
 #include "commands.h"
+#include "footfall/cli/number_checks.h"
 #include "footfall/import/terrain_generators.h"
 #include "footfall/import/terrain_loader.h"
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/grid.h"
 #include "footfall/terrain/point_file.h"
-#include "number_checks.h"
 #include "terrain_flags.h"
 
 namespace footfall::cli {

@@ -1,6 +1,6 @@
 #include "terrain_flags.h"
 
-#include "number_checks.h"
+#include "footfall/cli/number_checks.h"
 
 namespace footfall::cli {
 
