@@ -96,7 +96,8 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
   CHECK(off_terrain == 0);
   // Planted feet stay put; arcs clear the terrain; phases in order.
   std::vector<Vec3> arc;
-  std::vector<double> need;  // required clearance at each arc point
+  std::vector<double> need;        // required clearance at each arc point
+  std::vector<const WalkKey*> by;  // the foothold at that point's end of its arc
   for (size_t f = 0; f < c.feet.size(); ++f) {
     const auto& k = tracks[f]->keys;
     for (size_t i = 0; i + 1 < k.size(); ++i) {
@@ -116,8 +117,11 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
         const double s = j / 8.0;
         arc.push_back(at(s));
         need.push_back(0.25 * c.step_height * (1 - std::fabs(2 * s - 1)) - 1e-6);
+        by.push_back(&k[s <= 0.5 ? i : i + 2]);
       }
-      for (int j = 1; j < 10; ++j) arc.push_back(at(j / 10.0)), need.push_back(-t.spacing - 1e-6);
+      for (int j = 1; j < 10; ++j) {
+        arc.push_back(at(j / 10.0)), need.push_back(-t.spacing - 1e-6), by.push_back(nullptr);
+      }
     }
   }
   std::vector<Foothold> arc_snap(arc.size());
@@ -130,7 +134,17 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
     const Vec3 v = arc[i] - arc_snap[i].point;
     double clearance = Dot(v, arc_snap[i].normal);
     if (clearance > 0) clearance = std::max(clearance, Length(v) - 2 * t.spacing);
-    if (clearance < need[i]) ++below, worst = std::min(worst, clearance - need[i]);
+    // A foothold standing against the sample's face (on ground facing more than 45 degrees
+    // away, less than a step height in front of it: a toe at a riser): the arc near it keeps
+    // at least half the foot's own distance from that face.
+    double needed = need[i];
+    if (by[i]) {
+      const double kept = Dot(by[i]->position - arc_snap[i].point, arc_snap[i].normal);
+      if (Dot(arc_snap[i].normal, by[i]->normal) < std::sqrt(0.5) && kept >= 0 &&
+          kept <= c.step_height)
+        needed = std::min(needed, 0.5 * kept - 1e-6);
+    }
+    if (clearance < needed) ++below, worst = std::min(worst, clearance - needed);
   }
   INFO("arc points not clear of the terrain: " << below << " of " << arc.size() << ", worst by "
                                                << worst);

@@ -67,6 +67,17 @@ double Clearance(const Vec3& p, const Foothold& h, double gap) {
   return std::max(height, Length(v) - gap);
 }
 
+// The clearance an arc point must keep from h, its nearest sample: `nominal`, or, when the
+// foothold `foot` at that end of the arc stands against h's face (in front of its plane, nearer
+// than `near`, on ground unlike it: a toe at a riser), no more than half of what the foot itself
+// keeps from that plane.
+double ClearanceNeeded(double nominal, const Foothold& h, const Vec3& foot, const Vec3& foot_normal,
+                       double near) {
+  const double kept = Dot(foot - h.point, h.normal);
+  if (Dot(h.normal, foot_normal) >= kAlikeCos || kept < 0 || kept > near) return nominal;
+  return std::min(nominal, 0.5 * kept);
+}
+
 // One walking character.
 struct Agent {
   std::string id;                       // "" for a single character, else "c1".."cN"
@@ -691,13 +702,21 @@ Status Generator::ClearArcs(int k, std::string* error) {
         const ArcAgent& aa = arc_agents_[g];
         for (size_t i = aa.begin; i < aa.end; ++i) {
           Move& mv = moves[pending_[i]];
-          bool low[2] = {false, false};  // a check point too low in the first, second half
+          const Agent& a = agents_[mv.agent];
+          bool low[2] = {false, false};   // a check point too low in the first, second half
+          bool wall[2] = {false, false};  // ... beside a face unlike that half's foothold
           for (int j = 0; j < kArcChecks; ++j) {
             const Foothold& h = arc_answers_[i * kArcChecks + j];
+            if (h.status != Status::kOk) continue;
+            const int half = kArcS[j] > 0.5;
             const double nominal = c_.step_height * (1 - std::fabs(2 * kArcS[j] - 1));
-            if (h.status == Status::kOk &&
-                Clearance(arc_points_[i * kArcChecks + j], h, gap_) < kClearanceFraction * nominal)
-              low[kArcS[j] > 0.5] = true;
+            const double need =
+                ClearanceNeeded(kClearanceFraction * nominal, h, half ? mv.end : a.foot[mv.foot],
+                                half ? mv.end_normal : a.foot_normal[mv.foot], c_.step_height);
+            if (Clearance(arc_points_[i * kArcChecks + j], h, gap_) < need) {
+              low[half] = true;
+              wall[half] |= need < kClearanceFraction * nominal;
+            }
           }
           if (!low[0] && !low[1]) continue;
           if (round + 1 >= kMaxRaises) {
@@ -723,10 +742,12 @@ Status Generator::ClearArcs(int k, std::string* error) {
           // Between footholds that face alike, the mid key also slides toward the start when
           // the first half is low (a riser just ahead of the lifting foot: it lifts before it
           // travels), else toward the end (a nose just behind the landing foot: it travels
-          // before it lands). (Over an edge between faces, raising alone is what clears it.)
-          if (Dot(agents_[mv.agent].foot_normal[mv.foot], mv.end_normal) >= kAlikeCos) {
-            const Vec3& end = low[0] ? agents_[mv.agent].foot[mv.foot] : mv.end;
-            mv.mid += ProjectOnPlane(end - mv.mid, mv.mid_normal) * kSlide;
+          // before it lands); all the way when that foot stands against the face (a toe at a
+          // riser lifts straight up). (Over an edge between faces, raising alone clears it.)
+          if (Dot(a.foot_normal[mv.foot], mv.end_normal) >= kAlikeCos) {
+            const int half = low[0] ? 0 : 1;
+            const Vec3& end = half == 0 ? a.foot[mv.foot] : mv.end;
+            mv.mid += ProjectOnPlane(end - mv.mid, mv.mid_normal) * (wall[half] ? 1.0 : kSlide);
           }
           verdict_[i] = 1, raised_[g] = 1;
         }
