@@ -181,15 +181,22 @@ ff_status SendChunk(CLIENT* c, uint32_t upload, std::vector<ff_sample> samples,
 
 // The handle footfalld gave the one terrain it holds, for raw calls (sessions number their
 // terrains themselves).
-uint32_t OnlyServerTerrain(int port) {
+// The handles of the terrains footfalld holds, in its order (FF_LIST).
+std::vector<uint32_t> ServerTerrains(int port) {
   CLIENT* c = RawClient(port);
   ff_list_reply reply{};
   REQUIRE(ff_list_1(nullptr, &reply, c) == RPC_SUCCESS);
-  REQUIRE(reply.terrains.terrains_len == 1);
-  const uint32_t handle = reply.terrains.terrains_val[0];
+  const std::vector<uint32_t> handles(reply.terrains.terrains_val,
+                                      reply.terrains.terrains_val + reply.terrains.terrains_len);
   xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_list_reply), reinterpret_cast<char*>(&reply));
   clnt_destroy(c);
-  return handle;
+  return handles;
+}
+
+uint32_t OnlyServerTerrain(int port) {
+  const std::vector<uint32_t> handles = ServerTerrains(port);
+  REQUIRE(handles.size() == 1);
+  return handles[0];
 }
 
 // FF_INFO from a raw client; returns the status.
@@ -876,6 +883,42 @@ TEST_CASE("a closed connection's terrains are freed once unqueried for --orphan-
         std::string::npos);
   clnt_destroy(other);
   RequireServed(server.port());
+}
+
+TEST_CASE("at the terrain limit, a new terrain frees the least recently queried orphan", "[rpc]") {
+  ServerProcess server(0, {"--no-rpcbind"});
+  // Four connections hold 64 terrains each: the server's 256.
+  std::vector<std::unique_ptr<TerrainSession>> clients;
+  std::vector<uint32_t> first;  // the first connection's terrains, in handle order
+  for (int i = 0; i < 4; ++i) {
+    clients.push_back(Connect(server.port()));
+    for (int k = 0; k < 64; ++k) {
+      TerrainHandle t = 0;
+      REQUIRE(clients.back()->LoadSamples(MakeFlat(2, 1, 0), "t", &t) == Status::kOk);
+    }
+    if (i == 0) first = ServerTerrains(server.port());
+  }
+  REQUIRE(first.size() == 64);
+  auto late = Connect(server.port());
+  TerrainHandle t = 0;
+  CHECK(late->LoadSamples(MakeFlat(2, 1, 0), "late", &t) == Status::kLimitExceeded);
+  CHECK_THAT(late->last_error(), Catch::Contains("too many terrains loaded (limit 256)"));
+  // The first connection closes: its 64 terrains are orphans; one of them is queried again.
+  clients[0].reset();
+  CHECK(WaitFor([&] {
+    return server.Log().find("terrain " + std::to_string(first[63]) + " orphaned") !=
+           std::string::npos;
+  }));
+  CLIENT* other = RawClient(server.port());
+  REQUIRE(RawSnap(other, first[0]) == FF_OK);
+  // A new terrain now fits: the least recently queried orphan made room, the queried one stays.
+  REQUIRE(late->LoadSamples(MakeFlat(2, 1, 0), "late", &t) == Status::kOk);
+  CHECK(RawInfo(other, first[0]) == FF_OK);
+  CHECK(RawInfo(other, first[1]) == FF_UNKNOWN_TERRAIN);
+  CHECK(RawInfo(other, first[2]) == FF_OK);
+  CHECK(server.Log().find("freed orphaned terrain " + std::to_string(first[1]) + " early") !=
+        std::string::npos);
+  clnt_destroy(other);
 }
 
 TEST_CASE("footfalld holds each connection to --max-client-terrains", "[rpc]") {

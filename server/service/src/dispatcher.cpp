@@ -157,11 +157,20 @@ bool_t XdrLoadArgs(XDR* xdrs, LoadArgs* a) {
   return xdr_bytes(xdrs, &a->path, &a->path_len, FF_MAX_PATH) && xdr_double(xdrs, &a->separation);
 }
 
+// Logs the orphans the registry freed early to make room for a new terrain.
+void LogEvicted() {
+  for (const uint32_t handle : g_state->registry.TakeEvicted())
+    Log("freed orphaned terrain " + std::to_string(handle) +
+        " early: " + std::to_string(g_state->registry.limits().max_terrains) +
+        " terrains were loaded and a new one came (the least recently queried orphan goes)");
+}
+
 void Load(const LoadArgs& a, uint64_t client, ff_load_reply* r) {
   std::string message;
   uint32_t handle = 0;
   const std::string path = a.path ? std::string(a.path, a.path_len) : "";
   const Status s = g_state->registry.LoadFile(path, a.separation, client, &handle, &message);
+  LogEvicted();
   r->status = Wire(s);
   r->terrain = handle;
   if (s == Status::kOk) {
@@ -204,6 +213,7 @@ void UploadFinish(const ff_upload_args& a, uint64_t client, ff_load_reply* r) {
   std::string message;
   uint32_t handle = 0;
   const Status s = g_state->registry.FinishUpload(a.upload, client, &handle, &message);
+  LogEvicted();
   r->status = Wire(s);
   r->terrain = handle;
   if (s == Status::kOk) {

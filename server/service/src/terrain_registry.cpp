@@ -179,7 +179,7 @@ Status TerrainRegistry::Add(const std::string& name, RawSamples samples, uint64_
                             uint32_t* handle, std::string* message) {
   Status status = CheckQuota(owner, message);
   if (status != Status::kOk) return status;
-  if (terrains_.size() >= limits_.max_terrains) {
+  if (terrains_.size() >= limits_.max_terrains && !EvictOldestOrphan()) {
     *message = "too many terrains loaded (limit " + std::to_string(limits_.max_terrains) + ")";
     return Status::kLimitExceeded;
   }
@@ -350,6 +350,24 @@ std::vector<uint32_t> TerrainRegistry::DropClient(uint64_t owner) {
     orphaned.push_back(t.first);
   }
   return orphaned;
+}
+
+bool TerrainRegistry::EvictOldestOrphan() {
+  auto oldest = terrains_.end();
+  for (auto it = terrains_.begin(); it != terrains_.end(); ++it)
+    if (it->second->owner == 0 &&
+        (oldest == terrains_.end() || it->second->used < oldest->second->used))
+      oldest = it;
+  if (oldest == terrains_.end()) return false;
+  evicted_.push_back(oldest->first);
+  terrains_.erase(oldest);
+  return true;
+}
+
+std::vector<uint32_t> TerrainRegistry::TakeEvicted() {
+  std::vector<uint32_t> evicted;
+  evicted.swap(evicted_);
+  return evicted;
 }
 
 std::vector<uint32_t> TerrainRegistry::ExpireOrphans() {

@@ -86,12 +86,17 @@ class TerrainRegistry {
   // Frees orphaned terrains without a query for RegistryLimits::orphan_idle_s; returns their
   // handles.
   std::vector<uint32_t> ExpireOrphans();
+  // The orphans freed early since the last call, to make room for a new terrain when
+  // RegistryLimits::max_terrains were loaded (the least recently queried first).
+  std::vector<uint32_t> TakeEvicted();
 
   void Record(const RecentQuery& query);
   // Queries with sequence > after, oldest first, at most `max`; *latest is the newest sequence.
   std::vector<RecentQuery> RecentAfter(uint64_t after, size_t max, uint64_t* latest) const;
 
  private:
+  // Frees the least recently queried orphan; false when there is none.
+  bool EvictOldestOrphan();
   Status Add(const std::string& name, RawSamples samples, uint64_t owner, uint32_t* handle,
              std::string* message);
   // kLimitExceeded, with a message, when `owner` holds its quota of terrains.
@@ -113,6 +118,7 @@ class TerrainRegistry {
   uint32_t next_handle_;
   uint32_t next_upload_ = 1;
   std::map<uint32_t, std::unique_ptr<LoadedTerrain>> terrains_;
+  std::vector<uint32_t> evicted_;  // orphans freed to make room, until TakeEvicted
   std::map<uint32_t, Upload> uploads_;
   std::deque<RecentQuery> recent_;
   uint64_t sequence_ = 0;
