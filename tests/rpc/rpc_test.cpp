@@ -559,6 +559,30 @@ TEST_CASE("footfalld holds --max-samples over parallel uploads and mesh loads", 
           "(--max-samples 2000, 0 in use by loaded terrains and uploads in progress))");
     CHECK(rpc->LoadServerFile("square.obj", 0.283, &t) == Status::kOk);
   }
+  SECTION("orphans make room in the budget, least recently queried first") {
+    auto first = Connect(server.port());
+    auto second = Connect(server.port());
+    TerrainHandle t = 0;
+    REQUIRE(first->LoadSamples(MakeFlat(30, 1, 0), "first", &t) == Status::kOk);    // 900
+    REQUIRE(second->LoadSamples(MakeFlat(30, 1, 0), "second", &t) == Status::kOk);  // 900
+    const std::vector<uint32_t> held = ServerTerrains(server.port());  // first's, then second's
+    REQUIRE(held.size() == 2);
+    auto third = Connect(server.port());
+    CHECK(third->LoadSamples(MakeFlat(30, 1, 0), "third", &t) == Status::kLimitExceeded);
+    first.reset(), second.reset();  // both orphaned
+    CHECK(WaitFor([&] {
+      return server.Log().find("terrain " + std::to_string(held[1]) + " orphaned") !=
+             std::string::npos;
+    }));
+    CLIENT* other = RawClient(server.port());
+    REQUIRE(RawSnap(other, held[0]) == FF_OK);  // the first is queried again
+    REQUIRE(third->LoadSamples(MakeFlat(30, 1, 0), "third", &t) == Status::kOk);
+    CHECK(RawInfo(other, held[0]) == FF_OK);
+    CHECK(RawInfo(other, held[1]) == FF_UNKNOWN_TERRAIN);
+    CHECK(server.Log().find("freed orphaned terrain " + std::to_string(held[1]) + " early") !=
+          std::string::npos);
+    clnt_destroy(other);
+  }
   std::system(("rm -rf '" + root + "'").c_str());
 }
 

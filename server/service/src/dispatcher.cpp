@@ -157,12 +157,12 @@ bool_t XdrLoadArgs(XDR* xdrs, LoadArgs* a) {
   return xdr_bytes(xdrs, &a->path, &a->path_len, FF_MAX_PATH) && xdr_double(xdrs, &a->separation);
 }
 
-// Logs the orphans the registry freed early to make room for a new terrain.
+// Logs the orphans the registry freed early to make room for a new terrain or upload.
 void LogEvicted() {
   for (const uint32_t handle : g_state->registry.TakeEvicted())
     Log("freed orphaned terrain " + std::to_string(handle) +
-        " early: " + std::to_string(g_state->registry.limits().max_terrains) +
-        " terrains were loaded and a new one came (the least recently queried orphan goes)");
+        " early, to make room for a new one (at the terrain limit or the sample budget, the "
+        "least recently queried orphan goes)");
 }
 
 void Load(const LoadArgs& a, uint64_t client, ff_load_reply* r) {
@@ -190,6 +190,7 @@ void UploadBegin(const ff_upload_begin_args& a, uint64_t client, ff_upload_reply
   uint32_t upload = 0;
   const Status s =
       g_state->registry.BeginUpload(a.name ? a.name : "", a.total, client, &upload, &message);
+  LogEvicted();
   if (s != Status::kOk) LogError("upload", s, message);
   r->status = Wire(s);
   r->upload = upload;

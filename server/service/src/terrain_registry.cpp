@@ -183,6 +183,7 @@ Status TerrainRegistry::Add(const std::string& name, RawSamples samples, uint64_
     *message = "too many terrains loaded (limit " + std::to_string(limits_.max_terrains) + ")";
     return Status::kLimitExceeded;
   }
+  MakeRoomForSamples(samples.size());
   if (TotalSamples() + samples.size() > limits_.max_total_samples) {
     *message = std::to_string(samples.size()) + " samples do not fit in " + Budget();
     return Status::kLimitExceeded;
@@ -217,8 +218,9 @@ Status TerrainRegistry::LoadFile(const std::string& relative_path, double separa
   }
   TerrainLoadOptions options;
   options.separation = separation;
-  // Meshes are refused on the sampler's estimate, before any sampling.
-  const uint64_t used = TotalSamples();
+  // Meshes are refused on the sampler's estimate, before any sampling. Orphans count as room:
+  // Add frees them as needed.
+  const uint64_t used = TotalSamples() - OrphanSamples();
   options.max_samples = used < limits_.max_total_samples ? limits_.max_total_samples - used : 0;
   RawSamples samples;
   std::string error;
@@ -244,6 +246,7 @@ Status TerrainRegistry::BeginUpload(const std::string& name, uint64_t total, uin
     *message = "too many uploads in progress (limit " + std::to_string(limits_.max_uploads) + ")";
     return Status::kLimitExceeded;
   }
+  if (total <= limits_.max_total_samples) MakeRoomForSamples(total);
   if (total > limits_.max_total_samples || TotalSamples() + total > limits_.max_total_samples) {
     *message = "an upload of " + std::to_string(total) + " samples does not fit in " + Budget();
     return Status::kLimitExceeded;
@@ -362,6 +365,18 @@ bool TerrainRegistry::EvictOldestOrphan() {
   evicted_.push_back(oldest->first);
   terrains_.erase(oldest);
   return true;
+}
+
+uint64_t TerrainRegistry::OrphanSamples() const {
+  uint64_t total = 0;
+  for (const auto& t : terrains_)
+    if (t.second->owner == 0) total += t.second->grid.size();
+  return total;
+}
+
+void TerrainRegistry::MakeRoomForSamples(uint64_t samples) {
+  while (TotalSamples() + samples > limits_.max_total_samples && EvictOldestOrphan()) {
+  }
 }
 
 std::vector<uint32_t> TerrainRegistry::TakeEvicted() {

@@ -86,8 +86,8 @@ class TerrainRegistry {
   // Frees orphaned terrains without a query for RegistryLimits::orphan_idle_s; returns their
   // handles.
   std::vector<uint32_t> ExpireOrphans();
-  // The orphans freed early since the last call, to make room for a new terrain when
-  // RegistryLimits::max_terrains were loaded (the least recently queried first).
+  // The orphans freed early since the last call, to make room for a new terrain or upload at
+  // RegistryLimits::max_terrains or the sample budget (the least recently queried first).
   std::vector<uint32_t> TakeEvicted();
 
   void Record(const RecentQuery& query);
@@ -97,6 +97,10 @@ class TerrainRegistry {
  private:
   // Frees the least recently queried orphan; false when there is none.
   bool EvictOldestOrphan();
+  // Frees orphans, least recently queried first, until `samples` more fit in the budget or none
+  // is left.
+  void MakeRoomForSamples(uint64_t samples);
+  uint64_t OrphanSamples() const;  // samples of orphaned terrains
   Status Add(const std::string& name, RawSamples samples, uint64_t owner, uint32_t* handle,
              std::string* message);
   // kLimitExceeded, with a message, when `owner` holds its quota of terrains.
