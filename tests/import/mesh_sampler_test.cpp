@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "footfall/import/mesh_generators.h"
+#include "footfall/import/terrain_loader.h"
 #include "footfall/terrain/grid.h"
 #include "test_support.h"
 
@@ -188,6 +189,103 @@ TEST_CASE("SampleMesh: bad options are refused", "[import][sampler]") {
   o.separation = 1;
   CHECK(SampleMesh(bad, o, &out, &error) == Status::kInvalidArgument);
   CHECK(error.find("vertex 1") != std::string::npos);
+}
+
+}  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("SampleMesh: long thin triangles are refused before they are cut", "[import][sampler]") {
+  // Two slivers 10000 long and 1e-4 wide: 16000 samples by area at s = 0.01, but millions of
+  // pieces along their length.
+  TriangleMesh sliver;
+  sliver.vertices = {{0, 0, 0}, {1e-4, 0, 0}, {1e-4, 1e4, 0}, {0, 1e4, 0}};
+  sliver.triangles = {{0, 1, 2}, {0, 2, 3}};
+  MeshSampleOptions o;
+  o.separation = 0.01;
+  o.max_samples = 20000;
+  RawSamples out;
+  std::string error;
+  CHECK(SampleMesh(sliver, o, &out, &error) == Status::kLimitExceeded);
+  CHECK(error.find("long and thin") != std::string::npos);
+  CHECK(out.size() == 0);
+  // With room for its pieces (about 1.1 million at s = 5), the same mesh samples, every sample
+  // on it.
+  o.separation = 5;
+  o.max_samples = 100000;
+  const Status status = SampleMesh(sliver, o, &out, &error);
+  INFO(error);
+  REQUIRE(status == Status::kOk);
+  CHECK(out.size() > 1000);
+  for (const Vec3& p : out.points) CHECK(test::DistanceToMesh(sliver, p) < 1e-5 * 1e4);
+}
+
+TEST_CASE("ResampleTerrainMesh: finest_default refines the file's spacing within the budget",
+          "[import][sampler]") {
+  test::TempDir dir;
+  // A 40 x 40 height field of 1-unit cells: the file's own spacing is 1.
+  std::string asc = "ncols 40\nnrows 40\nxllcorner 0\nyllcorner 0\ncellsize 1\n";
+  for (int r = 0; r < 40; ++r) {
+    for (int c = 0; c < 40; ++c) asc += std::to_string(0.1 * ((r * 7 + c * 3) % 5)) + " ";
+    asc += "\n";
+  }
+  const std::string path = dir.Write("field.asc", asc);
+  TerrainLoadOptions options;
+  TriangleMesh mesh;
+  TerrainLoadReport report;
+  std::string error;
+  REQUIRE(ReadTerrainMesh(path, options, &mesh, &error, &report) == Status::kOk);
+  CHECK(report.format == "heightmap");
+  CHECK(report.file_separation == 1);
+  RawSamples samples;
+
+  SECTION("no finest_default: the file's spacing, as LoadTerrain") {
+    REQUIRE(ResampleTerrainMesh(path, mesh, options, &samples, &error, &report) == Status::kOk);
+    CHECK(report.separation == 1);
+    RawSamples loaded;
+    REQUIRE(LoadTerrain(path, options, &loaded, &error) == Status::kOk);
+    CHECK(loaded.points == samples.points);
+  }
+  SECTION("finer than the file: taken") {
+    options.finest_default = 0.25;
+    REQUIRE(ResampleTerrainMesh(path, mesh, options, &samples, &error, &report) == Status::kOk);
+    CHECK(report.separation == 0.25);
+    CHECK(report.samples == samples.size());
+    CHECK(LargestGap(samples, Sample(mesh, 0.05)) <= 0.25);
+  }
+  SECTION("coarser than the file: the file's spacing") {
+    options.finest_default = 3;
+    REQUIRE(ResampleTerrainMesh(path, mesh, options, &samples, &error, &report) == Status::kOk);
+    CHECK(report.separation == 1);
+  }
+  SECTION("beyond the sample budget: as fine as the budget allows") {
+    options.finest_default = 0.01;
+    options.max_samples = 20000;
+    REQUIRE(ResampleTerrainMesh(path, mesh, options, &samples, &error, &report) == Status::kOk);
+    CHECK(report.separation > 0.01);
+    CHECK(report.separation < 0.5);
+    CHECK(samples.size() <= 20000);
+    CHECK(samples.size() > 10000);
+  }
+  SECTION("an explicit separation wins") {
+    options.finest_default = 0.25;
+    options.separation = 0.5;
+    REQUIRE(ResampleTerrainMesh(path, mesh, options, &samples, &error, &report) == Status::kOk);
+    CHECK(report.separation == 0.5);
+  }
+}
+
+TEST_CASE("ReadTerrainMesh: point files and unknown extensions are not meshes",
+          "[import][sampler]") {
+  test::TempDir dir;
+  TriangleMesh mesh;
+  TerrainLoadReport report;
+  std::string error;
+  const std::string points = dir.Write("a.pts", "0 0 0 0 1 0\n");
+  CHECK(ReadTerrainMesh(points, TerrainLoadOptions{}, &mesh, &error, &report) ==
+        Status::kInvalidArgument);
+  CHECK(error.find("unknown terrain file extension 'pts'") == std::string::npos);
+  CHECK(error.find("a.pts") != std::string::npos);
 }
 
 }  // namespace footfall

@@ -16,8 +16,10 @@
 #include "footfall/cli/number_checks.h"
 #include "footfall/client/query_text.h"
 #include "footfall/export/walk_writer.h"
+#include "footfall/import/mesh_reader.h"
 #include "footfall/steps/generator.h"
 #include "footfall/steps/walk_json.h"
+#include "footfall/steps/walk_terrain.h"
 #include "footfall/terrain/file_extension.h"
 #include "terrain_flags.h"
 
@@ -93,6 +95,41 @@ class ProgressBar {
   bool shown_ = false;
 };
 
+// True when the terrain is a mesh or height map read here with no --separation: it is then
+// resampled for the character (walk_terrain.h).
+bool ResamplesForCharacter(const TerrainFlags& flags) {
+  if (flags.terrain.empty() || flags.load.separation > 0) return false;
+  const std::string ext = FileExtension(flags.terrain);
+  return IsMeshExtension(ext) || ext == "asc" || ext == "pgm";
+}
+
+std::string Box(const Vec3& lo, const Vec3& hi) {
+  std::ostringstream o;
+  o.precision(4);
+  o << "(" << lo.x << ", " << lo.y << ", " << lo.z << ") to (" << hi.x << ", " << hi.y << ", "
+    << hi.z << ")";
+  return o.str();
+}
+
+// Says on stderr how the terrain was resampled for the character, when not at its own spacing.
+void ReportResampling(const std::string& path, const Character& character, const WalkTerrain& t) {
+  const TerrainLoadReport& r = t.report;
+  if (!t.cropped && r.separation == r.file_separation) return;
+  std::ostringstream o;
+  o.precision(4);
+  o << "footfall generate: " << path << " resampled for " << character.name
+    << " at a separation of " << r.separation << " (its own spacing " << r.file_separation
+    << ", a quarter of the step " << t.wanted_separation << ")";
+  if (t.cropped) o << " within " << Box(t.region_min, t.region_max);
+  o << ": " << r.samples << " samples; --separation S resamples all of it at S\n";
+  if (r.separation > 1.0001 * std::min(t.wanted_separation, r.file_separation)) {
+    o << "footfall generate: not finer than " << r.separation
+      << ": the surface would need more samples than the limit; give fewer --steps or set "
+         "--separation\n";
+  }
+  std::cerr << o.str();
+}
+
 int RunGenerate(const GenerateFlags& flags) {
   std::string error;
   GenerateOptions options;
@@ -133,7 +170,22 @@ int RunGenerate(const GenerateFlags& flags) {
     TerrainHandle terrain = 0;
     TerrainFlags terrain_flags = flags.terrain;
     terrain_flags.threads = flags.threads;
-    if (OpenTerrain(terrain_flags, &session, &terrain, &error) != Status::kOk) goto bad_flag;
+    WalkTerrain prepared;
+    const bool resample = ResamplesForCharacter(terrain_flags);
+    if (resample) {
+      if (PrepareWalkTerrain(terrain_flags.terrain, terrain_flags.load, character, options,
+                             &prepared, &error) != Status::kOk)
+        goto bad_flag;
+      ReportResampling(terrain_flags.terrain, character, prepared);
+      options.start = prepared.start, options.has_start = true;
+      if (OpenSession(terrain_flags, &session, &error) != Status::kOk) goto bad_flag;
+      if (session->LoadSamples(prepared.samples, terrain_flags.terrain, &terrain) != Status::kOk) {
+        error = session->last_error();
+        goto bad_flag;
+      }
+    } else if (OpenTerrain(terrain_flags, &session, &terrain, &error) != Status::kOk) {
+      goto bad_flag;
+    }
     ProgressBar bar;
     const bool long_run =
         static_cast<long long>(flags.crowd) * (flags.steps < 0 ? 8 : flags.steps) >= 20000;
@@ -155,6 +207,12 @@ int RunGenerate(const GenerateFlags& flags) {
     }
     if (!walk.stopped.empty()) {
       std::cerr << "footfall generate: stopped early: " << walk.stopped << '\n';
+      if (resample && prepared.cropped && !prepared.region_is_bound) {
+        std::cerr << "footfall generate: the terrain was resampled only within "
+                  << Box(prepared.region_min, prepared.region_max)
+                  << ", around the path; a stop at its edge is that edge: give --steps or "
+                     "--separation\n";
+      }
       return 2;
     }
     return code;

@@ -38,6 +38,20 @@ void AddTerrainFlags(CLI::App* command, TerrainFlags* flags) {
       ->check(FiniteRange(0.001, 1e6));
 }
 
+Status OpenSession(const TerrainFlags& flags, std::unique_ptr<TerrainSession>* session,
+                   std::string* error) {
+  if (flags.server.empty()) {
+    *session = MakeEmbeddedSession(flags.threads);
+    return Status::kOk;
+  }
+  RpcOptions options;
+  options.call_timeout_s = flags.timeout_s;
+  const Status status = ParseHostPort(flags.server, &options, error);
+  if (status != Status::kOk) return status;
+  *session = MakeRpcSession(options);
+  return Status::kOk;
+}
+
 Status OpenTerrain(const TerrainFlags& flags, std::unique_ptr<TerrainSession>* session,
                    TerrainHandle* terrain, std::string* error) {
   if (flags.terrain.empty() == flags.server_terrain.empty()) {
@@ -48,19 +62,11 @@ Status OpenTerrain(const TerrainFlags& flags, std::unique_ptr<TerrainSession>* s
     *error = "--server-terrain needs --server HOST:PORT";
     return Status::kInvalidArgument;
   }
-  if (flags.server.empty()) {
-    *session = MakeEmbeddedSession(flags.threads);
-  } else {
-    RpcOptions options;
-    options.call_timeout_s = flags.timeout_s;
-    const Status status = ParseHostPort(flags.server, &options, error);
-    if (status != Status::kOk) return status;
-    *session = MakeRpcSession(options);
-  }
-  const Status status =
-      flags.terrain.empty()
-          ? (*session)->LoadServerFile(flags.server_terrain, flags.load.separation, terrain)
-          : (*session)->LoadFile(flags.terrain, flags.load, terrain);
+  Status status = OpenSession(flags, session, error);
+  if (status != Status::kOk) return status;
+  status = flags.terrain.empty()
+               ? (*session)->LoadServerFile(flags.server_terrain, flags.load.separation, terrain)
+               : (*session)->LoadFile(flags.terrain, flags.load, terrain);
   if (status != Status::kOk) *error = (*session)->last_error();
   return status;
 }

@@ -28,6 +28,11 @@ void AddLoadFlags(CLI::App* command, TerrainLoadOptions* load);
 // --flat-normals, --seed, --up-axis, --cell-size, --height-scale, --timeout.
 void AddTerrainFlags(CLI::App* command, TerrainFlags* flags);
 
+// Opens the session the flags ask for (embedded, or footfalld with --server) without loading
+// anything. On failure returns the status and a one-line message.
+Status OpenSession(const TerrainFlags& flags, std::unique_ptr<TerrainSession>* session,
+                   std::string* error);
+
 // Opens the session the flags ask for and loads the terrain. On failure returns the status and
 // a one-line message naming what failed.
 Status OpenTerrain(const TerrainFlags& flags, std::unique_ptr<TerrainSession>* session,

@@ -25,6 +25,8 @@ struct Attempt {
 constexpr int kMaxAttempts = 7;
 constexpr Attempt kAttempts[kMaxAttempts] = {{1.0, 0},   {0.6, 0},   {1.35, 0}, {0.3, 0},
                                              {1.0, 0.5}, {0.6, 0.5}, {0.3, 0.5}};
+// A foothold is looked for within this fraction of step_length of where the foot aims.
+constexpr double kFootholdTolerance = 0.5;
 constexpr int kMaxRaises = 8;         // swing arc raises before giving up
 constexpr double kRaise = 0.5;        // raise per round, in step heights
 constexpr double kSlide = 0.25;       // slide per round toward a blocked half's end (of the way)
@@ -272,7 +274,7 @@ void Generator::Steer(Agent& a) const {
 Status Generator::Run(std::string* error) {
   world_up_ = Normalize(o_.up);
   const int groups = static_cast<int>(c_.gait.size());
-  steps_ = o_.steps >= 0 ? o_.steps : (o_.path.empty() ? 8 : 10000);
+  steps_ = o_.steps >= 0 ? o_.steps : (o_.path.empty() ? kDefaultSteps : kMaxPathSteps);
   // The target locator's lead over the foot's rest position: with the body at the feet's
   // centroid, L * (G + 1) / (2G) makes every foot travel exactly L per step once walking
   // (half a step ahead for G -> infinity; 3/4 of a step for two gait groups).
@@ -534,7 +536,7 @@ Status Generator::QueryFootholds(std::string* error) {
     if (queries_.empty()) break;
     next_answers_.resize(queries_.size());
     const Status s = Check(session_.Next(terrain_, queries_.data(), queries_.size(),
-                                         0.5 * c_.step_length, next_answers_.data()),
+                                         kFootholdTolerance * c_.step_length, next_answers_.data()),
                            "next foothold", error);
     if (s != Status::kOk) return s;
     // Per character (its moves are contiguous): accept or refuse each answered foot, then the
@@ -591,7 +593,7 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
   std::ostringstream why;                // refused: say why (only built on this rare path)
   why.precision(3);
   if (!found) {
-    why << "no foothold within " << 0.5 * c_.step_length << " of " << Point(mv.ideal)
+    why << "no foothold within " << kFootholdTolerance * c_.step_length << " of " << Point(mv.ideal)
         << " (a gap or a cliff)";
   } else if (std::fabs(rise) > c_.max_rise) {
     why << "the foothold at " << Point(h.point) << (rise > 0 ? " rises " : " drops ")
@@ -869,6 +871,13 @@ Status Generator::Step(int k, std::string* error) {
 }
 
 }  // namespace
+
+double MaxStepTravel(const Character& character) {
+  double scale = 0, drop = 0;
+  for (const Attempt& a : kAttempts)
+    scale = std::max(scale, a.scale), drop = std::max(drop, a.drop);
+  return (scale + kFootholdTolerance) * character.step_length + drop * character.max_rise;
+}
 
 Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Character& character,
                     const GenerateOptions& given, Walk* out, std::string* error) {

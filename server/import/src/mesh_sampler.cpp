@@ -136,6 +136,53 @@ class CellMap {
   uint32_t last_tile_ = 0;
 };
 
+// A piece of a triangle in step 1's longest-edge bisection.
+struct Piece {
+  Vec3 p[3];
+  double b[3][2];  // barycentric (u, v) of each corner in the source triangle
+  int depth;
+};
+
+// Step 1 for triangle t: bisects its longest edge until each piece's centroid lies within
+// sqrt(h2) of the piece's corners (or 60 cuts deep), and calls leaf(piece) for each final
+// piece, in a fixed order, until leaf returns false. `stack` is scratch space.
+template <typename Leaf>
+void SplitTriangle(const TriangleMesh& mesh, size_t t, double h2, std::vector<Piece>* stack,
+                   const Leaf& leaf) {
+  const auto& tri = mesh.triangles[t];
+  stack->clear();
+  stack->push_back({{mesh.vertices[tri[0]], mesh.vertices[tri[1]], mesh.vertices[tri[2]]},
+                    {{0, 0}, {1, 0}, {0, 1}},
+                    0});
+  while (!stack->empty()) {
+    const Piece piece = stack->back();
+    stack->pop_back();
+    const Vec3 g = (piece.p[0] + piece.p[1] + piece.p[2]) / 3;
+    const double reach =
+        std::max({Distance2(g, piece.p[0]), Distance2(g, piece.p[1]), Distance2(g, piece.p[2])});
+    if (reach <= h2 || piece.depth >= 60) {
+      if (!leaf(piece)) return;
+      continue;
+    }
+    // Split the longest edge (i, j) at its midpoint; k is the opposite corner.
+    int i = 0;
+    double longest = -1;
+    for (int e = 0; e < 3; ++e) {
+      const double d = Distance2(piece.p[e], piece.p[(e + 1) % 3]);
+      if (d > longest) longest = d, i = e;
+    }
+    const int j = (i + 1) % 3;
+    Piece a = piece, b = piece;
+    const Vec3 m = (piece.p[i] + piece.p[j]) / 2;
+    const double mb[2] = {(piece.b[i][0] + piece.b[j][0]) / 2, (piece.b[i][1] + piece.b[j][1]) / 2};
+    a.p[j] = m, a.b[j][0] = mb[0], a.b[j][1] = mb[1];  // (i, m, k)
+    b.p[i] = m, b.b[i][0] = mb[0], b.b[i][1] = mb[1];  // (m, j, k)
+    a.depth = b.depth = piece.depth + 1;
+    stack->push_back(b);
+    stack->push_back(a);
+  }
+}
+
 Vec3 Blend(const Vec3& a, const Vec3& b, const Vec3& c, double u, double v) {
   return a * (1 - u - v) + b * u + c * v;
 }
@@ -241,61 +288,39 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
     return Status::kLimitExceeded;
   }
 
-  // 1. Candidates by longest-edge bisection, one per piece at its centroid.
-  std::vector<Candidate> candidates;
-  candidates.reserve(static_cast<size_t>(predicted * 6) + mesh.triangles.size());
-  struct Piece {
-    Vec3 p[3];
-    double b[3][2];  // barycentric (u, v) of each corner in the source triangle
-    int depth;
-  };
-  std::vector<Piece> stack;
+  // 1. Candidates by longest-edge bisection, one per piece at its centroid. Counted first:
+  // long thin triangles (a height map whose cells are far smaller than its heights) are cut
+  // into far more pieces than their area predicts, and are refused before any is stored.
   const size_t candidate_limit = options.max_samples * 32 + mesh.triangles.size();
-  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-    const auto& tri = mesh.triangles[t];
-    stack.push_back({{mesh.vertices[tri[0]], mesh.vertices[tri[1]], mesh.vertices[tri[2]]},
-                     {{0, 0}, {1, 0}, {0, 1}},
-                     0});
-    while (!stack.empty()) {
-      const Piece piece = stack.back();
-      stack.pop_back();
-      const Vec3 g = (piece.p[0] + piece.p[1] + piece.p[2]) / 3;
-      const double reach =
-          std::max({Distance2(g, piece.p[0]), Distance2(g, piece.p[1]), Distance2(g, piece.p[2])});
-      if (reach <= h2 || piece.depth >= 60) {
-        Candidate c;
-        const Vec3 local = g - lo;
-        c.offset[0] = static_cast<float>(local.x);
-        c.offset[1] = static_cast<float>(local.y);
-        c.offset[2] = static_cast<float>(local.z);
-        c.triangle = static_cast<uint32_t>(t);
-        c.u = static_cast<float>((piece.b[0][0] + piece.b[1][0] + piece.b[2][0]) / 3);
-        c.v = static_cast<float>((piece.b[0][1] + piece.b[1][1] + piece.b[2][1]) / 3);
-        candidates.push_back(c);
-        if (candidates.size() > candidate_limit) {
-          if (error) *error = "separation " + std::to_string(s) + " needs too many candidates";
-          return Status::kLimitExceeded;
-        }
-        continue;
-      }
-      // Split the longest edge (i, j) at its midpoint; k is the opposite corner.
-      int i = 0;
-      double longest = -1;
-      for (int e = 0; e < 3; ++e) {
-        const double d = Distance2(piece.p[e], piece.p[(e + 1) % 3]);
-        if (d > longest) longest = d, i = e;
-      }
-      const int j = (i + 1) % 3;
-      Piece a = piece, b = piece;
-      const Vec3 m = (piece.p[i] + piece.p[j]) / 2;
-      const double mb[2] = {(piece.b[i][0] + piece.b[j][0]) / 2,
-                            (piece.b[i][1] + piece.b[j][1]) / 2};
-      a.p[j] = m, a.b[j][0] = mb[0], a.b[j][1] = mb[1];  // (i, m, k)
-      b.p[i] = m, b.b[i][0] = mb[0], b.b[i][1] = mb[1];  // (m, j, k)
-      a.depth = b.depth = piece.depth + 1;
-      stack.push_back(b);
-      stack.push_back(a);
+  std::vector<Piece> stack;
+  size_t counted = 0;
+  for (size_t t = 0; t < mesh.triangles.size() && counted <= candidate_limit; ++t)
+    SplitTriangle(mesh, t, h2, &stack, [&](const Piece&) { return ++counted <= candidate_limit; });
+  if (counted > candidate_limit) {
+    if (error) {
+      *error = "separation " + Format3(s) + " would cut the mesh into more than " +
+               std::to_string(candidate_limit) +
+               " pieces: its triangles are long and thin for their area; choose a larger "
+               "separation";
     }
+    return Status::kLimitExceeded;
+  }
+  std::vector<Candidate> candidates;
+  candidates.reserve(counted);
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    SplitTriangle(mesh, t, h2, &stack, [&](const Piece& piece) {
+      const Vec3 g = (piece.p[0] + piece.p[1] + piece.p[2]) / 3;
+      Candidate c;
+      const Vec3 local = g - lo;
+      c.offset[0] = static_cast<float>(local.x);
+      c.offset[1] = static_cast<float>(local.y);
+      c.offset[2] = static_cast<float>(local.z);
+      c.triangle = static_cast<uint32_t>(t);
+      c.u = static_cast<float>((piece.b[0][0] + piece.b[1][0] + piece.b[2][0]) / 3);
+      c.v = static_cast<float>((piece.b[0][1] + piece.b[1][1] + piece.b[2][1]) / 3);
+      candidates.push_back(c);
+      return true;
+    });
   }
 
   // Cells of side r over the bounds; each candidate's cell id.

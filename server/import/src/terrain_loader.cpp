@@ -21,6 +21,8 @@ namespace {
 Status CheckOptions(const TerrainLoadOptions& o, std::string* error) {
   std::string what;
   if (!(std::isfinite(o.separation) && o.separation >= 0)) what = "separation must be >= 0";
+  if (!(std::isfinite(o.finest_default) && o.finest_default >= 0))
+    what = "finest default separation must be >= 0";
   if (!(std::isfinite(o.cell_size) && o.cell_size >= 0)) what = "cell size must be >= 0";
   if (!std::isfinite(o.height_scale)) what = "height scale must be finite";
   if (o.up_axis != 'x' && o.up_axis != 'y' && o.up_axis != 'z') what = "up axis must be x, y or z";
@@ -37,25 +39,6 @@ void Bounds(const RawSamples& samples, Vec3* lo, Vec3* hi) {
   }
 }
 
-Status Resample(const std::string& path, const TriangleMesh& mesh, double default_separation,
-                const TerrainLoadOptions& options, RawSamples* out, std::string* error,
-                TerrainLoadReport* report) {
-  MeshSampleOptions sample;
-  sample.separation = options.separation > 0 ? options.separation : default_separation;
-  sample.smooth_normals = options.smooth_normals;
-  sample.seed = options.seed;
-  sample.max_samples = options.max_samples;
-  std::string why;
-  const Status status = SampleMesh(mesh, sample, out, &why);
-  if (status != Status::kOk) {
-    if (error) *error = path + ": " + why;
-    return status;
-  }
-  report->area = SurfaceArea(mesh);
-  report->separation = sample.separation;
-  return Status::kOk;
-}
-
 Status LoadAny(const std::string& path, const std::string& ext, const TerrainLoadOptions& options,
                RawSamples* out, std::string* error, TerrainLoadReport* report) {
   if (IsPointFileExtension(ext)) {
@@ -67,42 +50,60 @@ Status LoadAny(const std::string& path, const std::string& ext, const TerrainLoa
     }
     return status;
   }
+  TriangleMesh mesh;
+  const Status status = ReadTerrainMesh(path, options, &mesh, error, report);
+  if (status != Status::kOk) return status;
+  return ResampleTerrainMesh(path, mesh, options, out, error, report);
+}
+
+}  // namespace
+
+Status ReadTerrainMesh(const std::string& path, const TerrainLoadOptions& options,
+                       TriangleMesh* mesh, std::string* error, TerrainLoadReport* report) {
+  *mesh = TriangleMesh{};
+  Status status = CheckOptions(options, error);
+  if (status != Status::kOk) return status;
+  const std::string ext = FileExtension(path);
+  if (IsPointFileExtension(ext)) {
+    if (error) *error = path + ": a point file, not a mesh or height map";
+    return Status::kInvalidArgument;
+  }
   if (IsMeshExtension(ext)) {
     report->format = "mesh";
-    TriangleMesh mesh;
     MeshReadReport read;
-    const Status status = ReadMesh(path, &mesh, error, &read);
+    status = ReadMesh(path, mesh, error, &read);
     if (status != Status::kOk) return status;
     report->vertices = read.vertices;
     report->faces = read.faces;
     report->skipped_faces = read.skipped_faces;
-    return Resample(path, mesh, DefaultSeparation(mesh), options, out, error, report);
+    report->file_separation = DefaultSeparation(*mesh);
+    return Status::kOk;
   }
   if (ext == "asc" || ext == "pgm") {
     report->format = "heightmap";
     HeightMap map;
-    Status status = ext == "asc" ? ReadAscGrid(path, &map, error) : ReadPgm(path, &map, error);
+    status = ext == "asc" ? ReadAscGrid(path, &map, error) : ReadPgm(path, &map, error);
     if (status != Status::kOk) return status;
     HeightMapFrame frame;
     frame.cell_size = options.cell_size > 0 ? options.cell_size : map.cell_size;
     frame.height_scale = options.height_scale;
     frame.up_axis = options.up_axis;
-    TriangleMesh mesh;
     std::string why;
-    status = HeightMapToMesh(map, frame, &mesh, &why);
+    status = HeightMapToMesh(map, frame, mesh, &why);
     if (status != Status::kOk) {
       if (error) *error = path + ": " + why;
       return status;
     }
-    report->vertices = mesh.vertices.size();
+    report->vertices = mesh->vertices.size();
     report->nodata_cells = map.heights.size() - map.ValidCount();
-    report->skipped_faces = RemoveDegenerateTriangles(&mesh);
-    report->faces = mesh.triangles.size();
-    if (mesh.triangles.empty()) {
+    report->skipped_faces = RemoveDegenerateTriangles(mesh);
+    report->faces = mesh->triangles.size();
+    report->file_separation = frame.cell_size;
+    if (mesh->triangles.empty()) {
       if (error) *error = path + ": no square of the grid has three cells with data";
       return Status::kParseError;
     }
-    return Resample(path, mesh, frame.cell_size, options, out, error, report);
+    return Status::kOk;
   }
   if (error) {
     *error = path + ": unknown terrain file extension '" + ext +
@@ -112,7 +113,35 @@ Status LoadAny(const std::string& path, const std::string& ext, const TerrainLoa
   return Status::kInvalidArgument;
 }
 
-}  // namespace
+Status ResampleTerrainMesh(const std::string& path, const TriangleMesh& mesh,
+                           const TerrainLoadOptions& options, RawSamples* out, std::string* error,
+                           TerrainLoadReport* report) {
+  out->clear();
+  const double file_separation = report->file_separation;
+  MeshSampleOptions sample;
+  sample.separation = options.separation > 0 ? options.separation : file_separation;
+  if (!(options.separation > 0) && options.finest_default > 0) {
+    // The finer of the file's default and finest_default, unless the sample budget needs
+    // coarser (1.001: a margin for the estimate's rounding).
+    const double fits =
+        1.001 * std::sqrt(1.6 * SurfaceArea(mesh) / std::max<double>(1, options.max_samples));
+    sample.separation = std::max(std::min(file_separation, options.finest_default), fits);
+  }
+  sample.smooth_normals = options.smooth_normals;
+  sample.seed = options.seed;
+  sample.max_samples = options.max_samples;
+  std::string why;
+  const Status status = SampleMesh(mesh, sample, out, &why);
+  if (status != Status::kOk) {
+    if (error) *error = path + ": " + why;
+    return status;
+  }
+  report->area = SurfaceArea(mesh);
+  report->separation = sample.separation;
+  report->samples = out->size();
+  Bounds(*out, &report->bounds_min, &report->bounds_max);
+  return Status::kOk;
+}
 
 Status LoadTerrain(const std::string& path, const TerrainLoadOptions& options, RawSamples* out,
                    std::string* error, TerrainLoadReport* report) {

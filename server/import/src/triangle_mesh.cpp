@@ -1,6 +1,7 @@
 #include "footfall/import/triangle_mesh.h"
 
 #include <algorithm>
+#include <limits>
 
 namespace footfall {
 
@@ -54,6 +55,84 @@ size_t RemoveDegenerateTriangles(TriangleMesh* mesh, double relative_epsilon) {
   }
   const size_t removed = mesh->triangles.size() - kept;
   mesh->triangles.resize(kept);
+  return removed;
+}
+
+namespace {
+
+// The point of triangle abc nearest to p, by the Voronoi region of p (after Ericson, "Real-Time
+// Collision Detection", 5.1.5).
+Vec3 NearestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = Dot(ab, ap), d2 = Dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Vec3 bp = p - b;
+  const double d3 = Dot(ab, bp), d4 = Dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
+  const Vec3 cp = p - c;
+  const double d5 = Dot(ab, cp), d6 = Dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0)
+    return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  const double denom = 1 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+}  // namespace
+
+Vec3 NearestSurfacePoint(const TriangleMesh& mesh, const Vec3& q) {
+  Vec3 best = q;
+  double best2 = std::numeric_limits<double>::infinity();
+  auto consider = [&](const Vec3& p) {
+    const double d2 = Length2(p - q);
+    if (d2 < best2) best2 = d2, best = p;
+  };
+  if (mesh.triangles.empty()) {
+    for (const Vec3& v : mesh.vertices) consider(v);
+    return best;
+  }
+  for (const auto& tri : mesh.triangles) {
+    consider(
+        NearestOnTriangle(q, mesh.vertices[tri[0]], mesh.vertices[tri[1]], mesh.vertices[tri[2]]));
+  }
+  return best;
+}
+
+size_t CropToBox(TriangleMesh* mesh, const Vec3& lo, const Vec3& hi) {
+  constexpr uint32_t kUnused = std::numeric_limits<uint32_t>::max();
+  std::vector<uint32_t> renumbered(mesh->vertices.size(), kUnused);
+  std::vector<Vec3> vertices;
+  size_t kept = 0;
+  for (size_t t = 0; t < mesh->triangles.size(); ++t) {
+    const auto& tri = mesh->triangles[t];
+    Vec3 tlo = mesh->vertices[tri[0]], thi = tlo;
+    for (uint32_t v : tri) {
+      const Vec3& p = mesh->vertices[v];
+      tlo = {std::min(tlo.x, p.x), std::min(tlo.y, p.y), std::min(tlo.z, p.z)};
+      thi = {std::max(thi.x, p.x), std::max(thi.y, p.y), std::max(thi.z, p.z)};
+    }
+    if (thi.x < lo.x || thi.y < lo.y || thi.z < lo.z || tlo.x > hi.x || tlo.y > hi.y ||
+        tlo.z > hi.z)
+      continue;
+    std::array<uint32_t, 3> out;
+    for (int k = 0; k < 3; ++k) {
+      uint32_t& id = renumbered[tri[k]];
+      if (id == kUnused) {
+        id = static_cast<uint32_t>(vertices.size());
+        vertices.push_back(mesh->vertices[tri[k]]);
+      }
+      out[k] = id;
+    }
+    mesh->triangles[kept++] = out;
+  }
+  const size_t removed = mesh->triangles.size() - kept;
+  mesh->triangles.resize(kept);
+  mesh->vertices.swap(vertices);
   return removed;
 }
 

@@ -21,6 +21,11 @@ namespace footfall {
 // terrain and their keys stay in the caches from one step to the next.
 constexpr int kInProcessCharactersPerPass = 1000;
 
+// Steps per character when GenerateOptions::steps is unset: without a path, and the most with
+// one (the walk ends at the goal).
+constexpr int kDefaultSteps = 8;
+constexpr int kMaxPathSteps = 10000;
+
 struct GenerateOptions {
   // Where the (first) character stands, snapped to the terrain. World space. Unset: the sample
   // nearest the centre of the top of the terrain's bounds (top along `up`).
@@ -31,8 +36,8 @@ struct GenerateOptions {
   // Waypoints to follow, in order (one point: a goal). World space. The heading turns toward
   // the current waypoint; the walk ends when the last one is reached (within half a step).
   std::vector<Vec3> path;
-  // Steps per character; one step moves one gait group. < 0: 8 without a path, up to 10000
-  // (until the goal) with one.
+  // Steps per character; one step moves one gait group. < 0: kDefaultSteps without a path, up
+  // to kMaxPathSteps (until the goal) with one.
   int steps = -1;
   double start_frame = 1;  // frame of the first keys
   double fps = 24;         // frames per second of the walk [Limit: > 0]
@@ -57,6 +62,10 @@ struct GenerateOptions {
   // empty.
   std::function<void(int, int)> progress;
 };
+
+// The farthest a foot of `character` can move in one step: its longest try, aimed down as far
+// as any try, plus the distance within which a foothold is taken. [Units: wu]
+double MaxStepTravel(const Character& character);
 
 // Generates the walk into *out (replacing it). Returns kOk when the walk was generated, even if
 // it stopped early: then out->stopped says at which step and position, and every key up to that

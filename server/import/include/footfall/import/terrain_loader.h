@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <string>
 
+#include "footfall/import/triangle_mesh.h"
 #include "footfall/terrain/samples.h"
 
 namespace footfall {
@@ -20,6 +21,10 @@ struct TerrainLoadOptions {
   // from a sample. [Units: wu] [Limit: >= 0] 0 picks a default: the mean edge length of a mesh,
   // the cell size of a height map.
   double separation = 0;
+  // Meshes and height maps, when `separation` is 0 and this is > 0: the separation is the finer
+  // of the file's default and this (a caller that needs samples this close: a character's
+  // steps), coarsened as needed to stay within max_samples. [Units: wu] [Limit: >= 0]
+  double finest_default = 0;
   // Meshes and height maps: normals interpolated from vertex normals (true) or taken from the
   // face (false).
   bool smooth_normals = true;
@@ -46,6 +51,7 @@ struct TerrainLoadReport {
   size_t nodata_cells = 0;      // height maps: cells left out
   double area = 0;              // [Units: wu^2] meshes and height maps
   double separation = 0;        // [Units: wu] the separation used (meshes and height maps)
+  double file_separation = 0;   // [Units: wu] the file's own default: mean edge / cell size
   size_t samples = 0;           // samples produced
   Vec3 bounds_min, bounds_max;  // world-space bounds of the samples
 };
@@ -55,5 +61,17 @@ struct TerrainLoadReport {
 // extension or bad option), kLimitExceeded (the separation would give too many samples).
 Status LoadTerrain(const std::string& path, const TerrainLoadOptions& options, RawSamples* out,
                    std::string* error, TerrainLoadReport* report = nullptr);
+
+// LoadTerrain's two halves for meshes and height maps, for callers that look at the surface
+// before sampling it (footfall generate crops it to where a walk can reach).
+// ReadTerrainMesh reads a mesh or height map file into *mesh (height maps under the options'
+// frame) and fills the report's format, counts and file_separation; point files are
+// kInvalidArgument. ResampleTerrainMesh samples a mesh as LoadTerrain would, with
+// report->file_separation as the file's default, and fills the rest of the report.
+Status ReadTerrainMesh(const std::string& path, const TerrainLoadOptions& options,
+                       TriangleMesh* mesh, std::string* error, TerrainLoadReport* report);
+Status ResampleTerrainMesh(const std::string& path, const TriangleMesh& mesh,
+                           const TerrainLoadOptions& options, RawSamples* out, std::string* error,
+                           TerrainLoadReport* report);
 
 }  // namespace footfall

@@ -32,4 +32,12 @@ void MeshBounds(const TriangleMesh& mesh, Vec3* lo, Vec3* hi);
 // diagonal (zero-area slivers, repeated vertices). Returns how many were removed.
 size_t RemoveDegenerateTriangles(TriangleMesh* mesh, double relative_epsilon = 1e-14);
 
+// The point of the mesh's surface nearest to q (a vertex for a mesh without triangles; q for an
+// empty mesh). A scan of every triangle.
+Vec3 NearestSurfacePoint(const TriangleMesh& mesh, const Vec3& q);
+
+// Keeps the triangles whose bounding box meets the box [lo, hi] and the vertices they use
+// (renumbered in order of first use). Returns how many triangles were removed.
+size_t CropToBox(TriangleMesh* mesh, const Vec3& lo, const Vec3& hi);
+
 }  // namespace footfall

@@ -1,0 +1,154 @@
+// Terrain set-up for a walk (walk_terrain.h): a height map whose cells are coarser than a
+// character's steps is resampled finely enough for it, only around where the walk goes, and the
+// walk then goes where the file's own spacing stops it.
+#include "footfall/steps/walk_terrain.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+
+#include "walk_checks.h"
+
+using namespace footfall;
+using namespace footfall::test;
+
+namespace {
+
+// A temporary ESRI ASCII grid of n x n cells of `cell` with gentle bumps (heights within a
+// fifth of a cell), removed by the destructor.
+struct BumpyAsc {
+  std::string path;
+  BumpyAsc(int n, double cell, const std::string& name) {
+    path = std::string(std::getenv("TMPDIR") ? std::getenv("TMPDIR") : "/tmp") + "/footfall_" +
+           name + "_" + std::to_string(::getpid()) + ".asc";
+    std::ofstream out(path);
+    out << "ncols " << n << "\nnrows " << n << "\nxllcorner 0\nyllcorner 0\ncellsize " << cell
+        << "\n";
+    for (int r = 0; r < n; ++r) {
+      for (int c = 0; c < n; ++c)
+        out << 0.1 * cell * (std::sin(0.7 * r) + std::cos(0.5 * c)) << ' ';
+      out << '\n';
+    }
+  }
+  ~BumpyAsc() { std::remove(path.c_str()); }
+};
+
+bool Inside(const Vec3& p, const WalkTerrain& t) {
+  return p.x >= t.region_min.x && p.y >= t.region_min.y && p.z >= t.region_min.z &&
+         p.x <= t.region_max.x && p.y <= t.region_max.y && p.z <= t.region_max.z;
+}
+
+size_t BodyKeys(const Walk& w) {
+  for (const WalkTrack& t : w.tracks)
+    if (t.kind == TrackKind::kBody) return t.keys.size();
+  return 0;
+}
+
+}  // namespace
+
+TEST_CASE("PrepareWalkTerrain: a height map coarser than the steps is walked after resampling",
+          "[steps][terrain]") {
+  for (const std::string& name : ShippedCharacters()) {
+    const Character c = LoadShipped(name);
+    INFO(name);
+    // Cells twice the step: the file's own samples lie farther apart than the foothold radius.
+    const double cell = 2 * c.step_length;
+    const BumpyAsc asc(80, cell, name);
+    GenerateOptions o;
+    o.steps = 12;
+    o.has_start = true;
+    o.start = {40 * cell, 5 * cell, 40 * cell};
+    o.heading = {1, 0, 1};
+
+    WalkTerrain prepared;
+    std::string error;
+    REQUIRE(PrepareWalkTerrain(asc.path, TerrainLoadOptions{}, c, o, &prepared, &error) ==
+            Status::kOk);
+    CHECK(prepared.report.separation == Approx(kSeparationPerStep * c.step_length));
+    CHECK(prepared.report.file_separation == Approx(cell));
+    // The start is the surface point nearest the point asked for: below it, give or take the
+    // bumps' slope.
+    CHECK(std::hypot(prepared.start.x - o.start.x, prepared.start.z - o.start.z) < cell);
+    CHECK(std::fabs(prepared.start.y) < 0.25 * cell);
+    // Cropped to the box of 12 steps: far less than the 160 steps of the file.
+    REQUIRE(prepared.cropped);
+    CHECK(prepared.region_is_bound);
+    CHECK(prepared.region_max.x - prepared.region_min.x < 0.75 * 80 * cell);
+
+    Terrain t = LoadTerrain(prepared.samples, prepared.report.separation);
+    GenerateOptions walk = o;
+    walk.start = prepared.start;
+    const Walk w = Generate(t, c, walk);
+    INFO(w.stopped);
+    CHECK(w.stopped.empty());
+    CHECK(BodyKeys(w) == 13);
+    CheckWalk(t, c, walk, w);
+    // Every key inside the box, and no foot moving farther in a step than MaxStepTravel.
+    for (const WalkTrack& track : w.tracks) {
+      for (const WalkKey& k : track.keys) CHECK(Inside(k.position, prepared));
+      if (track.kind != TrackKind::kFoot) continue;
+      const WalkKey* last_end = nullptr;
+      for (const WalkKey& k : track.keys) {
+        if (k.phase != KeyPhase::kEnd) continue;
+        if (last_end) CHECK(Distance(last_end->position, k.position) <= MaxStepTravel(c));
+        last_end = &k;
+      }
+    }
+
+    // The file's own samples: the same walk stops at once.
+    RawSamples own;
+    REQUIRE(footfall::LoadTerrain(asc.path, TerrainLoadOptions{}, &own, &error) == Status::kOk);
+    Terrain coarse = LoadTerrain(own, cell);
+    const Walk stopped = Generate(coarse, c, walk);
+    CHECK_FALSE(stopped.stopped.empty());
+    CHECK(BodyKeys(stopped) < 13);
+  }
+}
+
+TEST_CASE("PrepareWalkTerrain: without a start, the surface under the top centre",
+          "[steps][terrain]") {
+  const Character c = LoadShipped("biped");
+  const BumpyAsc asc(20, 1.0, "centre");
+  GenerateOptions o;  // no start, default up +Y
+  WalkTerrain prepared;
+  std::string error;
+  REQUIRE(PrepareWalkTerrain(asc.path, TerrainLoadOptions{}, c, o, &prepared, &error) ==
+          Status::kOk);
+  // The grid's points span 0 .. 19 in x and z: the start lies near 9.5, 9.5, on the surface.
+  CHECK(prepared.start.x == Approx(9.5).margin(0.5));
+  CHECK(prepared.start.z == Approx(9.5).margin(0.5));
+  CHECK(std::fabs(prepared.start.y) < 0.25);
+  // Eight steps of a biped reach beyond this 20 m field: nothing cropped.
+  CHECK_FALSE(prepared.cropped);
+  CHECK(prepared.report.separation == Approx(0.175));
+}
+
+TEST_CASE("PrepareWalkTerrain: a path walked to its end widens the box along it",
+          "[steps][terrain]") {
+  const Character c = LoadShipped("hexapod");
+  const BumpyAsc asc(100, 0.5, "path");
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {5, 1, 5};
+  o.path = {{30, 0, 5}, {30, 0, 40}};
+  WalkTerrain prepared;
+  std::string error;
+  REQUIRE(PrepareWalkTerrain(asc.path, TerrainLoadOptions{}, c, o, &prepared, &error) ==
+          Status::kOk);
+  CHECK_FALSE(prepared.region_is_bound);
+  REQUIRE(prepared.cropped);
+  for (const Vec3& p : {prepared.start, o.path[0], o.path[1]}) CHECK(Inside(p, prepared));
+  CHECK(prepared.region_max.x < 45);  // the terrain reaches 50
+  // A separation set by the caller is refused: the set-up chooses it.
+  TerrainLoadOptions set;
+  set.separation = 0.1;
+  CHECK(PrepareWalkTerrain(asc.path, set, c, o, &prepared, &error) == Status::kInvalidArgument);
+  // Point files are not resampled.
+  CHECK(PrepareWalkTerrain(FOOTFALL_SOURCE_DIR "/data/terrain/stairs.pts", TerrainLoadOptions{}, c,
+                           o, &prepared, &error) == Status::kInvalidArgument);
+}
