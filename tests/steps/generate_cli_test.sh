@@ -88,6 +88,7 @@ if [ -f "$dem" ]; then
     --out "$work/dem-own.json" 2> "$work/dem-own.err"
   check "dem --separation 1: stopped early (exit 2)" [ $? -eq 2 ]
   check "dem --separation 1: not resampled for the character" bash -c "! grep -q 'resampled for' '$work/dem-own.err'"
+  check "dem --separation 1: advice to resample at a quarter step" grep -q "too far for this character: resample it at a separation of 0.175" "$work/dem-own.err"
 elif [ -n "${CI:-}" ]; then
   check "shared data present in CI ($dem)" false
 else

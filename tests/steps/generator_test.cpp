@@ -423,6 +423,8 @@ TEST_CASE("A cliff stops the walk with the step, the position and the keys so fa
     CHECK_THAT(w.stopped,
                Catch::Contains("(6 more tries, shorter, longer or aimed down, refused too)"));
     CHECK_THAT(w.stopped, Catch::Contains("keys up to step " + std::to_string(done) + " kept"));
+    // Samples a tenth of a step apart are fine enough: no advice to resample.
+    CHECK_THAT(w.stopped, !Catch::Contains("resample"));
     CheckWalk(t, c, o, w);
     // Nothing lost: every foot ends planted at the edge side, with all its steps keyed.
     for (const WalkTrack& tr : w.tracks) {

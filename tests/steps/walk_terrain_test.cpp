@@ -107,6 +107,9 @@ TEST_CASE("PrepareWalkTerrain: a height map coarser than the steps is walked aft
     const Walk stopped = Generate(coarse, c, walk);
     CHECK_FALSE(stopped.stopped.empty());
     CHECK(BodyKeys(stopped) < 13);
+    // ... and says that the samples are too far apart, and at what to resample.
+    CHECK_THAT(stopped.stopped,
+               Catch::Contains("too far for this character: resample it at a separation of"));
   }
 }
 

@@ -595,6 +595,13 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
   if (!found) {
     why << "no foothold within " << kFootholdTolerance * c_.step_length << " of " << Point(mv.ideal)
         << " (a gap or a cliff)";
+    // Samples spread wider than half that radius leave gaps everywhere: say so.
+    const double spacing = 0.5 * gap_;
+    if (spacing > 0.5 * kFootholdTolerance * c_.step_length) {
+      why << "; the terrain's samples lie about " << spacing
+          << " apart, too far for this character: resample it at a separation of "
+          << kSeparationPerStep * c_.step_length;
+    }
   } else if (std::fabs(rise) > c_.max_rise) {
     why << "the foothold at " << Point(h.point) << (rise > 0 ? " rises " : " drops ")
         << std::fabs(rise) << ", more than max_rise " << c_.max_rise << " (a cliff)";

@@ -21,6 +21,10 @@ namespace footfall {
 // terrain and their keys stay in the caches from one step to the next.
 constexpr int kInProcessCharactersPerPass = 1000;
 
+// The sample spacing a character walks well on, as a fraction of its step_length: it looks
+// for each foothold within half a step of where it aims.
+constexpr double kSeparationPerStep = 0.25;
+
 // Steps per character when GenerateOptions::steps is unset: without a path, and the most with
 // one (the walk ends at the goal).
 constexpr int kDefaultSteps = 8;

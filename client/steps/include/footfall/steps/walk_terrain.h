@@ -3,10 +3,11 @@
 //
 // A file's own spacing (a DEM's metre, a mesh's mean edge) is often coarser than a character's
 // step: a biped looks for a foothold within 0.35 m of where it aims, an insect within 6 cm.
-// PrepareWalkTerrain resamples the surface at kSeparationPerStep of the character's step, but
-// only within a box around the start that the walk cannot leave (MaxStepTravel per step, the
-// feet's rest spread, the crowd's grid, the reach and the swing arcs' height), so that a small
-// character on a large terrain costs what its walk covers, not the whole file.
+// PrepareWalkTerrain resamples the surface at kSeparationPerStep (generator.h) of the
+// character's step, but only within a box around the start that the walk cannot leave
+// (MaxStepTravel per step, the feet's rest spread, the crowd's grid, the reach and the swing
+// arcs' height), so that a small character on a large terrain costs what its walk covers, not
+// the whole file.
 #pragma once
 
 #include <string>
@@ -16,9 +17,6 @@
 #include "footfall/steps/generator.h"
 
 namespace footfall {
-
-// Resampling separation as a fraction of the character's step_length.
-constexpr double kSeparationPerStep = 0.25;
 
 struct WalkTerrain {
   RawSamples samples;
