@@ -122,6 +122,15 @@ bad far-start "the start is too far from the terrain to snap" --terrain "$hills"
 bad fps-tiny "--fps: '1e-300' is not a finite number from 0.001 to 1e+06" --terrain "$hills" --character "$chars/biped.json" --fps 1e-300 --out "$work/x.json"
 bad start-frame "--start-frame: '-1e300' is not a finite number from -1e+09 to 1e+09" --terrain "$hills" --character "$chars/biped.json" --start-frame -1e300 --out "$work/x.json"
 bad crowd-spacing "--crowd-spacing: 'nan' is not a finite number from 0 to 1e+06" --terrain "$hills" --character "$chars/biped.json" --crowd-spacing nan --out "$work/x.json"
+# The walk never overwrites what it is made from (the same file by another name too).
+cp "$chars/biped.json" "$work/me.json"
+bad out-is-character "--out $work/../$(basename "$work")/me.json is the character file this walk reads" --terrain "$hills" --character "$work/me.json" --out "$work/../$(basename "$work")/me.json"
+check "out-is-character: the character file is intact" cmp -s "$chars/biped.json" "$work/me.json"
+awk 'NR <= 400' "$hills" > "$work/t.txt"
+cp "$work/t.txt" "$work/t-copy.txt"
+ln -s "$work/t.txt" "$work/link.json"
+bad out-is-terrain "--out $work/link.json is the terrain file this walk reads" --terrain "$work/t.txt" --character "$chars/biped.json" --out "$work/t.json" --out "$work/link.json"
+check "out-is-terrain: the terrain file is intact" cmp -s "$work/t.txt" "$work/t-copy.txt"
 check "bad flags: no output written" [ ! -e "$work/x.json" ]
 
 stop_server

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -155,6 +156,16 @@ int RunGenerate(const GenerateFlags& flags) {
       error =
           "--out " + out + ": unsupported output extension (expected .json, .gltf, .glb or .mel)";
       goto bad_flag;
+    }
+    // Never write over what the walk is made from.
+    for (const std::string* input : {&flags.character, &flags.terrain.terrain}) {
+      std::error_code ec;
+      if (!input->empty() && std::filesystem::equivalent(out, *input, ec)) {
+        error = "--out " + out + " is the " +
+                (input == &flags.character ? "character" : "terrain") +
+                " file this walk reads; choose another output name";
+        goto bad_flag;
+      }
     }
   }
   options.steps = flags.steps;
