@@ -1,5 +1,7 @@
 #include "footfall/import/height_map.h"
 
+#include <filesystem>
+
 #include "footfall/import/terrain_loader.h"
 #include "test_support.h"
 
@@ -123,6 +125,17 @@ TEST_CASE("Height maps: headers are checked against the data before anything is 
   CHECK(Contains(
       error,
       "big2.pgm:5: truncated: expected 10000000000 grey levels (100000 x 100000 pixels), found 3"));
+  // A header within its data but beyond the cell cap: refused before the pixels are read (a
+  // sparse file of 10001 x 10000 zero pixels, 100 MB that take no disk space).
+  {
+    const std::string header = "P5\n10001 10000\n255\n";
+    const std::string path = dir.Write("huge.pgm", header);
+    std::filesystem::resize_file(path, header.size() + size_t{10001} * 10000);
+    CHECK(ReadPgm(path, &map, &error) == Status::kParseError);
+    CHECK(Contains(error, "huge.pgm"));
+    CHECK(Contains(error, "100000000 cells a height map may have"));
+    CHECK(map.heights.capacity() == 0);
+  }
   // P5 pixels above maxval are refused like P2 grey levels.
   CHECK(ReadPgm(dir.Write("over.pgm",
                           std::string("P5\n2 2\n100\n") + '\x01' + '\x02' + '\xff' + '\x04'),
