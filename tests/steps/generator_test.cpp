@@ -737,3 +737,118 @@ TEST_CASE("A multiped walks over the Spot mesh, a closed surface with overhangs"
   for (const Quat& q : Body(w).rotations) most_down = std::min(most_down, BodyUp(q).y);
   CHECK(most_down < 0);
 }
+
+TEST_CASE("The shipped quadruped walks up and down a stair mesh, its body along the flight",
+          "[steps][generator]") {
+  // Ten steps of 0.18 x 0.28 m (33 degrees) between a floor and a landing, sampled with flat
+  // normals at a quarter and at 0.15 of the quadruped's step, five seeds each; its reach as
+  // shipped (0.8). The body's up is the normal of the plane of its feet, so on the flight it
+  // leans with the slope and the hind feet stay within reach, and its feet's frame lies halfway
+  // to the treads', so steps lead up the flight, not into its risers. With the feet's averaged
+  // normal alone none of these twenty walks got past the fourth step (hind feet 0.82 to 0.94
+  // from the body, or footholds on risers); now 9 of 10 reach the landing and 4 of 10 the
+  // floor (going down, footholds on the noses' riser samples are still refused as too steep).
+  const Character c = LoadShipped("quadruped");
+  const int steps = 10;
+  const double rise = 0.18, run = 0.28, top = steps * rise, end = steps * run, width = 2;
+  TriangleMesh flight;
+  auto quad = [&flight](const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+    const uint32_t i = static_cast<uint32_t>(flight.vertices.size());
+    flight.vertices.insert(flight.vertices.end(), {a, b, c, d});
+    flight.triangles.push_back({i, i + 1, i + 2});
+    flight.triangles.push_back({i, i + 2, i + 3});
+  };
+  quad({0, 0, -3}, {0, 0, 0}, {width, 0, 0}, {width, 0, -3});
+  for (int k = 0; k < steps; ++k) {
+    const double y0 = k * rise, y1 = y0 + rise, z = k * run;
+    quad({0, y0, z}, {0, y1, z}, {width, y1, z}, {width, y0, z});              // riser, -z
+    quad({0, y1, z}, {0, y1, z + run}, {width, y1, z + run}, {width, y1, z});  // tread, +y
+  }
+  quad({0, top, end}, {0, top, end + 3}, {width, top, end + 3}, {width, top, end});
+  int to_the_landing = 0, to_the_floor = 0;
+  double lean = 0;  // the largest lean back of the body halfway up a flight climbed
+  for (const double separation : {0.25 * c.step_length, 0.15 * c.step_length}) {
+    for (const uint64_t seed : {1, 2, 3, 4, 5}) {
+      RawSamples stairs;
+      MeshSampleOptions mo;
+      mo.separation = separation;
+      mo.smooth_normals = false;
+      mo.seed = seed;
+      REQUIRE(SampleMesh(flight, mo, &stairs, nullptr) == Status::kOk);
+      // Neighbouring samples lie at least 2/3 of the separation apart; CheckWalk's clearance
+      // (the distance to the nearest sample less twice that) stays within what the sampling
+      // guarantees (every surface point within one separation of a sample).
+      Terrain t = LoadTerrain(stairs, separation * 2 / 3);
+      for (const bool up : {true, false}) {
+        GenerateOptions o;
+        o.has_start = true;
+        o.start = up ? Vec3{1, 0, -1} : Vec3{1, top, end + 1};
+        o.heading = {0, 0, up ? 1.0 : -1.0};
+        o.steps = 80;
+        const Walk w = Generate(t, c, o);
+        INFO(separation << " seed " << seed << (up ? " up: " : " down: ") << w.stopped);
+        CheckWalk(t, c, o, w);
+        double highest = -1, lowest = 10;
+        for (const WalkTrack& track : w.tracks) {
+          if (track.kind != TrackKind::kFoot) continue;
+          for (const WalkKey& k : track.keys) {
+            highest = std::max(highest, k.position.y), lowest = std::min(lowest, k.position.y);
+          }
+        }
+        if (up && highest > top - 0.01) {
+          ++to_the_landing;
+          const WalkTrack& body = Body(w);
+          for (size_t i = 0; i < body.keys.size(); ++i) {
+            const double z = body.keys[i].position.z;
+            if (z > 0.35 * end && z < 0.65 * end)
+              lean = std::max(lean, -BodyUp(body.rotations[i]).z);
+          }
+        }
+        if (!up && lowest < 0.01) ++to_the_floor;
+      }
+    }
+  }
+  CHECK(to_the_landing >= 9);
+  CHECK(to_the_floor >= 4);
+  // Halfway up, the body leans back with the flight (33 degrees), far more than a tread's
+  // normal (0) would make it.
+  CHECK(lean > std::sin(20 * kPi / 180));
+}
+
+TEST_CASE("Insects walk up a thin wall, over its top and down the far side", "[steps][generator]") {
+  // A floor (y = 0, z from 0 to 2) cut by a wall 2 cm thick and 30 cm tall at z = 1: its two
+  // faces and its top, sampled 1 cm apart. Over the top, the feet stand on faces up to 180
+  // degrees apart; the body's up, the plane of the feet, turns over the top with them. (With
+  // the feet's averaged normal the insects stopped on the top.)
+  RawSamples wall;
+  const double s = 0.01;
+  for (int i = 0; i <= 150; ++i) {
+    const double x = i * s;
+    for (int k = 0; k <= 200; ++k) {
+      const double z = k * s;
+      if (z < 1.0 - 1e-9 || z > 1.02 + 1e-9) wall.push_back({x, 0, z}, {0, 1, 0});
+    }
+    for (int j = 1; j <= 30; ++j) {
+      wall.push_back({x, j * s, 1.0}, {0, 0, -1});
+      wall.push_back({x, j * s, 1.02}, {0, 0, 1});
+    }
+    wall.push_back({x, 0.3, 1.01}, {0, 1, 0});
+  }
+  Terrain t = LoadTerrain(wall, s);
+  for (const std::string name : {"hexapod", "octopod"}) {
+    const Character c = LoadShipped(name);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {0.75, 0, 0.6};
+    o.steps = 60;
+    const Walk w = Generate(t, c, o);
+    INFO(name << ": " << w.stopped);
+    CheckWalk(t, c, o, w);
+    // Every foot ends on the floor beyond the wall.
+    for (const WalkTrack& track : w.tracks) {
+      if (track.kind != TrackKind::kFoot) continue;
+      CHECK(track.keys.back().position.z > 1.1);
+      CHECK(track.keys.back().position.y == Approx(0).margin(1e-6));
+    }
+  }
+}

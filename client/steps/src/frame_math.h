@@ -22,6 +22,38 @@ inline Vec3 NormalizeOr(const Vec3& v, const Vec3& fallback) {
   return len > 1e-12 ? v / len : fallback;
 }
 
+// The unit normal of the plane fitted to points[0..n) (least squares), on the side of the unit
+// vector `side`; `side` itself when the points lie (nearly) on a line or the plane leans more
+// than 60 degrees from it. (The normal is the covariance's direction of least spread, found
+// from the largest of its three 2 x 2 minors.)
+inline Vec3 FittedPlaneNormal(const Vec3* points, size_t n, const Vec3& side) {
+  if (n < 3) return side;
+  Vec3 c;
+  for (size_t i = 0; i < n; ++i) c += points[i];
+  c = c / static_cast<double>(n);
+  double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 d = points[i] - c;
+    xx += d.x * d.x, xy += d.x * d.y, xz += d.x * d.z;
+    yy += d.y * d.y, yz += d.y * d.z, zz += d.z * d.z;
+  }
+  const double det_x = yy * zz - yz * yz, det_y = xx * zz - xz * xz, det_z = xx * yy - xy * xy;
+  const double det_max = std::max({det_x, det_y, det_z});
+  const double spread = xx + yy + zz;
+  if (!(det_max > 1e-6 * spread * spread)) return side;  // (nearly) collinear
+  Vec3 normal;
+  if (det_max == det_x) {
+    normal = {det_x, xz * yz - xy * zz, xy * yz - xz * yy};
+  } else if (det_max == det_y) {
+    normal = {xz * yz - xy * zz, det_y, xy * xz - yz * xx};
+  } else {
+    normal = {xy * yz - xz * yy, xy * xz - yz * xx, det_z};
+  }
+  normal = Normalize(normal);
+  if (Dot(normal, side) < 0) normal = normal * -1.0;
+  return Dot(normal, side) >= 0.5 ? normal : side;
+}
+
 // Angle between two unit vectors.
 inline double AngleBetween(const Vec3& a, const Vec3& b) {
   return std::acos(std::clamp(Dot(a, b), -1.0, 1.0));

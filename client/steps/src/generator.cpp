@@ -84,7 +84,9 @@ double ClearanceNeeded(double nominal, const Foothold& h, const Vec3& foot, cons
 struct Agent {
   std::string id;                       // "" for a single character, else "c1".."cN"
   Vec3 ground;                          // the body's ground point: centroid of the planted feet
-  Vec3 up;                              // the body's up (world up for bipeds)
+  Vec3 up;                              // the feet's frame: world up for bipeds, else the
+                                        // feet's averaged normal
+  Vec3 body_up;                         // the body's up (see BodyUp)
   Vec3 forward;                         // the body's heading, unit, perpendicular to up
   std::vector<Vec3> foot, foot_normal;  // planted feet
   std::vector<Vec3> path;
@@ -157,7 +159,19 @@ class Generator {
   Vec3 Place(const Agent& a, const Vec3& rest) const {
     return a.ground + Left(a) * rest.x + a.up * rest.y + a.forward * rest.z;
   }
-  Vec3 BodyUp(const Agent& a, const std::vector<Vec3>& normals) const;
+  // World up for bipeds, else the feet's averaged normal (`previous` when they cancel).
+  Vec3 AveragedUp(const Vec3& previous, const std::vector<Vec3>& normals) const;
+  // The up of the feet's frame, in which steps are aimed and footholds judged, for feet at
+  // `feet` on ground of `normals`: world up for bipeds, else halfway between their averaged
+  // normal and BodyUp (on stairs, between a tread's and the flight's, so steps lead up or down
+  // the flight rather than into its risers).
+  Vec3 FeetUp(const Vec3& previous, const std::vector<Vec3>& feet,
+              const std::vector<Vec3>& normals) const;
+  // The body's up over feet standing at `feet`: world up for bipeds; for multipeds the normal
+  // of the plane fitted to the feet, the terrain's at the body's scale (on stairs the flight's,
+  // not a tread's or a riser's), on the side of `feet_up`, which it falls back to for feet in a
+  // line or a plane leaning more than 60 degrees from it.
+  Vec3 BodyUp(const Vec3& feet_up, const std::vector<Vec3>& feet) const;
   void KeyFoot(const Agent& a, int foot, double frame, KeyPhase phase, const Vec3& p,
                const Vec3& n);
   void KeyBody(const Agent& a, double frame);
@@ -214,11 +228,23 @@ class Generator {
   std::vector<Foothold> answers_, next_answers_, arc_answers_;
 };
 
-Vec3 Generator::BodyUp(const Agent& a, const std::vector<Vec3>& normals) const {
+Vec3 Generator::AveragedUp(const Vec3& previous, const std::vector<Vec3>& normals) const {
   if (!c_.align_to_normal) return world_up_;
   Vec3 sum;
   for (const Vec3& n : normals) sum += n;
-  return NormalizeOr(sum, a.up);
+  return NormalizeOr(sum, previous);
+}
+
+Vec3 Generator::FeetUp(const Vec3& previous, const std::vector<Vec3>& feet,
+                       const std::vector<Vec3>& normals) const {
+  if (!c_.align_to_normal) return world_up_;
+  const Vec3 averaged = AveragedUp(previous, normals);
+  return NormalizeOr(averaged + BodyUp(averaged, feet), averaged);
+}
+
+Vec3 Generator::BodyUp(const Vec3& feet_up, const std::vector<Vec3>& feet) const {
+  if (!c_.align_to_normal) return world_up_;
+  return FittedPlaneNormal(feet.data(), feet.size(), feet_up);
 }
 
 void Generator::KeyFoot(const Agent& a, int foot, double frame, KeyPhase phase, const Vec3& p,
@@ -233,11 +259,12 @@ void Generator::KeyFoot(const Agent& a, int foot, double frame, KeyPhase phase, 
 void Generator::KeyBody(const Agent& a, double frame) {
   WalkKey key;
   key.frame = frame;
-  key.position = a.ground + a.up * c_.body_height;
-  key.normal = a.up;
+  key.position = a.ground + a.body_up * c_.body_height;
+  key.normal = a.body_up;
   WalkTrack& track = walk_.tracks[a.first_track + c_.feet.size()];
   track.keys.push_back(key);
-  track.rotations.push_back(QuatFromBasis(Left(a), a.up, a.forward));
+  const Vec3 forward = TangentForward(a.forward, a.forward, a.up, a.body_up);
+  track.rotations.push_back(QuatFromBasis(Cross(a.body_up, forward), a.body_up, forward));
 }
 
 void Generator::Stop(Agent& a, int step, const std::string& why) {
@@ -428,8 +455,9 @@ Status Generator::Setup(std::string* error) {
   s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()), "snap feet",
             error);
   if (s != Status::kOk) return s;
-  // 4. The body at the feet's centroid, raised by body_height along its up (multipeds: the
-  //    averaged foot normal); every foot and the body keyed planted at the start frame.
+  // 4. The body at the feet's centroid, raised by body_height along its up (multipeds: BodyUp;
+  //    the feet's frame from their averaged normal); every foot and the body keyed planted at
+  //    the start frame.
   for (int i = 0; i < n; ++i) {
     Agent& a = agents_[i];
     a.foot.resize(feet), a.foot_normal.resize(feet);
@@ -440,7 +468,8 @@ Status Generator::Setup(std::string* error) {
       centroid += a.foot[f];
     }
     const Vec3 old_up = a.up;
-    a.up = BodyUp(a, a.foot_normal);
+    a.up = AveragedUp(a.up, a.foot_normal);
+    a.body_up = BodyUp(a.up, a.foot);
     a.forward = TangentForward(a.forward, a.forward, old_up, a.up);
     a.ground = centroid / static_cast<double>(feet);
     for (size_t f = 0; f < feet; ++f) {
@@ -517,7 +546,7 @@ Status Generator::QueryFootholds(std::string* error) {
         // moves by this foot's displacement over the number of feet).
         for (int shrink = 0; shrink < 8; ++shrink) {
           const Vec3 ground = a.ground + v / static_cast<double>(feet);
-          const Vec3 body = ground + a.up * c_.body_height;
+          const Vec3 body = ground + a.body_up * c_.body_height;
           if (Distance(a.foot[mv.foot] + v, body) <= c_.reach) break;
           v = v * 0.75;
         }
@@ -625,14 +654,18 @@ void Generator::CheckReach(size_t m, size_t e) {
   const size_t feet = c_.feet.size();
   const Agent& a = agents_[moves[m].agent];
   const std::vector<int>& slot = move_of_foot_[group_];  // foot -> its move's offset, or -1
-  // The feet and normals after this step: each moving foot at its foothold.
-  Vec3 centroid, normal_sum;
+  // The feet and normals after this step, each moving foot at its foothold (per-thread
+  // scratch: characters are judged in parallel).
+  thread_local std::vector<Vec3> after, after_normals;
+  after.resize(feet), after_normals.resize(feet);
+  Vec3 centroid;
   for (size_t f = 0; f < feet; ++f) {
     const bool moving = slot[f] >= 0;
-    centroid += moving ? moves[m + slot[f]].end : a.foot[f];
-    normal_sum += moving ? moves[m + slot[f]].end_normal : a.foot_normal[f];
+    after[f] = moving ? moves[m + slot[f]].end : a.foot[f];
+    after_normals[f] = moving ? moves[m + slot[f]].end_normal : a.foot_normal[f];
+    centroid += after[f];
   }
-  const Vec3 up = c_.align_to_normal ? NormalizeOr(normal_sum, a.up) : world_up_;
+  const Vec3 up = BodyUp(FeetUp(a.up, after, after_normals), after);
   const Vec3 body = centroid / static_cast<double>(feet) + up * c_.body_height;
   for (size_t i = m; i < e; ++i) {
     const double dist = Distance(moves[i].end, body);
@@ -784,8 +817,8 @@ Status Generator::ClearArcs(int k, std::string* error) {
 }
 
 // 10. Key each foot (start, mid, end) and plant it; 11. move the body to the feet's centroid,
-//     raised along its up (multipeds: the averaged foot normal), heading carried along, and key
-//     it at touch-down. A character with a refused foot stops before this step's keys.
+//     raised along its up (multipeds: BodyUp; the feet's frame: FeetUp), heading carried along,
+//     and key it at touch-down. A character with a refused foot stops before this step's keys.
 void Generator::Finish(size_t w, int k) {
   const size_t per_agent = moves_.size() / walking_.size();
   const double f0 = o_.start_frame + static_cast<double>(k) * c_.frames_per_step;
@@ -822,7 +855,8 @@ void Generator::Finish(size_t w, int k) {
   for (const Vec3& p : a.foot) centroid += p;
   a.ground = centroid / static_cast<double>(a.foot.size());
   const Vec3 old_up = a.up;
-  a.up = BodyUp(a, a.foot_normal);
+  a.up = FeetUp(a.up, a.foot, a.foot_normal);
+  a.body_up = BodyUp(a.up, a.foot);
   a.forward = TangentForward(a.forward, a.forward, old_up, a.up);
   KeyBody(a, f1);
 }

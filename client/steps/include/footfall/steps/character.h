@@ -35,13 +35,13 @@ struct Character {
   double step_height = 0.15;  // swing arc height above the start-end chord [Limit: > 0]
   double body_height = 0.9;   // body above the feet's centroid, along the body's up [Limit: >= 0]
   int frames_per_step = 12;   // frames from lift-off to touch-down [Limit: >= 2]
-  // true (multipeds): the body's up is the averaged terrain normal under the feet, so it can
-  // walk on walls, ceilings and around spheres. false (bipeds): the body stays upright along the
-  // world up axis (--up).
+  // true (multipeds): the body's up follows the terrain under the feet (the plane fitted to
+  // them; README, "The algorithm", step 11), so it can walk on walls, ceilings and around
+  // spheres. false (bipeds): the body stays upright along the world up axis (--up).
   bool align_to_normal = false;
   // Slope awareness. A step whose ground rises or falls more than slope_threshold_deg along the
   // heading is shortened to slope_step_scale * step_length. Footholds whose normal leans more
-  // than max_slope_deg from the body's up, or which rise or fall more than max_rise along it,
+  // than max_slope_deg from the feet's up, or which rise or fall more than max_rise along it,
   // are refused (a shorter step is tried, then the walk stops).
   double slope_threshold_deg = 15;  // [Limit: 0..90]
   double slope_step_scale = 0.6;    // [Limit: (0, 1]]
