@@ -84,9 +84,8 @@ double ClearanceNeeded(double nominal, const Foothold& h, const Vec3& foot, cons
 struct Agent {
   std::string id;                       // "" for a single character, else "c1".."cN"
   Vec3 ground;                          // the body's ground point: centroid of the planted feet
-  Vec3 up;                              // the feet's frame: world up for bipeds, else the
-                                        // feet's averaged normal
-  Vec3 body_up;                         // the body's up (see BodyUp)
+  Vec3 up;                              // the up of the feet's frame (FeetUp)
+  Vec3 body_up;                         // the body's up (BodyUp)
   Vec3 forward;                         // the body's heading, unit, perpendicular to up
   std::vector<Vec3> foot, foot_normal;  // planted feet
   std::vector<Vec3> path;
