@@ -83,12 +83,13 @@ if [ -f "$dem" ]; then
     check "dem-$c: ten steps" [ "$(grep -o '"phase":"end"' "$work/dem-$c-embedded.json" | wc -l)" -ge 10 ]
   done
   check "dem-hexapod: cropped around the walk" grep -q "within (" "$work/dem-hexapod-embedded.err"
-  # --separation is taken as given: at the file's own metre a biped finds no foothold.
-  "$footfall" generate --terrain "$dem" --separation 1 --character "$chars/biped.json" \
+  # --separation is taken as given: at the file's own metre an insect finds no foothold, and
+  # the message says at what separation to resample.
+  "$footfall" generate --terrain "$dem" --separation 1 --character "$chars/hexapod.json" \
     --out "$work/dem-own.json" 2> "$work/dem-own.err"
   check "dem --separation 1: stopped early (exit 2)" [ $? -eq 2 ]
   check "dem --separation 1: not resampled for the character" bash -c "! grep -q 'resampled for' '$work/dem-own.err'"
-  check "dem --separation 1: advice to resample at a quarter step" grep -q "too far for this character: resample it at a separation of 0.175" "$work/dem-own.err"
+  check "dem --separation 1: advice to resample at a quarter step" grep -q "too far for this character: resample it at a separation of 0.03" "$work/dem-own.err"
 elif [ -n "${CI:-}" ]; then
   check "shared data present in CI ($dem)" false
 else

@@ -744,10 +744,12 @@ TEST_CASE("The shipped quadruped walks up and down a stair mesh, its body along 
   // normals at a quarter and at 0.15 of the quadruped's step, five seeds each; its reach as
   // shipped (0.8). The body's up is the normal of the plane of its feet, so on the flight it
   // leans with the slope and the hind feet stay within reach, and its feet's frame lies halfway
-  // to the treads', so steps lead up the flight, not into its risers. With the feet's averaged
-  // normal alone none of these twenty walks got past the fourth step (hind feet 0.82 to 0.94
-  // from the body, or footholds on risers); now 9 of 10 reach the landing and 4 of 10 the
-  // floor (going down, footholds on the noses' riser samples are still refused as too steep).
+  // to the treads', so steps lead up the flight, not into its risers; and its longer and
+  // aimed-down retries reach a full step, so a foot whose target locator caught on a nose
+  // reaches the tread below. With the feet's averaged normal alone none of these twenty walks
+  // got past the fourth step (hind feet 0.82 to 0.94 from the body, or footholds on risers);
+  // with the plane but short retries 9 of 10 reached the landing and 4 of 10 the floor; now 9
+  // and 8.
   const Character c = LoadShipped("quadruped");
   const int steps = 10;
   const double rise = 0.18, run = 0.28, top = steps * rise, end = steps * run, width = 2;
@@ -809,7 +811,7 @@ TEST_CASE("The shipped quadruped walks up and down a stair mesh, its body along 
     }
   }
   CHECK(to_the_landing >= 9);
-  CHECK(to_the_floor >= 4);
+  CHECK(to_the_floor >= 8);
   // Halfway up, the body leans back with the flight (33 degrees), far more than a tread's
   // normal (0) would make it.
   CHECK(lean > std::sin(20 * kPi / 180));

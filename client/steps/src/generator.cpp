@@ -532,6 +532,10 @@ Status Generator::QueryFootholds(std::string* error) {
         Vec3 v = target - a.foot[mv.foot];
         const double len = Length(v);
         if (len > max_len) v = v * (max_len / len);
+        // Longer and aimed-down retries reach a full step along the target's direction: a
+        // target locator caught on a stair's nose lies just ahead of a foot standing there.
+        if ((mv.attempt.scale > 1 || mv.attempt.drop > 0) && len > kInPlace * c_.step_length)
+          v = v * (max_len / Length(v));
         v = v * mv.attempt.scale;  // retries step shorter or longer
         if (Length(v) < kInPlace * c_.step_length) {
           if (mv.attempt.drop > 0) {
