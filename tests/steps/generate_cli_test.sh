@@ -90,6 +90,17 @@ if [ -f "$dem" ]; then
   check "dem --separation 1: stopped early (exit 2)" [ $? -eq 2 ]
   check "dem --separation 1: not resampled for the character" bash -c "! grep -q 'resampled for' '$work/dem-own.err'"
   check "dem --separation 1: advice to resample at a quarter step" grep -q "too far for this character: resample it at a separation of 0.03" "$work/dem-own.err"
+  # The same resampling as a point file, for footfalld's --data-root or a plugin's point file:
+  # terrain convert --character (the whole file), then walked as points.
+  "$footfall" terrain convert "$dem" --character "$chars/quadruped.json" -o "$work/dem-q.pts" > "$work/dem-q.out"
+  check "convert --character: exit 0" [ $? -eq 0 ]
+  check "convert --character: a quarter of the quadruped's step" grep -q "(separation 0.1)" "$work/dem-q.out"
+  "$footfall" generate --terrain "$work/dem-q.pts" --character "$chars/quadruped.json" --steps 10 \
+    --out "$work/dem-q.json" 2> /dev/null
+  check "convert --character: the quadruped walks the point file" [ $? -eq 0 ]
+  err=$("$footfall" terrain convert "$dem" --character "$chars/quadruped.json" --separation 1 -o "$work/x.pts" 2>&1)
+  check "convert --character --separation: exit 1" [ $? -eq 1 ]
+  check "convert --character --separation: message" grep -qF "give --separation or --character, not both" <<< "$err"
 elif [ -n "${CI:-}" ]; then
   check "shared data present in CI ($dem)" false
 else

@@ -13,6 +13,8 @@
 #include "footfall/cli/number_checks.h"
 #include "footfall/import/terrain_generators.h"
 #include "footfall/import/terrain_loader.h"
+#include "footfall/steps/character.h"
+#include "footfall/steps/walk_terrain.h"
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/grid.h"
 #include "footfall/terrain/point_file.h"
@@ -23,6 +25,7 @@ namespace {
 
 struct ConvertFlags {
   std::string input, output;
+  std::string character;  // resample for this character's steps (walk_terrain.h)
   TerrainLoadOptions load;
 };
 
@@ -59,7 +62,22 @@ int RunConvert(const ConvertFlags& flags) {
   RawSamples samples;
   std::string error;
   TerrainLoadReport report;
-  if (LoadTerrain(flags.input, flags.load, &samples, &error, &report) != Status::kOk) {
+  TerrainLoadOptions load = flags.load;
+  if (!flags.character.empty()) {
+    // The whole file, as fine as generate resamples it for the character's walk.
+    Character character;
+    if (load.separation > 0) {
+      error = "give --separation or --character, not both";
+    } else if (LoadCharacter(flags.character, &character, &error) == Status::kOk) {
+      load.finest_default = kSeparationPerStep * character.step_length;
+      load.max_samples = std::min(load.max_samples, kMaxWalkSamples);
+    }
+    if (!error.empty()) {
+      std::cerr << "footfall terrain convert: " << error << '\n';
+      return 1;
+    }
+  }
+  if (LoadTerrain(flags.input, load, &samples, &error, &report) != Status::kOk) {
     std::cerr << "footfall terrain convert: " << error << '\n';
     return 1;
   }
@@ -210,6 +228,10 @@ void AddTerrainCommand(CLI::App& app, int* exit_code) {
       ->required()
       ->check(kPointFileOutput);
   AddLoadFlags(c, &convert->load);
+  c->add_option("--character", convert->character,
+                "Meshes and height maps: resample as finely as footfall generate does for this "
+                "character (a quarter of its step, at most 2,000,000 samples); not with "
+                "--separation");
   c->callback([convert, exit_code] { *exit_code = RunConvert(*convert); });
 
   auto info = std::make_shared<InfoFlags>();

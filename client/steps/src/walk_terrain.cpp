@@ -14,9 +14,6 @@ constexpr double kArcStepHeights = 6;
 // With a path and no step count, the walk is taken to stay within this many steps' travel of
 // the box of its start and waypoints (it turns toward each waypoint as it goes).
 constexpr double kPathSlackSteps = 8;
-// At most this many samples, whatever the load's budget: the sampler needs several hundred bytes
-// per sample while it works.
-constexpr size_t kMaxWalkSamples = 2000000;
 
 // The point GenerateWalk starts from when none is given: the centre of the top of the bounds
 // along `up`.

@@ -18,6 +18,10 @@
 
 namespace footfall {
 
+// At most this many samples for a character, whatever the load's budget: the sampler needs
+// several hundred bytes per sample while it works.
+constexpr size_t kMaxWalkSamples = 2000000;
+
 struct WalkTerrain {
   RawSamples samples;
   TerrainLoadReport report;  // what was read and how it was resampled
