@@ -1,9 +1,11 @@
 #include "footfall/import/mesh_sampler.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -325,7 +327,7 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
 
   // Cells of side r over the bounds; each candidate's cell id.
   const size_t n = candidates.size();
-  CellMap table(static_cast<size_t>(predicted) + 16);
+  auto table = std::make_unique<CellMap>(static_cast<size_t>(predicted) + 16);
   std::vector<uint32_t> cell_of(n);
   std::vector<uint64_t> cell_keys;
   uint64_t last_key = ~0ull;
@@ -336,7 +338,7 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
     const uint64_t z = static_cast<uint64_t>(std::max(0.0, candidates[c].offset[2] * inv_cell));
     const uint64_t key = CellKey(x + 1, y + 1, z + 1);  // +1: neighbours never underflow
     if (key != last_key) {  // neighbouring candidates mostly share a cell
-      last_id = table.Insert(x + 1, y + 1, z + 1, static_cast<uint32_t>(cell_keys.size()));
+      last_id = table->Insert(x + 1, y + 1, z + 1, static_cast<uint32_t>(cell_keys.size()));
       if (last_id == cell_keys.size()) cell_keys.push_back(key);
       last_key = key;
     }
@@ -390,7 +392,7 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
         for (int dy = -1; dy <= 1; ++dy) {
           for (int dz = -1; dz <= 1; ++dz) {
             if (std::abs(dx) + std::abs(dy) + std::abs(dz) != ring) continue;
-            const uint32_t other = table.Find(x + dx, y + dy, z + dz);
+            const uint32_t other = table->Find(x + dx, y + dy, z + dz);
             if (other != kNone) neighbours.push_back(rank[other]);
           }
         }
@@ -398,6 +400,8 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
     }
     neighbour_start[id + 1] = static_cast<uint32_t>(neighbours.size());
   }
+  table.reset();  // what steps 2 and 3 no longer need goes before they allocate theirs
+  std::vector<uint32_t>().swap(rank);
 
   // 2. A seeded random order with locality (after Wei, "Parallel Poisson disk sampling", 2008):
   // each cell's candidates are shuffled; then, tile by tile, pass j tries the j-th candidate of
@@ -411,6 +415,7 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
     std::vector<uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
     for (size_t c = 0; c < n; ++c) by_cell[fill[cell_of[c]]++] = static_cast<uint32_t>(c);
   }
+  std::vector<uint32_t>().swap(cell_of);
   for (size_t id = 0; id < cells; ++id) {
     uint32_t* first = &by_cell[cell_start[id]];
     for (uint32_t m = cell_start[id + 1] - cell_start[id]; m > 1; --m) {
@@ -419,29 +424,46 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   }
 
   // 3. Accept candidates farther than r from every accepted sample. Each cell keeps the offsets
-  // of its accepted samples inline, for cache-friendly tests.
+  // of its first kInline accepted samples inline, for cache-friendly tests, and any more (rare:
+  // cells are r wide) in a shared overflow list.
+  constexpr uint32_t kInline = 2;
   struct Slots {
     uint32_t count;
-    float p[kSlots][3];
+    uint32_t more;  // with count > kInline: its entry in `overflow`
+    float p[kInline][3];
   };
   std::vector<Slots> slots(cells);
   for (Slots& slot : slots) slot.count = 0;
+  std::vector<std::array<float, 3 * (kSlots - kInline)>> overflow;
   std::vector<uint32_t> accepted;
   accepted.reserve(static_cast<size_t>(predicted * 1.2) + 16);
   const float r2f = static_cast<float>(r2);
+  auto near = [&](const float* p, const Candidate& cand) {
+    const float dx = p[0] - cand.offset[0], dy = p[1] - cand.offset[1], dz = p[2] - cand.offset[2];
+    return dx * dx + dy * dy + dz * dz < r2f;
+  };
   auto try_candidate = [&](uint32_t c, uint32_t cell) {
     const Candidate& cand = candidates[c];
     for (uint32_t e = neighbour_start[cell]; e < neighbour_start[cell + 1]; ++e) {
       const Slots& slot = slots[neighbours[e]];
-      for (uint32_t q = 0; q < slot.count; ++q) {
-        const float dx = slot.p[q][0] - cand.offset[0], dy = slot.p[q][1] - cand.offset[1],
-                    dz = slot.p[q][2] - cand.offset[2];
-        if (dx * dx + dy * dy + dz * dz < r2f) return;
-      }
+      for (uint32_t q = 0; q < std::min(slot.count, kInline); ++q)
+        if (near(slot.p[q], cand)) return;
+      for (uint32_t q = kInline; q < slot.count; ++q)
+        if (near(&overflow[slot.more][3 * (q - kInline)], cand)) return;
     }
     Slots& own = slots[cell];
     if (own.count == kSlots) return;
-    for (int d = 0; d < 3; ++d) own.p[own.count][d] = cand.offset[d];
+    float* to = own.p[0];
+    if (own.count < kInline) {
+      to = own.p[own.count];
+    } else {
+      if (own.count == kInline) {
+        own.more = static_cast<uint32_t>(overflow.size());
+        overflow.emplace_back();
+      }
+      to = &overflow[own.more][3 * (own.count - kInline)];
+    }
+    for (int d = 0; d < 3; ++d) to[d] = cand.offset[d];
     ++own.count;
     accepted.push_back(c);
   };
