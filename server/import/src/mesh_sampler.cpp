@@ -31,10 +31,11 @@ struct SplitMix64 {
   uint64_t state;
 };
 
+// A step-1 piece's centroid, relative to the cell grid's corner, for distance tests. Its
+// triangle and barycentric position are found again in step 4 from its index (candidates are
+// stored in triangle order, each triangle's pieces in SplitTriangle's order).
 struct Candidate {
-  float offset[3];  // position relative to the cell grid's corner, for distance tests
-  uint32_t triangle;
-  float u, v;  // barycentric weights of corners 1 and 2 of the triangle
+  float offset[3];
 };
 
 constexpr int kCellBits = 21;
@@ -309,21 +310,17 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   }
   std::vector<Candidate> candidates;
   candidates.reserve(counted);
+  std::vector<uint32_t> first_candidate(mesh.triangles.size() + 1);  // per triangle
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    first_candidate[t] = static_cast<uint32_t>(candidates.size());
     SplitTriangle(mesh, t, h2, &stack, [&](const Piece& piece) {
-      const Vec3 g = (piece.p[0] + piece.p[1] + piece.p[2]) / 3;
-      Candidate c;
-      const Vec3 local = g - lo;
-      c.offset[0] = static_cast<float>(local.x);
-      c.offset[1] = static_cast<float>(local.y);
-      c.offset[2] = static_cast<float>(local.z);
-      c.triangle = static_cast<uint32_t>(t);
-      c.u = static_cast<float>((piece.b[0][0] + piece.b[1][0] + piece.b[2][0]) / 3);
-      c.v = static_cast<float>((piece.b[0][1] + piece.b[1][1] + piece.b[2][1]) / 3);
-      candidates.push_back(c);
+      const Vec3 local = (piece.p[0] + piece.p[1] + piece.p[2]) / 3 - lo;
+      candidates.push_back({{static_cast<float>(local.x), static_cast<float>(local.y),
+                             static_cast<float>(local.z)}});
       return true;
     });
   }
+  first_candidate.back() = static_cast<uint32_t>(candidates.size());
 
   // Cells of side r over the bounds; each candidate's cell id.
   const size_t n = candidates.size();
@@ -493,12 +490,28 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
       options.smooth_normals ? VertexNormals(mesh) : std::vector<Vec3>{};
   out->points.reserve(accepted.size());
   out->normals.reserve(accepted.size());
-  for (uint32_t c : accepted) {
-    const Candidate& cand = candidates[c];
-    out->push_back(SamplePoint(mesh, cand.triangle, cand.u, cand.v),
-                   SampleNormal(mesh, vertex_normals, cand.triangle, cand.u, cand.v));
+  const size_t accepted_count = accepted.size();
+  std::vector<Candidate>().swap(candidates);  // no longer needed: step 4 cuts again
+  // Each triangle holding accepted pieces is cut again (the same pieces in the same order); a
+  // piece's barycentric position is the mean of its corners', as step 1 had it.
+  std::vector<std::array<float, 2>> piece_uv;
+  for (size_t a = 0; a < accepted.size();) {
+    const size_t t = static_cast<size_t>(
+        std::upper_bound(first_candidate.begin(), first_candidate.end(), accepted[a]) -
+        first_candidate.begin() - 1);
+    piece_uv.clear();
+    SplitTriangle(mesh, t, h2, &stack, [&](const Piece& piece) {
+      piece_uv.push_back({static_cast<float>((piece.b[0][0] + piece.b[1][0] + piece.b[2][0]) / 3),
+                          static_cast<float>((piece.b[0][1] + piece.b[1][1] + piece.b[2][1]) / 3)});
+      return true;
+    });
+    for (; a < accepted.size() && accepted[a] < first_candidate[t + 1]; ++a) {
+      const auto& uv = piece_uv[accepted[a] - first_candidate[t]];
+      out->push_back(SamplePoint(mesh, t, uv[0], uv[1]),
+                     SampleNormal(mesh, vertex_normals, t, uv[0], uv[1]));
+    }
   }
-  if (stats) stats->candidates = n, stats->samples = accepted.size();
+  if (stats) stats->candidates = n, stats->samples = accepted_count;
   return Status::kOk;
 }
 
