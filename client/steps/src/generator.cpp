@@ -380,16 +380,7 @@ Status Generator::Setup(std::string* error) {
              : 0;
   // 1. The start: --start, or the sample nearest the centre of the top of the bounds.
   Vec3 start = o_.start;
-  if (!o_.has_start) {
-    const Vec3 lo = info.stats.bounds_min, hi = info.stats.bounds_max;
-    const Vec3 centre = (lo + hi) * 0.5;
-    double top = 0;
-    for (int i = 0; i < 8; ++i) {
-      const Vec3 corner{i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z};
-      top = std::max(top, Dot(corner - centre, world_up_));
-    }
-    start = centre + world_up_ * top;
-  }
+  if (!o_.has_start) start = TopCentre(info.stats.bounds_min, info.stats.bounds_max, world_up_);
   Foothold first;
   s = Check(session_.Snap(terrain_, &start, 1, &first), "snap start", error);
   if (s != Status::kOk) return s;
@@ -915,6 +906,16 @@ Status Generator::Step(int k, std::string* error) {
 }
 
 }  // namespace
+
+Vec3 TopCentre(const Vec3& lo, const Vec3& hi, const Vec3& up) {
+  const Vec3 centre = (lo + hi) * 0.5;
+  double top = 0;
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 corner{i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z};
+    top = std::max(top, Dot(corner - centre, up));
+  }
+  return centre + up * top;
+}
 
 double MaxStepTravel(const Character& character) {
   double scale = 0, drop = 0;

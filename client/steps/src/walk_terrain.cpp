@@ -15,20 +15,6 @@ constexpr double kArcStepHeights = 6;
 // the box of its start and waypoints (it turns toward each waypoint as it goes).
 constexpr double kPathSlackSteps = 8;
 
-// The point GenerateWalk starts from when none is given: the centre of the top of the bounds
-// along `up`.
-Vec3 TopCentre(const TriangleMesh& mesh, const Vec3& up) {
-  Vec3 lo, hi;
-  MeshBounds(mesh, &lo, &hi);
-  const Vec3 centre = (lo + hi) * 0.5;
-  double top = 0;
-  for (int i = 0; i < 8; ++i) {
-    const Vec3 corner{i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z};
-    top = std::max(top, Dot(corner - centre, up));
-  }
-  return centre + up * top;
-}
-
 // How far from the start's ground point anything the walk touches can lie, beside the steps
 // themselves: the crowd's grid (each character snapped within twice its offset), the feet's
 // rest spread (each foot snapped within twice its rest distance), the reach, a step of
@@ -59,7 +45,10 @@ Status PrepareWalkTerrain(const std::string& path, const TerrainLoadOptions& loa
   Status status = ReadTerrainMesh(path, load, &mesh, error, &out->report);
   if (status != Status::kOk) return status;
   const Vec3 up = steps_detail::NormalizeOr(options.up, Vec3{0, 1, 0});
-  out->start = NearestSurfacePoint(mesh, options.has_start ? options.start : TopCentre(mesh, up));
+  Vec3 mesh_lo, mesh_hi;
+  MeshBounds(mesh, &mesh_lo, &mesh_hi);
+  out->start = NearestSurfacePoint(
+      mesh, options.has_start ? options.start : TopCentre(mesh_lo, mesh_hi, up));
 
   // The box the walk cannot leave: its steps from the start, or, along a path walked to its
   // end, the path's box widened by a few steps.
@@ -80,8 +69,6 @@ Status PrepareWalkTerrain(const std::string& path, const TerrainLoadOptions& loa
   }
   out->region_min = lo - Vec3{widen, widen, widen};
   out->region_max = hi + Vec3{widen, widen, widen};
-  Vec3 mesh_lo, mesh_hi;
-  MeshBounds(mesh, &mesh_lo, &mesh_hi);
   out->cropped = mesh_lo.x < out->region_min.x || mesh_lo.y < out->region_min.y ||
                  mesh_lo.z < out->region_min.z || mesh_hi.x > out->region_max.x ||
                  mesh_hi.y > out->region_max.y || mesh_hi.z > out->region_max.z;

@@ -67,6 +67,10 @@ struct GenerateOptions {
   std::function<void(int, int)> progress;
 };
 
+// Where GenerateWalk starts when GenerateOptions has no start (before snapping): the centre of
+// the top face of the box [lo, hi] along the unit vector `up`.
+Vec3 TopCentre(const Vec3& lo, const Vec3& hi, const Vec3& up);
+
 // The farthest a foot of `character` can move in one step: its longest try, aimed down as far
 // as any try, plus the distance within which a foothold is taken. [Units: wu]
 double MaxStepTravel(const Character& character);
