@@ -17,7 +17,6 @@
 #include "footfall/cli/number_checks.h"
 #include "footfall/client/query_text.h"
 #include "footfall/export/walk_writer.h"
-#include "footfall/import/mesh_reader.h"
 #include "footfall/steps/generator.h"
 #include "footfall/steps/walk_json.h"
 #include "footfall/steps/walk_terrain.h"
@@ -96,12 +95,11 @@ class ProgressBar {
   bool shown_ = false;
 };
 
-// True when the terrain is a mesh or height map read here with no --separation: it is then
-// resampled for the character (walk_terrain.h).
+// True when the terrain is read here, not as a point file, with no --separation: it is then
+// resampled for the character (walk_terrain.h; an unknown extension fails there).
 bool ResamplesForCharacter(const TerrainFlags& flags) {
-  if (flags.terrain.empty() || flags.load.separation > 0) return false;
-  const std::string ext = FileExtension(flags.terrain);
-  return IsMeshExtension(ext) || ext == "asc" || ext == "pgm";
+  return !flags.terrain.empty() && !(flags.load.separation > 0) &&
+         !IsPointFileExtension(FileExtension(flags.terrain));
 }
 
 std::string Box(const Vec3& lo, const Vec3& hi) {
