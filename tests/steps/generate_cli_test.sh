@@ -90,6 +90,10 @@ if [ -f "$dem" ]; then
   check "dem --separation 1: stopped early (exit 2)" [ $? -eq 2 ]
   check "dem --separation 1: not resampled for the character" bash -c "! grep -q 'resampled for' '$work/dem-own.err'"
   check "dem --separation 1: advice to resample at a quarter step" grep -q "too far for this character: resample it at a separation of 0.03" "$work/dem-own.err"
+  # A --start is snapped as given, as on point files: one beyond the queries' reach is refused.
+  err=$("$footfall" generate --terrain "$dem" --character "$chars/biped.json" --start 1e20,0,0 --out "$work/x.json" 2>&1)
+  check "dem far start: exit 1" [ $? -eq 1 ]
+  check "dem far start: message" grep -qF "the start is too far from the terrain to snap" <<< "$err"
   # The same resampling as a point file, for footfalld's --data-root or a plugin's point file:
   # terrain convert --character (the whole file), then walked as points.
   "$footfall" terrain convert "$dem" --character "$chars/quadruped.json" -o "$work/dem-q.pts" > "$work/dem-q.out"

@@ -186,7 +186,8 @@ int RunGenerate(const GenerateFlags& flags) {
                              &prepared, &error) != Status::kOk)
         goto bad_flag;
       ReportResampling(terrain_flags.terrain, character, prepared);
-      options.start = prepared.start, options.has_start = true;
+      // The default start, found on the surface before cropping (a --start is snapped as given).
+      if (!options.has_start) options.start = prepared.start, options.has_start = true;
       if (OpenSession(terrain_flags, &session, &error) != Status::kOk) goto bad_flag;
       if (session->LoadSamples(prepared.samples, terrain_flags.terrain, &terrain) != Status::kOk) {
         error = session->last_error();
