@@ -854,3 +854,31 @@ TEST_CASE("Insects walk up a thin wall, over its top and down the far side", "[s
     }
   }
 }
+
+TEST_CASE("A multiped with its feet in a line walks up a ramp (no plane to fit: averaged normal)",
+          "[steps][generator]") {
+  // Four feet on the body's axis: the plane of the feet is undefined, so the body's up falls
+  // back to the feet's averaged normal, and nothing turns NaN.
+  Character worm;
+  std::string error;
+  REQUIRE(ParseCharacter(R"({"format": "footfall-character", "version": 1, "name": "worm",
+    "feet": [{"name": "A", "rest": [0, 0, 0.3]}, {"name": "B", "rest": [0, 0, 0.1]},
+             {"name": "C", "rest": [0, 0, -0.1]}, {"name": "D", "rest": [0, 0, -0.3]}],
+    "gait": [["A", "C"], ["B", "D"]], "pairs": [["A"], ["B"], ["C"], ["D"]],
+    "step_length": 0.2, "step_height": 0.05, "body_height": 0.1, "frames_per_step": 6,
+    "align_to_normal": true, "reach": 0.5})",
+                         "worm", &worm, &error) == Status::kOk);
+  const double spacing = 0.02, slope = 20 * kPi / 180;
+  Terrain t = LoadTerrain(MakeRamp(100, 400, spacing, 20), spacing);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {1, std::sin(slope) * 1.0, std::cos(slope) * 1.0};
+  o.steps = 12;
+  const Walk w = Generate(t, worm, o);
+  INFO(w.stopped);
+  CHECK(w.stopped.empty());
+  CheckWalk(t, worm, o, w);
+  // The body's up is the ramp's normal (every foot on the same plane, normals alike).
+  const Vec3 ramp_normal{0, std::cos(slope), -std::sin(slope)};
+  for (const Quat& q : Body(w).rotations) CHECK(Dot(BodyUp(q), ramp_normal) > 0.999);
+}
