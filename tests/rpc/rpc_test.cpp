@@ -992,6 +992,9 @@ TEST_CASE("clients report a dead server and recover after a restart", "[rpc][rob
     CHECK(stuck.status == Status::kUnavailable);
     INFO(rpc->last_error());
     CHECK(rpc->last_error().find("Timed out") != std::string::npos);
+    // ... and says what the timeout was and what may help.
+    CHECK(rpc->last_error().find("no answer within the call timeout of") != std::string::npos);
+    CHECK(rpc->last_error().find("a longer timeout may help") != std::string::npos);
     const Foothold back = rpc->Snap(t, Vec3{5, 1, 5});
     REQUIRE(back.status == Status::kOk);
     RequireSame(back, before);

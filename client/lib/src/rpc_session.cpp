@@ -10,6 +10,7 @@
 #include <csignal>
 #include <cstring>
 #include <map>
+#include <sstream>
 
 #include "footfall.h"
 #include "footfall/client/terrain_session.h"
@@ -327,7 +328,15 @@ class RpcSession final : public TerrainSession {
   // Maps an RPC call result to a status; a transport failure drops the connection.
   Status Call(clnt_stat status, const char* what) {
     if (status == RPC_SUCCESS) return Status::kOk;
-    const std::string reason = clnt_sperrno(status);
+    std::string reason = clnt_sperrno(status);
+    if (status == RPC_TIMEDOUT) {
+      // Loading a large terrain (a mesh resampled finely) can take longer than a query.
+      std::ostringstream hint;
+      hint << " (no answer within the call timeout of " << options_.call_timeout_s
+           << " s: a busy or hung server, or a terrain that takes longer to load; a longer "
+              "timeout may help)";
+      reason += hint.str();
+    }
     Disconnect();
     return Fail(Status::kUnavailable,
                 std::string(what) + ": footfalld at " + Address() + ": " + reason);
