@@ -54,6 +54,15 @@ both big-crowd 0 --terrain "$work/floor.pts" --character "$chars/hexapod.json" -
 check "big crowd: 1100 characters" [ "$(grep -o '"name":"body","character":"c[0-9]*"' "$work/big-crowd-embedded.json" | wc -l)" -eq 1100 ]
 check "big crowd: progress bar reaches 100%" grep -q '100%' "$work/big-crowd-embedded.err"
 
+# The default start moves to where the character can stand: the top centre of the bundled
+# blocks is on a pile's edge (a foot on a vertical face, which stopped them at step 1); the
+# biped and the quadruped start on a flat top nearby and walk on (until a 1 m block's face).
+both biped-blocks 0 --terrain "$src/data/terrain/blocks.pts" --character "$chars/biped.json" --steps 2
+both quadruped-blocks 0 --terrain "$src/data/terrain/blocks.pts" --character "$chars/quadruped.json" --steps 8
+first_keys=$(grep -c '{"frame":1,"phase"' "$work/biped-blocks-embedded.json")
+level_keys=$(grep -c '{"frame":1,"phase".*"normal":\[0,1,0\]' "$work/biped-blocks-embedded.json")
+check "blocks: both feet start on level ground" [ "$first_keys" -eq 2 -a "$level_keys" -eq 2 ]
+
 # Directions with huge components are normalised without overflow: the same walk as 1,0,1.
 "$footfall" generate --terrain "$hills" --character "$chars/quadruped.json" --steps 16 \
   --heading 1e300,0,1e300 --up 0,1e300,0 --out "$work/huge-heading.json" 2> /dev/null

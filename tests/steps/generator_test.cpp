@@ -451,6 +451,93 @@ TEST_CASE("The default start is the sample nearest the top centre of the bounds"
 
 namespace {
 
+// A floor (y = 0, `n` x `n` samples) with a cone of 70-degree sides standing on its centre, base
+// radius `radius`: the top centre of the bounds is the cone's tip, where no character stands.
+// Without the floor, only the cone.
+RawSamples FloorWithCone(int n, double spacing, double radius, bool floor) {
+  const double side = (n - 1) * spacing, cx = 0.5 * side, cz = 0.5 * side;
+  const double tan_side = std::tan(70 * kPi / 180), height = radius * tan_side;
+  RawSamples s;
+  if (floor) {
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) {
+        const double x = i * spacing, z = j * spacing;
+        if (std::hypot(x - cx, z - cz) < radius) continue;  // under the cone
+        s.points.push_back({x, 0, z}), s.normals.push_back({0, 1, 0});
+      }
+    }
+  }
+  // Rings up the cone's side, samples about `spacing` apart along and around it.
+  const double along = spacing * std::sin(70 * kPi / 180);
+  for (double y = 0; y <= height; y += along) {
+    const double r = (height - y) / tan_side;
+    const int around = std::max(1, static_cast<int>(2 * kPi * r / spacing));
+    for (int k = 0; k < around; ++k) {
+      const double a = 2 * kPi * k / around;
+      const Vec3 n{std::cos(a) * std::sin(70 * kPi / 180), std::cos(70 * kPi / 180),
+                   std::sin(a) * std::sin(70 * kPi / 180)};
+      s.points.push_back({cx + r * std::cos(a), y, cz + r * std::sin(a)}), s.normals.push_back(n);
+    }
+  }
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("A start where the character cannot stand moves to the nearest place where it can",
+          "[steps][generator]") {
+  // The characters that cannot stand on the cone's sides: upright ones (those aligned to the
+  // terrain's normal stand on one side of it, their up along its normal).
+  int tested = 0;
+  for (const std::string& name : ShippedCharacters()) {
+    INFO(name);
+    const Character c = LoadShipped(name);
+    if (c.align_to_normal || c.max_slope_deg >= 70) continue;
+    ++tested;
+    const double spacing = 0.15 * c.step_length, radius = 2 * c.step_length;
+    const int n = static_cast<int>(8 * radius / spacing);
+    Terrain t = LoadTerrain(FloorWithCone(n, spacing, radius, true), spacing);
+    const double centre = 0.5 * (n - 1) * spacing;
+    GenerateOptions o;
+    o.steps = 2;
+    // The default start: the cone's tip, which moves down to the floor beside the cone.
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    CHECK(w.stopped.find("cannot stand") == std::string::npos);
+    const WalkKey& b = Body(w).keys.front();
+    CHECK(b.position.y == Approx(c.body_height).margin(1e-9));
+    for (const WalkTrack& tr : w.tracks)
+      if (tr.kind == TrackKind::kFoot) CHECK(tr.keys.front().position.y == Approx(0).margin(1e-6));
+    // The nearest such place: the candidates lie at the tip's height, and snap to the floor
+    // from radius / cos(70 deg) out (nearer, to the cone's side); the start lies within a
+    // grid cell and a foot's spread of there.
+    const double off = std::hypot(b.position.x - centre, b.position.z - centre);
+    double spread = 0;
+    for (const FootSpec& f : c.feet) spread = std::max(spread, Length(f.rest));
+    CHECK(off > radius);
+    CHECK(off < radius / std::cos(70 * kPi / 180) + spread + c.step_length);
+
+    // A start given on the tip stands there, and the walk stops at once saying why...
+    o.has_start = true;
+    o.start = {centre, 10 * radius, centre};
+    const Walk given = Generate(t, c, o);
+    CHECK_THAT(given.stopped, Catch::Contains("step 1: foot") && Catch::Contains("cannot stand"));
+    // ... unless it may move: then as the default start.
+    o.start_may_move = true;
+    const Walk moved = Generate(t, c, o);
+    CHECK(moved.stopped.find("cannot stand") == std::string::npos);
+    CHECK(Body(moved).keys.front().position.y == Approx(c.body_height).margin(1e-9));
+
+    // Nowhere to stand (the cone alone): the walk stops at its tip, as before.
+    Terrain cone = LoadTerrain(FloorWithCone(n, spacing, radius, false), spacing);
+    const Walk nowhere = Generate(cone, c, GenerateOptions{});
+    CHECK_THAT(nowhere.stopped, Catch::Contains("step 1: foot") && Catch::Contains("cannot stand"));
+  }
+  CHECK(tested >= 1);
+}
+
+namespace {
+
 // A real embedded session that counts the batch calls it serves.
 class CountingSession final : public TerrainSession {
  public:

@@ -155,3 +155,28 @@ TEST_CASE("PrepareWalkTerrain: a path walked to its end widens the box along it"
   CHECK(PrepareWalkTerrain(FOOTFALL_SOURCE_DIR "/data/terrain/stairs.pts", TerrainLoadOptions{}, c,
                            o, &prepared, &error) == Status::kInvalidArgument);
 }
+
+TEST_CASE("PrepareWalkTerrain: a start that may move keeps its search area in the box",
+          "[steps][terrain]") {
+  const Character c = LoadShipped("hexapod");
+  const BumpyAsc asc(60, 0.5, "search");
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {15, 0, 15};
+  o.steps = 4;
+  WalkTerrain fixed, moving;
+  std::string error;
+  REQUIRE(PrepareWalkTerrain(asc.path, TerrainLoadOptions{}, c, o, &fixed, &error) == Status::kOk);
+  o.start_may_move = true;
+  REQUIRE(PrepareWalkTerrain(asc.path, TerrainLoadOptions{}, c, o, &moving, &error) == Status::kOk);
+  REQUIRE(fixed.cropped);
+  REQUIRE(moving.cropped);
+  // Wider by the search radius on every side.
+  const double r = StartSearchRadius(c);
+  CHECK(r == Approx(kStartSearchSteps * c.step_length));
+  CHECK(fixed.region_min.x - moving.region_min.x == Approx(r));
+  CHECK(moving.region_max.z - fixed.region_max.z == Approx(r));
+  // Every candidate the generator may stand on lies inside (in the plane across up).
+  for (const Vec3& d : {Vec3{r, 0, 0}, Vec3{-r, 0, 0}, Vec3{0, 0, r}, Vec3{0, 0, -r}})
+    CHECK(Inside(moving.start + d, moving));
+}

@@ -186,8 +186,12 @@ int RunGenerate(const GenerateFlags& flags) {
                              &prepared, &error) != Status::kOk)
         goto bad_flag;
       ReportResampling(terrain_flags.terrain, character, prepared);
-      // The default start, found on the surface before cropping (a --start is snapped as given).
-      if (!options.has_start) options.start = prepared.start, options.has_start = true;
+      // The default start, found on the surface before cropping (a --start is snapped as
+      // given); it may still move to where the character can stand, within the crop.
+      if (!options.has_start) {
+        options.start = prepared.start, options.has_start = true;
+        options.start_may_move = true;
+      }
       if (OpenSession(terrain_flags, &session, &error) != Status::kOk) goto bad_flag;
       if (session->LoadSamples(prepared.samples, terrain_flags.terrain, &terrain) != Status::kOk) {
         error = session->last_error();
@@ -245,7 +249,8 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
       ->required();
   cmd->add_option("--start", flags->start,
                   "X,Y,Z where the character starts (default: the sample nearest the centre of "
-                  "the top of the terrain's bounds)");
+                  "the top of the terrain's bounds, or the nearest place within 12 steps where "
+                  "the character can stand)");
   cmd->add_option("--heading", flags->heading,
                   "DX,DY,DZ facing direction, projected onto the ground (default 0,0,1)");
   cmd->add_option("--path", flags->path,

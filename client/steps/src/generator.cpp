@@ -125,6 +125,15 @@ class Generator {
 
  private:
   Status Setup(std::string* error);
+  // 1. The start's sample: where `start` snaps, or, when it may move and the character cannot
+  //    stand there, the nearest candidate around it where it can (GenerateOptions).
+  Status FindStart(const Vec3& start, bool may_move, Foothold* first, std::string* error);
+  // 2. Stands a on `ground` in the start's frame (up0, fwd0): its up and its heading, turned
+  //    toward its path's first waypoint when it has one.
+  void Orient(Agent& a, const Foothold& ground, const Vec3& up0, const Vec3& fwd0) const;
+  // 3-4. Plants a's feet on `feet`, the snaps of their rest positions (Place), and moves its
+  //    frame and ground to them. Returns why a foot cannot stand there, or "".
+  std::string Plant(Agent& a, const Foothold* feet) const;
   Status Step(int k, std::string* error);
   Status QueryFootholds(std::string* error);
   // Accepts the answer h to mv's foothold query, or records why it is refused.
@@ -378,18 +387,13 @@ Status Generator::Setup(std::string* error) {
              ? 2 * g.cell_size *
                    std::sqrt(static_cast<double>(g.occupied_cells) / static_cast<double>(g.samples))
              : 0;
-  // 1. The start: --start, or the sample nearest the centre of the top of the bounds.
-  Vec3 start = o_.start;
-  if (!o_.has_start) start = TopCentre(info.stats.bounds_min, info.stats.bounds_max, world_up_);
+  // 1. The start: --start, or the centre of the top of the bounds; either may move to where
+  //    the character can stand.
+  const Vec3 start =
+      o_.has_start ? o_.start : TopCentre(info.stats.bounds_min, info.stats.bounds_max, world_up_);
   Foothold first;
-  s = Check(session_.Snap(terrain_, &start, 1, &first), "snap start", error);
+  s = FindStart(start, !o_.has_start || o_.start_may_move, &first, error);
   if (s != Status::kOk) return s;
-  if (first.status != Status::kOk) {
-    *error = first.status == Status::kInvalidArgument
-                 ? "the start is too far from the terrain to snap (queries reach 1e15 from it)"
-                 : "the terrain is empty: no sample to start on";
-    return Status::kInvalidArgument;
-  }
   // 2. The start frame: up (terrain normal for multipeds, world up for bipeds) and the heading
   //    projected onto the plane perpendicular to it. Crowds stand on a grid in that plane.
   const Vec3 up0 = c_.align_to_normal ? first.normal : world_up_;
@@ -417,14 +421,8 @@ Status Generator::Setup(std::string* error) {
   for (int i = 0; i < n; ++i) {
     Agent& a = agents_[i];
     if (n > 1) a.id = "c" + std::to_string(i + 1);
-    a.ground = answers_[i].point;
-    a.up = c_.align_to_normal ? answers_[i].normal : world_up_;
-    a.forward = TangentForward(o_.heading, fwd0, up0, a.up);
     for (const Vec3& p : o_.path) a.path.push_back(p + offsets[i]);
-    if (!a.path.empty()) {
-      const Vec3 to = ProjectOnPlane(a.path[0] - a.ground, a.up);
-      if (Length2(to) > 1e-18) a.forward = Normalize(to);
-    }
+    Orient(a, answers_[i], up0, fwd0);
     a.first_track = walk_.tracks.size();
     for (size_t f = 0; f <= feet; ++f) {
       WalkTrack t;
@@ -450,32 +448,123 @@ Status Generator::Setup(std::string* error) {
   //    the start frame.
   for (int i = 0; i < n; ++i) {
     Agent& a = agents_[i];
-    a.foot.resize(feet), a.foot_normal.resize(feet);
-    Vec3 centroid;
-    for (size_t f = 0; f < feet; ++f) {
-      a.foot[f] = answers_[i * feet + f].point;
-      a.foot_normal[f] = answers_[i * feet + f].normal;
-      centroid += a.foot[f];
-    }
-    const Vec3 old_up = a.up;
-    a.up = AveragedUp(a.up, a.foot_normal);
-    a.body_up = BodyUp(a.up, a.foot);
-    a.forward = TangentForward(a.forward, a.forward, old_up, a.up);
-    a.ground = centroid / static_cast<double>(feet);
-    for (size_t f = 0; f < feet; ++f) {
+    const std::string fault = Plant(a, &answers_[i * feet]);
+    for (size_t f = 0; f < feet; ++f)
       KeyFoot(a, static_cast<int>(f), o_.start_frame, KeyPhase::kEnd, a.foot[f], a.foot_normal[f]);
-      const double slope = Degrees(AngleBetween(a.foot_normal[f], a.up));
-      if (a.walking && slope > c_.max_slope_deg) {
-        std::ostringstream m;
-        m.precision(3);
-        m << "foot " << c_.feet[f].name << " cannot stand at " << Point(a.foot[f])
-          << ": ground leans " << slope << " deg, more than max_slope_deg " << c_.max_slope_deg;
-        Stop(a, 1, m.str());
-      }
-    }
+    if (!fault.empty()) Stop(a, 1, fault);
     KeyBody(a, o_.start_frame);
   }
   return Status::kOk;
+}
+
+Status Generator::FindStart(const Vec3& start, bool may_move, Foothold* first, std::string* error) {
+  Status s = Check(session_.Snap(terrain_, &start, 1, first), "snap start", error);
+  if (s != Status::kOk) return s;
+  if (first->status != Status::kOk) {
+    *error = first->status == Status::kInvalidArgument
+                 ? "the start is too far from the terrain to snap (queries reach 1e15 from it)"
+                 : "the terrain is empty: no sample to start on";
+    return Status::kInvalidArgument;
+  }
+  if (!may_move) return Status::kOk;
+  // Candidates on a grid of half a step across world up through the start's sample, nearest
+  // it first (the start itself first), each snapped; then the feet of one character standing
+  // on each. (A candidate snaps to the nearest sample: beside a tall feature it may snap to
+  // the feature's side rather than the ground below, and the search goes on farther out.)
+  const Vec3 centre = first->point;
+  const double cell = 0.5 * c_.step_length;
+  const int k = 2 * kStartSearchSteps;
+  std::vector<std::pair<int, int>> grid;
+  for (int j = -k; j <= k; ++j)
+    for (int i = -k; i <= k; ++i)
+      if (i * i + j * j <= k * k) grid.emplace_back(i, j);
+  std::stable_sort(grid.begin(), grid.end(), [](const auto& a, const auto& b) {
+    return a.first * a.first + a.second * a.second < b.first * b.first + b.second * b.second;
+  });
+  const Vec3 u = AnyPerpendicular(world_up_), v = Cross(world_up_, u);
+  const size_t feet = c_.feet.size();
+  const double beside = kFootholdTolerance * c_.step_length;
+  std::vector<Vec3> points;
+  std::vector<Foothold> grounds, snapped;
+  std::vector<Agent> stand;
+  // Candidates [b, e): sets *found to the first where the character can stand.
+  auto search = [&](size_t b, size_t e, bool* found) -> Status {
+    points.resize(e - b);
+    for (size_t m = b; m < e; ++m)
+      points[m - b] = centre + u * (grid[m].first * cell) + v * (grid[m].second * cell);
+    grounds.resize(points.size());
+    Status st = Check(session_.Snap(terrain_, points.data(), points.size(), grounds.data()),
+                      "snap start", error);
+    if (st != Status::kOk) return st;
+    stand.assign(grounds.size(), Agent{});
+    points.assign(grounds.size() * feet, Vec3{});
+    for (size_t m = 0; m < grounds.size(); ++m) {
+      if (grounds[m].status != Status::kOk) continue;
+      const Vec3 up0 = c_.align_to_normal ? grounds[m].normal : world_up_;
+      stand[m].path = o_.path;
+      Orient(stand[m], grounds[m], up0,
+             TangentForward(o_.heading, AnyPerpendicular(world_up_), world_up_, up0));
+      for (size_t f = 0; f < feet; ++f) points[m * feet + f] = Place(stand[m], c_.feet[f].rest);
+    }
+    snapped.resize(points.size());
+    st = Check(session_.Snap(terrain_, points.data(), points.size(), snapped.data()), "snap feet",
+               error);
+    if (st != Status::kOk) return st;
+    for (size_t m = 0; m < grounds.size() && !*found; ++m) {
+      if (grounds[m].status != Status::kOk) continue;
+      Agent& a = stand[m];
+      bool near = true;  // every foot near its rest position, along up and across it
+      for (size_t f = 0; f < feet && near; ++f) {
+        const Foothold& h = snapped[m * feet + f];
+        const Vec3 d = h.point - points[m * feet + f];
+        near = h.status == Status::kOk && std::fabs(Dot(d, a.up)) <= c_.max_rise &&
+               Length(ProjectOnPlane(d, a.up)) <= beside;
+      }
+      if (near && Plant(a, &snapped[m * feet]).empty()) *found = true, *first = grounds[m];
+    }
+    return Status::kOk;
+  };
+  // The start alone first: usually the character stands there, and nothing more is asked.
+  bool found = false;
+  s = search(0, 1, &found);
+  if (s == Status::kOk && !found) s = search(1, grid.size(), &found);
+  return s;  // found nowhere: the start's own sample, where Setup says why it cannot stand
+}
+
+void Generator::Orient(Agent& a, const Foothold& ground, const Vec3& up0, const Vec3& fwd0) const {
+  a.ground = ground.point;
+  a.up = c_.align_to_normal ? ground.normal : world_up_;
+  a.forward = TangentForward(o_.heading, fwd0, up0, a.up);
+  if (!a.path.empty()) {
+    const Vec3 to = ProjectOnPlane(a.path[0] - a.ground, a.up);
+    if (Length2(to) > 1e-18) a.forward = Normalize(to);
+  }
+}
+
+std::string Generator::Plant(Agent& a, const Foothold* feet) const {
+  const size_t n = c_.feet.size();
+  a.foot.resize(n), a.foot_normal.resize(n);
+  Vec3 centroid;
+  for (size_t f = 0; f < n; ++f) {
+    a.foot[f] = feet[f].point, a.foot_normal[f] = feet[f].normal;
+    centroid += a.foot[f];
+  }
+  const Vec3 old_up = a.up;
+  a.up = AveragedUp(a.up, a.foot_normal);
+  a.body_up = BodyUp(a.up, a.foot);
+  a.forward = TangentForward(a.forward, a.forward, old_up, a.up);
+  a.ground = centroid / static_cast<double>(n);
+  for (size_t f = 0; f < n; ++f) {
+    const double slope = Degrees(AngleBetween(a.foot_normal[f], a.up));
+    if (slope > c_.max_slope_deg) {
+      std::ostringstream m;
+      m.precision(3);
+      m << "foot " << c_.feet[f].name << " cannot stand at " << Point(a.foot[f])
+        << ": ground leans " << slope << " deg, more than max_slope_deg " << c_.max_slope_deg;
+      return m.str();
+    }
+  }
+  return "";
 }
 
 Status Generator::QueryFootholds(std::string* error) {
@@ -915,6 +1004,10 @@ Vec3 TopCentre(const Vec3& lo, const Vec3& hi, const Vec3& up) {
     top = std::max(top, Dot(corner - centre, up));
   }
   return centre + up * top;
+}
+
+double StartSearchRadius(const Character& character) {
+  return kStartSearchSteps * character.step_length;
 }
 
 double MaxStepTravel(const Character& character) {

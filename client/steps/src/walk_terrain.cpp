@@ -52,7 +52,10 @@ Status PrepareWalkTerrain(const std::string& path, const TerrainLoadOptions& loa
 
   // The box the walk cannot leave: its steps from the start, or, along a path walked to its
   // end, the path's box widened by a few steps.
-  const double spread = SpreadAroundStart(character, options);
+  // A start that may move (the default one) may stand anywhere within the search radius.
+  const bool may_move = !options.has_start || options.start_may_move;
+  const double spread =
+      SpreadAroundStart(character, options) + (may_move ? StartSearchRadius(character) : 0);
   const double travel = MaxStepTravel(character);
   Vec3 lo = out->start, hi = out->start;
   double widen = 0;

@@ -30,11 +30,23 @@ constexpr double kSeparationPerStep = 0.25;
 constexpr int kDefaultSteps = 8;
 constexpr int kMaxPathSteps = 10000;
 
+// A start that may move (the default start, or GenerateOptions::start_may_move) moves to the
+// nearest place within this many step lengths where the character can stand, looked for on a
+// grid of half a step.
+constexpr int kStartSearchSteps = 12;
+
 struct GenerateOptions {
-  // Where the (first) character stands, snapped to the terrain. World space. Unset: the sample
-  // nearest the centre of the top of the terrain's bounds (top along `up`).
+  // Where the (first) character stands, snapped to the terrain. World space. Unset: the centre
+  // of the top of the terrain's bounds (top along `up`), which may move (start_may_move).
   bool has_start = false;
   Vec3 start;
+  // With a start: false, the characters stand where it snaps (a foot that cannot stand there
+  // stops the walk at step 1); true, as for the default start: when the character cannot stand
+  // there (a foot on ground steeper than max_slope_deg, or more than max_rise above or below
+  // its rest position, or half a step beside it), it starts at the nearest point of a grid of
+  // half a step around the start, within kStartSearchSteps step lengths in the plane across
+  // `up`, where it can; if none, where the start snaps.
+  bool start_may_move = false;
   // Facing direction, projected onto the start's tangent plane. World space, non-zero.
   Vec3 heading{0, 0, 1};
   // Waypoints to follow, in order (one point: a goal). World space. The heading turns toward
@@ -70,6 +82,9 @@ struct GenerateOptions {
 // Where GenerateWalk starts when GenerateOptions has no start (before snapping): the centre of
 // the top face of the box [lo, hi] along the unit vector `up`.
 Vec3 TopCentre(const Vec3& lo, const Vec3& hi, const Vec3& up);
+
+// How far from the start the characters may stand when their start may move. [Units: wu]
+double StartSearchRadius(const Character& character);
 
 // The farthest a foot of `character` can move in one step: its longest try, aimed down as far
 // as any try, plus the distance within which a foothold is taken. [Units: wu]

@@ -5,9 +5,9 @@
 // step: a biped looks for a foothold within 0.35 m of where it aims, an insect within 6 cm.
 // PrepareWalkTerrain resamples the surface at kSeparationPerStep (generator.h) of the
 // character's step, but only within a box around the start that the walk cannot leave
-// (MaxStepTravel per step, the feet's rest spread, the crowd's grid, the reach and the swing
-// arcs' height), so that a small character on a large terrain costs what its walk covers, not
-// the whole file.
+// (MaxStepTravel per step, the feet's rest spread, the crowd's grid, the reach, the swing
+// arcs' height and, for a start that may move, StartSearchRadius), so that a small character on a
+// large terrain costs what its walk covers, not the whole file.
 #pragma once
 
 #include <string>
@@ -27,7 +27,8 @@ struct WalkTerrain {
   TerrainLoadReport report;  // what was read and how it was resampled
   // Where the walk starts: options.start, or the surface point nearest the centre of the top of
   // the terrain's bounds along options.up (GenerateWalk's default, found on the surface before
-  // cropping); world space, not yet snapped to a sample.
+  // cropping; the caller lets it move, GenerateOptions::start_may_move, within the box); world
+  // space, not yet snapped to a sample.
   Vec3 start;
   double wanted_separation = 0;  // kSeparationPerStep * step_length [Units: wu]
   // The box the surface was cropped to (triangles meeting it were kept); false: all of it.
