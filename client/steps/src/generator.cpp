@@ -50,6 +50,13 @@ constexpr size_t kNoQuery = ~size_t{0};
 // ~20 us).
 constexpr size_t kMinParallel = 512;
 
+// The distance from p to the box [lo, hi] (0 inside).
+double BoxDistance(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  const Vec3 out{std::max({lo.x - p.x, 0.0, p.x - hi.x}), std::max({lo.y - p.y, 0.0, p.y - hi.y}),
+                 std::max({lo.z - p.z, 0.0, p.z - hi.z})};
+  return Length(out);
+}
+
 std::string Point(const Vec3& p) {
   std::ostringstream o;
   o.precision(4);
@@ -201,6 +208,7 @@ class Generator {
   // The farthest a point of the surface may be from its nearest sample, estimated from the
   // grid: twice the mean spacing, cell_size / sqrt(samples per occupied cell). [Units: wu]
   double gap_ = 0;
+  Vec3 bounds_min_, bounds_max_;  // the terrain's samples' bounds
   // cos(max_slope_deg), sin(slope_threshold_deg): slope tests on dot products of unit vectors.
   double cos_max_slope_ = -1, sin_slope_threshold_ = 1;
   std::vector<Agent> agents_;
@@ -383,6 +391,7 @@ Status Generator::Setup(std::string* error) {
   Status s = Check(session_.Info(terrain_, &info), "terrain info", error);
   if (s != Status::kOk) return s;
   const GridStats& g = info.stats;
+  bounds_min_ = g.bounds_min, bounds_max_ = g.bounds_max;
   gap_ = g.samples > 0
              ? 2 * g.cell_size *
                    std::sqrt(static_cast<double>(g.occupied_cells) / static_cast<double>(g.samples))
@@ -705,8 +714,11 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
   std::ostringstream why;                // refused: say why (only built on this rare path)
   why.precision(3);
   if (!found) {
-    why << "no foothold within " << kFootholdTolerance * c_.step_length << " of " << Point(mv.ideal)
-        << " (a gap or a cliff)";
+    // Past the terrain's bounds by more than the radius, no sample can be a foothold.
+    const double radius = kFootholdTolerance * c_.step_length;
+    const bool beyond = BoxDistance(mv.ideal, bounds_min_, bounds_max_) > radius;
+    why << "no foothold within " << radius << " of " << Point(mv.ideal)
+        << (beyond ? " (the terrain ends before it)" : " (a gap or a cliff)");
     // Samples spread wider than half that radius leave gaps everywhere: say so.
     const double spacing = 0.5 * gap_;
     if (spacing > 0.5 * kFootholdTolerance * c_.step_length) {
