@@ -40,7 +40,7 @@ void BM_UniformRandom(benchmark::State& state) {
   const size_t count = static_cast<size_t>(state.range(0));
   footfall::RawSamples samples;
   for (auto _ : state) {
-    footfall::SampleMeshUniform(mesh, count, true, 1, &samples);
+    footfall::SampleMeshUniform(mesh, count, true, footfall::kDefaultCreaseAngleDeg, 1, &samples);
     benchmark::DoNotOptimize(samples.points.data());
   }
   state.counters["samples_per_s"] = benchmark::Counter(

@@ -42,6 +42,18 @@ expect(EXIT_ZERO "wrote" terrain convert "${WORK}/cube.obj" --separation 0.1 -o 
 expect(EXIT_ZERO "format: points" terrain info "${WORK}/cube.pts")
 expect(EXIT_ZERO "wrote" terrain make blocks --size 4 --spacing 0.2 -o "${WORK}/blocks.pts")
 expect(EXIT_ZERO "\"found\":true" query --terrain "${WORK}/cube.obj" --separation 0.1)
+# Smooth normals stop at the cube's edges (--crease-angle, default 60): the top face's normal is
+# straight up away from its centre; smoothed across every edge (180) it leans toward the corners.
+file(WRITE "${WORK}/stdin.txt" "normal 0.25 1.05 0.25\n")
+expect(EXIT_ZERO "\"normal\":[0.0,1.0,0.0]" query --terrain "${WORK}/cube.obj" --separation 0.1)
+execute_process(COMMAND "${FOOTFALL}" query --terrain "${WORK}/cube.obj" --separation 0.1
+                        --crease-angle 180
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out INPUT_FILE "${WORK}/stdin.txt")
+if(NOT rc EQUAL 0 OR NOT out MATCHES "\"found\":true" OR out MATCHES "\"normal\":\\[0.0,1.0,0.0\\]")
+  message(FATAL_ERROR "--crease-angle 180: expected a normal leaning off +y, got ${out}")
+endif()
+expect(EXIT_NONZERO "--crease-angle" query --terrain "${WORK}/cube.obj" --crease-angle 200)
+file(WRITE "${WORK}/stdin.txt" "snap 0.5 2 0.5\n")
 # Bad files: non-zero exit and a message naming the file and the problem.
 expect(EXIT_NONZERO "empty.obj: the file is empty" terrain info "${WORK}/empty.obj")
 expect(EXIT_NONZERO "nan.obj:2: vertex coordinate 'nan' is not a finite number"

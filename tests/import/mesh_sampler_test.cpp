@@ -65,7 +65,7 @@ TEST_CASE("SampleMesh: no surface point is farther than the separation from a sa
     for (double s : {0.2, 0.45}) {
       const RawSamples samples = Sample(mesh, s);
       RawSamples probes;
-      SampleMeshUniform(mesh, 20000, true, 77, &probes);
+      SampleMeshUniform(mesh, 20000, true, kDefaultCreaseAngleDeg, 77, &probes);
       // The vertices are the hardest points to reach (corners of the surface).
       for (const Vec3& v : mesh.vertices) probes.push_back(v, {0, 1, 0});
       CHECK(LargestGap(samples, probes) <= s * (1 + 1e-5));

@@ -95,7 +95,7 @@ TEST_CASE("Spot: a closed mesh with overhangs loads and answers queries", "[impo
   const TerrainGrid grid = Grid(samples);
   // Snap points around the cow: the answer lies on the surface, with an outward normal.
   RawSamples probes;
-  SampleMeshUniform(mesh, 300, false, 3, &probes);
+  SampleMeshUniform(mesh, 300, false, kDefaultCreaseAngleDeg, 3, &probes);
   for (size_t i = 0; i < probes.size(); ++i) {
     const Vec3 outside = probes.points[i] + probes.normals[i] * 0.01;
     const Foothold f = grid.Snap(outside);

@@ -61,4 +61,50 @@ TEST_CASE("CropToBox: keeps exactly the triangles meeting the box, and their ver
   CHECK(whole.triangles.size() == mesh.triangles.size());
 }
 
+TEST_CASE("CornerNormals: smooth across gentle edges, sharp at creases", "[import][mesh]") {
+  // Two unit squares folded along their shared edge (x from 0 to 1 at z = 0): one lies in the
+  // floor (normal +y), the other rises by `fold` degrees; vertices shared, as modelled.
+  constexpr double kPi = 3.14159265358979323846;
+  for (const double fold : {20.0, 59.0, 61.0, 90.0}) {
+    INFO("fold " << fold);
+    const double a = fold * kPi / 180;
+    TriangleMesh sheet;
+    sheet.vertices = {{0, 0, -1},
+                      {1, 0, -1},
+                      {0, 0, 0},
+                      {1, 0, 0},
+                      {0, std::sin(a), std::cos(a)},
+                      {1, std::sin(a), std::cos(a)}};
+    sheet.triangles = {{0, 2, 3}, {0, 3, 1}, {2, 4, 5}, {2, 5, 3}};
+    const Vec3 floor{0, 1, 0}, rise{0, std::cos(a), -std::sin(a)};
+    for (const double crease : {0.0, 60.0, 180.0}) {
+      INFO("crease " << crease);
+      const CornerNormals normals(sheet, crease);
+      const bool smooth = fold <= crease;
+      for (size_t t = 0; t < sheet.triangles.size(); ++t) {
+        const Vec3 face = t < 2 ? floor : rise;
+        const std::array<Vec3, 3> n = normals.Of(t);
+        for (int k = 0; k < 3; ++k) {
+          // Smooth: the area-weighted mean of every triangle at the vertex (each triangle is
+          // half a unit square here); sharp: the face's own.
+          const uint32_t v = sheet.triangles[t][k];
+          Vec3 sum;
+          for (size_t u = 0; u < sheet.triangles.size(); ++u) {
+            const auto& tri = sheet.triangles[u];
+            if (tri[0] == v || tri[1] == v || tri[2] == v) sum += u < 2 ? floor : rise;
+          }
+          const Vec3 want = smooth ? Normalize(sum) : face;
+          CHECK(Distance(n[k], want) < 1e-12);
+        }
+      }
+    }
+  }
+  // A degenerate triangle has no normal.
+  TriangleMesh flat;
+  flat.vertices = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+  flat.triangles = {{0, 1, 2}};
+  const std::array<Vec3, 3> none = CornerNormals(flat, 60).Of(0);
+  for (const Vec3& n : none) CHECK(n == Vec3{});
+}
+
 }  // namespace footfall

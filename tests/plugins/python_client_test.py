@@ -101,6 +101,26 @@ class SharedLogicTest(unittest.TestCase):
                 probe = [p[:3] for p in samples[::7]]
                 self.assertEqual(s.snap(a, probe), s.snap(b, probe))
 
+    def test_corner_normals_keep_sharp_edges(self):
+        # A floor square and a square folded up from its edge z = 0 by `fold` degrees, vertices
+        # shared: smooth across 20 degrees, sharp across 90 (the crease angle is 60).
+        for fold, sharp in ((20.0, False), (90.0, True)):
+            a = math.radians(fold)
+            pts = [(0, 0, -1), (1, 0, -1), (0, 0, 0), (1, 0, 0),
+                   (0, math.sin(a), math.cos(a)), (1, math.sin(a), math.cos(a))]
+            tris = [(0, 2, 3), (0, 3, 1), (2, 4, 5), (2, 5, 3)]
+            normals = ff.sampling.corner_normals(pts, tris)
+            floor = normals[0][1]  # tris[0] corner at vertex 2, on the fold
+            self.assertAlmostEqual(floor[1], 1.0 if sharp else math.cos(a / 2), delta=0.1)
+            self.assertEqual(normals[0][0], (0.0, 1.0, 0.0))  # away from the fold: the face's
+            samples = ff.sampling.sample_triangles(pts, tris, 0.25, normals)
+            on_floor = [s for s in samples if s[1] == 0 and s[2] < -1e-9]
+            self.assertTrue(on_floor)
+            leaning = [s for s in on_floor if abs(s[4] - 1.0) > 1e-9]
+            self.assertEqual(leaning == [], sharp)
+        # Smoothed everywhere (180): the fold's corner leans even at 90 degrees.
+        self.assertLess(ff.sampling.corner_normals(pts, tris, 180)[0][1][1], 0.99)
+
     def test_separation_must_be_positive(self):
         with self.assertRaises(ValueError):
             ff.sampling.sample_triangles([(0, 0, 0)] * 3, [(0, 1, 2)], 0)

@@ -11,7 +11,13 @@ void AddLoadFlags(CLI::App* command, TerrainLoadOptions* load) {
                    "than this from a sample (world units; 0: mean edge length / cell size)")
       ->check(FiniteAtLeast(0));
   command->add_flag("!--smooth-normals,--flat-normals", load->smooth_normals,
-                    "Sample normals from faces instead of interpolated vertex normals");
+                    "Sample normals from faces instead of interpolated corner normals");
+  command
+      ->add_option("--crease-angle", load->crease_angle_deg,
+                   "Meshes and height maps: edges whose faces meet at more than this many "
+                   "degrees stay sharp (smooth normals stop at them; default 30, 180: smooth "
+                   "everywhere)")
+      ->check(FiniteRange(0, 180));
   command->add_option("--seed", load->seed, "Seed of the mesh sampler");
   command->add_option("--up-axis", load->up_axis, "Height maps: up axis x, y or z")
       ->check(CLI::IsMember({'x', 'y', 'z'}));

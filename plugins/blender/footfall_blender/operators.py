@@ -76,9 +76,7 @@ def mesh_samples(context, obj, separation):
     try:
         mesh.calc_loop_triangles()
         mw = obj.matrix_world
-        nm = mw.to_3x3().inverted_safe().transposed()
         points = [to_ff(mw @ v.co) for v in mesh.vertices]
-        normals = [to_ff((nm @ v.normal).normalized()) for v in mesh.vertices]
         tris = [tuple(t.vertices) for t in mesh.loop_triangles]
     finally:
         evaluated.to_mesh_clear()
@@ -86,6 +84,9 @@ def mesh_samples(context, obj, separation):
         raise ValueError("%s has no faces" % obj.name)
     if mw.determinant() < 0:  # mirrored: keep the winding counter-clockwise
         tris = [(a, c, b) for a, b, c in tris]
+    # Normals from the geometry, as `footfall generate` samples a mesh file (smooth, sharp at
+    # edges past the crease angle), whatever the viewport's shading.
+    normals = sampling.corner_normals(points, tris)
     return sampling.sample_triangles(points, tris, separation, normals)
 
 

@@ -62,9 +62,10 @@ def _mesh_samples(mesh, separation):
     sel.add(mesh)
     fn = om.MFnMesh(sel.getDagPath(0))
     points = [(p.x, p.y, p.z) for p in fn.getPoints(om.MSpace.kWorld)]
-    normals = [(n.x, n.y, n.z) for n in fn.getVertexNormals(False, om.MSpace.kWorld)]
     counts, verts = fn.getTriangles()
     tris = [tuple(verts[i:i + 3]) for i in range(0, len(verts), 3)]
+    # Normals from the geometry, as `footfall generate` samples a mesh file.
+    normals = ffc.sampling.corner_normals(points, tris)
     return ffc.sampling.sample_triangles(points, tris, separation, normals)
 
 

@@ -2,7 +2,8 @@
 
 Each triangle is cut into a barycentric lattice whose edges are at most `separation` long; the
 lattice points are the samples (points shared by neighbouring triangles are kept once). Normals
-are the vertex normals interpolated across the triangle (smooth) or the face normal.
+are the triangle's corner normals interpolated across it (smooth: corner_normals, sharp at
+edges past a crease angle, as footfall's own sampler), or the face normal.
 """
 
 import math
@@ -25,17 +26,55 @@ def _unit(a):
     return None if n <= 1e-300 else (a[0] / n, a[1] / n, a[2] / n)
 
 
-def sample_triangles(points, triangles, separation, vertex_normals=None):
+# Edges whose faces meet at more than this many degrees stay sharp (footfall's
+# kDefaultCreaseAngleDeg): a stair's nose, a wall's foot, a block's rim.
+DEFAULT_CREASE_ANGLE_DEG = 60.0
+
+
+def corner_normals(points, triangles, crease_deg=DEFAULT_CREASE_ANGLE_DEG):
+    """Smooth normals that keep sharp edges, per triangle corner: corner k of triangle t gets the
+    area-weighted mean normal of the triangles around its vertex whose normals lie within
+    `crease_deg` of t's (t's own included). Returns, per triangle, three unit normals (None for
+    a degenerate triangle)."""
+    crosses = []
+    around = {}
+    for t, tri in enumerate(triangles):
+        a, b, c = (points[i] for i in tri)
+        crosses.append(_cross(_sub(b, a), _sub(c, a)))  # length = 2 * area: area weighting
+        for v in tri:
+            around.setdefault(v, []).append(t)
+    cos_crease = -2.0 if crease_deg >= 180 else math.cos(math.radians(max(crease_deg, 0.0)))
+    out = []
+    for t, tri in enumerate(triangles):
+        face = _unit(crosses[t])
+        if face is None:
+            out.append(None)
+            continue
+        corners = []
+        for v in tri:
+            sum_ = [0.0, 0.0, 0.0]
+            for u in around[v]:
+                n = crosses[u]
+                length = _length(n)
+                if length > 0 and n[0] * face[0] + n[1] * face[1] + n[2] * face[2] >= \
+                        cos_crease * length:
+                    sum_ = [sum_[d] + n[d] for d in range(3)]
+            corners.append(_unit(sum_) or face)
+        out.append(tuple(corners))
+    return out
+
+
+def sample_triangles(points, triangles, separation, normals=None):
     """points: (x, y, z) per vertex; triangles: (i, j, k) vertex indices, counter-clockwise
-    seen from the side the normals point to; separation [world units] > 0; vertex_normals:
-    per-vertex normals for smooth shading, or None for face normals. Returns a list of
-    (x, y, z, nx, ny, nz). Degenerate triangles are skipped."""
+    seen from the side the normals point to; separation [world units] > 0; normals: per
+    triangle, its three corner normals (corner_normals), or None for face normals. Returns a
+    list of (x, y, z, nx, ny, nz). Degenerate triangles are skipped."""
     if not separation > 0:
         raise ValueError("separation must be > 0, got %r" % (separation,))
     seen = set()
     quantum = separation * 1e-4
     out = []
-    for tri in triangles:
+    for t, tri in enumerate(triangles):
         a, b, c = (points[i] for i in tri)
         face = _unit(_cross(_sub(b, a), _sub(c, a)))
         if face is None:
@@ -43,8 +82,8 @@ def sample_triangles(points, triangles, separation, vertex_normals=None):
         longest = max(_length(_sub(b, a)), _length(_sub(c, b)), _length(_sub(a, c)))
         k = max(1, int(math.ceil(longest / separation - 1e-9)))
         na = nb = nc = None
-        if vertex_normals is not None:
-            na, nb, nc = (vertex_normals[i] for i in tri)
+        if normals is not None and normals[t] is not None:
+            na, nb, nc = normals[t]
         for i in range(k + 1):
             for j in range(k + 1 - i):
                 u, v = i / k, j / k

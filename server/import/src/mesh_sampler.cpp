@@ -190,14 +190,13 @@ Vec3 Blend(const Vec3& a, const Vec3& b, const Vec3& c, double u, double v) {
   return a * (1 - u - v) + b * u + c * v;
 }
 
-// Step 4: the sample normal at barycentric (u, v) of triangle t.
-Vec3 SampleNormal(const TriangleMesh& mesh, const std::vector<Vec3>& vertex_normals, size_t t,
-                  double u, double v) {
+// Step 4: the sample normal at barycentric (u, v) of triangle t, whose corner normals are
+// `corners` (CornerNormals::Of), or nullptr for the face's.
+Vec3 SampleNormal(const TriangleMesh& mesh, const std::array<Vec3, 3>* corners, size_t t, double u,
+                  double v) {
   const Vec3 face = Normalize(TriangleCross(mesh, t));
-  if (vertex_normals.empty()) return face;
-  const auto& tri = mesh.triangles[t];
-  const Vec3 n =
-      Blend(vertex_normals[tri[0]], vertex_normals[tri[1]], vertex_normals[tri[2]], u, v);
+  if (!corners) return face;
+  const Vec3 n = Blend((*corners)[0], (*corners)[1], (*corners)[2], u, v);
   const double length = Length(n);
   if (!(length > 1e-12) || Dot(n, face) <= 0) return face;
   return n / length;
@@ -486,8 +485,7 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
 
   // 4. Points and normals, in triangle order.
   std::sort(accepted.begin(), accepted.end());
-  const std::vector<Vec3> vertex_normals =
-      options.smooth_normals ? VertexNormals(mesh) : std::vector<Vec3>{};
+  const CornerNormals corner_normals(mesh, options.smooth_normals ? options.crease_angle_deg : 0);
   out->points.reserve(accepted.size());
   out->normals.reserve(accepted.size());
   const size_t accepted_count = accepted.size();
@@ -505,18 +503,20 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
                           static_cast<float>((piece.b[0][1] + piece.b[1][1] + piece.b[2][1]) / 3)});
       return true;
     });
+    const std::array<Vec3, 3> corners = corner_normals.Of(t);
     for (; a < accepted.size() && accepted[a] < first_candidate[t + 1]; ++a) {
       const auto& uv = piece_uv[accepted[a] - first_candidate[t]];
-      out->push_back(SamplePoint(mesh, t, uv[0], uv[1]),
-                     SampleNormal(mesh, vertex_normals, t, uv[0], uv[1]));
+      out->push_back(
+          SamplePoint(mesh, t, uv[0], uv[1]),
+          SampleNormal(mesh, options.smooth_normals ? &corners : nullptr, t, uv[0], uv[1]));
     }
   }
   if (stats) stats->candidates = n, stats->samples = accepted_count;
   return Status::kOk;
 }
 
-void SampleMeshUniform(const TriangleMesh& mesh, size_t count, bool smooth_normals, uint64_t seed,
-                       RawSamples* out) {
+void SampleMeshUniform(const TriangleMesh& mesh, size_t count, bool smooth_normals,
+                       double crease_angle_deg, uint64_t seed, RawSamples* out) {
   out->clear();
   if (mesh.triangles.empty()) return;
   std::vector<double> cumulative(mesh.triangles.size());
@@ -525,8 +525,7 @@ void SampleMeshUniform(const TriangleMesh& mesh, size_t count, bool smooth_norma
     total += Length(TriangleCross(mesh, t));
     cumulative[t] = total;
   }
-  const std::vector<Vec3> vertex_normals =
-      smooth_normals ? VertexNormals(mesh) : std::vector<Vec3>{};
+  const CornerNormals corner_normals(mesh, smooth_normals ? crease_angle_deg : 0);
   SplitMix64 rng(seed);
   out->points.reserve(count);
   out->normals.reserve(count);
@@ -537,7 +536,9 @@ void SampleMeshUniform(const TriangleMesh& mesh, size_t count, bool smooth_norma
         mesh.triangles.size() - 1);
     double u = rng.Unit(), v = rng.Unit();
     if (u + v > 1) u = 1 - u, v = 1 - v;
-    out->push_back(SamplePoint(mesh, t, u, v), SampleNormal(mesh, vertex_normals, t, u, v));
+    const std::array<Vec3, 3> corners = corner_normals.Of(t);
+    out->push_back(SamplePoint(mesh, t, u, v),
+                   SampleNormal(mesh, smooth_normals ? &corners : nullptr, t, u, v));
   }
 }
 

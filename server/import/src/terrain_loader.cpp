@@ -128,6 +128,7 @@ Status ResampleTerrainMesh(const std::string& path, const TriangleMesh& mesh,
     sample.separation = std::max(std::min(file_separation, options.finest_default), fits);
   }
   sample.smooth_normals = options.smooth_normals;
+  sample.crease_angle_deg = options.crease_angle_deg;
   sample.seed = options.seed;
   sample.max_samples = options.max_samples;
   std::string why;

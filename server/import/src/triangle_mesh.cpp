@@ -1,9 +1,13 @@
 #include "footfall/import/triangle_mesh.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace footfall {
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+}  // namespace
 
 Vec3 TriangleCross(const TriangleMesh& mesh, size_t t) {
   const auto& tri = mesh.triangles[t];
@@ -28,6 +32,39 @@ std::vector<Vec3> VertexNormals(const TriangleMesh& mesh) {
     n = length > 0 ? n / length : Vec3{};
   }
   return normals;
+}
+
+CornerNormals::CornerNormals(const TriangleMesh& mesh, double crease_deg)
+    : mesh_(mesh),
+      cos_crease_(crease_deg >= 180 ? -2.0 : std::cos(std::max(crease_deg, 0.0) * kPi / 180)) {
+  first_.assign(mesh.vertices.size() + 1, 0);
+  for (const auto& tri : mesh.triangles)
+    for (uint32_t v : tri) ++first_[v + 1];
+  for (size_t v = 0; v < mesh.vertices.size(); ++v) first_[v + 1] += first_[v];
+  around_.resize(first_.back());
+  std::vector<uint32_t> next(first_.begin(), first_.end() - 1);
+  for (size_t t = 0; t < mesh.triangles.size(); ++t)
+    for (uint32_t v : mesh.triangles[t]) around_[next[v]++] = static_cast<uint32_t>(t);
+}
+
+std::array<Vec3, 3> CornerNormals::Of(size_t t) const {
+  const Vec3 cross = TriangleCross(mesh_, t);
+  const double length = Length(cross);
+  std::array<Vec3, 3> out{};
+  if (!(length > 0)) return out;
+  const Vec3 face = cross / length;
+  for (int k = 0; k < 3; ++k) {
+    const uint32_t v = mesh_.triangles[t][k];
+    Vec3 sum;
+    for (uint32_t i = first_[v]; i < first_[v + 1]; ++i) {
+      const Vec3 n = TriangleCross(mesh_, around_[i]);  // length = 2 * area: area weighting
+      const double l = Length(n);
+      if (l > 0 && Dot(n, face) >= cos_crease_ * l) sum += n;
+    }
+    const double l = Length(sum);
+    out[k] = l > 0 ? sum / l : face;
+  }
+  return out;
 }
 
 void MeshBounds(const TriangleMesh& mesh, Vec3* lo, Vec3* hi) {

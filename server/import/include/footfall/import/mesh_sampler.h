@@ -29,12 +29,21 @@
 
 namespace footfall {
 
+// The default crease angle of smooth normals (MeshSampleOptions::crease_angle_deg). [Units:
+// degrees]
+constexpr double kDefaultCreaseAngleDeg = 60;
+
 struct MeshSampleOptions {
   // Point separation s: the farthest any surface point may be from a sample. [Units: wu] [Limit: >
   // 0]
   double separation = 1;
-  // Normals interpolated from vertex normals (true) or the face's (false).
+  // Normals interpolated across each triangle from its corners' (true: CornerNormals, smooth
+  // across edges gentler than crease_angle_deg) or the face's (false).
   bool smooth_normals = true;
+  // Edges whose faces meet at a larger angle stay sharp: each face keeps its own normal up to
+  // them. [Units: degrees] 30: a modelling package's usual auto smooth; >= 180: smooth across
+  // every edge (plain vertex normals).
+  double crease_angle_deg = kDefaultCreaseAngleDeg;
   // Seed of the visiting order; equal seeds give equal samples.
   uint64_t seed = 1;
   // Refuse (kLimitExceeded) when area / s^2 predicts more samples than this.
@@ -54,8 +63,8 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
 
 // A baseline for benchmarks and tests: `count` points drawn uniformly at random on the surface
 // (area-weighted triangle choice), with the same normal rule. No spacing guarantee.
-void SampleMeshUniform(const TriangleMesh& mesh, size_t count, bool smooth_normals, uint64_t seed,
-                       RawSamples* out);
+void SampleMeshUniform(const TriangleMesh& mesh, size_t count, bool smooth_normals,
+                       double crease_angle_deg, uint64_t seed, RawSamples* out);
 
 // The separation used when none is given: the mean edge length of the mesh. [Units: wu]
 double DefaultSeparation(const TriangleMesh& mesh);

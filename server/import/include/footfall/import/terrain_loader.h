@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <string>
 
+#include "footfall/import/mesh_sampler.h"
 #include "footfall/import/triangle_mesh.h"
 #include "footfall/terrain/samples.h"
 
@@ -25,9 +26,10 @@ struct TerrainLoadOptions {
   // of the file's default and this (a caller that needs samples this close: a character's
   // steps), coarsened as needed to stay within max_samples. [Units: wu] [Limit: >= 0]
   double finest_default = 0;
-  // Meshes and height maps: normals interpolated from vertex normals (true) or taken from the
-  // face (false).
+  // Meshes and height maps: normals interpolated from the corners' (true; smooth across
+  // edges gentler than crease_angle_deg, see CornerNormals) or taken from the face (false).
   bool smooth_normals = true;
+  double crease_angle_deg = kDefaultCreaseAngleDeg;  // [Units: degrees]
   // Seed of the deterministic sampler: equal seeds give equal samples.
   uint64_t seed = 1;
   // Height maps: the world axis heights go along ('x', 'y' or 'z'). [Default: 'y', as in Maya]

@@ -25,6 +25,27 @@ double SurfaceArea(const TriangleMesh& mesh);
 // no triangle, or whose triangle normals cancel, gets (0, 0, 0).
 std::vector<Vec3> VertexNormals(const TriangleMesh& mesh);
 
+// Smooth-shading normals that keep sharp edges, per triangle corner: corner k of triangle t
+// gets the area-weighted mean normal of the triangles around its vertex whose normals lie
+// within `crease_deg` of t's (t's own included). Faces meeting at a sharper edge (a stair's
+// nose, a block's rim, a wall's foot) keep their own normals right up to it, as a modelling
+// package shades them with auto smooth; gentler edges (a terrain's facets) are smoothed over.
+// crease_deg >= 180 gives the plain vertex normals of VertexNormals, 0 the face normals.
+class CornerNormals {
+ public:
+  // Keeps a reference to `mesh`, which must outlive this and not change.
+  CornerNormals(const TriangleMesh& mesh, double crease_deg);
+  // The unit normals at the corners of triangle t, in its vertex order (the face's normal at a
+  // corner whose neighbours' normals cancel; (0, 0, 0) for a degenerate triangle).
+  std::array<Vec3, 3> Of(size_t t) const;
+
+ private:
+  const TriangleMesh& mesh_;
+  double cos_crease_;
+  std::vector<uint32_t> first_;   // per vertex + 1: offsets into around_
+  std::vector<uint32_t> around_;  // the triangles using each vertex
+};
+
 // World-space bounds of the vertices; both (0, 0, 0) for an empty mesh.
 void MeshBounds(const TriangleMesh& mesh, Vec3* lo, Vec3* hi);
 
