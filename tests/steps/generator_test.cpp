@@ -991,6 +991,62 @@ TEST_CASE("Insects climb walls of a modelled mesh, whose edges keep their faces'
   }
 }
 
+TEST_CASE("Insects descend a modelled flight of stairs, a group waiting for a foot left behind",
+          "[steps][generator]") {
+  // Ten steps of 0.18 x 0.28 m between a floor and a landing, one profile extruded (shared
+  // vertices, exact normals: smooth normals stop at the 90-degree edges), sampled for each
+  // insect at a quarter step, six seeds. Going down a riser three to four times their body
+  // height, the front feet drop to the tread below while a hind foot still stands on the tread
+  // above, and every try of the stepping group would leave it beyond reach: then the group
+  // steps in place, and the next group, that foot's, steps on. (Without the wait none of the
+  // six hexapods and 3 of the six octopods reached the floor; with it 4 and 5.)
+  const int steps = 10;
+  const double rise = 0.18, run = 0.28, width = 1.5;
+  std::vector<Vec3> profile = {{0, 0, -1}, {0, 0, 0}};
+  for (int k = 0; k < steps; ++k) {
+    profile.push_back({0, (k + 1) * rise, k * run});
+    profile.push_back({0, (k + 1) * rise, (k + 1) * run});
+  }
+  profile.push_back({0, steps * rise, steps * run + 1.5});
+  TriangleMesh flight;
+  for (const Vec3& p : profile) {
+    flight.vertices.push_back(p);
+    flight.vertices.push_back(p + Vec3{width, 0, 0});
+  }
+  for (uint32_t k = 0; k + 1 < profile.size(); ++k) {
+    const uint32_t a = 2 * k, b = a + 1, c = a + 2, d = a + 3;
+    flight.triangles.push_back({a, c, d});
+    flight.triangles.push_back({a, d, b});
+  }
+  for (const std::string name : {"hexapod", "octopod"}) {
+    const Character c = LoadShipped(name);
+    int down = 0, waits = 0;
+    for (const uint64_t seed : {1, 2, 3, 4, 5, 6}) {
+      RawSamples samples;
+      MeshSampleOptions mo;
+      mo.separation = kSeparationPerStep * c.step_length;
+      mo.seed = seed;
+      REQUIRE(SampleMesh(flight, mo, &samples, nullptr) == Status::kOk);
+      Terrain t = LoadTerrain(samples, mo.separation * 2 / 3);
+      GenerateOptions o;
+      o.has_start = true;
+      o.start = {0.75, steps * rise, steps * run + 0.7};
+      o.heading = {0, 0, -1};
+      o.steps = 250;
+      const Walk w = Generate(t, c, o);
+      INFO(name << " seed " << seed << ": " << w.stopped);
+      CheckWalk(t, c, o, w);
+      if (Body(w).keys.back().position.y < 0.5 * rise) ++down;
+      // A wait: a step in which every foot of the group lifts and lands where it stood.
+      const auto& body = Body(w).keys;
+      for (size_t k = 1; k < body.size(); ++k) waits += body[k].position == body[k - 1].position;
+    }
+    INFO(name << ": " << down << " of 6 reached the floor, " << waits << " waits");
+    CHECK(down >= (name == "hexapod" ? 3 : 4));
+    CHECK(waits > 0);
+  }
+}
+
 TEST_CASE("A multiped with its feet in a line walks up a ramp (no plane to fit: averaged normal)",
           "[steps][generator]") {
   // Four feet on the body's axis: the plane of the feet is undefined, so the body's up falls

@@ -98,6 +98,7 @@ struct Agent {
   std::vector<Vec3> path;
   size_t waypoint = 0;
   bool walking = true;  // false once stopped or arrived
+  int waits = 0;        // steps in a row its group stepped in place, waiting for a planted foot
   std::string stopped;  // why it stopped early ("" when it did not)
   size_t first_track = 0;
 };
@@ -115,6 +116,9 @@ struct Move {
   // arc that cannot clear), which says more.
   std::string reason;
   bool reason_is_gap = false;
+  // A try found a foothold refused only because a planted foot would be left beyond reach: the
+  // character may wait for that foot (Finish).
+  bool held_by_planted = false;
   Vec3 end, end_normal;  // the accepted foothold
   Vec3 mid, mid_normal;
   Vec3 ideal;               // the last query's ideal point
@@ -783,7 +787,7 @@ void Generator::CheckReach(size_t m, size_t e) {
         << " from the body, beyond reach " << c_.reach;
     for (size_t i = m; i < e; ++i) {
       if (!moves[i].done) continue;
-      moves[i].done = false;
+      moves[i].done = false, moves[i].held_by_planted = true;
       if (KeepsReason(moves[i], false)) moves[i].reason = why.str(), moves[i].reason_is_gap = false;
     }
     break;
@@ -933,11 +937,26 @@ void Generator::Finish(size_t w, int k) {
              ": every target is where its foot already stands (a cliff, a gap or a dead end)");
     return;
   }
-  if (failed) {
+  // Held back only by a planted foot the body would leave beyond reach: the group steps in
+  // place, and the other groups, that foot's among them, step on; after a whole cycle of such
+  // waits the walk stops.
+  bool held = failed != nullptr;
+  for (size_t i = m; i < e && held; ++i) held = moves_[i].done || moves_[i].held_by_planted;
+  if (held && a.waits + 1 < static_cast<int>(c_.gait.size())) {
+    ++a.waits;
+    for (size_t i = m; i < e; ++i) {
+      Move& mv = moves_[i];
+      mv.end = a.foot[mv.foot], mv.end_normal = a.foot_normal[mv.foot];
+      mv.mid_normal = mv.end_normal, mv.mid = mv.end + mv.end_normal * c_.step_height;
+    }
+    failed = nullptr;
+  } else if (failed) {
     Stop(a, k + 1,
          "foot " + c_.feet[failed->foot].name + " at " + Point(a.foot[failed->foot]) + ": " +
              failed->reason);
     return;
+  } else {
+    a.waits = 0;
   }
   for (size_t i = m; i < e; ++i) {
     const Move& mv = moves_[i];
