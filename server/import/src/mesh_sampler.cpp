@@ -525,7 +525,13 @@ void SampleMeshUniform(const TriangleMesh& mesh, size_t count, bool smooth_norma
     total += Length(TriangleCross(mesh, t));
     cumulative[t] = total;
   }
-  const CornerNormals corner_normals(mesh, smooth_normals ? crease_angle_deg : 0);
+  // Every triangle's corner normals, computed once: the samples pick triangles at random.
+  std::vector<std::array<Vec3, 3>> corners;
+  if (smooth_normals) {
+    const CornerNormals corner_normals(mesh, crease_angle_deg);
+    corners.reserve(mesh.triangles.size());
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) corners.push_back(corner_normals.Of(t));
+  }
   SplitMix64 rng(seed);
   out->points.reserve(count);
   out->normals.reserve(count);
@@ -536,9 +542,8 @@ void SampleMeshUniform(const TriangleMesh& mesh, size_t count, bool smooth_norma
         mesh.triangles.size() - 1);
     double u = rng.Unit(), v = rng.Unit();
     if (u + v > 1) u = 1 - u, v = 1 - v;
-    const std::array<Vec3, 3> corners = corner_normals.Of(t);
     out->push_back(SamplePoint(mesh, t, u, v),
-                   SampleNormal(mesh, smooth_normals ? &corners : nullptr, t, u, v));
+                   SampleNormal(mesh, smooth_normals ? &corners[t] : nullptr, t, u, v));
   }
 }
 

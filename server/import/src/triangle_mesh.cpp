@@ -9,12 +9,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 }  // namespace
 
-Vec3 TriangleCross(const TriangleMesh& mesh, size_t t) {
-  const auto& tri = mesh.triangles[t];
-  const Vec3& a = mesh.vertices[tri[0]];
-  return Cross(mesh.vertices[tri[1]] - a, mesh.vertices[tri[2]] - a);
-}
-
 double SurfaceArea(const TriangleMesh& mesh) {
   double area = 0;
   for (size_t t = 0; t < mesh.triangles.size(); ++t) area += 0.5 * Length(TriangleCross(mesh, t));

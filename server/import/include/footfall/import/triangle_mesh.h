@@ -16,7 +16,11 @@ struct TriangleMesh {
 };
 
 // Twice the area of triangle t times its unit normal: Cross(b - a, c - a). [Units: wu^2]
-Vec3 TriangleCross(const TriangleMesh& mesh, size_t t);
+inline Vec3 TriangleCross(const TriangleMesh& mesh, size_t t) {
+  const auto& tri = mesh.triangles[t];
+  const Vec3& a = mesh.vertices[tri[0]];
+  return Cross(mesh.vertices[tri[1]] - a, mesh.vertices[tri[2]] - a);
+}
 
 // Sum of the triangle areas. [Units: wu^2]
 double SurfaceArea(const TriangleMesh& mesh);
