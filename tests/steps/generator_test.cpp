@@ -943,38 +943,52 @@ TEST_CASE("Insects walk up a thin wall, over its top and down the far side", "[s
   }
 }
 
+namespace {
+
+// A profile in the plane x = 0 extruded 1.5 m along +x, as a modelling package exports it: each
+// profile point's two vertices shared by the faces on either side of its edge.
+TriangleMesh Extruded(const std::vector<Vec3>& profile) {
+  TriangleMesh mesh;
+  for (const Vec3& p : profile) {
+    mesh.vertices.push_back(p);
+    mesh.vertices.push_back(p + Vec3{1.5, 0, 0});
+  }
+  for (uint32_t k = 0; k + 1 < profile.size(); ++k) {
+    const uint32_t a = 2 * k, b = a + 1, c = a + 2, d = a + 3;
+    mesh.triangles.push_back({a, c, d});
+    mesh.triangles.push_back({a, d, b});
+  }
+  return mesh;
+}
+
+// `mesh` sampled as `footfall generate` samples it for `c` (a quarter step, smooth normals).
+Terrain SampledFor(const TriangleMesh& mesh, const Character& c, uint64_t seed) {
+  RawSamples samples;
+  MeshSampleOptions mo;
+  mo.separation = kSeparationPerStep * c.step_length;
+  mo.seed = seed;
+  REQUIRE(SampleMesh(mesh, mo, &samples, nullptr) == Status::kOk);
+  // Neighbouring samples lie at least 2/3 of the separation apart (CheckWalk's spacing).
+  return LoadTerrain(samples, mo.separation * 2 / 3);
+}
+
+}  // namespace
+
 TEST_CASE("Insects climb walls of a modelled mesh, whose edges keep their faces' normals",
           "[steps][generator]") {
   // A floor (z < 0), a wall (z = 0, facing -z) and its top, 1.5 m wide, as a modelling package
-  // exports them: one profile extruded, its vertices shared by the faces on either side of an
-  // edge. Sampled as `footfall generate` samples a mesh for an insect (a quarter step, smooth
-  // normals), six seeds per wall height. Smooth normals stop at the wall's 90-degree edges
+  // exports them (Extruded), sampled as `footfall generate` samples a mesh for an insect, six
+  // seeds per wall height. Smooth normals stop at the wall's 90-degree edges
   // (kDefaultCreaseAngleDeg): interpolated from plain vertex normals instead, the wall's and
   // the floor's normals leaned up to 45 degrees toward each other, all the way across the
   // wall: 5 of 6 hexapods and 1 of 6 octopods got over the 1 m wall, none over 0.5 or 0.3 m.
   for (const double height : {1.0, 0.5, 0.3}) {
-    TriangleMesh wall;
-    const double width = 1.5;
-    const Vec3 profile[4] = {{0, 0, -1}, {0, 0, 0}, {0, height, 0}, {0, height, 1.5}};
-    for (const Vec3& p : profile) {
-      wall.vertices.push_back(p);
-      wall.vertices.push_back(p + Vec3{width, 0, 0});
-    }
-    for (uint32_t k = 0; k < 3; ++k) {
-      const uint32_t a = 2 * k, b = a + 1, c = a + 2, d = a + 3;
-      wall.triangles.push_back({a, c, d});
-      wall.triangles.push_back({a, d, b});
-    }
+    const TriangleMesh wall = Extruded({{0, 0, -1}, {0, 0, 0}, {0, height, 0}, {0, height, 1.5}});
     for (const std::string name : {"hexapod", "octopod"}) {
       const Character c = LoadShipped(name);
       int over = 0;
       for (const uint64_t seed : {1, 2, 3, 4, 5, 6}) {
-        RawSamples samples;
-        MeshSampleOptions mo;
-        mo.separation = kSeparationPerStep * c.step_length;
-        mo.seed = seed;
-        REQUIRE(SampleMesh(wall, mo, &samples, nullptr) == Status::kOk);
-        Terrain t = LoadTerrain(samples, mo.separation * 2 / 3);
+        Terrain t = SampledFor(wall, c, seed);
         GenerateOptions o;
         o.has_start = true;
         o.start = {0.75, 0, -0.5};
@@ -1001,33 +1015,19 @@ TEST_CASE("Insects descend a modelled flight of stairs, a group waiting for a fo
   // steps in place, and the next group, that foot's, steps on. (Without the wait none of the
   // six hexapods and 3 of the six octopods reached the floor; with it 4 and 5.)
   const int steps = 10;
-  const double rise = 0.18, run = 0.28, width = 1.5;
+  const double rise = 0.18, run = 0.28;
   std::vector<Vec3> profile = {{0, 0, -1}, {0, 0, 0}};
   for (int k = 0; k < steps; ++k) {
     profile.push_back({0, (k + 1) * rise, k * run});
     profile.push_back({0, (k + 1) * rise, (k + 1) * run});
   }
   profile.push_back({0, steps * rise, steps * run + 1.5});
-  TriangleMesh flight;
-  for (const Vec3& p : profile) {
-    flight.vertices.push_back(p);
-    flight.vertices.push_back(p + Vec3{width, 0, 0});
-  }
-  for (uint32_t k = 0; k + 1 < profile.size(); ++k) {
-    const uint32_t a = 2 * k, b = a + 1, c = a + 2, d = a + 3;
-    flight.triangles.push_back({a, c, d});
-    flight.triangles.push_back({a, d, b});
-  }
+  const TriangleMesh flight = Extruded(profile);
   for (const std::string name : {"hexapod", "octopod"}) {
     const Character c = LoadShipped(name);
     int down = 0, waits = 0;
     for (const uint64_t seed : {1, 2, 3, 4, 5, 6}) {
-      RawSamples samples;
-      MeshSampleOptions mo;
-      mo.separation = kSeparationPerStep * c.step_length;
-      mo.seed = seed;
-      REQUIRE(SampleMesh(flight, mo, &samples, nullptr) == Status::kOk);
-      Terrain t = LoadTerrain(samples, mo.separation * 2 / 3);
+      Terrain t = SampledFor(flight, c, seed);
       GenerateOptions o;
       o.has_start = true;
       o.start = {0.75, steps * rise, steps * run + 0.7};
