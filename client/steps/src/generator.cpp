@@ -139,6 +139,10 @@ class Generator {
   // 1. The start's sample: where `start` snaps, or, when it may move and the character cannot
   //    stand there, the nearest candidate around it where it can (GenerateOptions).
   Status FindStart(const Vec3& start, bool may_move, Foothold* first, std::string* error);
+  // 2. The heading at a start whose up is up0: GenerateOptions::heading projected across it.
+  Vec3 StartHeading(const Vec3& up0) const {
+    return TangentForward(o_.heading, AnyPerpendicular(world_up_), world_up_, up0);
+  }
   // 2. Stands a on `ground` in the start's frame (up0, fwd0): its up and its heading, turned
   //    toward its path's first waypoint when it has one.
   void Orient(Agent& a, const Foothold& ground, const Vec3& up0, const Vec3& fwd0) const;
@@ -410,7 +414,7 @@ Status Generator::Setup(std::string* error) {
   // 2. The start frame: up (terrain normal for multipeds, world up for bipeds) and the heading
   //    projected onto the plane perpendicular to it. Crowds stand on a grid in that plane.
   const Vec3 up0 = c_.align_to_normal ? first.normal : world_up_;
-  const Vec3 fwd0 = TangentForward(o_.heading, AnyPerpendicular(world_up_), world_up_, up0);
+  const Vec3 fwd0 = StartHeading(up0);
   const Vec3 left0 = Cross(up0, fwd0);
   const int n = std::max(1, o_.crowd);
   const int cols = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n))));
@@ -515,8 +519,7 @@ Status Generator::FindStart(const Vec3& start, bool may_move, Foothold* first, s
       if (grounds[m].status != Status::kOk) continue;
       const Vec3 up0 = c_.align_to_normal ? grounds[m].normal : world_up_;
       stand[m].path = o_.path;
-      Orient(stand[m], grounds[m], up0,
-             TangentForward(o_.heading, AnyPerpendicular(world_up_), world_up_, up0));
+      Orient(stand[m], grounds[m], up0, StartHeading(up0));
       for (size_t f = 0; f < feet; ++f) points[m * feet + f] = Place(stand[m], c_.feet[f].rest);
     }
     snapped.resize(points.size());
