@@ -15,8 +15,8 @@ void AddLoadFlags(CLI::App* command, TerrainLoadOptions* load) {
   command
       ->add_option("--crease-angle", load->crease_angle_deg,
                    "Meshes and height maps: edges whose faces meet at more than this many "
-                   "degrees stay sharp (smooth normals stop at them; default 30, 180: smooth "
-                   "everywhere)")
+                   "degrees stay sharp (smooth normals stop at them; 180: smooth everywhere)")
+      ->default_val(kDefaultCreaseAngleDeg)
       ->check(FiniteRange(0, 180));
   command->add_option("--seed", load->seed, "Seed of the mesh sampler");
   command->add_option("--up-axis", load->up_axis, "Height maps: up axis x, y or z")

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -485,7 +486,8 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
 
   // 4. Points and normals, in triangle order.
   std::sort(accepted.begin(), accepted.end());
-  const CornerNormals corner_normals(mesh, options.smooth_normals ? options.crease_angle_deg : 0);
+  std::optional<CornerNormals> corner_normals;
+  if (options.smooth_normals) corner_normals.emplace(mesh, options.crease_angle_deg);
   out->points.reserve(accepted.size());
   out->normals.reserve(accepted.size());
   const size_t accepted_count = accepted.size();
@@ -503,12 +505,12 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
                           static_cast<float>((piece.b[0][1] + piece.b[1][1] + piece.b[2][1]) / 3)});
       return true;
     });
-    const std::array<Vec3, 3> corners = corner_normals.Of(t);
+    std::array<Vec3, 3> corners;
+    if (corner_normals) corners = corner_normals->Of(t);
     for (; a < accepted.size() && accepted[a] < first_candidate[t + 1]; ++a) {
       const auto& uv = piece_uv[accepted[a] - first_candidate[t]];
-      out->push_back(
-          SamplePoint(mesh, t, uv[0], uv[1]),
-          SampleNormal(mesh, options.smooth_normals ? &corners : nullptr, t, uv[0], uv[1]));
+      out->push_back(SamplePoint(mesh, t, uv[0], uv[1]),
+                     SampleNormal(mesh, corner_normals ? &corners : nullptr, t, uv[0], uv[1]));
     }
   }
   if (stats) stats->candidates = n, stats->samples = accepted_count;
