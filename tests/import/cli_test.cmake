@@ -54,6 +54,17 @@ if(NOT rc EQUAL 0 OR NOT out MATCHES "\"found\":true" OR out MATCHES "\"normal\"
 endif()
 expect(EXIT_NONZERO "--crease-angle" query --terrain "${WORK}/cube.obj" --crease-angle 200)
 file(WRITE "${WORK}/stdin.txt" "snap 0.5 2 0.5\n")
+# A cube wound inside out is turned over: its top's normal faces up.
+file(READ "${WORK}/cube.obj" cube)
+string(REPLACE "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n"
+       "f 2 3 4 1\nf 8 7 6 5\nf 5 6 2 1\nf 6 7 3 2\nf 7 8 4 3\nf 8 5 1 4\n" inside_out "${cube}")
+file(WRITE "${WORK}/inside_out.obj" "${inside_out}")
+expect(EXIT_ZERO "faces turned over: all (the mesh was inside out)"
+       terrain info "${WORK}/inside_out.obj" --separation 0.1)
+expect(EXIT_ZERO "faces turned over: none" terrain info "${WORK}/cube.obj" --separation 0.1)
+file(WRITE "${WORK}/stdin.txt" "normal 0.25 1.05 0.25\n")
+expect(EXIT_ZERO "\"normal\":[0.0,1.0,0.0]" query --terrain "${WORK}/inside_out.obj" --separation 0.1)
+file(WRITE "${WORK}/stdin.txt" "snap 0.5 2 0.5\n")
 # Bad files: non-zero exit and a message naming the file and the problem.
 expect(EXIT_NONZERO "empty.obj: the file is empty" terrain info "${WORK}/empty.obj")
 expect(EXIT_NONZERO "nan.obj:2: vertex coordinate 'nan' is not a finite number"

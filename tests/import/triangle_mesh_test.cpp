@@ -107,4 +107,40 @@ TEST_CASE("CornerNormals: smooth across gentle edges, sharp at creases", "[impor
   for (const Vec3& n : none) CHECK(n == Vec3{});
 }
 
+TEST_CASE("TurnOutward: inside-out and downward meshes are turned over, others left alone",
+          "[import][mesh]") {
+  auto reversed = [](TriangleMesh m) {
+    for (auto& tri : m.triangles) std::swap(tri[1], tri[2]);
+    return m;
+  };
+  const Vec3 up{0, 1, 0};
+  struct Case {
+    TriangleMesh mesh;
+    MeshFacing when_reversed;
+  };
+  const Case cases[] = {{MakeSphereMesh({1, 2, 3}, 2.0, 2), MeshFacing::kInsideOut},
+                        {MakeRocksMesh(8, 0.5, 1.5, 3), MeshFacing::kFacingDown},
+                        {MakeStairsMesh(4, 0.2, 0.3, 1.0), MeshFacing::kFacingDown}};
+  for (const Case& c : cases) {
+    TriangleMesh as_is = c.mesh;
+    CHECK(TurnOutward(&as_is, up) == MeshFacing::kOutward);
+    CHECK(as_is.triangles == c.mesh.triangles);
+    TriangleMesh turned = reversed(c.mesh);
+    CHECK(TurnOutward(&turned, up) == c.when_reversed);
+    for (size_t t = 0; t < turned.triangles.size(); ++t)
+      CHECK(Distance(TriangleCross(turned, t), TriangleCross(c.mesh, t)) < 1e-12);
+  }
+  // Faces facing every way (a wall, facing +z or -z) and a terrain facing sideways (up is +y
+  // but the rocks face +y: a Z-up caller) are left as they are.
+  TriangleMesh wall;
+  wall.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  wall.triangles = {{0, 1, 2}, {0, 2, 3}};
+  for (const TriangleMesh& m : {wall, reversed(wall)}) {
+    TriangleMesh w = m;
+    CHECK(TurnOutward(&w, up) == MeshFacing::kOutward);
+  }
+  TriangleMesh rocks = reversed(MakeRocksMesh(8, 0.5, 1.5, 3));
+  CHECK(TurnOutward(&rocks, Vec3{0, 0, 1}) == MeshFacing::kOutward);
+}
+
 }  // namespace footfall

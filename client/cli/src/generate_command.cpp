@@ -113,6 +113,12 @@ std::string Box(const Vec3& lo, const Vec3& hi) {
 // Says on stderr how the terrain was resampled for the character, when not at its own spacing.
 void ReportResampling(const std::string& path, const Character& character, const WalkTerrain& t) {
   const TerrainLoadReport& r = t.report;
+  if (r.facing != MeshFacing::kOutward) {
+    std::cerr << "footfall generate: " << path << ": every face turned over ("
+              << (r.facing == MeshFacing::kInsideOut ? "the mesh was inside out"
+                                                     : "they faced down")
+              << ")\n";
+  }
   if (!t.cropped && r.separation == r.file_separation) return;
   std::ostringstream o;
   o.precision(4);

@@ -110,7 +110,12 @@ int RunInfo(const InfoFlags& flags) {
   if (report.format == "mesh") {
     std::cout << "vertices: " << report.vertices << '\n'
               << "faces: " << report.faces << '\n'
-              << "skipped faces: " << report.skipped_faces << '\n';
+              << "skipped faces: " << report.skipped_faces << '\n'
+              << "faces turned over: "
+              << (report.facing == MeshFacing::kInsideOut    ? "all (the mesh was inside out)"
+                  : report.facing == MeshFacing::kFacingDown ? "all (they faced down)"
+                                                             : "none")
+              << '\n';
   } else if (report.format == "heightmap") {
     std::cout << "cells with data: " << report.vertices << '\n'
               << "nodata cells: " << report.nodata_cells << '\n'

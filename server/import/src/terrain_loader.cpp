@@ -77,6 +77,9 @@ Status ReadTerrainMesh(const std::string& path, const TerrainLoadOptions& option
     report->faces = read.faces;
     report->skipped_faces = read.skipped_faces;
     report->file_separation = DefaultSeparation(*mesh);
+    const Vec3 up{options.up_axis == 'x' ? 1.0 : 0.0, options.up_axis == 'y' ? 1.0 : 0.0,
+                  options.up_axis == 'z' ? 1.0 : 0.0};
+    report->facing = TurnOutward(mesh, up);
     return Status::kOk;
   }
   if (ext == "asc" || ext == "pgm") {

@@ -61,6 +61,42 @@ std::array<Vec3, 3> CornerNormals::Of(size_t t) const {
   return out;
 }
 
+MeshFacing TurnOutward(TriangleMesh* mesh, const Vec3& up) {
+  if (mesh->triangles.empty()) return MeshFacing::kOutward;
+  // Closed when every directed edge (a, b) has its twin (b, a).
+  std::vector<uint64_t> edges, twins;
+  edges.reserve(3 * mesh->triangles.size()), twins.reserve(3 * mesh->triangles.size());
+  for (const auto& tri : mesh->triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const uint64_t a = tri[k], b = tri[(k + 1) % 3];
+      edges.push_back(a << 32 | b), twins.push_back(b << 32 | a);
+    }
+  }
+  std::sort(edges.begin(), edges.end()), std::sort(twins.begin(), twins.end());
+  const bool closed = edges == twins;
+  MeshFacing facing = MeshFacing::kOutward;
+  if (closed) {
+    // Six times the enclosed volume, about the first vertex (less cancellation).
+    const Vec3 o = mesh->vertices[mesh->triangles[0][0]];
+    double volume = 0;
+    for (const auto& tri : mesh->triangles)
+      volume += Dot(mesh->vertices[tri[0]] - o,
+                    Cross(mesh->vertices[tri[1]] - o, mesh->vertices[tri[2]] - o));
+    if (volume < 0) facing = MeshFacing::kInsideOut;
+  } else {
+    Vec3 sum;
+    double area = 0;
+    for (size_t t = 0; t < mesh->triangles.size(); ++t) {
+      const Vec3 n = TriangleCross(*mesh, t);
+      sum += n, area += Length(n);
+    }
+    if (area > 0 && Dot(sum, up) < -0.25 * area * Length(up)) facing = MeshFacing::kFacingDown;
+  }
+  if (facing != MeshFacing::kOutward)
+    for (auto& tri : mesh->triangles) std::swap(tri[1], tri[2]);
+  return facing;
+}
+
 void MeshBounds(const TriangleMesh& mesh, Vec3* lo, Vec3* hi) {
   if (mesh.vertices.empty()) {
     *lo = *hi = Vec3{};

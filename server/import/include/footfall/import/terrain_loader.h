@@ -32,7 +32,8 @@ struct TerrainLoadOptions {
   double crease_angle_deg = kDefaultCreaseAngleDeg;  // [Units: degrees]
   // Seed of the deterministic sampler: equal seeds give equal samples.
   uint64_t seed = 1;
-  // Height maps: the world axis heights go along ('x', 'y' or 'z'). [Default: 'y', as in Maya]
+  // Height maps: the world axis heights go along ('x', 'y' or 'z'); meshes: the up an open
+  // mesh's faces are turned to (TurnOutward). [Default: 'y', as in Maya]
   char up_axis = 'y';
   // Height maps: distance between neighbouring cells. [Units: wu] [Limit: >= 0] 0: the file's
   // CELLSIZE for .asc, 1 for .pgm.
@@ -46,10 +47,13 @@ struct TerrainLoadOptions {
 
 // What a load found, for `footfall terrain info` and server logs.
 struct TerrainLoadReport {
-  std::string format;           // "points", "mesh" or "heightmap"
-  size_t vertices = 0;          // meshes: as stored; height maps: valid cells
-  size_t faces = 0;             // meshes: polygons read; height maps: triangles built
-  size_t skipped_faces = 0;     // meshes: degenerate faces left out
+  std::string format;        // "points", "mesh" or "heightmap"
+  size_t vertices = 0;       // meshes: as stored; height maps: valid cells
+  size_t faces = 0;          // meshes: polygons read; height maps: triangles built
+  size_t skipped_faces = 0;  // meshes: degenerate faces left out
+  // Meshes: whether every face was turned over (TurnOutward: inside out, or facing down
+  // along up_axis) before sampling.
+  MeshFacing facing = MeshFacing::kOutward;
   size_t nodata_cells = 0;      // height maps: cells left out
   double area = 0;              // [Units: wu^2] meshes and height maps
   double separation = 0;        // [Units: wu] the separation used (meshes and height maps)

@@ -50,6 +50,21 @@ class CornerNormals {
   std::vector<uint32_t> around_;  // the triangles using each vertex
 };
 
+// How TurnOutward found a mesh's faces.
+enum class MeshFacing {
+  kOutward,     // left as they were
+  kInsideOut,   // closed, enclosing a negative volume: every face turned over
+  kFacingDown,  // open, facing mostly against `up`: every face turned over
+};
+
+// Turns every face of a mesh wound the wrong way over (reverses its winding), so that normals
+// face out of a closed mesh (the enclosed volume is positive) and up out of an open one, a
+// terrain: turned when the component along `up` of its faces' area-weighted normals sums to
+// less than -1/4 of its area (its faces face down, a steep flight of stairs' treads included;
+// rooms, caves and walls, whose faces face every way, are left alone). Closed: every edge used
+// once in each direction.
+MeshFacing TurnOutward(TriangleMesh* mesh, const Vec3& up);
+
 // World-space bounds of the vertices; both (0, 0, 0) for an empty mesh.
 void MeshBounds(const TriangleMesh& mesh, Vec3* lo, Vec3* hi);
 
