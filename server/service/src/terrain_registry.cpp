@@ -1,5 +1,7 @@
 #include "footfall/service/terrain_registry.h"
 
+#include "footfall/service/pinned_file.h"
+
 #include <fcntl.h>
 #include <limits.h>
 #include <stdlib.h>
@@ -212,6 +214,10 @@ Status TerrainRegistry::LoadFile(const std::string& relative_path, double separa
   if (status != Status::kOk) return status;
   status = CheckRegularFile(path, relative_path, message);
   if (status != Status::kOk) return status;
+  // Held open from here: what is read is the file just checked, wherever its path leads now.
+  PinnedFile pinned;
+  status = pinned.Open(data_root_, path, relative_path, message);
+  if (status != Status::kOk) return status;
   if (!(separation >= 0)) {
     *message = "separation must be >= 0";
     return Status::kInvalidArgument;
@@ -224,11 +230,11 @@ Status TerrainRegistry::LoadFile(const std::string& relative_path, double separa
   options.max_samples = used < limits_.max_total_samples ? limits_.max_total_samples - used : 0;
   RawSamples samples;
   std::string error;
-  status = LoadTerrain(path, options, &samples, &error);
+  status = LoadTerrain(pinned.path(), options, &samples, &error);
   if (status != Status::kOk) {
     // Report the path as the client gave it, not the server's layout.
-    const size_t at = error.find(path);
-    if (at != std::string::npos) error.replace(at, path.size(), relative_path);
+    const size_t at = error.find(pinned.path());
+    if (at != std::string::npos) error.replace(at, pinned.path().size(), relative_path);
     *message = error;
     if (status == Status::kLimitExceeded)
       *message += " (the limit is what is left of " + Budget() + ")";

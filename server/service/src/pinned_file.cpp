@@ -1,0 +1,67 @@
+#include "footfall/service/pinned_file.h"
+
+#include <fcntl.h>
+#include <limits.h>
+#include <stdlib.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdio>
+
+namespace footfall {
+
+PinnedFile::~PinnedFile() {
+  if (!link_.empty()) unlink(link_.c_str());
+  if (!dir_.empty()) rmdir(dir_.c_str());
+  if (fd_ >= 0) close(fd_);
+}
+
+Status PinnedFile::Open(const std::string& root, const std::string& path, const std::string& shown,
+                        std::string* message) {
+  fd_ = open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC | O_NOFOLLOW);
+  if (fd_ < 0) {
+    *message = "'" + shown + "': cannot open";
+    return Status::kIoError;
+  }
+  // Where the opened file lies now, whatever the path's components were swapped for.
+  const std::string self = "/proc/self/fd/" + std::to_string(fd_);
+  char real[PATH_MAX];
+  const ssize_t n = readlink(self.c_str(), real, sizeof real - 1);
+  if (n < 0) {
+    *message = "'" + shown + "': cannot tell where the opened file lies";
+    return Status::kIoError;
+  }
+  real[n] = '\0';
+  const std::string opened = real;
+  const bool inside = root == "/" || opened.compare(0, root.size() + 1, root + "/") == 0;
+  if (!inside) {
+    *message = "'" + shown + "' leads outside the data root";
+    return Status::kAccessDenied;
+  }
+  struct stat st {};
+  if (fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode)) {
+    *message = "'" + shown + "' is not a regular file: expected a regular terrain file";
+    return Status::kInvalidArgument;
+  }
+  // A private name for it: <tmp>/footfalld-XXXXXX/terrain.<ext> -> /proc/self/fd/N.
+  const char* tmp = getenv("TMPDIR");
+  std::string dir = std::string(tmp && *tmp ? tmp : "/tmp") + "/footfalld-XXXXXX";
+  if (!mkdtemp(dir.data())) {
+    *message = "'" + shown + "': cannot make a private directory to read it from";
+    return Status::kIoError;
+  }
+  dir_ = dir;
+  const size_t slash = path.rfind('/'), dot = path.rfind('.');
+  const std::string ext = dot != std::string::npos && (slash == std::string::npos || dot > slash)
+                              ? path.substr(dot)
+                              : "";
+  const std::string link = dir_ + "/terrain" + ext;
+  if (symlink(self.c_str(), link.c_str()) != 0) {
+    *message = "'" + shown + "': cannot make a private name to read it from";
+    return Status::kIoError;
+  }
+  link_ = link;
+  return Status::kOk;
+}
+
+}  // namespace footfall
