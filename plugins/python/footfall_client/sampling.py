@@ -43,6 +43,7 @@ def corner_normals(points, triangles, crease_deg=DEFAULT_CREASE_ANGLE_DEG):
         crosses.append(_cross(_sub(b, a), _sub(c, a)))  # length = 2 * area: area weighting
         for v in tri:
             around.setdefault(v, []).append(t)
+    lengths = [_length(n) for n in crosses]
     cos_crease = -2.0 if crease_deg >= 180 else math.cos(math.radians(max(crease_deg, 0.0)))
     out = []
     for t, tri in enumerate(triangles):
@@ -55,9 +56,8 @@ def corner_normals(points, triangles, crease_deg=DEFAULT_CREASE_ANGLE_DEG):
             sum_ = [0.0, 0.0, 0.0]
             for u in around[v]:
                 n = crosses[u]
-                length = _length(n)
-                if length > 0 and n[0] * face[0] + n[1] * face[1] + n[2] * face[2] >= \
-                        cos_crease * length:
+                if lengths[u] > 0 and n[0] * face[0] + n[1] * face[1] + n[2] * face[2] >= \
+                        cos_crease * lengths[u]:
                     sum_ = [sum_[d] + n[d] for d in range(3)]
             corners.append(_unit(sum_) or face)
         out.append(tuple(corners))
