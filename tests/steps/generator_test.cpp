@@ -1012,7 +1012,7 @@ TEST_CASE("Insects descend a modelled flight of stairs, a group waiting for a fo
   // insect at a quarter step, six seeds. Going down a riser three to four times their body
   // height, the front feet drop to the tread below while a hind foot still stands on the tread
   // above, and every try of the stepping group would leave it beyond reach: then the group
-  // steps in place, and the next group, that foot's, steps on. (Without the wait none of the
+  // waits, feet planted, and the next group, that foot's, steps on. (Without the wait none of the
   // six hexapods and 3 of the six octopods reached the floor; with it 4 and 5.)
   const int steps = 10;
   const double rise = 0.18, run = 0.28;
@@ -1037,7 +1037,7 @@ TEST_CASE("Insects descend a modelled flight of stairs, a group waiting for a fo
       INFO(name << " seed " << seed << ": " << w.stopped);
       CheckWalk(t, c, o, w);
       if (Body(w).keys.back().position.y < 0.5 * rise) ++down;
-      // A wait: a step in which every foot of the group lifts and lands where it stood.
+      // A wait: a step in which no foot moves and the body holds (CheckWalk checks the rest).
       const auto& body = Body(w).keys;
       for (size_t k = 1; k < body.size(); ++k) waits += body[k].position == body[k - 1].position;
     }

@@ -167,9 +167,23 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
   // Gait order: step k moves exactly group k % G, at frames start_frame + k * frames_per_step.
   const size_t steps = body.keys.size() - 1;
   const int groups = static_cast<int>(c.gait.size());
+  int waits = 0;
   for (size_t k = 0; k < steps; ++k) {
     const double f0 = o.start_frame + static_cast<double>(k) * c.frames_per_step;
     const auto& group = c.gait[k % groups];
+    // A wait (its group held back by a foot left behind): no foot lifts and the body holds.
+    bool any_lifts = false;
+    for (size_t f = 0; f < c.feet.size(); ++f)
+      for (const WalkKey& key : tracks[f]->keys)
+        any_lifts |= key.phase == KeyPhase::kStart && key.frame == f0;
+    if (!any_lifts) {
+      INFO("step " << k + 1 << ": no foot lifts");
+      CHECK(body.keys[k + 1].position == body.keys[k].position);
+      CHECK(body.keys[k + 1].frame == f0 + c.frames_per_step);
+      CHECK(++waits < groups);  // never a whole cycle of waits in a row
+      continue;
+    }
+    waits = 0;
     for (size_t f = 0; f < c.feet.size(); ++f) {
       bool lifts = false;
       for (const WalkKey& key : tracks[f]->keys)

@@ -940,27 +940,23 @@ void Generator::Finish(size_t w, int k) {
              ": every target is where its foot already stands (a cliff, a gap or a dead end)");
     return;
   }
-  // Held back only by a planted foot the body would leave beyond reach: the group steps in
-  // place, and the other groups, that foot's among them, step on; after a whole cycle of such
-  // waits the walk stops.
+  // Held back only by a planted foot the body would leave beyond reach: the group waits, its
+  // feet planted and the body still (keyed in place at touch-down), and the other groups, that
+  // foot's among them, step on; after a whole cycle of such waits in a row the walk stops.
   bool held = failed != nullptr;
   for (size_t i = m; i < e && held; ++i) held = moves_[i].done || moves_[i].held_by_planted;
   if (held && a.waits + 1 < static_cast<int>(c_.gait.size())) {
     ++a.waits;
-    for (size_t i = m; i < e; ++i) {
-      Move& mv = moves_[i];
-      mv.end = a.foot[mv.foot], mv.end_normal = a.foot_normal[mv.foot];
-      mv.mid_normal = mv.end_normal, mv.mid = mv.end + mv.end_normal * c_.step_height;
-    }
-    failed = nullptr;
-  } else if (failed) {
+    KeyBody(a, f1);
+    return;
+  }
+  if (failed) {
     Stop(a, k + 1,
          "foot " + c_.feet[failed->foot].name + " at " + Point(a.foot[failed->foot]) + ": " +
              failed->reason);
     return;
-  } else {
-    a.waits = 0;
   }
+  a.waits = 0;
   for (size_t i = m; i < e; ++i) {
     const Move& mv = moves_[i];
     KeyFoot(a, mv.foot, f0, KeyPhase::kStart, a.foot[mv.foot], a.foot_normal[mv.foot]);
