@@ -10,6 +10,10 @@
 
 namespace footfall {
 
+bool PathInside(const std::string& root, const std::string& path) {
+  return root == "/" || path == root || path.compare(0, root.size() + 1, root + "/") == 0;
+}
+
 PinnedFile::~PinnedFile() {
   if (!link_.empty()) unlink(link_.c_str());
   if (!dir_.empty()) rmdir(dir_.c_str());
@@ -32,9 +36,7 @@ Status PinnedFile::Open(const std::string& root, const std::string& path, const 
     return Status::kIoError;
   }
   real[n] = '\0';
-  const std::string opened = real;
-  const bool inside = root == "/" || opened.compare(0, root.size() + 1, root + "/") == 0;
-  if (!inside) {
+  if (!PathInside(root, real)) {
     *message = "'" + shown + "' leads outside the data root";
     return Status::kAccessDenied;
   }

@@ -16,11 +16,6 @@ namespace footfall {
 
 namespace {
 
-// True when canonical `path` is `root` or below it.
-bool Inside(const std::string& root, const std::string& path) {
-  return root == "/" || path == root || path.compare(0, root.size() + 1, root + "/") == 0;
-}
-
 // True when canonical `path` is an ancestor of `root` (a walk from "/" passes it on the way in).
 bool AboveRoot(const std::string& root, const std::string& path) {
   return path == "/" || root.compare(0, path.size() + 1, path + "/") == 0;
@@ -50,10 +45,10 @@ bool LeadsOutside(const std::string& root, const std::string& path, int depth) {
     char buffer[PATH_MAX];
     if (realpath(next.c_str(), buffer)) {
       at = buffer;
-      if (!Inside(root, at) && !AboveRoot(root, at)) return true;
+      if (!PathInside(root, at) && !AboveRoot(root, at)) return true;
       continue;
     }
-    if (!Inside(root, at)) return true;
+    if (!PathInside(root, at)) return true;
     const ssize_t n = readlink(next.c_str(), buffer, sizeof buffer - 1);
     if (n < 0) return false;  // missing below a directory of the root
     buffer[n] = '\0';
@@ -61,7 +56,7 @@ bool LeadsOutside(const std::string& root, const std::string& path, int depth) {
     for (size_t j = i + 1; j < parts.size(); ++j) rest += "/" + parts[j];
     return LeadsOutside(root, rest, depth + 1);
   }
-  return !Inside(root, at);
+  return !PathInside(root, at);
 }
 
 // What a file type is, for messages about files that are not regular.
@@ -111,7 +106,7 @@ Status ResolveUnderRoot(const std::string& root, const std::string& relative, st
     return Status::kIoError;
   }
   const std::string canonical = buffer;
-  if (!Inside(root, canonical)) {
+  if (!PathInside(root, canonical)) {
     *message = outside;
     return Status::kAccessDenied;
   }

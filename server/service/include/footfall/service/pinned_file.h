@@ -15,6 +15,9 @@
 
 namespace footfall {
 
+// True when the canonical `path` is the canonical directory `root` or lies below it.
+bool PathInside(const std::string& root, const std::string& path);
+
 class PinnedFile {
  public:
   PinnedFile() = default;
