@@ -113,13 +113,17 @@ class SharedLogicTest(unittest.TestCase):
             floor = normals[0][1]  # tris[0] corner at vertex 2, on the fold
             self.assertAlmostEqual(floor[1], 1.0 if sharp else math.cos(a / 2), delta=0.1)
             self.assertEqual(normals[0][0], (0.0, 1.0, 0.0))  # away from the fold: the face's
-            samples = ff.sampling.sample_triangles(pts, tris, 0.25, normals)
+            samples = ff.sampling.sample_triangles(pts, tris, 0.25, corner_normals=normals)
             on_floor = [s for s in samples if s[1] == 0 and s[2] < -1e-9]
             self.assertTrue(on_floor)
             leaning = [s for s in on_floor if abs(s[4] - 1.0) > 1e-9]
             self.assertEqual(leaning == [], sharp)
         # Smoothed everywhere (180): the fold's corner leans even at 90 degrees.
         self.assertLess(ff.sampling.corner_normals(pts, tris, 180)[0][1][1], 0.99)
+        # Per-vertex normals, as callers gave them before corner normals, still interpolate.
+        up = [(0.0, 1.0, 0.0)] * len(pts)
+        for s in ff.sampling.sample_triangles(pts, tris, 0.25, up):
+            self.assertEqual(s[3:], (0.0, 1.0, 0.0))
 
     def test_separation_must_be_positive(self):
         with self.assertRaises(ValueError):

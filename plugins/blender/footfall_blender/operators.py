@@ -87,7 +87,7 @@ def mesh_samples(context, obj, separation):
     # Normals from the geometry, as `footfall generate` samples a mesh file (smooth, sharp at
     # edges past the crease angle), whatever the viewport's shading.
     normals = sampling.corner_normals(points, tris)
-    return sampling.sample_triangles(points, tris, separation, normals)
+    return sampling.sample_triangles(points, tris, separation, corner_normals=normals)
 
 
 class FOOTFALL_OT_terrain_setup(bpy.types.Operator):

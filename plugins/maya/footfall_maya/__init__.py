@@ -66,7 +66,7 @@ def _mesh_samples(mesh, separation):
     tris = [tuple(verts[i:i + 3]) for i in range(0, len(verts), 3)]
     # Normals from the geometry, as `footfall generate` samples a mesh file.
     normals = ffc.sampling.corner_normals(points, tris)
-    return ffc.sampling.sample_triangles(points, tris, separation, normals)
+    return ffc.sampling.sample_triangles(points, tris, separation, corner_normals=normals)
 
 
 @_guard

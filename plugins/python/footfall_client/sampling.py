@@ -64,11 +64,12 @@ def corner_normals(points, triangles, crease_deg=DEFAULT_CREASE_ANGLE_DEG):
     return out
 
 
-def sample_triangles(points, triangles, separation, normals=None):
+def sample_triangles(points, triangles, separation, vertex_normals=None, corner_normals=None):
     """points: (x, y, z) per vertex; triangles: (i, j, k) vertex indices, counter-clockwise
-    seen from the side the normals point to; separation [world units] > 0; normals: per
-    triangle, its three corner normals (corner_normals), or None for face normals. Returns a
-    list of (x, y, z, nx, ny, nz). Degenerate triangles are skipped."""
+    seen from the side the normals point to; separation [world units] > 0. Normals are
+    interpolated from `corner_normals` (per triangle, its three corners': see corner_normals),
+    else from `vertex_normals` (one per vertex, smooth across every edge), else the face's.
+    Returns a list of (x, y, z, nx, ny, nz). Degenerate triangles are skipped."""
     if not separation > 0:
         raise ValueError("separation must be > 0, got %r" % (separation,))
     seen = set()
@@ -82,8 +83,11 @@ def sample_triangles(points, triangles, separation, normals=None):
         longest = max(_length(_sub(b, a)), _length(_sub(c, b)), _length(_sub(a, c)))
         k = max(1, int(math.ceil(longest / separation - 1e-9)))
         na = nb = nc = None
-        if normals is not None and normals[t] is not None:
-            na, nb, nc = normals[t]
+        if corner_normals is not None:
+            if corner_normals[t] is not None:
+                na, nb, nc = corner_normals[t]
+        elif vertex_normals is not None:
+            na, nb, nc = (vertex_normals[i] for i in tri)
         for i in range(k + 1):
             for j in range(k + 1 - i):
                 u, v = i / k, j / k
