@@ -43,6 +43,16 @@ bool Inside(const Vec3& p, const WalkTerrain& t) {
          p.x <= t.region_max.x && p.y <= t.region_max.y && p.z <= t.region_max.z;
 }
 
+// PrepareWalkTerrain on `asc` with the default load options; REQUIREs success.
+WalkTerrain Prepared(const BumpyAsc& asc, const Character& c, const GenerateOptions& o) {
+  WalkTerrain prepared;
+  std::string error;
+  const Status status = PrepareWalkTerrain(asc.path, TerrainLoadOptions{}, c, o, &prepared, &error);
+  INFO(error);
+  REQUIRE(status == Status::kOk);
+  return prepared;
+}
+
 size_t BodyKeys(const Walk& w) {
   for (const WalkTrack& t : w.tracks)
     if (t.kind == TrackKind::kBody) return t.keys.size();
@@ -65,10 +75,8 @@ TEST_CASE("PrepareWalkTerrain: a height map coarser than the steps is walked aft
     o.start = {40 * cell, 5 * cell, 40 * cell};
     o.heading = {1, 0, 1};
 
-    WalkTerrain prepared;
+    const WalkTerrain prepared = Prepared(asc, c, o);
     std::string error;
-    REQUIRE(PrepareWalkTerrain(asc.path, TerrainLoadOptions{}, c, o, &prepared, &error) ==
-            Status::kOk);
     CHECK(prepared.report.separation == Approx(kSeparationPerStep * c.step_length));
     CHECK(prepared.report.file_separation == Approx(cell));
     // The start is the surface point nearest the point asked for: below it, give or take the
@@ -118,10 +126,7 @@ TEST_CASE("PrepareWalkTerrain: without a start, the surface under the top centre
   const Character c = LoadShipped("biped");
   const BumpyAsc asc(20, 1.0, "centre");
   GenerateOptions o;  // no start, default up +Y
-  WalkTerrain prepared;
-  std::string error;
-  REQUIRE(PrepareWalkTerrain(asc.path, TerrainLoadOptions{}, c, o, &prepared, &error) ==
-          Status::kOk);
+  const WalkTerrain prepared = Prepared(asc, c, o);
   // The grid's points span 0 .. 19 in x and z: the start lies near 9.5, 9.5, on the surface.
   CHECK(prepared.start.x == Approx(9.5).margin(0.5));
   CHECK(prepared.start.z == Approx(9.5).margin(0.5));
@@ -139,10 +144,8 @@ TEST_CASE("PrepareWalkTerrain: a path walked to its end widens the box along it"
   o.has_start = true;
   o.start = {5, 1, 5};
   o.path = {{30, 0, 5}, {30, 0, 40}};
-  WalkTerrain prepared;
+  WalkTerrain prepared = Prepared(asc, c, o);
   std::string error;
-  REQUIRE(PrepareWalkTerrain(asc.path, TerrainLoadOptions{}, c, o, &prepared, &error) ==
-          Status::kOk);
   CHECK_FALSE(prepared.region_is_bound);
   REQUIRE(prepared.cropped);
   for (const Vec3& p : {prepared.start, o.path[0], o.path[1]}) CHECK(Inside(p, prepared));
@@ -164,11 +167,9 @@ TEST_CASE("PrepareWalkTerrain: a start that may move keeps its search area in th
   o.has_start = true;
   o.start = {15, 0, 15};
   o.steps = 4;
-  WalkTerrain fixed, moving;
-  std::string error;
-  REQUIRE(PrepareWalkTerrain(asc.path, TerrainLoadOptions{}, c, o, &fixed, &error) == Status::kOk);
+  const WalkTerrain fixed = Prepared(asc, c, o);
   o.start_may_move = true;
-  REQUIRE(PrepareWalkTerrain(asc.path, TerrainLoadOptions{}, c, o, &moving, &error) == Status::kOk);
+  const WalkTerrain moving = Prepared(asc, c, o);
   REQUIRE(fixed.cropped);
   REQUIRE(moving.cropped);
   // Wider by the search radius on every side.
