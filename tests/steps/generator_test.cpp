@@ -646,6 +646,48 @@ TEST_CASE("By default a crowd walks in passes in process and all at once out of 
   CHECK(differ == 0);
 }
 
+TEST_CASE("A generated walk's keys share one block that its tracks keep alive",
+          "[steps][generator][crowd]") {
+  // 100 hexapods x 40 steps: a few megabytes of keys, a block returned to the system (unmapped)
+  // when the last track holding it goes.
+  const Character c = LoadShipped("hexapod");
+  Terrain t = LoadTerrain(MakeFlat(300, 0.02, 0), 0.02);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {3, 0, 2};
+  o.steps = 40;
+  o.crowd = 100;
+  o.crowd_spacing = 0.2;
+  WalkTrack kept, copied;
+  std::vector<WalkKey> expected;
+  {
+    Walk w = Generate(t, c, o);
+    REQUIRE(w.stopped.empty());
+    const std::pmr::memory_resource* arena = w.tracks.front().memory.get();
+    REQUIRE(arena != nullptr);
+    for (const WalkTrack& track : w.tracks) {
+      REQUIRE(track.memory.get() == arena);
+      REQUIRE(track.keys.get_allocator().resource() == arena);
+    }
+    WalkTrack& last = w.tracks.back();  // the last character's body
+    expected.assign(last.keys.begin(), last.keys.end());
+    REQUIRE(expected.size() == static_cast<size_t>(o.steps + 1));
+    copied = last;  // a copy's keys live on the default heap
+    CHECK(copied.keys.get_allocator().resource() == std::pmr::get_default_resource());
+    kept = std::move(last);
+  }
+  // The walk is gone; the moved track still reads its keys, and grows past its reservation.
+  REQUIRE(kept.keys.size() == expected.size());
+  size_t differ = 0;
+  for (size_t k = 0; k < expected.size(); ++k)
+    differ += !(kept.keys[k].position == expected[k].position &&
+                copied.keys[k].position == expected[k].position);
+  CHECK(differ == 0);
+  for (int i = 0; i < 20000; ++i) kept.keys.push_back(expected[i % expected.size()]);
+  CHECK(kept.keys[expected.size() + 19999].position == expected[19999 % expected.size()].position);
+  CHECK(kept.keys.front().position == expected.front().position);
+}
+
 TEST_CASE("Generation is deterministic", "[steps][generator]") {
   const Character c = LoadShipped("quadruped");
   Terrain t = LoadTerrain(MakeHeightField(200, 200, 0.04, 0.1, 7), 0.04);

@@ -1,6 +1,7 @@
 // The batch threads (footfall/terrain/batch_pool.h): every query of a batch answered
 // exactly once whatever the threads and chunk sizes, exceptions carried back to the caller, the
-// pool still serving after one, and a pool shared by callers on several threads.
+// pool still serving after one, a pool shared by callers on several threads, and batches run
+// from inside a batch.
 #include <algorithm>
 #include <atomic>
 #include <stdexcept>
@@ -84,4 +85,32 @@ TEST_CASE("a shared pool serves callers on several threads at once", "[pool]") {
   }
   for (auto& c : callers) c.join();
   CHECK(wrong.load() == 0);
+}
+
+TEST_CASE("a batch run from inside a batch runs on the thread that asks", "[pool]") {
+  // Each outer item runs a whole inner batch on the same pool (a generator's pass asking the
+  // embedded engine): the inner batch is one call on the asking thread, whichever thread
+  // (caller or worker) that is, and every inner item is answered exactly once.
+  BatchPool pool(2, 100, 200);
+  for (int round = 0; round < 50; ++round) {
+    constexpr size_t kOuter = 4, kInner = 500;
+    std::vector<std::atomic<int>> hits(kOuter * kInner);
+    for (auto& h : hits) h = 0;
+    std::atomic<size_t> inner_calls{0}, off_thread{0};
+    pool.Run(kOuter, 1, [&](size_t b, size_t e) {
+      for (size_t o = b; o < e; ++o) {
+        const std::thread::id asking = std::this_thread::get_id();
+        pool.Run(kInner, 16, [&](size_t ib, size_t ie) {
+          ++inner_calls;
+          off_thread += std::this_thread::get_id() != asking;
+          for (size_t i = ib; i < ie; ++i) ++hits[o * kInner + i];
+        });
+      }
+    });
+    size_t wrong = 0;
+    for (auto& h : hits) wrong += h.load() != 1;
+    REQUIRE(wrong == 0);
+    REQUIRE(inner_calls.load() == kOuter);
+    REQUIRE(off_thread.load() == 0);
+  }
 }

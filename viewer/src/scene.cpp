@@ -241,7 +241,7 @@ void Scene::DrawWalk(const ViewState& view, DrawList* on_top) const {
     const Rgba color = FootColor(foot_index++);
     const Rgba dim{static_cast<uint8_t>(color.r / 2 + 40), static_cast<uint8_t>(color.g / 2 + 40),
                    static_cast<uint8_t>(color.b / 2 + 40), 255};
-    const std::vector<WalkKey>& keys = track.keys;
+    const auto& keys = track.keys;
     for (size_t i = 0; i < keys.size(); ++i) {
       const WalkKey& k = keys[i];
       if (k.phase == KeyPhase::kEnd || k.phase == KeyPhase::kStart || k.phase == KeyPhase::kNone)

@@ -39,7 +39,7 @@ Vec3 ArcPoint(const Vec3& start, const Vec3& mid, const Vec3& end, double t) {
 }
 
 TrackPose PoseAt(const WalkTrack& track, double frame) {
-  const std::vector<WalkKey>& keys = track.keys;
+  const auto& keys = track.keys;
   if (keys.empty()) return TrackPose{};
   if (frame <= keys.front().frame) return FromKey(track, 0);
   if (frame >= keys.back().frame) return FromKey(track, keys.size() - 1);

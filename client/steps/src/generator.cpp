@@ -4,12 +4,15 @@
 #include "footfall/terrain/batch_pool.h"
 
 #include <algorithm>
+#include <atomic>
 #include <climits>
 #include <cmath>
 #include <memory>
+#include <mutex>
 #include <sstream>
 
 #include "frame_math.h"
+#include "key_arena.h"
 
 namespace footfall {
 namespace {
@@ -128,14 +131,32 @@ struct Move {
 
 class Generator {
  public:
+  // Walks `agents` (filled by Setup) into *walk.
   Generator(TerrainSession& session, TerrainHandle terrain, const Character& c,
-            const GenerateOptions& o, Walk* walk)
-      : session_(session), terrain_(terrain), c_(c), o_(o), walk_(*walk) {}
+            const GenerateOptions& o, std::vector<Agent>* agents, Walk* walk)
+      : session_(session),
+        terrain_(terrain),
+        c_(c),
+        o_(o),
+        walk_(*walk),
+        agents_(*agents),
+        threads_(o.threads) {}
+
+  // A copy walks passes of its own, sharing the agents and the walk (WalkPassesInParallel).
+  Generator(const Generator&) = default;
 
   Status Run(std::string* error);
 
  private:
+  // Counts the work done across passes and reports it through GenerateOptions::progress.
+  class Progress;
   Status Setup(std::string* error);
+  // Walks the characters [begin, end) every step, counting each step done in *progress.
+  Status WalkPass(size_t begin, size_t end, Progress* progress, std::string* error);
+  // Walks `passes` passes of `per_pass` characters, in parallel: one pass at a time per thread,
+  // each thread with a copy of this generator. Returns the failure of the first pass that failed.
+  Status WalkPassesInParallel(size_t passes, size_t per_pass, Progress* progress,
+                              std::string* error);
   // 1. The start's sample: where `start` snaps, or, when it may move and the character cannot
   //    stand there, the nearest candidate around it where it can (GenerateOptions).
   Status FindStart(const Vec3& start, bool may_move, Foothold* first, std::string* error);
@@ -170,11 +191,11 @@ class Generator {
   // item's result must not depend on the split.
   template <typename Fn>
   void Parallel(size_t count, Fn&& fn) {
-    if (o_.threads <= 1 || count < kMinParallel) return fn(size_t{0}, count);
-    if (!pool_) pool_ = SharedBatchPool(o_.threads);  // the engine's threads, on first use
+    if (threads_ <= 1 || count < kMinParallel) return fn(size_t{0}, count);
+    if (!pool_) pool_ = SharedBatchPool(threads_);  // the engine's threads, on first use
     // Chunks of about count / (8 threads), taken in turn: a thread the system holds up delays
     // the others little.
-    const size_t chunk = std::max<size_t>(1, count / (8 * static_cast<size_t>(o_.threads)));
+    const size_t chunk = std::max<size_t>(1, count / (8 * static_cast<size_t>(threads_)));
     pool_->Run(count, chunk, fn);
   }
   void Steer(Agent& a) const;
@@ -210,6 +231,8 @@ class Generator {
   const Character& c_;
   const GenerateOptions& o_;
   Walk& walk_;
+  std::vector<Agent>& agents_;
+  int threads_;  // for Parallel; 1 in the copies that walk passes in parallel
   Vec3 world_up_;
   int steps_ = 0;
   double lead_ = 0;
@@ -219,7 +242,6 @@ class Generator {
   Vec3 bounds_min_, bounds_max_;  // the terrain's samples' bounds
   // cos(max_slope_deg), sin(slope_threshold_deg): slope tests on dot products of unit vectors.
   double cos_max_slope_ = -1, sin_slope_threshold_ = 1;
-  std::vector<Agent> agents_;
   size_t pass_begin_ = 0, pass_end_ = 0;  // the agents walking in this pass
   std::shared_ptr<BatchPool> pool_;
   std::vector<int> pair_of_foot_;
@@ -273,7 +295,7 @@ Vec3 Generator::BodyUp(const Vec3& feet_up, const std::vector<Vec3>& feet) const
 
 void Generator::KeyFoot(const Agent& a, int foot, double frame, KeyPhase phase, const Vec3& p,
                         const Vec3& n) {
-  std::vector<WalkKey>& keys = walk_.tracks[a.first_track + foot].keys;
+  std::pmr::vector<WalkKey>& keys = walk_.tracks[a.first_track + foot].keys;
   if (!keys.empty() && keys.back().frame == frame) keys.pop_back();  // lift-off replaces plant
   WalkKey key;
   key.frame = frame, key.phase = phase, key.position = p, key.normal = n;
@@ -322,6 +344,29 @@ void Generator::Steer(Agent& a) const {
   a.forward = Normalize(RotateAround(a.forward, a.up, std::clamp(angle, -max_turn, max_turn)));
 }
 
+class Generator::Progress {
+ public:
+  // `total` units of work, reported scaled down to fit an int.
+  Progress(const std::function<void(int, int)>& report, int64_t total)
+      : report_(report),
+        total_(total),
+        scale_(total > INT_MAX ? static_cast<double>(INT_MAX) / static_cast<double>(total) : 1.0) {}
+  void Add(int64_t work) {
+    if (!report_) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    done_ += work;
+    report_(static_cast<int>(static_cast<double>(done_) * scale_),
+            static_cast<int>(static_cast<double>(total_) * scale_));
+  }
+
+ private:
+  const std::function<void(int, int)>& report_;
+  const int64_t total_;
+  const double scale_;
+  std::mutex mutex_;
+  int64_t done_ = 0;
+};
+
 Status Generator::Run(std::string* error) {
   world_up_ = Normalize(o_.up);
   const int groups = static_cast<int>(c_.gait.size());
@@ -357,31 +402,22 @@ Status Generator::Run(std::string* error) {
   Status s = Setup(error);
   if (s != Status::kOk) return s;
   // Passes: the characters walk every step in groups of characters_per_pass, so that a group's
-  // terrain stays in the caches from one step to the next.
+  // terrain stays in the caches from one step to the next. In process, passes run in parallel,
+  // one per thread (no hand-over between threads within a step).
   const size_t n = agents_.size();
   int per_pass_option = o_.characters_per_pass;
   if (per_pass_option == 0)
     per_pass_option = session_.InProcess() ? kInProcessCharactersPerPass : -1;
   const size_t per_pass = per_pass_option > 0 ? static_cast<size_t>(per_pass_option) : n;
-  const int passes = static_cast<int>((n + per_pass - 1) / per_pass);
-  // Progress in steps times passes, scaled down if that overflows an int.
-  const int64_t total = int64_t{passes} * steps_;
-  const double scale = total > INT_MAX ? static_cast<double>(INT_MAX) / total : 1.0;
-  auto report = [&](int64_t done) {
-    if (o_.progress) o_.progress(static_cast<int>(done * scale), static_cast<int>(total * scale));
-  };
-  for (int pass = 0; pass < passes; ++pass) {
-    pass_begin_ = pass * per_pass, pass_end_ = std::min(n, pass_begin_ + per_pass);
-    for (int k = 0; k < steps_; ++k) {
-      bool any = false;
-      for (size_t i = pass_begin_; i < pass_end_ && !any; ++i) any = agents_[i].walking;
-      if (!any) break;
-      s = Step(k, error);
-      if (s != Status::kOk) return s;
-      report(int64_t{pass} * steps_ + k + 1);
-    }
-    report(int64_t{pass + 1} * steps_);
+  const size_t passes = (n + per_pass - 1) / per_pass;
+  Progress progress(o_.progress, int64_t{steps_} * static_cast<int64_t>(passes));
+  if (session_.InProcess() && threads_ > 1 && passes > 1) {
+    s = WalkPassesInParallel(passes, per_pass, &progress, error);
+  } else {
+    for (size_t pass = 0; pass < passes && s == Status::kOk; ++pass)
+      s = WalkPass(pass * per_pass, std::min(n, (pass + 1) * per_pass), &progress, error);
   }
+  if (s != Status::kOk) return s;
   // The walk's stop message: the first agent's, and how many others stopped.
   size_t stopped = 0;
   for (const Agent& a : agents_) {
@@ -391,6 +427,49 @@ Status Generator::Run(std::string* error) {
   if (stopped > 1)
     walk_.stopped += " (and " + std::to_string(stopped - 1) + " more characters stopped)";
   return Status::kOk;
+}
+
+Status Generator::WalkPass(size_t begin, size_t end, Progress* progress, std::string* error) {
+  pass_begin_ = begin, pass_end_ = end;
+  int k = 0;
+  for (; k < steps_; ++k) {
+    bool any = false;
+    for (size_t i = begin; i < end && !any; ++i) any = agents_[i].walking;
+    if (!any) break;
+    const Status s = Step(k, error);
+    if (s != Status::kOk) return s;
+    progress->Add(1);
+  }
+  progress->Add(steps_ - k);  // the steps left when every character stopped or arrived
+  return Status::kOk;
+}
+
+Status Generator::WalkPassesInParallel(size_t passes, size_t per_pass, Progress* progress,
+                                       std::string* error) {
+  if (!pool_) pool_ = SharedBatchPool(threads_);
+  std::vector<Generator> copies(static_cast<size_t>(threads_), *this);
+  for (Generator& g : copies) g.threads_ = 1;
+  std::atomic<size_t> next{0};
+  std::mutex mutex;
+  size_t failed_pass = passes;  // the first pass that failed, under mutex
+  Status failure = Status::kOk;
+  // One item per copy; each takes passes in turn until none is left (a thread that starts
+  // late takes fewer), or a pass failed.
+  pool_->Run(copies.size(), 1, [&](size_t b, size_t e) {
+    for (size_t c = b; c < e; ++c) {
+      for (size_t pass; (pass = next.fetch_add(1)) < passes;) {
+        std::string why;
+        const size_t first = pass * per_pass;
+        const Status s =
+            copies[c].WalkPass(first, std::min(agents_.size(), first + per_pass), progress, &why);
+        if (s == Status::kOk) continue;
+        std::lock_guard<std::mutex> lock(mutex);
+        if (pass < failed_pass) failed_pass = pass, failure = s, *error = why;
+        next.store(passes);
+      }
+    }
+  });
+  return failure;
 }
 
 Status Generator::Setup(std::string* error) {
@@ -434,7 +513,15 @@ Status Generator::Setup(std::string* error) {
   agents_.resize(n);
   walk_.tracks.clear();
   walk_.tracks.reserve(n * (feet + 1));
+  // Every track reserves the keys it will have if it walks every step (up to a cap), all in
+  // one arena.
   const size_t groups = c_.gait.size();
+  const size_t steps_of_foot = static_cast<size_t>(steps_) / groups + 1;
+  const size_t foot_keys = std::min<size_t>(3 * steps_of_foot + 1, 4096);
+  const size_t body_keys = std::min<size_t>(steps_ + 1, 4096);
+  const size_t character_bytes =
+      feet * foot_keys * sizeof(WalkKey) + body_keys * (sizeof(WalkKey) + sizeof(Quat));
+  auto arena = std::make_shared<KeyArena>(n * character_bytes);
   for (int i = 0; i < n; ++i) {
     Agent& a = agents_[i];
     if (n > 1) a.id = "c" + std::to_string(i + 1);
@@ -442,13 +529,15 @@ Status Generator::Setup(std::string* error) {
     Orient(a, answers_[i], up0, fwd0);
     a.first_track = walk_.tracks.size();
     for (size_t f = 0; f <= feet; ++f) {
-      WalkTrack t;
-      t.name = f < feet ? c_.feet[f].name : "body";
-      t.character = a.id;
-      t.kind = f < feet ? TrackKind::kFoot : TrackKind::kBody;
-      const size_t steps_of_foot = static_cast<size_t>(steps_) / groups + 1;
-      t.keys.reserve(std::min<size_t>(f < feet ? 3 * steps_of_foot + 1 : steps_ + 1, 4096));
-      if (f == feet) t.rotations.reserve(t.keys.capacity());
+      const bool body = f == feet;
+      WalkTrack t{body ? "body" : c_.feet[f].name,
+                  a.id,
+                  body ? TrackKind::kBody : TrackKind::kFoot,
+                  arena,
+                  std::pmr::vector<WalkKey>(arena.get()),
+                  std::pmr::vector<Quat>(arena.get())};
+      t.keys.reserve(body ? body_keys : foot_keys);
+      if (body) t.rotations.reserve(body_keys);
       walk_.tracks.push_back(std::move(t));
     }
   }
@@ -1091,7 +1180,8 @@ Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Charac
   }
   Walk walk;
   walk.fps = options.fps;
-  Generator g(session, terrain, character, options, &walk);
+  std::vector<Agent> agents;
+  Generator g(session, terrain, character, options, &agents, &walk);
   const Status s = g.Run(error);
   if (s != Status::kOk) return s;
   *out = std::move(walk);

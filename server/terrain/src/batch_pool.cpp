@@ -7,6 +7,10 @@
 namespace footfall {
 namespace {
 
+// The pool whose job the calling thread is running, if any: a Run it makes on that pool runs
+// on the calling thread (a nested batch, such as an embedded query inside a generator's pass).
+thread_local const BatchPool* running_job = nullptr;
+
 inline void CpuRelax() {
 #if defined(__x86_64__) || defined(__i386__)
   __builtin_ia32_pause();
@@ -49,11 +53,14 @@ void BatchPool::Drain(std::unique_lock<std::mutex>& lock) {
     const auto* fn = fn_;
     lock.unlock();
     std::exception_ptr error;
+    const BatchPool* outer = running_job;
+    running_job = this;
     try {
       (*fn)(begin, end);
     } catch (...) {
       error = std::current_exception();
     }
+    running_job = outer;
     lock.lock();
     if (error && !error_) error_ = error;
     const size_t finished = finished_.load(std::memory_order_relaxed) + (end - begin);
@@ -81,7 +88,7 @@ void BatchPool::Work() {
 void BatchPool::Run(size_t count, size_t chunk, const std::function<void(size_t, size_t)>& fn) {
   chunk = std::max<size_t>(1, chunk);
   std::unique_lock<std::mutex> run(run_mutex_, std::defer_lock);
-  if (workers_.empty() || count <= chunk || !run.try_lock()) {
+  if (workers_.empty() || count <= chunk || running_job == this || !run.try_lock()) {
     if (count > 0) fn(0, count);
     return;
   }

@@ -8,11 +8,8 @@
 #include <new>
 #include <vector>
 
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
-
 #include "footfall/terrain/grid.h"
+#include "footfall/terrain/large_memory.h"
 #include "grid_layout.h"
 
 namespace footfall {
@@ -58,29 +55,9 @@ void ChooseGridBox(const RawSamples& s, const double lo[3], const double hi[3], 
   }
 }
 
-// The grid's single allocation. Large grids are aligned to 2 MiB and marked for transparent
-// huge pages where the system offers them (Linux, madvise mode): random queries over a grid of
-// tens of megabytes otherwise spend much of their time in TLB misses. Throws std::bad_alloc.
-unsigned char* AllocateGridMemory(size_t bytes) {
-  constexpr size_t kHugePage = size_t{2} << 20;
-  bytes = std::max<size_t>(bytes, 1);
-  void* p = nullptr;
-  if (bytes < kHugePage) {
-    p = std::malloc(bytes);
-  } else {
-    const size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
-    p = std::aligned_alloc(kHugePage, rounded);
-#ifdef MADV_HUGEPAGE
-    if (p) madvise(p, rounded, MADV_HUGEPAGE);
-#endif
-  }
-  if (!p) throw std::bad_alloc();
-  return static_cast<unsigned char*>(p);
-}
-
 }  // namespace
 
-void TerrainGrid::FreeMemory::operator()(unsigned char* p) const { std::free(p); }
+void TerrainGrid::FreeMemory::operator()(unsigned char* p) const { FreeLargeMemory(p); }
 
 TerrainGrid::TerrainGrid() = default;
 TerrainGrid::~TerrainGrid() = default;
@@ -196,7 +173,8 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
   const size_t position_floats = 3 * n + 4;
   const size_t bytes = n * sizeof(SampleAnswer) + (cells + 1) * sizeof(uint32_t) +
                        blocks * 6 * sizeof(float) + position_floats * sizeof(float);
-  g.memory_.reset(AllocateGridMemory(bytes));
+  // One block, in huge pages when large (large_memory.h).
+  g.memory_.reset(static_cast<unsigned char*>(AllocateLargeMemory(bytes)));
   SampleAnswer* answers = reinterpret_cast<SampleAnswer*>(g.memory_.get());
   uint32_t* cell_start = reinterpret_cast<uint32_t*>(answers + n);
   float* block_bounds = reinterpret_cast<float*>(cell_start + cells + 1);

@@ -19,7 +19,7 @@ namespace footfall {
 
 // Characters walked together by default when the session answers in process: their stretch of
 // terrain and their keys stay in the caches from one step to the next.
-constexpr int kInProcessCharactersPerPass = 1000;
+constexpr int kInProcessCharactersPerPass = 250;
 
 // The sample spacing a character walks well on, as a fraction of its step_length: it looks
 // for each foothold within half a step of where it aims.

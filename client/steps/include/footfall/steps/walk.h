@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <memory_resource>
 #include <string>
 #include <vector>
 
@@ -37,10 +39,15 @@ struct WalkTrack {
   std::string name;       // foot name from the character file, or "body"
   std::string character;  // crowd runs: which character ("" for a single character)
   TrackKind kind = TrackKind::kFoot;
-  std::vector<WalkKey> keys;  // ascending frames
+  // Where keys and rotations live when it is not the default heap: the step generator puts a
+  // walk's keys in one block it shares between the tracks (a crowd's walk holds millions of
+  // keys). The track holds it, so a track outlives its walk safely; copies of the keys use the
+  // default heap.
+  std::shared_ptr<std::pmr::memory_resource> memory;
+  std::pmr::vector<WalkKey> keys;  // ascending frames
   // Body tracks: the body's world orientation at each key (rotations[i] at keys[i]). Empty for
   // feet.
-  std::vector<Quat> rotations;
+  std::pmr::vector<Quat> rotations;
 
   // The orientation at keys[i]: rotations[i], or the identity where there is none.
   Quat Rotation(size_t i) const { return i < rotations.size() ? rotations[i] : Quat{}; }

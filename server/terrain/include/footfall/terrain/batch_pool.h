@@ -43,7 +43,7 @@ class BatchPool {
   // returned. Without workers, or for at most `chunk` items, makes one call fn(0, count) on the
   // caller. The first exception fn throws is rethrown here once all calls are over. Callers on
   // several threads may share a pool: while one Run is under way, another caller's Run makes
-  // one call fn(0, count) on its own thread.
+  // one call fn(0, count) on its own thread, as does a Run made from inside fn (nested).
   void Run(size_t count, size_t chunk, const std::function<void(size_t, size_t)>& fn);
 
  private:

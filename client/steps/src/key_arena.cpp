@@ -1,0 +1,51 @@
+#include "key_arena.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <new>
+
+#include "footfall/terrain/large_memory.h"
+
+namespace footfall {
+namespace {
+
+// Blocks after the first: at least this large, as a walk that outgrows its reservation grows
+// by doubling tracks. [Units: bytes]
+constexpr size_t kMinBlock = size_t{2} << 20;
+
+}  // namespace
+
+KeyArena::KeyArena(size_t expected) {
+  if (expected > 0) AddBlock(expected);
+}
+
+KeyArena::~KeyArena() {
+  for (void* p : blocks_) FreeLargeMemory(p);
+}
+
+void KeyArena::AddBlock(size_t bytes) {
+  bytes = std::max(bytes, kMinBlock);
+  blocks_.reserve(blocks_.size() + 1);
+  void* p = AllocateLargeMemory(bytes);
+  blocks_.push_back(p);
+  next_ = static_cast<unsigned char*>(p);
+  end_ = next_ + bytes;
+}
+
+void* KeyArena::do_allocate(size_t bytes, size_t alignment) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto aligned = [&]() {
+    const uintptr_t at = reinterpret_cast<uintptr_t>(next_);
+    return next_ + ((alignment - at % alignment) % alignment);
+  };
+  unsigned char* p = next_ ? aligned() : nullptr;
+  if (!p || static_cast<size_t>(end_ - p) < bytes) {
+    if (bytes > SIZE_MAX - alignment) throw std::bad_alloc();
+    AddBlock(bytes + alignment);
+    p = aligned();
+  }
+  next_ = p + bytes;
+  return p;
+}
+
+}  // namespace footfall

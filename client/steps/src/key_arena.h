@@ -1,0 +1,38 @@
+// KeyArena: the memory of a generated walk's keys, shared by its tracks.
+#pragma once
+
+#include <cstddef>
+#include <memory_resource>
+#include <mutex>
+#include <vector>
+
+namespace footfall {
+
+// Hands out memory from large blocks (huge pages where the system offers them) and frees it
+// all at once when destroyed: a crowd's keys are written once, in millions, and fault in far
+// fewer pages than from the default heap. Thread-safe. Memory given back is not reused (tracks
+// are reserved to their expected length, so little is).
+class KeyArena : public std::pmr::memory_resource {
+ public:
+  // The first block holds `expected` bytes (0: allocated on first use).
+  explicit KeyArena(size_t expected);
+  ~KeyArena() override;
+  KeyArena(const KeyArena&) = delete;
+  KeyArena& operator=(const KeyArena&) = delete;
+
+ private:
+  void* do_allocate(size_t bytes, size_t alignment) override;
+  void do_deallocate(void*, size_t, size_t) override {}
+  bool do_is_equal(const std::pmr::memory_resource& other) const noexcept override {
+    return this == &other;
+  }
+  // Starts a block of at least `bytes`. Called with mutex_ held.
+  void AddBlock(size_t bytes);
+
+  std::mutex mutex_;
+  std::vector<void*> blocks_;
+  unsigned char* next_ = nullptr;  // free space of the last block: [next_, end_)
+  unsigned char* end_ = nullptr;
+};
+
+}  // namespace footfall
