@@ -55,7 +55,9 @@ class TerrainSession {
   // "embedded" or "rpc HOST:PORT".
   virtual std::string Describe() const = 0;
   // True when queries are answered in this process (no round trip per call): callers may then
-  // prefer several smaller batches that stay in the caches to one large one.
+  // prefer several smaller batches that stay in the caches to one large one, and may call
+  // Snap, Normal and Next from several threads at once on a loaded terrain (last_error() is
+  // then undefined after a failure). Other sessions serve one call at a time.
   virtual bool InProcess() const = 0;
   // The reason for the last failed call, one line.
   const std::string& last_error() const { return last_error_; }
