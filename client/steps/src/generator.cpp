@@ -219,6 +219,8 @@ class Generator {
   void KeyFoot(const Agent& a, int foot, double frame, KeyPhase phase, const Vec3& p,
                const Vec3& n);
   void KeyBody(const Agent& a, double frame);
+  // Keys a's feet and body where they stand, at the start frame.
+  void KeyStart(Agent& a);
   void Stop(Agent& a, int step, const std::string& why);
   // A failed batch call: the session's status, and its message prefixed with `what`.
   Status Check(Status status, const char* what, std::string* error) {
@@ -431,6 +433,8 @@ Status Generator::Run(std::string* error) {
 
 Status Generator::WalkPass(size_t begin, size_t end, Progress* progress, std::string* error) {
   pass_begin_ = begin, pass_end_ = end;
+  // The pass's characters' first keys: each thread first writes the keys' memory it fills.
+  for (size_t i = begin; i < end; ++i) KeyStart(agents_[i]);
   int k = 0;
   for (; k < steps_; ++k) {
     bool any = false;
@@ -550,17 +554,20 @@ Status Generator::Setup(std::string* error) {
             error);
   if (s != Status::kOk) return s;
   // 4. The body at the feet's centroid, raised by body_height along its up (multipeds: BodyUp;
-  //    the feet's frame from their averaged normal); every foot and the body keyed planted at
-  //    the start frame.
+  //    the feet's frame from their averaged normal). (Keyed at the start of their pass.)
   for (int i = 0; i < n; ++i) {
     Agent& a = agents_[i];
     const std::string fault = Plant(a, &answers_[i * feet]);
-    for (size_t f = 0; f < feet; ++f)
-      KeyFoot(a, static_cast<int>(f), o_.start_frame, KeyPhase::kEnd, a.foot[f], a.foot_normal[f]);
     if (!fault.empty()) Stop(a, 1, fault);
-    KeyBody(a, o_.start_frame);
   }
   return Status::kOk;
+}
+
+void Generator::KeyStart(Agent& a) {
+  // 4 (end). Every foot and the body keyed planted at the start frame.
+  for (size_t f = 0; f < c_.feet.size(); ++f)
+    KeyFoot(a, static_cast<int>(f), o_.start_frame, KeyPhase::kEnd, a.foot[f], a.foot_normal[f]);
+  KeyBody(a, o_.start_frame);
 }
 
 Status Generator::FindStart(const Vec3& start, bool may_move, Foothold* first, std::string* error) {
