@@ -220,7 +220,7 @@ class Generator {
                const Vec3& n);
   void KeyBody(const Agent& a, double frame);
   // Keys a's feet and body where they stand, at the start frame.
-  void KeyStart(Agent& a);
+  void KeyStart(const Agent& a);
   void Stop(Agent& a, int step, const std::string& why);
   // A failed batch call: the session's status, and its message prefixed with `what`.
   Status Check(Status status, const char* what, std::string* error) {
@@ -563,7 +563,7 @@ Status Generator::Setup(std::string* error) {
   return Status::kOk;
 }
 
-void Generator::KeyStart(Agent& a) {
+void Generator::KeyStart(const Agent& a) {
   // 4 (end). Every foot and the body keyed planted at the start frame.
   for (size_t f = 0; f < c_.feet.size(); ++f)
     KeyFoot(a, static_cast<int>(f), o_.start_frame, KeyPhase::kEnd, a.foot[f], a.foot_normal[f]);
