@@ -44,6 +44,13 @@ RawSamples TestTerrain() {
   return s;
 }
 
+// Load options with only a separation (the rest at their defaults).
+TerrainLoadOptions Separation(double separation) {
+  TerrainLoadOptions o;
+  o.separation = separation;
+  return o;
+}
+
 std::unique_ptr<TerrainSession> Connect(int port, double timeout_s = 5) {
   RpcOptions o;
   o.port = port;
@@ -423,12 +430,12 @@ TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
   ServerProcess server(0, {"--no-rpcbind", "--data-root", root});
   auto rpc = Connect(server.port());
   TerrainHandle t = 0;
-  CHECK(rpc->LoadServerFile("ok.pts", 0, &t) == Status::kOk);
+  CHECK(rpc->LoadServerFile("ok.pts", Separation(0), &t) == Status::kOk);
   CHECK(rpc->Snap(t, Vec3{0.9, 0, 0}).index == 1);
-  CHECK(rpc->LoadServerFile("/etc/passwd", 0, &t) == Status::kAccessDenied);
-  CHECK(rpc->LoadServerFile("missing.pts", 0, &t) == Status::kIoError);
-  CHECK(rpc->LoadServerFile("nowhere/missing.pts", 0, &t) == Status::kIoError);
-  REQUIRE(rpc->LoadServerFile("bad.pts", 0, &t) == Status::kParseError);
+  CHECK(rpc->LoadServerFile("/etc/passwd", Separation(0), &t) == Status::kAccessDenied);
+  CHECK(rpc->LoadServerFile("missing.pts", Separation(0), &t) == Status::kIoError);
+  CHECK(rpc->LoadServerFile("nowhere/missing.pts", Separation(0), &t) == Status::kIoError);
+  REQUIRE(rpc->LoadServerFile("bad.pts", Separation(0), &t) == Status::kParseError);
   CHECK(rpc->last_error() ==
         "bad.pts:2: column 3: 'zero' is not a number (expected x y z nx ny nz)");
   CHECK(server.Log().find("error: load") != std::string::npos);
@@ -440,7 +447,7 @@ TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
                                   "sub/../../" + base + "there.pts", "link.pts", "dangling.pts",
                                   "out/there.pts", "out/gone.pts", "out/no/such/dir.pts"}) {
       INFO(path);
-      CHECK(rpc->LoadServerFile(path, 0, &t) == Status::kAccessDenied);
+      CHECK(rpc->LoadServerFile(path, Separation(0), &t) == Status::kAccessDenied);
       CHECK(rpc->last_error() == "'" + path + "' leads outside the data root");
     }
   }
@@ -483,7 +490,7 @@ TEST_CASE("footfalld refuses files that are not regular and keeps serving", "[rp
       {"socket.pts", "'socket.pts' is a socket: expected a regular terrain file"}};
   for (const auto& c : cases) {
     TerrainHandle t = 0;
-    CHECK(rpc->LoadServerFile(c.first, 0, &t) == Status::kInvalidArgument);
+    CHECK(rpc->LoadServerFile(c.first, Separation(0), &t) == Status::kInvalidArgument);
     CHECK(rpc->last_error() == c.second);
   }
   RequireServed(server.port());  // another client is answered afterwards
@@ -500,7 +507,7 @@ TEST_CASE("footfalld escapes control characters from clients in its log", "[rpc]
   TerrainHandle t = 0;
   const std::string forged = "\nfootfalld: forged line\r\x1b[2J\\n";
   REQUIRE(rpc->LoadSamples(MakeFlat(4, 1, 0), "name" + forged, &t) == Status::kOk);
-  CHECK(rpc->LoadServerFile("path" + forged, 0, &t) == Status::kIoError);
+  CHECK(rpc->LoadServerFile("path" + forged, Separation(0), &t) == Status::kIoError);
   const std::string log = server.Log();
   INFO(log);
   CHECK(log.find("'name\\nfootfalld: forged line\\r\\x1b[2J\\\\n' (uploaded)") !=
@@ -514,6 +521,85 @@ TEST_CASE("footfalld escapes control characters from clients in its log", "[rpc]
     CHECK(line.rfind("footfalld: ", 0) == 0);
     CHECK(line.rfind("footfalld: forged", 0) != 0);
   }
+  std::system(("rm -rf '" + root + "'").c_str());
+}
+
+TEST_CASE("footfalld reads server files with every load option, as the embedded engine does",
+          "[rpc]") {
+  char tmpl[] = "/tmp/footfall-root-XXXXXX";
+  REQUIRE(mkdtemp(tmpl));
+  const std::string root = tmpl;
+  // A floor meeting a wall at a right angle (sharp below the crease angle, bent above it), and
+  // a 4 x 3 height map with a bump.
+  std::ofstream(root + "/corner.obj") << "v 0 0 0\nv 2 0 0\nv 2 0 2\nv 0 0 2\nv 2 1 0\nv 2 1 2\n"
+                                         "f 1 3 2\nf 1 4 3\nf 2 3 6\nf 2 6 5\n";
+  std::ofstream(root + "/bump.asc") << "ncols 4\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\n"
+                                       "0 0 0 0\n0 2 1 0\n0 0 0 0\n";
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", root});
+  auto rpc = Connect(server.port());
+  auto local = MakeEmbeddedSession(1);
+  // Probes near the floor's edge at the wall, on the wall, and over the height map.
+  const std::vector<Vec3> probes = {{1.9, 0.05, 1}, {1.95, 0.5, 1}, {1, 0.1, 1},
+                                    {1, 1.5, 1},    {1, 1, 2},      {2, 0.5, 0.5}};
+  // Loads `file` both ways with `o`; returns the remote answers after checking they equal the
+  // local ones.
+  auto load_both = [&](const std::string& file, const TerrainLoadOptions& o) {
+    TerrainHandle r = 0, l = 0;
+    INFO(file << ": " << rpc->last_error() << " / " << local->last_error());
+    REQUIRE(rpc->LoadServerFile(file, o, &r) == Status::kOk);
+    REQUIRE(local->LoadServerFile(root + "/" + file, o, &l) == Status::kOk);
+    TerrainInfo ri, li;
+    REQUIRE(rpc->Info(r, &ri) == Status::kOk);
+    REQUIRE(local->Info(l, &li) == Status::kOk);
+    CHECK(ri.stats.samples == li.stats.samples);
+    std::vector<Foothold> ra(probes.size()), la(probes.size());
+    REQUIRE(rpc->Snap(r, probes.data(), probes.size(), ra.data()) == Status::kOk);
+    REQUIRE(local->Snap(l, probes.data(), probes.size(), la.data()) == Status::kOk);
+    for (size_t i = 0; i < probes.size(); ++i) RequireSame(ra[i], la[i]);
+    return ra;
+  };
+  auto normals_differ = [](const std::vector<Foothold>& a, const std::vector<Foothold>& b) {
+    size_t n = 0;
+    for (size_t i = 0; i < a.size(); ++i) n += !(a[i].normal == b[i].normal);
+    return n;
+  };
+  TerrainLoadOptions o;
+  o.separation = 0.1;
+  const auto sharp = load_both("corner.obj", o);
+  o.crease_angle_deg = 180;
+  const auto bent = load_both("corner.obj", o);
+  CHECK(normals_differ(sharp, bent) > 0);  // the crease angle reached the server
+  o.smooth_normals = false;
+  const auto flat = load_both("corner.obj", o);
+  CHECK(normals_differ(flat, bent) > 0);
+  o = TerrainLoadOptions{};
+  o.separation = 0.2;
+  const auto seed1 = load_both("corner.obj", o);
+  o.seed = 7;
+  const auto seed7 = load_both("corner.obj", o);
+  size_t moved = 0;
+  for (size_t i = 0; i < seed1.size(); ++i) moved += !(seed1[i].point == seed7[i].point);
+  CHECK(moved > 0);
+  // Height maps: cell size, height scale and up axis.
+  o = TerrainLoadOptions{};
+  const auto plain = load_both("bump.asc", o);
+  o.cell_size = 0.5, o.height_scale = 0.25, o.up_axis = 'z';
+  const auto scaled = load_both("bump.asc", o);
+  moved = 0;
+  for (size_t i = 0; i < plain.size(); ++i) moved += !(plain[i].point == scaled[i].point);
+  CHECK(moved > 0);
+  // Bad options: the loader's message, as for a local file.
+  o = TerrainLoadOptions{};
+  TerrainHandle t = 0;
+  o.crease_angle_deg = 200;
+  CHECK(rpc->LoadServerFile("corner.obj", o, &t) == Status::kInvalidArgument);
+  CHECK_THAT(rpc->last_error(), Catch::Contains("crease angle must be from 0 to 180 degrees"));
+  o.crease_angle_deg = 60, o.up_axis = 'q';
+  CHECK(rpc->LoadServerFile("bump.asc", o, &t) == Status::kInvalidArgument);
+  CHECK_THAT(rpc->last_error(), Catch::Contains("up axis must be x, y or z"));
+  o.up_axis = 'y', o.finest_default = -1;
+  CHECK(rpc->LoadServerFile("bump.asc", o, &t) == Status::kInvalidArgument);
+  CHECK_THAT(rpc->last_error(), Catch::Contains("finest default separation must be >= 0"));
   std::system(("rm -rf '" + root + "'").c_str());
 }
 
@@ -552,12 +638,12 @@ TEST_CASE("footfalld holds --max-samples over parallel uploads and mesh loads", 
   SECTION("meshes are refused on the sampler's estimate, naming a separation that fits") {
     auto rpc = Connect(server.port());
     TerrainHandle t = 0;
-    CHECK(rpc->LoadServerFile("square.obj", 0.05, &t) == Status::kLimitExceeded);
+    CHECK(rpc->LoadServerFile("square.obj", Separation(0.05), &t) == Status::kLimitExceeded);
     CHECK(rpc->last_error() ==
           "square.obj: separation 0.05 would give about 64000 samples (limit 2000); choose a "
           "separation of at least 0.283 (the limit is what is left of the sample budget "
           "(--max-samples 2000, 0 in use by loaded terrains and uploads in progress))");
-    CHECK(rpc->LoadServerFile("square.obj", 0.283, &t) == Status::kOk);
+    CHECK(rpc->LoadServerFile("square.obj", Separation(0.283), &t) == Status::kOk);
   }
   SECTION("orphans make room in the budget, least recently queried first") {
     auto first = Connect(server.port());

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `footfall generate` end to end: identical walks from the embedded engine and a real footfalld
 # (single characters, a path, a crowd, a walk that stops at a cliff), every output format, the
-# exit status of a stopped walk, and the messages of bad flags.
+# exit status of a stopped walk, the messages of bad flags, and a mesh read by footfalld with
+# the loading flags.
 # Usage: generate_cli_test.sh FOOTFALL FOOTFALLD SOURCE_DIR
 set -u
 footfall=$1
@@ -158,5 +159,22 @@ bad out-is-terrain "--out $work/link.json is the terrain file this walk reads" -
 check "out-is-terrain: the terrain file is intact" cmp -s "$work/t.txt" "$work/t-copy.txt"
 check "bad flags: no output written" [ ! -e "$work/x.json" ]
 
+stop_server
+
+# 6. A mesh under footfalld's data root, read by the server with the loading flags given and,
+#    without --separation, at a quarter of the character's step: the walk is the one on the same
+#    file resampled locally at that separation (0.175 for the biped), crease angle included.
+mkdir -p "$work/root"
+printf 'v 0 0 0\nv 4 0 0\nv 4 0.7 4\nv 0 0.7 4\nf 1 3 2\nf 1 4 3\n' > "$work/root/ramp.obj"
+start_server "$footfalld" --data-root "$work/root"
+"$footfall" generate --server-terrain ramp.obj --server "$server" --crease-angle 30 --seed 3 \
+  --character "$chars/biped.json" --start 2,0.1,0.5 --steps 6 --out "$work/server-ramp.json" 2> "$work/server-ramp.err"
+check "server-terrain mesh: exit 0" [ $? -eq 0 ]
+"$footfall" generate --terrain "$work/root/ramp.obj" --separation 0.175 --crease-angle 30 --seed 3 \
+  --character "$chars/biped.json" --start 2,0.1,0.5 --steps 6 --out "$work/local-ramp.json" 2> /dev/null
+check "server-terrain mesh: the walk on the file resampled at a quarter step" cmp -s "$work/server-ramp.json" "$work/local-ramp.json"
+"$footfall" generate --server-terrain ramp.obj --server "$server" --seed 4 \
+  --character "$chars/biped.json" --start 2,0.1,0.5 --steps 6 --out "$work/server-ramp4.json" 2> /dev/null
+check "server-terrain mesh: the seed reaches the server" bash -c "! cmp -s '$work/server-ramp.json' '$work/server-ramp4.json'"
 stop_server
 finish

@@ -543,8 +543,9 @@ namespace {
 class CountingSession final : public TerrainSession {
  public:
   CountingSession() : inner_(MakeEmbeddedSession()) {}
-  Status LoadServerFile(const std::string& p, double s, TerrainHandle* out) override {
-    return inner_->LoadServerFile(p, s, out);
+  Status LoadServerFile(const std::string& p, const TerrainLoadOptions& o,
+                        TerrainHandle* out) override {
+    return inner_->LoadServerFile(p, o, out);
   }
   Status LoadSamples(const RawSamples& s, const std::string& n, TerrainHandle* out) override {
     return inner_->LoadSamples(s, n, out);

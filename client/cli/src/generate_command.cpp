@@ -203,8 +203,12 @@ int RunGenerate(const GenerateFlags& flags) {
         error = session->last_error();
         goto bad_flag;
       }
-    } else if (OpenTerrain(terrain_flags, &session, &terrain, &error) != Status::kOk) {
-      goto bad_flag;
+    } else {
+      // A file footfalld reads: the whole of it, as fine as the character needs (within the
+      // server's sample budget), when no separation is given.
+      if (!terrain_flags.server_terrain.empty() && !(terrain_flags.load.separation > 0))
+        terrain_flags.load.finest_default = kSeparationPerStep * character.step_length;
+      if (OpenTerrain(terrain_flags, &session, &terrain, &error) != Status::kOk) goto bad_flag;
     }
     ProgressBar bar;
     const bool long_run =

@@ -71,7 +71,7 @@ Status OpenTerrain(const TerrainFlags& flags, std::unique_ptr<TerrainSession>* s
   Status status = OpenSession(flags, session, error);
   if (status != Status::kOk) return status;
   status = flags.terrain.empty()
-               ? (*session)->LoadServerFile(flags.server_terrain, flags.load.separation, terrain)
+               ? (*session)->LoadServerFile(flags.server_terrain, flags.load, terrain)
                : (*session)->LoadFile(flags.terrain, flags.load, terrain);
   if (status != Status::kOk) *error = (*session)->last_error();
   return status;

@@ -129,7 +129,9 @@ int32_t ffc_load_server_file(ffc_session* s, const char* path, double separation
                              uint32_t* terrain) {
   return Guard(s, [&]() -> int32_t {
     if (!path || !terrain) return BadArgument(s, "path and terrain must not be NULL");
-    return Result(s, s->session->LoadServerFile(path, separation > 0 ? separation : 0, terrain));
+    footfall::TerrainLoadOptions options;
+    options.separation = separation > 0 ? separation : 0;
+    return Result(s, s->session->LoadServerFile(path, options, terrain));
   });
 }
 

@@ -13,9 +13,8 @@ class EmbeddedSession final : public TerrainSession {
   // Batches are shared with the threads - 1 persistent workers of the process's shared pool.
   explicit EmbeddedSession(int threads) : pool_(SharedBatchPool(threads)) {}
 
-  Status LoadServerFile(const std::string& path, double separation, TerrainHandle* out) override {
-    TerrainLoadOptions options;
-    options.separation = separation;
+  Status LoadServerFile(const std::string& path, const TerrainLoadOptions& options,
+                        TerrainHandle* out) override {
     return TerrainSession::LoadFile(path, options, out);
   }
 

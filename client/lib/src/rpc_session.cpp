@@ -71,10 +71,11 @@ class RpcSession final : public TerrainSession {
     return Register(std::move(source), out);
   }
 
-  Status LoadServerFile(const std::string& path, double separation, TerrainHandle* out) override {
+  Status LoadServerFile(const std::string& path, const TerrainLoadOptions& options,
+                        TerrainHandle* out) override {
     TerrainSource source;
     source.kind = TerrainSource::kServerFile;
-    source.path = path, source.options.separation = separation, source.name = path;
+    source.path = path, source.options = options, source.name = path;
     return Register(std::move(source), out);
   }
 
@@ -263,11 +264,19 @@ class RpcSession final : public TerrainSession {
   Status Upload(TerrainSource* source) {
     source->loaded = false;
     if (source->kind == TerrainSource::kServerFile) {
-      ff_load_args args;
+      const TerrainLoadOptions& o = source->options;
+      ff_load_options_args args;
       args.path = const_cast<char*>(source->path.c_str());
-      args.separation = source->options.separation;
+      args.separation = o.separation;
+      args.finest_default = o.finest_default;
+      args.smooth_normals = o.smooth_normals;
+      args.crease_angle_deg = o.crease_angle_deg;
+      args.seed = o.seed;
+      args.up_axis = o.up_axis;
+      args.cell_size = o.cell_size;
+      args.height_scale = o.height_scale;
       Reply<ff_load_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply));
-      const Status s = Call(ff_load_1(&args, &reply.value, client_), "load");
+      const Status s = Call(ff_load_options_1(&args, &reply.value, client_), "load");
       if (s != Status::kOk) return s;
       if (reply.value.status != FF_OK)
         return Fail(FromWire(reply.value.status),

@@ -26,6 +26,8 @@ Status CheckOptions(const TerrainLoadOptions& o, std::string* error) {
   if (!(std::isfinite(o.cell_size) && o.cell_size >= 0)) what = "cell size must be >= 0";
   if (!std::isfinite(o.height_scale)) what = "height scale must be finite";
   if (o.up_axis != 'x' && o.up_axis != 'y' && o.up_axis != 'z') what = "up axis must be x, y or z";
+  if (!(o.crease_angle_deg >= 0 && o.crease_angle_deg <= 180))
+    what = "crease angle must be from 0 to 180 degrees";
   if (what.empty()) return Status::kOk;
   if (error) *error = what;
   return Status::kInvalidArgument;

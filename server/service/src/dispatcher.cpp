@@ -157,6 +157,26 @@ bool_t XdrLoadArgs(XDR* xdrs, LoadArgs* a) {
   return xdr_bytes(xdrs, &a->path, &a->path_len, FF_MAX_PATH) && xdr_double(xdrs, &a->separation);
 }
 
+// ff_load_options_args, the path decoded as in LoadArgs.
+struct LoadOptionsArgs {
+  char* path = nullptr;
+  u_int path_len = 0;
+  double separation = 0, finest_default = 0;
+  bool_t smooth_normals = 1;
+  double crease_angle_deg = 0;
+  u_quad_t seed = 0;
+  int up_axis = 0;
+  double cell_size = 0, height_scale = 0;
+};
+
+bool_t XdrLoadOptionsArgs(XDR* xdrs, LoadOptionsArgs* a) {
+  return xdr_bytes(xdrs, &a->path, &a->path_len, FF_MAX_PATH) && xdr_double(xdrs, &a->separation) &&
+         xdr_double(xdrs, &a->finest_default) && xdr_bool(xdrs, &a->smooth_normals) &&
+         xdr_double(xdrs, &a->crease_angle_deg) && xdr_u_quad_t(xdrs, &a->seed) &&
+         xdr_int(xdrs, &a->up_axis) && xdr_double(xdrs, &a->cell_size) &&
+         xdr_double(xdrs, &a->height_scale);
+}
+
 // Logs the orphans the registry freed early to make room for a new terrain or upload.
 void LogEvicted() {
   for (const uint32_t handle : g_state->registry.TakeEvicted())
@@ -165,11 +185,11 @@ void LogEvicted() {
         "least recently queried orphan goes)");
 }
 
-void Load(const LoadArgs& a, uint64_t client, ff_load_reply* r) {
+void Load(const std::string& path, const TerrainLoadOptions& options, uint64_t client,
+          ff_load_reply* r) {
   std::string message;
   uint32_t handle = 0;
-  const std::string path = a.path ? std::string(a.path, a.path_len) : "";
-  const Status s = g_state->registry.LoadFile(path, a.separation, client, &handle, &message);
+  const Status s = g_state->registry.LoadFile(path, options, client, &handle, &message);
   LogEvicted();
   r->status = Wire(s);
   r->terrain = handle;
@@ -443,7 +463,28 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
     case FF_LOAD:
       return Serve<LoadArgs, ff_load_reply>(
           transport, AsXdrProc(XdrLoadArgs), FF_XDR(ff_load_reply), "load",
-          [client](const LoadArgs& a, ff_load_reply* r) { Load(a, client, r); });
+          [client](const LoadArgs& a, ff_load_reply* r) {
+            TerrainLoadOptions options;
+            options.separation = a.separation;
+            Load(a.path ? std::string(a.path, a.path_len) : "", options, client, r);
+          });
+    case FF_LOAD_OPTIONS:
+      return Serve<LoadOptionsArgs, ff_load_reply>(
+          transport, AsXdrProc(XdrLoadOptionsArgs), FF_XDR(ff_load_reply), "load",
+          [client](const LoadOptionsArgs& a, ff_load_reply* r) {
+            TerrainLoadOptions options;
+            options.separation = a.separation;
+            options.finest_default = a.finest_default;
+            options.smooth_normals = a.smooth_normals != 0;
+            options.crease_angle_deg = a.crease_angle_deg;
+            options.seed = a.seed;
+            // Anything but x, y or z (a character or not) is refused by the loader.
+            const bool axis = a.up_axis == 'x' || a.up_axis == 'y' || a.up_axis == 'z';
+            options.up_axis = axis ? static_cast<char>(a.up_axis) : '?';
+            options.cell_size = a.cell_size;
+            options.height_scale = a.height_scale;
+            Load(a.path ? std::string(a.path, a.path_len) : "", options, client, r);
+          });
     case FF_UPLOAD_BEGIN:
       return Serve<ff_upload_begin_args, ff_upload_reply>(
           transport, FF_XDR(ff_upload_begin_args), FF_XDR(ff_upload_reply), "upload",

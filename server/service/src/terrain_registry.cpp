@@ -200,7 +200,7 @@ Status TerrainRegistry::Add(const std::string& name, RawSamples samples, uint64_
   return Status::kOk;
 }
 
-Status TerrainRegistry::LoadFile(const std::string& relative_path, double separation,
+Status TerrainRegistry::LoadFile(const std::string& relative_path, TerrainLoadOptions options,
                                  uint64_t owner, uint32_t* handle, std::string* message) {
   Status status = CheckQuota(owner, message);  // before reading or sampling anything
   if (status != Status::kOk) return status;
@@ -213,12 +213,6 @@ Status TerrainRegistry::LoadFile(const std::string& relative_path, double separa
   PinnedFile pinned;
   status = pinned.Open(data_root_, path, relative_path, message);
   if (status != Status::kOk) return status;
-  if (!(separation >= 0)) {
-    *message = "separation must be >= 0";
-    return Status::kInvalidArgument;
-  }
-  TerrainLoadOptions options;
-  options.separation = separation;
   // Meshes are refused on the sampler's estimate, before any sampling. Orphans count as room:
   // Add frees them as needed.
   const uint64_t used = TotalSamples() - OrphanSamples();

@@ -34,8 +34,10 @@ class TerrainSession {
   virtual Status LoadFile(const std::string& path, const TerrainLoadOptions& options,
                           TerrainHandle* out);
   // Loads a file that the serving engine reads itself: a path under footfalld's data root
-  // (RPC), or a local path (embedded). `separation` resamples meshes. [Units: wu]
-  virtual Status LoadServerFile(const std::string& path, double separation, TerrainHandle* out) = 0;
+  // (RPC), or a local path (embedded), with `options` as LoadFile (footfalld applies its own
+  // sample budget instead of options.max_samples).
+  virtual Status LoadServerFile(const std::string& path, const TerrainLoadOptions& options,
+                                TerrainHandle* out) = 0;
   // Loads samples held by the caller; `name` labels the terrain in logs and info.
   virtual Status LoadSamples(const RawSamples& samples, const std::string& name,
                              TerrainHandle* out) = 0;

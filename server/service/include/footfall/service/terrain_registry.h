@@ -50,12 +50,13 @@ class TerrainRegistry {
   // `data_root` confines server-side loads; empty refuses them.
   TerrainRegistry(std::string data_root, RegistryLimits limits);
 
-  // Loads a file under the data root. kAccessDenied for paths escaping it (.., symlinks).
+  // Loads a file under the data root with `options` (their max_samples is replaced by what is
+  // left of the budget). kAccessDenied for paths escaping it (.., symlinks).
   // Meshes and height maps are refused before sampling when the sampler's estimate exceeds the
   // samples left in the budget (RegistryLimits::max_total_samples).
   // The terrain belongs to client `owner`; kLimitExceeded when that client already holds
   // RegistryLimits::max_client_terrains.
-  Status LoadFile(const std::string& relative_path, double separation, uint64_t owner,
+  Status LoadFile(const std::string& relative_path, TerrainLoadOptions options, uint64_t owner,
                   uint32_t* handle, std::string* message);
   // Starts an upload for client `owner` (a connection), reserving its announced total against
   // the sample budget until it finishes, fails, expires or DropClient(owner). kLimitExceeded
