@@ -1,6 +1,8 @@
 // The step generator on generated terrain, for every shipped character: slopes, stairs, a
 // sphere, a wall, a path with a 90-degree turn, a cliff, crowds. Every walk is checked against
 // the invariants of walk_checks.h.
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -687,6 +689,36 @@ TEST_CASE("A generated walk's keys share one block that its tracks keep alive",
   for (int i = 0; i < 20000; ++i) kept.keys.push_back(expected[i % expected.size()]);
   CHECK(kept.keys[expected.size() + 19999].position == expected[19999 % expected.size()].position);
   CHECK(kept.keys.front().position == expected.front().position);
+}
+
+TEST_CASE("A crowd that reserves more keys than it writes backs only the keys it writes",
+          "[steps][generator][crowd]") {
+  // 600 hexapods x 10,000 steps reserve about 1.2 GB of keys (4096 per foot); on a 3 m floor
+  // they reach its edge and stop within a few steps. Blocks in huge pages would be backed whole
+  // on their first key; beyond the huge-page budget the keys use ordinary pages.
+  const Character c = LoadShipped("hexapod");
+  Terrain t = LoadTerrain(MakeFlat(150, 0.02, 0), 0.02);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {1.5, 0, 1.5};
+  o.steps = 10000;
+  o.crowd = 600;
+  o.crowd_spacing = 0.08;
+  auto resident_mb = [] {
+    std::ifstream statm("/proc/self/statm");
+    double size = 0, resident = 0;
+    statm >> size >> resident;
+    return resident * static_cast<double>(sysconf(_SC_PAGESIZE)) / (1 << 20);
+  };
+  const double before = resident_mb();
+  const Walk w = Generate(t, c, o);
+  const double grown = resident_mb() - before;
+  CHECK_THAT(w.stopped, Catch::Contains("more characters stopped"));
+  size_t keys = 0;
+  for (const WalkTrack& track : w.tracks) keys += track.keys.size();
+  INFO("resident memory grew " << grown << " MB for " << keys << " keys");
+  CHECK(keys < 600 * 7 * 200);
+  CHECK(grown < 300);
 }
 
 TEST_CASE("Generation is deterministic", "[steps][generator]") {

@@ -9,24 +9,22 @@
 namespace footfall {
 namespace {
 
-// Blocks after the first: at least this large, as a walk that outgrows its reservation grows
-// by doubling tracks. [Units: bytes]
+// Blocks hold at least this many bytes: one huge page. [Units: bytes]
 constexpr size_t kMinBlock = size_t{2} << 20;
 
 }  // namespace
 
-KeyArena::KeyArena(size_t expected) {
-  if (expected > 0) AddBlock(expected);
-}
+KeyArena::KeyArena(size_t expected)
+    : huge_pages_(expected <= kHugePagesUpTo), block_(std::clamp(expected, kMinBlock, kMaxBlock)) {}
 
 KeyArena::~KeyArena() {
   for (void* p : blocks_) FreeLargeMemory(p);
 }
 
 void KeyArena::AddBlock(size_t bytes) {
-  bytes = std::max(bytes, kMinBlock);
+  bytes = std::max(bytes, block_);
   blocks_.reserve(blocks_.size() + 1);
-  void* p = AllocateLargeMemory(bytes);
+  void* p = AllocateLargeMemory(bytes, huge_pages_);
   blocks_.push_back(p);
   next_ = static_cast<unsigned char*>(p);
   end_ = next_ + bytes;

@@ -8,13 +8,21 @@
 
 namespace footfall {
 
-// Hands out memory from large blocks (huge pages where the system offers them) and frees it
-// all at once when destroyed: a crowd's keys are written once, in millions, and fault in far
-// fewer pages than from the default heap. Thread-safe. Memory given back is not reused (tracks
-// are reserved to their expected length, so little is).
+// Hands out memory from large blocks and frees it all at once when destroyed: a crowd's keys
+// are written once, in millions, and fault in far fewer pages than from the default heap.
+// Thread-safe. Memory given back is not reused (tracks are reserved to their expected length,
+// so little is).
 class KeyArena : public std::pmr::memory_resource {
  public:
-  // The first block holds `expected` bytes (0: allocated on first use).
+  // Up to this many bytes expected, blocks are in huge pages; beyond, in ordinary pages, as
+  // the reservations may then far exceed the keys written (a path walk reserves for its
+  // longest, a crowd may stop early) and a huge page is backed whole once touched.
+  static constexpr size_t kHugePagesUpTo = size_t{1} << 30;
+  // Blocks hold at most this many bytes (more only for a single larger request): no single
+  // mapping asks for all of a large reservation at once.
+  static constexpr size_t kMaxBlock = size_t{256} << 20;
+
+  // Sized for `expected` bytes in all, allocated as they are asked for.
   explicit KeyArena(size_t expected);
   ~KeyArena() override;
   KeyArena(const KeyArena&) = delete;
@@ -29,6 +37,8 @@ class KeyArena : public std::pmr::memory_resource {
   // Starts a block of at least `bytes`. Called with mutex_ held.
   void AddBlock(size_t bytes);
 
+  const bool huge_pages_;
+  const size_t block_;  // bytes per block
   std::mutex mutex_;
   std::vector<void*> blocks_;
   unsigned char* next_ = nullptr;  // free space of the last block: [next_, end_)

@@ -10,7 +10,7 @@
 
 namespace footfall {
 
-void* AllocateLargeMemory(size_t bytes) {
+void* AllocateLargeMemory(size_t bytes, bool huge_pages) {
   constexpr size_t kHugePage = size_t{2} << 20;
   bytes = std::max<size_t>(bytes, 1);
   void* p = nullptr;
@@ -21,7 +21,7 @@ void* AllocateLargeMemory(size_t bytes) {
     if (rounded < bytes) throw std::bad_alloc();  // overflow
     p = std::aligned_alloc(kHugePage, rounded);
 #ifdef MADV_HUGEPAGE
-    if (p) madvise(p, rounded, MADV_HUGEPAGE);
+    if (p && huge_pages) madvise(p, rounded, MADV_HUGEPAGE);
 #endif
   }
   if (!p) throw std::bad_alloc();

@@ -5,11 +5,13 @@
 
 namespace footfall {
 
-// Allocates `bytes` (at least 1). From 2 MiB on, the block is aligned to 2 MiB and marked for
-// transparent huge pages where the system offers them (Linux, madvise mode): random access over
-// tens of megabytes otherwise spends much of its time in TLB misses, and first touches of a
-// fresh block fault 512 times less often. Throws std::bad_alloc. Free with FreeLargeMemory.
-void* AllocateLargeMemory(size_t bytes);
+// Allocates `bytes` (at least 1). From 2 MiB on, the block is aligned to 2 MiB and, with
+// `huge_pages`, marked for transparent huge pages where the system offers them (Linux, madvise
+// mode): random access over tens of megabytes otherwise spends much of its time in TLB misses,
+// and first touches of a fresh block fault 512 times less often. A huge page is backed whole
+// on its first touch: leave `huge_pages` off for blocks that may be touched sparsely. Throws
+// std::bad_alloc. Free with FreeLargeMemory.
+void* AllocateLargeMemory(size_t bytes, bool huge_pages = true);
 void FreeLargeMemory(void* p);
 
 }  // namespace footfall
