@@ -3,8 +3,9 @@
 // top-level README.md ("The algorithm"); generator.cpp repeats the numbers in comments.
 //
 // It asks the terrain only through a TerrainSession, so the embedded engine and footfalld give
-// the same walk. Each round of queries of a step is one batch call for all characters (crowds
-// included); the RPC backend splits it into protocol-sized calls.
+// the same walk. Each round of queries of a step is one batch call for all the characters of a
+// pass (GenerateOptions::characters_per_pass); the RPC backend splits it into protocol-sized
+// calls.
 #pragma once
 
 #include <functional>
@@ -18,7 +19,8 @@
 namespace footfall {
 
 // Characters walked together by default when the session answers in process: their stretch of
-// terrain and their keys stay in the caches from one step to the next.
+// terrain and their keys stay in the caches of the thread walking them from one step to the
+// next.
 constexpr int kInProcessCharactersPerPass = 250;
 
 // The sample spacing a character walks well on, as a fraction of its step_length: it looks
@@ -64,11 +66,13 @@ struct GenerateOptions {
   // character id "c1".."cN".
   int crowd = 1;
   double crowd_spacing = 0;
-  // Threads for the generator's own per-character work (large crowds only; the session splits
-  // its batches by itself). The walk is the same whatever the count. [Limit: >= 1]
+  // Threads for the generator's own work on large crowds: in process, passes walked in parallel,
+  // one per thread; otherwise the per-character work between batches (the session splits its
+  // batches by itself). The walk is the same whatever the count. [Limit: >= 1]
   int threads = 1;
-  // Characters walked together: the crowd walks every step in groups of this many characters,
-  // one group after the other, so that each group's stretch of terrain stays in the caches.
+  // Characters walked together: the crowd walks every step in groups of this many characters
+  // (passes), so that each group's stretch of terrain stays in the caches; in process, with
+  // threads > 1, each thread walks one pass at a time, else the passes follow one another.
   // < 0: all at once, which makes every round of queries of a step one batch call for the
   // whole crowd (the right choice over RPC). 0: chosen by the session,
   // kInProcessCharactersPerPass when it answers in process, else all at once. The walk is the
