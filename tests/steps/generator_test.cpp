@@ -72,6 +72,17 @@ void WalkTwelveSteps(Terrain& t, const Character& c, const Vec3& start, bool for
   }
 }
 
+// A crowd of `crowd` characters `spacing` apart around `start`, walking `steps` steps.
+GenerateOptions CrowdOptions(const Vec3& start, int steps, int crowd, double spacing) {
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = start;
+  o.steps = steps;
+  o.crowd = crowd;
+  o.crowd_spacing = spacing;
+  return o;
+}
+
 }  // namespace
 
 TEST_CASE("Walks up and down a 20-degree ramp", "[steps][generator]") {
@@ -584,12 +595,7 @@ TEST_CASE("A crowd batches every character's queries into one call per round",
   auto run = [&](int crowd, CountingSession* session, Walk* w) {
     TerrainHandle h;
     REQUIRE(session->LoadSamples(ground, "flat", &h) == Status::kOk);
-    GenerateOptions o;
-    o.has_start = true;
-    o.start = {1.8, 0, 1.2};
-    o.steps = 10;
-    o.crowd = crowd;
-    o.crowd_spacing = 0.5;
+    GenerateOptions o = CrowdOptions({1.8, 0, 1.2}, 10, crowd, 0.5);
     std::string error;
     REQUIRE(GenerateWalk(*session, h, c, o, w, &error) == Status::kOk);
     Terrain t = LoadTerrain(ground, 0.012);
@@ -618,12 +624,7 @@ TEST_CASE("By default a crowd walks in passes in process and all at once out of 
   auto run = [&](CountingSession* session, int* passes) {
     TerrainHandle h;
     REQUIRE(session->LoadSamples(ground, "flat", &h) == Status::kOk);
-    GenerateOptions o;
-    o.has_start = true;
-    o.start = {2.4, 0, 2.2};
-    o.steps = steps;
-    o.crowd = crowd;
-    o.crowd_spacing = 0.1;
+    GenerateOptions o = CrowdOptions({2.4, 0, 2.2}, steps, crowd, 0.1);
     o.progress = [passes, steps](int, int total) { *passes = total / steps; };
     Walk w;
     std::string error;
@@ -655,12 +656,7 @@ TEST_CASE("A generated walk's keys share one block that its tracks keep alive",
   // when the last track holding it goes.
   const Character c = LoadShipped("hexapod");
   Terrain t = LoadTerrain(MakeFlat(300, 0.02, 0), 0.02);
-  GenerateOptions o;
-  o.has_start = true;
-  o.start = {3, 0, 2};
-  o.steps = 40;
-  o.crowd = 100;
-  o.crowd_spacing = 0.2;
+  GenerateOptions o = CrowdOptions({3, 0, 2}, 40, 100, 0.2);
   WalkTrack kept, copied;
   std::vector<WalkKey> expected;
   {
@@ -698,12 +694,7 @@ TEST_CASE("A crowd that reserves more keys than it writes backs only the keys it
   // on their first key; beyond the huge-page budget the keys use ordinary pages.
   const Character c = LoadShipped("hexapod");
   Terrain t = LoadTerrain(MakeFlat(150, 0.02, 0), 0.02);
-  GenerateOptions o;
-  o.has_start = true;
-  o.start = {1.5, 0, 1.5};
-  o.steps = 10000;
-  o.crowd = 600;
-  o.crowd_spacing = 0.08;
+  GenerateOptions o = CrowdOptions({1.5, 0, 1.5}, 10000, 600, 0.08);
   auto resident_mb = [] {
     std::ifstream statm("/proc/self/statm");
     double size = 0, resident = 0;
@@ -744,12 +735,7 @@ TEST_CASE("A large crowd's walk is the same on one thread and on two",
     auto session = MakeEmbeddedSession(threads);
     TerrainHandle h;
     REQUIRE(session->LoadSamples(ground, "bumps", &h) == Status::kOk);
-    GenerateOptions o;
-    o.has_start = true;
-    o.start = {7.5, 0, 7};
-    o.steps = 4;
-    o.crowd = 2100;
-    o.crowd_spacing = 0.3;
+    GenerateOptions o = CrowdOptions({7.5, 0, 7}, 4, 2100, 0.3);
     o.threads = threads;
     Walk w;
     std::string error;

@@ -145,32 +145,60 @@ uint64_t ConnectionOf(SVCXPRT* transport) {
 
 // --- procedures -------------------------------------------------------------------------
 
-// ff_load_args decoded with the path's length kept (the same bytes as xdr_string): a C string
-// would end the path at a NUL byte inside it, and load another file than the one named.
+// A path decoded with its length kept (the same bytes as xdr_string): a C string would end the
+// path at a NUL byte inside it, and load another file than the one named.
+struct WirePath {
+  char* bytes = nullptr;
+  u_int length = 0;
+  std::string str() const { return bytes ? std::string(bytes, length) : ""; }
+};
+
+bool_t XdrWirePath(XDR* xdrs, WirePath* p) {
+  return xdr_bytes(xdrs, &p->bytes, &p->length, FF_MAX_PATH);
+}
+
+// ff_load_args.
 struct LoadArgs {
-  char* path = nullptr;
-  u_int path_len = 0;
+  WirePath path;
   double separation = 0;
+  TerrainLoadOptions Options() const {
+    TerrainLoadOptions o;
+    o.separation = separation;
+    return o;
+  }
 };
 
 bool_t XdrLoadArgs(XDR* xdrs, LoadArgs* a) {
-  return xdr_bytes(xdrs, &a->path, &a->path_len, FF_MAX_PATH) && xdr_double(xdrs, &a->separation);
+  return XdrWirePath(xdrs, &a->path) && xdr_double(xdrs, &a->separation);
 }
 
-// ff_load_options_args, the path decoded as in LoadArgs.
+// ff_load_options_args.
 struct LoadOptionsArgs {
-  char* path = nullptr;
-  u_int path_len = 0;
+  WirePath path;
   double separation = 0, finest_default = 0;
   bool_t smooth_normals = 1;
   double crease_angle_deg = 0;
   u_quad_t seed = 0;
   int up_axis = 0;
   double cell_size = 0, height_scale = 0;
+  TerrainLoadOptions Options() const {
+    TerrainLoadOptions o;
+    o.separation = separation;
+    o.finest_default = finest_default;
+    o.smooth_normals = smooth_normals != 0;
+    o.crease_angle_deg = crease_angle_deg;
+    o.seed = seed;
+    // Anything but x, y or z (a character or not) is refused by the loader.
+    const bool axis = up_axis == 'x' || up_axis == 'y' || up_axis == 'z';
+    o.up_axis = axis ? static_cast<char>(up_axis) : '?';
+    o.cell_size = cell_size;
+    o.height_scale = height_scale;
+    return o;
+  }
 };
 
 bool_t XdrLoadOptionsArgs(XDR* xdrs, LoadOptionsArgs* a) {
-  return xdr_bytes(xdrs, &a->path, &a->path_len, FF_MAX_PATH) && xdr_double(xdrs, &a->separation) &&
+  return XdrWirePath(xdrs, &a->path) && xdr_double(xdrs, &a->separation) &&
          xdr_double(xdrs, &a->finest_default) && xdr_bool(xdrs, &a->smooth_normals) &&
          xdr_double(xdrs, &a->crease_angle_deg) && xdr_u_quad_t(xdrs, &a->seed) &&
          xdr_int(xdrs, &a->up_axis) && xdr_double(xdrs, &a->cell_size) &&
@@ -461,29 +489,16 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
       svc_sendreply(transport, FF_XDR_VOID, nullptr);
       return;
     case FF_LOAD:
-      return Serve<LoadArgs, ff_load_reply>(
-          transport, AsXdrProc(XdrLoadArgs), FF_XDR(ff_load_reply), "load",
-          [client](const LoadArgs& a, ff_load_reply* r) {
-            TerrainLoadOptions options;
-            options.separation = a.separation;
-            Load(a.path ? std::string(a.path, a.path_len) : "", options, client, r);
-          });
+      return Serve<LoadArgs, ff_load_reply>(transport, AsXdrProc(XdrLoadArgs),
+                                            FF_XDR(ff_load_reply), "load",
+                                            [client](const LoadArgs& a, ff_load_reply* r) {
+                                              Load(a.path.str(), a.Options(), client, r);
+                                            });
     case FF_LOAD_OPTIONS:
       return Serve<LoadOptionsArgs, ff_load_reply>(
           transport, AsXdrProc(XdrLoadOptionsArgs), FF_XDR(ff_load_reply), "load",
           [client](const LoadOptionsArgs& a, ff_load_reply* r) {
-            TerrainLoadOptions options;
-            options.separation = a.separation;
-            options.finest_default = a.finest_default;
-            options.smooth_normals = a.smooth_normals != 0;
-            options.crease_angle_deg = a.crease_angle_deg;
-            options.seed = a.seed;
-            // Anything but x, y or z (a character or not) is refused by the loader.
-            const bool axis = a.up_axis == 'x' || a.up_axis == 'y' || a.up_axis == 'z';
-            options.up_axis = axis ? static_cast<char>(a.up_axis) : '?';
-            options.cell_size = a.cell_size;
-            options.height_scale = a.height_scale;
-            Load(a.path ? std::string(a.path, a.path_len) : "", options, client, r);
+            Load(a.path.str(), a.Options(), client, r);
           });
     case FF_UPLOAD_BEGIN:
       return Serve<ff_upload_begin_args, ff_upload_reply>(
