@@ -588,9 +588,15 @@ TEST_CASE("footfalld reads server files with every load option, as the embedded 
   moved = 0;
   for (size_t i = 0; i < plain.size(); ++i) moved += !(plain[i].point == scaled[i].point);
   CHECK(moved > 0);
-  // Bad options: the loader's message, as for a local file.
+  // The client's own sample limit, below the server's budget.
   o = TerrainLoadOptions{};
   TerrainHandle t = 0;
+  o.separation = 0.01, o.max_samples = 1000;
+  CHECK(rpc->LoadServerFile("corner.obj", o, &t) == Status::kLimitExceeded);
+  CHECK_THAT(rpc->last_error(),
+             Catch::EndsWith("(limit 1000); choose a separation of at least 0.098"));
+  // Bad options: the loader's message, as for a local file.
+  o = TerrainLoadOptions{};
   o.crease_angle_deg = 200;
   CHECK(rpc->LoadServerFile("corner.obj", o, &t) == Status::kInvalidArgument);
   CHECK_THAT(rpc->last_error(), Catch::Contains("crease angle must be from 0 to 180 degrees"));

@@ -204,10 +204,12 @@ int RunGenerate(const GenerateFlags& flags) {
         goto bad_flag;
       }
     } else {
-      // A file footfalld reads: the whole of it, as fine as the character needs (within the
-      // server's sample budget), when no separation is given.
-      if (!terrain_flags.server_terrain.empty() && !(terrain_flags.load.separation > 0))
+      // A file footfalld reads: the whole of it, as fine as the character needs within the
+      // samples a walk's terrain may have (and the server's budget), when no separation is given.
+      if (!terrain_flags.server_terrain.empty() && !(terrain_flags.load.separation > 0)) {
         terrain_flags.load.finest_default = kSeparationPerStep * character.step_length;
+        terrain_flags.load.max_samples = std::min(terrain_flags.load.max_samples, kMaxWalkSamples);
+      }
       if (OpenTerrain(terrain_flags, &session, &terrain, &error) != Status::kOk) goto bad_flag;
     }
     ProgressBar bar;

@@ -275,6 +275,7 @@ class RpcSession final : public TerrainSession {
       args.up_axis = o.up_axis;
       args.cell_size = o.cell_size;
       args.height_scale = o.height_scale;
+      args.max_samples = o.max_samples;
       Reply<ff_load_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply));
       const Status s = Call(ff_load_options_1(&args, &reply.value, client_), "load");
       if (s != Status::kOk) return s;

@@ -181,6 +181,7 @@ struct LoadOptionsArgs {
   u_quad_t seed = 0;
   int up_axis = 0;
   double cell_size = 0, height_scale = 0;
+  u_quad_t max_samples = 0;
   TerrainLoadOptions Options() const {
     TerrainLoadOptions o;
     o.separation = separation;
@@ -193,6 +194,7 @@ struct LoadOptionsArgs {
     o.up_axis = axis ? static_cast<char>(up_axis) : '?';
     o.cell_size = cell_size;
     o.height_scale = height_scale;
+    o.max_samples = static_cast<size_t>(max_samples);
     return o;
   }
 };
@@ -202,7 +204,7 @@ bool_t XdrLoadOptionsArgs(XDR* xdrs, LoadOptionsArgs* a) {
          xdr_double(xdrs, &a->finest_default) && xdr_bool(xdrs, &a->smooth_normals) &&
          xdr_double(xdrs, &a->crease_angle_deg) && xdr_u_quad_t(xdrs, &a->seed) &&
          xdr_int(xdrs, &a->up_axis) && xdr_double(xdrs, &a->cell_size) &&
-         xdr_double(xdrs, &a->height_scale);
+         xdr_double(xdrs, &a->height_scale) && xdr_u_quad_t(xdrs, &a->max_samples);
 }
 
 // Logs the orphans the registry freed early to make room for a new terrain or upload.

@@ -216,7 +216,9 @@ Status TerrainRegistry::LoadFile(const std::string& relative_path, TerrainLoadOp
   // Meshes are refused on the sampler's estimate, before any sampling. Orphans count as room:
   // Add frees them as needed.
   const uint64_t used = TotalSamples() - OrphanSamples();
-  options.max_samples = used < limits_.max_total_samples ? limits_.max_total_samples - used : 0;
+  const uint64_t left = used < limits_.max_total_samples ? limits_.max_total_samples - used : 0;
+  const bool budget_binds = left < options.max_samples;
+  options.max_samples = static_cast<size_t>(std::min<uint64_t>(options.max_samples, left));
   RawSamples samples;
   std::string error;
   status = LoadTerrain(pinned.path(), options, &samples, &error);
@@ -225,7 +227,7 @@ Status TerrainRegistry::LoadFile(const std::string& relative_path, TerrainLoadOp
     const size_t at = error.find(pinned.path());
     if (at != std::string::npos) error.replace(at, pinned.path().size(), relative_path);
     *message = error;
-    if (status == Status::kLimitExceeded)
+    if (status == Status::kLimitExceeded && budget_binds)
       *message += " (the limit is what is left of " + Budget() + ")";
     return status;
   }

@@ -34,8 +34,8 @@ class TerrainSession {
   virtual Status LoadFile(const std::string& path, const TerrainLoadOptions& options,
                           TerrainHandle* out);
   // Loads a file that the serving engine reads itself: a path under footfalld's data root
-  // (RPC), or a local path (embedded), with `options` as LoadFile (footfalld applies its own
-  // sample budget instead of options.max_samples).
+  // (RPC), or a local path (embedded), with `options` as LoadFile (footfalld also holds meshes
+  // and height maps within what is left of its sample budget).
   virtual Status LoadServerFile(const std::string& path, const TerrainLoadOptions& options,
                                 TerrainHandle* out) = 0;
   // Loads samples held by the caller; `name` labels the terrain in logs and info.

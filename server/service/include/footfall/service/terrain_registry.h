@@ -50,8 +50,8 @@ class TerrainRegistry {
   // `data_root` confines server-side loads; empty refuses them.
   TerrainRegistry(std::string data_root, RegistryLimits limits);
 
-  // Loads a file under the data root with `options` (their max_samples is replaced by what is
-  // left of the budget). kAccessDenied for paths escaping it (.., symlinks).
+  // Loads a file under the data root with `options` (their max_samples lowered to what is left
+  // of the budget). kAccessDenied for paths escaping it (.., symlinks).
   // Meshes and height maps are refused before sampling when the sampler's estimate exceeds the
   // samples left in the budget (RegistryLimits::max_total_samples).
   // The terrain belongs to client `owner`; kLimitExceeded when that client already holds
