@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <optional>
 #include <string>
 
 #include <catch2/catch.hpp>
@@ -652,13 +653,15 @@ TEST_CASE("By default a crowd walks in passes in process and all at once out of 
 
 TEST_CASE("A generated walk's keys share one block that its tracks keep alive",
           "[steps][generator][crowd]") {
-  // 100 hexapods x 40 steps: a few megabytes of keys, a block returned to the system (unmapped)
-  // when the last track holding it goes.
+  // 100 hexapods x 40 steps: a few megabytes of keys, a block returned to the system when the
+  // last track holding it goes. After the walks are gone, new walks are generated (reusing
+  // their memory), and the kept tracks must still read their own keys.
   const Character c = LoadShipped("hexapod");
   Terrain t = LoadTerrain(MakeFlat(300, 0.02, 0), 0.02);
   GenerateOptions o = CrowdOptions({3, 0, 2}, 40, 100, 0.2);
-  WalkTrack kept, copied;
-  std::vector<WalkKey> expected;
+  std::optional<WalkTrack> kept, assigned;
+  WalkTrack copied;
+  std::vector<WalkKey> expected, expected_assigned;
   {
     Walk w = Generate(t, c, o);
     REQUIRE(w.stopped.empty());
@@ -671,20 +674,36 @@ TEST_CASE("A generated walk's keys share one block that its tracks keep alive",
     WalkTrack& last = w.tracks.back();  // the last character's body
     expected.assign(last.keys.begin(), last.keys.end());
     REQUIRE(expected.size() == static_cast<size_t>(o.steps + 1));
-    copied = last;  // a copy's keys live on the default heap
+    copied = last;  // a copy's keys live on the default heap, and hold no block
     CHECK(copied.keys.get_allocator().resource() == std::pmr::get_default_resource());
-    kept = std::move(last);
+    CHECK(copied.memory.get() == nullptr);
+    kept.emplace(std::move(last));  // moved: the keys and their block go along
+    CHECK(kept->memory.get() == arena);
+    // A track of this walk assigned another walk's track keeps its keys in this walk's block,
+    // and keeps that block alive.
+    assigned.emplace(std::move(w.tracks.front()));
+    o.start = {1, 0, 1};
+    Walk other = Generate(t, c, o);
+    expected_assigned.assign(other.tracks.front().keys.begin(), other.tracks.front().keys.end());
+    *assigned = std::move(other.tracks.front());
+    CHECK(assigned->memory.get() == arena);
+    CHECK(assigned->keys.get_allocator().resource() == arena);
   }
-  // The walk is gone; the moved track still reads its keys, and grows past its reservation.
-  REQUIRE(kept.keys.size() == expected.size());
+  o.start = {4, 0, 3};
+  const Walk reuse1 = Generate(t, c, o), reuse2 = Generate(t, c, o);
+  REQUIRE(kept->keys.size() == expected.size());
+  REQUIRE(assigned->keys.size() == expected_assigned.size());
   size_t differ = 0;
   for (size_t k = 0; k < expected.size(); ++k)
-    differ += !(kept.keys[k].position == expected[k].position &&
+    differ += !(kept->keys[k].position == expected[k].position &&
                 copied.keys[k].position == expected[k].position);
+  for (size_t k = 0; k < expected_assigned.size(); ++k)
+    differ += !(assigned->keys[k].position == expected_assigned[k].position);
   CHECK(differ == 0);
-  for (int i = 0; i < 20000; ++i) kept.keys.push_back(expected[i % expected.size()]);
-  CHECK(kept.keys[expected.size() + 19999].position == expected[19999 % expected.size()].position);
-  CHECK(kept.keys.front().position == expected.front().position);
+  // A kept track grows past its reservation.
+  for (int i = 0; i < 20000; ++i) kept->keys.push_back(expected[i % expected.size()]);
+  CHECK(kept->keys[expected.size() + 19999].position == expected[19999 % expected.size()].position);
+  CHECK(kept->keys.front().position == expected.front().position);
 }
 
 TEST_CASE("A crowd that reserves more keys than it writes backs only the keys it writes",

@@ -537,7 +537,7 @@ Status Generator::Setup(std::string* error) {
       WalkTrack t{body ? "body" : c_.feet[f].name,
                   a.id,
                   body ? TrackKind::kBody : TrackKind::kFoot,
-                  arena,
+                  KeyMemory(arena),
                   std::pmr::vector<WalkKey>(arena.get()),
                   std::pmr::vector<Quat>(arena.get())};
       t.keys.reserve(body ? body_keys : foot_keys);

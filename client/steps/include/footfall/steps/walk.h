@@ -34,6 +34,26 @@ static_assert(sizeof(WalkKey) == 64, "WalkKey is one cache line's worth");
 
 enum class TrackKind { kFoot, kBody };
 
+// Keeps alive the memory resource a track's keys were allocated from, exactly as long as the
+// keys are: it follows the keys as std::pmr::vector's allocator does. Moving a track moves it
+// along; a copy of a track (whose keys go to the default heap) holds none; assigning to a track
+// keeps the track's own (its keys stay where they were allocated).
+class KeyMemory {
+ public:
+  KeyMemory() = default;
+  explicit KeyMemory(std::shared_ptr<std::pmr::memory_resource> resource)
+      : resource_(std::move(resource)) {}
+  KeyMemory(const KeyMemory&) {}
+  KeyMemory(KeyMemory&&) noexcept = default;
+  KeyMemory& operator=(const KeyMemory&) { return *this; }
+  KeyMemory& operator=(KeyMemory&&) noexcept { return *this; }
+  // The resource, or nullptr for the default heap.
+  std::pmr::memory_resource* get() const { return resource_.get(); }
+
+ private:
+  std::shared_ptr<std::pmr::memory_resource> resource_;
+};
+
 // The keys of one animated node: a foot IK target or a body.
 struct WalkTrack {
   std::string name;       // foot name from the character file, or "body"
@@ -42,8 +62,8 @@ struct WalkTrack {
   // Where keys and rotations live when it is not the default heap: the step generator puts a
   // walk's keys in one block it shares between the tracks (a crowd's walk holds millions of
   // keys). The track holds it, so a track outlives its walk safely; copies of the keys use the
-  // default heap.
-  std::shared_ptr<std::pmr::memory_resource> memory;
+  // default heap. Declared before the keys: destroyed after them.
+  KeyMemory memory;
   std::pmr::vector<WalkKey> keys;  // ascending frames
   // Body tracks: the body's world orientation at each key (rotations[i] at keys[i]). Empty for
   // feet.
