@@ -606,6 +606,33 @@ TEST_CASE("footfalld reads server files with every load option, as the embedded 
   o.up_axis = 'y', o.finest_default = -1;
   CHECK(rpc->LoadServerFile("bump.asc", o, &t) == Status::kInvalidArgument);
   CHECK_THAT(rpc->last_error(), Catch::Contains("finest default separation must be >= 0"));
+  // On the wire, an up axis is an int: one that is 'y' only in its low byte is refused, not cut
+  // down to 'y'; a NaN crease angle too. The server goes on serving.
+  CLIENT* raw = RawClient(server.port());
+  ff_load_options_args args{};
+  args.path = const_cast<char*>("bump.asc");
+  args.smooth_normals = 1;
+  args.crease_angle_deg = 60;
+  args.seed = 1;
+  args.height_scale = 1;
+  args.max_samples = 1000000;
+  args.up_axis = 'y' + 256;
+  ff_load_reply reply{};
+  REQUIRE(ff_load_options_1(&args, &reply, raw) == RPC_SUCCESS);
+  CHECK(reply.status == FF_INVALID_ARGUMENT);
+  CHECK_THAT(std::string(reply.message), Catch::Contains("up axis must be x, y or z"));
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&reply));
+  args.up_axis = 'y', args.crease_angle_deg = std::nan("");
+  reply = ff_load_reply{};
+  REQUIRE(ff_load_options_1(&args, &reply, raw) == RPC_SUCCESS);
+  CHECK(reply.status == FF_INVALID_ARGUMENT);
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&reply));
+  args.crease_angle_deg = 60;
+  reply = ff_load_reply{};
+  REQUIRE(ff_load_options_1(&args, &reply, raw) == RPC_SUCCESS);
+  CHECK(reply.status == FF_OK);
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&reply));
+  clnt_destroy(raw);
   std::system(("rm -rf '" + root + "'").c_str());
 }
 
