@@ -518,14 +518,18 @@ Status Generator::Setup(std::string* error) {
   walk_.tracks.clear();
   walk_.tracks.reserve(n * (feet + 1));
   // Every track reserves the keys it will have if it walks every step (up to a cap), all in
-  // one arena.
+  // one arena. (Exactly those keys when the steps are given and under the cap; a path walk's
+  // steps are only a bound.)
   const size_t groups = c_.gait.size();
   const size_t steps_of_foot = static_cast<size_t>(steps_) / groups + 1;
-  const size_t foot_keys = std::min<size_t>(3 * steps_of_foot + 1, 4096);
-  const size_t body_keys = std::min<size_t>(steps_ + 1, 4096);
+  constexpr size_t kMaxReserved = 4096;
+  const size_t foot_keys = std::min<size_t>(3 * steps_of_foot + 1, kMaxReserved);
+  const size_t body_keys = std::min<size_t>(steps_ + 1, kMaxReserved);
   const size_t character_bytes =
       feet * foot_keys * sizeof(WalkKey) + body_keys * (sizeof(WalkKey) + sizeof(Quat));
-  auto arena = std::make_shared<KeyArena>(n * character_bytes);
+  const bool exact = o_.steps >= 0 && 3 * steps_of_foot + 1 <= kMaxReserved &&
+                     static_cast<size_t>(steps_) + 1 <= kMaxReserved;
+  auto arena = std::make_shared<KeyArena>(n * character_bytes, exact);
   for (int i = 0; i < n; ++i) {
     Agent& a = agents_[i];
     if (n > 1) a.id = "c" + std::to_string(i + 1);

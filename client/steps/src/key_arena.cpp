@@ -14,8 +14,9 @@ constexpr size_t kMinBlock = size_t{2} << 20;
 
 }  // namespace
 
-KeyArena::KeyArena(size_t expected)
-    : huge_pages_(expected <= kHugePagesUpTo), block_(std::clamp(expected, kMinBlock, kMaxBlock)) {}
+KeyArena::KeyArena(size_t expected, bool exact)
+    : huge_pages_(exact && expected <= kHugePagesUpTo),
+      block_(std::clamp(expected, kMinBlock, kMaxBlock)) {}
 
 KeyArena::~KeyArena() {
   for (void* p : blocks_) FreeLargeMemory(p);

@@ -14,16 +14,17 @@ namespace footfall {
 // so little is).
 class KeyArena : public std::pmr::memory_resource {
  public:
-  // Up to this many bytes expected, blocks are in huge pages; beyond, in ordinary pages, as
-  // the reservations may then far exceed the keys written (a path walk reserves for its
-  // longest, a crowd may stop early) and a huge page is backed whole once touched.
+  // Blocks are in huge pages when the reservations are exact and hold at most this many bytes;
+  // else in ordinary pages: a huge page is backed whole once touched, and reservations that are
+  // only a bound (a path walk's, for its longest) may far exceed the keys written.
   static constexpr size_t kHugePagesUpTo = size_t{1} << 30;
   // Blocks hold at most this many bytes (more only for a single larger request): no single
   // mapping asks for all of a large reservation at once.
   static constexpr size_t kMaxBlock = size_t{256} << 20;
 
-  // Sized for `expected` bytes in all, allocated as they are asked for.
-  explicit KeyArena(size_t expected);
+  // Sized for `expected` bytes in all, allocated as they are asked for. `exact`: they are what a
+  // walk of every step writes (so touching them all costs no more than such a walk).
+  KeyArena(size_t expected, bool exact);
   ~KeyArena() override;
   KeyArena(const KeyArena&) = delete;
   KeyArena& operator=(const KeyArena&) = delete;
