@@ -636,6 +636,36 @@ TEST_CASE("footfalld reads server files with every load option, as the embedded 
   std::system(("rm -rf '" + root + "'").c_str());
 }
 
+TEST_CASE("A server-side load may take longer than a query's call timeout", "[rpc]") {
+  char tmpl[] = "/tmp/footfall-root-XXXXXX";
+  REQUIRE(mkdtemp(tmpl));
+  const std::string root = tmpl;
+  std::ofstream(root + "/corner.obj") << "v 0 0 0\nv 2 0 0\nv 2 0 2\nv 0 0 2\nv 2 1 0\nv 2 1 2\n"
+                                         "f 1 3 2\nf 1 4 3\nf 2 3 6\nf 2 6 5\n";
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", root});
+  // About 540,000 samples: a few seconds of resampling, far beyond a half-second call timeout.
+  TerrainLoadOptions o;
+  o.separation = 0.004;
+  RpcOptions ro;
+  ro.port = server.port();
+  ro.call_timeout_s = 0.5;
+  auto rpc = MakeRpcSession(ro);
+  TerrainHandle t = 0;
+  const auto begin = std::chrono::steady_clock::now();
+  INFO(rpc->last_error());
+  REQUIRE(rpc->LoadServerFile("corner.obj", o, &t) == Status::kOk);
+  CHECK(std::chrono::steady_clock::now() - begin > std::chrono::milliseconds(500));
+  TerrainInfo info;
+  REQUIRE(rpc->Info(t, &info) == Status::kOk);  // queries wait the call timeout again
+  CHECK(info.stats.samples > 400000);
+  // Without the longer wait for loads, the same load times out, and says so.
+  ro.load_timeout_s = 0;
+  auto hasty = MakeRpcSession(ro);
+  CHECK(hasty->LoadServerFile("corner.obj", o, &t) == Status::kUnavailable);
+  CHECK_THAT(hasty->last_error(), Catch::Contains("no answer within the call timeout of 0.5 s"));
+  std::system(("rm -rf '" + root + "'").c_str());
+}
+
 TEST_CASE("footfalld holds --max-samples over parallel uploads and mesh loads", "[rpc]") {
   char tmpl[] = "/tmp/footfall-root-XXXXXX";
   REQUIRE(mkdtemp(tmpl));

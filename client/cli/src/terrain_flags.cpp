@@ -40,7 +40,9 @@ void AddTerrainFlags(CLI::App* command, TerrainFlags* flags) {
   command->add_option("--server", flags->server,
                       "footfalld HOST:PORT; without it the embedded engine answers");
   AddLoadFlags(command, &flags->load);
-  command->add_option("--timeout", flags->timeout_s, "RPC call timeout in seconds")
+  command
+      ->add_option("--timeout", flags->timeout_s,
+                   "RPC call timeout in seconds (a --server-terrain load waits at least 300 s)")
       ->check(FiniteRange(0.001, 1e6));
 }
 

@@ -53,6 +53,13 @@ int ConnectWithTimeout(const addrinfo* a, double timeout_s, std::string* reason)
 
 }  // namespace
 
+void SetCallTimeout(CLIENT* client, double seconds) {
+  timeval timeout;
+  timeout.tv_sec = static_cast<time_t>(seconds);
+  timeout.tv_usec = static_cast<suseconds_t>((seconds - static_cast<double>(timeout.tv_sec)) * 1e6);
+  clnt_control(client, CLSET_TIMEOUT, reinterpret_cast<char*>(&timeout));
+}
+
 CLIENT* ConnectFootfalld(const RpcOptions& options, std::string* reason) {
   addrinfo hints{};
   hints.ai_family = AF_UNSPEC;
@@ -81,11 +88,7 @@ CLIENT* ConnectFootfalld(const RpcOptions& options, std::string* reason) {
     }
     int close_fd = 1;
     clnt_control(client, CLSET_FD_CLOSE, reinterpret_cast<char*>(&close_fd));
-    timeval timeout;
-    timeout.tv_sec = static_cast<time_t>(options.call_timeout_s);
-    timeout.tv_usec = static_cast<suseconds_t>(
-        (options.call_timeout_s - static_cast<double>(timeout.tv_sec)) * 1e6);
-    clnt_control(client, CLSET_TIMEOUT, reinterpret_cast<char*>(&timeout));
+    SetCallTimeout(client, options.call_timeout_s);
   }
   freeaddrinfo(found);
   return client;

@@ -17,4 +17,7 @@ namespace footfall {
 // (CLSET_FD_CLOSE): clnt_destroy closes it.
 CLIENT* ConnectFootfalld(const RpcOptions& options, std::string* reason);
 
+// Sets how long the client's calls wait for their answer. [Units: s]
+void SetCallTimeout(CLIENT* client, double seconds);
+
 }  // namespace footfall

@@ -277,7 +277,11 @@ class RpcSession final : public TerrainSession {
       args.height_scale = o.height_scale;
       args.max_samples = o.max_samples;
       Reply<ff_load_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply));
-      const Status s = Call(ff_load_options_1(&args, &reply.value, client_), "load");
+      const double wait_s = std::max(options_.call_timeout_s, options_.load_timeout_s);
+      SetCallTimeout(client_, wait_s);
+      const clnt_stat sent = ff_load_options_1(&args, &reply.value, client_);
+      SetCallTimeout(client_, options_.call_timeout_s);
+      const Status s = Call(sent, "load", wait_s);
       if (s != Status::kOk) return s;
       if (reply.value.status != FF_OK)
         return Fail(FromWire(reply.value.status),
@@ -335,14 +339,16 @@ class RpcSession final : public TerrainSession {
     return Fail(Status::kUnknownTerrain, "no terrain with handle " + std::to_string(terrain));
   }
 
-  // Maps an RPC call result to a status; a transport failure drops the connection.
-  Status Call(clnt_stat status, const char* what) {
+  // Maps an RPC call result to a status; a transport failure drops the connection. `waited_s`:
+  // the call's timeout, for the message (call_timeout_s when negative).
+  Status Call(clnt_stat status, const char* what, double waited_s = -1) {
     if (status == RPC_SUCCESS) return Status::kOk;
     std::string reason = clnt_sperrno(status);
     if (status == RPC_TIMEDOUT) {
       // Loading a large terrain (a mesh resampled finely) can take longer than a query.
       std::ostringstream hint;
-      hint << " (no answer within the call timeout of " << options_.call_timeout_s
+      hint << " (no answer within the call timeout of "
+           << (waited_s < 0 ? options_.call_timeout_s : waited_s)
            << " s: a busy or hung server, or a terrain that takes longer to load; a longer "
               "timeout may help)";
       reason += hint.str();

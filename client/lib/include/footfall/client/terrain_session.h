@@ -82,6 +82,9 @@ struct RpcOptions {
   int port = 7407;               // footfalld's default port
   double call_timeout_s = 10;    // [Units: s] per call
   double connect_timeout_s = 2;  // [Units: s] per connection attempt
+  // [Units: s] per load of a server-side file, when longer than call_timeout_s: resampling a
+  // large mesh or height map finely takes longer than any query.
+  double load_timeout_s = 300;
 };
 
 // A client of footfalld. It connects lazily, reports kUnavailable when the server is gone or
