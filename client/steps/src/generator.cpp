@@ -451,6 +451,9 @@ Status Generator::WalkPass(size_t begin, size_t end, Progress* progress, std::st
 Status Generator::WalkPassesInParallel(size_t passes, size_t per_pass, Progress* progress,
                                        std::string* error) {
   if (!pool_) pool_ = SharedBatchPool(threads_);
+  // The set-up's buffers hold every character's feet; a pass refills them for its own.
+  std::vector<Vec3>().swap(points_);
+  std::vector<Foothold>().swap(answers_);
   std::vector<Generator> copies(static_cast<size_t>(threads_), *this);
   for (Generator& g : copies) g.threads_ = 1;
   std::atomic<size_t> next{0};
