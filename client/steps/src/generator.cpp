@@ -454,7 +454,7 @@ Status Generator::WalkPassesInParallel(size_t passes, size_t per_pass, Progress*
   // The set-up's buffers hold every character's feet; a pass refills them for its own.
   std::vector<Vec3>().swap(points_);
   std::vector<Foothold>().swap(answers_);
-  std::vector<Generator> copies(static_cast<size_t>(threads_), *this);
+  std::vector<Generator> copies(std::min(static_cast<size_t>(threads_), passes), *this);
   for (Generator& g : copies) g.threads_ = 1;
   std::atomic<size_t> next{0};
   std::mutex mutex;
