@@ -44,6 +44,28 @@ RawSamples TestTerrain() {
   return s;
 }
 
+// A fresh folder for footfalld's --data-root, removed (with `also`, if set) at the end of the
+// test however it ends.
+struct TempRoot {
+  std::string path, also;
+  TempRoot() {
+    char tmpl[] = "/tmp/footfall-root-XXXXXX";
+    REQUIRE(mkdtemp(tmpl));
+    path = tmpl;
+  }
+  ~TempRoot() {
+    std::string command = "rm -rf '" + path + "'";
+    if (!also.empty()) command += " '" + also + "'";
+    std::system(command.c_str());
+  }
+  TempRoot(const TempRoot&) = delete;
+  TempRoot& operator=(const TempRoot&) = delete;
+};
+
+// A floor meeting a wall at a right angle, 2 x 2 and 2 x 1 units.
+constexpr const char* kCornerObj =
+    "v 0 0 0\nv 2 0 0\nv 2 0 2\nv 0 0 2\nv 2 1 0\nv 2 1 2\nf 1 3 2\nf 1 4 3\nf 2 3 6\nf 2 6 5\n";
+
 // Load options with only a separation (the rest at their defaults).
 TerrainLoadOptions Separation(double separation) {
   TerrainLoadOptions o;
@@ -414,10 +436,10 @@ bool_t EncodeRawLoad(XDR* xdrs, RawLoadArgs* a) {
 }
 
 TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
-  char tmpl[] = "/tmp/footfall-root-XXXXXX";
-  REQUIRE(mkdtemp(tmpl));
-  const std::string root = tmpl;
+  TempRoot temp;
+  const std::string& root = temp.path;
   const std::string outside = root + "-outside";  // a folder beside the root
+  temp.also = outside;
   {
     REQUIRE(mkdir(outside.c_str(), 0700) == 0);
     std::ofstream(root + "/ok.pts") << "0 0 0 0 1 0\n1 0 0 0 1 0\n";
@@ -467,13 +489,11 @@ TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
     xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&reply));
     clnt_destroy(c);
   }
-  std::system(("rm -rf '" + root + "' '" + outside + "'").c_str());
 }
 
 TEST_CASE("footfalld refuses files that are not regular and keeps serving", "[rpc][robustness]") {
-  char tmpl[] = "/tmp/footfall-root-XXXXXX";
-  REQUIRE(mkdtemp(tmpl));
-  const std::string root = tmpl;
+  const TempRoot temp;
+  const std::string& root = temp.path;
   REQUIRE(mkfifo((root + "/fifo.pts").c_str(), 0600) == 0);  // open() for reading would block
   REQUIRE(mkdir((root + "/dir.pts").c_str(), 0700) == 0);
   const int unix_socket = socket(AF_UNIX, SOCK_STREAM, 0);
@@ -495,13 +515,11 @@ TEST_CASE("footfalld refuses files that are not regular and keeps serving", "[rp
   }
   RequireServed(server.port());  // another client is answered afterwards
   close(unix_socket);
-  std::system(("rm -rf '" + root + "'").c_str());
 }
 
 TEST_CASE("footfalld escapes control characters from clients in its log", "[rpc][robustness]") {
-  char tmpl[] = "/tmp/footfall-root-XXXXXX";
-  REQUIRE(mkdtemp(tmpl));
-  const std::string root = tmpl;
+  const TempRoot temp;
+  const std::string& root = temp.path;
   ServerProcess server(0, {"--no-rpcbind", "--data-root", root});
   auto rpc = Connect(server.port());
   TerrainHandle t = 0;
@@ -521,18 +539,15 @@ TEST_CASE("footfalld escapes control characters from clients in its log", "[rpc]
     CHECK(line.rfind("footfalld: ", 0) == 0);
     CHECK(line.rfind("footfalld: forged", 0) != 0);
   }
-  std::system(("rm -rf '" + root + "'").c_str());
 }
 
 TEST_CASE("footfalld reads server files with every load option, as the embedded engine does",
           "[rpc]") {
-  char tmpl[] = "/tmp/footfall-root-XXXXXX";
-  REQUIRE(mkdtemp(tmpl));
-  const std::string root = tmpl;
+  const TempRoot temp;
+  const std::string& root = temp.path;
   // A floor meeting a wall at a right angle (sharp below the crease angle, bent above it), and
   // a 4 x 3 height map with a bump.
-  std::ofstream(root + "/corner.obj") << "v 0 0 0\nv 2 0 0\nv 2 0 2\nv 0 0 2\nv 2 1 0\nv 2 1 2\n"
-                                         "f 1 3 2\nf 1 4 3\nf 2 3 6\nf 2 6 5\n";
+  std::ofstream(root + "/corner.obj") << kCornerObj;
   std::ofstream(root + "/bump.asc") << "ncols 4\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\n"
                                        "0 0 0 0\n0 2 1 0\n0 0 0 0\n";
   ServerProcess server(0, {"--no-rpcbind", "--data-root", root});
@@ -633,15 +648,12 @@ TEST_CASE("footfalld reads server files with every load option, as the embedded 
   CHECK(reply.status == FF_OK);
   xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&reply));
   clnt_destroy(raw);
-  std::system(("rm -rf '" + root + "'").c_str());
 }
 
 TEST_CASE("A server-side load may take longer than a query's call timeout", "[rpc]") {
-  char tmpl[] = "/tmp/footfall-root-XXXXXX";
-  REQUIRE(mkdtemp(tmpl));
-  const std::string root = tmpl;
-  std::ofstream(root + "/corner.obj") << "v 0 0 0\nv 2 0 0\nv 2 0 2\nv 0 0 2\nv 2 1 0\nv 2 1 2\n"
-                                         "f 1 3 2\nf 1 4 3\nf 2 3 6\nf 2 6 5\n";
+  const TempRoot temp;
+  const std::string& root = temp.path;
+  std::ofstream(root + "/corner.obj") << kCornerObj;
   ServerProcess server(0, {"--no-rpcbind", "--data-root", root});
   // About 540,000 samples: a few seconds of resampling, far beyond a half-second call timeout.
   TerrainLoadOptions o;
@@ -663,13 +675,11 @@ TEST_CASE("A server-side load may take longer than a query's call timeout", "[rp
   auto hasty = MakeRpcSession(ro);
   CHECK(hasty->LoadServerFile("corner.obj", o, &t) == Status::kUnavailable);
   CHECK_THAT(hasty->last_error(), Catch::Contains("no answer within the call timeout of 0.5 s"));
-  std::system(("rm -rf '" + root + "'").c_str());
 }
 
 TEST_CASE("footfalld holds --max-samples over parallel uploads and mesh loads", "[rpc]") {
-  char tmpl[] = "/tmp/footfall-root-XXXXXX";
-  REQUIRE(mkdtemp(tmpl));
-  const std::string root = tmpl;
+  const TempRoot temp;
+  const std::string& root = temp.path;
   std::ofstream(root + "/square.obj")  // 10 x 10: 100 square units
       << "v 0 0 0\nv 10 0 0\nv 10 0 10\nv 0 0 10\nf 1 3 2\nf 1 4 3\n";
   ServerProcess server(0, {"--no-rpcbind", "--data-root", root, "--max-samples", "2000"});
@@ -732,7 +742,6 @@ TEST_CASE("footfalld holds --max-samples over parallel uploads and mesh loads", 
           std::string::npos);
     clnt_destroy(other);
   }
-  std::system(("rm -rf '" + root + "'").c_str());
 }
 
 TEST_CASE("footfalld refuses uploaded samples out of range, per chunk", "[rpc]") {
