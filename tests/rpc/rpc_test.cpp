@@ -208,8 +208,6 @@ ff_status SendChunk(CLIENT* c, uint32_t upload, std::vector<ff_sample> samples,
   return status;
 }
 
-// The handle footfalld gave the one terrain it holds, for raw calls (sessions number their
-// terrains themselves).
 // The handles of the terrains footfalld holds, in its order (FF_LIST).
 std::vector<uint32_t> ServerTerrains(int port) {
   CLIENT* c = RawClient(port);
@@ -222,6 +220,8 @@ std::vector<uint32_t> ServerTerrains(int port) {
   return handles;
 }
 
+// The handle footfalld gave the one terrain it holds, for raw calls (sessions number their
+// terrains themselves).
 uint32_t OnlyServerTerrain(int port) {
   const std::vector<uint32_t> handles = ServerTerrains(port);
   REQUIRE(handles.size() == 1);
@@ -675,6 +675,95 @@ TEST_CASE("A server-side load may take longer than a query's call timeout", "[rp
   auto hasty = MakeRpcSession(ro);
   CHECK(hasty->LoadServerFile("corner.obj", o, &t) == Status::kUnavailable);
   CHECK_THAT(hasty->last_error(), Catch::Contains("no answer within the call timeout of 0.5 s"));
+}
+
+// A load that resamples corner.obj (kCornerObj) at 4 mm: about 540,000 samples, seconds of work.
+TerrainLoadOptions SlowLoad() {
+  TerrainLoadOptions o;
+  o.separation = 0.004;
+  return o;
+}
+
+TEST_CASE("A server-side load does not hold up the other clients", "[rpc]") {
+  const TempRoot temp;
+  std::ofstream(temp.path + "/corner.obj") << kCornerObj;
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", temp.path});
+  auto b = Connect(server.port());
+  TerrainHandle small = 0;
+  REQUIRE(b->LoadServerFile("corner.obj", Separation(0.1), &small) == Status::kOk);
+  auto snap_ok = [&] {
+    const Vec3 p{0.5, 0.5, 0.5};
+    Foothold f;
+    return b->Snap(small, &p, 1, &f) == Status::kOk && f.status == Status::kOk;
+  };
+
+  SECTION("others are answered while it runs, and it ends with its terrain") {
+    std::atomic<bool> sent{false}, done{false};
+    Status loaded = Status::kInternalError;
+    TerrainHandle big = 0;
+    std::thread a([&] {
+      auto session = Connect(server.port(), 60);
+      sent = true;
+      loaded = session->LoadServerFile("corner.obj", SlowLoad(), &big);
+      done = true;
+      TerrainInfo info;
+      if (loaded == Status::kOk && session->Info(big, &info) != Status::kOk)
+        loaded = Status::kUnknownTerrain;
+    });
+    while (!sent) std::this_thread::yield();
+    // Well after the load request went out, b is answered again and again before it ends (a
+    // server busy with the load would answer b's first query only after it).
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    int answered = 0;
+    while (!done) {
+      REQUIRE(snap_ok());
+      answered += !done;
+    }
+    a.join();
+    CHECK(loaded == Status::kOk);
+    CHECK(answered >= 10);
+    CHECK_THAT(server.Log(), Catch::Contains("loaded terrain " + std::to_string(big)));
+  }
+  SECTION("a client that goes away meanwhile: its load is dropped, the others go on") {
+    CLIENT* a = RawClient(server.port());
+    // Sends FF_LOAD_OPTIONS and closes without waiting for the reply.
+    ff_load_options_args args{};
+    args.path = const_cast<char*>("corner.obj");
+    args.separation = 0.004;
+    args.smooth_normals = 1;
+    args.crease_angle_deg = 60;
+    args.seed = 1;
+    args.up_axis = 'y';
+    args.height_scale = 1;
+    args.max_samples = 20000000;
+    ff_load_reply reply{};
+    timeval brief{0, 200000};
+    CHECK(clnt_call(a, FF_LOAD_OPTIONS, reinterpret_cast<xdrproc_t>(xdr_ff_load_options_args),
+                    reinterpret_cast<char*>(&args), reinterpret_cast<xdrproc_t>(xdr_ff_load_reply),
+                    reinterpret_cast<char*>(&reply), brief) == RPC_TIMEDOUT);
+    clnt_destroy(a);
+    CHECK(snap_ok());
+    for (int i = 0; i < 600 && server.Log().find("dropped") == std::string::npos; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    CHECK_THAT(server.Log(),
+               Catch::Contains("load of 'corner.obj' dropped: its connection closed before it "
+                               "finished"));
+    CHECK(snap_ok());
+    CHECK(ServerTerrains(server.port()).size() == 1);  // b's only
+  }
+  SECTION("SIGTERM during a load stops the server at once") {
+    std::thread a([&] {
+      auto session = Connect(server.port(), 60);
+      TerrainHandle big = 0;
+      CHECK(session->LoadServerFile("corner.obj", SlowLoad(), &big) != Status::kOk);
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    const int status = server.Terminate();  // waits at most 5 s
+    a.join();
+    CHECK(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 0);
+    CHECK_THAT(server.Log(), Catch::Contains("a server-side load was in progress: abandoned"));
+  }
 }
 
 TEST_CASE("footfalld holds --max-samples over parallel uploads and mesh loads", "[rpc]") {

@@ -10,9 +10,11 @@
 #include <new>
 #include <set>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
+#include "deferred_reply.h"
 #include "footfall.h"
 #include "footfall/rpc/batch_xdr.h"
 #include "footfall/terrain/batch_pool.h"
@@ -215,12 +217,9 @@ void LogEvicted() {
         "least recently queried orphan goes)");
 }
 
-void Load(const std::string& path, const TerrainLoadOptions& options, uint64_t client,
-          ff_load_reply* r) {
-  std::string message;
-  uint32_t handle = 0;
-  const Status s = g_state->registry.LoadFile(path, options, client, &handle, &message);
-  LogEvicted();
+// A load's reply: its handle, or its error; logged.
+void ReplyLoaded(Status s, uint32_t handle, const std::string& path, std::string message,
+                 ff_load_reply* r) {
   r->status = Wire(s);
   r->terrain = handle;
   if (s == Status::kOk) {
@@ -233,6 +232,32 @@ void Load(const std::string& path, const TerrainLoadOptions& options, uint64_t c
     LogError("load", s, message);
   }
   r->message = Message(message);
+}
+
+// The reply ticket of each load in the LoadQueue.
+std::map<const PendingLoad*, uint64_t> g_load_tickets;
+
+// FF_LOAD and FF_LOAD_OPTIONS: what needs no reading is checked at once (an error is answered
+// at once: false); the load is then queued, and its reply held until it is done (true; see
+// FinishLoads). Meanwhile the other clients are served.
+bool StartLoad(SVCXPRT* transport, const std::string& path, const TerrainLoadOptions& options,
+               uint64_t client, ff_load_reply* r) {
+  auto load = std::make_unique<PendingLoad>();
+  std::string message;
+  Status s = g_state->registry.PrepareLoad(path, options, client, load.get(), &message);
+  if (s == Status::kOk) {
+    const PendingLoad* key = load.get();
+    if (g_state->loads->Submit(&load)) {
+      g_load_tickets[key] = HoldReply(transport);
+      return true;
+    }
+    s = Status::kLimitExceeded;
+    message = std::to_string(kMaxQueuedLoads) +
+              " server-side loads are in progress, the most footfalld queues: try again when "
+              "one has finished";
+  }
+  ReplyLoaded(s, 0, path, message, r);
+  return false;
 }
 
 void UploadBegin(const ff_upload_begin_args& a, uint64_t client, ff_upload_reply* r) {
@@ -434,7 +459,8 @@ void Recent(const ff_recent_args& a, ff_recent_reply* r) {
 
 // Decodes the arguments into `args` (set up by the caller: empty, or pointing at storage),
 // runs the handler, replies and frees the arguments, whatever happens. Every reply type starts
-// with its ff_status, which an exception turns into an error.
+// with its ff_status, which an exception turns into an error. A handler that returns true has
+// held its reply (HoldReply) and sends it later.
 template <typename Args, typename Res, typename Fn>
 void ServeWith(SVCXPRT* transport, xdrproc_t decode, Args& args, xdrproc_t encode, const char* proc,
                Fn&& fn) {
@@ -446,14 +472,22 @@ void ServeWith(SVCXPRT* transport, xdrproc_t decode, Args& args, xdrproc_t encod
   }
   Res res{};
   const char* failure = nullptr;
+  bool held = false;
   try {
-    fn(args, &res);
+    if constexpr (std::is_same_v<std::invoke_result_t<Fn&, Args&, Res*>, bool>)
+      held = fn(args, &res);
+    else
+      fn(args, &res);
   } catch (const std::bad_alloc&) {
     failure = "out of memory";
   } catch (const std::exception& e) {
     failure = e.what();
   } catch (...) {
     failure = "unknown exception";
+  }
+  if (held) {
+    svc_freeargs(transport, decode, reinterpret_cast<char*>(&args));
+    return;
   }
   if (failure) {
     Log(std::string("error: ") + proc + ": " + failure);
@@ -485,22 +519,29 @@ void Serve(SVCXPRT* transport, xdrproc_t decode, xdrproc_t encode, const char* p
 #define FF_XDR_VOID reinterpret_cast<xdrproc_t>(reinterpret_cast<void*>(xdr_void))
 
 void Dispatch(svc_req* request, SVCXPRT* transport) {
+  if (ReplyHeld(transport)) {
+    // Only a client that sent another request before its load's reply, then closed, gets here
+    // (a held connection is read only once in error).
+    svcerr_systemerr(transport);
+    Log("error: a request sent while the connection's load was in progress: refused");
+    return;
+  }
   const uint64_t client = ConnectionOf(transport);
   switch (request->rq_proc) {
     case FF_NULL:
       svc_sendreply(transport, FF_XDR_VOID, nullptr);
       return;
     case FF_LOAD:
-      return Serve<LoadArgs, ff_load_reply>(transport, AsXdrProc(XdrLoadArgs),
-                                            FF_XDR(ff_load_reply), "load",
-                                            [client](const LoadArgs& a, ff_load_reply* r) {
-                                              Load(a.path.str(), a.Options(), client, r);
-                                            });
+      return Serve<LoadArgs, ff_load_reply>(
+          transport, AsXdrProc(XdrLoadArgs), FF_XDR(ff_load_reply), "load",
+          [transport, client](const LoadArgs& a, ff_load_reply* r) {
+            return StartLoad(transport, a.path.str(), a.Options(), client, r);
+          });
     case FF_LOAD_OPTIONS:
       return Serve<LoadOptionsArgs, ff_load_reply>(
           transport, AsXdrProc(XdrLoadOptionsArgs), FF_XDR(ff_load_reply), "load",
-          [client](const LoadOptionsArgs& a, ff_load_reply* r) {
-            Load(a.path.str(), a.Options(), client, r);
+          [transport, client](const LoadOptionsArgs& a, ff_load_reply* r) {
+            return StartLoad(transport, a.path.str(), a.Options(), client, r);
           });
     case FF_UPLOAD_BEGIN:
       return Serve<ff_upload_begin_args, ff_upload_reply>(
@@ -589,6 +630,30 @@ void ReapConnections() {
   }
 }
 
+void FinishLoads() {
+  if (!g_state) return;
+  for (const std::unique_ptr<PendingLoad>& load : g_state->loads->TakeFinished()) {
+    const auto it = g_load_tickets.find(load.get());
+    if (it == g_load_tickets.end()) continue;
+    const uint64_t ticket = it->second;
+    g_load_tickets.erase(it);
+    if (!HeldReplyOpen(ticket)) {
+      SendHeldReply(ticket, FF_XDR(ff_load_reply), nullptr);  // releases the ticket
+      Log("load of '" + load->relative_path +
+          "' dropped: its connection closed before it finished");
+      continue;
+    }
+    ff_load_reply r{};
+    std::string message;
+    uint32_t handle = 0;
+    const Status s = g_state->registry.FinishLoad(load.get(), &handle, &message);
+    LogEvicted();
+    ReplyLoaded(s, handle, load->relative_path, message, &r);
+    if (!SendHeldReply(ticket, FF_XDR(ff_load_reply), &r))
+      Log("error: load: reply could not be sent");
+  }
+}
+
 void ExpireIdle() {
   if (!g_state) return;
   g_state->registry.ExpireUploads();
@@ -600,6 +665,7 @@ void ExpireIdle() {
 DispatchFn InstallDispatcher(ServiceState* state) {
   g_state = state;
   g_pool = std::make_unique<BatchPool>(state->batch_threads);
+  state->loads = std::make_unique<LoadQueue>(kMaxQueuedLoads);
   g_storage.points.resize(FF_MAX_BATCH);
   g_storage.steps.resize(FF_MAX_BATCH);
   g_storage.answers.resize(FF_MAX_BATCH);

@@ -5,9 +5,11 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 
 #include "footfall/service/terrain_registry.h"
+#include "load_queue.h"
 
 namespace footfall {
 
@@ -23,7 +25,12 @@ struct ServiceState {
   int batch_threads = 1;
   std::map<int, Connection> connections;  // by socket
   uint64_t next_connection = 1;
+  std::unique_ptr<LoadQueue> loads;  // server-side loads in progress (set by InstallDispatcher)
 };
+
+// [Units: loads] Server-side loads queued or running at once; one more is refused
+// (FF_LIMIT_EXCEEDED). Each connection has at most one: it waits for its reply.
+constexpr size_t kMaxQueuedLoads = 16;
 
 using DispatchFn = void (*)(svc_req*, SVCXPRT*);
 
@@ -35,6 +42,10 @@ DispatchFn InstallDispatcher(ServiceState* state);
 // terrains. Call after every svc_getreq_poll, so a closed socket is noticed before its number
 // can be reused.
 void ReapConnections();
+
+// Replies to the server-side loads that have finished (LoadQueue::wake_fd() is readable),
+// adding their terrains. A load whose connection closed meanwhile is dropped, with a log line.
+void FinishLoads();
 
 // Drops idle uploads and frees orphaned terrains left unqueried past their grace period, with a
 // log line each. Call about once a second.

@@ -99,20 +99,29 @@ int main(int argc, char** argv) {
 
   std::signal(SIGPIPE, SIG_IGN);
   setvbuf(stderr, nullptr, _IOLBF, 0);
-  footfall::RpcServer server(options);
-  if (!server.Start(&error)) {
-    std::fprintf(stderr, "footfalld: %s\n", error.c_str());
-    return 1;
+  bool abandoned_load = false;
+  {
+    footfall::RpcServer server(options);
+    if (!server.Start(&error)) {
+      std::fprintf(stderr, "footfalld: %s\n", error.c_str());
+      return 1;
+    }
+    if (!port_file.empty()) {
+      std::ofstream(port_file) << server.port() << "\n";
+    }
+    g_server = &server;
+    struct sigaction action {};
+    action.sa_handler = OnStopSignal;  // no SA_RESTART: poll returns EINTR at once
+    sigaction(SIGTERM, &action, nullptr);
+    sigaction(SIGINT, &action, nullptr);
+    server.Run();
+    g_server = nullptr;
+    abandoned_load = server.abandoned_load();
+  }  // unregistered from rpcbind
+  if (abandoned_load) {
+    // The load's thread still reads the file: end without running static destructors.
+    std::fflush(nullptr);
+    std::_Exit(0);
   }
-  if (!port_file.empty()) {
-    std::ofstream(port_file) << server.port() << "\n";
-  }
-  g_server = &server;
-  struct sigaction action {};
-  action.sa_handler = OnStopSignal;  // no SA_RESTART: poll returns EINTR at once
-  sigaction(SIGTERM, &action, nullptr);
-  sigaction(SIGINT, &action, nullptr);
-  server.Run();
-  g_server = nullptr;
   return 0;
 }

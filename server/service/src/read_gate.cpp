@@ -43,13 +43,17 @@ ReadGate::ReadGate(size_t send_buffer, double stuck_limit_s)
     : max_queued_(send_buffer > kReplyRoomBytes ? send_buffer - kReplyRoomBytes : 0),
       stuck_limit_s_(stuck_limit_s) {}
 
-int ReadGate::Prepare(std::vector<pollfd>* fds, int idle_ms) {
+int ReadGate::Prepare(std::vector<pollfd>* fds, int idle_ms, const std::set<int>& held) {
   fds->assign(svc_pollfd, svc_pollfd + svc_max_pollfd);
   const auto now = std::chrono::steady_clock::now();
   bool any_waiting = false;
   for (pollfd& p : *fds) {
     p.revents = 0;
     if (p.fd < 0) continue;
+    if (held.count(p.fd)) {
+      p.events = POLLRDHUP;  // the client closing, which Collect hands to libtirpc
+      continue;
+    }
     // The listening socket answers EINVAL, and is always read (accept).
     int queued = 0;
     if (ioctl(p.fd, SIOCOUTQ, &queued) != 0 || static_cast<size_t>(queued) <= max_queued_) {
@@ -74,7 +78,7 @@ void ReadGate::Collect(const std::vector<pollfd>& fds, std::vector<pollfd>* read
   readable->clear();
   for (const pollfd& p : fds) {
     if (p.revents == 0) continue;
-    if ((p.events & kReadEvents) || (p.revents & (POLLERR | POLLHUP | POLLNVAL))) {
+    if ((p.events & kReadEvents) || (p.revents & (POLLERR | POLLHUP | POLLNVAL | POLLRDHUP))) {
       readable->push_back(p);
     } else if (p.revents & POLLOUT) {
       // The kernel calls a socket writable at a third free, which may be less than a reply:

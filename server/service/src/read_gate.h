@@ -12,6 +12,7 @@
 
 #include <chrono>
 #include <cstddef>
+#include <set>
 #include <unordered_map>
 #include <vector>
 
@@ -39,9 +40,11 @@ class ReadGate {
 
   // Copies libtirpc's svc_pollfd into `fds`, replacing POLLIN by POLLOUT for connections without
   // room for a reply (or by nothing for those the kernel already called writable, rechecked at
-  // every call), and shutting down those without room for longer than the limit. Returns the
-  // poll timeout [Units: ms]: short while any connection waits, else `idle_ms`.
-  int Prepare(std::vector<pollfd>* fds, int idle_ms);
+  // every call), and shutting down those without room for longer than the limit. Connections in
+  // `held` (waiting for a reply held for later, deferred_reply.h) are polled only for errors and
+  // for the client closing.
+  // Returns the poll timeout [Units: ms]: short while any connection waits, else `idle_ms`.
+  int Prepare(std::vector<pollfd>* fds, int idle_ms, const std::set<int>& held);
 
   // After poll: puts into `readable` the entries of `fds` that libtirpc should serve (ready for
   // reading, or in error), each with its revents, so that svc_getreq_poll(readable, size) reads

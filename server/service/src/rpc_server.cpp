@@ -16,6 +16,7 @@
 #include <memory>
 #include <vector>
 
+#include "deferred_reply.h"
 #include "dispatcher.h"
 #include "footfall.h"
 #include "read_gate.h"
@@ -109,7 +110,7 @@ bool RpcServer::Start(std::string* error) {
     return false;
   }
   g_state = std::make_unique<ServiceState>(ServiceState{
-      TerrainRegistry(options_.data_root, options_.limits), options_.batch_threads, {}, 1});
+      TerrainRegistry(options_.data_root, options_.limits), options_.batch_threads, {}, 1, {}});
   const DispatchFn dispatch = InstallDispatcher(g_state.get());
   if (!svc_register(transport, FOOTFALL_PROG, FOOTFALL_V1, dispatch, 0)) {
     *error = "cannot register the RPC program";
@@ -139,14 +140,18 @@ void RpcServer::Run() {
   std::vector<pollfd> fds, readable;
   auto last_expiry = std::chrono::steady_clock::now();
   while (!stop_.load()) {
-    const int timeout_ms = gate.Prepare(&fds, 250);
+    const int timeout_ms = gate.Prepare(&fds, 250, HeldSockets());
+    fds.push_back({g_state->loads->wake_fd(), POLLIN, 0});  // finished loads
     const int ready = poll(fds.data(), fds.size(), timeout_ms);
     if (ready < 0) {
       if (errno == EINTR) continue;
       std::fprintf(stderr, "footfalld: error: poll: %s\n", std::strerror(errno));
       break;
     }
-    if (ready > 0) {
+    const bool loads_done = fds.back().revents != 0;
+    fds.pop_back();
+    if (loads_done) FinishLoads();
+    if (ready > (loads_done ? 1 : 0)) {
       // svc_getreq_poll serves the first `count` entries with revents set, reading a request
       // from each: hand it only those whose reply fits.
       gate.Collect(fds, &readable);
@@ -158,6 +163,10 @@ void RpcServer::Run() {
       ExpireIdle();
       last_expiry = now;
     }
+  }
+  if (g_state->loads->Abandon()) {
+    std::fprintf(stderr, "footfalld: a server-side load was in progress: abandoned\n");
+    abandoned_load_ = true;
   }
   std::fprintf(stderr, "footfalld: stopped\n");
 }

@@ -176,10 +176,6 @@ Status TerrainRegistry::Add(const std::string& name, RawSamples samples, uint64_
                             uint32_t* handle, std::string* message) {
   Status status = CheckQuota(owner, message);
   if (status != Status::kOk) return status;
-  if (terrains_.size() >= limits_.max_terrains && !EvictOldestOrphan()) {
-    *message = "too many terrains loaded (limit " + std::to_string(limits_.max_terrains) + ")";
-    return Status::kLimitExceeded;
-  }
   MakeRoomForSamples(samples.size());
   if (TotalSamples() + samples.size() > limits_.max_total_samples) {
     *message = std::to_string(samples.size()) + " samples do not fit in " + Budget();
@@ -187,12 +183,31 @@ Status TerrainRegistry::Add(const std::string& name, RawSamples samples, uint64_
   }
   status = ValidateAndNormalize(&samples, message);
   if (status != Status::kOk) return status;
+  TerrainGrid grid;
+  status = TerrainGrid::Build(samples, GridOptions{}, &grid, message);
+  if (status != Status::kOk) return status;
+  return AddGrid(name, std::move(grid), owner, handle, message);
+}
+
+Status TerrainRegistry::AddGrid(const std::string& name, TerrainGrid grid, uint64_t owner,
+                                uint32_t* handle, std::string* message) {
+  Status status = CheckQuota(owner, message);
+  if (status != Status::kOk) return status;
+  if (terrains_.size() >= limits_.max_terrains && !EvictOldestOrphan()) {
+    *message = "too many terrains loaded (limit " + std::to_string(limits_.max_terrains) + ")";
+    return Status::kLimitExceeded;
+  }
+  const size_t samples = grid.stats().samples;
+  MakeRoomForSamples(samples);
+  if (TotalSamples() + samples > limits_.max_total_samples) {
+    *message = std::to_string(samples) + " samples do not fit in " + Budget();
+    return Status::kLimitExceeded;
+  }
   auto terrain = std::make_unique<LoadedTerrain>();
   terrain->name = name;
   terrain->owner = owner;
   terrain->used = std::chrono::steady_clock::now();
-  status = TerrainGrid::Build(samples, GridOptions{}, &terrain->grid, message);
-  if (status != Status::kOk) return status;
+  terrain->grid = std::move(grid);
   uint32_t h = next_handle_++;
   while (h == 0 || terrains_.count(h)) h = next_handle_++;
   terrains_.emplace(h, std::move(terrain));
@@ -202,6 +217,15 @@ Status TerrainRegistry::Add(const std::string& name, RawSamples samples, uint64_
 
 Status TerrainRegistry::LoadFile(const std::string& relative_path, TerrainLoadOptions options,
                                  uint64_t owner, uint32_t* handle, std::string* message) {
+  PendingLoad load;
+  const Status status = PrepareLoad(relative_path, std::move(options), owner, &load, message);
+  if (status != Status::kOk) return status;
+  RunLoad(&load);
+  return FinishLoad(&load, handle, message);
+}
+
+Status TerrainRegistry::PrepareLoad(const std::string& relative_path, TerrainLoadOptions options,
+                                    uint64_t owner, PendingLoad* load, std::string* message) {
   Status status = CheckQuota(owner, message);  // before reading or sampling anything
   if (status != Status::kOk) return status;
   std::string path;
@@ -210,28 +234,45 @@ Status TerrainRegistry::LoadFile(const std::string& relative_path, TerrainLoadOp
   status = CheckRegularFile(path, relative_path, message);
   if (status != Status::kOk) return status;
   // Held open from here: what is read is the file just checked, wherever its path leads now.
-  PinnedFile pinned;
-  status = pinned.Open(data_root_, path, relative_path, message);
+  auto pinned = std::make_unique<PinnedFile>();
+  status = pinned->Open(data_root_, path, relative_path, message);
   if (status != Status::kOk) return status;
   // Meshes are refused on the sampler's estimate, before any sampling. Orphans count as room:
-  // Add frees them as needed.
+  // AddGrid frees them as needed.
   const uint64_t used = TotalSamples() - OrphanSamples();
   const uint64_t left = used < limits_.max_total_samples ? limits_.max_total_samples - used : 0;
-  const bool budget_binds = left < options.max_samples;
+  load->budget_binds = left < options.max_samples;
   options.max_samples = static_cast<size_t>(std::min<uint64_t>(options.max_samples, left));
+  load->relative_path = relative_path;
+  load->options = std::move(options);
+  load->owner = owner;
+  load->pinned = std::move(pinned);
+  return Status::kOk;
+}
+
+void RunLoad(PendingLoad* load) {
   RawSamples samples;
   std::string error;
-  status = LoadTerrain(pinned.path(), options, &samples, &error);
-  if (status != Status::kOk) {
-    // Report the path as the client gave it, not the server's layout.
-    const size_t at = error.find(pinned.path());
-    if (at != std::string::npos) error.replace(at, pinned.path().size(), relative_path);
-    *message = error;
-    if (status == Status::kLimitExceeded && budget_binds)
+  const std::string& pinned = load->pinned->path();
+  load->status = LoadTerrain(pinned, load->options, &samples, &error);
+  if (load->status == Status::kOk) load->status = ValidateAndNormalize(&samples, &error);
+  if (load->status == Status::kOk)
+    load->status = TerrainGrid::Build(samples, GridOptions{}, &load->grid, &error);
+  // Report the path as the client gave it, not the server's layout.
+  const size_t at = error.find(pinned);
+  if (at != std::string::npos) error.replace(at, pinned.size(), load->relative_path);
+  load->message = std::move(error);
+  load->pinned.reset();  // read: the private name goes
+}
+
+Status TerrainRegistry::FinishLoad(PendingLoad* load, uint32_t* handle, std::string* message) {
+  if (load->status != Status::kOk) {
+    *message = load->message;
+    if (load->status == Status::kLimitExceeded && load->budget_binds)
       *message += " (the limit is what is left of " + Budget() + ")";
-    return status;
+    return load->status;
   }
-  return Add(relative_path, std::move(samples), owner, handle, message);
+  return AddGrid(load->relative_path, std::move(load->grid), load->owner, handle, message);
 }
 
 Status TerrainRegistry::BeginUpload(const std::string& name, uint64_t total, uint64_t owner,

@@ -41,6 +41,9 @@ class RpcServer {
   // Serves until Stop() is called (from a signal handler or another thread).
   void Run();
   void Stop() { stop_.store(true); }
+  // After Run: a server-side load was still running, and was left to its thread. The process
+  // must end with _exit (the loaders' static data must outlive it).
+  bool abandoned_load() const { return abandoned_load_; }
 
  private:
   RpcServerOptions options_;
@@ -48,6 +51,7 @@ class RpcServer {
   int port_ = 0;
   size_t send_buffer_ = 0;  // [Units: bytes] of every connection, as the kernel reports it
   bool registered_rpcbind_ = false;
+  bool abandoned_load_ = false;
   std::atomic<bool> stop_{false};
 };
 

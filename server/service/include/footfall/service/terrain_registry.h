@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "footfall/import/terrain_loader.h"
+#include "footfall/service/pinned_file.h"
 #include "footfall/terrain/grid.h"
 
 namespace footfall {
@@ -35,6 +36,26 @@ struct LoadedTerrain {
   std::chrono::steady_clock::time_point used;
 };
 
+// A server-side load between its three stages: checked and pinned by
+// TerrainRegistry::PrepareLoad (the registry's thread), read, resampled and built by RunLoad (any
+// thread: it touches no registry state), added by TerrainRegistry::FinishLoad (the registry's
+// thread again). A load can take seconds, so footfalld runs the middle stage off its RPC thread.
+struct PendingLoad {
+  std::string relative_path;   // as the client named it
+  TerrainLoadOptions options;  // max_samples lowered to what was left of the budget
+  bool budget_binds = false;   // the budget, not the client, set options.max_samples
+  uint64_t owner = 0;          // the client (connection) that asked
+  std::unique_ptr<PinnedFile> pinned;
+  // RunLoad's result: on kOk the built grid, else the error (naming relative_path).
+  Status status = Status::kInternalError;
+  std::string message;
+  TerrainGrid grid;
+};
+
+// The middle stage of a load: reads and resamples the pinned file, validates the samples and
+// builds the grid into `load`, whose status and message say how it went.
+void RunLoad(PendingLoad* load);
+
 // One answered query, as the live view shows it.
 struct RecentQuery {
   uint64_t sequence = 0;
@@ -56,8 +77,16 @@ class TerrainRegistry {
   // samples left in the budget (RegistryLimits::max_total_samples).
   // The terrain belongs to client `owner`; kLimitExceeded when that client already holds
   // RegistryLimits::max_client_terrains.
+  // LoadFile is PrepareLoad, RunLoad and FinishLoad in a row.
   Status LoadFile(const std::string& relative_path, TerrainLoadOptions options, uint64_t owner,
                   uint32_t* handle, std::string* message);
+  // LoadFile's first stage: every check that needs no reading (quota, path, file type), the file
+  // pinned, the budget applied. On kOk, *load is ready for RunLoad.
+  Status PrepareLoad(const std::string& relative_path, TerrainLoadOptions options, uint64_t owner,
+                     PendingLoad* load, std::string* message);
+  // LoadFile's last stage: the load's error, or its grid added for load->owner if the quota,
+  // the terrain limit and the budget still allow (other loads may have finished meanwhile).
+  Status FinishLoad(PendingLoad* load, uint32_t* handle, std::string* message);
   // Starts an upload for client `owner` (a connection), reserving its announced total against
   // the sample budget until it finishes, fails, expires or DropClient(owner). kLimitExceeded
   // when the budget cannot hold it, or when `owner` already holds its quota of terrains.
@@ -104,6 +133,9 @@ class TerrainRegistry {
   uint64_t OrphanSamples() const;  // samples of orphaned terrains
   Status Add(const std::string& name, RawSamples samples, uint64_t owner, uint32_t* handle,
              std::string* message);
+  // Adds a built grid; kLimitExceeded when the quota, the terrain limit or the budget refuse it.
+  Status AddGrid(const std::string& name, TerrainGrid grid, uint64_t owner, uint32_t* handle,
+                 std::string* message);
   // kLimitExceeded, with a message, when `owner` holds its quota of terrains.
   Status CheckQuota(uint64_t owner, std::string* message) const;
   // Samples held by loaded terrains plus those reserved by uploads in progress.
