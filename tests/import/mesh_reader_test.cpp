@@ -159,6 +159,35 @@ TEST_CASE("ReadMesh: bad meshes give clear errors", "[import][mesh]") {
           Status::kParseError);
     CHECK(Contains(error, "missing.obj:3: face uses vertex 3 but only 2 vertices"));
   }
+  SECTION("OFF variants are checked as OFF; other dimensions, binary OFF and .om are refused") {
+    // A NOFF whose header claims 2e9 faces took 8 GB in OpenMesh before this check.
+    const std::string noff =
+        "NOFF\n3 2000000000 0\n0 0 0 0 1 0\n1 0 0 0 1 0\n0 0 1 0 1 0\n3 0 1 2\n";
+    CHECK(Read(dir.Write("huge.off", noff), &mesh, &error) == Status::kParseError);
+    CHECK(Contains(error, "huge.off: truncated: header declares 2000000000 faces, found 1"));
+    CHECK(Read(dir.Write("nan.off",
+                         "COFF\n3 1 0\n0 0 0 1 1 1\nnan 0 0 1 1 1\n0 1 0 1 1 1\n"
+                         "3 0 1 2\n"),
+               &mesh, &error) == Status::kParseError);
+    CHECK(Contains(error, "nan.off:4: vertex coordinate 'nan' is not a finite number"));
+    const std::string cnoff =
+        "CNOFF\n3 1 0\n0 0 0 0 0 1 255 0 0\n1 0 0 0 0 1 0 255 0\n0 1 0 0 0 1 0 0 255\n3 0 1 2\n";
+    REQUIRE(Read(dir.Write("ok.off", cnoff), &mesh, &error) == Status::kOk);
+    CHECK(mesh.vertices.size() == 3);
+    CHECK(mesh.triangles.size() == 1);
+    CHECK(Read(dir.Write("four.off", "4OFF\n1 0 0\n0 0 0 1\n"), &mesh, &error) ==
+          Status::kParseError);
+    CHECK(Contains(error, "four.off:1: '4OFF' files are not read"));
+    CHECK(Read(dir.Write("bin.off", "OFF BINARY\n"), &mesh, &error) == Status::kParseError);
+    CHECK(Contains(error, "bin.off:1: binary OFF is not read"));
+    // OpenMesh's own reader asserts (the process aborts) on this damaged .om header.
+    std::string om("OMP\"\x00\xa3\xe1\x11\x00\xa3\xe1\x11\x00\xa3\xe1\x11", 16);
+    om += std::string(8, '\0');
+    RawSamples samples;
+    CHECK(LoadTerrain(dir.Write("damaged.om", om), TerrainLoadOptions{}, &samples, &error) ==
+          Status::kInvalidArgument);
+    CHECK(Contains(error, "damaged.om: OpenMesh's .om format is not read"));
+  }
   SECTION("missing file and unknown extension") {
     CHECK(Read(dir.File("absent.obj"), &mesh, &error) == Status::kIoError);
     CHECK(Contains(error, "absent.obj: cannot open"));

@@ -227,7 +227,7 @@ void AddTerrainCommand(CLI::App& app, int* exit_code) {
   auto convert = std::make_shared<ConvertFlags>();
   CLI::App* c = terrain->add_subcommand(
       "convert", "Resample a mesh or height map (or copy a point file) into a point file");
-  c->add_option("input", convert->input, "Terrain file (.obj .ply .off .stl .om .asc .pgm .pts)")
+  c->add_option("input", convert->input, "Terrain file (.obj .ply .off .stl .asc .pgm .pts)")
       ->required();
   c->add_option("-o,--output", convert->output, "Point file to write (.pts .xyz .txt)")
       ->required()

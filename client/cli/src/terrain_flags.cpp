@@ -34,7 +34,7 @@ void AddLoadFlags(CLI::App* command, TerrainLoadOptions* load) {
 void AddTerrainFlags(CLI::App* command, TerrainFlags* flags) {
   command->add_option("--terrain", flags->terrain,
                       "Terrain file on this machine: points (.pts .xyz .txt), mesh (.obj .ply .off "
-                      ".stl .om) or height map (.asc .pgm)");
+                      ".stl) or height map (.asc .pgm)");
   command->add_option("--server-terrain", flags->server_terrain,
                       "Terrain file under footfalld's --data-root, read by the server");
   command->add_option("--server", flags->server,

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <vector>
 
@@ -127,13 +128,26 @@ Status CheckOffFile(const std::string& path, long long* faces, std::vector<Vec3>
   };
   std::vector<std::string> t;
   if (!next(&t)) return Fail(path, "empty OFF file, expected the OFF header", error);
-  if (t[0] != "OFF") {
-    if (t[0].size() >= 3 && t[0].compare(t[0].size() - 3, 3, "OFF") == 0) {
-      return Status::kOk;  // COFF, NOFF, binary ...: left to OpenMesh
+  // OFF and its text variants [ST][C][N]OFF: texture coordinates, colours and normals follow
+  // each vertex's three coordinates (checked as far as the coordinates). 4OFF and nOFF (other
+  // dimensions) and binary OFF are refused: OpenMesh reads them unchecked, and a wrong count in
+  // them can take all memory.
+  const std::string& header = t[0];
+  const bool off = std::regex_match(header, std::regex("(ST)?C?N?OFF"));
+  if (!off) {
+    if (header.size() >= 3 && header.compare(header.size() - 3, 3, "OFF") == 0) {
+      return Fail(At(path, number),
+                  "'" + header +
+                      "' files are not read (expected OFF, COFF, NOFF, CNOFF or STOFF "
+                      "in text)",
+                  error);
     }
-    return Fail(At(path, number), "expected the header 'OFF', found '" + t[0] + "'", error);
+    return Fail(At(path, number), "expected the header 'OFF', found '" + header + "'", error);
   }
   t.erase(t.begin());
+  if (!t.empty() && t[0] == "BINARY") {
+    return Fail(At(path, number), "binary OFF is not read (expected a text OFF)", error);
+  }
   if (t.empty() && !next(&t)) return Fail(path, "truncated: expected the OFF counts", error);
   long long nv = 0, nf = 0;
   if (t.size() < 2 || !ParseInteger(t[0], &nv) || !ParseInteger(t[1], &nf) || nv < 0 || nf < 0) {

@@ -78,7 +78,7 @@ std::string FirstLine(const std::string& text) {
 }  // namespace
 
 bool IsMeshExtension(const std::string& ext) {
-  return ext == "obj" || ext == "ply" || ext == "off" || ext == "stl" || ext == "om";
+  return ext == "obj" || ext == "ply" || ext == "off" || ext == "stl";
 }
 
 Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
@@ -87,7 +87,7 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
   if (report) *report = MeshReadReport{};
   const std::string ext = FileExtension(path);
   if (!IsMeshExtension(ext)) {
-    if (error) *error = path + ": not a mesh extension '" + ext + "' (obj, ply, off, stl, om)";
+    if (error) *error = path + ": not a mesh extension '" + ext + "' (obj, ply, off, stl)";
     return Status::kInvalidArgument;
   }
   {

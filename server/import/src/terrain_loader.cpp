@@ -110,9 +110,15 @@ Status ReadTerrainMesh(const std::string& path, const TerrainLoadOptions& option
     }
     return Status::kOk;
   }
-  if (error) {
+  if (error && ext == "om") {
+    // OpenMesh's reader of its own binary format asserts on malformed files: the process
+    // would abort (footfalld with it).
+    *error = path +
+             ": OpenMesh's .om format is not read (its reader aborts on a damaged file); export "
+             "the mesh as .obj, .ply, .off or .stl";
+  } else if (error) {
     *error = path + ": unknown terrain file extension '" + ext +
-             "' (expected points .pts .xyz .txt, meshes .obj .ply .off .stl .om, height maps "
+             "' (expected points .pts .xyz .txt, meshes .obj .ply .off .stl, height maps "
              ".asc .pgm)";
   }
   return Status::kInvalidArgument;

@@ -18,7 +18,7 @@ struct MeshReadReport {
   size_t skipped_faces = 0;  // degenerate faces and zero-area fan triangles left out
 };
 
-// True for the extensions ReadMesh takes: obj, ply, off, stl, om (any case, without the dot).
+// True for the extensions ReadMesh takes: obj, ply, off, stl (any case, without the dot).
 bool IsMeshExtension(const std::string& lower_extension);
 
 // Reads `path` into *out. Errors, each with a message naming the file (and the line where the

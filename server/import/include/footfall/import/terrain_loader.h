@@ -1,6 +1,6 @@
 // Loads terrain samples from any supported file, chosen by extension (any case):
 //   .pts .xyz .txt            the point file (footfall/terrain/point_file.h), taken as it is
-//   .obj .ply .off .stl .om   polygon meshes (mesh_reader.h), resampled (mesh_sampler.h)
+//   .obj .ply .off .stl       polygon meshes (mesh_reader.h), resampled (mesh_sampler.h)
 //   .asc                      ESRI ASCII grids (height_map.h), resampled
 //   .pgm                      8/16-bit PGM height maps (height_map.h), resampled
 #pragma once
