@@ -102,6 +102,25 @@ TEST_CASE("Height maps: bad files give clear errors", "[import][heightmap]") {
   CHECK(ReadPgm(dir.File("absent.pgm"), &map, &error) == Status::kIoError);
 }
 
+TEST_CASE("Height maps far taller than their cells are refused before they are cut",
+          "[import][heightmap]") {
+  test::TempDir dir;
+  // 2 x 2 pixels of 16 bits at the default height scale (one unit per grey level): slivers one
+  // unit wide and 65535 tall. Cut under the budget's limit alone, they took 80 s and 4.6 GB.
+  RawSamples samples;
+  std::string error;
+  CHECK(LoadTerrain(dir.Write("tall.pgm", "P2\n2 2\n65535\n0 65535\n100 200\n"),
+                    TerrainLoadOptions{}, &samples, &error) == Status::kLimitExceeded);
+  CHECK(Contains(error, "tall.pgm: separation 1 would cut the mesh into more than"));
+  CHECK(Contains(error, "check --height-scale and --cell-size"));
+  CHECK(samples.size() == 0);
+  // Scaled to metres of a 1 m grid, the same file loads.
+  TerrainLoadOptions scaled;
+  scaled.height_scale = 1e-4;
+  REQUIRE(LoadTerrain(dir.File("tall.pgm"), scaled, &samples, &error) == Status::kOk);
+  CHECK(samples.size() > 0);
+}
+
 TEST_CASE("Height maps: headers are checked against the data before anything is allocated",
           "[import][heightmap]") {
   test::TempDir dir;

@@ -145,6 +145,11 @@ Status ResampleTerrainMesh(const std::string& path, const TriangleMesh& mesh,
   std::string why;
   const Status status = SampleMesh(mesh, sample, out, &why);
   if (status != Status::kOk) {
+    if (status == Status::kLimitExceeded && report->format == "heightmap" &&
+        why.find("long and thin") != std::string::npos)
+      why +=
+          " (a height map's cells are thin when its heights are far larger than its cell "
+          "size: check --height-scale and --cell-size)";
     if (error) *error = path + ": " + why;
     return status;
   }
