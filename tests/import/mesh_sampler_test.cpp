@@ -195,6 +195,19 @@ TEST_CASE("SampleMesh: bad options are refused", "[import][sampler]") {
 
 namespace footfall {
 
+TEST_CASE("SampleMesh: a separation far too small for the area says how many samples it means",
+          "[import][sampler]") {
+  TriangleMesh huge;  // 8e28 square units
+  huge.vertices = {{0, 0, 0}, {4e14, 0, 0}, {0, 0, 4e14}};
+  huge.triangles = {{0, 2, 1}};
+  MeshSampleOptions o;
+  o.separation = 1;
+  RawSamples out;
+  std::string error;
+  CHECK(SampleMesh(huge, o, &out, &error) == Status::kLimitExceeded);
+  CHECK(error.find("would give about 1.28e+29 samples") != std::string::npos);
+}
+
 TEST_CASE("SampleMesh: long thin triangles are refused before they are cut", "[import][sampler]") {
   // Two slivers 10000 long and 1e-4 wide: 16000 samples by area at s = 0.01, but millions of
   // pieces along their length.

@@ -271,9 +271,9 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
       // The smallest separation whose estimate fits, rounded up to 3 significant digits.
       const double fits = std::sqrt(1.6 * area / std::max<double>(1, options.max_samples));
       *error = "separation " + Format3(s) + " would give about " +
-               std::to_string(std::llround(predicted)) + " samples (limit " +
-               std::to_string(options.max_samples) + "); choose a separation of at least " +
-               Format3(RoundUp3(fits));
+               (predicted < 9e18 ? std::to_string(std::llround(predicted)) : Format3(predicted)) +
+               " samples (limit " + std::to_string(options.max_samples) +
+               "); choose a separation of at least " + Format3(RoundUp3(fits));
     }
     return Status::kLimitExceeded;
   }

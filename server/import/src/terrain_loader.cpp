@@ -104,6 +104,13 @@ Status ReadTerrainMesh(const std::string& path, const TerrainLoadOptions& option
     report->skipped_faces = RemoveDegenerateTriangles(mesh);
     report->faces = mesh->triangles.size();
     report->file_separation = frame.cell_size;
+    if (mesh->triangles.empty() && report->skipped_faces > 0) {
+      if (error)
+        *error = path + ": all " + std::to_string(report->skipped_faces) +
+                 " triangles of the grid are degenerate, too thin for their length (heights far "
+                 "larger than the cell size: check --height-scale and --cell-size)";
+      return Status::kParseError;
+    }
     if (mesh->triangles.empty()) {
       if (error) *error = path + ": no square of the grid has three cells with data";
       return Status::kParseError;
