@@ -617,11 +617,18 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
 
 void ReapConnections() {
   if (!g_state || g_state->connections.empty()) return;
-  std::set<int> open;
-  for (int i = 0; i < svc_max_pollfd; ++i)
-    if (svc_pollfd[i].fd >= 0) open.insert(svc_pollfd[i].fd);
+  // Which sockets are open, by number (one pass, no allocation once grown: this runs after
+  // every request, with thousands of connections open).
+  static std::vector<char> open;
+  open.assign(open.size(), 0);
+  for (int i = 0; i < svc_max_pollfd; ++i) {
+    const int fd = svc_pollfd[i].fd;
+    if (fd < 0) continue;
+    if (static_cast<size_t>(fd) >= open.size()) open.resize(static_cast<size_t>(fd) + 1, 0);
+    open[static_cast<size_t>(fd)] = 1;
+  }
   for (auto it = g_state->connections.begin(); it != g_state->connections.end();) {
-    if (open.count(it->first)) {
+    if (static_cast<size_t>(it->first) < open.size() && open[static_cast<size_t>(it->first)]) {
       ++it;
       continue;
     }

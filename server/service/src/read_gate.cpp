@@ -54,6 +54,7 @@ int ReadGate::Prepare(std::vector<pollfd>* fds, int idle_ms, const std::set<int>
       p.events = POLLRDHUP;  // the client closing, which Collect hands to libtirpc
       continue;
     }
+    if (!served_.count(p.fd) && !waiting_.count(p.fd)) continue;  // had room, nothing written
     // The listening socket answers EINVAL, and is always read (accept).
     int queued = 0;
     if (ioctl(p.fd, SIOCOUTQ, &queued) != 0 || static_cast<size_t>(queued) <= max_queued_) {
@@ -71,6 +72,7 @@ int ReadGate::Prepare(std::vector<pollfd>* fds, int idle_ms, const std::set<int>
     p.events = w.writable ? 0 : POLLOUT;
     any_waiting = true;
   }
+  served_.clear();
   return any_waiting ? kRecheckMs : idle_ms;
 }
 
@@ -80,6 +82,7 @@ void ReadGate::Collect(const std::vector<pollfd>& fds, std::vector<pollfd>* read
     if (p.revents == 0) continue;
     if ((p.events & kReadEvents) || (p.revents & (POLLERR | POLLHUP | POLLNVAL | POLLRDHUP))) {
       readable->push_back(p);
+      served_.insert(p.fd);
     } else if (p.revents & POLLOUT) {
       // The kernel calls a socket writable at a third free, which may be less than a reply:
       // stop polling it for POLLOUT (it would spin) and only recheck it in Prepare.

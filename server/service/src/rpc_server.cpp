@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <set>
 #include <vector>
 
 #include "deferred_reply.h"
@@ -150,7 +151,12 @@ void RpcServer::Run() {
     }
     const bool loads_done = fds.back().revents != 0;
     fds.pop_back();
-    if (loads_done) FinishLoads();
+    if (loads_done) {
+      const std::set<int> held = HeldSockets();
+      FinishLoads();
+      for (const int fd : held)
+        if (!HeldSockets().count(fd)) gate.Wrote(fd);
+    }
     if (ready > (loads_done ? 1 : 0)) {
       // svc_getreq_poll serves the first `count` entries with revents set, reading a request
       // from each: hand it only those whose reply fits.
