@@ -244,6 +244,18 @@ TEST_CASE("TerrainGrid answers exactly as brute force", "[terrain][grid]") {
     CheckAgainstBruteForce(g, 3000, 10);
     // The outliers do not stretch the cells: the bulk still gets a fine grid.
     CHECK(g.stats().cell_size < 5);
+    // Stored as float offsets from the bulk's centre: the outlier 1e6 away moves by up to
+    // 2^-5 (float spacing there), and the grid says so.
+    CHECK(g.stats().max_rounding > 0);
+    CHECK(g.stats().max_rounding <= 0.04);
+    const Foothold far = g.Snap({1e6, 0, 0});
+    REQUIRE(far.status == Status::kOk);
+    CHECK(far.index == s.size() - 3);
+    CHECK(Distance(far.point, {1e6, 0, 0}) <= g.stats().max_rounding);
+    // Samples on a float grid near the centre are kept exactly.
+    RawSamples exact;
+    for (int i = 0; i < 8; ++i) exact.push_back({i * 0.5, 0, (i % 3) * 0.25}, {0, 1, 0});
+    CHECK(Build(exact).stats().max_rounding == 0);
   }
   SECTION("with huge coordinates (near 1e5)") {
     RawSamples s = MakeHeightField(60, 60, 0.5, 2, 12);

@@ -128,7 +128,9 @@ int RunInfo(const InfoFlags& flags) {
             << "bounds: " << Format(report.bounds_min) << " to " << Format(report.bounds_max)
             << '\n'
             << "grid: " << g.cells[0] << " x " << g.cells[1] << " x " << g.cells[2] << " cells of "
-            << g.cell_size << ", " << g.occupied_cells << " occupied, " << g.bytes << " bytes\n";
+            << g.cell_size << ", " << g.occupied_cells << " occupied, " << g.bytes << " bytes\n"
+            << "stored within: " << g.max_rounding
+            << " of the given coordinates (float offsets from the centre of the bulk)\n";
   return 0;
 }
 

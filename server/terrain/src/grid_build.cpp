@@ -106,11 +106,15 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
   }
   // 3. Positions as float offsets from the origin; bounds recomputed from the stored values.
   std::vector<float> local(3 * n);
+  double rounding2 = 0;
   for (size_t i = 0; i < n; ++i) {
     const Vec3& p = samples.points[i];
-    local[3 * i + 0] = static_cast<float>(p.x - g.origin_[0]);
-    local[3 * i + 1] = static_cast<float>(p.y - g.origin_[1]);
-    local[3 * i + 2] = static_cast<float>(p.z - g.origin_[2]);
+    const Vec3 offset{p.x - g.origin_[0], p.y - g.origin_[1], p.z - g.origin_[2]};
+    local[3 * i + 0] = static_cast<float>(offset.x);
+    local[3 * i + 1] = static_cast<float>(offset.y);
+    local[3 * i + 2] = static_cast<float>(offset.z);
+    const Vec3 kept{local[3 * i + 0], local[3 * i + 1], local[3 * i + 2]};
+    rounding2 = std::max(rounding2, Distance2(kept, offset));
   }
   for (int a = 0; a < 3; ++a) g.bounds_lo_[a] = kInf, g.bounds_hi_[a] = -kInf;
   for (size_t i = 0; i < 3 * n; ++i) {
@@ -231,6 +235,7 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
   st.cell_size = h;
   st.occupied_cells = occupied_cells;
   st.bytes = bytes;
+  st.max_rounding = std::sqrt(rounding2);
   const double* o = g.origin_;
   st.bounds_min = {o[0] + g.bounds_lo_[0], o[1] + g.bounds_lo_[1], o[2] + g.bounds_lo_[2]};
   st.bounds_max = {o[0] + g.bounds_hi_[0], o[1] + g.bounds_hi_[1], o[2] + g.bounds_hi_[2]};

@@ -64,6 +64,10 @@ struct GridStats {
   size_t bytes = 0;             // the grid's single allocation
   Vec3 bounds_min, bounds_max;  // world-space bounds of all samples
   Vec3 grid_min, grid_max;      // world-space box the cells divide (the bulk of the samples)
+  // [Units: wu] The farthest a stored sample lies from the sample as given: samples are float
+  // offsets from the centre of the bulk, kept to about 6e-8 of their distance from it. Queries
+  // are exact for the samples as stored.
+  double max_rounding = 0;
 };
 
 struct GridOptions {
