@@ -227,6 +227,16 @@ TEST_CASE("WriteGltf rejects walks glTF cannot hold", "[export][gltf]") {
     CHECK(WriteGltf(walk, path, &error) == Status::kInvalidArgument);
     CHECK_THAT(error, Catch::Contains("track 2 'body' key 1 has a zero rotation quaternion"));
   }
+  SECTION("distinct frames that float seconds cannot tell apart") {
+    // At 1e6 fps from frame 1e9, frames a millionth of a second apart share a float time:
+    // merging them silently dropped keys.
+    walk.fps = 1e6;
+    for (WalkTrack& t : walk.tracks)
+      for (WalkKey& k : t.keys) k.frame += 1e9;
+    CHECK(WriteGltf(walk, path, &error) == Status::kInvalidArgument);
+    CHECK_THAT(error, Catch::Contains("glTF times are float seconds, and frames 1000000001"));
+    CHECK_THAT(error, Catch::Contains("start the walk nearer frame 0 or use a lower fps"));
+  }
   SECTION("a body key without its rotation") {
     walk.tracks[2].rotations.pop_back();
     CHECK(WriteGltf(walk, path, &error) == Status::kInvalidArgument);
@@ -234,6 +244,16 @@ TEST_CASE("WriteGltf rejects walks glTF cannot hold", "[export][gltf]") {
   }
   std::ifstream written(path);
   CHECK_FALSE(written.good());  // nothing written
+}
+
+TEST_CASE("MaxFloatRounding: how far glTF's float positions move a walk's keys", "[export][gltf]") {
+  Walk walk = test::BipedWalk();
+  CHECK(MaxFloatRounding(walk) < 1e-7);
+  // At UTM-like coordinates floats are a quarter unit apart.
+  for (WalkTrack& t : walk.tracks)
+    for (WalkKey& k : t.keys) k.position = k.position + Vec3{5e5, 0, 4e6};
+  CHECK(MaxFloatRounding(walk) > 0.01);
+  CHECK(MaxFloatRounding(walk) <= 0.25);
 }
 
 TEST_CASE("WriteGltf reports unwritable paths as I/O errors", "[export][gltf]") {

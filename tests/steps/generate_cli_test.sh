@@ -81,6 +81,16 @@ check "cliff: keys kept" [ "$(grep -c '"phase":"end"' "$work/biped-cliff-embedde
 check "formats: exit 2 for a stopped walk" [ $? -eq 2 ]
 for f in all.json all.gltf all.glb all.mel; do check "formats: $f written" [ -s "$work/$f" ]; done
 check "formats: MEL keys the feet" grep -q 'setKeyframe' "$work/all.mel"
+# At UTM-like coordinates glTF's floats move keys visibly: a warning says by how much; none near
+# the origin.
+awk '{ printf "%.3f %s %.3f %s %s %s\n", $1 + 500000, $2, $3 + 4000000, $4, $5, $6 }' "$work/floor.pts" > "$work/utm.pts"
+"$footfall" generate --terrain "$work/utm.pts" --character "$chars/hexapod.json" --steps 4 \
+  --start 500001.2,0,4000001.2 --out "$work/utm.gltf" 2> "$work/utm.err"
+check "glTF at UTM coordinates: written" [ -s "$work/utm.gltf" ]
+check "glTF at UTM coordinates: the float rounding is reported" grep -q "utm.gltf: glTF stores positions as floats, and at these coordinates keys move by up to" "$work/utm.err"
+"$footfall" generate --terrain "$work/floor.pts" --character "$chars/hexapod.json" --steps 4 \
+  --start 1.2,0,1.2 --out "$work/near.gltf" 2> "$work/near.err"
+check "glTF near the origin: no warning" [ ! -s "$work/near.err" ]
 
 # 4. A real DEM (Kootenai river banks, ../shared/data): its 1 m cells are coarser than every
 #    shipped character's step. Unless --separation says otherwise, generate resamples it for the

@@ -16,6 +16,7 @@
 #include "commands.h"
 #include "footfall/cli/number_checks.h"
 #include "footfall/client/query_text.h"
+#include "footfall/export/gltf_writer.h"
 #include "footfall/export/walk_writer.h"
 #include "footfall/steps/generator.h"
 #include "footfall/steps/walk_json.h"
@@ -226,6 +227,17 @@ int RunGenerate(const GenerateFlags& flags) {
     }
     int code = 0;
     for (const std::string& out : flags.out) {
+      const std::string ext = FileExtension(out);
+      if (ext == "gltf" || ext == "glb") {
+        // Visible in a DCC's viewport at real-world (UTM) coordinates.
+        const double rounding = MaxFloatRounding(walk);
+        if (rounding > 1e-4) {
+          std::cerr << "footfall generate: warning: " << out
+                    << ": glTF stores positions as floats, and at these coordinates keys move by "
+                       "up to "
+                    << rounding << " (JSON and MEL keep full precision)\n";
+        }
+      }
       if (WriteOutput(walk, out, &error) != Status::kOk) {
         std::cerr << "footfall generate: " << error << '\n';
         code = 1;

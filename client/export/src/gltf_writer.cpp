@@ -2,6 +2,7 @@
 
 #include <tiny_gltf.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cstring>
 #include <sstream>
@@ -52,7 +53,21 @@ Status TrackSamples(const WalkTrack& track, size_t track_index, double fps, Samp
     }
     const float time = static_cast<float>(key.frame / fps);
     if (!samples->times.empty() && time <= samples->times.back()) {
-      samples->keys.back() = index;  // the same time once rounded to float: the later key wins
+      const WalkKey& before = track.keys[samples->keys.back()];
+      if (before.frame != key.frame) {
+        // Distinct frames that float seconds cannot tell apart: merging them would lose keys.
+        std::ostringstream message;
+        message.precision(10);
+        message << "glTF times are float seconds, and frames " << before.frame << " and "
+                << key.frame << " of track " << track_index << " '"
+                << walk_export::QualifiedTrackName(track, track_index) << "' both become " << time
+                << " s at " << fps
+                << " fps; start the walk nearer frame 0 or use a lower fps (JSON and MEL keep "
+                   "every key)";
+        SetError(error, message.str());
+        return Status::kInvalidArgument;
+      }
+      samples->keys.back() = index;  // keys on the same frame: the later one wins
       continue;
     }
     samples->times.push_back(time);
@@ -228,6 +243,18 @@ Status WriteGltf(const Walk& walk, const std::string& path, std::string* error) 
   GltfOptions options;
   options.binary = EndsWithGlb(path);
   return WriteGltf(walk, path, options, error);
+}
+
+double MaxFloatRounding(const Walk& walk) {
+  double worst = 0;
+  for (const WalkTrack& track : walk.tracks) {
+    for (const WalkKey& key : track.keys) {
+      const Vec3& p = key.position;
+      const Vec3 kept{static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)};
+      worst = std::max(worst, Distance(kept, p));
+    }
+  }
+  return worst;
 }
 
 }  // namespace footfall

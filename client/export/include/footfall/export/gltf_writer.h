@@ -22,7 +22,10 @@ struct GltfOptions {
 //   Each node's rest translation (and rotation for bodies) is its first key.
 // - Channels: feet animate translation; bodies translation and rotation (normalised
 //   quaternions). Times in seconds = frame / fps. glTF needs strictly increasing times: keys are
-//   ordered by frame (stable) and of several keys on the same frame only the last one is kept.
+//   ordered by frame (stable) and of several keys on the same frame only the last one is kept;
+//   distinct frames whose times are the same float (a start frame far from 0 at a high fps) are
+//   refused (kInvalidArgument), as merging them would lose keys. Positions are floats too: at
+//   coordinates near 4e6 they move by up to 0.25 (MaxFloatRounding).
 // - Node extras hold {"kind", "character", "track"}; the animation's extras hold {"fps"} and
 //   {"stopped"} when the walk stopped early. World units are written unchanged (glTF metres).
 // Returns kInvalidArgument (with `*error` set) for fps <= 0, a negative frame, NaN/Inf values or
@@ -32,5 +35,9 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
 
 // As above, binary when `path` ends in ".glb" (any case), JSON otherwise.
 Status WriteGltf(const Walk& walk, const std::string& path, std::string* error);
+
+// [Units: wu] The farthest any key of `walk` moves once its position is rounded to float, as
+// glTF stores it (0 for a walk near the origin at ordinary spacings).
+double MaxFloatRounding(const Walk& walk);
 
 }  // namespace footfall
