@@ -678,6 +678,23 @@ TEST_CASE("A server-side load may take longer than a query's call timeout", "[rp
   CHECK_THAT(hasty->last_error(), Catch::Contains("no answer within the call timeout of 0.5 s"));
 }
 
+TEST_CASE("A terrain of no samples is refused by both sessions and by footfalld", "[rpc]") {
+  ServerProcess server;
+  auto rpc = Connect(server.port());
+  auto embedded = MakeEmbeddedSession(1);
+  TerrainHandle t = 0;
+  CHECK(embedded->LoadSamples(RawSamples{}, "none", &t) == Status::kInvalidArgument);
+  CHECK_THAT(embedded->last_error(), Catch::Contains("none: no samples"));
+  CHECK(rpc->LoadSamples(RawSamples{}, "none", &t) == Status::kInvalidArgument);
+  CHECK_THAT(rpc->last_error(), Catch::Contains("none: no samples"));
+  CLIENT* c = RawClient(server.port());
+  uint32_t upload = 0;
+  std::string message;
+  CHECK(BeginUpload(c, 0, &upload, &message) == FF_INVALID_ARGUMENT);
+  CHECK(message == "an upload of no samples (a terrain needs at least one)");
+  clnt_destroy(c);
+}
+
 // A load that resamples corner.obj (kCornerObj) at 4 mm: about 540,000 samples, seconds of work.
 TerrainLoadOptions SlowLoad() {
   TerrainLoadOptions o;

@@ -1154,3 +1154,36 @@ TEST_CASE("A multiped with its feet in a line walks up a ramp (no plane to fit: 
   const Vec3 ramp_normal{0, std::cos(slope), -std::sin(slope)};
   for (const Quat& q : Body(w).rotations) CHECK(Dot(BodyUp(q), ramp_normal) > 0.999);
 }
+
+namespace footfall::test {
+
+TEST_CASE("Options no walk can follow are refused with the reason", "[steps][generator]") {
+  Terrain t = LoadTerrain(MakeFlat(40, 0.05, 0), 0.05);
+  Walk w;
+  std::string error;
+  SECTION("a heading along the up where the character starts") {
+    // The insect's up is the floor's normal: straight up gives no direction on the ground (it
+    // used to fall back to another direction silently).
+    GenerateOptions o;
+    o.heading = {0, 2, 0};
+    CHECK(GenerateWalk(*t.session, t.handle, LoadShipped("hexapod"), o, &w, &error) ==
+          Status::kInvalidArgument);
+    CHECK_THAT(error, Catch::Contains("the heading (0.0000, 1.0000, 0.0000) is along the up"));
+    // With a path, the heading is not used.
+    o.path = {{1.5, 0, 1.5}};
+    CHECK(GenerateWalk(*t.session, t.handle, LoadShipped("hexapod"), o, &w, &error) == Status::kOk);
+  }
+  SECTION("a start frame or fps beyond the command line's bounds, from any caller") {
+    GenerateOptions o;
+    o.start_frame = 1e300;  // every key landed on one frame
+    CHECK(GenerateWalk(*t.session, t.handle, LoadShipped("biped"), o, &w, &error) ==
+          Status::kInvalidArgument);
+    CHECK_THAT(error, Catch::Contains("the start frame within +-1e+09"));
+    o.start_frame = 1;
+    o.fps = 1e7;
+    CHECK(GenerateWalk(*t.session, t.handle, LoadShipped("biped"), o, &w, &error) ==
+          Status::kInvalidArgument);
+  }
+}
+
+}  // namespace footfall::test

@@ -260,6 +260,16 @@ bad_flag:
   return 1;
 }
 
+// Refuses an empty or blank value: `--path ""` would otherwise read as no path at all.
+CLI::Validator NotBlank(const std::string& expected) {
+  return CLI::Validator(
+      [expected](std::string& value) {
+        return value.find_first_not_of(" \t") == std::string::npos ? "expected " + expected
+                                                                   : std::string();
+      },
+      "");
+}
+
 }  // namespace
 
 void AddGenerateCommand(CLI::App& app, int* exit_code) {
@@ -274,21 +284,25 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
   cmd->add_option("--start", flags->start,
                   "X,Y,Z where the character starts (default: the sample nearest the centre of "
                   "the top of the terrain's bounds, or the nearest place within 12 steps where "
-                  "the character can stand)");
+                  "the character can stand)")
+      ->check(NotBlank("X,Y,Z"));
   cmd->add_option("--heading", flags->heading,
-                  "DX,DY,DZ facing direction, projected onto the ground (default 0,0,1)");
+                  "DX,DY,DZ facing direction, projected onto the ground (default 0,0,1)")
+      ->check(NotBlank("DX,DY,DZ"));
   cmd->add_option("--path", flags->path,
                   "Waypoints \"X,Y,Z X,Y,Z ...\" to follow (one point: a goal); the walk ends "
-                  "at the last one");
+                  "at the last one")
+      ->check(NotBlank("at least one waypoint X,Y,Z"));
   cmd->add_option("--steps", flags->steps,
                   "Steps per character, one gait group each (default 8; with --path, until "
                   "the goal)")
       ->check(CLI::Range(0, 1000000));
   cmd->add_option("--start-frame", flags->start_frame, "Frame of the first keys (default 1)")
-      ->check(FiniteRange(-1e9, 1e9));
+      ->check(FiniteRange(-kMaxStartFrame, kMaxStartFrame));
   cmd->add_option("--fps", flags->fps, "Frames per second of the walk (default 24)")
-      ->check(FiniteRange(0.001, 1e6));
-  cmd->add_option("--up", flags->up, "X,Y,Z world up of bipeds (default 0,1,0, as in Maya)");
+      ->check(FiniteRange(0.001, kMaxFps));
+  cmd->add_option("--up", flags->up, "X,Y,Z world up of bipeds (default 0,1,0, as in Maya)")
+      ->check(NotBlank("X,Y,Z"));
   cmd->add_option("--crowd", flags->crowd,
                   "Generate this many characters at once on a grid around --start")
       ->check(CLI::Range(1, 1000000));

@@ -20,6 +20,8 @@ class EmbeddedSession final : public TerrainSession {
 
   Status LoadSamples(const RawSamples& samples, const std::string& name,
                      TerrainHandle* out) override {
+    if (samples.size() == 0)
+      return Fail(Status::kInvalidArgument, name + ": no samples (a terrain needs at least one)");
     RawSamples copy = samples;
     std::string error;
     Status status = ValidateAndNormalize(&copy, &error);

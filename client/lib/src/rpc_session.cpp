@@ -81,6 +81,8 @@ class RpcSession final : public TerrainSession {
 
   Status LoadSamples(const RawSamples& samples, const std::string& name,
                      TerrainHandle* out) override {
+    if (samples.size() == 0)
+      return Fail(Status::kInvalidArgument, name + ": no samples (a terrain needs at least one)");
     TerrainSource source;
     source.kind = TerrainSource::kSamples;
     source.samples = samples, source.name = name;

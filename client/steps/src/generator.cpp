@@ -532,6 +532,19 @@ Status Generator::Setup(std::string* error) {
       feet * foot_keys * sizeof(WalkKey) + body_keys * (sizeof(WalkKey) + sizeof(Quat));
   const bool exact = o_.steps >= 0 && 3 * steps_of_foot + 1 <= kMaxReserved &&
                      static_cast<size_t>(steps_) + 1 <= kMaxReserved;
+  // A heading along the up where the character starts gives no direction on the ground (it
+  // used to fall back to another direction silently).
+  if (o_.path.empty() && n > 0) {
+    const Vec3 up = c_.align_to_normal ? answers_[0].normal : world_up_;
+    if (Length2(ProjectOnPlane(o_.heading, up)) <= 1e-8 * Length2(o_.heading)) {
+      std::ostringstream m;
+      m << "the heading " << Point(o_.heading) << " is along the up " << Point(up)
+        << " where the character starts: it gives no direction on the ground; give a heading "
+           "along the ground";
+      *error = m.str();
+      return Status::kInvalidArgument;
+    }
+  }
   auto arena = std::make_shared<KeyArena>(n * character_bytes, exact);
   for (int i = 0; i < n; ++i) {
     Agent& a = agents_[i];
@@ -1165,9 +1178,12 @@ Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Charac
     *error = "heading must be a non-zero finite vector";
     return Status::kInvalidArgument;
   }
-  if (!IsFinite(options.start) || !std::isfinite(options.start_frame) || !(options.fps > 0) ||
-      !std::isfinite(options.fps)) {
-    *error = "start, start frame and fps must be finite (fps > 0)";
+  if (!IsFinite(options.start) || !(std::fabs(options.start_frame) <= kMaxStartFrame) ||
+      !(options.fps > 0) || !(options.fps <= kMaxFps)) {
+    std::ostringstream m;
+    m << "start must be finite, the start frame within +-" << kMaxStartFrame
+      << " and fps above 0 and at most " << kMaxFps;
+    *error = m.str();
     return Status::kInvalidArgument;
   }
   for (const Vec3& p : options.path) {

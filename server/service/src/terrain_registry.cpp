@@ -280,6 +280,10 @@ Status TerrainRegistry::BeginUpload(const std::string& name, uint64_t total, uin
   ExpireUploads();
   const Status quota = CheckQuota(owner, message);
   if (quota != Status::kOk) return quota;
+  if (total == 0) {
+    *message = "an upload of no samples (a terrain needs at least one)";
+    return Status::kInvalidArgument;
+  }
   if (uploads_.size() >= limits_.max_uploads) {
     *message = "too many uploads in progress (limit " + std::to_string(limits_.max_uploads) + ")";
     return Status::kLimitExceeded;

@@ -36,6 +36,10 @@ constexpr int kMaxPathSteps = 10000;
 // nearest place within this many step lengths where the character can stand, looked for on a
 // grid of half a step.
 constexpr int kStartSearchSteps = 12;
+// Bounds of GenerateOptions::start_frame and fps, for every caller (command line, C ABI,
+// plugins): a frame of 1e300 put every key on one frame.
+constexpr double kMaxStartFrame = 1e9;
+constexpr double kMaxFps = 1e6;
 
 struct GenerateOptions {
   // Where the (first) character stands, snapped to the terrain. World space. Unset: the centre
