@@ -159,6 +159,24 @@ TEST_CASE("ReadMesh: bad meshes give clear errors", "[import][mesh]") {
           Status::kParseError);
     CHECK(Contains(error, "missing.obj:3: face uses vertex 3 but only 2 vertices"));
   }
+  SECTION("ASCII PLY values are checked line by line") {
+    const std::string header =
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    // Each used to read as "3 vertices but no faces".
+    CHECK(Read(dir.Write("nan.ply", header + "nan 0 0\n1 0 0\n0 0 1\n3 0 1 2\n"), &mesh, &error) ==
+          Status::kParseError);
+    CHECK(Contains(error, "nan.ply:10: vertex coordinate 'nan' is not a finite number"));
+    CHECK(Read(dir.Write("index.ply", header + "0 0 0\n1 0 0\n0 0 1\n3 0 1 9\n"), &mesh, &error) ==
+          Status::kParseError);
+    CHECK(Contains(error, "index.ply:13: face vertex '9' is not an index below 3"));
+    CHECK(Read(dir.Write("short.ply", header + "0 0 0\n1 0 0\n0 0 1\n5 0 1 2\n"), &mesh, &error) ==
+          Status::kParseError);
+    CHECK(Contains(error, "short.ply:13: list 'vertex_indices' needs its count and that many"));
+    REQUIRE(Read(dir.Write("good.ply", header + "0 0 0\n1 0 0\n0 0 1\n3 0 1 2\n"), &mesh, &error) ==
+            Status::kOk);
+    CHECK(mesh.triangles.size() == 1);
+  }
   SECTION("OFF variants are checked as OFF; other dimensions, binary OFF and .om are refused") {
     // A NOFF whose header claims 2e9 faces took 8 GB in OpenMesh before this check.
     const std::string noff =

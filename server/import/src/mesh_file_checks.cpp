@@ -210,8 +210,10 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
   struct Element {
     std::string name;
     long long count = 0;
-    long long fixed_bytes = 0;     // fixed-size properties
-    long long list_min_bytes = 0;  // list properties, counting 3 items per face list
+    long long fixed_bytes = 0;            // fixed-size properties
+    long long list_min_bytes = 0;         // list properties, counting 3 items per face list
+    std::vector<std::string> properties;  // names, in order
+    std::vector<bool> lists;              // whether each is a list
   };
   std::vector<Element> elements;
   std::string format;
@@ -250,10 +252,12 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
           return Fail(At(path, number), "unknown PLY property type", error);
         }
         e.list_min_bytes += count_size + (e.name == "face" ? 3 * item_size : 0);
+        e.properties.push_back(t[4]), e.lists.push_back(true);
       } else if (t.size() >= 3) {
         const int size = type_size(t[1]);
         if (!size) return Fail(At(path, number), "unknown PLY type '" + t[1] + "'", error);
         e.fixed_bytes += size;
+        e.properties.push_back(t[2]), e.lists.push_back(false);
       }
     }
   }
@@ -262,11 +266,65 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
     if (e.name == "face") *faces = e.count;
   }
   if (format == "ascii") {
-    long long records = 0;
-    for (const Element& e : elements) records += e.count;
+    long long records = 0, vertices = 0;
+    for (const Element& e : elements) {
+      records += e.count;
+      if (e.name == "vertex") vertices = e.count;
+    }
+    // Each data line against its element: vertices' x, y, z finite; faces' index lists of 3 or
+    // more indices of declared vertices.
     long long found = 0;
+    size_t element = 0;
+    long long in_element = 0;
     while (std::getline(in, line)) {
-      if (!Tokens(line).empty()) ++found;
+      ++number;
+      const std::vector<std::string> t = Tokens(line);
+      if (t.empty()) continue;
+      ++found;
+      while (element < elements.size() && in_element >= elements[element].count)
+        ++element, in_element = 0;
+      if (element >= elements.size()) continue;  // extra lines: OpenMesh ignores them
+      ++in_element;
+      const Element& e = elements[element];
+      size_t at = 0;
+      for (size_t p = 0; p < e.properties.size(); ++p) {
+        if (at >= t.size()) {
+          return Fail(At(path, number),
+                      "expected a value for " + e.name + " property '" + e.properties[p] + "'",
+                      error);
+        }
+        if (!e.lists[p]) {
+          const std::string& name = e.properties[p];
+          double value = 0;
+          if (e.name == "vertex" && (name == "x" || name == "y" || name == "z")) {
+            const Status s = CheckCoordinate(At(path, number), t[at], &value, error);
+            if (s != Status::kOk) return s;
+          }
+          ++at;
+          continue;
+        }
+        long long n = 0;
+        if (!ParseInteger(t[at], &n) || n < 0 || at + 1 + static_cast<size_t>(n) > t.size()) {
+          return Fail(At(path, number),
+                      "list '" + e.properties[p] + "' needs its count and that many items", error);
+        }
+        const bool indices = e.name == "face" && (e.properties[p] == "vertex_indices" ||
+                                                  e.properties[p] == "vertex_index");
+        if (indices && n < 3) {
+          return Fail(At(path, number),
+                      "face has " + std::to_string(n) + " vertices, expected 3 or more", error);
+        }
+        for (long long i = 1; indices && i <= n; ++i) {
+          long long index = 0;
+          if (!ParseInteger(t[at + i], &index) || index < 0 || index >= vertices) {
+            return Fail(
+                At(path, number),
+                "face vertex '" + t[at + i] + "' is not an index below " + std::to_string(vertices),
+                error);
+          }
+        }
+        at += 1 + static_cast<size_t>(n);
+      }
     }
     if (found < records) {
       return Fail(path,
