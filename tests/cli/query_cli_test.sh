@@ -32,6 +32,17 @@ check "zero direction" grep -q '"line":5,"message":"next: direction DX DY DZ mus
 check "answers after errors" grep -q '"op":"snap","found":true,"index":12' <(sed -n 5p "$work/out.jsonl")
 check "count" grep -qF '{"op":"error","line":7,"message":"normal: expected 3 numbers, found 2"}' <(sed -n 6p "$work/out.jsonl")
 check "commas separate numbers" grep -q '"op":"snap","found":true,"index":12' <(sed -n 7p "$work/out.jsonl")
+# A line longer than 4096 characters (here 5 MB, no newline after it at first) is an error of
+# its own, skipped without being held; the next lines are answered; the last line may lack its
+# newline.
+{ printf 'snap 1 0 1\nsnap 1 0 '; head -c 5000000 /dev/zero | tr '\0' '7'; printf '\nsnap 2 0 2\nsnap 1 0 1'; } |
+  "$footfall" query --terrain "$work/flat.pts" > "$work/long.jsonl"
+rc=$?
+check "long line: exit 1" [ "$rc" -eq 1 ]
+check "long line: four answers" [ "$(wc -l < "$work/long.jsonl")" -eq 4 ]
+check "long line: an error naming the line" grep -qx '{"op":"error","line":2,"message":"line longer than 4096 characters"}' <(sed -n 2p "$work/long.jsonl")
+check "long line: the lines after it are answered" grep -q '"op":"snap","found":true,"index":12' <(sed -n 3p "$work/long.jsonl")
+check "long line: a last line without newline is answered" grep -q '"op":"snap","found":true' <(sed -n 4p "$work/long.jsonl")
 
 # 3. Bad terrain files: the documented message and a non-zero exit, never a crash.
 bad() {  # bad NAME CONTENT EXPECTED_MESSAGE

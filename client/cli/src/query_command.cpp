@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <iostream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,31 @@ struct Command {
 };
 
 // Parses one command line; returns false for blank and comment lines.
+// [Units: characters] The longest query line read: the longest valid one is about 200; a longer
+// one is an error, read past without being kept (a 200 MB line held 1.4 GB).
+constexpr std::streamsize kMaxLine = 4096;
+
+// Reads one line of `in` into *text, at most kMaxLine characters; *too_long when it had more
+// (the rest is skipped). False at the end of the input.
+bool ReadLine(std::istream& in, std::string* text, bool* too_long) {
+  *too_long = false;
+  text->resize(static_cast<size_t>(kMaxLine) + 1);
+  in.getline(&(*text)[0], kMaxLine + 1);
+  const std::streamsize got = in.gcount();
+  if (got == 0 && in.eof()) return false;
+  if (in.fail() && !in.eof()) {  // the buffer filled before the line ended
+    in.clear();
+    in.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
+    *too_long = true;
+    text->clear();
+    return true;
+  }
+  const bool delimited = !in.eof();
+  text->resize(static_cast<size_t>(got - (delimited ? 1 : 0)));
+  in.clear(in.rdstate() & std::ios::eofbit);
+  return true;
+}
+
 bool ParseCommand(const std::string& text, size_t line, Command* out) {
   const std::string command = text.substr(0, text.find('#'));
   if (command.find_first_not_of(" \t\r\v\f") == std::string::npos) return false;
@@ -120,10 +146,17 @@ int RunQuery(const QueryFlags& flags) {
   std::string text;
   size_t line = 0;
   constexpr size_t kBlock = 4096;
-  while (std::getline(std::cin, text)) {
+  bool too_long = false;
+  while (ReadLine(std::cin, &text, &too_long)) {
     ++line;
     Command c;
-    if (ParseCommand(text, line, &c)) block.push_back(std::move(c));
+    if (too_long) {
+      c.line = line;
+      c.error = "line longer than " + std::to_string(kMaxLine) + " characters";
+      block.push_back(std::move(c));
+    } else if (ParseCommand(text, line, &c)) {
+      block.push_back(std::move(c));
+    }
     // Answer at once when no more input is waiting, so interactive callers are never stalled.
     if (block.size() >= kBlock || (!block.empty() && !InputReady())) {
       ok = RunBlock(*session, terrain, flags.tolerance, block) && ok;
