@@ -159,6 +159,14 @@ TEST_CASE("ReadMesh: bad meshes give clear errors", "[import][mesh]") {
           Status::kParseError);
     CHECK(Contains(error, "missing.obj:3: face uses vertex 3 but only 2 vertices"));
   }
+  SECTION("ASCII STL facets are triangles") {
+    // OpenMesh kept the first three vertices of a four-vertex loop and dropped the fourth.
+    const std::string quad =
+        "solid q\nfacet normal 0 1 0\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 0 1\n"
+        "vertex 0 0 1\nendloop\nendfacet\nendsolid q\n";
+    CHECK(Read(dir.Write("quad.stl", quad), &mesh, &error) == Status::kParseError);
+    CHECK(Contains(error, "quad.stl:8: facet loop has 4 vertices, expected 3"));
+  }
   SECTION("ASCII PLY values are checked line by line") {
     const std::string header =
         "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"

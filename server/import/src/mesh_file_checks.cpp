@@ -370,15 +370,28 @@ Status CheckStlFile(const std::string& path, std::string* error) {
                     std::to_string(size) + " bytes",
                 error);
   }
-  // ASCII STL: finite vertices and a closing 'endsolid'.
+  // ASCII STL: finite vertices, three to a facet's loop, and a closing 'endsolid'.
   in.seekg(0);
   std::string line;
   bool closed = false;
+  int in_loop = -1;  // vertices of the open loop; -1 outside one
   for (size_t number = 1; std::getline(in, line); ++number) {
     const std::vector<std::string> t = Tokens(line);
     if (t.empty()) continue;
     if (t[0] == "endsolid") closed = true;
+    if (t[0] == "outer") in_loop = 0;
+    if (t[0] == "endloop") {
+      if (in_loop >= 0 && in_loop != 3) {
+        return Fail(At(path, number),
+                    "facet loop has " + std::to_string(in_loop) +
+                        " vertices, expected 3 (STL "
+                        "facets are triangles)",
+                    error);
+      }
+      in_loop = -1;
+    }
     if (t[0] == "vertex") {
+      if (in_loop >= 0) ++in_loop;
       if (t.size() < 4) return Fail(At(path, number), "vertex needs 3 coordinates", error);
       for (int i = 1; i <= 3; ++i) {
         double c;
