@@ -209,6 +209,21 @@ ff_status SendChunk(CLIENT* c, uint32_t upload, std::vector<ff_sample> samples,
   return status;
 }
 
+// FF_LOAD_OPTIONS arguments with the loader's defaults (TerrainLoadOptions) for `path`.
+ff_load_options_args DefaultLoadOptionsArgs(const char* path) {
+  const TerrainLoadOptions o;
+  ff_load_options_args args{};
+  args.path = const_cast<char*>(path);
+  args.separation = o.separation;
+  args.smooth_normals = o.smooth_normals;
+  args.crease_angle_deg = o.crease_angle_deg;
+  args.seed = o.seed;
+  args.up_axis = o.up_axis;
+  args.height_scale = o.height_scale;
+  args.max_samples = o.max_samples;
+  return args;
+}
+
 // The handles of the terrains footfalld holds, in its order (FF_LIST).
 std::vector<uint32_t> ServerTerrains(int port) {
   CLIENT* c = RawClient(port);
@@ -625,12 +640,7 @@ TEST_CASE("footfalld reads server files with every load option, as the embedded 
   // On the wire, an up axis is an int: one that is 'y' only in its low byte is refused, not cut
   // down to 'y'; a NaN crease angle too. The server goes on serving.
   CLIENT* raw = RawClient(server.port());
-  ff_load_options_args args{};
-  args.path = const_cast<char*>("bump.asc");
-  args.smooth_normals = 1;
-  args.crease_angle_deg = 60;
-  args.seed = 1;
-  args.height_scale = 1;
+  ff_load_options_args args = DefaultLoadOptionsArgs("bump.asc");
   args.max_samples = 1000000;
   args.up_axis = 'y' + 256;
   ff_load_reply reply{};
@@ -746,15 +756,8 @@ TEST_CASE("A server-side load does not hold up the other clients", "[rpc]") {
   SECTION("a client that goes away meanwhile: its load is dropped, the others go on") {
     CLIENT* a = RawClient(server.port());
     // Sends FF_LOAD_OPTIONS and closes without waiting for the reply.
-    ff_load_options_args args{};
-    args.path = const_cast<char*>("corner.obj");
+    ff_load_options_args args = DefaultLoadOptionsArgs("corner.obj");
     args.separation = 0.004;
-    args.smooth_normals = 1;
-    args.crease_angle_deg = 60;
-    args.seed = 1;
-    args.up_axis = 'y';
-    args.height_scale = 1;
-    args.max_samples = 20000000;
     ff_load_reply reply{};
     timeval brief{0, 200000};
     CHECK(clnt_call(a, FF_LOAD_OPTIONS, reinterpret_cast<xdrproc_t>(xdr_ff_load_options_args),
