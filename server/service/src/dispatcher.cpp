@@ -217,25 +217,42 @@ void LogEvicted() {
         "least recently queried orphan goes)");
 }
 
-// A load's reply: its handle, or its error; logged.
-void ReplyLoaded(Status s, uint32_t handle, const std::string& path, std::string message,
-                 ff_load_reply* r) {
+// The reply of a load (a file's `path`) or of an upload (`upload`: its name in `path`): its
+// handle, or its error; logged.
+void ReplyLoaded(Status s, uint32_t handle, const std::string& path, bool upload,
+                 std::string message, ff_load_reply* r) {
   r->status = Wire(s);
   r->terrain = handle;
   if (s == Status::kOk) {
     const GridStats& st = g_state->registry.Find(handle)->grid.stats();
-    message = "loaded " + path;
-    Log("loaded terrain " + std::to_string(handle) + " from '" + path +
-        "': " + std::to_string(st.samples) + " samples, grid " + std::to_string(st.cells[0]) + "x" +
+    message = upload ? "" : "loaded " + path;
+    Log("loaded terrain " + std::to_string(handle) +
+        (upload ? " '" + path + "' (uploaded)" : " from '" + path + "'") + ": " +
+        std::to_string(st.samples) + " samples, grid " + std::to_string(st.cells[0]) + "x" +
         std::to_string(st.cells[1]) + "x" + std::to_string(st.cells[2]));
   } else {
-    LogError("load", s, message);
+    LogError(upload ? "upload" : "load", s, message);
   }
   r->message = Message(message);
 }
 
 // The reply ticket of each load in the LoadQueue.
 std::map<const PendingLoad*, uint64_t> g_load_tickets;
+
+// Queues a prepared load and holds the request's reply for it; false (the load untouched) when
+// the queue is full.
+bool QueueLoad(SVCXPRT* transport, std::unique_ptr<PendingLoad>* load) {
+  const PendingLoad* key = load->get();
+  if (!g_state->loads->Submit(load)) return false;
+  g_load_tickets[key] = HoldReply(transport);
+  return true;
+}
+
+std::string QueueFullMessage() {
+  return std::to_string(kMaxQueuedLoads) +
+         " loads and uploads are being built, the most footfalld queues: try again when one "
+         "has finished";
+}
 
 // FF_LOAD and FF_LOAD_OPTIONS: what needs no reading is checked at once (an error is answered
 // at once: false); the load is then queued, and its reply held until it is done (true; see
@@ -246,17 +263,11 @@ bool StartLoad(SVCXPRT* transport, const std::string& path, const TerrainLoadOpt
   std::string message;
   Status s = g_state->registry.PrepareLoad(path, options, client, load.get(), &message);
   if (s == Status::kOk) {
-    const PendingLoad* key = load.get();
-    if (g_state->loads->Submit(&load)) {
-      g_load_tickets[key] = HoldReply(transport);
-      return true;
-    }
+    if (QueueLoad(transport, &load)) return true;
     s = Status::kLimitExceeded;
-    message = std::to_string(kMaxQueuedLoads) +
-              " server-side loads are in progress, the most footfalld queues: try again when "
-              "one has finished";
+    message = QueueFullMessage();
   }
-  ReplyLoaded(s, 0, path, message, r);
+  ReplyLoaded(s, 0, path, false, message, r);
   return false;
 }
 
@@ -285,23 +296,21 @@ void UploadChunk(const ff_upload_chunk_args& a, uint64_t client, ff_status_reply
   r->message = Message(message);
 }
 
-void UploadFinish(const ff_upload_args& a, uint64_t client, ff_load_reply* r) {
+// FF_UPLOAD_FINISH: as StartLoad, the grid built off the RPC thread (a grid of millions of
+// samples takes a good part of a second).
+bool StartUploadFinish(SVCXPRT* transport, const ff_upload_args& a, uint64_t client,
+                       ff_load_reply* r) {
+  auto load = std::make_unique<PendingLoad>();
   std::string message;
-  uint32_t handle = 0;
-  const Status s = g_state->registry.FinishUpload(a.upload, client, &handle, &message);
-  LogEvicted();
-  r->status = Wire(s);
-  r->terrain = handle;
+  Status s = g_state->registry.PrepareFinishUpload(a.upload, client, load.get(), &message);
   if (s == Status::kOk) {
-    const LoadedTerrain* t = g_state->registry.Find(handle);
-    const GridStats& st = t->grid.stats();
-    Log("loaded terrain " + std::to_string(handle) + " '" + t->name + "' (uploaded): " +
-        std::to_string(st.samples) + " samples, grid " + std::to_string(st.cells[0]) + "x" +
-        std::to_string(st.cells[1]) + "x" + std::to_string(st.cells[2]));
-  } else {
-    LogError("upload", s, message);
+    if (QueueLoad(transport, &load)) return true;
+    g_state->registry.DropLoad(load.get());
+    s = Status::kLimitExceeded;
+    message = QueueFullMessage();
   }
-  r->message = Message(message);
+  ReplyLoaded(s, 0, "", true, message, r);
+  return false;
 }
 
 void Info(const ff_terrain_args& a, ff_info_reply* r) {
@@ -558,7 +567,9 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
     case FF_UPLOAD_FINISH:
       return Serve<ff_upload_args, ff_load_reply>(
           transport, FF_XDR(ff_upload_args), FF_XDR(ff_load_reply), "upload",
-          [client](const ff_upload_args& a, ff_load_reply* r) { UploadFinish(a, client, r); });
+          [transport, client](const ff_upload_args& a, ff_load_reply* r) {
+            return StartUploadFinish(transport, a, client, r);
+          });
     case FF_INFO:
       return Serve<ff_terrain_args, ff_info_reply>(transport, FF_XDR(ff_terrain_args),
                                                    FF_XDR(ff_info_reply), "info", Info);
@@ -646,7 +657,8 @@ void FinishLoads() {
     g_load_tickets.erase(it);
     if (!HeldReplyOpen(ticket)) {
       SendHeldReply(ticket, FF_XDR(ff_load_reply), nullptr);  // releases the ticket
-      Log("load of '" + load->relative_path +
+      g_state->registry.DropLoad(load.get());
+      Log(std::string(load->upload ? "upload" : "load of") + " '" + load->relative_path +
           "' dropped: its connection closed before it finished");
       continue;
     }
@@ -655,9 +667,10 @@ void FinishLoads() {
     uint32_t handle = 0;
     const Status s = g_state->registry.FinishLoad(load.get(), &handle, &message);
     LogEvicted();
-    ReplyLoaded(s, handle, load->relative_path, message, &r);
+    ReplyLoaded(s, handle, load->relative_path, load->upload, message, &r);
     if (!SendHeldReply(ticket, FF_XDR(ff_load_reply), &r))
-      Log("error: load: reply could not be sent");
+      Log(std::string("error: ") + (load->upload ? "upload" : "load") +
+          ": reply could not be sent");
   }
 }
 
@@ -672,7 +685,7 @@ void ExpireIdle() {
 DispatchFn InstallDispatcher(ServiceState* state) {
   g_state = state;
   g_pool = std::make_unique<BatchPool>(state->batch_threads);
-  state->loads = std::make_unique<LoadQueue>(kMaxQueuedLoads);
+  state->loads = std::make_unique<LoadQueue>(kMaxQueuedLoads, kLoadWorkers);
   g_storage.points.resize(FF_MAX_BATCH);
   g_storage.steps.resize(FF_MAX_BATCH);
   g_storage.answers.resize(FF_MAX_BATCH);

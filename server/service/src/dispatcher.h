@@ -31,6 +31,8 @@ struct ServiceState {
 // [Units: loads] Server-side loads queued or running at once; one more is refused
 // (FF_LIMIT_EXCEEDED). Each connection has at most one: it waits for its reply.
 constexpr size_t kMaxQueuedLoads = 16;
+// Loads and upload grids built at once (each on a thread of its own).
+constexpr int kLoadWorkers = 2;
 
 using DispatchFn = void (*)(svc_req*, SVCXPRT*);
 

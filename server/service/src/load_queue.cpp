@@ -13,10 +13,11 @@ LoadQueue::State::~State() {
   if (wake_fd >= 0) close(wake_fd);
 }
 
-LoadQueue::LoadQueue(size_t capacity) : capacity_(capacity), state_(std::make_shared<State>()) {
+LoadQueue::LoadQueue(size_t capacity, int workers)
+    : capacity_(capacity), state_(std::make_shared<State>()) {
   state_->wake_fd = eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
   if (state_->wake_fd < 0) throw std::runtime_error("cannot create the load queue's eventfd");
-  worker_ = std::thread([state = state_] { Work(state); });
+  for (int i = 0; i < workers; ++i) workers_.emplace_back([state = state_] { Work(state); });
 }
 
 LoadQueue::~LoadQueue() {
@@ -26,7 +27,8 @@ LoadQueue::~LoadQueue() {
     state_->waiting.clear();
   }
   state_->wake_worker.notify_all();
-  if (worker_.joinable()) worker_.join();
+  for (std::thread& worker : workers_)
+    if (worker.joinable()) worker.join();
 }
 
 int LoadQueue::wake_fd() const { return state_->wake_fd; }
@@ -35,7 +37,8 @@ bool LoadQueue::Submit(std::unique_ptr<PendingLoad>* load) {
   State& s = *state_;
   {
     std::lock_guard<std::mutex> lock(s.mutex);
-    if (s.stop || s.waiting.size() + s.finished.size() + (s.running ? 1 : 0) >= capacity_)
+    if (s.stop ||
+        s.waiting.size() + s.finished.size() + static_cast<size_t>(s.running) >= capacity_)
       return false;
     s.waiting.push_back(std::move(*load));
   }
@@ -55,21 +58,16 @@ std::vector<std::unique_ptr<PendingLoad>> LoadQueue::TakeFinished() {
   return done;
 }
 
-size_t LoadQueue::InFlight() const {
-  State& s = *state_;
-  std::lock_guard<std::mutex> lock(s.mutex);
-  return s.waiting.size() + s.finished.size() + (s.running ? 1 : 0);
-}
-
 bool LoadQueue::Abandon() {
   State& s = *state_;
   std::lock_guard<std::mutex> lock(s.mutex);
   s.stop = true;
   s.waiting.clear();
   s.wake_worker.notify_all();
-  if (!s.running || !worker_.joinable()) return false;
-  worker_.detach();
-  return true;
+  const bool running = s.running > 0;
+  for (std::thread& worker : workers_)
+    if (worker.joinable()) worker.detach();  // the idle ones end at once
+  return running;
 }
 
 void LoadQueue::Work(const std::shared_ptr<State>& state) {
@@ -80,7 +78,7 @@ void LoadQueue::Work(const std::shared_ptr<State>& state) {
     if (s.stop) return;
     std::unique_ptr<PendingLoad> load = std::move(s.waiting.front());
     s.waiting.pop_front();
-    s.running = true;
+    ++s.running;
     lock.unlock();
     try {
       RunLoad(load.get());
@@ -92,7 +90,7 @@ void LoadQueue::Work(const std::shared_ptr<State>& state) {
       load->message = e.what();
     }
     lock.lock();
-    s.running = false;
+    --s.running;
     if (s.stop) return;  // abandoned, or the queue is going: nobody takes it back
     s.finished.push_back(std::move(load));
     const uint64_t one = 1;

@@ -1,10 +1,11 @@
-// LoadQueue: runs footfalld's server-side loads on a thread of their own (internal to
-// footfall::service).
+// LoadQueue: runs footfalld's server-side loads and upload grids on threads of their own
+// (internal to footfall::service).
 //
 // Reading and resampling a large mesh or height map takes seconds; done on the RPC thread, it
 // would hold up every other client meanwhile. The RPC thread submits a prepared load
 // (TerrainRegistry::PrepareLoad), polls wake_fd() beside its sockets, and takes the finished
-// loads back to add them to the registry and reply. Loads run one at a time, in order.
+// loads back to add them to the registry and reply. Loads start in the order submitted, as many
+// at once as there are workers.
 #pragma once
 
 #include <condition_variable>
@@ -21,24 +22,22 @@ namespace footfall {
 
 class LoadQueue {
  public:
-  // At most `capacity` loads waiting or running at once.
-  explicit LoadQueue(size_t capacity);
-  // Waits for the load running, if any (unless abandoned).
+  // At most `capacity` loads waiting or running at once, on `workers` threads.
+  LoadQueue(size_t capacity, int workers);
+  // Waits for the loads running, if any (unless abandoned).
   ~LoadQueue();
   LoadQueue(const LoadQueue&) = delete;
   LoadQueue& operator=(const LoadQueue&) = delete;
 
   // Queues a load; false (the load untouched) when `capacity` loads are already in the queue.
   bool Submit(std::unique_ptr<PendingLoad>* load);
-  // The loads finished since the last call, in the order submitted; clears wake_fd().
+  // The loads finished since the last call, in the order they finished; clears wake_fd().
   std::vector<std::unique_ptr<PendingLoad>> TakeFinished();
   // Readable (POLLIN) while finished loads wait to be taken.
   int wake_fd() const;
-  // Loads submitted and not yet taken back.
-  size_t InFlight() const;
-  // Drops the waiting loads and, if one is running, leaves it to finish on its own (it holds
-  // what it uses): the process must then end with _exit, as the loaders use static data.
-  // Returns whether one was running.
+  // Drops the waiting loads and leaves those running to finish on their own (they hold what
+  // they use): the process must then end with _exit, as the loaders use static data. Returns
+  // whether any was running.
   bool Abandon();
 
  private:
@@ -49,14 +48,14 @@ class LoadQueue {
     std::mutex mutex;
     std::condition_variable wake_worker;
     std::deque<std::unique_ptr<PendingLoad>> waiting, finished;
-    bool running = false;  // the worker holds a load
+    int running = 0;  // loads the workers hold
     bool stop = false;
   };
   static void Work(const std::shared_ptr<State>& state);
 
   size_t capacity_;
   std::shared_ptr<State> state_;
-  std::thread worker_;
+  std::vector<std::thread> workers_;
 };
 
 }  // namespace footfall

@@ -154,7 +154,7 @@ uint64_t TerrainRegistry::TotalSamples() const {
   uint64_t total = 0;
   for (const auto& t : terrains_) total += t.second->grid.size();
   for (const auto& u : uploads_) total += u.second.total;
-  return total;
+  return total + building_;
 }
 
 std::string TerrainRegistry::Budget() const {
@@ -251,21 +251,28 @@ Status TerrainRegistry::PrepareLoad(const std::string& relative_path, TerrainLoa
 }
 
 void RunLoad(PendingLoad* load) {
-  RawSamples samples;
+  RawSamples samples = std::move(load->samples);
   std::string error;
-  const std::string& pinned = load->pinned->path();
-  load->status = LoadTerrain(pinned, load->options, &samples, &error);
+  const std::string pinned = load->pinned ? load->pinned->path() : "";
+  load->status = Status::kOk;
+  if (load->pinned) load->status = LoadTerrain(pinned, load->options, &samples, &error);
   if (load->status == Status::kOk) load->status = ValidateAndNormalize(&samples, &error);
   if (load->status == Status::kOk)
     load->status = TerrainGrid::Build(samples, GridOptions{}, &load->grid, &error);
   // Report the path as the client gave it, not the server's layout.
-  const size_t at = error.find(pinned);
+  const size_t at = pinned.empty() ? std::string::npos : error.find(pinned);
   if (at != std::string::npos) error.replace(at, pinned.size(), load->relative_path);
   load->message = std::move(error);
   load->pinned.reset();  // read: the private name goes
 }
 
+void TerrainRegistry::DropLoad(PendingLoad* load) {
+  building_ -= std::min(building_, load->reserved);
+  load->reserved = 0;
+}
+
 Status TerrainRegistry::FinishLoad(PendingLoad* load, uint32_t* handle, std::string* message) {
+  DropLoad(load);  // counted as a terrain from here, if it is added
   if (load->status != Status::kOk) {
     *message = load->message;
     if (load->status == Status::kLimitExceeded && load->budget_binds)
@@ -333,6 +340,15 @@ Status TerrainRegistry::AppendUpload(uint32_t upload, uint64_t owner, const RawS
 
 Status TerrainRegistry::FinishUpload(uint32_t upload, uint64_t owner, uint32_t* handle,
                                      std::string* message) {
+  PendingLoad load;
+  const Status status = PrepareFinishUpload(upload, owner, &load, message);
+  if (status != Status::kOk) return status;
+  RunLoad(&load);
+  return FinishLoad(&load, handle, message);
+}
+
+Status TerrainRegistry::PrepareFinishUpload(uint32_t upload, uint64_t owner, PendingLoad* load,
+                                            std::string* message) {
   auto it = uploads_.find(upload);
   if (it == uploads_.end() || it->second.owner != owner) {
     *message = "no upload " + std::to_string(upload) + " in progress on this connection";
@@ -345,7 +361,13 @@ Status TerrainRegistry::FinishUpload(uint32_t upload, uint64_t owner, uint32_t* 
                std::to_string(u.total) + " samples";
     return Status::kInvalidArgument;
   }
-  return Add(u.name, std::move(u.samples), owner, handle, message);
+  load->relative_path = u.name;
+  load->owner = owner;
+  load->samples = std::move(u.samples);
+  load->reserved = u.total;
+  load->upload = true;
+  building_ += u.total;
+  return Status::kOk;
 }
 
 Status TerrainRegistry::Unload(uint32_t handle, uint64_t requester, std::string* message) {

@@ -41,11 +41,14 @@ struct LoadedTerrain {
 // thread: it touches no registry state), added by TerrainRegistry::FinishLoad (the registry's
 // thread again). A load can take seconds, so footfalld runs the middle stage off its RPC thread.
 struct PendingLoad {
-  std::string relative_path;   // as the client named it
-  TerrainLoadOptions options;  // max_samples lowered to what was left of the budget
-  bool budget_binds = false;   // the budget, not the client, set options.max_samples
-  uint64_t owner = 0;          // the client (connection) that asked
-  std::unique_ptr<PinnedFile> pinned;
+  std::string relative_path;           // as the client named it (an upload: its name)
+  TerrainLoadOptions options;          // max_samples lowered to what was left of the budget
+  bool budget_binds = false;           // the budget, not the client, set options.max_samples
+  uint64_t owner = 0;                  // the client (connection) that asked
+  std::unique_ptr<PinnedFile> pinned;  // a file to read; or, when null, `samples`
+  RawSamples samples;                  // an upload's samples (kept in the budget: `reserved`)
+  uint64_t reserved = 0;
+  bool upload = false;  // an upload's samples (FF_UPLOAD_FINISH), not a file
   // RunLoad's result: on kOk the built grid, else the error (naming relative_path).
   Status status = Status::kInternalError;
   std::string message;
@@ -97,6 +100,12 @@ class TerrainRegistry {
                       std::string* message);
   // Makes the upload a terrain belonging to `owner`.
   Status FinishUpload(uint32_t upload, uint64_t owner, uint32_t* handle, std::string* message);
+  // FinishUpload's first stage, for RunLoad and FinishLoad: the complete upload's samples move
+  // to *load, still counted in the budget until FinishLoad or DropLoad.
+  Status PrepareFinishUpload(uint32_t upload, uint64_t owner, PendingLoad* load,
+                             std::string* message);
+  // Forgets a prepared load that will not be finished (its client went away).
+  void DropLoad(PendingLoad* load);
   // Ends the uploads of a client that went away, releasing their reservations, and orphans its
   // terrains (they stay queryable until RegistryLimits::orphan_idle_s pass without a query).
   // Returns the handles orphaned.
@@ -138,7 +147,7 @@ class TerrainRegistry {
                  std::string* message);
   // kLimitExceeded, with a message, when `owner` holds its quota of terrains.
   Status CheckQuota(uint64_t owner, std::string* message) const;
-  // Samples held by loaded terrains plus those reserved by uploads in progress.
+  // Samples held by loaded terrains plus those reserved by uploads in progress or being built.
   uint64_t TotalSamples() const;
   // "the sample budget (--max-samples N, M in use)", for messages.
   std::string Budget() const;
@@ -157,6 +166,7 @@ class TerrainRegistry {
   std::map<uint32_t, std::unique_ptr<LoadedTerrain>> terrains_;
   std::vector<uint32_t> evicted_;  // orphans freed to make room, until TakeEvicted
   std::map<uint32_t, Upload> uploads_;
+  uint64_t building_ = 0;  // samples of finished uploads whose grids are being built
   std::deque<RecentQuery> recent_;
   uint64_t sequence_ = 0;
 };
