@@ -233,6 +233,24 @@ class GenerateTest(unittest.TestCase):
             for key in track["keys"]:
                 self.assertTrue(all(math.isfinite(v) for v in key["position"]))
 
+    def test_generate_crowd_spacing_matches_cli(self):
+        character = os.path.join(CHARACTERS, "biped.json")
+        with ff.Session.rpc("127.0.0.1", self.server.port) as s:
+            t = s.load_file(HILLS)
+            request = {"character_file": character, "start": [20.0, 0.0, 12.0], "steps": 3,
+                       "crowd": 4, "crowd_spacing": 1.5}
+            walk = s.generate(t, request)
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "walk.json")
+            subprocess.run([self.cli, "generate", "--terrain", HILLS, "--character", character,
+                            "--start", "20,0,12", "--steps", "3", "--crowd", "4",
+                            "--crowd-spacing", "1.5", "--out", out], check=True)
+            with open(out) as f:
+                expected = json.load(f)
+        self.assertEqual(walk, expected)
+        bodies = [tr for tr in walk["tracks"] if tr["kind"] == "body"]
+        self.assertEqual(len(bodies), 4)
+
     def test_generate_bad_request_raises(self):
         with ff.Session.rpc("127.0.0.1", self.server.port) as s:
             t = s.load_file(HILLS)

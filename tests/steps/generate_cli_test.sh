@@ -110,6 +110,11 @@ if [ -f "$dem" ]; then
   check "dem --separation 1: stopped early (exit 2)" [ $? -eq 2 ]
   check "dem --separation 1: not resampled for the character" bash -c "! grep -q 'resampled for' '$work/dem-own.err'"
   check "dem --separation 1: advice to resample at a quarter step" grep -q "too far for this character: resample it at a separation of 0.03" "$work/dem-own.err"
+  # Where the terrain simply ends (a goal far off it), no advice to resample.
+  "$footfall" generate --terrain "$hills" --character "$chars/biped.json" --start 8,0,8 \
+    --path "8,0,12 100,0,100" --out "$work/off-edge.json" 2> "$work/off-edge.err"
+  check "terrain ends: the stop says so" grep -q "the terrain ends before it" "$work/off-edge.err"
+  check "terrain ends: no advice to resample" bash -c "! grep -q resample '$work/off-edge.err'"
   # A --start is snapped as given, as on point files: one beyond the queries' reach is refused.
   err=$("$footfall" generate --terrain "$dem" --character "$chars/biped.json" --start 1e20,0,0 --out "$work/x.json" 2>&1)
   check "dem far start: exit 1" [ $? -eq 1 ]
@@ -156,6 +161,8 @@ bad zero-heading "heading must be a non-zero finite vector" --terrain "$hills" -
 bad empty-path "--path: expected at least one waypoint X,Y,Z" --terrain "$hills" --character "$chars/biped.json" --path " " --out "$work/x.json"
 bad empty-heading "--heading: expected DX,DY,DZ" --terrain "$hills" --character "$chars/biped.json" --heading "" --out "$work/x.json"
 bad heading-up "the heading (0.0000, 1.0000, 0.0000) is along the up (0.0000, 1.0000, 0.0000) where the character starts" --terrain "$hills" --character "$chars/biped.json" --heading 0,1,0 --out "$work/x.json"
+bad gltf-negative-frame "--out $work/neg.gltf: glTF animation times must be >= 0, and --start-frame is -100" --terrain "$hills" --character "$chars/biped.json" --start-frame -100 --out "$work/neg.json" --out "$work/neg.gltf"
+check "gltf-negative-frame: nothing written" [ ! -e "$work/neg.json" ]
 bad far-start "the start is too far from the terrain to snap" --terrain "$hills" --character "$chars/biped.json" --start 1e20,0,0 --out "$work/x.json"
 # Numbers: finite, within readable bounds, one check for every float flag.
 bad fps-tiny "--fps: '1e-300' is not a finite number from 0.001 to 1e+06" --terrain "$hills" --character "$chars/biped.json" --fps 1e-300 --out "$work/x.json"

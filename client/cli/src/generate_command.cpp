@@ -162,6 +162,14 @@ int RunGenerate(const GenerateFlags& flags) {
           "--out " + out + ": unsupported output extension (expected .json, .gltf, .glb or .mel)";
       goto bad_flag;
     }
+    // Refused before anything is generated or written (glTF times are >= 0).
+    if ((ext == "gltf" || ext == "glb") && flags.start_frame < 0) {
+      std::ostringstream m;
+      m << "--out " << out << ": glTF animation times must be >= 0, and --start-frame is "
+        << flags.start_frame << "; start at frame 0 or later, or write .json or .mel only";
+      error = m.str();
+      goto bad_flag;
+    }
     // Never write over what the walk is made from.
     for (const std::string* input : {&flags.character, &flags.terrain.terrain}) {
       std::error_code ec;

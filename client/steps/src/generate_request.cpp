@@ -46,8 +46,9 @@ Status ParseGenerateRequest(const std::string& text, Character* character, Gener
     return Status::kParseError;
   }
   static const std::set<std::string> kKnown = {
-      "character", "character_file", "start", "heading", "path",
-      "steps",     "start_frame",    "up",    "fps",     "crowd"};
+      "character", "character_file", "start",        "heading",
+      "path",      "steps",          "start_frame",  "up",
+      "fps",       "crowd",          "crowd_spacing"};
   for (auto it = j.begin(); it != j.end(); ++it) {
     if (!kKnown.count(it.key())) {
       *error = "request: unknown field '" + it.key() + "'";
@@ -82,6 +83,13 @@ Status ParseGenerateRequest(const std::string& text, Character* character, Gener
   if (ok && j.contains("start_frame"))
     ok = ReadNumber(j["start_frame"], "start_frame", &o.start_frame, error);
   if (ok && j.contains("fps")) ok = ReadNumber(j["fps"], "fps", &o.fps, error);
+  if (ok && j.contains("crowd_spacing")) {
+    ok = ReadNumber(j["crowd_spacing"], "crowd_spacing", &o.crowd_spacing, error);
+    if (ok && !(o.crowd_spacing >= 0)) {
+      *error = "request: 'crowd_spacing': expected a number >= 0";
+      ok = false;
+    }
+  }
   for (const char* key : {"steps", "crowd"}) {
     if (!ok || !j.contains(key)) continue;
     if (!j[key].is_number_integer()) {

@@ -842,9 +842,11 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
     const bool beyond = BoxDistance(mv.ideal, bounds_min_, bounds_max_) > radius;
     why << "no foothold within " << radius << " of " << Point(mv.ideal)
         << (beyond ? " (the terrain ends before it)" : " (a gap or a cliff)");
-    // Samples spread wider than half that radius leave gaps everywhere: say so.
+    // Samples spread wider than half that radius leave gaps everywhere: say so, unless the
+    // terrain simply ends there or resampling would not bring them closer.
     const double spacing = 0.5 * gap_;
-    if (spacing > 0.5 * kFootholdTolerance * c_.step_length) {
+    if (!beyond && spacing > 0.5 * kFootholdTolerance * c_.step_length &&
+        kSeparationPerStep * c_.step_length < 0.8 * spacing) {
       why << "; the terrain's samples lie about " << spacing
           << " apart, too far for this character: resample it at a separation of "
           << kSeparationPerStep * c_.step_length;
