@@ -149,20 +149,39 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
   INFO("arc points not clear of the terrain: " << below << " of " << arc.size() << ", worst by "
                                                << worst);
   CHECK(below == 0);
-  // The body follows the feet.
+  // The body follows the feet, clear of the terrain: body_height along its up above the feet's
+  // centroid, or up to body_height more where the terrain comes nearer than half its
+  // body_height. It may lie behind its nearest sample's plane only where rising would not help
+  // (that plane along its up: beside a wall's face or over an edge) or may not (raised as far as
+  // the feet's reach or the raise's bound allow).
   const Vec3 world_up = Normalize(o.up);
+  std::vector<Foothold> body_snap(body.keys.size());
+  std::vector<Vec3> body_points;
+  for (const WalkKey& b : body.keys) body_points.push_back(b.position);
+  REQUIRE(t.session->Snap(t.handle, body_points.data(), body_points.size(), body_snap.data()) ==
+          Status::kOk);
   for (size_t i = 0; i < body.keys.size(); ++i) {
     const WalkKey& b = body.keys[i];
     Vec3 centroid;
+    double farthest = 0;
     for (size_t f = 0; f < c.feet.size(); ++f) {
       const Vec3 p = FootAt(*tracks[f], b.frame);
       centroid += p;
-      CHECK(Distance(p, b.position) <= c.reach + 1e-9);
+      farthest = std::max(farthest, Distance(p, b.position));
     }
+    CHECK(farthest <= c.reach + 1e-9);
     centroid = centroid / static_cast<double>(c.feet.size());
     const Vec3 up = c.align_to_normal ? QuatAxisY(body.rotations[i]) : world_up;
-    const Vec3 expected = centroid + up * c.body_height;
-    CHECK(Distance(expected, b.position) < 1e-6);
+    const double raised = Dot(b.position - centroid, up) - c.body_height;
+    INFO("body key " << i << " at frame " << b.frame);
+    CHECK(raised >= -1e-6);
+    CHECK(raised <= c.body_height + 1e-6);
+    CHECK(Distance(centroid + up * (c.body_height + raised), b.position) < 1e-6);
+    const Vec3 v = b.position - body_snap[i].point;
+    const bool behind = Dot(v, body_snap[i].normal) < -1e-9;
+    const bool across = Dot(up, body_snap[i].normal) < 0.25;
+    const bool bound = farthest >= c.reach - 1e-6 || raised >= c.body_height - 1e-6;
+    CHECK((!behind || across || bound));
   }
   // Gait order: step k moves exactly group k % G, at frames start_frame + k * frames_per_step.
   const size_t steps = body.keys.size() - 1;

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <climits>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <sstream>
@@ -34,6 +35,11 @@ constexpr int kMaxRaises = 8;         // swing arc raises before giving up
 constexpr double kRaise = 0.5;        // raise per round, in step heights
 constexpr double kSlide = 0.25;       // slide per round toward a blocked half's end (of the way)
 constexpr double kAlikeCos = 0.7071;  // footholds whose normals are within 45 deg face alike
+// A body key keeps at least this fraction of body_height from the terrain (measured as arcs
+// are, from its nearest sample); nearer, it is raised along its up, in up to kBodyRounds rounds
+// of at most body_height each, and never beyond reach of a foot.
+constexpr double kBodyClearance = 0.5;
+constexpr int kBodyRounds = 3;
 // Points checked along the start-mid-end arc. Each is snapped: its clearance is measured along
 // the normal of its nearest sample, and a Snap answer elsewhere proves only that no sample lies
 // closer to that point than the answer, which bounds neither which sample is nearest here nor
@@ -218,8 +224,15 @@ class Generator {
   Vec3 BodyUp(const Vec3& feet_up, const std::vector<Vec3>& feet) const;
   void KeyFoot(const Agent& a, int foot, double frame, KeyPhase phase, const Vec3& p,
                const Vec3& n);
-  void KeyBody(const Agent& a, double frame);
-  // Keys a's feet and body where they stand, at the start frame.
+  // Keys a's body at `frame`, `raise` above its place along its up.
+  void KeyBody(const Agent& a, double frame, double raise);
+  // Keys the bodies in body_due_ (agent, frame), each raised where the terrain comes nearer
+  // than kBodyClearance (a body over a block's edge as the feet wrap around it, a ridge between
+  // the feet); their points are snapped in one batch per round. Empties body_due_.
+  Status KeyBodies(std::string* error);
+  // The most `a`'s body may rise along its up with every foot still within reach.
+  double MaxBodyRaise(const Agent& a) const;
+  // Keys a's feet where they stand at the start frame, and asks for its body (body_due_).
   void KeyStart(const Agent& a);
   void Stop(Agent& a, int step, const std::string& why);
   // A failed batch call: the session's status, and its message prefixed with `what`.
@@ -274,6 +287,12 @@ class Generator {
   std::vector<Vec3> points_, arc_points_;  // setup and locators; arc check points
   std::vector<StepQuery> queries_;
   std::vector<Foothold> answers_, next_answers_, arc_answers_;
+  // Bodies to key (KeyBodies): (agent, frame); per walking character the frame its body is due
+  // at this step (NaN: none).
+  std::vector<std::pair<size_t, double>> body_due_;
+  std::vector<double> body_frame_, body_raise_;
+  std::vector<size_t> body_pending_, body_still_;
+  std::vector<Vec3> body_points_;
 };
 
 Vec3 Generator::AveragedUp(const Vec3& previous, const std::vector<Vec3>& normals) const {
@@ -304,10 +323,10 @@ void Generator::KeyFoot(const Agent& a, int foot, double frame, KeyPhase phase, 
   keys.push_back(key);
 }
 
-void Generator::KeyBody(const Agent& a, double frame) {
+void Generator::KeyBody(const Agent& a, double frame, double raise) {
   WalkKey key;
   key.frame = frame;
-  key.position = a.ground + a.body_up * c_.body_height;
+  key.position = a.ground + a.body_up * (c_.body_height + raise);
   key.normal = a.body_up;
   WalkTrack& track = walk_.tracks[a.first_track + c_.feet.size()];
   track.keys.push_back(key);
@@ -435,6 +454,8 @@ Status Generator::WalkPass(size_t begin, size_t end, Progress* progress, std::st
   pass_begin_ = begin, pass_end_ = end;
   // The pass's characters' first keys: each thread first writes the keys' memory it fills.
   for (size_t i = begin; i < end; ++i) KeyStart(agents_[i]);
+  Status started = KeyBodies(error);
+  if (started != Status::kOk) return started;
   int k = 0;
   for (; k < steps_; ++k) {
     bool any = false;
@@ -587,7 +608,62 @@ void Generator::KeyStart(const Agent& a) {
   // 4 (end). Every foot and the body keyed planted at the start frame.
   for (size_t f = 0; f < c_.feet.size(); ++f)
     KeyFoot(a, static_cast<int>(f), o_.start_frame, KeyPhase::kEnd, a.foot[f], a.foot_normal[f]);
-  KeyBody(a, o_.start_frame);
+  body_due_.emplace_back(static_cast<size_t>(&a - agents_.data()), o_.start_frame);
+}
+
+double Generator::MaxBodyRaise(const Agent& a) const {
+  // |ground + up (h + r) - foot| <= reach for every foot: r below the larger root of a
+  // quadratic in r, per foot.
+  double most = c_.body_height;
+  for (const Vec3& foot : a.foot) {
+    const Vec3 d = a.ground + a.body_up * c_.body_height - foot;
+    const double b = Dot(d, a.body_up), rest = Length2(d) - c_.reach * c_.reach;
+    const double disc = b * b - rest;
+    most = std::min(most, disc >= 0 ? -b + std::sqrt(disc) : 0.0);
+  }
+  return std::max(0.0, most);
+}
+
+Status Generator::KeyBodies(std::string* error) {
+  // 11 (end). The body's clearance, as arcs measure theirs.
+  const size_t n = body_due_.size();
+  body_raise_.assign(n, 0);
+  body_pending_.resize(n);
+  for (size_t i = 0; i < n; ++i) body_pending_[i] = i;
+  const double need = kBodyClearance * c_.body_height;
+  for (int round = 0; round < kBodyRounds && !body_pending_.empty(); ++round) {
+    body_points_.resize(body_pending_.size());
+    for (size_t j = 0; j < body_pending_.size(); ++j) {
+      const size_t i = body_pending_[j];
+      const Agent& a = agents_[body_due_[i].first];
+      body_points_[j] = a.ground + a.body_up * (c_.body_height + body_raise_[i]);
+    }
+    answers_.resize(body_points_.size());
+    const Status s =
+        Check(session_.Snap(terrain_, body_points_.data(), body_points_.size(), answers_.data()),
+              "snap bodies", error);
+    if (s != Status::kOk) return s;
+    body_still_.clear();
+    for (size_t j = 0; j < body_pending_.size(); ++j) {
+      const size_t i = body_pending_[j];
+      const Foothold& h = answers_[j];
+      if (h.status != Status::kOk || Clearance(body_points_[j], h, gap_) >= need) continue;
+      const Agent& a = agents_[body_due_[i].first];
+      const double along = Dot(a.body_up, h.normal);
+      if (along < 0.25) continue;  // rising would barely leave that face
+      const double height = Dot(body_points_[j] - h.point, h.normal);
+      const double raise = std::min(
+          {body_raise_[i] + std::min((need - height) / along, c_.body_height), MaxBodyRaise(a)});
+      if (raise <= body_raise_[i]) continue;
+      body_raise_[i] = raise;
+      body_still_.push_back(i);
+    }
+    body_pending_.swap(body_still_);
+  }
+  for (size_t i = 0; i < n; ++i)
+    KeyBody(agents_[body_due_[i].first], body_due_[i].second, body_raise_[i]);
+  body_due_.clear();
+  return Status::kOk;
 }
 
 Status Generator::FindStart(const Vec3& start, bool may_move, Foothold* first, std::string* error) {
@@ -1065,7 +1141,7 @@ void Generator::Finish(size_t w, int k) {
   for (size_t i = m; i < e && held; ++i) held = moves_[i].done || moves_[i].held_by_planted;
   if (held && a.waits + 1 < static_cast<int>(c_.gait.size())) {
     ++a.waits;
-    KeyBody(a, f1);
+    body_frame_[w] = f1;
     return;
   }
   if (failed) {
@@ -1089,7 +1165,7 @@ void Generator::Finish(size_t w, int k) {
   a.up = FeetUp(a.up, a.foot, a.foot_normal);
   a.body_up = BodyUp(a.up, a.foot);
   a.forward = TangentForward(a.forward, a.forward, old_up, a.up);
-  KeyBody(a, f1);
+  body_frame_[w] = f1;  // keyed by KeyBodies at the end of the step
 }
 
 Status Generator::Step(int k, std::string* error) {
@@ -1134,12 +1210,15 @@ Status Generator::Step(int k, std::string* error) {
   // through both again.
   walkers_.resize(walking_.size());
   for (size_t w = 0; w < walking_.size(); ++w) walkers_[w] = w;
+  body_frame_.assign(walking_.size(), std::numeric_limits<double>::quiet_NaN());
   while (!walkers_.empty()) {
     Status st = QueryFootholds(error);
     if (st == Status::kOk) st = ClearArcs(k, error);
     if (st != Status::kOk) return st;
   }
-  return Status::kOk;
+  for (size_t w = 0; w < walking_.size(); ++w)
+    if (!std::isnan(body_frame_[w])) body_due_.emplace_back(walking_[w], body_frame_[w]);
+  return KeyBodies(error);
 }
 
 }  // namespace
