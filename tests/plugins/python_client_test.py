@@ -206,26 +206,31 @@ class GenerateTest(unittest.TestCase):
         cls.cli = os.environ.get("FOOTFALL_CLI") or os.path.join(REPO, "build", "client", "cli",
                                                                    "footfall")
         cls.server = ff.LocalServer().start()
+        cls.character = os.path.join(CHARACTERS, "biped.json")  # hills: 0.25 m samples
 
     @classmethod
     def tearDownClass(cls):
         cls.server.stop()
 
-    def test_generate_matches_cli(self):
-        character = os.path.join(CHARACTERS, "biped.json")  # hills: 0.25 m samples
-        self.assertTrue(os.path.isfile(character), character)
+    def _generate_both(self, request, flags):
+        """The walk of `request` through ffc_generate over RPC, and `footfall generate` with
+        `flags` on the same terrain and character."""
         with ff.Session.rpc("127.0.0.1", self.server.port) as s:
             t = s.load_file(HILLS)
-            request = {"character_file": character, "start": [20.0, 0.0, 12.0],
-                       "heading": [0.0, 0.0, 1.0], "steps": 6, "start_frame": 1}
-            walk = s.generate(t, request)
+            walk = s.generate(t, dict(request, character_file=self.character))
         with tempfile.TemporaryDirectory() as tmp:
             out = os.path.join(tmp, "walk.json")
-            subprocess.run([self.cli, "generate", "--terrain", HILLS, "--character", character,
-                            "--start", "20,0,12", "--heading", "0,0,1", "--steps", "6",
-                            "--start-frame", "1", "--out", out], check=True)
+            subprocess.run([self.cli, "generate", "--terrain", HILLS, "--character",
+                            self.character] + flags + ["--out", out], check=True)
             with open(out) as f:
-                expected = json.load(f)
+                return walk, json.load(f)
+
+    def test_generate_matches_cli(self):
+        self.assertTrue(os.path.isfile(self.character), self.character)
+        walk, expected = self._generate_both(
+            {"start": [20.0, 0.0, 12.0], "heading": [0.0, 0.0, 1.0], "steps": 6,
+             "start_frame": 1},
+            ["--start", "20,0,12", "--heading", "0,0,1", "--steps", "6", "--start-frame", "1"])
         self.assertEqual(walk, expected)
         feet = [tr for tr in walk["tracks"] if tr["kind"] == "foot"]
         self.assertEqual(len(feet), 2)
@@ -234,19 +239,9 @@ class GenerateTest(unittest.TestCase):
                 self.assertTrue(all(math.isfinite(v) for v in key["position"]))
 
     def test_generate_crowd_spacing_matches_cli(self):
-        character = os.path.join(CHARACTERS, "biped.json")
-        with ff.Session.rpc("127.0.0.1", self.server.port) as s:
-            t = s.load_file(HILLS)
-            request = {"character_file": character, "start": [20.0, 0.0, 12.0], "steps": 3,
-                       "crowd": 4, "crowd_spacing": 1.5}
-            walk = s.generate(t, request)
-        with tempfile.TemporaryDirectory() as tmp:
-            out = os.path.join(tmp, "walk.json")
-            subprocess.run([self.cli, "generate", "--terrain", HILLS, "--character", character,
-                            "--start", "20,0,12", "--steps", "3", "--crowd", "4",
-                            "--crowd-spacing", "1.5", "--out", out], check=True)
-            with open(out) as f:
-                expected = json.load(f)
+        walk, expected = self._generate_both(
+            {"start": [20.0, 0.0, 12.0], "steps": 3, "crowd": 4, "crowd_spacing": 1.5},
+            ["--start", "20,0,12", "--steps", "3", "--crowd", "4", "--crowd-spacing", "1.5"])
         self.assertEqual(walk, expected)
         bodies = [tr for tr in walk["tracks"] if tr["kind"] == "body"]
         self.assertEqual(len(bodies), 4)
