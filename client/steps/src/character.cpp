@@ -163,8 +163,12 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
         const std::string where = "'feet'[" + std::to_string(i) + "]";
         FootSpec spec;
         if (!f.is_object() || !f.contains("name") || !f["name"].is_string() ||
-            f["name"].get<std::string>().empty() || !f.contains("rest")) {
+            !f.contains("rest")) {
           r.Fail(Status::kParseError, where + ": expected {\"name\": STRING, \"rest\": [x, y, z]}");
+          break;
+        }
+        if (f["name"].get<std::string>().empty()) {
+          r.Fail(Status::kParseError, where + ".name: expected a non-empty name");
           break;
         }
         if (detail::FindUnknownKey(f, kKnownFoot, &unknown)) {
