@@ -295,6 +295,31 @@ TEST_CASE("live: a server that never sees a query ends the wait with a message",
   CHECK_THAT(r.err, Catch::Contains("received 0 of 1 queries"));
 }
 
+TEST_CASE("a walk drawn on a terrain it was not made on is pointed out", "[viewer][walk]") {
+  const std::string dir = test::TempDir();
+  test::WriteFile(dir + "/walk.json", WalkJson());
+  // A floor with a sample under every planted key of WalkJson(), and the same 100 units away.
+  std::string here, there;
+  for (int k = 0; k <= 12; ++k) {
+    for (int i = 0; i <= 24; ++i) {
+      here += std::to_string(i * 0.25) + " 0 " + std::to_string(k * 0.25) + " 0 1 0\n";
+      there += std::to_string(100 + i * 0.25) + " 0 " + std::to_string(k * 0.25) + " 0 1 0\n";
+    }
+  }
+  test::WriteFile(dir + "/here.pts", here);
+  test::WriteFile(dir + "/there.pts", there);
+  const std::string shot = dir + "/x.png";
+  RunResult r =
+      View({"--terrain", dir + "/here.pts", "--walk", dir + "/walk.json", "--screenshot", shot});
+  CHECK(r.exit_code == 0);
+  CHECK_THAT(r.err, !Catch::Contains("warning"));
+  r = View({"--terrain", dir + "/there.pts", "--walk", dir + "/walk.json", "--screenshot", shot});
+  CHECK(r.exit_code == 0);  // still drawn
+  CHECK_THAT(r.err, Catch::Contains("warning: 4 of 4 planted foot keys of " + dir +
+                                    "/walk.json lie more than a grid cell"));
+  CHECK_THAT(r.err, Catch::Contains("the walk was made on another terrain?"));
+}
+
 TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][errors]") {
   const std::string dir = test::TempDir();
   const std::string shot = dir + "/x.png";

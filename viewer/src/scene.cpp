@@ -118,6 +118,22 @@ Status Scene::LoadWalk(const std::string& path, std::string* error) {
   return Status::kOk;
 }
 
+size_t Scene::PlantedKeysOffTerrain(double limit, size_t* planted) const {
+  *planted = 0;
+  if (!has_terrain() || !has_walk()) return 0;
+  size_t off = 0;
+  for (const WalkTrack& t : walk_.tracks) {
+    if (t.kind != TrackKind::kFoot) continue;
+    for (const WalkKey& k : t.keys) {
+      if (k.phase != KeyPhase::kStart && k.phase != KeyPhase::kEnd) continue;
+      ++*planted;
+      const Foothold h = grid_.Snap(k.position);
+      off += h.status != Status::kOk || Distance(h.point, k.position) > limit;
+    }
+  }
+  return off;
+}
+
 void Scene::AddLive(const std::vector<RecentQuery>& queries) {
   for (const RecentQuery& q : queries) {
     live_.push_back(FromRecent(q, has_terrain() ? &grid_ : nullptr));

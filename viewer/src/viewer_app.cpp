@@ -408,6 +408,19 @@ int RunViewer(const ViewerOptions& options) {
   }
   if (!options.walk.empty() && app.scene.LoadWalk(options.walk, &error) != Status::kOk)
     return Fail(error);
+  {
+    // A walk drawn on a terrain it was not made on floats or sinks: say so. (A foot key of a
+    // walk made on this terrain is a sample; a grid cell is some 3.5 sample spacings.)
+    size_t planted = 0;
+    const size_t off =
+        app.scene.PlantedKeysOffTerrain(app.scene.grid().stats().cell_size, &planted);
+    if (off > 0 && 10 * off > planted) {
+      std::cerr << "footfall-view: warning: " << off << " of " << planted
+                << " planted foot keys of " << options.walk << " lie more than a grid cell ("
+                << app.scene.grid().stats().cell_size << ") from every sample of "
+                << options.terrain << ": the walk was made on another terrain?\n";
+    }
+  }
   app.scene.Finalize();
   app.view.color = options.height_colors ? ColorMode::kHeight : ColorMode::kNormal;
   app.view.show_cells = options.show_cells;

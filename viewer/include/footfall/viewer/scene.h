@@ -55,6 +55,10 @@ class Scene {
   // Reads a footfall-walk JSON file (footfall/steps/walk_json.h); body rotations are
   // normalised for drawing.
   Status LoadWalk(const std::string& path, std::string* error);
+  // How many of the walk's planted foot keys (start and end) lie farther than `limit` from
+  // every terrain sample, of *planted: a walk made on another terrain shows as many. 0 without
+  // a terrain or a walk.
+  size_t PlantedKeysOffTerrain(double limit, size_t* planted) const;
   // Adds queries received from footfalld, traced on the local grid when there is one. Keeps
   // the newest `kMaxLive`.
   void AddLive(const std::vector<RecentQuery>& queries);
