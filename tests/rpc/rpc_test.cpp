@@ -786,6 +786,35 @@ TEST_CASE("A server-side load does not hold up the other clients", "[rpc]") {
     CHECK(WEXITSTATUS(status) == 0);
     CHECK_THAT(server.Log(), Catch::Contains("a server-side load was in progress: abandoned"));
   }
+  SECTION("at most 16 loads queue; one more is refused at once") {
+    // Sends a slow load on each of 16 connections without waiting for the replies (two run,
+    // fourteen wait), then a seventeenth.
+    std::vector<CLIENT*> clients;
+    ff_load_options_args args = DefaultLoadOptionsArgs("corner.obj");
+    args.separation = 0.004;
+    auto send_load = [&](CLIENT* c, ff_load_reply* reply, timeval wait) {
+      return clnt_call(c, FF_LOAD_OPTIONS, reinterpret_cast<xdrproc_t>(xdr_ff_load_options_args),
+                       reinterpret_cast<char*>(&args),
+                       reinterpret_cast<xdrproc_t>(xdr_ff_load_reply),
+                       reinterpret_cast<char*>(reply), wait);
+    };
+    for (int i = 0; i < 16; ++i) {
+      clients.push_back(RawClient(server.port()));
+      ff_load_reply reply{};
+      CHECK(send_load(clients.back(), &reply, timeval{0, 20000}) == RPC_TIMEDOUT);
+    }
+    CLIENT* late = RawClient(server.port());
+    ff_load_reply reply{};
+    REQUIRE(send_load(late, &reply, timeval{5, 0}) == RPC_SUCCESS);
+    CHECK(reply.status == FF_LIMIT_EXCEEDED);
+    CHECK_THAT(std::string(reply.message),
+               Catch::Contains("16 loads and uploads are being built, the most footfalld queues"));
+    xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&reply));
+    CHECK(snap_ok());  // and the others are still served
+    clnt_destroy(late);
+    for (CLIENT* c : clients) clnt_destroy(c);
+    CHECK(WIFEXITED(server.Terminate()));
+  }
 }
 
 TEST_CASE("footfalld holds --max-samples over parallel uploads and mesh loads", "[rpc]") {
