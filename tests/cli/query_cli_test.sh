@@ -88,5 +88,15 @@ for flag in "--orphan-timeout nan" "--unread-timeout inf" "--unread-timeout 0"; 
   check "footfalld $flag: exit non-zero" [ $? -ne 0 ]
   check "footfalld $flag: message" grep -qE "is not a number of seconds (from|above) 0 to 1e\+09" <<< "$err"
 done
+# A budget is a whole number of samples ("-5" read as a huge budget).
+for value in -5 99999999999999999999999 1.5; do
+  err=$(timeout 5 "$footfalld" --listen 127.0.0.1:0 --no-rpcbind --max-samples "$value" 2>&1)
+  check "footfalld --max-samples $value: exit non-zero" [ $? -ne 0 ]
+  check "footfalld --max-samples $value: message" grep -qF "'$value' is not a whole number of samples from 0 to 1e12" <<< "$err"
+done
+# A port file it cannot write is an error (a supervisor waiting for it would wait forever).
+err=$(timeout 5 "$footfalld" --listen 127.0.0.1:0 --no-rpcbind --port-file "$work/no/such/dir/port" 2>&1)
+check "footfalld unwritable --port-file: exit 1" [ $? -eq 1 ]
+check "footfalld unwritable --port-file: message" grep -qF -- "--port-file $work/no/such/dir/port: cannot write the port there" <<< "$err"
 
 finish

@@ -817,6 +817,33 @@ TEST_CASE("A server-side load does not hold up the other clients", "[rpc]") {
   }
 }
 
+TEST_CASE("SIGTERM during a load leaves no private file name behind", "[rpc]") {
+  const TempRoot temp, scratch;
+  std::ofstream(temp.path + "/corner.obj") << kCornerObj;
+  // footfalld pins each file it loads under a private name in $TMPDIR (PinnedFile): its
+  // destructor, which removes the name, never runs when a load is abandoned at SIGTERM.
+  const char* before = getenv("TMPDIR");
+  const std::string saved = before ? before : "";
+  setenv("TMPDIR", scratch.path.c_str(), 1);
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", temp.path});
+  if (before)
+    setenv("TMPDIR", saved.c_str(), 1);
+  else
+    unsetenv("TMPDIR");
+  std::thread a([&] {
+    auto session = Connect(server.port(), 60);
+    TerrainHandle big = 0;
+    session->LoadServerFile("corner.obj", SlowLoad(), &big);
+  });
+  for (int i = 0;
+       i < 100 && std::system(("ls '" + scratch.path + "' | grep -q footfalld-").c_str()); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the load has pinned its file
+  CHECK(WIFEXITED(server.Terminate()));
+  a.join();
+  CHECK_THAT(server.Log(), Catch::Contains("a server-side load was in progress: abandoned"));
+  CHECK(std::system(("ls -A '" + scratch.path + "' | grep -q .").c_str()) != 0);  // empty
+}
+
 TEST_CASE("footfalld holds --max-samples over parallel uploads and mesh loads", "[rpc]") {
   const TempRoot temp;
   const std::string& root = temp.path;
@@ -1361,14 +1388,31 @@ TEST_CASE("footfalld registers with rpcbind and answers rpcinfo", "[rpc][rpcbind
   }
   ServerProcess server(0, {});
   CHECK(server.Log().find("registered with rpcbind") != std::string::npos);
-  const std::string command = "rpcinfo -t 127.0.0.1 " + std::to_string(FOOTFALL_PROG) + " 1 2>&1";
-  FILE* p = popen(command.c_str(), "r");
-  REQUIRE(p);
-  char buffer[512] = {0};
-  const size_t n = fread(buffer, 1, sizeof buffer - 1, p);
-  const int rc = pclose(p);
-  const std::string out(buffer, n);
-  INFO(out);
-  CHECK(rc == 0);
-  CHECK(out.find("ready and waiting") != std::string::npos);
+  // Whether rpcinfo reaches footfall's program through rpcbind.
+  auto rpcinfo_answers = [] {
+    const std::string command = "rpcinfo -t 127.0.0.1 " + std::to_string(FOOTFALL_PROG) + " 1 2>&1";
+    FILE* p = popen(command.c_str(), "r");
+    REQUIRE(p);
+    char buffer[512] = {0};
+    const size_t n = fread(buffer, 1, sizeof buffer - 1, p);
+    const int rc = pclose(p);
+    const std::string out(buffer, n);
+    INFO(out);
+    return rc == 0 && out.find("ready and waiting") != std::string::npos;
+  };
+  CHECK(rpcinfo_answers());
+  {
+    // A second server leaves the first one's registration alone (taking it over left the first
+    // unregistered once the second stopped).
+    ServerProcess second(0, {});
+    CHECK_THAT(second.Log(), Catch::Contains("rpcbind already has the footfalld on port " +
+                                             std::to_string(server.port())));
+  }
+  CHECK(rpcinfo_answers());
+  // SIGHUP (a closed terminal) stops it cleanly, unregistered (it died registered).
+  REQUIRE(kill(server.pid(), SIGHUP) == 0);
+  for (int i = 0; i < 100 && server.Log().find("footfalld: stopped") == std::string::npos; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  CHECK_THAT(server.Log(), Catch::Contains("footfalld: stopped"));
+  CHECK_FALSE(rpcinfo_answers());
 }

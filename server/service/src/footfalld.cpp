@@ -12,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "footfall/service/pinned_file.h"
 #include "footfall/service/rpc_server.h"
 
 namespace {
@@ -52,6 +53,18 @@ CLI::Validator Seconds(bool zero_ok) {
       "SECONDS");
 }
 
+// --max-samples: a whole number of samples up to 1e12 (CLI11 took "-5" for a huge budget).
+CLI::Validator SampleCount() {
+  return CLI::Validator(
+      [](std::string& input) -> std::string {
+        const bool digits = !input.empty() && input.size() <= 13 &&
+                            input.find_first_not_of("0123456789") == std::string::npos;
+        if (digits && std::stod(input) <= 1e12) return std::string();
+        return "'" + input + "' is not a whole number of samples from 0 to 1e12";
+      },
+      "SAMPLES");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -70,7 +83,8 @@ int main(int argc, char** argv) {
                  "Threads per batch query (default: the hardware's cores)")
       ->check(CLI::Range(1, 64));
   app.add_option("--max-samples", options.limits.max_total_samples,
-                 "Samples held over all terrains and uploads");
+                 "Samples held over all terrains and uploads")
+      ->check(SampleCount());
   app.add_option("--orphan-timeout", options.limits.orphan_idle_s,
                  "Seconds without queries after which a terrain whose connection has closed is "
                  "freed (default 600)")
@@ -107,19 +121,29 @@ int main(int argc, char** argv) {
       return 1;
     }
     if (!port_file.empty()) {
-      std::ofstream(port_file) << server.port() << "\n";
+      std::ofstream out(port_file);
+      out << server.port() << "\n";
+      if (!out.flush()) {
+        // A supervisor waiting for the file would wait forever.
+        std::fprintf(stderr, "footfalld: --port-file %s: cannot write the port there\n",
+                     port_file.c_str());
+        return 1;
+      }
     }
     g_server = &server;
     struct sigaction action {};
     action.sa_handler = OnStopSignal;  // no SA_RESTART: poll returns EINTR at once
     sigaction(SIGTERM, &action, nullptr);
     sigaction(SIGINT, &action, nullptr);
+    sigaction(SIGHUP, &action, nullptr);  // a closed terminal: stop cleanly, unregistered
     server.Run();
     g_server = nullptr;
     abandoned_load = server.abandoned_load();
   }  // unregistered from rpcbind
   if (abandoned_load) {
-    // The load's thread still reads the file: end without running static destructors.
+    // The load's thread still reads the file: end without running static destructors (its
+    // private name for the file is removed first).
+    footfall::RemovePinnedNames();
     std::fflush(nullptr);
     std::_Exit(0);
   }

@@ -7,14 +7,33 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <map>
+#include <mutex>
 
 namespace footfall {
+namespace {
+
+// The private names of the open PinnedFiles (link -> its directory).
+std::mutex g_names_mutex;
+std::map<std::string, std::string> g_names;
+
+}  // namespace
+
+void RemovePinnedNames() {
+  std::lock_guard<std::mutex> lock(g_names_mutex);
+  for (const auto& [link, dir] : g_names) unlink(link.c_str()), rmdir(dir.c_str());
+  g_names.clear();
+}
 
 bool PathInside(const std::string& root, const std::string& path) {
   return root == "/" || path == root || path.compare(0, root.size() + 1, root + "/") == 0;
 }
 
 PinnedFile::~PinnedFile() {
+  {
+    std::lock_guard<std::mutex> lock(g_names_mutex);
+    g_names.erase(link_);
+  }
   if (!link_.empty()) unlink(link_.c_str());
   if (!dir_.empty()) rmdir(dir_.c_str());
   if (fd_ >= 0) close(fd_);
@@ -63,6 +82,8 @@ Status PinnedFile::Open(const std::string& root, const std::string& path, const 
     return Status::kIoError;
   }
   link_ = link;
+  std::lock_guard<std::mutex> lock(g_names_mutex);
+  g_names.emplace(link_, dir_);
   return Status::kOk;
 }
 

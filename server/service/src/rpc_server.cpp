@@ -42,13 +42,34 @@ bool RpcbindRunning() {
   return up;
 }
 
+// The port rpcbind has for footfall's program when a server still accepts connections there
+// (another footfalld), else 0.
+int LiveRegisteredPort() {
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  const unsigned short port = pmap_getport(&a, FOOTFALL_PROG, FOOTFALL_V1, IPPROTO_TCP);
+  if (port == 0) return 0;
+  const int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return 0;
+  a.sin_port = htons(port);
+  const bool live = connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+  close(fd);
+  return live ? port : 0;
+}
+
 }  // namespace
 
 RpcServer::RpcServer(RpcServerOptions options) : options_(std::move(options)) {}
 
 RpcServer::~RpcServer() {
-  if (registered_rpcbind_) pmap_unset(FOOTFALL_PROG, FOOTFALL_V1);
-  svc_unregister(FOOTFALL_PROG, FOOTFALL_V1);
+  // libtirpc's svc_unregister also unsets the program at rpcbind, whoever registered it: a
+  // server that did not register (another footfalld had) must leave rpcbind alone, and its
+  // dispatch entry goes with the process.
+  if (registered_rpcbind_) {
+    pmap_unset(FOOTFALL_PROG, FOOTFALL_V1);
+    svc_unregister(FOOTFALL_PROG, FOOTFALL_V1);
+  }
 }
 
 bool RpcServer::Start(std::string* error) {
@@ -121,8 +142,15 @@ bool RpcServer::Start(std::string* error) {
                options_.listen_host.c_str(), port_, static_cast<unsigned>(FOOTFALL_PROG),
                static_cast<unsigned>(FOOTFALL_V1));
   if (options_.use_rpcbind) {
-    if (RpcbindRunning()) {
-      pmap_unset(FOOTFALL_PROG, FOOTFALL_V1);
+    const int other = RpcbindRunning() ? LiveRegisteredPort() : 0;
+    if (other != 0 && other != port_) {
+      // Taking the registration over would leave that server unregistered once this one stops.
+      std::fprintf(stderr,
+                   "footfalld: rpcbind already has the footfalld on port %d; not registering "
+                   "(clients connect to this one by port)\n",
+                   other);
+    } else if (RpcbindRunning()) {
+      pmap_unset(FOOTFALL_PROG, FOOTFALL_V1);  // a stale registration of a server gone
       registered_rpcbind_ =
           pmap_set(FOOTFALL_PROG, FOOTFALL_V1, IPPROTO_TCP, static_cast<unsigned short>(port_));
       std::fprintf(stderr, registered_rpcbind_ ? "footfalld: registered with rpcbind\n"
