@@ -198,6 +198,74 @@ class RpcTest(unittest.TestCase):
             ff.Session.rpc("127.0.0.1", 70000)
 
 
+class RotationTest(unittest.TestCase):
+    """Body rotations as Maya's XYZ Euler angles (the Maya plugin keys them)."""
+
+    @staticmethod
+    def _matrix_of_euler(e):
+        a, b, c = (math.radians(v) for v in e)
+        rx = [[1, 0, 0], [0, math.cos(a), -math.sin(a)], [0, math.sin(a), math.cos(a)]]
+        ry = [[math.cos(b), 0, math.sin(b)], [0, 1, 0], [-math.sin(b), 0, math.cos(b)]]
+        rz = [[math.cos(c), -math.sin(c), 0], [math.sin(c), math.cos(c), 0], [0, 0, 1]]
+
+        def mul(p, q):
+            return [[sum(p[i][k] * q[k][j] for k in range(3)) for j in range(3)]
+                    for i in range(3)]
+        return mul(rz, mul(ry, rx))  # Maya's XYZ rotate order
+
+    @staticmethod
+    def _matrix_of_quat(q):
+        n = math.sqrt(sum(c * c for c in q))
+        x, y, z, w = (c / n for c in q)
+        return [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+
+    def test_euler_angles_rebuild_the_rotation(self):
+        # The plugin's old formulas composed R = Rx * Ry * Rz: off by up to 0.28 for a body
+        # turned 40 degrees and pitched 20.
+        rng = __import__("random").Random(5)
+        quats = [(0.0, math.sin(math.radians(20)), 0.0, math.cos(math.radians(20))),
+                 (0.17, 0.33, 0.05, 0.93), (0.0, 0.7071068, 0.0, 0.7071068)]
+        quats += [tuple(rng.uniform(-1, 1) for _ in range(4)) for _ in range(200)]
+        for q in quats:
+            e = ff.rotation.quat_to_euler_xyz(q)
+            got, want = self._matrix_of_euler(e), self._matrix_of_quat(q)
+            for i in range(3):
+                for j in range(3):
+                    self.assertAlmostEqual(got[i][j], want[i][j], places=9, msg=str(q))
+
+    def test_keys_match_the_mel_export(self):
+        cli = os.environ.get("FOOTFALL_CLI") or os.path.join(REPO, "build", "client", "cli",
+                                                               "footfall")
+        with tempfile.TemporaryDirectory() as tmp:
+            json_out, mel_out = os.path.join(tmp, "w.json"), os.path.join(tmp, "w.mel")
+            subprocess.run([cli, "generate", "--terrain", HILLS, "--character",
+                            os.path.join(CHARACTERS, "quadruped.json"), "--start", "20,0,12",
+                            "--path", "24,0,12 24,0,6 18,0,6", "--steps", "30",
+                            "--out", json_out, "--out", mel_out],
+                           check=True, stderr=subprocess.DEVNULL)
+            with open(json_out) as f:
+                walk = json.load(f)
+            with open(mel_out) as f:
+                mel = f.read()
+        keyed = {}
+        for m in __import__("re").finditer(
+                r"setKeyframe -t (\S+) -at rotate([XYZ]) -v (\S+) ", mel):
+            keyed.setdefault(float(m.group(1)), {})[m.group(2)] = float(m.group(3))
+        body = [t for t in walk["tracks"] if t["kind"] == "body"][0]
+        self.assertGreater(len(body["keys"]), 20)
+        previous = None
+        for key in body["keys"]:
+            euler = ff.rotation.quat_to_euler_xyz(key["rotation"])
+            if previous is not None:
+                euler = ff.rotation.closest_euler(euler, previous)
+            previous = euler
+            want = keyed[float(key["frame"])]
+            for axis, value in zip("XYZ", euler):
+                self.assertAlmostEqual(value, want[axis], places=4)
+
+
 class GenerateTest(unittest.TestCase):
     """ffc_generate over RPC gives the same walk JSON as `footfall generate`."""
 

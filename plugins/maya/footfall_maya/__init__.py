@@ -166,17 +166,19 @@ def key_walk(walk, feet, body):
         node = body if is_body else feet.get(track.get("name"))
         if not node:
             continue
+        previous = None
         for key in track.get("keys", []):
             frame = key["frame"]
             mc.xform(node, ws=True, t=key["position"])
             mc.setKeyframe(node, attribute="translate", time=frame)
             if is_body and "rotation" in key:
-                x, y, z, w = key["rotation"]
-                # Quaternion -> XYZ Euler degrees (Maya's default rotate order).
-                rx = math.degrees(math.atan2(2 * (w * x - y * z), 1 - 2 * (x * x + y * y)))
-                ry = math.degrees(math.asin(max(-1.0, min(1.0, 2 * (w * y + x * z)))))
-                rz = math.degrees(math.atan2(2 * (w * z - x * y), 1 - 2 * (y * y + z * z)))
-                mc.xform(node, ws=True, ro=(rx, ry, rz))
+                # XYZ Euler degrees as Maya's default rotate order composes them, unwrapped from
+                # the previous key (as the MEL export keys them).
+                euler = ffc.rotation.quat_to_euler_xyz(key["rotation"])
+                if previous is not None:
+                    euler = ffc.rotation.closest_euler(euler, previous)
+                previous = euler
+                mc.xform(node, ws=True, ro=euler)
                 mc.setKeyframe(node, attribute="rotate", time=frame)
             count += 1
     return count

@@ -1,0 +1,43 @@
+"""Body rotations for DCCs that key Euler angles (Maya): footfall's quaternions as XYZ Euler
+angles in degrees, as Maya's default rotate order composes them (R = Rz * Ry * Rx), unwrapped
+key to key. The same conversion as the MEL export (client/export/src/euler.cpp). Pure Python."""
+
+import math
+
+
+def quat_to_euler_xyz(q):
+    """(x, y, z, w) -> (rx, ry, rz) degrees with R = Rz(rz) * Ry(ry) * Rx(rx)."""
+    n = math.sqrt(sum(c * c for c in q))
+    x, y, z, w = (c / n for c in q)
+    m00 = 1 - 2 * (y * y + z * z)
+    m01 = 2 * (x * y - z * w)
+    m10 = 2 * (x * y + z * w)
+    m11 = 1 - 2 * (x * x + z * z)
+    m20 = 2 * (x * z - y * w)
+    m21 = 2 * (y * z + x * w)
+    m22 = 1 - 2 * (x * x + y * y)
+    sin_b = max(-1.0, min(1.0, -m20))
+    b = math.asin(sin_b)
+    if abs(sin_b) > 1 - 1e-12:  # gimbal lock: X and Z turn about the same axis; all in Z
+        a, c = 0.0, math.atan2(-m01, m11)
+    else:
+        a, c = math.atan2(m21, m22), math.atan2(m10, m00)
+    return (math.degrees(a), math.degrees(b), math.degrees(c))
+
+
+def _unwrap(angle, target):
+    return angle + 360.0 * round((target - angle) / 360.0)
+
+
+def closest_euler(euler, previous):
+    """The angles equal to `euler` as a rotation that lie closest to `previous` (degrees), so
+    that interpolating between keys turns the short way instead of spinning through 360."""
+    def unwrap_all(e):
+        return tuple(_unwrap(e[i], previous[i]) for i in range(3))
+
+    def l1(e):
+        return sum(abs(e[i] - previous[i]) for i in range(3))
+
+    direct = unwrap_all(euler)
+    alternative = unwrap_all((euler[0] + 180.0, 180.0 - euler[1], euler[2] + 180.0))
+    return alternative if l1(alternative) < l1(direct) else direct
