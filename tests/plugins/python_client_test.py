@@ -184,6 +184,20 @@ class RpcTest(unittest.TestCase):
         self.assertTrue(hold.ok, hold)
         self.assertEqual(hold.point, (1.0, 0.0, 2.5))
 
+    def test_connection_finds_a_server_restarted_on_its_port(self):
+        # The plugins' Connection: after a restart its first command used to fail once ("no
+        # footfalld answers"), as the session noticed the broken connection only then.
+        c = ff.Connection()
+        try:
+            self.assertIs(c.get("127.0.0.1", self.server.port, start_local=False).ping(), True)
+            self.server.kill()
+            self.server.restart()
+            s = c.get("127.0.0.1", self.server.port, start_local=False)
+            self.assertTrue(s.ping())
+            self.assertIsNone(c.local)  # no local server started instead
+        finally:
+            c.shutdown()
+
     def test_no_server_is_a_clear_error(self):
         port = self.server.port
         self.server.stop()
