@@ -145,6 +145,41 @@ class SharedLogicTest(unittest.TestCase):
             ff.character.parse('{"feet": [{"name": "L"}]}', "bad.json")
         self.assertIn("bad.json: feet[0]", e.exception.message)
 
+    def test_character_files_the_plugins_cannot_rig_are_refused_before_anything_is_made(self):
+        # Each of these escaped from Blender's Character Setup as a Python traceback
+        # (KeyError, ZeroDivisionError, IndexError), after half the rig was made.
+        feet = '[{"name": "L", "rest": [0.1, 0, 0]}, {"name": "R", "rest": [-0.1, 0, 0]}]'
+        cases = {'{"feet": %s, "pairs": [["L", "NOPE"]]}' % feet: "pairs[0]: no foot named 'NOPE'",
+                 '{"feet": %s, "pairs": [[]]}' % feet: "pairs[0]: expected a non-empty list",
+                 '{"feet": [{"name": "L", "rest": [0.1, 0]}]}': "feet[0]: expected",
+                 '{"feet": [{"name": "", "rest": [0.1, 0, 0]}]}': "feet[0]: expected",
+                 '{"feet": [{"name": "L", "rest": [0, 0, 0]}, {"name": "L", "rest": [1, 0, 0]}]}':
+                     "feet[1]: the name 'L' is used twice"}
+        for text, message in cases.items():
+            with self.assertRaises(ff.FootfallError, msg=text) as e:
+                ff.character.parse(text, "c.json")
+            self.assertIn("c.json: " + message, e.exception.message)
+
+    def test_walk_files_are_checked_before_anything_is_keyed(self):
+        good = {"tracks": [{"name": "L", "kind": "foot", "keys": [
+            {"frame": 1, "position": [0, 0, 0]}]}, {"name": "body", "kind": "body", "keys": [
+                {"frame": 1, "position": [0, 1, 0], "rotation": [0, 0, 0, 1]}]}]}
+        ff.character.check_walk(good, "w.json")
+        bad = [({"tracks": [1]}, "tracks[0]: expected"),
+               ({"tracks": [{"name": "L", "keys": [{"frame": 1, "position": [0, 0]}]}]},
+                "tracks[0].keys[0]: expected \"position\""),
+               ({"tracks": [{"name": "L", "keys": [{"frame": float("nan"),
+                                                    "position": [0, 0, 0]}]}]},
+                "tracks[0].keys[0]: expected a finite \"frame\""),
+               ({"tracks": [{"name": "b", "kind": "body", "keys": [
+                   {"frame": 1, "position": [0, 0, 0], "rotation": [0, 0, 1]}]}]},
+                "expected \"rotation\""),
+               ([], "expected footfall walk JSON")]
+        for walk, message in bad:
+            with self.assertRaises(ValueError, msg=str(walk)) as e:
+                ff.character.check_walk(walk, "w.json")
+            self.assertIn(message, str(e.exception))
+
 
 class RpcTest(unittest.TestCase):
     def setUp(self):

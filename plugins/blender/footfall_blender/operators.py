@@ -395,8 +395,7 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
             else:
                 with open(path) as f:
                     walk = json.load(f)
-            if not isinstance(walk, dict) or not isinstance(walk.get("tracks"), list):
-                raise ValueError("%s: expected footfall walk JSON with a \"tracks\" list" % path)
+            character.check_walk(walk, path)  # before anything is made
             rig_obj = active_rig(context)
             if rig_obj is not None:
                 feet, body = rig_targets(rig_obj)
@@ -426,7 +425,12 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
         walk dict (positions converted back to footfall's frame), then removes what it made."""
         before = set(bpy.data.objects)
         actions_before = set(bpy.data.actions)
-        result = bpy.ops.import_scene.gltf(filepath=path)
+        try:
+            result = bpy.ops.import_scene.gltf(filepath=path)
+        except RuntimeError as e:  # the importer's own error on a damaged file
+            for obj in set(bpy.data.objects) - before:
+                bpy.data.objects.remove(obj)
+            raise ValueError("Blender's glTF importer: %s" % str(e).strip()) from None
         if "FINISHED" not in result:
             raise ValueError("Blender's glTF importer failed")
         made = [o for o in bpy.data.objects if o not in before]

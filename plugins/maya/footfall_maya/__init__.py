@@ -233,6 +233,7 @@ def import_walk(path, rig=None):
     """Keys a footfall walk JSON file onto `rig` (or new locators)."""
     with open(path) as f:
         walk = json.load(f)
+    ffc.character.check_walk(walk, path)  # before any locator is made
     if rig:
         _, feet, body = _rig_targets(rig)
     else:

@@ -27,7 +27,7 @@ def parse(text, name="character"):
         data = json.loads(text)
     except ValueError as e:
         raise FootfallError(6, "%s: %s" % (name, e), "character") from None
-    feet(data, name)  # validates
+    pairs(data, name)  # validates the feet and the pairs
     return data
 
 
@@ -47,11 +47,19 @@ def feet(data, name="character"):
     out = []
     for i, foot in enumerate(raw):
         try:
-            pos = foot.get("rest", foot.get("position"))
-            out.append((str(foot["name"]), _vec(pos)))
+            pos = _vec(foot.get("rest", foot.get("position")))
+            foot_name = foot["name"]
+            if (not isinstance(foot_name, str) or not foot_name or len(pos) != 3 or
+                    not all(math.isfinite(c) for c in pos)):
+                raise ValueError
+            out.append((foot_name, pos))
         except (AttributeError, KeyError, TypeError, ValueError):
-            raise FootfallError(INVALID_ARGUMENT, "%s: feet[%d]: expected {\"name\": ..., "
-                                "\"rest\": [x, y, z]}" % (name, i), "character") from None
+            raise FootfallError(INVALID_ARGUMENT, "%s: feet[%d]: expected {\"name\": NAME, "
+                                "\"rest\": [x, y, z]} (a non-empty name, three finite numbers)"
+                                % (name, i), "character") from None
+        if foot_name in [f[0] for f in out[:-1]]:
+            raise FootfallError(INVALID_ARGUMENT, "%s: feet[%d]: the name '%s' is used twice"
+                                % (name, i, foot_name), "character")
     return out
 
 
@@ -72,14 +80,24 @@ def is_biped(data):
     return not bool(data.get("align_to_normal", False))
 
 
-def pairs(data):
+def pairs(data, name="character"):
     """Foot pairs that share a central locator: the file's "pairs" (groups of foot names), or
     else each left foot (x > 0) with the right foot (x < 0) nearest to its mirror; a foot left
-    over stands alone. [(name, [foot names])]"""
+    over stands alone. [(name, [foot names])]. FootfallError for a pair that is empty or names
+    a foot the file does not have."""
+    fs = feet(data, name)
     given = data.get("pairs")
     if isinstance(given, list) and given:
+        names = {f[0] for f in fs}
+        for i, group in enumerate(given):
+            if not isinstance(group, list) or not group:
+                raise FootfallError(INVALID_ARGUMENT, "%s: pairs[%d]: expected a non-empty list "
+                                    "of foot names" % (name, i), "character")
+            for foot_name in group:
+                if foot_name not in names:
+                    raise FootfallError(INVALID_ARGUMENT, "%s: pairs[%d]: no foot named %r"
+                                        % (name, i, foot_name), "character")
         return [("_".join(str(n) for n in group), [str(n) for n in group]) for group in given]
-    fs = feet(data)
     left = [f for f in fs if f[1][0] > 0]
     right = [f for f in fs if f[1][0] <= 0]
     out, used = [], set()
@@ -111,3 +129,35 @@ def with_overrides(data, **values):
         if value is not None and value > 0:
             out[key] = int(value) if key == "frames_per_step" else float(value)
     return out
+
+
+def check_walk(walk, name="walk"):
+    """Raises ValueError naming the first problem of a footfall walk dict (JSON format
+    "footfall-walk", as read from a file), before a plugin keys or creates anything: tracks
+    with a name and a kind, keys with a finite frame, a position of three finite numbers and,
+    where given, a rotation of four."""
+    if not isinstance(walk, dict) or not isinstance(walk.get("tracks"), list):
+        raise ValueError("%s: expected footfall walk JSON with a \"tracks\" list" % name)
+
+    def finite(values, count):
+        return (isinstance(values, list) and len(values) == count and
+                all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+                    for v in values))
+
+    for t, track in enumerate(walk["tracks"]):
+        where = "%s: tracks[%d]" % (name, t)
+        if not isinstance(track, dict) or not isinstance(track.get("name"), str) or \
+                track.get("kind", "foot") not in ("foot", "body"):
+            raise ValueError("%s: expected {\"name\": NAME, \"kind\": \"foot\"|\"body\", "
+                             "\"keys\": [...]}" % where)
+        keys = track.get("keys", [])
+        if not isinstance(keys, list):
+            raise ValueError("%s.keys: expected a list" % where)
+        for k, key in enumerate(keys):
+            at = "%s.keys[%d]" % (where, k)
+            if not isinstance(key, dict) or not finite([key.get("frame")], 1):
+                raise ValueError("%s: expected a finite \"frame\"" % at)
+            if not finite(key.get("position"), 3):
+                raise ValueError("%s: expected \"position\": [x, y, z] (finite numbers)" % at)
+            if "rotation" in key and not finite(key["rotation"], 4):
+                raise ValueError("%s: expected \"rotation\": [x, y, z, w] (finite numbers)" % at)
