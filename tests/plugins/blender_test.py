@@ -229,6 +229,32 @@ class BlenderAddonTest(unittest.TestCase):
         for t in targets:
             self.assertIn(t.parent, centres)
 
+    def test_3b_bad_character_or_walk_is_a_report_and_makes_nothing(self):
+        # A pair naming a missing foot raised KeyError through the operator after the body and
+        # the feet were made; a walk whose key has two coordinates raised IndexError.
+        with open(os.path.join(CHARACTERS, "hexapod.json")) as f:
+            data = json.load(f)
+        data["pairs"] = [["L1", "NOPE"]]
+        bad_character = os.path.join(ARGS.work_dir, "badpair.json")
+        with open(bad_character, "w") as f:
+            json.dump(data, f)
+        bad_walk = os.path.join(ARGS.work_dir, "pos2.json")
+        with open(bad_walk, "w") as f:
+            json.dump({"tracks": [{"name": "L1", "kind": "foot", "keys": [
+                {"frame": 1, "position": [0, 0]}]}]}, f)
+        before = set(bpy.data.objects)
+        with self.assertRaises(RuntimeError) as e:
+            bpy.ops.footfall.character_setup(character_file=bad_character, mode="CREATE",
+                                             name="broken")
+        self.assertIn("pairs[0]: no foot named 'NOPE'", str(e.exception))
+        self.assertNotIn("Traceback", str(e.exception))
+        bpy.context.scene.footfall.rig = None
+        self.select([], None)
+        with self.assertRaises(RuntimeError) as e:
+            bpy.ops.footfall.import_walk(filepath=bad_walk)
+        self.assertIn("tracks[0].keys[0]: expected \"position\"", str(e.exception))
+        self.assertEqual(set(bpy.data.objects), before)
+
     def test_4_biped_setup_picks_ik_targets(self):
         with open(os.path.join(CHARACTERS, "biped.json")) as f:
             names = [foot["name"] for foot in json.load(f)["feet"]]
