@@ -343,6 +343,12 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
             terrain = _connection.terrain(TERRAIN)
             wm.progress_begin(0, total)
             done = 0
+            # Each call asks for the walk up to `done` steps; the walk is the same for the steps
+            # already keyed (the generator is deterministic), so only keys from the last keyed
+            # frame on are set again (re-keying the whole walk at every call made a 1000-step
+            # walk take 25 s, and longer ones ever slower).
+            keying.clear_keys(list(feet.values()) + [body], settings.start_frame)
+            last_frame = None
             while done < total:
                 done = min(total, done + chunk)
                 _status(context, "footfall: generating step %d of %d" % (done, total))
@@ -350,8 +356,11 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
                 status, walk_text_new, message = s.generate_json(terrain, request)
                 if walk_text_new is not None:
                     walk = json.loads(walk_text_new)
-                    keying.clear_keys(list(feet.values()) + [body], settings.start_frame)
-                    keyed = keying.key_walk(walk, feet, body)
+                    keying.key_walk(walk, feet, body, from_frame=last_frame)
+                    frames = [k["frame"] for t in walk.get("tracks", []) for k in t.get("keys", [])]
+                    last_frame = max(frames) if frames else last_frame
+                    keyed = sum(len(t.get("keys", [])) for t in walk.get("tracks", [])
+                                if (t.get("kind") == "body" and body) or t.get("name") in feet)
                     walk_text = walk_text_new
                     stopped = walk.get("stopped")
                 else:
