@@ -118,11 +118,12 @@ def character_setup(character_file, name=None, ik_handles=None, body=None):
     mc.addAttr(rig, longName="footfallBody", attributeType="message")
     mc.connectAttr(body + ".message", rig + ".footfallBody")
     placed = {}
-    for foot, rest in feet:
+    for index, (foot, rest) in enumerate(feet):
         point, _ = _snap(s, terrain, (ground[0] + rest[0], ground[1], ground[2] + rest[2]))
         handle = (ik_handles or {}).get(foot) or mc.spaceLocator(name="%s_%s" % (name, foot))[0]
         mc.xform(handle, ws=True, t=point)
-        attr = "footfallFoot_" + foot
+        # By the foot's index: a foot name need not be a valid Maya attribute name.
+        attr = _foot_attr(index)
         mc.addAttr(rig, longName=attr, attributeType="message")
         mc.connectAttr(handle + ".message", rig + "." + attr)
         placed[foot] = point
@@ -147,11 +148,19 @@ def character_setup(character_file, name=None, ik_handles=None, body=None):
 
 # -- Generate Walk --------------------------------------------------------------------------------
 
+def _foot_attr(index):
+    """The rig's message attribute linking foot `index` (file order) to its IK handle."""
+    return "footfallFoot%d" % index
+
+
 def _rig_targets(rig):
     data = json.loads(mc.getAttr(rig + "." + RIG_ATTR))
     feet = {}
-    for foot, _ in character.feet(data):
-        src = mc.listConnections(rig + ".footfallFoot_" + foot, source=True) or []
+    for index, (foot, _) in enumerate(character.feet(data)):
+        attr = _foot_attr(index)
+        if not mc.attributeQuery(attr, node=rig, exists=True):
+            attr = "footfallFoot_" + foot  # a rig made before attributes went by index
+        src = mc.listConnections(rig + "." + attr, source=True) or []
         if src:
             feet[foot] = src[0]
     body = (mc.listConnections(rig + ".footfallBody", source=True) or [None])[0]
