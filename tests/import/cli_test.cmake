@@ -53,6 +53,26 @@ if(NOT rc EQUAL 0 OR NOT out MATCHES "\"found\":true" OR out MATCHES "\"normal\"
   message(FATAL_ERROR "--crease-angle 180: expected a normal leaning off +y, got ${out}")
 endif()
 expect(EXIT_NONZERO "--crease-angle" query --terrain "${WORK}/cube.obj" --crease-angle 200)
+# --flat-normals takes each face's normal even where corners are smoothed (--crease-angle 180);
+# --smooth-normals is the default.
+execute_process(COMMAND "${FOOTFALL}" query --terrain "${WORK}/cube.obj" --separation 0.1
+                        --crease-angle 180 --flat-normals
+                RESULT_VARIABLE rc OUTPUT_VARIABLE flat INPUT_FILE "${WORK}/stdin.txt")
+if(NOT rc EQUAL 0 OR NOT flat MATCHES "\"normal\":\\[0.0,1.0,0.0\\]")
+  message(FATAL_ERROR "--flat-normals: expected the top face's normal, got ${flat}")
+endif()
+execute_process(COMMAND "${FOOTFALL}" query --terrain "${WORK}/cube.obj" --separation 0.1
+                        --crease-angle 180 --smooth-normals
+                RESULT_VARIABLE rc OUTPUT_VARIABLE smooth INPUT_FILE "${WORK}/stdin.txt")
+if(NOT rc EQUAL 0 OR NOT smooth STREQUAL out)
+  message(FATAL_ERROR "--smooth-normals: expected the default's answer ${out}, got ${smooth}")
+endif()
+# A height map's frame given for another kind of file is refused, not ignored.
+expect(EXIT_NONZERO "applies to height maps (.asc .pgm) only, not to a mesh"
+       terrain info "${WORK}/cube.obj" --height-scale 10)
+expect(EXIT_NONZERO "applies to height maps (.asc .pgm) only, not to a point file"
+       query --terrain "${SOURCE_DIR}/data/terrain/ramp.pts" --cell-size 2)
+expect(EXIT_ZERO "format: heightmap" terrain info "${WORK}/hill.asc" --height-scale 2 --cell-size 3)
 file(WRITE "${WORK}/stdin.txt" "snap 0.5 2 0.5\n")
 # A cube wound inside out is turned over: its top's normal faces up.
 file(READ "${WORK}/cube.obj" cube)

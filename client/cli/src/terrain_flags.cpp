@@ -10,8 +10,10 @@ void AddLoadFlags(CLI::App* command, TerrainLoadOptions* load) {
                    "Meshes and height maps: resample so that no surface point is farther "
                    "than this from a sample (world units; 0: mean edge length / cell size)")
       ->check(FiniteAtLeast(0));
-  command->add_flag("!--smooth-normals,--flat-normals", load->smooth_normals,
-                    "Sample normals from faces instead of interpolated corner normals");
+  // --smooth-normals sets true (the default), --flat-normals false.
+  command->add_flag("--smooth-normals,!--flat-normals", load->smooth_normals,
+                    "Meshes and height maps: --flat-normals samples normals from faces instead "
+                    "of interpolated corner normals (--smooth-normals, the default)");
   command
       ->add_option("--crease-angle", load->crease_angle_deg,
                    "Meshes and height maps: edges whose faces meet at more than this many "

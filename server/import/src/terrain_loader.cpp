@@ -33,6 +33,19 @@ Status CheckOptions(const TerrainLoadOptions& o, std::string* error) {
   return Status::kInvalidArgument;
 }
 
+// A height map's frame (cell size, height scale) given for another kind of file: it would be
+// ignored, and the terrain not the one the caller asked for.
+Status CheckHeightMapOnly(const std::string& path, const std::string& ext,
+                          const TerrainLoadOptions& o, std::string* error) {
+  if (ext == "asc" || ext == "pgm" || (o.cell_size == 0 && o.height_scale == 1)) return Status::kOk;
+  if (error)
+    *error = path +
+             ": a cell size or height scale (--cell-size, --height-scale) applies to "
+             "height maps (.asc .pgm) only, not to " +
+             (IsPointFileExtension(ext) ? "a point file" : "a mesh");
+  return Status::kInvalidArgument;
+}
+
 void Bounds(const RawSamples& samples, Vec3* lo, Vec3* hi) {
   *lo = *hi = samples.size() ? samples.points[0] : Vec3{};
   for (const Vec3& p : samples.points) {
@@ -45,7 +58,9 @@ Status LoadAny(const std::string& path, const std::string& ext, const TerrainLoa
                RawSamples* out, std::string* error, TerrainLoadReport* report) {
   if (IsPointFileExtension(ext)) {
     report->format = "points";
-    const Status status = ReadPointFile(path, out, error);
+    Status status = CheckHeightMapOnly(path, ext, options, error);
+    if (status != Status::kOk) return status;
+    status = ReadPointFile(path, out, error);
     if (status == Status::kOk && out->size() == 0) {
       if (error) *error = path + ": no samples (expected at least one line x y z nx ny nz)";
       return Status::kParseError;
@@ -72,6 +87,8 @@ Status ReadTerrainMesh(const std::string& path, const TerrainLoadOptions& option
   }
   if (IsMeshExtension(ext)) {
     report->format = "mesh";
+    status = CheckHeightMapOnly(path, ext, options, error);
+    if (status != Status::kOk) return status;
     MeshReadReport read;
     status = ReadMesh(path, mesh, error, &read);
     if (status != Status::kOk) return status;
