@@ -74,6 +74,19 @@ check "heading 1e300,0,1e300: the walk of 1,0,1" cmp -s "$work/huge-heading.json
 check "cliff: message on stderr" grep -qE 'stopped early: step [0-9]+: foot [LR] at \([0-9.]+, [0-9.-]+, [0-9.]+\): .*cliff' "$work/biped-cliff-embedded.err"
 check "cliff: message in the walk" grep -qE '"stopped":"step [0-9]+: foot' "$work/biped-cliff-embedded.json"
 check "cliff: keys kept" [ "$(grep -c '"phase":"end"' "$work/biped-cliff-embedded.json")" -gt 8 ]
+# A crowd walking toward the cliff: its front row (c4-c6) stops first. The walk names the
+# earliest stop; stderr lists every character's.
+"$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --crowd 6 \
+  --start 2.5,0,4 --steps 40 --out "$work/crowd-cliff.json" 2> "$work/crowd-cliff.err"
+check "crowd cliff: exit 2" [ $? -eq 2 ]
+check "crowd cliff: the earliest stop named" grep -q '"stopped":"step 4 of c4: .*(and 5 more characters stopped)"' "$work/crowd-cliff.json"
+check "crowd cliff: every stop listed" [ "$(grep -cE '^  step [0-9]+ of c[1-6]: foot' "$work/crowd-cliff.err")" -eq 6 ]
+check "crowd cliff: the back row's stop listed" grep -qE '^  step [0-9]+ of c1: foot' "$work/crowd-cliff.err"
+# A goal straight above the start: no steps, and a note that says why.
+"$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,4 \
+  --path 2.5,5,4 --out "$work/goal-above.json" 2> "$work/goal-above.err"
+check "goal above the start: exit 0" [ $? -eq 0 ]
+check "goal above the start: the note" grep -q "no steps: the path's goal is already reached where the character starts" "$work/goal-above.err"
 
 # 3. Every output format at once; a stopped walk still writes them all.
 "$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
@@ -167,7 +180,8 @@ bad far-start "the start is too far from the terrain to snap" --terrain "$hills"
 # Numbers: finite, within readable bounds, one check for every float flag.
 bad fps-tiny "--fps: '1e-300' is not a finite number from 0.001 to 1e+06" --terrain "$hills" --character "$chars/biped.json" --fps 1e-300 --out "$work/x.json"
 bad start-frame "--start-frame: '-1e300' is not a finite number from -1e+09 to 1e+09" --terrain "$hills" --character "$chars/biped.json" --start-frame -1e300 --out "$work/x.json"
-bad crowd-spacing "--crowd-spacing: 'nan' is not a finite number from 0 to 1e+06" --terrain "$hills" --character "$chars/biped.json" --crowd-spacing nan --out "$work/x.json"
+bad crowd-spacing "--crowd-spacing: 'nan' is not a finite number > 0 and <= 1e+06" --terrain "$hills" --character "$chars/biped.json" --crowd-spacing nan --out "$work/x.json"
+bad crowd-spacing-0 "--crowd-spacing: '0' is not a finite number > 0 and <= 1e+06" --terrain "$hills" --character "$chars/biped.json" --crowd-spacing 0 --out "$work/x.json"
 # The walk never overwrites what it is made from (the same file by another name too).
 cp "$chars/biped.json" "$work/me.json"
 bad out-is-character "--out $work/../$(basename "$work")/me.json is the character file this walk reads" --terrain "$hills" --character "$work/me.json" --out "$work/../$(basename "$work")/me.json"

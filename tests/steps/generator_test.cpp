@@ -351,6 +351,63 @@ TEST_CASE("Multipeds start on a wall or a ceiling", "[steps][generator]") {
   }
 }
 
+TEST_CASE("A gait of one group keys every touch-down, its feet lifting from there",
+          "[steps][generator]") {
+  // The quadruped with all four feet in one group (a hop), and a single foot.
+  Character hop = LoadShipped("quadruped");
+  hop.gait = {{0, 1, 2, 3}};
+  Character one = LoadShipped("biped");
+  one.feet.resize(1);
+  one.gait = {{0}};
+  one.pairs = {{0}};
+  for (const Character& c : {hop, one}) {
+    INFO(c.feet.size() << " feet");
+    Terrain t = LoadTerrain(MakeFlat(200, 0.05, 0), 0.05);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {5, 0, 2};
+    o.steps = 9;
+    const Walk w = Generate(t, c, o);
+    REQUIRE(w.stopped.empty());
+    CheckWalk(t, c, o, w);
+    for (const WalkTrack& tr : w.tracks) {
+      if (tr.kind != TrackKind::kFoot) continue;
+      int ends = 0, mids = 0;
+      for (const WalkKey& k : tr.keys)
+        ends += k.phase == KeyPhase::kEnd, mids += k.phase == KeyPhase::kMid;
+      CHECK(mids == 9);
+      CHECK(ends == 9);  // every step's touch-down (it was only the last one's)
+    }
+  }
+}
+
+TEST_CASE("Feet whose rests are off the body's origin walk straight", "[steps][generator]") {
+  // One foot 0.1 to the left of and 0.2 ahead of the body, and a biped shifted 0.3 sideways:
+  // their walks follow the heading (each drifted by its rests' offset every step).
+  Character one = LoadShipped("biped");
+  one.feet.resize(1);
+  one.feet[0].rest = {0.1, 0, 0.2};
+  one.gait = {{0}};
+  one.pairs = {{0}};
+  Character shifted = LoadShipped("biped");
+  for (FootSpec& f : shifted.feet) f.rest.x += 0.3;
+  shifted.reach += 0.3;
+  for (const Character& c : {one, shifted}) {
+    INFO(c.feet.size() << " feet");
+    Terrain t = LoadTerrain(MakeFlat(200, 0.05, 0), 0.05);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {5, 0, 2};
+    o.steps = 10;
+    const Walk w = Generate(t, c, o);
+    REQUIRE(w.stopped.empty());
+    CheckWalk(t, c, o, w);
+    const auto& body = Body(w).keys;
+    CHECK(std::fabs(body.back().position.x - body.front().position.x) < 0.06);
+    CHECK(body.back().position.z - body.front().position.z > 2);
+  }
+}
+
 TEST_CASE("Any heading, not only +Z", "[steps][generator]") {
   const Character c = LoadShipped("biped");
   Terrain t = LoadTerrain(MakeFlat(200, 0.05, 0), 0.05);

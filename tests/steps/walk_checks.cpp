@@ -60,6 +60,14 @@ std::vector<const WalkTrack*> TracksOf(const Walk& w, const std::string& charact
 
 namespace {
 
+// Whether keys[i] is where a swing starts: a start key, or a touch-down followed by a mid key
+// (a foot that lifts on the frame it lands, in a gait of one group).
+bool LiftsAt(const std::pmr::vector<WalkKey>& keys, size_t i) {
+  if (keys[i].phase == KeyPhase::kStart) return true;
+  return keys[i].phase == KeyPhase::kEnd && i + 1 < keys.size() &&
+         keys[i + 1].phase == KeyPhase::kMid;
+}
+
 Vec3 QuatAxisY(const Quat& q) {
   return {2 * (q.x * q.y - q.w * q.z), 1 - 2 * (q.x * q.x + q.z * q.z),
           2 * (q.y * q.z + q.w * q.x)};
@@ -101,11 +109,13 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
   for (size_t f = 0; f < c.feet.size(); ++f) {
     const auto& k = tracks[f]->keys;
     for (size_t i = 0; i + 1 < k.size(); ++i) {
+      // After a touch-down the foot lifts from where it landed: a start key there, or, when it
+      // lifts on the frame it landed (a gait of one group), its swing starts from the end key.
       if (k[i].phase == KeyPhase::kEnd) {
-        REQUIRE(k[i + 1].phase == KeyPhase::kStart);
-        REQUIRE(k[i + 1].position == k[i].position);
+        REQUIRE(k[i + 1].phase != KeyPhase::kEnd);
+        if (k[i + 1].phase == KeyPhase::kStart) REQUIRE(k[i + 1].position == k[i].position);
       }
-      if (k[i].phase != KeyPhase::kStart) continue;
+      if (!LiftsAt(k, i)) continue;
       REQUIRE(i + 2 < k.size());
       REQUIRE(k[i + 1].phase == KeyPhase::kMid);
       REQUIRE(k[i + 2].phase == KeyPhase::kEnd);
@@ -193,8 +203,8 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
     // A wait (its group held back by a foot left behind): no foot lifts and the body holds.
     bool any_lifts = false;
     for (size_t f = 0; f < c.feet.size(); ++f)
-      for (const WalkKey& key : tracks[f]->keys)
-        any_lifts |= key.phase == KeyPhase::kStart && key.frame == f0;
+      for (size_t i = 0; i < tracks[f]->keys.size(); ++i)
+        any_lifts |= LiftsAt(tracks[f]->keys, i) && tracks[f]->keys[i].frame == f0;
     if (!any_lifts) {
       INFO("step " << k + 1 << ": no foot lifts");
       CHECK(body.keys[k + 1].position == body.keys[k].position);
@@ -205,8 +215,8 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
     waits = 0;
     for (size_t f = 0; f < c.feet.size(); ++f) {
       bool lifts = false;
-      for (const WalkKey& key : tracks[f]->keys)
-        lifts |= key.phase == KeyPhase::kStart && key.frame == f0;
+      for (size_t i = 0; i < tracks[f]->keys.size(); ++i)
+        lifts |= LiftsAt(tracks[f]->keys, i) && tracks[f]->keys[i].frame == f0;
       const bool in_group =
           std::find(group.begin(), group.end(), static_cast<int>(f)) != group.end();
       INFO("step " << k + 1 << " foot " << c.feet[f].name);

@@ -233,6 +233,13 @@ int RunGenerate(const GenerateFlags& flags) {
       std::cerr << "footfall generate: " << error << '\n';
       return 1;
     }
+    if (!options.path.empty() && walk.stopped.empty() && !walk.tracks.empty() &&
+        std::all_of(walk.tracks.begin(), walk.tracks.end(),
+                    [](const WalkTrack& t) { return t.keys.size() <= 1; })) {
+      std::cerr << "footfall generate: note: no steps: the path's goal is already reached where "
+                   "the character starts (a waypoint counts as reached within half a step along "
+                   "the ground, whatever its height above it)\n";
+    }
     int code = 0;
     for (const std::string& out : flags.out) {
       const std::string ext = FileExtension(out);
@@ -253,6 +260,14 @@ int RunGenerate(const GenerateFlags& flags) {
     }
     if (!walk.stopped.empty()) {
       std::cerr << "footfall generate: stopped early: " << walk.stopped << '\n';
+      // A crowd: every character's reason, up to a screenful.
+      constexpr size_t kMaxListed = 20;
+      if (walk.stops.size() > 1) {
+        for (size_t i = 0; i < walk.stops.size() && i < kMaxListed; ++i)
+          std::cerr << "  " << walk.stops[i] << '\n';
+        if (walk.stops.size() > kMaxListed)
+          std::cerr << "  ... and " << walk.stops.size() - kMaxListed << " more\n";
+      }
       if (resample && prepared.cropped && !prepared.region_is_bound) {
         std::cerr << "footfall generate: the terrain was resampled only within "
                   << Box(prepared.region_min, prepared.region_max)
@@ -316,7 +331,7 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
       ->check(CLI::Range(1, 1000000));
   cmd->add_option("--crowd-spacing", flags->crowd_spacing,
                   "Distance between crowd characters (default: twice the character's reach)")
-      ->check(FiniteRange(0, 1e6));
+      ->check(FiniteAboveUpTo(0, 1e6));
   cmd->add_option("--threads", flags->threads,
                   "Threads for the embedded engine's queries and the generator's own work "
                   "(default: the hardware's; the walk is the same whatever the count)")

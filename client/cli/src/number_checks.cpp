@@ -45,4 +45,9 @@ CLI::Validator FiniteRange(double lo, double hi) {
               [lo, hi](double x) { return x >= lo && x <= hi; });
 }
 
+CLI::Validator FiniteAboveUpTo(double lo, double hi) {
+  return Make("a finite number > " + Text(lo) + " and <= " + Text(hi),
+              [lo, hi](double x) { return x > lo && x <= hi; });
+}
+
 }  // namespace footfall::cli

@@ -235,8 +235,9 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
         r.Range(c.max_turn_deg, 0, 180, true, false, "max_turn_deg");
   }
   if (r.status == Status::kOk) {
+    const Vec3 centroid = RestCentroid(c);
     for (const FootSpec& f : c.feet) {
-      const double rest = Length(f.rest + Vec3{0, -c.body_height, 0});
+      const double rest = Length(f.rest - centroid + Vec3{0, -c.body_height, 0});
       if (rest >= c.reach) {
         std::ostringstream m;
         m << "'reach' = " << c.reach << " must exceed foot '" << f.name
@@ -252,6 +253,12 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
   }
   *out = std::move(c);
   return Status::kOk;
+}
+
+Vec3 RestCentroid(const Character& c) {
+  Vec3 sum;
+  for (const FootSpec& f : c.feet) sum += f.rest;
+  return c.feet.empty() ? sum : sum / static_cast<double>(c.feet.size());
 }
 
 Status LoadCharacter(const std::string& path, Character* out, std::string* error) {

@@ -106,9 +106,10 @@ struct Agent {
   std::vector<Vec3> foot, foot_normal;  // planted feet
   std::vector<Vec3> path;
   size_t waypoint = 0;
-  bool walking = true;  // false once stopped or arrived
-  int waits = 0;        // steps in a row its group stepped in place, waiting for a planted foot
-  std::string stopped;  // why it stopped early ("" when it did not)
+  bool walking = true;   // false once stopped or arrived
+  int waits = 0;         // steps in a row its group stepped in place, waiting for a planted foot
+  std::string stopped;   // why it stopped early ("" when it did not)
+  int stopped_step = 0;  // the step it stopped at
   size_t first_track = 0;
 };
 
@@ -260,7 +261,8 @@ class Generator {
   size_t pass_begin_ = 0, pass_end_ = 0;  // the agents walking in this pass
   std::shared_ptr<BatchPool> pool_;
   std::vector<int> pair_of_foot_;
-  std::vector<Vec3> pair_centre_;                 // rest centre of each pair, character space
+  std::vector<Vec3> rest_;         // each foot's rest less RestCentroid, character space
+  std::vector<Vec3> pair_centre_;  // rest centre of each pair, as rest_
   std::vector<std::vector<int>> pairs_of_group_;  // pairs with a foot in each gait group
   // slot_of_foot_[g][j]: index in pairs_of_group_[g] of the pair of foot gait[g][j]
   std::vector<std::vector<size_t>> slot_of_foot_;
@@ -317,7 +319,13 @@ Vec3 Generator::BodyUp(const Vec3& feet_up, const std::vector<Vec3>& feet) const
 void Generator::KeyFoot(const Agent& a, int foot, double frame, KeyPhase phase, const Vec3& p,
                         const Vec3& n) {
   std::pmr::vector<WalkKey>& keys = walk_.tracks[a.first_track + foot].keys;
-  if (!keys.empty() && keys.back().frame == frame) keys.pop_back();  // lift-off replaces plant
+  if (!keys.empty() && keys.back().frame == frame) {
+    // A foot lifting on the frame it stands at: at the start frame the lift-off replaces the
+    // plant; later (a gait of one group, whose feet land and lift on the same frame) the
+    // touch-down stays, and the swing starts from it.
+    if (frame != o_.start_frame) return;
+    keys.pop_back();
+  }
   WalkKey key;
   key.frame = frame, key.phase = phase, key.position = p, key.normal = n;
   keys.push_back(key);
@@ -341,6 +349,7 @@ void Generator::Stop(Agent& a, int step, const std::string& why) {
   if (!a.id.empty()) m << " of " << a.id;
   m << ": " << why << "; walk stopped, keys up to step " << step - 1 << " kept";
   a.stopped = m.str();
+  a.stopped_step = step;
 }
 
 // Turns the heading toward the current waypoint, at most max_turn_deg per step; marks the
@@ -401,10 +410,14 @@ Status Generator::Run(std::string* error) {
       c_.max_slope_deg >= 180 ? -2.0 : std::cos(Radians(std::max(c_.max_slope_deg, 0.0)));
   sin_slope_threshold_ =
       c_.slope_threshold_deg >= 90 ? 2.0 : std::sin(Radians(std::max(c_.slope_threshold_deg, 0.0)));
+  // The body stands over the feet's centroid, so feet are placed about it: rests off their
+  // centroid would otherwise move the character sideways by that offset every step.
+  rest_.clear();
+  for (const FootSpec& f : c_.feet) rest_.push_back(f.rest - RestCentroid(c_));
   pair_of_foot_.assign(c_.feet.size(), 0);
   for (size_t p = 0; p < c_.pairs.size(); ++p) {
     Vec3 centre;
-    for (int f : c_.pairs[p]) pair_of_foot_[f] = static_cast<int>(p), centre += c_.feet[f].rest;
+    for (int f : c_.pairs[p]) pair_of_foot_[f] = static_cast<int>(p), centre += rest_[f];
     pair_centre_.push_back(centre / static_cast<double>(c_.pairs[p].size()));
   }
   pairs_of_group_.assign(groups, {});
@@ -439,14 +452,19 @@ Status Generator::Run(std::string* error) {
       s = WalkPass(pass * per_pass, std::min(n, (pass + 1) * per_pass), &progress, error);
   }
   if (s != Status::kOk) return s;
-  // The walk's stop message: the first agent's, and how many others stopped.
-  size_t stopped = 0;
-  for (const Agent& a : agents_) {
-    if (a.stopped.empty()) continue;
-    if (stopped++ == 0) walk_.stopped = a.stopped;
-  }
-  if (stopped > 1)
-    walk_.stopped += " (and " + std::to_string(stopped - 1) + " more characters stopped)";
+  // The walk's stop message: the earliest stop (the first character's among those of that
+  // step), and how many others stopped; Walk::stops has every one.
+  std::vector<const Agent*> stopped;
+  for (const Agent& a : agents_)
+    if (!a.stopped.empty()) stopped.push_back(&a);
+  std::stable_sort(stopped.begin(), stopped.end(), [](const Agent* x, const Agent* y) {
+    return x->stopped_step < y->stopped_step;
+  });
+  walk_.stops.clear();
+  for (const Agent* a : stopped) walk_.stops.push_back(a->stopped);
+  if (!stopped.empty()) walk_.stopped = stopped[0]->stopped;
+  if (stopped.size() > 1)
+    walk_.stopped += " (and " + std::to_string(stopped.size() - 1) + " more characters stopped)";
   return Status::kOk;
 }
 
@@ -589,7 +607,7 @@ Status Generator::Setup(std::string* error) {
   // 3. Snap the feet at their rest positions around each start.
   points_.resize(n * feet);
   for (int i = 0; i < n; ++i)
-    for (size_t f = 0; f < feet; ++f) points_[i * feet + f] = Place(agents_[i], c_.feet[f].rest);
+    for (size_t f = 0; f < feet; ++f) points_[i * feet + f] = Place(agents_[i], rest_[f]);
   answers_.resize(points_.size());
   s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()), "snap feet",
             error);
@@ -712,7 +730,7 @@ Status Generator::FindStart(const Vec3& start, bool may_move, Foothold* first, s
       const Vec3 up0 = c_.align_to_normal ? grounds[m].normal : world_up_;
       stand[m].path = o_.path;
       Orient(stand[m], grounds[m], up0, StartHeading(up0));
-      for (size_t f = 0; f < feet; ++f) points[m * feet + f] = Place(stand[m], c_.feet[f].rest);
+      for (size_t f = 0; f < feet; ++f) points[m * feet + f] = Place(stand[m], rest_[f]);
     }
     snapped.resize(points.size());
     st = Check(session_.Snap(terrain_, points.data(), points.size(), snapped.data()), "snap feet",
@@ -813,7 +831,7 @@ Status Generator::QueryFootholds(std::string* error) {
         if (Dot(n, a.up) < cos_max_slope_) n = a.up;  // leans past max_slope_deg: an edge
         const Vec3 f = TangentForward(a.forward, a.forward, a.up, n);
         const Vec3 l = Cross(n, f);
-        const Vec3 d = c_.feet[mv.foot].rest - pair_centre_[p];
+        const Vec3 d = rest_[mv.foot] - pair_centre_[p];
         const Vec3 target = locator_[pending_[i]] + l * d.x + n * d.y + f * d.z;
         double max_len = c_.step_length;  // shorter where the heading climbs or falls steeply
         if (std::fabs(Dot(f, a.up)) > sin_slope_threshold_) max_len *= c_.slope_step_scale;

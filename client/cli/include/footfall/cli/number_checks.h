@@ -15,5 +15,7 @@ CLI::Validator FiniteAtLeast(double lo);
 CLI::Validator FiniteAbove(double lo);
 // A finite number in [lo, hi].
 CLI::Validator FiniteRange(double lo, double hi);
+// A finite number in (lo, hi].
+CLI::Validator FiniteAboveUpTo(double lo, double hi);
 
 }  // namespace footfall::cli

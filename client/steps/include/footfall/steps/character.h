@@ -19,7 +19,8 @@ constexpr int kCharacterFormatVersion = 1;
 struct FootSpec {
   std::string name;  // track name in the walk, unique within the character
   // Rest position relative to the body's ground point (the terrain point under the body),
-  // character space. [Units: wu] y is usually 0.
+  // character space. [Units: wu] y is usually 0. A walk keeps the body over the feet's
+  // centroid, so it places feet at their rests less RestCentroid (the same for symmetric feet).
   Vec3 rest;
 };
 
@@ -61,6 +62,9 @@ struct Character {
 // gait/pairs.
 Status ParseCharacter(const std::string& text, const std::string& source, Character* out,
                       std::string* error);
+
+// The centroid of the feet's rest positions: where a walk puts the body's ground point.
+Vec3 RestCentroid(const Character& c);
 
 // Reads and parses a character file. kIoError when it cannot be read.
 Status LoadCharacter(const std::string& path, Character* out, std::string* error);

@@ -77,8 +77,12 @@ struct Walk {
   double fps = 24;
   std::vector<WalkTrack> tracks;
   // Empty when every requested step was generated; otherwise why the walk stopped early (for
-  // example at a cliff: the step and position). The keys up to that point are kept.
+  // example at a cliff: the step and position). The keys up to that point are kept. A crowd's
+  // names its earliest stop and counts the others.
   std::string stopped;
+  // Every stopped character's reason, earliest step first (not written to files: the walk JSON
+  // carries `stopped` alone).
+  std::vector<std::string> stops;
 };
 
 const char* PhaseName(KeyPhase phase);  // "start", "mid", "end" or ""
