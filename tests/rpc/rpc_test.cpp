@@ -636,7 +636,8 @@ TEST_CASE("footfalld reads server files with every load option, as the embedded 
   CHECK_THAT(rpc->last_error(), Catch::Contains("up axis must be x, y or z"));
   o.up_axis = 'y', o.finest_default = -1;
   CHECK(rpc->LoadServerFile("bump.asc", o, &t) == Status::kInvalidArgument);
-  CHECK_THAT(rpc->last_error(), Catch::Contains("finest default separation must be >= 0"));
+  CHECK_THAT(rpc->last_error(),
+             Catch::Contains("finest default separation must be a finite number >= 0"));
   // On the wire, an up axis is an int: one that is 'y' only in its low byte is refused, not cut
   // down to 'y'; a NaN crease angle too. The server goes on serving.
   CLIENT* raw = RawClient(server.port());

@@ -1,7 +1,14 @@
 // The character file and walk JSON readers (round trips, each kind of bad input named), and the
 // C ABI's ffc_generate against GenerateWalk.
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include <catch2/catch.hpp>
 
@@ -180,5 +187,72 @@ TEST_CASE("ffc_generate gives the walk GenerateWalk gives", "[steps][c_api]") {
   CHECK_THAT(std::string(json), Catch::Contains("\"phase\":\"end\""));
   CHECK_THAT(ffc_last_error(s), Catch::StartsWith("step "));
   ffc_free_string(json);
+  ffc_close(s);
+}
+
+TEST_CASE("The C ABI refuses what would crash or hang it, and takes turns between threads",
+          "[steps][c_api]") {
+  ffc_session* s = ffc_open_embedded();
+  REQUIRE(s);
+  char* json = nullptr;
+  // A request nested 100,000 deep (serialising it again recursed once per level: a crash).
+  const std::string deep =
+      "{\"character\": " + std::string(100000, '[') + std::string(100000, ']') + "}";
+  CHECK(ffc_generate(s, 0, deep.c_str(), &json) == FF_C_PARSE_ERROR);
+  CHECK_THAT(ffc_last_error(s), Catch::Contains("nested deeper than"));
+  CHECK(json == nullptr);
+  // Malformed JSON says where; integers out of range are refused, not wrapped.
+  CHECK(ffc_generate(s, 0, R"({"steps": 3,})", &json) == FF_C_PARSE_ERROR);
+  CHECK_THAT(ffc_last_error(s), Catch::Contains("malformed JSON at byte"));
+  const std::string file = std::string(FOOTFALL_SOURCE_DIR) + "/data/characters/biped.json";
+  for (const char* field :
+       {R"("steps": 18446744073709551615)", R"("steps": -1)", R"("crowd": 0)", R"("crowd": -1)"}) {
+    const std::string request = R"({"character_file": ")" + file + "\", " + field + "}";
+    INFO(request);
+    CHECK(ffc_generate(s, 0, request.c_str(), &json) == FF_C_PARSE_ERROR);
+    CHECK_THAT(ffc_last_error(s), Catch::Contains("out of range"));
+  }
+  // A character file that is a FIFO: refused at once (opening it waited for a writer).
+  char dir[] = "/tmp/footfall-fifo-XXXXXX";
+  REQUIRE(mkdtemp(dir));
+  const std::string fifo = std::string(dir) + "/character.json";
+  REQUIRE(mkfifo(fifo.c_str(), 0600) == 0);
+  const std::string request = R"({"character_file": ")" + fifo + "\"}";
+  CHECK(ffc_generate(s, 0, request.c_str(), &json) == FF_C_INVALID_ARGUMENT);
+  CHECK_THAT(ffc_last_error(s), Catch::Contains("a FIFO, not a regular file"));
+  unlink(fifo.c_str());
+  rmdir(dir);
+  // Counts no memory can hold: a limit, not an internal error.
+  double point[3] = {0, 0, 0};
+  ffc_foothold out[1];
+  CHECK(ffc_snap(s, 0, point, ~size_t{0} / 2, out) == FF_C_LIMIT_EXCEEDED);
+  // Timeouts without a bound are refused.
+  CHECK(ffc_open_rpc(nullptr, 9, std::nan("")) == nullptr);
+  CHECK(ffc_open_rpc(nullptr, 9, HUGE_VAL) == nullptr);
+  CHECK(ffc_open_rpc(nullptr, 9, 1e300) == nullptr);
+  // A server-side path longer than the protocol carries: refused before any call is made.
+  ffc_session* rpc = ffc_open_rpc(nullptr, 9, 1);
+  REQUIRE(rpc);
+  uint32_t terrain = 0;
+  CHECK(ffc_load_server_file(rpc, std::string(5000, 'a').c_str(), 0, &terrain) ==
+        FF_C_INVALID_ARGUMENT);
+  CHECK_THAT(ffc_last_error(rpc), Catch::Contains("at most 1024 bytes"));
+  ffc_close(rpc);
+  // Four threads failing calls on one session and reading its error (the error string was
+  // shared unguarded: heap corruption).
+  std::vector<std::thread> threads;
+  std::atomic<int> wrong{0};
+  for (int t = 0; t < 4; ++t) {
+    threads.emplace_back([&, t] {
+      for (int i = 0; i < 2000; ++i) {
+        uint32_t handle = 0;
+        const std::string missing = "/nonexistent/" + std::to_string(t) + ".pts";
+        if (ffc_load_file(s, missing.c_str(), 0, &handle) != FF_C_IO_ERROR) ++wrong;
+        if (std::string(ffc_last_error(s)).find("cannot open") == std::string::npos) ++wrong;
+      }
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  CHECK(wrong == 0);
   ffc_close(s);
 }

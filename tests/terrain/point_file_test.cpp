@@ -94,5 +94,15 @@ TEST_CASE("ReadPointFile reports a missing file", "[terrain][point_file]") {
   RawSamples s;
   std::string error;
   CHECK(ReadPointFile("/nonexistent/terrain.pts", &s, &error) == Status::kIoError);
-  CHECK(error == "/nonexistent/terrain.pts: cannot open file");
+  CHECK(error == "/nonexistent/terrain.pts: cannot open file: No such file or directory");
+}
+
+TEST_CASE("ReadPointFile refuses a FIFO or a device at once", "[terrain][point_file]") {
+  RawSamples s;
+  std::string error;
+  // Reading /dev/zero never ends; opening a FIFO waits for a writer.
+  CHECK(ReadPointFile("/dev/zero", &s, &error) == Status::kInvalidArgument);
+  CHECK(error == "/dev/zero: cannot open file: a device, not a regular file");
+  CHECK(ReadPointFile("/tmp", &s, &error) == Status::kInvalidArgument);
+  CHECK(error == "/tmp: cannot open file: a directory");
 }

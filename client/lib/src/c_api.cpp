@@ -5,7 +5,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <mutex>
 #include <new>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -15,6 +17,9 @@
 #include "footfall/steps/walk_json.h"
 
 struct ffc_session {
+  // Calls on one session from several threads take turns (the sessions below are not
+  // thread-safe, and neither is `error`).
+  mutable std::mutex mutex;
   std::unique_ptr<footfall::TerrainSession> session;
   std::string error;
 };
@@ -23,6 +28,8 @@ namespace {
 
 using footfall::Foothold;
 using footfall::Status;
+
+constexpr double kMaxTimeout = 1e6;  // seconds, as footfall's --timeout
 
 int32_t Result(ffc_session* s, Status status) {
   if (status != Status::kOk) s->error = s->session->last_error();
@@ -44,10 +51,14 @@ void Copy(const Foothold& f, ffc_foothold* out) {
 template <typename Fn>
 int32_t Guard(ffc_session* s, Fn&& fn) {
   if (!s) return FF_C_INVALID_ARGUMENT;
+  std::lock_guard<std::mutex> lock(s->mutex);
   try {
     return fn();
   } catch (const std::bad_alloc&) {
     s->error = "out of memory";
+    return FF_C_LIMIT_EXCEEDED;
+  } catch (const std::length_error&) {
+    s->error = "too many items for memory";
     return FF_C_LIMIT_EXCEEDED;
   } catch (const std::exception& e) {
     s->error = std::string("internal error: ") + e.what();
@@ -93,6 +104,7 @@ ffc_session* ffc_open_embedded(void) {
 ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s) {
   std::signal(SIGPIPE, SIG_IGN);
   if (port < 1 || port > 65535) return nullptr;
+  if (!(timeout_s <= kMaxTimeout)) return nullptr;  // NaN, infinite or beyond any bound
   try {
     footfall::RpcOptions options;
     if (host && *host) options.host = host;
@@ -109,7 +121,12 @@ ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s) {
 void ffc_close(ffc_session* session) { delete session; }
 
 const char* ffc_last_error(const ffc_session* session) {
-  return session ? session->error.c_str() : "no session";
+  if (!session) return "no session";
+  // The calling thread's copy: another thread's call may replace the session's meanwhile.
+  thread_local std::string copy;
+  std::lock_guard<std::mutex> lock(session->mutex);
+  copy = session->error;
+  return copy.c_str();
 }
 
 const char* ffc_status_name(int32_t status) {

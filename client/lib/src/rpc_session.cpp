@@ -73,6 +73,11 @@ class RpcSession final : public TerrainSession {
 
   Status LoadServerFile(const std::string& path, const TerrainLoadOptions& options,
                         TerrainHandle* out) override {
+    if (path.size() > FF_MAX_PATH || path.find('\0') != std::string::npos) {
+      return Fail(Status::kInvalidArgument,
+                  "a server-side path is at most " + std::to_string(FF_MAX_PATH) +
+                      " bytes, without NUL (this one: " + std::to_string(path.size()) + ")");
+    }
     TerrainSource source;
     source.kind = TerrainSource::kServerFile;
     source.path = path, source.options = options, source.name = path;

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "footfall/terrain/input_file.h"
 #include "json_input.h"
 
 namespace footfall {
@@ -262,6 +263,8 @@ Vec3 RestCentroid(const Character& c) {
 }
 
 Status LoadCharacter(const std::string& path, Character* out, std::string* error) {
+  const Status status = CheckInputFile(path, "character file", error);
+  if (status != Status::kOk) return status;
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     *error = path + ": cannot open character file";

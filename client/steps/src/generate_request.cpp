@@ -40,8 +40,26 @@ bool ReadNumber(const json& j, const char* key, double* out, std::string* error)
 
 Status ParseGenerateRequest(const std::string& text, Character* character, GenerateOptions* options,
                             std::string* error) {
-  const json j = json::parse(text, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) {
+  // Nesting deeper than any request needs is refused: serialising the character object again
+  // (below) recurses once per level, and a plugin thread's stack is small.
+  constexpr int kMaxDepth = 32;
+  bool too_deep = false;
+  json j;
+  try {
+    j = json::parse(text, [&](int depth, json::parse_event_t, json&) {
+      too_deep |= depth > kMaxDepth;
+      return true;
+    });
+  } catch (const json::parse_error& e) {
+    *error = "request: malformed JSON at byte " + std::to_string(e.byte) + ": " +
+             std::string(e.what()).substr(std::string(e.what()).find(':') + 2);
+    return Status::kParseError;
+  }
+  if (too_deep) {
+    *error = "request: nested deeper than " + std::to_string(kMaxDepth) + " levels";
+    return Status::kParseError;
+  }
+  if (!j.is_object()) {
     *error = "request: not a JSON object";
     return Status::kParseError;
   }
@@ -96,9 +114,14 @@ Status ParseGenerateRequest(const std::string& text, Character* character, Gener
       *error = std::string("request: '") + key + "': expected an integer";
       ok = false;
     } else {
-      const long long v = j[key].get<long long>();
-      if (v < -1 || v > 1000000) {
-        *error = std::string("request: '") + key + "': out of range";
+      // (An unsigned number above 2^63 would read as negative.)
+      const long long v = j[key].is_number_unsigned() && j[key].get<uint64_t>() > 1000000
+                              ? 1000001
+                              : j[key].get<long long>();
+      const long long lo = std::string(key) == "steps" ? 0 : 1;
+      if (v < lo || v > 1000000) {
+        *error = std::string("request: '") + key + "': out of range (expected " +
+                 std::to_string(lo) + " to 1000000)";
         ok = false;
       } else {
         (std::string(key) == "steps" ? o.steps : o.crowd) = static_cast<int>(v);

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "footfall/terrain/input_file.h"
 #include "json_input.h"
 
 namespace footfall {
@@ -247,6 +248,8 @@ Status ParseWalkJson(const std::string& text, const std::string& source, Walk* o
 }
 
 Status ReadWalkJson(const std::string& path, Walk* out, std::string* error) {
+  const Status status = CheckInputFile(path, "walk file", error);
+  if (status != Status::kOk) return status;
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     *error = path + ": cannot open walk file";

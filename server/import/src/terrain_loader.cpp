@@ -8,6 +8,7 @@
 #include "footfall/import/mesh_reader.h"
 #include "footfall/import/mesh_sampler.h"
 #include "footfall/terrain/file_extension.h"
+#include "footfall/terrain/input_file.h"
 #include "footfall/terrain/point_file.h"
 
 namespace footfall {
@@ -20,10 +21,12 @@ namespace {
 
 Status CheckOptions(const TerrainLoadOptions& o, std::string* error) {
   std::string what;
-  if (!(std::isfinite(o.separation) && o.separation >= 0)) what = "separation must be >= 0";
+  if (!(std::isfinite(o.separation) && o.separation >= 0))
+    what = "separation must be a finite number >= 0";
   if (!(std::isfinite(o.finest_default) && o.finest_default >= 0))
-    what = "finest default separation must be >= 0";
-  if (!(std::isfinite(o.cell_size) && o.cell_size >= 0)) what = "cell size must be >= 0";
+    what = "finest default separation must be a finite number >= 0";
+  if (!(std::isfinite(o.cell_size) && o.cell_size >= 0))
+    what = "cell size must be a finite number >= 0";
   if (!std::isfinite(o.height_scale)) what = "height scale must be finite";
   if (o.up_axis != 'x' && o.up_axis != 'y' && o.up_axis != 'z') what = "up axis must be x, y or z";
   if (!(o.crease_angle_deg >= 0 && o.crease_angle_deg <= 180))
@@ -81,6 +84,10 @@ Status ReadTerrainMesh(const std::string& path, const TerrainLoadOptions& option
   Status status = CheckOptions(options, error);
   if (status != Status::kOk) return status;
   const std::string ext = FileExtension(path);
+  if (!IsPointFileExtension(ext)) {
+    status = CheckInputFile(path, "terrain file", error);
+    if (status != Status::kOk) return status;
+  }
   if (IsPointFileExtension(ext)) {
     if (error) *error = path + ": a point file, not a mesh or height map";
     return Status::kInvalidArgument;

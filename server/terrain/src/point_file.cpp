@@ -9,6 +9,8 @@
 #include <string_view>
 #include <system_error>
 
+#include "footfall/terrain/input_file.h"
+
 namespace footfall {
 namespace {
 
@@ -100,6 +102,9 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
 }
 
 Status ReadPointFile(const std::string& path, RawSamples* out, std::string* error) {
+  out->clear();
+  const Status status = CheckInputFile(path, "file", error);
+  if (status != Status::kOk) return status;
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     out->clear();

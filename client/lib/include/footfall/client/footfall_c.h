@@ -3,8 +3,9 @@
  * A session is the embedded engine or a footfalld connection. Every function returns an
  * ff_c_status (0 = FF_C_OK, same values as ff_status in rpc/footfall.x); on failure,
  * ffc_last_error() gives a one-line reason. No function throws, aborts or raises a signal
- * (SIGPIPE is ignored once a session is opened). Sessions are not thread-safe: one per thread.
- * Points are world space, 3 doubles each; normals are unit.
+ * (SIGPIPE is ignored once a session is opened). Calls on one session from several threads
+ * take turns; open a session per thread to query in parallel. Counts no memory can hold give
+ * FF_C_LIMIT_EXCEEDED. Points are world space, 3 doubles each; normals are unit.
  */
 #ifndef FOOTFALL_C_H_
 #define FOOTFALL_C_H_
@@ -47,10 +48,14 @@ int ffc_abi_version(void);
 /* Opens the in-process engine. Never NULL. */
 ffc_session* ffc_open_embedded(void);
 /* Opens a footfalld client; it connects lazily (the first call may return FF_C_UNAVAILABLE).
- * host NULL means 127.0.0.1; timeout_s <= 0 means 10 s per call. NULL only on bad arguments. */
+ * host NULL means 127.0.0.1; timeout_s <= 0 means 10 s per call. NULL only on bad arguments:
+ * a port outside 1-65535, a timeout above 1e6 s, infinite or NaN. */
 ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s);
+/* Frees the session and its terrains: the pointer is invalid afterwards (closing it twice, or
+ * while another thread is in a call on it, is undefined). NULL is ignored. */
 void ffc_close(ffc_session* session);
-/* The reason for the session's last failed call; valid until the next call. Never NULL. */
+/* The reason for the session's last failed call (from any thread), as a copy that stays valid
+ * until this thread calls ffc_last_error again. Not cleared by calls that succeed. Never NULL. */
 const char* ffc_last_error(const ffc_session* session);
 /* A stable name for a status, e.g. "no_foothold". */
 const char* ffc_status_name(int32_t status);
@@ -80,7 +85,10 @@ int32_t ffc_next(ffc_session* s, uint32_t terrain, const double* steps, size_t c
 /* Generates a walk with the step generator, exactly as `footfall generate` does.
  * request_json: {"character": {...character file object...} or "character_file": PATH,
  *                "start": [x,y,z], "heading": [x,y,z], "path": [[x,y,z],...], "steps": N,
- *                "start_frame": F, "up": [x,y,z]} (keys as the command's flags).
+ *                "start_frame": F, "up": [x,y,z], "fps": F, "crowd": N, "crowd_spacing": D}
+ * (keys as the command's flags; steps 0 to 1e6, crowd 1 to 1e6, crowd_spacing 0 for the
+ * default; nesting deeper than 32 levels is refused; the character file must be a regular
+ * file).
  * On FF_C_OK and on a walk that stopped early, *walk_json receives the walk as footfall's JSON
  * (release it with ffc_free_string); a walk that stopped early returns FF_C_NO_FOOTHOLD,
  * still fills *walk_json with the keys so far, and sets ffc_last_error() to why it stopped. */
