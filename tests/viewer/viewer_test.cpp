@@ -343,6 +343,29 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     CHECK(r.exit_code == 2);
     CHECK_THAT(r.err, Catch::Contains("direction DX DY DZ must be non-zero"));
   }
+  SECTION("points no camera can frame") {
+    // (A point 1e300 away put the camera at NaN: a blank image and exit 0.)
+    RunResult r = View({"--terrain", kTerrain, "--query", "snap 1e300 0 0", "--screenshot", shot});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("expected a point within +-1e15"));
+    test::WriteFile(dir + "/far.json",
+                    "{\"format\": \"footfall-walk\", \"version\": 1, \"fps\": 24, \"tracks\": "
+                    "[{\"name\": \"L\", \"kind\": \"foot\", \"keys\": [{\"frame\": 1, "
+                    "\"phase\": \"end\", \"position\": [1e308, 0, 0], \"normal\": [0, 1, 0]}]}]}");
+    r = View({"--walk", dir + "/far.json", "--screenshot", shot});
+    CHECK(r.exit_code == 1);
+    CHECK_THAT(r.err, Catch::Contains("tracks[0].keys[0].position: expected coordinates within "
+                                      "+-1e15"));
+  }
+  SECTION("screenshots that cannot be written") {
+    // An empty path ran the interactive viewer (a hang under Xvfb); a full disk gave exit 0.
+    RunResult r = View({"--terrain", kTerrain, "--screenshot", ""});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("--screenshot: expected a PNG file path"));
+    r = View({"--terrain", kTerrain, "--screenshot", "/dev/full"});
+    CHECK(r.exit_code == 1);
+    CHECK_THAT(r.err, Catch::Contains("/dev/full: cannot write PNG: No space left on device"));
+  }
   SECTION("unreachable server") {
     const RunResult r = View({"--server", "127.0.0.1:1", "--live", "--screenshot", shot});
     CHECK(r.exit_code == 1);

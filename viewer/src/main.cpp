@@ -58,7 +58,8 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--timeout", o.timeout_s, "Bound on waits for the server (s)")
       ->check(footfall::cli::FiniteRange(0.001, 1e6));
-  app.add_option("--screenshot", o.screenshot, "Render one frame off screen to this PNG and exit");
+  app.add_option("--screenshot", o.screenshot, "Render one frame off screen to this PNG and exit")
+      ->check(footfall::cli::NotBlank("a PNG file path"));
   app.add_option("--size", size, "Window or image size WxH (default 1280x800)");
   auto* frame_opt = app.add_option("--frame", frame, "Walk frame to show")
                         ->check(footfall::cli::FiniteRange(-1e9, 1e9));

@@ -1,9 +1,32 @@
 #include "footfall/viewer/png_writer.h"
 
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 
 namespace footfall::viewer {
+namespace {
+
+// stb's own file writer ignores write errors (a full disk gave a truncated PNG and success):
+// the PNG is written through this sink, which remembers the first failure.
+struct Sink {
+  FILE* file = nullptr;
+  int error = 0;  // errno of the first failed write
+};
+
+void Write(void* context, void* data, int size) {
+  Sink* sink = static_cast<Sink*>(context);
+  if (sink->error == 0 && size > 0 &&
+      std::fwrite(data, 1, static_cast<size_t>(size), sink->file) != static_cast<size_t>(size))
+    sink->error = errno ? errno : EIO;
+}
+
+}  // namespace
 
 bool WritePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgba,
               std::string* error) {
@@ -16,8 +39,21 @@ bool WritePng(const std::string& path, int width, int height, const std::vector<
   for (size_t i = 0; i < pixels; ++i) {
     rgb[i * 3] = rgba[i * 4], rgb[i * 3 + 1] = rgba[i * 4 + 1], rgb[i * 3 + 2] = rgba[i * 4 + 2];
   }
-  if (!stbi_write_png(path.c_str(), width, height, 3, rgb.data(), width * 3)) {
-    *error = path + ": cannot write PNG";
+  Sink sink;
+  sink.file = std::fopen(path.c_str(), "wb");
+  if (!sink.file) {
+    *error = path + ": cannot write PNG: " + std::strerror(errno);
+    return false;
+  }
+  const int encoded = stbi_write_png_to_func(Write, &sink, width, height, 3, rgb.data(), width * 3);
+  if (std::fflush(sink.file) != 0 && sink.error == 0) sink.error = errno ? errno : EIO;
+  if (std::fclose(sink.file) != 0 && sink.error == 0) sink.error = errno ? errno : EIO;
+  if (!encoded || sink.error) {
+    *error = path + ": cannot write PNG" +
+             (sink.error ? std::string(": ") + std::strerror(sink.error) : std::string());
+    struct stat st;
+    if (::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode))
+      std::remove(path.c_str());  // not a truncated image left behind (never a device)
     return false;
   }
   return true;

@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "footfall/client/recent_queries.h"
+#include "footfall/steps/walk_json.h"
 #include "footfall/viewer/png_writer.h"
 #include "footfall/viewer/renderer.h"
 #include "footfall/viewer/scene.h"
@@ -385,6 +386,13 @@ int RunViewer(const ViewerOptions& options) {
     QuerySpec spec;
     std::string error;
     if (!ParseQueryText(text, &spec, &error)) return Fail("--query \"" + text + "\": " + error, 2);
+    // (Drawn, a point 1e300 away put the camera at NaN and gave a blank image.)
+    const Vec3& p = spec.point;
+    if (!(std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) <= kMaxKeyCoordinate))
+      return Fail("--query \"" + text +
+                      "\": expected a point within +-1e15 (nothing farther "
+                      "can be drawn)",
+                  2);
     spec.tolerance = options.tolerance;
     specs.push_back(spec);
   }

@@ -283,16 +283,6 @@ bad_flag:
   return 1;
 }
 
-// Refuses an empty or blank value: `--path ""` would otherwise read as no path at all.
-CLI::Validator NotBlank(const std::string& expected) {
-  return CLI::Validator(
-      [expected](std::string& value) {
-        return value.find_first_not_of(" \t") == std::string::npos ? "expected " + expected
-                                                                   : std::string();
-      },
-      "");
-}
-
 }  // namespace
 
 void AddGenerateCommand(CLI::App& app, int* exit_code) {

@@ -45,6 +45,15 @@ CLI::Validator FiniteRange(double lo, double hi) {
               [lo, hi](double x) { return x >= lo && x <= hi; });
 }
 
+CLI::Validator NotBlank(const std::string& expected) {
+  return CLI::Validator(
+      [expected](std::string& value) {
+        return value.find_first_not_of(" \t") == std::string::npos ? "expected " + expected
+                                                                   : std::string();
+      },
+      "");
+}
+
 CLI::Validator FiniteAboveUpTo(double lo, double hi) {
   return Make("a finite number > " + Text(lo) + " and <= " + Text(hi),
               [lo, hi](double x) { return x > lo && x <= hi; });

@@ -65,6 +65,15 @@ struct Reader {
     *out = {v[0], v[1], v[2]};
     return true;
   }
+  // A key's position: within +-kMaxKeyCoordinate (a viewer framing a key at 1e300 got NaN).
+  bool Position(const json& j, const std::string& where, Vec3* out) {
+    if (!Vec(j, where, out)) return false;
+    for (double v : {out->x, out->y, out->z})
+      if (!(std::fabs(v) <= kMaxKeyCoordinate))
+        return Fail(where,
+                    "expected coordinates within +-1e15 (terrain samples lie within +-5e14)");
+    return true;
+  }
 };
 
 }  // namespace
@@ -210,7 +219,7 @@ Status ParseWalkJson(const std::string& text, const std::string& source, Walk* o
           r.Fail(kw + ".frame", "frames must increase along a track");
           break;
         }
-        if (!r.Vec(k["position"], kw + ".position", &key.position)) break;
+        if (!r.Position(k["position"], kw + ".position", &key.position)) break;
         if (track.kind == TrackKind::kFoot) {
           const std::string phase =
               k.contains("phase") && k["phase"].is_string() ? k["phase"].get<std::string>() : "?";

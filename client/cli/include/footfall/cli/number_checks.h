@@ -1,6 +1,6 @@
-// CLI11 checks for the floating-point flags of every `footfall` command: each refuses NaN,
-// infinities and text that is not a number, and names its bounds as plain numbers ("0 to 1e+06",
-// not CLI11's 309-digit limits of double).
+// CLI11 checks for the flags of every `footfall` command and of footfall-view. The number checks
+// refuse NaN, infinities and text that is not a number, and name their bounds as plain numbers
+// ("0 to 1e+06", not CLI11's 309-digit limits of double).
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -17,5 +17,8 @@ CLI::Validator FiniteAbove(double lo);
 CLI::Validator FiniteRange(double lo, double hi);
 // A finite number in (lo, hi].
 CLI::Validator FiniteAboveUpTo(double lo, double hi);
+// Text that is not empty or blank ("expected EXPECTED" otherwise): a flag given an unset shell
+// variable.
+CLI::Validator NotBlank(const std::string& expected);
 
 }  // namespace footfall::cli

@@ -23,11 +23,15 @@ std::string WalkToJson(const Walk& walk);
 // Writes WalkToJson(walk) to `path`. kIoError with a message naming the file on failure.
 Status WriteWalkJson(const Walk& walk, const std::string& path, std::string* error);
 
+// Keys lie within +-this of the origin: terrain samples within +-5e14 (terrain::kMaxCoordinate),
+// and what a walk adds above them.
+constexpr double kMaxKeyCoordinate = 1e15;
+
 // Parses walk JSON. `source` names it in errors: "SOURCE:LINE:COLUMN: malformed JSON: ..." for
 // text that is not JSON, "SOURCE: tracks[2].keys[5].position: expected an array of 3 numbers"
-// for a wrong structure. Frames must increase along each track and body rotations must be
-// non-zero quaternions (read as written, not normalised). kParseError for malformed or
-// unsupported input.
+// for a wrong structure. Frames must increase along each track, positions lie within
+// +-kMaxKeyCoordinate and body rotations must be non-zero quaternions (read as written, not
+// normalised). kParseError for malformed or unsupported input.
 Status ParseWalkJson(const std::string& text, const std::string& source, Walk* out,
                      std::string* error);
 
