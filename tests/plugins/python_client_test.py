@@ -68,6 +68,30 @@ class EmbeddedTest(unittest.TestCase):
         self.assertEqual(e.exception.status_name, "unknown_terrain")
         self.assertTrue(e.exception.message)
 
+    def test_paths_as_bytes_path_objects_and_undecodable_names(self):
+        import pathlib
+        import shutil
+        # bytes were sent as the text "b'...'"; an undecodable name raised UnicodeEncodeError.
+        t = self.s.load_file(HILLS.encode())
+        self.assertEqual(self.s.info(t)[0], self.s.info(self.s.load_file(pathlib.Path(HILLS)))[0])
+        folder = tempfile.mkdtemp()
+        try:
+            odd = os.path.join(folder.encode(), b"h\xe9\xff.pts")
+            shutil.copyfile(HILLS, odd)
+            name = os.fsdecode(odd)  # a str holding surrogate escapes
+            self.assertEqual(self.s.info(self.s.load_file(name))[0], self.s.info(t)[0])
+        finally:
+            shutil.rmtree(folder)
+        with self.assertRaises(ff.FootfallError) as e:
+            self.s.load_file(12345)
+        self.assertEqual(e.exception.status_name, "invalid_argument")
+
+    def test_unbounded_timeouts_are_refused(self):
+        for timeout in (float("inf"), float("nan"), 1e300, "soon"):
+            with self.assertRaises(ff.FootfallError) as e:
+                ff.Session.rpc("127.0.0.1", 9, timeout)
+            self.assertIn("timeout", e.exception.message)
+
     def test_closed_session_raises_instead_of_crashing(self):
         self.s.close()
         with self.assertRaises(ff.FootfallError) as e:

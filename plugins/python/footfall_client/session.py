@@ -2,6 +2,7 @@
 
 import ctypes
 import json
+import os
 from array import array
 from collections import namedtuple
 
@@ -49,6 +50,15 @@ Foothold = namedtuple("Foothold", "status status_name index point normal")
 Foothold.ok = property(lambda self: self.status == OK)
 
 
+def _path_bytes(path, function):
+    """A path (str, bytes or os.PathLike) as the bytes the C library opens: str paths as the
+    file system encodes them (undecodable names round-trip), bytes as they are."""
+    try:
+        return os.fsencode(path)
+    except (TypeError, UnicodeError) as e:
+        raise FootfallError(INVALID_ARGUMENT, "path %r: %s" % (path, e), function)
+
+
 def _flat(rows, width, what):
     """rows: a sequence of `width`-tuples, or an already flat sequence of floats -> array('d')."""
     flat = array("d")
@@ -91,7 +101,14 @@ class Session:
         lib = load_library(library)
         if not isinstance(port, int) or not 1 <= port <= 65535:
             raise FootfallError(INVALID_ARGUMENT, "port %r: expected 1 to 65535" % (port,), "ffc_open_rpc")
-        handle = lib.lib.ffc_open_rpc((host or "").encode(), port, float(timeout))
+        try:
+            timeout = float(timeout)
+        except (TypeError, ValueError):
+            timeout = float("nan")
+        if not timeout <= 1e6:
+            raise FootfallError(INVALID_ARGUMENT, "timeout %r: expected at most 1e6 seconds"
+                                % (timeout,), "ffc_open_rpc")
+        handle = lib.lib.ffc_open_rpc((host or "").encode(), port, timeout)
         if not handle:
             raise FootfallError(INVALID_ARGUMENT, "cannot open a client for %s:%d" % (host, port),
                                 "ffc_open_rpc")
@@ -160,16 +177,18 @@ class Session:
         separation [world units] resamples meshes (0: the library's default)."""
         h = self._handle("ffc_load_file")
         out = ctypes.c_uint32()
-        self._check(self._lib.lib.ffc_load_file(h, str(path).encode(), float(separation),
-                                                ctypes.byref(out)), "ffc_load_file")
+        self._check(self._lib.lib.ffc_load_file(h, _path_bytes(path, "ffc_load_file"),
+                                                float(separation), ctypes.byref(out)),
+                    "ffc_load_file")
         return out.value
 
     def load_server_file(self, path, separation=0.0):
         """Loads a file under footfalld's data root (RPC) or a local path (embedded)."""
         h = self._handle("ffc_load_server_file")
         out = ctypes.c_uint32()
-        self._check(self._lib.lib.ffc_load_server_file(h, str(path).encode(), float(separation),
-                                                       ctypes.byref(out)), "ffc_load_server_file")
+        self._check(self._lib.lib.ffc_load_server_file(h, _path_bytes(path, "ffc_load_server_file"),
+                                                       float(separation), ctypes.byref(out)),
+                    "ffc_load_server_file")
         return out.value
 
     def load_samples(self, samples, name="samples"):
@@ -179,7 +198,8 @@ class Session:
         flat = _flat(samples, 6, "samples")
         out = ctypes.c_uint32()
         self._check(self._lib.lib.ffc_load_samples(h, _pointer(flat), len(flat) // 6,
-                                                   name.encode(), ctypes.byref(out)),
+                                                   str(name).encode("utf-8", "replace"),
+                                                   ctypes.byref(out)),
                     "ffc_load_samples")
         return out.value
 
