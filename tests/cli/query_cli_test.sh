@@ -77,6 +77,9 @@ check "402 answers" [ "$(wc -l < "$work/rpc.jsonl")" -eq 402 ]
 err=$(echo "snap 0 0 0" | "$footfall" query --server-terrain ../../etc/passwd --server "127.0.0.1:$port" 2>&1 >/dev/null)
 check "escape refused: exit 1" [ $? -eq 1 ]
 check "escape refused: message" grep -qF "'../../etc/passwd' leads outside the data root" <<< "$err"
+err=$(echo "snap 0 0 0" | "$footfall" query --server-terrain sub/../flat.pts --server "127.0.0.1:$port" 2>&1 >/dev/null)
+check "'..' within the root refused: exit 1" [ $? -eq 1 ]
+check "'..' within the root refused: message" grep -qF "'sub/../flat.pts': '..' is not allowed in a path under the data root" <<< "$err"
 check "server logs loads" grep -q "loaded terrain" "$work/server.log"
 stop_server
 err=$(echo "snap 0 0 0" | "$footfall" query --terrain "$work/flat.pts" --server "127.0.0.1:$port" 2>&1 >/dev/null)
@@ -98,5 +101,20 @@ done
 err=$(timeout 5 "$footfalld" --listen 127.0.0.1:0 --no-rpcbind --port-file "$work/no/such/dir/port" 2>&1)
 check "footfalld unwritable --port-file: exit 1" [ $? -eq 1 ]
 check "footfalld unwritable --port-file: message" grep -qF -- "--port-file $work/no/such/dir/port: cannot write the port there" <<< "$err"
+# A low soft limit on descriptors is raised to the hard one (at the limit libtirpc closes the
+# least recently active connections, an idle client's among them).
+hard=$(ulimit -Hn)
+[ "$hard" = unlimited ] && hard=1048576
+if [ "$hard" -gt 64 ]; then
+  (ulimit -Sn 64; exec "$footfalld" --listen 127.0.0.1:0 --no-rpcbind --port-file "$work/port2" 2> "$work/limit.log") &
+  limited=$!
+  for _ in $(seq 100); do [ -s "$work/port2" ] && break; sleep 0.05; done
+  soft=$(awk '/Max open files/ { print $4 }' "/proc/$limited/limits")
+  check "footfalld raises its descriptor limit to the hard one" [ "$soft" = "$hard" ]
+  check "footfalld says so" grep -q "open descriptor limit raised from 64 to" "$work/limit.log"
+  kill "$limited"; wait "$limited" 2>/dev/null
+else
+  check "a hard descriptor limit above 64 to test with" false
+fi
 
 finish

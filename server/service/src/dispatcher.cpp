@@ -476,7 +476,9 @@ void ServeWith(SVCXPRT* transport, xdrproc_t decode, Args& args, xdrproc_t encod
   if (!svc_getargs(transport, decode, reinterpret_cast<char*>(&args))) {
     svc_freeargs(transport, decode, reinterpret_cast<char*>(&args));
     svcerr_decode(transport);
-    Log(std::string("error: ") + proc + ": malformed request rejected");
+    Log(std::string("error: ") + proc +
+        ": malformed request rejected (its arguments do not decode: more items than the "
+        "protocol allows or than were sent, a string too long, or a value out of its type)");
     return;
   }
   Res res{};
@@ -588,7 +590,8 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
     case FF_NORMAL: {
       const int op = request->rq_proc == FF_SNAP ? FF_OP_SNAP : FF_OP_NORMAL;
       return Serve<ff_point_args, ff_result>(
-          transport, FF_XDR(ff_point_args), FF_XDR(ff_result), "snap",
+          transport, FF_XDR(ff_point_args), FF_XDR(ff_result),
+          request->rq_proc == FF_SNAP ? "snap" : "normal",
           [op](const ff_point_args& a, ff_result* r) { Point(a, r, op); });
     }
     case FF_NEXT:
@@ -602,7 +605,8 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
       args.capacity = FF_MAX_BATCH;
       return ServeWith<PointBatchView<Vec3>, BatchReplyView<Foothold>>(
           transport, AsXdrProc(XdrPointBatchView<Vec3>), args,
-          AsXdrProc(XdrBatchReplyView<Foothold>), "snap batch",
+          AsXdrProc(XdrBatchReplyView<Foothold>),
+          request->rq_proc == FF_SNAP_BATCH ? "snap batch" : "normal batch",
           [op](const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r) {
             PointBatch(a, r, op);
           });

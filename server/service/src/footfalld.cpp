@@ -1,5 +1,6 @@
 // footfalld: the footfall terrain query server (ONC RPC over TCP).
 #include <signal.h>
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <cmath>
@@ -67,6 +68,21 @@ CLI::Validator SampleCount() {
 
 }  // namespace
 
+// Raises the soft limit on open descriptors to the hard one: at the limit, libtirpc closes the
+// least recently active connections to accept new ones (an idle client that owns terrains
+// among them), so the limit is what a flood of connections must reach.
+static void RaiseOpenFileLimit() {
+  struct rlimit limit;
+  if (getrlimit(RLIMIT_NOFILE, &limit) != 0 || limit.rlim_cur >= limit.rlim_max) return;
+  const rlim_t before = limit.rlim_cur;
+  // (An unlimited hard limit still stops at the kernel's nr_open: ask for a million.)
+  limit.rlim_cur = limit.rlim_max == RLIM_INFINITY ? rlim_t{1} << 20 : limit.rlim_max;
+  if (setrlimit(RLIMIT_NOFILE, &limit) == 0)
+    std::fprintf(stderr, "footfalld: open descriptor limit raised from %llu to %llu\n",
+                 static_cast<unsigned long long>(before),
+                 static_cast<unsigned long long>(limit.rlim_cur));
+}
+
 int main(int argc, char** argv) {
   CLI::App app{"footfalld: serves footfall terrain queries over ONC RPC (TCP)"};
   std::string listen = "127.0.0.1:7407";
@@ -113,6 +129,7 @@ int main(int argc, char** argv) {
 
   std::signal(SIGPIPE, SIG_IGN);
   setvbuf(stderr, nullptr, _IOLBF, 0);
+  RaiseOpenFileLimit();
   bool abandoned_load = false;
   {
     footfall::RpcServer server(options);

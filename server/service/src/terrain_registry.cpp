@@ -89,11 +89,22 @@ Status ResolveUnderRoot(const std::string& root, const std::string& relative, st
   }
   // Every path that leaves the root gets this one answer, whether or not its target exists.
   const std::string outside = "'" + relative + "' leads outside the data root";
+  // '..' is refused whatever it leads to; read without the file system (no answer tells what
+  // exists), a path whose '..' stays within the root is told so.
+  int depth = 0;
+  bool climbs = false, leaves = false;
   for (const std::string& part : Components(relative)) {
     if (part == "..") {
-      *message = outside;
-      return Status::kAccessDenied;
+      climbs = true;
+      leaves |= --depth < 0;
+    } else if (part != "." && !part.empty()) {
+      ++depth;
     }
+  }
+  if (climbs) {
+    *message =
+        leaves ? outside : "'" + relative + "': '..' is not allowed in a path under the data root";
+    return Status::kAccessDenied;
   }
   const std::string joined = root + "/" + relative;
   char buffer[PATH_MAX];
