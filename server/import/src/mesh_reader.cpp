@@ -20,29 +20,21 @@ struct DoubleTraits : public OpenMesh::DefaultTraits {
 };
 using PolyMesh = OpenMesh::PolyMesh_ArrayKernelT<DoubleTraits>;
 
-// OpenMesh reports problems on its global streams omerr/omlog/omout. While reading we send
-// them to a buffer (counting its messages) instead of the process's stderr; a mutex keeps
-// concurrent loads from mixing their messages.
+// OpenMesh reports problems on its global streams omerr/omlog/omout. They go, for good, to a
+// buffer of ours instead of the process's stderr: connected once, as OpenMesh's disconnect never
+// frees what its connect allocated (connecting for each read leaked 96 bytes a mesh). A read
+// holds the buffer, empty when it starts, behind a mutex so concurrent loads do not mix their
+// messages.
 class CapturedOpenMeshMessages {
  public:
   CapturedOpenMeshMessages() : lock_(Mutex()) {
-    had_cerr_ = ::omerr().disconnect(std::cerr);
-    had_clog_ = ::omlog().disconnect(std::clog);
-    had_cout_ = ::omout().disconnect(std::cout);
-    ::omerr().connect(buffer_);
-    ::omlog().connect(buffer_);
-    ::omout().connect(buffer_);
+    Buffer().str("");
+    Buffer().clear();
   }
-  ~CapturedOpenMeshMessages() {
-    Finish();
-    if (had_cerr_) ::omerr().connect(std::cerr);
-    if (had_clog_) ::omlog().connect(std::clog);
-    if (had_cout_) ::omout().connect(std::cout);
-  }
-  // Everything OpenMesh said so far.
+  // Everything OpenMesh said since this capture started.
   std::string Text() {
-    Finish();
-    return buffer_.str();
+    ::omerr().flush(), ::omlog().flush(), ::omout().flush();
+    return Buffer().str();
   }
 
  private:
@@ -50,17 +42,17 @@ class CapturedOpenMeshMessages {
     static std::mutex mutex;
     return mutex;
   }
-  void Finish() {
-    if (finished_) return;
-    ::omerr().flush(), ::omlog().flush(), ::omout().flush();
-    ::omerr().disconnect(buffer_);
-    ::omlog().disconnect(buffer_);
-    ::omout().disconnect(buffer_);
-    finished_ = true;
+  static std::ostringstream& Buffer() {
+    static std::ostringstream* const buffer = [] {
+      auto* b = new std::ostringstream;  // never freed: OpenMesh's streams write to it to the end
+      ::omerr().disconnect(std::cerr), ::omlog().disconnect(std::clog);
+      ::omout().disconnect(std::cout);
+      ::omerr().connect(*b), ::omlog().connect(*b), ::omout().connect(*b);
+      return b;
+    }();
+    return *buffer;
   }
   std::lock_guard<std::mutex> lock_;
-  std::ostringstream buffer_;
-  bool had_cerr_ = false, had_clog_ = false, had_cout_ = false, finished_ = false;
 };
 
 size_t CountOccurrences(const std::string& text, const std::string& what) {
