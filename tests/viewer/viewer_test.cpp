@@ -402,6 +402,9 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     RunResult r = View({"--terrain", kTerrain, "--size", "12by4", "--screenshot", shot});
     CHECK(r.exit_code == 2);
     CHECK_THAT(r.err, Catch::Contains("--size \"12by4\": expected WIDTHxHEIGHT"));
+    r = View({"--terrain", kTerrain, "--size", "20000x20000", "--screenshot", shot});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("in whole pixels from 1 to 16384"));
     r = View({"--screenshot", shot});
     CHECK(r.exit_code == 2);
     CHECK_THAT(r.err, Catch::Contains("nothing to show"));

@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
         wh[0] != std::floor(wh[0]) || wh[1] != std::floor(wh[1]) || wh[0] < 1 || wh[1] < 1 ||
         wh[0] > 16384 || wh[1] > 16384) {
       std::cerr << "footfall-view: --size \"" << size
-                << "\": expected WIDTHxHEIGHT in pixels, e.g. 1280x800\n";
+                << "\": expected WIDTHxHEIGHT in whole pixels from 1 to 16384, e.g. 1280x800\n";
       return 2;
     }
     o.width = static_cast<int>(wh[0]), o.height = static_cast<int>(wh[1]);
