@@ -60,14 +60,6 @@ std::vector<const WalkTrack*> TracksOf(const Walk& w, const std::string& charact
 
 namespace {
 
-// Whether keys[i] is where a swing starts: a start key, or a touch-down followed by a mid key
-// (a foot that lifts on the frame it lands, in a gait of one group).
-bool LiftsAt(const std::pmr::vector<WalkKey>& keys, size_t i) {
-  if (keys[i].phase == KeyPhase::kStart) return true;
-  return keys[i].phase == KeyPhase::kEnd && i + 1 < keys.size() &&
-         keys[i + 1].phase == KeyPhase::kMid;
-}
-
 Vec3 QuatAxisY(const Quat& q) {
   return {2 * (q.x * q.y - q.w * q.z), 1 - 2 * (q.x * q.x + q.z * q.z),
           2 * (q.y * q.z + q.w * q.x)};
@@ -115,7 +107,7 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
         REQUIRE(k[i + 1].phase != KeyPhase::kEnd);
         if (k[i + 1].phase == KeyPhase::kStart) REQUIRE(k[i + 1].position == k[i].position);
       }
-      if (!LiftsAt(k, i)) continue;
+      if (k[i].phase != KeyPhase::kStart && !SwingStartsAt(k, i)) continue;
       REQUIRE(i + 2 < k.size());
       REQUIRE(k[i + 1].phase == KeyPhase::kMid);
       REQUIRE(k[i + 2].phase == KeyPhase::kEnd);
@@ -204,7 +196,7 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
     bool any_lifts = false;
     for (size_t f = 0; f < c.feet.size(); ++f)
       for (size_t i = 0; i < tracks[f]->keys.size(); ++i)
-        any_lifts |= LiftsAt(tracks[f]->keys, i) && tracks[f]->keys[i].frame == f0;
+        any_lifts |= SwingStartsAt(tracks[f]->keys, i) && tracks[f]->keys[i].frame == f0;
     if (!any_lifts) {
       INFO("step " << k + 1 << ": no foot lifts");
       CHECK(body.keys[k + 1].position == body.keys[k].position);
@@ -216,7 +208,7 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
     for (size_t f = 0; f < c.feet.size(); ++f) {
       bool lifts = false;
       for (size_t i = 0; i < tracks[f]->keys.size(); ++i)
-        lifts |= LiftsAt(tracks[f]->keys, i) && tracks[f]->keys[i].frame == f0;
+        lifts |= SwingStartsAt(tracks[f]->keys, i) && tracks[f]->keys[i].frame == f0;
       const bool in_group =
           std::find(group.begin(), group.end(), static_cast<int>(f)) != group.end();
       INFO("step " << k + 1 << " foot " << c.feet[f].name);

@@ -466,6 +466,24 @@ TEST_CASE("walk poses follow keys and swing arcs", "[viewer][walk]") {
   SECTION("the body interpolates linearly") {
     CHECK(viewer::PoseAt(walk.tracks[2], 13).position.x == Approx(3));
   }
+  SECTION("a foot lifting on the frame it lands swings from its end key") {
+    // A gait of one group: end, mid, end, mid, end.
+    WalkTrack hop;
+    hop.kind = TrackKind::kFoot;
+    const KeyPhase phases[5] = {KeyPhase::kEnd, KeyPhase::kMid, KeyPhase::kEnd, KeyPhase::kMid,
+                                KeyPhase::kEnd};
+    for (int k = 0; k < 5; ++k) {
+      WalkKey key;
+      key.frame = 1 + 3 * k, key.phase = phases[k];
+      key.position = {k * 0.5, k % 2 ? 0.5 : 0.0, 0};
+      hop.keys.push_back(key);
+    }
+    for (double frame : {2.5, 8.5}) {  // halfway up the first and the second swing
+      const viewer::TrackPose p = viewer::PoseAt(hop, frame);
+      CHECK(p.swinging);
+      CHECK(p.position.y > 0.25);  // on the arc, above the straight line's 0.25
+    }
+  }
   double first = 0, last = 0;
   viewer::FrameRange(walk, &first, &last);
   CHECK(first == 1);

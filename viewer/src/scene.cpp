@@ -262,8 +262,7 @@ void Scene::DrawWalk(const ViewState& view, DrawList* on_top) const {
       const WalkKey& k = keys[i];
       if (k.phase == KeyPhase::kEnd || k.phase == KeyPhase::kStart || k.phase == KeyPhase::kNone)
         on_top->Point(ToRender(k.position), dim, 7);  // a foothold
-      if (k.phase == KeyPhase::kStart && i + 2 < keys.size() &&
-          keys[i + 1].phase == KeyPhase::kMid && keys[i + 2].phase == KeyPhase::kEnd) {
+      if (SwingStartsAt(keys, i)) {
         const int kSegments = 16;
         glm::vec3 prev = ToRender(k.position);
         for (int s = 1; s <= kSegments; ++s) {

@@ -52,13 +52,11 @@ TrackPose PoseAt(const WalkTrack& track, double frame) {
   const WalkKey& b = keys[i + 1];
   TrackPose pose;
   if (track.kind == TrackKind::kFoot) {
-    // A start, mid, end triple around `frame` makes a swing arc.
+    // A swing's lift-off, mid and touch-down keys around `frame` make its arc.
     size_t s = keys.size();
-    if (a.phase == KeyPhase::kStart && b.phase == KeyPhase::kMid && i + 2 < keys.size() &&
-        keys[i + 2].phase == KeyPhase::kEnd) {
+    if (SwingStartsAt(keys, i)) {
       s = i;
-    } else if (a.phase == KeyPhase::kMid && b.phase == KeyPhase::kEnd && i >= 1 &&
-               keys[i - 1].phase == KeyPhase::kStart) {
+    } else if (i >= 1 && SwingStartsAt(keys, i - 1)) {
       s = i - 1;
     }
     if (s < keys.size()) {
@@ -80,7 +78,7 @@ TrackPose PoseAt(const WalkTrack& track, double frame) {
   const Vec3 n = Lerp(a.normal, b.normal, t);
   pose.normal = Length2(n) > 0 ? Normalize(n) : a.normal;
   pose.rotation = Slerp(track.Rotation(i), track.Rotation(i + 1), t);
-  pose.swinging = a.phase == KeyPhase::kStart || a.phase == KeyPhase::kMid;
+  pose.swinging = a.phase == KeyPhase::kMid;  // (a lift-off with its mid key is an arc above)
   return pose;
 }
 

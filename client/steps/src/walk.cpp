@@ -16,4 +16,11 @@ const char* PhaseName(KeyPhase phase) {
   return "";
 }
 
+bool SwingStartsAt(const std::pmr::vector<WalkKey>& keys, size_t i) {
+  if (i + 2 >= keys.size() || keys[i + 1].phase != KeyPhase::kMid ||
+      keys[i + 2].phase != KeyPhase::kEnd)
+    return false;
+  return keys[i].phase == KeyPhase::kStart || keys[i].phase == KeyPhase::kEnd;
+}
+
 }  // namespace footfall

@@ -87,4 +87,9 @@ struct Walk {
 
 const char* PhaseName(KeyPhase phase);  // "start", "mid", "end" or ""
 
+// Whether keys[i] of a foot track starts a swing (keys[i + 1] its mid key, keys[i + 2] its
+// touch-down): a start key, or an end key followed by a mid key (a foot that lifts on the frame
+// it lands, in a gait of one group).
+bool SwingStartsAt(const std::pmr::vector<WalkKey>& keys, size_t i);
+
 }  // namespace footfall
