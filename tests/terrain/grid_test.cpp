@@ -370,6 +370,11 @@ TEST_CASE("TerrainGrid next with a tolerance as large as the terrain", "[terrain
                   "next from " + Describe(q.foot) + " along " + Describe(q.direction) +
                       " tolerance " + std::to_string(tolerance));
     }
+    // Tolerances whose square overflows are as unbounded as 1e6 is here (they were invalid).
+    for (double tolerance : {1e155, 1e300, std::numeric_limits<double>::max()}) {
+      RequireSame(g.Next(q, tolerance), g.Next(q, 1e6), "tolerance " + std::to_string(tolerance));
+      RequireSame(oracle.Next(q, tolerance), g.Next(q, 1e6), "brute force");
+    }
   }
   // Walking off the +X edge with a huge tolerance: every sample is behind the foot, and only the
   // cells the foot's plane crosses are scanned. (How long the search takes is measured by

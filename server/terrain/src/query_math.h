@@ -2,6 +2,7 @@
 // predicates. Everything is in the grid's local frame (world minus origin), in double.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -58,7 +59,10 @@ inline bool MakeNextFrame(const double origin[3], const StepQuery& q, double tol
     frame->dir[a] = dir[a];
     frame->ideal[a] = frame->foot[a] + dir[a];
   }
-  frame->radius2 = tolerance > 0 ? tolerance * tolerance : len2;
+  // A tolerance beyond any distance within query range reaches every sample as it is: squaring
+  // it must not overflow (above 1e154 every query came back invalid).
+  const double reach = std::min(tolerance, 4 * kMaxQueryDistance);
+  frame->radius2 = tolerance > 0 ? reach * reach : len2;
   return std::isfinite(frame->radius2) && InQueryRange(frame->foot) && InQueryRange(frame->ideal);
 }
 
