@@ -412,8 +412,9 @@ Status Generator::Run(std::string* error) {
       c_.slope_threshold_deg >= 90 ? 2.0 : std::sin(Radians(std::max(c_.slope_threshold_deg, 0.0)));
   // The body stands over the feet's centroid, so feet are placed about it: rests off their
   // centroid would otherwise move the character sideways by that offset every step.
+  const Vec3 centroid = RestCentroid(c_);
   rest_.clear();
-  for (const FootSpec& f : c_.feet) rest_.push_back(f.rest - RestCentroid(c_));
+  for (const FootSpec& f : c_.feet) rest_.push_back(f.rest - centroid);
   pair_of_foot_.assign(c_.feet.size(), 0);
   for (size_t p = 0; p < c_.pairs.size(); ++p) {
     Vec3 centre;
