@@ -320,6 +320,76 @@ class BlenderAddonTest(unittest.TestCase):
             bpy.ops.footfall.import_walk(filepath=os.path.join(ARGS.work_dir, "none.json"))
         self.assertIn("cannot import", str(e.exception))
 
+    def test_7b_failures_keep_what_the_user_has(self):
+        rig = bpy.data.objects["biped_rig"]
+        feet = {f.name: f.target for f in rig.footfall_rig.feet}
+        body = rig.footfall_rig.body
+        before = {o.name: fcurve_keys(o, "location", 3) for o in list(feet.values()) + [body]}
+        self.assertTrue(all(before.values()))
+        bpy.context.scene.footfall.rig = rig
+        # A Generate Walk the generator refuses (frames_per_step 1) cleared the walk first.
+        settings = bpy.context.scene.footfall
+        saved = settings.frames_per_step
+        settings.frames_per_step = 1
+        try:
+            with self.assertRaises(RuntimeError) as e:
+                bpy.ops.footfall.generate_walk()
+            self.assertIn("the rig's keys are unchanged", str(e.exception))
+        finally:
+            settings.frames_per_step = saved
+        # An import with no track for this rig cleared its keys before finding none.
+        other = os.path.join(ARGS.work_dir, "other.json")
+        with open(other, "w") as f:
+            json.dump({"tracks": [{"name": "X1", "kind": "foot", "keys": [
+                {"frame": 1, "position": [0, 0, 0]}]}]}, f)
+        with self.assertRaises(RuntimeError) as e:
+            bpy.ops.footfall.import_walk(filepath=other)
+        self.assertIn("no track for this rig", str(e.exception))
+        after = {o.name: fcurve_keys(o, "location", 3) for o in list(feet.values()) + [body]}
+        self.assertEqual(after, before)
+        # Character files the generator refuses, and a "name" that is not text: a report, and
+        # nothing made (a version 2 file made a whole rig; a numeric name raised TypeError).
+        with open(os.path.join(CHARACTERS, "biped.json")) as f:
+            data = json.load(f)
+        objects = set(bpy.data.objects)
+        for change, message in ((("version", 2), "version"),
+                                (("frames_per_step", 1), "frames_per_step"),
+                                (("name", 5), "'name' must be a string")):
+            bad = dict(data)
+            bad[change[0]] = change[1]
+            path = os.path.join(ARGS.work_dir, "bad_%s.json" % change[0])
+            with open(path, "w") as f:
+                json.dump(bad, f)
+            with self.assertRaises(RuntimeError) as e:
+                bpy.ops.footfall.character_setup(character_file=path, mode="CREATE")
+            self.assertIn(message, str(e.exception))
+            self.assertNotIn("Traceback", str(e.exception))
+        self.assertEqual(set(bpy.data.objects), objects)
+
+    def test_7c_import_crowd_walk(self):
+        # Each character of a crowd walk gets its own empties (all its tracks were keyed onto
+        # one set: the last character's).
+        rig = bpy.data.objects["biped_rig"]
+        out = os.path.join(ARGS.work_dir, "crowd.json")
+        run_cli("generate", "--terrain", self.pts, "--character", rig.footfall_rig.character_path,
+                "--start", csv(to_ff(rig.matrix_world.translation)), "--steps", 4,
+                "--crowd", 2, "--out", out)
+        with open(out) as f:
+            walk = json.load(f)
+        bpy.context.scene.footfall.rig = None
+        self.select([], None)
+        self.assertEqual(bpy.ops.footfall.import_walk(filepath=out), {"FINISHED"})
+        for who in ("c1", "c2"):
+            part = {"tracks": [t for t in walk["tracks"] if t["character"] == who]}
+            feet = {t["name"]: bpy.data.objects["crowd_%s_%s" % (who, t["name"])]
+                    for t in part["tracks"] if t["kind"] == "foot"}
+            self.assert_keys_equal_walk(part, feet, bpy.data.objects["crowd_%s_body" % who])
+        # Onto a rig: refused, nothing changed.
+        bpy.context.scene.footfall.rig = rig
+        with self.assertRaises(RuntimeError) as e:
+            bpy.ops.footfall.import_walk(filepath=out)
+        self.assertIn("a crowd walk (2 characters)", str(e.exception))
+
     def test_8_import_gltf_walk(self):
         out = os.path.join(ARGS.work_dir, "biped_cli.gltf")
         rig = bpy.data.objects["biped_rig"]

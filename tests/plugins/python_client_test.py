@@ -153,6 +153,76 @@ class SharedLogicTest(unittest.TestCase):
         with self.assertRaises(ValueError):
             ff.sampling.sample_triangles([(0, 0, 0)] * 3, [(0, 1, 2)], 0)
 
+    def test_sampling_refuses_more_samples_than_a_dcc_can_hold_before_sampling(self):
+        # A 10 m square at 1 mm: about 100 million samples (tens of GB in pure Python).
+        pts = [(0, 0, 0), (10, 0, 0), (0, 0, 10), (10, 0, 10)]
+        with self.assertRaises(ValueError) as e:
+            ff.sampling.sample_triangles(pts, [(0, 2, 1), (1, 2, 3)], 0.001)
+        self.assertIn("would make more than 2000000 samples", str(e.exception))
+        self.assertEqual(len(ff.sampling.sample_triangles(pts, [(0, 2, 1)], 20.0)), 3)
+
+    def test_character_checked_as_the_generator_reads_it(self):
+        with open(os.path.join(CHARACTERS, "biped.json")) as f:
+            data = json.load(f)
+        s = ff.Session.embedded()
+        try:
+            s.check_character(data)
+            for key, value, message in (("version", 2, "version"),
+                                        ("frames_per_step", 1, "'frames_per_step' = 1"),
+                                        ("colour", "red", "unknown field 'colour'")):
+                bad = dict(data)
+                bad[key] = value
+                with self.assertRaises(ff.FootfallError) as e:
+                    s.check_character(bad, "bad.json")
+                self.assertIn(message, e.exception.message)
+                self.assertTrue(e.exception.message.startswith("bad.json"), e.exception.message)
+        finally:
+            s.close()
+        self.assertEqual(ff.character.display_name(data, "file"), data["name"])
+        self.assertEqual(ff.character.display_name({}, "file"), "file")
+        with self.assertRaises(ff.FootfallError):
+            ff.character.display_name({"name": 5}, "file")
+
+    def test_rest_positions_about_the_feet_centroid(self):
+        # The walk keeps the body over the feet's centroid: setup places feet as it does.
+        data = {"feet": [{"name": "A", "rest": [0.4, 0, 0.2]}, {"name": "B", "rest": [0.2, 0, 0.2]}]}
+        got = ff.character.rest_positions(data)
+        self.assertEqual([n for n, _ in got], ["A", "B"])
+        for (_, p), want in zip(got, ((0.1, 0.0, 0.0), (-0.1, 0.0, 0.0))):
+            for a, b in zip(p, want):
+                self.assertAlmostEqual(a, b)
+
+    def test_files_that_are_not_regular_are_refused_before_opening(self):
+        # Opening a FIFO waits for a writer: the DCC hung.
+        folder = tempfile.mkdtemp()
+        try:
+            fifo = os.path.join(folder, "character.json")
+            os.mkfifo(fifo)
+            with self.assertRaises(ff.FootfallError) as e:
+                ff.character.load(fifo)
+            self.assertIn("not a regular file", e.exception.message)
+        finally:
+            os.unlink(fifo)
+            os.rmdir(folder)
+
+    def test_frame_quaternion(self):
+        from footfall_client.rotation import quat_from_frame, quat_to_euler_xyz
+        self.assertEqual(quat_from_frame((0, 1, 0), (0, 0, 1)), (0.0, 0.0, 0.0, 1.0))
+        for up, forward in (((1, 1, 0), (0, 0, 1)), ((0, 0.2, 1), (1, 0, 0)),
+                            ((0, -1, 0), (0, 0, 1)), ((0, 1, 0), (0, 1, 0))):
+            x, y, z, w = quat_from_frame(up, forward)
+
+            def rotate(v):  # q v q*
+                t = (2 * (y * v[2] - z * v[1]), 2 * (z * v[0] - x * v[2]), 2 * (x * v[1] - y * v[0]))
+                return (v[0] + w * t[0] + y * t[2] - z * t[1], v[1] + w * t[1] + z * t[0] - x * t[2],
+                        v[2] + w * t[2] + x * t[1] - y * t[0])
+            n = math.sqrt(sum(c * c for c in up))
+            for a, b in zip(rotate((0, 1, 0)), (c / n for c in up)):
+                self.assertAlmostEqual(a, b)
+            z_axis = rotate((0, 0, 1))
+            self.assertAlmostEqual(sum(z_axis[i] * up[i] for i in range(3)), 0)
+            self.assertEqual(len(quat_to_euler_xyz((x, y, z, w))), 3)
+
     def test_character_pairs_and_overrides(self):
         data = ff.character.parse(json.dumps({
             "feet": [{"name": "L", "rest": [0.1, 0, 0]}, {"name": "R", "rest": [-0.1, 0, 0]},

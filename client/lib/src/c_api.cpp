@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "footfall/client/terrain_session.h"
+#include "footfall/steps/character.h"
 #include "footfall/steps/generate_request.h"
 #include "footfall/steps/generator.h"
 #include "footfall/steps/walk_json.h"
@@ -247,5 +248,17 @@ int32_t ffc_generate(ffc_session* s, uint32_t terrain, const char* request_json,
 }
 
 void ffc_free_string(char* text) { std::free(text); }
+
+int32_t ffc_check_character(ffc_session* s, const char* character_json) {
+  return Guard(s, [&]() -> int32_t {
+    if (!character_json) return BadArgument(s, "character_json must not be NULL");
+    footfall::Character character;
+    std::string error;
+    const Status status =
+        footfall::ParseCharacter(character_json, "character", &character, &error);
+    if (status != Status::kOk) s->error = error;
+    return static_cast<int32_t>(status);
+  });
+}
 
 }  // extern "C"

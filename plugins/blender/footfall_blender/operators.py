@@ -155,7 +155,7 @@ def _frame(up, forward):
 def _snap(s, terrain, point):
     hold = s.snap(terrain, [to_ff(point)])[0]
     if not hold.ok:
-        raise ffc.FootfallError(hold.status, "no terrain near %s" % tuple(round(c, 3) for c in point),
+        raise ffc.FootfallError(hold.status, "no terrain near (%.3f, %.3f, %.3f)" % tuple(point),
                                 "ffc_snap")
     return Vector(from_ff(hold.point)), Vector(from_ff(hold.normal))
 
@@ -178,11 +178,14 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
     def execute(self, context):
         try:
             data = character.load(bpy.path.abspath(self.character_file))
-            feet = character.feet(data, self.character_file)
             s = session(context)
+            # As the generator reads it, before anything is made (a file it refuses made a
+            # whole rig, and the error came only at Generate Walk).
+            s.check_character(data, self.character_file)
+            feet = character.rest_positions(data, self.character_file)
             terrain = _connection.terrain(TERRAIN)
             return self._setup(context, s, terrain, data, feet)
-        except (ffc.FootfallError, ValueError, OSError) as e:
+        except (ffc.FootfallError, ValueError, OSError, TypeError, KeyError) as e:
             return _fail(self, _error_text(e))
 
     def _pick(self, context, feet):
@@ -203,8 +206,8 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
         return body, chosen
 
     def _setup(self, context, s, terrain, data, feet):
-        rig_name = self.name or data.get("name") or os.path.splitext(
-            os.path.basename(self.character_file))[0]
+        rig_name = self.name or character.display_name(
+            data, os.path.splitext(os.path.basename(self.character_file))[0])
         height = character.body_height(data)
         step = character.number(data, "step_length", 0.5)
         if self.mode == "PICK":
@@ -219,6 +222,15 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
         multiped = not character.is_biped(data)
         up = normal if multiped else Vector((0, 0, 1))
         rot = _frame(up, forward)
+        # Every snap before anything is made: a failure leaves no half-built rig.
+        foot_points = {}
+        for name, offset in feet:
+            local = Vector(from_ff((offset[0], 0.0, offset[2])))
+            foot_points[name] = _snap(s, terrain, ground + rot @ local)[0]
+        centres = []
+        for pair_name, members in character.pairs(data):
+            centre = sum((foot_points[m] for m in members), Vector()) / len(members)
+            centres.append((pair_name, members) + _snap(s, terrain, centre))
 
         root = _empty(context, rig_name + "_rig", "ARROWS", 0.5)
         root.matrix_world = Matrix.Translation(ground) @ rot.to_4x4()
@@ -236,8 +248,7 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
         # +Z forward; Blender: -X ... see axes.py), targets half a step in front of each foot.
         placed = {}
         for name, offset in feet:
-            local = Vector(from_ff((offset[0], 0.0, offset[2])))
-            foot_point, foot_normal = _snap(s, terrain, ground + rot @ local)
+            foot_point = foot_points[name]
             obj = targets.get(name) or _empty(context, "%s_%s" % (rig_name, name), "SPHERE", 0.08)
             m = obj.matrix_world.copy()
             m.translation = foot_point
@@ -247,9 +258,7 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
             item.name = name
             item.target = obj
         fwd = rot @ Vector((0, -1, 0))
-        for pair_name, members in character.pairs(data):
-            centre = sum((placed[m][1] for m in members), Vector()) / len(members)
-            point, normal = _snap(s, terrain, centre)
+        for pair_name, members, point, normal in centres:
             central = _empty(context, "%s_%s_center" % (rig_name, pair_name), "CIRCLE", 0.3,
                              parent=root)
             central.matrix_world = Matrix.Translation(point) @ _frame(normal, fwd).to_4x4()
@@ -346,8 +355,8 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
             # Each call asks for the walk up to `done` steps; the walk is the same for the steps
             # already keyed (the generator is deterministic), so only keys from the last keyed
             # frame on are set again (re-keying the whole walk at every call made a 1000-step
-            # walk take 25 s, and longer ones ever slower).
-            keying.clear_keys(list(feet.values()) + [body], settings.start_frame)
+            # walk take 25 s, and longer ones ever slower). The previous walk's keys go only once
+            # the first call has given a walk (a refused character kept nothing of either).
             last_frame = None
             while done < total:
                 done = min(total, done + chunk)
@@ -356,6 +365,8 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
                 status, walk_text_new, message = s.generate_json(terrain, request)
                 if walk_text_new is not None:
                     walk = json.loads(walk_text_new)
+                    if walk_text is None:
+                        keying.clear_keys(list(feet.values()) + [body], settings.start_frame)
                     keying.key_walk(walk, feet, body, from_frame=last_frame)
                     frames = [k["frame"] for t in walk.get("tracks", []) for k in t.get("keys", [])]
                     last_frame = max(frames) if frames else last_frame
@@ -372,6 +383,8 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
                 if chunk_hook is not None:
                     chunk_hook(self, done)
         except (ffc.FootfallError, ValueError, OSError) as e:
+            if walk_text is None:  # nothing generated: the rig's keys are as they were
+                return _fail(self, "%s; the rig's keys are unchanged" % _error_text(e))
             self.report({"ERROR"}, "%s; %d keys made before it were kept" % (_error_text(e), keyed))
             return {"FINISHED"} if keyed else {"CANCELLED"}
         finally:
@@ -402,21 +415,40 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
             if path.lower().endswith((".gltf", ".glb")):
                 walk = self._walk_from_gltf(context, path)
             else:
-                with open(path) as f:
-                    walk = json.load(f)
+                walk = json.loads(character.read_text(path, "walk file"))
             character.check_walk(walk, path)  # before anything is made
+            crowd = sorted({t.get("character", "") for t in walk["tracks"]})
             rig_obj = active_rig(context)
             if rig_obj is not None:
+                if len(crowd) > 1:
+                    raise ValueError("a crowd walk (%d characters) goes onto new empties, one set "
+                                     "per character: deselect the rig and clear the scene's "
+                                     "footfall rig first" % len(crowd))
                 feet, body = rig_targets(rig_obj)
+                # Nothing is cleared unless the walk keys something of this rig.
+                if not any((t.get("kind") == "body" and body) or t["name"] in feet
+                           for t in walk["tracks"]):
+                    return _fail(self, "footfall: %s has no track for this rig's feet or body; the "
+                                 "rig's keys are unchanged" % path)
+                sets = [(walk, feet, body)]
             else:
-                feet, body = self._empties(context, walk, os.path.splitext(os.path.basename(path))[0])
-            first = min((k["frame"] for t in walk["tracks"] for k in t.get("keys", [])), default=0)
-            keying.clear_keys(list(feet.values()) + [body], first)
-            count = keying.key_walk(walk, feet, body)
-        except (OSError, ValueError, KeyError, TypeError) as e:
-            return _fail(self, "footfall: cannot import %s: %s" % (path, e))
+                base = os.path.splitext(os.path.basename(path))[0]
+                sets = []
+                for who in crowd:  # one set of empties per character of a crowd
+                    part = {"tracks": [t for t in walk["tracks"] if t.get("character", "") == who]}
+                    name = "%s_%s" % (base, who) if who else base
+                    sets.append((part,) + self._empties(context, part, name))
+            count = 0
+            for part, feet, body in sets:
+                first = min((k["frame"] for t in part["tracks"] for k in t.get("keys", [])),
+                            default=0)
+                keying.clear_keys(list(feet.values()) + [body], first)
+                count += keying.key_walk(part, feet, body)
+        except (ffc.FootfallError, OSError, ValueError, KeyError, TypeError) as e:
+            why = e.message if isinstance(e, ffc.FootfallError) else e
+            return _fail(self, "footfall: cannot import %s: %s" % (path, why))
         if count == 0:
-            return _fail(self, "footfall: %s has no track for this rig's feet or body" % path)
+            return _fail(self, "footfall: %s has no keys" % path)
         self.report({"INFO"}, "footfall: %d keys imported from %s" % (count, os.path.basename(path)))
         return {"FINISHED"}
 

@@ -49,6 +49,8 @@ def _guard(fn):
             _error("%s (%s)" % (e.message, e.status_name))
         except (ValueError, OSError, RuntimeError) as e:
             _error(str(e))
+        except Exception as e:  # anything else is a bug: reported, never a traceback into Maya
+            _error("%s: %s" % (type(e).__name__, e))
         return None
     run.__name__ = fn.__name__
     return run
@@ -91,58 +93,86 @@ def terrain_setup(separation=0.25, point_file=None):
 def _snap(s, terrain, point):
     hold = s.snap(terrain, [point])[0]
     if not hold.ok:
-        raise ValueError("no terrain near %s" % (point,))
+        raise ValueError("no terrain near (%.3f, %.3f, %.3f)" % tuple(point))
     return hold.point, hold.normal
+
+
+def _unit(v):
+    n = math.sqrt(sum(c * c for c in v))
+    return tuple(c / n for c in v) if n > 0 else None
+
+
+def _cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _orient(node, up, forward):
+    """Turns `node` (world space) so that its Y is `up` and its Z `forward` across it."""
+    euler = ffc.rotation.quat_to_euler_xyz(ffc.rotation.quat_from_frame(up, forward))
+    mc.xform(node, ws=True, ro=euler)
 
 
 @_guard
 def character_setup(character_file, name=None, ik_handles=None, body=None):
-    """Sets up a character at the origin-facing +Z (or at `body`): foot IK handles given as
-    {foot name: handle} (created as locators when None), target locators half a step ahead of
-    each foot under a central locator per foot pair, aligned to the terrain normal."""
+    """Sets up a character at the origin facing +Z (or at `body`, facing as it does): foot IK
+    handles given as {foot name: handle} (created as locators when None), target locators half
+    a step ahead of each foot under a central locator per foot pair, aligned to the terrain
+    normal. Checks the file as the generator reads it, and snaps everything, before anything is
+    made; one undo chunk."""
     data = character.load(character_file)
-    feet = character.feet(data, character_file)
     s = _session()
+    s.check_character(data, character_file)
+    feet = character.rest_positions(data, character_file)
     terrain = _connection.terrain(TERRAIN)
-    name = name or data.get("name") or "character"
+    name = name or character.display_name(data, "character")
     origin = mc.xform(body, q=True, ws=True, t=True) if body else [0.0, 0.0, 0.0]
+    forward = (0.0, 0.0, 1.0)
+    if body:
+        m = mc.xform(body, q=True, ws=True, m=True)
+        forward = _unit((m[8], 0.0, m[10])) or forward  # its Z on the ground (bipeds: Y up)
+    left = _cross((0.0, 1.0, 0.0), forward)
     ground, normal = _snap(s, terrain, origin)
-    rig = mc.group(empty=True, name=name + "_rig")
-    mc.addAttr(rig, longName=RIG_ATTR, dataType="string")
-    mc.setAttr(rig + "." + RIG_ATTR, json.dumps(data), type="string")
-    mc.xform(rig, ws=True, t=ground)
-    if not body:
-        body = mc.spaceLocator(name=name + "_body")[0]
-    height = character.body_height(data)
-    mc.xform(body, ws=True, t=(ground[0], ground[1] + height, ground[2]))
-    mc.addAttr(rig, longName="footfallBody", attributeType="message")
-    mc.connectAttr(body + ".message", rig + ".footfallBody")
     placed = {}
-    for index, (foot, rest) in enumerate(feet):
-        point, _ = _snap(s, terrain, (ground[0] + rest[0], ground[1], ground[2] + rest[2]))
-        handle = (ik_handles or {}).get(foot) or mc.spaceLocator(name="%s_%s" % (name, foot))[0]
-        mc.xform(handle, ws=True, t=point)
-        # By the foot's index: a foot name need not be a valid Maya attribute name.
-        attr = _foot_attr(index)
-        mc.addAttr(rig, longName=attr, attributeType="message")
-        mc.connectAttr(handle + ".message", rig + "." + attr)
-        placed[foot] = point
-    step = character.number(data, "step_length", 0.6)
+    for foot, rest in feet:
+        at = [ground[i] + left[i] * rest[0] + forward[i] * rest[2] for i in range(3)]
+        placed[foot] = _snap(s, terrain, at)[0]
+    centres = []
     for pair, members in character.pairs(data):
         centre = [sum(placed[m][i] for m in members) / len(members) for i in range(3)]
-        point, normal = _snap(s, terrain, centre)
-        central = mc.spaceLocator(name="%s_%s_center" % (name, pair))[0]
-        mc.parent(central, rig)
-        mc.xform(central, ws=True, t=point)
-        # Align the locator's Y to the normal (rotation about the axis normal x Y).
-        axis = (normal[2], 0.0, -normal[0])
-        angle = math.degrees(math.acos(max(-1.0, min(1.0, normal[1]))))
-        if angle > 1e-6:
-            mc.rotate(axis[0] * angle, 0, axis[2] * angle, central, ws=True, r=True)
-        for m in members:
-            target = mc.spaceLocator(name="%s_%s_target" % (name, m))[0]
-            mc.parent(target, central)
-            mc.xform(target, ws=True, t=(placed[m][0], placed[m][1], placed[m][2] + step / 2))
+        centres.append((pair, members) + _snap(s, terrain, centre))
+    step = character.number(data, "step_length", 0.6)
+    height = character.body_height(data)
+    mc.undoInfo(openChunk=True, chunkName="footfall character setup")
+    try:
+        rig = mc.group(empty=True, name=name + "_rig")
+        mc.addAttr(rig, longName=RIG_ATTR, dataType="string")
+        mc.setAttr(rig + "." + RIG_ATTR, json.dumps(data), type="string")
+        mc.xform(rig, ws=True, t=ground)
+        _orient(rig, (0.0, 1.0, 0.0), forward)  # Generate Walk heads along the rig's Z
+        if not body:
+            body = mc.spaceLocator(name=name + "_body")[0]
+        mc.xform(body, ws=True, t=(ground[0], ground[1] + height, ground[2]))
+        mc.addAttr(rig, longName="footfallBody", attributeType="message")
+        mc.connectAttr(body + ".message", rig + ".footfallBody")
+        for index, (foot, _) in enumerate(feet):
+            handle = (ik_handles or {}).get(foot) or mc.spaceLocator(name="%s_%s" % (name, foot))[0]
+            mc.xform(handle, ws=True, t=placed[foot])
+            # By the foot's index: a foot name need not be a valid Maya attribute name.
+            attr = _foot_attr(index)
+            mc.addAttr(rig, longName=attr, attributeType="message")
+            mc.connectAttr(handle + ".message", rig + "." + attr)
+        for pair, members, point, normal in centres:
+            central = mc.parent(mc.spaceLocator(name="%s_%s_center" % (name, pair))[0], rig)[0]
+            mc.xform(central, ws=True, t=point)
+            _orient(central, normal, forward)  # Y along the normal, Z the heading across it
+            for m in members:
+                target = mc.parent(mc.spaceLocator(name="%s_%s_target" % (name, m))[0],
+                                   central)[0]
+                p = placed[m]
+                mc.xform(target, ws=True,
+                         t=[p[i] + forward[i] * step / 2 for i in range(3)])
+    finally:
+        mc.undoInfo(closeChunk=True)
     return rig
 
 
@@ -167,8 +197,9 @@ def _rig_targets(rig):
     return data, feet, body
 
 
-def key_walk(walk, feet, body):
-    """Keys the walk (footfall JSON dict) on the IK handles and body, as the seed's tool did."""
+def key_walk(walk, feet, body, from_frame=None):
+    """Keys the walk (footfall JSON dict) on the IK handles and body, as the seed's tool did;
+    with `from_frame`, only its keys from that frame on (those before are keyed already)."""
     count = 0
     for track in walk.get("tracks", []):
         is_body = track.get("kind") == "body"
@@ -178,15 +209,19 @@ def key_walk(walk, feet, body):
         previous = None
         for key in track.get("keys", []):
             frame = key["frame"]
-            mc.xform(node, ws=True, t=key["position"])
-            mc.setKeyframe(node, attribute="translate", time=frame)
+            euler = None
             if is_body and "rotation" in key:
                 # XYZ Euler degrees as Maya's default rotate order composes them, unwrapped from
-                # the previous key (as the MEL export keys them).
+                # the previous key (as the MEL export keys them), keyed or not.
                 euler = ffc.rotation.quat_to_euler_xyz(key["rotation"])
                 if previous is not None:
                     euler = ffc.rotation.closest_euler(euler, previous)
                 previous = euler
+            if from_frame is not None and frame < from_frame:
+                continue
+            mc.xform(node, ws=True, t=key["position"])
+            mc.setKeyframe(node, attribute="translate", time=frame)
+            if euler is not None:
                 mc.xform(node, ws=True, ro=euler)
                 mc.setKeyframe(node, attribute="rotate", time=frame)
             count += 1
@@ -206,28 +241,36 @@ def generate_walk(rig, steps=8, start_frame=1, frames_per_step=0, step_length=0.
     request = {"character": data, "start": start, "heading": [m[8], m[9], m[10]],
                "start_frame": start_frame}
     if path:
-        cvs = mc.ls(path + ".cv[*]", flatten=True)
-        request["path"] = [mc.pointPosition(cv, world=True) for cv in cvs]
+        request["path"] = _curve_points(path)
     chunk = chunk_steps or max(1, int(math.ceil(steps / 10.0)))
     s = _session()
     terrain = _connection.terrain(TERRAIN)
-    bar = "MayaWindow|mainProgressBar" if mc.control("MayaWindow|mainProgressBar", exists=True) \
-        else None
+    bar = _main_progress_bar()
     if bar:
         mc.progressBar(bar, e=True, beginProgress=True, maxValue=steps,
                        status="footfall: generating")
     mc.undoInfo(openChunk=True, chunkName="footfall generate walk")
     try:
         done = 0
+        last_frame = None
+        nodes = [n for n in list(feet.values()) + [body] if n]
         while done < steps:
             done = min(steps, done + chunk)
             request["steps"] = done
             status, text, message = s.generate_json(terrain, request)
-            if text is not None:
-                walk = json.loads(text)
-                key_walk(walk, feet, body)
-            if status != 0 or (text is not None and walk.get("stopped")):
-                raise ffc.FootfallError(status or 1, message or walk.get("stopped"), "generate")
+            walk = json.loads(text) if text is not None else None
+            if walk is not None:
+                if last_frame is None:
+                    # The previous walk goes once this one has keys (a refused request keeps it).
+                    mc.cutKey(nodes, time=(start_frame, 1e9), attribute=["translate", "rotate"],
+                              clear=True)
+                # Each call gives the walk so far: only its new keys are set.
+                key_walk(walk, feet, body, from_frame=last_frame)
+                frames = [k["frame"] for t in walk.get("tracks", []) for k in t.get("keys", [])]
+                last_frame = max(frames) if frames else last_frame
+            stopped = walk.get("stopped") if walk is not None else None
+            if status != 0 or stopped:
+                raise ffc.FootfallError(status or 1, message or stopped or "no walk", "generate")
             if bar:
                 mc.progressBar(bar, e=True, progress=done)
     finally:
@@ -237,19 +280,56 @@ def generate_walk(rig, steps=8, start_frame=1, frames_per_step=0, step_length=0.
     return done
 
 
+def _curve_points(curve):
+    """Points along a NURBS curve (on it, not its control vertices), four per span."""
+    spans = max(1, mc.getAttr(curve + ".spans"))
+    lo, hi = mc.getAttr(curve + ".minValue"), mc.getAttr(curve + ".maxValue")
+    n = 4 * spans
+    return [mc.pointOnCurve(curve, parameter=lo + (hi - lo) * i / n, position=True)
+            for i in range(n + 1)]
+
+
+def _main_progress_bar():
+    try:
+        import maya.mel
+        bar = maya.mel.eval("$footfallTmp = $gMainProgressBar")
+    except (ImportError, RuntimeError):
+        return None
+    return bar if bar and mc.progressBar(bar, exists=True) else None
+
+
 @_guard
 def import_walk(path, rig=None):
-    """Keys a footfall walk JSON file onto `rig` (or new locators)."""
-    with open(path) as f:
-        walk = json.load(f)
+    """Keys a footfall walk JSON file onto `rig` (or new locators, one set per character of a
+    crowd). Nothing is changed unless the walk keys something."""
+    walk = json.loads(ffc.character.read_text(path, "walk file"))
     ffc.character.check_walk(walk, path)  # before any locator is made
+    crowd = sorted({t.get("character", "") for t in walk["tracks"]})
     if rig:
+        if len(crowd) > 1:
+            raise ValueError("a crowd walk (%d characters) goes onto new locators: import it "
+                             "without a rig" % len(crowd))
         _, feet, body = _rig_targets(rig)
+        if not any((t.get("kind") == "body" and body) or t["name"] in feet
+                   for t in walk["tracks"]):
+            raise ValueError("%s has no track for this rig's feet or body" % path)
+        sets = [(walk, feet, body)]
     else:
-        feet = {t["name"]: mc.spaceLocator(name=t["name"])[0]
-                for t in walk["tracks"] if t.get("kind") == "foot"}
-        body = mc.spaceLocator(name="body")[0]
-    return key_walk(walk, feet, body)
+        sets = []
+        for who in crowd:
+            part = {"tracks": [t for t in walk["tracks"] if t.get("character", "") == who]}
+            prefix = who + "_" if who else ""
+            feet = {t["name"]: mc.spaceLocator(name=prefix + t["name"])[0]
+                    for t in part["tracks"] if t.get("kind") == "foot"}
+            body = mc.spaceLocator(name=prefix + "body")[0]
+            sets.append((part, feet, body))
+    count = 0
+    for part, feet, body in sets:
+        first = min((k["frame"] for t in part["tracks"] for k in t.get("keys", [])), default=0)
+        nodes = [n for n in list(feet.values()) + [body] if n]
+        mc.cutKey(nodes, time=(first, 1e9), attribute=["translate", "rotate"], clear=True)
+        count += key_walk(part, feet, body)
+    return count
 
 
 # -- The window -----------------------------------------------------------------------------------
@@ -289,6 +369,7 @@ def show():
     mc.frameLayout(label="Character Setup", collapsable=True)
     cfile = mc.textFieldButtonGrp(label="Character file", buttonLabel="...")
 
+    @_guard
     def setup(*_):
         sel = mc.ls(selection=True) or []
         data = character.load(mc.textFieldButtonGrp(cfile, q=True, text=True))

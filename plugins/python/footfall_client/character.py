@@ -4,6 +4,8 @@ Pure Python; footfall's frame (Y up, the character facing +Z, +X its left)."""
 
 import json
 import math
+import os
+import stat
 
 from .session import INVALID_ARGUMENT, FootfallError
 
@@ -12,14 +14,28 @@ OVERRIDES = {"step_length": "step_length", "step_height": "step_height",
              "frames_per_step": "frames_per_step"}
 
 
+def read_text(path, what="file"):
+    """The text of the regular file at `path`; FootfallError io_error when it cannot be read,
+    invalid_argument for a directory, FIFO or device (opening a FIFO waits for a writer: the
+    DCC would hang)."""
+    shown = path if path else "''"
+    try:
+        mode = os.stat(path).st_mode
+        if not stat.S_ISREG(mode):
+            raise FootfallError(INVALID_ARGUMENT, "%s: cannot open %s: not a regular file"
+                                % (shown, what), what)
+        with open(path, encoding="utf-8") as f:
+            return f.read()
+    except OSError as e:
+        raise FootfallError(5, "%s: cannot open %s: %s" % (shown, what, e.strerror or e),
+                            what) from None
+    except UnicodeDecodeError as e:
+        raise FootfallError(6, "%s: not UTF-8 text (byte %d)" % (shown, e.start), what) from None
+
+
 def load(path):
     """The character file at `path` as a dict; FootfallError (io_error/parse_error) otherwise."""
-    try:
-        with open(path) as f:
-            text = f.read()
-    except OSError as e:
-        raise FootfallError(5, "%s: %s" % (path, e.strerror or e), "character") from None
-    return parse(text, path)
+    return parse(read_text(path, "character file"), path)
 
 
 def parse(text, name="character"):
@@ -61,6 +77,26 @@ def feet(data, name="character"):
             raise FootfallError(INVALID_ARGUMENT, "%s: feet[%d]: the name '%s' is used twice"
                                 % (name, i, foot_name), "character")
     return out
+
+
+def rest_positions(data, name="character"):
+    """[(foot name, (x, y, z))] as a walk places the feet: rests less their centroid (the body
+    stands over the feet's centroid; the same as feet() for symmetric feet)."""
+    fs = feet(data, name)
+    c = [sum(p[i] for _, p in fs) / len(fs) for i in range(3)]
+    return [(n, (p[0] - c[0], p[1] - c[1], p[2] - c[2])) for n, p in fs]
+
+
+def display_name(data, fallback):
+    """The character's "name", or `fallback` when it has none; FootfallError when "name" is not
+    a string."""
+    value = data.get("name") if isinstance(data, dict) else None
+    if value is None or value == "":
+        return fallback
+    if not isinstance(value, str):
+        raise FootfallError(INVALID_ARGUMENT, "%s: 'name' must be a string, found %s"
+                            % (fallback, type(value).__name__), "character")
+    return value
 
 
 def number(data, key, default):

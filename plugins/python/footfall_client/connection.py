@@ -11,6 +11,7 @@ class Connection:
         self.session = None
         self.local = None          # LocalServer this connection started, if any
         self._target = None        # (host, port) the session talks to
+        self._timeout = None       # its call timeout [s]
         self._terrains = {}        # name -> [source, terrain id, session]
 
     def describe(self):
@@ -26,8 +27,8 @@ class Connection:
         target = (host or "127.0.0.1", int(port))
         if self.local is not None and self.local.running():
             target = ("127.0.0.1", self.local.port)
-        if self.session is None or self._target != target:
-            self._open(target, timeout)
+        if self.session is None or self._target != target or self._timeout != timeout:
+            self._open(target, timeout)  # (a changed timeout was ignored until host or port changed)
         # A server restarted on the same port since the last call: the first call finds the
         # old connection broken and the session reconnects on the next, so ask twice.
         if self.session.ping() or self.session.ping():
@@ -53,7 +54,7 @@ class Connection:
         if self.session is not None:
             self.session.close()
         self.session = Session.rpc(target[0], target[1], timeout)
-        self._target = target
+        self._target, self._timeout = target, timeout
 
     # -- terrains -----------------------------------------------------------------------------
 

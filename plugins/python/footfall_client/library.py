@@ -76,6 +76,7 @@ def _declare(lib):
         # char** out: declared as a void pointer so ctypes leaves the memory to ffc_free_string.
         "ffc_generate": (c.c_int32, [sess, c.c_uint32, c.c_char_p, c.POINTER(c.c_void_p)]),
         "ffc_free_string": (None, [c.c_void_p]),
+        "ffc_check_character": (c.c_int32, [sess, c.c_char_p]),
     }
     missing = []
     for name, (restype, argtypes) in sigs.items():

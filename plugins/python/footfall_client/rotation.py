@@ -41,3 +41,40 @@ def closest_euler(euler, previous):
     direct = unwrap_all(euler)
     alternative = unwrap_all((euler[0] + 180.0, 180.0 - euler[1], euler[2] + 180.0))
     return alternative if l1(alternative) < l1(direct) else direct
+
+
+def quat_from_frame(up, forward):
+    """(x, y, z, w): the rotation taking the character axes (Y up, Z forward) to `up` and to
+    `forward` projected across it (any direction across `up` when forward lies along it), as the
+    walk's body keys are. Both in footfall's (= Maya's) frame."""
+    def unit(v):
+        n = math.sqrt(sum(c * c for c in v))
+        return tuple(c / n for c in v) if n > 0 else None
+
+    def cross(a, b):
+        return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+    y = unit(up) or (0.0, 1.0, 0.0)
+    d = sum(forward[i] * y[i] for i in range(3))
+    z = unit(tuple(forward[i] - d * y[i] for i in range(3)))
+    if z is None:
+        z = unit(cross((1.0, 0.0, 0.0) if abs(y[0]) < 0.9 else (0.0, 0.0, 1.0), y))
+    x = cross(y, z)
+    # Columns x, y, z; the matrix to a quaternion (Shepperd).
+    m00, m01, m02 = x[0], y[0], z[0]
+    m10, m11, m12 = x[1], y[1], z[1]
+    m20, m21, m22 = x[2], y[2], z[2]
+    trace = m00 + m11 + m22
+    if trace > 0:
+        s = 2 * math.sqrt(trace + 1)
+        q = ((m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s, s / 4)
+    elif m00 > m11 and m00 > m22:
+        s = 2 * math.sqrt(1 + m00 - m11 - m22)
+        q = (s / 4, (m01 + m10) / s, (m02 + m20) / s, (m21 - m12) / s)
+    elif m11 > m22:
+        s = 2 * math.sqrt(1 + m11 - m00 - m22)
+        q = ((m01 + m10) / s, s / 4, (m12 + m21) / s, (m02 - m20) / s)
+    else:
+        s = 2 * math.sqrt(1 + m22 - m00 - m11)
+        q = ((m02 + m20) / s, (m12 + m21) / s, s / 4, (m10 - m01) / s)
+    return q if q[3] >= 0 else tuple(-c for c in q)

@@ -64,14 +64,35 @@ def corner_normals(points, triangles, crease_deg=DEFAULT_CREASE_ANGLE_DEG):
     return out
 
 
-def sample_triangles(points, triangles, separation, vertex_normals=None, corner_normals=None):
+# Pure Python holds about 500 bytes and 8 us per sample: beyond this many, a DCC would stall for
+# minutes and run out of memory (a 10 m plane at 1 mm: 100 million).
+MAX_SAMPLES = 2000000
+
+
+def _lattice_size(points, tri, separation):
+    a, b, c = (points[i] for i in tri)
+    longest = max(_length(_sub(b, a)), _length(_sub(c, b)), _length(_sub(a, c)))
+    k = max(1, int(math.ceil(longest / separation - 1e-9)))
+    return (k + 1) * (k + 2) // 2
+
+
+def sample_triangles(points, triangles, separation, vertex_normals=None, corner_normals=None,
+                     max_samples=MAX_SAMPLES):
     """points: (x, y, z) per vertex; triangles: (i, j, k) vertex indices, counter-clockwise
     seen from the side the normals point to; separation [world units] > 0. Normals are
     interpolated from `corner_normals` (per triangle, its three corners': see corner_normals),
     else from `vertex_normals` (one per vertex, smooth across every edge), else the face's.
-    Returns a list of (x, y, z, nx, ny, nz). Degenerate triangles are skipped."""
+    Returns a list of (x, y, z, nx, ny, nz). Degenerate triangles are skipped. ValueError, before
+    any sampling, when the lattices would hold more than max_samples points."""
     if not separation > 0:
         raise ValueError("separation must be > 0, got %r" % (separation,))
+    total = 0
+    for tri in triangles:
+        total += _lattice_size(points, tri, separation)
+        if total > max_samples:
+            raise ValueError("a separation of %g would make more than %d samples: choose a "
+                             "larger separation, or resample the mesh with `footfall terrain "
+                             "convert` and load the point file" % (separation, max_samples))
     seen = set()
     quantum = separation * 1e-4
     out = []

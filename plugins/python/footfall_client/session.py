@@ -258,6 +258,21 @@ class Session:
 
     # -- walks --------------------------------------------------------------------------------
 
+    def check_character(self, data, name="character"):
+        """Raises FootfallError naming the first problem of a character (a dict, or a character
+        file's text) as the generator reads it; nothing is generated. A library without
+        ffc_check_character (an older one) checks nothing."""
+        h = self._handle("ffc_check_character")
+        if not self._lib.has("ffc_check_character"):
+            return
+        text = data if isinstance(data, str) else json.dumps(data)
+        status = self._lib.lib.ffc_check_character(h, text.encode("utf-8", "replace"))
+        if status != OK:
+            message = self.last_error()
+            if message.startswith("character"):
+                message = name + message[len("character"):]
+            raise FootfallError(status, message, "ffc_check_character")
+
     def generate_json(self, terrain, request):
         """Runs the step generator (as `footfall generate` does) and returns (status, walk JSON
         text or None, message). request: a dict or JSON text (keys of footfall_c.h)."""

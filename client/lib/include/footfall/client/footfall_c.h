@@ -95,6 +95,11 @@ int32_t ffc_next(ffc_session* s, uint32_t terrain, const double* steps, size_t c
 int32_t ffc_generate(ffc_session* s, uint32_t terrain, const char* request_json, char** walk_json);
 void ffc_free_string(char* text);
 
+/* Checks a character file's JSON object (text) as ffc_generate would read it, without
+ * generating anything: FF_C_OK, or the status and ffc_last_error naming the first problem
+ * (a plugin checks a file before it builds a rig from it). No server call. */
+int32_t ffc_check_character(ffc_session* s, const char* character_json);
+
 #ifdef __cplusplus
 }
 #endif
