@@ -63,7 +63,17 @@ check "empty terrain: exit 1" [ $? -eq 1 ]
 check "empty terrain: message" grep -qF "$work/empty.pts: no samples (expected at least one line x y z nx ny nz)" <<< "$err"
 err=$("$footfall" bench --terrain "$hills" --jitter nan 2>&1 >/dev/null)
 check "nan jitter refused" [ $? -ne 0 ]
-check "nan jitter: message" grep -qF -- "--jitter: 'nan' is not a finite number >= 0" <<< "$err"
+check "nan jitter: message" grep -qF -- "--jitter: 'nan' is not a finite number from 0 to 1e+12" <<< "$err"
+# A step of 0 (every next query invalid) and one so long no query is valid are refused; a
+# jitter of 0 is taken as given (it was replaced by the default).
+err=$("$footfall" bench --terrain "$hills" --step 0 2>&1 >/dev/null)
+check "zero step refused" [ $? -ne 0 ]
+check "zero step: message" grep -qF -- "--step: '0' is not a finite number > 0 and <= 1e+12" <<< "$err"
+err=$("$footfall" bench --terrain "$hills" --step 1e300 2>&1 >/dev/null)
+check "huge step refused" [ $? -ne 0 ]
+out=$("$footfall" bench --terrain "$hills" --jitter 0 --queries 64 --min-time 0.001 2>/dev/null)
+check "jitter 0 taken as given" grep -q "jitter 0)" <<< "$out"
+check "batches no larger than the queries" grep -q "batches of 64" <<< "$out"
 err=$("$footfall" bench --terrain "$hills" --queries 0 2>&1 >/dev/null)
 check "zero queries refused" [ $? -ne 0 ]
 stop_server

@@ -32,6 +32,12 @@ check "zero direction" grep -q '"line":5,"message":"next: direction DX DY DZ mus
 check "answers after errors" grep -q '"op":"snap","found":true,"index":12' <(sed -n 5p "$work/out.jsonl")
 check "count" grep -qF '{"op":"error","line":7,"message":"normal: expected 3 numbers, found 2"}' <(sed -n 6p "$work/out.jsonl")
 check "commas separate numbers" grep -q '"op":"snap","found":true,"index":12' <(sed -n 7p "$work/out.jsonl")
+# A byte that is not UTF-8 in a line: that line's error (the byte replaced), and the run goes on
+# (the JSON writer threw, and no later line was answered).
+printf 'snap \xff 0 0\nsnap 2 0 2\n' | "$footfall" query --terrain "$work/flat.pts" > "$work/utf8.jsonl"
+check "non-UTF-8 byte: exit 1" [ $? -eq 1 ]
+check "non-UTF-8 byte: the line's error" grep -q '"op":"error","line":1,"message":"snap: argument 1' <(sed -n 1p "$work/utf8.jsonl")
+check "non-UTF-8 byte: the next line answered" grep -q '"op":"snap","found":true,"index":12' <(sed -n 2p "$work/utf8.jsonl")
 # A line longer than 4096 characters (here 5 MB, no newline after it at first) is an error of
 # its own, skipped without being held; the next lines are answered; the last line may lack its
 # newline.

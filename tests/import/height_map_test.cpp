@@ -148,6 +148,11 @@ TEST_CASE("Height maps: headers are checked against the data before anything is 
   CHECK(Contains(
       error,
       "big2.pgm:5: truncated: expected 10000000000 grey levels (100000 x 100000 pixels), found 3"));
+  // Sizes too large for an integer are printed as numbers (they overflowed to
+  // -9223372036854775808).
+  CHECK(ReadAscGrid(dir.Write("huge.asc", "ncols 1e30\nnrows 2\ncellsize 1\n1 2\n3 4\n"), &map,
+                    &error) == Status::kParseError);
+  CHECK(Contains(error, "expected 2e+30 values (2 rows of 1e+30), found 4"));
   // A header within its data but beyond the cell cap: refused before the pixels are read (a
   // sparse file of 10001 x 10000 zero pixels, 100 MB that take no disk space).
   {

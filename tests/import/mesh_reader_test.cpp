@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 
@@ -185,6 +187,51 @@ TEST_CASE("ReadMesh: bad meshes give clear errors", "[import][mesh]") {
     CHECK(Read(dir.Write("missing.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n"), &mesh, &error) ==
           Status::kParseError);
     CHECK(Contains(error, "missing.obj:3: face uses vertex 3 but only 2 vertices"));
+  }
+  SECTION("binary PLY and STL values are checked as the text formats' are") {
+    // OpenMesh dropped a binary PLY face with an index out of range, and a binary STL facet
+    // with a NaN vertex, silently: the rest loaded as if whole.
+    auto ply = [](bool big_endian, float x0, int index) {
+      std::string s = std::string("ply\nformat binary_") + (big_endian ? "big" : "little") +
+                      "_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                      "property float z\nelement face 2\nproperty list uchar int "
+                      "vertex_indices\nend_header\n";
+      auto put = [&](const void* p, size_t n) {
+        std::string bytes(static_cast<const char*>(p), n);
+        if (big_endian) std::reverse(bytes.begin(), bytes.end());
+        s += bytes;
+      };
+      const float v[4][3] = {{x0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}};
+      for (const auto& p : v)
+        for (float c : p) put(&c, 4);
+      const int faces[2][3] = {{0, 2, 1}, {0, 3, index}};
+      for (const auto& f : faces) {
+        s += '\3';
+        for (int i : f) put(&i, 4);
+      }
+      return s;
+    };
+    REQUIRE(Read(dir.Write("good.ply", ply(false, 0, 2)), &mesh, &error) == Status::kOk);
+    CHECK(mesh.triangles.size() == 2);
+    REQUIRE(Read(dir.Write("big.ply", ply(true, 0, 2)), &mesh, &error) == Status::kOk);
+    CHECK(mesh.triangles.size() == 2);
+    CHECK(Read(dir.Write("index.ply", ply(true, 0, 1000000)), &mesh, &error) ==
+          Status::kParseError);
+    CHECK(Contains(error, "index.ply: face 2: vertex index 1000000 is not an index below 4"));
+    CHECK(Read(dir.Write("nan.ply", ply(false, std::nanf(""), 2)), &mesh, &error) ==
+          Status::kParseError);
+    CHECK(Contains(error, "nan.ply: vertex 1: coordinate x is NaN, infinite or beyond +-5e14"));
+    std::string stl(80, ' ');
+    const uint32_t count = 2;
+    stl.append(reinterpret_cast<const char*>(&count), 4);
+    const float facets[2][12] = {{0, 1, 0, std::nanf(""), 0, 0, 0, 0, 1, 1, 0, 0},
+                                 {0, 1, 0, 1, 0, 0, 0, 0, 1, 1, 0, 1}};
+    for (const auto& f : facets) {
+      stl.append(reinterpret_cast<const char*>(f), sizeof f);
+      stl.append(2, '\0');
+    }
+    CHECK(Read(dir.Write("nan.stl", stl), &mesh, &error) == Status::kParseError);
+    CHECK(Contains(error, "nan.stl: facet 1: a vertex coordinate is NaN"));
   }
   SECTION("ASCII STL facets are triangles") {
     // OpenMesh kept the first three vertices of a four-vertex loop and dropped the fourth.

@@ -230,7 +230,7 @@ struct App {
       j["live"]["after"] = live->start_after();
     }
     std::ofstream out(options.dump_state);
-    out << j.dump(2) << '\n';
+    out << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
     out.flush();
     if (!out) {
       Fail(options.dump_state + ": cannot write the state dump");

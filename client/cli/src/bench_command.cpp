@@ -31,8 +31,8 @@ struct BenchFlags {
   TerrainFlags terrain;
   size_t queries = 65536;
   size_t batch = 4096;
-  double jitter = 0;  // 0: a quarter of the grid's cell size
-  double step = 0;    // 0: twice the grid's cell size
+  double jitter = -1;  // < 0: a quarter of the grid's cell size
+  double step = 0;     // 0: twice the grid's cell size
   double min_time = 0.3;
   uint64_t seed = 1;
   bool json = false;
@@ -161,7 +161,7 @@ int RunBench(const BenchFlags& flags) {
     std::cerr << who << info.name << ": the terrain has no samples\n";
     return 1;
   }
-  const double jitter = flags.jitter > 0 ? flags.jitter : 0.25 * st.cell_size;
+  const double jitter = flags.jitter >= 0 ? flags.jitter : 0.25 * st.cell_size;
   const double step = flags.step > 0 ? flags.step : 2 * st.cell_size;
   std::vector<Vec3> random;
   if (MakeQueries(*session, terrain, st, flags, jitter, &random, &error) != Status::kOk) {
@@ -250,7 +250,8 @@ int RunBench(const BenchFlags& flags) {
         },
         k, 0.1, &unused);
   }
-  const std::string batch_name = "batches of " + std::to_string(flags.batch);
+  const std::string batch_name =
+      "batches of " + std::to_string(std::min(flags.batch, flags.queries));
   for (int order = 0; order < 2 && ok; ++order) {
     const std::string o = order == 0 ? "random" : "coherent";
     const std::vector<Vec3>& q = order == 0 ? random : coherent;
@@ -316,7 +317,7 @@ int RunBench(const BenchFlags& flags) {
       list.push_back(e);
     }
     j["figures"] = list;
-    std::cout << j.dump(2) << '\n';
+    std::cout << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
     return 0;
   }
   std::cout << "backend: " << session->Describe() << '\n'
@@ -355,13 +356,14 @@ void AddBenchCommand(CLI::App& app, int* exit_code) {
       ->check(CLI::Range(1, 256));
   cmd->add_option("--queries", flags->queries, "query points per pass")
       ->check(CLI::Range(size_t{1}, size_t{1} << 24));
-  cmd->add_option("--batch", flags->batch, "queries per batch call (at most 4096 over RPC)")
+  cmd->add_option("--batch", flags->batch,
+                  "queries per batch call (over RPC, a batch above 4096 goes as several calls)")
       ->check(CLI::Range(size_t{1}, size_t{1} << 20));
   cmd->add_option("--jitter", flags->jitter,
                   "how far query points lie off the terrain, per axis (default: a quarter cell)")
-      ->check(FiniteAtLeast(0));
+      ->check(FiniteRange(0, 1e12));
   cmd->add_option("--step", flags->step, "step length of next queries (default: two cells)")
-      ->check(FiniteAtLeast(0));
+      ->check(FiniteAboveUpTo(0, 1e12));
   cmd->add_option("--min-time", flags->min_time, "seconds each figure is measured for at least")
       ->check(FiniteRange(0.001, 3600));
   cmd->add_option("--query-seed", flags->seed, "seed of the query points");

@@ -122,7 +122,8 @@ bool RunBlock(TerrainSession& session, TerrainHandle terrain, double tolerance,
         ok = false;
       }
     }
-    std::cout << j.dump() << '\n';
+    // (Replacing bytes that are not UTF-8: a line holding one threw, and ended the run.)
+    std::cout << j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
   }
   std::cout.flush();
   return ok;

@@ -35,7 +35,9 @@ void Vector(std::string& out, const Vec3& v) {
   out += ']';
 }
 
-void String(std::string& out, const std::string& s) { out += json(s).dump(); }
+void String(std::string& out, const std::string& s) {
+  out += json(s).dump(-1, ' ', false, json::error_handler_t::replace);  // never throws
+}
 
 const char* KindName(TrackKind kind) { return kind == TrackKind::kFoot ? "foot" : "body"; }
 

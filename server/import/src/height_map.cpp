@@ -81,8 +81,14 @@ Status ReadWhole(const std::string& path, std::string* text, std::string* error)
   return Status::kOk;
 }
 
-// A whole number of the header as text ("1000000000", not "1e+09").
-std::string Count(double n) { return std::to_string(static_cast<long long>(n)); }
+// A whole number of the header as text ("1000000000", not "1e+09"; beyond 1e18, as "1e+30":
+// the conversion to an integer overflowed to -9223372036854775808).
+std::string Count(double n) {
+  if (std::fabs(n) < 1e18) return std::to_string(static_cast<long long>(n));
+  std::ostringstream out;
+  out << n;
+  return out.str();
+}
 
 // Counts the tokens `reader` has left, up to one more than a height map may have, and the line
 // of the last one counted.

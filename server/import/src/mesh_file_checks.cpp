@@ -22,6 +22,69 @@ Status Fail(const std::string& where, const std::string& what, std::string* erro
 
 std::string At(const std::string& path, size_t line) { return path + ":" + std::to_string(line); }
 
+// Reads binary PLY values of a named type, in the file's byte order, through a buffer.
+class PlyValues {
+ public:
+  PlyValues(std::istream& in, bool big_endian) : in_(in), swap_(big_endian) {}
+  // The next value of `type` as a double; false at the end of the data.
+  bool Next(const std::string& type, double* out) {
+    unsigned char b[8];
+    const int size = SizeOf(type);
+    if (size == 0 || !Take(b, size)) return false;
+    if (swap_) std::reverse(b, b + size);
+    if (type == "char" || type == "int8")
+      *out = static_cast<int8_t>(b[0]);
+    else if (type == "uchar" || type == "uint8")
+      *out = b[0];
+    else if (type == "short" || type == "int16")
+      *out = Get<int16_t>(b);
+    else if (type == "ushort" || type == "uint16")
+      *out = Get<uint16_t>(b);
+    else if (type == "int" || type == "int32")
+      *out = Get<int32_t>(b);
+    else if (type == "uint" || type == "uint32")
+      *out = Get<uint32_t>(b);
+    else if (type == "float" || type == "float32")
+      *out = Get<float>(b);
+    else
+      *out = Get<double>(b);
+    return true;
+  }
+  static int SizeOf(const std::string& type) {
+    if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+    if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+    if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" ||
+        type == "float32")
+      return 4;
+    if (type == "double" || type == "float64") return 8;
+    return 0;
+  }
+
+ private:
+  template <typename T>
+  static T Get(const unsigned char* b) {
+    T v;
+    std::memcpy(&v, b, sizeof v);  // little-endian hosts (every platform we build for)
+    return v;
+  }
+  bool Take(unsigned char* out, int size) {
+    for (int i = 0; i < size; ++i) {
+      if (at_ == end_) {
+        in_.read(reinterpret_cast<char*>(buffer_), sizeof buffer_);
+        at_ = buffer_, end_ = buffer_ + in_.gcount();
+        if (at_ == end_) return false;
+      }
+      out[i] = *at_++;
+    }
+    return true;
+  }
+  std::istream& in_;
+  const bool swap_;
+  unsigned char buffer_[1 << 16];
+  unsigned char* at_ = buffer_;
+  unsigned char* end_ = buffer_;
+};
+
 std::vector<std::string> Tokens(const std::string& line) {
   std::istringstream in(line);
   std::vector<std::string> tokens;
@@ -210,10 +273,12 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
   struct Element {
     std::string name;
     long long count = 0;
-    long long fixed_bytes = 0;            // fixed-size properties
-    long long list_min_bytes = 0;         // list properties, counting 3 items per face list
-    std::vector<std::string> properties;  // names, in order
-    std::vector<bool> lists;              // whether each is a list
+    long long fixed_bytes = 0;             // fixed-size properties
+    long long list_min_bytes = 0;          // list properties, counting 3 items per face list
+    std::vector<std::string> properties;   // names, in order
+    std::vector<bool> lists;               // whether each is a list
+    std::vector<std::string> types;        // each one's type (lists: their items')
+    std::vector<std::string> count_types;  // lists: their counts' type ("" for scalars)
   };
   std::vector<Element> elements;
   std::string format;
@@ -253,11 +318,13 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
         }
         e.list_min_bytes += count_size + (e.name == "face" ? 3 * item_size : 0);
         e.properties.push_back(t[4]), e.lists.push_back(true);
+        e.types.push_back(t[3]), e.count_types.push_back(t[2]);
       } else if (t.size() >= 3) {
         const int size = type_size(t[1]);
         if (!size) return Fail(At(path, number), "unknown PLY type '" + t[1] + "'", error);
         e.fixed_bytes += size;
         e.properties.push_back(t[2]), e.lists.push_back(false);
+        e.types.push_back(t[1]), e.count_types.push_back("");
       }
     }
   }
@@ -345,6 +412,65 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
                     " bytes of " + format + " data, the file has " + std::to_string(data_bytes),
                 error);
   }
+  if (format != "binary_little_endian" && format != "binary_big_endian") return Status::kOk;
+  // Binary data, as the ASCII lines are checked: vertices' x, y, z finite, faces' index lists
+  // of 3 or more indices of declared vertices (OpenMesh dropped a face with a bad index
+  // silently, and read a NaN vertex).
+  long long vertices = 0;
+  for (const Element& e : elements)
+    if (e.name == "vertex") vertices = e.count;
+  in.clear();
+  in.seekg(data_start);
+  PlyValues values(in, format == "binary_big_endian");
+  auto truncated = [&](const Element& e, long long r) {
+    return Fail(path,
+                "truncated: the binary data ends in " + e.name + " " + std::to_string(r + 1) +
+                    " of " + std::to_string(e.count),
+                error);
+  };
+  for (const Element& e : elements) {
+    for (long long r = 0; r < e.count; ++r) {
+      for (size_t p = 0; p < e.properties.size(); ++p) {
+        double v = 0;
+        const std::string& name = e.properties[p];
+        if (!e.lists[p]) {
+          if (!values.Next(e.types[p], &v)) return truncated(e, r);
+          if (e.name == "vertex" && (name == "x" || name == "y" || name == "z") &&
+              !(std::fabs(v) <= terrain::kMaxCoordinate)) {
+            return Fail(path,
+                        "vertex " + std::to_string(r + 1) + ": coordinate " + name +
+                            " is NaN, infinite or beyond +-5e14",
+                        error);
+          }
+          continue;
+        }
+        double n = 0;
+        if (!values.Next(e.count_types[p], &n)) return truncated(e, r);
+        const bool indices =
+            e.name == "face" && (name == "vertex_indices" || name == "vertex_index");
+        if (indices && n < 3) {
+          return Fail(path,
+                      "face " + std::to_string(r + 1) + " has " +
+                          std::to_string(static_cast<long long>(n)) +
+                          " vertices, expected 3 or more",
+                      error);
+        }
+        for (double i = 0; i < n; ++i) {
+          if (!values.Next(e.types[p], &v)) return truncated(e, r);
+          if (indices && !(v >= 0 && v < static_cast<double>(vertices))) {
+            std::ostringstream m;
+            m << "face " << r + 1 << ": vertex index ";
+            if (std::fabs(v) < 1e18)
+              m << static_cast<long long>(v);
+            else
+              m << v;
+            m << " is not an index below " << vertices;
+            return Fail(path, m.str(), error);
+          }
+        }
+      }
+    }
+  }
   return Status::kOk;
 }
 
@@ -358,7 +484,30 @@ Status CheckStlFile(const std::string& path, std::string* error) {
   if (size >= 84) {
     uint32_t count = 0;
     std::memcpy(&count, head.data() + 80, 4);  // little-endian on every platform we build for
-    if (84 + 50ll * count == size) return Status::kOk;  // a complete binary STL
+    if (84 + 50ll * count == size) {  // a complete binary STL: its vertices finite (OpenMesh
+      in.clear();                     // dropped a facet with a NaN vertex, silently)
+      in.seekg(84);
+      std::vector<char> facets(50 * 4096);
+      for (uint32_t done = 0; done < count;) {
+        const uint32_t n = std::min<uint32_t>(count - done, 4096);
+        if (!in.read(facets.data(), 50 * static_cast<std::streamsize>(n)))
+          return Fail(path, "truncated: cannot read facet " + std::to_string(done + 1), error);
+        for (uint32_t f = 0; f < n; ++f) {
+          float v[9];
+          std::memcpy(v, facets.data() + 50 * f + 12, sizeof v);
+          for (float c : v) {
+            if (!(std::fabs(c) <= terrain::kMaxCoordinate)) {
+              return Fail(path,
+                          "facet " + std::to_string(done + f + 1) +
+                              ": a vertex coordinate is NaN, infinite or beyond +-5e14",
+                          error);
+            }
+          }
+        }
+        done += n;
+      }
+      return Status::kOk;
+    }
   }
   if (head.compare(0, 5, "solid") != 0) {
     if (size < 84) return Fail(path, "truncated: a binary STL needs an 84-byte header", error);
