@@ -28,7 +28,7 @@ check "malformed lines exit 1" [ "$rc" -eq 1 ]
 check "eight lines give seven answers" [ "$(wc -l < "$work/out.jsonl")" -eq 7 ]
 check "bad number" grep -q '{"op":"error","line":2,"message":"snap: argument 2 '"'"'x'"'"' is not a finite number"}' "$work/out.jsonl"
 check "unknown command" grep -qF '"line":4,"message":"unknown command '"'"'jump'"'"' (expected snap X Y Z, normal X Y Z or next X Y Z DX DY DZ)"}' "$work/out.jsonl"
-check "zero direction" grep -q '"line":5,"message":"next: direction DX DY DZ must be non-zero"' "$work/out.jsonl"
+check "zero direction" grep -q '"line":5,"message":"next: direction DX DY DZ must be non-zero' "$work/out.jsonl"
 check "answers after errors" grep -q '"op":"snap","found":true,"index":12' <(sed -n 5p "$work/out.jsonl")
 check "count" grep -qF '{"op":"error","line":7,"message":"normal: expected 3 numbers, found 2"}' <(sed -n 6p "$work/out.jsonl")
 check "commas separate numbers" grep -q '"op":"snap","found":true,"index":12' <(sed -n 7p "$work/out.jsonl")
@@ -107,6 +107,14 @@ done
 err=$(timeout 5 "$footfalld" --listen 127.0.0.1:0 --no-rpcbind --port-file "$work/no/such/dir/port" 2>&1)
 check "footfalld unwritable --port-file: exit 1" [ $? -eq 1 ]
 check "footfalld unwritable --port-file: message" grep -qF -- "--port-file $work/no/such/dir/port: cannot write the port there" <<< "$err"
+# A height map larger than the memory the process may use is refused from its header (it ran
+# out of memory after a minute of work); here 25 M pixels (a sparse file) under a 2 GB limit.
+printf 'P5\n5000 5000\n255\n' > "$work/huge.pgm"
+truncate -s $(( $(stat -c %s "$work/huge.pgm") + 25000000 )) "$work/huge.pgm"
+err=$( (ulimit -v 2000000; "$footfall" terrain info "$work/huge.pgm") 2>&1)
+check "height map beyond memory: exit 1" [ $? -eq 1 ]
+check "height map beyond memory: message" grep -qF "huge.pgm:2: the header declares 5000 x 5000 pixels: reading it needs about 3.25 GB, more than the 2.05 GB of memory this process may use" <<< "$err"
+
 # A low soft limit on descriptors is raised to the hard one (at the limit libtirpc closes the
 # least recently active connections, an idle client's among them).
 hard=$(ulimit -Hn)

@@ -254,8 +254,7 @@ int32_t ffc_check_character(ffc_session* s, const char* character_json) {
     if (!character_json) return BadArgument(s, "character_json must not be NULL");
     footfall::Character character;
     std::string error;
-    const Status status =
-        footfall::ParseCharacter(character_json, "character", &character, &error);
+    const Status status = footfall::ParseCharacter(character_json, "character", &character, &error);
     if (status != Status::kOk) s->error = error;
     return static_cast<int32_t>(status);
   });

@@ -5,6 +5,8 @@
 #include <sstream>
 #include <vector>
 
+#include "footfall/terrain/shown_text.h"
+
 namespace footfall {
 namespace {
 
@@ -57,7 +59,7 @@ bool ParseQueryText(const std::string& text, QueryText* out, std::string* error)
   } else if (op == "next") {
     query.op = QueryOp::kNext, want = 6;
   } else {
-    *error = "unknown command '" + op + "' (expected " + kForms + ")";
+    *error = "unknown command '" + ShownText(op) + "' (expected " + kForms + ")";
     return false;
   }
   if (tokens.size() - 1 != want) {
@@ -68,7 +70,7 @@ bool ParseQueryText(const std::string& text, QueryText* out, std::string* error)
   double v[6] = {0, 0, 0, 0, 0, 0};
   for (size_t i = 0; i < want; ++i) {
     if (!ParseFiniteNumber(tokens[i + 1], &v[i])) {
-      *error = op + ": argument " + std::to_string(i + 1) + " '" + tokens[i + 1] +
+      *error = op + ": argument " + std::to_string(i + 1) + " '" + ShownText(tokens[i + 1]) +
                "' is not a finite number";
       return false;
     }
@@ -76,7 +78,9 @@ bool ParseQueryText(const std::string& text, QueryText* out, std::string* error)
   query.point = {v[0], v[1], v[2]};
   query.direction = {v[3], v[4], v[5]};
   if (query.op == QueryOp::kNext && Length2(query.direction) == 0) {
-    *error = "next: direction DX DY DZ must be non-zero";
+    *error =
+        "next: direction DX DY DZ must be non-zero (and its squared length above the "
+        "smallest double: components beyond about 1e-154)";
     return false;
   }
   *out = query;

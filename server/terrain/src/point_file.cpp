@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "footfall/terrain/input_file.h"
+#include "footfall/terrain/shown_text.h"
 
 namespace footfall {
 namespace {
@@ -53,25 +54,25 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
         const auto [ptr, ec] = std::from_chars(first, last, value);
         if (ec == std::errc::result_out_of_range && ptr == last) {
           return Fail(name, line_no,
-                      "column " + std::to_string(count + 1) + ": '" + std::string(token) +
+                      "column " + std::to_string(count + 1) + ": '" + ShownText(token) +
                           "' is out of range (expected a finite number)",
                       out, error);
         }
         if (ec != std::errc() || ptr != last) {
           return Fail(name, line_no,
-                      "column " + std::to_string(count + 1) + ": '" + std::string(token) +
+                      "column " + std::to_string(count + 1) + ": '" + ShownText(token) +
                           "' is not a number (expected x y z nx ny nz)",
                       out, error);
         }
         if (!std::isfinite(value)) {
           return Fail(name, line_no,
-                      "column " + std::to_string(count + 1) + ": '" + std::string(token) +
+                      "column " + std::to_string(count + 1) + ": '" + ShownText(token) +
                           "' is NaN or infinite (expected a finite number)",
                       out, error);
         }
         if (count < 3 && std::fabs(value) > terrain::kMaxCoordinate) {
           std::ostringstream m;
-          m << "column " << count + 1 << ": " << token << " is out of range (expected |"
+          m << "column " << count + 1 << ": " << ShownText(token) << " is out of range (expected |"
             << "xyz"[count] << "| <= " << terrain::kMaxCoordinate << ")";
           return Fail(name, line_no, m.str(), out, error);
         }
