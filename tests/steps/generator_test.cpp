@@ -73,6 +73,20 @@ void WalkTwelveSteps(Terrain& t, const Character& c, const Vec3& start, bool for
   }
 }
 
+// `steps` steps of c from (5, 0, 2) along +Z on a flat floor 10 m wide: not stopped, and every
+// invariant of CheckWalk held.
+Walk CheckedWalkOnFlat(const Character& c, int steps) {
+  Terrain t = LoadTerrain(MakeFlat(200, 0.05, 0), 0.05);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {5, 0, 2};
+  o.steps = steps;
+  Walk w = Generate(t, c, o);
+  REQUIRE(w.stopped.empty());
+  CheckWalk(t, c, o, w);
+  return w;
+}
+
 // A crowd of `crowd` characters `spacing` apart around `start`, walking `steps` steps.
 GenerateOptions CrowdOptions(const Vec3& start, int steps, int crowd, double spacing) {
   GenerateOptions o;
@@ -362,14 +376,7 @@ TEST_CASE("A gait of one group keys every touch-down, its feet lifting from ther
   one.pairs = {{0}};
   for (const Character& c : {hop, one}) {
     INFO(c.feet.size() << " feet");
-    Terrain t = LoadTerrain(MakeFlat(200, 0.05, 0), 0.05);
-    GenerateOptions o;
-    o.has_start = true;
-    o.start = {5, 0, 2};
-    o.steps = 9;
-    const Walk w = Generate(t, c, o);
-    REQUIRE(w.stopped.empty());
-    CheckWalk(t, c, o, w);
+    const Walk w = CheckedWalkOnFlat(c, 9);
     for (const WalkTrack& tr : w.tracks) {
       if (tr.kind != TrackKind::kFoot) continue;
       int ends = 0, mids = 0;
@@ -394,14 +401,7 @@ TEST_CASE("Feet whose rests are off the body's origin walk straight", "[steps][g
   shifted.reach += 0.3;
   for (const Character& c : {one, shifted}) {
     INFO(c.feet.size() << " feet");
-    Terrain t = LoadTerrain(MakeFlat(200, 0.05, 0), 0.05);
-    GenerateOptions o;
-    o.has_start = true;
-    o.start = {5, 0, 2};
-    o.steps = 10;
-    const Walk w = Generate(t, c, o);
-    REQUIRE(w.stopped.empty());
-    CheckWalk(t, c, o, w);
+    const Walk w = CheckedWalkOnFlat(c, 10);
     const auto& body = Body(w).keys;
     CHECK(std::fabs(body.back().position.x - body.front().position.x) < 0.06);
     CHECK(body.back().position.z - body.front().position.z > 2);

@@ -50,6 +50,7 @@ class PlyValues {
       *out = Get<double>(b);
     return true;
   }
+  // Bytes of a PLY type, 0 for an unknown one.
   static int SizeOf(const std::string& type) {
     if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
     if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
@@ -282,15 +283,7 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
   };
   std::vector<Element> elements;
   std::string format;
-  auto type_size = [](const std::string& type) -> int {
-    if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
-    if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
-    if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" ||
-        type == "float32")
-      return 4;
-    if (type == "double" || type == "float64") return 8;
-    return 0;
-  };
+  const auto type_size = PlyValues::SizeOf;
   bool ended = false;
   while (std::getline(in, line)) {
     ++number;
