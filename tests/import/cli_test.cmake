@@ -67,6 +67,17 @@ execute_process(COMMAND "${FOOTFALL}" query --terrain "${WORK}/cube.obj" --separ
 if(NOT rc EQUAL 0 OR NOT smooth STREQUAL out)
   message(FATAL_ERROR "--smooth-normals: expected the default's answer ${out}, got ${smooth}")
 endif()
+# What OpenMesh misreads is refused with why: a byte order mark (an OBJ lost its first vertex),
+# CR-only lines, an upper-case ASCII STL (read as binary).
+string(ASCII 239 187 191 bom)
+file(WRITE "${WORK}/bom.obj" "${bom}v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 3 2\n")
+expect(EXIT_NONZERO "bom.obj: starts with a UTF-8 byte order mark" terrain info "${WORK}/bom.obj")
+file(WRITE "${WORK}/cr.obj" "v 0 0 0\rv 1 0 0\rv 0 0 1\rf 1 3 2\r")
+expect(EXIT_NONZERO "cr.obj: lines end in CR alone" terrain info "${WORK}/cr.obj")
+file(WRITE "${WORK}/upper.stl" "SOLID x\nfacet normal 0 1 0\nouter loop\nvertex 0 0 0\n"
+     "vertex 1 0 0\nvertex 0 0 1\nendloop\nendfacet\nENDSOLID x\n")
+expect(EXIT_NONZERO "upper.stl: an ASCII STL must begin with 'solid' in lower case"
+       terrain info "${WORK}/upper.stl")
 # A height map's frame given for another kind of file is refused, not ignored.
 expect(EXIT_NONZERO "applies to height maps (.asc .pgm) only, not to a mesh"
        terrain info "${WORK}/cube.obj" --height-scale 10)

@@ -1,6 +1,7 @@
 #include "mesh_file_checks.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -8,6 +9,7 @@
 #include <fstream>
 #include <regex>
 #include <sstream>
+#include <string_view>
 #include <vector>
 
 #include "footfall/terrain/samples.h"
@@ -125,10 +127,33 @@ std::string StripComment(const std::string& line) {
   return s;
 }
 
+// What OpenMesh's text readers misread at the start of a file: a UTF-8 byte order mark (an OBJ
+// lost its first vertex to it) and lines ended by CR alone (read as one line).
+Status CheckTextStart(const std::string& path, std::string* error) {
+  std::ifstream in(path, std::ios::binary);
+  char head[65536];
+  in.read(head, sizeof head);
+  const std::string_view text(head, static_cast<size_t>(in.gcount()));
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") {
+    return Fail(path,
+                "starts with a UTF-8 byte order mark, which OpenMesh cannot read: save it "
+                "without one",
+                error);
+  }
+  const size_t cr = text.find('\r');
+  if (cr != std::string_view::npos && text.find('\n') == std::string_view::npos &&
+      cr + 1 < text.size()) {
+    return Fail(path, "lines end in CR alone (classic Mac OS): convert them to LF or CR LF", error);
+  }
+  return Status::kOk;
+}
+
 }  // namespace
 
 Status CheckObjFile(const std::string& path, long long* faces, std::vector<Vec3>* coordinates,
                     std::string* error) {
+  const Status start = CheckTextStart(path, error);
+  if (start != Status::kOk) return start;
   std::ifstream in(path);
   std::string line;
   long long vertices = 0;
@@ -178,6 +203,8 @@ Status CheckObjFile(const std::string& path, long long* faces, std::vector<Vec3>
 Status CheckOffFile(const std::string& path, long long* faces, std::vector<Vec3>* coordinates,
                     std::string* error) {
   *faces = -1;
+  const Status start = CheckTextStart(path, error);
+  if (start != Status::kOk) return start;
   std::ifstream in(path);
   std::string line;
   size_t number = 0;
@@ -501,6 +528,14 @@ Status CheckStlFile(const std::string& path, std::string* error) {
       }
       return Status::kOk;
     }
+  }
+  if (head.size() >= 5 && head.compare(0, 5, "solid") != 0 &&
+      std::equal(head.begin(), head.begin() + 5, "solid",
+                 [](char a, char b) { return std::tolower(static_cast<unsigned char>(a)) == b; })) {
+    return Fail(path,
+                "an ASCII STL must begin with 'solid' in lower case (OpenMesh reads it as "
+                "binary otherwise)",
+                error);
   }
   if (head.compare(0, 5, "solid") != 0) {
     if (size < 84) return Fail(path, "truncated: a binary STL needs an 84-byte header", error);
