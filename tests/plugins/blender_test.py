@@ -373,7 +373,7 @@ class BlenderAddonTest(unittest.TestCase):
         out = os.path.join(ARGS.work_dir, "crowd.json")
         run_cli("generate", "--terrain", self.pts, "--character", rig.footfall_rig.character_path,
                 "--start", csv(to_ff(rig.matrix_world.translation)), "--steps", 4,
-                "--crowd", 2, "--out", out)
+                "--crowd", 2, "--out", out, "--out", out[:-5] + "_gltf.gltf")
         with open(out) as f:
             walk = json.load(f)
         bpy.context.scene.footfall.rig = None
@@ -384,11 +384,21 @@ class BlenderAddonTest(unittest.TestCase):
             feet = {t["name"]: bpy.data.objects["crowd_%s_%s" % (who, t["name"])]
                     for t in part["tracks"] if t["kind"] == "foot"}
             self.assert_keys_equal_walk(part, feet, bpy.data.objects["crowd_%s_body" % who])
+        # The same walk as glTF: its nodes name their character (the tracks were mixed onto
+        # one set of empties).
+        self.assertEqual(bpy.ops.footfall.import_walk(filepath=out[:-5] + "_gltf.gltf"),
+                         {"FINISHED"})
+        for who in ("c1", "c2"):
+            part = {"tracks": [t for t in walk["tracks"] if t["character"] == who]}
+            feet = {t["name"]: bpy.data.objects["crowd_gltf_%s_%s" % (who, t["name"])]
+                    for t in part["tracks"] if t["kind"] == "foot"}
+            self.assert_keys_equal_walk(part, feet, bpy.data.objects["crowd_gltf_%s_body" % who])
         # Onto a rig: refused, nothing changed.
         bpy.context.scene.footfall.rig = rig
-        with self.assertRaises(RuntimeError) as e:
-            bpy.ops.footfall.import_walk(filepath=out)
-        self.assertIn("a crowd walk (2 characters)", str(e.exception))
+        for path in (out, out[:-5] + "_gltf.gltf"):
+            with self.assertRaises(RuntimeError) as e:
+                bpy.ops.footfall.import_walk(filepath=path)
+            self.assertIn("a crowd walk (2 characters)", str(e.exception))
 
     def test_8_import_gltf_walk(self):
         out = os.path.join(ARGS.work_dir, "biped_cli.gltf")

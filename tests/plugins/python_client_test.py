@@ -86,6 +86,25 @@ class EmbeddedTest(unittest.TestCase):
             self.s.load_file(12345)
         self.assertEqual(e.exception.status_name, "invalid_argument")
 
+    def test_closed_sessions_do_not_answer_and_odd_arguments_raise_footfall_errors(self):
+        s = ff.Session.embedded()
+        s.close()
+        self.assertFalse(s.ping())
+        with self.assertRaises(ff.FootfallError):
+            self.s.check_character(b"{}")
+        with self.assertRaises(ff.FootfallError) as e:
+            self.s.load_file("/tmp/no\x00pe.pts")
+        self.assertIn("NUL", e.exception.message)
+        folder = tempfile.mkdtemp()
+        try:
+            fifo = os.path.join(folder, "out.pts")
+            os.mkfifo(fifo)
+            with self.assertRaises(ValueError):  # writing would wait for a reader
+                ff.sampling.write_point_file(fifo, [(0, 0, 0, 0, 1, 0)])
+        finally:
+            os.unlink(fifo)
+            os.rmdir(folder)
+
     def test_unbounded_timeouts_are_refused(self):
         for timeout in (float("inf"), float("nan"), 1e300, "soon"):
             with self.assertRaises(ff.FootfallError) as e:
@@ -160,6 +179,16 @@ class SharedLogicTest(unittest.TestCase):
             ff.sampling.sample_triangles(pts, [(0, 2, 1), (1, 2, 3)], 0.001)
         self.assertIn("would make more than 2000000 samples", str(e.exception))
         self.assertEqual(len(ff.sampling.sample_triangles(pts, [(0, 2, 1)], 20.0)), 3)
+        # Shared lattice points are counted once: a 700 x 700 vertex grid at its own spacing
+        # (490,000 samples) passes (it was refused at any separation).
+        n = 700
+        grid = [(float(i), 0.0, float(j)) for j in range(n) for i in range(n)]
+        tris = []
+        for j in range(n - 1):
+            for i in range(n - 1):
+                a = j * n + i
+                tris += [(a, a + n, a + 1), (a + 1, a + n, a + n + 1)]
+        ff.sampling.check_sample_count(grid, tris, 1.5)
 
     def test_character_checked_as_the_generator_reads_it(self):
         with open(os.path.join(CHARACTERS, "biped.json")) as f:

@@ -205,13 +205,17 @@ TEST_CASE("The C ABI refuses what would crash or hang it, and takes turns betwee
   CHECK(ffc_generate(s, 0, R"({"steps": 3,})", &json) == FF_C_PARSE_ERROR);
   CHECK_THAT(ffc_last_error(s), Catch::Contains("malformed JSON at byte"));
   const std::string file = std::string(FOOTFALL_SOURCE_DIR) + "/data/characters/biped.json";
-  for (const char* field :
-       {R"("steps": 18446744073709551615)", R"("steps": -1)", R"("crowd": 0)", R"("crowd": -1)"}) {
+  for (const char* field : {R"("steps": 18446744073709551615)", R"("steps": -1)", R"("crowd": 0)",
+                            R"("crowd": -1)", R"("fps": 1e-300)", R"("crowd_spacing": 1e308)"}) {
     const std::string request = R"({"character_file": ")" + file + "\", " + field + "}";
     INFO(request);
     CHECK(ffc_generate(s, 0, request.c_str(), &json) == FF_C_PARSE_ERROR);
-    CHECK_THAT(ffc_last_error(s), Catch::Contains("out of range"));
+    CHECK_THAT(ffc_last_error(s), Catch::Contains("out of range") || Catch::Contains("from "));
   }
+  // A NUL in a character file's path: refused (the path was read cut short at it).
+  const std::string nul = R"({"character_file": ")" + file + R"(\u0000junk"})";
+  CHECK(ffc_generate(s, 0, nul.c_str(), &json) == FF_C_PARSE_ERROR);
+  CHECK_THAT(ffc_last_error(s), Catch::Contains("without NUL bytes"));
   // A character file that is a FIFO: refused at once (opening it waited for a writer).
   char dir[] = "/tmp/footfall-fifo-XXXXXX";
   REQUIRE(mkdtemp(dir));

@@ -86,8 +86,9 @@ Status ParseGenerateRequest(const std::string& text, Character* character, Gener
     }
     s = ParseCharacter(j["character"].dump(), "request character", character, error);
   } else {
-    if (!j["character_file"].is_string()) {
-      *error = "request: 'character_file': expected a path";
+    if (!j["character_file"].is_string() ||
+        j["character_file"].get<std::string>().find('\0') != std::string::npos) {
+      *error = "request: 'character_file': expected a path (without NUL bytes)";
       return Status::kParseError;
     }
     s = LoadCharacter(j["character_file"].get<std::string>(), character, error);
@@ -100,11 +101,18 @@ Status ParseGenerateRequest(const std::string& text, Character* character, Gener
   if (ok && j.contains("up")) ok = ReadVec(j["up"], "up", &o.up, error);
   if (ok && j.contains("start_frame"))
     ok = ReadNumber(j["start_frame"], "start_frame", &o.start_frame, error);
-  if (ok && j.contains("fps")) ok = ReadNumber(j["fps"], "fps", &o.fps, error);
+  // The bounds of `footfall generate`'s flags.
+  if (ok && j.contains("fps")) {
+    ok = ReadNumber(j["fps"], "fps", &o.fps, error);
+    if (ok && !(o.fps >= 0.001 && o.fps <= kMaxFps)) {
+      *error = "request: 'fps': expected a number from 0.001 to 1e+06";
+      ok = false;
+    }
+  }
   if (ok && j.contains("crowd_spacing")) {
     ok = ReadNumber(j["crowd_spacing"], "crowd_spacing", &o.crowd_spacing, error);
-    if (ok && !(o.crowd_spacing >= 0)) {
-      *error = "request: 'crowd_spacing': expected a number >= 0";
+    if (ok && !(o.crowd_spacing >= 0 && o.crowd_spacing <= 1e6)) {
+      *error = "request: 'crowd_spacing': expected a number from 0 (the default) to 1e+06";
       ok = false;
     }
   }

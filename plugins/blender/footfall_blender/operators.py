@@ -86,6 +86,7 @@ def mesh_samples(context, obj, separation):
         tris = [(a, c, b) for a, b, c in tris]
     # Normals from the geometry, as `footfall generate` samples a mesh file (smooth, sharp at
     # edges past the crease angle), whatever the viewport's shading.
+    sampling.check_sample_count(points, tris, separation)  # before the slow corner normals
     normals = sampling.corner_normals(points, tris)
     return sampling.sample_triangles(points, tris, separation, corner_normals=normals)
 
@@ -501,7 +502,10 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
             if kind == "foot":
                 for key in keys:
                     key.pop("rotation", None)
-            tracks.append({"name": name, "kind": kind, "keys": keys})
+            track = {"name": name, "kind": kind, "keys": keys}
+            if obj.get("character"):  # a crowd's: imported per character, as from JSON
+                track["character"] = str(obj.get("character"))
+            tracks.append(track)
         for obj in made:
             bpy.data.objects.remove(obj)
         for action in set(bpy.data.actions) - actions_before:

@@ -67,6 +67,7 @@ def _mesh_samples(mesh, separation):
     counts, verts = fn.getTriangles()
     tris = [tuple(verts[i:i + 3]) for i in range(0, len(verts), 3)]
     # Normals from the geometry, as `footfall generate` samples a mesh file.
+    ffc.sampling.check_sample_count(points, tris, separation)  # before the slow corner normals
     normals = ffc.sampling.corner_normals(points, tris)
     return ffc.sampling.sample_triangles(points, tris, separation, corner_normals=normals)
 

@@ -7,6 +7,7 @@ edges past a crease angle, as footfall's own sampler), or the face normal.
 """
 
 import math
+import os
 
 
 def _sub(a, b):
@@ -69,11 +70,22 @@ def corner_normals(points, triangles, crease_deg=DEFAULT_CREASE_ANGLE_DEG):
 MAX_SAMPLES = 2000000
 
 
-def _lattice_size(points, tri, separation):
-    a, b, c = (points[i] for i in tri)
-    longest = max(_length(_sub(b, a)), _length(_sub(c, b)), _length(_sub(a, c)))
-    k = max(1, int(math.ceil(longest / separation - 1e-9)))
-    return (k + 1) * (k + 2) // 2
+def check_sample_count(points, triangles, separation, max_samples=MAX_SAMPLES):
+    """Raises ValueError when sampling `triangles` at `separation` would make more than
+    max_samples samples: the vertices, plus each triangle's lattice points inside it and half
+    of those on its edges (shared with the neighbour). Cheap: call it before anything slow."""
+    if not separation > 0:
+        raise ValueError("separation must be > 0, got %r" % (separation,))
+    total = len(points)
+    for tri in triangles:
+        a, b, c = (points[i] for i in tri)
+        longest = max(_length(_sub(b, a)), _length(_sub(c, b)), _length(_sub(a, c)))
+        k = max(1, int(math.ceil(longest / separation - 1e-9)))
+        total += (k - 1) * (k - 2) // 2 + 1.5 * (k - 1)
+        if total > max_samples:
+            raise ValueError("a separation of %g would make more than %d samples: choose a "
+                             "larger separation, or resample the mesh with `footfall terrain "
+                             "convert` and load the point file" % (separation, max_samples))
 
 
 def sample_triangles(points, triangles, separation, vertex_normals=None, corner_normals=None,
@@ -84,15 +96,7 @@ def sample_triangles(points, triangles, separation, vertex_normals=None, corner_
     else from `vertex_normals` (one per vertex, smooth across every edge), else the face's.
     Returns a list of (x, y, z, nx, ny, nz). Degenerate triangles are skipped. ValueError, before
     any sampling, when the lattices would hold more than max_samples points."""
-    if not separation > 0:
-        raise ValueError("separation must be > 0, got %r" % (separation,))
-    total = 0
-    for tri in triangles:
-        total += _lattice_size(points, tri, separation)
-        if total > max_samples:
-            raise ValueError("a separation of %g would make more than %d samples: choose a "
-                             "larger separation, or resample the mesh with `footfall terrain "
-                             "convert` and load the point file" % (separation, max_samples))
+    check_sample_count(points, triangles, separation, max_samples)
     seen = set()
     quantum = separation * 1e-4
     out = []
@@ -126,7 +130,10 @@ def sample_triangles(points, triangles, separation, vertex_normals=None, corner_
 
 
 def write_point_file(path, samples, comment="footfall terrain points from Blender"):
-    """Writes samples as footfall's point file, with every double exactly (repr)."""
+    """Writes samples as footfall's point file, with every double exactly (repr). ValueError for
+    a path that exists and is not a regular file (opening a FIFO waits for a reader)."""
+    if os.path.exists(path) and not os.path.isfile(path):
+        raise ValueError("%s: not a regular file: expected a point file to write" % path)
     with open(path, "w") as f:
         f.write("# %s: x y z nx ny nz\n" % comment)
         for s in samples:

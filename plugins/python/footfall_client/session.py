@@ -54,9 +54,12 @@ def _path_bytes(path, function):
     """A path (str, bytes or os.PathLike) as the bytes the C library opens: str paths as the
     file system encodes them (undecodable names round-trip), bytes as they are."""
     try:
-        return os.fsencode(path)
+        encoded = os.fsencode(path)
     except (TypeError, UnicodeError) as e:
         raise FootfallError(INVALID_ARGUMENT, "path %r: %s" % (path, e), function)
+    if b"\0" in encoded:  # C would read it cut short at the NUL
+        raise FootfallError(INVALID_ARGUMENT, "path %r: holds a NUL byte" % (path,), function)
+    return encoded
 
 
 def _flat(rows, width, what):
@@ -217,6 +220,8 @@ class Session:
     def ping(self):
         """True when the server answers (any reply), False when it is unavailable. Makes one
         round trip (loads and unloads a one-sample terrain); never raises for a missing server."""
+        if self._h is None:
+            return False  # closed: nothing answers
         try:
             t = self.load_samples([(0.0, 0.0, 0.0, 0.0, 1.0, 0.0)], "ping")
         except FootfallError as e:
@@ -265,6 +270,10 @@ class Session:
         h = self._handle("ffc_check_character")
         if not self._lib.has("ffc_check_character"):
             return
+        if not isinstance(data, (str, dict)):
+            raise FootfallError(INVALID_ARGUMENT, "%s: expected a character as a dict or JSON "
+                                "text, got %s" % (name, type(data).__name__),
+                                "ffc_check_character")
         text = data if isinstance(data, str) else json.dumps(data)
         status = self._lib.lib.ffc_check_character(h, text.encode("utf-8", "replace"))
         if status != OK:
