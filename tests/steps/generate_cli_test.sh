@@ -87,6 +87,16 @@ check "crowd cliff: the back row's stop listed" grep -qE '^  step [0-9]+ of c1: 
   --path 2.5,5,4 --out "$work/goal-above.json" 2> "$work/goal-above.err"
 check "goal above the start: exit 0" [ $? -eq 0 ]
 check "goal above the start: the note" grep -q "no steps: the path's goal is already reached where the character starts" "$work/goal-above.err"
+"$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,1 \
+  --path 2.5,0,4 --steps 0 --out "$work/steps0.json" 2> "$work/steps0.err"
+check "--steps 0 with a path: no note about the goal" bash -c "! grep -q 'goal is already reached' '$work/steps0.err'"
+# A glTF output that cannot hold the walk's times is named; the JSON beside it is written (it
+# keeps every key).
+"$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,1 \
+  --steps 4 --start-frame 1e9 --fps 1e6 --out "$work/far.json" --out "$work/far.gltf" 2> "$work/far.err"
+check "glTF times collide: exit 1" [ $? -eq 1 ]
+check "glTF times collide: the output named" grep -qF -- "--out $work/far.gltf: glTF times are float seconds" "$work/far.err"
+check "glTF times collide: the JSON written" [ -s "$work/far.json" ]
 
 # 3. Every output format at once; a stopped walk still writes them all.
 "$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \

@@ -233,7 +233,8 @@ int RunGenerate(const GenerateFlags& flags) {
       std::cerr << "footfall generate: " << error << '\n';
       return 1;
     }
-    if (!options.path.empty() && walk.stopped.empty() && !walk.tracks.empty() &&
+    if (!options.path.empty() && options.steps != 0 && walk.stopped.empty() &&
+        !walk.tracks.empty() &&
         std::all_of(walk.tracks.begin(), walk.tracks.end(),
                     [](const WalkTrack& t) { return t.keys.size() <= 1; })) {
       std::cerr << "footfall generate: note: no steps: the path's goal is already reached where "
@@ -254,7 +255,9 @@ int RunGenerate(const GenerateFlags& flags) {
         }
       }
       if (WriteOutput(walk, out, &error) != Status::kOk) {
-        std::cerr << "footfall generate: " << error << '\n';
+        // Named by its output (the other outputs are still written).
+        const bool named = error.compare(0, out.size(), out) == 0;
+        std::cerr << "footfall generate: " << (named ? "" : "--out " + out + ": ") << error << '\n';
         code = 1;
       }
     }

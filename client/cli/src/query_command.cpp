@@ -178,7 +178,8 @@ void AddQueryCommand(CLI::App& app, int* exit_code) {
       "'next X Y Z DX DY DZ'; one JSON object per line on stdout");
   AddTerrainFlags(cmd, &flags->terrain);
   cmd->add_option("--tolerance", flags->tolerance,
-                  "next: candidate radius around the ideal point (default: the step length)")
+                  "next: candidate radius around the ideal point (default, and 0: the step "
+                  "length)")
       ->check(FiniteAtLeast(0));
   cmd->callback([flags, exit_code] { *exit_code = RunQuery(*flags); });
 }

@@ -465,7 +465,8 @@ Status Generator::Run(std::string* error) {
   for (const Agent* a : stopped) walk_.stops.push_back(a->stopped);
   if (!stopped.empty()) walk_.stopped = stopped[0]->stopped;
   if (stopped.size() > 1)
-    walk_.stopped += " (and " + std::to_string(stopped.size() - 1) + " more characters stopped)";
+    walk_.stopped += " (and " + std::to_string(stopped.size() - 1) +
+                     (stopped.size() == 2 ? " more character" : " more characters") + " stopped)";
   return Status::kOk;
 }
 
