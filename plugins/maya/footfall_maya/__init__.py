@@ -98,15 +98,6 @@ def _snap(s, terrain, point):
     return hold.point, hold.normal
 
 
-def _unit(v):
-    n = math.sqrt(sum(c * c for c in v))
-    return tuple(c / n for c in v) if n > 0 else None
-
-
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
 def _orient(node, up, forward):
     """Turns `node` (world space) so that its Y is `up` and its Z `forward` across it."""
     euler = ffc.rotation.quat_to_euler_xyz(ffc.rotation.quat_from_frame(up, forward))
@@ -130,8 +121,8 @@ def character_setup(character_file, name=None, ik_handles=None, body=None):
     forward = (0.0, 0.0, 1.0)
     if body:
         m = mc.xform(body, q=True, ws=True, m=True)
-        forward = _unit((m[8], 0.0, m[10])) or forward  # its Z on the ground (bipeds: Y up)
-    left = _cross((0.0, 1.0, 0.0), forward)
+        forward = ffc.vectors.unit((m[8], 0.0, m[10])) or forward  # its Z on the ground (bipeds: Y up)
+    left = ffc.vectors.cross((0.0, 1.0, 0.0), forward)
     ground, normal = _snap(s, terrain, origin)
     placed = {}
     for foot, rest in feet:

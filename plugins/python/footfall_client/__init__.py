@@ -22,7 +22,7 @@ from .session import (
 )
 from .server import LocalServer, ServerError, find_footfalld
 from .connection import Connection
-from . import character, rotation, sampling
+from . import character, rotation, sampling, vectors
 
 __all__ = [
     "Connection",

@@ -4,6 +4,8 @@ key to key. The same conversion as the MEL export (client/export/src/euler.cpp).
 
 import math
 
+from .vectors import cross, unit
+
 
 def quat_to_euler_xyz(q):
     """(x, y, z, w) -> (rx, ry, rz) degrees with R = Rz(rz) * Ry(ry) * Rx(rx)."""
@@ -47,13 +49,6 @@ def quat_from_frame(up, forward):
     """(x, y, z, w): the rotation taking the character axes (Y up, Z forward) to `up` and to
     `forward` projected across it (any direction across `up` when forward lies along it), as the
     walk's body keys are. Both in footfall's (= Maya's) frame."""
-    def unit(v):
-        n = math.sqrt(sum(c * c for c in v))
-        return tuple(c / n for c in v) if n > 0 else None
-
-    def cross(a, b):
-        return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
     y = unit(up) or (0.0, 1.0, 0.0)
     d = sum(forward[i] * y[i] for i in range(3))
     z = unit(tuple(forward[i] - d * y[i] for i in range(3)))

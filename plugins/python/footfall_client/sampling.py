@@ -9,22 +9,7 @@ edges past a crease angle, as footfall's own sampler), or the face normal.
 import math
 import os
 
-
-def _sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _length(a):
-    return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
-
-
-def _unit(a):
-    n = _length(a)
-    return None if n <= 1e-300 else (a[0] / n, a[1] / n, a[2] / n)
+from .vectors import cross as _cross, length as _length, sub as _sub, unit as _unit
 
 
 # Edges whose faces meet at more than this many degrees stay sharp (footfall's
