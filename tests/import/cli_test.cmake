@@ -78,6 +78,20 @@ file(WRITE "${WORK}/upper.stl" "SOLID x\nfacet normal 0 1 0\nouter loop\nvertex 
      "vertex 1 0 0\nvertex 0 0 1\nendloop\nendfacet\nENDSOLID x\n")
 expect(EXIT_NONZERO "upper.stl: an ASCII STL must begin with 'solid' in lower case"
        terrain info "${WORK}/upper.stl")
+# OFF counts on the header line and '#' comments (OpenMesh read no vertices, or bad faces), a
+# PLY vertex list property (it read no faces), a binary STL longer than its triangles.
+file(WRITE "${WORK}/oneline.off" "OFF 3 1 0\n0 0 0\n1 0 0\n0 0 1\n3 0 2 1\n")
+expect(EXIT_NONZERO "oneline.off:1: expected the counts on the line after 'OFF'"
+       terrain info "${WORK}/oneline.off")
+file(WRITE "${WORK}/comment.off" "OFF\n3 1 0\n0 0 0\n# a comment\n1 0 0\n0 0 1\n3 0 2 1\n")
+expect(EXIT_NONZERO "comment.off:4: a '#' comment, which OpenMesh's OFF reader does not skip"
+       terrain info "${WORK}/comment.off")
+file(WRITE "${WORK}/vlist.ply" "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+     "property float y\nproperty float z\nproperty list uchar float texcoord\nelement face 1\n"
+     "property list uchar int vertex_indices\nend_header\n0 0 0 2 0 0\n1 0 0 2 1 0\n"
+     "0 0 1 2 0 1\n3 0 2 1\n")
+expect(EXIT_NONZERO "vlist.ply:7: vertex property 'texcoord' is a list"
+       terrain info "${WORK}/vlist.ply")
 # A height map's frame given for another kind of file is refused, not ignored.
 expect(EXIT_NONZERO "applies to height maps (.asc .pgm) only, not to a mesh"
        terrain info "${WORK}/cube.obj" --height-scale 10)

@@ -232,6 +232,10 @@ TEST_CASE("ReadMesh: bad meshes give clear errors", "[import][mesh]") {
     }
     CHECK(Read(dir.Write("nan.stl", stl), &mesh, &error) == Status::kParseError);
     CHECK(Contains(error, "nan.stl: facet 1: a vertex coordinate is NaN"));
+    CHECK(Read(dir.Write("long.stl", stl + "xx"), &mesh, &error) == Status::kParseError);
+    CHECK(Contains(error,
+                   "long.stl: extra bytes: binary STL declares 2 triangles (184 bytes), "
+                   "the file has 186 bytes"));
   }
   SECTION("ASCII STL facets are triangles") {
     // OpenMesh kept the first three vertices of a four-vertex loop and dropped the fourth.

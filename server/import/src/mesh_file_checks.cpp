@@ -208,10 +208,13 @@ Status CheckOffFile(const std::string& path, long long* faces, std::vector<Vec3>
   std::ifstream in(path);
   std::string line;
   size_t number = 0;
-  // The next non-blank, comment-free line's tokens, or false at the end of the file.
+  // The next non-blank line's tokens, or false at the end of the file. OpenMesh's OFF reader
+  // skips no comments (it read none of the vertices, or faces of vertices that do not exist).
+  size_t comment = 0;  // the first line with a '#'
   auto next = [&](std::vector<std::string>* tokens) {
     while (std::getline(in, line)) {
       ++number;
+      if (comment == 0 && line.find('#') != std::string::npos) comment = number;
       *tokens = Tokens(StripComment(line));
       if (!tokens->empty()) return true;
     }
@@ -223,7 +226,7 @@ Status CheckOffFile(const std::string& path, long long* faces, std::vector<Vec3>
   // each vertex's three coordinates (checked as far as the coordinates). 4OFF and nOFF (other
   // dimensions) and binary OFF are refused: OpenMesh reads them unchecked, and a wrong count in
   // them can take all memory.
-  const std::string& header = t[0];
+  const std::string header = t[0];  // (a copy: t is erased below)
   const bool off = std::regex_match(header, std::regex("(ST)?C?N?OFF"));
   if (!off) {
     if (header.size() >= 3 && header.compare(header.size() - 3, 3, "OFF") == 0) {
@@ -238,6 +241,12 @@ Status CheckOffFile(const std::string& path, long long* faces, std::vector<Vec3>
   t.erase(t.begin());
   if (!t.empty() && t[0] == "BINARY") {
     return Fail(At(path, number), "binary OFF is not read (expected a text OFF)", error);
+  }
+  if (!t.empty()) {
+    return Fail(At(path, number),
+                "expected the counts on the line after '" + header +
+                    "' (OpenMesh reads them there: it read no vertices)",
+                error);
   }
   if (t.empty() && !next(&t)) return Fail(path, "truncated: expected the OFF counts", error);
   long long nv = 0, nf = 0;
@@ -285,6 +294,10 @@ Status CheckOffFile(const std::string& path, long long* faces, std::vector<Vec3>
                     error);
       }
     }
+  }
+  if (comment != 0) {
+    return Fail(At(path, comment),
+                "a '#' comment, which OpenMesh's OFF reader does not skip: remove it", error);
   }
   return Status::kOk;
 }
@@ -335,6 +348,13 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
         const int count_size = type_size(t[2]), item_size = type_size(t[3]);
         if (!count_size || !item_size) {
           return Fail(At(path, number), "unknown PLY property type", error);
+        }
+        if (e.name == "vertex") {
+          // OpenMesh's PLY reader reads no vertex with a list (and then no face): "no faces".
+          return Fail(At(path, number),
+                      "vertex property '" + t[4] +
+                          "' is a list, which OpenMesh's PLY reader cannot read: remove it",
+                      error);
         }
         e.list_min_bytes += count_size + (e.name == "face" ? 3 * item_size : 0);
         e.properties.push_back(t[4]), e.lists.push_back(true);
@@ -541,10 +561,12 @@ Status CheckStlFile(const std::string& path, std::string* error) {
     if (size < 84) return Fail(path, "truncated: a binary STL needs an 84-byte header", error);
     uint32_t count = 0;
     std::memcpy(&count, head.data() + 80, 4);
+    const long long want = 84 + 50ll * count;
     return Fail(path,
-                "truncated: binary STL declares " + std::to_string(count) + " triangles (" +
-                    std::to_string(84 + 50ll * count) + " bytes), the file has " +
-                    std::to_string(size) + " bytes",
+                std::string(size < want ? "truncated: " : "extra bytes: ") +
+                    "binary STL declares " + std::to_string(count) + " triangles (" +
+                    std::to_string(want) + " bytes), the file has " + std::to_string(size) +
+                    " bytes",
                 error);
   }
   // ASCII STL: finite vertices, three to a facet's loop, and a closing 'endsolid'.
