@@ -53,11 +53,19 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
       {{"[[\"L\"], [\"R\"]]", "[[\"L\"], [\"X\"]]"}, "b.json: 'gait'[1]: no foot named 'X'"},
       {{"[[\"L\"], [\"R\"]]", "[[\"L\"]]"}, "b.json: 'gait': foot 'R' is in no group"},
       {{"[[\"L\"], [\"R\"]]", "[[\"L\", \"L\"], [\"R\"]]"}, "foot 'L' is listed twice"},
-      {{"\"reach\": 1.1", "\"reach\": 0.5"}, "'reach' = 0.5 must exceed foot 'L''s rest distance"},
+      {{"\"reach\": 1.1", "\"reach\": 0.5"},
+       "'reach' = 0.5 must exceed the distance from the body to the rest of foot 'L' (0.9"},
+      // Numbers are shown as written, never rounded onto the limit they break.
+      {{"\"step_length\": 0.6", "\"step_length\": 1000000000.001"},
+       "'step_length' = 1000000000.001 is out of range (0, 1e+09]"},
+      {{"\"frames_per_step\": 10", "\"frames_per_step\": 2147483648"},
+       "'frames_per_step' = 2147483648 is out of range [2, 1e+06]"},
+      // Rests are lengths like the others (1e300 made the reach check say "inf").
+      {{"[0.1, 0, 0]", "[1e300, 0, 0]"}, "'feet'[0].rest: 1e+300 is out of range [-1e9, 1e9]"},
       {{"\"name\": \"b\"", "\"nmae\": \"b\""},
        "b.json: unknown field 'nmae' (known fields: align_to_normal, body_height, comment,"},
       {{"[0.1, 0, 0]}", "[0.1, 0, 0], \"size\": 1}"},
-       "b.json: 'feet'[0]: unknown field 'size' (known fields: name, rest)"},
+       "b.json: 'feet'[0]: unknown field 'size' (known fields: comment, name, rest)"},
       // The version is compared exactly: 2^32 + 1 does not wrap to 1.
       {{"\"version\": 1", "\"version\": 4294967297"},
        "b.json: 'version' 4294967297 is not supported"},
@@ -87,6 +95,22 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
   CHECK(ParseCharacter("{\"format\": \"footfall-character\",\n\"version\": 1,\n\"step_length\": }",
                        "b.json", &c, &error) == Status::kParseError);
   CHECK_THAT(error, Catch::StartsWith("b.json:3:16: malformed JSON: syntax error"));
+  // Malformed too, and said so with where: a number beyond a double (nlohmann threw a bare
+  // "number overflow"), a NUL byte (nlohmann read it as the end of the input), a key given twice
+  // (the last one silently won).
+  CHECK(ParseCharacter("{\"format\": \"footfall-character\",\n\"version\": 1e999}", "b.json", &c,
+                       &error) == Status::kParseError);
+  CHECK_THAT(error, Catch::StartsWith("b.json:2:12: malformed JSON: number overflow parsing "
+                                      "'1e999'"));
+  CHECK(ParseCharacter(std::string("{\"format\":\0 1}", 14), "b.json", &c, &error) ==
+        Status::kParseError);
+  CHECK_THAT(error, Catch::StartsWith("b.json:1:11: malformed JSON: a NUL byte"));
+  CHECK(ParseCharacter(Biped("\"step_length\": 0.6", "\"step_length\": 0.6, \"step_length\": -5"),
+                       "b.json", &c, &error) == Status::kParseError);
+  CHECK_THAT(error, Catch::Contains("b.json: malformed JSON: the key 'step_length' appears twice"));
+  // Keys may repeat in different objects; a foot may carry a comment as the file may.
+  CHECK(ParseCharacter(Biped("[0.1, 0, 0]}", "[0.1, 0, 0], \"comment\": \"left\"}"), "b.json", &c,
+                       &error) == Status::kOk);
   // A UTF-8 byte order mark is skipped.
   CHECK(ParseCharacter("\xEF\xBB\xBF" + Biped(), "b.json", &c, &error) == Status::kOk);
   CHECK(LoadCharacter("/nonexistent/c.json", &c, &error) == Status::kIoError);
@@ -141,6 +165,8 @@ TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]")
       // The position is the last character the parser read: the end of the unexpected "24".
       {"{\"format\": \"footfall-walk\",\n \"fps\": 24 24}",
        "w.json:2:13: malformed JSON: syntax error"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"fps":30,"tracks":[]})",
+       "w.json: malformed JSON: the key 'fps' appears twice"},
   };
   for (const auto& [input, message] : bad) {
     INFO(message);
@@ -203,7 +229,11 @@ TEST_CASE("The C ABI refuses what would crash or hang it, and takes turns betwee
   CHECK(json == nullptr);
   // Malformed JSON says where; integers out of range are refused, not wrapped.
   CHECK(ffc_generate(s, 0, R"({"steps": 3,})", &json) == FF_C_PARSE_ERROR);
-  CHECK_THAT(ffc_last_error(s), Catch::Contains("malformed JSON at byte"));
+  CHECK_THAT(ffc_last_error(s), Catch::Contains("request:1:13: malformed JSON"));
+  CHECK(ffc_generate(s, 0, R"({"steps": 1e999})", &json) == FF_C_PARSE_ERROR);
+  CHECK_THAT(ffc_last_error(s), Catch::Contains("request:1:11: malformed JSON: number overflow"));
+  CHECK(ffc_generate(s, 0, R"({"steps": 3, "steps": 4})", &json) == FF_C_PARSE_ERROR);
+  CHECK_THAT(ffc_last_error(s), Catch::Contains("the key 'steps' appears twice"));
   const std::string file = std::string(FOOTFALL_SOURCE_DIR) + "/data/characters/biped.json";
   for (const char* field : {R"("steps": 18446744073709551615)", R"("steps": -1)", R"("crowd": 0)",
                             R"("crowd": -1)", R"("fps": 1e-300)", R"("crowd_spacing": 1e308)"}) {

@@ -295,6 +295,33 @@ TEST_CASE("Multipeds walk around a sphere, bipeds stop where it gets too steep",
   }
 }
 
+TEST_CASE("A stop shows the value that broke a limit, never rounded onto the limit",
+          "[steps][generator]") {
+  // Flat ground up to z = 0, then a 20-degree ramp; the biped allows 19.99999 degrees.
+  Character c = LoadShipped("biped");
+  c.max_slope_deg = 19.99999;
+  const double spacing = 0.05;
+  RawSamples ground = MakeFlat(160, spacing, 0);
+  for (Vec3& p : ground.points) p.z -= 160 * spacing;
+  const RawSamples ramp = MakeRamp(160, 160, spacing, 20);
+  ground.points.insert(ground.points.end(), ramp.points.begin(), ramp.points.end());
+  ground.normals.insert(ground.normals.end(), ramp.normals.begin(), ramp.normals.end());
+  Terrain t = LoadTerrain(ground, spacing);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {4, 0, -3};
+  o.steps = 20;
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  const size_t leans = w.stopped.find(" leans "), limit = w.stopped.find("max_slope_deg ");
+  REQUIRE(leans != std::string::npos);
+  REQUIRE(limit != std::string::npos);
+  const double shown = std::stod(w.stopped.substr(leans + 7));
+  const double shown_limit = std::stod(w.stopped.substr(limit + 14));
+  CHECK(shown_limit == c.max_slope_deg);
+  CHECK(shown > shown_limit);
+}
+
 TEST_CASE("Multipeds climb a wall, others stop at it", "[steps][generator]") {
   for (const std::string& name : ShippedCharacters()) {
     const Character c = LoadShipped(name);

@@ -9,10 +9,14 @@
 #include <nlohmann/json.hpp>
 
 #include "footfall/terrain/input_file.h"
+#include "footfall/terrain/shown_text.h"
 #include "json_input.h"
 
 namespace footfall {
 namespace {
+
+// [Units: wu] The largest length a character file may give (rests, step, heights, reach).
+constexpr double kMaxLength = 1e9;
 
 using nlohmann::json;
 
@@ -50,6 +54,9 @@ struct Reader {
     for (int i = 0; i < 3; ++i) {
       if (!j[i].is_number() || !std::isfinite(j[i].get<double>()))
         return Fail(Status::kParseError, where + ": expected finite numbers");
+      if (!(std::fabs(j[i].get<double>()) <= kMaxLength))
+        return Fail(Status::kInvalidArgument,
+                    where + ": " + NumberText(j[i].get<double>()) + " is out of range [-1e9, 1e9]");
       v[i] = j[i].get<double>();
     }
     *out = {v[0], v[1], v[2]};
@@ -58,10 +65,10 @@ struct Reader {
   bool Range(double v, double lo, double hi, bool lo_open, bool hi_open, const char* key) {
     const bool ok = (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
     if (ok) return true;
-    std::ostringstream m;
-    m << "'" << key << "' = " << v << " is out of range " << (lo_open ? "(" : "[") << lo << ", "
-      << hi << (hi_open ? ")" : "]");
-    return Fail(Status::kInvalidArgument, m.str());
+    return Fail(Status::kInvalidArgument, std::string("'") + key + "' = " + NumberText(v) +
+                                              " is out of range " + (lo_open ? "(" : "[") +
+                                              NumberText(lo) + ", " + NumberText(hi) +
+                                              (hi_open ? ")" : "]"));
   }
   // A list of groups of foot names, each name used exactly once over all groups.
   bool Groups(const json& j, const char* key, const std::map<std::string, int>& feet,
@@ -128,7 +135,7 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
                                                "reach",
                                                "max_turn_deg",
                                                "comment"};
-  static const std::set<std::string> kKnownFoot = {"name", "rest"};
+  static const std::set<std::string> kKnownFoot = {"name", "rest", "comment"};
   std::string unknown;
   if (detail::FindUnknownKey(j, kKnown, &unknown))
     r.Fail(Status::kParseError, detail::UnknownFieldMessage(unknown, kKnown));
@@ -224,15 +231,15 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
     c.frames_per_step = static_cast<int>(std::min(fps, 1e6));
   }
   if (r.status == Status::kOk) {
-    r.Range(c.step_length, 0, 1e9, true, false, "step_length") &&
-        r.Range(c.step_height, 0, 1e9, true, false, "step_height") &&
-        r.Range(c.body_height, 0, 1e9, false, false, "body_height") &&
+    r.Range(c.step_length, 0, kMaxLength, true, false, "step_length") &&
+        r.Range(c.step_height, 0, kMaxLength, true, false, "step_height") &&
+        r.Range(c.body_height, 0, kMaxLength, false, false, "body_height") &&
         r.Range(fps, 2, 1e6, false, false, "frames_per_step") &&
         r.Range(c.slope_threshold_deg, 0, 90, false, false, "slope_threshold_deg") &&
         r.Range(c.slope_step_scale, 0, 1, true, false, "slope_step_scale") &&
         r.Range(c.max_slope_deg, 0, 180, true, true, "max_slope_deg") &&
-        r.Range(c.max_rise, 0, 1e9, true, false, "max_rise") &&
-        r.Range(c.reach, 0, 1e9, true, false, "reach") &&
+        r.Range(c.max_rise, 0, kMaxLength, true, false, "max_rise") &&
+        r.Range(c.reach, 0, kMaxLength, true, false, "reach") &&
         r.Range(c.max_turn_deg, 0, 180, true, false, "max_turn_deg");
   }
   if (r.status == Status::kOk) {
@@ -240,10 +247,10 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
     for (const FootSpec& f : c.feet) {
       const double rest = Length(f.rest - centroid + Vec3{0, -c.body_height, 0});
       if (rest >= c.reach) {
-        std::ostringstream m;
-        m << "'reach' = " << c.reach << " must exceed foot '" << f.name
-          << "''s rest distance from the body (" << rest << ")";
-        r.Fail(Status::kInvalidArgument, m.str());
+        r.Fail(Status::kInvalidArgument, "'reach' = " + NumberText(c.reach) +
+                                             " must exceed the distance from the body to the "
+                                             "rest of foot '" +
+                                             f.name + "' (" + NumberText(rest) + ")");
         break;
       }
     }

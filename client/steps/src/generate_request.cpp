@@ -5,6 +5,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "json_input.h"
+
 namespace footfall {
 namespace {
 
@@ -43,22 +45,8 @@ Status ParseGenerateRequest(const std::string& text, Character* character, Gener
   // Nesting deeper than any request needs is refused: serialising the character object again
   // (below) recurses once per level, and a plugin thread's stack is small.
   constexpr int kMaxDepth = 32;
-  bool too_deep = false;
   json j;
-  try {
-    j = json::parse(text, [&](int depth, json::parse_event_t, json&) {
-      too_deep |= depth > kMaxDepth;
-      return true;
-    });
-  } catch (const json::parse_error& e) {
-    *error = "request: malformed JSON at byte " + std::to_string(e.byte) + ": " +
-             std::string(e.what()).substr(std::string(e.what()).find(':') + 2);
-    return Status::kParseError;
-  }
-  if (too_deep) {
-    *error = "request: nested deeper than " + std::to_string(kMaxDepth) + " levels";
-    return Status::kParseError;
-  }
+  if (!detail::ParseJsonText(text, "request", &j, error, kMaxDepth)) return Status::kParseError;
   if (!j.is_object()) {
     *error = "request: not a JSON object";
     return Status::kParseError;

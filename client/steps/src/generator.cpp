@@ -2,6 +2,7 @@
 // top-level README.md.
 #include "footfall/steps/generator.h"
 #include "footfall/terrain/batch_pool.h"
+#include "footfall/terrain/shown_text.h"
 
 #include <algorithm>
 #include <atomic>
@@ -64,6 +65,17 @@ double BoxDistance(const Vec3& p, const Vec3& lo, const Vec3& hi) {
   const Vec3 out{std::max({lo.x - p.x, 0.0, p.x - hi.x}), std::max({lo.y - p.y, 0.0, p.y - hi.y}),
                  std::max({lo.z - p.z, 0.0, p.z - hi.z})};
   return Length(out);
+}
+
+// `value` to 3 significant digits, or to as many more as it takes to differ from `limit`, which
+// it breaks: "leans 100.0001 deg, more than max_slope_deg 100", never "leans 100 ... 100".
+std::string Beyond(double value, double limit) {
+  for (int digits = 3;; ++digits) {
+    std::ostringstream a, b;
+    a.precision(digits), b.precision(digits);
+    a << value, b << limit;
+    if (a.str() != b.str() || digits >= 17) return a.str();
+  }
 }
 
 std::string Point(const Vec3& p) {
@@ -788,7 +800,8 @@ std::string Generator::Plant(Agent& a, const Foothold* feet) const {
       std::ostringstream m;
       m.precision(3);
       m << "foot " << c_.feet[f].name << " cannot stand at " << Point(a.foot[f])
-        << ": ground leans " << slope << " deg, more than max_slope_deg " << c_.max_slope_deg;
+        << ": ground leans " << Beyond(slope, c_.max_slope_deg) << " deg, more than max_slope_deg "
+        << NumberText(c_.max_slope_deg);
       return m.str();
     }
   }
@@ -949,11 +962,12 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
     }
   } else if (std::fabs(rise) > c_.max_rise) {
     why << "the foothold at " << Point(h.point) << (rise > 0 ? " rises " : " drops ")
-        << std::fabs(rise) << ", more than max_rise " << c_.max_rise << " (a cliff)";
+        << Beyond(std::fabs(rise), c_.max_rise) << ", more than max_rise "
+        << NumberText(c_.max_rise) << " (a cliff)";
   } else {
     why << "the foothold at " << Point(h.point) << " leans "
-        << Degrees(AngleBetween(h.normal, a.up)) << " deg, more than max_slope_deg "
-        << c_.max_slope_deg << " (too steep)";
+        << Beyond(Degrees(AngleBetween(h.normal, a.up)), c_.max_slope_deg)
+        << " deg, more than max_slope_deg " << NumberText(c_.max_slope_deg) << " (too steep)";
   }
   mv.reason = why.str(), mv.reason_is_gap = !found;
 }
@@ -988,8 +1002,8 @@ void Generator::CheckReach(size_t m, size_t e) {
     if (dist > c_.reach) {
       std::ostringstream why;
       why.precision(3);
-      why << "the foothold at " << Point(moves[i].end) << " is " << dist
-          << " from the body, beyond reach " << c_.reach;
+      why << "the foothold at " << Point(moves[i].end) << " is " << Beyond(dist, c_.reach)
+          << " from the body, beyond reach " << NumberText(c_.reach);
       moves[i].done = false;
       if (KeepsReason(moves[i], false)) moves[i].reason = why.str(), moves[i].reason_is_gap = false;
     }
@@ -1000,8 +1014,8 @@ void Generator::CheckReach(size_t m, size_t e) {
     if (slot[f] >= 0 || dist <= c_.reach) continue;
     std::ostringstream why;
     why.precision(3);
-    why << "the step would leave foot " << c_.feet[f].name << " " << dist
-        << " from the body, beyond reach " << c_.reach;
+    why << "the step would leave foot " << c_.feet[f].name << " " << Beyond(dist, c_.reach)
+        << " from the body, beyond reach " << NumberText(c_.reach);
     for (size_t i = m; i < e; ++i) {
       if (!moves[i].done) continue;
       moves[i].done = false, moves[i].held_by_planted = true;

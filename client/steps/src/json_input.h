@@ -13,9 +13,11 @@ namespace footfall::detail {
 
 // Parses `text` (a leading UTF-8 byte order mark is skipped) into *out. On malformed JSON returns
 // false with "SOURCE:LINE:COLUMN: malformed JSON: WHAT" in *error, LINE and COLUMN (1-based,
-// column in bytes) locating the last byte the parser read.
+// column in bytes) locating the last byte the parser read. Also refused, as malformed: a NUL
+// byte, a number beyond the range of a double, a key repeated within one object, and (when
+// max_depth > 0) nesting deeper than max_depth.
 bool ParseJsonText(const std::string& text, const std::string& source, nlohmann::json* out,
-                   std::string* error);
+                   std::string* error, int max_depth = 0);
 
 // True when `j` is an integer equal to `expected`, with no wrap-around (4294967297 is not 1).
 bool IsInteger(const nlohmann::json& j, int64_t expected);
