@@ -103,6 +103,12 @@ check "glTF times collide: the JSON written" [ -s "$work/far.json" ]
   --steps 100 --out "$work/all.json" --out "$work/all.gltf" --out "$work/all.glb" --out "$work/all.mel" 2>/dev/null
 check "formats: exit 2 for a stopped walk" [ $? -eq 2 ]
 for f in all.json all.gltf all.glb all.mel; do check "formats: $f written" [ -s "$work/$f" ]; done
+# A stopped walk with an output that could not be written is an error (1), not a stop (2).
+"$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
+  --steps 100 --out "$work/no/such/dir/walk.json" --out "$work/stopped-ok.json" 2> "$work/stopped-bad.err"
+check "stopped walk, unwritten output: exit 1" [ $? -eq 1 ]
+check "stopped walk, unwritten output: named" grep -qF "cannot open '$work/no/such/dir/walk.json' for writing: No such file or directory" "$work/stopped-bad.err"
+check "stopped walk, unwritten output: the other written" [ -s "$work/stopped-ok.json" ]
 check "formats: MEL keys the feet" grep -q 'setKeyframe' "$work/all.mel"
 # At UTM-like coordinates glTF's floats move keys visibly: a warning says by how much; none near
 # the origin.
@@ -192,6 +198,12 @@ bad fps-tiny "--fps: '1e-300' is not a finite number from 0.001 to 1e+06" --terr
 bad start-frame "--start-frame: '-1e300' is not a finite number from -1e+09 to 1e+09" --terrain "$hills" --character "$chars/biped.json" --start-frame -1e300 --out "$work/x.json"
 bad crowd-spacing "--crowd-spacing: 'nan' is not a finite number > 0 and <= 1e+06" --terrain "$hills" --character "$chars/biped.json" --crowd-spacing nan --out "$work/x.json"
 bad crowd-spacing-0 "--crowd-spacing: '0' is not a finite number > 0 and <= 1e+06" --terrain "$hills" --character "$chars/biped.json" --crowd-spacing 0 --out "$work/x.json"
+# Two outputs that are one file (by a link, or the same path spelt twice) are refused before
+# anything is generated.
+ln -sf "$work/alias-target.json" "$work/alias.mel"
+bad out-aliased "--out $work/alias-target.json and --out $work/alias.mel are the same file" --terrain "$hills" --character "$chars/biped.json" --out "$work/alias-target.json" --out "$work/alias.mel"
+bad out-twice "are the same file" --terrain "$hills" --character "$chars/biped.json" --out "$work/twice.json" --out "$work/./twice.json"
+check "out-twice: nothing written" [ ! -e "$work/twice.json" ]
 # The walk never overwrites what it is made from (the same file by another name too).
 cp "$chars/biped.json" "$work/me.json"
 bad out-is-character "--out $work/../$(basename "$work")/me.json is the character file this walk reads" --terrain "$hills" --character "$work/me.json" --out "$work/../$(basename "$work")/me.json"

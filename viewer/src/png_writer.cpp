@@ -1,10 +1,9 @@
 #include "footfall/viewer/png_writer.h"
 
-#include <sys/stat.h>
-
 #include <cerrno>
 #include <cstdio>
-#include <cstring>
+
+#include "footfall/terrain/output_file.h"
 
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
@@ -39,21 +38,23 @@ bool WritePng(const std::string& path, int width, int height, const std::vector<
   for (size_t i = 0; i < pixels; ++i) {
     rgb[i * 3] = rgba[i * 4], rgb[i * 3 + 1] = rgba[i * 4 + 1], rgb[i * 3 + 2] = rgba[i * 4 + 2];
   }
-  Sink sink;
-  sink.file = std::fopen(path.c_str(), "wb");
-  if (!sink.file) {
-    *error = path + ": cannot write PNG: " + std::strerror(errno);
-    return false;
-  }
-  const int encoded = stbi_write_png_to_func(Write, &sink, width, height, 3, rgb.data(), width * 3);
-  if (std::fflush(sink.file) != 0 && sink.error == 0) sink.error = errno ? errno : EIO;
-  if (std::fclose(sink.file) != 0 && sink.error == 0) sink.error = errno ? errno : EIO;
-  if (!encoded || sink.error) {
-    *error = path + ": cannot write PNG" +
-             (sink.error ? std::string(": ") + std::strerror(sink.error) : std::string());
-    struct stat st;
-    if (::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode))
-      std::remove(path.c_str());  // not a truncated image left behind (never a device)
+  std::string message;
+  const Status status = ReplaceFile(
+      path,
+      [&](std::FILE* file) {
+        Sink sink;
+        sink.file = file;
+        const int encoded =
+            stbi_write_png_to_func(Write, &sink, width, height, 3, rgb.data(), width * 3);
+        if (sink.error) errno = sink.error;
+        return encoded && sink.error == 0;
+      },
+      &message);
+  if (status != Status::kOk) {
+    // "cannot write 'PATH': REASON" -> "PATH: cannot write PNG: REASON"
+    const size_t reason = message.rfind("': ");
+    *error = path + ": cannot write PNG: " +
+             (reason == std::string::npos ? message : message.substr(reason + 3));
     return false;
   }
   return true;

@@ -17,6 +17,7 @@
 
 #include "footfall/client/recent_queries.h"
 #include "footfall/steps/walk_json.h"
+#include "footfall/terrain/output_file.h"
 #include "footfall/viewer/png_writer.h"
 #include "footfall/viewer/renderer.h"
 #include "footfall/viewer/scene.h"
@@ -229,11 +230,11 @@ struct App {
       j["live"]["server"] = live->Address();
       j["live"]["after"] = live->start_after();
     }
-    std::ofstream out(options.dump_state);
-    out << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
-    out.flush();
-    if (!out) {
-      Fail(options.dump_state + ": cannot write the state dump");
+    std::string message;
+    if (ReplaceFile(options.dump_state,
+                    j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + '\n',
+                    &message) != Status::kOk) {
+      Fail(options.dump_state + ": cannot write the state dump: " + message);
       return false;
     }
     return true;

@@ -62,6 +62,21 @@ bool ParseVec(const std::string& text, const std::string& flag, Vec3* out, std::
   return true;
 }
 
+// The file that writing `path` creates or replaces: symbolic links followed, also those naming
+// a file not there yet, and the path made absolute and normal.
+std::filesystem::path WrittenFile(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path p = fs::absolute(path, ec).lexically_normal();
+  for (int hops = 0; hops < 40 && fs::is_symlink(fs::symlink_status(p, ec)); ++hops) {
+    const fs::path to = fs::read_symlink(p, ec);
+    if (ec) break;
+    p = (to.is_absolute() ? to : p.parent_path() / to).lexically_normal();
+  }
+  const fs::path canonical = fs::weakly_canonical(p, ec);
+  return ec ? p : canonical;
+}
+
 // Writes one output, chosen by its extension.
 Status WriteOutput(const Walk& walk, const std::string& path, std::string* error) {
   const std::string ext = FileExtension(path);
@@ -170,6 +185,17 @@ int RunGenerate(const GenerateFlags& flags) {
       error = m.str();
       goto bad_flag;
     }
+    // Two outputs naming one file (the same path, or links to one file) would overwrite each
+    // other: the last written would win, silently.
+    for (const std::string& other : flags.out) {
+      if (&other == &out) break;
+      std::error_code ec;
+      if (WrittenFile(out) == WrittenFile(other) || std::filesystem::equivalent(out, other, ec)) {
+        error = "--out " + other + " and --out " + out +
+                " are the same file; give each output its own file";
+        goto bad_flag;
+      }
+    }
     // Never write over what the walk is made from.
     for (const std::string* input : {&flags.character, &flags.terrain.terrain}) {
       std::error_code ec;
@@ -277,7 +303,7 @@ int RunGenerate(const GenerateFlags& flags) {
                   << ", around the path; a stop at its edge is that edge: give --steps or "
                      "--separation\n";
       }
-      return 2;
+      return code != 0 ? code : 2;  // an output not written is an error before a stop
     }
     return code;
   }

@@ -8,8 +8,8 @@
 namespace footfall {
 namespace walk_export {
 
-// Replaces the file at `path` with `bytes`. kIoError with a message naming the path and the
-// system's reason when it cannot be opened, written or closed.
+// Replaces the file at `path` with `bytes` (ReplaceFile: a failed write leaves the old file
+// whole). kIoError with a message naming the path and the system's reason.
 Status WriteFileBytes(const std::string& path, const std::string& bytes, std::string* error);
 
 }  // namespace walk_export

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "footfall/terrain/input_file.h"
+#include "footfall/terrain/output_file.h"
 #include "json_input.h"
 
 namespace footfall {
@@ -131,19 +132,7 @@ std::string WalkToJson(const Walk& walk) {
 }
 
 Status WriteWalkJson(const Walk& walk, const std::string& path, std::string* error) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) {
-    *error = path + ": cannot open for writing";
-    return Status::kIoError;
-  }
-  const std::string text = WalkToJson(walk);
-  out.write(text.data(), static_cast<std::streamsize>(text.size()));
-  out.close();
-  if (!out) {
-    *error = path + ": write failed";
-    return Status::kIoError;
-  }
-  return Status::kOk;
+  return ReplaceFile(path, WalkToJson(walk), error);
 }
 
 Status ParseWalkJson(const std::string& text, const std::string& source, Walk* out,

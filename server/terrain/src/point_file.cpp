@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "footfall/terrain/input_file.h"
+#include "footfall/terrain/output_file.h"
 #include "footfall/terrain/shown_text.h"
 
 namespace footfall {
@@ -116,33 +117,30 @@ Status ReadPointFile(const std::string& path, RawSamples* out, std::string* erro
 }
 
 Status WritePointFile(const std::string& path, const RawSamples& samples, std::string* error) {
-  FILE* f = std::fopen(path.c_str(), "wb");
-  if (!f) {
-    if (error) *error = path + ": cannot write file";
-    return Status::kIoError;
-  }
-  std::fprintf(f, "# footfall terrain points: x y z nx ny nz (%zu samples)\n", samples.size());
-  // Each number as the shortest text that reads back as the same double: the file holds the
-  // samples exactly (12 digits moved samples 1e10 from the origin by up to 0.05).
-  char line[6 * 32];
-  for (size_t i = 0; i < samples.size(); ++i) {
-    const Vec3& p = samples.points[i];
-    const Vec3& n = samples.normals[i];
-    char* at = line;
-    for (double v : {p.x, p.y, p.z, n.x, n.y, n.z}) {
-      at = std::to_chars(at, line + sizeof line - 1, v).ptr;
-      *at++ = ' ';
-    }
-    at[-1] = '\n';
-    std::fwrite(line, 1, static_cast<size_t>(at - line), f);
-  }
-  const bool written = std::fflush(f) == 0 && !std::ferror(f);
-  const bool ok = std::fclose(f) == 0 && written;
-  if (!ok) {
-    if (error) *error = path + ": write failed";
-    return Status::kIoError;
-  }
-  return Status::kOk;
+  return ReplaceFile(
+      path,
+      [&samples](FILE* f) {
+        std::fprintf(f, "# footfall terrain points: x y z nx ny nz (%zu samples)\n",
+                     samples.size());
+        // Each number as the shortest text that reads back as the same double: the file holds
+        // the samples exactly (12 digits moved samples 1e10 from the origin by up to 0.05).
+        char line[6 * 32];
+        for (size_t i = 0; i < samples.size(); ++i) {
+          const Vec3& p = samples.points[i];
+          const Vec3& n = samples.normals[i];
+          char* at = line;
+          for (double v : {p.x, p.y, p.z, n.x, n.y, n.z}) {
+            at = std::to_chars(at, line + sizeof line - 1, v).ptr;
+            *at++ = ' ';
+          }
+          at[-1] = '\n';
+          if (std::fwrite(line, 1, static_cast<size_t>(at - line), f) !=
+              static_cast<size_t>(at - line))
+            return false;
+        }
+        return true;
+      },
+      error);
 }
 
 }  // namespace footfall

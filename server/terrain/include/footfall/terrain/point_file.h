@@ -19,7 +19,8 @@ Status ReadPointFile(const std::string& path, RawSamples* out, std::string* erro
 Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* out,
                        std::string* error);
 
-// Writes samples as a point file with a header comment; kIoError if the file cannot be written.
+// Writes samples as a point file with a header comment (ReplaceFile: a failed write leaves the
+// old file whole); kIoError if the file cannot be written.
 Status WritePointFile(const std::string& path, const RawSamples& samples, std::string* error);
 
 }  // namespace footfall

@@ -1,0 +1,119 @@
+// ReplaceFile: what a failed write leaves behind (the old file, whole, and nothing else), and
+// how it treats permissions, symbolic links, devices and missing directories.
+#include <dirent.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include "footfall/terrain/output_file.h"
+
+using namespace footfall;
+
+namespace {
+
+struct Dir {
+  std::string path;
+  Dir() {
+    char name[] = "/tmp/footfall_output_XXXXXX";
+    path = ::mkdtemp(name);
+  }
+  ~Dir() { std::system(("rm -rf '" + path + "'").c_str()); }
+  std::vector<std::string> Entries() const {
+    std::vector<std::string> names;
+    DIR* d = ::opendir(path.c_str());
+    while (dirent* e = ::readdir(d))
+      if (std::string(e->d_name) != "." && std::string(e->d_name) != "..")
+        names.push_back(e->d_name);
+    ::closedir(d);
+    return names;
+  }
+};
+
+std::string Read(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+mode_t Mode(const std::string& path) {
+  struct stat st;
+  REQUIRE(::stat(path.c_str(), &st) == 0);
+  return st.st_mode & 07777;
+}
+
+}  // namespace
+
+TEST_CASE("ReplaceFile replaces a file whole, or leaves it as it was", "[terrain][output_file]") {
+  Dir dir;
+  const std::string file = dir.path + "/walk.json";
+  std::string error;
+  REQUIRE(ReplaceFile(file, "old content\n", &error) == Status::kOk);
+  CHECK(Read(file) == "old content\n");
+  // New files get the permissions the umask allows, as fopen would give them.
+  const mode_t mask = ::umask(022);
+  ::umask(mask);
+  CHECK(Mode(file) == (0666 & ~mask));
+
+  // A write that fails half-way (a full disk) leaves the old file whole and no temporary file.
+  const Status failed = ReplaceFile(
+      file,
+      [](std::FILE* f) {
+        std::fputs("half of the new", f);
+        return false;
+      },
+      &error);
+  CHECK(failed == Status::kIoError);
+  CHECK_THAT(error, Catch::StartsWith("cannot write '" + file + "': "));
+  CHECK(Read(file) == "old content\n");
+  CHECK(dir.Entries() == std::vector<std::string>{"walk.json"});
+  // So does an exception thrown while writing (out of memory).
+  CHECK(ReplaceFile(
+            file, [](std::FILE*) -> bool { throw std::bad_alloc(); }, &error) == Status::kIoError);
+  CHECK(Read(file) == "old content\n");
+  CHECK(dir.Entries().size() == 1);
+
+  // A replaced file keeps its permissions.
+  ::chmod(file.c_str(), 0640);
+  REQUIRE(ReplaceFile(file, "new content\n", &error) == Status::kOk);
+  CHECK(Read(file) == "new content\n");
+  CHECK(Mode(file) == 0640);
+  CHECK(dir.Entries().size() == 1);
+}
+
+TEST_CASE("ReplaceFile follows symbolic links and writes devices in place",
+          "[terrain][output_file]") {
+  Dir dir;
+  const std::string target = dir.path + "/target.mel", link = dir.path + "/link.mel";
+  std::string error;
+  REQUIRE(ReplaceFile(target, "one", &error) == Status::kOk);
+  REQUIRE(::symlink(target.c_str(), link.c_str()) == 0);
+  REQUIRE(ReplaceFile(link, "two", &error) == Status::kOk);
+  struct stat st;
+  REQUIRE(::lstat(link.c_str(), &st) == 0);
+  CHECK(S_ISLNK(st.st_mode));  // the link stays a link
+  CHECK(Read(target) == "two");
+
+  // Devices are written in place (never renamed over): /dev/null takes anything, /dev/full
+  // says why it does not.
+  CHECK(ReplaceFile("/dev/null", "x", &error) == Status::kOk);
+  REQUIRE(::stat("/dev/null", &st) == 0);
+  CHECK(S_ISCHR(st.st_mode));
+  CHECK(ReplaceFile("/dev/full", std::string(100000, 'x'), &error) == Status::kIoError);
+  CHECK_THAT(error, Catch::Contains("cannot write '/dev/full': No space left on device"));
+
+  // A missing directory or a directory as the target: refused with the reason.
+  CHECK(ReplaceFile(dir.path + "/no/such/walk.json", "x", &error) == Status::kIoError);
+  CHECK_THAT(error, Catch::Contains("cannot open '" + dir.path +
+                                    "/no/such/walk.json' for writing: No such file or directory"));
+  CHECK(ReplaceFile(dir.path, "x", &error) == Status::kIoError);
+  CHECK_THAT(error, Catch::Contains("Is a directory"));
+}
