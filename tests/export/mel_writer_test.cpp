@@ -204,6 +204,25 @@ TEST_CASE("WriteMel names without a Maya time unit and special characters", "[ex
   std::remove(path.c_str());
 }
 
+TEST_CASE("WriteMel keeps comments to one line and names Maya's second and millisecond units",
+          "[export][mel]") {
+  Walk walk = test::BipedWalk();
+  walk.tracks[0].name = "L\\";  // a backslash ending a comment line could join the next to it
+  walk.stopped = "a\x1b[2J reason\\";
+  for (const auto& [fps, unit] : {std::pair<double, std::string>{1, "sec"}, {1000, "millisec"}}) {
+    walk.fps = fps;
+    const std::string path = WriteAndKeep(walk, "units.mel");
+    CHECK(ParseMel(path).time_unit == unit);
+    std::ifstream in(path);
+    for (std::string line; std::getline(in, line);) {
+      INFO(line);
+      CHECK((line.empty() || line.back() != '\\'));
+      CHECK(line.find('\x1b') == std::string::npos);
+    }
+    std::remove(path.c_str());
+  }
+}
+
 TEST_CASE("WriteMel reports bad walks and unwritable paths", "[export][mel]") {
   std::string error;
   Walk walk = test::BipedWalk();

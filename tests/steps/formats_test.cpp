@@ -60,6 +60,12 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
        "'step_length' = 1000000000.001 is out of range (0, 1e+09]"},
       {{"\"frames_per_step\": 10", "\"frames_per_step\": 2147483648"},
        "'frames_per_step' = 2147483648 is out of range [2, 1e+06]"},
+      // Control characters in names: a NUL cut glTF node names short, others broke MEL lines.
+      {{"{\"name\": \"L\"", "{\"name\": \"L\\u0000a\""},
+       "b.json: 'feet'[0].name: expected a name without control characters (byte 0x00 at offset "
+       "1)"},
+      {{"\"name\": \"b\"", "\"name\": \"b\\tc\""},
+       "b.json: 'name': expected a name without control characters (byte 0x09 at offset 1)"},
       // Rests are lengths like the others (1e300 made the reach check say "inf").
       {{"[0.1, 0, 0]", "[1e300, 0, 0]"}, "'feet'[0].rest: 1e+300 is out of range [-1e9, 1e9]"},
       {{"\"name\": \"b\"", "\"nmae\": \"b\""},
@@ -165,6 +171,9 @@ TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]")
       // The position is the last character the parser read: the end of the unexpected "24".
       {"{\"format\": \"footfall-walk\",\n \"fps\": 24 24}",
        "w.json:2:13: malformed JSON: syntax error"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L\u001b[2J","kind":"foot","keys":[]}]})",
+       "w.json: tracks[0].name: expected a name without control characters (byte 0x1b at offset "
+       "1)"},
       {R"({"format":"footfall-walk","version":1,"fps":24,"fps":30,"tracks":[]})",
        "w.json: malformed JSON: the key 'fps' appears twice"},
   };

@@ -103,6 +103,21 @@ check "glTF times collide: the JSON written" [ -s "$work/far.json" ]
   --steps 100 --out "$work/all.json" --out "$work/all.gltf" --out "$work/all.glb" --out "$work/all.mel" 2>/dev/null
 check "formats: exit 2 for a stopped walk" [ $? -eq 2 ]
 for f in all.json all.gltf all.glb all.mel; do check "formats: $f written" [ -s "$work/$f" ]; done
+# Far from frame 0, glTF's float seconds move keys off their frames: a warning says by how much.
+"$footfall" generate --terrain "$hills" --character "$chars/biped.json" --steps 4 \
+  --start-frame 10000000 --out "$work/late.gltf" 2> "$work/late.err"
+check "glTF late frames: exit 0" [ $? -eq 0 ]
+check "glTF late frames: warned" grep -qF "$work/late.gltf: glTF stores times as float seconds, and at these frames keys move by up to 0.25 frames" "$work/late.err"
+"$footfall" generate --terrain "$hills" --character "$chars/biped.json" --steps 4 \
+  --out "$work/early.gltf" 2> "$work/early.err"
+check "glTF early frames: no warning" [ ! -s "$work/early.err" ]
+# A glTF the process has no memory left to write is refused up front (tinygltf aborted the
+# process, losing the outputs after it); the others are written.
+(ulimit -v 700000; "$footfall" generate --terrain "$hills" --character "$chars/biped.json" \
+  --crowd 20000 --crowd-spacing 1 --steps 10 --out "$work/oom.gltf" --out "$work/oom.json" 2> "$work/oom.err")
+check "glTF beyond memory: exit 1" [ $? -eq 1 ]
+check "glTF beyond memory: said so" grep -qF -- "--out $work/oom.gltf: writing the walk as glTF needs about" "$work/oom.err"
+check "glTF beyond memory: the JSON written" [ -s "$work/oom.json" ]
 # A stopped walk with an output that could not be written is an error (1), not a stop (2).
 "$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
   --steps 100 --out "$work/no/such/dir/walk.json" --out "$work/stopped-ok.json" 2> "$work/stopped-bad.err"

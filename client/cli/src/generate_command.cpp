@@ -279,6 +279,13 @@ int RunGenerate(const GenerateFlags& flags) {
                        "up to "
                     << rounding << " (JSON and MEL keep full precision)\n";
         }
+        const double late = MaxTimeRounding(walk);
+        if (late > 0.01) {
+          std::cerr << "footfall generate: warning: " << out
+                    << ": glTF stores times as float seconds, and at these frames keys move by up "
+                       "to "
+                    << late << " frames (JSON and MEL keep the frames exact)\n";
+        }
       }
       if (WriteOutput(walk, out, &error) != Status::kOk) {
         // Named by its output (the other outputs are still written).

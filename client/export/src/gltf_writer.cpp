@@ -10,6 +10,7 @@
 
 #include "file_output.h"
 #include "footfall/terrain/file_extension.h"
+#include "footfall/terrain/large_memory.h"
 #include "walk_prep.h"
 
 namespace footfall {
@@ -108,6 +109,26 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
                  std::string* error) {
   Status status = walk_export::CheckWalk(walk, error);
   if (status != Status::kOk) return status;
+  // tinygltf serialises in functions that may not throw: running out of memory there aborts the
+  // process (and loses the outputs not yet written). A walk this process cannot hold as glTF is
+  // refused first. Measured peaks: about 9 KB a track (its accessors, views and their JSON),
+  // and the buffer three times over for .glb, five times as base64 text for .gltf.
+  double buffer_bytes = 0;
+  for (const WalkTrack& track : walk.tracks)
+    buffer_bytes += static_cast<double>(track.keys.size()) *
+                    (track.kind == TrackKind::kBody ? 4 + 12 + 16 : 4 + 12);
+  const double needed = buffer_bytes * (options.binary ? 3 : 5) +
+                        9e3 * static_cast<double>(walk.tracks.size()) + 64e6;
+  const double available = AvailableMemoryBytes();
+  if (available > 0 && needed > available) {
+    std::ostringstream m;
+    m.precision(3);
+    m << "writing the walk as glTF needs about " << needed / 1e9 << " GB, more than the "
+      << available / 1e9
+      << " GB this process has free (write .json or .mel, or fewer characters or steps)";
+    SetError(error, m.str());
+    return Status::kLimitExceeded;
+  }
 
   tinygltf::Model model;
   model.asset.version = "2.0";
@@ -243,6 +264,17 @@ Status WriteGltf(const Walk& walk, const std::string& path, std::string* error) 
   GltfOptions options;
   options.binary = EndsWithGlb(path);
   return WriteGltf(walk, path, options, error);
+}
+
+double MaxTimeRounding(const Walk& walk) {
+  double worst = 0;
+  for (const WalkTrack& track : walk.tracks) {
+    for (const WalkKey& key : track.keys) {
+      const double kept = static_cast<double>(static_cast<float>(key.frame / walk.fps));
+      worst = std::max(worst, std::fabs(kept * walk.fps - key.frame));
+    }
+  }
+  return worst;
 }
 
 double MaxFloatRounding(const Walk& walk) {

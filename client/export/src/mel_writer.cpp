@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "file_output.h"
@@ -60,17 +61,22 @@ std::string MelString(const std::string& text) {
         out += "\\t";
         break;
       default:
-        out += c;
+        // Other control bytes have no MEL escape (names with them are refused on reading).
+        out += static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? '?' : c;
     }
   }
   return out + "\"";
 }
 
-// Text safe inside a `//` comment line.
+// Text safe inside a `//` comment line: no line breaks or other control bytes, and no
+// backslash (one at the end of the line could join the next line to the comment).
 std::string CommentText(const std::string& text) {
   std::string out = text;
   for (char& c : out) {
-    if (c == '\n' || c == '\r') c = ' ';
+    if (c == '\n' || c == '\r' || c == '\t')
+      c = ' ';
+    else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f || c == '\\')
+      c = '?';
   }
   return out;
 }
@@ -84,7 +90,8 @@ std::string MayaTimeUnit(double fps) {
   static const Named kNamed[] = {{15, "game"},          {24, "film"},          {25, "pal"},
                                  {30, "ntsc"},          {48, "show"},          {50, "palf"},
                                  {60, "ntscf"},         {23.976, "23.976fps"}, {29.97, "29.97fps"},
-                                 {47.952, "47.952fps"}, {59.94, "59.94fps"}};
+                                 {47.952, "47.952fps"}, {59.94, "59.94fps"},   {1, "sec"},
+                                 {1000, "millisec"}};
   for (const Named& named : kNamed) {
     if (std::abs(fps - named.fps) < 1e-3) return named.unit;
   }
@@ -107,13 +114,14 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
   // Group names (one per crowd character, in order of appearance) and locator names, all
   // unique in the file.
   std::vector<std::string> characters;
+  std::unordered_map<std::string, int> group_index;
   std::vector<int> group_of(walk.tracks.size(), -1);
   for (size_t t = 0; t < walk.tracks.size(); ++t) {
     const std::string& character = walk.tracks[t].character;
     if (character.empty()) continue;
-    auto it = std::find(characters.begin(), characters.end(), character);
-    group_of[t] = static_cast<int>(it - characters.begin());
-    if (it == characters.end()) characters.push_back(character);
+    const auto found = group_index.emplace(character, static_cast<int>(characters.size()));
+    if (found.second) characters.push_back(character);
+    group_of[t] = found.first->second;
   }
   std::vector<std::string> names;
   for (const std::string& character : characters) names.push_back(MayaName(character));

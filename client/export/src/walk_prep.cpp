@@ -5,6 +5,8 @@
 #include <numeric>
 #include <set>
 #include <sstream>
+#include <unordered_map>
+#include <unordered_set>
 
 namespace footfall {
 namespace walk_export {
@@ -87,17 +89,17 @@ std::string QualifiedTrackName(const WalkTrack& track, size_t index) {
 }
 
 std::vector<std::string> UniqueNames(const std::vector<std::string>& names) {
-  std::set<std::string> taken(names.begin(), names.end());
-  std::set<std::string> used;
+  std::unordered_set<std::string> taken(names.begin(), names.end());
+  std::unordered_set<std::string> used;
+  std::unordered_map<std::string, int> next_suffix;  // per name: the first suffix to try
   std::vector<std::string> unique;
   unique.reserve(names.size());
   for (const std::string& name : names) {
     // A suffixed name never takes a name that another track carries as its own.
     std::string candidate = name;
-    for (int suffix = 2;
-         used.count(candidate) != 0 || (candidate != name && taken.count(candidate) != 0);
-         ++suffix) {
-      candidate = name + "_" + std::to_string(suffix);
+    int& suffix = next_suffix.emplace(name, 2).first->second;
+    while (used.count(candidate) != 0 || (candidate != name && taken.count(candidate) != 0)) {
+      candidate = name + "_" + std::to_string(suffix++);
     }
     used.insert(candidate);
     unique.push_back(candidate);

@@ -157,6 +157,9 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
   if (r.status == Status::kOk && j.contains("name")) {
     if (!j["name"].is_string())
       r.Mistyped("name", "a string", j["name"]);
+    else if (!detail::ControlCharacterIn(j["name"].get<std::string>()).empty())
+      r.Fail(Status::kParseError,
+             "'name': " + detail::ControlCharacterIn(j["name"].get<std::string>()));
     else
       c.name = j["name"].get<std::string>();
   }
@@ -177,6 +180,11 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
         }
         if (f["name"].get<std::string>().empty()) {
           r.Fail(Status::kParseError, where + ".name: expected a non-empty name");
+          break;
+        }
+        const std::string control = detail::ControlCharacterIn(f["name"].get<std::string>());
+        if (!control.empty()) {
+          r.Fail(Status::kParseError, where + ".name: " + control);
           break;
         }
         if (detail::FindUnknownKey(f, kKnownFoot, &unknown)) {

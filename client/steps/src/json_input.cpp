@@ -1,6 +1,7 @@
 #include "json_input.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <vector>
 
 #include "footfall/terrain/shown_text.h"
@@ -97,6 +98,19 @@ bool ParseJsonText(const std::string& text, const std::string& source, json* out
     return false;
   }
   return true;
+}
+
+std::string ControlCharacterIn(const std::string& name) {
+  for (size_t i = 0; i < name.size(); ++i) {
+    const unsigned char c = static_cast<unsigned char>(name[i]);
+    if (c < 0x20 || c == 0x7f) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02x", c);
+      return "expected a name without control characters (byte " + std::string(hex) +
+             " at offset " + std::to_string(i) + ")";
+    }
+  }
+  return "";
 }
 
 bool IsInteger(const json& j, int64_t expected) {

@@ -19,6 +19,11 @@ namespace footfall::detail {
 bool ParseJsonText(const std::string& text, const std::string& source, nlohmann::json* out,
                    std::string* error, int max_depth = 0);
 
+// When `name` holds a control character (a byte below 0x20, or 0x7f: NUL, newline, escape...),
+// which no exporter or DCC can keep in a name: "a name without control characters (byte 0xNN
+// at offset K)"; else "".
+std::string ControlCharacterIn(const std::string& name);
+
 // True when `j` is an integer equal to `expected`, with no wrap-around (4294967297 is not 1).
 bool IsInteger(const nlohmann::json& j, int64_t expected);
 

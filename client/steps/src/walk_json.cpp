@@ -174,12 +174,20 @@ Status ParseWalkJson(const std::string& text, const std::string& source, Walk* o
         break;
       }
       track.name = t["name"].get<std::string>();
+      if (!detail::ControlCharacterIn(track.name).empty()) {
+        r.Fail(tw + ".name", detail::ControlCharacterIn(track.name));
+        break;
+      }
       if (t.contains("character")) {
         if (!t["character"].is_string()) {
           r.Fail(tw + ".character", "expected a string");
           break;
         }
         track.character = t["character"].get<std::string>();
+        if (!detail::ControlCharacterIn(track.character).empty()) {
+          r.Fail(tw + ".character", detail::ControlCharacterIn(track.character));
+          break;
+        }
       }
       const std::string kind =
           t.contains("kind") && t["kind"].is_string() ? t["kind"].get<std::string>() : "";

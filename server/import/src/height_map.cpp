@@ -1,8 +1,5 @@
 #include "footfall/import/height_map.h"
 
-#include <sys/resource.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -11,6 +8,7 @@
 #include <iterator>
 #include <sstream>
 
+#include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/samples.h"
 
 namespace footfall {
@@ -126,10 +124,7 @@ Status CheckGridSize(const std::string& path, const std::string& header, double 
   // Reading, meshing and resampling take about 130 bytes a cell (measured: 1.1 GB for 3000 x
   // 3000): a grid this machine cannot hold is refused now, not after a minute of work.
   constexpr double kBytesPerCell = 130;
-  double memory = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * sysconf(_SC_PAGESIZE);
-  struct rlimit limit;
-  if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
-    memory = std::min(memory, static_cast<double>(limit.rlim_cur));
+  const double memory = UsableMemoryBytes();
   if (memory > 0 && cells * kBytesPerCell > memory) {
     std::ostringstream m;
     m.precision(3);

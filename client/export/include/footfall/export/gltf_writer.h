@@ -29,7 +29,9 @@ struct GltfOptions {
 // - Node extras hold {"kind", "character", "track"}; the animation's extras hold {"fps"} and
 //   {"stopped"} when the walk stopped early. World units are written unchanged (glTF metres).
 // Returns kInvalidArgument (with `*error` set) for fps <= 0, a negative frame, NaN/Inf values or
-// a zero quaternion; kIoError naming `path` when the file cannot be written. `error` may be null.
+// a zero quaternion; kLimitExceeded when writing it would need more memory than the process has
+// free (AvailableMemoryBytes); kIoError naming `path` when the file cannot be written. `error` may
+// be null.
 Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& options,
                  std::string* error);
 
@@ -39,5 +41,10 @@ Status WriteGltf(const Walk& walk, const std::string& path, std::string* error);
 // [Units: wu] The farthest any key of `walk` moves once its position is rounded to float, as
 // glTF stores it (0 for a walk near the origin at ordinary spacings).
 double MaxFloatRounding(const Walk& walk);
+
+// [Units: frames] The farthest any key of `walk` moves in time once its time (frame / fps) is
+// rounded to float seconds, as glTF stores it (0 for frames and rates of ordinary size; half a
+// frame from frame 2^24 on).
+double MaxTimeRounding(const Walk& walk);
 
 }  // namespace footfall

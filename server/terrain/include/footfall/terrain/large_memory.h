@@ -14,4 +14,13 @@ namespace footfall {
 void* AllocateLargeMemory(size_t bytes, bool huge_pages = true);
 void FreeLargeMemory(void* p);
 
+// [Units: bytes] The memory this process may still take: the system's available memory
+// (MemAvailable), or what its address-space limit (RLIMIT_AS) leaves when that is less. 0 when
+// unknown. For refusing work that would run out of memory half-way with a message up front.
+double AvailableMemoryBytes();
+
+// [Units: bytes] The memory this process may use at most: physical memory, or its address-space
+// limit when lower. 0 when unknown.
+double UsableMemoryBytes();
+
 }  // namespace footfall
