@@ -254,6 +254,16 @@ class BlenderAddonTest(unittest.TestCase):
             bpy.ops.footfall.import_walk(filepath=bad_walk)
         self.assertIn("tracks[0].keys[0]: expected \"position\"", str(e.exception))
         self.assertEqual(set(bpy.data.objects), before)
+        # Frames beyond Blender's range (its frames are floats within +-1048574): keys piled onto
+        # a few frames, and the import said it had imported them all.
+        far_walk = os.path.join(ARGS.work_dir, "far_frames.json")
+        with open(far_walk, "w") as f:
+            json.dump({"tracks": [{"name": "L1", "kind": "foot", "keys": [
+                {"frame": -1e9 + i, "phase": "end", "position": [0, 0, i]} for i in range(4)]}]}, f)
+        with self.assertRaises(RuntimeError) as e:
+            bpy.ops.footfall.import_walk(filepath=far_walk)
+        self.assertIn("frame -1000000000 is beyond Blender's frame range", str(e.exception))
+        self.assertEqual(set(bpy.data.objects), before)
 
     def test_4_biped_setup_picks_ik_targets(self):
         with open(os.path.join(CHARACTERS, "biped.json")) as f:

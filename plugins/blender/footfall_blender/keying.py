@@ -13,6 +13,21 @@ def _world_to_local(obj, world):
     return (obj.parent.matrix_world @ obj.matrix_parent_inverse).inverted() @ world
 
 
+# Blender's frame range (MAXFRAME): keys beyond it land on the wrong frames, or on one.
+MAX_FRAME = 1048574
+
+
+def check_frames(walk):
+    """Raises ValueError when a key of `walk` lies beyond Blender's frame range."""
+    for track in walk.get("tracks", []):
+        for key in track.get("keys", []):
+            frame = float(key["frame"])
+            if not -MAX_FRAME <= frame <= MAX_FRAME:
+                raise ValueError("track '%s': frame %.15g is beyond Blender's frame range (-%d "
+                                 "to %d); generate it with a start frame nearer 0"
+                                 % (track.get("name"), frame, MAX_FRAME, MAX_FRAME))
+
+
 def clear_keys(objects, from_frame):
     """Removes location/rotation keys at frames >= from_frame from `objects`."""
     for obj in objects:

@@ -366,6 +366,7 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
                 status, walk_text_new, message = s.generate_json(terrain, request)
                 if walk_text_new is not None:
                     walk = json.loads(walk_text_new)
+                    keying.check_frames(walk)
                     if walk_text is None:
                         keying.clear_keys(list(feet.values()) + [body], settings.start_frame)
                     keying.key_walk(walk, feet, body, from_frame=last_frame)
@@ -418,6 +419,7 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
             else:
                 walk = json.loads(character.read_text(path, "walk file"))
             character.check_walk(walk, path)  # before anything is made
+            keying.check_frames(walk)
             crowd = sorted({t.get("character", "") for t in walk["tracks"]})
             rig_obj = active_rig(context)
             if rig_obj is not None:

@@ -67,7 +67,7 @@ class FootfallScene(bpy.types.PropertyGroup):
     rig: PointerProperty(type=bpy.types.Object, name="Rig",
                          poll=lambda self, obj: obj.footfall_rig.is_rig)
     steps: IntProperty(name="Steps", default=8, min=1, max=100000)
-    start_frame: IntProperty(name="Start frame", default=1)
+    start_frame: IntProperty(name="Start frame", default=1, min=-1048574, max=1048574)
     frames_per_step: IntProperty(name="Frames per step", default=0, min=0,
                                  description="0: the character file's value")
     step_length: FloatProperty(name="Step length", default=0.0, min=0.0, unit="LENGTH",
