@@ -3,8 +3,9 @@
 # Usage: scripts/install-deps.sh [core|test|viewer|blender|all]...   (default: core)
 set -euo pipefail
 
+# python3 packs the Blender add-on's zip, which every build makes.
 core=(cmake g++ make pkg-config cpp libtirpc-dev rpcsvc-proto nlohmann-json3-dev libcli11-dev
-      libopenmesh-dev libtinygltf-dev libstb-dev)
+      libopenmesh-dev libtinygltf-dev libstb-dev python3)
 test=(catch2 libbenchmark-dev libnanoflann-dev rpcbind nodejs npm clang-format git)
 viewer=(libglfw3-dev libglm-dev libgl-dev libgl1-mesa-dri xvfb xauth)
 blender=(blender python3 python3-numpy)

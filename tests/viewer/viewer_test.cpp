@@ -343,6 +343,34 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     CHECK(r.exit_code == 2);
     CHECK_THAT(r.err, Catch::Contains("direction DX DY DZ must be non-zero"));
   }
+  SECTION("queries take footfall query's '#' comments; bad loading flags exit 2") {
+    RunResult r = View({"--terrain", kTerrain, "--query", "snap 16 1 11 # the rock", "--screenshot",
+                        dir + "/ok.png"});
+    CHECK(r.exit_code == 0);
+    r = View({"--terrain", kTerrain, "--query", "# only a comment", "--screenshot", shot});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("--query \"# only a comment\": expected snap X Y Z"));
+    r = View({"--terrain", kTerrain, "--separation", "nan", "--screenshot", shot});
+    CHECK(r.exit_code == 2);
+    r = View({"--terrain", kTerrain, "--up-axis", "w", "--screenshot", shot});
+    CHECK(r.exit_code == 2);
+  }
+  SECTION("height maps take every loading flag footfall's commands take") {
+    // A 3 x 3 grid of 1 m cells; --cell-size 2 --height-scale 10 makes it 4 m across, 20 high
+    // (resampled: the samples come within a separation of its edges).
+    test::WriteFile(dir + "/g.asc",
+                    "ncols 3\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\n"
+                    "0 1 2\n0 1 2\n0 1 2\n");
+    const RunResult r = View({"--terrain", dir + "/g.asc", "--cell-size", "2", "--height-scale",
+                              "10", "--crease-angle", "30", "--flat-normals", "--seed", "3",
+                              "--screenshot", dir + "/ok.png", "--dump-state", dir + "/g.json"});
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    const json state = json::parse(test::ReadFile(dir + "/g.json"));
+    const auto lo = state["terrain"]["bounds_min"], hi = state["terrain"]["bounds_max"];
+    CHECK(hi[0].get<double>() - lo[0].get<double>() == Approx(4).margin(0.5));
+    CHECK(hi[1].get<double>() - lo[1].get<double>() == Approx(20).margin(2));
+  }
   SECTION("points no camera can frame") {
     // (A point 1e300 away put the camera at NaN: a blank image and exit 0.)
     RunResult r = View({"--terrain", kTerrain, "--query", "snap 1e300 0 0", "--screenshot", shot});

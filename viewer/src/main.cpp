@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "footfall/cli/load_flags.h"
 #include "footfall/cli/number_checks.h"
 #include "footfall/viewer/viewer_app.h"
 
@@ -41,9 +42,7 @@ int main(int argc, char** argv) {
   std::string size, camera;
   double frame = 0;
   app.add_option("--terrain", o.terrain, "Terrain file (.pts/.xyz/.txt or any loader format)");
-  app.add_option("--separation", o.load.separation, "Mesh resampling distance (wu)")
-      ->check(CLI::NonNegativeNumber);
-  app.add_option("--up-axis", o.load.up_axis, "Height maps: up axis x, y or z");
+  footfall::cli::AddLoadFlags(&app, &o.load);
   app.add_option("--query", o.queries,
                  "A query to draw, repeatable: \"next X Y Z DX DY DZ\", \"snap X Y Z\", "
                  "\"normal X Y Z\"");

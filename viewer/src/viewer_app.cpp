@@ -386,7 +386,12 @@ int RunViewer(const ViewerOptions& options) {
   for (const std::string& text : options.queries) {
     QuerySpec spec;
     std::string error;
-    if (!ParseQueryText(text, &spec, &error)) return Fail("--query \"" + text + "\": " + error, 2);
+    // The syntax of `footfall query`, '#' comments included.
+    const std::string query = WithoutComment(text);
+    if (query.find_first_not_of(" \t\r\v\f") == std::string::npos)
+      return Fail(
+          "--query \"" + text + "\": expected snap X Y Z, normal X Y Z or next X Y Z DX DY DZ", 2);
+    if (!ParseQueryText(query, &spec, &error)) return Fail("--query \"" + text + "\": " + error, 2);
     // (Drawn, a point 1e300 away put the camera at NaN and gave a blank image.)
     const Vec3& p = spec.point;
     if (!(std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) <= kMaxKeyCoordinate))

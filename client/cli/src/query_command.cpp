@@ -51,7 +51,7 @@ bool ReadLine(std::istream& in, std::string* text, bool* too_long) {
 }
 
 bool ParseCommand(const std::string& text, size_t line, Command* out) {
-  const std::string command = text.substr(0, text.find('#'));
+  const std::string command = WithoutComment(text);
   if (command.find_first_not_of(" \t\r\v\f") == std::string::npos) return false;
   *out = Command{};
   out->line = line;

@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "footfall/cli/load_flags.h"
 #include "footfall/client/terrain_session.h"
 
 namespace footfall::cli {
@@ -19,10 +20,6 @@ struct TerrainFlags {
   double timeout_s = 10;
   int threads = 1;  // threads of the embedded engine's batch queries (unused with --server)
 };
-
-// Adds the options of loading meshes and height maps: --separation, --flat-normals, --seed,
-// --up-axis, --cell-size, --height-scale.
-void AddLoadFlags(CLI::App* command, TerrainLoadOptions* load);
 
 // Adds --terrain (required unless `terrain_optional`), --server-terrain, --server, --separation,
 // --flat-normals, --seed, --up-axis, --cell-size, --height-scale, --timeout.

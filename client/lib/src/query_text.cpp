@@ -37,6 +37,8 @@ const char* QueryOpName(QueryOp op) {
   return "unknown";
 }
 
+std::string WithoutComment(const std::string& line) { return line.substr(0, line.find('#')); }
+
 bool ParseQueryText(const std::string& text, QueryText* out, std::string* error) {
   std::string spaced = text;
   for (char& c : spaced) {

@@ -25,11 +25,14 @@ struct QueryText {
 // else, including "nan", "inf", out-of-range values and trailing characters.
 bool ParseFiniteNumber(const std::string& token, double* value);
 
-// Parses one query line (no comments: callers strip them). Numbers are finite decimals, with an
-// optional leading '+'. On failure returns false, leaves *out alone and sets *error to one line
-// saying what was expected, e.g. "normal: expected 3 numbers, found 2",
-// "snap: argument 2 'x' is not a finite number", "next: direction DX DY DZ must be non-zero",
-// "unknown command 'jump' (expected snap X Y Z, normal X Y Z or next X Y Z DX DY DZ)".
+// `line` without its comment: the text before the first '#'.
+std::string WithoutComment(const std::string& line);
+
+// Parses one query line (no comments: callers strip them, WithoutComment). Numbers are finite
+// decimals, with an optional leading '+'. On failure returns false, leaves *out alone and sets
+// *error to one line saying what was expected, e.g. "normal: expected 3 numbers, found 2", "snap:
+// argument 2 'x' is not a finite number", "next: direction DX DY DZ must be non-zero", "unknown
+// command 'jump' (expected snap X Y Z, normal X Y Z or next X Y Z DX DY DZ)".
 bool ParseQueryText(const std::string& text, QueryText* out, std::string* error);
 
 // "next 1 0 2 0.5 0 0": the query in the syntax ParseQueryText reads (numbers to 6 significant

@@ -1,0 +1,16 @@
+// The flags of loading meshes and height maps (--separation, --flat-normals, --crease-angle,
+// --seed, --up-axis, --cell-size, --height-scale), shared by every command that reads a terrain
+// file: footfall's and footfall-view's.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include "footfall/client/terrain_session.h"
+
+namespace footfall::cli {
+
+// Adds the options of loading meshes and height maps to `command`, writing into *load. Bad
+// values are CLI11 validation errors (the command's parse fails with a message naming the flag).
+void AddLoadFlags(CLI::App* command, TerrainLoadOptions* load);
+
+}  // namespace footfall::cli
