@@ -222,6 +222,18 @@ TEST_CASE("SampleMesh: long thin triangles are refused before they are cut", "[i
   CHECK(SampleMesh(sliver, o, &out, &error) == Status::kLimitExceeded);
   CHECK(error.find("long and thin") != std::string::npos);
   CHECK(out.size() == 0);
+  // Both refusals suggest a separation that is then taken (by area alone, the first suggested
+  // one the second refused).
+  for (const double tried : {0.01, 1e-5}) {
+    o.separation = tried;
+    CHECK(SampleMesh(sliver, o, &out, &error) == Status::kLimitExceeded);
+    const size_t at = error.find("choose a separation of at least ");
+    REQUIRE(at != std::string::npos);
+    MeshSampleOptions suggested = o;
+    suggested.separation = std::stod(error.substr(at + 32));
+    INFO(error);
+    CHECK(SampleMesh(sliver, suggested, &out, &error) == Status::kOk);
+  }
   // With room for its pieces (about 1.1 million at s = 5), the same mesh samples, every sample
   // on it.
   o.separation = 5;

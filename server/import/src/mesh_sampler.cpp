@@ -240,6 +240,40 @@ double RoundUp3(double x) {
   return std::ceil(x / step) * step;
 }
 
+// What step 1 of SampleMesh allows at separation s: its estimate of the pieces the mesh is cut
+// into (from each triangle's longest edge, squared in `longest2`) against its limit.
+bool PiecesFit(const std::vector<double>& longest2, double area, size_t max_samples, double s) {
+  const double h2 = (s / 3) * (s / 3);
+  double estimate = 0;
+  for (double l2 : longest2) estimate += std::max(1.0, l2 / (2.25 * h2));
+  const double predicted = 1.6 * area / (s * s);
+  const double limit =
+      std::min(std::max(256 * predicted, 4e6), 32.0 * static_cast<double>(max_samples)) +
+      static_cast<double>(longest2.size());
+  return estimate <= limit;
+}
+
+// The smallest separation, rounded up to 3 significant digits, that SampleMesh takes: its
+// samples within max_samples, and its pieces (long thin triangles make many) within their limit.
+double SeparationThatFits(const TriangleMesh& mesh, double area, size_t max_samples) {
+  std::vector<double> longest2;
+  longest2.reserve(mesh.triangles.size());
+  for (const auto& tri : mesh.triangles) {
+    const Vec3 &a = mesh.vertices[tri[0]], &b = mesh.vertices[tri[1]], &c = mesh.vertices[tri[2]];
+    longest2.push_back(std::max({Distance2(a, b), Distance2(b, c), Distance2(c, a)}));
+  }
+  double lo = std::sqrt(1.6 * area / std::max<double>(1, static_cast<double>(max_samples)));
+  if (!(lo > 0)) lo = 1e-300;
+  if (PiecesFit(longest2, area, max_samples, lo)) return RoundUp3(lo);
+  double hi = lo;
+  for (int i = 0; i < 2100 && !PiecesFit(longest2, area, max_samples, hi); ++i) hi *= 2;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = std::sqrt(lo * hi);
+    (PiecesFit(longest2, area, max_samples, mid) ? hi : lo) = mid;
+  }
+  return RoundUp3(hi);
+}
+
 }  // namespace
 
 double DefaultSeparation(const TriangleMesh& mesh) {
@@ -268,12 +302,11 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   const double predicted = 1.6 * area / (s * s);
   if (predicted > static_cast<double>(options.max_samples)) {
     if (error) {
-      // The smallest separation whose estimate fits, rounded up to 3 significant digits.
-      const double fits = std::sqrt(1.6 * area / std::max<double>(1, options.max_samples));
       *error = "separation " + Format3(s) + " would give about " +
                (predicted < 9e18 ? std::to_string(std::llround(predicted)) : Format3(predicted)) +
                " samples (limit " + std::to_string(options.max_samples) +
-               "); choose a separation of at least " + Format3(RoundUp3(fits));
+               "); choose a separation of at least " +
+               Format3(SeparationThatFits(mesh, area, options.max_samples));
     }
     return Status::kLimitExceeded;
   }
@@ -321,8 +354,10 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
     if (error) {
       *error = "separation " + Format3(s) + " would cut the mesh into more than " +
                std::to_string(candidate_limit) +
-               " pieces: its triangles are long and thin for their area; choose a larger "
-               "separation";
+               " pieces: its triangles are long and thin for their area; choose a separation "
+               "of at least " +
+               Format3(std::max(SeparationThatFits(mesh, area, options.max_samples),
+                                RoundUp3(1.01 * s)));
     }
     return Status::kLimitExceeded;
   }
