@@ -97,12 +97,18 @@ for flag in "--orphan-timeout nan" "--unread-timeout inf" "--unread-timeout 0"; 
   check "footfalld $flag: exit non-zero" [ $? -ne 0 ]
   check "footfalld $flag: message" grep -qE "is not a number of seconds (from|above) 0 to 1e\+09" <<< "$err"
 done
-# A budget is a whole number of samples ("-5" read as a huge budget).
-for value in -5 99999999999999999999999 1.5; do
+# A budget is a whole number of samples ("-5" read as a huge budget); a bad flag exits 2.
+for value in -5 99999999999999999999999 1.5 0x10 1e13; do
   err=$(timeout 5 "$footfalld" --listen 127.0.0.1:0 --no-rpcbind --max-samples "$value" 2>&1)
-  check "footfalld --max-samples $value: exit non-zero" [ $? -ne 0 ]
+  check "footfalld --max-samples $value: exit 2" [ $? -eq 2 ]
   check "footfalld --max-samples $value: message" grep -qF "'$value' is not a whole number of samples from 0 to 1e12" <<< "$err"
 done
+# Written with an exponent, as its own message writes the bound: 2e1 samples hold no 25-sample
+# terrain.
+start_server "$footfalld" --max-samples 2e1
+err=$(echo "snap 0 0 0" | "$footfall" query --terrain "$work/flat.pts" --server "$server" 2>&1 >/dev/null)
+check "footfalld --max-samples 2e1: a 25-sample upload refused" grep -qF "(--max-samples 20," <<< "$err"
+stop_server
 # A port file it cannot write is an error (a supervisor waiting for it would wait forever).
 err=$(timeout 5 "$footfalld" --listen 127.0.0.1:0 --no-rpcbind --port-file "$work/no/such/dir/port" 2>&1)
 check "footfalld unwritable --port-file: exit 1" [ $? -eq 1 ]

@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -58,10 +59,15 @@ CLI::Validator Seconds(bool zero_ok) {
 CLI::Validator SampleCount() {
   return CLI::Validator(
       [](std::string& input) -> std::string {
-        const bool digits = !input.empty() && input.size() <= 13 &&
-                            input.find_first_not_of("0123456789") == std::string::npos;
-        if (digits && std::stod(input) <= 1e12) return std::string();
-        return "'" + input + "' is not a whole number of samples from 0 to 1e12";
+        // Digits, or a number written with an exponent ("2e7"), rewritten as digits for CLI11.
+        char* end = nullptr;
+        const double x = std::strtod(input.c_str(), &end);
+        const bool ok = !input.empty() && *end == '\0' && std::isdigit(uint8_t(input[0])) &&
+                        input.find_first_not_of("0123456789.eE+") == std::string::npos &&
+                        std::isfinite(x) && x >= 0 && x <= 1e12 && x == std::floor(x);
+        if (!ok) return "'" + input + "' is not a whole number of samples from 0 to 1e12";
+        input = std::to_string(static_cast<unsigned long long>(x));
+        return std::string();
       },
       "SAMPLES");
 }
@@ -99,8 +105,8 @@ int main(int argc, char** argv) {
                  "Threads per batch query (default: the hardware's cores)")
       ->check(CLI::Range(1, 64));
   app.add_option("--max-samples", options.limits.max_total_samples,
-                 "Samples held over all terrains and uploads")
-      ->check(SampleCount());
+                 "Samples held over all terrains and uploads (default 268435456, 2^28)")
+      ->transform(SampleCount());
   app.add_option("--orphan-timeout", options.limits.orphan_idle_s,
                  "Seconds without queries after which a terrain whose connection has closed is "
                  "freed (default 600)")
@@ -110,13 +116,13 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 256));
   app.add_option("--unread-timeout", options.unread_timeout_s,
                  "Seconds a client may leave its replies unread, with no room for another, "
-                 "before its connection is closed")
+                 "before its connection is closed (default 30)")
       ->check(Seconds(false));
   app.add_option("--port-file", port_file, "Write the bound port to this file once listening");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    return app.exit(e) == 0 ? 0 : 2;  // --help: 0; a refused flag: 2, as for --listen
   }
   std::string error;
   if (!ParseListen(listen, &options.listen_host, &options.port)) {
