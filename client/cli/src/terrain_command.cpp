@@ -261,7 +261,8 @@ void AddTerrainCommand(CLI::App& app, int* exit_code) {
       ->check(FiniteAbove(0))
       ->capture_default_str();
   m->add_option("--seed", make->seed, "Seed (blocks, rocks, hills)")->capture_default_str();
-  m->add_option("--steps", make->steps, "stairs: number of steps")
+  m->add_option("--steps", make->steps,
+                "stairs: number of treads, the first on the ground (one riser fewer)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   m->add_option("--rise", make->rise, "stairs: step height")

@@ -16,8 +16,10 @@ RawSamples MakeHeightField(int nx, int nz, double spacing, double amplitude, uin
 // Samples spread evenly over a sphere (Fibonacci lattice), normals pointing outwards.
 RawSamples MakeSphere(int count, const Vec3& centre, double radius);
 
-// A staircase along +Z: `steps` steps of given rise and run, `width` wide (X), treads and risers
-// sampled at `spacing`, normals +Y on treads and -Z on risers.
+// A staircase along +Z: `steps` treads of the given run, `width` wide (X), the first on the
+// ground (y = 0) and each next one `rise` higher (so steps - 1 risers, the top tread at
+// (steps - 1) * rise); treads and risers sampled at `spacing`, normals +Y on treads and -Z on
+// risers.
 RawSamples MakeStairs(int steps, double rise, double run, double width, double spacing);
 
 // A closed room: floor (normal +Y), four walls (normals inward) and a ceiling (normal -Y), size
