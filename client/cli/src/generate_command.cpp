@@ -18,10 +18,12 @@
 #include "footfall/client/query_text.h"
 #include "footfall/export/gltf_writer.h"
 #include "footfall/export/walk_writer.h"
+#include "footfall/import/terrain_loader.h"
 #include "footfall/steps/generator.h"
 #include "footfall/steps/walk_json.h"
 #include "footfall/steps/walk_terrain.h"
 #include "footfall/terrain/file_extension.h"
+#include "footfall/terrain/shown_text.h"
 #include "terrain_flags.h"
 
 namespace footfall::cli {
@@ -246,6 +248,21 @@ int RunGenerate(const GenerateFlags& flags) {
         terrain_flags.load.max_samples = std::min(terrain_flags.load.max_samples, kMaxWalkSamples);
       }
       if (OpenTerrain(terrain_flags, &session, &terrain, &error) != Status::kOk) goto bad_flag;
+      // footfalld resampled a mesh or height map itself: say with how many samples, as a local
+      // file's resampling is reported.
+      TerrainInfo info;
+      if (!terrain_flags.server_terrain.empty() &&
+          !IsPointFileExtension(FileExtension(terrain_flags.server_terrain)) &&
+          session->Info(terrain, &info) == Status::kOk) {
+        std::cerr << "footfall generate: footfalld resampled " << terrain_flags.server_terrain
+                  << ": " << info.stats.samples << " samples"
+                  << (terrain_flags.load.separation > 0
+                          ? std::string(" at --separation ") +
+                                NumberText(terrain_flags.load.separation)
+                          : std::string(" as fine as a quarter of the step within 2,000,000 and "
+                                        "what is left of its --max-samples budget"))
+                  << "\n";
+      }
     }
     ProgressBar bar;
     const bool long_run =
