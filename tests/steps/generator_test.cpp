@@ -493,6 +493,27 @@ TEST_CASE("The heading follows a path with a 90-degree turn", "[steps][generator
   }
 }
 
+TEST_CASE("A path walk that runs out of steps before its goal says so as a stop",
+          "[steps][generator]") {
+  // Back and forth between two points 4 m apart, 2000 times: more than the 10,000 steps a path
+  // walk takes without --steps (it ended there with no word, as if it had arrived).
+  const Character c = LoadShipped("biped");
+  Terrain t = LoadTerrain(MakeFlat(200, 0.05, 0), 0.05);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {5, 0, 2};
+  for (int i = 0; i < 2000; ++i) o.path.push_back({5, 0, i % 2 ? 2.0 : 8.0});
+  const Walk w = Generate(t, c, o);
+  CHECK_THAT(w.stopped, Catch::StartsWith("step 10001: the path's goal (5.0000, 0.0000, 2.0000) "
+                                          "is still ") &&
+                            Catch::Contains("after 10000 steps, the most a path walk takes "
+                                            "without --steps"));
+  CHECK(StepsDone(w) == 10000);
+  // With --steps the walk is as asked: no stop.
+  o.steps = 50;
+  CHECK(Generate(t, c, o).stopped.empty());
+}
+
 TEST_CASE("A cliff stops the walk with the step, the position and the keys so far",
           "[steps][generator]") {
   for (const std::string& name : ShippedCharacters()) {

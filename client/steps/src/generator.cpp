@@ -465,6 +465,20 @@ Status Generator::Run(std::string* error) {
       s = WalkPass(pass * per_pass, std::min(n, (pass + 1) * per_pass), &progress, error);
   }
   if (s != Status::kOk) return s;
+  // A path walk without --steps that used every step it may take without reaching its goal
+  // stopped short of what was asked: said as a stop (exit status 2), its keys kept.
+  if (o_.steps < 0 && !o_.path.empty()) {
+    for (Agent& a : agents_) {
+      if (!a.walking || !a.stopped.empty() || a.path.empty()) continue;
+      const double left = Length(ProjectOnPlane(a.path.back() - a.ground, a.up));
+      std::ostringstream why;
+      why.precision(4);
+      why << "the path's goal " << Point(a.path.back()) << " is still " << left
+          << " away after " << steps_
+          << " steps, the most a path walk takes without --steps (give --steps to walk farther)";
+      Stop(a, steps_ + 1, why.str());
+    }
+  }
   // The walk's stop message: the earliest stop (the first character's among those of that
   // step), and how many others stopped; Walk::stops has every one.
   std::vector<const Agent*> stopped;
