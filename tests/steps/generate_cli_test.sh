@@ -212,6 +212,7 @@ bad far-start "the start is too far from the terrain to snap" --terrain "$hills"
 bad fps-tiny "--fps: '1e-300' is not a finite number from 0.001 to 1e+06" --terrain "$hills" --character "$chars/biped.json" --fps 1e-300 --out "$work/x.json"
 bad start-frame "--start-frame: '-1e300' is not a finite number from -1e+09 to 1e+09" --terrain "$hills" --character "$chars/biped.json" --start-frame -1e300 --out "$work/x.json"
 bad crowd-spacing "--crowd-spacing: 'nan' is not a finite number > 0 and <= 1e+06" --terrain "$hills" --character "$chars/biped.json" --crowd-spacing nan --out "$work/x.json"
+bad seed-negative "--seed: '-1' is not a whole number from 0 to 18446744073709551615" --terrain "$hills" --character "$chars/biped.json" --seed -1 --out "$work/x.json"
 bad crowd-spacing-0 "--crowd-spacing: '0' is not a finite number > 0 and <= 1e+06" --terrain "$hills" --character "$chars/biped.json" --crowd-spacing 0 --out "$work/x.json"
 # Two outputs that are one file (by a link, or the same path spelt twice) are refused before
 # anything is generated.

@@ -20,7 +20,19 @@ void AddLoadFlags(CLI::App* command, TerrainLoadOptions* load) {
                    "degrees stay sharp (smooth normals stop at them; 180: smooth everywhere)")
       ->default_val(kDefaultCreaseAngleDeg)
       ->check(FiniteRange(0, 180));
-  command->add_option("--seed", load->seed, "Seed of the mesh sampler");
+  // (CLI11 read "-1" as 2^64 - 1.)
+  command
+      ->add_option("--seed", load->seed,
+                   "Seed of the mesh sampler, a whole number from 0 to 2^64 - 1 (default 1)")
+      ->check(CLI::Validator(
+          [](std::string& input) -> std::string {
+            if (!input.empty() && input.size() <= 20 &&
+                input.find_first_not_of("0123456789") == std::string::npos &&
+                (input.size() < 20 || input <= "18446744073709551615"))
+              return std::string();
+            return "'" + input + "' is not a whole number from 0 to 18446744073709551615";
+          },
+          "SEED"));
   command->add_option("--up-axis", load->up_axis, "Height maps: up axis x, y or z")
       ->check(CLI::IsMember({'x', 'y', 'z'}));
   command
