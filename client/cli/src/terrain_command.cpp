@@ -18,6 +18,7 @@
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/grid.h"
 #include "footfall/terrain/point_file.h"
+#include "footfall/terrain/shown_text.h"
 #include "terrain_flags.h"
 
 namespace footfall::cli {
@@ -161,8 +162,9 @@ int RunMake(const MakeFlags& f) {
   if (!(estimate <= kMaxMadeSamples)) {
     std::ostringstream m;
     m << "footfall terrain make: " << k << ": these sizes at --spacing " << f.spacing
-      << " give about " << std::setprecision(3) << estimate << " samples, more than the "
-      << std::setprecision(10) << kMaxMadeSamples
+      << " give about "
+      << (estimate < 1e15 ? std::to_string(std::llround(estimate)) : NumberText(estimate))
+      << " samples, more than the " << std::setprecision(10) << kMaxMadeSamples
       << " allowed (raise --spacing or make it smaller)";
     std::cerr << m.str() << '\n';
     return 1;

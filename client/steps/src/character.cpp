@@ -147,7 +147,9 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
       r.Mistyped("format", "a string", j["format"]);
     else if (j["format"].get<std::string>() != "footfall-character")
       r.Fail(Status::kParseError, "'format': expected \"footfall-character\"");
-    else if (!j.contains("version") || !j["version"].is_number_integer())
+    else if (!j.contains("version"))
+      r.Fail(Status::kParseError, "missing field 'version' (expected 1)");
+    else if (!j["version"].is_number_integer())
       r.Fail(Status::kParseError, "'version': expected an integer");
     else if (!detail::IsInteger(j["version"], kCharacterFormatVersion))
       r.Fail(Status::kParseError, "'version' " + j["version"].dump() +
