@@ -1176,6 +1176,14 @@ void Generator::Finish(size_t w, int k) {
   bool in_place = true;
   for (size_t i = m; i < e; ++i)
     in_place &= moves_[i].done && moves_[i].end == a.foot[moves_[i].foot];
+  // Every foot of the group steps in place: it waits, as a held group does, for the other
+  // groups to move the body on (a hind foot at the terrain's back edge, whose target lies behind
+  // it until the front feet step); a whole cycle of groups in place is a dead end.
+  if (in_place && !failed && a.waits + 1 < static_cast<int>(c_.gait.size())) {
+    ++a.waits;
+    body_frame_[w] = f1;
+    return;
+  }
   if (in_place && !failed) {
     Stop(a, k + 1,
          "no way forward from " + Point(a.ground) +
