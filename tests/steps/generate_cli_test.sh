@@ -118,6 +118,11 @@ check "glTF early frames: no warning" [ ! -s "$work/early.err" ]
 check "glTF beyond memory: exit 1" [ $? -eq 1 ]
 check "glTF beyond memory: said so" grep -qF -- "--out $work/oom.gltf: writing the walk as glTF needs about" "$work/oom.err"
 check "glTF beyond memory: the JSON written" [ -s "$work/oom.json" ]
+# A crowd beyond memory says how large it is (it said "out of memory" alone).
+(ulimit -v 500000; "$footfall" generate --terrain "$hills" --character "$chars/biped.json" \
+  --crowd 100000 --crowd-spacing 0.1 --steps 100 --out "$work/oom-crowd.json" 2> "$work/oom-crowd.err")
+check "crowd beyond memory: exit 1" [ $? -eq 1 ]
+check "crowd beyond memory: said how large" grep -qF "out of memory generating 100000 characters x 100 steps: about 4e+07 keys" "$work/oom-crowd.err"
 # A stopped walk with an output that could not be written is an error (1), not a stop (2).
 "$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
   --steps 100 --out "$work/no/such/dir/walk.json" --out "$work/stopped-ok.json" 2> "$work/stopped-bad.err"

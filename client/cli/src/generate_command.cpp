@@ -270,7 +270,26 @@ int RunGenerate(const GenerateFlags& flags) {
     if (flags.progress || (long_run && isatty(STDERR_FILENO)))
       options.progress = [&bar](int done, int total) { bar.Update(done, total); };
     Walk walk;
-    const Status status = GenerateWalk(*session, terrain, character, options, &walk, &error);
+    Status status;
+    try {
+      status = GenerateWalk(*session, terrain, character, options, &walk, &error);
+    } catch (const std::bad_alloc&) {
+      bar.Finish();
+      // Per character and step: start, mid and end keys of a group's feet, and a body key.
+      const double steps = flags.steps < 0 ? kMaxPathSteps : flags.steps;
+      const double keys = static_cast<double>(flags.crowd) * steps *
+                          (3.0 * static_cast<double>(character.feet.size()) /
+                               static_cast<double>(character.gait.size()) +
+                           1);
+      std::ostringstream m;
+      m.precision(3);
+      m << "out of memory generating " << flags.crowd
+        << (flags.crowd == 1 ? " character" : " characters") << " x " << steps << " steps: about "
+        << keys << " keys, " << keys * 68 / 1e9
+        << " GB; nothing was written (give fewer --crowd or --steps)";
+      std::cerr << "footfall generate: " << m.str() << '\n';
+      return 1;
+    }
     bar.Finish();
     if (status != Status::kOk) {
       std::cerr << "footfall generate: " << error << '\n';
@@ -304,7 +323,16 @@ int RunGenerate(const GenerateFlags& flags) {
                     << late << " frames (JSON and MEL keep the frames exact)\n";
         }
       }
-      if (WriteOutput(walk, out, &error) != Status::kOk) {
+      Status written;
+      try {
+        written = WriteOutput(walk, out, &error);
+      } catch (const std::bad_alloc&) {
+        error =
+            "out of memory writing it (the outputs before it are written; the walk JSON "
+            "takes least)";
+        written = Status::kLimitExceeded;
+      }
+      if (written != Status::kOk) {
         // Named by its output (the other outputs are still written).
         const bool named = error.compare(0, out.size(), out) == 0;
         std::cerr << "footfall generate: " << (named ? "" : "--out " + out + ": ") << error << '\n';
