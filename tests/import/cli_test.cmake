@@ -134,7 +134,7 @@ expect(EXIT_NONZERO "--spacing: 'nan' is not a finite number > 0"
        terrain make flat --spacing nan -o "${WORK}/x.pts")
 expect(EXIT_NONZERO "--slope: '1e300' is not a finite number from -80 to 80"
        terrain make ramp --slope 1e300 -o "${WORK}/x.pts")
-expect(EXIT_NONZERO "hills: these sizes at --spacing 0.05 give about 4e+12 samples, more than the 20000000 allowed"
+expect(EXIT_NONZERO "hills: these sizes at --spacing 0.05 give about 4000004000001 samples, more than the 20000000 allowed"
        terrain make hills --size 100000 -o "${WORK}/x.pts")
 expect(EXIT_NONZERO "flat: these sizes at --spacing 0.001 give about 4e+24 samples"
        terrain make flat --size 2000000000 --spacing 0.001 -o "${WORK}/x.pts")

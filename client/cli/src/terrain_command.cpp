@@ -18,7 +18,6 @@
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/grid.h"
 #include "footfall/terrain/point_file.h"
-#include "footfall/terrain/shown_text.h"
 #include "terrain_flags.h"
 
 namespace footfall::cli {
@@ -155,6 +154,13 @@ double EstimateSamples(const MakeFlags& f) {
   return side * side;
 }
 
+// `x` with 3 significant digits ("4e+24"), for counts far beyond any limit.
+std::string Format3(double x) {
+  std::ostringstream o;
+  o << std::setprecision(3) << x;
+  return o.str();
+}
+
 int RunMake(const MakeFlags& f) {
   RawSamples samples;
   const std::string& k = f.kind;
@@ -163,7 +169,7 @@ int RunMake(const MakeFlags& f) {
     std::ostringstream m;
     m << "footfall terrain make: " << k << ": these sizes at --spacing " << f.spacing
       << " give about "
-      << (estimate < 1e15 ? std::to_string(std::llround(estimate)) : NumberText(estimate))
+      << (estimate < 1e15 ? std::to_string(std::llround(estimate)) : Format3(estimate))
       << " samples, more than the " << std::setprecision(10) << kMaxMadeSamples
       << " allowed (raise --spacing or make it smaller)";
     std::cerr << m.str() << '\n';

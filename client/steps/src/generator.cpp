@@ -473,8 +473,8 @@ Status Generator::Run(std::string* error) {
       const double left = Length(ProjectOnPlane(a.path.back() - a.ground, a.up));
       std::ostringstream why;
       why.precision(4);
-      why << "the path's goal " << Point(a.path.back()) << " is still " << left
-          << " away after " << steps_
+      why << "the path's goal " << Point(a.path.back()) << " is still " << left << " away after "
+          << steps_
           << " steps, the most a path walk takes without --steps (give --steps to walk farther)";
       Stop(a, steps_ + 1, why.str());
     }
