@@ -66,6 +66,9 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
        "1)"},
       {{"\"name\": \"b\"", "\"name\": \"b\\tc\""},
        "b.json: 'name': expected a name without control characters (byte 0x09 at offset 1)"},
+      // A foot called "body" took the body's name in Blender rigs.
+      {{"{\"name\": \"L\"", "{\"name\": \"body\""},
+       "b.json: 'feet'[0].name: 'body' names the body's track"},
       // Rests are lengths like the others (1e300 made the reach check say "inf").
       {{"[0.1, 0, 0]", "[1e300, 0, 0]"}, "'feet'[0].rest: 1e+300 is out of range [-1e9, 1e9]"},
       {{"\"name\": \"b\"", "\"nmae\": \"b\""},

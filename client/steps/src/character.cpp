@@ -189,6 +189,12 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
           r.Fail(Status::kParseError, where + ".name: " + control);
           break;
         }
+        // Walks, exporters and DCC rigs name the body's track and node "body".
+        if (f["name"].get<std::string>() == "body") {
+          r.Fail(Status::kInvalidArgument,
+                 where + ".name: 'body' names the body's track; choose another foot name");
+          break;
+        }
         if (detail::FindUnknownKey(f, kKnownFoot, &unknown)) {
           r.Fail(Status::kParseError,
                  where + ": " + detail::UnknownFieldMessage(unknown, kKnownFoot));
