@@ -118,6 +118,40 @@ check "glTF early frames: no warning" [ ! -s "$work/early.err" ]
 check "glTF beyond memory: exit 1" [ $? -eq 1 ]
 check "glTF beyond memory: said so" grep -qF -- "--out $work/oom.gltf: writing the walk as glTF needs about" "$work/oom.err"
 check "glTF beyond memory: the JSON written" [ -s "$work/oom.json" ]
+# Memory short while serialising glTF: a string stream that cannot grow dropped the rest of the
+# file, and the cut file replaced the good one with exit 0. Whatever the machine's memory makes
+# of it, the file is whole, or refused and the previous one kept.
+"$footfall" terrain make flat --size 20 --spacing 0.05 -o "$work/flat20.pts" > /dev/null
+python3 - "$work/centipede.json" <<'PY'
+import json, sys
+feet = [{"name": "%s%d" % (s, i), "rest": [0.06 if s == "L" else -0.06, 0, 0.3 - 0.03 * i]}
+        for s in "LR" for i in range(20)]
+odd = lambda f: (int(f["name"][1:]) + (f["name"][0] == "R")) % 2
+json.dump({"format": "footfall-character", "version": 1, "name": "centipede", "feet": feet,
+           "gait": [[f["name"] for f in feet if odd(f) == g] for g in (0, 1)],
+           "step_length": 0.1, "step_height": 0.04, "body_height": 0.04, "frames_per_step": 6,
+           "align_to_normal": True, "max_slope_deg": 100, "max_rise": 0.07, "reach": 0.6},
+          open(sys.argv[1], "w"))
+PY
+for limit in 450000 550000; do
+  for ext in gltf glb; do
+    echo PREVIOUS > "$work/short.$ext"
+    (ulimit -v $limit; "$footfall" generate --terrain "$work/flat20.pts" --character "$work/centipede.json" \
+      --threads 1 --crowd 400 --crowd-spacing 0.45 --start 10,0,5 --steps 60 --out "$work/short.$ext" 2> /dev/null)
+    rc=$?
+    if [ $rc -eq 1 ]; then
+      check "glTF with memory short ($ext, $limit): refused, the previous file kept" grep -qx PREVIOUS "$work/short.$ext"
+    else
+      check "glTF with memory short ($ext, $limit): written whole" python3 -c "
+import json, struct, sys
+d = open(sys.argv[1], 'rb').read()
+if sys.argv[1].endswith('.glb'):
+    assert struct.unpack('<4sII', d[:12])[2] == len(d)
+else:
+    json.loads(d)" "$work/short.$ext"
+    fi
+  done
+done
 # A crowd beyond memory says how large it is (it said "out of memory" alone).
 (ulimit -v 500000; "$footfall" generate --terrain "$hills" --character "$chars/biped.json" \
   --crowd 100000 --crowd-spacing 0.1 --steps 100 --out "$work/oom-crowd.json" 2> "$work/oom-crowd.err")
