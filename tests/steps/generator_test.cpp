@@ -1000,6 +1000,46 @@ TEST_CASE("Bad options are refused with a message", "[steps][generator]") {
   CHECK_THAT(error, Catch::Contains("handle"));
 }
 
+TEST_CASE("A character milling about at a dead end stops", "[steps][generator][shared-data]") {
+  // Real data from ../shared/data: the Kootenai DEM resampled at 0.175. An asymmetric
+  // three-legged character on a path shuffled its feet about the same spot for 947 steps before
+  // a group happened to step in place; with in-place groups waiting, it shuffled for every step
+  // it was given.
+  const std::string path =
+      FOOTFALL_SOURCE_DIR "/../shared/data/terrain/terrain_kootenai_1m_50x37.asc";
+  std::ifstream probe(path);
+  if (!probe) {
+    if (std::getenv("CI")) FAIL("shared data missing in CI: " << path);
+    WARN("skipped: shared data not found at " << path << " (CI is unset)");
+    return;
+  }
+  RawSamples dem;
+  std::string error;
+  TerrainLoadOptions lo;
+  lo.separation = 0.175;
+  REQUIRE(footfall::LoadTerrain(path, lo, &dem, &error) == Status::kOk);
+  Terrain t = LoadTerrain(dem, 0.175);
+  Character asym;
+  REQUIRE(ParseCharacter(R"({"format": "footfall-character", "version": 1, "name": "asym",
+    "feet": [{"name": "L", "rest": [0.3, 0, 0.1]}, {"name": "R", "rest": [-0.1, 0, -0.2]},
+             {"name": "T", "rest": [0.05, 0, -0.6]}],
+    "gait": [["L"], ["R"], ["T"]], "step_length": 0.4, "step_height": 0.1, "body_height": 0.45,
+    "frames_per_step": 8, "align_to_normal": true, "max_rise": 0.25, "reach": 1.0,
+    "max_slope_deg": 50})",
+                         "asym", &asym, &error) == Status::kOk);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {14.7, 0, 9};
+  o.path = {{14.7, 0, 25.2}, {34.3, 0, 25.2}, {34.3, 0, 10.8}, {22.05, 0, 16.2}};
+  o.steps = 5000;
+  const Walk w = Generate(t, asym, o);
+  INFO(w.stopped);
+  CHECK_THAT(w.stopped, Catch::Contains("the body has stayed within half a step of it for 12 "
+                                        "steps (a dead end)"));
+  CHECK(StepsDone(w) < 100);
+  CheckWalk(t, asym, o, w);
+}
+
 TEST_CASE("A multiped walks over the Spot mesh, a closed surface with overhangs",
           "[steps][generator][shared-data]") {
   // Real data from ../shared/data: Keenan Crane's Spot (public domain), resampled by
