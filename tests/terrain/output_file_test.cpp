@@ -1,8 +1,12 @@
 // ReplaceFile: what a failed write leaves behind (the old file, whole, and nothing else), and
 // how it treats permissions, symbolic links, devices and missing directories.
 #include <dirent.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <csignal>
 
 #include <cstdio>
 #include <cstdlib>
@@ -116,4 +120,91 @@ TEST_CASE("ReplaceFile follows symbolic links and writes devices in place",
                                     "/no/such/walk.json' for writing: No such file or directory"));
   CHECK(ReplaceFile(dir.path, "x", &error) == Status::kIoError);
   CHECK_THAT(error, Catch::Contains("Is a directory"));
+}
+
+TEST_CASE("ReplaceFile creates the file a dangling link names, and takes long names",
+          "[terrain][output_file]") {
+  Dir dir;
+  std::string error;
+  // A link to a file not there yet: the file is made where it points, the link kept.
+  REQUIRE(::symlink("made.json", (dir.path + "/link.json").c_str()) == 0);
+  REQUIRE(ReplaceFile(dir.path + "/link.json", "new", &error) == Status::kOk);
+  struct stat st;
+  REQUIRE(::lstat((dir.path + "/link.json").c_str(), &st) == 0);
+  CHECK(S_ISLNK(st.st_mode));
+  CHECK(Read(dir.path + "/made.json") == "new");
+  // A name of 250 bytes: its ".NAME.XXXXXX" temporary name would be too long.
+  const std::string long_name = dir.path + "/" + std::string(245, 'w') + ".json";
+  CHECK(ReplaceFile(long_name, "long", &error) == Status::kOk);
+  CHECK(Read(long_name) == "long");
+  CHECK(dir.Entries().size() == 3);
+}
+
+TEST_CASE("ReplaceFile writes hard-linked files in place and refuses files it may not write",
+          "[terrain][output_file]") {
+  Dir dir;
+  std::string error;
+  const std::string a = dir.path + "/a.mel", b = dir.path + "/b.mel";
+  REQUIRE(ReplaceFile(a, "old", &error) == Status::kOk);
+  REQUIRE(::link(a.c_str(), b.c_str()) == 0);
+  REQUIRE(ReplaceFile(a, "new", &error) == Status::kOk);
+  CHECK(Read(b) == "new");  // both names show the new content
+  // A read-only file: refused as opening it for writing would be (root may write anything).
+  const std::string locked = dir.path + "/locked.json";
+  REQUIRE(ReplaceFile(locked, "kept", &error) == Status::kOk);
+  ::chmod(locked.c_str(), 0444);
+  const Status status = ReplaceFile(locked, "new", &error);
+  if (::geteuid() == 0) {
+    CHECK(status == Status::kOk);
+    CHECK(Mode(locked) == 0444);
+  } else {
+    CHECK(status == Status::kIoError);
+    CHECK_THAT(error, Catch::Contains("Permission denied"));
+    CHECK(Read(locked) == "kept");
+  }
+}
+
+TEST_CASE("A program's signals and file size limit leave no temporary file behind",
+          "[terrain][output_file]") {
+  Dir dir;
+  const std::string file = dir.path + "/walk.json";
+  std::string error;
+  REQUIRE(ReplaceFile(file, "old", &error) == Status::kOk);
+  // SIGTERM in the middle of a write: the process ends by the signal, the temporary file goes.
+  const pid_t child = ::fork();
+  if (child == 0) {
+    RemoveTemporaryFileOnSignal();
+    std::string e;
+    ReplaceFile(
+        file,
+        [](std::FILE* f) {
+          std::fputs("half", f);
+          std::fflush(f);
+          std::raise(SIGTERM);
+          return true;
+        },
+        &e);
+    ::_exit(0);
+  }
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  CHECK(WIFSIGNALED(status));
+  CHECK(WTERMSIG(status) == SIGTERM);
+  CHECK(Read(file) == "old");
+  CHECK(dir.Entries() == std::vector<std::string>{"walk.json"});
+  // Past the file size limit: a message, not SIGXFSZ.
+  const pid_t limited = ::fork();
+  if (limited == 0) {
+    RemoveTemporaryFileOnSignal();
+    struct rlimit limit = {1000, 1000};
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    std::string e;
+    const Status s = ReplaceFile(file, std::string(100000, 'x'), &e);
+    ::_exit(s == Status::kIoError && e.find("File too large") != std::string::npos ? 7 : 1);
+  }
+  ::waitpid(limited, &status, 0);
+  CHECK(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 7);
+  CHECK(Read(file) == "old");
+  CHECK(dir.Entries() == std::vector<std::string>{"walk.json"});
 }

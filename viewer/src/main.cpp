@@ -10,6 +10,7 @@
 
 #include "footfall/cli/load_flags.h"
 #include "footfall/cli/number_checks.h"
+#include "footfall/terrain/output_file.h"
 #include "footfall/viewer/viewer_app.h"
 
 namespace {
@@ -34,6 +35,7 @@ bool ParseNumbers(const std::string& text, size_t count, std::vector<double>* ou
 
 int main(int argc, char** argv) {
   std::signal(SIGPIPE, SIG_IGN);
+  footfall::RemoveTemporaryFileOnSignal();  // an interrupted write leaves no temporary file
   footfall::viewer::ViewerOptions o;
   CLI::App app{
       "footfall-view: draws terrain samples, queries (foot, direction, cells, candidates, chosen "

@@ -7,9 +7,11 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
+#include "footfall/terrain/output_file.h"
 
 int main(int argc, char** argv) {
-  std::signal(SIGPIPE, SIG_IGN);  // a vanished server must give an error, not kill us
+  std::signal(SIGPIPE, SIG_IGN);            // a vanished server must give an error, not kill us
+  footfall::RemoveTemporaryFileOnSignal();  // an interrupted write leaves no temporary file
   CLI::App app{"footfall: places footsteps of bipeds and multipeds on uneven terrain"};
   app.require_subcommand(1);
   int exit_code = 0;

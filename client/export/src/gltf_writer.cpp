@@ -260,8 +260,9 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
   // A string stream that cannot grow (memory short) sets its failbit and drops the rest:
   // tinygltf does not look, and a cut file would replace a good one.
   if (!out) {
-    SetError(error, "out of memory serialising the walk as glTF (write .json or .mel, or fewer "
-                    "characters or steps)");
+    SetError(error,
+             "out of memory serialising the walk as glTF (write .json or .mel, or fewer "
+             "characters or steps)");
     return Status::kLimitExceeded;
   }
   return walk_export::WriteFileBytes(path, out.str(), error);

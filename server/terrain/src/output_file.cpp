@@ -4,8 +4,10 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <climits>
+#include <csignal>
 #include <cstdlib>
 #include <cstring>
 
@@ -44,17 +46,46 @@ mode_t CurrentUmask() {
   return mask;
 }
 
+// The file that writing `path` creates or replaces: symbolic links followed, also a link naming
+// a file not there yet (it is created where the link points).
+std::string FollowLinks(const std::string& path) {
+  std::string p = path;
+  for (int hops = 0; hops < 40; ++hops) {
+    struct stat st;
+    if (::lstat(p.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) break;
+    char to[PATH_MAX];
+    const ssize_t n = ::readlink(p.c_str(), to, sizeof to - 1);
+    if (n <= 0) break;
+    const std::string target(to, static_cast<size_t>(n));
+    const size_t slash = p.rfind('/');
+    p = target[0] == '/' || slash == std::string::npos ? target : p.substr(0, slash + 1) + target;
+  }
+  return p;
+}
+
+// The temporary file being written, for RemoveTemporaryFileOnSignal's handler.
+std::atomic<const char*> g_temporary{nullptr};
+
+void RemoveTemporaryAndReraise(int signal_number) {
+  const char* temporary = g_temporary.load();
+  if (temporary != nullptr) ::unlink(temporary);
+  std::signal(signal_number, SIG_DFL);
+  std::raise(signal_number);
+}
+
 }  // namespace
+
+void RemoveTemporaryFileOnSignal() {
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGQUIT})
+    std::signal(signal_number, RemoveTemporaryAndReraise);
+  // Past the file size limit a write fails (EFBIG) and is reported, instead of killing the
+  // process with the temporary file left behind.
+  std::signal(SIGXFSZ, SIG_IGN);
+}
 
 Status ReplaceFile(const std::string& path, const std::function<bool(std::FILE*)>& write,
                    std::string* error) {
-  // A symbolic link is followed to the file it names (when there is one).
-  std::string target = path;
-  struct stat link_st;
-  if (::lstat(path.c_str(), &link_st) == 0 && S_ISLNK(link_st.st_mode)) {
-    char resolved[PATH_MAX];
-    if (::realpath(path.c_str(), resolved) != nullptr) target = resolved;
-  }
+  const std::string target = FollowLinks(path);
   struct stat st;
   const bool exists = ::stat(target.c_str(), &st) == 0;
   auto in_place = [&]() {
@@ -63,37 +94,48 @@ Status ReplaceFile(const std::string& path, const std::function<bool(std::FILE*)
     const int failure = WriteAndClose(file, write);
     return failure ? Fail("cannot write", path, failure, error) : Status::kOk;
   };
-  if (exists && !S_ISREG(st.st_mode)) return in_place();
+  // Devices and FIFOs are written as they are; a file with other names (hard links) in place,
+  // so that every name keeps showing the new content.
+  if (exists && (!S_ISREG(st.st_mode) || st.st_nlink > 1)) return in_place();
+  // A file its owner made read-only stays refused, as opening it for writing would be.
+  if (exists && ::access(target.c_str(), W_OK) != 0) return Fail("cannot open", path, errno, error);
   const size_t slash = target.rfind('/');
   const std::string dir = slash == std::string::npos ? "" : target.substr(0, slash + 1);
   const std::string name = slash == std::string::npos ? target : target.substr(slash + 1);
-  std::string temp = dir + "." + name + ".XXXXXX";
+  // ".NAME.XXXXXX" beside it; a name too long for that takes a short temporary name.
+  std::string temp = dir + (name.size() <= 200 ? "." + name : std::string(".footfall")) + ".XXXXXX";
   const int fd = ::mkstemp(&temp[0]);
-  if (fd < 0) {
-    const int why = errno;
-    // A directory that takes no new file may still let an existing file be rewritten.
-    if (exists && (why == EACCES || why == EPERM || why == EROFS || why == ENAMETOOLONG))
-      return in_place();
-    return Fail("cannot open", path, why, error);
+  if (fd < 0) return Fail("cannot open", path, errno, error);
+  g_temporary.store(temp.c_str());
+  if (exists) {
+    ::fchmod(fd, st.st_mode & 07777);
+    if (::fchown(fd, st.st_uid, st.st_gid) != 0) {
+      // Not ours to give away (only root may): the file becomes the writer's, as a new one.
+    }
+  } else {
+    ::fchmod(fd, 0666 & ~CurrentUmask());
   }
-  ::fchmod(fd, exists ? (st.st_mode & 07777) : (0666 & ~CurrentUmask()));
   std::FILE* file = ::fdopen(fd, "wb");
   if (!file) {
     const int why = errno;
     ::close(fd);
     ::unlink(temp.c_str());
+    g_temporary.store(nullptr);
     return Fail("cannot write", path, why, error);
   }
   const int failure = WriteAndClose(file, write);
   if (failure != 0) {
     ::unlink(temp.c_str());
+    g_temporary.store(nullptr);
     return Fail("cannot write", path, failure, error);
   }
   if (::rename(temp.c_str(), target.c_str()) != 0) {
     const int why = errno;
     ::unlink(temp.c_str());
+    g_temporary.store(nullptr);
     return Fail("cannot write", path, why, error);
   }
+  g_temporary.store(nullptr);
   return Status::kOk;
 }
 

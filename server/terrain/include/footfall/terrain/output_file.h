@@ -1,10 +1,12 @@
 // Writing files so that a failed write never destroys what was there: the new content goes to a
 // temporary file beside the target and replaces it (a rename) only once it is complete, with the
-// target's permissions. A full disk, a write error or an exception leaves the old file whole and
-// no temporary file behind. Through a symbolic link, the file it names is replaced (the link
-// stays). A target that is not a regular file (a device such as /dev/null, a FIFO), or one in a
-// directory that takes no new file, is written in place. Not synced to disk: a power cut may
-// still lose the new content, never the old one to a write error.
+// target's permissions (and owner, where the writer may give it). A full disk, a write error or
+// an exception leaves the old file whole and no temporary file behind. Through a symbolic link
+// (also one naming a file not there yet), the file it names is written (the link stays). A
+// target the writer may not write is refused, as opening it would be, and so is one in a
+// directory that takes no new file. Written in place: a device such as /dev/null or a FIFO, and
+// a file with other names (hard links), so that every name shows the new content. Not synced
+// to disk: a power cut may still lose the new content, never the old one to a write error.
 #pragma once
 
 #include <cstdio>
@@ -25,5 +27,10 @@ Status ReplaceFile(const std::string& path, const std::function<bool(std::FILE*)
 
 // The same with the whole new content given.
 Status ReplaceFile(const std::string& path, std::string_view bytes, std::string* error);
+
+// For programs (not libraries: it sets process-wide signal handlers): SIGINT, SIGTERM, SIGHUP and
+// SIGQUIT remove the temporary file being written before the process ends as they would end
+// it, and SIGXFSZ is ignored, so that a write past the file size limit fails with a message.
+void RemoveTemporaryFileOnSignal();
 
 }  // namespace footfall
