@@ -355,6 +355,18 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     r = View({"--terrain", kTerrain, "--up-axis", "w", "--screenshot", shot});
     CHECK(r.exit_code == 2);
   }
+  SECTION("outputs never replace the inputs or each other") {
+    // (A screenshot over the terrain file turned it into a PNG.)
+    test::WriteFile(dir + "/t.pts", test::ReadFile(kTerrain));
+    RunResult r = View({"--terrain", dir + "/t.pts", "--screenshot", dir + "/./t.pts"});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("is the --terrain file; choose another output name"));
+    CHECK(test::ReadFile(dir + "/t.pts") == test::ReadFile(kTerrain));
+    r = View({"--terrain", dir + "/t.pts", "--screenshot", dir + "/s.png", "--dump-state",
+              dir + "/s.png"});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("--screenshot and --dump-state name the same file"));
+  }
   SECTION("height maps take every loading flag footfall's commands take") {
     // A 3 x 3 grid of 1 m cells; --cell-size 2 --height-scale 10 makes it 4 m across, 20 high
     // (resampled: the samples come within a separation of its edges).

@@ -380,6 +380,22 @@ int RunViewer(const ViewerOptions& options) {
     return Fail("--query needs --terrain FILE (queries run on the local terrain)", 2);
   if (options.live_wait > 0 && options.screenshot.empty())
     return Fail("--live-wait is for --screenshot", 2);
+  // What the viewer writes never replaces what it reads, nor each other.
+  const std::pair<const char*, const std::string*> outputs[] = {
+      {"--screenshot", &options.screenshot}, {"--dump-state", &options.dump_state}};
+  const std::pair<const char*, const std::string*> inputs[] = {{"--terrain", &options.terrain},
+                                                               {"--walk", &options.walk}};
+  for (const auto& [flag, path] : outputs) {
+    if (path->empty()) continue;
+    for (const auto& [in_flag, in_path] : inputs)
+      if (!in_path->empty() && SameFile(*path, *in_path))
+        return Fail(std::string(flag) + " " + *path + " is the " + in_flag +
+                        " file; choose another output name",
+                    2);
+  }
+  if (!options.screenshot.empty() && !options.dump_state.empty() &&
+      SameFile(options.screenshot, options.dump_state))
+    return Fail("--screenshot and --dump-state name the same file; give each its own", 2);
   if (options.width <= 0 || options.height <= 0 || options.width > 16384 || options.height > 16384)
     return Fail("--size: width and height must be within 1..16384", 2);
   std::vector<QuerySpec> specs;

@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -23,6 +22,7 @@
 #include "footfall/steps/walk_json.h"
 #include "footfall/steps/walk_terrain.h"
 #include "footfall/terrain/file_extension.h"
+#include "footfall/terrain/output_file.h"
 #include "footfall/terrain/shown_text.h"
 #include "terrain_flags.h"
 
@@ -62,21 +62,6 @@ bool ParseVec(const std::string& text, const std::string& flag, Vec3* out, std::
   }
   *out = {v[0], v[1], v[2]};
   return true;
-}
-
-// The file that writing `path` creates or replaces: symbolic links followed, also those naming
-// a file not there yet, and the path made absolute and normal.
-std::filesystem::path WrittenFile(const std::string& path) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::path p = fs::absolute(path, ec).lexically_normal();
-  for (int hops = 0; hops < 40 && fs::is_symlink(fs::symlink_status(p, ec)); ++hops) {
-    const fs::path to = fs::read_symlink(p, ec);
-    if (ec) break;
-    p = (to.is_absolute() ? to : p.parent_path() / to).lexically_normal();
-  }
-  const fs::path canonical = fs::weakly_canonical(p, ec);
-  return ec ? p : canonical;
 }
 
 // Writes one output, chosen by its extension.
@@ -191,8 +176,7 @@ int RunGenerate(const GenerateFlags& flags) {
     // other: the last written would win, silently.
     for (const std::string& other : flags.out) {
       if (&other == &out) break;
-      std::error_code ec;
-      if (WrittenFile(out) == WrittenFile(other) || std::filesystem::equivalent(out, other, ec)) {
+      if (SameFile(out, other)) {
         error = "--out " + other + " and --out " + out +
                 " are the same file; give each output its own file";
         goto bad_flag;
@@ -200,8 +184,7 @@ int RunGenerate(const GenerateFlags& flags) {
     }
     // Never write over what the walk is made from.
     for (const std::string* input : {&flags.character, &flags.terrain.terrain}) {
-      std::error_code ec;
-      if (!input->empty() && std::filesystem::equivalent(out, *input, ec)) {
+      if (!input->empty() && SameFile(out, *input)) {
         error = "--out " + out + " is the " +
                 (input == &flags.character ? "character" : "terrain") +
                 " file this walk reads; choose another output name";

@@ -10,6 +10,7 @@
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 
 namespace footfall {
 namespace {
@@ -137,6 +138,18 @@ Status ReplaceFile(const std::string& path, const std::function<bool(std::FILE*)
   }
   g_temporary.store(nullptr);
   return Status::kOk;
+}
+
+bool SameFile(const std::string& a, const std::string& b) {
+  namespace fs = std::filesystem;
+  auto written = [](const std::string& path) {
+    std::error_code ec;
+    const fs::path p = fs::absolute(FollowLinks(path), ec).lexically_normal();
+    const fs::path canonical = fs::weakly_canonical(p, ec);
+    return ec ? p : canonical;
+  };
+  std::error_code ec;
+  return written(a) == written(b) || fs::equivalent(a, b, ec);
 }
 
 Status ReplaceFile(const std::string& path, std::string_view bytes, std::string* error) {

@@ -28,6 +28,11 @@ Status ReplaceFile(const std::string& path, const std::function<bool(std::FILE*)
 // The same with the whole new content given.
 Status ReplaceFile(const std::string& path, std::string_view bytes, std::string* error);
 
+// True when writing `a` would write the file `b` names, or the file writing `b` would write:
+// the same path however spelt, links followed (also ones naming a file not there yet), or hard
+// links to one file.
+bool SameFile(const std::string& a, const std::string& b);
+
 // For programs (not libraries: it sets process-wide signal handlers): SIGINT, SIGTERM, SIGHUP and
 // SIGQUIT remove the temporary file being written before the process ends as they would end
 // it, and SIGXFSZ is ignored, so that a write past the file size limit fails with a message.
