@@ -64,6 +64,8 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
       {{"{\"name\": \"L\"", "{\"name\": \"L\\u0000a\""},
        "b.json: 'feet'[0].name: expected a name without control characters (byte 0x00 at offset "
        "1)"},
+      {{"{\"name\": \"L\"", "{\"name\": \"L\\u0085\""},
+       "'feet'[0].name: expected a name without control characters (byte 0xc2 at offset 1)"},
       {{"\"name\": \"b\"", "\"name\": \"b\\tc\""},
        "b.json: 'name': expected a name without control characters (byte 0x09 at offset 1)"},
       // A foot called "body" took the body's name in Blender rigs.
@@ -117,7 +119,8 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
   CHECK_THAT(error, Catch::StartsWith("b.json:1:11: malformed JSON: a NUL byte"));
   CHECK(ParseCharacter(Biped("\"step_length\": 0.6", "\"step_length\": 0.6, \"step_length\": -5"),
                        "b.json", &c, &error) == Status::kParseError);
-  CHECK_THAT(error, Catch::Contains("b.json: malformed JSON: the key 'step_length' appears twice"));
+  CHECK_THAT(error,
+             Catch::Contains("b.json:3:72: malformed JSON: the key 'step_length' appears twice"));
   // Keys may repeat in different objects; a foot may carry a comment as the file may.
   CHECK(ParseCharacter(Biped("[0.1, 0, 0]}", "[0.1, 0, 0], \"comment\": \"left\"}"), "b.json", &c,
                        &error) == Status::kOk);
@@ -179,7 +182,7 @@ TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]")
        "w.json: tracks[0].name: expected a name without control characters (byte 0x1b at offset "
        "1)"},
       {R"({"format":"footfall-walk","version":1,"fps":24,"fps":30,"tracks":[]})",
-       "w.json: malformed JSON: the key 'fps' appears twice"},
+       "w.json:1:48: malformed JSON: the key 'fps' appears twice"},
   };
   for (const auto& [input, message] : bad) {
     INFO(message);

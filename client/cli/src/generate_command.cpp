@@ -266,10 +266,11 @@ int RunGenerate(const GenerateFlags& flags) {
                            1);
       std::ostringstream m;
       m.precision(3);
+      const bool capped = flags.steps < 0 && !options.path.empty();
       m << "out of memory generating " << flags.crowd
-        << (flags.crowd == 1 ? " character" : " characters") << " x " << steps << " steps: about "
-        << keys << " keys, " << keys * 68 / 1e9
-        << " GB; nothing was written (give fewer --crowd or --steps)";
+        << (flags.crowd == 1 ? " character" : " characters") << " x " << (capped ? "up to " : "")
+        << steps << " steps: " << (capped ? "up to " : "") << "about " << keys << " keys, "
+        << keys * 68 / 1e9 << " GB; nothing was written (give fewer --crowd or --steps)";
       std::cerr << "footfall generate: " << m.str() << '\n';
       return 1;
     }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <set>
 #include <vector>
 
 #include "footfall/terrain/shown_text.h"
@@ -28,6 +29,40 @@ std::string Where(const std::string& text, size_t at) {
 struct DuplicateKey {
   std::string key;
 };
+
+// Where in `text` (valid JSON up to it) a key first appears a second time in one object: the byte
+// offset of its opening quote, or npos. (nlohmann's callback says which key, not where.)
+size_t RepeatedKeyAt(const std::string& text) {
+  std::vector<std::set<std::string>> objects;  // keys of each open object, innermost last
+  std::vector<bool> is_object;                 // each open bracket: object or array
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '{' || c == '[') {
+      is_object.push_back(c == '{');
+      if (c == '{') objects.emplace_back();
+    } else if (c == '}' || c == ']') {
+      if (!is_object.empty() && is_object.back() && !objects.empty()) objects.pop_back();
+      if (!is_object.empty()) is_object.pop_back();
+    } else if (c == '"') {
+      size_t end = i + 1;
+      while (end < text.size() && text[end] != '"') end += text[end] == '\\' ? 2 : 1;
+      if (end >= text.size()) return std::string::npos;
+      size_t next = text.find_first_not_of(" \t\r\n", end + 1);
+      if (next != std::string::npos && text[next] == ':' && !is_object.empty() &&
+          is_object.back() && !objects.empty()) {
+        std::string key;
+        try {
+          key = json::parse(text.substr(i, end + 1 - i)).get<std::string>();
+        } catch (const json::exception&) {
+          return std::string::npos;
+        }
+        if (!objects.back().insert(key).second) return i;
+      }
+      i = end;
+    }
+  }
+  return std::string::npos;
+}
 
 }  // namespace
 
@@ -89,7 +124,9 @@ bool ParseJsonText(const std::string& text, const std::string& source, json* out
     *error = source + ": malformed JSON: " + e.what();
     return false;
   } catch (const DuplicateKey& d) {
-    *error = source + ": malformed JSON: the key '" + ShownText(d.key) +
+    const size_t at = RepeatedKeyAt(text);
+    *error = source + (at != std::string::npos ? ":" + Where(text, at) : std::string()) +
+             ": malformed JSON: the key '" + ShownText(d.key) +
              "' appears twice in one object (each field once)";
     return false;
   }
@@ -103,7 +140,11 @@ bool ParseJsonText(const std::string& text, const std::string& source, json* out
 std::string ControlCharacterIn(const std::string& name) {
   for (size_t i = 0; i < name.size(); ++i) {
     const unsigned char c = static_cast<unsigned char>(name[i]);
-    if (c < 0x20 || c == 0x7f) {
+    // C1 controls (U+0080 to U+009F) are 0xC2 0x80..0x9F in UTF-8.
+    const bool c1 = c == 0xC2 && i + 1 < name.size() &&
+                    static_cast<unsigned char>(name[i + 1]) >= 0x80 &&
+                    static_cast<unsigned char>(name[i + 1]) <= 0x9F;
+    if (c < 0x20 || c == 0x7f || c1) {
       char hex[8];
       std::snprintf(hex, sizeof hex, "0x%02x", c);
       return "expected a name without control characters (byte " + std::string(hex) +
