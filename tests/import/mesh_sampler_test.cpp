@@ -234,6 +234,22 @@ TEST_CASE("SampleMesh: long thin triangles are refused before they are cut", "[i
     INFO(error);
     CHECK(SampleMesh(sliver, suggested, &out, &error) == Status::kOk);
   }
+  // Two unit triangles 1e6 apart: the sampler's cells cannot span that at small separations,
+  // and the refusal for it suggests one too (it suggested none, and the sample budget's
+  // suggestion was then refused for it).
+  TriangleMesh far;
+  far.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {1e6, 0, 0}, {1e6 + 1, 0, 0}, {1e6, 0, 1}};
+  far.triangles = {{0, 2, 1}, {3, 5, 4}};
+  for (const double tried : {0.1, 1e-4}) {
+    MeshSampleOptions fo;
+    fo.separation = tried;
+    CHECK(SampleMesh(far, fo, &out, &error) == Status::kLimitExceeded);
+    const size_t at = error.find("choose a separation of at least ");
+    REQUIRE(at != std::string::npos);
+    fo.separation = std::stod(error.substr(at + 32));
+    INFO(error);
+    CHECK(SampleMesh(far, fo, &out, &error) == Status::kOk);
+  }
   // With room for its pieces (about 1.1 million at s = 5), the same mesh samples, every sample
   // on it.
   o.separation = 5;

@@ -256,22 +256,28 @@ bool PiecesFit(const std::vector<double>& longest2, double area, size_t max_samp
 // The smallest separation, rounded up to 3 significant digits, that SampleMesh takes: its
 // samples within max_samples, and its pieces (long thin triangles make many) within their limit.
 double SeparationThatFits(const TriangleMesh& mesh, double area, size_t max_samples) {
+  // The sampler's cells (2s/3 wide) must number fewer than kCellLimit - 2 along every axis.
+  Vec3 lo, hi;
+  MeshBounds(mesh, &lo, &hi);
+  const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+  const double for_extent = 1.01 * 1.5 * extent / static_cast<double>(kCellLimit - 2);
   std::vector<double> longest2;
   longest2.reserve(mesh.triangles.size());
   for (const auto& tri : mesh.triangles) {
     const Vec3 &a = mesh.vertices[tri[0]], &b = mesh.vertices[tri[1]], &c = mesh.vertices[tri[2]];
     longest2.push_back(std::max({Distance2(a, b), Distance2(b, c), Distance2(c, a)}));
   }
-  double lo = std::sqrt(1.6 * area / std::max<double>(1, static_cast<double>(max_samples)));
-  if (!(lo > 0)) lo = 1e-300;
-  if (PiecesFit(longest2, area, max_samples, lo)) return RoundUp3(lo);
-  double hi = lo;
-  for (int i = 0; i < 2100 && !PiecesFit(longest2, area, max_samples, hi); ++i) hi *= 2;
+  double low = std::max(
+      for_extent, std::sqrt(1.6 * area / std::max<double>(1, static_cast<double>(max_samples))));
+  if (!(low > 0)) low = 1e-300;
+  if (PiecesFit(longest2, area, max_samples, low)) return RoundUp3(low);
+  double high = low;
+  for (int i = 0; i < 2100 && !PiecesFit(longest2, area, max_samples, high); ++i) high *= 2;
   for (int i = 0; i < 60; ++i) {
-    const double mid = std::sqrt(lo * hi);
-    (PiecesFit(longest2, area, max_samples, mid) ? hi : lo) = mid;
+    const double mid = std::sqrt(low * high);
+    (PiecesFit(longest2, area, max_samples, mid) ? high : low) = mid;
   }
-  return RoundUp3(hi);
+  return RoundUp3(high);
 }
 
 }  // namespace
@@ -320,7 +326,10 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   const Vec3 extent = hi - lo;
   if (extent.x * inv_cell >= kCellLimit - 2 || extent.y * inv_cell >= kCellLimit - 2 ||
       extent.z * inv_cell >= kCellLimit - 2) {
-    if (error) *error = "separation " + std::to_string(s) + " is too small for the mesh's extent";
+    if (error)
+      *error = "separation " + Format3(s) +
+               " is too small for the mesh's extent; choose a separation of at least " +
+               Format3(SeparationThatFits(mesh, area, options.max_samples));
     return Status::kLimitExceeded;
   }
 
