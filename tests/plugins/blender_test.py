@@ -347,6 +347,17 @@ class BlenderAddonTest(unittest.TestCase):
             self.assertIn("the rig's keys are unchanged", str(e.exception))
         finally:
             settings.frames_per_step = saved
+        # A walk that would end beyond Blender's frame range: refused before anything is keyed
+        # (its first chunk was keyed, the rig's keys cleared, before a later chunk was refused).
+        saved_frame = settings.start_frame
+        settings.start_frame = 1048570
+        try:
+            with self.assertRaises(RuntimeError) as e:
+                bpy.ops.footfall.generate_walk()
+            self.assertIn("beyond Blender's frame range", str(e.exception))
+            self.assertIn("the rig's keys are unchanged", str(e.exception))
+        finally:
+            settings.start_frame = saved_frame
         # An import with no track for this rig cleared its keys before finding none.
         other = os.path.join(ARGS.work_dir, "other.json")
         with open(other, "w") as f:

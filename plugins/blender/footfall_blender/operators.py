@@ -349,6 +349,13 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
         keyed = 0
         walk_text = None
         try:
+            # The whole walk's frames within Blender's range, before anything is keyed.
+            request = walk_request(context, rig_obj, total, settings.start_frame)
+            last = settings.start_frame + total * int(request["character"]["frames_per_step"])
+            if last > keying.MAX_FRAME:
+                raise ValueError("the walk would end at frame %d, beyond Blender's frame range "
+                                 "(-%d to %d): start earlier or ask fewer steps"
+                                 % (last, keying.MAX_FRAME, keying.MAX_FRAME))
             s = session(context)
             terrain = _connection.terrain(TERRAIN)
             wm.progress_begin(0, total)
