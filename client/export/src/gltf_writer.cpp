@@ -63,8 +63,8 @@ Status TrackSamples(const WalkTrack& track, size_t track_index, double fps, Samp
                 << key.frame << " of track " << track_index << " '"
                 << walk_export::QualifiedTrackName(track, track_index) << "' both become " << time
                 << " s at " << fps
-                << " fps; start the walk nearer frame 0 or use a lower fps (JSON and MEL keep "
-                   "every key)";
+                << " fps; start the walk nearer frame 0 (whatever the fps, a float tells frames "
+                   "apart only up to about 1e7; JSON and MEL keep every key)";
         SetError(error, message.str());
         return Status::kInvalidArgument;
       }
