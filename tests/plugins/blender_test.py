@@ -337,27 +337,24 @@ class BlenderAddonTest(unittest.TestCase):
         before = {o.name: fcurve_keys(o, "location", 3) for o in list(feet.values()) + [body]}
         self.assertTrue(all(before.values()))
         bpy.context.scene.footfall.rig = rig
-        # A Generate Walk the generator refuses (frames_per_step 1) cleared the walk first.
         settings = bpy.context.scene.footfall
-        saved = settings.frames_per_step
-        settings.frames_per_step = 1
-        try:
-            with self.assertRaises(RuntimeError) as e:
-                bpy.ops.footfall.generate_walk()
-            self.assertIn("the rig's keys are unchanged", str(e.exception))
-        finally:
-            settings.frames_per_step = saved
+
+        def generate_refused(setting, value, *messages):
+            saved = getattr(settings, setting)
+            setattr(settings, setting, value)
+            try:
+                with self.assertRaises(RuntimeError) as e:
+                    bpy.ops.footfall.generate_walk()
+                for message in messages + ("the rig's keys are unchanged",):
+                    self.assertIn(message, str(e.exception))
+            finally:
+                setattr(settings, setting, saved)
+
+        # A Generate Walk the generator refuses (frames_per_step 1) cleared the walk first.
+        generate_refused("frames_per_step", 1)
         # A walk that would end beyond Blender's frame range: refused before anything is keyed
         # (its first chunk was keyed, the rig's keys cleared, before a later chunk was refused).
-        saved_frame = settings.start_frame
-        settings.start_frame = 1048570
-        try:
-            with self.assertRaises(RuntimeError) as e:
-                bpy.ops.footfall.generate_walk()
-            self.assertIn("beyond Blender's frame range", str(e.exception))
-            self.assertIn("the rig's keys are unchanged", str(e.exception))
-        finally:
-            settings.start_frame = saved_frame
+        generate_refused("start_frame", 1048570, "beyond Blender's frame range")
         # An import with no track for this rig cleared its keys before finding none.
         other = os.path.join(ARGS.work_dir, "other.json")
         with open(other, "w") as f:
