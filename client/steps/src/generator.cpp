@@ -880,9 +880,6 @@ Status Generator::QueryFootholds(std::string* error) {
         double max_len = c_.step_length;  // shorter where the heading climbs or falls steeply
         if (std::fabs(Dot(f, a.up)) > sin_slope_threshold_) max_len *= c_.slope_step_scale;
         Vec3 v = target - a.foot[mv.foot];
-        // A target behind the foot (a hind foot standing at the terrain's back edge, ahead of
-        // its rest): the foot steps in place and its group waits for the body to move on.
-        if (Dot(v, a.forward) < 0) v = Vec3{};
         const double len = Length(v);
         if (len > max_len) v = v * (max_len / len);
         // Longer and aimed-down retries reach a full step along the target's direction: a
