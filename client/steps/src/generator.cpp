@@ -120,11 +120,6 @@ struct Agent {
   size_t waypoint = 0;
   bool walking = true;  // false once stopped or arrived
   int waits = 0;        // steps in a row its group stepped in place, waiting for a planted foot
-  // Groups that stepped in place (every foot's target where it stands, or behind it) since the
-  // body last got half a step from `idle_from`: a whole cycle of them is a dead end, however the
-  // other groups shuffle in between.
-  int idle_groups = 0;
-  Vec3 idle_from;
   // Where the body was at step `window_step`: a body that stays within half a step of it for
   // Generator::window_steps_ steps is milling about at a dead end.
   Vec3 window_from;
@@ -215,7 +210,7 @@ class Generator {
   Status ClearArcs(int k, std::string* error);
   // Keys (or stops) the w-th walking character at step k once its moves are final.
   void Finish(size_t w, int k);
-  int window_steps_ = 12;  // steps a body must get half a step in (Agent::window_from)
+  int window_steps_ = 100;  // steps a body must get half a step in (Agent::window_from)
   // fn(begin, end) over [0, count), split across the pool's threads for large counts. Each
   // item's result must not depend on the split.
   template <typename Fn>
@@ -423,11 +418,12 @@ Status Generator::Run(std::string* error) {
   world_up_ = Normalize(o_.up);
   const int groups = static_cast<int>(c_.gait.size());
   steps_ = o_.steps >= 0 ? o_.steps : (o_.path.empty() ? kDefaultSteps : kMaxPathSteps);
-  // Long enough for four gait cycles, and for turning about on a path (at max_turn_deg a step)
-  // with two cycles to spare.
+  // Far longer than any stall of a walk that goes on (characters turning about a waypoint on
+  // stairs stood within half a step for 32 steps, then walked on): 100 steps, 16 gait cycles,
+  // or a half turn at max_turn_deg and four cycles, whichever is longest.
   window_steps_ =
-      std::max({12, 4 * groups,
-                static_cast<int>(std::min(400.0, std::ceil(180 / c_.max_turn_deg))) + 2 * groups});
+      std::max({100, 16 * groups,
+                static_cast<int>(std::min(1000.0, std::ceil(180 / c_.max_turn_deg))) + 4 * groups});
   // The target locator's lead over the foot's rest position: with the body at the feet's
   // centroid, L * (G + 1) / (2G) makes every foot travel exactly L per step once walking
   // (half a step ahead for G -> infinity; 3/4 of a step for two gait groups).
@@ -1205,12 +1201,10 @@ void Generator::Finish(size_t w, int k) {
   // Every foot of the group steps in place: it waits, as a held group does, for the other
   // groups to move the body on (a hind foot at the terrain's back edge, whose target lies behind
   // it until the front feet step); a whole cycle of groups in place is a dead end.
-  if (in_place && !failed) {
-    if (a.idle_groups == 0) a.idle_from = a.ground;
-    if (++a.idle_groups < static_cast<int>(c_.gait.size())) {
-      body_frame_[w] = f1;
-      return;
-    }
+  if (in_place && !failed && a.waits + 1 < static_cast<int>(c_.gait.size())) {
+    ++a.waits;
+    body_frame_[w] = f1;
+    return;
   }
   if (in_place && !failed) {
     Stop(a, k + 1,
@@ -1245,8 +1239,6 @@ void Generator::Finish(size_t w, int k) {
   Vec3 centroid;
   for (const Vec3& p : a.foot) centroid += p;
   a.ground = centroid / static_cast<double>(a.foot.size());
-  if (a.idle_groups > 0 && Distance(a.ground, a.idle_from) >= 0.5 * c_.step_length)
-    a.idle_groups = 0;  // on its way again
   const Vec3 old_up = a.up;
   a.up = FeetUp(a.up, a.foot, a.foot_normal);
   a.body_up = BodyUp(a.up, a.foot);
