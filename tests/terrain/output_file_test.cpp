@@ -140,7 +140,7 @@ TEST_CASE("ReplaceFile creates the file a dangling link names, and takes long na
   CHECK(dir.Entries().size() == 3);
 }
 
-TEST_CASE("ReplaceFile writes hard-linked files in place and refuses files it may not write",
+TEST_CASE("ReplaceFile keeps a hard link's old content, refuses loops and files it may not write",
           "[terrain][output_file]") {
   Dir dir;
   std::string error;
@@ -148,7 +148,17 @@ TEST_CASE("ReplaceFile writes hard-linked files in place and refuses files it ma
   REQUIRE(ReplaceFile(a, "old", &error) == Status::kOk);
   REQUIRE(::link(a.c_str(), b.c_str()) == 0);
   REQUIRE(ReplaceFile(a, "new", &error) == Status::kOk);
-  CHECK(Read(b) == "new");  // both names show the new content
+  CHECK(Read(a) == "new");
+  CHECK(Read(b) == "old");  // nothing lost under the other name (written in place, a failed
+                            // write cut both)
+  // A loop of links: refused (a regular file took the link's place).
+  REQUIRE(::symlink("lb.json", (dir.path + "/la.json").c_str()) == 0);
+  REQUIRE(::symlink("la.json", (dir.path + "/lb.json").c_str()) == 0);
+  CHECK(ReplaceFile(dir.path + "/la.json", "x", &error) == Status::kIoError);
+  CHECK_THAT(error, Catch::Contains("Too many levels of symbolic links"));
+  struct stat st;
+  REQUIRE(::lstat((dir.path + "/la.json").c_str(), &st) == 0);
+  CHECK(S_ISLNK(st.st_mode));
   // A read-only file: refused as opening it for writing would be (root may write anything).
   const std::string locked = dir.path + "/locked.json";
   REQUIRE(ReplaceFile(locked, "kept", &error) == Status::kOk);

@@ -49,11 +49,16 @@ mode_t CurrentUmask() {
 
 // The file that writing `path` creates or replaces: symbolic links followed, also a link naming
 // a file not there yet (it is created where the link points).
-std::string FollowLinks(const std::string& path) {
+std::string FollowLinks(const std::string& path, bool* loop = nullptr) {
   std::string p = path;
-  for (int hops = 0; hops < 40; ++hops) {
+  if (loop) *loop = false;
+  for (int hops = 0;; ++hops) {
     struct stat st;
     if (::lstat(p.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) break;
+    if (hops == 40) {  // a loop of links, or a chain longer than the system follows
+      if (loop) *loop = true;
+      break;
+    }
     char to[PATH_MAX];
     const ssize_t n = ::readlink(p.c_str(), to, sizeof to - 1);
     if (n <= 0) break;
@@ -86,7 +91,9 @@ void RemoveTemporaryFileOnSignal() {
 
 Status ReplaceFile(const std::string& path, const std::function<bool(std::FILE*)>& write,
                    std::string* error) {
-  const std::string target = FollowLinks(path);
+  bool loop = false;
+  const std::string target = FollowLinks(path, &loop);
+  if (loop) return Fail("cannot open", path, ELOOP, error);
   struct stat st;
   const bool exists = ::stat(target.c_str(), &st) == 0;
   auto in_place = [&]() {
@@ -95,13 +102,19 @@ Status ReplaceFile(const std::string& path, const std::function<bool(std::FILE*)
     const int failure = WriteAndClose(file, write);
     return failure ? Fail("cannot write", path, failure, error) : Status::kOk;
   };
-  // Devices and FIFOs are written as they are; a file with other names (hard links) in place,
-  // so that every name keeps showing the new content.
-  if (exists && (!S_ISREG(st.st_mode) || st.st_nlink > 1)) return in_place();
+  // Devices and FIFOs are written as they are.
+  if (exists && !S_ISREG(st.st_mode)) return in_place();
   // A file its owner made read-only stays refused, as opening it for writing would be.
   if (exists && ::access(target.c_str(), W_OK) != 0) return Fail("cannot open", path, errno, error);
   const size_t slash = target.rfind('/');
   const std::string dir = slash == std::string::npos ? "" : target.substr(0, slash + 1);
+  // Another user's file that this one may write, in a sticky directory (/tmp) neither owns: no
+  // rename may replace it, so it is written in place (as before; a failed write can cut it).
+  struct stat dir_st;
+  if (exists && ::geteuid() != 0 && st.st_uid != ::geteuid() &&
+      ::stat(dir.empty() ? "." : dir.c_str(), &dir_st) == 0 && (dir_st.st_mode & S_ISVTX) &&
+      dir_st.st_uid != ::geteuid())
+    return in_place();
   const std::string name = slash == std::string::npos ? target : target.substr(slash + 1);
   // ".NAME.XXXXXX" beside it; a name too long for that takes a short temporary name.
   std::string temp = dir + (name.size() <= 200 ? "." + name : std::string(".footfall")) + ".XXXXXX";

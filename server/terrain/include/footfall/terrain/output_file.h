@@ -4,9 +4,11 @@
 // an exception leaves the old file whole and no temporary file behind. Through a symbolic link
 // (also one naming a file not there yet), the file it names is written (the link stays). A
 // target the writer may not write is refused, as opening it would be, and so is one in a
-// directory that takes no new file. Written in place: a device such as /dev/null or a FIFO, and
-// a file with other names (hard links), so that every name shows the new content. Not synced
-// to disk: a power cut may still lose the new content, never the old one to a write error.
+// directory that takes no new file, and a loop of links. A file with other names (hard links)
+// gets a new file under this name; the other names keep the old content. Written in place: a
+// device such as /dev/null or a FIFO, and another user's writable file in a sticky directory
+// (/tmp), which no rename may replace. Not synced to disk: a power cut may still lose the new
+// content, never the old one to a write error.
 #pragma once
 
 #include <cstdio>
