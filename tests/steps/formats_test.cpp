@@ -65,7 +65,7 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
        "b.json: 'feet'[0].name: expected a name without control characters (byte 0x00 at offset "
        "1)"},
       {{"{\"name\": \"L\"", "{\"name\": \"L\\u0085\""},
-       "'feet'[0].name: expected a name without control characters (byte 0xc2 at offset 1)"},
+       "'feet'[0].name: expected a name without control characters (character U+0085 at offset 1)"},
       {{"\"name\": \"b\"", "\"name\": \"b\\tc\""},
        "b.json: 'name': expected a name without control characters (byte 0x09 at offset 1)"},
       // A foot called "body" took the body's name in Blender rigs.

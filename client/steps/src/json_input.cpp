@@ -140,16 +140,18 @@ bool ParseJsonText(const std::string& text, const std::string& source, json* out
 std::string ControlCharacterIn(const std::string& name) {
   for (size_t i = 0; i < name.size(); ++i) {
     const unsigned char c = static_cast<unsigned char>(name[i]);
-    // C1 controls (U+0080 to U+009F) are 0xC2 0x80..0x9F in UTF-8.
-    const bool c1 = c == 0xC2 && i + 1 < name.size() &&
-                    static_cast<unsigned char>(name[i + 1]) >= 0x80 &&
-                    static_cast<unsigned char>(name[i + 1]) <= 0x9F;
-    if (c < 0x20 || c == 0x7f || c1) {
-      char hex[8];
-      std::snprintf(hex, sizeof hex, "0x%02x", c);
-      return "expected a name without control characters (byte " + std::string(hex) +
-             " at offset " + std::to_string(i) + ")";
+    char what[32] = "";
+    if (c < 0x20 || c == 0x7f) {
+      std::snprintf(what, sizeof what, "byte 0x%02x", c);
+    } else if (c == 0xC2 && i + 1 < name.size() &&
+               static_cast<unsigned char>(name[i + 1]) >= 0x80 &&
+               static_cast<unsigned char>(name[i + 1]) <= 0x9F) {
+      // C1 controls (U+0080 to U+009F) are 0xC2 0x80..0x9F in UTF-8.
+      std::snprintf(what, sizeof what, "character U+%04X", static_cast<unsigned char>(name[i + 1]));
     }
+    if (what[0] != '\0')
+      return "expected a name without control characters (" + std::string(what) + " at offset " +
+             std::to_string(i) + ")";
   }
   return "";
 }
