@@ -158,11 +158,18 @@ done
 check "crowd beyond memory: exit 1" [ $? -eq 1 ]
 check "crowd beyond memory: said how large" grep -qF "out of memory generating 100000 characters x 100 steps: about 4e+07 keys" "$work/oom-crowd.err"
 # A stopped walk with an output that could not be written is an error (1), not a stop (2).
+ln -sf /dev/full "$work/full.json"
 "$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
-  --steps 100 --out "$work/no/such/dir/walk.json" --out "$work/stopped-ok.json" 2> "$work/stopped-bad.err"
+  --steps 100 --out "$work/full.json" --out "$work/stopped-ok.json" 2> "$work/stopped-bad.err"
 check "stopped walk, unwritten output: exit 1" [ $? -eq 1 ]
-check "stopped walk, unwritten output: named" grep -qF "cannot open '$work/no/such/dir/walk.json' for writing: No such file or directory" "$work/stopped-bad.err"
+check "stopped walk, unwritten output: named" grep -qF "cannot write '$work/full.json': No space left on device" "$work/stopped-bad.err"
 check "stopped walk, unwritten output: the other written" [ -s "$work/stopped-ok.json" ]
+# An output that cannot be written at all is refused before the walk is generated.
+"$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
+  --steps 100 --out "$work/no/such/dir/walk.json" --out "$work/early-ok.json" 2> "$work/early-bad.err"
+check "unwritable output: exit 1" [ $? -eq 1 ]
+check "unwritable output: named before generating" grep -qF -- "--out $work/no/such/dir/walk.json: cannot open '$work/no/such/dir/walk.json' for writing: No such file or directory" "$work/early-bad.err"
+check "unwritable output: nothing generated" bash -c "! grep -q 'stopped early' '$work/early-bad.err' && [ ! -e '$work/early-ok.json' ]"
 check "formats: MEL keys the feet" grep -q 'setKeyframe' "$work/all.mel"
 # At UTM-like coordinates glTF's floats move keys visibly: a warning says by how much; none near
 # the origin.

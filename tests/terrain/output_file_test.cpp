@@ -151,11 +151,18 @@ TEST_CASE("ReplaceFile keeps a hard link's old content, refuses loops and files 
   CHECK(Read(a) == "new");
   CHECK(Read(b) == "old");  // nothing lost under the other name (written in place, a failed
                             // write cut both)
+  // CheckWritable says the same before anything is written.
+  CHECK(CheckWritable(a, &error) == Status::kOk);
+  CHECK(CheckWritable(dir.path + "/new.json", &error) == Status::kOk);
+  CHECK(CheckWritable(dir.path + "/no/such/x.json", &error) == Status::kIoError);
+  CHECK_THAT(error, Catch::Contains("No such file or directory"));
+  CHECK(dir.Entries().size() == 2);  // nothing made by the checks
   // A loop of links: refused (a regular file took the link's place).
   REQUIRE(::symlink("lb.json", (dir.path + "/la.json").c_str()) == 0);
   REQUIRE(::symlink("la.json", (dir.path + "/lb.json").c_str()) == 0);
   CHECK(ReplaceFile(dir.path + "/la.json", "x", &error) == Status::kIoError);
   CHECK_THAT(error, Catch::Contains("Too many levels of symbolic links"));
+  CHECK(CheckWritable(dir.path + "/la.json", &error) == Status::kIoError);
   struct stat st;
   REQUIRE(::lstat((dir.path + "/la.json").c_str(), &st) == 0);
   CHECK(S_ISLNK(st.st_mode));

@@ -182,6 +182,12 @@ int RunGenerate(const GenerateFlags& flags) {
         goto bad_flag;
       }
     }
+    // An output that cannot be written is said now, not after a long walk.
+    std::string unwritable;
+    if (CheckWritable(out, &unwritable) != Status::kOk) {
+      error = "--out " + out + ": " + unwritable;
+      goto bad_flag;
+    }
     // Never write over what the walk is made from.
     for (const std::string* input : {&flags.character, &flags.terrain.terrain}) {
       if (!input->empty() && SameFile(out, *input)) {

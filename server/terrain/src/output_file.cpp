@@ -79,6 +79,47 @@ void RemoveTemporaryAndReraise(int signal_number) {
   std::raise(signal_number);
 }
 
+// How a file is written: where (links followed), and whether in place or by rename.
+struct WritePlan {
+  std::string target;
+  bool exists = false;
+  bool in_place = false;
+  struct stat st {};
+};
+
+// Decides how `path` is written, or why it cannot be (the checks ReplaceFile makes before it
+// writes anything).
+Status PlanWrite(const std::string& path, WritePlan* plan, std::string* error) {
+  bool loop = false;
+  plan->target = FollowLinks(path, &loop);
+  if (loop) return Fail("cannot open", path, ELOOP, error);
+  const std::string& target = plan->target;
+  plan->exists = ::stat(target.c_str(), &plan->st) == 0;
+  const struct stat& st = plan->st;
+  // A file its owner made read-only stays refused, as opening it for writing would be.
+  if (plan->exists && ::access(target.c_str(), W_OK) != 0)
+    return Fail("cannot open", path, errno, error);
+  // Devices and FIFOs are written as they are.
+  if (plan->exists && !S_ISREG(st.st_mode)) {
+    plan->in_place = true;
+    return Status::kOk;
+  }
+  const size_t slash = target.rfind('/');
+  const std::string dir = slash == std::string::npos ? "." : target.substr(0, slash + 1);
+  // Another user's file that this one may write, in a sticky directory (/tmp) neither owns: no
+  // rename may replace it, so it is written in place (as before; a failed write can cut it).
+  struct stat dir_st;
+  if (::stat(dir.c_str(), &dir_st) != 0) return Fail("cannot open", path, errno, error);
+  if (plan->exists && ::geteuid() != 0 && st.st_uid != ::geteuid() && (dir_st.st_mode & S_ISVTX) &&
+      dir_st.st_uid != ::geteuid()) {
+    plan->in_place = true;
+    return Status::kOk;
+  }
+  // The temporary file is made in the directory.
+  if (::access(dir.c_str(), W_OK | X_OK) != 0) return Fail("cannot open", path, errno, error);
+  return Status::kOk;
+}
+
 }  // namespace
 
 void RemoveTemporaryFileOnSignal() {
@@ -89,32 +130,27 @@ void RemoveTemporaryFileOnSignal() {
   std::signal(SIGXFSZ, SIG_IGN);
 }
 
+Status CheckWritable(const std::string& path, std::string* error) {
+  WritePlan plan;
+  return PlanWrite(path, &plan, error);
+}
+
 Status ReplaceFile(const std::string& path, const std::function<bool(std::FILE*)>& write,
                    std::string* error) {
-  bool loop = false;
-  const std::string target = FollowLinks(path, &loop);
-  if (loop) return Fail("cannot open", path, ELOOP, error);
-  struct stat st;
-  const bool exists = ::stat(target.c_str(), &st) == 0;
-  auto in_place = [&]() {
+  WritePlan plan;
+  const Status planned = PlanWrite(path, &plan, error);
+  if (planned != Status::kOk) return planned;
+  const std::string& target = plan.target;
+  const bool exists = plan.exists;
+  const struct stat& st = plan.st;
+  if (plan.in_place) {
     std::FILE* file = std::fopen(target.c_str(), "wb");
     if (!file) return Fail("cannot open", path, errno, error);
     const int failure = WriteAndClose(file, write);
     return failure ? Fail("cannot write", path, failure, error) : Status::kOk;
-  };
-  // Devices and FIFOs are written as they are.
-  if (exists && !S_ISREG(st.st_mode)) return in_place();
-  // A file its owner made read-only stays refused, as opening it for writing would be.
-  if (exists && ::access(target.c_str(), W_OK) != 0) return Fail("cannot open", path, errno, error);
+  }
   const size_t slash = target.rfind('/');
   const std::string dir = slash == std::string::npos ? "" : target.substr(0, slash + 1);
-  // Another user's file that this one may write, in a sticky directory (/tmp) neither owns: no
-  // rename may replace it, so it is written in place (as before; a failed write can cut it).
-  struct stat dir_st;
-  if (exists && ::geteuid() != 0 && st.st_uid != ::geteuid() &&
-      ::stat(dir.empty() ? "." : dir.c_str(), &dir_st) == 0 && (dir_st.st_mode & S_ISVTX) &&
-      dir_st.st_uid != ::geteuid())
-    return in_place();
   const std::string name = slash == std::string::npos ? target : target.substr(slash + 1);
   // ".NAME.XXXXXX" beside it; a name too long for that takes a short temporary name.
   std::string temp = dir + (name.size() <= 200 ? "." + name : std::string(".footfall")) + ".XXXXXX";

@@ -30,6 +30,11 @@ Status ReplaceFile(const std::string& path, const std::function<bool(std::FILE*)
 // The same with the whole new content given.
 Status ReplaceFile(const std::string& path, std::string_view bytes, std::string* error);
 
+// The checks ReplaceFile makes before it writes, without writing: kIoError with its message when
+// `path` could not be written (a missing or read-only directory, a read-only file, a loop of
+// links), so that a long job can be refused before it starts.
+Status CheckWritable(const std::string& path, std::string* error);
+
 // True when writing `a` would write the file `b` names, or the file writing `b` would write:
 // the same path however spelt, links followed (also ones naming a file not there yet), or hard
 // links to one file.
