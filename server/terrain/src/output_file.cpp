@@ -165,26 +165,21 @@ Status ReplaceFile(const std::string& path, const std::function<bool(std::FILE*)
   } else {
     ::fchmod(fd, 0666 & ~CurrentUmask());
   }
+  // Every failure from here removes the temporary file, and leaves the target as it was.
+  auto abandon = [&](int why) {
+    ::unlink(temp.c_str());
+    g_temporary.store(nullptr);
+    return Fail("cannot write", path, why, error);
+  };
   std::FILE* file = ::fdopen(fd, "wb");
   if (!file) {
     const int why = errno;
     ::close(fd);
-    ::unlink(temp.c_str());
-    g_temporary.store(nullptr);
-    return Fail("cannot write", path, why, error);
+    return abandon(why);
   }
   const int failure = WriteAndClose(file, write);
-  if (failure != 0) {
-    ::unlink(temp.c_str());
-    g_temporary.store(nullptr);
-    return Fail("cannot write", path, failure, error);
-  }
-  if (::rename(temp.c_str(), target.c_str()) != 0) {
-    const int why = errno;
-    ::unlink(temp.c_str());
-    g_temporary.store(nullptr);
-    return Fail("cannot write", path, why, error);
-  }
+  if (failure != 0) return abandon(failure);
+  if (::rename(temp.c_str(), target.c_str()) != 0) return abandon(errno);
   g_temporary.store(nullptr);
   return Status::kOk;
 }
