@@ -1,6 +1,9 @@
 // ReplaceFile: what a failed write leaves behind (the old file, whole, and nothing else), and
-// how it treats permissions, symbolic links, devices and missing directories.
+// how it treats permissions, symbolic links, devices, missing and read-only directories, and
+// other users' files.
 #include <dirent.h>
+#include <grp.h>
+#include <pwd.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -11,6 +14,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -179,6 +183,90 @@ TEST_CASE("ReplaceFile keeps a hard link's old content, refuses loops and files 
     CHECK_THAT(error, Catch::Contains("Permission denied"));
     CHECK(Read(locked) == "kept");
   }
+}
+
+namespace {
+
+// Runs `body` in a child process as the user nobody when the tests run as root (root may write
+// anything: the checks below need a user who may not), else as the current user. Returns the
+// child's message: empty when every check passed, else the first that failed.
+std::string AsUnprivileged(const std::function<std::string()>& body) {
+  int fds[2];
+  REQUIRE(::pipe(fds) == 0);
+  const pid_t child = ::fork();
+  if (child == 0) {
+    ::close(fds[0]);
+    std::string message;
+    if (::geteuid() == 0) {
+      const passwd* nobody = ::getpwnam("nobody");
+      if (!nobody || ::setgroups(0, nullptr) != 0 || ::setgid(nobody->pw_gid) != 0 ||
+          ::setuid(nobody->pw_uid) != 0)
+        message = "cannot become the user nobody";
+    }
+    if (message.empty()) message = body();
+    if (!message.empty() && ::write(fds[1], message.data(), message.size()) < 0) ::_exit(2);
+    ::_exit(0);
+  }
+  ::close(fds[1]);
+  std::string message;
+  char buffer[256];
+  for (ssize_t n; (n = ::read(fds[0], buffer, sizeof buffer)) > 0;)
+    message.append(buffer, static_cast<size_t>(n));
+  ::close(fds[0]);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) message += " (the child failed)";
+  return message;
+}
+
+uid_t Owner(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0 ? st.st_uid : static_cast<uid_t>(-1);
+}
+
+}  // namespace
+
+TEST_CASE("ReplaceFile writes in place where no rename may replace the file",
+          "[terrain][output_file]") {
+  Dir dir;
+  std::string error;
+  const bool root = ::geteuid() == 0;
+  ::chmod(dir.path.c_str(), 0755);
+  // A writable file in a directory that takes no new file: written in place; a new file there
+  // is refused, naming the directory.
+  const std::string ro = dir.path + "/ro", kept = ro + "/walk.json";
+  REQUIRE(::mkdir(ro.c_str(), 0755) == 0);
+  REQUIRE(ReplaceFile(kept, "old", &error) == Status::kOk);
+  ::chmod(kept.c_str(), 0666);
+  ::chmod(ro.c_str(), 0555);
+  // Another user's writable file in a sticky directory: written in place, still theirs. Only
+  // root can set this up (the file must belong to a user other than the writer).
+  const std::string sticky = dir.path + "/sticky", shared = sticky + "/shared.json";
+  REQUIRE(::mkdir(sticky.c_str(), 0777) == 0);
+  ::chmod(sticky.c_str(), 01777);
+  REQUIRE(ReplaceFile(shared, "old", &error) == Status::kOk);
+  ::chmod(shared.c_str(), 0666);
+  const std::string message = AsUnprivileged([&]() -> std::string {
+    std::string e;
+    if (ReplaceFile(kept, "new", &e) != Status::kOk) return "read-only directory: " + e;
+    if (Read(kept) != "new") return "read-only directory: not written";
+    if (CheckWritable(ro + "/other.json", &e) != Status::kIoError ||
+        e.find("the directory '" + ro + "/' takes no new file") == std::string::npos)
+      return "read-only directory, new file: '" + e + "'";
+    if (ReplaceFile(ro + "/other.json", "x", &e) != Status::kIoError)
+      return "read-only directory, new file: written";
+    if (!root) return "";
+    if (ReplaceFile(shared, "new", &e) != Status::kOk) return "sticky directory: " + e;
+    if (Read(shared) != "new") return "sticky directory: not written";
+    return "";
+  });
+  CHECK(message == "");
+  if (root) {
+    CHECK(Owner(shared) == 0);  // still root's: written in place, not replaced
+  } else {
+    WARN("not run as root: another user's file in a sticky directory was not checked");
+  }
+  ::chmod(ro.c_str(), 0755);
 }
 
 TEST_CASE("A program's signals and file size limit leave no temporary file behind",

@@ -115,8 +115,19 @@ Status PlanWrite(const std::string& path, WritePlan* plan, std::string* error) {
     plan->in_place = true;
     return Status::kOk;
   }
-  // The temporary file is made in the directory.
-  if (::access(dir.c_str(), W_OK | X_OK) != 0) return Fail("cannot open", path, errno, error);
+  // The temporary file is made in the directory. Where none may be made, a file there that may
+  // be written is written in place (as before; a failed write can cut it).
+  if (::access(dir.c_str(), W_OK | X_OK) != 0) {
+    const int why = errno;
+    if (plan->exists) {
+      plan->in_place = true;
+      return Status::kOk;
+    }
+    if (error)
+      *error = "cannot create '" + path + "': the directory '" + dir + "' takes no new file (" +
+               std::strerror(why) + ")";
+    return Status::kIoError;
+  }
   return Status::kOk;
 }
 

@@ -3,12 +3,13 @@
 // target's permissions (and owner, where the writer may give it). A full disk, a write error or
 // an exception leaves the old file whole and no temporary file behind. Through a symbolic link
 // (also one naming a file not there yet), the file it names is written (the link stays). A
-// target the writer may not write is refused, as opening it would be, and so is one in a
-// directory that takes no new file, and a loop of links. A file with other names (hard links)
-// gets a new file under this name; the other names keep the old content. Written in place: a
-// device such as /dev/null or a FIFO, and another user's writable file in a sticky directory
-// (/tmp), which no rename may replace. Not synced to disk: a power cut may still lose the new
-// content, never the old one to a write error.
+// target the writer may not write is refused, as opening it would be, and so are a new file in
+// a directory that takes no new file, and a loop of links. A file with other names (hard links)
+// gets a new file under this name; the other names keep the old content. Written in place (where
+// a failed write can cut the file): a device such as /dev/null or a FIFO, another user's writable
+// file in a sticky directory (/tmp), which no rename may replace, and a writable file in a
+// directory that takes no new file (no temporary file can be made beside it). Not synced to disk: a
+// power cut may still lose the new content, never the old one to a write error.
 #pragma once
 
 #include <cstdio>
@@ -23,7 +24,7 @@ namespace footfall {
 // Calls write(file) to write the new content, then replaces the file at `path` with it. `write`
 // returns false when it failed (the stream's own errors are checked too). On failure returns
 // kIoError with "cannot write 'PATH': REASON" (or "cannot open 'PATH' for writing: REASON") in
-// *error, and the file at `path` is as it was.
+// *error, and the file at `path` is as it was (unless written in place).
 Status ReplaceFile(const std::string& path, const std::function<bool(std::FILE*)>& write,
                    std::string* error);
 
@@ -31,8 +32,8 @@ Status ReplaceFile(const std::string& path, const std::function<bool(std::FILE*)
 Status ReplaceFile(const std::string& path, std::string_view bytes, std::string* error);
 
 // The checks ReplaceFile makes before it writes, without writing: kIoError with its message when
-// `path` could not be written (a missing or read-only directory, a read-only file, a loop of
-// links), so that a long job can be refused before it starts.
+// `path` could not be written (a missing directory, a read-only file, a new file in a read-only
+// directory, a loop of links), so that a long job can be refused before it starts.
 Status CheckWritable(const std::string& path, std::string* error);
 
 // True when writing `a` would write the file `b` names, or the file writing `b` would write:
