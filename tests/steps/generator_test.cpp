@@ -201,6 +201,28 @@ TEST_CASE("The shipped quadruped climbs the shipped stairs, the insects walk dow
   }
 }
 
+TEST_CASE("Feet off the terrain's back edge wait for the body to move on, in any gait order",
+          "[steps][generator]") {
+  // The octopod one foot at a time, hind feet first, starting with its hind half off the back
+  // edge of flat ground: the hind feet snap onto the edge, ahead of their rests, so their
+  // targets lie behind them. They stepped backwards, over the edge ("the terrain ends before
+  // it", at step 1); now, finding no foothold there, they keep their place until the front
+  // feet have moved the body on.
+  Character c = LoadShipped("octopod");
+  c.gait = {{3}, {7}, {2}, {6}, {1}, {5}, {0}, {4}};  // L4, R4, L3, R3, L2, R2, L1, R1
+  const double spacing = c.step_length / 10;
+  Terrain t = LoadTerrain(MakeFlat(200, spacing, 0), spacing);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {100 * spacing, 0, -0.05};  // the ground point itself behind the edge
+  o.steps = 48;
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CHECK(w.stopped.empty());
+  CheckWalk(t, c, o, w);
+  CHECK(Body(w).keys.back().position.z > Body(w).keys.front().position.z + 2 * c.step_length);
+}
+
 TEST_CASE("Swing arcs clear a resampled stair mesh, whose riser tops lie beside the noses",
           "[steps][generator]") {
   // Poisson-disk samples with flat normals: above a nose, the nearest sample is often the top of

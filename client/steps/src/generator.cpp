@@ -205,6 +205,10 @@ class Generator {
   static bool KeepsReason(const Move& mv, bool gap) {
     return mv.reason.empty() || (mv.reason_is_gap && !gap);
   }
+  // 8 (end). A foot refused every foothold toward a target behind it along the heading (a hind
+  // foot standing at a terrain's back edge, ahead of its rest) keeps its place: a step in place,
+  // so its group waits for the body to move on rather than stop the walk.
+  void KeepPlaceIfBehind(Move& mv) const;
   // Gives up on mv's foothold after its last try; its reason says how many were refused.
   static void Fail(Move& mv);
   Status ClearArcs(int k, std::string* error);
@@ -924,8 +928,10 @@ Status Generator::QueryFootholds(std::string* error) {
         const size_t m = walkers_[i] * per_agent, e = m + per_agent;
         bool all_done = true;
         for (size_t j = m; j < e; ++j) {
-          if (moves[j].query != kNoQuery)
+          if (moves[j].query != kNoQuery) {
             Judge(moves[j], next_answers_[moves[j].query]), moves[j].query = kNoQuery;
+            if (!moves[j].done && moves[j].attempts >= kMaxAttempts) KeepPlaceIfBehind(moves[j]);
+          }
           all_done &= moves[j].done;
         }
         if (all_done) CheckReach(m, e);
@@ -995,6 +1001,13 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
         << " deg, more than max_slope_deg " << NumberText(c_.max_slope_deg) << " (too steep)";
   }
   mv.reason = why.str(), mv.reason_is_gap = !found;
+}
+
+void Generator::KeepPlaceIfBehind(Move& mv) const {
+  const Agent& a = agents_[mv.agent];
+  const Vec3 intended = mv.step + a.up * (mv.attempt.drop * c_.max_rise);
+  if (Dot(intended, a.forward) >= 0) return;
+  mv.done = true, mv.end = a.foot[mv.foot], mv.end_normal = a.foot_normal[mv.foot];
 }
 
 void Generator::Fail(Move& mv) {
