@@ -10,6 +10,14 @@ source "$(dirname "$0")/../support/cli_checks.sh"
 # A 5 x 5 flat terrain at y = 0, samples at integer x, z.
 for z in 0 1 2 3 4; do for x in 0 1 2 3 4; do echo "$x 0 $z 0 1 0"; done; done > "$work/flat.pts"
 
+# 0. No command, or a word that names none: the commands are listed, exit 1.
+"$footfall" > /dev/null 2> "$work/err.txt"
+check "no command: exit 1" [ $? -eq 1 ]
+check "no command: the commands listed" grep -qx 'footfall: a command is required: query, terrain, generate, bench (footfall --help)' "$work/err.txt"
+"$footfall" qeury --terrain "$work/flat.pts" > /dev/null 2> "$work/err.txt"
+check "unknown command: exit 1" [ $? -eq 1 ]
+check "unknown command: named" grep -qF "footfall: unknown command 'qeury': expected one of query, terrain, generate, bench" "$work/err.txt"
+
 # 1. Answers, in order, one JSON object per line.
 printf 'snap 1.2 3 2.9\nnormal 4 4 4\nnext 1 0 1 0 0 2\nnext 1 0 4 0 0 2\n' |
   "$footfall" query --terrain "$work/flat.pts" > "$work/out.jsonl"

@@ -3,6 +3,7 @@
 #include <exception>
 #include <iostream>
 #include <new>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
@@ -19,6 +20,22 @@ int main(int argc, char** argv) {
   footfall::cli::AddTerrainCommand(app, &exit_code);
   footfall::cli::AddGenerateCommand(app, &exit_code);
   footfall::cli::AddBenchCommand(app, &exit_code);
+  // No command, or a word that names none: say which there are (CLI11 only says that one is
+  // required).
+  std::string names;
+  bool known = false;
+  for (const CLI::App* command : app.get_subcommands({})) {
+    names += (names.empty() ? "" : ", ") + command->get_name();
+    known |= argc >= 2 && command->check_name(argv[1]);
+  }
+  if (argc < 2 || (argv[1][0] != '-' && !known)) {
+    if (argc < 2)
+      std::cerr << "footfall: a command is required: " << names << " (footfall --help)\n";
+    else
+      std::cerr << "footfall: unknown command '" << argv[1] << "': expected one of " << names
+                << " (footfall --help)\n";
+    return 1;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
