@@ -138,6 +138,7 @@ TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]")
   o.crowd = 2;
   o.crowd_spacing = 0.6;
   const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
   const std::string text = WalkToJson(w);
   Walk back;
   std::string error;

@@ -5,6 +5,7 @@
 #include "footfall/terrain/shown_text.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <climits>
 #include <cmath>
@@ -12,6 +13,7 @@
 #include <memory>
 #include <mutex>
 #include <sstream>
+#include <unordered_map>
 
 #include "frame_math.h"
 #include "key_arena.h"
@@ -111,6 +113,7 @@ double ClearanceNeeded(double nominal, const Foothold& h, const Vec3& foot, cons
 // One walking character.
 struct Agent {
   std::string id;                       // "" for a single character, else "c1".."cN"
+  bool left_out = false;                // a crowd's character starting on another: no tracks
   Vec3 ground;                          // the body's ground point: centroid of the planted feet
   Vec3 up;                              // the up of the feet's frame (FeetUp)
   Vec3 body_up;                         // the body's up (BodyUp)
@@ -193,6 +196,12 @@ class Generator {
   // 3-4. Plants a's feet on `feet`, the snaps of their rest positions (Place), and moves its
   //    frame and ground to them. Returns why a foot cannot stand there, or "".
   std::string Plant(Agent& a, const Foothold* feet) const;
+  // For each of the n crowd starts (places on the grid, and their snaps), another start nearer
+  // than `apart` that keeps it out, or -1. Starts that snapped nearer their places keep out
+  // those that moved farther (then those earlier in the grid the later); a start kept out keeps
+  // no other out.
+  static std::vector<int> CrowdedStarts(const Vec3* places, const Foothold* starts, int n,
+                                        double apart);
   Status Step(int k, std::string* error);
   Status QueryFootholds(std::string* error);
   // Accepts the answer h to mv's foothold query, or records why it is refused.
@@ -508,6 +517,17 @@ Status Generator::Run(std::string* error) {
   if (stopped.size() > 1)
     walk_.stopped += " (and " + std::to_string(stopped.size() - 1) +
                      (stopped.size() == 2 ? " more character" : " more characters") + " stopped)";
+  // Characters left out of a crowd leave no tracks.
+  if (std::any_of(agents_.begin(), agents_.end(), [](const Agent& a) { return a.left_out; })) {
+    const size_t per_agent = c_.feet.size() + 1;
+    std::vector<WalkTrack> kept;
+    kept.reserve(walk_.tracks.size());
+    for (const Agent& a : agents_)
+      if (!a.left_out)
+        for (size_t t = a.first_track; t < a.first_track + per_agent; ++t)
+          kept.push_back(std::move(walk_.tracks[t]));
+    walk_.tracks = std::move(kept);
+  }
   return Status::kOk;
 }
 
@@ -599,6 +619,11 @@ Status Generator::Setup(std::string* error) {
   answers_.resize(n);
   s = Check(session_.Snap(terrain_, points_.data(), n, answers_.data()), "snap start", error);
   if (s != Status::kOk) return s;
+  // Where the grid runs off the terrain (or past a narrow one), several places snap onto one
+  // edge: a character starting within half the spacing of an earlier one stays out.
+  const std::vector<int> crowded = CrowdedStarts(points_.data(), answers_.data(), n, 0.5 * spacing);
+  std::vector<Vec3> snapped_start(n);
+  for (int i = 0; i < n; ++i) snapped_start[i] = answers_[i].point;
   agents_.resize(n);
   walk_.tracks.clear();
   walk_.tracks.reserve(n * (feet + 1));
@@ -660,9 +685,63 @@ Status Generator::Setup(std::string* error) {
   for (int i = 0; i < n; ++i) {
     Agent& a = agents_[i];
     const std::string fault = Plant(a, &answers_[i * feet]);
-    if (!fault.empty()) Stop(a, 1, fault);
+    if (!fault.empty()) {
+      Stop(a, 1, fault);
+    } else if (crowded[i] >= 0) {
+      const Agent& other = agents_[crowded[i]];
+      std::ostringstream m;
+      m.precision(3);
+      m << "step 1 of " << a.id << ": its place on the crowd's grid, "
+        << Point(first.point + offsets[i]) << ", snaps to " << Point(snapped_start[i])
+        << ", within " << Distance(snapped_start[i], snapped_start[crowded[i]]) << " of "
+        << other.id << "'s start (the grid runs off the terrain there): left out of the walk";
+      a.walking = false, a.left_out = true;
+      a.stopped = m.str(), a.stopped_step = 1;
+    }
   }
   return Status::kOk;
+}
+
+std::vector<int> Generator::CrowdedStarts(const Vec3* places, const Foothold* starts, int n,
+                                          double apart) {
+  // A hash of cells `apart` wide: only the 27 cells around a start can hold one nearer.
+  std::vector<int> crowded(static_cast<size_t>(n), -1);
+  if (n < 2 || !(apart > 0)) return crowded;
+  struct CellHash {
+    size_t operator()(const std::array<int64_t, 3>& c) const {
+      return static_cast<size_t>(c[0] * 73856093 ^ c[1] * 19349663 ^ c[2] * 83492791);
+    }
+  };
+  std::unordered_map<std::array<int64_t, 3>, std::vector<int>, CellHash> cells;
+  auto cell_of = [apart](const Vec3& p) {
+    return std::array<int64_t, 3>{static_cast<int64_t>(std::floor(p.x / apart)),
+                                  static_cast<int64_t>(std::floor(p.y / apart)),
+                                  static_cast<int64_t>(std::floor(p.z / apart))};
+  };
+  // The characters that snapped nearest their places first (those on the terrain before those
+  // pushed onto its edge), in grid order among equals.
+  std::vector<int> order(static_cast<size_t>(n));
+  std::vector<double> moved(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) order[i] = i, moved[i] = Distance(places[i], starts[i].point);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return moved[a] < moved[b]; });
+  for (int i : order) {
+    if (starts[i].status != Status::kOk) continue;
+    const Vec3& p = starts[i].point;
+    const std::array<int64_t, 3> c = cell_of(p);
+    for (int64_t dz = -1; dz <= 1 && crowded[i] < 0; ++dz)
+      for (int64_t dy = -1; dy <= 1 && crowded[i] < 0; ++dy)
+        for (int64_t dx = -1; dx <= 1 && crowded[i] < 0; ++dx) {
+          const auto it = cells.find({c[0] + dx, c[1] + dy, c[2] + dz});
+          if (it == cells.end()) continue;
+          for (int j : it->second)
+            if (Distance(starts[j].point, p) < apart) {
+              crowded[i] = j;
+              break;
+            }
+        }
+    if (crowded[i] < 0) cells[c].push_back(i);  // only characters that walk keep others off
+  }
+  return crowded;
 }
 
 void Generator::KeyStart(const Agent& a) {
