@@ -388,6 +388,46 @@ TEST_CASE("TerrainGrid next with a tolerance as large as the terrain", "[terrain
   CHECK(trace.candidates.empty());
 }
 
+TEST_CASE("TerrainGrid next from flat ground straight up skips blocks level with the foot",
+          "[terrain][grid]") {
+  // Flat ground at y = 0 (and a tilted plane): a foot on it stepping up, or up and a little
+  // along, with tolerances up to beyond the terrain. Straight up from the flat ground no
+  // sample is ahead (level with the foot is not ahead): every block is skipped from its tight
+  // bounds (the padded ones kept them all, and each query scanned every sample).
+  const TerrainGrid flat = Build(MakeFlat(200, 0.1, 0));
+  RawSamples plane;  // rising 0.3 along x
+  for (int i = 0; i < 200; ++i)
+    for (int k = 0; k < 200; ++k) {
+      plane.points.push_back({0.1 * i, 0.03 * i, 0.1 * k});
+      plane.normals.push_back({-0.3, 1, 0});
+    }
+  const TerrainGrid tilted = Build(plane);
+  for (const TerrainGrid* g : {&flat, &tilted}) {
+    const BruteForce oracle(*g);
+    const GridStats& st = g->stats();
+    const Vec3 mid = (st.bounds_min + st.bounds_max) * 0.5;
+    for (const Vec3& dir : {Vec3{0, 0.5, 0}, Vec3{0, -0.5, 0}, Vec3{1e-9, 0.5, 0},
+                            Vec3{0.001, 0.5, -0.002}, Vec3{0.5, 0.5, 0}}) {
+      for (const Vec3& foot : {Vec3{mid.x, 0, mid.z}, Vec3{st.bounds_min.x, 0, mid.z},
+                               Vec3{mid.x + 0.05, 0, mid.z + 0.05}}) {
+        const Vec3 on = g->Snap(foot).point;
+        for (double tolerance : {0.0, 10.0, 1e4}) {
+          RequireSame(g->Next({on, dir}, tolerance), oracle.Next({on, dir}, tolerance),
+                      "next from " + Describe(on) + " along " + Describe(dir) + " tolerance " +
+                          std::to_string(tolerance));
+        }
+      }
+    }
+  }
+  const GridStats& st = flat.stats();
+  QueryTrace trace;
+  const Vec3 mid = (st.bounds_min + st.bounds_max) * 0.5;
+  const Foothold f = flat.Next({flat.Snap({mid.x, 0, mid.z}).point, {0, 0.5, 0}}, 1e4, &trace);
+  CHECK(f.status == Status::kNoFoothold);
+  INFO("samples examined " << trace.examined_samples.size() << " of " << st.samples);
+  CHECK(trace.examined_samples.size() * 10 < st.samples);
+}
+
 TEST_CASE("TerrainGrid keeps memory bounded", "[terrain][grid]") {
   SECTION("an empty grid answers no foothold") {
     TerrainGrid g;

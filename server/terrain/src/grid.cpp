@@ -198,6 +198,7 @@ void TerrainGrid::Search(const double c[3], Scanner& scanner) const {
           gap2(c[0], bb[0], bb[3]) + gap2(c[1], bb[1], bb[4]) + gap2(c[2], bb[2], bb[5]);
       if (d2 > scanner.limit2()) continue;
       if (Scanner::kUsesBox) {
+        if (!scanner.KeepBlock(bb)) continue;
         const double lo[3] = {bb[0] - pad, bb[1] - pad, bb[2] - pad};
         const double hi[3] = {bb[3] + pad, bb[4] + pad, bb[5] + pad};
         if (!scanner.KeepCell(lo, hi)) continue;
@@ -300,6 +301,7 @@ struct TerrainGrid::SnapScanner {
   static constexpr bool kUsesBox = false;
   double limit2() const { return best_d2; }
   bool KeepCell(const double*, const double*) const { return true; }
+  bool KeepBlock(const float*) const { return true; }
   void Scan(uint32_t cell, uint32_t b, uint32_t e) {
     if (kTraced) {
       trace->cells.push_back(cell);
@@ -334,6 +336,16 @@ struct TerrainGrid::NextScanner {
       support += d * ((d > 0 ? hi[a] : lo[a]) - f->foot[a]);
     }
     return support > 0;  // the padded box absorbs rounding
+  }
+  // Skips a block whose samples all lie behind the foot or level with it, from the tight bounds
+  // of its samples: the corner farthest along dir, computed as Ahead computes a sample's, is
+  // not ahead. (Rounding is monotonic, so no sample of the block computes farther ahead than
+  // that corner: exact, with no pad. A foot on flat ground stepping straight up with a large
+  // tolerance skips every block instead of scanning every sample.)
+  bool KeepBlock(const float* bb) const {
+    float corner[3];
+    for (int a = 0; a < 3; ++a) corner[a] = f->dir[a] > 0 ? bb[3 + a] : bb[a];
+    return detail::Ahead(corner, *f);
   }
   void Scan(uint32_t cell, uint32_t b, uint32_t e) {
     if (kTraced) trace->cells.push_back(cell);
