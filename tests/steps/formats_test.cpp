@@ -280,6 +280,7 @@ TEST_CASE("The C ABI refuses what would crash or hang it, and takes turns betwee
   // Timeouts without a bound are refused.
   CHECK(ffc_open_rpc(nullptr, 9, std::nan("")) == nullptr);
   CHECK(ffc_open_rpc(nullptr, 9, HUGE_VAL) == nullptr);
+  CHECK(ffc_open_rpc(nullptr, 9, -HUGE_VAL) == nullptr);
   CHECK(ffc_open_rpc(nullptr, 9, 1e300) == nullptr);
   // A server-side path longer than the protocol carries: refused before any call is made.
   ffc_session* rpc = ffc_open_rpc(nullptr, 9, 1);

@@ -114,7 +114,7 @@ check "glTF early frames: no warning" [ ! -s "$work/early.err" ]
 # A glTF the process has no memory left to write is refused up front (tinygltf aborted the
 # process, losing the outputs after it); the others are written.
 (ulimit -v 700000; "$footfall" generate --terrain "$hills" --character "$chars/biped.json" \
-  --crowd 20000 --crowd-spacing 1 --steps 10 --out "$work/oom.gltf" --out "$work/oom.json" 2> "$work/oom.err")
+  --crowd 20000 --crowd-spacing 0.25 --steps 10 --out "$work/oom.gltf" --out "$work/oom.json" 2> "$work/oom.err")
 check "glTF beyond memory: exit 1" [ $? -eq 1 ]
 check "glTF beyond memory: said so" grep -qF -- "--out $work/oom.gltf: writing the walk as glTF needs about" "$work/oom.err"
 check "glTF beyond memory: the JSON written" [ -s "$work/oom.json" ]

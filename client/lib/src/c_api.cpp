@@ -1,6 +1,7 @@
 // The C ABI over TerrainSession. Nothing may throw across it: every entry point catches.
 #include "footfall/client/footfall_c.h"
 
+#include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
@@ -105,7 +106,8 @@ ffc_session* ffc_open_embedded(void) {
 ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s) {
   std::signal(SIGPIPE, SIG_IGN);
   if (port < 1 || port > 65535) return nullptr;
-  if (!(timeout_s <= kMaxTimeout)) return nullptr;  // NaN, infinite or beyond any bound
+  // NaN, infinite either way, or beyond any bound.
+  if (!std::isfinite(timeout_s) || timeout_s > kMaxTimeout) return nullptr;
   try {
     footfall::RpcOptions options;
     if (host && *host) options.host = host;
