@@ -81,6 +81,16 @@ std::unique_ptr<TerrainSession> Connect(int port, double timeout_s = 5) {
   return MakeRpcSession(o);
 }
 
+// A session whose destruction leaves its terrains to footfalld as orphans, as a lost connection
+// does.
+std::unique_ptr<TerrainSession> ConnectLeavingOrphans(int port) {
+  RpcOptions o;
+  o.port = port;
+  o.call_timeout_s = 5;
+  o.unload_on_close = false;
+  return MakeRpcSession(o);
+}
+
 void RequireSame(const Foothold& a, const Foothold& b) {
   REQUIRE(static_cast<int>(a.status) == static_cast<int>(b.status));
   REQUIRE(a.index == b.index);
@@ -887,8 +897,8 @@ TEST_CASE("footfalld holds --max-samples over parallel uploads and mesh loads", 
     CHECK(rpc->LoadServerFile("square.obj", Separation(0.283), &t) == Status::kOk);
   }
   SECTION("orphans make room in the budget, least recently queried first") {
-    auto first = Connect(server.port());
-    auto second = Connect(server.port());
+    auto first = ConnectLeavingOrphans(server.port());
+    auto second = ConnectLeavingOrphans(server.port());
     TerrainHandle t = 0;
     REQUIRE(first->LoadSamples(MakeFlat(30, 1, 0), "first", &t) == Status::kOk);    // 900
     REQUIRE(second->LoadSamples(MakeFlat(30, 1, 0), "second", &t) == Status::kOk);  // 900
@@ -1240,9 +1250,39 @@ TEST_CASE("only the connection that loaded a terrain may unload it", "[rpc]") {
   clnt_destroy(other);
 }
 
+TEST_CASE("a closed session unloads its terrains, and any client may unload an orphan", "[rpc]") {
+  ServerProcess server;
+  CLIENT* other = RawClient(server.port());
+  {
+    auto closing = Connect(server.port());
+    TerrainHandle a = 0, b = 0;
+    REQUIRE(closing->LoadSamples(MakeFlat(10, 1, 0), "a", &a) == Status::kOk);
+    REQUIRE(closing->LoadSamples(MakeFlat(10, 1, 0), "b", &b) == Status::kOk);
+    REQUIRE(ServerTerrains(server.port()).size() == 2);
+  }  // closed: both unloaded at once (they stayed for --orphan-timeout, 600 s)
+  CHECK(ServerTerrains(server.port()).empty());
+  {
+    auto leaving = ConnectLeavingOrphans(server.port());
+    TerrainHandle t = 0;
+    REQUIRE(leaving->LoadSamples(MakeFlat(10, 1, 0), "kept", &t) == Status::kOk);
+  }
+  const uint32_t orphan = OnlyServerTerrain(server.port());
+  CHECK(WaitFor([&] {
+    return server.Log().find("terrain " + std::to_string(orphan) + " orphaned") !=
+           std::string::npos;
+  }));
+  CHECK(RawSnap(other, orphan) == FF_OK);
+  // Its owner, reconnected, has another connection: any client may unload it (it returned OK
+  // to the reconnected owner and kept the terrain).
+  std::string message;
+  CHECK(RawUnload(other, orphan, &message) == FF_OK);
+  CHECK(RawInfo(other, orphan) == FF_UNKNOWN_TERRAIN);
+  clnt_destroy(other);
+}
+
 TEST_CASE("a closed connection's terrains are freed once unqueried for --orphan-timeout", "[rpc]") {
   ServerProcess server(0, {"--no-rpcbind", "--orphan-timeout", "2"});
-  auto owner = Connect(server.port());
+  auto owner = ConnectLeavingOrphans(server.port());
   TerrainHandle t = 0;
   REQUIRE(owner->LoadSamples(MakeFlat(10, 1, 0), "flat", &t) == Status::kOk);
   const uint32_t handle = OnlyServerTerrain(server.port());
@@ -1253,9 +1293,6 @@ TEST_CASE("a closed connection's terrains are freed once unqueried for --orphan-
     REQUIRE(RawSnap(other, handle) == FF_OK);
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
   }
-  std::string message;
-  CHECK(RawUnload(other, handle, &message) == FF_ACCESS_DENIED);
-  CHECK(message.find("was loaded by a connection that has closed") != std::string::npos);
   // Unqueried, it goes (FF_INFO is not a query: it does not keep it).
   CHECK(WaitFor([&] { return RawInfo(other, handle) == FF_UNKNOWN_TERRAIN; }));
   const std::string log = server.Log();
@@ -1273,7 +1310,7 @@ TEST_CASE("at the terrain limit, a new terrain frees the least recently queried 
   std::vector<std::unique_ptr<TerrainSession>> clients;
   std::vector<uint32_t> first;  // the first connection's terrains, in handle order
   for (int i = 0; i < 4; ++i) {
-    clients.push_back(Connect(server.port()));
+    clients.push_back(ConnectLeavingOrphans(server.port()));
     for (int k = 0; k < 64; ++k) {
       TerrainHandle t = 0;
       REQUIRE(clients.back()->LoadSamples(MakeFlat(2, 1, 0), "t", &t) == Status::kOk);

@@ -24,6 +24,9 @@ static_assert(static_cast<int>(Status::kOk) == FF_OK, "status mirrors ff_status"
 static_assert(static_cast<int>(Status::kNoFoothold) == FF_NO_FOOTHOLD, "");
 static_assert(static_cast<int>(Status::kInternalError) == FF_INTERNAL_ERROR, "");
 
+// [Units: s] the longest a destroyed session waits for each unload (RpcOptions::unload_on_close).
+constexpr double kCloseTimeout = 2;
+
 ff_vec3 ToWire(const Vec3& v) { return {v.x, v.y, v.z}; }
 Vec3 FromWire(const ff_vec3& v) { return {v.x, v.y, v.z}; }
 
@@ -61,7 +64,18 @@ class RpcSession final : public TerrainSession {
   explicit RpcSession(const RpcOptions& options) : options_(options) {
     std::signal(SIGPIPE, SIG_IGN);
   }
-  ~RpcSession() override { Disconnect(); }
+  ~RpcSession() override {
+    if (options_.unload_on_close && client_) {
+      SetCallTimeout(client_, std::min(options_.call_timeout_s, kCloseTimeout));
+      for (const auto& entry : terrains_) {
+        if (!entry.second.loaded || !client_) continue;
+        ff_terrain_args args{entry.second.server_handle};
+        Reply<ff_status_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_status_reply));
+        if (ff_unload_1(&args, &reply.value, client_) != RPC_SUCCESS) break;  // gone: orphans
+      }
+    }
+    Disconnect();
+  }
 
   Status LoadFile(const std::string& path, const TerrainLoadOptions& options,
                   TerrainHandle* out) override {

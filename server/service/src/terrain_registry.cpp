@@ -387,11 +387,11 @@ Status TerrainRegistry::Unload(uint32_t handle, uint64_t requester, std::string*
     *message = "no terrain " + std::to_string(handle);
     return Status::kUnknownTerrain;
   }
-  if (it->second->owner != requester) {
+  // An orphan (its connection closed) may be unloaded by any client: its owner, reconnected,
+  // has another connection.
+  if (it->second->owner != requester && it->second->owner != 0) {
     *message = "terrain " + std::to_string(handle) +
-               (it->second->owner == 0
-                    ? " was loaded by a connection that has closed: it is freed once unused"
-                    : " was loaded by another connection: only that connection may unload it");
+               " was loaded by another connection: only that connection may unload it";
     return Status::kAccessDenied;
   }
   terrains_.erase(it);

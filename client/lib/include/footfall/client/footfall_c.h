@@ -51,8 +51,9 @@ ffc_session* ffc_open_embedded(void);
  * host NULL means 127.0.0.1; timeout_s <= 0 means 10 s per call. NULL only on bad arguments:
  * a port outside 1-65535, a timeout above 1e6 s, infinite or NaN. */
 ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s);
-/* Frees the session and its terrains: the pointer is invalid afterwards (closing it twice, or
- * while another thread is in a call on it, is undefined). NULL is ignored. */
+/* Frees the session and its terrains (an RPC session unloads them from footfalld while it is
+ * connected, waiting at most 2 s per terrain): the pointer is invalid afterwards (closing it
+ * twice, or while another thread is in a call on it, is undefined). NULL is ignored. */
 void ffc_close(ffc_session* session);
 /* The reason for the session's last failed call (from any thread), as a copy that stays valid
  * until this thread calls ffc_last_error again. Not cleared by calls that succeed. Never NULL. */

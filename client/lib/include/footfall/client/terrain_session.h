@@ -85,6 +85,11 @@ struct RpcOptions {
   // [Units: s] per load of a server-side file, when longer than call_timeout_s: resampling a
   // large mesh or height map finely takes longer than any query.
   double load_timeout_s = 300;
+  // Destroying the session unloads its terrains from footfalld (best effort, while connected;
+  // each call waits at most 2 s). False leaves them to footfalld as orphans, which any client
+  // may query until --orphan-timeout passes without a query (a loader that exits while others
+  // query its terrains).
+  bool unload_on_close = true;
 };
 
 // A client of footfalld. It connects lazily, reports kUnavailable when the server is gone or

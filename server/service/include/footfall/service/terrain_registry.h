@@ -110,8 +110,8 @@ class TerrainRegistry {
   // terrains (they stay queryable until RegistryLimits::orphan_idle_s pass without a query).
   // Returns the handles orphaned.
   std::vector<uint32_t> DropClient(uint64_t owner);
-  // Unloads a terrain of client `requester`: kAccessDenied for another client's terrain or an
-  // orphan, kUnknownTerrain for no terrain.
+  // Unloads a terrain of client `requester`, or an orphan: kAccessDenied for another client's
+  // terrain, kUnknownTerrain for no terrain.
   Status Unload(uint32_t handle, uint64_t requester, std::string* message);
   // The terrain, for reading its description (not a query); nullptr if there is none.
   const LoadedTerrain* Find(uint32_t handle) const;
