@@ -922,6 +922,38 @@ TEST_CASE("footfalld holds --max-samples over parallel uploads and mesh loads", 
   }
 }
 
+TEST_CASE("one connection holds at most 4 uploads, and an upload without samples is dropped",
+          "[rpc]") {
+  // One client could take all 32 upload slots and keep them with an empty chunk now and then:
+  // every other client's upload was refused.
+  ServerProcess server(0, {"--no-rpcbind", "--upload-timeout", "1"});
+  CLIENT* a = RawClient(server.port());
+  CLIENT* b = RawClient(server.port());
+  std::string message;
+  std::vector<uint32_t> held(4);
+  for (uint32_t& upload : held) REQUIRE(BeginUpload(a, 10, &upload, &message) == FF_OK);
+  uint32_t more = 0;
+  CHECK(BeginUpload(a, 10, &more, &message) == FF_LIMIT_EXCEEDED);
+  CHECK(message ==
+        "this connection has 4 uploads in progress, the most one connection may have: finish "
+        "one first");
+  uint32_t other = 0;
+  REQUIRE(BeginUpload(b, 10, &other, &message) == FF_OK);
+  // Empty chunks keep no upload alive; chunks with samples do.
+  bool dropped = false;
+  std::string why;
+  for (int i = 0; i < 10 && !dropped; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(400));
+    dropped = SendChunk(a, held[0], {}, &why) != FF_OK;
+    REQUIRE(SendChunk(b, other, {ff_sample{{0, 0, 1.0 * i}, {0, 1, 0}}}, &message) == FF_OK);
+  }
+  CHECK(dropped);
+  CHECK_THAT(why, Catch::Contains("no upload " + std::to_string(held[0])));
+  clnt_destroy(a);
+  clnt_destroy(b);
+  RequireServed(server.port());
+}
+
 TEST_CASE("footfalld refuses uploaded samples out of range, per chunk", "[rpc]") {
   ServerProcess server;
   CLIENT* c = RawClient(server.port());

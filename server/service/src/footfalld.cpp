@@ -111,6 +111,9 @@ int main(int argc, char** argv) {
                  "Seconds without queries after which a terrain whose connection has closed is "
                  "freed (default 600)")
       ->check(Seconds(true));
+  app.add_option("--upload-timeout", options.limits.upload_idle_s,
+                 "Seconds an upload may go without samples before it is dropped (default 120)")
+      ->check(Seconds(false));
   app.add_option("--max-client-terrains", options.limits.max_client_terrains,
                  "Terrains one connection may hold loaded at once (default 64)")
       ->check(CLI::Range(1, 256));

@@ -302,6 +302,13 @@ Status TerrainRegistry::BeginUpload(const std::string& name, uint64_t total, uin
     *message = "an upload of no samples (a terrain needs at least one)";
     return Status::kInvalidArgument;
   }
+  size_t own = 0;
+  for (const auto& u : uploads_) own += u.second.owner == owner;
+  if (own >= limits_.max_client_uploads) {
+    *message = "this connection has " + std::to_string(own) +
+               " uploads in progress, the most one connection may have: finish one first";
+    return Status::kLimitExceeded;
+  }
   if (uploads_.size() >= limits_.max_uploads) {
     *message = "too many uploads in progress (limit " + std::to_string(limits_.max_uploads) + ")";
     return Status::kLimitExceeded;
@@ -345,7 +352,7 @@ Status TerrainRegistry::AppendUpload(uint32_t upload, uint64_t owner, const RawS
   }
   u.samples.points.insert(u.samples.points.end(), chunk.points.begin(), chunk.points.end());
   u.samples.normals.insert(u.samples.normals.end(), chunk.normals.begin(), chunk.normals.end());
-  u.touched = std::chrono::steady_clock::now();
+  if (chunk.size() > 0) u.touched = std::chrono::steady_clock::now();  // samples are progress
   return Status::kOk;
 }
 

@@ -22,8 +22,11 @@ struct RegistryLimits {
   double orphan_idle_s = 600;  // [Units: s] an orphaned terrain without queries this long is freed
   size_t max_total_samples = 1u << 28;  // over all terrains and uploads
   size_t max_uploads = 32;              // in progress at once
-  double upload_idle_s = 120;           // [Units: s] an upload idle this long is dropped
-  size_t recent_capacity = 4096;        // queries kept for FF_RECENT
+  size_t max_client_uploads = 4;        // in progress at once on one connection
+  // [Units: s] an upload that receives no samples this long is dropped (empty chunks do not
+  // count)
+  double upload_idle_s = 120;
+  size_t recent_capacity = 4096;  // queries kept for FF_RECENT
 };
 
 struct LoadedTerrain {
