@@ -764,6 +764,22 @@ TEST_CASE("A server-side load does not hold up the other clients", "[rpc]") {
     CHECK(answered >= 10);
     CHECK(samples > 400000);
   }
+  SECTION("a load asking for more samples than one load may have is refused, naming the cap") {
+    // A client's max_samples of 2^64-1 was held only to the budget (2^28): a small height map
+    // sampled that finely kept a load thread busy for minutes and ran out of memory.
+    CLIENT* a = RawClient(server.port());
+    ff_load_options_args args = DefaultLoadOptionsArgs("corner.obj");
+    args.separation = 1e-4;
+    args.max_samples = ~u_quad_t{0};
+    ff_load_reply reply{};
+    REQUIRE(ff_load_options_1(&args, &reply, a) == RPC_SUCCESS);
+    CHECK(reply.status == FF_LIMIT_EXCEEDED);
+    CHECK_THAT(std::string(reply.message ? reply.message : ""),
+               Catch::Contains("samples per load of a mesh or height map"));
+    xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&reply));
+    clnt_destroy(a);
+    CHECK(snap_ok());
+  }
   SECTION("a client that goes away meanwhile: its load is dropped, the others go on") {
     CLIENT* a = RawClient(server.port());
     // Sends FF_LOAD_OPTIONS and closes without waiting for the reply.

@@ -1,6 +1,7 @@
 #include "footfall/service/terrain_registry.h"
 
 #include "footfall/service/pinned_file.h"
+#include "footfall/terrain/large_memory.h"
 
 #include <fcntl.h>
 #include <limits.h>
@@ -252,13 +253,25 @@ Status TerrainRegistry::PrepareLoad(const std::string& relative_path, TerrainLoa
   // AddGrid frees them as needed.
   const uint64_t used = TotalSamples() - OrphanSamples();
   const uint64_t left = used < limits_.max_total_samples ? limits_.max_total_samples - used : 0;
-  load->budget_binds = left < options.max_samples;
-  options.max_samples = static_cast<size_t>(std::min<uint64_t>(options.max_samples, left));
+  const uint64_t per_load = MaxSamplesPerLoad();
+  load->budget_binds = left < options.max_samples && left <= per_load;
+  load->per_load_binds = per_load < options.max_samples && per_load < left;
+  options.max_samples =
+      static_cast<size_t>(std::min<uint64_t>({options.max_samples, left, per_load}));
   load->relative_path = relative_path;
   load->options = std::move(options);
   load->owner = owner;
   load->pinned = std::move(pinned);
   return Status::kOk;
+}
+
+uint64_t MaxSamplesPerLoad() {
+  // The sampler needs about 400 bytes per sample while it works, and two loads run at once.
+  constexpr uint64_t kMostPerLoad = 20000000, kSamplerBytes = 400, kLoadsAtOnce = 2;
+  const double memory = UsableMemoryBytes();
+  const uint64_t fits =
+      memory > 0 ? static_cast<uint64_t>(memory / (kSamplerBytes * kLoadsAtOnce)) : kMostPerLoad;
+  return std::max<uint64_t>(1000, std::min(kMostPerLoad, fits));
 }
 
 void RunLoad(PendingLoad* load) {
@@ -288,6 +301,10 @@ Status TerrainRegistry::FinishLoad(PendingLoad* load, uint32_t* handle, std::str
     *message = load->message;
     if (load->status == Status::kLimitExceeded && load->budget_binds)
       *message += " (the limit is what is left of " + Budget() + ")";
+    if (load->status == Status::kLimitExceeded && load->per_load_binds)
+      *message += " (the limit is footfalld's " + std::to_string(MaxSamplesPerLoad()) +
+                  " samples per load of a mesh or height map, which this machine's memory "
+                  "holds while sampling)";
     return load->status;
   }
   return AddGrid(load->relative_path, std::move(load->grid), load->owner, handle, message);

@@ -47,6 +47,7 @@ struct PendingLoad {
   std::string relative_path;           // as the client named it (an upload: its name)
   TerrainLoadOptions options;          // max_samples lowered to what was left of the budget
   bool budget_binds = false;           // the budget, not the client, set options.max_samples
+  bool per_load_binds = false;         // ... MaxSamplesPerLoad did
   uint64_t owner = 0;                  // the client (connection) that asked
   std::unique_ptr<PinnedFile> pinned;  // a file to read; or, when null, `samples`
   RawSamples samples;                  // an upload's samples (kept in the budget: `reserved`)
@@ -60,6 +61,10 @@ struct PendingLoad {
 
 // The middle stage of a load: reads and resamples the pinned file, validates the samples and
 // builds the grid into `load`, whose status and message say how it went.
+// The most samples one server-side load of a mesh or height map may be sampled to: 20,000,000,
+// or fewer when this machine's memory could not hold two such loads sampling at once.
+uint64_t MaxSamplesPerLoad();
+
 void RunLoad(PendingLoad* load);
 
 // One answered query, as the live view shows it.
