@@ -344,6 +344,15 @@ TEST_CASE("TerrainGrid next follows the candidate rules", "[terrain][grid]") {
     CHECK(g.Next({{5, 0, INFINITY}, {0, 0, 1}}, 0).status == Status::kInvalidArgument);
     CHECK(g.Snap({NAN, 0, 0}).status == Status::kInvalidArgument);
   }
+  SECTION("a direction too small to square is not zero") {
+    // |d|^2 underflows to 0: it was refused as a zero direction. With a tolerance the nearest
+    // sample ahead within it is the answer; without, only a sample at the ideal point would be.
+    const Foothold f = g.Next({{5, 0, 5}, {1e-170, 0, 0}}, 2);
+    REQUIRE(f.status == Status::kOk);
+    CHECK(f.point == Vec3{6, 0, 5});
+    CHECK(g.Next({{5, 0, 5}, {1e-170, 0, 0}}, 0).status == Status::kNoFoothold);
+    CHECK(g.Next({{5, 0, 5}, {0, -1e-300, 0}}, 0).status == Status::kNoFoothold);
+  }
 }
 
 TEST_CASE("TerrainGrid next with a tolerance as large as the terrain", "[terrain][grid]") {

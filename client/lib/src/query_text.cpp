@@ -79,10 +79,9 @@ bool ParseQueryText(const std::string& text, QueryText* out, std::string* error)
   }
   query.point = {v[0], v[1], v[2]};
   query.direction = {v[3], v[4], v[5]};
-  if (query.op == QueryOp::kNext && Length2(query.direction) == 0) {
-    *error =
-        "next: direction DX DY DZ must be non-zero (and its squared length above the "
-        "smallest double: components beyond about 1e-154)";
+  if (query.op == QueryOp::kNext && query.direction.x == 0 && query.direction.y == 0 &&
+      query.direction.z == 0) {
+    *error = "next: direction DX DY DZ must be non-zero";
     return false;
   }
   *out = query;

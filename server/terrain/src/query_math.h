@@ -50,8 +50,10 @@ struct NextFrame {
 inline bool MakeNextFrame(const double origin[3], const StepQuery& q, double tolerance,
                           NextFrame* frame) {
   if (!IsFinite(q.foot) || !IsFinite(q.direction) || !std::isfinite(tolerance)) return false;
+  // Any non-zero direction is valid, also one whose squared length underflows (1e-170): its
+  // candidate radius is then the tolerance, or (without one) the ideal point alone.
+  if (q.direction.x == 0 && q.direction.y == 0 && q.direction.z == 0) return false;
   const double len2 = Length2(q.direction);
-  if (!(len2 > 0) || !std::isfinite(len2)) return false;
   const double foot[3] = {q.foot.x, q.foot.y, q.foot.z};
   const double dir[3] = {q.direction.x, q.direction.y, q.direction.z};
   for (int a = 0; a < 3; ++a) {
