@@ -105,6 +105,30 @@ class EmbeddedTest(unittest.TestCase):
             os.unlink(fifo)
             os.rmdir(folder)
 
+    def test_bad_terrain_ids_numbers_and_requests_raise_footfall_errors(self):
+        t = self.s.load_samples(flat_grid(3), "small")
+        # Ids beyond uint32_t wrapped onto another terrain (unload(2**32 + t) unloaded t).
+        for bad in (2 ** 32 + t, -1, None, "x", 1.0, True):
+            with self.assertRaises(ff.FootfallError) as e:
+                self.s.unload(bad)
+            self.assertEqual(e.exception.status_name, "invalid_argument")
+            self.assertIn("terrain", e.exception.message)
+            for call in (lambda: self.s.info(bad), lambda: self.s.snap(bad, [(0, 0, 0)]),
+                         lambda: self.s.next(bad, [(0, 0, 0, 1, 0, 0)]),
+                         lambda: self.s.generate(bad, {"steps": 1})):
+                with self.assertRaises(ff.FootfallError):
+                    call()
+        self.assertEqual(self.s.info(t)[0], 9)  # still loaded
+        for call in (lambda: self.s.next(t, [(0, 0, 0, 1, 0, 0)], "wide"),
+                     lambda: self.s.load_file("x.pts", "fine"),
+                     lambda: self.s.generate(t, ["steps", 1]),
+                     lambda: self.s.generate(t, {"steps": float("nan")}),
+                     lambda: self.s.generate(t, {"steps": object()})):
+            with self.assertRaises(ff.FootfallError) as e:
+                call()
+            self.assertEqual(e.exception.status_name, "invalid_argument")
+        self.s.unload(t)
+
     def test_unbounded_timeouts_are_refused(self):
         for timeout in (float("inf"), float("nan"), 1e300, "soon"):
             with self.assertRaises(ff.FootfallError) as e:

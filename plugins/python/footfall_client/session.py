@@ -82,6 +82,36 @@ def _flat(rows, width, what):
     return flat
 
 
+def _terrain(terrain, function):
+    """A terrain id as the C library takes it (uint32_t): ids beyond it wrapped onto others."""
+    if isinstance(terrain, bool) or not isinstance(terrain, int) or not 0 <= terrain < 2 ** 32:
+        raise FootfallError(INVALID_ARGUMENT, "terrain %r: expected a terrain id as a load_* call "
+                            "returned (a whole number from 0 to 4294967295)" % (terrain,), function)
+    return terrain
+
+
+def _number(value, what, function):
+    """A float for the C library, or FootfallError naming `what`."""
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise FootfallError(INVALID_ARGUMENT, "%s %r: expected a number" % (what, value),
+                            function) from None
+
+
+def _json_text(value, what, function):
+    """A dict (or JSON text) as UTF-8 JSON bytes, or FootfallError naming `what`."""
+    if isinstance(value, str):
+        return value.encode("utf-8", "replace")
+    if not isinstance(value, dict):
+        raise FootfallError(INVALID_ARGUMENT, "%s: expected a dict or JSON text, got %s"
+                            % (what, type(value).__name__), function)
+    try:
+        return json.dumps(value, allow_nan=False).encode("utf-8", "replace")
+    except (TypeError, ValueError) as e:
+        raise FootfallError(INVALID_ARGUMENT, "%s: %s" % (what, e), function) from None
+
+
 def _pointer(flat):
     if not flat:
         return ctypes.POINTER(ctypes.c_double)()
@@ -181,7 +211,8 @@ class Session:
         h = self._handle("ffc_load_file")
         out = ctypes.c_uint32()
         self._check(self._lib.lib.ffc_load_file(h, _path_bytes(path, "ffc_load_file"),
-                                                float(separation), ctypes.byref(out)),
+                                                _number(separation, "separation", "ffc_load_file"),
+                                                ctypes.byref(out)),
                     "ffc_load_file")
         return out.value
 
@@ -189,8 +220,10 @@ class Session:
         """Loads a file under footfalld's data root (RPC) or a local path (embedded)."""
         h = self._handle("ffc_load_server_file")
         out = ctypes.c_uint32()
-        self._check(self._lib.lib.ffc_load_server_file(h, _path_bytes(path, "ffc_load_server_file"),
-                                                       float(separation), ctypes.byref(out)),
+        self._check(self._lib.lib.ffc_load_server_file(
+                        h, _path_bytes(path, "ffc_load_server_file"),
+                        _number(separation, "separation", "ffc_load_server_file"),
+                        ctypes.byref(out)),
                     "ffc_load_server_file")
         return out.value
 
@@ -207,14 +240,16 @@ class Session:
         return out.value
 
     def unload(self, terrain):
-        self._check(self._lib.lib.ffc_unload(self._handle("ffc_unload"), terrain), "ffc_unload")
+        self._check(self._lib.lib.ffc_unload(self._handle("ffc_unload"),
+                                             _terrain(terrain, "ffc_unload")), "ffc_unload")
 
     def info(self, terrain):
         """(sample count, (min x, min y, min z, max x, max y, max z)) of a terrain."""
         h = self._handle("ffc_info")
         count = ctypes.c_uint64()
         bounds = (ctypes.c_double * 6)()
-        self._check(self._lib.lib.ffc_info(h, terrain, ctypes.byref(count), bounds), "ffc_info")
+        self._check(self._lib.lib.ffc_info(h, _terrain(terrain, "ffc_info"), ctypes.byref(count),
+                                           bounds), "ffc_info")
         return count.value, tuple(bounds)
 
     def ping(self):
@@ -236,6 +271,7 @@ class Session:
 
     def _points(self, fn_name, terrain, points):
         h = self._handle(fn_name)
+        terrain = _terrain(terrain, fn_name)
         flat = _flat(points, 3, "points")
         n = len(flat) // 3
         out = (FfcFoothold * max(n, 1))()
@@ -254,10 +290,12 @@ class Session:
         """The next foothold for each step (foot x, y, z, direction x, y, z): a list of
         Foothold. tolerance <= 0: the candidate radius is the step length."""
         h = self._handle("ffc_next")
+        terrain = _terrain(terrain, "ffc_next")
+        tolerance = _number(tolerance, "tolerance", "ffc_next")
         flat = _flat(steps, 6, "steps")
         n = len(flat) // 6
         out = (FfcFoothold * max(n, 1))()
-        self._check(self._lib.lib.ffc_next(h, terrain, _pointer(flat), n, float(tolerance), out),
+        self._check(self._lib.lib.ffc_next(h, terrain, _pointer(flat), n, tolerance, out),
                     "ffc_next")
         return self._answers(out, n)
 
@@ -289,9 +327,10 @@ class Session:
         if not self._lib.has("ffc_generate"):
             raise FootfallError(INTERNAL_ERROR, "%s has no ffc_generate (an older library)"
                                 % self._lib.path, "ffc_generate")
-        text = request if isinstance(request, str) else json.dumps(request)
+        terrain = _terrain(terrain, "ffc_generate")
+        text = _json_text(request, "request", "ffc_generate")
         out = ctypes.c_void_p()
-        status = self._lib.lib.ffc_generate(h, terrain, text.encode(), ctypes.byref(out))
+        status = self._lib.lib.ffc_generate(h, terrain, text, ctypes.byref(out))
         walk = None
         if out.value:
             try:
