@@ -166,6 +166,32 @@ TEST_CASE("Walks up and down stairs", "[steps][generator]") {
   }
 }
 
+TEST_CASE("The default start stands no foot on ground steeper than max_slope_deg",
+          "[steps][generator]") {
+  // The shipped quadruped on the shipped stairs, default start: its front paws stood on a
+  // riser (90 degrees from up), which passed against the feet's averaged normal (two risers and
+  // two treads: 45 degrees).
+  RawSamples stairs;
+  std::string error;
+  REQUIRE(footfall::LoadTerrain(FOOTFALL_SOURCE_DIR "/data/terrain/stairs.pts",
+                                TerrainLoadOptions{}, &stairs, &error) == Status::kOk);
+  Terrain t = LoadTerrain(stairs, 0.03);
+  for (const std::string name : {"quadruped", "hexapod", "octopod"}) {
+    const Character c = LoadShipped(name);
+    INFO(name);
+    GenerateOptions o;
+    o.steps = 1;
+    const Walk w = Generate(t, c, o);
+    for (const WalkTrack& track : w.tracks) {
+      if (track.kind != TrackKind::kFoot) continue;
+      const WalkKey& first = track.keys.front();
+      INFO(track.name << " at " << first.position.x << ", " << first.position.y << ", "
+                      << first.position.z);
+      CHECK(first.normal.y >= std::cos(c.max_slope_deg * M_PI / 180));  // from world up
+    }
+  }
+}
+
 TEST_CASE("The shipped quadruped climbs the shipped stairs, the insects walk down them",
           "[steps][generator]") {
   // data/terrain/stairs.pts: 8 steps of 0.18 x 0.3 m along +Z, 1.5 m wide, top tread at 1.26.

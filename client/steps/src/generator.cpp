@@ -865,8 +865,11 @@ Status Generator::FindStart(const Vec3& start, bool may_move, Foothold* first, s
       for (size_t f = 0; f < feet && near; ++f) {
         const Foothold& h = snapped[m * feet + f];
         const Vec3 d = h.point - points[m * feet + f];
+        // ... and on ground within max_slope_deg of the up it was placed with (Plant judges the
+        // feet's averaged normal: two paws on a stair's riser and two on its tread averaged 45
+        // degrees, and the default start stood them there).
         near = h.status == Status::kOk && std::fabs(Dot(d, a.up)) <= c_.max_rise &&
-               Length(ProjectOnPlane(d, a.up)) <= beside;
+               Length(ProjectOnPlane(d, a.up)) <= beside && Dot(h.normal, a.up) >= cos_max_slope_;
       }
       if (near && Plant(a, &snapped[m * feet]).empty()) *found = true, *first = grounds[m];
     }
