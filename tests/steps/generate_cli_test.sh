@@ -203,7 +203,7 @@ if [ -f "$dem" ]; then
   # Where the terrain simply ends (a goal far off it), no advice to resample.
   "$footfall" generate --terrain "$hills" --character "$chars/biped.json" --start 8,0,8 \
     --path "8,0,12 100,0,100" --out "$work/off-edge.json" 2> "$work/off-edge.err"
-  check "terrain ends: the stop says so" grep -q "the terrain ends before it" "$work/off-edge.err"
+  check "terrain ends: the stop says so" grep -qF "the terrain ends, or rises as a wall at its bounds, before it" "$work/off-edge.err"
   check "terrain ends: no advice to resample" bash -c "! grep -q resample '$work/off-edge.err'"
   # A --start is snapped as given, as on point files: one beyond the queries' reach is refused.
   err=$("$footfall" generate --terrain "$dem" --character "$chars/biped.json" --start 1e20,0,0 --out "$work/x.json" 2>&1)

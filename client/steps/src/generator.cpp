@@ -1063,7 +1063,8 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
     const double radius = kFootholdTolerance * c_.step_length;
     const bool beyond = BoxDistance(mv.ideal, bounds_min_, bounds_max_) > radius;
     why << "no foothold within " << radius << " of " << Point(mv.ideal)
-        << (beyond ? " (the terrain ends before it)" : " (a gap or a cliff)");
+        << (beyond ? " (the terrain ends, or rises as a wall at its bounds, before it)"
+                   : " (a gap or a cliff)");
     // Samples spread wider than half that radius leave gaps everywhere: say so, unless the
     // terrain simply ends there or resampling would not bring them closer.
     const double spacing = 0.5 * gap_;
