@@ -117,6 +117,12 @@ start_server "$footfalld" --max-samples 2e1
 err=$(echo "snap 0 0 0" | "$footfall" query --terrain "$work/flat.pts" --server "$server" 2>&1 >/dev/null)
 check "footfalld --max-samples 2e1: a 25-sample upload refused" grep -qF "(--max-samples 20," <<< "$err"
 stop_server
+# Without --max-samples, the default 2^28 is lowered to what the memory the process may use
+# holds (100 bytes per sample): a 2 GB limit holds 20,480,000.
+err=$( (ulimit -v 2000000; timeout 2 "$footfalld" --listen 127.0.0.1:0 --no-rpcbind) 2>&1)
+check "footfalld default budget: lowered to memory" grep -qF "footfalld: sample budget 20480000 (this machine's memory at 100 bytes per sample" <<< "$err"
+err=$( (ulimit -v 2000000; timeout 2 "$footfalld" --listen 127.0.0.1:0 --no-rpcbind --max-samples 1e9) 2>&1)
+check "footfalld --max-samples: kept as given" bash -c '! grep -q "sample budget" <<< "$1"' _ "$err"
 # A port file it cannot write is an error (a supervisor waiting for it would wait forever).
 err=$(timeout 5 "$footfalld" --listen 127.0.0.1:0 --no-rpcbind --port-file "$work/no/such/dir/port" 2>&1)
 check "footfalld unwritable --port-file: exit 1" [ $? -eq 1 ]

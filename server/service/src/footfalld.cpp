@@ -16,6 +16,7 @@
 
 #include "footfall/service/pinned_file.h"
 #include "footfall/service/rpc_server.h"
+#include "footfall/terrain/large_memory.h"
 
 namespace {
 
@@ -105,7 +106,8 @@ int main(int argc, char** argv) {
                  "Threads per batch query (default: the hardware's cores)")
       ->check(CLI::Range(1, 64));
   app.add_option("--max-samples", options.limits.max_total_samples,
-                 "Samples held over all terrains and uploads (default 268435456, 2^28)")
+                 "Samples held over all terrains and uploads (default 268435456, 2^28, or what "
+                 "memory holds at 100 bytes per sample)")
       ->transform(SampleCount());
   app.add_option("--orphan-timeout", options.limits.orphan_idle_s,
                  "Seconds without queries after which a terrain whose connection has closed is "
@@ -138,6 +140,19 @@ int main(int argc, char** argv) {
 
   std::signal(SIGPIPE, SIG_IGN);
   setvbuf(stderr, nullptr, _IOLBF, 0);
+  // The default budget, lowered to what this machine's memory holds: a finished upload peaks
+  // near 100 bytes per sample (its samples and its grid at once).
+  if (app.count("--max-samples") == 0) {
+    constexpr double kPeakBytesPerSample = 100;
+    const double fits = footfall::UsableMemoryBytes() / kPeakBytesPerSample;
+    if (fits > 0 && fits < static_cast<double>(options.limits.max_total_samples)) {
+      options.limits.max_total_samples = static_cast<size_t>(std::max(fits, 1e6));
+      std::fprintf(stderr,
+                   "footfalld: sample budget %zu (this machine's memory at %.0f bytes per "
+                   "sample; --max-samples sets another)\n",
+                   options.limits.max_total_samples, kPeakBytesPerSample);
+    }
+  }
   RaiseOpenFileLimit();
   bool abandoned_load = false;
   {
