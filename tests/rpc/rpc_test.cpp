@@ -461,6 +461,47 @@ bool_t EncodeRawLoad(XDR* xdrs, RawLoadArgs* a) {
   return xdr_bytes(xdrs, &bytes, &length, FF_MAX_PATH) && xdr_double(xdrs, &a->separation);
 }
 
+TEST_CASE("A batch past --batch-time-limit lets other clients in and is completed exactly",
+          "[rpc][robustness]") {
+  // Snaps from 1e10 above flat ground: rounding ties most samples, so each compares all 90,000
+  // (a full batch of them on 1M samples held footfalld for 20 s, and other clients timed out).
+  ServerProcess server(0, {"--no-rpcbind", "--threads", "1", "--batch-time-limit", "0.05"});
+  const RawSamples ground = MakeFlat(300, 0.1, 0);
+  std::vector<Vec3> far(FF_MAX_BATCH);
+  for (size_t i = 0; i < far.size(); ++i) far[i] = {0.007 * i, 1e10, 0.003 * i};
+  auto embedded = MakeEmbeddedSession();
+  TerrainHandle e = 0;
+  REQUIRE(embedded->LoadSamples(ground, "flat", &e) == Status::kOk);
+  std::vector<Foothold> expected(far.size());
+  REQUIRE(embedded->Snap(e, far.data(), far.size(), expected.data()) == Status::kOk);
+
+  auto slow = Connect(server.port(), 60);
+  auto quick = Connect(server.port(), 60);
+  TerrainHandle t = 0, q = 0;
+  REQUIRE(slow->LoadSamples(ground, "flat", &t) == Status::kOk);
+  REQUIRE(quick->LoadSamples(MakeFlat(10, 1, 0), "small", &q) == Status::kOk);
+  std::atomic<int> order{0};
+  int slow_done = 0, quick_done = 0;
+  std::vector<Foothold> got(far.size());
+  Status slow_status = Status::kInternalError;
+  std::thread a([&] {
+    slow_status = slow->Snap(t, far.data(), far.size(), got.data());
+    slow_done = ++order;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));  // the batch under way
+  for (int i = 0; i < 3; ++i) CHECK(quick->Snap(q, Vec3{1, 0, 1}).status == Status::kOk);
+  quick_done = ++order;
+  a.join();
+  CHECK(quick_done == 1);  // served while the costly batch went on, not after it
+  CHECK(slow_done == 2);
+  REQUIRE(slow_status == Status::kOk);
+  for (size_t i = 0; i < far.size(); ++i) {
+    INFO("query " << i);
+    RequireSame(got[i], expected[i]);
+  }
+  CHECK_THAT(server.Log(), Catch::Contains("past its time limit (0.05 s)"));
+}
+
 TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
   TempRoot temp;
   const std::string& root = temp.path;

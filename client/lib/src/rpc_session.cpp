@@ -156,24 +156,28 @@ class RpcSession final : public TerrainSession {
   Status Next(TerrainHandle terrain, const StepQuery* queries, size_t count, double tolerance,
               Foothold* out) override {
     if (!std::isfinite(tolerance)) return Fail(Status::kInvalidArgument, "tolerance is not finite");
-    for (size_t begin = 0; begin < count; begin += FF_MAX_BATCH) {
-      const size_t n = std::min<size_t>(FF_MAX_BATCH, count - begin);
-      const Status s = WithTerrain(terrain, [&](uint32_t server) -> Status {
-        // Encoded straight from the caller's queries, answers decoded straight into `out`.
+    auto call = [&](const StepQuery* q, size_t n, Foothold* answers) {
+      return WithTerrain(terrain, [&](uint32_t server) -> Status {
+        // Encoded straight from the caller's queries, answers decoded straight into `answers`.
         NextBatchView<StepQuery> args;
         args.terrain = server;
         args.tolerance = tolerance;
         args.count = args.capacity = static_cast<u_int>(n);
-        args.queries = const_cast<StepQuery*>(queries + begin);  // only read: encoded
+        args.queries = const_cast<StepQuery*>(q);  // only read: encoded
         BatchReplyView<Foothold> reply;
-        reply.results = out + begin;
+        reply.results = answers;
         reply.capacity = static_cast<u_int>(n);
         const Status cs =
             Call(CallBatch(FF_NEXT_BATCH, AsXdrProc(XdrNextBatchView<StepQuery>), &args, &reply),
                  "next");
         if (cs != Status::kOk) return cs;
-        return TakeBatch(reply, n, out + begin, "next");
+        return TakeBatch(reply, n, answers, "next");
       });
+    };
+    for (size_t begin = 0; begin < count; begin += FF_MAX_BATCH) {
+      const size_t n = std::min<size_t>(FF_MAX_BATCH, count - begin);
+      Status s = call(queries + begin, n, out + begin);
+      if (s == Status::kOk) s = AskAgain(queries + begin, n, out + begin, "next", call);
       if (s != Status::kOk) return s;
     }
     return Status::kOk;
@@ -188,25 +192,54 @@ class RpcSession final : public TerrainSession {
   Status PointBatch(TerrainHandle terrain, const Vec3* points, size_t count, Foothold* out,
                     bool normal) {
     const char* what = normal ? "normal" : "snap";
-    for (size_t begin = 0; begin < count; begin += FF_MAX_BATCH) {
-      const size_t n = std::min<size_t>(FF_MAX_BATCH, count - begin);
-      const Status s = WithTerrain(terrain, [&](uint32_t server) -> Status {
+    auto call = [&](const Vec3* p, size_t n, Foothold* answers) {
+      return WithTerrain(terrain, [&](uint32_t server) -> Status {
         PointBatchView<Vec3> args;
         args.terrain = server;
         args.count = args.capacity = static_cast<u_int>(n);
-        args.points = const_cast<Vec3*>(points + begin);  // only read: encoded
+        args.points = const_cast<Vec3*>(p);  // only read: encoded
         BatchReplyView<Foothold> reply;
-        reply.results = out + begin;
+        reply.results = answers;
         reply.capacity = static_cast<u_int>(n);
         const Status st = Call(CallBatch(normal ? FF_NORMAL_BATCH : FF_SNAP_BATCH,
                                          AsXdrProc(XdrPointBatchView<Vec3>), &args, &reply),
                                what);
         if (st != Status::kOk) return st;
-        return TakeBatch(reply, n, out + begin, what);
+        return TakeBatch(reply, n, answers, what);
       });
+    };
+    for (size_t begin = 0; begin < count; begin += FF_MAX_BATCH) {
+      const size_t n = std::min<size_t>(FF_MAX_BATCH, count - begin);
+      Status s = call(points + begin, n, out + begin);
+      if (s == Status::kOk) s = AskAgain(points + begin, n, out + begin, what, call);
       if (s != Status::kOk) return s;
     }
     return Status::kOk;
+  }
+
+  // Sends again, in calls of their own, the queries footfalld left for later (kLimitExceeded:
+  // its batch ran past --batch-time-limit, and it served other clients meanwhile), until each
+  // is answered. `call(queries, count, answers)` makes one batch call.
+  template <typename Query, typename CallFn>
+  Status AskAgain(const Query* queries, size_t n, Foothold* out, const char* what, CallFn&& call) {
+    std::vector<size_t> left;
+    std::vector<Query> again;
+    std::vector<Foothold> answers;
+    for (size_t before = n + 1;;) {
+      left.clear();
+      for (size_t i = 0; i < n; ++i)
+        if (out[i].status == Status::kLimitExceeded) left.push_back(i);
+      if (left.empty()) return Status::kOk;
+      if (left.size() >= before)  // footfalld always answers some: this one answered none
+        return Fail(Status::kInternalError,
+                    std::string(what) + ": footfalld answered none of the queries asked again");
+      before = left.size();
+      again.resize(left.size()), answers.resize(left.size());
+      for (size_t k = 0; k < left.size(); ++k) again[k] = queries[left[k]];
+      const Status s = call(again.data(), again.size(), answers.data());
+      if (s != Status::kOk) return s;
+      for (size_t k = 0; k < left.size(); ++k) out[left[k]] = answers[k];
+    }
   }
 
   // One batch call with the fast filters; the answers land in reply->results.

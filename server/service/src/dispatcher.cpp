@@ -3,6 +3,8 @@
 
 #include <poll.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -396,14 +398,33 @@ void ClearFailed(Foothold* f) {
 }
 
 // Answers queries [0, n) of a batch into g_storage.answers on the batch threads; `answer(b, e)`
-// fills answers [b, e).
+// fills answers [b, e). Chunks taken after the batch's time limit are answered
+// kLimitExceeded (the first always is answered: every call makes progress).
 template <typename Fn>
 void RunBatch(size_t n, BatchReplyView<Foothold>* r, Fn&& answer) {
   Foothold* answers = g_storage.answers.data();
-  g_pool->Run(n, BatchPool::kQueryChunk, [&](size_t b, size_t e) {
-    answer(b, e, answers);
-    for (size_t i = b; i < e; ++i) ClearFailed(&answers[i]);
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(g_state->batch_time_limit_s));
+  std::atomic<size_t> late{0};
+  g_pool->Run(n, BatchPool::kQueryChunk, [&](size_t begin, size_t end) {
+    // One call may cover the whole batch (one thread): the limit is checked every chunk.
+    for (size_t b = begin; b < end; b += BatchPool::kQueryChunk) {
+      const size_t e = std::min(end, b + BatchPool::kQueryChunk);
+      if (b > 0 && std::chrono::steady_clock::now() > deadline) {
+        for (size_t i = b; i < e; ++i)
+          answers[i] = Foothold{}, answers[i].status = Status::kLimitExceeded;
+        late += e - b;
+        continue;
+      }
+      answer(b, e, answers);
+      for (size_t i = b; i < e; ++i) ClearFailed(&answers[i]);
+    }
   });
+  if (late > 0)
+    Log("batch of " + std::to_string(n) + " queries past its time limit (" +
+        SecondsText(g_state->batch_time_limit_s) + "): " + std::to_string(late.load()) +
+        " answered limit_exceeded, to be asked again");
   r->status = FF_OK;
   r->count = r->capacity = static_cast<u_int>(n);
   r->results = answers;

@@ -23,6 +23,7 @@ struct Connection {
 struct ServiceState {
   TerrainRegistry registry;
   int batch_threads = 1;
+  double batch_time_limit_s = 1;          // RpcServerOptions::batch_time_limit_s
   std::map<int, Connection> connections;  // by socket
   uint64_t next_connection = 1;
   std::unique_ptr<LoadQueue> loads;  // server-side loads in progress (set by InstallDispatcher)

@@ -113,6 +113,11 @@ int main(int argc, char** argv) {
                  "Seconds without queries after which a terrain whose connection has closed is "
                  "freed (default 600)")
       ->check(Seconds(true));
+  app.add_option("--batch-time-limit", options.batch_time_limit_s,
+                 "Seconds a batch may take before its remaining queries are answered "
+                 "limit_exceeded, for the client to ask again, so that other clients are served "
+                 "meanwhile (default 1)")
+      ->check(Seconds(false));
   app.add_option("--upload-timeout", options.limits.upload_idle_s,
                  "Seconds an upload may go without samples before it is dropped (default 120)")
       ->check(Seconds(false));

@@ -131,8 +131,13 @@ bool RpcServer::Start(std::string* error) {
     *error = "cannot create the RPC transport";
     return false;
   }
-  g_state = std::make_unique<ServiceState>(ServiceState{
-      TerrainRegistry(options_.data_root, options_.limits), options_.batch_threads, {}, 1, {}});
+  g_state = std::make_unique<ServiceState>(
+      ServiceState{TerrainRegistry(options_.data_root, options_.limits),
+                   options_.batch_threads,
+                   options_.batch_time_limit_s,
+                   {},
+                   1,
+                   {}});
   const DispatchFn dispatch = InstallDispatcher(g_state.get());
   if (!svc_register(transport, FOOTFALL_PROG, FOOTFALL_V1, dispatch, 0)) {
     *error = "cannot register the RPC program";

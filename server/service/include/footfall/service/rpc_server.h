@@ -24,6 +24,10 @@ struct RpcServerOptions {
   int batch_threads = 1;    // threads per batch query
   // [Units: s] A connection whose unread replies leave no room for another this long is closed.
   double unread_timeout_s = 30;
+  // [Units: s] A batch still being answered after this long answers its remaining queries
+  // FF_LIMIT_EXCEEDED ("ask again": the client library sends them again in another call), so
+  // that costly queries cannot hold the other clients up for longer.
+  double batch_time_limit_s = 1;
   RegistryLimits limits;
 };
 
