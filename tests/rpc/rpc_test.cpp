@@ -1223,6 +1223,9 @@ TEST_CASE("misbehaving clients leave others served and memory flat", "[rpc][robu
     INFO("RSS before " << before << " KiB, after " << after << " KiB");
     CHECK(after - before < 4096);
     RequireServed(server.port());
+    // The log names the peer and the likely causes, a record split in fragments among them.
+    CHECK_THAT(server.Log(), Catch::Contains("snap batch: malformed request from 127.0.0.1:"));
+    CHECK_THAT(server.Log(), Catch::Contains("more than one record fragment"));
   }
   // The loader's terrain is still there and answers.
   CHECK(loader->Snap(remote, Vec3{1, 0, 1}).status == Status::kOk);

@@ -20,6 +20,7 @@
 #include "footfall.h"
 #include "footfall/rpc/batch_xdr.h"
 #include "footfall/terrain/batch_pool.h"
+#include "read_gate.h"
 
 namespace footfall {
 namespace {
@@ -497,9 +498,11 @@ void ServeWith(SVCXPRT* transport, xdrproc_t decode, Args& args, xdrproc_t encod
   if (!svc_getargs(transport, decode, reinterpret_cast<char*>(&args))) {
     svc_freeargs(transport, decode, reinterpret_cast<char*>(&args));
     svcerr_decode(transport);
-    Log(std::string("error: ") + proc +
-        ": malformed request rejected (its arguments do not decode: more items than the "
-        "protocol allows or than were sent, a string too long, or a value out of its type)");
+    Log(std::string("error: ") + proc + ": malformed request from " + PeerOf(transport->xp_fd) +
+        " rejected (its arguments do not decode: more items than the protocol allows or than "
+        "were sent, a string too long, a value out of its type, or a request sent in more than "
+        "one record fragment: a client must send each in one, with a send size of at least "
+        "FF_MAX_REQUEST_BYTES)");
     return;
   }
   Res res{};

@@ -18,7 +18,8 @@ constexpr int kRecheckMs = 10;
 
 constexpr short kReadEvents = POLLIN | POLLPRI | POLLRDNORM | POLLRDBAND;
 
-// "ADDR:PORT" of the peer of `fd`, or "an unknown peer".
+}  // namespace
+
 std::string PeerOf(int fd) {
   sockaddr_storage address{};
   socklen_t len = sizeof address;
@@ -36,8 +37,6 @@ std::string PeerOf(int fd) {
   port = ntohs(a->sin_port);
   return std::string(host) + ":" + std::to_string(port);
 }
-
-}  // namespace
 
 ReadGate::ReadGate(size_t send_buffer, double stuck_limit_s)
     : max_queued_(send_buffer > kReplyRoomBytes ? send_buffer - kReplyRoomBytes : 0),

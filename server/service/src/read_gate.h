@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cstddef>
 #include <set>
+#include <string>
 #include <unordered_map>
 #include <unordered_set>
 #include <vector>
@@ -31,6 +32,9 @@ static_assert(kMaxReplyBytes >= 28 + 16 + static_cast<size_t>(FF_MAX_RECENT) * 1
 // [Units: bytes] The free send-buffer space a connection needs before a request is read from it:
 // a largest reply and a quarter more, for the kernel's own accounting of queued buffers.
 constexpr size_t kReplyRoomBytes = kMaxReplyBytes + kMaxReplyBytes / 4;
+
+// "ADDR:PORT" of the peer of socket `fd`, for log lines, or "an unknown peer".
+std::string PeerOf(int fd);
 
 class ReadGate {
  public:
