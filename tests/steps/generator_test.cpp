@@ -171,11 +171,7 @@ TEST_CASE("The default start stands no foot on ground steeper than max_slope_deg
   // The shipped quadruped on the shipped stairs, default start: its front paws stood on a
   // riser (90 degrees from up), which passed against the feet's averaged normal (two risers and
   // two treads: 45 degrees).
-  RawSamples stairs;
-  std::string error;
-  REQUIRE(footfall::LoadTerrain(FOOTFALL_SOURCE_DIR "/data/terrain/stairs.pts",
-                                TerrainLoadOptions{}, &stairs, &error) == Status::kOk);
-  Terrain t = LoadTerrain(stairs, 0.03);
+  Terrain t = LoadTerrain(LoadShippedTerrain("stairs"), 0.03);
   for (const std::string name : {"quadruped", "hexapod", "octopod"}) {
     const Character c = LoadShipped(name);
     INFO(name);
@@ -196,11 +192,7 @@ TEST_CASE("The shipped quadruped climbs the shipped stairs, the insects walk dow
           "[steps][generator]") {
   // data/terrain/stairs.pts: 8 steps of 0.18 x 0.3 m along +Z, 1.5 m wide, top tread at 1.26.
   // The quadruped's toes start close to each riser, so its swing lifts before it travels.
-  RawSamples stairs;
-  std::string error;
-  REQUIRE(footfall::LoadTerrain(FOOTFALL_SOURCE_DIR "/data/terrain/stairs.pts",
-                                TerrainLoadOptions{}, &stairs, &error) == Status::kOk);
-  Terrain t = LoadTerrain(stairs, 0.03);
+  Terrain t = LoadTerrain(LoadShippedTerrain("stairs"), 0.03);
   // Also the quadruped in a four-beat walk, hind foot first: at this start its hind feet stand
   // off the flight's back edge, their targets behind them until a front foot steps (it stopped
   // at step 1 as at a dead end).
@@ -293,10 +285,7 @@ TEST_CASE("A foot whose swing arc cannot clear takes its next foothold instead",
   // file: queries answer it, so footholds at a nose are refused as too steep and footholds
   // just past one are often reached by arcs that snap to it and cannot clear. The quadruped
   // climbs anyway by taking its next, shorter or longer, foothold.
-  RawSamples lattice;
-  std::string error;
-  REQUIRE(footfall::LoadTerrain(FOOTFALL_SOURCE_DIR "/data/terrain/stairs.pts",
-                                TerrainLoadOptions{}, &lattice, &error) == Status::kOk);
+  const RawSamples lattice = LoadShippedTerrain("stairs");
   RawSamples doubled;
   for (size_t i = 0; i < lattice.size(); ++i) {
     const Vec3 p = lattice.points[i];
@@ -989,10 +978,7 @@ TEST_CASE(
   // round of arc checks) and some characters stop.
   Character c = LoadShipped("hexapod");
   c.max_rise = 0.03;  // so that some characters stop at ridges
-  RawSamples rocks;
-  std::string error;
-  REQUIRE(footfall::LoadTerrain(FOOTFALL_SOURCE_DIR "/data/terrain/rocks.pts", TerrainLoadOptions{},
-                                &rocks, &error) == Status::kOk);
+  const RawSamples rocks = LoadShippedTerrain("rocks");
   GenerateOptions o;
   o.steps = 30;
   o.crowd = 600;

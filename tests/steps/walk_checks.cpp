@@ -5,6 +5,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "footfall/import/terrain_loader.h"
+
 namespace footfall::test {
 
 const std::vector<std::string>& ShippedCharacters() {
@@ -19,6 +21,15 @@ Character LoadShipped(const std::string& name) {
   INFO(error);
   REQUIRE(LoadCharacter(path, &c, &error) == Status::kOk);
   return c;
+}
+
+RawSamples LoadShippedTerrain(const std::string& name) {
+  RawSamples samples;
+  std::string error;
+  const std::string path = std::string(FOOTFALL_SOURCE_DIR) + "/data/terrain/" + name + ".pts";
+  INFO(error);
+  REQUIRE(footfall::LoadTerrain(path, TerrainLoadOptions{}, &samples, &error) == Status::kOk);
+  return samples;
 }
 
 Terrain LoadTerrain(const RawSamples& samples, double spacing) {

@@ -14,8 +14,9 @@
 
 namespace footfall::test {
 
-const std::vector<std::string>& ShippedCharacters();  // "biped", "quadruped", ...
-Character LoadShipped(const std::string& name);       // from data/characters (REQUIREs success)
+const std::vector<std::string>& ShippedCharacters();     // "biped", "quadruped", ...
+Character LoadShipped(const std::string& name);          // from data/characters (REQUIREs success)
+RawSamples LoadShippedTerrain(const std::string& name);  // data/terrain/NAME.pts (REQUIREs success)
 
 // A terrain loaded into a fresh embedded session.
 struct Terrain {
