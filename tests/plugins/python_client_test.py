@@ -119,18 +119,26 @@ class EmbeddedTest(unittest.TestCase):
                 with self.assertRaises(ff.FootfallError):
                     call()
         self.assertEqual(self.s.info(t)[0], 9)  # still loaded
+        deep = {}
+        for _ in range(100000):  # nested past Python's recursion limit
+            deep = {"a": deep}
         for call in (lambda: self.s.next(t, [(0, 0, 0, 1, 0, 0)], "wide"),
                      lambda: self.s.load_file("x.pts", "fine"),
                      lambda: self.s.generate(t, ["steps", 1]),
                      lambda: self.s.generate(t, {"steps": float("nan")}),
-                     lambda: self.s.generate(t, {"steps": object()})):
+                     lambda: self.s.generate(t, {"steps": object()}),
+                     lambda: self.s.next(t, [(0, 0, 0, 1, 0, 0)], 10 ** 400),
+                     lambda: self.s.snap(t, [(10 ** 400, 0, 0)]),
+                     lambda: self.s.load_file("x.pts", 10 ** 400),
+                     lambda: self.s.generate(t, deep),
+                     lambda: self.s.check_character(deep)):
             with self.assertRaises(ff.FootfallError) as e:
                 call()
             self.assertEqual(e.exception.status_name, "invalid_argument")
         self.s.unload(t)
 
     def test_unbounded_timeouts_are_refused(self):
-        for timeout in (float("inf"), float("nan"), 1e300, "soon"):
+        for timeout in (float("inf"), float("nan"), 1e300, "soon", 10 ** 400):
             with self.assertRaises(ff.FootfallError) as e:
                 ff.Session.rpc("127.0.0.1", 9, timeout)
             self.assertIn("timeout", e.exception.message)

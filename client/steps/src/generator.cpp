@@ -836,6 +836,7 @@ Status Generator::FindStart(const Vec3& start, bool may_move, Foothold* first, s
   std::vector<Vec3> points;
   std::vector<Foothold> grounds, snapped;
   std::vector<Agent> stand;
+  bool level_feet = true;  // the first search: every foot on ground within max_slope_deg
   // Candidates [b, e): sets *found to the first where the character can stand.
   auto search = [&](size_t b, size_t e, bool* found) -> Status {
     points.resize(e - b);
@@ -865,20 +866,27 @@ Status Generator::FindStart(const Vec3& start, bool may_move, Foothold* first, s
       for (size_t f = 0; f < feet && near; ++f) {
         const Foothold& h = snapped[m * feet + f];
         const Vec3 d = h.point - points[m * feet + f];
-        // ... and on ground within max_slope_deg of the up it was placed with (Plant judges the
-        // feet's averaged normal: two paws on a stair's riser and two on its tread averaged 45
-        // degrees, and the default start stood them there).
+        // ... and, in the first search, on ground within max_slope_deg of the up it was placed
+        // with (Plant judges the feet's averaged normal: two paws on a stair's riser and two on
+        // its tread averaged 45 degrees, and the default start stood them there).
         near = h.status == Status::kOk && std::fabs(Dot(d, a.up)) <= c_.max_rise &&
-               Length(ProjectOnPlane(d, a.up)) <= beside && Dot(h.normal, a.up) >= cos_max_slope_;
+               Length(ProjectOnPlane(d, a.up)) <= beside &&
+               (!level_feet || Dot(h.normal, a.up) >= cos_max_slope_);
       }
       if (near && Plant(a, &snapped[m * feet]).empty()) *found = true, *first = grounds[m];
     }
     return Status::kOk;
   };
-  // The start alone first: usually the character stands there, and nothing more is asked.
+  // The start alone first: usually the character stands there, and nothing more is asked. A
+  // place with every foot on level enough ground first; else one where Plant accepts the feet
+  // (a diagonal across a flight of stairs has no place of the first kind within reach).
   bool found = false;
-  s = search(0, 1, &found);
-  if (s == Status::kOk && !found) s = search(1, grid.size(), &found);
+  for (bool level : {true, false}) {
+    level_feet = level;
+    s = search(0, 1, &found);
+    if (s == Status::kOk && !found) s = search(1, grid.size(), &found);
+    if (s != Status::kOk || found) break;
+  }
   return s;  // found nowhere: the start's own sample, where Setup says why it cannot stand
 }
 

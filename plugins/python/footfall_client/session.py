@@ -73,7 +73,7 @@ def _flat(rows, width, what):
                 if len(row) != width:
                     raise ValueError
                 flat.extend(float(v) for v in row)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise FootfallError(INVALID_ARGUMENT, "%s: expected %d numbers per item" % (what, width),
                             "python") from None
     if len(flat) % width:
@@ -94,7 +94,7 @@ def _number(value, what, function):
     """A float for the C library, or FootfallError naming `what`."""
     try:
         return float(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise FootfallError(INVALID_ARGUMENT, "%s %r: expected a number" % (what, value),
                             function) from None
 
@@ -108,7 +108,7 @@ def _json_text(value, what, function):
                             % (what, type(value).__name__), function)
     try:
         return json.dumps(value, allow_nan=False).encode("utf-8", "replace")
-    except (TypeError, ValueError) as e:
+    except (TypeError, ValueError, RecursionError) as e:
         raise FootfallError(INVALID_ARGUMENT, "%s: %s" % (what, e), function) from None
 
 
@@ -136,7 +136,7 @@ class Session:
             raise FootfallError(INVALID_ARGUMENT, "port %r: expected 1 to 65535" % (port,), "ffc_open_rpc")
         try:
             timeout = float(timeout)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             timeout = float("nan")
         if not timeout <= 1e6:
             raise FootfallError(INVALID_ARGUMENT, "timeout %r: expected at most 1e6 seconds"
@@ -312,8 +312,8 @@ class Session:
             raise FootfallError(INVALID_ARGUMENT, "%s: expected a character as a dict or JSON "
                                 "text, got %s" % (name, type(data).__name__),
                                 "ffc_check_character")
-        text = data if isinstance(data, str) else json.dumps(data)
-        status = self._lib.lib.ffc_check_character(h, text.encode("utf-8", "replace"))
+        text = _json_text(data, name, "ffc_check_character")
+        status = self._lib.lib.ffc_check_character(h, text)
         if status != OK:
             message = self.last_error()
             if message.startswith("character"):
