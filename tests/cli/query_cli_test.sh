@@ -17,6 +17,14 @@ check "no command: the commands listed" grep -qx 'footfall: a command is require
 "$footfall" qeury --terrain "$work/flat.pts" > /dev/null 2> "$work/err.txt"
 check "unknown command: exit 1" [ $? -eq 1 ]
 check "unknown command: named" grep -qF "footfall: unknown command 'qeury': expected one of query, terrain, generate, bench" "$work/err.txt"
+"$footfall" terrain > /dev/null 2> "$work/err.txt"
+check "no terrain command: exit 1" [ $? -eq 1 ]
+check "no terrain command: its commands listed" grep -qx 'footfall terrain: a command is required: convert, info, make (footfall terrain --help)' "$work/err.txt"
+"$footfall" terrain mkae > /dev/null 2> "$work/err.txt"
+check "unknown terrain command: named" grep -qF "footfall terrain: unknown command 'mkae': expected one of convert, info, make" "$work/err.txt"
+"$footfall" -v > /dev/null 2> "$work/err.txt"
+check "an option before any command: exit 1" [ $? -eq 1 ]
+check "an option before any command: named" grep -qF "footfall: unknown option '-v' where a command is expected: query, terrain, generate, bench" "$work/err.txt"
 
 # 1. Answers, in order, one JSON object per line.
 printf 'snap 1.2 3 2.9\nnormal 4 4 4\nnext 1 0 1 0 0 2\nnext 1 0 4 0 0 2\n' |

@@ -4,11 +4,48 @@
 #include <iostream>
 #include <new>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
 #include "footfall/terrain/output_file.h"
+
+namespace {
+
+// What is wrong with the command words of argv (a command missing, or a word or option that
+// names none where a command is expected), or "" when CLI11 can take it from there.
+std::string CommandHint(const CLI::App& root, int argc, char** argv) {
+  const CLI::App* at = &root;
+  std::string path = "footfall";
+  auto names = [](const CLI::App* app) {
+    std::string list;
+    for (const CLI::App* command : app->get_subcommands({}))
+      list += (list.empty() ? "" : ", ") + command->get_name();
+    return list;
+  };
+  for (int i = 1; i < argc; ++i) {
+    const std::vector<const CLI::App*> commands = at->get_subcommands({});
+    if (commands.empty()) return "";  // a command's own flags and arguments: CLI11's
+    const std::string word = argv[i];
+    if (word == "-h" || word == "--help") return "";
+    if (!word.empty() && word[0] == '-')
+      return path + ": unknown option '" + word + "' where a command is expected: " + names(at) +
+             " (" + path + " --help)";
+    const CLI::App* next = nullptr;
+    for (const CLI::App* command : commands)
+      if (command->check_name(word)) next = command;
+    if (!next)
+      return path + ": unknown command '" + word + "': expected one of " + names(at) + " (" + path +
+             " --help)";
+    at = next;
+    path += " " + next->get_name();
+  }
+  if (at->get_subcommands({}).empty()) return "";
+  return path + ": a command is required: " + names(at) + " (" + path + " --help)";
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   std::signal(SIGPIPE, SIG_IGN);            // a vanished server must give an error, not kill us
@@ -22,18 +59,9 @@ int main(int argc, char** argv) {
   footfall::cli::AddBenchCommand(app, &exit_code);
   // No command, or a word that names none: say which there are (CLI11 only says that one is
   // required).
-  std::string names;
-  bool known = false;
-  for (const CLI::App* command : app.get_subcommands({})) {
-    names += (names.empty() ? "" : ", ") + command->get_name();
-    known |= argc >= 2 && command->check_name(argv[1]);
-  }
-  if (argc < 2 || (argv[1][0] != '-' && !known)) {
-    if (argc < 2)
-      std::cerr << "footfall: a command is required: " << names << " (footfall --help)\n";
-    else
-      std::cerr << "footfall: unknown command '" << argv[1] << "': expected one of " << names
-                << " (footfall --help)\n";
+  const std::string hint = CommandHint(app, argc, argv);
+  if (!hint.empty()) {
+    std::cerr << hint << '\n';
     return 1;
   }
   try {
