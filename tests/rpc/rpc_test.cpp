@@ -178,14 +178,15 @@ void RequireServed(int port) {
   CHECK(f.point == Vec3{3, 0, 5});
 }
 
-// A raw rpcgen client of footfalld on loopback (rpcgen's stubs, no session logic).
-CLIENT* RawClient(int port) {
+// A raw rpcgen client of footfalld on loopback (rpcgen's stubs, no session logic). Its send
+// size (libtirpc's default unless given) fragments larger requests, which footfalld drops.
+CLIENT* RawClient(int port, u_int send_size = 0) {
   sockaddr_in addr{};
   addr.sin_family = AF_INET;
   addr.sin_port = htons(static_cast<uint16_t>(port));
   addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   int sock = RPC_ANYSOCK;
-  CLIENT* c = clnttcp_create(&addr, FOOTFALL_PROG, FOOTFALL_V1, &sock, 0, 0);
+  CLIENT* c = clnttcp_create(&addr, FOOTFALL_PROG, FOOTFALL_V1, &sock, send_size, send_size);
   REQUIRE(c != nullptr);
   return c;
 }
@@ -500,6 +501,36 @@ TEST_CASE("A batch past --batch-time-limit lets other clients in and is complete
     RequireSame(got[i], expected[i]);
   }
   CHECK_THAT(server.Log(), Catch::Contains("past its time limit (0.05 s)"));
+
+  // Only connections that said they ask again (FF_ASK_AGAIN, as the library does) get batches
+  // in parts: a client that never did (an older library) gets whole batches, however long.
+  std::vector<uint32_t> handles = ServerTerrains(server.port());
+  REQUIRE(handles.size() == 2);
+  std::vector<ff_vec3> wire(far.size());
+  for (size_t i = 0; i < far.size(); ++i) wire[i] = {far[i].x, far[i].y, far[i].z};
+  auto limited = [&](CLIENT* c) {
+    ff_point_batch_args args{};
+    args.terrain = handles[0];  // the flat ground, loaded first
+    args.points.points_len = static_cast<u_int>(wire.size());
+    args.points.points_val = wire.data();
+    ff_batch_reply reply{};
+    REQUIRE(ff_snap_batch_1(&args, &reply, c) == RPC_SUCCESS);
+    REQUIRE(reply.status == FF_OK);
+    REQUIRE(reply.results.results_len == wire.size());
+    size_t later = 0;
+    for (u_int i = 0; i < reply.results.results_len; ++i)
+      later += reply.results.results_val[i].status == FF_LIMIT_EXCEEDED;
+    xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_batch_reply), reinterpret_cast<char*>(&reply));
+    return later;
+  };
+  CLIENT* raw = RawClient(server.port(), FF_MAX_REQUEST_BYTES + 8192);
+  CHECK(limited(raw) == 0);
+  ff_status_reply asked{};
+  REQUIRE(ff_ask_again_1(nullptr, &asked, raw) == RPC_SUCCESS);
+  CHECK(asked.status == FF_OK);
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_status_reply), reinterpret_cast<char*>(&asked));
+  CHECK(limited(raw) > 0);
+  clnt_destroy(raw);
 }
 
 TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {

@@ -130,6 +130,12 @@ void DropClient(const Connection& connection) {
         SecondsText(g_state->registry.limits().orphan_idle_s) + " without queries");
 }
 
+// True when the connection of `transport` asked for batches in parts (FF_ASK_AGAIN).
+bool AsksAgain(SVCXPRT* transport) {
+  const auto it = g_state->connections.find(transport->xp_fd);
+  return it != g_state->connections.end() && it->second.asks_again;
+}
+
 // The connection a request came on, registered on its first request.
 uint64_t ConnectionOf(SVCXPRT* transport) {
   const netbuf& address = transport->xp_rtaddr;
@@ -399,14 +405,17 @@ void ClearFailed(Foothold* f) {
 }
 
 // Answers queries [0, n) of a batch into g_storage.answers on the batch threads; `answer(b, e)`
-// fills answers [b, e). Chunks taken after the batch's time limit are answered
-// kLimitExceeded (the first always is answered: every call makes progress).
+// fills answers [b, e). For a connection that asks again (`in_parts`), chunks taken after the
+// batch's time limit are answered kLimitExceeded (the first always is answered: every call makes
+// progress).
 template <typename Fn>
-void RunBatch(size_t n, BatchReplyView<Foothold>* r, Fn&& answer) {
+void RunBatch(size_t n, BatchReplyView<Foothold>* r, bool in_parts, Fn&& answer) {
   Foothold* answers = g_storage.answers.data();
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                            std::chrono::duration<double>(g_state->batch_time_limit_s));
+  const auto deadline = in_parts
+                            ? std::chrono::steady_clock::now() +
+                                  std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                      std::chrono::duration<double>(g_state->batch_time_limit_s))
+                            : std::chrono::steady_clock::time_point::max();
   std::atomic<size_t> late{0};
   g_pool->Run(n, BatchPool::kQueryChunk, [&](size_t begin, size_t end) {
     // One call may cover the whole batch (one thread): the limit is checked every chunk.
@@ -431,7 +440,7 @@ void RunBatch(size_t n, BatchReplyView<Foothold>* r, Fn&& answer) {
   r->results = answers;
 }
 
-void PointBatch(const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r, int op) {
+void PointBatch(const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r, int op, bool in_parts) {
   const LoadedTerrain* t = g_state->registry.Use(a.terrain);
   if (!t) {
     r->status = FF_UNKNOWN_TERRAIN;
@@ -439,14 +448,14 @@ void PointBatch(const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r, int 
   }
   const size_t n = a.count;
   const Vec3* points = a.points;
-  RunBatch(n, r, [&](size_t b, size_t e, Foothold* out) {
+  RunBatch(n, r, in_parts, [&](size_t b, size_t e, Foothold* out) {
     t->grid.SnapBatch(points + b, e - b, out + b);
   });
   for (size_t i = 0; i < n && i < kRecordPerBatch; ++i)
     Record(a.terrain, op, points[i], Vec3{}, 0, r->results[i]);
 }
 
-void NextBatch(const NextBatchView<StepQuery>& a, BatchReplyView<Foothold>* r) {
+void NextBatch(const NextBatchView<StepQuery>& a, BatchReplyView<Foothold>* r, bool in_parts) {
   const LoadedTerrain* t = g_state->registry.Use(a.terrain);
   if (!t) {
     r->status = FF_UNKNOWN_TERRAIN;
@@ -459,7 +468,7 @@ void NextBatch(const NextBatchView<StepQuery>& a, BatchReplyView<Foothold>* r) {
   const size_t n = a.count;
   const StepQuery* steps = a.queries;
   const double tolerance = a.tolerance;
-  RunBatch(n, r, [&](size_t b, size_t e, Foothold* out) {
+  RunBatch(n, r, in_parts, [&](size_t b, size_t e, Foothold* out) {
     t->grid.NextBatch(steps + b, e - b, tolerance, out + b);
   });
   for (size_t i = 0; i < n && i < kRecordPerBatch; ++i)
@@ -631,8 +640,8 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
           transport, AsXdrProc(XdrPointBatchView<Vec3>), args,
           AsXdrProc(XdrBatchReplyView<Foothold>),
           request->rq_proc == FF_SNAP_BATCH ? "snap batch" : "normal batch",
-          [op](const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r) {
-            PointBatch(a, r, op);
+          [op, transport](const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r) {
+            PointBatch(a, r, op, AsksAgain(transport));
           });
     }
     case FF_NEXT_BATCH: {
@@ -641,7 +650,22 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
       args.capacity = FF_MAX_BATCH;
       return ServeWith<NextBatchView<StepQuery>, BatchReplyView<Foothold>>(
           transport, AsXdrProc(XdrNextBatchView<StepQuery>), args,
-          AsXdrProc(XdrBatchReplyView<Foothold>), "next batch", NextBatch);
+          AsXdrProc(XdrBatchReplyView<Foothold>), "next batch",
+          [transport](const NextBatchView<StepQuery>& a, BatchReplyView<Foothold>* r) {
+            NextBatch(a, r, AsksAgain(transport));
+          });
+    }
+    case FF_ASK_AGAIN: {
+      struct Empty {
+        int unused;
+      };
+      return Serve<Empty, ff_status_reply>(
+          transport, FF_XDR_VOID, FF_XDR(ff_status_reply), "ask again",
+          [transport](const Empty&, ff_status_reply* r) {
+            g_state->connections[transport->xp_fd].asks_again = true;  // registered above
+            r->status = FF_OK;
+            r->message = Message("");
+          });
     }
     case FF_RECENT:
       return Serve<ff_recent_args, ff_recent_reply>(transport, FF_XDR(ff_recent_args),

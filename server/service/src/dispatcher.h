@@ -18,6 +18,7 @@ namespace footfall {
 struct Connection {
   uint64_t id = 0;
   std::string peer;
+  bool asks_again = false;  // FF_ASK_AGAIN: its batches may be answered in parts
 };
 
 struct ServiceState {
