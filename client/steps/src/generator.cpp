@@ -600,10 +600,15 @@ Status Generator::Setup(std::string* error) {
   s = FindStart(start, !o_.has_start || o_.start_may_move, &first, error);
   if (s != Status::kOk) return s;
   // 2. The start frame: up (terrain normal for multipeds, world up for bipeds) and the heading
-  //    projected onto the plane perpendicular to it. Crowds stand on a grid in that plane.
+  //    projected onto the plane perpendicular to it. Crowds stand on a grid in that plane, or,
+  //    on ground within 45 degrees of world up, across world up: one bump's normal tilted a
+  //    large grid metres above and below the ground, and its places snapped onto the bumps'
+  //    tops together (826 of 10,000 insects on gentle bumps started on another's sample).
   const Vec3 up0 = c_.align_to_normal ? first.normal : world_up_;
   const Vec3 fwd0 = StartHeading(up0);
-  const Vec3 left0 = Cross(up0, fwd0);
+  const Vec3 grid_up = Dot(up0, world_up_) >= std::sqrt(0.5) ? world_up_ : up0;
+  const Vec3 grid_fwd = Normalize(ProjectOnPlane(fwd0, grid_up));
+  const Vec3 grid_left = Cross(grid_up, grid_fwd);
   const int n = std::max(1, o_.crowd);
   const int cols = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n))));
   const int rows = (n + cols - 1) / cols;
@@ -613,7 +618,7 @@ Status Generator::Setup(std::string* error) {
   for (int i = 0; i < n; ++i) {
     const double x = (i % cols - (cols - 1) / 2.0) * spacing;
     const double z = (i / cols - (rows - 1) / 2.0) * spacing;
-    offsets[i] = n == 1 ? Vec3{} : left0 * x + fwd0 * z;
+    offsets[i] = n == 1 ? Vec3{} : grid_left * x + grid_fwd * z;
     points_[i] = first.point + offsets[i];
   }
   answers_.resize(n);
