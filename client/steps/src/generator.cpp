@@ -625,7 +625,7 @@ Status Generator::Setup(std::string* error) {
   s = Check(session_.Snap(terrain_, points_.data(), n, answers_.data()), "snap start", error);
   if (s != Status::kOk) return s;
   // Where the grid runs off the terrain (or past a narrow one), several places snap onto one
-  // edge: a character starting within half the spacing of an earlier one stays out.
+  // edge: a character starting within half the spacing of another stays out (CrowdedStarts).
   const std::vector<int> crowded = CrowdedStarts(points_.data(), answers_.data(), n, 0.5 * spacing);
   std::vector<Vec3> snapped_start(n);
   for (int i = 0; i < n; ++i) snapped_start[i] = answers_[i].point;
@@ -719,9 +719,10 @@ std::vector<int> Generator::CrowdedStarts(const Vec3* places, const Foothold* st
   };
   std::unordered_map<std::array<int64_t, 3>, std::vector<int>, CellHash> cells;
   auto cell_of = [apart](const Vec3& p) {
-    return std::array<int64_t, 3>{static_cast<int64_t>(std::floor(p.x / apart)),
-                                  static_cast<int64_t>(std::floor(p.y / apart)),
-                                  static_cast<int64_t>(std::floor(p.z / apart))};
+    auto index = [apart](double v) {  // clamped: a tiny spacing must not overflow the cast
+      return static_cast<int64_t>(std::clamp(std::floor(v / apart), -9e18, 9e18));
+    };
+    return std::array<int64_t, 3>{index(p.x), index(p.y), index(p.z)};
   };
   // The characters that snapped nearest their places first (those on the terrain before those
   // pushed onto its edge), in grid order among equals.
