@@ -67,12 +67,8 @@ class RpcSession final : public TerrainSession {
   ~RpcSession() override {
     if (options_.unload_on_close && client_) {
       SetCallTimeout(client_, std::min(options_.call_timeout_s, kCloseTimeout));
-      for (const auto& entry : terrains_) {
-        if (!entry.second.loaded || !client_) continue;
-        ff_terrain_args args{entry.second.server_handle};
-        Reply<ff_status_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_status_reply));
-        if (ff_unload_1(&args, &reply.value, client_) != RPC_SUCCESS) break;  // gone: orphans
-      }
+      for (const auto& entry : terrains_)
+        if (entry.second.loaded && UnloadOnServer(entry.second) != RPC_SUCCESS) break;  // orphans
     }
     Disconnect();
   }
@@ -136,11 +132,7 @@ class RpcSession final : public TerrainSession {
   Status Unload(TerrainHandle terrain) override {
     auto it = terrains_.find(terrain);
     if (it == terrains_.end()) return Unknown(terrain);
-    if (it->second.loaded && client_) {
-      ff_terrain_args args{it->second.server_handle};
-      Reply<ff_status_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_status_reply));
-      Call(ff_unload_1(&args, &reply.value, client_), "unload");  // best effort
-    }
+    if (it->second.loaded && client_) Call(UnloadOnServer(it->second), "unload");  // best effort
     terrains_.erase(it);
     return Status::kOk;
   }
@@ -215,6 +207,14 @@ class RpcSession final : public TerrainSession {
       if (s != Status::kOk) return s;
     }
     return Status::kOk;
+  }
+
+  // Asks the connected footfalld to unload a loaded terrain; the call's status (the reply's is
+  // not needed: an unload is best effort).
+  clnt_stat UnloadOnServer(const TerrainSource& source) {
+    ff_terrain_args args{source.server_handle};
+    Reply<ff_status_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_status_reply));
+    return ff_unload_1(&args, &reply.value, client_);
   }
 
   // Sends again, in calls of their own, the queries footfalld left for later (kLimitExceeded:
