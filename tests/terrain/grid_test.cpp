@@ -355,6 +355,42 @@ TEST_CASE("TerrainGrid next follows the candidate rules", "[terrain][grid]") {
   }
 }
 
+TEST_CASE("TerrainGrid next never answers a point level with the foot by the caller's arithmetic",
+          "[terrain][grid]") {
+  // Far from the world origin (here across x = 2^17, where doubles change their step), a stored
+  // point's world position, origin + its float offset, rounds. From a foot placed exactly on
+  // such a reported point the sample itself lies level with the foot (dot 0), but its local
+  // offset and the foot's differed by that rounding: it was answered as ahead of itself.
+  RawSamples s;
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-0.9, 0.9);
+  for (int i = 0; i < 40; ++i) {
+    for (int k = 0; k < 40; ++k) {
+      s.points.push_back({131072.0 + 3 * i - 60.1 + u(rng), 50.3 + u(rng), -65536.7 + 3 * k});
+      s.normals.push_back({0, 1, 0});
+    }
+  }
+  const TerrainGrid g = Build(s);
+  const BruteForce oracle(g);
+  int answered = 0, checked = 0;
+  g.ForEachSample([&](uint32_t index, const Vec3& w, const Vec3&) {
+    for (const Vec3& d : {Vec3{0.5, 0, 0}, Vec3{-0.5, 0, 0}, Vec3{0, 0.5, 0}, Vec3{0, -0.5, 0},
+                          Vec3{0, 0, 0.5}, Vec3{0, 0, -0.5}, Vec3{0.3, 0.2, -0.3}}) {
+      const StepQuery q{w, d};
+      const Foothold f = g.Next(q, 1.0);
+      RequireSame(f, oracle.Next(q, 1.0), "brute force");
+      ++checked;
+      if (f.status != Status::kOk) continue;
+      ++answered;
+      INFO("foot on sample " << index << " at " << Describe(w) << " along " << Describe(d)
+                             << ": answer " << f.index);
+      REQUIRE(Dot(f.point - w, d) > 0);
+    }
+  });
+  CHECK(checked == 1600 * 7);
+  CHECK(answered > 0);  // some neighbours come within reach
+}
+
 TEST_CASE("TerrainGrid next with a tolerance as large as the terrain", "[terrain][grid]") {
   // 200 x 200 samples, 0.1 apart: steps from every edge outward and inward, from inside and
   // from beyond the bounds, with tolerances from a step to far beyond the terrain.

@@ -328,14 +328,12 @@ struct TerrainGrid::NextScanner {
 
   static constexpr bool kUsesBox = true;
   double limit2() const { return best_d2; }
-  // Skips a cell lying wholly behind the foot: its farthest corner along dir is not ahead.
+  // Skips a cell lying wholly behind the foot: its farthest corner along dir is not ahead
+  // (exact, as AheadBy is monotonic; the padded box holds every sample of the cell).
   bool KeepCell(const double* lo, const double* hi) const {
-    double support = 0;
-    for (int a = 0; a < 3; ++a) {
-      const double d = f->dir[a];
-      support += d * ((d > 0 ? hi[a] : lo[a]) - f->foot[a]);
-    }
-    return support > 0;  // the padded box absorbs rounding
+    double corner[3];
+    for (int a = 0; a < 3; ++a) corner[a] = f->dir[a] > 0 ? hi[a] : lo[a];
+    return detail::AheadBy(corner, *f) > 0;
   }
   // Skips a block whose samples all lie behind the foot or level with it, from the tight bounds
   // of its samples: the corner farthest along dir, computed as Ahead computes a sample's, is

@@ -1,5 +1,6 @@
 // Arithmetic shared by TerrainGrid and BruteForce, so both compute bit-identical distances and
-// predicates. Everything is in the grid's local frame (world minus origin), in double.
+// predicates. Distances are in the grid's local frame (world minus origin), in double; the
+// ahead test is on the world points answers report.
 #pragma once
 
 #include <algorithm>
@@ -37,11 +38,12 @@ inline bool InQueryRange(const double c[3]) {
          std::fabs(c[2]) <= kMaxQueryDistance;
 }
 
-// A next query in local coordinates.
+// A next query: its ideal point in local coordinates, its foot in world coordinates (see Ahead).
 struct NextFrame {
-  double foot[3];
+  double origin[3];  // the grid's
+  double foot[3];    // world
   double dir[3];
-  double ideal[3];
+  double ideal[3];  // local
   double radius2;
 };
 
@@ -56,24 +58,36 @@ inline bool MakeNextFrame(const double origin[3], const StepQuery& q, double tol
   const double len2 = Length2(q.direction);
   const double foot[3] = {q.foot.x, q.foot.y, q.foot.z};
   const double dir[3] = {q.direction.x, q.direction.y, q.direction.z};
+  double local_foot[3];
   for (int a = 0; a < 3; ++a) {
-    frame->foot[a] = foot[a] - origin[a];
+    frame->origin[a] = origin[a];
+    frame->foot[a] = foot[a];
     frame->dir[a] = dir[a];
-    frame->ideal[a] = frame->foot[a] + dir[a];
+    local_foot[a] = foot[a] - origin[a];
+    frame->ideal[a] = local_foot[a] + dir[a];
   }
   // A tolerance beyond any distance within query range reaches every sample as it is: squaring
   // it must not overflow (above 1e154 every query came back invalid).
   const double reach = std::min(tolerance, 4 * kMaxQueryDistance);
   frame->radius2 = tolerance > 0 ? reach * reach : len2;
-  return std::isfinite(frame->radius2) && InQueryRange(frame->foot) && InQueryRange(frame->ideal);
+  return std::isfinite(frame->radius2) && InQueryRange(local_foot) && InQueryRange(frame->ideal);
 }
 
-// True when a stored point is strictly ahead of the foot: dot(p - foot, dir) > 0.
+// dot(w - foot, dir) for the world point w = origin + p that an answer at local point p
+// reports, computed as a caller checks it: no answer is level with or behind the foot by the
+// caller's arithmetic. Non-decreasing in each coordinate of p along the sign of dir (rounding
+// is monotonic), so a box's corner farthest along dir bounds every point inside it.
+inline double AheadBy(const double p[3], const NextFrame& f) {
+  const double ax = (f.origin[0] + p[0]) - f.foot[0];
+  const double ay = (f.origin[1] + p[1]) - f.foot[1];
+  const double az = (f.origin[2] + p[2]) - f.foot[2];
+  return ax * f.dir[0] + ay * f.dir[1] + az * f.dir[2];
+}
+
+// True when a stored (float, local) point is strictly ahead of the foot (AheadBy > 0).
 inline bool Ahead(const float* p, const NextFrame& f) {
-  const double ax = static_cast<double>(p[0]) - f.foot[0];
-  const double ay = static_cast<double>(p[1]) - f.foot[1];
-  const double az = static_cast<double>(p[2]) - f.foot[2];
-  return ax * f.dir[0] + ay * f.dir[1] + az * f.dir[2] > 0;
+  const double d[3] = {p[0], p[1], p[2]};
+  return AheadBy(d, f) > 0;
 }
 
 }  // namespace detail
