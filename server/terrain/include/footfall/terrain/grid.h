@@ -122,7 +122,8 @@ class TerrainGrid {
   Foothold Normal(const Vec3& q, QueryTrace* trace = nullptr) const { return Snap(q, trace); }
 
   // The foothold for a foot at q.foot moving along q.direction. Candidates are samples p ahead
-  // of the foot, dot(p - foot, direction) > 0, within `radius` of the ideal point
+  // of the foot, dot(p - foot, direction) > 0 in double for p the point an answer reports
+  // (never level with the foot by a caller's own check), within `radius` of the ideal point
   // foot + direction, where radius = tolerance if tolerance > 0 and |direction| otherwise.
   // The answer is the candidate nearest the ideal point (ties: lowest index), or kNoFoothold.
   // kInvalidArgument for a zero or non-finite direction, non-finite foot or tolerance.
