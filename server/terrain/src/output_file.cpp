@@ -36,6 +36,12 @@ int WriteAndClose(std::FILE* file, const std::function<bool(std::FILE*)>& write)
   if (!ok && failure == 0) failure = errno ? errno : EIO;
   if (std::fflush(file) != 0 && failure == 0) failure = errno ? errno : EIO;
   if (std::ferror(file) && failure == 0) failure = EIO;
+  // A regular file reaches the disk before it counts as written (and before it replaces the
+  // old one): a full or failing disk or quota reported only at write-back is an error here.
+  struct stat st;
+  if (failure == 0 && ::fstat(::fileno(file), &st) == 0 && S_ISREG(st.st_mode) &&
+      ::fsync(::fileno(file)) != 0)
+    failure = errno ? errno : EIO;
   if (std::fclose(file) != 0 && failure == 0) failure = errno ? errno : EIO;
   return failure;
 }
@@ -192,6 +198,12 @@ Status ReplaceFile(const std::string& path, const std::function<bool(std::FILE*)
   if (failure != 0) return abandon(failure);
   if (::rename(temp.c_str(), target.c_str()) != 0) return abandon(errno);
   g_temporary.store(nullptr);
+  // The rename itself reaches the disk with its directory (best effort: the file is written).
+  const int dir_fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir_fd >= 0) {
+    ::fsync(dir_fd);
+    ::close(dir_fd);
+  }
   return Status::kOk;
 }
 
