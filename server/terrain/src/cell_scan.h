@@ -50,6 +50,10 @@ inline void ScanCellNearest(const float* xyz, uint32_t first, uint32_t count, co
     least = nearer ? d2 : least;
     at = nearer ? lane + static_cast<double>(i) : at;
   }
+  // No lane reached the best so far (most neighbour cells): nothing to merge.
+  const double bound = *best_d2;
+  const auto reached = least <= Double4{bound, bound, bound, bound};
+  if (!(reached[0] | reached[1] | reached[2] | reached[3])) return;
   const Double4 half = __builtin_shufflevector(least, least, 2, 3, 0, 1);
   const Double4 pair = least < half ? least : half;
   const Double4 swap = __builtin_shufflevector(pair, pair, 1, 0, 3, 2);
