@@ -73,6 +73,38 @@ TEST_CASE("SampleMesh: no surface point is farther than the separation from a sa
   }
 }
 
+TEST_CASE("SampleMesh: both faces of a slab thinner than the separation are covered",
+          "[import][sampler]") {
+  // A floor modelled as a closed box 2 x 2, s / 4 thick (outward winding). Pieces of the top
+  // and the bottom lie closer than the minimum distance: they thinned each other out, leaving
+  // each face with gaps of 1.5-2.3 s, so that a foot on the top snapped to the underside.
+  const double s = 0.1, t = s / 4, l = 2;
+  TriangleMesh box;
+  for (int i = 0; i < 8; ++i)
+    box.vertices.push_back({i & 1 ? l : 0, i & 2 ? 0.0 : -t, i & 4 ? l : 0});
+  // Faces as quads (outward), each split in two.
+  const int quads[6][4] = {{2, 6, 7, 3}, {0, 1, 5, 4}, {0, 2, 3, 1},
+                           {4, 5, 7, 6}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    box.triangles.push_back(
+        {static_cast<uint32_t>(q[0]), static_cast<uint32_t>(q[1]), static_cast<uint32_t>(q[2])});
+    box.triangles.push_back(
+        {static_cast<uint32_t>(q[0]), static_cast<uint32_t>(q[2]), static_cast<uint32_t>(q[3])});
+  }
+  const RawSamples samples = Sample(box, s, false);
+  for (double side : {1.0, -1.0}) {
+    INFO((side > 0 ? "top" : "bottom"));
+    RawSamples own, probes;
+    for (size_t i = 0; i < samples.size(); ++i)
+      if (samples.normals[i].y * side > 0.5) own.push_back(samples.points[i], samples.normals[i]);
+    for (int i = 0; i <= 80; ++i)
+      for (int k = 0; k <= 80; ++k)
+        probes.push_back({l * i / 80, side > 0 ? 0 : -t, l * k / 80}, {0, side, 0});
+    REQUIRE(own.size() > 0);
+    CHECK(LargestGap(own, probes) <= s * (1 + 1e-5));
+  }
+}
+
 TEST_CASE("SampleMesh: samples do not clump", "[import][sampler]") {
   const TriangleMesh mesh = MakeRocksMesh(10, 0.4, 0.8, 4);
   const double s = 0.25;

@@ -35,14 +35,26 @@ struct SplitMix64 {
 // A step-1 piece's centroid, relative to the cell grid's corner, for distance tests. Its
 // triangle and barycentric position are found again in step 4 from its index (candidates are
 // stored in triangle order, each triangle's pieces in SplitTriangle's order).
+// `side` is its triangle's unit normal times 127, rounded: pieces facing apart (a thin slab's
+// top and bottom) do not thin each other out.
 struct Candidate {
   float offset[3];
+  int8_t side[4];  // x, y, z; the fourth is padding
 };
+
+// True when two pieces face the same way, within 90 degrees (a zero side, from a triangle too
+// thin for a normal, faces every way).
+bool SameSide(const int8_t* a, const int8_t* b) {
+  const int dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  const bool a_zero = (a[0] | a[1] | a[2]) == 0, b_zero = (b[0] | b[1] | b[2]) == 0;
+  return dot > 0 || a_zero || b_zero;
+}
 
 constexpr int kCellBits = 21;
 constexpr uint64_t kCellLimit = 1ull << kCellBits;
 constexpr uint32_t kNone = 0xffffffffu;
-constexpr int kSlots = 8;  // points >= r apart in a cube of side r: at most its 8 corners
+// Points >= r apart in a cube of side r: at most its 8 corners, on each side of a thin slab.
+constexpr int kSlots = 16;
 
 uint64_t CellKey(uint64_t x, uint64_t y, uint64_t z) {
   return (x << (2 * kCellBits)) | (y << kCellBits) | z;
@@ -375,10 +387,18 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   std::vector<uint32_t> first_candidate(mesh.triangles.size() + 1);  // per triangle
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     first_candidate[t] = static_cast<uint32_t>(candidates.size());
+    const Vec3 normal = Normalize(TriangleCross(mesh, t));
+    int8_t side[4] = {0, 0, 0, 0};
+    if (IsFinite(normal)) {
+      side[0] = static_cast<int8_t>(std::lround(127 * normal.x));
+      side[1] = static_cast<int8_t>(std::lround(127 * normal.y));
+      side[2] = static_cast<int8_t>(std::lround(127 * normal.z));
+    }
     SplitTriangle(mesh, t, h2, &stack, [&](const Piece& piece) {
       const Vec3 local = (piece.p[0] + piece.p[1] + piece.p[2]) / 3 - lo;
-      candidates.push_back({{static_cast<float>(local.x), static_cast<float>(local.y),
-                             static_cast<float>(local.z)}});
+      candidates.push_back(
+          {{static_cast<float>(local.x), static_cast<float>(local.y), static_cast<float>(local.z)},
+           {side[0], side[1], side[2], 0}});
       return true;
     });
   }
@@ -489,17 +509,19 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   struct Slots {
     uint32_t count;
     uint32_t more;  // with count > kInline: its entry in `overflow`
-    float p[kInline][3];
+    Candidate p[kInline];
   };
   std::vector<Slots> slots(cells);
   for (Slots& slot : slots) slot.count = 0;
-  std::vector<std::array<float, 3 * (kSlots - kInline)>> overflow;
+  std::vector<std::array<Candidate, kSlots - kInline>> overflow;
   std::vector<uint32_t> accepted;
   accepted.reserve(static_cast<size_t>(predicted * 1.2) + 16);
   const float r2f = static_cast<float>(r2);
-  auto near = [&](const float* p, const Candidate& cand) {
+  // Too near an accepted piece facing the same way.
+  auto near = [&](const Candidate& a, const Candidate& cand) {
+    const float* p = a.offset;
     const float dx = p[0] - cand.offset[0], dy = p[1] - cand.offset[1], dz = p[2] - cand.offset[2];
-    return dx * dx + dy * dy + dz * dz < r2f;
+    return dx * dx + dy * dy + dz * dz < r2f && SameSide(a.side, cand.side);
   };
   auto try_candidate = [&](uint32_t c, uint32_t cell) {
     const Candidate& cand = candidates[c];
@@ -508,21 +530,21 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
       for (uint32_t q = 0; q < std::min(slot.count, kInline); ++q)
         if (near(slot.p[q], cand)) return;
       for (uint32_t q = kInline; q < slot.count; ++q)
-        if (near(&overflow[slot.more][3 * (q - kInline)], cand)) return;
+        if (near(overflow[slot.more][q - kInline], cand)) return;
     }
     Slots& own = slots[cell];
     if (own.count == kSlots) return;
-    float* to = own.p[0];
+    Candidate* to = &own.p[0];
     if (own.count < kInline) {
-      to = own.p[own.count];
+      to = &own.p[own.count];
     } else {
       if (own.count == kInline) {
         own.more = static_cast<uint32_t>(overflow.size());
         overflow.emplace_back();
       }
-      to = &overflow[own.more][3 * (own.count - kInline)];
+      to = &overflow[own.more][own.count - kInline];
     }
-    for (int d = 0; d < 3; ++d) to[d] = cand.offset[d];
+    *to = cand;
     ++own.count;
     accepted.push_back(c);
   };
