@@ -365,6 +365,23 @@ TEST_CASE("A stop shows the value that broke a limit, never rounded onto the lim
   CHECK(shown > shown_limit);
 }
 
+TEST_CASE("A stop on ground facing down names the likely causes", "[steps][generator]") {
+  // Flat ground whose normals face down (the underside of a thin slab, or inward faces): the
+  // stop said only that the ground leans 180 degrees.
+  const Character c = LoadShipped("biped");
+  const double spacing = 0.05;
+  RawSamples ground = MakeFlat(80, spacing, 0);
+  for (Vec3& n : ground.normals) n = {0, -1, 0};
+  Terrain t = LoadTerrain(ground, spacing);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {2, 0, 2};
+  o.steps = 4;
+  const Walk w = Generate(t, c, o);
+  CHECK_THAT(w.stopped, Catch::Contains("leans 180") && Catch::Contains("it faces down") &&
+                            Catch::Contains("separation below its thickness"));
+}
+
 TEST_CASE("Multipeds climb a wall, others stop at it", "[steps][generator]") {
   for (const std::string& name : ShippedCharacters()) {
     const Character c = LoadShipped(name);

@@ -92,6 +92,13 @@ std::string Point(const Vec3& p) {
 // farthest the surface may be from its nearest sample. No sample is nearer than h, so no
 // surface is nearer than that: above a stair's nose, whose nearest sample may be the riser's
 // top, a point high up is in the clear although it lies little in front of the riser's plane.
+// For ground facing away from the character's up (more than 120 degrees): the likely causes.
+std::string FacingDownHint(double slope_deg) {
+  if (!(slope_deg > 120)) return "";
+  return "; it faces down: the underside of a surface thinner than the terrain's sample spacing "
+         "(resample at a separation below its thickness) or a mesh whose faces face inward";
+}
+
 double Clearance(const Vec3& p, const Foothold& h, double gap) {
   const Vec3 v = p - h.point;
   const double height = Dot(v, h.normal);
@@ -926,7 +933,7 @@ std::string Generator::Plant(Agent& a, const Foothold* feet) const {
       m.precision(3);
       m << "foot " << c_.feet[f].name << " cannot stand at " << Point(a.foot[f])
         << ": ground leans " << Beyond(slope, c_.max_slope_deg) << " deg, more than max_slope_deg "
-        << NumberText(c_.max_slope_deg);
+        << NumberText(c_.max_slope_deg) << FacingDownHint(slope);
       return m.str();
     }
   }
@@ -1093,9 +1100,10 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
         << Beyond(std::fabs(rise), c_.max_rise) << ", more than max_rise "
         << NumberText(c_.max_rise) << " (a cliff)";
   } else {
-    why << "the foothold at " << Point(h.point) << " leans "
-        << Beyond(Degrees(AngleBetween(h.normal, a.up)), c_.max_slope_deg)
-        << " deg, more than max_slope_deg " << NumberText(c_.max_slope_deg) << " (too steep)";
+    const double slope = Degrees(AngleBetween(h.normal, a.up));
+    why << "the foothold at " << Point(h.point) << " leans " << Beyond(slope, c_.max_slope_deg)
+        << " deg, more than max_slope_deg " << NumberText(c_.max_slope_deg) << " (too steep)"
+        << FacingDownHint(slope);
   }
   mv.reason = why.str(), mv.reason_is_gap = !found;
 }
