@@ -160,4 +160,49 @@ expect(EXIT_NONZERO "hill.asc: the grid spans 2e+15"
 expect(EXIT_NONZERO "unknown terrain file extension 'dae'" terrain info "${WORK}/terrain.dae")
 expect(EXIT_NONZERO "absent.obj: cannot open" query --terrain "${WORK}/absent.obj")
 expect(EXIT_NONZERO "choose a separation of at least" terrain info "${WORK}/cube.obj" --separation 0.0001)
+# Stairs going down along +z (a negative rise): their risers face +z (they were left out).
+expect(EXIT_ZERO "wrote" terrain make stairs --steps 3 --rise -0.2 --spacing 0.05 -o "${WORK}/down.pts")
+file(WRITE "${WORK}/riser.txt" "snap 0.5 -0.1 0.35\n")
+execute_process(COMMAND "${FOOTFALL}" query --terrain "${WORK}/down.pts" INPUT_FILE "${WORK}/riser.txt"
+                OUTPUT_VARIABLE riser RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0 OR NOT riser MATCHES "\"normal\":\\[0\\.0,0\\.0,1\\.0\\]")
+  message(FATAL_ERROR "the riser of stairs going down does not face +z: ${riser}")
+endif()
+# Seeds are whole numbers from 0 to 2^64 - 1 everywhere (make read -1 and 1e23 as 2^64 - 1).
+foreach(seed "-1" "18446744073709551616" "1.5")
+  expect(EXIT_NONZERO "--seed: '${seed}' is not a whole number from 0 to 18446744073709551615"
+         terrain make hills --seed ${seed} -o "${WORK}/x.pts")
+endforeach()
+# convert never writes over its input; --separation with a point file is refused, not ignored.
+file(WRITE "${WORK}/two.pts" "# surveyed\n0 0 0 0 1 0\n1 0 0 0 1 0\n")
+expect(EXIT_NONZERO "two.pts: the output is the input file"
+       terrain convert "${WORK}/two.pts" -o "${WORK}/two.pts")
+file(READ "${WORK}/two.pts" kept)
+if(NOT kept MATCHES "# surveyed")
+  message(FATAL_ERROR "terrain convert wrote over its input")
+endif()
+foreach(command "terrain;info" "query;--terrain")
+  expect(EXIT_NONZERO "--separation resamples meshes and height maps only"
+         ${command} "${WORK}/two.pts" --separation 0.1)
+endforeach()
+# Bounds far from the origin keep their digits.
+file(WRITE "${WORK}/far_bulk.pts" "10000000.125 0 0 0 1 0\n10000000.5 0 1 0 1 0\n")
+expect(EXIT_ZERO "bounds: (10000000.125, 0, 0) to (10000000.5, 0, 1)" terrain info "${WORK}/far_bulk.pts")
+expect(EXIT_NONZERO "would give more than 1e+308 samples"
+       terrain info "${WORK}/cube.obj" --separation 1e-300)
+# Height map headers: each key once, its number on its own line, cellsize with its line.
+file(WRITE "${WORK}/twice.asc" "ncols 2\nnrows 2\ncellsize 1\ncellsize 2\n1 2\n3 4\n")
+expect(EXIT_NONZERO "twice.asc:4: header 'cellsize' given again (first on line 3)"
+       terrain info "${WORK}/twice.asc")
+file(WRITE "${WORK}/bare.asc" "ncols 2\nnrows 2\ncellsize 1\nNODATA_value\n1 2\n3 4\n")
+expect(EXIT_NONZERO "bare.asc:4: header 'NODATA_value' needs a number on its line"
+       terrain info "${WORK}/bare.asc")
+file(WRITE "${WORK}/neg.asc" "ncols 2\nnrows 2\ncellsize -1\n1 2\n3 4\n")
+expect(EXIT_NONZERO "neg.asc:3: cellsize -1 (expected a number > 0)" terrain info "${WORK}/neg.asc")
+string(ASCII 27 escape)
+file(WRITE "${WORK}/esc.asc" "ncols 2\nnrows 2\ncellsize 1\n1 2\n3 ${escape}]0x\n")
+expect(EXIT_NONZERO "esc.asc:5: value '?]0x' is not a finite number" terrain info "${WORK}/esc.asc")
+file(WRITE "${WORK}/more.pgm" "P2\n2 2\n9\n1 2\n3 4 5\n")
+expect(EXIT_NONZERO "more.pgm:5: more than the 4 grey levels the header declares"
+       terrain info "${WORK}/more.pgm")
 file(REMOVE_RECURSE "${WORK}")

@@ -1,6 +1,7 @@
 // The point file reader: valid files load with normalised normals; each kind of bad line gives
 // an error naming file, line and what was expected.
 #include <unistd.h>
+#include <cmath>
 
 #include <cstdio>
 #include <cstdlib>
@@ -48,6 +49,20 @@ TEST_CASE("ReadPointStream accepts a UTF-8 byte order mark and bare decimal poin
   REQUIRE(s.size() == 2);
   CHECK(s.points[0] == Vec3{0.5, 5, 10});
   CHECK(s.points[1] == Vec3{0, 2, 0.03});
+}
+
+TEST_CASE("ReadPointStream reads numbers too small for a double as zero", "[terrain][point_file]") {
+  // 1e-400 was refused as out of range, though OBJ and height maps read it as 0.
+  RawSamples s;
+  std::string error;
+  const std::string tiny = "0." + std::string(400, '0') + "1";
+  REQUIRE(Read("1e-400 -1e-400 " + tiny + " 0 1 0\n", &s, &error) == Status::kOk);
+  REQUIRE(s.size() == 1);
+  CHECK(s.points[0].x == 0);
+  CHECK(std::signbit(s.points[0].y));
+  CHECK(s.points[0].z == 0);
+  CHECK(Read("1e400 0 0 0 1 0\n", &s, &error) == Status::kParseError);
+  CHECK_THAT(error, Catch::Contains("t.pts:1: column 1: '1e400' is out of range"));
 }
 
 TEST_CASE("ReadPointStream rejects bad lines with file and line", "[terrain][point_file]") {

@@ -1,6 +1,8 @@
 #include "footfall/cli/load_flags.h"
 
 #include "footfall/cli/number_checks.h"
+#include "footfall/import/terrain_loader.h"
+#include "footfall/terrain/file_extension.h"
 
 namespace footfall::cli {
 
@@ -20,19 +22,10 @@ void AddLoadFlags(CLI::App* command, TerrainLoadOptions* load) {
                    "degrees stay sharp (smooth normals stop at them; 180: smooth everywhere)")
       ->default_val(kDefaultCreaseAngleDeg)
       ->check(FiniteRange(0, 180));
-  // (CLI11 read "-1" as 2^64 - 1.)
   command
       ->add_option("--seed", load->seed,
                    "Seed of the mesh sampler, a whole number from 0 to 2^64 - 1 (default 1)")
-      ->check(CLI::Validator(
-          [](std::string& input) -> std::string {
-            if (!input.empty() && input.size() <= 20 &&
-                input.find_first_not_of("0123456789") == std::string::npos &&
-                (input.size() < 20 || input <= "18446744073709551615"))
-              return std::string();
-            return "'" + input + "' is not a whole number from 0 to 18446744073709551615";
-          },
-          "SEED"));
+      ->check(Seed());
   command->add_option("--up-axis", load->up_axis, "Height maps: up axis x, y or z")
       ->check(CLI::IsMember({'x', 'y', 'z'}));
   command
@@ -43,6 +36,15 @@ void AddLoadFlags(CLI::App* command, TerrainLoadOptions* load) {
       ->add_option("--height-scale", load->height_scale,
                    "Height maps: world height of one file unit (metre or grey level)")
       ->check(Finite());
+}
+
+bool SeparationApplies(const std::string& path, const TerrainLoadOptions& load,
+                       std::string* error) {
+  if (!(load.separation > 0) || !IsPointFileExtension(FileExtension(path))) return true;
+  *error = path +
+           ": --separation resamples meshes and height maps only; a point file is used as it is "
+           "(leave --separation out)";
+  return false;
 }
 
 }  // namespace footfall::cli

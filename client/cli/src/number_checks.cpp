@@ -59,4 +59,16 @@ CLI::Validator FiniteAboveUpTo(double lo, double hi) {
               [lo, hi](double x) { return x > lo && x <= hi; });
 }
 
+CLI::Validator Seed() {
+  return CLI::Validator(
+      [](std::string& input) -> std::string {
+        if (!input.empty() && input.size() <= 20 &&
+            input.find_first_not_of("0123456789") == std::string::npos &&
+            (input.size() < 20 || input <= "18446744073709551615"))
+          return std::string();
+        return "'" + input + "' is not a whole number from 0 to 18446744073709551615";
+      },
+      "SEED");
+}
+
 }  // namespace footfall::cli

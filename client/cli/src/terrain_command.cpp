@@ -17,6 +17,7 @@
 #include "footfall/steps/walk_terrain.h"
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/grid.h"
+#include "footfall/terrain/output_file.h"
 #include "footfall/terrain/point_file.h"
 #include "terrain_flags.h"
 
@@ -52,9 +53,10 @@ struct MakeFlags {
   double radius = 3;
 };
 
+// Enough digits to tell apart samples a millimetre apart a thousand kilometres out.
 std::string Format(const Vec3& v) {
   std::ostringstream out;
-  out << std::setprecision(6) << "(" << v.x << ", " << v.y << ", " << v.z << ")";
+  out << std::setprecision(12) << "(" << v.x << ", " << v.y << ", " << v.z << ")";
   return out.str();
 }
 
@@ -77,7 +79,10 @@ int RunConvert(const ConvertFlags& flags) {
       return 1;
     }
   }
-  if (LoadTerrain(flags.input, load, &samples, &error, &report) != Status::kOk) {
+  if (error.empty() && SameFile(flags.input, flags.output))
+    error = flags.output + ": the output is the input file (write the points to another file)";
+  if (error.empty()) SeparationApplies(flags.input, load, &error);
+  if (!error.empty() || LoadTerrain(flags.input, load, &samples, &error, &report) != Status::kOk) {
     std::cerr << "footfall terrain convert: " << error << '\n';
     return 1;
   }
@@ -95,7 +100,8 @@ int RunInfo(const InfoFlags& flags) {
   RawSamples samples;
   std::string error;
   TerrainLoadReport report;
-  if (LoadTerrain(flags.input, flags.load, &samples, &error, &report) != Status::kOk) {
+  if (!SeparationApplies(flags.input, flags.load, &error) ||
+      LoadTerrain(flags.input, flags.load, &samples, &error, &report) != Status::kOk) {
     std::cerr << "footfall terrain info: " << error << '\n';
     return 1;
   }
@@ -126,7 +132,7 @@ int RunInfo(const InfoFlags& flags) {
   }
   std::cout << "samples: " << report.samples << '\n'
             << "bounds: " << Format(report.bounds_min) << " to " << Format(report.bounds_max)
-            << '\n'
+            << " (of the samples)\n"
             << "grid: " << g.cells[0] << " x " << g.cells[1] << " x " << g.cells[2] << " cells of "
             << g.cell_size << ", " << g.occupied_cells << " occupied, " << g.bytes << " bytes\n"
             << "stored within: " << g.max_rounding
@@ -268,12 +274,15 @@ void AddTerrainCommand(CLI::App& app, int* exit_code) {
   m->add_option("--spacing", make->spacing, "Distance between samples")
       ->check(FiniteAbove(0))
       ->capture_default_str();
-  m->add_option("--seed", make->seed, "Seed (blocks, rocks, hills)")->capture_default_str();
+  m->add_option("--seed", make->seed,
+                "Seed (blocks, rocks, hills), a whole number from 0 to 2^64 - 1")
+      ->check(Seed())
+      ->capture_default_str();
   m->add_option("--steps", make->steps,
                 "stairs: number of treads, the first on the ground (one riser fewer)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  m->add_option("--rise", make->rise, "stairs: step height")
+  m->add_option("--rise", make->rise, "stairs: step height (negative: stairs going down along +z)")
       ->check(Finite())
       ->capture_default_str();
   m->add_option("--run", make->run, "stairs: step depth")

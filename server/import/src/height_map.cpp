@@ -2,14 +2,19 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/samples.h"
+#include "footfall/terrain/shown_text.h"
 
 namespace footfall {
 namespace {
@@ -71,9 +76,10 @@ class TokenReader {
 };
 
 Status ReadWhole(const std::string& path, std::string* text, std::string* error) {
+  errno = 0;
   std::ifstream in(path, std::ios::binary);
   if (!in) {
-    if (error) *error = path + ": cannot open";
+    if (error) *error = path + ": cannot open: " + std::strerror(errno ? errno : EIO);
     return Status::kIoError;
   }
   text->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
@@ -151,7 +157,9 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
   std::string key, value;
   double ncols = -1, nrows = -1, cellsize = -1, nodata = NAN;
   bool has_nodata = false;
-  size_t size_line = 1;  // the line of ncols or nrows, whichever comes last
+  size_t size_line = 1;      // the line of ncols or nrows, whichever comes last
+  size_t cellsize_line = 0;  // 0: no cellsize
+  std::vector<std::pair<std::string, size_t>> seen;  // header keys (lower case) and their lines
   // Header: KEY VALUE pairs until the first token that is a number.
   for (;;) {
     const TokenReader before = reader;
@@ -162,21 +170,32 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
       reader = before;  // the first data value
       break;
     }
-    if (!reader.Next(&value) || !ParseDouble(value, &number)) {
-      return Fail(path + ":" + std::to_string(line), "header '" + key + "' needs a number", error);
+    // The value on the key's own line: a key alone is not given the first data value.
+    if (!reader.Next(&value) || reader.line() != line || !ParseDouble(value, &number)) {
+      return Fail(path + ":" + std::to_string(line),
+                  "header '" + ShownText(key) + "' needs a number on its line", error);
     }
     const std::string k = Lower(key);
+    for (const auto& [earlier, at] : seen) {
+      if (earlier == k) {
+        return Fail(path + ":" + std::to_string(line),
+                    "header '" + ShownText(key) + "' given again (first on line " +
+                        std::to_string(at) + ")",
+                    error);
+      }
+    }
+    seen.emplace_back(k, line);
     if (k == "ncols") {
       ncols = number, size_line = line;
     } else if (k == "nrows") {
       nrows = number, size_line = line;
     } else if (k == "cellsize") {
-      cellsize = number;
+      cellsize = number, cellsize_line = line;
     } else if (k == "nodata_value") {
       nodata = number, has_nodata = true;
     } else if (k != "xllcorner" && k != "yllcorner" && k != "xllcenter" && k != "yllcenter") {
       return Fail(path + ":" + std::to_string(line),
-                  "unknown header '" + key +
+                  "unknown header '" + ShownText(key) +
                       "' (expected ncols, nrows, xllcorner, yllcorner, cellsize, NODATA_value)",
                   error);
     }
@@ -184,7 +203,11 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
   if (!(ncols >= 1 && nrows >= 1 && ncols == std::floor(ncols) && nrows == std::floor(nrows))) {
     return Fail(path, "header needs whole ncols and nrows >= 1", error);
   }
-  if (!(cellsize > 0)) return Fail(path, "header needs cellsize > 0", error);
+  if (cellsize_line == 0) return Fail(path, "header needs cellsize (a number > 0)", error);
+  if (!(cellsize > 0)) {
+    return Fail(path + ":" + std::to_string(cellsize_line),
+                "cellsize " + NumberText(cellsize) + " (expected a number > 0)", error);
+  }
   const double cells = ncols * nrows;
   size_t last_line;
   const size_t present = CountValues(reader, cells, &last_line);
@@ -209,13 +232,13 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
     double h;
     if (!ParseDouble(value, &h)) {
       return Fail(path + ":" + std::to_string(reader.line()),
-                  "value '" + value + "' is not a finite number", error);
+                  "value '" + ShownText(value) + "' is not a finite number", error);
     }
     out->heights[i] = h;
     out->valid[i] = !(has_nodata && h == nodata);
     if (out->valid[i] && std::fabs(h) > terrain::kMaxCoordinate) {
       return Fail(path + ":" + std::to_string(reader.line()),
-                  "value " + value + " is out of range (expected |height| <= " +
+                  "value " + ShownText(value) + " is out of range (expected |height| <= " +
                       Number(terrain::kMaxCoordinate) + ")",
                   error);
     }
@@ -305,9 +328,14 @@ Status ReadPgm(const std::string& path, HeightMap* out, std::string* error) {
     }
     if (!ParseDouble(token, &h) || h < 0 || h > fields[2]) {
       return Fail(path + ":" + std::to_string(reader.line()),
-                  "grey level '" + token + "' is not a number from 0 to maxval", error);
+                  "grey level '" + ShownText(token) + "' is not a number from 0 to maxval", error);
     }
     out->heights[i] = h;
+  }
+  if (reader.Next(&token)) {
+    return Fail(path + ":" + std::to_string(reader.line()),
+                "more than the " + std::to_string(total) + " grey levels the header declares",
+                error);
   }
   return Status::kOk;
 }

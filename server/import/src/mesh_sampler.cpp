@@ -320,8 +320,10 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   const double predicted = 1.6 * area / (s * s);
   if (predicted > static_cast<double>(options.max_samples)) {
     if (error) {
-      *error = "separation " + Format3(s) + " would give about " +
-               (predicted < 9e18 ? std::to_string(std::llround(predicted)) : Format3(predicted)) +
+      *error = "separation " + Format3(s) + " would give " +
+               (predicted < 9e18           ? "about " + std::to_string(std::llround(predicted))
+                : std::isfinite(predicted) ? "about " + Format3(predicted)
+                                           : std::string("more than 1e+308")) +
                " samples (limit " + std::to_string(options.max_samples) +
                "); choose a separation of at least " +
                Format3(SeparationThatFits(mesh, area, options.max_samples));

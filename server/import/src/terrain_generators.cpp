@@ -68,14 +68,16 @@ RawSamples MakeStairs(int steps, double rise, double run, double width, double s
   RawSamples s;
   const int across = std::max(1, static_cast<int>(std::round(width / spacing)));
   const int along = std::max(1, static_cast<int>(std::round(run / spacing)));
-  const int up = std::max(1, static_cast<int>(std::round(rise / spacing)));
+  const int up = std::max(1, static_cast<int>(std::round(std::fabs(rise) / spacing)));
+  // Risers face the way down: -z on stairs rising along +z, +z on stairs falling along it.
+  const Vec3 riser_normal{0, 0, rise > 0 ? -1.0 : 1.0};
   for (int step = 0; step < steps; ++step) {
     const double y = step * rise, z0 = step * run;
     for (int a = 0; a <= across; ++a) {
       const double x = a * width / across;
       for (int b = 0; b < along; ++b) s.push_back({x, y, z0 + b * run / along}, {0, 1, 0});
       if (step + 1 < steps) {
-        for (int c = 1; c < up; ++c) s.push_back({x, y + c * rise / up, z0 + run}, {0, 0, -1});
+        for (int c = 1; c < up; ++c) s.push_back({x, y + c * rise / up, z0 + run}, riser_normal);
       }
     }
   }

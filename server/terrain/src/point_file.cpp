@@ -1,8 +1,10 @@
 #include "footfall/terrain/point_file.h"
 
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <istream>
 #include <sstream>
@@ -17,6 +19,15 @@ namespace footfall {
 namespace {
 
 bool IsSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+// For a number out of a double's range: true when it is too small (a negative exponent, or no
+// exponent and no whole part, as 0.000...1), false when too large.
+bool Underflows(std::string_view number) {
+  const size_t e = number.find_first_of("eE");
+  if (e != std::string_view::npos) return e + 1 < number.size() && number[e + 1] == '-';
+  if (!number.empty() && (number[0] == '-' || number[0] == '+')) number.remove_prefix(1);
+  return number.substr(0, 2) == "0." || number.substr(0, 1) == ".";
+}
 
 Status Fail(const std::string& name, size_t line, const std::string& what, RawSamples* out,
             std::string* error) {
@@ -53,13 +64,17 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
         if (*first == '+') ++first;  // from_chars rejects a leading '+'
         double value = 0;
         const auto [ptr, ec] = std::from_chars(first, last, value);
-        if (ec == std::errc::result_out_of_range && ptr == last) {
+        // Too small for a double (1e-400, 0.000...) reads as 0, as other readers have it; too
+        // large is refused.
+        const bool tiny = ec == std::errc::result_out_of_range && ptr == last && Underflows(token);
+        if (tiny) value = token[0] == '-' ? -0.0 : 0.0;
+        if (ec == std::errc::result_out_of_range && ptr == last && !tiny) {
           return Fail(name, line_no,
                       "column " + std::to_string(count + 1) + ": '" + ShownText(token) +
                           "' is out of range (expected a finite number)",
                       out, error);
         }
-        if (ec != std::errc() || ptr != last) {
+        if (!tiny && (ec != std::errc() || ptr != last)) {
           return Fail(name, line_no,
                       "column " + std::to_string(count + 1) + ": '" + ShownText(token) +
                           "' is not a number (expected x y z nx ny nz)",
@@ -107,10 +122,11 @@ Status ReadPointFile(const std::string& path, RawSamples* out, std::string* erro
   out->clear();
   const Status status = CheckInputFile(path, "file", error);
   if (status != Status::kOk) return status;
+  errno = 0;
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     out->clear();
-    if (error) *error = path + ": cannot open file";
+    if (error) *error = path + ": cannot open file: " + std::strerror(errno ? errno : EIO);
     return Status::kIoError;
   }
   return ReadPointStream(in, path, out, error);

@@ -17,6 +17,9 @@ CLI::Validator FiniteAbove(double lo);
 CLI::Validator FiniteRange(double lo, double hi);
 // A finite number in (lo, hi].
 CLI::Validator FiniteAboveUpTo(double lo, double hi);
+// A whole number from 0 to 2^64 - 1, written in decimal digits only (CLI11 alone read "-1" as
+// 2^64 - 1 and clamped larger numbers to it).
+CLI::Validator Seed();
 // Text that is not empty or blank ("expected EXPECTED" otherwise): a flag given an unset shell
 // variable.
 CLI::Validator NotBlank(const std::string& expected);

@@ -18,8 +18,8 @@ RawSamples MakeSphere(int count, const Vec3& centre, double radius);
 
 // A staircase along +Z: `steps` treads of the given run, `width` wide (X), the first on the
 // ground (y = 0) and each next one `rise` higher (so steps - 1 risers, the top tread at
-// (steps - 1) * rise); treads and risers sampled at `spacing`, normals +Y on treads and -Z on
-// risers.
+// (steps - 1) * rise); treads and risers sampled at `spacing`, normals +Y on treads and, on
+// risers, -Z (a positive rise) or +Z (a negative rise: stairs going down along +Z).
 RawSamples MakeStairs(int steps, double rise, double run, double width, double spacing);
 
 // A closed room: floor (normal +Y), four walls (normals inward) and a ceiling (normal -Y), size
