@@ -360,3 +360,68 @@ TEST_CASE("ReadMesh: coordinates beyond kMaxCoordinate are refused with file and
 }
 
 }  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("ReadMesh: OFF faces may carry a colour after their indices", "[import][mesh]") {
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  MeshReadReport report;
+  // A 2 x 1 floor of quads: 'n i1 .. in' then nothing, a colour map index, R G B or R G B A.
+  const std::string head = "OFF\n6 2 0\n0 0 0\n1 0 0\n2 0 0\n0 0 1\n1 0 1\n2 0 1\n";
+  for (const std::string colour : {"", " 7", " 0.8 0.8 0.8", " 255 0 0", " 1 0.5 0 0.25"}) {
+    INFO("colour '" << colour << "'");
+    const std::string off = head + "4 0 3 4 1" + colour + "\n4 1 4 5 2" + colour + "\n";
+    REQUIRE(Read(dir.Write("colour.off", off), &mesh, &error, &report) == Status::kOk);
+    CHECK(report.faces == 2);
+    CHECK(report.skipped_faces == 0);
+    CHECK(mesh.triangles.size() == 4);
+    CHECK(SurfaceArea(mesh) == Approx(2));
+  }
+  CHECK(Read(dir.Write("two.off", head + "4 0 3 4 1 1 2\n4 1 4 5 2\n"), &mesh, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error,
+                 "two.off:9: expected 4 vertex indices and then nothing or a colour (1, "
+                 "3 or 4 numbers), found 2 values after the indices"));
+  CHECK(Read(dir.Write("word.off", head + "4 0 3 4 1\n4 1 4 5 2 red\n"), &mesh, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error, "word.off:10: face colour value 'red' is not a number"));
+}
+
+TEST_CASE("ReadMesh: PLY elements are read in any order", "[import][mesh]") {
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int vertex_indices\n"
+      "element vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+      "3 0 2 1\n0 0 0\n1 0 0\n0 0 1\n";
+  REQUIRE(Read(dir.Write("faces_first.ply", ply), &mesh, &error) == Status::kOk);
+  REQUIRE(mesh.triangles.size() == 1);
+  CHECK(mesh.vertices[1] == Vec3{1, 0, 0});
+  CHECK(Dot(TriangleCross(mesh, 0), Vec3{0, 1, 0}) == Approx(1));
+}
+
+TEST_CASE("ReadMesh: faces counts the file's polygons, skipped_faces those left out",
+          "[import][mesh]") {
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  MeshReadReport report;
+  // Two good triangles, one collinear, two repeating a vertex.
+  const std::string obj =
+      "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 2 0 0\nv 0 0 1\nf 1 5 3\nf 1 3 2\nf 1 2 4\nf 1 1 2\nf 2 2 2\n";
+  REQUIRE(Read(dir.Write("counts.obj", obj), &mesh, &error, &report) == Status::kOk);
+  CHECK(report.faces == 5);
+  CHECK(report.skipped_faces == 3);
+  CHECK(mesh.triangles.size() == 2);
+  CHECK(SurfaceArea(mesh) == Approx(1));
+  // A quad with one collinear fan triangle is used, not skipped.
+  REQUIRE(Read(dir.Write("quad.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 1 0 1\nf 1 4 3 2\n"), &mesh,
+               &error, &report) == Status::kOk);
+  CHECK(report.faces == 1);
+  CHECK(report.skipped_faces == 0);
+}
+
+}  // namespace footfall

@@ -1,6 +1,7 @@
 #include "mesh_file_checks.h"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
@@ -10,6 +11,7 @@
 #include <regex>
 #include <sstream>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "footfall/terrain/samples.h"
@@ -150,14 +152,12 @@ Status CheckTextStart(const std::string& path, std::string* error) {
 
 }  // namespace
 
-Status CheckObjFile(const std::string& path, long long* faces, std::vector<Vec3>* coordinates,
-                    std::string* error) {
+Status ParseObjFile(const std::string& path, ParsedMesh* out, std::string* error) {
   const Status start = CheckTextStart(path, error);
   if (start != Status::kOk) return start;
   std::ifstream in(path);
   std::string line;
   long long vertices = 0;
-  *faces = 0;
   for (size_t number = 1; std::getline(in, line); ++number) {
     const std::vector<std::string> t = Tokens(StripComment(line));
     if (t.empty()) continue;
@@ -172,10 +172,9 @@ Status CheckObjFile(const std::string& path, long long* faces, std::vector<Vec3>
         const Status s = CheckCoordinate(At(path, number), t[i], &c[i - 1], error);
         if (s != Status::kOk) return s;
       }
-      coordinates->push_back({c[0], c[1], c[2]});
+      out->vertices.push_back({c[0], c[1], c[2]});
       ++vertices;
     } else if (t[0] == "f") {
-      ++*faces;
       if (t.size() < 4) {
         return Fail(At(path, number),
                     "face has " + std::to_string(t.size() - 1) + " vertices, expected 3 or more",
@@ -194,15 +193,15 @@ Status CheckObjFile(const std::string& path, long long* faces, std::vector<Vec3>
                           std::to_string(vertices) + " vertices are defined before it",
                       error);
         }
+        out->corners.push_back(static_cast<uint32_t>(index > 0 ? index - 1 : vertices + index));
       }
+      out->EndFace(number);
     }
   }
   return Status::kOk;
 }
 
-Status CheckOffFile(const std::string& path, long long* faces, std::vector<Vec3>* coordinates,
-                    std::string* error) {
-  *faces = -1;
+Status ParseOffFile(const std::string& path, ParsedMesh* out, std::string* error) {
   const Status start = CheckTextStart(path, error);
   if (start != Status::kOk) return start;
   std::ifstream in(path);
@@ -253,7 +252,6 @@ Status CheckOffFile(const std::string& path, long long* faces, std::vector<Vec3>
   if (t.size() < 2 || !ParseInteger(t[0], &nv) || !ParseInteger(t[1], &nf) || nv < 0 || nf < 0) {
     return Fail(At(path, number), "expected counts 'VERTICES FACES EDGES'", error);
   }
-  *faces = nf;
   for (long long v = 0; v < nv; ++v) {
     if (!next(&t)) {
       return Fail(path,
@@ -267,7 +265,7 @@ Status CheckOffFile(const std::string& path, long long* faces, std::vector<Vec3>
       const Status s = CheckCoordinate(At(path, number), t[i], &c[i], error);
       if (s != Status::kOk) return s;
     }
-    coordinates->push_back({c[0], c[1], c[2]});
+    out->vertices.push_back({c[0], c[1], c[2]});
   }
   for (long long f = 0; f < nf; ++f) {
     if (!next(&t)) {
@@ -293,7 +291,29 @@ Status CheckOffFile(const std::string& path, long long* faces, std::vector<Vec3>
                     "face vertex '" + t[i] + "' is not an index below " + std::to_string(nv),
                     error);
       }
+      out->corners.push_back(static_cast<uint32_t>(index));
     }
+    // After the indices, OFF allows a face colour: none, a colour map index, or R G B [A]
+    // (integers 0 to 255 or numbers 0 to 1). It is dropped.
+    const size_t extra = t.size() - static_cast<size_t>(n) - 1;
+    if (extra == 2 || extra > 4) {
+      return Fail(At(path, number),
+                  "expected " + std::to_string(n) +
+                      " vertex indices and then nothing or a colour (1, 3 or 4 numbers), found " +
+                      std::to_string(extra) + " values after the indices",
+                  error);
+    }
+    for (size_t i = static_cast<size_t>(n) + 1; i < t.size(); ++i) {
+      char* end = nullptr;
+      const double value = std::strtod(t[i].c_str(), &end);
+      if (end == t[i].c_str() || *end != '\0' || !std::isfinite(value)) {
+        return Fail(At(path, number),
+                    "face colour value '" + t[i] + "' is not a number (expected " +
+                        std::to_string(n) + " vertex indices, then nothing or R G B [A])",
+                    error);
+      }
+    }
+    out->EndFace(number);
   }
   if (comment != 0) {
     return Fail(At(path, comment),
@@ -302,8 +322,7 @@ Status CheckOffFile(const std::string& path, long long* faces, std::vector<Vec3>
   return Status::kOk;
 }
 
-Status CheckPlyFile(const std::string& path, long long* faces, std::string* error) {
-  *faces = -1;
+Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error) {
   std::ifstream in(path, std::ios::binary);
   std::string line;
   size_t number = 0;
@@ -350,7 +369,7 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
           return Fail(At(path, number), "unknown PLY property type", error);
         }
         if (e.name == "vertex") {
-          // OpenMesh's PLY reader reads no vertex with a list (and then no face): "no faces".
+          // Kept from when OpenMesh read PLY: it read no vertex with a list (and then no face).
           return Fail(At(path, number),
                       "vertex property '" + t[4] +
                           "' is a list, which OpenMesh's PLY reader cannot read: remove it",
@@ -369,17 +388,32 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
     }
   }
   if (!ended) return Fail(path, "truncated: the PLY header has no 'end_header'", error);
+  // The vertices' x, y, z and the faces' index lists, in whatever order the elements come.
+  long long vertices = 0;
   for (const Element& e : elements) {
-    if (e.name == "face") *faces = e.count;
-  }
-  if (format == "ascii") {
-    long long records = 0, vertices = 0;
-    for (const Element& e : elements) {
-      records += e.count;
-      if (e.name == "vertex") vertices = e.count;
+    if (e.name != "vertex") continue;
+    vertices = e.count;
+    for (const char* axis : {"x", "y", "z"}) {
+      if (std::find(e.properties.begin(), e.properties.end(), axis) == e.properties.end() &&
+          e.count > 0) {
+        return Fail(path, std::string("the vertex element has no property '") + axis + "'", error);
+      }
     }
-    // Each data line against its element: vertices' x, y, z finite; faces' index lists of 3 or
-    // more indices of declared vertices.
+  }
+  auto axis_of = [](const Element& e, size_t p) {
+    const std::string& name = e.properties[p];
+    if (e.name != "vertex" || e.lists[p] || name.size() != 1) return -1;
+    return name[0] == 'x' ? 0 : name[0] == 'y' ? 1 : name[0] == 'z' ? 2 : -1;
+  };
+  auto is_indices = [](const Element& e, size_t p) {
+    return e.name == "face" && e.lists[p] &&
+           (e.properties[p] == "vertex_indices" || e.properties[p] == "vertex_index");
+  };
+  if (format == "ascii") {
+    long long records = 0;
+    for (const Element& e : elements) records += e.count;
+    // One record per line, checked against its element: vertices' x, y, z finite; faces'
+    // index lists of 3 or more indices of declared vertices.
     long long found = 0;
     size_t element = 0;
     long long in_element = 0;
@@ -390,10 +424,12 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
       ++found;
       while (element < elements.size() && in_element >= elements[element].count)
         ++element, in_element = 0;
-      if (element >= elements.size()) continue;  // extra lines: OpenMesh ignores them
+      if (element >= elements.size()) continue;  // extra lines after the last element: ignored
       ++in_element;
       const Element& e = elements[element];
       size_t at = 0;
+      Vec3 point;
+      bool face = false;
       for (size_t p = 0; p < e.properties.size(); ++p) {
         if (at >= t.size()) {
           return Fail(At(path, number),
@@ -401,11 +437,12 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
                       error);
         }
         if (!e.lists[p]) {
-          const std::string& name = e.properties[p];
-          double value = 0;
-          if (e.name == "vertex" && (name == "x" || name == "y" || name == "z")) {
+          const int axis = axis_of(e, p);
+          if (axis >= 0) {
+            double value = 0;
             const Status s = CheckCoordinate(At(path, number), t[at], &value, error);
             if (s != Status::kOk) return s;
+            (axis == 0 ? point.x : axis == 1 ? point.y : point.z) = value;
           }
           ++at;
           continue;
@@ -415,8 +452,7 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
           return Fail(At(path, number),
                       "list '" + e.properties[p] + "' needs its count and that many items", error);
         }
-        const bool indices = e.name == "face" && (e.properties[p] == "vertex_indices" ||
-                                                  e.properties[p] == "vertex_index");
+        const bool indices = is_indices(e, p) && !face;
         if (indices && n < 3) {
           return Fail(At(path, number),
                       "face has " + std::to_string(n) + " vertices, expected 3 or more", error);
@@ -429,9 +465,13 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
                 "face vertex '" + t[at + i] + "' is not an index below " + std::to_string(vertices),
                 error);
           }
+          out->corners.push_back(static_cast<uint32_t>(index));
         }
+        if (indices) face = true;
         at += 1 + static_cast<size_t>(n);
       }
+      if (e.name == "vertex") out->vertices.push_back(point);
+      if (face) out->EndFace(number);
     }
     if (found < records) {
       return Fail(path,
@@ -440,6 +480,13 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
                   error);
     }
     return Status::kOk;
+  }
+  if (format != "binary_little_endian" && format != "binary_big_endian") {
+    return Fail(path,
+                "format '" + format +
+                    "' is not a PLY format (expected ascii, binary_little_endian or "
+                    "binary_big_endian)",
+                error);
   }
   const std::streamoff data_start = in.tellg();
   in.seekg(0, std::ios::end);
@@ -452,13 +499,8 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
                     " bytes of " + format + " data, the file has " + std::to_string(data_bytes),
                 error);
   }
-  if (format != "binary_little_endian" && format != "binary_big_endian") return Status::kOk;
   // Binary data, as the ASCII lines are checked: vertices' x, y, z finite, faces' index lists
-  // of 3 or more indices of declared vertices (OpenMesh dropped a face with a bad index
-  // silently, and read a NaN vertex).
-  long long vertices = 0;
-  for (const Element& e : elements)
-    if (e.name == "vertex") vertices = e.count;
+  // of 3 or more indices of declared vertices.
   in.clear();
   in.seekg(data_start);
   PlyValues values(in, format == "binary_big_endian");
@@ -470,24 +512,26 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
   };
   for (const Element& e : elements) {
     for (long long r = 0; r < e.count; ++r) {
+      Vec3 point;
+      bool face = false;
       for (size_t p = 0; p < e.properties.size(); ++p) {
         double v = 0;
         const std::string& name = e.properties[p];
         if (!e.lists[p]) {
           if (!values.Next(e.types[p], &v)) return truncated(e, r);
-          if (e.name == "vertex" && (name == "x" || name == "y" || name == "z") &&
-              !(std::fabs(v) <= terrain::kMaxCoordinate)) {
+          const int axis = axis_of(e, p);
+          if (axis >= 0 && !(std::fabs(v) <= terrain::kMaxCoordinate)) {
             return Fail(path,
                         "vertex " + std::to_string(r + 1) + ": coordinate " + name +
                             " is NaN, infinite or beyond +-5e14",
                         error);
           }
+          if (axis >= 0) (axis == 0 ? point.x : axis == 1 ? point.y : point.z) = v;
           continue;
         }
         double n = 0;
         if (!values.Next(e.count_types[p], &n)) return truncated(e, r);
-        const bool indices =
-            e.name == "face" && (name == "vertex_indices" || name == "vertex_index");
+        const bool indices = is_indices(e, p) && !face;
         if (indices && n < 3) {
           return Fail(path,
                       "face " + std::to_string(r + 1) + " has " +
@@ -507,14 +551,43 @@ Status CheckPlyFile(const std::string& path, long long* faces, std::string* erro
             m << " is not an index below " << vertices;
             return Fail(path, m.str(), error);
           }
+          if (indices) out->corners.push_back(static_cast<uint32_t>(v));
         }
+        if (indices) face = true;
       }
+      if (e.name == "vertex") out->vertices.push_back(point);
+      if (face) out->EndFace(0);
     }
   }
   return Status::kOk;
 }
 
-Status CheckStlFile(const std::string& path, std::string* error) {
+// Merges STL corners at the same point into one vertex.
+class StlVertices {
+ public:
+  explicit StlVertices(std::vector<Vec3>* vertices) : vertices_(vertices) {}
+  uint32_t Add(const Vec3& p) {
+    const Key key{p.x + 0.0, p.y + 0.0, p.z + 0.0};  // -0 and 0 alike
+    const auto [it, added] = index_.emplace(key, static_cast<uint32_t>(vertices_->size()));
+    if (added) vertices_->push_back(p);
+    return it->second;
+  }
+
+ private:
+  using Key = std::array<double, 3>;
+  struct Hash {
+    size_t operator()(const Key& k) const {
+      size_t h = 0;
+      for (double c : k) h = h * 1000003u ^ std::hash<double>()(c);
+      return h;
+    }
+  };
+  std::vector<Vec3>* vertices_;
+  std::unordered_map<Key, uint32_t, Hash> index_;
+};
+
+Status ParseStlFile(const std::string& path, ParsedMesh* out, std::string* error) {
+  StlVertices merged(&out->vertices);
   std::ifstream in(path, std::ios::binary);
   in.seekg(0, std::ios::end);
   const long long size = static_cast<long long>(in.tellg());
@@ -543,6 +616,9 @@ Status CheckStlFile(const std::string& path, std::string* error) {
                           error);
             }
           }
+          for (int k = 0; k < 3; ++k)
+            out->corners.push_back(merged.Add({v[3 * k], v[3 * k + 1], v[3 * k + 2]}));
+          out->EndFace(0);
         }
         done += n;
       }
@@ -578,7 +654,10 @@ Status CheckStlFile(const std::string& path, std::string* error) {
     const std::vector<std::string> t = Tokens(line);
     if (t.empty()) continue;
     if (t[0] == "endsolid") closed = true;
-    if (t[0] == "outer") in_loop = 0;
+    if (t[0] == "outer") {
+      in_loop = 0;
+      out->corners.resize(out->face_start.back());  // a loop left open before: dropped
+    }
     if (t[0] == "endloop") {
       if (in_loop >= 0 && in_loop != 3) {
         return Fail(At(path, number),
@@ -587,16 +666,18 @@ Status CheckStlFile(const std::string& path, std::string* error) {
                         "facets are triangles)",
                     error);
       }
+      if (in_loop == 3) out->EndFace(number);
       in_loop = -1;
     }
     if (t[0] == "vertex") {
       if (in_loop >= 0) ++in_loop;
       if (t.size() < 4) return Fail(At(path, number), "vertex needs 3 coordinates", error);
+      double c[3];
       for (int i = 1; i <= 3; ++i) {
-        double c;
-        const Status s = CheckCoordinate(At(path, number), t[i], &c, error);
+        const Status s = CheckCoordinate(At(path, number), t[i], &c[i - 1], error);
         if (s != Status::kOk) return s;
       }
+      if (in_loop >= 1 && in_loop <= 3) out->corners.push_back(merged.Add({c[0], c[1], c[2]}));
     }
   }
   if (!closed) return Fail(path, "truncated: ASCII STL has no closing 'endsolid'", error);

@@ -1,12 +1,15 @@
 #include "footfall/import/mesh_reader.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <mutex>
 #include <sstream>
+#include <utility>
+#include <vector>
 
-#include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
+#include <OpenMesh/Core/System/omstream.hh>
 
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/samples.h"
@@ -55,16 +58,11 @@ class CapturedOpenMeshMessages {
   std::lock_guard<std::mutex> lock_;
 };
 
-size_t CountOccurrences(const std::string& text, const std::string& what) {
-  size_t count = 0;
-  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++count;
-  return count;
-}
-
-// The first line of OpenMesh's messages, for error reports.
-std::string FirstLine(const std::string& text) {
-  std::string line = text.substr(0, text.find('\n'));
-  return line.empty() ? "no details" : line;
+// "face 3, line 8" (text files) or "face 3", for messages.
+std::string FaceName(const detail::ParsedMesh& mesh, size_t f) {
+  std::string name = "face " + std::to_string(f + 1);
+  if (f < mesh.face_line.size()) name += ", line " + std::to_string(mesh.face_line[f]);
+  return name;
 }
 
 }  // namespace
@@ -93,107 +91,87 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
       return Status::kParseError;
     }
   }
-  Status status = Status::kOk;
-  long long declared_faces = -1;
-  std::vector<Vec3> exact;  // OBJ, OFF: the coordinates in double, in file order
-  if (ext == "obj") status = detail::CheckObjFile(path, &declared_faces, &exact, error);
-  if (ext == "off") status = detail::CheckOffFile(path, &declared_faces, &exact, error);
-  if (ext == "ply") status = detail::CheckPlyFile(path, &declared_faces, error);
-  if (ext == "stl") status = detail::CheckStlFile(path, error);
+  detail::ParsedMesh parsed;
+  const Status status = ext == "obj"   ? detail::ParseObjFile(path, &parsed, error)
+                        : ext == "off" ? detail::ParseOffFile(path, &parsed, error)
+                        : ext == "ply" ? detail::ParsePlyFile(path, &parsed, error)
+                                       : detail::ParseStlFile(path, &parsed, error);
   if (status != Status::kOk) return status;
-
-  PolyMesh mesh;
-  mesh.request_vertex_status();
-  mesh.request_edge_status();
-  mesh.request_face_status();
-  std::string messages;
-  bool read = false;
-  {
-    CapturedOpenMeshMessages capture;
-    OpenMesh::IO::Options options;
-    read = OpenMesh::IO::read_mesh(mesh, path, options);
-    messages = capture.Text();
-  }
-  if (!read) {
-    if (error) *error = path + ": OpenMesh cannot read it as " + ext + ": " + FirstLine(messages);
-    return Status::kParseError;
-  }
-  if (CountOccurrences(messages, "invalid vertex index")) {
-    if (error) *error = path + ": a face uses a vertex that does not exist (truncated file?)";
-    return Status::kParseError;
-  }
-  // Faces OpenMesh dropped (repeated vertices): declared minus read where the file declares.
-  size_t skipped = CountOccurrences(messages, "equal vertices");
-  if (declared_faces > static_cast<long long>(mesh.n_faces())) {
-    skipped = static_cast<size_t>(declared_faces) - mesh.n_faces();
-  }
-
-  // Vertices, all finite. OpenMesh parses text coordinates as float; where the file's own
-  // double-precision coordinates match its vertices one to one, they are used instead.
-  const bool use_exact = exact.size() == mesh.n_vertices();
-  out->vertices.resize(mesh.n_vertices());
-  for (const auto vh : mesh.vertices()) {
-    const auto& p = mesh.point(vh);
-    const Vec3 v = use_exact ? exact[vh.idx()] : Vec3{p[0], p[1], p[2]};
-    if (!IsFinite(v)) {
-      if (error)
-        *error = path + ": vertex " + std::to_string(vh.idx() + 1) + " has a non-finite coordinate";
-      return Status::kParseError;
-    }
-    const double limit = terrain::kMaxCoordinate;
-    if (std::fabs(v.x) > limit || std::fabs(v.y) > limit || std::fabs(v.z) > limit) {
-      if (error) {
-        std::ostringstream m;
-        m << path << ": vertex " << vh.idx() + 1 << " (" << v.x << ", " << v.y << ", " << v.z
-          << ") is out of range (expected |coordinate| <= " << limit << ")";
-        *error = m.str();
-      }
-      return Status::kParseError;
-    }
-    out->vertices[vh.idx()] = v;
-  }
-  if (mesh.n_vertices() == 0) {
+  if (parsed.vertices.empty()) {
     if (error) *error = path + ": no vertices: the mesh is empty";
     return Status::kParseError;
   }
-  if (mesh.n_faces() == 0) {
+  const size_t faces = parsed.Faces();
+  if (faces == 0) {
     if (error)
-      *error = path + ": " + std::to_string(mesh.n_vertices()) +
+      *error = path + ": " + std::to_string(parsed.vertices.size()) +
                " vertices but no faces: expected a polygon mesh";
     return Status::kParseError;
   }
+  auto corners_of = [&](size_t f) {
+    return std::make_pair(parsed.corners.data() + parsed.face_start[f],
+                          parsed.face_start[f + 1] - parsed.face_start[f]);
+  };
 
-  // Faces OpenMesh could only add by duplicating their vertices break the manifold property.
-  size_t non_manifold = 0;
-  int first_bad = -1;
-  for (const auto fh : mesh.faces()) {
-    if (mesh.status(fh).fixed_nonmanifold()) {
-      if (first_bad < 0) first_bad = fh.idx();
-      ++non_manifold;
-    }
-  }
-  if (non_manifold) {
-    if (error) {
-      *error = path + ": the mesh is not manifold: " + std::to_string(non_manifold) +
-               " faces (the first is face " + std::to_string(first_bad + 1) +
-               ") share an edge with two other faces or meet another sheet at a single vertex";
-    }
-    return Status::kParseError;
+  // 1. Faces using a vertex twice are left out.
+  std::vector<char> used(faces, 1);
+  std::vector<uint32_t> sorted;
+  for (size_t f = 0; f < faces; ++f) {
+    const auto [c, n] = corners_of(f);
+    sorted.assign(c, c + n);
+    std::sort(sorted.begin(), sorted.end());
+    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) used[f] = 0;
   }
 
-  // Fan triangulation in stored order.
-  std::vector<uint32_t> corners;
-  for (const auto fh : mesh.faces()) {
-    corners.clear();
-    for (const auto vh : mesh.fv_range(fh)) corners.push_back(static_cast<uint32_t>(vh.idx()));
-    for (size_t i = 2; i < corners.size(); ++i) {
-      out->triangles.push_back({corners[0], corners[i - 1], corners[i]});
+  // 2. Manifold: every face must join OpenMesh's half-edge mesh, as two faces at most share an
+  // edge and the faces around a vertex form fans.
+  {
+    PolyMesh mesh;
+    for (const Vec3& v : parsed.vertices) mesh.add_vertex(PolyMesh::Point(v.x, v.y, v.z));
+    std::vector<PolyMesh::VertexHandle> handles;
+    size_t non_manifold = 0, first_bad = 0;
+    CapturedOpenMeshMessages capture;  // add_face says why it refused a face
+    for (size_t f = 0; f < faces; ++f) {
+      if (!used[f]) continue;
+      const auto [c, n] = corners_of(f);
+      handles.clear();
+      for (size_t k = 0; k < n; ++k)
+        handles.push_back(PolyMesh::VertexHandle(static_cast<int>(c[k])));
+      if (mesh.add_face(handles).is_valid()) continue;
+      if (non_manifold++ == 0) first_bad = f;
+    }
+    if (non_manifold) {
+      if (error) {
+        *error = path + ": the mesh is not manifold: " + std::to_string(non_manifold) +
+                 " faces (the first is " + FaceName(parsed, first_bad) +
+                 ") share an edge with two other faces or meet another sheet at a single vertex";
+      }
+      return Status::kParseError;
     }
   }
-  skipped += RemoveDegenerateTriangles(out);
+
+  // 3. Polygons triangulated as fans in stored order; triangles of zero area left out, and a
+  // face left with none is skipped.
+  out->vertices = std::move(parsed.vertices);
+  Vec3 lo, hi;
+  MeshBounds(*out, &lo, &hi);
+  const double limit = 1e-14 * Length2(hi - lo);
+  size_t skipped = 0;
+  for (size_t f = 0; f < faces; ++f) {
+    const size_t before = out->triangles.size();
+    if (used[f]) {
+      const auto [c, n] = corners_of(f);
+      for (size_t i = 2; i < n; ++i) {
+        out->triangles.push_back({c[0], c[i - 1], c[i]});
+        if (!(0.5 * Length(TriangleCross(*out, out->triangles.size() - 1)) > limit))
+          out->triangles.pop_back();
+      }
+    }
+    if (out->triangles.size() == before) ++skipped;
+  }
   if (report) {
-    report->vertices = mesh.n_vertices();
-    report->faces = mesh.n_faces();
+    report->vertices = out->vertices.size();
+    report->faces = faces;
     report->skipped_faces = skipped;
   }
   if (out->triangles.empty()) {

@@ -1,6 +1,6 @@
-// Reads polygon meshes (OBJ, PLY, OFF, STL, OM; chosen by extension) with OpenMesh into a
-// TriangleMesh. Polygons are fan-triangulated in their stored vertex order (exact for convex
-// polygons). Faces with repeated vertices and triangles of zero area are skipped and counted.
+// Reads polygon meshes (OBJ, PLY, OFF, STL; chosen by extension) into a TriangleMesh. Polygons
+// are fan-triangulated in their stored vertex order (exact for convex polygons). Faces with
+// repeated vertices, and faces whose triangles all have zero area, are skipped and counted.
 // Normals, texture coordinates and colours in the file are ignored.
 #pragma once
 
@@ -13,9 +13,9 @@
 namespace footfall {
 
 struct MeshReadReport {
-  size_t vertices = 0;       // as stored in the file
-  size_t faces = 0;          // polygons read
-  size_t skipped_faces = 0;  // degenerate faces and zero-area fan triangles left out
+  size_t vertices = 0;       // as stored in the file (STL: distinct corner points)
+  size_t faces = 0;          // polygons in the file, skipped ones included
+  size_t skipped_faces = 0;  // of those, left out: a repeated vertex, or zero area
 };
 
 // True for the extensions ReadMesh takes: obj, ply, off, stl (any case, without the dot).
@@ -23,8 +23,8 @@ bool IsMeshExtension(const std::string& lower_extension);
 
 // Reads `path` into *out. Errors, each with a message naming the file (and the line where the
 // format is text): kIoError (cannot open), kParseError (empty file, no faces, truncated data,
-// a non-finite coordinate, a face using a missing vertex, a non-manifold edge or vertex, or
-// anything OpenMesh rejects), kInvalidArgument (not a mesh extension).
+// a non-finite coordinate, a face using a missing vertex, a non-manifold edge or vertex),
+// kInvalidArgument (not a mesh extension).
 Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
                 MeshReadReport* report = nullptr);
 
