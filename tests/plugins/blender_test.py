@@ -20,7 +20,7 @@ import unittest
 
 import addon_utils
 import bpy
-from mathutils import Vector, kdtree
+from mathutils import Quaternion, Vector, kdtree
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
@@ -315,6 +315,83 @@ class BlenderAddonTest(unittest.TestCase):
     def test_6_biped_walk_matches_cli(self):
         walk = self._generate_and_compare("biped_rig", 8)
         self.assertEqual(len([t for t in walk["tracks"] if t["kind"] == "foot"]), 2)
+
+    def assert_world_at_key_frames(self, walk, feet, body):
+        """At each key's frame, the objects are where the walk puts them, in world space."""
+        scene = bpy.context.scene
+        frame = scene.frame_current
+        worst = 0.0
+        try:
+            for track in walk["tracks"]:
+                is_body = track["kind"] == "body"
+                obj = body if is_body else feet[track["name"]]
+                for k in track["keys"]:
+                    scene.frame_set(int(k["frame"]))
+                    mw = obj.matrix_world
+                    worst = max(worst, (mw.translation - Vector(from_ff(k["position"]))).length)
+                    if is_body:
+                        x, y, z, w = k["rotation"]
+                        got = mw.to_quaternion()
+                        self.assertGreater(abs(got.dot(Quaternion((w, x, -z, y)))), 1 - TOL,
+                                           "body rotation at %s" % k["frame"])
+        finally:
+            scene.frame_set(frame)
+        self.assertLess(worst, 1e-4)
+
+    def test_6b_targets_under_an_animated_parent(self):
+        # Targets (and a body) parented to an animated control: each key was converted to the
+        # parent's space with the parent's matrix at the frame the user was on, so at the other
+        # frames the feet were up to a metre off the walk.
+        scene = bpy.context.scene
+        scene.frame_set(1)
+        control = bpy.data.objects.new("mover_control", None)
+        scene.collection.objects.link(control)
+        control.keyframe_insert("location", frame=1)
+        control.keyframe_insert("rotation_euler", frame=1)
+        control.location = (1.0, 0.5, 0.3)
+        control.rotation_euler = (0.0, 0.0, math.radians(25))
+        control.keyframe_insert("location", frame=100)
+        control.keyframe_insert("rotation_euler", frame=100)
+        scene.frame_set(1)
+        body = bpy.data.objects.new("mover_body", None)
+        scene.collection.objects.link(body)
+        body.parent = control
+        body.location = (2.5, -3.5, 1.0)
+        body.rotation_euler = (0.0, 0.0, math.pi)  # faces +Y
+        targets = []
+        for name, x in (("L", 2.62), ("R", 2.38)):
+            e = bpy.data.objects.new("mover_IK_" + name, None)
+            scene.collection.objects.link(e)
+            e.parent = control
+            e.location = (x, -3.5, 0.0)
+            targets.append(e)
+        # One foot under the body, which the walk keys (in chunks: each chunk's body keys bend
+        # its curve before them).
+        targets[0].parent = body
+        targets[0].location = (-0.12, 0.0, -1.0)
+        bpy.context.view_layer.update()
+        self.select(targets + [body], body)
+        result = bpy.ops.footfall.character_setup(
+            character_file=os.path.join(CHARACTERS, "biped.json"), mode="PICK", name="mover")
+        self.assertEqual(result, {"FINISHED"})
+        rig = bpy.data.objects["mover_rig"]
+        feet = {f.name: f.target for f in rig.footfall_rig.feet}
+        settings = scene.footfall
+        settings.rig, settings.steps, settings.start_frame = rig, 6, 1
+        scene.frame_set(50)  # the user looks at another frame than the walk's first
+        self.assertEqual(bpy.ops.footfall.generate_walk(chunk_steps=2), {"FINISHED"})
+        self.assertEqual(scene.frame_current, 50)
+        walk = json.loads(bpy.data.texts["footfall_walk.json"].as_string())
+        self.assertEqual(walk, self.cli_walk(rig, 6, "mover_cli")[0])
+        self.assert_world_at_key_frames(walk, feet, body)
+        # Import Walk keys the same way.
+        path = os.path.join(ARGS.work_dir, "mover_cli.json")
+        clear_animation(list(feet.values()) + [body])
+        self.assertEqual(bpy.ops.footfall.import_walk(filepath=path), {"FINISHED"})
+        self.assertEqual(scene.frame_current, 50)
+        self.assert_world_at_key_frames(walk, feet, body)
+        settings.rig = None
+        scene.frame_set(1)
 
     def test_7_import_json_walk(self):
         path = os.path.join(ARGS.work_dir, "hexapod_rig_cli.json")

@@ -1,16 +1,80 @@
 """Keys a footfall walk (the walk JSON as a dict) onto Blender objects, in world space."""
 
+import math
+
 import bpy
 from mathutils import Matrix, Quaternion, Vector
 
 from .axes import from_ff, quat_from_ff
 
 
-def _world_to_local(obj, world):
-    """The matrix_basis that puts `obj` at world matrix `world` given its parent."""
-    if obj.parent is None:
-        return world
-    return (obj.parent.matrix_world @ obj.matrix_parent_inverse).inverted() @ world
+def _moves(obj):
+    """True when obj's world matrix may change from frame to frame: it or an object up its
+    parent chain has animation data (an action, NLA tracks or drivers) or constraints."""
+    while obj is not None:
+        ad = obj.animation_data
+        if ad is not None and (ad.action is not None or len(ad.nla_tracks) or len(ad.drivers)):
+            return True
+        if len(obj.constraints):
+            return True
+        obj = obj.parent
+    return False
+
+
+def _under(obj, ancestor):
+    """True when `ancestor` is up obj's parent chain."""
+    obj = obj.parent
+    while obj is not None:
+        if obj == ancestor:
+            return True
+        obj = obj.parent
+    return False
+
+
+class _ParentSpaces:
+    """The matrix taking world space to an object's matrix_basis space (its parent's world
+    matrix and parent inverse, inverted), at a key's frame. A static parent chain's is read
+    once; an animated one's is evaluated at each key's frame (the scene is set to that frame
+    and subframe, once per frame for all objects); restore() goes back to the frame the scene
+    was on. Objects parented to a bone are taken as parented to the armature object."""
+
+    def __init__(self, scene):
+        self.scene = scene
+        self.frame = (scene.frame_current, scene.frame_subframe)
+        self.moved = False
+        self._at = {}  # (frame, parent name) -> parent world matrix at that frame
+
+    def inverse(self, obj, frames):
+        """One world-to-basis matrix per frame of `frames` (ascending) for `obj`."""
+        parent = obj.parent
+        if parent is None:
+            return [Matrix.Identity(4)] * len(frames)
+        pinv = obj.matrix_parent_inverse.copy()
+        if not _moves(parent):
+            m = (parent.matrix_world @ pinv).inverted()
+            return [m] * len(frames)
+        out = []
+        for frame in frames:
+            key = (frame, parent.name)
+            if key not in self._at:
+                whole = math.floor(frame)
+                self.scene.frame_set(int(whole), subframe=frame - whole)
+                self.moved = True
+                self._at[key] = parent.matrix_world.copy()
+            out.append((self._at[key] @ pinv).inverted())
+        return out
+
+    def forget(self, parent):
+        """Drops what was read of `parent` (its keys have just changed) and has its action
+        evaluated again (keys added through keyframe_points are not seen otherwise)."""
+        if parent.animation_data is not None and parent.animation_data.action is not None:
+            parent.animation_data.action.update_tag()
+        self._at = {k: m for k, m in self._at.items() if k[1] != parent.name}
+
+    def restore(self):
+        if self.moved:
+            self.scene.frame_set(self.frame[0], subframe=self.frame[1])
+            self.moved = False
 
 
 # Blender's frame range (MAXFRAME): keys beyond it land on the wrong frames, or on one.
@@ -96,39 +160,63 @@ def key_walk(walk, feet, body, from_frame=None):
     """Keys every track of `walk`: feet {foot name: object} get location keys, `body` gets
     location and quaternion keys (world orientation of the walk). Tracks without an object are
     skipped; with `from_frame`, so are keys before it (keyed already: a longer walk generated
-    again keeps the keys of its first steps). Returns the number of keys set."""
-    count = 0
+    again keeps the keys of its first steps). Keys are world positions: an object under an
+    animated parent is keyed in its parent's space at each key's frame (the scene's frame is
+    the same afterwards). Returns the number of keys set."""
+    # A foot under the body: the body's keys set again from `from_frame` on bend its curve
+    # before that frame too, so such a foot's keys of the whole walk are set again.
+    again = []
+    plan = []  # (object, is body, frames, world matrices), in the order they are keyed
     for track in walk.get("tracks", []):
         is_body = track.get("kind") == "body"
         obj = body if is_body else feet.get(track.get("name"))
         if obj is None:
             continue
-        if is_body:
-            obj.rotation_mode = "QUATERNION"
-        frames, locations, rotations = [], [], []
+        start = from_frame
+        if start is not None and not is_body and body is not None and _under(obj, body):
+            start = None
+            again.append(obj)
+        orientation = obj.matrix_world.normalized()  # a foot's, kept (read at this frame)
+        frames, worlds = [], []
         for key in sorted(track.get("keys", []), key=lambda k: float(k["frame"])):
             frame = float(key["frame"])
-            if from_frame is not None and frame < from_frame:
+            if start is not None and frame < start:
                 continue
             loc = Vector(from_ff(key["position"]))
             if is_body and "rotation" in key:
                 rot = Quaternion(quat_from_ff(key["rotation"]))
                 world = Matrix.Translation(loc) @ rot.to_matrix().to_4x4()
             else:
-                world = obj.matrix_world.normalized().copy()
+                world = orientation.copy()
                 world.translation = loc
-            l, r, _ = _world_to_local(obj, world).decompose()
             if frames and frames[-1] == frame:  # the later key of a frame wins
-                frames.pop(), locations.pop(), rotations.pop()
+                frames.pop(), worlds.pop()
             frames.append(frame)
-            locations.append(tuple(l))
-            rotations.append(tuple(r))
-        if not frames:
-            continue
-        _key_channel(obj, "location", locations, frames)
-        if is_body:
-            _key_channel(obj, "rotation_quaternion", rotations, frames)
-        count += len(frames)
+            worlds.append(world)
+        if frames:
+            if obj in again:
+                clear_keys([obj], frames[0])
+            plan.append((obj, is_body, frames, worlds))
+    # The body first: feet parented to it are keyed in its space at their frames.
+    plan.sort(key=lambda p: not p[1])
+    spaces = _ParentSpaces(bpy.context.scene)
+    count = 0
+    try:
+        for obj, is_body, frames, worlds in plan:
+            if is_body:
+                obj.rotation_mode = "QUATERNION"
+            locations, rotations = [], []
+            for inverse, world in zip(spaces.inverse(obj, frames), worlds):
+                l, r, _ = (inverse @ world).decompose()
+                locations.append(tuple(l))
+                rotations.append(tuple(r))
+            _key_channel(obj, "location", locations, frames)
+            if is_body:
+                _key_channel(obj, "rotation_quaternion", rotations, frames)
+            spaces.forget(obj)
+            count += len(frames)
+    finally:
+        spaces.restore()
     return count
 
 
