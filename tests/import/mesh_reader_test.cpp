@@ -425,3 +425,28 @@ TEST_CASE("ReadMesh: faces counts the file's polygons, skipped_faces those left 
 }
 
 }  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("ReadMesh: an ASCII PLY record with a value too many is refused at its line",
+          "[import][mesh]") {
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string vertices = "0 0 0\n1 0 0\n1 0 1\n0 0 1\n";
+  REQUIRE(Read(dir.Write("ok.ply", header + vertices + "3 0 2 1\n3 0 3 2\n"), &mesh, &error) ==
+          Status::kOk);
+  CHECK(Read(dir.Write("face.ply", header + vertices + "3 0 2 1 3\n3 0 3 2\n"), &mesh, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error,
+                 "face.ply:14: expected 4 values for face 1: vertex_indices (its count, 3, and "
+                 "3 items); found 5"));
+  CHECK(Read(dir.Write("vertex.ply", header + "0 0 0\n1 0 0 7\n1 0 1\n0 0 1\n3 0 2 1\n3 0 3 2\n"),
+             &mesh, &error) == Status::kParseError);
+  CHECK(Contains(error, "vertex.ply:11: expected 3 values for vertex 2: x y z; found 4"));
+}
+
+}  // namespace footfall

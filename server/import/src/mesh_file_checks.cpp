@@ -430,6 +430,7 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
       size_t at = 0;
       Vec3 point;
       bool face = false;
+      std::string expected;  // the properties, as read: "x y z" or "vertex_indices (4 + 4)"
       for (size_t p = 0; p < e.properties.size(); ++p) {
         if (at >= t.size()) {
           return Fail(At(path, number),
@@ -445,6 +446,7 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
             (axis == 0 ? point.x : axis == 1 ? point.y : point.z) = value;
           }
           ++at;
+          expected += (expected.empty() ? "" : " ") + e.properties[p];
           continue;
         }
         long long n = 0;
@@ -469,6 +471,15 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
         }
         if (indices) face = true;
         at += 1 + static_cast<size_t>(n);
+        expected += (expected.empty() ? "" : " ") + e.properties[p] + " (its count, " +
+                    std::to_string(n) + ", and " + std::to_string(n) + " items)";
+      }
+      if (at < t.size()) {
+        return Fail(At(path, number),
+                    "expected " + std::to_string(at) + " values for " + e.name + " " +
+                        std::to_string(in_element) + ": " + expected + "; found " +
+                        std::to_string(t.size()),
+                    error);
       }
       if (e.name == "vertex") out->vertices.push_back(point);
       if (face) out->EndFace(number);
