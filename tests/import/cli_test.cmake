@@ -205,4 +205,13 @@ expect(EXIT_NONZERO "esc.asc:5: value '?]0x' is not a finite number" terrain inf
 file(WRITE "${WORK}/more.pgm" "P2\n2 2\n9\n1 2\n3 4 5\n")
 expect(EXIT_NONZERO "more.pgm:5: more than the 4 grey levels the header declares"
        terrain info "${WORK}/more.pgm")
+# A sampling the process's memory cannot hold is refused at once, saying so (it ran out of
+# memory after seconds with a bare message).
+file(WRITE "${WORK}/floor.obj" "v 0 0 0\nv 0 0 100\nv 100 0 100\nv 100 0 0\nf 1 2 3 4\n")
+execute_process(COMMAND sh -c "ulimit -v 1500000 && exec \"$0\" terrain info \"$1\" --separation 0.03"
+                        "${FOOTFALL}" "${WORK}/floor.obj"
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(rc EQUAL 0 OR NOT err MATCHES "what this process's memory holds while sampling")
+  message(FATAL_ERROR "a sampling beyond memory was not refused up front (exit ${rc}):\n${out}${err}")
+endif()
 file(REMOVE_RECURSE "${WORK}")

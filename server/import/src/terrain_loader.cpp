@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
+#include <string>
 
 #include "footfall/import/height_map.h"
 #include "footfall/import/mesh_reader.h"
 #include "footfall/import/mesh_sampler.h"
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/input_file.h"
+#include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/point_file.h"
 
 namespace footfall {
@@ -155,26 +158,38 @@ Status ReadTerrainMesh(const std::string& path, const TerrainLoadOptions& option
   return Status::kInvalidArgument;
 }
 
+// Bytes of address space the sampler may need per sample (its resident peak is about 340;
+// growing arrays hold two copies at once).
+constexpr double kSamplingBytes = 1000;
+
 Status ResampleTerrainMesh(const std::string& path, const TriangleMesh& mesh,
                            const TerrainLoadOptions& options, RawSamples* out, std::string* error,
                            TerrainLoadReport* report) {
   out->clear();
   const double file_separation = report->file_separation;
   MeshSampleOptions sample;
+  // At most what this process's memory holds while sampling (the CLI ran for seconds, then
+  // died with a bare "out of memory").
+  const double memory = UsableMemoryBytes();
+  const size_t fits_memory =
+      memory > 0 ? static_cast<size_t>(std::max(1000.0, memory / kSamplingBytes)) : SIZE_MAX;
+  sample.max_samples = std::min(options.max_samples, fits_memory);
   sample.separation = options.separation > 0 ? options.separation : file_separation;
   if (!(options.separation > 0) && options.finest_default > 0) {
     // The finer of the file's default and finest_default, unless the sample budget needs
     // coarser (1.001: a margin for the estimate's rounding).
     const double fits =
-        1.001 * std::sqrt(1.6 * SurfaceArea(mesh) / std::max<double>(1, options.max_samples));
+        1.001 * std::sqrt(1.6 * SurfaceArea(mesh) / std::max<double>(1, sample.max_samples));
     sample.separation = std::max(std::min(file_separation, options.finest_default), fits);
   }
   sample.smooth_normals = options.smooth_normals;
   sample.crease_angle_deg = options.crease_angle_deg;
   sample.seed = options.seed;
-  sample.max_samples = options.max_samples;
   std::string why;
   const Status status = SampleMesh(mesh, sample, out, &why);
+  if (status == Status::kLimitExceeded && fits_memory < options.max_samples)
+    why += " (the limit is what this process's memory holds while sampling: " +
+           std::to_string(static_cast<long long>(memory / (1 << 20))) + " MB)";
   if (status != Status::kOk) {
     if (status == Status::kLimitExceeded && report->format == "heightmap" &&
         why.find("long and thin") != std::string::npos)
