@@ -450,3 +450,21 @@ TEST_CASE("ReadMesh: an ASCII PLY record with a value too many is refused at its
 }
 
 }  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("ReadMesh: OBJ indices out of range are refused however negative", "[import][mesh]") {
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  for (const std::string index : {"-5", "-4294967295", "-9223372036854775807",
+                                  "-9223372036854775808", "-99999999999999999999"}) {
+    INFO(index);
+    const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 0 1\nv 1 0 1\nf 1 3 2\nf 2 3 " + index + "\n";
+    CHECK(Read(dir.Write("far.obj", obj), &mesh, &error) == Status::kParseError);
+    CHECK(Contains(error, "far.obj:6: face uses vertex " + index +
+                              " but only 4 vertices are defined before it"));
+  }
+}
+
+}  // namespace footfall

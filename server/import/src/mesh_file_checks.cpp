@@ -182,15 +182,17 @@ Status ParseObjFile(const std::string& path, ParsedMesh* out, std::string* error
       }
       for (size_t i = 1; i < t.size(); ++i) {
         long long index = 0;
-        if (!ParseInteger(t[i].substr(0, t[i].find('/')), &index) || index == 0) {
+        const std::string digits = t[i].substr(0, t[i].find('/'));
+        if (!ParseInteger(digits, &index) || index == 0) {
           return Fail(At(path, number),
                       "face vertex '" + t[i] + "' is not a vertex index (1-based or negative)",
                       error);
         }
-        if (index > vertices || -index > vertices) {
+        // (Compared without negating: -LLONG_MIN overflows, and strtoll saturates to it.)
+        if (index > vertices || index < -vertices) {
           return Fail(At(path, number),
-                      "face uses vertex " + std::to_string(index) + " but only " +
-                          std::to_string(vertices) + " vertices are defined before it",
+                      "face uses vertex " + digits + " but only " + std::to_string(vertices) +
+                          " vertices are defined before it",
                       error);
         }
         out->corners.push_back(static_cast<uint32_t>(index > 0 ? index - 1 : vertices + index));
