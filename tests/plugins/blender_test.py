@@ -20,7 +20,7 @@ import unittest
 
 import addon_utils
 import bpy
-from mathutils import Quaternion, Vector, kdtree
+from mathutils import Euler, Quaternion, Vector, kdtree
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
@@ -71,6 +71,18 @@ def fcurve_keys(obj, path, count):
         for kp in fc.keyframe_points:
             out.setdefault(kp.co[0], [None] * count)[i] = kp.co[1]
     return {f: tuple(v) for f, v in out.items()}
+
+
+def body_rotation_keys(obj):
+    """{frame: quaternion} from obj's rotation keys in the path of its rotation mode."""
+    mode = obj.rotation_mode
+    if mode == "QUATERNION":
+        return {f: Quaternion(v) for f, v in fcurve_keys(obj, "rotation_quaternion", 4).items()}
+    if mode == "AXIS_ANGLE":
+        return {f: Quaternion(v[1:], v[0])
+                for f, v in fcurve_keys(obj, "rotation_axis_angle", 4).items()}
+    return {f: Euler(v, mode).to_quaternion()
+            for f, v in fcurve_keys(obj, "rotation_euler", 3).items()}
 
 
 def clear_animation(objects):
@@ -158,7 +170,7 @@ class BlenderAddonTest(unittest.TestCase):
                     self.assertAlmostEqual(g, w, delta=TOL * max(1.0, abs(w)),
                                            msg="%s frame %s" % (track["name"], k["frame"]))
             if is_body:
-                rots = fcurve_keys(obj, "rotation_quaternion", 4)
+                rots = body_rotation_keys(obj)
                 for k in track["keys"]:
                     x, y, z, w = k["rotation"]
                     want = (w, x, -z, y)
@@ -392,6 +404,68 @@ class BlenderAddonTest(unittest.TestCase):
         self.assert_world_at_key_frames(walk, feet, body)
         settings.rig = None
         scene.frame_set(1)
+
+    def test_6c_picked_body_keeps_its_rotation_mode(self):
+        # Character Setup switched a picked body to quaternion rotation: the user's Euler keys
+        # stopped driving it, and the walk was keyed as quaternions.
+        scene = bpy.context.scene
+        scene.frame_set(1)
+        body = bpy.data.objects.new("turner_body", None)
+        scene.collection.objects.link(body)
+        body.rotation_mode = "ZXY"
+        body.location = (-2.5, -3.5, 1.0)
+        user = {-30.0: (0.0, 0.0, math.pi - 0.4), -10.0: (0.0, 0.0, math.pi)}  # faces +Y
+        for frame, angles in user.items():
+            body.rotation_euler = angles
+            body.keyframe_insert("rotation_euler", frame=frame)
+        targets = []
+        for name, x in (("L", -2.38), ("R", -2.62)):
+            e = bpy.data.objects.new("turner_IK_" + name, None)
+            scene.collection.objects.link(e)
+            e.location = (x, -3.5, 0.0)
+            targets.append(e)
+        scene.frame_set(1)
+        self.select(targets + [body], body)
+        self.assertEqual(bpy.ops.footfall.character_setup(
+            character_file=os.path.join(CHARACTERS, "biped.json"), mode="PICK", name="turner"),
+            {"FINISHED"})
+        self.assertEqual(body.rotation_mode, "ZXY")
+        rig = bpy.data.objects["turner_rig"]
+        feet = {f.name: f.target for f in rig.footfall_rig.feet}
+        settings = scene.footfall
+        settings.rig, settings.start_frame = rig, 1
+        for steps in (6, 4):  # the second walk clears the first's Euler keys after its end
+            settings.steps = steps
+            self.assertEqual(bpy.ops.footfall.generate_walk(chunk_steps=2), {"FINISHED"})
+            walk, _ = self.cli_walk(rig, steps, "turner_%d" % steps)
+            self.assertEqual(body.rotation_mode, "ZXY")
+            paths = {fc.data_path for fc in body.animation_data.action.fcurves}
+            self.assertEqual(paths, {"location", "rotation_euler"})
+            keys = fcurve_keys(body, "rotation_euler", 3)
+            body_frames = [float(k["frame"]) for t in walk["tracks"] if t["kind"] == "body"
+                           for k in t["keys"]]
+            self.assertEqual(sorted(keys), sorted(user) + body_frames)
+            for frame, angles in user.items():  # the user's keys before the walk stay
+                for g, w in zip(keys[frame], angles):
+                    self.assertAlmostEqual(g, w, delta=TOL)
+            # Each key's angles near the one before (no turn of 360 degrees between keys:
+            # the walk faces +Y, where angles from -pi to pi wrap).
+            frames = sorted(keys)
+            for a, b in zip(frames, frames[1:]):
+                for u, v in zip(keys[a], keys[b]):
+                    self.assertLess(abs(u - v), 1.0, "Euler keys %s -> %s: %s -> %s"
+                                    % (a, b, keys[a], keys[b]))
+            self.assert_keys_equal_walk(walk, feet, body)
+            self.assert_world_at_key_frames(walk, feet, body)
+        # An axis-angle body is keyed as axis-angle.
+        clear_animation([body] + targets)
+        body.rotation_mode = "AXIS_ANGLE"
+        self.assertEqual(bpy.ops.footfall.generate_walk(chunk_steps=2), {"FINISHED"})
+        paths = {fc.data_path for fc in body.animation_data.action.fcurves}
+        self.assertEqual(paths, {"location", "rotation_axis_angle"})
+        self.assert_keys_equal_walk(walk, feet, body)
+        self.assert_world_at_key_frames(walk, feet, body)
+        settings.rig = None
 
     def test_7_import_json_walk(self):
         path = os.path.join(ARGS.work_dir, "hexapod_rig_cli.json")

@@ -3,7 +3,7 @@
 import math
 
 import bpy
-from mathutils import Matrix, Quaternion, Vector
+from mathutils import Euler, Matrix, Quaternion, Vector
 
 from .axes import from_ff, quat_from_ff
 
@@ -92,14 +92,25 @@ def check_frames(walk):
                                  % (track.get("name"), frame, MAX_FRAME, MAX_FRAME))
 
 
-def clear_keys(objects, from_frame):
-    """Removes location/rotation keys at frames >= from_frame from `objects`."""
+# The property holding an object's rotation in each rotation mode (the Euler orders: the rest).
+_ROTATION_PATHS = {"QUATERNION": "rotation_quaternion", "AXIS_ANGLE": "rotation_axis_angle"}
+
+
+def rotation_path(obj):
+    """The data path of obj's rotation in its rotation mode (the one Blender evaluates)."""
+    return _ROTATION_PATHS.get(obj.rotation_mode, "rotation_euler")
+
+
+def clear_keys(objects, from_frame, body=None):
+    """Removes location keys at frames >= from_frame from `objects`, and the rotation keys of
+    `body` (one of them) in the path of its rotation mode."""
     for obj in objects:
         action = obj.animation_data.action if obj and obj.animation_data else None
         if action is None:
             continue
+        paths = ("location", rotation_path(obj)) if obj == body else ("location",)
         for fc in list(action.fcurves):
-            if fc.data_path not in ("location", "rotation_quaternion"):
+            if fc.data_path not in paths:
                 continue
             for i in reversed(range(len(fc.keyframe_points))):
                 if fc.keyframe_points[i].co[0] >= from_frame - 1e-6:
@@ -107,6 +118,42 @@ def clear_keys(objects, from_frame):
             fc.update()
             if not fc.keyframe_points:
                 action.fcurves.remove(fc)
+
+
+def _rotation_values(obj, rotations, first_frame):
+    """obj's rotation path and its values for the world-to-basis quaternions `rotations`, in
+    obj's rotation mode: Euler angles each as near the one before as the angles allow (no
+    turns of 360 degrees between keys), quaternions (and axis-angles) on the hemisphere of the
+    one before. The first is near obj's curve at `first_frame` (or its current rotation)."""
+    path = rotation_path(obj)
+    width = 3 if path == "rotation_euler" else 4
+    action = obj.animation_data.action if obj.animation_data else None
+    curves = [action.fcurves.find(path, index=i) if action else None for i in range(width)]
+    current = getattr(obj, path)
+    before = [fc.evaluate(first_frame) if fc is not None and len(fc.keyframe_points) else v
+              for fc, v in zip(curves, current)]
+    values = []
+    if path == "rotation_euler":
+        previous = Euler(before, obj.rotation_mode)
+        for r in rotations:
+            previous = r.to_euler(obj.rotation_mode, previous)
+            values.append(tuple(previous))
+        return path, values
+    if path == "rotation_quaternion":
+        previous = Quaternion(before)
+    else:
+        previous = Quaternion(before[1:], before[0])
+    for r in rotations:
+        q = r.copy()
+        if previous.dot(q) < 0:
+            q.negate()
+        previous = q
+        if path == "rotation_quaternion":
+            values.append(tuple(q))
+        else:
+            axis, angle = q.to_axis_angle()
+            values.append((angle,) + tuple(axis))
+    return path, values
 
 
 def _fcurve(obj, path, index):
@@ -158,7 +205,7 @@ def _key_channel(obj, path, values, frames):
 
 def key_walk(walk, feet, body, from_frame=None):
     """Keys every track of `walk`: feet {foot name: object} get location keys, `body` gets
-    location and quaternion keys (world orientation of the walk). Tracks without an object are
+    location and rotation keys (world orientation of the walk) in its rotation mode. Tracks without an object are
     skipped; with `from_frame`, so are keys before it (keyed already: a longer walk generated
     again keeps the keys of its first steps). Keys are world positions: an object under an
     animated parent is keyed in its parent's space at each key's frame (the scene's frame is
@@ -203,16 +250,16 @@ def key_walk(walk, feet, body, from_frame=None):
     count = 0
     try:
         for obj, is_body, frames, worlds in plan:
-            if is_body:
-                obj.rotation_mode = "QUATERNION"
             locations, rotations = [], []
             for inverse, world in zip(spaces.inverse(obj, frames), worlds):
                 l, r, _ = (inverse @ world).decompose()
                 locations.append(tuple(l))
-                rotations.append(tuple(r))
+                rotations.append(r)
+            if is_body:
+                path, values = _rotation_values(obj, rotations, frames[0])
             _key_channel(obj, "location", locations, frames)
             if is_body:
-                _key_channel(obj, "rotation_quaternion", rotations, frames)
+                _key_channel(obj, path, values, frames)
             spaces.forget(obj)
             count += len(frames)
     finally:

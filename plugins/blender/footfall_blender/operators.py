@@ -239,9 +239,9 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
         rig.is_rig = True
         rig.character_path = self.character_file
         rig.character_json = json.dumps(data)
-        if body is None:
+        if body is None:  # a picked body keeps its rotation mode (the user's keys use it)
             body = _empty(context, rig_name + "_body", "CUBE", 0.3 * height)
-        body.rotation_mode = "QUATERNION"
+            body.rotation_mode = "QUATERNION"
         body.matrix_world = Matrix.Translation(ground + up.normalized() * height) @ rot.to_4x4()
         rig.body = body
 
@@ -375,7 +375,8 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
                     walk = json.loads(walk_text_new)
                     keying.check_frames(walk)
                     if walk_text is None:
-                        keying.clear_keys(list(feet.values()) + [body], settings.start_frame)
+                        keying.clear_keys(list(feet.values()) + [body], settings.start_frame,
+                                          body)
                     keying.key_walk(walk, feet, body, from_frame=last_frame)
                     frames = [k["frame"] for t in walk.get("tracks", []) for k in t.get("keys", [])]
                     last_frame = max(frames) if frames else last_frame
@@ -452,7 +453,7 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
             for part, feet, body in sets:
                 first = min((k["frame"] for t in part["tracks"] for k in t.get("keys", [])),
                             default=0)
-                keying.clear_keys(list(feet.values()) + [body], first)
+                keying.clear_keys(list(feet.values()) + [body], first, body)
                 count += keying.key_walk(part, feet, body)
         except (ffc.FootfallError, OSError, ValueError, KeyError, TypeError) as e:
             why = e.message if isinstance(e, ffc.FootfallError) else e
@@ -467,6 +468,7 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
         for track in walk["tracks"]:
             if track.get("kind") == "body":
                 body = _empty(context, "%s_body" % name, "CUBE", 0.3)
+                body.rotation_mode = "QUATERNION"
             else:
                 feet[track["name"]] = _empty(context, "%s_%s" % (name, track["name"]), "SPHERE", 0.08)
         return feet, body
