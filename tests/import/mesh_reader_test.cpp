@@ -468,3 +468,35 @@ TEST_CASE("ReadMesh: OBJ indices out of range are refused however negative", "[i
 }
 
 }  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("ReadMesh: messages show control bytes of the file as '?'", "[import][mesh]") {
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  auto has_control = [](const std::string& text) {
+    return std::any_of(text.begin(), text.end(),
+                       [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; });
+  };
+  CHECK(Read(dir.Write("a.off", "OFF\033]0;title\007\n"), &mesh, &error) == Status::kParseError);
+  CHECK(Contains(error, "a.off:1: expected the header 'OFF', found 'OFF?]0;title?'"));
+  CHECK_FALSE(has_control(error));
+  CHECK(Read(dir.Write("a.obj", "v 0 0 0\nv 1 \033[2J 0\nv 0 0 1\nf 1 3 2\n"), &mesh, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error, "a.obj:2: vertex coordinate '?[2J' is not a finite number"));
+  CHECK_FALSE(has_control(error));
+  CHECK(Read(dir.Write("f.obj", "v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 3 \0332\n"), &mesh, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error, "f.obj:4: face vertex '?2' is not a vertex index"));
+  CHECK_FALSE(has_control(error));
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 0 1\n3 0 1 \0332\n";
+  CHECK(Read(dir.Write("a.ply", ply), &mesh, &error) == Status::kParseError);
+  CHECK(Contains(error, "a.ply:13: face vertex '?2' is not an index below 3"));
+  CHECK_FALSE(has_control(error));
+}
+
+}  // namespace footfall

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "footfall/terrain/samples.h"
+#include "footfall/terrain/shown_text.h"
 
 namespace footfall::detail {
 namespace {
@@ -106,10 +107,11 @@ Status CheckCoordinate(const std::string& where, const std::string& token, doubl
   const double value = std::strtod(begin, &end);
   *value_out = value;
   if (end == begin || *end != '\0' || !std::isfinite(value))
-    return Fail(where, "vertex coordinate '" + token + "' is not a finite number", error);
+    return Fail(where, "vertex coordinate '" + ShownText(token) + "' is not a finite number",
+                error);
   if (std::fabs(value) > terrain::kMaxCoordinate) {
     std::ostringstream m;
-    m << "vertex coordinate " << token
+    m << "vertex coordinate " << ShownText(token)
       << " is out of range (expected |coordinate| <= " << terrain::kMaxCoordinate << ")";
     return Fail(where, m.str(), error);
   }
@@ -184,15 +186,16 @@ Status ParseObjFile(const std::string& path, ParsedMesh* out, std::string* error
         long long index = 0;
         const std::string digits = t[i].substr(0, t[i].find('/'));
         if (!ParseInteger(digits, &index) || index == 0) {
-          return Fail(At(path, number),
-                      "face vertex '" + t[i] + "' is not a vertex index (1-based or negative)",
-                      error);
+          return Fail(
+              At(path, number),
+              "face vertex '" + ShownText(t[i]) + "' is not a vertex index (1-based or negative)",
+              error);
         }
         // (Compared without negating: -LLONG_MIN overflows, and strtoll saturates to it.)
         if (index > vertices || index < -vertices) {
           return Fail(At(path, number),
-                      "face uses vertex " + digits + " but only " + std::to_string(vertices) +
-                          " vertices are defined before it",
+                      "face uses vertex " + ShownText(digits) + " but only " +
+                          std::to_string(vertices) + " vertices are defined before it",
                       error);
         }
         out->corners.push_back(static_cast<uint32_t>(index > 0 ? index - 1 : vertices + index));
@@ -232,12 +235,13 @@ Status ParseOffFile(const std::string& path, ParsedMesh* out, std::string* error
   if (!off) {
     if (header.size() >= 3 && header.compare(header.size() - 3, 3, "OFF") == 0) {
       return Fail(At(path, number),
-                  "'" + header +
+                  "'" + ShownText(header) +
                       "' files are not read (expected OFF, COFF, NOFF, CNOFF or STOFF "
                       "in text)",
                   error);
     }
-    return Fail(At(path, number), "expected the header 'OFF', found '" + header + "'", error);
+    return Fail(At(path, number), "expected the header 'OFF', found '" + ShownText(header) + "'",
+                error);
   }
   t.erase(t.begin());
   if (!t.empty() && t[0] == "BINARY") {
@@ -245,7 +249,7 @@ Status ParseOffFile(const std::string& path, ParsedMesh* out, std::string* error
   }
   if (!t.empty()) {
     return Fail(At(path, number),
-                "expected the counts on the line after '" + header +
+                "expected the counts on the line after '" + ShownText(header) +
                     "' (OpenMesh reads them there: it read no vertices)",
                 error);
   }
@@ -289,9 +293,10 @@ Status ParseOffFile(const std::string& path, ParsedMesh* out, std::string* error
     for (long long i = 1; i <= n; ++i) {
       long long index = 0;
       if (!ParseInteger(t[i], &index) || index < 0 || index >= nv) {
-        return Fail(At(path, number),
-                    "face vertex '" + t[i] + "' is not an index below " + std::to_string(nv),
-                    error);
+        return Fail(
+            At(path, number),
+            "face vertex '" + ShownText(t[i]) + "' is not an index below " + std::to_string(nv),
+            error);
       }
       out->corners.push_back(static_cast<uint32_t>(index));
     }
@@ -310,7 +315,7 @@ Status ParseOffFile(const std::string& path, ParsedMesh* out, std::string* error
       const double value = std::strtod(t[i].c_str(), &end);
       if (end == t[i].c_str() || *end != '\0' || !std::isfinite(value)) {
         return Fail(At(path, number),
-                    "face colour value '" + t[i] + "' is not a number (expected " +
+                    "face colour value '" + ShownText(t[i]) + "' is not a number (expected " +
                         std::to_string(n) + " vertex indices, then nothing or R G B [A])",
                     error);
       }
@@ -360,7 +365,8 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
       Element e;
       e.name = t[1];
       if (!ParseInteger(t[2], &e.count) || e.count < 0) {
-        return Fail(At(path, number), "element count '" + t[2] + "' is not a count", error);
+        return Fail(At(path, number), "element count '" + ShownText(t[2]) + "' is not a count",
+                    error);
       }
       elements.push_back(e);
     } else if (t[0] == "property" && !elements.empty()) {
@@ -373,7 +379,7 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
         if (e.name == "vertex") {
           // Kept from when OpenMesh read PLY: it read no vertex with a list (and then no face).
           return Fail(At(path, number),
-                      "vertex property '" + t[4] +
+                      "vertex property '" + ShownText(t[4]) +
                           "' is a list, which OpenMesh's PLY reader cannot read: remove it",
                       error);
         }
@@ -382,7 +388,8 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
         e.types.push_back(t[3]), e.count_types.push_back(t[2]);
       } else if (t.size() >= 3) {
         const int size = type_size(t[1]);
-        if (!size) return Fail(At(path, number), "unknown PLY type '" + t[1] + "'", error);
+        if (!size)
+          return Fail(At(path, number), "unknown PLY type '" + ShownText(t[1]) + "'", error);
         e.fixed_bytes += size;
         e.properties.push_back(t[2]), e.lists.push_back(false);
         e.types.push_back(t[1]), e.count_types.push_back("");
@@ -436,7 +443,8 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
       for (size_t p = 0; p < e.properties.size(); ++p) {
         if (at >= t.size()) {
           return Fail(At(path, number),
-                      "expected a value for " + e.name + " property '" + e.properties[p] + "'",
+                      "expected a value for " + ShownText(e.name) + " property '" +
+                          ShownText(e.properties[p]) + "'",
                       error);
         }
         if (!e.lists[p]) {
@@ -448,13 +456,15 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
             (axis == 0 ? point.x : axis == 1 ? point.y : point.z) = value;
           }
           ++at;
-          expected += (expected.empty() ? "" : " ") + e.properties[p];
+          expected += (expected.empty() ? "" : " ") + ShownText(e.properties[p]);
           continue;
         }
         long long n = 0;
         if (!ParseInteger(t[at], &n) || n < 0 || at + 1 + static_cast<size_t>(n) > t.size()) {
-          return Fail(At(path, number),
-                      "list '" + e.properties[p] + "' needs its count and that many items", error);
+          return Fail(
+              At(path, number),
+              "list '" + ShownText(e.properties[p]) + "' needs its count and that many items",
+              error);
         }
         const bool indices = is_indices(e, p) && !face;
         if (indices && n < 3) {
@@ -464,21 +474,21 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
         for (long long i = 1; indices && i <= n; ++i) {
           long long index = 0;
           if (!ParseInteger(t[at + i], &index) || index < 0 || index >= vertices) {
-            return Fail(
-                At(path, number),
-                "face vertex '" + t[at + i] + "' is not an index below " + std::to_string(vertices),
-                error);
+            return Fail(At(path, number),
+                        "face vertex '" + ShownText(t[at + i]) + "' is not an index below " +
+                            std::to_string(vertices),
+                        error);
           }
           out->corners.push_back(static_cast<uint32_t>(index));
         }
         if (indices) face = true;
         at += 1 + static_cast<size_t>(n);
-        expected += (expected.empty() ? "" : " ") + e.properties[p] + " (its count, " +
+        expected += (expected.empty() ? "" : " ") + ShownText(e.properties[p]) + " (its count, " +
                     std::to_string(n) + ", and " + std::to_string(n) + " items)";
       }
       if (at < t.size()) {
         return Fail(At(path, number),
-                    "expected " + std::to_string(at) + " values for " + e.name + " " +
+                    "expected " + std::to_string(at) + " values for " + ShownText(e.name) + " " +
                         std::to_string(in_element) + ": " + expected + "; found " +
                         std::to_string(t.size()),
                     error);
@@ -496,7 +506,7 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
   }
   if (format != "binary_little_endian" && format != "binary_big_endian") {
     return Fail(path,
-                "format '" + format +
+                "format '" + ShownText(format) +
                     "' is not a PLY format (expected ascii, binary_little_endian or "
                     "binary_big_endian)",
                 error);
@@ -509,7 +519,8 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
   if (data_bytes < need) {
     return Fail(path,
                 "truncated: the header's elements need at least " + std::to_string(need) +
-                    " bytes of " + format + " data, the file has " + std::to_string(data_bytes),
+                    " bytes of " + ShownText(format) + " data, the file has " +
+                    std::to_string(data_bytes),
                 error);
   }
   // Binary data, as the ASCII lines are checked: vertices' x, y, z finite, faces' index lists
@@ -519,8 +530,8 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
   PlyValues values(in, format == "binary_big_endian");
   auto truncated = [&](const Element& e, long long r) {
     return Fail(path,
-                "truncated: the binary data ends in " + e.name + " " + std::to_string(r + 1) +
-                    " of " + std::to_string(e.count),
+                "truncated: the binary data ends in " + ShownText(e.name) + " " +
+                    std::to_string(r + 1) + " of " + std::to_string(e.count),
                 error);
   };
   for (const Element& e : elements) {
@@ -535,7 +546,7 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
           const int axis = axis_of(e, p);
           if (axis >= 0 && !(std::fabs(v) <= terrain::kMaxCoordinate)) {
             return Fail(path,
-                        "vertex " + std::to_string(r + 1) + ": coordinate " + name +
+                        "vertex " + std::to_string(r + 1) + ": coordinate " + ShownText(name) +
                             " is NaN, infinite or beyond +-5e14",
                         error);
           }
