@@ -628,6 +628,64 @@ class BlenderAddonTest(unittest.TestCase):
         self.assert_keys_equal_walk(full, feet, body)
 
 
+    def test_9z_each_scene_and_file_has_its_own_terrain(self):
+        # One terrain served the whole Blender session: another scene, or the file made by
+        # File > New, walked on the previous terrain without a word, and it stayed loaded.
+        connection = self.ops._connection
+        scene = bpy.context.scene
+        character_file = os.path.join(CHARACTERS, "biped.json")
+        rig = bpy.data.objects["biped_rig"]
+        body = rig.footfall_rig.body
+        other = bpy.data.scenes.new("other")
+        objects = set(bpy.data.objects)
+        keys = fcurve_keys(body, "location", 3)
+
+        def in_other():
+            return bpy.context.temp_override(scene=other, view_layer=other.view_layers[0])
+        with in_other():
+            other.footfall.rig = rig
+            with self.assertRaises(RuntimeError) as e:
+                bpy.ops.footfall.character_setup(character_file=character_file, mode="CREATE")
+            self.assertIn("no terrain in this scene: run Terrain Setup first", str(e.exception))
+            with self.assertRaises(RuntimeError) as e:
+                bpy.ops.footfall.generate_walk()
+            self.assertIn("no terrain in this scene: run Terrain Setup first", str(e.exception))
+        self.assertEqual(set(bpy.data.objects), objects)
+        self.assertEqual(fcurve_keys(body, "location", 3), keys)
+        # Its own terrain; Terrain Setup again replaces it (the old one is unloaded), and the
+        # first scene keeps its own.
+        key = scene.footfall.terrain_key
+        self.assertTrue(connection.has_terrain(key))
+        ids = []
+        with in_other():
+            other.footfall.terrain_source, other.footfall.terrain_file = "FILE", self.pts
+            for _ in range(2):
+                self.assertEqual(bpy.ops.footfall.terrain_setup(), {"FINISHED"})
+                ids.append(connection.terrain(other.footfall.terrain_key))
+        self.assertNotEqual(other.footfall.terrain_key, key)
+        self.assertEqual(sorted(connection.terrain_names()),
+                         sorted([key, other.footfall.terrain_key]))
+        session = connection.session
+        with self.assertRaises(Exception) as e:
+            session.info(ids[0])
+        self.assertEqual(e.exception.status_name, "unknown_terrain")
+        ids = [connection.terrain(key), ids[1]]
+        self.assertEqual(session.info(ids[0])[0], self._count)
+        # File > New: the closed file's terrains are unloaded from the server, and the new
+        # file has none.
+        bpy.ops.wm.read_homefile(use_empty=True)
+        self.assertEqual(connection.terrain_names(), [])
+        for terrain in ids:
+            with self.assertRaises(Exception) as e:
+                session.info(terrain)
+            self.assertEqual(e.exception.status_name, "unknown_terrain")
+        bpy.context.scene.cursor.location = (0.0, 0.0, 0.0)
+        with self.assertRaises(RuntimeError) as e:
+            bpy.ops.footfall.character_setup(character_file=character_file, mode="CREATE")
+        self.assertIn("no terrain in this scene: run Terrain Setup first", str(e.exception))
+        self.assertEqual(len(bpy.data.objects), 0)
+
+
 def main():
     suite = unittest.defaultTestLoader.loadTestsFromTestCase(BlenderAddonTest)
     result = unittest.TextTestRunner(verbosity=2, stream=sys.stdout).run(suite)

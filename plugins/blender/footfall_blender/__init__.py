@@ -19,13 +19,22 @@ from . import keying, operators, props, ui  # noqa: E402,F401
 _classes = props.classes + operators.classes + ui.classes
 
 
+@bpy.app.handlers.persistent
+def _file_loaded(*_):
+    """A file opened (or File > New): its scenes' terrains stay, the others are unloaded."""
+    operators.unload_unused_terrains()
+
+
 def register():
     for cls in _classes:
         bpy.utils.register_class(cls)
     props.attach()
+    bpy.app.handlers.load_post.append(_file_loaded)
 
 
 def unregister():
+    if _file_loaded in bpy.app.handlers.load_post:
+        bpy.app.handlers.load_post.remove(_file_loaded)
     operators.shutdown()
     props.detach()
     for cls in reversed(_classes):

@@ -5,6 +5,7 @@ import json
 import math
 import os
 import tempfile
+import uuid
 
 import bpy
 from bpy.props import EnumProperty, IntProperty, StringProperty
@@ -23,7 +24,6 @@ character = ffc.character
 sampling = ffc.sampling
 
 _connection = ffc.Connection()
-TERRAIN = "scene"
 # Called after each chunk of Generate Walk with (operator, steps done); tests use it to stop the
 # server in the middle of a walk.
 chunk_hook = None
@@ -45,6 +45,38 @@ def session(context):
 
 def describe_connection():
     return _connection.describe()
+
+
+# -- terrains: one per scene ---------------------------------------------------------------------
+
+def scene_terrain_loaded(scene):
+    """True when `scene`'s terrain is loaded in this Blender session."""
+    key = scene.footfall.terrain_key
+    return bool(key) and _connection.has_terrain(key)
+
+
+def scene_terrain_key(scene):
+    """The name of `scene`'s terrain (set by its Terrain Setup) in the add-on's connection.
+    Raises ValueError when the scene has none loaded in this Blender session."""
+    key = scene.footfall.terrain_key
+    if not key:
+        raise ValueError("no terrain in this scene: run Terrain Setup first")
+    if not _connection.has_terrain(key):
+        raise ValueError("the terrain of this scene (%s) is not loaded in this Blender session: "
+                         "run Terrain Setup again" % (scene.footfall.terrain_name or "unnamed"))
+    return key
+
+
+def unload_unused_terrains():
+    """Unloads the terrains no scene of the open file refers to (a file closed, a scene
+    deleted). Never raises."""
+    try:
+        used = {scene.footfall.terrain_key for scene in bpy.data.scenes}
+        for name in _connection.terrain_names():
+            if name not in used:
+                _connection.unload(name)
+    except Exception:
+        pass
 
 
 def _fail(op, message):
@@ -102,13 +134,16 @@ class FOOTFALL_OT_terrain_setup(bpy.types.Operator):
 
     def execute(self, context):
         settings = context.scene.footfall
+        # A new key each time: a copied scene shares its original's key until either runs
+        # Terrain Setup, and must not replace the other's terrain.
+        key = "scene-" + uuid.uuid4().hex
         try:
             s = session(context)
             if settings.terrain_source == "FILE":
                 path = bpy.path.abspath(settings.terrain_file)
                 if not path:
                     return _fail(self, "footfall: choose a terrain file first")
-                terrain = _connection.load_file(TERRAIN, path, settings.separation)
+                terrain = _connection.load_file(key, path, settings.separation)
                 name = os.path.basename(path)
             else:
                 obj = context.active_object
@@ -118,13 +153,16 @@ class FOOTFALL_OT_terrain_setup(bpy.types.Operator):
                 if self.save_points:
                     sampling.write_point_file(bpy.path.abspath(self.save_points), samples,
                                               "footfall terrain points from Blender " + obj.name)
-                terrain = _connection.load_samples(TERRAIN, samples)
+                terrain = _connection.load_samples(key, samples)
                 name = obj.name
             count, _ = s.info(terrain)
         except (ffc.FootfallError, ValueError, OSError) as e:
+            _connection.unload(key)
             return _fail(self, _error_text(e))
+        settings.terrain_key = key
         settings.terrain_name = name
         settings.sample_count = count
+        unload_unused_terrains()  # this scene's previous terrain, unless a copy still uses it
         self.report({"INFO"}, "footfall: terrain %s, %d samples on %s"
                     % (name, count, _connection.describe()))
         return {"FINISHED"}
@@ -178,13 +216,14 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
 
     def execute(self, context):
         try:
+            key = scene_terrain_key(context.scene)  # before connecting, or anything made
             data = character.load(bpy.path.abspath(self.character_file))
             s = session(context)
             # As the generator reads it, before anything is made (a file it refuses made a
             # whole rig, and the error came only at Generate Walk).
             s.check_character(data, self.character_file)
             feet = character.rest_positions(data, self.character_file)
-            terrain = _connection.terrain(TERRAIN)
+            terrain = _connection.terrain(key)  # uploaded again if the session changed
             return self._setup(context, s, terrain, data, feet)
         except (ffc.FootfallError, ValueError, OSError, TypeError, KeyError) as e:
             return _fail(self, _error_text(e))
@@ -356,8 +395,9 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
                 raise ValueError("the walk would end at frame %d, beyond Blender's frame range "
                                  "(-%d to %d): start earlier or ask fewer steps"
                                  % (last, keying.MAX_FRAME, keying.MAX_FRAME))
+            key = scene_terrain_key(context.scene)
             s = session(context)
-            terrain = _connection.terrain(TERRAIN)
+            terrain = _connection.terrain(key)  # uploaded again if the session changed
             wm.progress_begin(0, total)
             done = 0
             # Each call asks for the walk up to `done` steps; the walk is the same for the steps

@@ -62,6 +62,9 @@ class FootfallScene(bpy.types.PropertyGroup):
                               unit="LENGTH", description="Distance between terrain samples")
     terrain_file: StringProperty(name="Terrain file", subtype="FILE_PATH")
     terrain_name: StringProperty(name="Terrain", default="")
+    # The scene's terrain in the add-on's connection (a new key at each Terrain Setup); empty:
+    # none yet. Another scene, or another file, has its own.
+    terrain_key: StringProperty(name="Terrain key", default="", options={"HIDDEN"})
     sample_count: IntProperty(name="Samples", default=0)
     # Character Setup / Generate Walk
     rig: PointerProperty(type=bpy.types.Object, name="Rig",

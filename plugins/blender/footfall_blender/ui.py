@@ -22,8 +22,12 @@ class FOOTFALL_PT_terrain(_Panel, bpy.types.Panel):
             col.prop(s, "terrain_file")
         col.prop(s, "separation")
         col.operator("footfall.terrain_setup")
-        if s.terrain_name:
+        if s.terrain_name and operators.scene_terrain_loaded(context.scene):
             col.label(text="%s: %d samples" % (s.terrain_name, s.sample_count))
+        elif s.terrain_name:
+            col.label(text="%s: not loaded in this session" % s.terrain_name)
+        else:
+            col.label(text="No terrain in this scene")
         col.label(text="Server: " + operators.describe_connection())
 
 

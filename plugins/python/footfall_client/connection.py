@@ -99,6 +99,20 @@ class Connection:
     def has_terrain(self, name):
         return name in self._terrains
 
+    def terrain_names(self):
+        """The names of the terrains loaded through this connection."""
+        return list(self._terrains)
+
+    def unload(self, name):
+        """Forgets terrain `name` and unloads it from the server, when it was loaded on the
+        current session (a failure to unload is ignored: the server drops it with the session)."""
+        entry = self._terrains.pop(name, None)
+        if entry and self.session is not None and entry[2] is self.session:
+            try:
+                self.session.unload(entry[1])
+            except FootfallError:
+                pass
+
     def shutdown(self):
         """Closes the session and stops a server this connection started."""
         if self.session is not None:
