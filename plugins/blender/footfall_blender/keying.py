@@ -205,11 +205,11 @@ def _key_channel(obj, path, values, frames):
 
 def key_walk(walk, feet, body, from_frame=None):
     """Keys every track of `walk`: feet {foot name: object} get location keys, `body` gets
-    location and rotation keys (world orientation of the walk) in its rotation mode. Tracks without an object are
-    skipped; with `from_frame`, so are keys before it (keyed already: a longer walk generated
-    again keeps the keys of its first steps). Keys are world positions: an object under an
-    animated parent is keyed in its parent's space at each key's frame (the scene's frame is
-    the same afterwards). Returns the number of keys set."""
+    location and rotation keys (world orientation of the walk) in its rotation mode. Tracks
+    without an object are skipped; with `from_frame`, so are keys before it (keyed already: a
+    longer walk generated again keeps the keys of its first steps). Keys are world positions:
+    an object under an animated parent is keyed in its parent's space at each key's frame (the
+    scene's frame is the same afterwards). Returns the number of keys set."""
     # A foot under the body: the body's keys set again from `from_frame` on bend its curve
     # before that frame too, so such a foot's keys of the whole walk are set again.
     again = []
