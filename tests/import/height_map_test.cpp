@@ -114,8 +114,9 @@ TEST_CASE("Height maps far taller than their cells are refused before they are c
   CHECK(Contains(error, "tall.pgm: separation 1 would cut the mesh into more than"));
   CHECK(Contains(error, "check --height-scale and --cell-size"));
   CHECK(samples.size() == 0);
-  // Heights of 1e14 on 1-unit cells: every triangle is degenerate, and the error says so.
-  CHECK(LoadTerrain(dir.Write("needle.asc", "ncols 2\nnrows 2\ncellsize 1\n1e14 0\n0 0\n"),
+  // Heights of 1e14 at opposite corners of 1-unit cells: every triangle is a needle (1 wide,
+  // 1e14 long), and the error says so.
+  CHECK(LoadTerrain(dir.Write("needle.asc", "ncols 2\nnrows 2\ncellsize 1\n1e14 0\n0 1e14\n"),
                     TerrainLoadOptions{}, &samples, &error) == Status::kParseError);
   CHECK(Contains(error, "needle.asc: all 2 triangles of the grid are degenerate"));
   // Scaled to metres of a 1 m grid, the same file loads.

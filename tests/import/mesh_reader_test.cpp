@@ -500,3 +500,26 @@ TEST_CASE("ReadMesh: messages show control bytes of the file as '?'", "[import][
 }
 
 }  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("ReadMesh: small faces far apart are kept", "[import][mesh]") {
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  MeshReadReport report;
+  REQUIRE(Read(dir.Write("apart.obj",
+                         "v 0 0 0\nv 1 0 0\nv 0 0 1\nv 1e7 0 0\nv 10000001 0 0\nv 1e7 0 1\n"
+                         "f 1 3 2\nf 4 6 5\n"),
+               &mesh, &error, &report) == Status::kOk);
+  CHECK(report.skipped_faces == 0);
+  CHECK(SurfaceArea(mesh) == Approx(1));
+  REQUIRE(Read(dir.Write("pebble.obj",
+                         "v 0 0 0\nv 100000 0 0\nv 0 0 100000\nv 5 1 5\nv 5.01 1 5\nv 5 1 5.01\n"
+                         "f 1 3 2\nf 4 6 5\n"),
+               &mesh, &error, &report) == Status::kOk);
+  CHECK(report.skipped_faces == 0);
+  CHECK(mesh.triangles.size() == 2);
+}
+
+}  // namespace footfall

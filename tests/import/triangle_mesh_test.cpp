@@ -144,3 +144,29 @@ TEST_CASE("TurnOutward: inside-out and downward meshes are turned over, others l
 }
 
 }  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("IsDegenerateTriangle: judged on the triangle's own size and position",
+          "[import][mesh]") {
+  // Real triangles, whatever the rest of a mesh: a 1 m triangle 1e7 from the origin, a 1 cm one
+  // near it, a 1e-6 one at the origin.
+  CHECK_FALSE(IsDegenerateTriangle({1e7, 0, 0}, {1e7, 0, 1}, {1e7 + 1, 0, 0}));
+  CHECK_FALSE(IsDegenerateTriangle({5, 1, 5}, {5, 1, 5.01}, {5.01, 1, 5}));
+  CHECK_FALSE(IsDegenerateTriangle({0, 0, 0}, {0, 0, 1e-6}, {1e-6, 0, 0}));
+  // Zero area: collinear (exactly, or within the rounding of the coordinates), a repeated
+  // point, a needle 1e14 long and 1 wide.
+  CHECK(IsDegenerateTriangle({0, 0, 0}, {1, 0, 0}, {2, 0, 0}));
+  CHECK(IsDegenerateTriangle({0, 0, 0}, {0.1, 0, 0.1}, {0.3, 0, 0.3}));
+  CHECK(IsDegenerateTriangle({1e7, 0, 0}, {1e7 + 0.1, 0, 1e-12}, {1e7 + 0.2, 0, 0}));
+  CHECK(IsDegenerateTriangle({1, 2, 3}, {1, 2, 3}, {4, 5, 6}));
+  CHECK(IsDegenerateTriangle({0, 1e14, 0}, {1, 0, 0}, {0, 0, 1}));
+  // RemoveDegenerateTriangles keeps a pebble beside a 100 km ground triangle.
+  TriangleMesh mesh;
+  mesh.vertices = {{0, 0, 0}, {1e5, 0, 0}, {0, 0, 1e5}, {5, 1, 5}, {5.01, 1, 5}, {5, 1, 5.01}};
+  mesh.triangles = {{0, 2, 1}, {3, 5, 4}};
+  CHECK(RemoveDegenerateTriangles(&mesh) == 0);
+  CHECK(mesh.triangles.size() == 2);
+}
+
+}  // namespace footfall

@@ -153,18 +153,15 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
   // 3. Polygons triangulated as fans in stored order; triangles of zero area left out, and a
   // face left with none is skipped.
   out->vertices = std::move(parsed.vertices);
-  Vec3 lo, hi;
-  MeshBounds(*out, &lo, &hi);
-  const double limit = 1e-14 * Length2(hi - lo);
   size_t skipped = 0;
   for (size_t f = 0; f < faces; ++f) {
     const size_t before = out->triangles.size();
     if (used[f]) {
       const auto [c, n] = corners_of(f);
       for (size_t i = 2; i < n; ++i) {
-        out->triangles.push_back({c[0], c[i - 1], c[i]});
-        if (!(0.5 * Length(TriangleCross(*out, out->triangles.size() - 1)) > limit))
-          out->triangles.pop_back();
+        const auto& v = out->vertices;
+        if (!IsDegenerateTriangle(v[c[0]], v[c[i - 1]], v[c[i]]))
+          out->triangles.push_back({c[0], c[i - 1], c[i]});
       }
     }
     if (out->triangles.size() == before) ++skipped;

@@ -109,15 +109,27 @@ void MeshBounds(const TriangleMesh& mesh, Vec3* lo, Vec3* hi) {
   }
 }
 
+bool IsDegenerateTriangle(const Vec3& a, const Vec3& b, const Vec3& c, double relative_epsilon) {
+  const double longest =
+      std::sqrt(std::max({Length2(b - a), Length2(c - b), Length2(a - c)}));  // [wu]
+  double largest = 0;  // [wu] the largest |coordinate|
+  for (const Vec3* p : {&a, &b, &c})
+    largest = std::max({largest, std::fabs(p->x), std::fabs(p->y), std::fabs(p->z)});
+  // Twice the area is the height times the longest edge. Each coordinate is off by up to half
+  // an epsilon of itself, which moves the computed cross product by a few epsilons of the
+  // largest coordinate times the edge.
+  const double rounding = 8 * std::numeric_limits<double>::epsilon() * largest;
+  return !(Length(Cross(b - a, c - a)) > longest * (relative_epsilon * longest + rounding));
+}
+
 size_t RemoveDegenerateTriangles(TriangleMesh* mesh, double relative_epsilon) {
-  Vec3 lo, hi;
-  MeshBounds(*mesh, &lo, &hi);
-  const double limit = relative_epsilon * Length2(hi - lo);
   size_t kept = 0;
   for (size_t t = 0; t < mesh->triangles.size(); ++t) {
     const auto& tri = mesh->triangles[t];
     const bool repeated = tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2];
-    if (repeated || !(0.5 * Length(TriangleCross(*mesh, t)) > limit)) continue;
+    if (repeated || IsDegenerateTriangle(mesh->vertices[tri[0]], mesh->vertices[tri[1]],
+                                         mesh->vertices[tri[2]], relative_epsilon))
+      continue;
     mesh->triangles[kept++] = tri;
   }
   const size_t removed = mesh->triangles.size() - kept;

@@ -68,9 +68,16 @@ MeshFacing TurnOutward(TriangleMesh* mesh, const Vec3& up);
 // World-space bounds of the vertices; both (0, 0, 0) for an empty mesh.
 void MeshBounds(const TriangleMesh& mesh, Vec3* lo, Vec3* hi);
 
-// Removes triangles whose area is at most `relative_epsilon` times the squared bounding-box
-// diagonal (zero-area slivers, repeated vertices). Returns how many were removed.
-size_t RemoveDegenerateTriangles(TriangleMesh* mesh, double relative_epsilon = 1e-14);
+// True when triangle (a, b, c) has no area to speak of, judged on its own size and position:
+// its height over its longest edge is at most `relative_epsilon` times that edge (a collinear
+// sliver or a needle), or within the rounding of its coordinates (8 double epsilons of its
+// largest |coordinate|). A 1 cm triangle is real at 1e7 from the origin, or in a 100 km mesh.
+bool IsDegenerateTriangle(const Vec3& a, const Vec3& b, const Vec3& c,
+                          double relative_epsilon = 1e-12);
+
+// Removes triangles repeating a vertex and those IsDegenerateTriangle calls degenerate. Returns
+// how many were removed.
+size_t RemoveDegenerateTriangles(TriangleMesh* mesh, double relative_epsilon = 1e-12);
 
 // The point of the mesh's surface nearest to q (a vertex for a mesh without triangles; q for an
 // empty mesh). A scan of every triangle.
