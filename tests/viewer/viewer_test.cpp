@@ -163,6 +163,49 @@ TEST_CASE("screenshot of a next query shows the chosen sample where it projects"
   CHECK(share < 0.98);
 }
 
+TEST_CASE("a camera's clip planes follow the terrain beside the eye, not its target",
+          "[viewer][camera]") {
+  // (The near plane was 1e-4 of the distance to the target: a target 1e6 away clipped the
+  // terrain under the eye, a blank image with exit 0; at 2e19 the camera became NaN.)
+  const std::string dir = test::TempDir();
+  std::string flat;  // y = 0 over [-10, 10] x [-10, 10], normals up (drawn 128, 255, 128)
+  for (int k = 0; k <= 100; ++k) {
+    for (int i = 0; i <= 100; ++i)
+      flat += std::to_string(-10 + i * 0.2) + " 0 " + std::to_string(-10 + k * 0.2) + " 0 1 0\n";
+  }
+  test::WriteFile(dir + "/flat.pts", flat);
+  // The same eye, half a unit above the ground, looking the same way at ever farther targets.
+  auto shoot = [&](const std::string& target, json* state) {
+    const std::string shot = dir + "/shot.png";
+    const RunResult r =
+        View({"--terrain", dir + "/flat.pts", "--camera", "0 0.5 0 " + target, "--size", "320x200",
+              "--screenshot", shot, "--dump-state", dir + "/state.json"});
+    INFO("target " << target << ": " << r.err);
+    REQUIRE(r.exit_code == 0);
+    *state = json::parse(test::ReadFile(dir + "/state.json"));
+    return CountColor(ReadPng(shot), {128, 255, 128});
+  };
+  json state;
+  const int near_target = shoot("10 0 10", &state);
+  INFO("terrain pixels with the target 10 away: " << near_target);
+  REQUIRE(near_target > 320 * 200 / 4);
+  for (const std::string target : {"1e6 0 1e6", "1e15 0 1e15"}) {
+    const int far_target = shoot(target, &state);
+    INFO("target " << target << ": " << far_target << " terrain pixels");
+    CHECK(far_target > near_target * 8 / 10);
+    // The eye stays where it was put.
+    CHECK(state["camera"]["eye"] == json::array({0.0, 0.5, 0.0}));
+  }
+  CHECK(state["camera"]["target"][0].get<double>() == 1e15);
+  // Beyond what a query may reach, the camera is refused.
+  const RunResult r = View({"--terrain", dir + "/flat.pts", "--camera", "0 0.5 0 2e19 0 2e19",
+                            "--screenshot", dir + "/refused.png"});
+  CHECK(r.exit_code == 2);
+  CHECK_THAT(r.err, Catch::Contains("--camera: expected the eye and the target within +-1e15"));
+  std::ifstream none(dir + "/refused.png");
+  CHECK_FALSE(none.good());
+}
+
 TEST_CASE("height colouring and grid cells change the picture", "[viewer][screenshot]") {
   const std::string dir = test::TempDir();
   REQUIRE(View({"--terrain", kTerrain, "--height-colors", "--cells", "--size", "320x200",

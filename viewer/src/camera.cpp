@@ -7,62 +7,118 @@
 
 namespace footfall::viewer {
 namespace {
-constexpr float kMaxPitch = 1.55f;  // just under 89 degrees
+
+constexpr double kMaxPitch = 1.55;      // just under 89 degrees
+constexpr double kNearRatio = 1e-5;     // the nearest the near plane comes: far * this
+constexpr double kMinDepthSpan = 0.01;  // far - near >= far * this (float depth stays exact)
+constexpr double kMinZoom = 1e-4;       // Zoom brings the eye no nearer the target
+constexpr double kMaxZoom = 1e15;       // nor farther ([Units: render units])
+
+// The unit vector along d and its length, without the underflow of squaring tiny components.
+glm::dvec3 UnitAndLength(const glm::dvec3& d, double* length) {
+  const double m = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+  if (!(m > 0)) {
+    *length = 0;
+    return glm::dvec3(0, 0, 1);
+  }
+  const glm::dvec3 u = d / m;
+  const double n = glm::length(u);
+  *length = m * n;
+  return u / n;
 }
 
-void OrbitCamera::Frame(const glm::vec3& lo, const glm::vec3& hi) {
-  target_ = 0.5f * (lo + hi);
-  radius_ = std::max(0.5f * glm::length(hi - lo), 0.5f);
-  const float half_fov = glm::radians(kFovYDegrees) * 0.5f;
+}  // namespace
+
+void OrbitCamera::PlaceEye() {
+  const glm::dvec3 dir(std::cos(pitch_) * std::sin(yaw_), std::sin(pitch_),
+                       std::cos(pitch_) * std::cos(yaw_));
+  eye_ = target_ + distance_ * dir;
+}
+
+void OrbitCamera::Frame(const glm::dvec3& lo, const glm::dvec3& hi) {
+  target_ = 0.5 * (lo + hi);
+  const double radius = std::max(0.5 * glm::length(hi - lo), 0.5);
+  const double half_fov = glm::radians(kFovYDegrees) * 0.5;
   // The bounding sphere just fits the vertical field of view (so all of the box does).
-  distance_ = radius_ / std::sin(half_fov) * 1.02f;
+  distance_ = radius / std::sin(half_fov) * 1.02;
+  PlaceEye();
 }
 
-void OrbitCamera::LookAt(const glm::vec3& eye, const glm::vec3& target) {
+void OrbitCamera::LookAt(const glm::dvec3& eye, const glm::dvec3& target) {
   target_ = target;
-  const glm::vec3 d = eye - target;
-  distance_ = std::max(glm::length(d), 1e-4f);
-  pitch_ = std::clamp(std::asin(std::clamp(d.y / distance_, -1.0f, 1.0f)), -kMaxPitch, kMaxPitch);
+  double length = 0;
+  const glm::dvec3 d = UnitAndLength(eye - target, &length);
+  distance_ = length;
+  const double pitch = std::asin(std::clamp(d.y, -1.0, 1.0));
+  pitch_ = std::clamp(pitch, -kMaxPitch, kMaxPitch);
   yaw_ = std::atan2(d.x, d.z);
-  radius_ = std::max(radius_, distance_);
+  if (pitch_ == pitch) {
+    eye_ = eye;
+  } else {
+    PlaceEye();
+  }
 }
 
-void OrbitCamera::Orbit(float yaw_delta, float pitch_delta) {
+void OrbitCamera::Orbit(double yaw_delta, double pitch_delta) {
   yaw_ += yaw_delta;
   pitch_ = std::clamp(pitch_ + pitch_delta, -kMaxPitch, kMaxPitch);
+  PlaceEye();
 }
 
-void OrbitCamera::Pan(float dx_fraction, float dy_fraction) {
-  const glm::mat4 view = View();
-  const glm::vec3 right(view[0][0], view[1][0], view[2][0]);
-  const glm::vec3 up(view[0][1], view[1][1], view[2][1]);
-  const float height = 2 * distance_ * std::tan(glm::radians(kFovYDegrees) * 0.5f);
-  target_ += (-dx_fraction * right + dy_fraction * up) * height;
+void OrbitCamera::Pan(double dx_fraction, double dy_fraction) {
+  const glm::dmat4 view = View();
+  const glm::dvec3 right(view[0][0], view[1][0], view[2][0]);
+  const glm::dvec3 up(view[0][1], view[1][1], view[2][1]);
+  const double height = 2 * distance_ * std::tan(glm::radians(kFovYDegrees) * 0.5);
+  const glm::dvec3 shift = (-dx_fraction * right + dy_fraction * up) * height;
+  target_ += shift;
+  eye_ += shift;
 }
 
-void OrbitCamera::Zoom(float factor) { distance_ = std::max(distance_ * factor, 1e-4f); }
-
-glm::vec3 OrbitCamera::Eye() const {
-  const glm::vec3 dir(std::cos(pitch_) * std::sin(yaw_), std::sin(pitch_),
-                      std::cos(pitch_) * std::cos(yaw_));
-  return target_ + distance_ * dir;
+void OrbitCamera::Zoom(double factor) {
+  distance_ =
+      std::clamp(distance_ * factor, std::min(distance_, kMinZoom), std::max(distance_, kMaxZoom));
+  PlaceEye();
 }
 
-glm::mat4 OrbitCamera::View() const { return glm::lookAt(Eye(), target_, glm::vec3(0, 1, 0)); }
-
-glm::mat4 OrbitCamera::Projection(float aspect) const {
-  const float reach = distance_ + 2 * radius_;
-  const float near_plane = std::max(reach * 1e-4f, 1e-4f);
-  return glm::perspective(glm::radians(kFovYDegrees), aspect, near_plane, reach * 2);
+glm::dvec3 OrbitCamera::Forward() const {
+  // From yaw and pitch, not from eye - target: defined however near the two are.
+  return -glm::dvec3(std::cos(pitch_) * std::sin(yaw_), std::sin(pitch_),
+                     std::cos(pitch_) * std::cos(yaw_));
 }
 
-bool OrbitCamera::Project(const glm::vec3& p, int width, int height, glm::vec2* pixel) const {
-  const glm::vec4 clip =
-      Projection(static_cast<float>(width) / static_cast<float>(height)) * View() * glm::vec4(p, 1);
+glm::dmat4 OrbitCamera::View() const {
+  return glm::lookAt(eye_, eye_ + Forward(), glm::dvec3(0, 1, 0));
+}
+
+glm::dmat4 OrbitCamera::Projection(double aspect, const glm::dvec3& lo,
+                                   const glm::dvec3& hi) const {
+  // The depths of the box's corners along the view direction.
+  const glm::dvec3 forward = Forward();
+  double nearest = HUGE_VAL, farthest = -HUGE_VAL;
+  for (int i = 0; i < 8; ++i) {
+    const glm::dvec3 corner(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
+    const double depth = glm::dot(corner - eye_, forward);
+    nearest = std::min(nearest, depth);
+    farthest = std::max(farthest, depth);
+  }
+  const double fov = glm::radians(kFovYDegrees);
+  // All of the box behind the eye: nothing to draw, any planes will do.
+  if (!(farthest > 0)) return glm::perspective(fov, aspect, 1.0, 2.0);
+  const double far_plane = farthest * 1.001;
+  const double near_plane =
+      std::max(std::min(nearest * 0.999, far_plane * (1 - kMinDepthSpan)), far_plane * kNearRatio);
+  return glm::perspective(fov, aspect, near_plane, far_plane);
+}
+
+bool OrbitCamera::Project(const glm::dvec3& p, int width, int height, glm::dvec2* pixel) const {
+  // Clip x and y do not depend on the depth planes: any will do.
+  const double aspect = static_cast<double>(width) / static_cast<double>(height);
+  const glm::dmat4 projection = glm::perspective(glm::radians(kFovYDegrees), aspect, 1.0, 2.0);
+  const glm::dvec4 clip = projection * View() * glm::dvec4(p, 1);
   if (clip.w <= 0) return false;
-  const glm::vec2 ndc(clip.x / clip.w, clip.y / clip.w);
-  *pixel = glm::vec2((ndc.x * 0.5f + 0.5f) * static_cast<float>(width),
-                     (0.5f - ndc.y * 0.5f) * static_cast<float>(height));
+  const glm::dvec2 ndc(clip.x / clip.w, clip.y / clip.w);
+  *pixel = glm::dvec2((ndc.x * 0.5 + 0.5) * width, (0.5 - ndc.y * 0.5) * height);
   return true;
 }
 

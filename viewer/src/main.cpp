@@ -70,8 +70,8 @@ int main(int argc, char** argv) {
   app.add_flag("--height-colors", o.height_colors, "Colour samples by height, not by normal");
   app.add_flag("--cells", o.show_cells, "Draw the occupied grid cells");
   app.add_option("--camera", camera,
-                 "Camera \"EX EY EZ TX TY TZ\": eye and target in world space (y up, 45 degree "
-                 "vertical field of view); default frames everything");
+                 "Camera \"EX EY EZ TX TY TZ\": eye and target in world space, within +-1e15 (y "
+                 "up, 45 degree vertical field of view); default frames everything");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

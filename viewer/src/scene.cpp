@@ -38,7 +38,9 @@ glm::vec3 Direction(const Vec3& v) {
 }
 
 ordered_json Json(const Vec3& v) { return ordered_json::array({v.x, v.y, v.z}); }
-ordered_json Json(const glm::vec2& v) { return ordered_json::array({v.x, v.y}); }
+ordered_json Json(const glm::dvec2& v) {
+  return ordered_json::array({static_cast<float>(v.x), static_cast<float>(v.y)});
+}
 
 void Grow(const Vec3& p, Vec3* lo, Vec3* hi, bool* any) {
   if (!*any) {
@@ -50,7 +52,25 @@ void Grow(const Vec3& p, Vec3* lo, Vec3* hi, bool* any) {
   hi->x = std::max(hi->x, p.x), hi->y = std::max(hi->y, p.y), hi->z = std::max(hi->z, p.z);
 }
 
+// The radius of the ring drawn around a next query's ideal point. [Units: wu]
+double RingRadius(const QueryView& q) {
+  return q.trace.radius > 0     ? q.trace.radius
+         : q.spec.tolerance > 0 ? q.spec.tolerance
+                                : Length(q.spec.direction);
+}
+
 }  // namespace
+
+void Scene::GrowDrawn(const QueryView& q) {
+  Grow(q.spec.point, &drawn_lo_, &drawn_hi_, &has_drawn_);
+  if (q.spec.op == QueryOp::kNext) {
+    const Vec3 ideal = q.spec.point + q.spec.direction;
+    const double r = RingRadius(q);
+    Grow(ideal - Vec3{r, r, r}, &drawn_lo_, &drawn_hi_, &has_drawn_);
+    Grow(ideal + Vec3{r, r, r}, &drawn_lo_, &drawn_hi_, &has_drawn_);
+  }
+  if (q.result.status == Status::kOk) Grow(q.result.point, &drawn_lo_, &drawn_hi_, &has_drawn_);
+}
 
 Rgba FootColor(size_t track_index) {
   static const Rgba kPalette[] = {{255, 80, 40, 255},   {40, 130, 255, 255},  {60, 220, 60, 255},
@@ -95,6 +115,7 @@ Status Scene::AddQuery(const QuerySpec& spec, std::string* error) {
   const QueryView& q = queries_.back();
   Grow(q.spec.point, &lo_, &hi_, &has_bounds_);
   Grow(q.trace.ideal, &lo_, &hi_, &has_bounds_);
+  GrowDrawn(q);
   return Status::kOk;
 }
 
@@ -137,6 +158,7 @@ size_t Scene::PlantedKeysOffTerrain(double limit, size_t* planted) const {
 void Scene::AddLive(const std::vector<RecentQuery>& queries) {
   for (const RecentQuery& q : queries) {
     live_.push_back(FromRecent(q, has_terrain() ? &grid_ : nullptr));
+    GrowDrawn(live_.back());
     ++live_received_;
   }
   if (live_.size() > kMaxLive)
@@ -145,6 +167,10 @@ void Scene::AddLive(const std::vector<RecentQuery>& queries) {
 
 void Scene::Finalize() {
   origin_ = has_bounds_ ? 0.5 * (lo_ + hi_) : Vec3{};
+  if (has_bounds_) {
+    Grow(lo_, &drawn_lo_, &drawn_hi_, &has_drawn_);
+    Grow(hi_, &drawn_lo_, &drawn_hi_, &has_drawn_);
+  }
   // Without samples, size markers after the scene: a walk of a few metres or of a kilometre.
   if (!has_terrain() && has_bounds_) spacing_ = std::max(Distance(lo_, hi_) / 300, 1e-3);
 }
@@ -154,16 +180,34 @@ glm::vec3 Scene::ToRender(const Vec3& world) const {
   return glm::vec3(static_cast<float>(r.x), static_cast<float>(r.y), static_cast<float>(r.z));
 }
 
-Vec3 Scene::ToWorld(const glm::vec3& render) const {
+glm::dvec3 Scene::ToRenderDouble(const Vec3& world) const {
+  const Vec3 r = world - origin_;
+  return glm::dvec3(r.x, r.y, r.z);
+}
+
+Vec3 Scene::ToWorld(const glm::dvec3& render) const {
   return origin_ + Vec3{render.x, render.y, render.z};
 }
 
-void Scene::RenderBounds(glm::vec3* lo, glm::vec3* hi) const {
+void Scene::RenderBounds(glm::dvec3* lo, glm::dvec3* hi) const {
   if (!has_bounds_) {
-    *lo = glm::vec3(-0.5f), *hi = glm::vec3(0.5f);
+    *lo = glm::dvec3(-0.5), *hi = glm::dvec3(0.5);
     return;
   }
-  *lo = ToRender(lo_), *hi = ToRender(hi_);
+  *lo = ToRenderDouble(lo_), *hi = ToRenderDouble(hi_);
+}
+
+void Scene::DrawnBounds(glm::dvec3* lo, glm::dvec3* hi) const {
+  if (!has_drawn_) {
+    RenderBounds(lo, hi);
+    return;
+  }
+  *lo = ToRenderDouble(drawn_lo_), *hi = ToRenderDouble(drawn_hi_);
+  // Room for markers drawn around points (normals and body axes up to 8 sample spacings long,
+  // crosses, arrow heads) and for the grid cells around the samples.
+  double margin = 0.05 * glm::length(*hi - *lo) + 16 * std::max(spacing_, 0.02);
+  if (has_terrain()) margin += grid_.stats().cell_size;
+  *lo -= glm::dvec3(margin), *hi += glm::dvec3(margin);
 }
 
 std::vector<DrawVertex> Scene::TerrainPoints(ColorMode mode) const {
@@ -206,9 +250,7 @@ void Scene::DrawQuery(const QueryView& q, bool latest, DrawList* depth_tested,
     on_top->Arrow(foot, ideal, std::max(step * 0.15f, unit), colors::kArrow);
     on_top->Point(ideal, colors::kIdeal, 8 * marker);
     // The candidate radius, as a ring in the horizontal plane around the ideal point.
-    const float radius = static_cast<float>(q.trace.radius > 0     ? q.trace.radius
-                                            : q.spec.tolerance > 0 ? q.spec.tolerance
-                                                                   : step);
+    const float radius = static_cast<float>(RingRadius(q));
     const int kSegments = 48;
     for (int i = 0; i < kSegments; ++i) {
       const float a0 = 6.2831853f * static_cast<float>(i) / kSegments;
@@ -299,11 +341,10 @@ void Scene::Draw(const ViewState& view, DrawList* depth_tested, DrawList* on_top
 ordered_json Scene::Describe(const ViewState& view, const OrbitCamera& camera, int width,
                              int height) const {
   auto pixel = [&](const Vec3& world, ordered_json* j) {
-    glm::vec2 px(0, 0);
-    const bool front = camera.Project(ToRender(world), width, height, &px);
+    glm::dvec2 px(0, 0);
+    const bool front = camera.Project(ToRenderDouble(world), width, height, &px);
     (*j)["pixel"] = Json(px);
-    (*j)["visible"] = front && px.x >= 0 && px.y >= 0 && px.x < static_cast<float>(width) &&
-                      px.y < static_cast<float>(height);
+    (*j)["visible"] = front && px.x >= 0 && px.y >= 0 && px.x < width && px.y < height;
   };
   auto query_json = [&](const QueryView& q) {
     ordered_json j;
@@ -327,7 +368,7 @@ ordered_json Scene::Describe(const ViewState& view, const OrbitCamera& camera, i
   };
   ordered_json root;
   root["image"] = {{"width", width}, {"height", height}};
-  root["camera"] = {{"eye", Json(ToWorld(camera.Eye()))},
+  root["camera"] = {{"eye", Json(ToWorld(camera.eye()))},
                     {"target", Json(ToWorld(camera.target()))},
                     {"fov_y_degrees", OrbitCamera::kFovYDegrees}};
   root["color_mode"] = view.color == ColorMode::kNormal ? "normal" : "height";

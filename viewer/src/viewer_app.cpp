@@ -120,7 +120,7 @@ struct App {
   explicit App(const ViewerOptions& o) : options(o) {}
 
   void FrameAll() {
-    glm::vec3 lo, hi;
+    glm::dvec3 lo, hi;
     scene.RenderBounds(&lo, &hi);
     camera.Frame(lo, hi);
   }
@@ -158,10 +158,13 @@ struct App {
       renderer->SetTerrain(scene.TerrainPoints(view.color));
       terrain_dirty = false;
     }
-    const float aspect = static_cast<float>(width) / static_cast<float>(std::max(height, 1));
-    const glm::mat4 projection = camera.Projection(aspect);
-    const glm::mat4 view_projection = projection * camera.View();
-    const float point_scale = static_cast<float>(height) * projection[1][1] * 0.5f;
+    // The camera in double (its target may lie 1e15 away), the product in float for GL.
+    const double aspect = static_cast<double>(width) / static_cast<double>(std::max(height, 1));
+    glm::dvec3 lo, hi;
+    scene.DrawnBounds(&lo, &hi);
+    const glm::dmat4 projection = camera.Projection(aspect, lo, hi);
+    const glm::mat4 view_projection(projection * camera.View());
+    const float point_scale = static_cast<float>(height * projection[1][1] * 0.5);
     renderer->Begin(width, height, colors::kBackground);
     renderer->DrawTerrain(view_projection, point_scale);
     DrawList depth_tested, on_top, screen;
@@ -398,6 +401,16 @@ int RunViewer(const ViewerOptions& options) {
     return Fail("--screenshot and --dump-state name the same file; give each its own", 2);
   if (options.width <= 0 || options.height <= 0 || options.width > 16384 || options.height > 16384)
     return Fail("--size: width and height must be within 1..16384", 2);
+  if (options.has_camera) {
+    // (A target 2e19 away put the camera at NaN: a blank image and exit 0.)
+    for (const Vec3& p : {options.eye, options.target}) {
+      if (!(std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) <= kMaxKeyCoordinate))
+        return Fail(
+            "--camera: expected the eye and the target within +-1e15 (nothing farther "
+            "can be drawn)",
+            2);
+    }
+  }
   std::vector<QuerySpec> specs;
   for (const std::string& text : options.queries) {
     QuerySpec spec;
@@ -463,7 +476,8 @@ int RunViewer(const ViewerOptions& options) {
   }
   app.FrameAll();
   if (options.has_camera)
-    app.camera.LookAt(app.scene.ToRender(options.eye), app.scene.ToRender(options.target));
+    app.camera.LookAt(app.scene.ToRenderDouble(options.eye),
+                      app.scene.ToRenderDouble(options.target));
 
   // 3. Open a window (hidden for screenshots) with an OpenGL 3.3 core context.
   glfwSetErrorCallback(OnGlfwError);

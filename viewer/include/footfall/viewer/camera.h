@@ -1,5 +1,7 @@
 // OrbitCamera: a perspective camera circling a target point, y up, in render space (world
 // space minus the scene origin, so float vertices stay precise far from the world origin).
+// The camera itself is kept in double precision: an eye beside the scene may look at a target
+// up to 1e15 away (--camera) and still be placed to the unit.
 #pragma once
 
 #include <glm/glm.hpp>
@@ -9,38 +11,50 @@ namespace footfall::viewer {
 class OrbitCamera {
  public:
   // Vertical field of view. [Units: degrees]
-  static constexpr float kFovYDegrees = 45.0f;
+  static constexpr double kFovYDegrees = 45.0;
 
   // Looks at the box [lo, hi] (render space) from the current direction, far enough to see
   // all of it. An empty or degenerate box is treated as a 1-unit box around its centre.
-  void Frame(const glm::vec3& lo, const glm::vec3& hi);
-  // Places the eye and the target (render space). eye != target.
-  void LookAt(const glm::vec3& eye, const glm::vec3& target);
+  void Frame(const glm::dvec3& lo, const glm::dvec3& hi);
+  // Places the eye and the target (render space). eye != target. The eye is kept as given
+  // unless the view is within a degree of vertical, which is tilted to 89 degrees about the
+  // target.
+  void LookAt(const glm::dvec3& eye, const glm::dvec3& target);
 
   // Turns around the target. [Units: radians] Pitch stays within (-89, 89) degrees.
-  void Orbit(float yaw_delta, float pitch_delta);
-  // Moves the target in the view plane by a fraction of the view height.
-  void Pan(float dx_fraction, float dy_fraction);
-  // Multiplies the distance to the target by `factor` (> 0).
-  void Zoom(float factor);
+  void Orbit(double yaw_delta, double pitch_delta);
+  // Moves the eye and the target in the view plane by a fraction of the view height at the
+  // target.
+  void Pan(double dx_fraction, double dy_fraction);
+  // Multiplies the distance to the target by `factor` (> 0), within [1e-4, 1e15].
+  void Zoom(double factor);
 
-  glm::vec3 Eye() const;
-  const glm::vec3& target() const { return target_; }
-  float distance() const { return distance_; }
-  glm::mat4 View() const;
-  // Perspective projection for a viewport of this aspect ratio (width / height).
-  glm::mat4 Projection(float aspect) const;
+  const glm::dvec3& eye() const { return eye_; }
+  const glm::dvec3& target() const { return target_; }
+  double distance() const { return distance_; }
+  // A unit vector from the eye toward the target.
+  glm::dvec3 Forward() const;
+  glm::dmat4 View() const;
+  // Perspective projection for a viewport of this aspect ratio (width / height), its near and
+  // far planes chosen from the depths of the box [lo, hi] (render space: everything drawn)
+  // seen from the eye, whatever the target's distance: nothing in the box is clipped between
+  // far * 1e-5 and far. (Depth is 24-bit: a box reaching from the eye to far keeps about 1/170
+  // of far as its depth resolution at far.)
+  glm::dmat4 Projection(double aspect, const glm::dvec3& lo, const glm::dvec3& hi) const;
 
   // Projects a render-space point to pixels of a width x height image (x right, y down, origin
   // at the top-left pixel corner). Returns false for points behind the eye.
-  bool Project(const glm::vec3& p, int width, int height, glm::vec2* pixel) const;
+  bool Project(const glm::dvec3& p, int width, int height, glm::dvec2* pixel) const;
 
  private:
-  glm::vec3 target_{0, 0, 0};
-  float distance_ = 10;
-  float yaw_ = 0.6f;    // [Units: radians] around +y, 0 looks along -z
-  float pitch_ = 0.6f;  // [Units: radians] above the horizon
-  float radius_ = 1;    // the framed box's half diagonal, for the clip planes
+  // Places the eye at `distance_` from the target along yaw and pitch.
+  void PlaceEye();
+
+  glm::dvec3 target_{0, 0, 0};
+  glm::dvec3 eye_{0, 0, 10};
+  double distance_ = 10;  // [Units: render units] |eye - target|
+  double yaw_ = 0.6;      // [Units: radians] around +y, 0 looks along -z
+  double pitch_ = 0.6;    // [Units: radians] above the horizon
 };
 
 }  // namespace footfall::viewer

@@ -77,11 +77,18 @@ class Scene {
   const std::vector<QueryView>& queries() const { return queries_; }
   const std::vector<QueryView>& live() const { return live_; }
 
-  // World space to render space (world minus the origin), and the render-space bounds of
-  // everything loaded (a unit box when nothing is).
+  // World space to render space (world minus the origin): in float for vertices, in double
+  // for the camera; and back.
   glm::vec3 ToRender(const Vec3& world) const;
-  Vec3 ToWorld(const glm::vec3& render) const;
-  void RenderBounds(glm::vec3* lo, glm::vec3* hi) const;
+  glm::dvec3 ToRenderDouble(const Vec3& world) const;
+  Vec3 ToWorld(const glm::dvec3& render) const;
+  // The render-space bounds of everything loaded (a unit box when nothing is): what the
+  // camera frames.
+  void RenderBounds(glm::dvec3* lo, glm::dvec3* hi) const;
+  // The render-space bounds of everything drawn: what is loaded, the live queries received,
+  // and room for the markers around them (rings, normals, cells). The camera keeps all of it
+  // between its clip planes.
+  void DrawnBounds(glm::dvec3* lo, glm::dvec3* hi) const;
 
   // The terrain samples as world-sized points in render space, coloured by `mode`.
   std::vector<DrawVertex> TerrainPoints(ColorMode mode) const;
@@ -98,6 +105,8 @@ class Scene {
  private:
   void DrawQuery(const QueryView& q, bool latest, DrawList* depth_tested, DrawList* on_top) const;
   void DrawWalk(const ViewState& view, DrawList* on_top) const;
+  // Grows the drawn bounds by a query's points and its candidate ring.
+  void GrowDrawn(const QueryView& q);
 
   std::string terrain_path_, walk_path_;
   RawSamples samples_;
@@ -110,6 +119,8 @@ class Scene {
   Vec3 origin_;
   Vec3 lo_, hi_;
   bool has_bounds_ = false;
+  Vec3 drawn_lo_, drawn_hi_;  // lo_, hi_ and what only adds to the picture (world space)
+  bool has_drawn_ = false;
 };
 
 }  // namespace footfall::viewer
