@@ -288,6 +288,37 @@ TEST_CASE("screenshot of a walk shows the feet where the JSON puts them at that 
   }
 }
 
+TEST_CASE("why a walk stopped is shown in full, wrapped to the window", "[viewer][walk]") {
+  // (The reason ran off the right edge of the window in one line.)
+  const std::string dir = test::TempDir();
+  const std::string reason =
+      "step 5: foot L at (0.8700, 1.2600, 2.3700): no foothold within 0.35 of (0.8700, 1.2600, "
+      "2.8950) (the terrain ends, or rises as a wall at its bounds, before it) (6 more tries, "
+      "shorter, longer or aimed down, refused too); walk stopped, keys up to step 4 kept";
+  std::string walk = WalkJson();
+  walk.replace(walk.find("\"fps\": 24,"), 10, "\"fps\": 24, \"stopped\": \"" + reason + "\",");
+  test::WriteFile(dir + "/walk.json", walk);
+  const int width = 480;
+  const RunResult r = View({"--walk", dir + "/walk.json", "--size", "480x360", "--screenshot",
+                            dir + "/shot.png", "--dump-state", dir + "/state.json"});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const json state = json::parse(test::ReadFile(dir + "/state.json"));
+  std::string shown;  // the lines from "stopped: " on, joined again
+  for (const json& line : state["hud"]) {
+    const std::string text = line["text"];
+    INFO("HUD line \"" << text << "\"");
+    CHECK(line["x"].get<double>() >= 0);
+    CHECK(line["x"].get<double>() + line["width"].get<double>() <= width - 6);
+    if (!shown.empty()) {
+      shown += " " + text;
+    } else if (text.find("stopped: ") != std::string::npos) {
+      shown = text.substr(text.find("stopped: "));
+    }
+  }
+  CHECK(shown == "stopped: " + reason);
+}
+
 TEST_CASE("live: the viewer shows a query another client sends to footfalld", "[viewer][live]") {
   const std::string dir = test::TempDir();
   test::Child server(

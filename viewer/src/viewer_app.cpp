@@ -36,6 +36,49 @@ std::string g_glfw_error;  // the last GLFW error, for messages
 
 void OnGlfwError(int, const char* description) { g_glfw_error = description ? description : ""; }
 
+// `text` as lines no wider than `max_width` pixels at `scale`: its items (parts between
+// `separator`s) joined while they fit; an item wider than a line is broken at its spaces, and
+// a word wider than a line between its characters. Line breaks and tabs count as spaces.
+std::vector<std::string> WrapText(std::string text, const std::string& separator, float scale,
+                                  float max_width) {
+  for (char& c : text) {
+    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
+  }
+  auto fits = [&](const std::string& s) { return DrawList::TextWidth(s, scale) <= max_width; };
+  std::vector<std::string> lines;
+  std::string line;
+  for (size_t begin = 0; begin < text.size();) {
+    size_t end = text.find(separator, begin);
+    if (end == std::string::npos) end = text.size();
+    std::string item = text.substr(begin, end - begin);
+    begin = end + separator.size();
+    if (item.empty()) continue;
+    const std::string joined = line.empty() ? item : line + separator + item;
+    if (fits(joined)) {
+      line = joined;
+      continue;
+    }
+    if (!line.empty()) lines.push_back(line);
+    line.clear();
+    if (separator != " " && !fits(item)) {
+      std::vector<std::string> words = WrapText(item, " ", scale, max_width);
+      line = words.back();
+      words.pop_back();
+      lines.insert(lines.end(), words.begin(), words.end());
+      continue;
+    }
+    while (!fits(item)) {
+      size_t n = 1;
+      while (n < item.size() && fits(item.substr(0, n + 1))) ++n;
+      lines.push_back(item.substr(0, n));
+      item.erase(0, n);
+    }
+    line = item;
+  }
+  if (!line.empty() || lines.empty()) lines.push_back(line);
+  return lines;
+}
+
 // Polls footfalld on its own thread so a slow or vanished server never stalls drawing.
 class LiveFollower {
  public:
@@ -113,6 +156,12 @@ struct App {
   GLFWwindow* window = nullptr;
   bool playing = false;
   bool terrain_dirty = true;
+  // The overlay's lines of text as last drawn (pixels: top-left corner and width).
+  struct HudLine {
+    std::string text;
+    float x, y, width;
+  };
+  std::vector<HudLine> hud_lines;
   // Mouse drag state.
   bool rotating = false, panning = false;
   double last_x = 0, last_y = 0;
@@ -176,32 +225,29 @@ struct App {
   }
 
   void DrawOverlay(int width, int height, DrawList* screen) {
+    hud_lines.clear();
     const float scale = width >= 900 ? 1.5f : 1.0f;
     const float line = 12 * scale;
     const Rgba text{230, 230, 230, 255};
-    screen->Rect(0, 0, static_cast<float>(width), line + 6, Rgba{0, 0, 0, 140});
-    screen->Text(6, 4, InfoText(), scale, text);
-    // The help line, wrapped at its item separators to fit the width.
-    std::vector<std::string> lines(1);
-    const std::string help = HelpText();
-    for (size_t begin = 0; begin < help.size();) {
-      size_t end = help.find("   ", begin);
-      if (end == std::string::npos) end = help.size();
-      const std::string item = help.substr(begin, end - begin);
-      const std::string joined = lines.back().empty() ? item : lines.back() + "   " + item;
-      if (!lines.back().empty() &&
-          DrawList::TextWidth(joined, scale) > static_cast<float>(width) - 12) {
-        lines.push_back(item);
-      } else {
-        lines.back() = joined;
+    // Every line of text is wrapped to the window, 6 px from its edges, and recorded.
+    const float max_width = static_cast<float>(width) - 12;
+    auto draw_lines = [&](float x, float top, const std::vector<std::string>& lines) {
+      for (size_t i = 0; i < lines.size(); ++i) {
+        const float y = top + static_cast<float>(i) * line;
+        screen->Text(x, y, lines[i], scale, text);
+        hud_lines.push_back({lines[i], x, y, DrawList::TextWidth(lines[i], scale)});
       }
-      begin = end + 3;
-    }
+    };
+    const std::vector<std::string> info = WrapText(InfoText(), "   ", scale, max_width);
+    screen->Rect(0, 0, static_cast<float>(width), static_cast<float>(info.size()) * line + 6,
+                 Rgba{0, 0, 0, 140});
+    draw_lines(6, 4, info);
+    // The help line, wrapped at its item separators.
+    const std::vector<std::string> lines = WrapText(HelpText(), "   ", scale, max_width);
     const float top = static_cast<float>(height) - static_cast<float>(lines.size()) * line - 6;
     screen->Rect(0, top - 4, static_cast<float>(width), static_cast<float>(height),
                  Rgba{0, 0, 0, 140});
-    for (size_t i = 0; i < lines.size(); ++i)
-      screen->Text(6, top + static_cast<float>(i) * line, lines[i], scale, text);
+    draw_lines(6, top, lines);
     if (scene.has_walk()) {
       // The timeline: a bar over the walk's frames with a marker at the current frame.
       const float bar_y = top - 14;
@@ -214,8 +260,11 @@ struct App {
       std::ostringstream f;
       f << "frame " << view.frame << " of " << scene.first_frame() << "-" << scene.last_frame()
         << " at " << scene.walk().fps << " fps" << (playing ? "  (playing)" : "");
+      // Why the walk stopped, in full: wrapped over as many lines as it takes.
       if (!scene.walk().stopped.empty()) f << "   stopped: " << scene.walk().stopped;
-      screen->Text(x0, bar_y - line - 6, f.str(), scale, text);
+      const std::vector<std::string> frame_lines =
+          WrapText(f.str(), "   ", scale, static_cast<float>(width) - 2 * x0);
+      draw_lines(x0, bar_y - static_cast<float>(frame_lines.size()) * line - 6, frame_lines);
     }
   }
 
@@ -229,6 +278,9 @@ struct App {
   bool WriteDump(int width, int height) {
     if (options.dump_state.empty()) return true;
     nlohmann::ordered_json j = scene.Describe(view, camera, width, height);
+    j["hud"] = nlohmann::ordered_json::array();
+    for (const HudLine& l : hud_lines)
+      j["hud"].push_back({{"text", l.text}, {"x", l.x}, {"y", l.y}, {"width", l.width}});
     if (live) {
       j["live"]["server"] = live->Address();
       j["live"]["after"] = live->start_after();
