@@ -523,3 +523,18 @@ TEST_CASE("ReadMesh: small faces far apart are kept", "[import][mesh]") {
 }
 
 }  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("ReadMesh: a concave polygon covers only itself", "[import][mesh]") {
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  const std::string obj =
+      "v 2 0 1\nv 1 0 1\nv 1 0 2\nv 0 0 2\nv 0 0 0\nv 2 0 0\nf 1 2 3 4 5 6\n";  // an L facing -y
+  REQUIRE(Read(dir.Write("L.obj", obj), &mesh, &error) == Status::kOk);
+  CHECK(SurfaceArea(mesh) == Approx(3));
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) CHECK(TriangleCross(mesh, t).y < 0);
+}
+
+}  // namespace footfall

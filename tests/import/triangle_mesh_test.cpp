@@ -170,3 +170,63 @@ TEST_CASE("IsDegenerateTriangle: judged on the triangle's own size and position"
 }
 
 }  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("TriangulatePolygon: ear clipping in the polygon's plane, a fan when convex",
+          "[import][mesh]") {
+  using Triangles = std::vector<std::array<uint32_t, 3>>;
+  auto area = [](const std::vector<Vec3>& v, const Triangles& t, Vec3 up) {
+    double sum = 0;
+    for (const auto& tri : t)
+      sum += 0.5 * Dot(Cross(v[tri[1]] - v[tri[0]], v[tri[2]] - v[tri[0]]), up);
+    return sum;
+  };
+  SECTION("a convex polygon gives the fan of its first corner") {
+    const std::vector<Vec3> v = {{0, 0, 0}, {0, 0, 1}, {1, 0, 2}, {2, 0, 1}, {2, 0, 0}};
+    Triangles t;
+    CHECK(TriangulatePolygon(v, {0, 1, 2, 3, 4}, &t));
+    CHECK(t == Triangles{{0, 1, 2}, {0, 2, 3}, {0, 3, 4}});
+  }
+  SECTION("an L-shaped floor is cut along its inside, every piece facing as it does") {
+    // (2,0,1) (1,0,1) (1,0,2) (0,0,2) (0,0,0) (2,0,0), facing -y: the notch is x, z in (1, 2).
+    const std::vector<Vec3> v = {{2, 0, 1}, {1, 0, 1}, {1, 0, 2}, {0, 0, 2}, {0, 0, 0}, {2, 0, 0}};
+    Triangles t;
+    CHECK(TriangulatePolygon(v, {0, 1, 2, 3, 4, 5}, &t));
+    REQUIRE(t.size() == 4);
+    for (const auto& tri : t) {
+      const Vec3 n = Cross(v[tri[1]] - v[tri[0]], v[tri[2]] - v[tri[0]]);
+      CHECK(n.y < 0);
+      const Vec3 centre = (v[tri[0]] + v[tri[1]] + v[tri[2]]) / 3;
+      CHECK_FALSE((centre.x > 1 && centre.z > 1));
+    }
+    CHECK(area(v, t, {0, -1, 0}) == Approx(3));
+  }
+  SECTION("a tilted concave polygon, in its own plane") {
+    // A star of 10 corners around the axis (1, 1, 1).
+    const Vec3 u = Normalize(Vec3{1, -1, 0}), w = Normalize(Cross(Vec3{1, 1, 1}, u));
+    std::vector<Vec3> v;
+    std::vector<uint32_t> corners;
+    for (int i = 0; i < 10; ++i) {
+      const double r = i % 2 ? 0.4 : 1.0, a = i * 3.14159265358979 / 5;
+      v.push_back(Vec3{5, 6, 7} + u * (r * std::cos(a)) + w * (r * std::sin(a)));
+      corners.push_back(static_cast<uint32_t>(i));
+    }
+    Triangles t;
+    CHECK(TriangulatePolygon(v, corners, &t));
+    CHECK(t.size() == 8);
+    // The star's area: 10 triangles between the centre and its edges.
+    double star = 0;
+    for (int i = 0; i < 10; ++i)
+      star += 0.5 * Length(Cross(v[i] - Vec3{5, 6, 7}, v[(i + 1) % 10] - Vec3{5, 6, 7}));
+    CHECK(area(v, t, Normalize(Cross(u, w))) == Approx(star));
+  }
+  SECTION("a self-intersecting polygon falls back to a fan") {
+    const std::vector<Vec3> v = {{0, 0, 0}, {1, 0, 1}, {1, 0, 0}, {0, 0, 1}};  // a bow tie
+    Triangles t;
+    TriangulatePolygon(v, {0, 1, 2, 3}, &t);
+    CHECK(t.size() == 2);
+  }
+}
+
+}  // namespace footfall

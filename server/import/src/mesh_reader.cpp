@@ -1,6 +1,7 @@
 #include "footfall/import/mesh_reader.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <mutex>
@@ -150,19 +151,23 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
     }
   }
 
-  // 3. Polygons triangulated as fans in stored order; triangles of zero area left out, and a
+  // 3. Polygons triangulated by ear clipping in their plane (the fan of the first corner for a
+  // convex polygon; a fan for a self-intersecting one); triangles of no area left out, and a
   // face left with none is skipped.
   out->vertices = std::move(parsed.vertices);
   size_t skipped = 0;
+  std::vector<uint32_t> polygon;
+  std::vector<std::array<uint32_t, 3>> pieces;
   for (size_t f = 0; f < faces; ++f) {
     const size_t before = out->triangles.size();
     if (used[f]) {
       const auto [c, n] = corners_of(f);
-      for (size_t i = 2; i < n; ++i) {
-        const auto& v = out->vertices;
-        if (!IsDegenerateTriangle(v[c[0]], v[c[i - 1]], v[c[i]]))
-          out->triangles.push_back({c[0], c[i - 1], c[i]});
-      }
+      polygon.assign(c, c + n);
+      pieces.clear();
+      TriangulatePolygon(out->vertices, polygon, &pieces);
+      const auto& v = out->vertices;
+      for (const auto& t : pieces)
+        if (!IsDegenerateTriangle(v[t[0]], v[t[1]], v[t[2]])) out->triangles.push_back(t);
     }
     if (out->triangles.size() == before) ++skipped;
   }

@@ -109,6 +109,66 @@ void MeshBounds(const TriangleMesh& mesh, Vec3* lo, Vec3* hi) {
   }
 }
 
+bool TriangulatePolygon(const std::vector<Vec3>& vertices, const std::vector<uint32_t>& corners,
+                        std::vector<std::array<uint32_t, 3>>* triangles) {
+  const size_t n = corners.size();
+  if (n < 3) return true;
+  // Positions relative to the first corner (less cancellation far from the origin).
+  const Vec3 origin = vertices[corners[0]];
+  auto at = [&](uint32_t v) { return vertices[v] - origin; };
+  Vec3 normal;  // Newell's: twice the vector area, robust to non-planar polygons
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 p = at(corners[i]), q = at(corners[(i + 1) % n]);
+    normal += Vec3{(p.y - q.y) * (p.z + q.z), (p.z - q.z) * (p.x + q.x), (p.x - q.x) * (p.y + q.y)};
+  }
+  std::vector<uint32_t> rest(corners);
+  bool clipped_all = true;
+  while (rest.size() > 3) {
+    const size_t m = rest.size();
+    // An ear: a convex corner whose triangle holds no other corner (on its edges included).
+    // Tried from the second corner on, so that a convex polygon gives the fan of the first.
+    size_t ear = m;
+    for (size_t step = 0; step < m && ear == m; ++step) {
+      const size_t i = (step + 1) % m;
+      const Vec3 a = at(rest[(i + m - 1) % m]), b = at(rest[i]), c = at(rest[(i + 1) % m]);
+      if (!(Dot(Cross(b - a, c - b), normal) > 0)) continue;
+      bool empty = true;
+      for (size_t j = 0; j < m && empty; ++j) {
+        if (j == i || j == (i + 1) % m || j == (i + m - 1) % m) continue;
+        const Vec3 p = at(rest[j]);
+        if (p == a || p == b || p == c) continue;
+        empty = !(Dot(Cross(b - a, p - a), normal) >= 0 && Dot(Cross(c - b, p - b), normal) >= 0 &&
+                  Dot(Cross(a - c, p - c), normal) >= 0);
+      }
+      if (empty) ear = i;
+    }
+    // Else a straight corner (collinear with its neighbours, as rounding leaves it): its
+    // triangle has no area, and removing it changes no other.
+    const double flattest = 1e-9;
+    if (ear == m) {
+      size_t best = m;
+      for (size_t i = 0; i < m; ++i) {
+        const Vec3 a = at(rest[(i + m - 1) % m]), b = at(rest[i]), c = at(rest[(i + 1) % m]);
+        const double scale = Length(b - a) * Length(c - b) * Length(normal);
+        const double turn = std::fabs(Dot(Cross(b - a, c - b), normal));
+        if (!(scale > 0) || turn <= flattest * scale) {
+          best = i;
+          break;
+        }
+      }
+      ear = best;
+    }
+    if (ear == m) {
+      clipped_all = false;  // self-intersecting: fanned below
+      break;
+    }
+    triangles->push_back({rest[(ear + m - 1) % m], rest[ear], rest[(ear + 1) % m]});
+    rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(ear));
+  }
+  for (size_t i = 2; i < rest.size(); ++i) triangles->push_back({rest[0], rest[i - 1], rest[i]});
+  return clipped_all;
+}
+
 bool IsDegenerateTriangle(const Vec3& a, const Vec3& b, const Vec3& c, double relative_epsilon) {
   const double longest =
       std::sqrt(std::max({Length2(b - a), Length2(c - b), Length2(a - c)}));  // [wu]

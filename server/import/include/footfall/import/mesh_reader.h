@@ -1,5 +1,6 @@
 // Reads polygon meshes (OBJ, PLY, OFF, STL; chosen by extension) into a TriangleMesh. Polygons
-// are fan-triangulated in their stored vertex order (exact for convex polygons). Faces with
+// are triangulated by ear clipping in their plane (TriangulatePolygon: the fan of the first
+// corner for a convex polygon, concave ones cut along their inside only). Faces with
 // repeated vertices, and faces whose triangles all have zero area, are skipped and counted.
 // Normals, texture coordinates and colours in the file are ignored.
 #pragma once

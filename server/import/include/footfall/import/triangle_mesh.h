@@ -68,6 +68,14 @@ MeshFacing TurnOutward(TriangleMesh* mesh, const Vec3& up);
 // World-space bounds of the vertices; both (0, 0, 0) for an empty mesh.
 void MeshBounds(const TriangleMesh& mesh, Vec3* lo, Vec3* hi);
 
+// Triangulates the polygon `corners` (indices into `vertices`, in order around it) by ear
+// clipping in the plane of its Newell normal, appending triangles wound as the polygon is to
+// *triangles. A convex polygon gives the fan from its first corner; a concave one is cut along
+// its inside only. Returns false when ear clipping finds no ear (a self-intersecting polygon):
+// the rest is then fanned from its first remaining corner.
+bool TriangulatePolygon(const std::vector<Vec3>& vertices, const std::vector<uint32_t>& corners,
+                        std::vector<std::array<uint32_t, 3>>* triangles);
+
 // True when triangle (a, b, c) has no area to speak of, judged on its own size and position:
 // its height over its longest edge is at most `relative_epsilon` times that edge (a collinear
 // sliver or a needle), or within the rounding of its coordinates (8 double epsilons of its
