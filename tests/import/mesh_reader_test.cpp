@@ -538,3 +538,38 @@ TEST_CASE("ReadMesh: a concave polygon covers only itself", "[import][mesh]") {
 }
 
 }  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("ReadMesh: a face wound against its neighbours is turned to match them",
+          "[import][mesh]") {
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  MeshReadReport report;
+  // A 10 x 10 quad floor facing +y, its face 56 wound the other way.
+  const int n = 10;
+  std::string obj;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) obj += "v " + std::to_string(i) + " 0 " + std::to_string(j) + "\n";
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const int a = i * (n + 1) + j + 1;
+      int f[4] = {a, a + 1, a + n + 2, a + n + 1};
+      if (i * n + j == 55) std::reverse(f, f + 4);
+      obj += "f " + std::to_string(f[0]) + " " + std::to_string(f[1]) + " " + std::to_string(f[2]) +
+             " " + std::to_string(f[3]) + "\n";
+    }
+  }
+  REQUIRE(Read(dir.Write("one_flipped.obj", obj), &mesh, &error, &report) == Status::kOk);
+  CHECK(report.faces == 100);
+  CHECK(report.turned_faces == 1);
+  CHECK(report.skipped_faces == 0);
+  CHECK(SurfaceArea(mesh) == Approx(100));
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) CHECK(TriangleCross(mesh, t).y > 0);
+  // The cube, wound consistently, turns none.
+  REQUIRE(Read(dir.Write("cube.obj", kCubeObj), &mesh, &error, &report) == Status::kOk);
+  CHECK(report.turned_faces == 0);
+}
+
+}  // namespace footfall

@@ -124,7 +124,83 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
     if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) used[f] = 0;
   }
 
-  // 2. Manifold: every face must join OpenMesh's half-edge mesh, as two faces at most share an
+  // 2. Faces wound against their neighbours are turned to match them: across an edge of two
+  // faces, one goes a -> b and the other b -> a. In each connected sheet the winding of most of
+  // its faces is kept (a sheet that cannot be wound consistently is left as it is).
+  size_t turned = 0;
+  {
+    struct Side {
+      uint64_t edge;  // the lower vertex << 32 | the higher
+      uint32_t face;
+      bool forward;  // goes lower -> higher
+      bool operator<(const Side& o) const { return edge < o.edge; }
+    };
+    std::vector<Side> sides;
+    for (size_t f = 0; f < faces; ++f) {
+      if (!used[f]) continue;
+      const auto [c, n] = corners_of(f);
+      for (size_t k = 0; k < n; ++k) {
+        const uint64_t a = c[k], b = c[(k + 1) % n];
+        sides.push_back({std::min(a, b) << 32 | std::max(a, b), static_cast<uint32_t>(f), a < b});
+      }
+    }
+    std::sort(sides.begin(), sides.end());
+    // Neighbours across edges of exactly two faces: (face, other, whether they disagree).
+    std::vector<size_t> first(faces + 1, 0);
+    std::vector<std::pair<uint32_t, bool>> across;
+    std::vector<std::array<uint32_t, 3>> pairs;  // face, other, disagree
+    for (size_t i = 0; i < sides.size();) {
+      size_t j = i;
+      while (j < sides.size() && sides[j].edge == sides[i].edge) ++j;
+      if (j - i == 2 && sides[i].face != sides[i + 1].face) {
+        const uint32_t disagree = sides[i].forward == sides[i + 1].forward;
+        pairs.push_back({sides[i].face, sides[i + 1].face, disagree});
+        pairs.push_back({sides[i + 1].face, sides[i].face, disagree});
+      }
+      i = j;
+    }
+    for (const auto& p : pairs) ++first[p[0] + 1];
+    for (size_t f = 0; f < faces; ++f) first[f + 1] += first[f];
+    across.resize(pairs.size());
+    std::vector<size_t> next(first.begin(), first.end() - 1);
+    for (const auto& p : pairs) across[next[p[0]]++] = {p[1], p[2] != 0};
+    constexpr uint8_t kUnseen = 2;
+    std::vector<uint8_t> flip(faces, kUnseen);
+    std::vector<uint32_t> sheet, queue;
+    for (size_t start = 0; start < faces; ++start) {
+      if (!used[start] || flip[start] != kUnseen) continue;
+      sheet.clear();
+      flip[start] = 0;
+      sheet.push_back(static_cast<uint32_t>(start));
+      bool consistent = true;
+      for (size_t q = 0; q < sheet.size(); ++q) {
+        const uint32_t f = sheet[q];
+        for (size_t i = first[f]; i < first[f + 1]; ++i) {
+          const auto [g, disagree] = across[i];
+          const uint8_t want = flip[f] ^ static_cast<uint8_t>(disagree);
+          if (flip[g] == kUnseen) {
+            flip[g] = want;
+            sheet.push_back(g);
+          } else if (flip[g] != want) {
+            consistent = false;
+          }
+        }
+      }
+      size_t flipped = 0;
+      for (uint32_t f : sheet) flipped += flip[f];
+      if (!consistent || flipped == 0) continue;
+      const uint8_t turn = 2 * flipped > sheet.size() ? 0 : 1;  // the minority is turned
+      for (uint32_t f : sheet) {
+        if (flip[f] != turn) continue;
+        std::reverse(
+            parsed.corners.begin() + static_cast<std::ptrdiff_t>(parsed.face_start[f]),
+            parsed.corners.begin() + static_cast<std::ptrdiff_t>(parsed.face_start[f + 1]));
+        ++turned;
+      }
+    }
+  }
+
+  // 3. Manifold: every face must join OpenMesh's half-edge mesh, as two faces at most share an
   // edge and the faces around a vertex form fans.
   {
     PolyMesh mesh;
@@ -151,7 +227,7 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
     }
   }
 
-  // 3. Polygons triangulated by ear clipping in their plane (the fan of the first corner for a
+  // 4. Polygons triangulated by ear clipping in their plane (the fan of the first corner for a
   // convex polygon; a fan for a self-intersecting one); triangles of no area left out, and a
   // face left with none is skipped.
   out->vertices = std::move(parsed.vertices);
@@ -175,6 +251,7 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
     report->vertices = out->vertices.size();
     report->faces = faces;
     report->skipped_faces = skipped;
+    report->turned_faces = turned;
   }
   if (out->triangles.empty()) {
     if (error) *error = path + ": every face is degenerate (zero area)";
