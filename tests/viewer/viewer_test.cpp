@@ -329,14 +329,15 @@ TEST_CASE("live: the viewer shows a query another client sends to footfalld", "[
   const std::string address = "127.0.0.1:" + port;
 
   test::Child viewer({kView, "--terrain", kTerrain, "--server", address, "--live", "--live-wait",
-                      "1", "--timeout", "30", "--size", "640x400", "--screenshot",
+                      "2", "--timeout", "30", "--size", "640x400", "--screenshot",
                       dir + "/live.png", "--dump-state", dir + "/state.json"},
                      {test::XDisplay()});
   INFO("viewer stderr: " << viewer.Err());
   REQUIRE(viewer.WaitForOutput("live: following footfalld at " + address, kTimeout));
 
+  // A next and a normal (footfall query sent normals as snaps: the viewer showed them so).
   const RunResult client = Run({FOOTFALL_CLI, "query", "--terrain", kTerrain, "--server", address},
-                               {}, kTimeout, "next 10 1 10 1.2 0 0.3\n");
+                               {}, kTimeout, "next 10 1 10 1.2 0 0.3\nnormal 12 1 12\n");
   INFO("footfall query: " << client.out << client.err);
   REQUIRE(client.exit_code == 0);
   const json answer = json::parse(client.out.substr(0, client.out.find('\n')));
@@ -346,9 +347,12 @@ TEST_CASE("live: the viewer shows a query another client sends to footfalld", "[
   REQUIRE(viewer.Wait(kTimeout, &code));
   REQUIRE(code == 0);
   const json state = json::parse(test::ReadFile(dir + "/state.json"));
-  REQUIRE(state["live"]["received"].get<int>() >= 1);
-  const json& q = state["live"]["queries"][0];
-  CHECK(q["op"] == "next");
+  REQUIRE(state["live"]["received"].get<int>() >= 2);
+  json q, normal;
+  for (const json& live : state["live"]["queries"]) (live["op"] == "next" ? q : normal) = live;
+  REQUIRE(q.is_object());
+  REQUIRE(normal.is_object());
+  CHECK(normal["op"] == "normal");
   CHECK(q["index"] == answer["index"]);
   CHECK(q["traced"] == true);  // re-traced on the local copy of the terrain
   REQUIRE(q["visible"] == true);

@@ -69,37 +69,51 @@ bool InputReady() {
 // Runs a block of commands (batching each kind) and prints one line per command, in order.
 bool RunBlock(TerrainSession& session, TerrainHandle terrain, double tolerance,
               const std::vector<Command>& block) {
-  std::vector<Vec3> points;
+  // Snaps and normals go as their own batches (a server shows each as what it is).
+  std::vector<Vec3> snaps, normals;
   std::vector<StepQuery> steps;
   for (const Command& c : block) {
     if (!c.error.empty()) continue;
     if (c.query.op == QueryOp::kNext)
       steps.push_back({c.query.point, c.query.direction});
     else
-      points.push_back(c.query.point);
+      (c.query.op == QueryOp::kNormal ? normals : snaps).push_back(c.query.point);
   }
-  std::vector<Foothold> point_answers(points.size()), step_answers(steps.size());
-  Status ps = points.empty()
-                  ? Status::kOk
-                  : session.Snap(terrain, points.data(), points.size(), point_answers.data());
-  std::string perr = session.last_error();
-  Status ss = steps.empty() ? Status::kOk
-                            : session.Next(terrain, steps.data(), steps.size(), tolerance,
-                                           step_answers.data());
-  std::string serr = session.last_error();
+  std::vector<Foothold> snap_answers(snaps.size()), normal_answers(normals.size()),
+      step_answers(steps.size());
+  const Status snap_status =
+      snaps.empty() ? Status::kOk
+                    : session.Snap(terrain, snaps.data(), snaps.size(), snap_answers.data());
+  const std::string snap_error = session.last_error();
+  const Status normal_status =
+      normals.empty()
+          ? Status::kOk
+          : session.Normal(terrain, normals.data(), normals.size(), normal_answers.data());
+  const std::string normal_error = session.last_error();
+  const Status step_status = steps.empty() ? Status::kOk
+                                           : session.Next(terrain, steps.data(), steps.size(),
+                                                          tolerance, step_answers.data());
+  const std::string step_error = session.last_error();
   bool ok = true;
-  size_t pi = 0, si = 0;
+  size_t snap_at = 0, normal_at = 0, step_at = 0;
   for (const Command& c : block) {
     nlohmann::ordered_json j;
     if (!c.error.empty()) {
       j = {{"op", "error"}, {"line", c.line}, {"message", c.error}};
       ok = false;
     } else {
-      const bool next = c.query.op == QueryOp::kNext;
-      const Status call = next ? ss : ps;
-      const Foothold& f = next ? step_answers[si++] : point_answers[pi++];
+      const QueryOp op = c.query.op;
+      const Status call = op == QueryOp::kNext     ? step_status
+                          : op == QueryOp::kNormal ? normal_status
+                                                   : snap_status;
+      const Foothold& f = op == QueryOp::kNext     ? step_answers[step_at++]
+                          : op == QueryOp::kNormal ? normal_answers[normal_at++]
+                                                   : snap_answers[snap_at++];
       if (call != Status::kOk) {
-        j = {{"op", "error"}, {"line", c.line}, {"message", next ? serr : perr}};
+        const std::string& why = op == QueryOp::kNext     ? step_error
+                                 : op == QueryOp::kNormal ? normal_error
+                                                          : snap_error;
+        j = {{"op", "error"}, {"line", c.line}, {"message", why}};
         ok = false;
       } else if (f.status == Status::kOk) {
         j = {{"op", QueryOpName(c.query.op)},
