@@ -104,7 +104,7 @@ file(READ "${WORK}/cube.obj" cube)
 string(REPLACE "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n"
        "f 2 3 4 1\nf 8 7 6 5\nf 5 6 2 1\nf 6 7 3 2\nf 7 8 4 3\nf 8 5 1 4\n" inside_out "${cube}")
 file(WRITE "${WORK}/inside_out.obj" "${inside_out}")
-expect(EXIT_ZERO "faces turned over: all (the mesh was inside out)"
+expect(EXIT_ZERO "faces turned over: 1 of 1 closed shells inside out: 12 faces turned over"
        terrain info "${WORK}/inside_out.obj" --separation 0.1)
 expect(EXIT_ZERO "faces turned over: none" terrain info "${WORK}/cube.obj" --separation 0.1)
 file(WRITE "${WORK}/stdin.txt" "normal 0.25 1.05 0.25\n")

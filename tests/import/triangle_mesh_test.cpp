@@ -116,19 +116,24 @@ TEST_CASE("TurnOutward: inside-out and downward meshes are turned over, others l
   const Vec3 up{0, 1, 0};
   struct Case {
     TriangleMesh mesh;
-    MeshFacing when_reversed;
+    bool closed;
   };
-  const Case cases[] = {{MakeSphereMesh({1, 2, 3}, 2.0, 2), MeshFacing::kInsideOut},
-                        {MakeRocksMesh(8, 0.5, 1.5, 3), MeshFacing::kFacingDown},
-                        {MakeStairsMesh(4, 0.2, 0.3, 1.0), MeshFacing::kFacingDown}};
+  const Case cases[] = {{MakeSphereMesh({1, 2, 3}, 2.0, 2), true},
+                        {MakeRocksMesh(8, 0.5, 1.5, 3), false},
+                        {MakeStairsMesh(4, 0.2, 0.3, 1.0), false}};
   for (const Case& c : cases) {
     TriangleMesh as_is = c.mesh;
-    CHECK(TurnOutward(&as_is, up) == MeshFacing::kOutward);
+    const MeshTurnover kept = TurnOutward(&as_is, up);
+    CHECK(kept.turned_faces == 0);
+    CHECK(kept.closed_shells == (c.closed ? 1u : 0u));
     CHECK(as_is.triangles == c.mesh.triangles);
     TriangleMesh turned = reversed(c.mesh);
-    CHECK(TurnOutward(&turned, up) == c.when_reversed);
-    for (size_t t = 0; t < turned.triangles.size(); ++t)
-      CHECK(Distance(TriangleCross(turned, t), TriangleCross(c.mesh, t)) < 1e-12);
+    const MeshTurnover t = TurnOutward(&turned, up);
+    CHECK(t.turned_faces == c.mesh.triangles.size());
+    CHECK(t.inside_out_shells == (c.closed ? 1u : 0u));
+    CHECK(t.open_faced_down == !c.closed);
+    for (size_t i = 0; i < turned.triangles.size(); ++i)
+      CHECK(Distance(TriangleCross(turned, i), TriangleCross(c.mesh, i)) < 1e-12);
   }
   // Faces facing every way (a wall, facing +z or -z) and a terrain facing sideways (up is +y
   // but the rocks face +y: a Z-up caller) are left as they are.
@@ -137,10 +142,40 @@ TEST_CASE("TurnOutward: inside-out and downward meshes are turned over, others l
   wall.triangles = {{0, 1, 2}, {0, 2, 3}};
   for (const TriangleMesh& m : {wall, reversed(wall)}) {
     TriangleMesh w = m;
-    CHECK(TurnOutward(&w, up) == MeshFacing::kOutward);
+    CHECK(TurnOutward(&w, up).turned_faces == 0);
   }
   TriangleMesh rocks = reversed(MakeRocksMesh(8, 0.5, 1.5, 3));
-  CHECK(TurnOutward(&rocks, Vec3{0, 0, 1}) == MeshFacing::kOutward);
+  CHECK(TurnOutward(&rocks, Vec3{0, 0, 1}).turned_faces == 0);
+}
+
+TEST_CASE("TurnOutward: each closed shell is judged on its own", "[import][mesh]") {
+  // An inside-out sphere and a smaller one wound right, in one mesh (and open ground beside
+  // them, facing up): only the inside-out shell is turned (the whole mesh's volume, negative,
+  // turned both).
+  const TriangleMesh big = MakeSphereMesh({0, 3, 0}, 2.0, 2);
+  const TriangleMesh small = MakeSphereMesh({6, 1, 0}, 0.5, 2);
+  const TriangleMesh ground = MakeRocksMesh(6, 0.5, 0.3, 2);
+  TriangleMesh mesh;
+  auto append = [&](const TriangleMesh& part, bool flip) {
+    const uint32_t base = static_cast<uint32_t>(mesh.vertices.size());
+    mesh.vertices.insert(mesh.vertices.end(), part.vertices.begin(), part.vertices.end());
+    for (auto tri : part.triangles) {
+      if (flip) std::swap(tri[1], tri[2]);
+      mesh.triangles.push_back({tri[0] + base, tri[1] + base, tri[2] + base});
+    }
+  };
+  append(big, true), append(small, false), append(ground, false);
+  const TriangleMesh before = mesh;
+  const MeshTurnover t = TurnOutward(&mesh, {0, 1, 0});
+  CHECK(t.closed_shells == 2);
+  CHECK(t.inside_out_shells == 1);
+  CHECK_FALSE(t.open_faced_down);
+  CHECK(t.open_faces == ground.triangles.size());
+  CHECK(t.turned_faces == big.triangles.size());
+  for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+    const bool in_big = i < big.triangles.size();
+    CHECK((mesh.triangles[i] == before.triangles[i]) == !in_big);
+  }
 }
 
 }  // namespace footfall

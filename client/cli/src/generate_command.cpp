@@ -116,12 +116,8 @@ std::string Box(const Vec3& lo, const Vec3& hi) {
 // Says on stderr how the terrain was resampled for the character, when not at its own spacing.
 void ReportResampling(const std::string& path, const Character& character, const WalkTerrain& t) {
   const TerrainLoadReport& r = t.report;
-  if (r.facing != MeshFacing::kOutward) {
-    std::cerr << "footfall generate: " << path << ": every face turned over ("
-              << (r.facing == MeshFacing::kInsideOut ? "the mesh was inside out"
-                                                     : "they faced down")
-              << ")\n";
-  }
+  const std::string turned = DescribeTurnover(r);
+  if (!turned.empty()) std::cerr << "footfall generate: " << path << ": " << turned << '\n';
   if (!t.cropped && r.separation == r.file_separation) return;
   std::ostringstream o;
   o.precision(4);

@@ -115,13 +115,10 @@ int RunInfo(const InfoFlags& flags) {
   std::cout << "file: " << flags.input << '\n' << "format: " << report.format << '\n';
   if (report.format == "mesh") {
     std::cout << "vertices: " << report.vertices << '\n'
-              << "faces: " << report.faces << '\n'
-              << "skipped faces: " << report.skipped_faces << '\n'
+              << "faces: " << report.faces << " (polygons in the file)\n"
+              << "skipped faces: " << report.skipped_faces << " (of those, left out)\n"
               << "faces turned over: "
-              << (report.facing == MeshFacing::kInsideOut    ? "all (the mesh was inside out)"
-                  : report.facing == MeshFacing::kFacingDown ? "all (they faced down)"
-                                                             : "none")
-              << '\n';
+              << (DescribeTurnover(report).empty() ? "none" : DescribeTurnover(report)) << '\n';
   } else if (report.format == "heightmap") {
     std::cout << "cells with data: " << report.vertices << '\n'
               << "nodata cells: " << report.nodata_cells << '\n'

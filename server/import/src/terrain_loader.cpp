@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "footfall/import/height_map.h"
 #include "footfall/import/mesh_reader.h"
@@ -105,10 +106,11 @@ Status ReadTerrainMesh(const std::string& path, const TerrainLoadOptions& option
     report->vertices = read.vertices;
     report->faces = read.faces;
     report->skipped_faces = read.skipped_faces;
+    report->rewound_faces = read.turned_faces;
     report->file_separation = DefaultSeparation(*mesh);
     const Vec3 up{options.up_axis == 'x' ? 1.0 : 0.0, options.up_axis == 'y' ? 1.0 : 0.0,
                   options.up_axis == 'z' ? 1.0 : 0.0};
-    report->facing = TurnOutward(mesh, up);
+    report->turnover = TurnOutward(mesh, up);
     return Status::kOk;
   }
   if (ext == "asc" || ext == "pgm") {
@@ -204,6 +206,23 @@ Status ResampleTerrainMesh(const std::string& path, const TriangleMesh& mesh,
   report->samples = out->size();
   Bounds(*out, &report->bounds_min, &report->bounds_max);
   return Status::kOk;
+}
+
+std::string DescribeTurnover(const TerrainLoadReport& report) {
+  const MeshTurnover& t = report.turnover;
+  std::vector<std::string> parts;
+  if (report.rewound_faces > 0)
+    parts.push_back(std::to_string(report.rewound_faces) +
+                    " faces wound against their neighbours turned to match them");
+  if (t.inside_out_shells > 0)
+    parts.push_back(std::to_string(t.inside_out_shells) + " of " + std::to_string(t.closed_shells) +
+                    " closed shells inside out");
+  if (t.open_faced_down)
+    parts.push_back("the " + std::to_string(t.open_faces) + " faces of its open parts faced down");
+  std::string text;
+  for (const std::string& part : parts) text += (text.empty() ? "" : "; ") + part;
+  if (t.turned_faces > 0) text += ": " + std::to_string(t.turned_faces) + " faces turned over";
+  return text;
 }
 
 Status LoadTerrain(const std::string& path, const TerrainLoadOptions& options, RawSamples* out,

@@ -61,40 +61,63 @@ std::array<Vec3, 3> CornerNormals::Of(size_t t) const {
   return out;
 }
 
-MeshFacing TurnOutward(TriangleMesh* mesh, const Vec3& up) {
-  if (mesh->triangles.empty()) return MeshFacing::kOutward;
-  // Closed when every directed edge (a, b) has its twin (b, a).
-  std::vector<uint64_t> edges, twins;
-  edges.reserve(3 * mesh->triangles.size()), twins.reserve(3 * mesh->triangles.size());
+MeshTurnover TurnOutward(TriangleMesh* mesh, const Vec3& up) {
+  MeshTurnover out;
+  const size_t n = mesh->triangles.size();
+  if (n == 0) return out;
+  // Connected parts: triangles sharing a vertex (union-find over vertices).
+  std::vector<uint32_t> parent(mesh->vertices.size());
+  for (uint32_t v = 0; v < parent.size(); ++v) parent[v] = v;
+  auto root = [&](uint32_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
   for (const auto& tri : mesh->triangles) {
-    for (int k = 0; k < 3; ++k) {
-      const uint64_t a = tri[k], b = tri[(k + 1) % 3];
-      edges.push_back(a << 32 | b), twins.push_back(b << 32 | a);
+    const uint32_t a = root(tri[0]);
+    for (int k = 1; k < 3; ++k) {
+      const uint32_t b = root(tri[k]);
+      if (a != b) parent[b] = a;
     }
   }
-  std::sort(edges.begin(), edges.end()), std::sort(twins.begin(), twins.end());
-  const bool closed = edges == twins;
-  MeshFacing facing = MeshFacing::kOutward;
-  if (closed) {
-    // Six times the enclosed volume, about the first vertex (less cancellation).
-    const Vec3 o = mesh->vertices[mesh->triangles[0][0]];
-    double volume = 0;
-    for (const auto& tri : mesh->triangles)
-      volume += Dot(mesh->vertices[tri[0]] - o,
-                    Cross(mesh->vertices[tri[1]] - o, mesh->vertices[tri[2]] - o));
-    if (volume < 0) facing = MeshFacing::kInsideOut;
-  } else {
-    Vec3 sum;
-    double area = 0;
-    for (size_t t = 0; t < mesh->triangles.size(); ++t) {
-      const Vec3 n = TriangleCross(*mesh, t);
-      sum += n, area += Length(n);
-    }
-    if (area > 0 && Dot(sum, up) < -0.25 * area * Length(up)) facing = MeshFacing::kFacingDown;
+  // A part is closed when each of its directed edges (a, b) has its twin (b, a).
+  std::vector<uint64_t> edges;
+  edges.reserve(3 * n);
+  for (const auto& tri : mesh->triangles)
+    for (int k = 0; k < 3; ++k) edges.push_back(uint64_t{tri[k]} << 32 | tri[(k + 1) % 3]);
+  std::sort(edges.begin(), edges.end());
+  std::vector<uint8_t> open(parent.size(), 0);  // per part (its root vertex)
+  for (const uint64_t e : edges) {
+    const uint64_t twin = e << 32 | e >> 32;
+    if (!std::binary_search(edges.begin(), edges.end(), twin)) open[root(e >> 32)] = 1;
   }
-  if (facing != MeshFacing::kOutward)
-    for (auto& tri : mesh->triangles) std::swap(tri[1], tri[2]);
-  return facing;
+  // Six times each closed part's volume, about its root vertex (less cancellation); the open
+  // parts' area-weighted normal and area.
+  std::vector<double> volume(parent.size(), 0);
+  std::vector<uint8_t> counted(parent.size(), 0);
+  Vec3 open_sum;
+  double open_area = 0;
+  for (size_t t = 0; t < n; ++t) {
+    const auto& tri = mesh->triangles[t];
+    const uint32_t r = root(tri[0]);
+    if (open[r]) {
+      const Vec3 c = TriangleCross(*mesh, t);
+      open_sum += c, open_area += Length(c), ++out.open_faces;
+      continue;
+    }
+    if (!counted[r]) counted[r] = 1, ++out.closed_shells;
+    const Vec3& o = mesh->vertices[r];
+    volume[r] += Dot(mesh->vertices[tri[0]] - o,
+                     Cross(mesh->vertices[tri[1]] - o, mesh->vertices[tri[2]] - o));
+  }
+  for (uint32_t v = 0; v < parent.size(); ++v)
+    if (counted[v] && volume[v] < 0) ++out.inside_out_shells;
+  out.open_faced_down = open_area > 0 && Dot(open_sum, up) < -0.25 * open_area * Length(up);
+  for (auto& tri : mesh->triangles) {
+    const uint32_t r = root(tri[0]);
+    if (open[r] ? out.open_faced_down : volume[r] < 0)
+      std::swap(tri[1], tri[2]), ++out.turned_faces;
+  }
+  return out;
 }
 
 void MeshBounds(const TriangleMesh& mesh, Vec3* lo, Vec3* hi) {

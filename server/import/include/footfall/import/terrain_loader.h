@@ -51,9 +51,11 @@ struct TerrainLoadReport {
   size_t vertices = 0;       // meshes: as stored; height maps: valid cells
   size_t faces = 0;          // meshes: polygons read; height maps: triangles built
   size_t skipped_faces = 0;  // meshes: degenerate faces left out
-  // Meshes: whether every face was turned over (TurnOutward: inside out, or facing down
-  // along up_axis) before sampling.
-  MeshFacing facing = MeshFacing::kOutward;
+  // Meshes: faces turned over before sampling: each to match the winding of its neighbours
+  // (MeshReadReport::turned_faces), then closed shells inside out and open parts facing down
+  // along up_axis (TurnOutward).
+  size_t rewound_faces = 0;
+  MeshTurnover turnover;
   size_t nodata_cells = 0;      // height maps: cells left out
   double area = 0;              // [Units: wu^2] meshes and height maps
   double separation = 0;        // [Units: wu] the separation used (meshes and height maps)
@@ -61,6 +63,10 @@ struct TerrainLoadReport {
   size_t samples = 0;           // samples produced
   Vec3 bounds_min, bounds_max;  // world-space bounds of the samples
 };
+
+// What a mesh load turned over, in a phrase ("1 of 2 closed shells was inside out: 3030 faces
+// turned over"), or "" when nothing was.
+std::string DescribeTurnover(const TerrainLoadReport& report);
 
 // Loads `path` into *out. Errors: kIoError (cannot open), kParseError (malformed content,
 // message "FILE:LINE: what was expected" or "FILE: what is wrong"), kInvalidArgument (unknown

@@ -50,20 +50,23 @@ class CornerNormals {
   std::vector<uint32_t> around_;  // the triangles using each vertex
 };
 
-// How TurnOutward found a mesh's faces.
-enum class MeshFacing {
-  kOutward,     // left as they were
-  kInsideOut,   // closed, enclosing a negative volume: every face turned over
-  kFacingDown,  // open, facing mostly against `up`: every face turned over
+// What TurnOutward turned over.
+struct MeshTurnover {
+  size_t closed_shells = 0;      // connected parts that are closed
+  size_t inside_out_shells = 0;  // ... of them enclosing a negative volume: turned over
+  size_t open_faces = 0;         // faces of the open parts, taken together
+  bool open_faced_down = false;  // ... turned over, as they faced down
+  size_t turned_faces = 0;       // faces turned over in all
 };
 
-// Turns every face of a mesh wound the wrong way over (reverses its winding), so that normals
-// face out of a closed mesh (the enclosed volume is positive) and up out of an open one, a
-// terrain: turned when the component along `up` of its faces' area-weighted normals sums to
-// less than -1/4 of its area (its faces face down, a steep flight of stairs' treads included;
-// rooms, caves and walls, whose faces face every way, are left alone). Closed: every edge used
-// once in each direction.
-MeshFacing TurnOutward(TriangleMesh* mesh, const Vec3& up);
+// Turns the faces of a mesh wound the wrong way over (reverses their winding), so that normals
+// face out of each closed shell (a connected part whose every edge is used once in each
+// direction: turned when the volume it encloses is negative) and up out of the open parts, a
+// terrain: turned, all together, when the component along `up` of their area-weighted normals
+// sums to less than -1/4 of their area (they face down, a steep flight of stairs' treads
+// included; rooms, caves and walls, whose faces face every way, are left alone). A closed room
+// modelled facing in cannot be told from an inside-out box: it is turned over.
+MeshTurnover TurnOutward(TriangleMesh* mesh, const Vec3& up);
 
 // World-space bounds of the vertices; both (0, 0, 0) for an empty mesh.
 void MeshBounds(const TriangleMesh& mesh, Vec3* lo, Vec3* hi);
