@@ -84,7 +84,7 @@ file(WRITE "${WORK}/oneline.off" "OFF 3 1 0\n0 0 0\n1 0 0\n0 0 1\n3 0 2 1\n")
 expect(EXIT_NONZERO "oneline.off:1: expected the counts on the line after 'OFF'"
        terrain info "${WORK}/oneline.off")
 file(WRITE "${WORK}/comment.off" "OFF\n3 1 0\n0 0 0\n# a comment\n1 0 0\n0 0 1\n3 0 2 1\n")
-expect(EXIT_NONZERO "comment.off:4: a '#' comment, which OpenMesh's OFF reader does not skip"
+expect(EXIT_NONZERO "comment.off:4: a '#' comment, which footfall's OFF reader does not read"
        terrain info "${WORK}/comment.off")
 file(WRITE "${WORK}/vlist.ply" "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
      "property float y\nproperty float z\nproperty list uchar float texcoord\nelement face 1\n"

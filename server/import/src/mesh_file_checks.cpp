@@ -324,7 +324,7 @@ Status ParseOffFile(const std::string& path, ParsedMesh* out, std::string* error
   }
   if (comment != 0) {
     return Fail(At(path, comment),
-                "a '#' comment, which OpenMesh's OFF reader does not skip: remove it", error);
+                "a '#' comment, which footfall's OFF reader does not read: remove it", error);
   }
   return Status::kOk;
 }
@@ -378,10 +378,11 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
         }
         if (e.name == "vertex") {
           // Kept from when OpenMesh read PLY: it read no vertex with a list (and then no face).
-          return Fail(At(path, number),
-                      "vertex property '" + ShownText(t[4]) +
-                          "' is a list, which OpenMesh's PLY reader cannot read: remove it",
-                      error);
+          return Fail(
+              At(path, number),
+              "vertex property '" + ShownText(t[4]) +
+                  "' is a list, which footfall's PLY reader does not read on vertices: remove it",
+              error);
         }
         e.list_min_bytes += count_size + (e.name == "face" ? 3 * item_size : 0);
         e.properties.push_back(t[4]), e.lists.push_back(true);

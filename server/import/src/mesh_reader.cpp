@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <mutex>
 #include <sstream>
@@ -82,9 +84,10 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
     return Status::kInvalidArgument;
   }
   {
+    errno = 0;
     std::ifstream probe(path, std::ios::binary);
     if (!probe) {
-      if (error) *error = path + ": cannot open";
+      if (error) *error = path + ": cannot open: " + std::strerror(errno ? errno : EIO);
       return Status::kIoError;
     }
     if (probe.peek() == std::ifstream::traits_type::eof()) {
