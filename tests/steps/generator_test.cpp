@@ -365,6 +365,38 @@ TEST_CASE("A stop shows the value that broke a limit, never rounded onto the lim
   CHECK(shown > shown_limit);
 }
 
+TEST_CASE("Feet that snap onto one sample at the start take their own", "[steps][generator]") {
+  // Ground sampled 0.25 apart, coarser than the biped's stance (0.24): started on a sample,
+  // both feet snapped onto it (the bundled hills walk began so). On a beam one sample wide they
+  // still share it (the stance narrows).
+  const Character c = LoadShipped("biped");
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {5, 0, 5};
+  o.steps = 4;
+  {
+    Terrain t = LoadTerrain(MakeFlat(41, 0.25, 0), 0.25);
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    std::vector<Vec3> starts;
+    for (const WalkTrack& track : w.tracks)
+      if (track.kind == TrackKind::kFoot) starts.push_back(track.keys.front().position);
+    REQUIRE(starts.size() == 2);
+    CHECK(Distance(starts[0], starts[1]) == Approx(0.25));
+  }
+  {
+    RawSamples beam;
+    for (int k = 0; k <= 80; ++k) beam.push_back({5, 0, 0.125 * k}, {0, 1, 0});
+    Terrain t = LoadTerrain(beam, 0.125);
+    const Walk w = Generate(t, c, o);
+    std::vector<Vec3> starts;
+    for (const WalkTrack& track : w.tracks)
+      if (track.kind == TrackKind::kFoot) starts.push_back(track.keys.front().position);
+    REQUIRE(starts.size() == 2);
+    CHECK(Distance(starts[0], starts[1]) == 0);
+  }
+}
+
 TEST_CASE("A stop on ground facing down names the likely causes", "[steps][generator]") {
   // Flat ground whose normals face down (the underside of a thin slab, or inward faces): the
   // stop said only that the ground leans 180 degrees.

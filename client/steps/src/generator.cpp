@@ -203,6 +203,14 @@ class Generator {
   // 3-4. Plants a's feet on `feet`, the snaps of their rest positions (Place), and moves its
   //    frame and ground to them. Returns why a foot cannot stand there, or "".
   std::string Plant(Agent& a, const Foothold* feet) const;
+  // 3. Feet of one character that snapped onto one sample (a terrain coarser than the stance,
+  //    the start on a sample between two rests): each but the one nearest it snaps again from
+  //    the far side of its rest, and takes that sample when no other foot has it and it lies
+  //    within a sample spacing as near its rest. (On a beam narrower than the stance the far
+  //    side gives the same sample: they share it.) `places` are the rest positions of `total`
+  //    feet, `count` a character, `feet` their snaps, updated.
+  Status SeparateSharedFeet(const Vec3* places, Foothold* feet, size_t total, size_t count,
+                            std::string* error);
   // For each of the n crowd starts (places on the grid, and their snaps), another start nearer
   // than `apart` that keeps it out, or -1. Starts that snapped nearer their places keep out
   // those that moved farther (then those earlier in the grid the later); a start kept out keeps
@@ -691,6 +699,8 @@ Status Generator::Setup(std::string* error) {
   answers_.resize(points_.size());
   s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()), "snap feet",
             error);
+  if (s == Status::kOk)
+    s = SeparateSharedFeet(points_.data(), answers_.data(), points_.size(), feet, error);
   if (s != Status::kOk) return s;
   // 4. The body at the feet's centroid, raised by body_height along its up (multipeds: BodyUp;
   //    the feet's frame from their averaged normal). (Keyed at the start of their pass.)
@@ -816,6 +826,49 @@ Status Generator::KeyBodies(std::string* error) {
   for (size_t i = 0; i < n; ++i)
     KeyBody(agents_[body_due_[i].first], body_due_[i].second, body_raise_[i]);
   body_due_.clear();
+  return Status::kOk;
+}
+
+Status Generator::SeparateSharedFeet(const Vec3* places, Foothold* feet, size_t total, size_t count,
+                                     std::string* error) {
+  if (count < 2) return Status::kOk;
+  std::vector<size_t> movers;
+  for (size_t c = 0; c < total; c += count) {
+    for (size_t f = c; f < c + count; ++f) {
+      if (feet[f].status != Status::kOk) continue;
+      // f moves when another foot of its character shares its sample and is nearer it (or as
+      // near, and earlier).
+      const double mine = Distance(places[f], feet[f].point);
+      for (size_t g = c; g < c + count; ++g) {
+        if (g == f || feet[g].status != Status::kOk || feet[g].index != feet[f].index) continue;
+        const double theirs = Distance(places[g], feet[g].point);
+        if (theirs < mine || (theirs == mine && g < f)) {
+          movers.push_back(f);
+          break;
+        }
+      }
+    }
+  }
+  if (movers.empty()) return Status::kOk;
+  std::vector<Vec3> far(movers.size());
+  for (size_t i = 0; i < movers.size(); ++i) {
+    const size_t f = movers[i];
+    far[i] = places[f] * 2.0 - feet[f].point;
+  }
+  std::vector<Foothold> again(movers.size());
+  const Status s =
+      Check(session_.Snap(terrain_, far.data(), far.size(), again.data()), "snap feet", error);
+  if (s != Status::kOk) return s;
+  for (size_t i = 0; i < movers.size(); ++i) {
+    const size_t f = movers[i], c = f - f % count;
+    const Foothold& h = again[i];
+    if (h.status != Status::kOk ||
+        Distance(places[f], h.point) > Distance(places[f], feet[f].point) + gap_)
+      continue;
+    bool taken = false;
+    for (size_t g = c; g < c + count; ++g) taken |= g != f && feet[g].index == h.index;
+    if (!taken) feet[f] = h;
+  }
   return Status::kOk;
 }
 
