@@ -317,6 +317,11 @@ TEST_CASE("why a walk stopped is shown in full, wrapped to the window", "[viewer
     }
   }
   CHECK(shown == "stopped: " + reason);
+  // A window narrower than a character: wrapping looped, filling memory.
+  const RunResult tiny =
+      View({"--walk", dir + "/walk.json", "--size", "8x8", "--screenshot", dir + "/tiny.png"});
+  INFO(tiny.err);
+  CHECK(tiny.exit_code == 0);
 }
 
 TEST_CASE("live: the viewer shows a query another client sends to footfalld", "[viewer][live]") {

@@ -38,12 +38,14 @@ void OnGlfwError(int, const char* description) { g_glfw_error = description ? de
 
 // `text` as lines no wider than `max_width` pixels at `scale`: its items (parts between
 // `separator`s) joined while they fit; an item wider than a line is broken at its spaces, and
-// a word wider than a line between its characters. Line breaks and tabs count as spaces.
+// a word wider than a line between its characters (one a line, at least, in a window narrower
+// than a character). Line breaks and tabs count as spaces.
 std::vector<std::string> WrapText(std::string text, const std::string& separator, float scale,
                                   float max_width) {
   for (char& c : text) {
     if (c == '\n' || c == '\r' || c == '\t') c = ' ';
   }
+  max_width = std::max(max_width, DrawList::TextWidth("W", scale));
   auto fits = [&](const std::string& s) { return DrawList::TextWidth(s, scale) <= max_width; };
   std::vector<std::string> lines;
   std::string line;
@@ -67,7 +69,7 @@ std::vector<std::string> WrapText(std::string text, const std::string& separator
       lines.insert(lines.end(), words.begin(), words.end());
       continue;
     }
-    while (!fits(item)) {
+    while (!item.empty() && !fits(item)) {
       size_t n = 1;
       while (n < item.size() && fits(item.substr(0, n + 1))) ++n;
       lines.push_back(item.substr(0, n));

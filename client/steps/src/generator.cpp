@@ -87,11 +87,6 @@ std::string Point(const Vec3& p) {
   return o.str();
 }
 
-// How far p is above the terrain, from h, the sample nearest to it: its height along h's
-// normal (negative: below the terrain), or, when larger, its distance to h less `gap`, the
-// farthest the surface may be from its nearest sample. No sample is nearer than h, so no
-// surface is nearer than that: above a stair's nose, whose nearest sample may be the riser's
-// top, a point high up is in the clear although it lies little in front of the riser's plane.
 // For ground facing away from the character's up (more than 120 degrees): the likely causes.
 std::string FacingDownHint(double slope_deg) {
   if (!(slope_deg > 120)) return "";
@@ -99,6 +94,11 @@ std::string FacingDownHint(double slope_deg) {
          "(resample at a separation below its thickness) or a mesh whose faces face inward";
 }
 
+// How far p is above the terrain, from h, the sample nearest to it: its height along h's
+// normal (negative: below the terrain), or, when larger, its distance to h less `gap`, the
+// farthest the surface may be from its nearest sample. No sample is nearer than h, so no
+// surface is nearer than that: above a stair's nose, whose nearest sample may be the riser's
+// top, a point high up is in the clear although it lies little in front of the riser's plane.
 double Clearance(const Vec3& p, const Foothold& h, double gap) {
   const Vec3 v = p - h.point;
   const double height = Dot(v, h.normal);
