@@ -144,6 +144,30 @@ bool TriangulatePolygon(const std::vector<Vec3>& vertices, const std::vector<uin
     const Vec3 p = at(corners[i]), q = at(corners[(i + 1) % n]);
     normal += Vec3{(p.y - q.y) * (p.z + q.z), (p.z - q.z) * (p.x + q.x), (p.x - q.x) * (p.y + q.y)};
   }
+  auto fan = [&](const std::vector<uint32_t>& around) {
+    for (size_t i = 2; i < around.size(); ++i)
+      triangles->push_back({around[0], around[i - 1], around[i]});
+  };
+  // No plane (a bow tie's areas cancel): nothing to clip in.
+  if (!(Length2(normal) > 0) || !IsFinite(normal)) {
+    fan(corners);
+    return false;
+  }
+  // Convex (no corner turns against the normal): the fan, in linear time.
+  bool convex = true;
+  for (size_t i = 0; i < n && convex; ++i) {
+    const Vec3 a = at(corners[(i + n - 1) % n]), b = at(corners[i]), c = at(corners[(i + 1) % n]);
+    convex = Dot(Cross(b - a, c - b), normal) >= 0;
+  }
+  if (convex) {
+    fan(corners);
+    return true;
+  }
+  // Ear clipping takes up to n^3 steps: polygons of more corners are fanned.
+  if (n > kMaxClippedCorners) {
+    fan(corners);
+    return false;
+  }
   std::vector<uint32_t> rest(corners);
   bool clipped_all = true;
   while (rest.size() > 3) {
@@ -188,7 +212,7 @@ bool TriangulatePolygon(const std::vector<Vec3>& vertices, const std::vector<uin
     triangles->push_back({rest[(ear + m - 1) % m], rest[ear], rest[(ear + 1) % m]});
     rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(ear));
   }
-  for (size_t i = 2; i < rest.size(); ++i) triangles->push_back({rest[0], rest[i - 1], rest[i]});
+  fan(rest);
   return clipped_all;
 }
 

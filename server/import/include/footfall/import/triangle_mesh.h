@@ -71,11 +71,16 @@ MeshTurnover TurnOutward(TriangleMesh* mesh, const Vec3& up);
 // World-space bounds of the vertices; both (0, 0, 0) for an empty mesh.
 void MeshBounds(const TriangleMesh& mesh, Vec3* lo, Vec3* hi);
 
+// Non-convex polygons of more corners than this are fanned (ear clipping takes up to n^3 steps).
+constexpr size_t kMaxClippedCorners = 256;
+
 // Triangulates the polygon `corners` (indices into `vertices`, in order around it) by ear
 // clipping in the plane of its Newell normal, appending triangles wound as the polygon is to
-// *triangles. A convex polygon gives the fan from its first corner; a concave one is cut along
-// its inside only. Returns false when ear clipping finds no ear (a self-intersecting polygon):
-// the rest is then fanned from its first remaining corner.
+// *triangles. A convex polygon gives the fan from its first corner (in linear time); a concave
+// one is cut along its inside only. Returns false when it fans instead: a polygon without a
+// plane (its areas cancel, as a bow tie's), a non-convex one of more than kMaxClippedCorners
+// corners, or one where ear clipping finds no ear (self-intersecting: the rest is fanned from
+// its first remaining corner).
 bool TriangulatePolygon(const std::vector<Vec3>& vertices, const std::vector<uint32_t>& corners,
                         std::vector<std::array<uint32_t, 3>>* triangles);
 
