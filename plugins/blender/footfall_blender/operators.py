@@ -127,7 +127,9 @@ class FOOTFALL_OT_terrain_setup(bpy.types.Operator):
     """Send the selected mesh (resampled at the point separation) or a point file to footfalld"""
     bl_idname = "footfall.terrain_setup"
     bl_label = "Terrain Setup"
-    bl_options = {"REGISTER"}
+    # A step of its own: undoing what follows keeps the scene's terrain, undoing it brings the
+    # previous one back (still loaded: terrains are unloaded only when a file is loaded).
+    bl_options = {"REGISTER", "UNDO"}
 
     save_points: StringProperty(name="Save samples", subtype="FILE_PATH", default="",
                                 description="Also write the samples sent as a point file")
@@ -162,7 +164,6 @@ class FOOTFALL_OT_terrain_setup(bpy.types.Operator):
         settings.terrain_key = key
         settings.terrain_name = name
         settings.sample_count = count
-        unload_unused_terrains()  # this scene's previous terrain, unless a copy still uses it
         self.report({"INFO"}, "footfall: terrain %s, %d samples on %s"
                     % (name, count, _connection.describe()))
         return {"FINISHED"}
