@@ -53,8 +53,6 @@ bool SameSide(const int8_t* a, const int8_t* b) {
 constexpr int kCellBits = 21;
 constexpr uint64_t kCellLimit = 1ull << kCellBits;
 constexpr uint32_t kNone = 0xffffffffu;
-// Points >= r apart in a cube of side r: at most its 8 corners, on each side of a thin slab.
-constexpr int kSlots = 16;
 
 uint64_t CellKey(uint64_t x, uint64_t y, uint64_t z) {
   return (x << (2 * kCellBits)) | (y << kCellBits) | z;
@@ -504,18 +502,24 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
     }
   }
 
-  // 3. Accept candidates farther than r from every accepted sample. Each cell keeps the offsets
-  // of its first kInline accepted samples inline, for cache-friendly tests, and any more (rare:
-  // cells are r wide) in a shared overflow list.
-  constexpr uint32_t kInline = 2;
+  // 3. Accept candidates farther than r from every accepted sample facing the same way. Each
+  // cell keeps its first kInline accepted samples inline, for cache-friendly tests, and any
+  // more (rare: cells are r wide) in a chain of overflow blocks. (Samples facing the same way
+  // are at most 8 a cell, its corners; facing every way, as on rough detail, a few dozen.)
+  constexpr uint32_t kInline = 2, kBlock = 6;
   struct Slots {
     uint32_t count;
-    uint32_t more;  // with count > kInline: its entry in `overflow`
+    uint32_t more;  // with count > kInline: its first block in `overflow`
+    uint32_t last;  // ... and its last
     Candidate p[kInline];
+  };
+  struct Block {
+    Candidate p[kBlock];
+    uint32_t next = kNone;
   };
   std::vector<Slots> slots(cells);
   for (Slots& slot : slots) slot.count = 0;
-  std::vector<std::array<Candidate, kSlots - kInline>> overflow;
+  std::vector<Block> overflow;
   std::vector<uint32_t> accepted;
   accepted.reserve(static_cast<size_t>(predicted * 1.2) + 16);
   const float r2f = static_cast<float>(r2);
@@ -531,20 +535,28 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
       const Slots& slot = slots[neighbours[e]];
       for (uint32_t q = 0; q < std::min(slot.count, kInline); ++q)
         if (near(slot.p[q], cand)) return;
-      for (uint32_t q = kInline; q < slot.count; ++q)
-        if (near(overflow[slot.more][q - kInline], cand)) return;
+      uint32_t block = slot.more;
+      for (uint32_t q = kInline; q < slot.count; q += kBlock, block = overflow[block].next) {
+        for (uint32_t k = 0; k < std::min(kBlock, slot.count - q); ++k)
+          if (near(overflow[block].p[k], cand)) return;
+      }
     }
     Slots& own = slots[cell];
-    if (own.count == kSlots) return;
     Candidate* to = &own.p[0];
     if (own.count < kInline) {
       to = &own.p[own.count];
     } else {
-      if (own.count == kInline) {
-        own.more = static_cast<uint32_t>(overflow.size());
+      const uint32_t at = (own.count - kInline) % kBlock;
+      if (at == 0) {  // a new block, first or chained
+        const uint32_t block = static_cast<uint32_t>(overflow.size());
         overflow.emplace_back();
+        if (own.count == kInline)
+          own.more = block;
+        else
+          overflow[own.last].next = block;
+        own.last = block;
       }
-      to = &overflow[own.more][own.count - kInline];
+      to = &overflow[own.last].p[at];
     }
     *to = cand;
     ++own.count;
