@@ -197,6 +197,17 @@ TEST_CASE("a camera's clip planes follow the terrain beside the eye, not its tar
     CHECK(state["camera"]["eye"] == json::array({0.0, 0.5, 0.0}));
   }
   CHECK(state["camera"]["target"][0].get<double>() == 1e15);
+  // An eye 1e15 away still looks at its target: the query there is drawn at the centre (eye +
+  // the view direction rounded by 0.125, turning the view up to 5 degrees: 18 px off).
+  const RunResult aimed = View({"--terrain", dir + "/flat.pts", "--camera", "1e15 7e14 3e14 2 0 2",
+                                "--query", "snap 2 0 2", "--size", "800x600", "--screenshot",
+                                dir + "/aimed.png", "--dump-state", dir + "/aimed.json"});
+  INFO(aimed.err);
+  REQUIRE(aimed.exit_code == 0);
+  const json at = json::parse(test::ReadFile(dir + "/aimed.json"));
+  REQUIRE(at["queries"].size() == 1);
+  CHECK(std::fabs(at["queries"][0]["pixel"][0].get<double>() - 400) < 1);
+  CHECK(std::fabs(at["queries"][0]["pixel"][1].get<double>() - 300) < 1);
   // Beyond what a query may reach, the camera is refused.
   const RunResult r = View({"--terrain", dir + "/flat.pts", "--camera", "0 0.5 0 2e19 0 2e19",
                             "--screenshot", dir + "/refused.png"});

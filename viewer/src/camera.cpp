@@ -88,7 +88,15 @@ glm::dvec3 OrbitCamera::Forward() const {
 }
 
 glm::dmat4 OrbitCamera::View() const {
-  return glm::lookAt(eye_, eye_ + Forward(), glm::dvec3(0, 1, 0));
+  // glm::lookAt's basis, from the direction itself: eye + Forward() rounds far from the origin
+  // (at 1e15 a unit of precision is 0.125: the view turned by up to 5 degrees).
+  const glm::dvec3 f = glm::normalize(Forward());
+  const glm::dvec3 s = glm::normalize(glm::cross(f, glm::dvec3(0, 1, 0)));
+  const glm::dvec3 u = glm::cross(s, f);
+  glm::dmat4 m(1);
+  for (int i = 0; i < 3; ++i) m[i][0] = s[i], m[i][1] = u[i], m[i][2] = -f[i];
+  m[3][0] = -glm::dot(s, eye_), m[3][1] = -glm::dot(u, eye_), m[3][2] = glm::dot(f, eye_);
+  return m;
 }
 
 glm::dmat4 OrbitCamera::Projection(double aspect, const glm::dvec3& lo,
