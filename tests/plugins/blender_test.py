@@ -414,7 +414,10 @@ class BlenderAddonTest(unittest.TestCase):
         scene.collection.objects.link(body)
         body.rotation_mode = "ZXY"
         body.location = (-2.5, -3.5, 1.0)
-        user = {-30.0: (0.0, 0.0, math.pi - 0.4), -10.0: (0.0, 0.0, math.pi)}  # faces +Y
+        # Faces +Y; with a key of the user's after the walks' end, which they keep (it went:
+        # Generate Walk cleared the rig's keys from the start frame on).
+        user = {-30.0: (0.0, 0.0, math.pi - 0.4), -10.0: (0.0, 0.0, math.pi),
+                900.0: (0.0, 0.0, math.pi - 0.2)}
         for frame, angles in user.items():
             body.rotation_euler = angles
             body.keyframe_insert("rotation_euler", frame=frame)
@@ -444,8 +447,8 @@ class BlenderAddonTest(unittest.TestCase):
             keys = fcurve_keys(body, "rotation_euler", 3)
             body_frames = [float(k["frame"]) for t in walk["tracks"] if t["kind"] == "body"
                            for k in t["keys"]]
-            self.assertEqual(sorted(keys), sorted(user) + body_frames)
-            for frame, angles in user.items():  # the user's keys before the walk stay
+            self.assertEqual(sorted(keys), sorted(list(user) + body_frames))
+            for frame, angles in user.items():  # the user's keys before and after the walk stay
                 for g, w in zip(keys[frame], angles):
                     self.assertAlmostEqual(g, w, delta=TOL)
             # Each key's angles near the one before (no turn of 360 degrees between keys:

@@ -101,9 +101,10 @@ def rotation_path(obj):
     return _ROTATION_PATHS.get(obj.rotation_mode, "rotation_euler")
 
 
-def clear_keys(objects, from_frame, body=None):
-    """Removes location keys at frames >= from_frame from `objects`, and the rotation keys of
-    `body` (one of them) in the path of its rotation mode."""
+def clear_keys(objects, from_frame, body=None, to_frame=None):
+    """Removes location keys at frames from from_frame to to_frame (None: on to the end) from
+    `objects`, and the rotation keys of `body` (one of them) in the path of its rotation
+    mode."""
     for obj in objects:
         action = obj.animation_data.action if obj and obj.animation_data else None
         if action is None:
@@ -113,7 +114,8 @@ def clear_keys(objects, from_frame, body=None):
             if fc.data_path not in paths:
                 continue
             for i in reversed(range(len(fc.keyframe_points))):
-                if fc.keyframe_points[i].co[0] >= from_frame - 1e-6:
+                frame = fc.keyframe_points[i].co[0]
+                if frame >= from_frame - 1e-6 and (to_frame is None or frame <= to_frame + 1e-6):
                     fc.keyframe_points.remove(fc.keyframe_points[i], fast=True)
             fc.update()
             if not fc.keyframe_points:
@@ -242,7 +244,7 @@ def key_walk(walk, feet, body, from_frame=None):
             worlds.append(world)
         if frames:
             if obj in again:
-                clear_keys([obj], frames[0])
+                clear_keys([obj], frames[0], to_frame=frames[-1])
             plan.append((obj, is_body, frames, worlds))
     # The body first: feet parented to it are keyed in its space at their frames.
     plan.sort(key=lambda p: not p[1])

@@ -277,6 +277,7 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
         root.matrix_world = Matrix.Translation(ground) @ rot.to_4x4()
         rig = root.footfall_rig
         rig.is_rig = True
+        rig.walk_end_known, rig.walk_end = True, -keying.MAX_FRAME - 1  # no walk yet
         rig.character_path = self.character_file
         rig.character_json = json.dumps(data)
         if body is None:  # a picked body keeps its rotation mode (the user's keys use it)
@@ -416,8 +417,13 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
                     walk = json.loads(walk_text_new)
                     keying.check_frames(walk)
                     if walk_text is None:
+                        # The previous walk's keys (up to its end, or on to the last key for a
+                        # rig of an older version); the user's keys after both walks stay.
+                        rig = rig_obj.footfall_rig
+                        to_frame = max(last, rig.walk_end) if rig.walk_end_known else None
                         keying.clear_keys(list(feet.values()) + [body], settings.start_frame,
-                                          body)
+                                          body, to_frame)
+                        rig.walk_end_known, rig.walk_end = True, last
                     keying.key_walk(walk, feet, body, from_frame=last_frame)
                     frames = [k["frame"] for t in walk.get("tracks", []) for k in t.get("keys", [])]
                     last_frame = max(frames) if frames else last_frame

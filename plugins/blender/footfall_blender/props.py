@@ -51,6 +51,11 @@ class FootfallRig(bpy.types.PropertyGroup):
     character_json: StringProperty(name="Character", description="The character file's JSON")
     body: PointerProperty(type=bpy.types.Object, name="Body")
     feet: CollectionProperty(type=FootfallFoot)
+    # The last frame Generate Walk may have keyed on this rig, when known (rigs set up by this
+    # version): a new walk replaces keys only up to the later of its end and this; keys the
+    # user set after both are kept.
+    walk_end_known: BoolProperty(default=False)
+    walk_end: FloatProperty(default=0.0)
 
 
 class FootfallScene(bpy.types.PropertyGroup):
