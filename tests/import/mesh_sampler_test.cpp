@@ -105,6 +105,17 @@ TEST_CASE("SampleMesh: both faces of a slab thinner than the separation are cove
   }
 }
 
+TEST_CASE("SampleMesh: a vertex no face uses does not widen the mesh", "[import][sampler]") {
+  // A 1 m square and a stray vertex 1e7 away: a separation of 0.001 was refused as too small
+  // for the mesh's extent.
+  TriangleMesh m = Square(1);
+  m.vertices.push_back({1e7, 0, 1e7});
+  Vec3 lo, hi;
+  MeshBounds(m, &lo, &hi);
+  CHECK(hi == Vec3{1, 0, 1});
+  CHECK(Sample(m, 0.01).size() > 10000);
+}
+
 TEST_CASE("SampleMesh: samples do not clump", "[import][sampler]") {
   const TriangleMesh mesh = MakeRocksMesh(10, 0.4, 0.8, 4);
   const double s = 0.25;

@@ -121,14 +121,17 @@ MeshTurnover TurnOutward(TriangleMesh* mesh, const Vec3& up) {
 }
 
 void MeshBounds(const TriangleMesh& mesh, Vec3* lo, Vec3* hi) {
-  if (mesh.vertices.empty()) {
+  if (mesh.triangles.empty()) {
     *lo = *hi = Vec3{};
     return;
   }
-  *lo = *hi = mesh.vertices[0];
-  for (const Vec3& v : mesh.vertices) {
-    lo->x = std::min(lo->x, v.x), lo->y = std::min(lo->y, v.y), lo->z = std::min(lo->z, v.z);
-    hi->x = std::max(hi->x, v.x), hi->y = std::max(hi->y, v.y), hi->z = std::max(hi->z, v.z);
+  *lo = *hi = mesh.vertices[mesh.triangles[0][0]];
+  for (const auto& tri : mesh.triangles) {
+    for (const uint32_t i : tri) {
+      const Vec3& v = mesh.vertices[i];
+      lo->x = std::min(lo->x, v.x), lo->y = std::min(lo->y, v.y), lo->z = std::min(lo->z, v.z);
+      hi->x = std::max(hi->x, v.x), hi->y = std::max(hi->y, v.y), hi->z = std::max(hi->z, v.z);
+    }
   }
 }
 

@@ -68,7 +68,8 @@ struct MeshTurnover {
 // modelled facing in cannot be told from an inside-out box: it is turned over.
 MeshTurnover TurnOutward(TriangleMesh* mesh, const Vec3& up);
 
-// World-space bounds of the vertices; both (0, 0, 0) for an empty mesh.
+// World-space bounds of the vertices its triangles use (a stray vertex far away widened the
+// sampler's cells until a fine separation was refused); both (0, 0, 0) without triangles.
 void MeshBounds(const TriangleMesh& mesh, Vec3* lo, Vec3* hi);
 
 // Non-convex polygons of more corners than this are fanned (ear clipping takes up to n^3 steps).
