@@ -160,10 +160,6 @@ Status ReadTerrainMesh(const std::string& path, const TerrainLoadOptions& option
   return Status::kInvalidArgument;
 }
 
-// Bytes of address space the sampler may need per sample (its resident peak is about 340;
-// growing arrays hold two copies at once).
-constexpr double kSamplingBytes = 1000;
-
 Status ResampleTerrainMesh(const std::string& path, const TriangleMesh& mesh,
                            const TerrainLoadOptions& options, RawSamples* out, std::string* error,
                            TerrainLoadReport* report) {
@@ -174,7 +170,9 @@ Status ResampleTerrainMesh(const std::string& path, const TriangleMesh& mesh,
   // died with a bare "out of memory").
   const double memory = UsableMemoryBytes();
   const size_t fits_memory =
-      memory > 0 ? static_cast<size_t>(std::max(1000.0, memory / kSamplingBytes)) : SIZE_MAX;
+      memory > 0 ? static_cast<size_t>(
+                       std::max(1000.0, memory / static_cast<double>(kSamplingBytesPerSample)))
+                 : SIZE_MAX;
   sample.max_samples = std::min(options.max_samples, fits_memory);
   sample.separation = options.separation > 0 ? options.separation : file_separation;
   if (!(options.separation > 0) && options.finest_default > 0) {

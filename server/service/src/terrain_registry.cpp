@@ -266,14 +266,12 @@ Status TerrainRegistry::PrepareLoad(const std::string& relative_path, TerrainLoa
 }
 
 uint64_t MaxSamplesPerLoad() {
-  // The sampler's resident peak is about 340 bytes per sample, its address space (what a
-  // ulimit -v counts: growing arrays hold old and new copies at once) up to three times that;
-  // two loads run at once. (At 400 bytes, a load within the cap under ulimit -v 4 GB still ran
-  // out of memory.)
-  constexpr uint64_t kMostPerLoad = 20000000, kSamplerBytes = 1000, kLoadsAtOnce = 2;
+  // kSamplingBytesPerSample each, and two loads run at once.
+  constexpr uint64_t kMostPerLoad = 20000000, kLoadsAtOnce = 2;
   const double memory = UsableMemoryBytes();
   const uint64_t fits =
-      memory > 0 ? static_cast<uint64_t>(memory / (kSamplerBytes * kLoadsAtOnce)) : kMostPerLoad;
+      memory > 0 ? static_cast<uint64_t>(memory / (kSamplingBytesPerSample * kLoadsAtOnce))
+                 : kMostPerLoad;
   return std::max<uint64_t>(1000, std::min(kMostPerLoad, fits));
 }
 

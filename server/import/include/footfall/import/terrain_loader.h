@@ -64,6 +64,12 @@ struct TerrainLoadReport {
   Vec3 bounds_min, bounds_max;  // world-space bounds of the samples
 };
 
+// Bytes of address space the mesh sampler may need per sample: its resident peak is about 340,
+// and growing arrays hold old and new copies at once (what a ulimit -v counts; at 400 bytes a
+// load within the cap under ulimit -v 4 GB still ran out of memory). Loads sample at most what
+// the process's memory holds at this rate.
+constexpr uint64_t kSamplingBytesPerSample = 1000;
+
 // What a mesh load turned over, in a phrase ("1 of 2 closed shells was inside out: 3030 faces
 // turned over"), or "" when nothing was.
 std::string DescribeTurnover(const TerrainLoadReport& report);
