@@ -43,14 +43,32 @@ constexpr double kAlikeCos = 0.7071;  // footholds whose normals are within 45 d
 // of at most body_height each, and never beyond reach of a foot.
 constexpr double kBodyClearance = 0.5;
 constexpr int kBodyRounds = 3;
-// Points checked along the start-mid-end arc. Each is snapped: its clearance is measured along
-// the normal of its nearest sample, and a Snap answer elsewhere proves only that no sample lies
-// closer to that point than the answer, which bounds neither which sample is nearest here nor
-// its normal. (A point between two points of the same straight half that share a nearest sample
-// shares it too, Voronoi cells being convex; but measured on the bench's ground, samples a third
-// of a step apart, that would spare at most one query in seven, for an extra round of queries.)
-constexpr int kArcChecks = 7;
-constexpr double kArcS[kArcChecks] = {0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875};
+// Points checked along each start-mid-end arc, evenly spaced: at least kMinArcChecks, and as many
+// more as keep them no farther apart than the terrain's gap (about twice its sample spacing), up
+// to kMaxArcChecks (ArcChecks). Between two check points an arc may graze a sharp edge by about
+// their spacing: seven points on a 1.8 m stride over stairs sampled every 2 cm let its last stretch
+// pass 7.5 cm through a nose. Each point is snapped: its clearance is measured along the normal
+// of its nearest sample, and a Snap answer elsewhere proves only that no sample lies closer to
+// that point than the answer, which bounds neither which sample is nearest here nor its normal.
+// (A point between two points of the same straight half that share a nearest sample shares it
+// too, Voronoi cells being convex; but measured on the bench's ground, samples a third of a step
+// apart, that would spare at most one query in seven, for an extra round of queries.)
+constexpr size_t kMinArcChecks = 7;
+constexpr size_t kMaxArcChecks = 63;
+
+// The number of points checked along an arc of `length` (its longer half twice), no farther
+// apart than `gap`: 7, 15, 23, ... 63, so that the seven points of the shortest arcs (at
+// eighths) are always among them.
+size_t ArcChecks(double length, double gap) {
+  const double eighths = gap > 0 ? std::ceil(length / gap / 8) : 1;
+  return 8 * static_cast<size_t>(std::clamp(eighths, 1.0, (kMaxArcChecks + 1) / 8.0)) - 1;
+}
+
+// The j-th of an arc's `checks` points, as a fraction of the arc (0: its start key, 0.5: its
+// mid key, 1: its end key).
+double ArcS(size_t j, size_t checks) {
+  return static_cast<double>(j + 1) / static_cast<double>(checks + 1);
+}
 // Required clearance at each check point, as a fraction of the arc's nominal clearance there
 // (the step height at the mid key, falling linearly to 0 at the start and end keys).
 constexpr double kClearanceFraction = 0.25;
@@ -332,6 +350,7 @@ class Generator {
   // Query points and answers of each round, one buffer per kind of round so that their sizes
   // stay the same from step to step (no refill on resize).
   std::vector<Vec3> points_, arc_points_;  // setup and locators; arc check points
+  std::vector<size_t> arc_first_;          // per pending move: its first arc check point
   std::vector<StepQuery> queries_;
   std::vector<Foothold> answers_, next_answers_, arc_answers_;
   // Bodies to key (KeyBodies): (agent, frame); per walking character the frame its body is due
@@ -1239,7 +1258,7 @@ Status Generator::ClearArcs(int k, std::string* error) {
     arc_agents_.push_back({w, begin, pending_.size()});
   }
   for (int round = 0; !arc_agents_.empty(); ++round) {
-    arc_points_.resize(pending_.size() * kArcChecks);
+    arc_first_.resize(pending_.size() + 1);
     Parallel(pending_.size(), [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {
         Move& mv = moves[pending_[i]];
@@ -1249,9 +1268,21 @@ Status Generator::ClearArcs(int k, std::string* error) {
           mv.mid_normal = NormalizeOr(a.foot_normal[mv.foot] + mv.end_normal, a.up);
           mv.mid = (start + mv.end) * 0.5 + mv.mid_normal * c_.step_height;
         }
-        for (int j = 0; j < kArcChecks; ++j) {
-          const double s = kArcS[j];
-          arc_points_[i * kArcChecks + j] =
+        const double half = std::max(Distance(start, mv.mid), Distance(mv.mid, mv.end));
+        arc_first_[i + 1] = ArcChecks(2 * half, gap_);
+      }
+    });
+    arc_first_[0] = 0;
+    for (size_t i = 0; i < pending_.size(); ++i) arc_first_[i + 1] += arc_first_[i];
+    arc_points_.resize(arc_first_[pending_.size()]);
+    Parallel(pending_.size(), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        const Move& mv = moves[pending_[i]];
+        const Vec3& start = agents_[mv.agent].foot[mv.foot];
+        const size_t first = arc_first_[i], checks = arc_first_[i + 1] - first;
+        for (size_t j = 0; j < checks; ++j) {
+          const double s = ArcS(j, checks);
+          arc_points_[first + j] =
               s <= 0.5 ? Lerp(start, mv.mid, 2 * s) : Lerp(mv.mid, mv.end, 2 * s - 1);
         }
       }
@@ -1273,15 +1304,17 @@ Status Generator::ClearArcs(int k, std::string* error) {
           const Agent& a = agents_[mv.agent];
           bool low[2] = {false, false};   // a check point too low in the first, second half
           bool wall[2] = {false, false};  // ... beside a face unlike that half's foothold
-          for (int j = 0; j < kArcChecks; ++j) {
-            const Foothold& h = arc_answers_[i * kArcChecks + j];
+          const size_t first = arc_first_[i], checks = arc_first_[i + 1] - first;
+          for (size_t j = 0; j < checks; ++j) {
+            const Foothold& h = arc_answers_[first + j];
+            const double s = ArcS(j, checks);
             if (h.status != Status::kOk) continue;
-            const int half = kArcS[j] > 0.5;
-            const double nominal = c_.step_height * (1 - std::fabs(2 * kArcS[j] - 1));
+            const int half = s > 0.5;
+            const double nominal = c_.step_height * (1 - std::fabs(2 * s - 1));
             const double need =
                 ClearanceNeeded(kClearanceFraction * nominal, h, half ? mv.end : a.foot[mv.foot],
                                 half ? mv.end_normal : a.foot_normal[mv.foot], c_.step_height);
-            if (Clearance(arc_points_[i * kArcChecks + j], h, gap_) < need) {
+            if (Clearance(arc_points_[first + j], h, gap_) < need) {
               low[half] = true;
               wall[half] |= need < kClearanceFraction * nominal;
             }
