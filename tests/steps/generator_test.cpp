@@ -1325,6 +1325,52 @@ TEST_CASE("Insects before a wall thinner than their step stop there, no swing pa
   }
 }
 
+TEST_CASE("Insects climb a box, cross its top and climb down its far side", "[steps][generator]") {
+  // A floor (y = 0, z from 0 to 2) with a box 30 cm tall and 30 cm deep across it at z = 1,
+  // sampled 1 cm apart: its front face, its top and its back face.
+  RawSamples box;
+  const double s = 0.01, depth = 0.3;
+  for (int i = 0; i <= 150; ++i) {
+    const double x = i * s;
+    for (int k = 0; k <= 200; ++k) {
+      const double z = k * s;
+      if (z < 1.0 - 1e-9 || z > 1.0 + depth + 1e-9) box.push_back({x, 0, z}, {0, 1, 0});
+    }
+    for (int j = 1; j <= 30; ++j) {
+      box.push_back({x, j * s, 1.0}, {0, 0, -1});
+      box.push_back({x, j * s, 1.0 + depth}, {0, 0, 1});
+    }
+    for (int k = 1; k < 30; ++k) box.push_back({x, 0.3, 1.0 + k * s}, {0, 1, 0});
+  }
+  Terrain t = LoadTerrain(box, s);
+  auto inside = [&](const Vec3& p) {
+    if (p.y < 0) return -p.y;
+    if (p.z > 1.0 && p.z < 1.0 + depth && p.y < 0.3)
+      return std::min({p.z - 1.0, 1.0 + depth - p.z, 0.3 - p.y});
+    return 0.0;
+  };
+  for (const std::string name : {"hexapod", "octopod"}) {
+    const Character c = LoadShipped(name);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {0.75, 0, 0.6};
+    o.steps = 60;
+    const Walk w = Generate(t, c, o);
+    INFO(name << ": " << w.stopped);
+    CheckWalk(t, c, o, w);
+    CHECK(DeepestSwing(w, inside) <= s);
+    // The body went over the top and every foot ends on the floor beyond the box.
+    double highest = 0;
+    for (const WalkKey& k : Body(w).keys) highest = std::max(highest, k.position.y);
+    CHECK(highest > 0.3);
+    for (const WalkTrack& track : w.tracks) {
+      if (track.kind != TrackKind::kFoot) continue;
+      CHECK(track.keys.back().position.z > 1.0 + depth + 0.05);
+      CHECK(track.keys.back().position.y == Approx(0).margin(1e-6));
+    }
+  }
+}
+
 TEST_CASE("Long strides over finely sampled stairs keep their swings out of the noses",
           "[steps][generator]") {
   // A biped 2.5 times human size on stairs sampled every 2 cm (rise 20 cm, run 30 cm): each
