@@ -51,10 +51,41 @@ const WalkTrack& Body(const Walk& w) {
   return w.tracks.front();
 }
 
+// The deepest any swing (start->mid, mid->end, sampled every 1/200) passes into the solid whose
+// depth at a point `depth_at` gives (positive inside).
+template <typename Depth>
+double DeepestSwing(const Walk& w, const Depth& depth_at) {
+  double deepest = 0;
+  for (const WalkTrack& t : w.tracks) {
+    if (t.kind != TrackKind::kFoot) continue;
+    for (size_t i = 0; i + 2 < t.keys.size(); ++i) {
+      if (t.keys[i + 1].phase != KeyPhase::kMid) continue;
+      const Vec3 &a = t.keys[i].position, &m = t.keys[i + 1].position, &b = t.keys[i + 2].position;
+      for (int j = 1; j < 200; ++j) {
+        deepest = std::max(deepest, depth_at(Lerp(a, m, j / 200.0)));
+        deepest = std::max(deepest, depth_at(Lerp(m, b, j / 200.0)));
+      }
+    }
+  }
+  return deepest;
+}
+
+// How deep p lies in a flight of `steps` stairs along +z with flat faces: column k (z from
+// k * run to (k + 1) * run) solid up to first_top + k * rise, its riser at z = k * run; before
+// the flight (z < 0) the floor y = 0, past it the top tread's height (positive inside).
+double FlightDepth(const Vec3& p, int steps, double rise, double run, double first_top) {
+  const double k = std::clamp(std::floor(p.z / run), -1.0, steps - 1.0);
+  const double top = k < 0 ? 0 : first_top + k * rise;
+  if (p.y >= top) return 0;
+  const double below = top - p.y;
+  const double lower = k < 1 ? 0 : first_top + (k - 1) * rise;  // the column in front
+  return k >= 0 && p.y > lower && p.z < (k + 1) * run ? std::min(below, p.z - k * run) : below;
+}
+
 // Walks 12 steps from `start` along +Z (`forward`) or -Z and checks the walk: no stop, every
 // invariant of CheckWalk, and the body rising by more than `rise` (a negative `rise`: falling by
 // more than -rise).
-void WalkTwelveSteps(Terrain& t, const Character& c, const Vec3& start, bool forward, double rise) {
+Walk WalkTwelveSteps(Terrain& t, const Character& c, const Vec3& start, bool forward, double rise) {
   GenerateOptions o;
   o.has_start = true;
   o.start = start;
@@ -72,6 +103,7 @@ void WalkTwelveSteps(Terrain& t, const Character& c, const Vec3& start, bool for
   } else {
     CHECK(climbed < rise);
   }
+  return w;
 }
 
 // `steps` steps of c from (5, 0, 2) along +Z on a flat floor 10 m wide: not stopped, and every
@@ -157,12 +189,15 @@ TEST_CASE("Walks up and down stairs", "[steps][generator]") {
     const double s = Scale(c);
     const double rise = 0.15 * s, run = 0.35 * s;
     const int steps = 24;
-    Terrain t = LoadTerrain(MakeStairs(steps, rise, run, 8 * c.reach, 0.025 * s), 0.025 * s);
+    const double spacing = 0.025 * s;
+    Terrain t = LoadTerrain(MakeStairs(steps, rise, run, 8 * c.reach, spacing), spacing);
+    auto depth = [&](const Vec3& p) { return FlightDepth(p, steps, rise, run, 0); };
     INFO(name << " up");
-    WalkTwelveSteps(t, c, {4 * c.reach, 0, c.reach}, true, 3 * rise);
+    CHECK(DeepestSwing(WalkTwelveSteps(t, c, {4 * c.reach, 0, c.reach}, true, 3 * rise), depth) <=
+          spacing);
     INFO(name << " down");
-    WalkTwelveSteps(t, c, {4 * c.reach, rise * (steps - 1), run * steps - c.reach}, false,
-                    -2 * rise);
+    const Vec3 top{4 * c.reach, rise * (steps - 1), run * steps - c.reach};
+    CHECK(DeepestSwing(WalkTwelveSteps(t, c, top, false, -2 * rise), depth) <= spacing);
   }
 }
 
@@ -273,6 +308,8 @@ TEST_CASE("Swing arcs clear a resampled stair mesh, whose riser tops lie beside 
       const Walk w = Generate(t, c, o);
       INFO(separation << " " << seed << ": " << w.stopped);
       CheckWalk(t, c, o, w);
+      auto depth = [](const Vec3& p) { return FlightDepth(p, 8, 0.18, 0.3, 0.18); };
+      CHECK(DeepestSwing(w, depth) <= separation);
       to_the_top += Body(w).keys.back().position.y > 8 * 0.18;
     }
   }
@@ -1234,6 +1271,8 @@ TEST_CASE("The shipped quadruped walks up and down a stair mesh, its body along 
         const Walk w = Generate(t, c, o);
         INFO(separation << " seed " << seed << (up ? " up: " : " down: ") << w.stopped);
         CheckWalk(t, c, o, w);
+        auto depth = [&](const Vec3& p) { return FlightDepth(p, steps, rise, run, rise); };
+        CHECK(DeepestSwing(w, depth) <= separation);
         double highest = -1, lowest = 10;
         for (const WalkTrack& track : w.tracks) {
           if (track.kind != TrackKind::kFoot) continue;
@@ -1259,25 +1298,6 @@ TEST_CASE("The shipped quadruped walks up and down a stair mesh, its body along 
   // Halfway up, the body leans back with the flight (33 degrees), far more than a tread's
   // normal (0) would make it.
   CHECK(lean > std::sin(20 * kPi / 180));
-}
-
-// The deepest any swing (start->mid, mid->end, sampled every 1/200) passes into the solid whose
-// depth at a point `depth_at` gives (positive inside).
-template <typename Depth>
-double DeepestSwing(const Walk& w, const Depth& depth_at) {
-  double deepest = 0;
-  for (const WalkTrack& t : w.tracks) {
-    if (t.kind != TrackKind::kFoot) continue;
-    for (size_t i = 0; i + 2 < t.keys.size(); ++i) {
-      if (t.keys[i + 1].phase != KeyPhase::kMid) continue;
-      const Vec3 &a = t.keys[i].position, &m = t.keys[i + 1].position, &b = t.keys[i + 2].position;
-      for (int j = 1; j < 200; ++j) {
-        deepest = std::max(deepest, depth_at(Lerp(a, m, j / 200.0)));
-        deepest = std::max(deepest, depth_at(Lerp(m, b, j / 200.0)));
-      }
-    }
-  }
-  return deepest;
 }
 
 TEST_CASE("Insects before a wall thinner than their step stop there, no swing passing through it",
@@ -1384,14 +1404,7 @@ TEST_CASE("Long strides over finely sampled stairs keep their swings out of the 
   const double rise = 0.2, run = 0.3, spacing = 0.02;
   const int steps = 16;
   Terrain t = LoadTerrain(MakeStairs(steps, rise, run, 2.0, spacing), spacing);
-  // Depth into the flight (MakeStairs: treads at y = k * rise over z in [k * run, (k + 1) *
-  // run), risers facing -z): below a tread's top, or, above the tread before, behind the riser.
-  auto depth = [&](const Vec3& p) {
-    const double k = std::floor(p.z / run);
-    if (k < 0 || k >= steps || p.y >= k * rise) return 0.0;
-    const double below = k * rise - p.y;
-    return p.y > (k - 1) * rise ? std::min(below, p.z - k * run) : below;
-  };
+  auto depth = [&](const Vec3& p) { return FlightDepth(p, steps, rise, run, 0); };
   for (const bool up : {true, false}) {
     GenerateOptions o;
     o.has_start = true;
