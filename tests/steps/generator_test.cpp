@@ -300,7 +300,9 @@ TEST_CASE("Swing arcs clear a resampled stair mesh, whose riser tops lie beside 
       mo.smooth_normals = false;
       mo.seed = seed;
       REQUIRE(SampleMesh(MakeStairsMesh(8, 0.18, 0.3, 1.5), mo, &stairs, nullptr) == Status::kOk);
-      Terrain t = LoadTerrain(stairs, separation);
+      // Neighbouring samples lie at least 2/3 of the separation apart (CheckWalk's spacing:
+      // no surface nearer than the distance to the nearest sample less twice that).
+      Terrain t = LoadTerrain(stairs, separation * 2 / 3);
       GenerateOptions o;
       o.has_start = true;
       o.start = {0.75, 0, -0.6};
@@ -1393,28 +1395,50 @@ TEST_CASE("Insects climb a box, cross its top and climb down its far side", "[st
 
 TEST_CASE("Long strides over finely sampled stairs keep their swings out of the noses",
           "[steps][generator]") {
-  // A biped 2.5 times human size on stairs sampled every 2 cm (rise 20 cm, run 30 cm): each
-  // stride spans several treads and lands in a tread's inner corner, under the next nose. Seven
-  // check points let the straight stretch into that corner pass 7.5 cm through the nose; the
-  // points are now no farther apart than about two sample spacings.
-  Character c = LoadShipped("biped");
-  c.feet[0].rest = {0.2, 0, 0}, c.feet[1].rest = {-0.2, 0, 0};
-  c.step_length = 1.8, c.step_height = 0.4, c.body_height = 3.0, c.reach = 3.6;
-  c.max_rise = 0.9, c.frames_per_step = 16;
-  const double rise = 0.2, run = 0.3, spacing = 0.02;
-  const int steps = 16;
-  Terrain t = LoadTerrain(MakeStairs(steps, rise, run, 2.0, spacing), spacing);
-  auto depth = [&](const Vec3& p) { return FlightDepth(p, steps, rise, run, 0); };
-  for (const bool up : {true, false}) {
-    GenerateOptions o;
-    o.has_start = true;
-    o.start = up ? Vec3{1, 0, 0.15} : Vec3{1, rise * (steps - 1), run * steps - 0.15};
-    o.heading = {0, 0, up ? 1.0 : -1.0};
-    o.steps = 10;
-    const Walk w = Generate(t, c, o);
-    INFO((up ? "up: " : "down: ") << w.stopped);
-    CHECK(StepsDone(w) >= 4);
-    CHECK(DeepestSwing(w, depth) <= spacing);
+  // Bipeds of 1.8 and 3 m strides on stairs sampled every 2 cm (rise 20 cm, run 30 cm)
+  // after 2 m of floor, each riser's samples reaching up to its nose: each stride spans several
+  // treads and lands in a tread's inner corner, under the next nose. Seven check points let the
+  // straight stretch into that corner pass 7.5 cm through the nose; the points are now no
+  // farther apart than about two sample spacings. And among that many, some lie high over a
+  // nose just behind its riser's plane, whose top sample is nearest: taken as below the
+  // terrain, they stopped the larger biped at its second step down.
+  const double rise = 0.2, run = 0.3, spacing = 0.02, floor = 2;
+  const int steps = 20;
+  RawSamples stairs;
+  for (int i = 0; i <= 100; ++i) {
+    const double x = i * spacing;
+    for (int k = 0; k <= 100; ++k) stairs.push_back({x, 0, k * spacing}, {0, 1, 0});
+    for (int n = 0; n < steps; ++n) {
+      const double z0 = floor + n * run;
+      for (int j = 1; j <= 10; ++j) stairs.push_back({x, n * rise + j * spacing, z0}, {0, 0, -1});
+      for (int k = 1; k <= 15; ++k)
+        stairs.push_back({x, (n + 1) * rise, z0 + k * spacing}, {0, 1, 0});
+    }
+  }
+  Terrain t = LoadTerrain(stairs, spacing);
+  auto depth = [&](const Vec3& p) {
+    return FlightDepth(p - Vec3{0, 0, floor}, steps, rise, run, rise);
+  };
+  struct Size {
+    double rest, step_length, step_height, body_height, reach, max_rise;
+  };
+  for (const Size& z : {Size{0.2, 1.8, 0.4, 3.0, 3.6, 0.9}, Size{0.5, 3.0, 0.6, 4.0, 6.0, 1.0}}) {
+    Character c = LoadShipped("biped");
+    c.feet[0].rest = {z.rest, 0, 0}, c.feet[1].rest = {-z.rest, 0, 0};
+    c.step_length = z.step_length, c.step_height = z.step_height;
+    c.body_height = z.body_height, c.reach = z.reach, c.max_rise = z.max_rise;
+    c.frames_per_step = 16;
+    for (const bool up : {true, false}) {
+      GenerateOptions o;
+      o.has_start = true;
+      o.start = up ? Vec3{1, 0, 0.3} : Vec3{1, rise * steps, floor + run * steps - 0.1};
+      o.heading = {0, 0, up ? 1.0 : -1.0};
+      o.steps = 6;
+      const Walk w = Generate(t, c, o);
+      INFO(z.step_length << (up ? " up: " : " down: ") << w.stopped);
+      CHECK(w.stopped.empty());
+      CHECK(DeepestSwing(w, depth) <= spacing);
+    }
   }
 }
 

@@ -146,7 +146,8 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
     // spacing (no surface is nearer than that).
     const Vec3 v = arc[i] - arc_snap[i].point;
     double clearance = Dot(v, arc_snap[i].normal);
-    if (clearance > 0) clearance = std::max(clearance, Length(v) - 2 * t.spacing);
+    if (clearance > 0 || Length2(v) - clearance * clearance > 4 * t.spacing * t.spacing)
+      clearance = std::max(clearance, Length(v) - 2 * t.spacing);
     // A foothold standing against the sample's face (on ground facing more than 45 degrees
     // away, less than a step height in front of it: a toe at a riser): the arc near it keeps
     // at least half the foot's own distance from that face.
