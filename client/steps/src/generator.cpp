@@ -60,8 +60,10 @@ constexpr size_t kMaxArcChecks = 63;
 // apart than `gap`: 7, 15, 23, ... 63, so that the seven points of the shortest arcs (at
 // eighths) are always among them.
 size_t ArcChecks(double length, double gap) {
-  const double eighths = gap > 0 ? std::ceil(length / gap / 8) : 1;
-  return 8 * static_cast<size_t>(std::clamp(eighths, 1.0, (kMaxArcChecks + 1) / 8.0)) - 1;
+  if (!(gap > 0)) return kMinArcChecks;
+  const double eighths = std::ceil(length / gap / 8);
+  constexpr double kMost = (kMaxArcChecks + 1) / 8;
+  return 8 * static_cast<size_t>(eighths > 1 ? std::min(eighths, kMost) : 1.0) - 1;
 }
 
 // The j-th of an arc's `checks` points, as a fraction of the arc (0: its start key, 0.5: its
