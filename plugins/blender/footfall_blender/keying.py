@@ -8,14 +8,83 @@ from mathutils import Euler, Matrix, Quaternion, Vector
 from .axes import from_ff, quat_from_ff
 
 
+def _path_curve(obj):
+    """True when obj is a curve whose children follow its path (Path Animation on)."""
+    return obj.type == "CURVE" and obj.data is not None and obj.data.use_path
+
+
+def unsupported_parent(obj):
+    """Why obj's parent relation cannot be keyed exactly (None when it can). Object, lattice
+    and armature-deform parents give their children the parent's world matrix, bone parents
+    their bone's; a vertex parent gives the vertices' (deformed) position, and a curve with Path
+    Animation a point on its path, which the add-on cannot compute."""
+    parent = obj.parent
+    if parent is None:
+        return None
+    if obj.parent_type in ("VERTEX", "VERTEX_3"):
+        return ("%s is parented to %s of %s, whose position footfall cannot compute: parent it "
+                "to an object or a bone" % (obj.name, "a vertex" if obj.parent_type == "VERTEX"
+                                            else "three vertices", parent.name))
+    if obj.parent_type == "OBJECT" and _path_curve(parent):
+        return ("%s is parented to curve %s, whose Path Animation moves its children along the "
+                "path, which footfall cannot compute: parent it to an object or a bone (or turn "
+                "the curve's Path Animation off and place it again)" % (obj.name, parent.name))
+    return None
+
+
+def check_parents(objects):
+    """Raises ValueError naming the first of `objects` (None ones skipped) whose parent relation
+    cannot be keyed exactly (see unsupported_parent)."""
+    for obj in objects:
+        why = unsupported_parent(obj) if obj is not None else None
+        if why:
+            raise ValueError(why)
+
+
+def _bone(obj):
+    """The pose bone obj is parented to (parent type BONE on an armature), or None."""
+    parent = obj.parent
+    if obj.parent_type != "BONE" or parent is None or parent.type != "ARMATURE":
+        return None
+    return parent.pose.bones.get(obj.parent_bone)
+
+
+def _parent_world(obj):
+    """The world matrix obj's parent gives it (as Blender's BKE_object_get_parent_matrix), as
+    evaluated now: the parent's world matrix, times for a bone parent the bone's pose matrix
+    and the bone's length along its Y (children of a bone hang from its tail), or for a bone
+    with relative parenting its channel matrix. (A bone that does not exist gives the
+    armature's matrix, as in Blender.)"""
+    parent = obj.parent
+    bone = _bone(obj)
+    if bone is None:
+        return parent.matrix_world.copy()
+    if bone.bone.use_relative_parent:
+        return parent.matrix_world @ bone.matrix_channel
+    return parent.matrix_world @ bone.matrix @ Matrix.Translation((0.0, bone.bone.length, 0.0))
+
+
+def _parent_key(obj):
+    """What obj's parent space depends on: its parent object and bone."""
+    bone = _bone(obj)
+    return (obj.parent.name, bone.name if bone is not None else "")
+
+
 def _moves(obj):
-    """True when obj's world matrix may change from frame to frame: it or an object up its
-    parent chain has animation data (an action, NLA tracks or drivers) or constraints."""
+    """True when obj's world matrix (or a bone's of it) may change from frame to frame: it or
+    an object up its parent chain has animation data (an action, NLA tracks or drivers),
+    constraints (on the object or, for an armature, on a bone), or hangs from vertices or a
+    path (which any animation of the mesh or curve moves)."""
     while obj is not None:
         ad = obj.animation_data
         if ad is not None and (ad.action is not None or len(ad.nla_tracks) or len(ad.drivers)):
             return True
         if len(obj.constraints):
+            return True
+        if obj.type == "ARMATURE" and obj.pose is not None and \
+                any(len(bone.constraints) for bone in obj.pose.bones):
+            return True
+        if obj.parent is not None and unsupported_parent(obj):
             return True
         obj = obj.parent
     return False
@@ -32,35 +101,38 @@ def _under(obj, ancestor):
 
 
 class _ParentSpaces:
-    """The matrix taking world space to an object's matrix_basis space (its parent's world
-    matrix and parent inverse, inverted), at a key's frame. A static parent chain's is read
-    once; an animated one's is evaluated at each key's frame (the scene is set to that frame
-    and subframe, once per frame for all objects); restore() goes back to the frame the scene
-    was on. Objects parented to a bone are taken as parented to the armature object."""
+    """The matrix taking world space to an object's matrix_basis space (its parent's matrix,
+    see _parent_world, and its parent inverse, inverted), at a key's frame. A static parent
+    chain's is read once; an animated one's is evaluated at each key's frame (the scene is set
+    to that frame and subframe, once per frame for all objects); restore() goes back to the
+    frame the scene was on. A parent relation unsupported_parent refuses raises ValueError."""
 
     def __init__(self, scene):
         self.scene = scene
         self.frame = (scene.frame_current, scene.frame_subframe)
         self.moved = False
-        self._at = {}  # (frame, parent name) -> parent world matrix at that frame
+        self._at = {}  # (frame, parent key) -> parent matrix at that frame
 
     def inverse(self, obj, frames):
         """One world-to-basis matrix per frame of `frames` (ascending) for `obj`."""
         parent = obj.parent
         if parent is None:
             return [Matrix.Identity(4)] * len(frames)
+        why = unsupported_parent(obj)
+        if why:
+            raise ValueError(why)
         pinv = obj.matrix_parent_inverse.copy()
         if not _moves(parent):
-            m = (parent.matrix_world @ pinv).inverted()
+            m = (_parent_world(obj) @ pinv).inverted()
             return [m] * len(frames)
         out = []
         for frame in frames:
-            key = (frame, parent.name)
+            key = (frame, _parent_key(obj))
             if key not in self._at:
                 whole = math.floor(frame)
                 self.scene.frame_set(int(whole), subframe=frame - whole)
                 self.moved = True
-                self._at[key] = parent.matrix_world.copy()
+                self._at[key] = _parent_world(obj)
             out.append((self._at[key] @ pinv).inverted())
         return out
 
@@ -69,7 +141,7 @@ class _ParentSpaces:
         evaluated again (keys added through keyframe_points are not seen otherwise)."""
         if parent.animation_data is not None and parent.animation_data.action is not None:
             parent.animation_data.action.update_tag()
-        self._at = {k: m for k, m in self._at.items() if k[1] != parent.name}
+        self._at = {k: m for k, m in self._at.items() if k[1][0] != parent.name}
 
     def restore(self):
         if self.moved:

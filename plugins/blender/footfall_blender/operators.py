@@ -390,6 +390,8 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
         keyed = 0
         walk_text = None
         try:
+            # Parents the keys cannot be computed in, before anything is keyed.
+            keying.check_parents(list(feet.values()) + [body])
             # The whole walk's frames within Blender's range, before anything is keyed.
             request = walk_request(context, rig_obj, total, settings.start_frame)
             last = settings.start_frame + total * int(request["character"]["frames_per_step"])
@@ -483,6 +485,7 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
                                      "per character: deselect the rig and clear the scene's "
                                      "footfall rig first" % len(crowd))
                 feet, body = rig_targets(rig_obj)
+                keying.check_parents(list(feet.values()) + [body])
                 # Nothing is cleared unless the walk keys something of this rig.
                 if not any((t.get("kind") == "body" and body) or t["name"] in feet
                            for t in walk["tracks"]):
