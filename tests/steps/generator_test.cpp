@@ -436,6 +436,63 @@ TEST_CASE("Feet that snap onto one sample at the start take their own", "[steps]
   }
 }
 
+TEST_CASE("An upright body stops before a slab lower than it, its legs never through the slab",
+          "[steps][generator]") {
+  // A floor and, 0.6 to 0.7 m above it, a slab over z from 2 to 4 m (both faces and its edges
+  // sampled every 4 cm): a biped (body 0.95 m up) walked on under it, feet on the floor and
+  // body over the slab, its legs through the slab for 7 steps. Now the walk stops at the first
+  // step whose body has no room, with the keys before it; each body key's straight lines to
+  // the feet stay out of the slab.
+  const double s = 0.04;
+  RawSamples ground;
+  for (int i = 0; i <= 75; ++i) {
+    const double x = i * s;
+    for (int k = 0; k <= 150; ++k) {
+      const double z = k * s;
+      ground.push_back({x, 0, z}, {0, 1, 0});
+      if (z >= 2 - 1e-9 && z <= 4 + 1e-9) {
+        ground.push_back({x, 0.7, z}, {0, 1, 0});
+        ground.push_back({x, 0.6, z}, {0, -1, 0});
+      }
+    }
+    for (const double y : {0.62, 0.66}) {
+      ground.push_back({x, y, 2}, {0, 0, -1});
+      ground.push_back({x, y, 4}, {0, 0, 1});
+    }
+  }
+  Terrain t = LoadTerrain(ground, s);
+  auto in_slab = [](const Vec3& p) {
+    return p.z > 2 && p.z < 4 && p.y > 0.6 && p.y < 0.7
+               ? std::min({p.z - 2, 4 - p.z, p.y - 0.6, 0.7 - p.y})
+               : 0.0;
+  };
+  {
+    const Character c = LoadShipped("biped");
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {1.5, 0, 0.5};
+    o.steps = 16;
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    CheckWalk(t, c, o, w);
+    CHECK_THAT(w.stopped, Catch::Contains("no room for the body"));
+    CHECK(StepsDone(w) >= 2);
+    double deepest = 0;
+    for (size_t b = 0; b < Body(w).keys.size(); ++b) {
+      const WalkKey& body = Body(w).keys[b];
+      for (const WalkTrack& foot : w.tracks) {
+        if (foot.kind != TrackKind::kFoot) continue;
+        Vec3 at = foot.keys.front().position;  // where the foot stands at the body key's frame
+        for (const WalkKey& k : foot.keys)
+          if (k.frame <= body.frame) at = k.position;
+        for (int j = 1; j < 100; ++j)
+          deepest = std::max(deepest, in_slab(Lerp(at, body.position, j / 100.0)));
+      }
+    }
+    CHECK(deepest == 0);
+  }
+}
+
 TEST_CASE("A stop on ground facing down names the likely causes", "[steps][generator]") {
   // Flat ground whose normals face down (the underside of a thin slab, or inward faces): the
   // stop said only that the ground leans 180 degrees.

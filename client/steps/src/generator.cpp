@@ -43,6 +43,13 @@ constexpr double kAlikeCos = 0.7071;  // footholds whose normals are within 45 d
 // of at most body_height each, and never beyond reach of a foot.
 constexpr double kBodyClearance = 0.5;
 constexpr int kBodyRounds = 3;
+// Room for an upright body (bipeds): points of its spine, from half body_height above the
+// feet's centroid up to the body, at most this many and no farther apart than the terrain's
+// gap, must not lie behind the terrain; else the walk stops before that step (a biped walking
+// under a slab lower than its body had its feet under it and its body over it). Not for
+// multipeds: over a convex edge their feet's centroid lies inside the terrain, and their bodies
+// dip into stair noses by a centimetre or two (both seen in tests), which would stop them.
+constexpr size_t kMaxSpineChecks = 17;
 // Points checked along each start-mid-end arc, evenly spaced: at least kMinArcChecks, and as many
 // more as keep them no farther apart than the terrain's gap (about twice its sample spacing), up
 // to kMaxArcChecks (ArcChecks). Between two check points an arc may graze a sharp edge by about
@@ -305,6 +312,8 @@ class Generator {
   // Keys a's feet where they stand at the start frame, and asks for its body (body_due_).
   void KeyStart(const Agent& a);
   void Stop(Agent& a, int step, const std::string& why);
+  // Takes back the foot keys of a step that started at frame f0 (its body not yet keyed).
+  void UnkeyStep(const Agent& a, double f0);
   // A failed batch call: the session's status, and its message prefixed with `what`.
   Status Check(Status status, const char* what, std::string* error) {
     if (status != Status::kOk) *error = std::string(what) + ": " + session_.last_error();
@@ -365,6 +374,8 @@ class Generator {
   std::vector<double> body_frame_, body_raise_;
   std::vector<size_t> body_pending_, body_still_;
   std::vector<Vec3> body_points_;
+  std::vector<size_t> spine_first_;  // per due body: its first spine point (KeyBodies)
+
 };
 
 Vec3 Generator::AveragedUp(const Vec3& previous, const std::vector<Vec3>& normals) const {
@@ -848,10 +859,67 @@ Status Generator::KeyBodies(std::string* error) {
     }
     body_pending_.swap(body_still_);
   }
-  for (size_t i = 0; i < n; ++i)
-    KeyBody(agents_[body_due_[i].first], body_due_[i].second, body_raise_[i]);
+  // Room for an upright body (kMaxSpineChecks), after the start (where it stands as asked) and
+  // when its spine is longer than the gap (shorter, the samples cannot tell).
+  spine_first_.assign(n + 1, 0);
+  body_points_.clear();
+  for (size_t i = 0; i < n; ++i) {
+    const Agent& a = agents_[body_due_[i].first];
+    const double low = 0.5 * c_.body_height, high = c_.body_height + body_raise_[i];
+    const double span = high - low;
+    if (!c_.align_to_normal && body_due_[i].second != o_.start_frame && gap_ > 0 &&
+        span >= gap_) {
+      const size_t count =
+          static_cast<size_t>(std::min(std::ceil(span / gap_), kMaxSpineChecks - 1.0)) + 1;
+      for (size_t j = 0; j < count; ++j)
+        body_points_.push_back(a.ground + a.body_up * (low + span * static_cast<double>(j) /
+                                                                static_cast<double>(count - 1)));
+    }
+    spine_first_[i + 1] = body_points_.size();
+  }
+  if (!body_points_.empty()) {
+    answers_.resize(body_points_.size());
+    const Status s =
+        Check(session_.Snap(terrain_, body_points_.data(), body_points_.size(), answers_.data()),
+              "snap bodies", error);
+    if (s != Status::kOk) return s;
+  }
+  for (size_t i = 0; i < n; ++i) {
+    Agent& a = agents_[body_due_[i].first];
+    const double frame = body_due_[i].second;
+    size_t behind = spine_first_[i + 1];
+    for (size_t j = spine_first_[i]; j < spine_first_[i + 1] && behind == spine_first_[i + 1]; ++j)
+      if (answers_[j].status == Status::kOk && Clearance(body_points_[j], answers_[j], gap_) < 0)
+        behind = j;
+    if (behind == spine_first_[i + 1]) {
+      KeyBody(a, frame, body_raise_[i]);
+      continue;
+    }
+    std::ostringstream why;
+    why << "no room for the body at " << Point(body_points_[spine_first_[i + 1] - 1])
+        << ": the terrain at " << Point(answers_[behind].point)
+        << " lies between it and its feet (an overhang or a ceiling lower than body_height, or a "
+           "body inside the terrain)";
+    UnkeyStep(a, frame - c_.frames_per_step);
+    Stop(a, static_cast<int>(std::lround((frame - o_.start_frame) / c_.frames_per_step)),
+         why.str());
+  }
   body_due_.clear();
   return Status::kOk;
+}
+
+void Generator::UnkeyStep(const Agent& a, double f0) {
+  // Keys after f0 go; a lift-off at f0 goes too (at the start frame it becomes the plant it
+  // replaced again); a touch-down at f0 that a gait of one group lifted from stays.
+  for (size_t f = 0; f < c_.feet.size(); ++f) {
+    std::pmr::vector<WalkKey>& keys = walk_.tracks[a.first_track + f].keys;
+    while (!keys.empty() && keys.back().frame > f0) keys.pop_back();
+    if (keys.empty() || keys.back().frame != f0 || keys.back().phase != KeyPhase::kStart) continue;
+    if (f0 == o_.start_frame)
+      keys.back().phase = KeyPhase::kEnd;
+    else
+      keys.pop_back();
+  }
 }
 
 Status Generator::SeparateSharedFeet(const Vec3* places, Foothold* feet, size_t total, size_t count,
