@@ -436,6 +436,46 @@ TEST_CASE("Feet that snap onto one sample at the start take their own", "[steps]
   }
 }
 
+TEST_CASE("A start beside a box's foot stands on the floor, a crowd's grid across it",
+          "[steps][generator]") {
+  // A floor sampled every 4 cm and a box (0.25 m tall, from z = 2) whose front face, sampled
+  // every 2 cm up, is 5 mm from the start: its samples lie nearer the start than the floor's. The
+  // start took the face, and a crowd stood on a grid up it, six of nine left out; now on the floor
+  // and the box's top.
+  RawSamples ground;
+  const double s = 0.04;
+  for (int i = 0; i <= 75; ++i) {
+    const double x = i * s;
+    for (int k = 0; k <= 150; ++k) {
+      const double z = k * s;
+      ground.push_back({x, z >= 2 && z <= 3 ? 0.25 : 0.0, z}, {0, 1, 0});
+    }
+    for (int j = 1; j < 12; ++j) {
+      ground.push_back({x, j * 0.25 / 12, 2}, {0, 0, -1});
+      ground.push_back({x, j * 0.25 / 12, 3}, {0, 0, 1});
+    }
+  }
+  Terrain t = LoadTerrain(ground, s);
+  const Character c = LoadShipped("quadruped");
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {1.48, 0.01, 1.995};
+  o.heading = {0, 0, -1};
+  o.crowd = 9;
+  o.crowd_spacing = 0.7;
+  o.steps = 2;
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CHECK_THAT(w.stopped, !Catch::Contains("left out"));
+  size_t feet = 0;
+  for (const WalkTrack& track : w.tracks) {
+    if (track.kind != TrackKind::kFoot) continue;
+    ++feet;
+    CHECK(track.keys.front().normal == Vec3{0, 1, 0});  // on the floor or the box's top
+  }
+  CHECK(feet == 9 * c.feet.size());
+}
+
 TEST_CASE("An upright body stops before a slab lower than it, its legs never through the slab",
           "[steps][generator]") {
   // A floor and, 0.6 to 0.7 m above it, a slab over z from 2 to 4 m (both faces and its edges

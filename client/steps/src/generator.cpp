@@ -375,7 +375,6 @@ class Generator {
   std::vector<size_t> body_pending_, body_still_;
   std::vector<Vec3> body_points_;
   std::vector<size_t> spine_first_;  // per due body: its first spine point (KeyBodies)
-
 };
 
 Vec3 Generator::AveragedUp(const Vec3& previous, const std::vector<Vec3>& normals) const {
@@ -867,13 +866,12 @@ Status Generator::KeyBodies(std::string* error) {
     const Agent& a = agents_[body_due_[i].first];
     const double low = 0.5 * c_.body_height, high = c_.body_height + body_raise_[i];
     const double span = high - low;
-    if (!c_.align_to_normal && body_due_[i].second != o_.start_frame && gap_ > 0 &&
-        span >= gap_) {
+    if (!c_.align_to_normal && body_due_[i].second != o_.start_frame && gap_ > 0 && span >= gap_) {
       const size_t count =
           static_cast<size_t>(std::min(std::ceil(span / gap_), kMaxSpineChecks - 1.0)) + 1;
       for (size_t j = 0; j < count; ++j)
         body_points_.push_back(a.ground + a.body_up * (low + span * static_cast<double>(j) /
-                                                                static_cast<double>(count - 1)));
+                                                                 static_cast<double>(count - 1)));
     }
     spine_first_[i + 1] = body_points_.size();
   }
@@ -974,7 +972,25 @@ Status Generator::FindStart(const Vec3& start, bool may_move, Foothold* first, s
                  : "the terrain is empty: no sample to start on";
     return Status::kInvalidArgument;
   }
-  if (!may_move) return Status::kOk;
+  if (!may_move) {
+    // A start beside the foot of a wall (a box's face nearer than the lattice's next floor
+    // sample) or just inside a block takes the ground nearest it below or above, when that lies
+    // within half a step and leans within max_slope_deg of world up: a crowd started 2 cm in
+    // front of a box stood on a grid up its face. A start up a wall or on a ceiling stays.
+    if (Dot(first->normal, world_up_) >= cos_max_slope_) return Status::kOk;
+    const double beside = kFootholdTolerance * c_.step_length;
+    const Vec3 probes[2] = {start - world_up_ * beside, start + world_up_ * beside};
+    Foothold grounds[2];
+    s = Check(session_.Snap(terrain_, probes, 2, grounds), "snap start", error);
+    if (s != Status::kOk) return s;
+    double nearest = beside;
+    for (const Foothold& g : grounds) {
+      if (g.status != Status::kOk || Dot(g.normal, world_up_) < cos_max_slope_) continue;
+      const double d = Distance(g.point, start);
+      if (d <= nearest) nearest = d, *first = g;
+    }
+    return Status::kOk;
+  }
   // Candidates on a grid of half a step across world up through the start's sample, nearest
   // it first (the start itself first), each snapped; then the feet of one character standing
   // on each. (A candidate snaps to the nearest sample: beside a tall feature it may snap to
