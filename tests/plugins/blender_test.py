@@ -570,12 +570,9 @@ class BlenderAddonTest(unittest.TestCase):
         for parent, kind, message in ((cube, "VERTEX", "parented to a vertex of Cube"),
                                       (cube, "VERTEX_3", "parented to three vertices of Cube"),
                                       (curve, "OBJECT", "Path Animation")):
-            world = target.matrix_world.copy()
             target.parent, target.parent_type = parent, kind
             if kind.startswith("VERTEX"):
                 target.parent_vertices = (0, 1, 2)
-            bpy.context.view_layer.update()  # the cube's evaluated mesh, for its vertices
-            target.matrix_world = world
             bpy.context.view_layer.update()
             before = {o.name: fcurve_keys(o, "location", 3) for o in objects}
             with self.assertRaises(RuntimeError) as e:
@@ -598,6 +595,94 @@ class BlenderAddonTest(unittest.TestCase):
         for obj in (cube, curve):
             bpy.data.objects.remove(obj)
         scene.footfall.rig = None
+
+    def test_6f_feet_under_the_body_keyed_again_only_where_it_changed(self):
+        # Feet under the body were keyed again over the whole walk at each chunk, the scene
+        # stepped through all their frames so far at each chunk (4830 frames for a walk of 400
+        # steps with 1200 frames keyed: seconds in a heavy scene). They are keyed again only
+        # from where the body's new keys changed its curve, with the same keys to the bit.
+        scene = bpy.context.scene
+        scene.frame_set(1)
+        control = bpy.data.objects.new("stepper_control", None)
+        scene.collection.objects.link(control)
+        control.keyframe_insert("location", frame=1)
+        control.location = (0.2, 0.3, 0.05)
+        control.keyframe_insert("location", frame=150)
+        scene.frame_set(1)
+        body = bpy.data.objects.new("stepper_body", None)
+        scene.collection.objects.link(body)
+        body.parent = control
+        body.location = (-1.0, -4.3, 1.0)
+        body.rotation_euler = (0.0, 0.0, math.pi)  # faces +Y
+        targets = []
+        for name, x in (("L", 0.12), ("R", -0.12)):
+            e = bpy.data.objects.new("stepper_IK_" + name, None)
+            scene.collection.objects.link(e)
+            e.parent = body
+            e.location = (x, 0.0, -1.0)
+            targets.append(e)
+        bpy.context.view_layer.update()
+        self.select(targets + [body], body)
+        self.assertEqual(bpy.ops.footfall.character_setup(
+            character_file=os.path.join(CHARACTERS, "biped.json"), mode="PICK", name="stepper"),
+            {"FINISHED"})
+        rig = bpy.data.objects["stepper_rig"]
+        feet = {f.name: f.target for f in rig.footfall_rig.feet}
+        settings = scene.footfall
+        settings.rig, settings.steps, settings.start_frame = rig, 16, 1
+
+        def keys():
+            """Every key of the feet and the body: frames, values and handles."""
+            out = {}
+            for obj in targets + [body]:
+                for fc in obj.animation_data.action.fcurves:
+                    out[(obj.name, fc.data_path, fc.array_index)] = [
+                        (tuple(k.co), tuple(k.handle_left), tuple(k.handle_right))
+                        for k in fc.keyframe_points]
+            return out
+        steps = []
+
+        def count(*_):
+            steps.append(scene.frame_current)
+        edit = bpy.context.preferences.edit
+        saved = edit.fcurve_new_auto_smoothing
+        bpy.app.handlers.frame_change_post.append(count)
+        try:
+            # Blender's default smoothing of new F-curves (continuous acceleration: a new key
+            # moves the handles of a dozen keys before it, by less and less, down to the last
+            # bit of a float, so chunks of 2 steps save little) and none (a new key moves the
+            # handles of the key before it only).
+            for smoothing in ("CONT_ACCEL", "NONE"):
+                edit.fcurve_new_auto_smoothing = smoothing
+                clear_animation(targets + [body])
+                del steps[:]
+                self.assertEqual(bpy.ops.footfall.generate_walk(chunk_steps=16), {"FINISHED"})
+                whole, whole_steps = keys(), len(steps)
+                del steps[:]
+                self.assertEqual(bpy.ops.footfall.generate_walk(chunk_steps=2), {"FINISHED"})
+                chunked_steps = len(steps)
+                self.assertEqual(body.animation_data.action.fcurves[0].auto_smoothing, smoothing)
+                self.assertEqual(keys(), whole)  # in 8 chunks, the same keys as in 1, to the bit
+                walk = json.loads(bpy.data.texts["footfall_walk.json"].as_string())
+                self.assert_world_at_key_frames(walk, feet, body, tol=1e-5)
+                # One chunk: the body's frames, then the feet's (each frame once for both), and
+                # back to the frame it was on.
+                frames = {t["kind"]: set() for t in walk["tracks"]}
+                for t in walk["tracks"]:
+                    frames[t["kind"]].update(k["frame"] for k in t["keys"])
+                self.assertEqual(whole_steps, len(frames["body"]) + len(frames["foot"]) + 1)
+                # Eight: the feet's frames again only from where the body's curve changed (they
+                # were all stepped through again at each chunk: 184 frames, either smoothing).
+                print("%s: frames stepped through: %d for the walk in one chunk, %d in eight"
+                      % (smoothing, whole_steps, chunked_steps))
+                if smoothing == "NONE":
+                    self.assertLess(chunked_steps, 1.9 * whole_steps)
+        finally:
+            bpy.app.handlers.frame_change_post.remove(count)
+            edit.fcurve_new_auto_smoothing = saved
+        self.assertEqual(walk, self.cli_walk(rig, 16, "stepper_cli")[0])
+        settings.rig = None
+        scene.frame_set(1)
 
     def test_7_import_json_walk(self):
         path = os.path.join(ARGS.work_dir, "hexapod_rig_cli.json")

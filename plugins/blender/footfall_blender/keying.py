@@ -1,5 +1,6 @@
 """Keys a footfall walk (the walk JSON as a dict) onto Blender objects, in world space."""
 
+import bisect
 import math
 
 import bpy
@@ -102,39 +103,52 @@ def _under(obj, ancestor):
 
 class _ParentSpaces:
     """The matrix taking world space to an object's matrix_basis space (its parent's matrix,
-    see _parent_world, and its parent inverse, inverted), at a key's frame. A static parent
-    chain's is read once; an animated one's is evaluated at each key's frame (the scene is set
-    to that frame and subframe, once per frame for all objects); restore() goes back to the
-    frame the scene was on. A parent relation unsupported_parent refuses raises ValueError."""
+    see _parent_world, and its parent inverse, inverted), at a key's frame. read() reads them
+    for a group of objects: a static parent chain's once, an animated one's at each key's frame,
+    the scene stepped once through the frames the group needs (set to each frame and subframe
+    once, for all its objects); restore() goes back to the frame the scene was on."""
 
     def __init__(self, scene):
         self.scene = scene
         self.frame = (scene.frame_current, scene.frame_subframe)
         self.moved = False
-        self._at = {}  # (frame, parent key) -> parent matrix at that frame
+        self._at = {}  # (frame, parent key) -> parent matrix then; (None, parent key): static
+
+    def read(self, jobs):
+        """Reads what inverse() needs for `jobs`, (object, frames) pairs. Raises ValueError for
+        a parent relation unsupported_parent refuses."""
+        wanted = {}  # frame -> {parent key: an object with that parent}
+        for obj, frames in jobs:
+            if obj.parent is None:
+                continue
+            why = unsupported_parent(obj)
+            if why:
+                raise ValueError(why)
+            key = _parent_key(obj)
+            if not _moves(obj.parent):
+                if (None, key) not in self._at:
+                    self._at[(None, key)] = _parent_world(obj)
+                continue
+            for frame in frames:
+                if (frame, key) not in self._at:
+                    wanted.setdefault(frame, {})[key] = obj
+        for frame in sorted(wanted):
+            whole = math.floor(frame)
+            self.scene.frame_set(int(whole), subframe=frame - whole)
+            self.moved = True
+            for key, obj in wanted[frame].items():
+                self._at[(frame, key)] = _parent_world(obj)
 
     def inverse(self, obj, frames):
-        """One world-to-basis matrix per frame of `frames` (ascending) for `obj`."""
-        parent = obj.parent
-        if parent is None:
+        """One world-to-basis matrix per frame of `frames` for `obj` (read() first)."""
+        if obj.parent is None:
             return [Matrix.Identity(4)] * len(frames)
-        why = unsupported_parent(obj)
-        if why:
-            raise ValueError(why)
-        pinv = obj.matrix_parent_inverse.copy()
-        if not _moves(parent):
-            m = (_parent_world(obj) @ pinv).inverted()
-            return [m] * len(frames)
-        out = []
-        for frame in frames:
-            key = (frame, _parent_key(obj))
-            if key not in self._at:
-                whole = math.floor(frame)
-                self.scene.frame_set(int(whole), subframe=frame - whole)
-                self.moved = True
-                self._at[key] = _parent_world(obj)
-            out.append((self._at[key] @ pinv).inverted())
-        return out
+        pinv = obj.matrix_parent_inverse
+        key = _parent_key(obj)
+        static = self._at.get((None, key))
+        if static is not None:
+            return [(static @ pinv).inverted()] * len(frames)
+        return [(self._at[(frame, key)] @ pinv).inverted() for frame in frames]
 
     def forget(self, parent):
         """Drops what was read of `parent` (its keys have just changed) and has its action
@@ -147,6 +161,72 @@ class _ParentSpaces:
         if self.moved:
             self.scene.frame_set(self.frame[0], subframe=self.frame[1])
             self.moved = False
+
+
+# What an F-curve's keys hold that its value between two keys depends on, and their widths.
+_KEY_PROPS = (("co", 2), ("handle_left", 2), ("handle_right", 2), ("interpolation", 1),
+              ("easing", 1))
+
+
+def _curves(obj):
+    """What obj's action evaluates to, key by key: {(data path, index): (linear extrapolation,
+    flat lists of the keys' _KEY_PROPS)}, to find later where a change of its keys moved it.
+    None when a change may move it anywhere in time: F-curve modifiers, NLA tracks (or tweak
+    mode) or drivers."""
+    ad = obj.animation_data
+    if ad is None or ad.action is None:
+        return {}
+    if len(ad.nla_tracks) or ad.use_tweak_mode or len(ad.drivers):
+        return None
+    out = {}
+    for fc in ad.action.fcurves:
+        if len(fc.modifiers):
+            return None
+        points = fc.keyframe_points
+        data = [fc.extrapolation == "LINEAR"]
+        for prop, width in _KEY_PROPS:
+            values = [0] * (width * len(points))
+            points.foreach_get(prop, values)
+            data.append(values)
+        out[(fc.data_path, fc.array_index)] = tuple(data)
+    return out
+
+
+def _changed_from(before, after):
+    """The first frame at which F-curves keyed as `after` may evaluate otherwise than keyed as
+    `before` (snapshots of _curves), None when nowhere, -inf when anywhere. An F-curve between
+    two keys depends on those two keys only (their frames, values, handles, interpolation):
+    keys the same up to key i - 1 leave it the same up to key i - 1's frame. (Before the first
+    key, extrapolated linearly, it depends on the first two.)"""
+    if before is None or after is None:
+        return -math.inf
+    first = None
+    for path in set(before) | set(after):
+        old, new = before.get(path), after.get(path)
+        if old is None or new is None or old[0] != new[0]:
+            return -math.inf
+        n = min(len(old[1]), len(new[1])) // 2
+
+        def same(k):  # the first k keys are the same
+            return all(o[:width * k] == w[:width * k]
+                       for o, w, (_, width) in zip(old[1:], new[1:], _KEY_PROPS))
+        if same(n):
+            if len(old[1]) == len(new[1]):
+                continue
+            i = n
+        else:  # the first key that differs, by halving (slices compare at C speed)
+            i, bad = 0, n
+            while bad - i > 1:
+                mid = (i + bad) // 2
+                if same(mid):
+                    i = mid
+                else:
+                    bad = mid
+        if i == 0 or (new[0] and i == 1):
+            return -math.inf
+        frame = new[1][2 * (i - 1)]
+        first = frame if first is None else min(first, frame)
+    return first
 
 
 # Blender's frame range (MAXFRAME): keys beyond it land on the wrong frames, or on one.
@@ -277,6 +357,22 @@ def _key_channel(obj, path, values, frames):
     setattr(obj, path, values[-1])
 
 
+def _worlds(is_body, keys, orientation):
+    """The world matrices of a track's keys: the body's positions and rotations, a foot's
+    positions in `orientation`."""
+    worlds = []
+    for key in keys:
+        loc = Vector(from_ff(key["position"]))
+        if is_body and "rotation" in key:
+            rot = Quaternion(quat_from_ff(key["rotation"]))
+            world = Matrix.Translation(loc) @ rot.to_matrix().to_4x4()
+        else:
+            world = orientation.copy()
+            world.translation = loc
+        worlds.append(world)
+    return worlds
+
+
 def key_walk(walk, feet, body, from_frame=None):
     """Keys every track of `walk`: feet {foot name: object} get location keys, `body` gets
     location and rotation keys (world orientation of the walk) in its rotation mode. Tracks
@@ -284,58 +380,68 @@ def key_walk(walk, feet, body, from_frame=None):
     longer walk generated again keeps the keys of its first steps). Keys are world positions:
     an object under an animated parent is keyed in its parent's space at each key's frame (the
     scene's frame is the same afterwards). Returns the number of keys set."""
-    # A foot under the body: the body's keys set again from `from_frame` on bend its curve
-    # before that frame too, so such a foot's keys of the whole walk are set again.
-    again = []
-    plan = []  # (object, is body, frames, world matrices), in the order they are keyed
+    tracks = []  # (object, is body, frames, keys, orientation) of the whole track, by frame
     for track in walk.get("tracks", []):
         is_body = track.get("kind") == "body"
         obj = body if is_body else feet.get(track.get("name"))
         if obj is None:
             continue
-        start = from_frame
-        if start is not None and not is_body and body is not None and _under(obj, body):
-            start = None
-            again.append(obj)
-        orientation = obj.matrix_world.normalized()  # a foot's, kept (read at this frame)
-        frames, worlds = [], []
+        frames, keys = [], []
         for key in sorted(track.get("keys", []), key=lambda k: float(k["frame"])):
             frame = float(key["frame"])
-            if start is not None and frame < start:
-                continue
-            loc = Vector(from_ff(key["position"]))
-            if is_body and "rotation" in key:
-                rot = Quaternion(quat_from_ff(key["rotation"]))
-                world = Matrix.Translation(loc) @ rot.to_matrix().to_4x4()
-            else:
-                world = orientation.copy()
-                world.translation = loc
             if frames and frames[-1] == frame:  # the later key of a frame wins
-                frames.pop(), worlds.pop()
+                frames.pop(), keys.pop()
             frames.append(frame)
-            worlds.append(world)
-        if frames:
-            if obj in again:
-                clear_keys([obj], frames[0], to_frame=frames[-1])
-            plan.append((obj, is_body, frames, worlds))
-    # The body first: feet parented to it are keyed in its space at their frames.
-    plan.sort(key=lambda p: not p[1])
+            keys.append(key)
+        if frames:  # a foot keeps its orientation (read at this frame)
+            tracks.append((obj, is_body, frames, keys, obj.matrix_world.normalized()))
+    # An object under another keyed object (a foot under the body) is keyed in its space, so
+    # after it, in groups by the number of keyed objects above (the scene stepped once through
+    # each group's frames). The keys an object above sets from `from_frame` on bend its curve
+    # before that frame too (from the key before the first that changed): the object under it
+    # is keyed again from there (it was keyed again over the whole walk, at each chunk).
+    objects = [t[0] for t in tracks]
+    above = {obj: [a for a in objects if a is not obj and _under(obj, a)] for obj in objects}
+    below = {a for obj in objects for a in above[obj]}
+    groups = {}
+    for track in tracks:
+        groups.setdefault(len(above[track[0]]), []).append(track)
     spaces = _ParentSpaces(bpy.context.scene)
+    changed = {}  # keyed object with keyed objects under it -> _changed_from of its keys
     count = 0
     try:
-        for obj, is_body, frames, worlds in plan:
-            locations, rotations = [], []
-            for inverse, world in zip(spaces.inverse(obj, frames), worlds):
-                l, r, _ = (inverse @ world).decompose()
-                locations.append(tuple(l))
-                rotations.append(r)
-            if is_body:
-                path, values = _rotation_values(obj, rotations, frames[0])
-            _key_channel(obj, "location", locations, frames)
-            if is_body:
-                _key_channel(obj, path, values, frames)
-            spaces.forget(obj)
-            count += len(frames)
+        for depth in sorted(groups):
+            jobs = []
+            for obj, is_body, frames, keys, orientation in groups[depth]:
+                start = from_frame
+                for a in above[obj]:
+                    if changed.get(a) is not None and start is not None:
+                        start = min(start, changed[a])
+                first = 0 if start is None else bisect.bisect_left(frames, start)
+                if first == len(frames):
+                    continue
+                jobs.append((obj, is_body, frames[first:], keys[first:], orientation,
+                             start is not None and start < from_frame))
+            spaces.read([(job[0], job[2]) for job in jobs])
+            for obj, is_body, frames, keys, orientation, again in jobs:
+                worlds = _worlds(is_body, keys, orientation)
+                before = _curves(obj) if obj in below else None
+                if again:  # keys from where the objects above changed
+                    clear_keys([obj], frames[0], to_frame=frames[-1])
+                locations, rotations = [], []
+                for inverse, world in zip(spaces.inverse(obj, frames), worlds):
+                    l, r, _ = (inverse @ world).decompose()
+                    locations.append(tuple(l))
+                    rotations.append(r)
+                if is_body:
+                    path, values = _rotation_values(obj, rotations, frames[0])
+                _key_channel(obj, "location", locations, frames)
+                if is_body:
+                    _key_channel(obj, path, values, frames)
+                spaces.forget(obj)
+                if obj in below:
+                    changed[obj] = _changed_from(before, _curves(obj))
+                count += len(frames)
     finally:
         spaces.restore()
     return count
