@@ -14,8 +14,10 @@ import argparse
 import json
 import math
 import os
+import signal
 import subprocess
 import sys
+import time
 import unittest
 
 import addon_utils
@@ -845,6 +847,84 @@ class BlenderAddonTest(unittest.TestCase):
         self.assert_keys_equal_walk(full, feet, body)
 
 
+    def test_9y_a_deleted_scenes_terrains_are_unloaded(self):
+        # Terrains were unloaded only when a file was loaded: a deleted scene's stayed loaded on
+        # the server for the rest of the Blender session.
+        connection, ops = self.ops._connection, self.ops
+        scene = bpy.context.scene
+        key = scene.footfall.terrain_key
+        self.assertTrue(connection.has_terrain(key))
+
+        def scene_with_terrain(name, setups=1):
+            other = bpy.data.scenes.new(name)
+            with bpy.context.temp_override(scene=other, view_layer=other.view_layers[0]):
+                other.footfall.terrain_source, other.footfall.terrain_file = "FILE", self.pts
+                keys = []
+                for _ in range(setups):
+                    self.assertEqual(bpy.ops.footfall.terrain_setup(), {"FINISHED"})
+                    keys.append(other.footfall.terrain_key)
+            return other, keys
+
+        def gone(ids):
+            for terrain in ids:
+                with self.assertRaises(Exception) as e:  # (the add-on's own FootfallError)
+                    connection.session.info(terrain)
+                self.assertEqual(e.exception.status_name, "unknown_terrain")
+        # Deleted: the next command that calls the server unloads its terrain first (here
+        # one that fails after connecting).
+        doomed, keys = scene_with_terrain("doomed")
+        ids = [connection.terrain(keys[0])]
+        bpy.data.scenes.remove(doomed)
+        with self.assertRaises(RuntimeError):
+            bpy.ops.footfall.character_setup(
+                character_file=os.path.join(ARGS.work_dir, "bad_frames_per_step.json"))
+        self.assertNotIn(keys[0], connection.terrain_names())
+        gone(ids)
+        self.assertTrue(connection.has_terrain(key))
+        # Or the next depsgraph update has them unloaded from a timer (the event loop runs it;
+        # here the test does), on a thread of its own. Both the scene's terrain and the one
+        # its second Terrain Setup replaced (kept while the scene lived, for an undo) go.
+        if bpy.app.timers.is_registered(ops._release_timer):  # (from the first deletion)
+            bpy.app.timers.unregister(ops._release_timer)
+        doomed, keys = scene_with_terrain("doomed with two terrains", setups=2)
+        ids = [connection.terrain(k) for k in keys]
+        bpy.context.view_layer.update()
+        self.assertFalse(bpy.app.timers.is_registered(ops._release_timer))
+        self.assertEqual(ops.unused_terrains(), [])
+        bpy.data.scenes.remove(doomed)
+        bpy.context.view_layer.update()
+        self.assertTrue(bpy.app.timers.is_registered(ops._release_timer))
+        bpy.app.timers.unregister(ops._release_timer)
+        ops._release_timer()
+        ops.wait_for_unloads()
+        for k in keys:
+            self.assertNotIn(k, connection.terrain_names())
+        gone(ids)
+        self.assertEqual(connection.session.info(connection.terrain(key))[0], self._count)
+        # A hung server holds up the unload thread for one call timeout, not Blender.
+        saved = self.prefs.timeout
+        self.prefs.timeout = 1.0
+        doomed, keys = scene_with_terrain("doomed on a hung server")
+        bpy.data.scenes.remove(doomed)
+        own = connection.local
+        process = own.process if own is not None and own.running() else self.server.process
+        os.kill(process.pid, signal.SIGSTOP)
+        try:
+            began = time.monotonic()
+            ops.release_unused_terrains()
+            self.assertLess(time.monotonic() - began, 0.5)
+            ops.wait_for_unloads()
+            print("unload on a stopped server: the thread took %.2f s (call timeout 1 s)"
+                  % (time.monotonic() - began))
+            self.assertLess(time.monotonic() - began, 3.0)
+        finally:
+            os.kill(process.pid, signal.SIGCONT)
+            self.prefs.timeout = saved
+        self.assertNotIn(keys[0], connection.terrain_names())
+        self.assertTrue(connection.has_terrain(key))
+        if bpy.app.timers.is_registered(ops._release_timer):
+            bpy.app.timers.unregister(ops._release_timer)
+
     def test_9z_each_scene_and_file_has_its_own_terrain(self):
         # One terrain served the whole Blender session: another scene, or the file made by
         # File > New, walked on the previous terrain without a word, and it stayed loaded.
@@ -909,6 +989,7 @@ class BlenderAddonTest(unittest.TestCase):
         # File > New: the closed file's terrains are unloaded from the server, and the new
         # file has none.
         bpy.ops.wm.read_homefile(use_empty=True)
+        self.ops.wait_for_unloads()  # (unloaded in the background)
         self.assertEqual(connection.terrain_names(), [])
         for terrain in ids:
             with self.assertRaises(Exception) as e:

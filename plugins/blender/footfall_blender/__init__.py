@@ -22,7 +22,13 @@ _classes = props.classes + operators.classes + ui.classes
 @bpy.app.handlers.persistent
 def _file_loaded(*_):
     """A file opened (or File > New): its scenes' terrains stay, the others are unloaded."""
-    operators.unload_unused_terrains()
+    operators.file_loaded()
+
+
+@bpy.app.handlers.persistent
+def _depsgraph_updated(*_):
+    """A scene deleted: its terrains are unloaded (soon after, in the background)."""
+    operators.scenes_changed()
 
 
 def register():
@@ -30,11 +36,14 @@ def register():
         bpy.utils.register_class(cls)
     props.attach()
     bpy.app.handlers.load_post.append(_file_loaded)
+    bpy.app.handlers.depsgraph_update_post.append(_depsgraph_updated)
 
 
 def unregister():
     if _file_loaded in bpy.app.handlers.load_post:
         bpy.app.handlers.load_post.remove(_file_loaded)
+    if _depsgraph_updated in bpy.app.handlers.depsgraph_update_post:
+        bpy.app.handlers.depsgraph_update_post.remove(_depsgraph_updated)
     operators.shutdown()
     props.detach()
     for cls in reversed(_classes):

@@ -5,6 +5,7 @@ import json
 import math
 import os
 import tempfile
+import threading
 import uuid
 
 import bpy
@@ -31,16 +32,28 @@ chunk_hook = None
 
 def shutdown():
     """Closes the connection and stops a footfalld the add-on started."""
+    if bpy.app.timers.is_registered(_release_timer):
+        bpy.app.timers.unregister(_release_timer)
+    wait_for_unloads()
     _connection.shutdown()
+    _terrain_scenes.clear()
 
 
 def session(context):
+    """The connection's session (a server that answers), once the terrains no scene uses any
+    more are unloaded (see release_unused_terrains)."""
+    wait_for_unloads()  # the connection is used by one thread at a time
     prefs = preferences(context)
     if prefs is None:
-        return _connection.get()
-    return _connection.get(prefs.host, prefs.port, prefs.start_local,
-                           bpy.path.abspath(prefs.footfalld) if prefs.footfalld else None,
-                           prefs.timeout)
+        s = _connection.get()
+    else:
+        s = _connection.get(prefs.host, prefs.port, prefs.start_local,
+                            bpy.path.abspath(prefs.footfalld) if prefs.footfalld else None,
+                            prefs.timeout)
+    for name in unused_terrains():  # the server has just answered
+        _terrain_scenes.pop(name, None)
+        _connection.unload(name)
+    return s
 
 
 def describe_connection():
@@ -67,16 +80,105 @@ def scene_terrain_key(scene):
     return key
 
 
-def unload_unused_terrains():
-    """Unloads the terrains no scene of the open file refers to (a file closed, a scene
-    deleted). Never raises."""
+# The scenes (their as_pointer(), which undo keeps) each loaded terrain was loaded for or used
+# by since the file was opened. A terrain stays loaded while one of them exists, even when none
+# refers to it now (undoing Terrain Setup in that scene brings it back), and is unloaded once
+# none does (its scenes deleted) and no scene refers to it.
+_terrain_scenes = {}
+# The thread unloading terrains (release_unused_terrains), while it runs. Only one thread uses
+# the connection at a time: session() waits for it.
+_unloader = None
+
+
+def unused_terrains():
+    """The names of the loaded terrains that no scene refers to and whose scenes are all gone.
+    Reads the scenes only (no server call)."""
+    loaded = set(_connection.terrain_names())
+    if not loaded:
+        return []
+    live = set()
+    for scene in bpy.data.scenes:
+        pointer = scene.as_pointer()
+        live.add(pointer)
+        key = scene.footfall.terrain_key
+        if key in loaded:  # a copied scene shares its original's terrain
+            _terrain_scenes.setdefault(key, set()).add(pointer)
+    return sorted(name for name in loaded if not _terrain_scenes.get(name, set()) & live)
+
+
+def _unload(names):
+    for name in names:
+        try:
+            _connection.unload(name)
+        except Exception:  # (a failed unload is ignored: the server drops it with the session)
+            pass
+
+
+def wait_for_unloads():
+    """Waits for the unloads release_unused_terrains started. Each is one call within the
+    connection's call timeout, and a call that times out disconnects the session, so that the
+    ones after it make no call: a hung server holds this up to one timeout."""
+    global _unloader
+    if _unloader is not None:
+        _unloader.join()
+        _unloader = None
+
+
+def release_unused_terrains():
+    """Starts unloading the terrains unused_terrains() names, on a thread of its own: a hung
+    server holds no one up (but the next command that calls the server, see session()). When
+    unloads still run, tries again in a second, from a timer. Never raises."""
+    global _unloader
     try:
-        used = {scene.footfall.terrain_key for scene in bpy.data.scenes}
-        for name in _connection.terrain_names():
-            if name not in used:
-                _connection.unload(name)
+        if _unloader is not None and _unloader.is_alive():
+            _schedule_release(1.0)
+            return
+        names = unused_terrains()
+        if not names:
+            return
+        for name in names:
+            _terrain_scenes.pop(name, None)
+        _unloader = threading.Thread(target=_unload, args=(names,), name="footfall unload",
+                                     daemon=True)
+        _unloader.start()
     except Exception:
         pass
+
+
+def _release_timer():
+    release_unused_terrains()
+    return None  # once
+
+
+def _schedule_release(delay=0.0):
+    if not bpy.app.timers.is_registered(_release_timer):
+        bpy.app.timers.register(_release_timer, first_interval=delay)
+
+
+def scenes_changed():
+    """After a depsgraph update (a scene deleted, among others): when a loaded terrain is no
+    longer used, has release_unused_terrains() run from a timer, outside the operator or
+    update running now. No server call; never raises."""
+    try:
+        if unused_terrains():
+            _schedule_release()
+    except Exception:
+        pass
+
+
+def file_loaded():
+    """A file was opened (or File > New): the terrains its scenes refer to stay, now theirs,
+    and the others are unloaded (in the background). Never raises."""
+    try:
+        _terrain_scenes.clear()
+        loaded = set(_connection.terrain_names())
+        for scene in bpy.data.scenes:
+            if scene.footfall.terrain_key in loaded:
+                _terrain_scenes.setdefault(scene.footfall.terrain_key, set()).add(
+                    scene.as_pointer())
+    except Exception:
+        pass
+    release_unused_terrains()
 
 
 def _fail(op, message):
@@ -128,7 +230,7 @@ class FOOTFALL_OT_terrain_setup(bpy.types.Operator):
     bl_idname = "footfall.terrain_setup"
     bl_label = "Terrain Setup"
     # A step of its own: undoing what follows keeps the scene's terrain, undoing it brings the
-    # previous one back (still loaded: terrains are unloaded only when a file is loaded).
+    # previous one back (still loaded: a scene's terrains stay loaded while the scene exists).
     bl_options = {"REGISTER", "UNDO"}
 
     save_points: StringProperty(name="Save samples", subtype="FILE_PATH", default="",
@@ -139,6 +241,8 @@ class FOOTFALL_OT_terrain_setup(bpy.types.Operator):
         # A new key each time: a copied scene shares its original's key until either runs
         # Terrain Setup, and must not replace the other's terrain.
         key = "scene-" + uuid.uuid4().hex
+        # This scene's from now on, even before it refers to it.
+        _terrain_scenes[key] = {context.scene.as_pointer()}
         try:
             s = session(context)
             if settings.terrain_source == "FILE":
@@ -160,6 +264,7 @@ class FOOTFALL_OT_terrain_setup(bpy.types.Operator):
             count, _ = s.info(terrain)
         except (ffc.FootfallError, ValueError, OSError) as e:
             _connection.unload(key)
+            _terrain_scenes.pop(key, None)
             return _fail(self, _error_text(e))
         settings.terrain_key = key
         settings.terrain_name = name
