@@ -82,6 +82,37 @@ double FlightDepth(const Vec3& p, int steps, double rise, double run, double fir
   return k >= 0 && p.y > lower && p.z < (k + 1) * run ? std::min(below, p.z - k * run) : below;
 }
 
+// A floor (y = 0) of (nx + 1) x (nz + 1) samples `s` apart, cut across by a block from z0 to z1,
+// `height` tall: its faces (-z at z0, +z at z1) sampled in `rows` rows up to its top, and its
+// top on the floor's lattice between them (with its edges when `edges_on_top`, else the faces'
+// top rows hold them).
+RawSamples FloorWithBlock(double s, int nx, int nz, double z0, double z1, double height, int rows,
+                          bool edges_on_top) {
+  RawSamples out;
+  for (int i = 0; i <= nx; ++i) {
+    const double x = i * s;
+    for (int k = 0; k <= nz; ++k) {
+      const double z = k * s;
+      const bool on = z >= z0 - 1e-9 && z <= z1 + 1e-9;
+      const bool edge = std::fabs(z - z0) < 1e-9 || std::fabs(z - z1) < 1e-9;
+      if (!on) out.push_back({x, 0, z}, {0, 1, 0});
+      if (on && (edges_on_top || !edge)) out.push_back({x, height, z}, {0, 1, 0});
+    }
+    for (int j = 1; j < rows + !edges_on_top; ++j) {
+      out.push_back({x, j * height / rows, z0}, {0, 0, -1});
+      out.push_back({x, j * height / rows, z1}, {0, 0, 1});
+    }
+  }
+  return out;
+}
+
+// How deep p lies below that floor or in that block (positive inside).
+double FloorOrBlockDepth(const Vec3& p, double z0, double z1, double height) {
+  if (p.y < 0) return -p.y;
+  if (p.z > z0 && p.z < z1 && p.y < height) return std::min({p.z - z0, z1 - p.z, height - p.y});
+  return 0;
+}
+
 // Walks 12 steps from `start` along +Z (`forward`) or -Z and checks the walk: no stop, every
 // invariant of CheckWalk, and the body rising by more than `rise` (a negative `rise`: falling by
 // more than -rise).
@@ -442,19 +473,8 @@ TEST_CASE("A start beside a box's foot stands on the floor, a crowd's grid acros
   // every 2 cm up, is 5 mm from the start: its samples lie nearer the start than the floor's. The
   // start took the face, and a crowd stood on a grid up it, six of nine left out; now on the floor
   // and the box's top.
-  RawSamples ground;
   const double s = 0.04;
-  for (int i = 0; i <= 75; ++i) {
-    const double x = i * s;
-    for (int k = 0; k <= 150; ++k) {
-      const double z = k * s;
-      ground.push_back({x, z >= 2 && z <= 3 ? 0.25 : 0.0, z}, {0, 1, 0});
-    }
-    for (int j = 1; j < 12; ++j) {
-      ground.push_back({x, j * 0.25 / 12, 2}, {0, 0, -1});
-      ground.push_back({x, j * 0.25 / 12, 3}, {0, 0, 1});
-    }
-  }
+  const RawSamples ground = FloorWithBlock(s, 75, 150, 2, 3, 0.25, 12, true);
   Terrain t = LoadTerrain(ground, s);
   const Character c = LoadShipped("quadruped");
   GenerateOptions o;
@@ -1407,26 +1427,9 @@ TEST_CASE("Insects before a wall thinner than their step stop there, no swing pa
   // apart, and some passed through the wall's middle (so the insects "crossed" it). Arcs are now
   // checked at points no farther apart than about two sample spacings: no arc reaches the floor
   // behind, and the walk stops with the keys so far.
-  RawSamples wall;
   const double s = 0.01;
-  for (int i = 0; i <= 150; ++i) {
-    const double x = i * s;
-    for (int k = 0; k <= 200; ++k) {
-      const double z = k * s;
-      if (z < 1.0 - 1e-9 || z > 1.02 + 1e-9) wall.push_back({x, 0, z}, {0, 1, 0});
-    }
-    for (int j = 1; j <= 30; ++j) {
-      wall.push_back({x, j * s, 1.0}, {0, 0, -1});
-      wall.push_back({x, j * s, 1.02}, {0, 0, 1});
-    }
-    wall.push_back({x, 0.3, 1.01}, {0, 1, 0});
-  }
-  Terrain t = LoadTerrain(wall, s);
-  auto depth = [](const Vec3& p) {
-    if (p.y < 0) return -p.y;
-    if (p.z > 1.0 && p.z < 1.02 && p.y < 0.3) return std::min({p.z - 1.0, 1.02 - p.z, 0.3 - p.y});
-    return 0.0;
-  };
+  Terrain t = LoadTerrain(FloorWithBlock(s, 150, 200, 1.0, 1.02, 0.3, 30, false), s);
+  auto depth = [](const Vec3& p) { return FloorOrBlockDepth(p, 1.0, 1.02, 0.3); };
   for (const std::string name : {"hexapod", "octopod"}) {
     const Character c = LoadShipped(name);
     GenerateOptions o;
@@ -1447,27 +1450,9 @@ TEST_CASE("Insects before a wall thinner than their step stop there, no swing pa
 TEST_CASE("Insects climb a box, cross its top and climb down its far side", "[steps][generator]") {
   // A floor (y = 0, z from 0 to 2) with a box 30 cm tall and 30 cm deep across it at z = 1,
   // sampled 1 cm apart: its front face, its top and its back face.
-  RawSamples box;
   const double s = 0.01, depth = 0.3;
-  for (int i = 0; i <= 150; ++i) {
-    const double x = i * s;
-    for (int k = 0; k <= 200; ++k) {
-      const double z = k * s;
-      if (z < 1.0 - 1e-9 || z > 1.0 + depth + 1e-9) box.push_back({x, 0, z}, {0, 1, 0});
-    }
-    for (int j = 1; j <= 30; ++j) {
-      box.push_back({x, j * s, 1.0}, {0, 0, -1});
-      box.push_back({x, j * s, 1.0 + depth}, {0, 0, 1});
-    }
-    for (int k = 1; k < 30; ++k) box.push_back({x, 0.3, 1.0 + k * s}, {0, 1, 0});
-  }
-  Terrain t = LoadTerrain(box, s);
-  auto inside = [&](const Vec3& p) {
-    if (p.y < 0) return -p.y;
-    if (p.z > 1.0 && p.z < 1.0 + depth && p.y < 0.3)
-      return std::min({p.z - 1.0, 1.0 + depth - p.z, 0.3 - p.y});
-    return 0.0;
-  };
+  Terrain t = LoadTerrain(FloorWithBlock(s, 150, 200, 1.0, 1.0 + depth, 0.3, 30, false), s);
+  auto inside = [&](const Vec3& p) { return FloorOrBlockDepth(p, 1.0, 1.0 + depth, 0.3); };
   for (const std::string name : {"hexapod", "octopod"}) {
     const Character c = LoadShipped(name);
     GenerateOptions o;
