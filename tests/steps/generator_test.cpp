@@ -1419,6 +1419,24 @@ TEST_CASE("The shipped quadruped walks up and down a stair mesh, its body along 
   CHECK(lean > std::sin(20 * kPi / 180));
 }
 
+namespace {
+
+// 60 steps of a shipped insect from (0.75, 0, 0.6) along +z toward a FloorWithBlock's block at
+// z = 1, checked by CheckWalk.
+Walk InsectTowardBlock(Terrain& t, const std::string& name) {
+  const Character c = LoadShipped(name);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {0.75, 0, 0.6};
+  o.steps = 60;
+  const Walk w = Generate(t, c, o);
+  INFO(name << ": " << w.stopped);
+  CheckWalk(t, c, o, w);
+  return w;
+}
+
+}  // namespace
+
 TEST_CASE("Insects before a wall thinner than their step stop there, no swing passing through it",
           "[steps][generator]") {
   // A floor (y = 0, z from 0 to 2) cut by a wall 2 cm thick and 30 cm tall at z = 1: its two
@@ -1431,14 +1449,8 @@ TEST_CASE("Insects before a wall thinner than their step stop there, no swing pa
   Terrain t = LoadTerrain(FloorWithBlock(s, 150, 200, 1.0, 1.02, 0.3, 30, false), s);
   auto depth = [](const Vec3& p) { return FloorOrBlockDepth(p, 1.0, 1.02, 0.3); };
   for (const std::string name : {"hexapod", "octopod"}) {
-    const Character c = LoadShipped(name);
-    GenerateOptions o;
-    o.has_start = true;
-    o.start = {0.75, 0, 0.6};
-    o.steps = 60;
-    const Walk w = Generate(t, c, o);
+    const Walk w = InsectTowardBlock(t, name);
     INFO(name << ": " << w.stopped);
-    CheckWalk(t, c, o, w);
     CHECK_THAT(w.stopped, Catch::Contains("cannot clear the terrain"));
     CHECK(StepsDone(w) >= 3);
     CHECK(DeepestSwing(w, depth) == 0);
@@ -1454,14 +1466,8 @@ TEST_CASE("Insects climb a box, cross its top and climb down its far side", "[st
   Terrain t = LoadTerrain(FloorWithBlock(s, 150, 200, 1.0, 1.0 + depth, 0.3, 30, false), s);
   auto inside = [&](const Vec3& p) { return FloorOrBlockDepth(p, 1.0, 1.0 + depth, 0.3); };
   for (const std::string name : {"hexapod", "octopod"}) {
-    const Character c = LoadShipped(name);
-    GenerateOptions o;
-    o.has_start = true;
-    o.start = {0.75, 0, 0.6};
-    o.steps = 60;
-    const Walk w = Generate(t, c, o);
+    const Walk w = InsectTowardBlock(t, name);
     INFO(name << ": " << w.stopped);
-    CheckWalk(t, c, o, w);
     CHECK(DeepestSwing(w, inside) <= s);
     // The body went over the top and every foot ends on the floor beyond the box.
     double highest = 0;
