@@ -496,61 +496,119 @@ TEST_CASE("A start beside a box's foot stands on the floor, a crowd's grid acros
   CHECK(feet == 9 * c.feet.size());
 }
 
-TEST_CASE("An upright body stops before a slab lower than it, its legs never through the slab",
-          "[steps][generator]") {
-  // A floor and, 0.6 to 0.7 m above it, a slab over z from 2 to 4 m (both faces and its edges
-  // sampled every 4 cm): a biped (body 0.95 m up) walked on under it, feet on the floor and
-  // body over the slab, its legs through the slab for 7 steps. Now the walk stops at the first
-  // step whose body has no room, with the keys before it; each body key's straight lines to
-  // the feet stay out of the slab.
+namespace {
+
+// A floor sampled every 4 cm (x to 3 m, z to 6 m) and a slab from y = lo to hi over z from 2 to
+// 4 m, its faces on the same lattice; with `underside` false, only its top (a roof modelled as
+// one face, facing up). [Units: wu]
+RawSamples FloorAndSlab(double lo, double hi, bool underside) {
   const double s = 0.04;
-  RawSamples ground;
+  RawSamples out;
   for (int i = 0; i <= 75; ++i) {
     const double x = i * s;
     for (int k = 0; k <= 150; ++k) {
       const double z = k * s;
-      ground.push_back({x, 0, z}, {0, 1, 0});
-      if (z >= 2 - 1e-9 && z <= 4 + 1e-9) {
-        ground.push_back({x, 0.7, z}, {0, 1, 0});
-        ground.push_back({x, 0.6, z}, {0, -1, 0});
-      }
+      out.push_back({x, 0, z}, {0, 1, 0});
+      if (z < 2 - 1e-9 || z > 4 + 1e-9) continue;
+      out.push_back({x, hi, z}, {0, 1, 0});
+      if (underside) out.push_back({x, lo, z}, {0, -1, 0});
     }
-    for (const double y : {0.62, 0.66}) {
-      ground.push_back({x, y, 2}, {0, 0, -1});
-      ground.push_back({x, y, 4}, {0, 0, 1});
+    for (double y = lo + s / 2; underside && y < hi; y += s) {
+      out.push_back({x, y, 2}, {0, 0, -1});
+      out.push_back({x, y, 4}, {0, 0, 1});
     }
   }
-  Terrain t = LoadTerrain(ground, s);
-  auto in_slab = [](const Vec3& p) {
-    return p.z > 2 && p.z < 4 && p.y > 0.6 && p.y < 0.7
-               ? std::min({p.z - 2, 4 - p.z, p.y - 0.6, 0.7 - p.y})
-               : 0.0;
-  };
-  {
-    const Character c = LoadShipped("biped");
+  return out;
+}
+
+// The deepest any straight line from a body key to the feet (where they stand at its frame)
+// passes into the box z in (2, 4), y in (lo, hi).
+double DeepestLeg(const Walk& w, double lo, double hi) {
+  double deepest = 0;
+  for (const WalkTrack& body : w.tracks) {
+    if (body.kind != TrackKind::kBody) continue;
+    for (const WalkKey& b : body.keys) {
+      for (const WalkTrack& foot : w.tracks) {
+        if (foot.kind != TrackKind::kFoot || foot.character != body.character) continue;
+        Vec3 at = foot.keys.front().position;
+        for (const WalkKey& k : foot.keys)
+          if (k.frame <= b.frame) at = k.position;
+        for (int j = 1; j < 200; ++j) {
+          const Vec3 p = Lerp(at, b.position, j / 200.0);
+          if (p.z > 2 && p.z < 4 && p.y > lo && p.y < hi)
+            deepest = std::max(deepest, std::min({p.z - 2, 4 - p.z, p.y - lo, hi - p.y}));
+        }
+      }
+    }
+  }
+  return deepest;
+}
+
+}  // namespace
+
+TEST_CASE("An upright body stops before a slab lower than it, its legs never through the slab",
+          "[steps][generator]") {
+  // A floor and a slab 10 cm thick 0.6 m up, or 2 cm thick 0.65 m up (thinner than the spine's
+  // check points lie apart), over z from 2 to 4 m: a biped (body 0.95 m up) walked on under it,
+  // feet on the floor and body over the slab, its legs through the slab for 7 steps. Now the
+  // walk stops at the first step whose body has no room, with the keys before it (CheckWalk:
+  // every foot ends planted by the body's last key); each body key's straight lines to the
+  // feet stay out of the slab.
+  const Character c = LoadShipped("biped");
+  for (const auto& [lo, hi] : {std::pair{0.6, 0.7}, std::pair{0.65, 0.67}}) {
+    Terrain t = LoadTerrain(FloorAndSlab(lo, hi, true), 0.04);
     GenerateOptions o;
     o.has_start = true;
     o.start = {1.5, 0, 0.5};
     o.steps = 16;
     const Walk w = Generate(t, c, o);
-    INFO(w.stopped);
+    INFO(lo << " to " << hi << ": " << w.stopped);
     CheckWalk(t, c, o, w);
     CHECK_THAT(w.stopped, Catch::Contains("no room for the body"));
     CHECK(StepsDone(w) >= 2);
-    double deepest = 0;
-    for (size_t b = 0; b < Body(w).keys.size(); ++b) {
-      const WalkKey& body = Body(w).keys[b];
-      for (const WalkTrack& foot : w.tracks) {
-        if (foot.kind != TrackKind::kFoot) continue;
-        Vec3 at = foot.keys.front().position;  // where the foot stands at the body key's frame
-        for (const WalkKey& k : foot.keys)
-          if (k.frame <= body.frame) at = k.position;
-        for (int j = 1; j < 100; ++j)
-          deepest = std::max(deepest, in_slab(Lerp(at, body.position, j / 100.0)));
-      }
-    }
-    CHECK(deepest == 0);
+    CHECK(DeepestLeg(w, lo, hi) == 0);
   }
+}
+
+TEST_CASE("An upright body walks on under a roof above it, neither stopped nor raised toward it",
+          "[steps][generator]") {
+  // A roof 1.6 m up modelled as one face (samples facing up only) over a biped 0.95 m tall:
+  // body points under it lie behind its samples' plane, which stopped the walk ("no room") and
+  // raised the body toward it.
+  const Character c = LoadShipped("biped");
+  Terrain t = LoadTerrain(FloorAndSlab(1.6, 1.6, false), 0.04);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {1.5, 0, 1.5};
+  o.steps = 8;
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CheckWalk(t, c, o, w);
+  CHECK(w.stopped.empty());
+  for (const WalkKey& k : Body(w).keys) CHECK(k.position.y == Approx(c.body_height).margin(1e-6));
+}
+
+TEST_CASE("A start under a thin ceiling stays on its underside", "[steps][generator]") {
+  // A ceiling 3 cm thick (underside facing down at y = 0.3, top facing up at 0.33), a hexapod
+  // started at its underside: the start's probe for level ground took the top, through it.
+  RawSamples ceiling;
+  const double s = 0.01;
+  for (int i = 0; i <= 200; ++i) {
+    for (int k = 0; k <= 200; ++k) {
+      ceiling.push_back({i * s, 0.3, k * s}, {0, -1, 0});
+      ceiling.push_back({i * s, 0.33, k * s}, {0, 1, 0});
+    }
+  }
+  Terrain t = LoadTerrain(ceiling, s);
+  const Character c = LoadShipped("hexapod");
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {1, 0.3, 1};
+  o.steps = 4;
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  for (const WalkTrack& track : w.tracks)
+    if (track.kind == TrackKind::kFoot) CHECK(track.keys.front().position.y == Approx(0.3));
 }
 
 TEST_CASE("A stop on ground facing down names the likely causes", "[steps][generator]") {

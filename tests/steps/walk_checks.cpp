@@ -93,6 +93,12 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
     REQUIRE_FALSE(tr->keys.empty());
     for (size_t i = 1; i < tr->keys.size(); ++i) REQUIRE(tr->keys[i].frame > tr->keys[i - 1].frame);
   }
+  // Every foot ends planted, by the body's last key: no step keyed for the feet alone (a step
+  // the walk stopped at is taken back whole).
+  for (size_t f = 0; f < c.feet.size(); ++f) {
+    CHECK(tracks[f]->keys.back().phase == KeyPhase::kEnd);
+    CHECK(tracks[f]->keys.back().frame <= body.keys.back().frame);
+  }
   // Start and end keys on terrain samples, exactly.
   std::vector<Vec3> planted;
   std::vector<Vec3> normals;
@@ -192,7 +198,18 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
     CHECK(raised <= c.body_height + 1e-6);
     CHECK(Distance(centroid + up * (c.body_height + raised), b.position) < 1e-6);
     const Vec3 v = b.position - body_snap[i].point;
-    const bool behind = Dot(v, body_snap[i].normal) < -1e-9;
+    // (Behind a plane the most it may rise would not take it out of, a roof modelled as one
+    // face over it, the body is not raised: the most is body_height, less where a foot would be
+    // left beyond reach.)
+    double most = c.body_height;
+    for (size_t f = 0; f < c.feet.size(); ++f) {
+      const Vec3 d = centroid + up * c.body_height - FootAt(*tracks[f], b.frame);
+      const double h = Dot(d, up), disc = h * h - (Length2(d) - c.reach * c.reach);
+      most = std::min(most, disc >= 0 ? -h + std::sqrt(disc) : 0.0);
+    }
+    const double height = Dot(v, body_snap[i].normal);
+    const bool behind =
+        height < -1e-9 && height + (most - raised) * Dot(up, body_snap[i].normal) >= -1e-9;
     const bool across = Dot(up, body_snap[i].normal) < 0.25;
     const bool bound = farthest >= c.reach - 1e-6 || raised >= c.body_height - 1e-6;
     CHECK((!behind || across || bound));

@@ -45,10 +45,11 @@ constexpr double kBodyClearance = 0.5;
 constexpr int kBodyRounds = 3;
 // Room for an upright body (bipeds): points of its spine, from half body_height above the
 // feet's centroid up to the body, at most this many and no farther apart than the terrain's
-// gap, must not lie behind the terrain; else the walk stops before that step (a biped walking
-// under a slab lower than its body had its feet under it and its body over it). Not for
-// multipeds: over a convex edge their feet's centroid lies inside the terrain, and their bodies
-// dip into stair noses by a centimetre or two (both seen in tests), which would stop them.
+// gap, are snapped; a nearest sample on the spine's line (within the gap), above every foot by
+// more than the gap and below the body is terrain between the feet and the body, and the walk
+// stops before that step (a biped walking under a slab lower than its body had its feet under
+// it and its body over it). Not tried for multipeds, whose bodies lean with the terrain and
+// whose feet wrap around edges.
 constexpr size_t kMaxSpineChecks = 17;
 // Points checked along each start-mid-end arc, evenly spaced: at least kMinArcChecks, and as many
 // more as keep them no farther apart than the terrain's gap (about twice its sample spacing), up
@@ -66,10 +67,12 @@ constexpr size_t kMaxArcChecks = 63;
 // The number of points checked along an arc of `length` (its longer half twice), no farther
 // apart than `gap`: 7, 15, 23, ... 63, so that the seven points of the shortest arcs (at
 // eighths) are always among them.
+// [Units: length, gap in wu]
 size_t ArcChecks(double length, double gap) {
-  if (!(gap > 0)) return kMinArcChecks;
+  static_assert((kMaxArcChecks + 1) % 8 == 0 && (kMinArcChecks + 1) == 8, "checks at eighths");
+  if (!(gap > 0) || !std::isfinite(length)) return kMinArcChecks;
   const double eighths = std::ceil(length / gap / 8);
-  constexpr double kMost = (kMaxArcChecks + 1) / 8;
+  constexpr double kMost = (kMaxArcChecks + 1) / 8.0;
   return 8 * static_cast<size_t>(eighths > 1 ? std::min(eighths, kMost) : 1.0) - 1;
 }
 
@@ -126,14 +129,15 @@ std::string FacingDownHint(double slope_deg) {
 // farthest the surface may be from its nearest sample. No sample is nearer than h, so no
 // surface is nearer than that: above a stair's nose, whose nearest sample may be the riser's
 // top, a point high up is in the clear although it lies little in front of the riser's plane.
-// Behind h's plane, p is below only within `gap` of h along the plane: farther, the plane is
-// not the surface there (p high above a nose, just behind its riser's plane, is in the clear;
-// a point under a surface has a nearest sample nearly straight above it).
-// Dense arc checks put points there: a 3 m stride down stairs stopped at its second step.
-double Clearance(const Vec3& p, const Foothold& h, double gap) {
+// Behind h's plane, p is below only within `gap` of h along the plane or not above h along
+// `up`, the character's: farther and above, the plane is not the surface there (p high above a
+// nose, just behind its riser's plane, is in the clear; a point under a surface has a nearest
+// sample nearly straight above it). Dense arc checks put points there: a 3 m stride down
+// stairs stopped at its second step. [Units: gap in wu]
+double Clearance(const Vec3& p, const Foothold& h, double gap, const Vec3& up) {
   const Vec3 v = p - h.point;
   const double height = Dot(v, h.normal);
-  if (height <= 0 && Length2(v) - height * height <= gap * gap) return height;
+  if (height <= 0 && (Length2(v) - height * height <= gap * gap || Dot(v, up) <= 0)) return height;
   return std::max(height, Length(v) - gap);
 }
 
@@ -845,14 +849,18 @@ Status Generator::KeyBodies(std::string* error) {
     for (size_t j = 0; j < body_pending_.size(); ++j) {
       const size_t i = body_pending_[j];
       const Foothold& h = answers_[j];
-      if (h.status != Status::kOk || Clearance(body_points_[j], h, gap_) >= need) continue;
       const Agent& a = agents_[body_due_[i].first];
+      if (h.status != Status::kOk || Clearance(body_points_[j], h, gap_, a.body_up) >= need)
+        continue;
       const double along = Dot(a.body_up, h.normal);
       if (along < 0.25) continue;  // rising would barely leave that face
       const double height = Dot(body_points_[j] - h.point, h.normal);
-      const double raise = std::min(
-          {body_raise_[i] + std::min((need - height) / along, c_.body_height), MaxBodyRaise(a)});
+      const double most = std::min(c_.body_height, MaxBodyRaise(a));
+      const double raise = std::min(body_raise_[i] + std::min((need - height) / along, most), most);
       if (raise <= body_raise_[i]) continue;
+      // Behind a plane that the most it may rise does not take it out of (a roof modelled as
+      // one face, facing up, over the body): rising would only go toward it.
+      if (height + (most - body_raise_[i]) * along < 0) continue;
       body_raise_[i] = raise;
       body_still_.push_back(i);
     }
@@ -885,19 +893,30 @@ Status Generator::KeyBodies(std::string* error) {
   for (size_t i = 0; i < n; ++i) {
     Agent& a = agents_[body_due_[i].first];
     const double frame = body_due_[i].second;
-    size_t behind = spine_first_[i + 1];
-    for (size_t j = spine_first_[i]; j < spine_first_[i + 1] && behind == spine_first_[i + 1]; ++j)
-      if (answers_[j].status == Status::kOk && Clearance(body_points_[j], answers_[j], gap_) < 0)
-        behind = j;
-    if (behind == spine_first_[i + 1]) {
+    // A spine point's nearest sample across the spine: within the gap of its line, above every
+    // foot by more than the gap and below the body (whichever way it faces: a roof modelled as
+    // one face is a surface too).
+    const double top = c_.body_height + body_raise_[i];
+    auto across = [&](const Foothold& h) {
+      if (h.status != Status::kOk) return false;
+      const Vec3 d = h.point - a.ground;
+      if (Dot(d, a.body_up) >= top || Length(ProjectOnPlane(d, a.body_up)) > gap_) return false;
+      for (const Vec3& foot : a.foot)
+        if (Dot(h.point - foot, a.body_up) <= gap_) return false;
+      return true;
+    };
+    size_t crossing = spine_first_[i + 1];
+    for (size_t j = spine_first_[i]; j < spine_first_[i + 1] && crossing == spine_first_[i + 1];
+         ++j)
+      if (across(answers_[j])) crossing = j;
+    if (crossing == spine_first_[i + 1]) {
       KeyBody(a, frame, body_raise_[i]);
       continue;
     }
     std::ostringstream why;
     why << "no room for the body at " << Point(body_points_[spine_first_[i + 1] - 1])
-        << ": the terrain at " << Point(answers_[behind].point)
-        << " lies between it and its feet (an overhang or a ceiling lower than body_height, or a "
-           "body inside the terrain)";
+        << ": the terrain at " << Point(answers_[crossing].point)
+        << " lies between it and its feet (an overhang or a ceiling lower than body_height)";
     UnkeyStep(a, frame - c_.frames_per_step);
     Stop(a, static_cast<int>(std::lround((frame - o_.start_frame) / c_.frames_per_step)),
          why.str());
@@ -974,22 +993,19 @@ Status Generator::FindStart(const Vec3& start, bool may_move, Foothold* first, s
   }
   if (!may_move) {
     // A start beside the foot of a wall (a box's face nearer than the lattice's next floor
-    // sample) or just inside a block takes the ground nearest it below or above, when that lies
-    // within half a step and leans within max_slope_deg of world up: a crowd started 2 cm in
-    // front of a box stood on a grid up its face. A start up a wall or on a ceiling stays.
+    // sample) takes the ground below it, when that lies within half a step and leans within
+    // max_slope_deg of world up: a crowd started 2 cm in front of a box stood on a grid up its
+    // face. A start up a wall or on a ceiling (even a thin one: not the ground above) stays.
     if (Dot(first->normal, world_up_) >= cos_max_slope_) return Status::kOk;
     const double beside = kFootholdTolerance * c_.step_length;
-    const Vec3 probes[2] = {start - world_up_ * beside, start + world_up_ * beside};
-    Foothold grounds[2];
-    s = Check(session_.Snap(terrain_, probes, 2, grounds), "snap start", error);
-    if (s != Status::kOk) return s;
-    double nearest = beside;
-    for (const Foothold& g : grounds) {
-      if (g.status != Status::kOk || Dot(g.normal, world_up_) < cos_max_slope_) continue;
-      const double d = Distance(g.point, start);
-      if (d <= nearest) nearest = d, *first = g;
-    }
-    return Status::kOk;
+    const Vec3 below = start - world_up_ * beside;
+    Foothold ground;
+    s = Check(session_.Snap(terrain_, &below, 1, &ground), "snap start", error);
+    if (s == Status::kOk && ground.status == Status::kOk &&
+        Dot(ground.normal, world_up_) >= cos_max_slope_ &&
+        Dot(start - ground.point, world_up_) >= 0 && Distance(ground.point, start) <= beside)
+      *first = ground;
+    return s;
   }
   // Candidates on a grid of half a step across world up through the start's sample, nearest
   // it first (the start itself first), each snapped; then the feet of one character standing
@@ -1404,7 +1420,7 @@ Status Generator::ClearArcs(int k, std::string* error) {
             const double need =
                 ClearanceNeeded(kClearanceFraction * nominal, h, half ? mv.end : a.foot[mv.foot],
                                 half ? mv.end_normal : a.foot_normal[mv.foot], c_.step_height);
-            if (Clearance(arc_points_[first + j], h, gap_) < need) {
+            if (Clearance(arc_points_[first + j], h, gap_, a.up) < need) {
               low[half] = true;
               wall[half] |= need < kClearanceFraction * nominal;
             }
