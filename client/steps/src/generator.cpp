@@ -905,17 +905,16 @@ Status Generator::KeyBodies(std::string* error) {
         if (Dot(h.point - foot, a.body_up) <= gap_) return false;
       return true;
     };
-    size_t crossing = spine_first_[i + 1];
-    for (size_t j = spine_first_[i]; j < spine_first_[i + 1] && crossing == spine_first_[i + 1];
-         ++j)
-      if (across(answers_[j])) crossing = j;
-    if (crossing == spine_first_[i + 1]) {
+    const auto end = answers_.begin() + static_cast<std::ptrdiff_t>(spine_first_[i + 1]);
+    const auto crossing =
+        std::find_if(answers_.begin() + static_cast<std::ptrdiff_t>(spine_first_[i]), end, across);
+    if (crossing == end) {
       KeyBody(a, frame, body_raise_[i]);
       continue;
     }
     std::ostringstream why;
     why << "no room for the body at " << Point(body_points_[spine_first_[i + 1] - 1])
-        << ": the terrain at " << Point(answers_[crossing].point)
+        << ": the terrain at " << Point(crossing->point)
         << " lies between it and its feet (an overhang or a ceiling lower than body_height)";
     UnkeyStep(a, frame - c_.frames_per_step);
     Stop(a, static_cast<int>(std::lround((frame - o_.start_frame) / c_.frames_per_step)),
