@@ -9,7 +9,9 @@
 
 #include <chrono>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -65,13 +67,39 @@ void Kill(pid_t pid) {
   waitpid(pid, &status, 0);
 }
 
+// The directories TempDir made, removed with their files when the test program exits.
+class MadeDirs {
+ public:
+  ~MadeDirs() {
+    for (const std::string& d : dirs_) Remove(d);
+  }
+  void Add(const std::string& dir) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    dirs_.push_back(dir);
+  }
+  static void Remove(const std::string& dir) {
+    std::error_code ignored;
+    std::filesystem::remove_all(dir, ignored);
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::string> dirs_;
+};
+
+MadeDirs& Made() {
+  static MadeDirs made;
+  return made;
+}
+
 }  // namespace
 
 std::string TempDir() {
-  char pattern[] = "/tmp/footfall-viewer-test-XXXXXX";
-  const char* dir = mkdtemp(pattern);
-  if (!dir) throw std::runtime_error("mkdtemp failed");
-  return dir;
+  std::string pattern =
+      (std::filesystem::temp_directory_path() / "footfall-viewer-test-XXXXXX").string();
+  if (!mkdtemp(&pattern[0])) throw std::runtime_error("mkdtemp failed");
+  Made().Add(pattern);
+  return pattern;
 }
 
 std::string ReadFile(const std::string& path) {
@@ -107,6 +135,7 @@ RunResult Run(const std::vector<std::string>& argv, const std::vector<std::strin
   }
   result.out = ReadFile(out_path);
   result.err = ReadFile(err_path);
+  MadeDirs::Remove(dir);
   return result;
 }
 

@@ -43,7 +43,7 @@ class Child {
 // Throws with a clear message when Xvfb cannot be started.
 std::string XDisplay();
 
-// A fresh empty directory for one test's files.
+// A fresh empty directory for one test's files, removed with them when the test program exits.
 std::string TempDir();
 
 std::string ReadFile(const std::string& path);
