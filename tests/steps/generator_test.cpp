@@ -232,6 +232,31 @@ TEST_CASE("Walks up and down stairs", "[steps][generator]") {
   }
 }
 
+TEST_CASE("A multiped's body climbing stairs taller than itself stays out of their noses",
+          "[steps][generator]") {
+  // The octopod (4 cm body, reach 32 cm) up 18 cm stairs: with feet on two treads its body,
+  // raised at most body_height, stayed 2.9 cm behind a riser; a body inside the terrain may
+  // now rise as far as reach allows.
+  for (const char* name : {"octopod", "hexapod"}) {
+    const Character c = LoadShipped(name);
+    const int steps = 8;
+    const double rise = 0.18, run = 0.3, spacing = 0.02;
+    Terrain t = LoadTerrain(MakeStairs(steps, rise, run, 1.5, spacing), spacing);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {0.75, 0, -0.6};
+    o.steps = 60;
+    const Walk w = Generate(t, c, o);
+    INFO(name << ": " << w.stopped);
+    CheckWalk(t, c, o, w);
+    double deepest = 0;
+    for (const WalkKey& k : Body(w).keys)
+      deepest = std::max(deepest, FlightDepth(k.position, steps, rise, run, 0));
+    CHECK(deepest == 0);
+    CHECK(Body(w).keys.back().position.y > 3 * rise);
+  }
+}
+
 TEST_CASE("The default start stands no foot on ground steeper than max_slope_deg",
           "[steps][generator]") {
   // The shipped quadruped on the shipped stairs, default start: its front paws stood on a

@@ -171,7 +171,7 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
   CHECK(below == 0);
   // The body follows the feet, clear of the terrain: body_height along its up above the feet's
   // centroid, or up to body_height more where the terrain comes nearer than half its
-  // body_height. It may lie behind its nearest sample's plane only where rising would not help
+  // body_height (three times body_height more out of the terrain). It may lie behind its nearest sample's plane only where rising would not help
   // (that plane along its up: beside a wall's face or over an edge) or may not (raised as far as
   // the feet's reach or the raise's bound allow).
   const Vec3 world_up = Normalize(o.up);
@@ -195,13 +195,13 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
     const double raised = Dot(b.position - centroid, up) - c.body_height;
     INFO("body key " << i << " at frame " << b.frame);
     CHECK(raised >= -1e-6);
-    CHECK(raised <= c.body_height + 1e-6);
+    CHECK(raised <= 3 * c.body_height + 1e-6);
     CHECK(Distance(centroid + up * (c.body_height + raised), b.position) < 1e-6);
     const Vec3 v = b.position - body_snap[i].point;
     // (Behind a plane the most it may rise would not take it out of, a roof modelled as one
-    // face over it, the body is not raised: the most is body_height, less where a foot would be
-    // left beyond reach.)
-    double most = c.body_height;
+    // face over it, the body is not raised: the most is three times body_height, less where a
+    // foot would be left beyond reach.)
+    double most = 3 * c.body_height;
     for (size_t f = 0; f < c.feet.size(); ++f) {
       const Vec3 d = centroid + up * c.body_height - FootAt(*tracks[f], b.frame);
       const double h = Dot(d, up), disc = h * h - (Length2(d) - c.reach * c.reach);
@@ -211,7 +211,7 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
     const bool behind =
         height < -1e-9 && height + (most - raised) * Dot(up, body_snap[i].normal) >= -1e-9;
     const bool across = Dot(up, body_snap[i].normal) < 0.25;
-    const bool bound = farthest >= c.reach - 1e-6 || raised >= c.body_height - 1e-6;
+    const bool bound = farthest >= c.reach - 1e-6 || raised >= 3 * c.body_height - 1e-6;
     CHECK((!behind || across || bound));
   }
   // Gait order: step k moves exactly group k % G, at frames start_frame + k * frames_per_step.

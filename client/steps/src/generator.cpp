@@ -816,7 +816,7 @@ void Generator::KeyStart(const Agent& a) {
 double Generator::MaxBodyRaise(const Agent& a) const {
   // |ground + up (h + r) - foot| <= reach for every foot: r below the larger root of a
   // quadratic in r, per foot.
-  double most = c_.body_height;
+  double most = kBodyRounds * c_.body_height;
   for (const Vec3& foot : a.foot) {
     const Vec3 d = a.ground + a.body_up * c_.body_height - foot;
     const double b = Dot(d, a.body_up), rest = Length2(d) - c_.reach * c_.reach;
@@ -855,8 +855,11 @@ Status Generator::KeyBodies(std::string* error) {
       const double along = Dot(a.body_up, h.normal);
       if (along < 0.25) continue;  // rising would barely leave that face
       const double height = Dot(body_points_[j] - h.point, h.normal);
-      const double most = std::min(c_.body_height, MaxBodyRaise(a));
-      const double raise = std::min(body_raise_[i] + std::min((need - height) / along, most), most);
+      // Up to body_height when merely too near; a body inside the terrain (a multiped's between
+      // feet on two treads, behind a nose) as far as reach allows.
+      const double most = height < 0 ? MaxBodyRaise(a) : std::min(c_.body_height, MaxBodyRaise(a));
+      const double raise =
+          std::min(body_raise_[i] + std::min((need - height) / along, c_.body_height), most);
       if (raise <= body_raise_[i]) continue;
       // Behind a plane that the most it may rise does not take it out of (a roof modelled as
       // one face, facing up, over the body): rising would only go toward it.
