@@ -613,6 +613,37 @@ TEST_CASE("An upright body walks on under a roof above it, neither stopped nor r
   for (const WalkKey& k : Body(w).keys) CHECK(k.position.y == Approx(c.body_height).margin(1e-6));
 }
 
+TEST_CASE("A biped walks straight beside a wall, and stops before a block for its height",
+          "[steps][generator]") {
+  // A floor and a block 2 m tall across z from 2 to 3 m. Walking along +x with its body 0.24 m
+  // from the block's face: its pairs' central locators snapped onto the face (nearer than the
+  // floor to a point 0.26 m up) and drew the feet sideways into it; the spine's check then took
+  // the face for an overhang. Walking into the block: the stop named "no room for the body"
+  // (an overhang or a ceiling) instead of the too-steep face ahead.
+  const Character c = LoadShipped("biped");
+  const double s = 0.04;
+  Terrain t = LoadTerrain(FloorWithBlock(s, 150, 100, 2, 3, 2, 50, true), s);
+  GenerateOptions beside;
+  beside.has_start = true;
+  beside.start = {0.5, 0, 2 - 0.24};
+  beside.heading = {1, 0, 0};
+  beside.steps = 12;
+  const Walk w = Generate(t, c, beside);
+  INFO(w.stopped);
+  CheckWalk(t, c, beside, w);
+  CHECK(w.stopped.empty());
+  for (const WalkKey& k : Body(w).keys) CHECK(k.position.z == Approx(2 - 0.24).margin(0.03));
+  GenerateOptions into;
+  into.has_start = true;
+  into.start = {3, 0, 1};
+  into.steps = 40;
+  const Walk stopped = Generate(t, c, into);
+  INFO(stopped.stopped);
+  CheckWalk(t, c, into, stopped);
+  CHECK_THAT(stopped.stopped, Catch::Contains("too steep") || Catch::Contains("max_rise"));
+  CHECK_THAT(stopped.stopped, !Catch::Contains("no room"));
+}
+
 TEST_CASE("A start under a thin ceiling stays on its underside", "[steps][generator]") {
   // A ceiling 3 cm thick (underside facing down at y = 0.3, top facing up at 0.33), a hexapod
   // started at its underside: the start's probe for level ground took the top, through it.

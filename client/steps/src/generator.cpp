@@ -897,16 +897,23 @@ Status Generator::KeyBodies(std::string* error) {
     Agent& a = agents_[body_due_[i].first];
     const double frame = body_due_[i].second;
     // A spine point's nearest sample across the spine: within the gap of its line, above every
-    // foot by more than the gap and below the body (whichever way it faces: a roof modelled as
-    // one face is a surface too).
+    // foot by more than the gap and below the body, its plane crossing the spine within the gap
+    // of it (whichever way it faces: a roof modelled as one face is a surface too; a wall beside
+    // the spine, or a block's face ahead, does not cross it).
     const double top = c_.body_height + body_raise_[i];
+    const Vec3 spine_low = a.ground + a.body_up * (0.5 * c_.body_height);
+    const Vec3 spine_top = a.ground + a.body_up * top;
     auto across = [&](const Foothold& h) {
       if (h.status != Status::kOk) return false;
       const Vec3 d = h.point - a.ground;
       if (Dot(d, a.body_up) >= top || Length(ProjectOnPlane(d, a.body_up)) > gap_) return false;
       for (const Vec3& foot : a.foot)
         if (Dot(h.point - foot, a.body_up) <= gap_) return false;
-      return true;
+      const double below = Dot(spine_low - h.point, h.normal);
+      const double above = Dot(spine_top - h.point, h.normal);
+      if ((below > 0) == (above > 0) || below == above) return false;
+      const Vec3 crossing = Lerp(spine_low, spine_top, below / (below - above));
+      return Distance(crossing, h.point) <= gap_;
     };
     const auto end = answers_.begin() + static_cast<std::ptrdiff_t>(spine_first_[i + 1]);
     const auto crossing =
@@ -1149,6 +1156,12 @@ Status Generator::QueryFootholds(std::string* error) {
           const Vec3& placed = points_[l];
           if (Distance(h.point, placed) <= lead_) {
             locator_[m] = h.point, locator_normal_[m] = h.normal;
+            // On a face past max_slope_deg (a riser ahead, a wall beside the body) it keeps its
+            // place across the heading: a wall beside it drew the feet sideways into the wall.
+            if (Dot(h.normal, a.up) < cos_max_slope_) {
+              const Vec3 left = Left(a);
+              locator_[m] -= left * Dot(h.point - placed, left);
+            }
           } else {
             locator_[m] = placed - a.up * (0.5 * lead_), locator_normal_[m] = a.up;
           }
