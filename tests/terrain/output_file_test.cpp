@@ -160,6 +160,10 @@ TEST_CASE("ReplaceFile keeps a hard link's old content, refuses loops and files 
   CHECK(CheckWritable(dir.path + "/new.json", &error) == Status::kOk);
   CHECK(CheckWritable(dir.path + "/no/such/x.json", &error) == Status::kIoError);
   CHECK_THAT(error, Catch::Contains("No such file or directory"));
+  // A directory: refused before anything is written (ReplaceFile failed only when writing).
+  CHECK(CheckWritable(dir.path, &error) == Status::kIoError);
+  CHECK_THAT(error, Catch::Contains("Is a directory"));
+  CHECK(ReplaceFile(dir.path, "x", &error) == Status::kIoError);
   CHECK(dir.Entries().size() == 2);  // nothing made by the checks
   // A loop of links: refused (a regular file took the link's place).
   REQUIRE(::symlink("lb.json", (dir.path + "/la.json").c_str()) == 0);

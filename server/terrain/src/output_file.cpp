@@ -105,6 +105,8 @@ Status PlanWrite(const std::string& path, WritePlan* plan, std::string* error) {
   // A file its owner made read-only stays refused, as opening it for writing would be.
   if (plan->exists && ::access(target.c_str(), W_OK) != 0)
     return Fail("cannot open", path, errno, error);
+  // A directory is no file to write (refused up front, before a long job writes the others).
+  if (plan->exists && S_ISDIR(st.st_mode)) return Fail("cannot open", path, EISDIR, error);
   // Devices and FIFOs are written as they are.
   if (plan->exists && !S_ISREG(st.st_mode)) {
     plan->in_place = true;
