@@ -45,13 +45,24 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
   CHECK(c.gait.size() == 2);
   CHECK(c.frames_per_step == 10);
   CHECK(c.max_slope_deg == 50);  // default
+  // A version written 1.0 is the version 1, as frames_per_step 10.0 is 10.
+  CHECK(ParseCharacter(Biped("\"version\": 1", "\"version\": 1.0"), "b.json", &c, &error) ==
+        Status::kOk);
   for (const std::string& name : ShippedCharacters()) LoadShipped(name);
   const std::pair<std::pair<std::string, std::string>, std::string> bad[] = {
       {{"\"version\": 1", "\"version\": 2"}, "b.json: 'version' 2 is not supported"},
       {{"\"step_length\": 0.6", "\"step_length\": -1"},
        "b.json: 'step_length' = -1 is out of range"},
       {{"[[\"L\"], [\"R\"]]", "[[\"L\"], [\"X\"]]"}, "b.json: 'gait'[1]: no foot named 'X'"},
-      {{"[[\"L\"], [\"R\"]]", "[[\"L\"]]"}, "b.json: 'gait': foot 'R' is in no group"},
+      {{"[[\"L\"], [\"R\"]]", "[[\"L\"]]"},
+       "b.json: 'gait': foot 'R' is in none of them (list every foot once)"},
+      {{"\"pairs\": [[\"L\", \"R\"]]", "\"pairs\": [[\"L\"]]"},
+       "b.json: 'pairs': foot 'R' is in none of them (list every foot once, one alone as "
+       "[\"R\"])"},
+      // A misspelt foot field is named (not only the missing one it was meant to be).
+      {{"{\"name\": \"R\"", "{\"nmae\": \"R\""},
+       "b.json: 'feet'[1]: unknown field 'nmae' (known fields: comment, name, rest)"},
+      {{"\"version\": 1", "\"version\": 1.5"}, "b.json: 'version' 1.5 is not supported"},
       {{"[[\"L\"], [\"R\"]]", "[[\"L\", \"L\"], [\"R\"]]"}, "foot 'L' is listed twice"},
       {{"\"reach\": 1.1", "\"reach\": 0.5"},
        "'reach' = 0.5 must exceed the distance from the body to the rest of foot 'L' (0.9"},

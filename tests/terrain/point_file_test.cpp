@@ -79,6 +79,13 @@ TEST_CASE("ReadPointStream rejects bad lines with file and line", "[terrain][poi
     CHECK(error == "t.pts:3: column 3: 'abc' is not a number (expected x y z nx ny nz)");
     CHECK(Read("0 0 1.5x 0 1 0\n", &s, &error) == Status::kParseError);
     CHECK(error.find("t.pts:1: column 3") == 0);
+    // Control characters from the file reach no terminal: ESC and the C1 CSI (U+009B) as '?';
+    // other UTF-8 stays.
+    CHECK(Read("0 0 \x1b[31mA\xc2\x9b"
+               "31m\xc3\xa9 0 1 0\n",
+               &s, &error) == Status::kParseError);
+    CHECK(error ==
+          "t.pts:1: column 3: '?[31mA?31m\xc3\xa9' is not a number (expected x y z nx ny nz)");
   }
   SECTION("NaN or infinite") {
     CHECK(Read("0 0 0 0 1 0\nnan 0 0 0 1 0\n", &s, &error) == Status::kParseError);

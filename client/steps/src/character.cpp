@@ -99,7 +99,9 @@ struct Reader {
     if (seen.size() != feet.size()) {
       for (const auto& [name, index] : feet)
         if (!seen.count(index))
-          return Fail(Status::kInvalidArgument, k + ": foot '" + name + "' is in no group");
+          return Fail(Status::kInvalidArgument,
+                      k + ": foot '" + name + "' is in none of them (list every foot once" +
+                          (k == "'pairs'" ? ", one alone as [\"" + name + "\"])" : ")"));
     }
     return true;
   }
@@ -149,7 +151,7 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
       r.Fail(Status::kParseError, "'format': expected \"footfall-character\"");
     else if (!j.contains("version"))
       r.Fail(Status::kParseError, "missing field 'version' (expected 1)");
-    else if (!j["version"].is_number_integer())
+    else if (!j["version"].is_number())
       r.Fail(Status::kParseError, "'version': expected an integer");
     else if (!detail::IsInteger(j["version"], kCharacterFormatVersion))
       r.Fail(Status::kParseError, "'version' " + j["version"].dump() +
@@ -175,6 +177,12 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
         const json& f = (*feet)[i];
         const std::string where = "'feet'[" + std::to_string(i) + "]";
         FootSpec spec;
+        // A misspelt field is named before the missing one it was meant to be.
+        if (f.is_object() && detail::FindUnknownKey(f, kKnownFoot, &unknown)) {
+          r.Fail(Status::kParseError,
+                 where + ": " + detail::UnknownFieldMessage(unknown, kKnownFoot));
+          break;
+        }
         if (!f.is_object() || !f.contains("name") || !f["name"].is_string() ||
             !f.contains("rest")) {
           r.Fail(Status::kParseError, where + ": expected {\"name\": STRING, \"rest\": [x, y, z]}");
@@ -193,11 +201,6 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
         if (f["name"].get<std::string>() == "body") {
           r.Fail(Status::kInvalidArgument,
                  where + ".name: 'body' names the body's track; choose another foot name");
-          break;
-        }
-        if (detail::FindUnknownKey(f, kKnownFoot, &unknown)) {
-          r.Fail(Status::kParseError,
-                 where + ": " + detail::UnknownFieldMessage(unknown, kKnownFoot));
           break;
         }
         spec.name = f["name"].get<std::string>();

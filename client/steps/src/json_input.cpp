@@ -158,6 +158,7 @@ std::string ControlCharacterIn(const std::string& name) {
 
 bool IsInteger(const json& j, int64_t expected) {
   if (j.is_number_unsigned()) return expected >= 0 && j.get<uint64_t>() == uint64_t(expected);
+  if (j.is_number_float()) return j.get<double>() == static_cast<double>(expected);  // 1.0
   return j.is_number_integer() && j.get<int64_t>() == expected;
 }
 

@@ -24,7 +24,8 @@ bool ParseJsonText(const std::string& text, const std::string& source, nlohmann:
 // at offset K)"; else "".
 std::string ControlCharacterIn(const std::string& name);
 
-// True when `j` is an integer equal to `expected`, with no wrap-around (4294967297 is not 1).
+// True when `j` is a number equal to the integer `expected` (1 or 1.0), with no wrap-around
+// (4294967297 is not 1).
 bool IsInteger(const nlohmann::json& j, int64_t expected);
 
 // True when object `j` has a key not in `known`; *key is then the first such key.

@@ -150,8 +150,7 @@ Status ParseWalkJson(const std::string& text, const std::string& source, Walk* o
     r.Fail("format", std::string("must be a string, found ") + j["format"].type_name());
   } else if (j.value("format", std::string()) != "footfall-walk") {
     r.Fail("format", "expected \"footfall-walk\"");
-  } else if (!j.contains("version") || !j["version"].is_number_integer() ||
-             !detail::IsInteger(j["version"], kWalkFormatVersion)) {
+  } else if (!j.contains("version") || !detail::IsInteger(j["version"], kWalkFormatVersion)) {
     r.Fail("version", "expected " + std::to_string(kWalkFormatVersion));
   } else if (!j.contains("fps") || !r.Finite(j["fps"], "fps", &walk.fps)) {
     r.Fail("fps", "expected a positive number");
