@@ -311,7 +311,8 @@ class Generator {
   // than kBodyClearance (a body over a block's edge as the feet wrap around it, a ridge between
   // the feet); their points are snapped in one batch per round. Empties body_due_.
   Status KeyBodies(std::string* error);
-  // The most `a`'s body may rise along its up with every foot still within reach.
+  // The most `a`'s body may rise along its up with every foot still within reach, and at most
+  // kBodyRounds body heights.
   double MaxBodyRaise(const Agent& a) const;
   // Keys a's feet where they stand at the start frame, and asks for its body (body_due_).
   void KeyStart(const Agent& a);
