@@ -633,6 +633,15 @@ TEST_CASE("A biped walks straight beside a wall, and stops before a block for it
   CheckWalk(t, c, beside, w);
   CHECK(w.stopped.empty());
   for (const WalkKey& k : Body(w).keys) CHECK(k.position.z == Approx(2 - 0.24).margin(0.03));
+  // Full steps: as far as in the open, 1.2 m from the block (aimed at the wall's height, steps
+  // beside it were a third of step_length).
+  GenerateOptions open = beside;
+  open.start.z = 0.8;
+  const Walk away = Generate(t, c, open);
+  REQUIRE(away.stopped.empty());
+  const double travel = Body(w).keys.back().position.x - Body(w).keys.front().position.x;
+  CHECK(travel >= 0.95 * (Body(away).keys.back().position.x - Body(away).keys.front().position.x));
+  CHECK(travel > 0.4 * c.step_length * beside.steps);
   GenerateOptions into;
   into.has_start = true;
   into.start = {3, 0, 1};

@@ -1157,11 +1157,16 @@ Status Generator::QueryFootholds(std::string* error) {
           const Vec3& placed = points_[l];
           if (Distance(h.point, placed) <= lead_) {
             locator_[m] = h.point, locator_normal_[m] = h.normal;
-            // On a face past max_slope_deg (a riser ahead, a wall beside the body) it keeps its
-            // place across the heading: a wall beside it drew the feet sideways into the wall.
+            // On a face past max_slope_deg it keeps its place across the heading (a wall beside
+            // it drew the feet sideways into the wall), and on a face across the heading (a wall
+            // beside the body, rather than a riser ahead) its height too, as over a gap (aimed at
+            // the wall's height, steps beside it were a third of step_length).
             if (Dot(h.normal, a.up) < cos_max_slope_) {
               const Vec3 left = Left(a);
-              locator_[m] -= left * Dot(h.point - placed, left);
+              if (std::fabs(Dot(h.normal, left)) > std::fabs(Dot(h.normal, a.forward)))
+                locator_[m] = placed - a.up * (0.5 * lead_), locator_normal_[m] = a.up;
+              else
+                locator_[m] -= left * Dot(h.point - placed, left);
             }
           } else {
             locator_[m] = placed - a.up * (0.5 * lead_), locator_normal_[m] = a.up;
