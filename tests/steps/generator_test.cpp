@@ -580,7 +580,9 @@ TEST_CASE("An upright body stops before a slab lower than it, its legs never thr
   // every foot ends planted by the body's last key); each body key's straight lines to the
   // feet stay out of the slab.
   const Character c = LoadShipped("biped");
-  for (const auto& [lo, hi] : {std::pair{0.6, 0.7}, std::pair{0.65, 0.67}}) {
+  // A slab 0.3 to 0.44 m up, below half the body's height where the spine's check begins: the
+  // legs, lines from the feet to the body, are checked too.
+  for (const auto& [lo, hi] : {std::pair{0.6, 0.7}, std::pair{0.65, 0.67}, std::pair{0.3, 0.44}}) {
     Terrain t = LoadTerrain(FloorAndSlab(lo, hi, true), 0.04);
     GenerateOptions o;
     o.has_start = true;
