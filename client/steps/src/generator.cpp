@@ -118,11 +118,13 @@ std::string Point(const Vec3& p) {
   return o.str();
 }
 
-// For ground facing away from the character's up (more than 120 degrees): the likely causes.
+// For ground facing away from the character's up (more than 120 degrees): what would make it
+// so where the ground should face up (an underside is often just that: a log's, a beam's).
 std::string FacingDownHint(double slope_deg) {
   if (!(slope_deg > 120)) return "";
-  return "; it faces down: the underside of a surface thinner than the terrain's sample spacing "
-         "(resample at a separation below its thickness) or a mesh whose faces face inward";
+  return "; it faces down: if the ground there should face up, the surface may be thinner than "
+         "the terrain's sample spacing (resample at a separation below its thickness) or a "
+         "mesh's faces may face inward";
 }
 
 // How far p is above the terrain, from h, the sample nearest to it: its height along h's
