@@ -171,9 +171,9 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
   CHECK(below == 0);
   // The body follows the feet, clear of the terrain: body_height along its up above the feet's
   // centroid, or up to body_height more where the terrain comes nearer than half its
-  // body_height (three times body_height more out of the terrain). It may lie behind its nearest sample's plane only where rising would not help
-  // (that plane along its up: beside a wall's face or over an edge) or may not (raised as far as
-  // the feet's reach or the raise's bound allow).
+  // body_height (three times body_height more out of the terrain). It may lie behind its nearest
+  // sample's plane only where rising would not help (that plane along its up: beside a wall's face
+  // or over an edge) or may not (raised as far as the feet's reach or the raise's bound allow).
   const Vec3 world_up = Normalize(o.up);
   std::vector<Foothold> body_snap(body.keys.size());
   std::vector<Vec3> body_points;
