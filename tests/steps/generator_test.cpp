@@ -580,8 +580,9 @@ TEST_CASE("An upright body stops before a slab lower than it, its legs never thr
   // every foot ends planted by the body's last key); each body key's straight lines to the
   // feet stay out of the slab.
   const Character c = LoadShipped("biped");
-  // A slab 0.3 to 0.44 m up, below half the body's height where the spine's check begins: the
-  // legs, lines from the feet to the body, are checked too.
+  // A slab 0.3 to 0.44 m up lies below the spine's lowest point checked (half the body's
+  // height): its plane crosses the spine lower down (a first version of the crossing rule
+  // missed it, the legs through it).
   for (const auto& [lo, hi] : {std::pair{0.6, 0.7}, std::pair{0.65, 0.67}, std::pair{0.3, 0.44}}) {
     Terrain t = LoadTerrain(FloorAndSlab(lo, hi, true), 0.04);
     GenerateOptions o;
@@ -594,6 +595,28 @@ TEST_CASE("An upright body stops before a slab lower than it, its legs never thr
     CHECK_THAT(w.stopped, Catch::Contains("no room for the body"));
     CHECK(StepsDone(w) >= 2);
     CHECK(DeepestLeg(w, lo, hi) == 0);
+  }
+}
+
+TEST_CASE("A biped climbs steep stairs without taking the next nose for an overhang",
+          "[steps][generator]") {
+  // 19 cm risers, 26 cm treads, sampled every 3 cm: with both feet on a tread just before its
+  // riser, the next nose lies two spacings ahead of the spine, and its plane crossed the spine
+  // within the gap: every start stopped with "no room for the body" halfway up.
+  const Character c = LoadShipped("biped");
+  const int steps = 20;
+  const double rise = 0.19, run = 0.26, spacing = 0.03;
+  Terrain t = LoadTerrain(MakeStairs(steps, rise, run, 2, spacing), spacing);
+  for (const double z : {0.02, 0.11, 0.2}) {
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {1, 0, z};
+    o.steps = 40;
+    const Walk w = Generate(t, c, o);
+    INFO(z << ": " << w.stopped);
+    CheckWalk(t, c, o, w);
+    CHECK_THAT(w.stopped, !Catch::Contains("no room"));
+    CHECK(Body(w).keys.back().position.y > (steps - 2) * rise);
   }
 }
 

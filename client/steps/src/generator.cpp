@@ -44,13 +44,12 @@ constexpr double kAlikeCos = 0.7071;  // footholds whose normals are within 45 d
 constexpr double kBodyClearance = 0.5;
 constexpr int kBodyRounds = 3;
 // Room for an upright body (bipeds): points of its spine, from half body_height above the
-// feet's centroid up to the body, and of each leg, the line from a foot to the body, at most
-// this many a line and no farther apart than the terrain's gap, are snapped; a nearest sample
-// on a line (within the gap) whose plane crosses it, above every foot by more than the gap and
-// below the body, is terrain between the feet and the body, and the walk stops before that step
-// (a biped walking under a slab lower than its body had its feet under it and its body over
-// it; under a slab below half its body height, its legs through it). Not tried for multipeds,
-// whose bodies lean with the terrain and whose feet wrap around edges.
+// feet's centroid up to the body, at most this many and no farther apart than the terrain's
+// gap, are snapped; a nearest sample on the spine's line (within the gap), above every foot by
+// more than the gap and below the body is terrain between the feet and the body, and the walk
+// stops before that step (a biped walking under a slab lower than its body had its feet under
+// it and its body over it). Not tried for multipeds, whose bodies lean with the terrain and
+// whose feet wrap around edges.
 constexpr size_t kMaxSpineChecks = 17;
 // Points checked along each start-mid-end arc, evenly spaced: at least kMinArcChecks, and as many
 // more as keep them no farther apart than the terrain's gap (about twice its sample spacing), up
@@ -382,8 +381,7 @@ class Generator {
   std::vector<double> body_frame_, body_raise_;
   std::vector<size_t> body_pending_, body_still_;
   std::vector<Vec3> body_points_;
-  std::vector<size_t> spine_first_;                // per due body: its first room point (KeyBodies)
-  std::vector<std::pair<Vec3, Vec3>> room_lines_;  // per room point: its line, up to the body
+  std::vector<size_t> spine_first_;  // per due body: its first spine point (KeyBodies)
 };
 
 Vec3 Generator::AveragedUp(const Vec3& previous, const std::vector<Vec3>& normals) const {
@@ -874,32 +872,20 @@ Status Generator::KeyBodies(std::string* error) {
     }
     body_pending_.swap(body_still_);
   }
-  // Room for an upright body (kMaxSpineChecks), after the start (where it stands as asked):
-  // its spine and its legs, each line longer than the gap (shorter, the samples cannot tell).
+  // Room for an upright body (kMaxSpineChecks), after the start (where it stands as asked) and
+  // when its spine is longer than the gap (shorter, the samples cannot tell).
   spine_first_.assign(n + 1, 0);
   body_points_.clear();
-  room_lines_.clear();
-  auto check_line = [&](const Vec3& low, const Vec3& top) {
-    const double span = Distance(low, top);
-    if (!(span >= gap_)) return;
-    const size_t count =
-        static_cast<size_t>(std::min(std::ceil(span / gap_), kMaxSpineChecks - 1.0)) + 1;
-    for (size_t j = 0; j < count; ++j) {
-      body_points_.push_back(
-          Lerp(low, top, static_cast<double>(j) / static_cast<double>(count - 1)));
-      room_lines_.push_back({low, top});
-    }
-  };
   for (size_t i = 0; i < n; ++i) {
     const Agent& a = agents_[body_due_[i].first];
-    if (!c_.align_to_normal && body_due_[i].second != o_.start_frame && gap_ > 0) {
-      const Vec3 body = a.ground + a.body_up * (c_.body_height + body_raise_[i]);
-      check_line(a.ground + a.body_up * (0.5 * c_.body_height), body);
-      // Legs from the gap above their foot (the ground there is no obstacle) up to the body.
-      for (const Vec3& foot : a.foot) {
-        const double height = Dot(body - foot, a.body_up);
-        if (height > gap_) check_line(Lerp(foot, body, gap_ / height), body);
-      }
+    const double low = 0.5 * c_.body_height, high = c_.body_height + body_raise_[i];
+    const double span = high - low;
+    if (!c_.align_to_normal && body_due_[i].second != o_.start_frame && gap_ > 0 && span >= gap_) {
+      const size_t count =
+          static_cast<size_t>(std::min(std::ceil(span / gap_), kMaxSpineChecks - 1.0)) + 1;
+      for (size_t j = 0; j < count; ++j)
+        body_points_.push_back(a.ground + a.body_up * (low + span * static_cast<double>(j) /
+                                                                 static_cast<double>(count - 1)));
     }
     spine_first_[i + 1] = body_points_.size();
   }
@@ -913,34 +899,38 @@ Status Generator::KeyBodies(std::string* error) {
   for (size_t i = 0; i < n; ++i) {
     Agent& a = agents_[body_due_[i].first];
     const double frame = body_due_[i].second;
-    // A point's nearest sample across its line: within the gap of the line, above every foot by
-    // more than the gap and below the body, its plane crossing the line within the gap of it
-    // (whichever way it faces: a roof modelled as one face is a surface too; a wall beside the
-    // line, or a block's face ahead, does not cross it).
+    // A spine point's nearest sample across the spine: within the gap of its line, above every
+    // foot by more than the gap and below the body, its plane crossing the spine (from the gap
+    // above the feet's centroid up to the body) within half the gap of it, about one sample
+    // spacing (the next nose, two spacings ahead of a biped's spine on steep stairs, crossed it
+    // within the gap). Whichever way it faces: a roof modelled as one face is a surface too, and
+    // so is a slab below the lowest point checked; a wall beside the spine, or a block's face
+    // ahead, does not cross it.
     const double top = c_.body_height + body_raise_[i];
-    auto across = [&](size_t p) {
-      const Foothold& h = answers_[p];
+    const Vec3 spine_low = a.ground + a.body_up * gap_;
+    const Vec3 spine_top = a.ground + a.body_up * top;
+    auto across = [&](const Foothold& h) {
       if (h.status != Status::kOk) return false;
-      if (Dot(h.point - a.ground, a.body_up) >= top) return false;
+      const Vec3 d = h.point - a.ground;
+      if (Dot(d, a.body_up) >= top || Length(ProjectOnPlane(d, a.body_up)) > gap_) return false;
       for (const Vec3& foot : a.foot)
         if (Dot(h.point - foot, a.body_up) <= gap_) return false;
-      const auto& [low, high] = room_lines_[p];
-      const Vec3 along = Normalize(high - low);
-      if (Length(ProjectOnPlane(h.point - low, along)) > gap_) return false;
-      const double below = Dot(low - h.point, h.normal);
-      const double above = Dot(high - h.point, h.normal);
+      const double below = Dot(spine_low - h.point, h.normal);
+      const double above = Dot(spine_top - h.point, h.normal);
       if ((below > 0) == (above > 0) || below == above) return false;
-      return Distance(Lerp(low, high, below / (below - above)), h.point) <= gap_;
+      const Vec3 crossing = Lerp(spine_low, spine_top, below / (below - above));
+      return Distance(crossing, h.point) <= 0.5 * gap_;
     };
-    size_t p = spine_first_[i];
-    while (p < spine_first_[i + 1] && !across(p)) ++p;
-    if (p == spine_first_[i + 1]) {
+    const auto end = answers_.begin() + static_cast<std::ptrdiff_t>(spine_first_[i + 1]);
+    const auto crossing =
+        std::find_if(answers_.begin() + static_cast<std::ptrdiff_t>(spine_first_[i]), end, across);
+    if (crossing == end) {
       KeyBody(a, frame, body_raise_[i]);
       continue;
     }
     std::ostringstream why;
-    why << "no room for the body at " << Point(room_lines_[p].second) << ": the terrain at "
-        << Point(answers_[p].point)
+    why << "no room for the body at " << Point(body_points_[spine_first_[i + 1] - 1])
+        << ": the terrain at " << Point(crossing->point)
         << " lies between it and its feet (an overhang or a ceiling lower than body_height)";
     UnkeyStep(a, frame - c_.frames_per_step);
     Stop(a, static_cast<int>(std::lround((frame - o_.start_frame) / c_.frames_per_step)),
