@@ -63,6 +63,11 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
       {{"{\"name\": \"R\"", "{\"nmae\": \"R\""},
        "b.json: 'feet'[1]: unknown field 'nmae' (known fields: comment, name, rest)"},
       {{"\"version\": 1", "\"version\": 1.5"}, "b.json: 'version' 1.5 is not supported"},
+      // Names from the file reach no terminal with their control characters (ESC, the C1 CSI).
+      {{"\"reach\": 1.1", "\"reach\": 1.1, \"\\u001b[31m\\u009b31mx\": 1"},
+       "b.json: unknown field '?[31m?31mx' (known fields:"},
+      {{"[[\"L\"], [\"R\"]]", "[[\"L\"], [\"R\\u009b\"]]"},
+       "b.json: 'gait'[1]: no foot named 'R?'"},
       {{"[[\"L\"], [\"R\"]]", "[[\"L\", \"L\"], [\"R\"]]"}, "foot 'L' is listed twice"},
       {{"\"reach\": 1.1", "\"reach\": 0.5"},
        "'reach' = 0.5 must exceed the distance from the body to the rest of foot 'L' (0.9"},

@@ -250,7 +250,7 @@ bad character-version "$work/version.json: 'version' 4294967297 is not supported
 bad zero-heading "heading must be a non-zero finite vector" --terrain "$hills" --character "$chars/biped.json" --heading 0,0,0 --out "$work/x.json"
 # A waypoint past the terrain queries' reach: its squared distance overflowed and the walk
 # turned away from it.
-bad far-waypoint "path waypoint 2 (20, 0, 1e+155) is not a finite point within 1e+15 of the origin" --terrain "$hills" --character "$chars/biped.json" --path "20,0,30 20,0,1e155" --out "$work/x.json"
+bad far-waypoint "path waypoint 2 (20, 0, 1e+155) is not a finite point with each coordinate within +-1e+15" --terrain "$hills" --character "$chars/biped.json" --path "20,0,30 20,0,1e155" --out "$work/x.json"
 bad empty-path "--path: expected at least one waypoint X,Y,Z" --terrain "$hills" --character "$chars/biped.json" --path " " --out "$work/x.json"
 bad empty-heading "--heading: expected DX,DY,DZ" --terrain "$hills" --character "$chars/biped.json" --heading "" --out "$work/x.json"
 bad heading-up "the heading (0.0000, 1.0000, 0.0000) is along the up (0.0000, 1.0000, 0.0000) where the character starts" --terrain "$hills" --character "$chars/biped.json" --heading 0,1,0 --out "$work/x.json"

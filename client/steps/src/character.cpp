@@ -88,7 +88,7 @@ struct Reader {
         auto it = feet.find(name.get<std::string>());
         if (it == feet.end())
           return Fail(Status::kInvalidArgument,
-                      where + ": no foot named '" + name.get<std::string>() + "'");
+                      where + ": no foot named '" + ShownText(name.get<std::string>()) + "'");
         if (!seen.insert(it->second).second)
           return Fail(Status::kInvalidArgument,
                       where + ": foot '" + it->first + "' is listed twice");

@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "footfall/terrain/shown_text.h"
 #include "json_input.h"
 
 namespace footfall {
@@ -57,7 +58,7 @@ Status ParseGenerateRequest(const std::string& text, Character* character, Gener
       "fps",       "crowd",          "crowd_spacing"};
   for (auto it = j.begin(); it != j.end(); ++it) {
     if (!kKnown.count(it.key())) {
-      *error = "request: unknown field '" + it.key() + "'";
+      *error = "request: unknown field '" + ShownText(it.key()) + "'";
       return Status::kParseError;
     }
   }

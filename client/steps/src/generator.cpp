@@ -1689,8 +1689,8 @@ Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Charac
     if (!IsFinite(p) || std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) > kMaxWaypoint) {
       std::ostringstream m;
       m << "path waypoint " << i + 1 << " (" << p.x << ", " << p.y << ", " << p.z
-        << ") is not a finite point within " << kMaxWaypoint
-        << " of the origin (the reach of terrain queries)";
+        << ") is not a finite point with each coordinate within +-" << kMaxWaypoint
+        << " (the reach of terrain queries)";
       *error = m.str();
       return Status::kInvalidArgument;
     }

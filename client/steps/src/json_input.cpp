@@ -175,7 +175,7 @@ bool FindUnknownKey(const json& j, const std::set<std::string>& known, std::stri
 std::string UnknownFieldMessage(const std::string& key, const std::set<std::string>& known) {
   std::string list;
   for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
-  return "unknown field '" + key + "' (known fields: " + list + ")";
+  return "unknown field '" + ShownText(key) + "' (known fields: " + list + ")";
 }
 
 }  // namespace footfall::detail
