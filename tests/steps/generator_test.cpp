@@ -151,12 +151,18 @@ Walk CheckedWalkOnFlat(const Character& c, int steps) {
   return w;
 }
 
-// A crowd of `crowd` characters `spacing` apart around `start`, walking `steps` steps.
-GenerateOptions CrowdOptions(const Vec3& start, int steps, int crowd, double spacing) {
+// One character starting at `start`, walking `steps` steps.
+GenerateOptions StartOptions(const Vec3& start, int steps) {
   GenerateOptions o;
   o.has_start = true;
   o.start = start;
   o.steps = steps;
+  return o;
+}
+
+// A crowd of `crowd` characters `spacing` apart around `start`, walking `steps` steps.
+GenerateOptions CrowdOptions(const Vec3& start, int steps, int crowd, double spacing) {
+  GenerateOptions o = StartOptions(start, steps);
   o.crowd = crowd;
   o.crowd_spacing = spacing;
   return o;
@@ -242,10 +248,7 @@ TEST_CASE("A multiped's body climbing stairs taller than itself stays out of the
     const int steps = 8;
     const double rise = 0.18, run = 0.3, spacing = 0.02;
     Terrain t = LoadTerrain(MakeStairs(steps, rise, run, 1.5, spacing), spacing);
-    GenerateOptions o;
-    o.has_start = true;
-    o.start = {0.75, 0, -0.6};
-    o.steps = 60;
+    const GenerateOptions o = StartOptions({0.75, 0, -0.6}, 60);
     const Walk w = Generate(t, c, o);
     INFO(name << ": " << w.stopped);
     CheckWalk(t, c, o, w);
@@ -608,10 +611,7 @@ TEST_CASE("A biped climbs steep stairs without taking the next nose for an overh
   const double rise = 0.19, run = 0.26, spacing = 0.03;
   Terrain t = LoadTerrain(MakeStairs(steps, rise, run, 2, spacing), spacing);
   for (const double z : {0.02, 0.11, 0.2}) {
-    GenerateOptions o;
-    o.has_start = true;
-    o.start = {1, 0, z};
-    o.steps = 40;
+    const GenerateOptions o = StartOptions({1, 0, z}, 40);
     const Walk w = Generate(t, c, o);
     INFO(z << ": " << w.stopped);
     CheckWalk(t, c, o, w);
@@ -648,11 +648,8 @@ TEST_CASE("A biped walks straight beside a wall, and stops before a block for it
   const Character c = LoadShipped("biped");
   const double s = 0.04;
   Terrain t = LoadTerrain(FloorWithBlock(s, 150, 100, 2, 3, 2, 50, true), s);
-  GenerateOptions beside;
-  beside.has_start = true;
-  beside.start = {0.5, 0, 2 - 0.24};
+  GenerateOptions beside = StartOptions({0.5, 0, 2 - 0.24}, 12);
   beside.heading = {1, 0, 0};
-  beside.steps = 12;
   const Walk w = Generate(t, c, beside);
   INFO(w.stopped);
   CheckWalk(t, c, beside, w);
@@ -667,10 +664,7 @@ TEST_CASE("A biped walks straight beside a wall, and stops before a block for it
   const double travel = Body(w).keys.back().position.x - Body(w).keys.front().position.x;
   CHECK(travel >= 0.95 * (Body(away).keys.back().position.x - Body(away).keys.front().position.x));
   CHECK(travel > 0.4 * c.step_length * beside.steps);
-  GenerateOptions into;
-  into.has_start = true;
-  into.start = {3, 0, 1};
-  into.steps = 40;
+  const GenerateOptions into = StartOptions({3, 0, 1}, 40);
   const Walk stopped = Generate(t, c, into);
   INFO(stopped.stopped);
   CheckWalk(t, c, into, stopped);
