@@ -149,6 +149,31 @@ TEST_CASE("TurnOutward: inside-out and downward meshes are turned over, others l
   CHECK(TurnOutward(&rocks, Vec3{0, 0, 1}).turned_faces == 0);
 }
 
+TEST_CASE("TurnOutward: a shell closed but for a T-junction is closed", "[import][mesh]") {
+  // A unit cube whose top has a corner at the middle of its front edge, which the front face
+  // does not have: the zero-area triangle ear clipping leaves at a concave face's straight
+  // corner. Taken for an open part, an inside-out staircase of concave end faces was not
+  // turned over, and insects walked inside it.
+  TriangleMesh cube;
+  cube.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},  {0, 0, 1},
+                   {1, 0, 1}, {1, 1, 1}, {0, 1, 1}, {0.5, 0, 1}};
+  cube.triangles = {{0, 3, 2}, {0, 2, 1}, {4, 8, 7}, {8, 6, 7}, {8, 5, 6}, {0, 1, 5}, {0, 5, 4},
+                    {3, 7, 6}, {3, 6, 2}, {0, 4, 7}, {0, 7, 3}, {1, 2, 6}, {1, 6, 5}};
+  TriangleMesh as_is = cube;
+  const MeshTurnover kept = TurnOutward(&as_is, {0, 1, 0});
+  CHECK(kept.closed_shells == 1);
+  CHECK(kept.turned_faces == 0);
+  for (auto& tri : cube.triangles) std::swap(tri[1], tri[2]);
+  const MeshTurnover t = TurnOutward(&cube, {0, 1, 0});
+  CHECK(t.closed_shells == 1);
+  CHECK(t.inside_out_shells == 1);
+  CHECK(t.turned_faces == cube.triangles.size());
+  // A real opening stays open: the top without its middle triangle.
+  TriangleMesh holed = as_is;
+  holed.triangles.erase(holed.triangles.begin() + 3);
+  CHECK(TurnOutward(&holed, {0, 1, 0}).closed_shells == 0);
+}
+
 TEST_CASE("TurnOutward: each closed shell is judged on its own", "[import][mesh]") {
   // An inside-out sphere and a smaller one wound right, in one mesh (and open ground beside
   // them, facing up): only the inside-out shell is turned (the whole mesh's volume, negative,

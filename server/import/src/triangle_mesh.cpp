@@ -85,11 +85,45 @@ MeshTurnover TurnOutward(TriangleMesh* mesh, const Vec3& up) {
   for (const auto& tri : mesh->triangles)
     for (int k = 0; k < 3; ++k) edges.push_back(uint64_t{tri[k]} << 32 | tri[(k + 1) % 3]);
   std::sort(edges.begin(), edges.end());
-  std::vector<uint8_t> open(parent.size(), 0);  // per part (its root vertex)
+  std::vector<uint64_t> lone;  // edges without their twin
   for (const uint64_t e : edges) {
     const uint64_t twin = e << 32 | e >> 32;
-    if (!std::binary_search(edges.begin(), edges.end(), twin)) open[root(e >> 32)] = 1;
+    if (!std::binary_search(edges.begin(), edges.end(), twin)) lone.push_back(e);
   }
+  // A lone edge matched the other way by a chain of lone edges through corners on it is no
+  // opening: a T-junction, where a zero-area triangle was left out (a concave face's straight
+  // corner, as ear clipping leaves it).
+  std::vector<uint8_t> matched(lone.size(), 0);
+  auto from = [&](uint32_t v) {  // the lone edges starting at v
+    return std::equal_range(lone.begin(), lone.end(), uint64_t{v} << 32,
+                            [](uint64_t x, uint64_t y) { return (x >> 32) < (y >> 32); });
+  };
+  for (size_t i = 0; i < lone.size(); ++i) {
+    const uint32_t a = static_cast<uint32_t>(lone[i] >> 32), b = static_cast<uint32_t>(lone[i]);
+    const Vec3 ab = mesh->vertices[b] - mesh->vertices[a];
+    const double length2 = Length2(ab);
+    std::vector<size_t> chain;
+    for (uint32_t at = b; at != a && chain.size() < 64;) {
+      bool stepped = false;
+      for (auto [it, end] = from(at); it != end && !stepped; ++it) {
+        const uint32_t next = static_cast<uint32_t>(*it);
+        const Vec3 am = mesh->vertices[next] - mesh->vertices[a];
+        const double along = Dot(am, ab);
+        const bool on =
+            next == a || (Length2(Cross(ab, am)) <= 1e-18 * length2 * length2 && along > 0 &&
+                          along < Dot(mesh->vertices[at] - mesh->vertices[a], ab));
+        if (on) chain.push_back(static_cast<size_t>(it - lone.begin())), at = next, stepped = true;
+      }
+      if (!stepped) break;
+    }
+    if (!chain.empty() && static_cast<uint32_t>(lone[chain.back()]) == a) {
+      matched[i] = 1;
+      for (const size_t c : chain) matched[c] = 1;
+    }
+  }
+  std::vector<uint8_t> open(parent.size(), 0);  // per part (its root vertex)
+  for (size_t i = 0; i < lone.size(); ++i)
+    if (!matched[i]) open[root(static_cast<uint32_t>(lone[i] >> 32))] = 1;
   // Six times each closed part's volume, about its root vertex (less cancellation); the open
   // parts' area-weighted normal and area.
   std::vector<double> volume(parent.size(), 0);
