@@ -214,6 +214,44 @@ class BlenderAddonTest(unittest.TestCase):
         self.assertGreater(scene.sample_count, 200 * 200)
         self.assertEqual(scene.terrain_name, "terrain")
 
+    def test_1b_instances_on_the_terrain_mesh_are_sampled(self):
+        # A Geometry Nodes modifier's instances (a box put on a point of the ground by Instance
+        # on Points) were left out of the samples, though the viewport shows them.
+        bpy.ops.mesh.primitive_grid_add(x_subdivisions=10, y_subdivisions=10, size=4,
+                                        location=(20.0, 0.0, 0.0))
+        ground = bpy.context.active_object
+        tree = bpy.data.node_groups.new("footfall_test_box", "GeometryNodeTree")
+        tree.inputs.new("NodeSocketGeometry", "Geometry")
+        tree.outputs.new("NodeSocketGeometry", "Geometry")
+        nodes, links = tree.nodes, tree.links
+        inputs, outputs = nodes.new("NodeGroupInput"), nodes.new("NodeGroupOutput")
+        point = nodes.new("GeometryNodeMeshLine")
+        point.inputs["Count"].default_value = 1
+        point.inputs["Start Location"].default_value = (0.0, 0.0, 0.5)
+        box = nodes.new("GeometryNodeMeshCube")
+        box.inputs["Size"].default_value = (1.0, 1.0, 1.0)
+        instance = nodes.new("GeometryNodeInstanceOnPoints")
+        join = nodes.new("GeometryNodeJoinGeometry")
+        links.new(point.outputs["Mesh"], instance.inputs["Points"])
+        links.new(box.outputs["Mesh"], instance.inputs["Instance"])
+        links.new(inputs.outputs[0], join.inputs[0])
+        links.new(instance.outputs["Instances"], join.inputs[0])
+        links.new(join.outputs[0], outputs.inputs[0])
+        ground.modifiers.new("box", "NODES").node_group = tree
+        try:
+            bpy.context.view_layer.update()
+            instanced = self.ops.mesh_samples(bpy.context, ground, 0.1)
+            realize = nodes.new("GeometryNodeRealizeInstances")
+            links.new(join.outputs[0], realize.inputs[0])
+            links.new(realize.outputs[0], outputs.inputs[0])
+            bpy.context.view_layer.update()
+            realized = self.ops.mesh_samples(bpy.context, ground, 0.1)
+            self.assertEqual(len(instanced), len(realized))
+            self.assertAlmostEqual(max(s[1] for s in instanced), 1.0, delta=1e-6)  # the box top
+        finally:
+            bpy.data.objects.remove(ground)
+            bpy.data.node_groups.remove(tree)
+
     def test_2_bad_selection_is_a_report(self):
         self.select([], None)
         with self.assertRaises(RuntimeError) as e:
@@ -313,6 +351,7 @@ class BlenderAddonTest(unittest.TestCase):
         rig = bpy.data.objects[rig_name]
         scene = bpy.context.scene.footfall
         scene.rig, scene.steps, scene.start_frame = rig, steps, 1
+        self.select([rig], rig)  # the rig of the active object is keyed
         self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
         expected, _ = self.cli_walk(rig, steps, rig_name + "_cli")
         got = json.loads(bpy.data.texts["footfall_walk.json"].as_string())
@@ -394,6 +433,7 @@ class BlenderAddonTest(unittest.TestCase):
         feet = {f.name: f.target for f in rig.footfall_rig.feet}
         settings = scene.footfall
         settings.rig, settings.steps, settings.start_frame = rig, 6, 1
+        self.select([rig], rig)  # the rig of the active object is keyed
         scene.frame_set(50)  # the user looks at another frame than the walk's first
         self.assertEqual(bpy.ops.footfall.generate_walk(chunk_steps=2), {"FINISHED"})
         self.assertEqual(scene.frame_current, 50)
@@ -441,6 +481,7 @@ class BlenderAddonTest(unittest.TestCase):
         feet = {f.name: f.target for f in rig.footfall_rig.feet}
         settings = scene.footfall
         settings.rig, settings.start_frame = rig, 1
+        self.select([rig], rig)  # the rig of the active object is keyed
         for steps in (6, 4):  # the second walk clears the first's Euler keys after its end
             settings.steps = steps
             self.assertEqual(bpy.ops.footfall.generate_walk(chunk_steps=2), {"FINISHED"})
@@ -525,6 +566,7 @@ class BlenderAddonTest(unittest.TestCase):
         self.assertEqual(feet, targets)
         settings = scene.footfall
         settings.rig, settings.steps, settings.start_frame = rig, 6, 1
+        self.select([rig], rig)  # the rig of the active object is keyed
         # A static pose: the bones' matrices are read once.
         self.assertEqual(bpy.ops.footfall.generate_walk(chunk_steps=2), {"FINISHED"})
         walk = json.loads(bpy.data.texts["footfall_walk.json"].as_string())
@@ -567,6 +609,7 @@ class BlenderAddonTest(unittest.TestCase):
         curve = bpy.context.active_object
         self.assertTrue(curve.data.use_path)
         scene.footfall.rig, scene.footfall.steps = rig, 6
+        self.select([rig], rig)  # the rig of the active object is keyed
         path = os.path.join(ARGS.work_dir, "boner_cli.json")
         objects = list(feet.values()) + [body]
         for parent, kind, message in ((cube, "VERTEX", "parented to a vertex of Cube"),
@@ -632,6 +675,7 @@ class BlenderAddonTest(unittest.TestCase):
         feet = {f.name: f.target for f in rig.footfall_rig.feet}
         settings = scene.footfall
         settings.rig, settings.steps, settings.start_frame = rig, 16, 1
+        self.select([rig], rig)  # the rig of the active object is keyed
 
         def keys():
             """Every key of the feet and the body: frames, values and handles."""
@@ -707,6 +751,7 @@ class BlenderAddonTest(unittest.TestCase):
         before = {o.name: fcurve_keys(o, "location", 3) for o in list(feet.values()) + [body]}
         self.assertTrue(all(before.values()))
         bpy.context.scene.footfall.rig = rig
+        self.select([rig], rig)  # the rig of the active object is keyed
         settings = bpy.context.scene.footfall
 
         def generate_refused(setting, value, *messages):
@@ -783,10 +828,106 @@ class BlenderAddonTest(unittest.TestCase):
             self.assert_keys_equal_walk(part, feet, bpy.data.objects["crowd_gltf_%s_body" % who])
         # Onto a rig: refused, nothing changed.
         bpy.context.scene.footfall.rig = rig
+        self.select([rig], rig)  # the rig of the active object is keyed
         for path in (out, out[:-5] + "_gltf.gltf"):
             with self.assertRaises(RuntimeError) as e:
                 bpy.ops.footfall.import_walk(filepath=path)
             self.assertIn("a crowd walk (2 characters)", str(e.exception))
+
+    def test_7d_the_active_objects_rig_is_keyed(self):
+        # Generate Walk and Import keyed the rig in the Rig field (the one Character Setup made
+        # last) whichever rig's object was active, and Import with nothing active keyed it too.
+        settings = bpy.context.scene.footfall
+        hexapod, biped = bpy.data.objects["hexapod_rig"], bpy.data.objects["biped_rig"]
+        feet = {f.name: f.target for f in hexapod.footfall_rig.feet}
+        body = hexapod.footfall_rig.body
+        others = [f.target for f in biped.footfall_rig.feet] + [biped.footfall_rig.body]
+        before = {o.name: fcurve_keys(o, "location", 3) for o in others}
+        clear_animation(list(feet.values()) + [body])
+        settings.rig, settings.steps, settings.start_frame = biped, 6, 1
+        self.select([feet["L1"]], feet["L1"])  # one of the hexapod's IK targets
+        self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
+        walk, path = self.cli_walk(hexapod, 6, "hexapod_active")
+        self.assert_keys_equal_walk(walk, feet, body)
+        clear_animation(list(feet.values()) + [body])
+        self.select([body], body)
+        self.assertEqual(bpy.ops.footfall.import_walk(filepath=path), {"FINISHED"})
+        self.assert_keys_equal_walk(walk, feet, body)
+        # No rig active: new empties, whatever the Rig field holds.
+        self.select([], None)
+        objects = set(bpy.data.objects)
+        self.assertEqual(bpy.ops.footfall.import_walk(filepath=path), {"FINISHED"})
+        made = set(bpy.data.objects) - objects
+        self.assertEqual(sorted(o.name for o in made), sorted(
+            "hexapod_active_" + n for n in list(feet) + ["body"]))
+        for obj in made:
+            bpy.data.objects.remove(obj)
+        self.assertEqual({o.name: fcurve_keys(o, "location", 3) for o in others}, before)
+
+    def test_7e_a_deleted_rig_is_a_report(self):
+        # Deleted objects stay in bpy.data while the rig's properties refer to them: Generate
+        # Walk keyed them and reported success.
+        settings = bpy.context.scene.footfall
+        bpy.context.scene.cursor.location = (3.0, -1.0, 0.0)
+        self.assertEqual(bpy.ops.footfall.character_setup(
+            character_file=os.path.join(CHARACTERS, "biped.json"), mode="CREATE", name="doomed"),
+            {"FINISHED"})
+        rig = bpy.data.objects["doomed_rig"]
+        feet = {f.name: f.target for f in rig.footfall_rig.feet}
+        body = rig.footfall_rig.body
+        settings.steps, settings.start_frame = 4, 1
+        self.select([feet["L"]], feet["L"])
+        bpy.ops.object.delete()
+        self.select([rig], rig)
+        with self.assertRaises(RuntimeError) as e:
+            bpy.ops.footfall.generate_walk()
+        self.assertIn("foot L's IK target of doomed_rig (doomed_L) is no longer in the scene",
+                      str(e.exception))
+        with self.assertRaises(RuntimeError) as e:
+            bpy.ops.footfall.import_walk(
+                filepath=os.path.join(ARGS.work_dir, "biped_rig_cli.json"))
+        self.assertIn("(doomed_L) is no longer in the scene", str(e.exception))
+        self.select([rig, body, feet["R"]], rig)
+        bpy.ops.object.delete()
+        self.select([], None)
+        self.assertIs(settings.rig, rig)  # (the Rig field still refers to it)
+        with self.assertRaises(RuntimeError) as e:
+            bpy.ops.footfall.generate_walk()
+        self.assertIn("the rig doomed_rig is no longer in the scene: run Character Setup",
+                      str(e.exception))
+        for obj in list(feet.values()) + [body]:
+            self.assertEqual(fcurve_keys(obj, "location", 3), {}, obj.name)
+        settings.rig = None
+
+    def test_7f_a_beveled_path_is_its_centre_line(self):
+        # A path curve with Bevel Depth or Extrude was sent as its tube's (or ribbon's) vertices.
+        settings = bpy.context.scene.footfall
+        rig = bpy.data.objects["biped_rig"]
+        data = bpy.data.curves.new("bevelled_path", "CURVE")
+        data.dimensions = "3D"
+        spline = data.splines.new("POLY")
+        spline.points.add(2)
+        for p, co in zip(spline.points, [(0.0, 3.0, 0.5), (1.0, 1.0, 0.5), (0.0, -1.0, 0.5)]):
+            p.co = co + (1.0,)
+        path = bpy.data.objects.new("bevelled_path", data)
+        bpy.context.scene.collection.objects.link(path)
+        settings.path = path
+        try:
+            bpy.context.view_layer.update()
+            plain = self.ops.walk_request(bpy.context, rig, 4, 1)["path"]
+            self.assertEqual(len(plain), 3)
+            counts = (len(bpy.data.objects), len(bpy.data.curves))
+            for setting in ("bevel_depth", "extrude"):
+                setattr(data, setting, 0.3)
+                bpy.context.view_layer.update()
+                self.assertEqual(self.ops.walk_request(bpy.context, rig, 4, 1)["path"], plain,
+                                 setting)
+                setattr(data, setting, 0.0)
+            self.assertEqual((len(bpy.data.objects), len(bpy.data.curves)), counts)
+        finally:
+            settings.path = None
+            bpy.data.objects.remove(path)
+            bpy.data.curves.remove(data)
 
     def test_8_import_gltf_walk(self):
         out = os.path.join(ARGS.work_dir, "biped_cli.gltf")
@@ -807,9 +948,24 @@ class BlenderAddonTest(unittest.TestCase):
         body = rig.footfall_rig.body
         clear_animation(list(feet.values()) + [body])
         bpy.context.scene.footfall.rig = rig
+        self.select([rig], rig)  # the rig of the active object is keyed
         self.assertEqual(bpy.ops.footfall.import_walk(filepath=out), {"FINISHED"})
         # glTF holds 32-bit floats and times in seconds: the same keys as the JSON walk.
         self.assert_keys_equal_walk(walk, feet, body)
+
+    def test_8b_a_walk_after_an_import_replaces_it(self):
+        # Import left the rig's walk end where it was: a shorter Generate Walk afterwards kept
+        # the imported walk's later keys.
+        rig = bpy.data.objects["biped_rig"]
+        feet = {f.name: f.target for f in rig.footfall_rig.feet}
+        body = rig.footfall_rig.body
+        settings = bpy.context.scene.footfall
+        settings.rig, settings.steps, settings.start_frame = rig, 4, 1
+        self.select([rig], rig)
+        _, path = self.cli_walk(rig, 12, "biped_12")
+        self.assertEqual(bpy.ops.footfall.import_walk(filepath=path), {"FINISHED"})
+        self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
+        self.assert_keys_equal_walk(self.cli_walk(rig, 4, "biped_4_after_import")[0], feet, body)
 
     def test_9_server_killed_mid_walk(self):
         rig = bpy.data.objects["biped_rig"]
@@ -818,6 +974,7 @@ class BlenderAddonTest(unittest.TestCase):
         clear_animation(list(feet.values()) + [body])
         scene = bpy.context.scene.footfall
         scene.rig, scene.steps = rig, 10
+        self.select([rig], rig)  # the rig of the active object is keyed
         server = self.server
 
         def kill_after_second_chunk(op, done):

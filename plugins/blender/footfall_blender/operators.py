@@ -202,22 +202,47 @@ def _status(context, text):
 
 # -- Terrain Setup ------------------------------------------------------------------------------
 
-def mesh_samples(context, obj, separation):
-    """The evaluated mesh of `obj` resampled at `separation`, in footfall's frame."""
-    depsgraph = context.evaluated_depsgraph_get()
-    evaluated = obj.evaluated_get(depsgraph)
-    mesh = evaluated.to_mesh()
+def _add_triangles(source, matrix, points, tris):
+    """Appends the triangles of `source` (an evaluated object; its mesh) in world space by
+    `matrix` to `points` (footfall's frame) and `tris`, wound counter-clockwise when `matrix`
+    mirrors. An object with no mesh (an empty, a light) adds nothing."""
+    try:
+        mesh = source.to_mesh()
+    except RuntimeError:
+        return
+    if mesh is None:
+        return
     try:
         mesh.calc_loop_triangles()
-        mw = obj.matrix_world
-        points = [to_ff(mw @ v.co) for v in mesh.vertices]
-        tris = [tuple(t.vertices) for t in mesh.loop_triangles]
+        base = len(points)
+        points.extend(to_ff(matrix @ v.co) for v in mesh.vertices)
+        mirrored = matrix.determinant() < 0
+        for t in mesh.loop_triangles:
+            a, b, c = (base + i for i in t.vertices)
+            tris.append((a, c, b) if mirrored else (a, b, c))
     finally:
-        evaluated.to_mesh_clear()
+        source.to_mesh_clear()
+
+
+def mesh_triangles(context, obj):
+    """The points (footfall's frame) and triangles of `obj` as evaluated (modifiers count),
+    with the instances it makes (a Geometry Nodes modifier's Instance on Points, its instancing
+    of vertices or faces), each where the viewport shows it."""
+    depsgraph = context.evaluated_depsgraph_get()
+    points, tris = [], []
+    _add_triangles(obj.evaluated_get(depsgraph), obj.matrix_world, points, tris)
+    for inst in depsgraph.object_instances:
+        if inst.is_instance and inst.parent is not None and inst.parent.original == obj:
+            _add_triangles(inst.object, inst.matrix_world.copy(), points, tris)
+    return points, tris
+
+
+def mesh_samples(context, obj, separation):
+    """The evaluated mesh of `obj` (and its instances, see mesh_triangles) resampled at
+    `separation`, in footfall's frame."""
+    points, tris = mesh_triangles(context, obj)
     if not tris:
         raise ValueError("%s has no faces" % obj.name)
-    if mw.determinant() < 0:  # mirrored: keep the winding counter-clockwise
-        tris = [(a, c, b) for a, b, c in tris]
     # Normals from the geometry, as `footfall generate` samples a mesh file (smooth, sharp at
     # edges past the crease angle), whatever the viewport's shading.
     sampling.check_sample_count(points, tris, separation)  # before the slow corner normals
@@ -441,34 +466,85 @@ def walk_request(context, rig_obj, steps, start_frame):
 
 
 def curve_points(context, obj):
-    """World points of a curve (evaluated, as a mesh of its segments)."""
-    evaluated = obj.evaluated_get(context.evaluated_depsgraph_get())
-    mesh = evaluated.to_mesh()
+    """World points of a path curve's centre line: its splines as Blender evaluates them (at
+    their resolution), without Bevel or Extrude, whose tube or ribbon is not the path."""
+    data = obj.data.copy()
+    data.bevel_mode, data.bevel_object = "ROUND", None
+    data.bevel_depth, data.extrude = 0.0, 0.0
+    line = obj.copy()  # (modifiers and all; never linked to a scene)
+    line.data = data
     try:
-        pts = [obj.matrix_world @ v.co for v in mesh.vertices]
+        mesh = line.to_mesh()
+        try:
+            pts = [obj.matrix_world @ v.co for v in mesh.vertices] if mesh else []
+        finally:
+            line.to_mesh_clear()
     finally:
-        evaluated.to_mesh_clear()
+        bpy.data.objects.remove(line)
+        bpy.data.curves.remove(data)
     if len(pts) < 2:
         raise ValueError("path %s has fewer than 2 points" % obj.name)
     return pts
 
 
-def rig_targets(rig_obj):
+def in_scene(scene, obj):
+    """True when `obj` is in `scene` (an object deleted from it stays in bpy.data while the
+    add-on's properties refer to it)."""
+    return obj is not None and scene.objects.get(obj.name) == obj
+
+
+def rig_targets(scene, rig_obj):
+    """The rig's {foot name: IK target} and body (None: none). Raises ValueError when one of
+    them is no longer in `scene`."""
     rig = rig_obj.footfall_rig
     feet = {f.name: f.target for f in rig.feet if f.target is not None}
+    for what, obj in [("the body", rig.body)] + [("foot %s's IK target" % n, o)
+                                                 for n, o in feet.items()]:
+        if obj is not None and not in_scene(scene, obj):
+            raise ValueError("%s of %s (%s) is no longer in the scene: run Character Setup "
+                             "again" % (what, rig_obj.name, obj.name))
     return feet, rig.body
 
 
-def active_rig(context):
-    obj = context.scene.footfall.rig
-    if obj is not None and obj.footfall_rig.is_rig:
-        return obj
-    obj = context.active_object
+def rig_of(scene, obj):
+    """The rig (root empty, in `scene`) that `obj` belongs to: the root itself, an object under
+    it (its locators), its body or one of its IK targets, or an object under one of those;
+    None when it belongs to no rig."""
+    members = {}
+    for o in scene.objects:
+        rig = o.footfall_rig
+        if rig.is_rig:
+            members[o] = o
+            for m in [rig.body] + [f.target for f in rig.feet]:
+                if m is not None:
+                    members.setdefault(m, o)
     while obj is not None:
-        if obj.footfall_rig.is_rig:
-            return obj
+        if obj in members:
+            return members[obj]
         obj = obj.parent
     return None
+
+
+def active_rig(context):
+    """The rig of the active object (rig_of), or None."""
+    obj = context.active_object
+    return rig_of(context.scene, obj) if obj is not None else None
+
+
+def walk_rig(context):
+    """The rig Generate Walk keys: the active object's, else the scene's Rig field (the rig
+    Character Setup made last). Raises ValueError when there is none, or when the field's rig
+    is no longer in the scene."""
+    rig_obj = active_rig(context)
+    if rig_obj is not None:
+        return rig_obj
+    rig_obj = context.scene.footfall.rig
+    if rig_obj is None or not rig_obj.footfall_rig.is_rig:
+        raise ValueError("no rig: select one, or run Character Setup first")
+    if not in_scene(context.scene, rig_obj):
+        raise ValueError("the rig %s is no longer in the scene: run Character Setup"
+                         % rig_obj.name)
+    return rig_obj
 
 
 class FOOTFALL_OT_generate_walk(bpy.types.Operator):
@@ -483,10 +559,12 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
 
     def execute(self, context):
         settings = context.scene.footfall
-        rig_obj = active_rig(context)
-        if rig_obj is None:
-            return _fail(self, "footfall: no rig: run Character Setup first")
-        feet, body = rig_targets(rig_obj)
+        try:
+            scene_terrain_key(context.scene)  # first: a scene without one has no rig to walk
+            rig_obj = walk_rig(context)
+            feet, body = rig_targets(context.scene, rig_obj)
+        except ValueError as e:
+            return _fail(self, "footfall: %s; nothing keyed" % e)
         if not feet:
             return _fail(self, "footfall: rig %s has no foot IK targets" % rig_obj.name)
         total = settings.steps
@@ -575,6 +653,7 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
 
     def execute(self, context):
         path = self.filepath
+        rig_obj = active_rig(context)  # before the glTF importer changes the selection
         try:
             if path.lower().endswith((".gltf", ".glb")):
                 walk = self._walk_from_gltf(context, path)
@@ -583,33 +662,37 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
             character.check_walk(walk, path)  # before anything is made
             keying.check_frames(walk)
             crowd = sorted({t.get("character", "") for t in walk["tracks"]})
-            rig_obj = active_rig(context)
             if rig_obj is not None:
                 if len(crowd) > 1:
                     raise ValueError("a crowd walk (%d characters) goes onto new empties, one set "
-                                     "per character: deselect the rig and clear the scene's "
-                                     "footfall rig first" % len(crowd))
-                feet, body = rig_targets(rig_obj)
+                                     "per character: make no rig's object active first"
+                                     % len(crowd))
+                feet, body = rig_targets(context.scene, rig_obj)
                 keying.check_parents(list(feet.values()) + [body])
                 # Nothing is cleared unless the walk keys something of this rig.
                 if not any((t.get("kind") == "body" and body) or t["name"] in feet
                            for t in walk["tracks"]):
                     return _fail(self, "footfall: %s has no track for this rig's feet or body; the "
                                  "rig's keys are unchanged" % path)
-                sets = [(walk, feet, body)]
+                sets = [(walk, feet, body, rig_obj)]
             else:
                 base = os.path.splitext(os.path.basename(path))[0]
                 sets = []
                 for who in crowd:  # one set of empties per character of a crowd
                     part = {"tracks": [t for t in walk["tracks"] if t.get("character", "") == who]}
                     name = "%s_%s" % (base, who) if who else base
-                    sets.append((part,) + self._empties(context, part, name))
+                    sets.append((part,) + self._empties(context, part, name) + (None,))
             count = 0
-            for part, feet, body in sets:
-                first = min((k["frame"] for t in part["tracks"] for k in t.get("keys", [])),
-                            default=0)
+            for part, feet, body, rig_obj in sets:
+                frames = [k["frame"] for t in part["tracks"] for k in t.get("keys", [])]
+                first = min(frames, default=0)
                 keying.clear_keys(list(feet.values()) + [body], first, body)
                 count += keying.key_walk(part, feet, body)
+                if rig_obj is not None and frames:
+                    # The rig's walk now ends here (its keys after `first` are gone): a later
+                    # Generate Walk replaces them up to here.
+                    rig = rig_obj.footfall_rig
+                    rig.walk_end_known, rig.walk_end = True, max(frames)
         except (ffc.FootfallError, OSError, ValueError, KeyError, TypeError) as e:
             why = e.message if isinstance(e, ffc.FootfallError) else e
             return _fail(self, "footfall: cannot import %s: %s" % (path, why))
@@ -630,7 +713,18 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
 
     def _walk_from_gltf(self, context, path):
         """Imports the glTF with Blender's importer and reads its node animation back as a
-        walk dict (positions converted back to footfall's frame), then removes what it made."""
+        walk dict (positions converted back to footfall's frame), then removes what it made
+        and gives back the selection and the active object."""
+        layer = context.view_layer
+        active, selected = layer.objects.active, list(context.selected_objects)
+        try:
+            return self._read_gltf(path)
+        finally:
+            for obj in selected:
+                obj.select_set(True)
+            layer.objects.active = active
+
+    def _read_gltf(self, path):
         before = set(bpy.data.objects)
         actions_before = set(bpy.data.actions)
         try:

@@ -42,8 +42,13 @@ class FOOTFALL_PT_character(_Panel, bpy.types.Panel):
         op = col.operator("footfall.character_setup", text="Use Selected (active = body)")
         op.mode = "PICK"
         col.prop(s, "rig")
-        rig = operators.active_rig(context)
+        try:  # the rig Generate Walk keys: the active object's, else the field's
+            rig = operators.walk_rig(context)
+        except ValueError:
+            rig = None
         if rig is not None:
+            if rig != s.rig:
+                col.label(text="Active rig: " + rig.name)
             col.prop(rig.footfall_rig, "body")
             for foot in rig.footfall_rig.feet:
                 col.prop(foot, "target", text=foot.name)
