@@ -3,6 +3,7 @@
 // walk then goes where the file's own spacing stops it.
 #include "footfall/steps/walk_terrain.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -12,6 +13,7 @@
 
 #include <catch2/catch.hpp>
 
+#include "footfall/steps/character.h"
 #include "walk_checks.h"
 
 using namespace footfall;
@@ -180,4 +182,66 @@ TEST_CASE("PrepareWalkTerrain: a start that may move keeps its search area in th
   // Every candidate the generator may stand on lies inside (in the plane across up).
   for (const Vec3& d : {Vec3{r, 0, 0}, Vec3{-r, 0, 0}, Vec3{0, 0, r}, Vec3{0, 0, -r}})
     CHECK(Inside(moving.start + d, moving));
+}
+
+TEST_CASE("A multiped crossing a block's corner keeps its body out of the block",
+          "[steps][walk_terrain]") {
+  // A ten-legged multiped walking diagonally over the corner of a 1 m cube (an OBJ of six faces,
+  // resampled for it as footfall generate does): a body key whose nearest sample lay on a side
+  // face, which its most raise would not take it out of, was not raised (as under a roof) and
+  // stayed 3.8 cm inside.
+  const std::string path = std::string(std::getenv("TMPDIR") ? std::getenv("TMPDIR") : "/tmp") +
+                           "/footfall_cube_" + std::to_string(::getpid()) + ".obj";
+  {
+    std::ofstream out(path);
+    for (int i = 0; i < 8; ++i)
+      out << "v " << (i & 4 ? 0.5 : -0.5) << ' ' << (i & 2 ? 1 : 0) << ' ' << (i & 1 ? 0.5 : -0.5)
+          << '\n';
+    out << "f 1 2 4 3\nf 5 7 8 6\nf 1 5 6 2\nf 3 4 8 7\nf 1 3 7 5\nf 2 6 8 4\n";
+  }
+  // Ten legs in five pairs, 3 cm body, reach 40 cm.
+  std::string feet;
+  for (int i = 0; i < 5; ++i) {
+    const std::string z = std::to_string(0.24 - 0.12 * i);
+    feet += std::string(i ? "," : "") + "{\"name\": \"L" + std::to_string(i + 1) +
+            "\", \"rest\": [0.08, 0, " + z + "]}, {\"name\": \"R" + std::to_string(i + 1) +
+            "\", \"rest\": [-0.08, 0, " + z + "]}";
+  }
+  Character c;
+  std::string parse_error;
+  REQUIRE(ParseCharacter(
+              R"({"format": "footfall-character", "version": 1, "name": "centipede", "feet": [)" +
+                  feet +
+                  R"(], "gait": [["L1", "R2", "L3", "R4", "L5"], ["R1", "L2", "R3", "L4", "R5"]],
+                 "pairs": [["L1", "R1"], ["L2", "R2"], ["L3", "R3"], ["L4", "R4"], ["L5", "R5"]],
+                 "step_length": 0.08, "step_height": 0.03, "body_height": 0.03,
+                 "frames_per_step": 6, "align_to_normal": true, "slope_threshold_deg": 25,
+                 "slope_step_scale": 0.7, "max_slope_deg": 100, "max_rise": 0.06, "reach": 0.4,
+                 "max_turn_deg": 30})",
+              "centipede.json", &c, &parse_error) == Status::kOk);
+  for (const Vec3& heading : {Vec3{1, 0, 1}, Vec3{-1, 0, 1}}) {
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {0, 1, 0};
+    o.heading = heading;
+    o.steps = 60;
+    WalkTerrain prepared;
+    std::string error;
+    REQUIRE(PrepareWalkTerrain(path, TerrainLoadOptions{}, c, o, &prepared, &error) == Status::kOk);
+    Terrain t = LoadTerrain(prepared.samples, prepared.report.separation * 2 / 3);
+    const Walk w = Generate(t, c, o);
+    INFO(heading.x << ": " << w.stopped);
+    CheckWalk(t, c, o, w);
+    double deepest = 0;
+    for (const WalkTrack& track : w.tracks) {
+      if (track.kind != TrackKind::kBody) continue;
+      for (const WalkKey& k : track.keys) {
+        const Vec3& p = k.position;
+        deepest =
+            std::max(deepest, std::min({p.x + 0.5, 0.5 - p.x, p.y, 1 - p.y, p.z + 0.5, 0.5 - p.z}));
+      }
+    }
+    CHECK(deepest <= 0);
+  }
+  std::remove(path.c_str());
 }

@@ -864,9 +864,12 @@ Status Generator::KeyBodies(std::string* error) {
       const double raise =
           std::min(body_raise_[i] + std::min((need - height) / along, c_.body_height), most);
       if (raise <= body_raise_[i]) continue;
-      // Behind a plane that the most it may rise does not take it out of (a roof modelled as
-      // one face, facing up, over the body): rising would only go toward it.
-      if (height + (most - body_raise_[i]) * along < 0) continue;
+      // Behind a plane facing along its up (within 45 degrees) that the most it may rise does
+      // not take it out of (a roof modelled as one face, facing up, over the body): rising
+      // would only go toward it. (A face across its up, the side of a block whose corner the
+      // body is in, is left as rising takes the body toward the block's top: the next round
+      // judges it from there.)
+      if (along >= kAlikeCos && height + (most - body_raise_[i]) * along < 0) continue;
       body_raise_[i] = raise;
       body_still_.push_back(i);
     }
