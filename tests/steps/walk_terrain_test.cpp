@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <unistd.h>
 
@@ -244,4 +246,73 @@ TEST_CASE("A multiped crossing a block's corner keeps its body out of the block"
     CHECK(deepest <= 0);
   }
   std::remove(path.c_str());
+}
+
+TEST_CASE("A crowd whose grid runs off a slab's edge stands no two characters on one place",
+          "[steps][walk_terrain]") {
+  // 49 hexapods 0.3 apart around a corner of a closed rough slab (4 x 4 m, 20 cm thick; an OBJ
+  // resampled as footfall generate does): two places on the edge snapped apart, but their feet
+  // snapped alike, and both characters were kept, every first key identical.
+  const std::string path = std::string(std::getenv("TMPDIR") ? std::getenv("TMPDIR") : "/tmp") +
+                           "/footfall_slab_" + std::to_string(::getpid()) + ".obj";
+  {
+    constexpr int n = 48;
+    constexpr double half = 2.0, amp = 0.06;
+    auto coordinate = [](int i) { return -half + 2 * half * i / n; };
+    auto height = [](double x, double z) {
+      return amp * std::sin(3 * x) * std::cos(3 * z) +
+             0.5 * amp * std::sin(7 * x + 1) * std::sin(5 * z);
+    };
+    std::ofstream out(path);
+    out.precision(17);
+    // Vertices: the top (n + 1)^2, then the bottom (n + 1)^2; 1-based ids in the file.
+    for (int bottom = 0; bottom < 2; ++bottom)
+      for (int i = 0; i <= n; ++i)
+        for (int j = 0; j <= n; ++j) {
+          const double x = coordinate(i), z = coordinate(j);
+          out << "v " << x << ' ' << (bottom ? -0.2 : height(x, z)) << ' ' << z << '\n';
+        }
+    auto top = [](int i, int j) { return 1 + i * (n + 1) + j; };
+    auto low = [&](int i, int j) { return top(i, j) + (n + 1) * (n + 1); };
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j)
+        out << "f " << top(i, j) << ' ' << top(i, j + 1) << ' ' << top(i + 1, j + 1) << ' '
+            << top(i + 1, j) << '\n';
+    std::vector<std::pair<int, int>> ring;
+    for (int i = 0; i < n; ++i) ring.push_back({i, 0});
+    for (int j = 0; j < n; ++j) ring.push_back({n, j});
+    for (int i = n; i > 0; --i) ring.push_back({i, n});
+    for (int j = n; j > 0; --j) ring.push_back({0, j});
+    for (size_t k = 0; k < ring.size(); ++k) {
+      const auto [ai, aj] = ring[k];
+      const auto [bi, bj] = ring[(k + 1) % ring.size()];
+      out << "f " << top(ai, aj) << ' ' << top(bi, bj) << ' ' << low(bi, bj) << ' ' << low(ai, aj)
+          << '\n';
+    }
+    out << 'f';
+    for (const auto& [i, j] : ring) out << ' ' << low(i, j);
+    out << '\n';
+  }
+  const Character c = LoadShipped("hexapod");
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {1.7, 0, 1.7};
+  o.heading = {1, 0, 0};
+  o.steps = 4;
+  o.crowd = 49;
+  o.crowd_spacing = 0.3;
+  WalkTerrain prepared;
+  std::string error;
+  REQUIRE(PrepareWalkTerrain(path, TerrainLoadOptions{}, c, o, &prepared, &error) == Status::kOk);
+  std::remove(path.c_str());
+  Terrain t = LoadTerrain(prepared.samples, prepared.report.separation * 2 / 3);
+  const Walk w = Generate(t, c, o);
+  std::vector<Vec3> bodies;
+  for (const WalkTrack& track : w.tracks)
+    if (track.kind == TrackKind::kBody) bodies.push_back(track.keys.front().position);
+  CHECK(bodies.size() > 20);
+  size_t stacked = 0;
+  for (size_t i = 0; i < bodies.size(); ++i)
+    for (size_t j = i + 1; j < bodies.size(); ++j) stacked += Distance(bodies[i], bodies[j]) < 0.15;
+  CHECK(stacked == 0);
 }

@@ -763,6 +763,28 @@ Status Generator::Setup(std::string* error) {
       a.stopped = m.str(), a.stopped_step = 1;
     }
   }
+  // Feet planted where another character's are, within the terrain's gap (places on a terrain's
+  // edge whose snaps differ but whose feet snap alike): one of them is left out, as for starts.
+  std::vector<Foothold> grounds(static_cast<size_t>(n));
+  std::vector<Vec3> places(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    places[i] = first.point + offsets[i];
+    grounds[i].point = agents_[i].ground;
+    grounds[i].status = agents_[i].left_out ? Status::kNoFoothold : Status::kOk;
+  }
+  const std::vector<int> stacked =
+      CrowdedStarts(places.data(), grounds.data(), n, std::min(gap_, 0.5 * spacing));
+  for (int i = 0; i < n; ++i) {
+    Agent& a = agents_[i];
+    if (stacked[i] < 0 || a.left_out) continue;
+    std::ostringstream m;
+    m.precision(3);
+    m << "step 1 of " << a.id << ": its feet, around " << Point(a.ground) << ", stand within "
+      << Distance(a.ground, agents_[stacked[i]].ground) << " of " << agents_[stacked[i]].id
+      << "'s (the grid runs off the terrain there): left out of the walk";
+    a.walking = false, a.left_out = true;
+    a.stopped = m.str(), a.stopped_step = 1;
+  }
   return Status::kOk;
 }
 
