@@ -62,43 +62,6 @@ TEST_CASE("CropToBox: keeps exactly the triangles meeting the box, and their ver
   CHECK(whole.triangles.size() == mesh.triangles.size());
 }
 
-TEST_CASE("CropToBox: a triangle large beside the box is cut, keeping the pieces meeting it",
-          "[import][mesh]") {
-  // One 10 m triangle in the floor and a box of 0.5 m over part of it (a coarse mesh under a
-  // small character's walk): the whole triangle was kept, and sampled, far beyond the box.
-  TriangleMesh mesh;
-  mesh.vertices = {{0, 0, 0}, {0, 0, 10}, {10, 0, 0}};
-  mesh.triangles = {{0, 1, 2}};
-  const Vec3 lo{1, -0.25, 1}, hi{1.5, 0.25, 1.5};
-  TriangleMesh cropped = mesh;
-  CropToBox(&cropped, lo, hi);
-  REQUIRE(cropped.triangles.size() > 1);
-  double area = 0;
-  for (size_t t = 0; t < cropped.triangles.size(); ++t) {
-    const auto& tri = cropped.triangles[t];
-    const Vec3 &a = cropped.vertices[tri[0]], &b = cropped.vertices[tri[1]],
-               &c = cropped.vertices[tri[2]];
-    CHECK(std::max({Length(b - a), Length(c - b), Length(a - c)}) <= 0.25 * Length(hi - lo));
-    CHECK(TriangleCross(cropped, t).y > 0);  // the winding kept (facing +y as the triangle)
-    area += 0.5 * Length(TriangleCross(cropped, t));
-  }
-  CHECK(area < 0.02 * 50);  // a small part of the triangle's 50 square metres
-  // Every point of the triangle inside the box lies in a piece kept.
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> u(0, 1);
-  for (int i = 0; i < 200; ++i) {
-    const Vec3 p{lo.x + (hi.x - lo.x) * u(rng), 0, lo.z + (hi.z - lo.z) * u(rng)};
-    bool in = false;
-    for (const auto& tri : cropped.triangles) {
-      const Vec3 &a = cropped.vertices[tri[0]], &b = cropped.vertices[tri[1]],
-                 &c = cropped.vertices[tri[2]];
-      auto side = [&](const Vec3& e0, const Vec3& e1) { return Cross(e1 - e0, p - e0).y; };
-      in |= side(a, b) >= -1e-12 && side(b, c) >= -1e-12 && side(c, a) >= -1e-12;
-    }
-    CHECK(in);
-  }
-}
-
 TEST_CASE("CornerNormals: smooth across gentle edges, sharp at creases", "[import][mesh]") {
   // Two unit squares folded along their shared edge (x from 0 to 1 at z = 0): one lies in the
   // floor (normal +y), the other rises by `fold` degrees; vertices shared, as modelled.

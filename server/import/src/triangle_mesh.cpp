@@ -328,65 +328,33 @@ Vec3 NearestSurfacePoint(const TriangleMesh& mesh, const Vec3& q) {
 
 size_t CropToBox(TriangleMesh* mesh, const Vec3& lo, const Vec3& hi) {
   constexpr uint32_t kUnused = std::numeric_limits<uint32_t>::max();
-  constexpr int kMaxCuts = 12;                    // a piece is at least 4^-12 of its triangle
-  const double largest2 = Length2(hi - lo) / 16;  // a quarter of the box's diagonal, squared
   std::vector<uint32_t> renumbered(mesh->vertices.size(), kUnused);
   std::vector<Vec3> vertices;
-  std::vector<std::array<uint32_t, 3>> kept;
-  auto meets = [&](const Vec3& a, const Vec3& b, const Vec3& c) {
-    return std::max({a.x, b.x, c.x}) >= lo.x && std::max({a.y, b.y, c.y}) >= lo.y &&
-           std::max({a.z, b.z, c.z}) >= lo.z && std::min({a.x, b.x, c.x}) <= hi.x &&
-           std::min({a.y, b.y, c.y}) <= hi.y && std::min({a.z, b.z, c.z}) <= hi.z;
-  };
-  // A corner: a vertex of the mesh (kept once, renumbered in order of first use) or a new one.
-  struct Corner {
-    Vec3 at;
-    uint32_t source;  // the mesh's vertex, or kUnused for a cut's midpoint
-  };
-  auto id_of = [&](const Corner& k) {
-    if (k.source == kUnused) {
-      vertices.push_back(k.at);
-      return static_cast<uint32_t>(vertices.size() - 1);
+  size_t kept = 0;
+  for (size_t t = 0; t < mesh->triangles.size(); ++t) {
+    const auto& tri = mesh->triangles[t];
+    Vec3 tlo = mesh->vertices[tri[0]], thi = tlo;
+    for (uint32_t v : tri) {
+      const Vec3& p = mesh->vertices[v];
+      tlo = {std::min(tlo.x, p.x), std::min(tlo.y, p.y), std::min(tlo.z, p.z)};
+      thi = {std::max(thi.x, p.x), std::max(thi.y, p.y), std::max(thi.z, p.z)};
     }
-    uint32_t& id = renumbered[k.source];
-    if (id == kUnused) id = static_cast<uint32_t>(vertices.size()), vertices.push_back(k.at);
-    return id;
-  };
-  struct Piece {
-    std::array<Corner, 3> corners;
-    int cuts;
-  };
-  std::vector<Piece> pieces;
-  for (const auto& tri : mesh->triangles) {
-    pieces.clear();
-    pieces.push_back({{{{mesh->vertices[tri[0]], tri[0]},
-                        {mesh->vertices[tri[1]], tri[1]},
-                        {mesh->vertices[tri[2]], tri[2]}}},
-                      0});
-    while (!pieces.empty()) {
-      const Piece p = pieces.back();
-      pieces.pop_back();
-      const Vec3 &a = p.corners[0].at, &b = p.corners[1].at, &c = p.corners[2].at;
-      if (!meets(a, b, c)) continue;
-      const double longest2 = std::max({Length2(b - a), Length2(c - b), Length2(a - c)});
-      if (longest2 <= largest2 || p.cuts >= kMaxCuts) {
-        kept.push_back({id_of(p.corners[0]), id_of(p.corners[1]), id_of(p.corners[2])});
-        continue;
+    if (thi.x < lo.x || thi.y < lo.y || thi.z < lo.z || tlo.x > hi.x || tlo.y > hi.y ||
+        tlo.z > hi.z)
+      continue;
+    std::array<uint32_t, 3> out;
+    for (int k = 0; k < 3; ++k) {
+      uint32_t& id = renumbered[tri[k]];
+      if (id == kUnused) {
+        id = static_cast<uint32_t>(vertices.size());
+        vertices.push_back(mesh->vertices[tri[k]]);
       }
-      // Large beside the box (a coarse mesh's face under a small character's walk): cut into
-      // four at its edges' midpoints, winding kept, so that only what meets the box is sampled.
-      const Corner ab{(a + b) * 0.5, kUnused}, bc{(b + c) * 0.5, kUnused},
-          ca{(c + a) * 0.5, kUnused};
-      const int cuts = p.cuts + 1;
-      pieces.push_back({{{p.corners[0], ab, ca}}, cuts});
-      pieces.push_back({{{ab, p.corners[1], bc}}, cuts});
-      pieces.push_back({{{ca, bc, p.corners[2]}}, cuts});
-      pieces.push_back({{{ab, bc, ca}}, cuts});
+      out[k] = id;
     }
+    mesh->triangles[kept++] = out;
   }
-  const size_t before = mesh->triangles.size();
-  const size_t removed = before > kept.size() ? before - kept.size() : 0;
-  mesh->triangles.swap(kept);
+  const size_t removed = mesh->triangles.size() - kept;
+  mesh->triangles.resize(kept);
   mesh->vertices.swap(vertices);
   return removed;
 }

@@ -102,10 +102,7 @@ size_t RemoveDegenerateTriangles(TriangleMesh* mesh, double relative_epsilon = 1
 Vec3 NearestSurfacePoint(const TriangleMesh& mesh, const Vec3& q);
 
 // Keeps the triangles whose bounding box meets the box [lo, hi] and the vertices they use
-// (renumbered in order of first use). A triangle with an edge longer than a quarter of the box's
-// diagonal is first cut into four at its edges' midpoints, again while so (up to 12 times), and
-// only the pieces meeting the box are kept (their midpoints new vertices): a coarse mesh is then
-// sampled near the box only. Returns how many triangles fewer there are (0 when pieces add more).
+// (renumbered in order of first use). Returns how many triangles were removed.
 size_t CropToBox(TriangleMesh* mesh, const Vec3& lo, const Vec3& hi);
 
 }  // namespace footfall
