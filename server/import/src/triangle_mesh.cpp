@@ -92,26 +92,36 @@ MeshTurnover TurnOutward(TriangleMesh* mesh, const Vec3& up) {
   }
   // A lone edge matched the other way by a chain of lone edges through corners on it is no
   // opening: a T-junction, where a zero-area triangle was left out (a concave face's straight
-  // corner, as ear clipping leaves it).
+  // corner, as ear clipping leaves it, or a corner of one face modelled on another's edge). A
+  // corner is on the edge when the triangle it makes with the edge is degenerate as
+  // IsDegenerateTriangle judges it, its height at most kOnEdge of the edge (coordinates written
+  // with six decimals, as most exporters write them, put a modelled corner that far off). A
+  // corner with more than kMaxLoneOut lone edges leaving it (a hub of an open fan) is passed
+  // through by none, which keeps the search linear.
+  constexpr size_t kMaxLoneOut = 8;
+  constexpr double kOnEdge = 1e-5;
   std::vector<uint8_t> matched(lone.size(), 0);
   auto from = [&](uint32_t v) {  // the lone edges starting at v
     return std::equal_range(lone.begin(), lone.end(), uint64_t{v} << 32,
                             [](uint64_t x, uint64_t y) { return (x >> 32) < (y >> 32); });
   };
+  std::vector<size_t> chain;
   for (size_t i = 0; i < lone.size(); ++i) {
     const uint32_t a = static_cast<uint32_t>(lone[i] >> 32), b = static_cast<uint32_t>(lone[i]);
-    const Vec3 ab = mesh->vertices[b] - mesh->vertices[a];
-    const double length2 = Length2(ab);
-    std::vector<size_t> chain;
-    for (uint32_t at = b; at != a && chain.size() < 64;) {
+    const Vec3 &pa = mesh->vertices[a], &pb = mesh->vertices[b];
+    const Vec3 ab = pb - pa;
+    chain.clear();
+    // Each step goes to a corner strictly nearer a along the edge: the chain cannot loop.
+    for (uint32_t at = b; at != a;) {
+      const auto [first, last] = from(at);
+      if (static_cast<size_t>(last - first) > kMaxLoneOut) break;
       bool stepped = false;
-      for (auto [it, end] = from(at); it != end && !stepped; ++it) {
+      for (auto it = first; it != last && !stepped; ++it) {
         const uint32_t next = static_cast<uint32_t>(*it);
-        const Vec3 am = mesh->vertices[next] - mesh->vertices[a];
-        const double along = Dot(am, ab);
+        const Vec3& pn = mesh->vertices[next];
         const bool on =
-            next == a || (Length2(Cross(ab, am)) <= 1e-18 * length2 * length2 && along > 0 &&
-                          along < Dot(mesh->vertices[at] - mesh->vertices[a], ab));
+            next == a || (IsDegenerateTriangle(pa, pn, pb, kOnEdge) && Dot(pn - pa, ab) > 0 &&
+                          Dot(pn - pa, ab) < Dot(mesh->vertices[at] - pa, ab));
         if (on) chain.push_back(static_cast<size_t>(it - lone.begin())), at = next, stepped = true;
       }
       if (!stepped) break;
