@@ -763,8 +763,9 @@ Status Generator::Setup(std::string* error) {
       a.stopped = m.str(), a.stopped_step = 1;
     }
   }
-  // Feet planted where another character's are, within the terrain's gap (places on a terrain's
-  // edge whose snaps differ but whose feet snap alike): one of them is left out, as for starts.
+  // Feet planted exactly where another character's are (places on a terrain's edge whose snaps
+  // differ but whose feet snap alike): one of them is left out, as for starts. (Within the gap,
+  // characters stopped at step 1 kept neighbours that would have stood apart off.)
   std::vector<Foothold> grounds(static_cast<size_t>(n));
   std::vector<Vec3> places(static_cast<size_t>(n));
   for (int i = 0; i < n; ++i) {
@@ -772,8 +773,7 @@ Status Generator::Setup(std::string* error) {
     grounds[i].point = agents_[i].ground;
     grounds[i].status = agents_[i].left_out ? Status::kNoFoothold : Status::kOk;
   }
-  const std::vector<int> stacked =
-      CrowdedStarts(places.data(), grounds.data(), n, std::min(gap_, 0.5 * spacing));
+  const std::vector<int> stacked = CrowdedStarts(places.data(), grounds.data(), n, 1e-9 * spacing);
   for (int i = 0; i < n; ++i) {
     Agent& a = agents_[i];
     if (stacked[i] < 0 || a.left_out) continue;
