@@ -62,9 +62,9 @@ struct MeshTurnover {
 // Turns the faces of a mesh wound the wrong way over (reverses their winding), so that normals
 // face out of each closed shell (a connected part whose every edge is used once in each
 // direction, or matched the other way by a chain of edges through corners on it within 1e-5 of
-// its length, a T-junction: turned when the volume it encloses is negative) and up out of the open parts, a
-// terrain: turned, all together, when the component along `up` of their area-weighted normals
-// sums to less than -1/4 of their area (they face down, a steep flight of stairs' treads
+// its length, a T-junction: turned when the volume it encloses is negative) and up out of the open
+// parts, a terrain: turned, all together, when the component along `up` of their area-weighted
+// normals sums to less than -1/4 of their area (they face down, a steep flight of stairs' treads
 // included; rooms, caves and walls, whose faces face every way, are left alone). A closed room
 // modelled facing in cannot be told from an inside-out box: it is turned over.
 MeshTurnover TurnOutward(TriangleMesh* mesh, const Vec3& up);
