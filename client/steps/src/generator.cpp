@@ -778,10 +778,9 @@ Status Generator::Setup(std::string* error) {
     Agent& a = agents_[i];
     if (stacked[i] < 0 || a.left_out) continue;
     std::ostringstream m;
-    m.precision(3);
-    m << "step 1 of " << a.id << ": its feet, around " << Point(a.ground) << ", stand within "
-      << Distance(a.ground, agents_[stacked[i]].ground) << " of " << agents_[stacked[i]].id
-      << "'s (the grid runs off the terrain there): left out of the walk";
+    m << "step 1 of " << a.id << ": its feet, around " << Point(a.ground) << ", stand where "
+      << agents_[stacked[i]].id
+      << "'s do (the grid runs off the terrain there): left out of the walk";
     a.walking = false, a.left_out = true;
     a.stopped = m.str(), a.stopped_step = 1;
   }
