@@ -87,6 +87,16 @@ def body_rotation_keys(obj):
             for f, v in fcurve_keys(obj, "rotation_euler", 3).items()}
 
 
+def new_empty(name, parent=None, location=None):
+    """An empty linked to the current scene, under `parent`, at `location` (local)."""
+    obj = bpy.data.objects.new(name, None)
+    bpy.context.scene.collection.objects.link(obj)
+    obj.parent = parent
+    if location is not None:
+        obj.location = location
+    return obj
+
+
 def clear_animation(objects):
     for obj in objects:
         if obj.animation_data:
@@ -399,8 +409,7 @@ class BlenderAddonTest(unittest.TestCase):
         # frames the feet were up to a metre off the walk.
         scene = bpy.context.scene
         scene.frame_set(1)
-        control = bpy.data.objects.new("mover_control", None)
-        scene.collection.objects.link(control)
+        control = new_empty("mover_control")
         control.keyframe_insert("location", frame=1)
         control.keyframe_insert("rotation_euler", frame=1)
         control.location = (1.0, 0.5, 0.3)
@@ -408,10 +417,7 @@ class BlenderAddonTest(unittest.TestCase):
         control.keyframe_insert("location", frame=100)
         control.keyframe_insert("rotation_euler", frame=100)
         scene.frame_set(1)
-        body = bpy.data.objects.new("mover_body", None)
-        scene.collection.objects.link(body)
-        body.parent = control
-        body.location = (2.5, -3.5, 1.0)
+        body = new_empty("mover_body", control, (2.5, -3.5, 1.0))
         body.rotation_euler = (0.0, 0.0, math.pi)  # faces +Y
         targets = []
         for name, x in (("L", 2.62), ("R", 2.38)):
@@ -648,16 +654,12 @@ class BlenderAddonTest(unittest.TestCase):
         # from where the body's new keys changed its curve, with the same keys to the bit.
         scene = bpy.context.scene
         scene.frame_set(1)
-        control = bpy.data.objects.new("stepper_control", None)
-        scene.collection.objects.link(control)
+        control = new_empty("stepper_control")
         control.keyframe_insert("location", frame=1)
         control.location = (0.2, 0.3, 0.05)
         control.keyframe_insert("location", frame=150)
         scene.frame_set(1)
-        body = bpy.data.objects.new("stepper_body", None)
-        scene.collection.objects.link(body)
-        body.parent = control
-        body.location = (-1.0, -4.3, 1.0)
+        body = new_empty("stepper_body", control, (-1.0, -4.3, 1.0))
         body.rotation_euler = (0.0, 0.0, math.pi)  # faces +Y
         targets = []
         for name, x in (("L", 0.12), ("R", -0.12)):

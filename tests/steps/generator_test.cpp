@@ -396,10 +396,7 @@ TEST_CASE("A foot whose swing arc cannot clear takes its next foothold instead",
     doubled.push_back(lattice.points[i], lattice.normals[i]);
   Terrain t = LoadTerrain(doubled, 0.03);
   const Character c = LoadShipped("quadruped");
-  GenerateOptions o;
-  o.has_start = true;
-  o.start = {0.75, 0, 0.1};
-  o.steps = 40;
+  const GenerateOptions o = StartOptions({0.75, 0, 0.1}, 40);
   const Walk w = Generate(t, c, o);
   INFO(w.stopped);
   CheckWalk(t, c, o, w);
@@ -627,10 +624,7 @@ TEST_CASE("An upright body walks on under a roof above it, neither stopped nor r
   // raised the body toward it.
   const Character c = LoadShipped("biped");
   Terrain t = LoadTerrain(FloorAndSlab(1.6, 1.6, false), 0.04);
-  GenerateOptions o;
-  o.has_start = true;
-  o.start = {1.5, 0, 1.5};
-  o.steps = 8;
+  const GenerateOptions o = StartOptions({1.5, 0, 1.5}, 8);
   const Walk w = Generate(t, c, o);
   INFO(w.stopped);
   CheckWalk(t, c, o, w);
