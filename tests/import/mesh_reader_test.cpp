@@ -570,6 +570,25 @@ TEST_CASE("ReadMesh: a face wound against its neighbours is turned to match them
   // The cube, wound consistently, turns none.
   REQUIRE(Read(dir.Write("cube.obj", kCubeObj), &mesh, &error, &report) == Status::kOk);
   CHECK(report.turned_faces == 0);
+  // The same floor as a soup, each quad with its own copies of its corners (as split normals or
+  // texture seams export it): its faces meet where their corners coincide.
+  std::string soup;
+  int corners = 0;
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      int x[4] = {i, i, i + 1, i + 1}, z[4] = {j, j + 1, j + 1, j};
+      if (i * n + j == 55) std::reverse(x, x + 4), std::reverse(z, z + 4);
+      for (int k = 0; k < 4; ++k)
+        soup += "v " + std::to_string(x[k]) + " 0 " + std::to_string(z[k]) + "\n";
+      soup += "f " + std::to_string(corners + 1) + " " + std::to_string(corners + 2) + " " +
+              std::to_string(corners + 3) + " " + std::to_string(corners + 4) + "\n";
+      corners += 4;
+    }
+  }
+  REQUIRE(Read(dir.Write("soup.obj", soup), &mesh, &error, &report) == Status::kOk);
+  CHECK(report.vertices == 400);
+  CHECK(report.turned_faces == 1);
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) CHECK(TriangleCross(mesh, t).y > 0);
 }
 
 }  // namespace footfall

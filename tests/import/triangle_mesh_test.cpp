@@ -149,6 +149,36 @@ TEST_CASE("TurnOutward: inside-out and downward meshes are turned over, others l
   CHECK(TurnOutward(&rocks, Vec3{0, 0, 1}).turned_faces == 0);
 }
 
+TEST_CASE("TurnOutward: a closed soup, its corners split per face, is one closed shell",
+          "[import][mesh]") {
+  // Each triangle with its own copies of its corners (an STL-like soup, or a mesh exported with
+  // split normals): taken vertex by vertex it has no closed part, and an inside-out one kept
+  // its inward normals.
+  TriangleMesh sphere = MakeSphereMesh({1, 2, 3}, 2.0, 2), soup;
+  for (const auto& tri : sphere.triangles) {
+    const uint32_t first = static_cast<uint32_t>(soup.vertices.size());
+    for (uint32_t v : tri) soup.vertices.push_back(sphere.vertices[v]);
+    soup.triangles.push_back({first, first + 1, first + 2});
+  }
+  TriangleMesh as_is = soup;
+  const MeshTurnover kept = TurnOutward(&as_is, {0, 1, 0});
+  CHECK(kept.closed_shells == 1);
+  CHECK(kept.turned_faces == 0);
+  for (auto& tri : soup.triangles) std::swap(tri[1], tri[2]);
+  const MeshTurnover t = TurnOutward(&soup, {0, 1, 0});
+  CHECK(t.closed_shells == 1);
+  CHECK(t.inside_out_shells == 1);
+  CHECK(t.turned_faces == soup.triangles.size());
+  for (size_t i = 0; i < soup.triangles.size(); ++i)
+    CHECK(Distance(TriangleCross(soup, i), TriangleCross(as_is, i)) < 1e-12);
+}
+
+TEST_CASE("CoincidentVertexIds: the lowest index at each position", "[import][mesh]") {
+  const std::vector<Vec3> v = {{1, 0, 0}, {0, 0, 0}, {1, 0, 0}, {0, 0, -0.0}, {2, 0, 0}};
+  CHECK(CoincidentVertexIds(v) == std::vector<uint32_t>{0, 1, 0, 1, 4});
+  CHECK(CoincidentVertexIds({}).empty());
+}
+
 TEST_CASE("TurnOutward: a shell closed but for a T-junction is closed", "[import][mesh]") {
   // A unit cube whose top has a corner at the middle of its front edge, which the front face
   // does not have: the zero-area triangle ear clipping leaves at a concave face's straight

@@ -129,9 +129,11 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
 
   // 2. Faces wound against their neighbours are turned to match them: across an edge of two
   // faces, one goes a -> b and the other b -> a. In each connected sheet the winding of most of
-  // its faces is kept (a sheet that cannot be wound consistently is left as it is).
+  // its faces is kept (a sheet that cannot be wound consistently is left as it is). Faces meet
+  // where their corners are at the same position, as in a soup's or a split mesh's faces.
   size_t turned = 0;
   {
+    const std::vector<uint32_t> id = CoincidentVertexIds(parsed.vertices);
     struct Side {
       uint64_t edge;  // the lower vertex << 32 | the higher
       uint32_t face;
@@ -143,7 +145,8 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
       if (!used[f]) continue;
       const auto [c, n] = corners_of(f);
       for (size_t k = 0; k < n; ++k) {
-        const uint64_t a = c[k], b = c[(k + 1) % n];
+        const uint64_t a = id[c[k]], b = id[c[(k + 1) % n]];
+        if (a == b) continue;
         sides.push_back({std::min(a, b) << 32 | std::max(a, b), static_cast<uint32_t>(f), a < b});
       }
     }

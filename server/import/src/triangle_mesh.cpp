@@ -61,10 +61,31 @@ std::array<Vec3, 3> CornerNormals::Of(size_t t) const {
   return out;
 }
 
+std::vector<uint32_t> CoincidentVertexIds(const std::vector<Vec3>& vertices) {
+  std::vector<uint32_t> order(vertices.size()), id(vertices.size());
+  for (uint32_t v = 0; v < order.size(); ++v) order[v] = v;
+  auto less = [&](uint32_t a, uint32_t b) {
+    const Vec3 &p = vertices[a], &q = vertices[b];
+    if (p.x != q.x) return p.x < q.x;
+    if (p.y != q.y) return p.y < q.y;
+    if (p.z != q.z) return p.z < q.z;
+    return a < b;
+  };
+  std::sort(order.begin(), order.end(), less);
+  for (size_t i = 0; i < order.size(); ++i) {
+    const bool same = i > 0 && vertices[order[i]] == vertices[order[i - 1]];
+    id[order[i]] = same ? id[order[i - 1]] : order[i];
+  }
+  return id;
+}
+
 MeshTurnover TurnOutward(TriangleMesh* mesh, const Vec3& up) {
   MeshTurnover out;
   const size_t n = mesh->triangles.size();
   if (n == 0) return out;
+  // The topology by position: a soup's faces meet where their corners coincide.
+  const std::vector<uint32_t> id = CoincidentVertexIds(mesh->vertices);
+  auto corner = [&](const std::array<uint32_t, 3>& tri, int k) { return id[tri[k]]; };
   // Connected parts: triangles sharing a vertex (union-find over vertices).
   std::vector<uint32_t> parent(mesh->vertices.size());
   for (uint32_t v = 0; v < parent.size(); ++v) parent[v] = v;
@@ -73,9 +94,9 @@ MeshTurnover TurnOutward(TriangleMesh* mesh, const Vec3& up) {
     return v;
   };
   for (const auto& tri : mesh->triangles) {
-    const uint32_t a = root(tri[0]);
+    const uint32_t a = root(corner(tri, 0));
     for (int k = 1; k < 3; ++k) {
-      const uint32_t b = root(tri[k]);
+      const uint32_t b = root(corner(tri, k));
       if (a != b) parent[b] = a;
     }
   }
@@ -83,7 +104,8 @@ MeshTurnover TurnOutward(TriangleMesh* mesh, const Vec3& up) {
   std::vector<uint64_t> edges;
   edges.reserve(3 * n);
   for (const auto& tri : mesh->triangles)
-    for (int k = 0; k < 3; ++k) edges.push_back(uint64_t{tri[k]} << 32 | tri[(k + 1) % 3]);
+    for (int k = 0; k < 3; ++k)
+      edges.push_back(uint64_t{corner(tri, k)} << 32 | corner(tri, (k + 1) % 3));
   std::sort(edges.begin(), edges.end());
   std::vector<uint64_t> lone;  // edges without their twin
   for (const uint64_t e : edges) {
@@ -142,7 +164,7 @@ MeshTurnover TurnOutward(TriangleMesh* mesh, const Vec3& up) {
   double open_area = 0;
   for (size_t t = 0; t < n; ++t) {
     const auto& tri = mesh->triangles[t];
-    const uint32_t r = root(tri[0]);
+    const uint32_t r = root(corner(tri, 0));
     if (open[r]) {
       const Vec3 c = TriangleCross(*mesh, t);
       open_sum += c, open_area += Length(c), ++out.open_faces;
@@ -157,7 +179,7 @@ MeshTurnover TurnOutward(TriangleMesh* mesh, const Vec3& up) {
     if (counted[v] && volume[v] < 0) ++out.inside_out_shells;
   out.open_faced_down = open_area > 0 && Dot(open_sum, up) < -0.25 * open_area * Length(up);
   for (auto& tri : mesh->triangles) {
-    const uint32_t r = root(tri[0]);
+    const uint32_t r = root(corner(tri, 0));
     if (open[r] ? out.open_faced_down : volume[r] < 0)
       std::swap(tri[1], tri[2]), ++out.turned_faces;
   }

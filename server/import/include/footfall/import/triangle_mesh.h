@@ -50,6 +50,11 @@ class CornerNormals {
   std::vector<uint32_t> around_;  // the triangles using each vertex
 };
 
+// For each vertex, the lowest index of a vertex at exactly the same position: the mesh's
+// topology when vertices are split at seams (a triangle soup, or a mesh exported with its faces'
+// own copies of their corners, as split normals or texture seams leave it). O(n log n).
+std::vector<uint32_t> CoincidentVertexIds(const std::vector<Vec3>& vertices);
+
 // What TurnOutward turned over.
 struct MeshTurnover {
   size_t closed_shells = 0;      // connected parts that are closed
@@ -60,7 +65,8 @@ struct MeshTurnover {
 };
 
 // Turns the faces of a mesh wound the wrong way over (reverses their winding), so that normals
-// face out of each closed shell (a connected part whose every edge is used once in each
+// face out of each closed shell (a connected part, vertices at the same position joined as in
+// CoincidentVertexIds, whose every edge is used once in each
 // direction, or matched the other way by a chain of edges through corners on it within 1e-5 of
 // its length, a T-junction: turned when the volume it encloses is negative) and up out of the open
 // parts, a terrain: turned, all together, when the component along `up` of their area-weighted
