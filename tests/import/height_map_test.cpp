@@ -100,6 +100,21 @@ TEST_CASE("Height maps: bad files give clear errors", "[import][heightmap]") {
   CHECK(ReadPgm(dir.Write("magic.pgm", "P6 1 1 255\nabc"), &map, &error) == Status::kParseError);
   CHECK(Contains(error, "magic.pgm:1: expected the PGM magic"));
   CHECK(ReadPgm(dir.File("absent.pgm"), &map, &error) == Status::kIoError);
+  // Grey levels are whole numbers.
+  CHECK(ReadPgm(dir.Write("half.pgm", "P2 2 1 255\n1 1.5\n"), &map, &error) == Status::kParseError);
+  CHECK(Contains(error, "half.pgm:2: grey level '1.5' is not a whole number from 0 to maxval"));
+  // A file that does not start as its format does is refused before it is read whole (a 2 GB
+  // file of NUL bytes took 2 GB to say "out of memory").
+  CHECK(ReadAscGrid(dir.Write("nul.asc", std::string(4096, '\0')), &map, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error,
+                 "nul.asc:1: expected the grid header's first key ('ncols N'), found no "
+                 "word within its first 256 bytes"));
+  CHECK(ReadAscGrid(dir.Write("num.asc", "1 2 3\n"), &map, &error) == Status::kParseError);
+  CHECK(Contains(error, "num.asc:1: expected the grid header's first key ('ncols N'), found '1'"));
+  CHECK(ReadPgm(dir.Write("nul.pgm", std::string(4096, '\0')), &map, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error, "nul.pgm:1: expected the PGM magic"));
 }
 
 TEST_CASE("Height maps far taller than their cells are refused before they are cut",

@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "footfall/import/terrain_loader.h"
+#include "footfall/terrain/input_file.h"
 #include "test_support.h"
 
 namespace footfall {
@@ -160,6 +161,40 @@ TEST_CASE("ReadMesh: bad meshes give clear errors", "[import][mesh]") {
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n";
     CHECK(Read(dir.Write("fin.obj", obj), &mesh, &error) == Status::kParseError);
     CHECK(Contains(error, "fin.obj: the mesh is not manifold"));
+  }
+  SECTION("records beyond the declared counts") {
+    // Declaring 2 faces and holding 4 loaded half the area without a word.
+    CHECK(Read(dir.Write("more.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 2 1\n"), &mesh,
+               &error) == Status::kParseError);
+    CHECK(
+        Contains(error, "more.off:7: a line after the 3 vertices and 1 faces the counts declare"));
+    const std::string ply =
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+        "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n\n3 0 2 1\n";
+    CHECK(Read(dir.Write("more.ply", ply), &mesh, &error) == Status::kParseError);
+    CHECK(Contains(error, "more.ply:15: a record after the 4 the header declares"));
+  }
+  SECTION("a line longer than 1 MiB") {
+    CHECK(Read(dir.Write("long.obj", "v 0 0 0\n" + std::string(kMaxLineBytes + 1, '\0')), &mesh,
+               &error) == Status::kParseError);
+    CHECK(Contains(error, "long.obj:2: line longer than 1 MiB"));
+    CHECK(Read(dir.Write("long.off", "OFF\n" + std::string(kMaxLineBytes + 1, 'x')), &mesh,
+               &error) == Status::kParseError);
+    CHECK(Contains(error, "long.off:2: line longer than 1 MiB"));
+    CHECK(Read(dir.Write("long.stl", "solid x\n" + std::string(kMaxLineBytes + 1, 'x')), &mesh,
+               &error) == Status::kParseError);
+    CHECK(Contains(error, "long.stl:2: line longer than 1 MiB"));
+  }
+  SECTION("a binary STL whose header begins with 'solid', cut short") {
+    std::string stl = "solid exported" + std::string(66, ' ');
+    const uint32_t count = 2;
+    stl.append(reinterpret_cast<const char*>(&count), 4);
+    stl.append(50 + 40, '\0');  // a facet and most of another
+    CHECK(Read(dir.Write("cut.stl", stl), &mesh, &error) == Status::kParseError);
+    CHECK(Contains(error,
+                   "cut.stl: truncated: binary STL declares 2 triangles (184 bytes), the "
+                   "file has 174 bytes"));
   }
   SECTION("NaN vertex") {
     CHECK(Read(dir.Write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"), &mesh, &error) ==
@@ -525,6 +560,27 @@ TEST_CASE("ReadMesh: small faces far apart are kept", "[import][mesh]") {
 }  // namespace footfall
 
 namespace footfall {
+
+TEST_CASE("ReadMesh: a face listed twice is read once", "[import][mesh]") {
+  // Listed again the other way round, it doubled the area and, turned to match, half the
+  // samples faced down; in a larger mesh its edges made the mesh non-manifold.
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  MeshReadReport report;
+  const std::string obj = "v 0 0 0\nv 0 0 1\nv 1 0 0\nv 1 0 1\nf 1 2 3\nf 3 2 4\nf 3 2 1\n";
+  REQUIRE(Read(dir.Write("twice.obj", obj), &mesh, &error, &report) == Status::kOk);
+  CHECK(report.faces == 3);
+  CHECK(report.skipped_faces == 1);
+  CHECK(SurfaceArea(mesh) == Approx(1));
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) CHECK(TriangleCross(mesh, t).y > 0);
+  // Corners at the same position count as the same (a soup's face listed again).
+  const std::string soup =
+      "v 0 0 0\nv 0 0 1\nv 1 0 0\nv 1 0 0\nv 0 0 1\nv 0 0 0\nf 1 2 3\nf 4 5 6\n";
+  REQUIRE(Read(dir.Write("soup_twice.obj", soup), &mesh, &error, &report) == Status::kOk);
+  CHECK(report.skipped_faces == 1);
+  CHECK(SurfaceArea(mesh) == Approx(0.5));
+}
 
 TEST_CASE("ReadMesh: a concave polygon covers only itself", "[import][mesh]") {
   test::TempDir dir;

@@ -12,6 +12,8 @@
 
 #include "footfall/terrain/point_file.h"
 
+#include "footfall/terrain/input_file.h"
+
 using namespace footfall;
 
 namespace {
@@ -112,6 +114,18 @@ TEST_CASE("ReadPointStream rejects bad lines with file and line", "[terrain][poi
   SECTION("zero normal") {
     CHECK(Read("0 0 0 0 0 0\n", &s, &error) == Status::kParseError);
     CHECK(error == "t.pts:1: normal has zero length (expected a non-zero nx ny nz)");
+  }
+  SECTION("a line longer than 1 MiB") {
+    // A file of NUL bytes, or without line breaks, was read whole into one line (2 to 5 times
+    // its size in memory, "out of memory" or "read error" for large ones).
+    CHECK(Read("0 0 0 0 1 0\n" + std::string(kMaxLineBytes + 1, '\0') + "\n", &s, &error) ==
+          Status::kParseError);
+    CHECK(error == "t.pts:2: line longer than 1 MiB (expected x y z nx ny nz)");
+    // A line of exactly the limit is read (and judged on its numbers).
+    CHECK(Read("0 0 0 0 1 0" + std::string(kMaxLineBytes - 11, ' ') + "\n1 1 1 0 1 0", &s,
+               &error) == Status::kOk);
+    CHECK(s.size() == 2);
+    s.clear();
   }
   CHECK(s.size() == 0);
 }

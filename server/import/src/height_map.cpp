@@ -75,13 +75,41 @@ class TokenReader {
   size_t pos_ = 0, line_ = 1;
 };
 
-Status ReadWhole(const std::string& path, std::string* text, std::string* error) {
+// The first word of a text file (after a byte order mark and white space), if it ends within
+// its first 256 bytes; else "".
+std::string FirstWord(std::istream& in) {
+  char start[256];
+  in.read(start, sizeof start);
+  std::string head(start, static_cast<size_t>(in.gcount()));
+  in.clear();
+  in.seekg(0);
+  if (head.compare(0, 3, "\xEF\xBB\xBF") == 0) head.erase(0, 3);
+  const size_t begin = head.find_first_not_of(" \t\r\n");
+  if (begin == std::string::npos) return "";
+  const size_t end = head.find_first_of(" \t\r\n", begin);
+  if (end == std::string::npos && head.size() == sizeof start) return "";
+  return head.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
+}
+
+// Reads the file whole, once its first word is one `starts_ok` accepts (a file of NUL bytes or
+// without line breaks is refused before it is read; `expected` says what should start it).
+template <typename StartsOk>
+Status ReadWhole(const std::string& path, std::string* text, std::string* error,
+                 const StartsOk& starts_ok, const char* expected) {
   errno = 0;
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     if (error) *error = path + ": cannot open: " + std::strerror(errno ? errno : EIO);
     return Status::kIoError;
   }
+  const std::string word = FirstWord(in);
+  if (in.peek() != std::char_traits<char>::eof() && !starts_ok(word)) {
+    const std::string found =
+        word.empty() ? "no word within its first 256 bytes" : "'" + ShownText(word) + "'";
+    return Fail(path + ":1", std::string("expected ") + expected + ", found " + found, error);
+  }
+  in.clear();
+  in.seekg(0);
   text->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   if (text->compare(0, 3, "\xEF\xBB\xBF") == 0) text->erase(0, 3);  // UTF-8 byte order mark
   if (text->empty()) return Fail(path, "the file is empty, expected a height map", error);
@@ -151,7 +179,11 @@ size_t HeightMap::ValidCount() const {
 Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) {
   *out = HeightMap{};
   std::string text;
-  Status status = ReadWhole(path, &text, error);
+  auto header_word = [](const std::string& word) {
+    return !word.empty() && std::isalpha(static_cast<unsigned char>(word[0])) != 0;
+  };
+  Status status =
+      ReadWhole(path, &text, error, header_word, "the grid header's first key ('ncols N')");
   if (status != Status::kOk) return status;
   TokenReader reader(text, false);
   std::string key, value;
@@ -253,7 +285,11 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
 Status ReadPgm(const std::string& path, HeightMap* out, std::string* error) {
   *out = HeightMap{};
   std::string text;
-  Status status = ReadWhole(path, &text, error);
+  auto magic_word = [](const std::string& word) {
+    return word.compare(0, 2, "P5") == 0 || word.compare(0, 2, "P2") == 0;
+  };
+  Status status =
+      ReadWhole(path, &text, error, magic_word, "the PGM magic 'P5' (binary) or 'P2' (ASCII)");
   if (status != Status::kOk) return status;
   TokenReader reader(text, true);
   std::string magic, token;
@@ -326,9 +362,10 @@ Status ReadPgm(const std::string& path, HeightMap* out, std::string* error) {
                       std::to_string(i),
                   error);
     }
-    if (!ParseDouble(token, &h) || h < 0 || h > fields[2]) {
+    if (!ParseDouble(token, &h) || h < 0 || h > fields[2] || h != std::floor(h)) {
       return Fail(path + ":" + std::to_string(reader.line()),
-                  "grey level '" + ShownText(token) + "' is not a number from 0 to maxval", error);
+                  "grey level '" + ShownText(token) + "' is not a whole number from 0 to maxval",
+                  error);
     }
     out->heights[i] = h;
   }

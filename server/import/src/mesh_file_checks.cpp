@@ -14,6 +14,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "footfall/terrain/input_file.h"
 #include "footfall/terrain/samples.h"
 #include "footfall/terrain/shown_text.h"
 
@@ -26,6 +27,12 @@ Status Fail(const std::string& where, const std::string& what, std::string* erro
 }
 
 std::string At(const std::string& path, size_t line) { return path + ":" + std::to_string(line); }
+
+// The error for a line of a text mesh longer than kMaxLineBytes.
+Status TooLongLine(const std::string& path, const LineReader& lines, std::string* error) {
+  return Fail(At(path, lines.line_number()), LineReader::TooLongMessage("the lines of a text mesh"),
+              error);
+}
 
 // Reads binary PLY values of a named type, in the file's byte order, through a buffer.
 class PlyValues {
@@ -158,9 +165,10 @@ Status ParseObjFile(const std::string& path, ParsedMesh* out, std::string* error
   const Status start = CheckTextStart(path, error);
   if (start != Status::kOk) return start;
   std::ifstream in(path);
+  LineReader lines(in);
   std::string line;
   long long vertices = 0;
-  for (size_t number = 1; std::getline(in, line); ++number) {
+  for (size_t number = 1; lines.Next(&line); ++number) {
     const std::vector<std::string> t = Tokens(StripComment(line));
     if (t.empty()) continue;
     if (t[0] == "v") {
@@ -203,20 +211,22 @@ Status ParseObjFile(const std::string& path, ParsedMesh* out, std::string* error
       out->EndFace(number);
     }
   }
+  if (lines.too_long()) return TooLongLine(path, lines, error);
   return Status::kOk;
 }
 
-Status ParseOffFile(const std::string& path, ParsedMesh* out, std::string* error) {
-  const Status start = CheckTextStart(path, error);
-  if (start != Status::kOk) return start;
-  std::ifstream in(path);
+namespace {
+
+// ParseOffFile on the file's lines.
+Status ParseOffLines(const std::string& path, LineReader& lines, ParsedMesh* out,
+                     std::string* error) {
   std::string line;
   size_t number = 0;
   // The next non-blank line's tokens, or false at the end of the file. OpenMesh's OFF reader
   // skips no comments (it read none of the vertices, or faces of vertices that do not exist).
   size_t comment = 0;  // the first line with a '#'
   auto next = [&](std::vector<std::string>* tokens) {
-    while (std::getline(in, line)) {
+    while (lines.Next(&line)) {
       ++number;
       if (comment == 0 && line.find('#') != std::string::npos) comment = number;
       *tokens = Tokens(StripComment(line));
@@ -322,6 +332,12 @@ Status ParseOffFile(const std::string& path, ParsedMesh* out, std::string* error
     }
     out->EndFace(number);
   }
+  if (next(&t)) {
+    return Fail(At(path, number),
+                "a line after the " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
+                    " faces the counts declare (expected the end of the file)",
+                error);
+  }
   if (comment != 0) {
     return Fail(At(path, comment),
                 "a '#' comment, which footfall's OFF reader does not read: remove it", error);
@@ -329,11 +345,23 @@ Status ParseOffFile(const std::string& path, ParsedMesh* out, std::string* error
   return Status::kOk;
 }
 
+}  // namespace
+
+Status ParseOffFile(const std::string& path, ParsedMesh* out, std::string* error) {
+  const Status start = CheckTextStart(path, error);
+  if (start != Status::kOk) return start;
+  std::ifstream in(path);
+  LineReader lines(in);
+  const Status status = ParseOffLines(path, lines, out, error);
+  return lines.too_long() ? TooLongLine(path, lines, error) : status;
+}
+
 Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error) {
   std::ifstream in(path, std::ios::binary);
+  LineReader lines(in);
   std::string line;
   size_t number = 0;
-  if (!std::getline(in, line) || StripComment(line) != "ply") {
+  if (!lines.Next(&line) || StripComment(line) != "ply") {
     return Fail(At(path, 1), "expected the header line 'ply'", error);
   }
   number = 1;
@@ -351,7 +379,7 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
   std::string format;
   const auto type_size = PlyValues::SizeOf;
   bool ended = false;
-  while (std::getline(in, line)) {
+  while (lines.Next(&line)) {
     ++number;
     const std::vector<std::string> t = Tokens(StripComment(line));
     if (t.empty() || t[0] == "comment" || t[0] == "obj_info") continue;
@@ -397,6 +425,7 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
       }
     }
   }
+  if (lines.too_long()) return TooLongLine(path, lines, error);
   if (!ended) return Fail(path, "truncated: the PLY header has no 'end_header'", error);
   // The vertices' x, y, z and the faces' index lists, in whatever order the elements come.
   long long vertices = 0;
@@ -427,14 +456,19 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
     long long found = 0;
     size_t element = 0;
     long long in_element = 0;
-    while (std::getline(in, line)) {
+    while (lines.Next(&line)) {
       ++number;
       const std::vector<std::string> t = Tokens(line);
       if (t.empty()) continue;
       ++found;
       while (element < elements.size() && in_element >= elements[element].count)
         ++element, in_element = 0;
-      if (element >= elements.size()) continue;  // extra lines after the last element: ignored
+      if (element >= elements.size()) {
+        return Fail(At(path, number),
+                    "a record after the " + std::to_string(records) +
+                        " the header declares (expected the end of the file)",
+                    error);
+      }
       ++in_element;
       const Element& e = elements[element];
       size_t at = 0;
@@ -497,6 +531,7 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
       if (e.name == "vertex") out->vertices.push_back(point);
       if (face) out->EndFace(number);
     }
+    if (lines.too_long()) return TooLongLine(path, lines, error);
     if (found < records) {
       return Fail(path,
                   "truncated: the header declares " + std::to_string(records) +
@@ -658,7 +693,17 @@ Status ParseStlFile(const std::string& path, ParsedMesh* out, std::string* error
                 "binary otherwise)",
                 error);
   }
-  if (head.compare(0, 5, "solid") != 0) {
+  // Binary bytes (NUL or other control bytes) in the first facet: a binary STL, even when its
+  // header begins with 'solid', as some exporters write it.
+  std::string first(static_cast<size_t>(std::min<long long>(size, 84 + 50)), '\0');
+  in.clear();
+  in.seekg(0);
+  in.read(&first[0], static_cast<std::streamsize>(first.size()));
+  const bool binary_bytes = std::any_of(first.begin(), first.end(), [](char c) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    return u < 0x20 && u != '\t' && u != '\n' && u != '\r' && u != '\f' && u != '\v';
+  });
+  if (head.compare(0, 5, "solid") != 0 || (binary_bytes && size >= 84)) {
     if (size < 84) return Fail(path, "truncated: a binary STL needs an 84-byte header", error);
     uint32_t count = 0;
     std::memcpy(&count, head.data() + 80, 4);
@@ -675,7 +720,8 @@ Status ParseStlFile(const std::string& path, ParsedMesh* out, std::string* error
   std::string line;
   bool closed = false;
   int in_loop = -1;  // vertices of the open loop; -1 outside one
-  for (size_t number = 1; std::getline(in, line); ++number) {
+  LineReader lines(in);
+  for (size_t number = 1; lines.Next(&line); ++number) {
     const std::vector<std::string> t = Tokens(line);
     if (t.empty()) continue;
     if (t[0] == "endsolid") closed = true;
@@ -705,6 +751,7 @@ Status ParseStlFile(const std::string& path, ParsedMesh* out, std::string* error
       if (in_loop >= 1 && in_loop <= 3) out->corners.push_back(merged.Add({c[0], c[1], c[2]}));
     }
   }
+  if (lines.too_long()) return TooLongLine(path, lines, error);
   if (!closed) return Fail(path, "truncated: ASCII STL has no closing 'endsolid'", error);
   return Status::kOk;
 }

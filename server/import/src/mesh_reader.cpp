@@ -117,14 +117,49 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
                           parsed.face_start[f + 1] - parsed.face_start[f]);
   };
 
-  // 1. Faces using a vertex twice are left out.
+  // 1. Faces using a vertex twice are left out, and so is a face with the corners of an earlier
+  // one (the same face listed again, either way round: it doubled the area and, turned, faced
+  // the other way); corners at the same position count as the same.
+  const std::vector<uint32_t> id = CoincidentVertexIds(parsed.vertices);
   std::vector<char> used(faces, 1);
   std::vector<uint32_t> sorted;
+  std::vector<std::pair<uint64_t, uint32_t>> keyed;  // (hash of the sorted corners, face)
+  auto sorted_corners = [&](size_t f, std::vector<uint32_t>* out_corners) {
+    const auto [c, n] = corners_of(f);
+    out_corners->clear();
+    for (size_t k = 0; k < n; ++k) out_corners->push_back(id[c[k]]);
+    std::sort(out_corners->begin(), out_corners->end());
+  };
   for (size_t f = 0; f < faces; ++f) {
     const auto [c, n] = corners_of(f);
     sorted.assign(c, c + n);
     std::sort(sorted.begin(), sorted.end());
-    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) used[f] = 0;
+    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
+      used[f] = 0;
+      continue;
+    }
+    sorted_corners(f, &sorted);
+    uint64_t hash = 1469598103934665603ull;  // FNV-1a over the corner ids
+    for (uint32_t v : sorted) hash = (hash ^ v) * 1099511628211ull;
+    keyed.push_back({hash, static_cast<uint32_t>(f)});
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<uint32_t> other;
+  for (size_t i = 0; i < keyed.size();) {
+    size_t j = i + 1;
+    while (j < keyed.size() && keyed[j].first == keyed[i].first) ++j;
+    for (size_t a = i + 1; a < j; ++a) {  // faces of one hash, in file order: later ones go
+      sorted_corners(keyed[a].second, &sorted);
+      for (size_t b = i; b < a; ++b) {
+        if (!used[keyed[b].second]) continue;
+        sorted_corners(keyed[b].second, &other);
+        if (other == sorted) {
+          used[keyed[a].second] = 0;
+          break;
+        }
+      }
+    }
+    i = j;
   }
 
   // 2. Faces wound against their neighbours are turned to match them: across an edge of two
@@ -133,7 +168,6 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
   // where their corners are at the same position, as in a soup's or a split mesh's faces.
   size_t turned = 0;
   {
-    const std::vector<uint32_t> id = CoincidentVertexIds(parsed.vertices);
     struct Side {
       uint64_t edge;  // the lower vertex << 32 | the higher
       uint32_t face;

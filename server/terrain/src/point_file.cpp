@@ -43,7 +43,8 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
   out->clear();
   std::string text;
   size_t line_no = 0;
-  while (std::getline(in, text)) {
+  LineReader lines(in);
+  while (lines.Next(&text)) {
     ++line_no;
     std::string_view line(text);
     if (line_no == 1 && line.substr(0, 3) == "\xEF\xBB\xBF") line.remove_prefix(3);  // UTF-8 BOM
@@ -109,6 +110,9 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
                   error);
     }
     out->push_back({v[0], v[1], v[2]}, normal);
+  }
+  if (lines.too_long()) {
+    return Fail(name, line_no + 1, LineReader::TooLongMessage("x y z nx ny nz"), out, error);
   }
   if (in.bad()) {
     out->clear();

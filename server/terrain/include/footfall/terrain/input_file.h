@@ -1,6 +1,7 @@
 // The check every reader of a named input file makes before opening it.
 #pragma once
 
+#include <istream>
 #include <string>
 
 #include "footfall/terrain/status.h"
@@ -12,5 +13,30 @@ namespace footfall {
 // examined, kInvalidArgument for directories, FIFOs, devices and sockets (opening a FIFO would
 // wait for a writer; a device may never end).
 Status CheckInputFile(const std::string& path, const char* what, std::string* error);
+
+// The longest line a text terrain file may have. [Units: bytes] A file of NUL bytes or one
+// without line breaks is refused at its first line instead of being read whole.
+constexpr size_t kMaxLineBytes = size_t{1} << 20;
+
+// Reads a text file line by line as std::getline does (the '\n' dropped, a last line without
+// one included), but no line longer than kMaxLineBytes.
+class LineReader {
+ public:
+  explicit LineReader(std::istream& in) : in_(in) {}
+  // The next line into *line; false at the end of the stream, on a read error, and on a line
+  // longer than kMaxLineBytes (too_long() then true; the stream is left there).
+  bool Next(std::string* line);
+  bool too_long() const { return too_long_; }
+  // The 1-based number of the line last returned, or of the line too long.
+  size_t line_number() const { return number_; }
+  // "line longer than 1 MiB (expected text lines ...)": for a message at the line's number.
+  static std::string TooLongMessage(const char* expected);
+
+ private:
+  std::istream& in_;
+  std::string buffer_;
+  bool too_long_ = false;
+  size_t number_ = 0;
+};
 
 }  // namespace footfall
