@@ -181,6 +181,14 @@ check "glTF at UTM coordinates: the float rounding is reported" grep -q "utm.glt
 "$footfall" generate --terrain "$work/floor.pts" --character "$chars/hexapod.json" --steps 4 \
   --start 1.2,0,1.2 --out "$work/near.gltf" 2> "$work/near.err"
 check "glTF near the origin: no warning" [ ! -s "$work/near.err" ]
+# A glTF refused after the walk is made (float seconds cannot tell frames near 1e9 apart) keeps
+# the file of that name from before, and says so: it no longer matches the other outputs.
+cp "$work/near.gltf" "$work/stale.gltf"
+"$footfall" generate --terrain "$work/floor.pts" --character "$chars/hexapod.json" --steps 4 \
+  --start 1.2,0,1.2 --start-frame 1e9 --out "$work/stale.json" --out "$work/stale.gltf" 2> "$work/stale.err"
+check "glTF refused late: exit 1" [ $? -eq 1 ]
+check "glTF refused late: the other output written" [ -s "$work/stale.json" ]
+check "glTF refused late: the old file kept and said so" bash -c "cmp -s '$work/near.gltf' '$work/stale.gltf' && grep -qF '$work/stale.gltf is left as it was, from before this walk' '$work/stale.err'"
 
 # 4. A real DEM (Kootenai river banks, ../shared/data): its 1 m cells are coarser than every
 #    shipped character's step. Unless --separation says otherwise, generate resamples it for the

@@ -126,6 +126,33 @@ TEST_CASE("ReplaceFile follows symbolic links and writes devices in place",
   CHECK_THAT(error, Catch::Contains("Is a directory"));
 }
 
+TEST_CASE("ReplaceFile writes a FIFO once a process reads it, and gives up on one none reads",
+          "[terrain][output_file]") {
+  Dir dir;
+  const std::string fifo = dir.path + "/walk.json";
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  std::string error;
+  // No reader: a clear error after a bounded wait (it waited forever, and the outputs after it
+  // were never written).
+  CHECK(ReplaceFile(fifo, "x", &error) == Status::kIoError);
+  CHECK_THAT(error, Catch::Contains("cannot open '" + fifo +
+                                    "' for writing: no process reads the FIFO (waited 5 s)"));
+  // A reader that comes a little later gets the content.
+  const pid_t reader = ::fork();
+  REQUIRE(reader >= 0);
+  if (reader == 0) {
+    ::usleep(300000);
+    std::ifstream in(fifo, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    std::_Exit(text.str() == "walk" ? 0 : 1);
+  }
+  CHECK(ReplaceFile(fifo, "walk", &error) == Status::kOk);
+  int status = 0;
+  REQUIRE(::waitpid(reader, &status, 0) == reader);
+  CHECK((WIFEXITED(status) && WEXITSTATUS(status) == 0));
+}
+
 TEST_CASE("ReplaceFile creates the file a dangling link names, and takes long names",
           "[terrain][output_file]") {
   Dir dir;

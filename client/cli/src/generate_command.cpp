@@ -1,5 +1,7 @@
 // `footfall generate`: places the footsteps of a character (or a crowd) on a terrain and writes
 // the keyed walk as JSON, glTF (.gltf, .glb) or a Maya MEL script.
+#include <sys/stat.h>
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -322,6 +324,14 @@ int RunGenerate(const GenerateFlags& flags) {
         // Named by its output (the other outputs are still written).
         const bool named = error.compare(0, out.size(), out) == 0;
         std::cerr << "footfall generate: " << (named ? "" : "--out " + out + ": ") << error << '\n';
+        // A file of that name from before stays as it was: say so, as it no longer matches the
+        // other outputs.
+        struct stat st;
+        if (::stat(out.c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
+          std::cerr << "footfall generate: " << out
+                    << " is left as it was, from before this walk (it does not match the other "
+                       "outputs)\n";
+        }
         code = 1;
       }
     }

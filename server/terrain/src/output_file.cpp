@@ -15,6 +15,10 @@
 namespace footfall {
 namespace {
 
+// How long a FIFO written to may wait for a reader: tries x interval.
+constexpr int kFifoWaitTries = 50;
+constexpr int kFifoWaitMicroseconds = 100000;
+
 Status Fail(const std::string& what, const std::string& path, int error_number,
             std::string* error) {
   if (error)
@@ -163,7 +167,29 @@ Status ReplaceFile(const std::string& path, const std::function<bool(std::FILE*)
   const bool exists = plan.exists;
   const struct stat& st = plan.st;
   if (plan.in_place) {
-    std::FILE* file = std::fopen(target.c_str(), "wb");
+    std::FILE* file = nullptr;
+    if (exists && S_ISFIFO(st.st_mode)) {
+      // A FIFO opens for writing only once a process reads it: waited for a while, not forever
+      // (the walk is made by then; the other outputs are still written).
+      int fd = -1;
+      for (int tries = 0; fd < 0 && tries < kFifoWaitTries; ++tries) {
+        fd = ::open(target.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+        if (fd < 0 && errno != ENXIO) return Fail("cannot open", path, errno, error);
+        if (fd < 0) ::usleep(kFifoWaitMicroseconds);
+      }
+      if (fd < 0) {
+        if (error) {
+          *error = "cannot open '" + path + "' for writing: no process reads the FIFO (waited " +
+                   std::to_string(kFifoWaitTries * kFifoWaitMicroseconds / 1000000) + " s)";
+        }
+        return Status::kIoError;
+      }
+      ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+      file = ::fdopen(fd, "wb");
+      if (!file) ::close(fd);
+    } else {
+      file = std::fopen(target.c_str(), "wb");
+    }
     if (!file) return Fail("cannot open", path, errno, error);
     const int failure = WriteAndClose(file, write);
     return failure ? Fail("cannot write", path, failure, error) : Status::kOk;

@@ -6,10 +6,11 @@
 // target the writer may not write is refused, as opening it would be, and so are a new file in
 // a directory that takes no new file, and a loop of links. A file with other names (hard links)
 // gets a new file under this name; the other names keep the old content. Written in place (where
-// a failed write can cut the file): a device such as /dev/null or a FIFO, another user's writable
-// file in a sticky directory (/tmp), which no rename may replace, and a writable file in a
-// directory that takes no new file (no temporary file can be made beside it). Not synced to disk: a
-// power cut may still lose the new content, never the old one to a write error.
+// a failed write can cut the file): a device such as /dev/null or a FIFO (once a process reads
+// it: waited for up to 5 s), another user's writable file in a sticky directory (/tmp), which no
+// rename may replace, and a writable file in a directory that takes no new file (no temporary
+// file can be made beside it). Not synced to disk: a power cut may still lose the new content,
+// never the old one to a write error.
 #pragma once
 
 #include <cstdio>
