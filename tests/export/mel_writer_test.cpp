@@ -133,7 +133,7 @@ TEST_CASE("WriteMel keys a locator per track", "[export][mel]") {
         const WalkKey& key = walk.tracks[0].keys[i];
         const double expected[] = {key.position.x, key.position.y, key.position.z};
         CHECK(left.at(axes[axis])[i].frame == key.frame);
-        CHECK(left.at(axes[axis])[i].value == Approx(expected[axis]).margin(1e-6));
+        CHECK(left.at(axes[axis])[i].value == expected[axis]);
       }
     }
     // The later of the two frame-25 keys is the one kept.
@@ -160,6 +160,51 @@ TEST_CASE("WriteMel keys a locator per track", "[export][mel]") {
       CHECK(std::abs(body.at("rotateY")[i].value - body.at("rotateY")[i - 1].value) < 180);
     }
   }
+  std::remove(path.c_str());
+}
+
+TEST_CASE("WriteMel writes frames and values that read back exactly, without exponents",
+          "[export][mel]") {
+  // Fixed 6 decimals turned frame 1.0000004 into 1 and lost a small-scale world's positions.
+  Walk walk = test::BipedWalk();
+  WalkTrack& left = walk.tracks[0];
+  left.keys[0].frame = 1.0000004;
+  left.keys[0].position = {1e-9, 123456.789012345, -2.5e-5};
+  left.keys[1].position = {1e15, 0.1 + 0.2, -0.0};
+  left.keys[2].position = {-1.7976931348623157e308, 1e-300, 2.0 / 3.0};
+  left.keys[3].frame = 24.999999999999996;
+  walk.tracks[2].keys[0].frame = 1.0000004;
+  walk.tracks[2].keys[0].position = {-1e-12, 1e22, 1234.5};
+  const std::string path = WriteAndKeep(walk, "precision.mel");
+  const MelScript script = ParseMel(path);  // fails on any key line with an exponent
+  CHECK(script.min_time == 1.0000004);
+  const char* axes[] = {"translateX", "translateY", "translateZ"};
+  for (size_t t : {size_t{0}, size_t{2}}) {
+    const auto& keys = script.keys.at(script.locators[t]);
+    for (int axis = 0; axis < 3; ++axis) {
+      REQUIRE(keys.at(axes[axis]).size() == walk.tracks[t].keys.size());
+      for (size_t i = 0; i < walk.tracks[t].keys.size(); ++i) {
+        const WalkKey& key = walk.tracks[t].keys[i];
+        const double expected[] = {key.position.x, key.position.y, key.position.z};
+        INFO("track " << t << " key " << i << " axis " << axis);
+        CHECK(keys.at(axes[axis])[i].frame == key.frame);
+        CHECK(keys.at(axes[axis])[i].value == expected[axis]);
+      }
+    }
+  }
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  // Shortest form: no digits beyond those needed, "-0" written as 0, no trailing zeros.
+  CHECK_THAT(text.str(),
+             Catch::Contains("setKeyframe -t 1.0000004 -at translateX -v 0.000000001 "));
+  CHECK_THAT(text.str(), Catch::Contains("-at translateY -v 123456.789012345 "));
+  CHECK_THAT(text.str(), Catch::Contains("-at translateZ -v -0.000025 "));
+  CHECK_THAT(text.str(), Catch::Contains("-at translateX -v 1000000000000000 "));
+  CHECK_THAT(text.str(), Catch::Contains("-at translateY -v 0.30000000000000004 "));
+  CHECK_THAT(text.str(), Catch::Contains("-at translateZ -v 0 "));
+  CHECK_THAT(text.str(), Catch::Contains("-at translateY -v 10000000000000000000000 "));
+  CHECK_THAT(text.str(), Catch::Contains("-at translateZ -v 1234.5 "));
   std::remove(path.c_str());
 }
 

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <string>
 #include <unordered_map>
@@ -16,17 +17,41 @@
 namespace footfall {
 namespace {
 
-// A decimal MEL literal without exponent: up to 6 decimals, trailing zeros trimmed.
+// A decimal MEL literal without exponent that reads back as `value` exactly: the fewest
+// significant digits that round-trip, written in fixed notation, trailing zeros trimmed, "-0"
+// as "0". `value` must be finite.
 std::string Number(double value) {
+  // The shortest "%.{p}e" form that reads back to the same double (17 digits always do).
   char text[64];
-  std::snprintf(text, sizeof text, "%.6f", value);
-  std::string s = text;
+  for (int precision = 1; precision <= 17; ++precision) {
+    std::snprintf(text, sizeof text, "%.*e", precision - 1, value);
+    if (std::strtod(text, nullptr) == value) break;
+  }
+  // text is "[-]d[.ddd]e<exp>": split into sign, digits and the power of ten of the first digit.
+  const std::string scientific = text;
+  const size_t e = scientific.find('e');
+  const bool negative = scientific[0] == '-';
+  std::string digits;
+  for (size_t i = negative ? 1 : 0; i < e; ++i) {
+    if (scientific[i] != '.') digits += scientific[i];
+  }
+  const int exponent = std::atoi(scientific.c_str() + e + 1);
+  const int count = static_cast<int>(digits.size());
+  std::string s;
+  if (exponent < 0) {
+    s = "0." + std::string(static_cast<size_t>(-exponent - 1), '0') + digits;
+  } else if (exponent + 1 >= count) {
+    s = digits + std::string(static_cast<size_t>(exponent + 1 - count), '0');
+  } else {
+    s = digits.substr(0, static_cast<size_t>(exponent + 1)) + "." +
+        digits.substr(static_cast<size_t>(exponent + 1));
+  }
   if (s.find('.') != std::string::npos) {
     s.erase(s.find_last_not_of('0') + 1);
     if (s.back() == '.') s.pop_back();
   }
-  if (s == "-0") s = "0";
-  return s;
+  if (s == "0") return s;
+  return negative ? "-" + s : s;
 }
 
 // A valid Maya node name: [A-Za-z_][A-Za-z0-9_]*.
