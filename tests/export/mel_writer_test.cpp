@@ -37,6 +37,8 @@ struct MelScript {
   int braces = 0;
 };
 
+// Every setKeyframe line must match `key`: keys carry linear tangents, as glTF's LINEAR samplers,
+// and numbers have no exponent.
 MelScript ParseMel(const std::string& path) {
   std::ifstream in(path);
   REQUIRE(in.good());
@@ -50,7 +52,7 @@ MelScript ParseMel(const std::string& path) {
   static const std::regex track(
       R"re(^setAttr -type "string" \(\$footfall_node\[0\] \+ ".footfallTrack"\) "(.*)";$)re");
   static const std::regex key(
-      R"re(^setKeyframe -t (-?[0-9.]+) -at (translate[XYZ]|rotate[XYZ]) -v (-?[0-9.]+) \$footfall_node\[0\];$)re");
+      R"re(^setKeyframe -t (-?[0-9.]+) -at (translate[XYZ]|rotate[XYZ]) -v (-?[0-9.]+) -itt linear -ott linear \$footfall_node\[0\];$)re");
   MelScript script;
   std::string line, current;
   std::smatch m;

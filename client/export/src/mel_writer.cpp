@@ -194,6 +194,10 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
   }
 
   static const char* kAxes[] = {"X", "Y", "Z"};
+  // Linear in and out tangents on every key, as the glTF export's LINEAR samplers: the motion
+  // between keys does not depend on the Maya user's default tangent (a spline default made a
+  // planted foot drift between its equal end and start keys).
+  static const char* kLinear = " -itt linear -ott linear";
   for (size_t t = 0; t < walk.tracks.size(); ++t) {
     const WalkTrack& track = walk.tracks[t];
     const bool body = track.kind == TrackKind::kBody;
@@ -219,7 +223,7 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
       const std::string time = "setKeyframe -t " + Number(key.frame) + " -at ";
       const double translate[] = {key.position.x, key.position.y, key.position.z};
       for (int axis = 0; axis < 3; ++axis) {
-        mel += time + "translate" + kAxes[axis] + " -v " + Number(translate[axis]) +
+        mel += time + "translate" + kAxes[axis] + " -v " + Number(translate[axis]) + kLinear +
                " $footfall_node[0];\n";
       }
       if (body) {
@@ -228,7 +232,7 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
         previous_euler = euler;
         const double rotate[] = {euler.x, euler.y, euler.z};
         for (int axis = 0; axis < 3; ++axis) {
-          mel += time + "rotate" + kAxes[axis] + " -v " + Number(rotate[axis]) +
+          mel += time + "rotate" + kAxes[axis] + " -v " + Number(rotate[axis]) + kLinear +
                  " $footfall_node[0];\n";
         }
       }

@@ -19,6 +19,7 @@ namespace footfall {
 // 3. per track, creates a locator (`spaceLocator -n`), parents it, and keys translateX/Y/Z at
 //    every key frame (bodies also rotateX/Y/Z: the quaternion as Euler XYZ degrees, unwrapped so
 //    consecutive keys take the shortest turn). Frames are written as they are in the walk.
+//    Every key has linear in and out tangents, as the glTF export's LINEAR samplers.
 // Frames and values are MEL decimals without exponent, with the fewest digits that read back as
 // the same double (a walk in tiny or huge units keeps full precision).
 // Node names are sanitised to Maya names ([A-Za-z_][A-Za-z0-9_]*; other characters become '_')
