@@ -27,6 +27,7 @@ struct MelKey {
 // What a MEL walk script does, recovered line by line.
 struct MelScript {
   std::string time_unit;
+  std::string root;  // the root group's createNode name
   double min_time = NAN, max_time = NAN;
   std::vector<std::string> groups;                // createNode transform -parent names, in order
   std::vector<std::string> locators;              // spaceLocator -n names, in order
@@ -44,6 +45,8 @@ MelScript ParseMel(const std::string& path) {
   REQUIRE(in.good());
   static const std::regex unit(R"re(^currentUnit -time "([^"]+)";$)re");
   static const std::regex playback(R"re(^playbackOptions -minTime (\S+) -maxTime (\S+) .*;$)re");
+  static const std::regex root(
+      R"re(^string \$footfall_root = `createNode transform -name "(\w+)"`;$)re");
   static const std::regex group(
       R"re(^\$footfall_groups\[(\d+)\] = `createNode transform -name "(\w+)" -parent \$footfall_root`;$)re");
   static const std::regex locator(R"re(^\$footfall_node = `spaceLocator -n "(\w+)"`;$)re");
@@ -64,6 +67,8 @@ MelScript ParseMel(const std::string& path) {
     } else if (std::regex_match(line, m, playback)) {
       script.min_time = std::stod(m[1]);
       script.max_time = std::stod(m[2]);
+    } else if (std::regex_match(line, m, root)) {
+      script.root = m[1];
     } else if (std::regex_match(line, m, group)) {
       REQUIRE(std::stoul(m[1]) == script.groups.size());
       script.groups.push_back(m[2]);
@@ -113,6 +118,7 @@ TEST_CASE("WriteMel keys a locator per track", "[export][mel]") {
   const MelScript script = ParseMel(path);
   CHECK(script.braces == 0);
   CHECK(script.time_unit == "film");
+  CHECK(script.root == "footfall_walk");
   CHECK(script.min_time == 1);
   CHECK(script.max_time == 37);
   CHECK(script.groups.empty());
@@ -229,6 +235,34 @@ TEST_CASE("WriteMel groups crowd characters and sanitises names", "[export][mel]
   CHECK(script.keys.at("ant_2_L1").count("rotateY") == 0);
   CHECK(script.keys.at("ant_2_L1").at("translateX")[2].value == Approx(1.9));
   std::remove(path.c_str());
+}
+
+TEST_CASE("WriteMel gives no group or locator the root group's name", "[export][mel]") {
+  // A foot named footfall_walk got the root's name, and Maya renamed one of the two.
+  SECTION("feet") {
+    Walk walk = test::BipedWalk();
+    walk.tracks[0].name = "footfall_walk";
+    walk.tracks[1].name = "footfall_walk_2";
+    const std::string path = WriteAndKeep(walk, "root_name.mel");
+    const MelScript script = ParseMel(path);
+    CHECK(script.root == "footfall_walk");
+    CHECK(script.locators ==
+          std::vector<std::string>{"footfall_walk_3", "footfall_walk_2", "body"});
+    CHECK(script.track_attr.at("footfall_walk_3") == "footfall_walk");
+    std::remove(path.c_str());
+  }
+  SECTION("crowd characters") {
+    Walk walk = test::CrowdWalk();
+    for (WalkTrack& track : walk.tracks) {
+      if (track.character == "ant 1") track.character = "footfall walk";
+    }
+    const std::string path = WriteAndKeep(walk, "root_name_crowd.mel");
+    const MelScript script = ParseMel(path);
+    CHECK(script.root == "footfall_walk");
+    CHECK(script.groups == std::vector<std::string>{"footfall_walk_2", "ant_2"});
+    CHECK(script.parent_of.at("footfall_walk_L1") == "footfall_walk_2");
+    std::remove(path.c_str());
+  }
 }
 
 TEST_CASE("WriteMel names without a Maya time unit and special characters", "[export][mel]") {

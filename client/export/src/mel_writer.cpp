@@ -130,6 +130,9 @@ std::string MayaTimeUnit(double fps) {
   return "";
 }
 
+// The name of the group holding the whole walk.
+constexpr char kRootName[] = "footfall_walk";
+
 }  // namespace
 
 Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
@@ -137,7 +140,7 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
   if (status != Status::kOk) return status;
 
   // Group names (one per crowd character, in order of appearance) and locator names, all
-  // unique in the file.
+  // unique in the file and none the root group's name (Maya would rename one of the two).
   std::vector<std::string> characters;
   std::unordered_map<std::string, int> group_index;
   std::vector<int> group_of(walk.tracks.size(), -1);
@@ -148,12 +151,13 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
     if (found.second) characters.push_back(character);
     group_of[t] = found.first->second;
   }
-  std::vector<std::string> names;
+  std::vector<std::string> names = {kRootName};
   for (const std::string& character : characters) names.push_back(MayaName(character));
   for (size_t t = 0; t < walk.tracks.size(); ++t) {
     names.push_back(MayaName(walk_export::QualifiedTrackName(walk.tracks[t], t)));
   }
-  names = walk_export::UniqueNames(names);
+  names = walk_export::UniqueNames(names);  // the root, first, keeps its name
+  names.erase(names.begin());
 
   double first_frame = std::numeric_limits<double>::infinity();
   double last_frame = -std::numeric_limits<double>::infinity();
@@ -185,7 +189,7 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
            " -animationStartTime " + Number(first_frame) + " -animationEndTime " +
            Number(last_frame) + ";\n";
   }
-  mel += "string $footfall_root = `createNode transform -name \"footfall_walk\"`;\n";
+  mel += "string $footfall_root = `createNode transform -name " + MelString(kRootName) + "`;\n";
   mel += "string $footfall_groups[];\n";
   mel += "string $footfall_node[];\n";
   for (size_t c = 0; c < characters.size(); ++c) {

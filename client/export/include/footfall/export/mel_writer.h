@@ -23,7 +23,8 @@ namespace footfall {
 // Frames and values are MEL decimals without exponent, with the fewest digits that read back as
 // the same double (a walk in tiny or huge units keeps full precision).
 // Node names are sanitised to Maya names ([A-Za-z_][A-Za-z0-9_]*; other characters become '_')
-// and made unique in the file. The script uses the names Maya returns, so it still works when
+// and made unique in the file and against the root group's name (a foot named footfall_walk
+// becomes footfall_walk_2). The script uses the names Maya returns, so it still works when
 // the scene already holds nodes of the same names. Keys on the same frame: the last one wins.
 // Returns kInvalidArgument (with `*error` set) for fps <= 0, NaN/Inf values or a zero quaternion;
 // kIoError naming `path` when the file cannot be written. `error` may be null.
