@@ -1,4 +1,4 @@
-// Quaternion to Euler XYZ conversion: the angles rebuild the same rotation, including at
+// Quaternion to Euler XYZ and ZXY conversion: the angles rebuild the same rotation, including at
 // gimbal lock, and unwrapping picks the equivalent triple nearest the previous key.
 #include <cmath>
 #include <random>
@@ -29,6 +29,12 @@ Quat AxisAngle(const Vec3& axis, double degrees) {
 Quat FromEulerXyz(const Vec3& e) {
   return Multiply(AxisAngle({0, 0, 1}, e.z),
                   Multiply(AxisAngle({0, 1, 0}, e.y), AxisAngle({1, 0, 0}, e.x)));
+}
+
+// Maya ZXY order: Z first, then X, then Y, about the parent axes.
+Quat FromEulerZxy(const Vec3& e) {
+  return Multiply(AxisAngle({0, 1, 0}, e.y),
+                  Multiply(AxisAngle({1, 0, 0}, e.x), AxisAngle({0, 0, 1}, e.z)));
 }
 
 double AbsDot(const Quat& a, const Quat& b) {
@@ -84,5 +90,75 @@ TEST_CASE("ClosestEulerXyzDegrees unwraps toward the previous key", "[export][eu
     CHECK(e.y == Approx(100));
     CHECK(e.z == Approx(180));
     CHECK(AbsDot(FromEulerXyz(e), FromEulerXyz({0, 80, 0})) == Approx(1).margin(1e-9));
+  }
+}
+
+TEST_CASE("QuatToEulerZxyDegrees rebuilds the rotation", "[export][euler]") {
+  SECTION("known angles") {
+    const Vec3 e = QuatToEulerZxyDegrees(FromEulerZxy({10, 20, 30}));
+    CHECK(e.x == Approx(10));
+    CHECK(e.y == Approx(20));
+    CHECK(e.z == Approx(30));
+    // Heading is Y alone, whatever it is: +-X (yaw +-90) is no special case.
+    for (double yaw : {-45.0, 90.0, -90.0, 180.0}) {
+      const Vec3 h = QuatToEulerZxyDegrees(AxisAngle({0, 1, 0}, yaw));
+      CHECK(h.x == Approx(0).margin(1e-12));
+      CHECK(std::abs(h.y) == Approx(std::abs(yaw)));
+      CHECK(h.z == Approx(0).margin(1e-12));
+    }
+    const Vec3 tilted = QuatToEulerZxyDegrees(FromEulerZxy({-5, 90, 3}));
+    CHECK(tilted.x == Approx(-5));
+    CHECK(tilted.y == Approx(90));
+    CHECK(tilted.z == Approx(3));
+  }
+  SECTION("random rotations, not unit length") {
+    std::mt19937 rng(11);
+    std::normal_distribution<double> normal;
+    for (int i = 0; i < 1000; ++i) {
+      const Quat q{normal(rng), normal(rng), normal(rng), normal(rng)};
+      const Vec3 e = QuatToEulerZxyDegrees(q);
+      CHECK(e.x >= -90);
+      CHECK(e.x <= 90);
+      CHECK(std::abs(e.y) <= 180);
+      CHECK(std::abs(e.z) <= 180);
+      CHECK(AbsDot(FromEulerZxy(e), q) == Approx(1).margin(1e-9));
+    }
+  }
+  SECTION("gimbal lock") {
+    for (double pitch : {90.0, -90.0}) {
+      const Quat q = FromEulerZxy({pitch, 25, 40});
+      const Vec3 e = QuatToEulerZxyDegrees(q);
+      CHECK(e.x == pitch);
+      CHECK(e.z == 0);
+      CHECK(AbsDot(FromEulerZxy(e), q) == Approx(1).margin(1e-9));
+    }
+  }
+}
+
+TEST_CASE("ClosestEulerZxyDegrees unwraps toward the previous key", "[export][euler]") {
+  SECTION("the alternative solution is the same rotation") {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> angle(-180, 180);
+    for (int i = 0; i < 100; ++i) {
+      const Vec3 e{angle(rng) / 2, angle(rng), angle(rng)};
+      const Quat q = FromEulerZxy({180 - e.x, e.y + 180, e.z + 180});
+      CHECK(AbsDot(FromEulerZxy(e), q) == Approx(1).margin(1e-12));
+    }
+  }
+  SECTION("adds whole turns") {
+    const Vec3 e = ClosestEulerZxyDegrees({0, -170, 0}, {0, 170, 0});
+    CHECK(e.y == Approx(190));
+    const Vec3 f = ClosestEulerZxyDegrees({5, 10, 15}, {5, 730, -345});
+    CHECK(f.x == Approx(5));
+    CHECK(f.y == Approx(730));
+    CHECK(f.z == Approx(15 - 360));
+  }
+  SECTION("takes the alternative solution when it is nearer") {
+    const Vec3 previous{100, 180, 180};  // past +90 on X, reached by unwrapping
+    const Vec3 e = ClosestEulerZxyDegrees({80, 0, 0}, previous);
+    CHECK(e.x == Approx(100));
+    CHECK(e.y == Approx(180));
+    CHECK(e.z == Approx(180));
+    CHECK(AbsDot(FromEulerZxy(e), FromEulerZxy({80, 0, 0})) == Approx(1).margin(1e-9));
   }
 }

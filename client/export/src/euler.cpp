@@ -55,4 +55,38 @@ Vec3 ClosestEulerXyzDegrees(const Vec3& euler, const Vec3& previous) {
   return L1(alternative, previous) < L1(direct, previous) ? alternative : direct;
 }
 
+Vec3 QuatToEulerZxyDegrees(const Quat& q_in) {
+  const double n = std::sqrt(q_in.x * q_in.x + q_in.y * q_in.y + q_in.z * q_in.z + q_in.w * q_in.w);
+  const double x = q_in.x / n, y = q_in.y / n, z = q_in.z / n, w = q_in.w / n;
+  // Rotation matrix entries (column vectors) needed for R = Ry(b) * Rx(a) * Rz(c):
+  // m12 = -sin a; m02, m22 = sin b cos a, cos b cos a; m10, m11 = cos a sin c, cos a cos c.
+  const double m00 = 1 - 2 * (y * y + z * z);
+  const double m02 = 2 * (x * z + y * w);
+  const double m10 = 2 * (x * y + z * w);
+  const double m11 = 1 - 2 * (x * x + z * z);
+  const double m12 = 2 * (y * z - x * w);
+  const double m20 = 2 * (x * z - y * w);
+  const double m22 = 1 - 2 * (x * x + y * y);
+  const double sin_a = std::clamp(-m12, -1.0, 1.0);
+  double a, b, c;
+  if (std::abs(sin_a) > 1 - 1e-12) {
+    // Gimbal lock: Z and Y turn about the same axis; put it all in Y (m00 = cos b,
+    // m20 = -sin b with c = 0).
+    a = std::copysign(kPi / 2, sin_a);
+    b = std::atan2(-m20, m00);
+    c = 0;
+  } else {
+    a = std::asin(sin_a);
+    b = std::atan2(m02, m22);
+    c = std::atan2(m10, m11);
+  }
+  return {a * kDegrees, b * kDegrees, c * kDegrees};
+}
+
+Vec3 ClosestEulerZxyDegrees(const Vec3& euler, const Vec3& previous) {
+  const Vec3 direct = UnwrapAll(euler, previous);
+  const Vec3 alternative = UnwrapAll({180.0 - euler.x, euler.y + 180.0, euler.z + 180.0}, previous);
+  return L1(alternative, previous) < L1(direct, previous) ? alternative : direct;
+}
+
 }  // namespace footfall

@@ -17,4 +17,17 @@ Vec3 QuatToEulerXyzDegrees(const Quat& q);
 // so keyed rotations do not spin the long way round between keys.
 Vec3 ClosestEulerXyzDegrees(const Vec3& euler, const Vec3& previous);
 
+// Euler angles in degrees for Maya's rotate order ZXY: rotating by z about the Z axis, then x
+// about X, then y about Y (all about the parent's axes; R = Ry(y) * Rx(x) * Rz(z) on column
+// vectors) gives the rotation of `q`. With Y up, heading is y alone, and gimbal lock (x = +-90)
+// needs the body pitched 90 degrees (facing straight up or down), which a walk never does.
+// `q` need not be unit length but must be non-zero. x is in [-90, 90]; y and z in [-180, 180].
+// At gimbal lock (x = +-90) z is 0 and the remaining turn is in y.
+Vec3 QuatToEulerZxyDegrees(const Quat& q);
+
+// The Euler triple equivalent to `euler` (degrees, ZXY order) that is closest to `previous`:
+// adds multiples of 360 per angle and also tries the alternative solution (180-x, y+180, z+180),
+// so keyed rotations do not spin the long way round between keys.
+Vec3 ClosestEulerZxyDegrees(const Vec3& euler, const Vec3& previous);
+
 }  // namespace footfall
