@@ -403,10 +403,10 @@ class RpcTest(unittest.TestCase):
 
 
 class RotationTest(unittest.TestCase):
-    """Body rotations as Maya's XYZ Euler angles (the Maya plugin keys them)."""
+    """Rotations as Maya's XYZ and ZXY Euler angles (the Maya plugin keys bodies in ZXY)."""
 
     @staticmethod
-    def _matrix_of_euler(e):
+    def _matrix_of_euler(e, order="xyz"):
         a, b, c = (math.radians(v) for v in e)
         rx = [[1, 0, 0], [0, math.cos(a), -math.sin(a)], [0, math.sin(a), math.cos(a)]]
         ry = [[math.cos(b), 0, math.sin(b)], [0, 1, 0], [-math.sin(b), 0, math.cos(b)]]
@@ -415,6 +415,8 @@ class RotationTest(unittest.TestCase):
         def mul(p, q):
             return [[sum(p[i][k] * q[k][j] for k in range(3)) for j in range(3)]
                     for i in range(3)]
+        if order == "zxy":
+            return mul(ry, mul(rx, rz))  # Maya's ZXY rotate order: Z first, then X, then Y
         return mul(rz, mul(ry, rx))  # Maya's XYZ rotate order
 
     @staticmethod
@@ -438,6 +440,45 @@ class RotationTest(unittest.TestCase):
             for i in range(3):
                 for j in range(3):
                     self.assertAlmostEqual(got[i][j], want[i][j], places=9, msg=str(q))
+
+    def _assert_same_matrix(self, got, want, msg):
+        for i in range(3):
+            for j in range(3):
+                self.assertAlmostEqual(got[i][j], want[i][j], places=9, msg=msg)
+
+    def test_zxy_angles_rebuild_the_rotation(self):
+        rng = __import__("random").Random(9)
+        quats = [(0.0, math.sin(math.radians(45)), 0.0, math.cos(math.radians(45))),  # yaw 90
+                 (0.17, 0.33, 0.05, 0.93)]
+        quats += [tuple(rng.uniform(-1, 1) for _ in range(4)) for _ in range(200)]
+        for q in quats:
+            e = ff.rotation.quat_to_euler_zxy(q)
+            self.assertTrue(-90 <= e[0] <= 90, msg=str(e))
+            self._assert_same_matrix(self._matrix_of_euler(e, "zxy"), self._matrix_of_quat(q),
+                                     str(q))
+        # Heading +X is yaw alone, far from gimbal lock.
+        e = ff.rotation.quat_to_euler_zxy(quats[0])
+        for got, want in zip(e, (0.0, 90.0, 0.0)):
+            self.assertAlmostEqual(got, want, places=9)
+        # Gimbal lock (pitched 90 degrees): all the turn about the vertical in Y, Z 0.
+        for pitch in (90.0, -90.0):
+            want = self._matrix_of_euler((pitch, 25.0, 40.0), "zxy")
+            # The quaternion of that matrix (trace > 0 here).
+            s = 2 * math.sqrt(1 + want[0][0] + want[1][1] + want[2][2])
+            q = ((want[2][1] - want[1][2]) / s, (want[0][2] - want[2][0]) / s,
+                 (want[1][0] - want[0][1]) / s, s / 4)
+            e = ff.rotation.quat_to_euler_zxy(q)
+            self.assertEqual((e[0], e[2]), (pitch, 0.0))
+            self._assert_same_matrix(self._matrix_of_euler(e, "zxy"), want, str(pitch))
+
+    def test_zxy_unwrap_takes_the_nearest_equivalent(self):
+        e = ff.rotation.closest_euler_zxy((0.0, -170.0, 0.0), (0.0, 170.0, 0.0))
+        self.assertAlmostEqual(e[1], 190.0)
+        e = ff.rotation.closest_euler_zxy((80.0, 0.0, 0.0), (100.0, 180.0, 180.0))
+        for got, want in zip(e, (100.0, 180.0, 180.0)):
+            self.assertAlmostEqual(got, want)
+        self._assert_same_matrix(self._matrix_of_euler(e, "zxy"),
+                                 self._matrix_of_euler((80.0, 0.0, 0.0), "zxy"), str(e))
 
     def test_keys_match_the_mel_export(self):
         cli = os.environ.get("FOOTFALL_CLI") or os.path.join(REPO, "build", "client", "cli",

@@ -1,6 +1,8 @@
-"""Body rotations for DCCs that key Euler angles (Maya): footfall's quaternions as XYZ Euler
-angles in degrees, as Maya's default rotate order composes them (R = Rz * Ry * Rx), unwrapped
-key to key. The same conversion as the MEL export (client/export/src/euler.cpp). Pure Python."""
+"""Body rotations for DCCs that key Euler angles (Maya): footfall's quaternions as Euler angles
+in degrees, unwrapped key to key, the same conversions as client/export/src/euler.cpp. Pure
+Python. Bodies are keyed in rotate order ZXY (R = Ry * Rx * Rz), as the MEL export keys them:
+heading is the Y angle alone, so an upright body is never at gimbal lock whatever its heading
+(in Maya's default XYZ order a body heading +-X is). XYZ (R = Rz * Ry * Rx) turns other nodes."""
 
 import math
 
@@ -32,7 +34,7 @@ def _unwrap(angle, target):
 
 
 def closest_euler(euler, previous):
-    """The angles equal to `euler` as a rotation that lie closest to `previous` (degrees), so
+    """The XYZ angles equal to `euler` as a rotation that lie closest to `previous` (degrees), so
     that interpolating between keys turns the short way instead of spinning through 360."""
     def unwrap_all(e):
         return tuple(_unwrap(e[i], previous[i]) for i in range(3))
@@ -42,6 +44,40 @@ def closest_euler(euler, previous):
 
     direct = unwrap_all(euler)
     alternative = unwrap_all((euler[0] + 180.0, 180.0 - euler[1], euler[2] + 180.0))
+    return alternative if l1(alternative) < l1(direct) else direct
+
+
+def quat_to_euler_zxy(q):
+    """(x, y, z, w) -> (rx, ry, rz) degrees with R = Ry(ry) * Rx(rx) * Rz(rz): Maya's rotate
+    order ZXY (rotateOrder 2). rx is in [-90, 90]; at gimbal lock (rx = +-90) rz is 0."""
+    n = math.sqrt(sum(c * c for c in q))
+    x, y, z, w = (c / n for c in q)
+    m00 = 1 - 2 * (y * y + z * z)
+    m02 = 2 * (x * z + y * w)
+    m10 = 2 * (x * y + z * w)
+    m11 = 1 - 2 * (x * x + z * z)
+    m12 = 2 * (y * z - x * w)
+    m20 = 2 * (x * z - y * w)
+    m22 = 1 - 2 * (x * x + y * y)
+    sin_a = max(-1.0, min(1.0, -m12))
+    if abs(sin_a) > 1 - 1e-12:  # gimbal lock: Z and Y turn about the same axis; all in Y
+        a, b, c = math.copysign(math.pi / 2, sin_a), math.atan2(-m20, m00), 0.0
+    else:
+        a, b, c = math.asin(sin_a), math.atan2(m02, m22), math.atan2(m10, m11)
+    return (math.degrees(a), math.degrees(b), math.degrees(c))
+
+
+def closest_euler_zxy(euler, previous):
+    """As closest_euler, for ZXY angles (quat_to_euler_zxy): the alternative solution is
+    (180 - rx, ry + 180, rz + 180)."""
+    def unwrap_all(e):
+        return tuple(_unwrap(e[i], previous[i]) for i in range(3))
+
+    def l1(e):
+        return sum(abs(e[i] - previous[i]) for i in range(3))
+
+    direct = unwrap_all(euler)
+    alternative = unwrap_all((180.0 - euler[0], euler[1] + 180.0, euler[2] + 180.0))
     return alternative if l1(alternative) < l1(direct) else direct
 
 
