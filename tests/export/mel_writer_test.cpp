@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <random>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -33,6 +34,7 @@ struct MelScript {
   std::vector<std::string> locators;              // spaceLocator -n names, in order
   std::map<std::string, std::string> parent_of;   // locator -> "$footfall_root" or group
   std::map<std::string, std::string> track_attr;  // locator -> footfallTrack value
+  std::map<std::string, int> rotate_order;        // locator -> rotateOrder set (bodies)
   std::map<std::string, std::map<std::string, std::vector<MelKey>>> keys;  // loc -> attr
   std::vector<std::string> warnings;
   int braces = 0;
@@ -54,6 +56,8 @@ MelScript ParseMel(const std::string& path) {
       R"re(^\$footfall_node = `parent \$footfall_node\[0\] (\$footfall_root|\$footfall_groups\[(\d+)\])`;$)re");
   static const std::regex track(
       R"re(^setAttr -type "string" \(\$footfall_node\[0\] \+ ".footfallTrack"\) "(.*)";$)re");
+  static const std::regex rotate_order(
+      R"re(^setAttr \(\$footfall_node\[0\] \+ "\.rotateOrder"\) (\d);$)re");
   static const std::regex key(
       R"re(^setKeyframe -t (-?[0-9.]+) -at (translate[XYZ]|rotate[XYZ]) -v (-?[0-9.]+) -itt linear -ott linear \$footfall_node\[0\];$)re");
   MelScript script;
@@ -80,6 +84,10 @@ MelScript ParseMel(const std::string& path) {
       script.parent_of[current] = m[2].matched ? script.groups.at(std::stoul(m[2])) : m[1].str();
     } else if (std::regex_match(line, m, track)) {
       script.track_attr[current] = m[1];
+    } else if (std::regex_match(line, m, rotate_order)) {
+      REQUIRE(!current.empty());
+      REQUIRE(script.keys.count(current) == 0);  // set before any key
+      script.rotate_order[current] = std::stoi(m[1]);
     } else if (std::regex_match(line, m, key)) {
       REQUIRE(!current.empty());
       script.keys[current][m[2]].push_back({std::stod(m[1]), std::stod(m[3])});
@@ -99,15 +107,51 @@ std::string WriteAndKeep(const Walk& walk, const std::string& name) {
   return path;
 }
 
-// The rotation matrix R = Rz * Ry * Rx of Euler XYZ degrees applied to `v`.
-Vec3 RotateEuler(const Vec3& euler_deg, const Vec3& v) {
+// The rotation matrix R = Ry * Rx * Rz of Euler degrees in Maya's ZXY rotate order (Z first,
+// then X, then Y) applied to `v`.
+Vec3 RotateEulerZxy(const Vec3& euler_deg, const Vec3& v) {
   const double k = 3.14159265358979323846 / 180;
   const double cx = std::cos(euler_deg.x * k), sx = std::sin(euler_deg.x * k);
   const double cy = std::cos(euler_deg.y * k), sy = std::sin(euler_deg.y * k);
   const double cz = std::cos(euler_deg.z * k), sz = std::sin(euler_deg.z * k);
-  Vec3 a{v.x, cx * v.y - sx * v.z, sx * v.y + cx * v.z};
-  Vec3 b{cy * a.x + sy * a.z, a.y, -sy * a.x + cy * a.z};
-  return {cz * b.x - sz * b.y, sz * b.x + cz * b.y, b.z};
+  Vec3 a{cz * v.x - sz * v.y, sz * v.x + cz * v.y, v.z};
+  Vec3 b{a.x, cx * a.y - sx * a.z, sx * a.y + cx * a.z};
+  return {cy * b.x + sy * b.z, b.y, -sy * b.x + cy * b.z};
+}
+
+// `v` rotated by `q` (any non-zero length).
+Vec3 RotateQuat(const Quat& q_in, const Vec3& v) {
+  const double n = std::sqrt(q_in.x * q_in.x + q_in.y * q_in.y + q_in.z * q_in.z + q_in.w * q_in.w);
+  const double x = q_in.x / n, y = q_in.y / n, z = q_in.z / n, w = q_in.w / n;
+  const Vec3 t{2 * (y * v.z - z * v.y), 2 * (z * v.x - x * v.z), 2 * (x * v.y - y * v.x)};
+  return {v.x + w * t.x + y * t.z - z * t.y, v.y + w * t.y + z * t.x - x * t.z,
+          v.z + w * t.z + x * t.y - y * t.x};
+}
+
+// The body locator's Euler keys (rotateX/Y/Z) in key order.
+std::vector<Vec3> BodyEuler(const MelScript& script, const std::string& locator) {
+  const auto& keys = script.keys.at(locator);
+  std::vector<Vec3> euler;
+  for (size_t i = 0; i < keys.at("rotateX").size(); ++i) {
+    euler.push_back(
+        {keys.at("rotateX")[i].value, keys.at("rotateY")[i].value, keys.at("rotateZ")[i].value});
+  }
+  return euler;
+}
+
+// Checks that every key's Euler angles, applied in ZXY order, turn the axes as `rotations` do.
+void CheckReproduces(const std::vector<Vec3>& euler, const std::vector<Quat>& rotations) {
+  REQUIRE(euler.size() == rotations.size());
+  for (size_t i = 0; i < euler.size(); ++i) {
+    for (const Vec3& axis : {Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}}) {
+      const Vec3 got = RotateEulerZxy(euler[i], axis);
+      const Vec3 want = RotateQuat(rotations[i], axis);
+      INFO("key " << i << " axis " << axis.x << axis.y << axis.z);
+      CHECK(got.x == Approx(want.x).margin(1e-9));
+      CHECK(got.y == Approx(want.y).margin(1e-9));
+      CHECK(got.z == Approx(want.z).margin(1e-9));
+    }
+  }
 }
 
 }  // namespace
@@ -149,15 +193,18 @@ TEST_CASE("WriteMel keys a locator per track", "[export][mel]") {
     CHECK(right.at("translateY")[2].value == Approx(0.01));
   }
   SECTION("body: translate and rotate keys; Euler angles reproduce the quaternions") {
+    CHECK(script.rotate_order.at("body") == 2);  // zxy
+    CHECK(script.rotate_order.count("L") == 0);
     const auto& body = script.keys.at("body");
     REQUIRE(body.size() == 6);
     for (const auto& entry : body) CHECK(entry.second.size() == 5);
+    const std::vector<Vec3> eulers = BodyEuler(script, "body");
+    CheckReproduces(eulers, {walk.tracks[2].rotations.begin(), walk.tracks[2].rotations.end()});
     const double yaw[] = {0, 60, 150, 170, 190};
     for (size_t i = 0; i < 5; ++i) {
-      const Vec3 euler{body.at("rotateX")[i].value, body.at("rotateY")[i].value,
-                       body.at("rotateZ")[i].value};
+      const Vec3 euler = eulers[i];
       // Rotating the forward axis by the Euler angles matches yawing it.
-      const Vec3 forward = RotateEuler(euler, {0, 0, 1});
+      const Vec3 forward = RotateEulerZxy(euler, {0, 0, 1});
       const double k = 3.14159265358979323846 / 180;
       CHECK(forward.x == Approx(std::sin(yaw[i] * k)).margin(1e-5));
       CHECK(forward.z == Approx(std::cos(yaw[i] * k)).margin(1e-5));
@@ -216,6 +263,64 @@ TEST_CASE("WriteMel writes frames and values that read back exactly, without exp
   std::remove(path.c_str());
 }
 
+TEST_CASE("WriteMel keys bodies in rotate order ZXY, smooth at every heading", "[export][mel]") {
+  const double k = 3.14159265358979323846 / 180;
+  const auto axis_angle = [k](const Vec3& axis, double degrees) {
+    const double half = degrees * k / 2;
+    return Quat{axis.x * std::sin(half), axis.y * std::sin(half), axis.z * std::sin(half),
+                std::cos(half)};
+  };
+  const auto multiply = [](const Quat& a, const Quat& b) {
+    return Quat{a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
+                a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
+                a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w,
+                a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z};
+  };
+  Walk walk;
+  walk.fps = 24;
+  // A body on a slope (tilted 4 degrees about X and 3 about Z) turning 2 degrees a key through
+  // heading +X (yaw 90, gimbal lock in XYZ) and on through 180 and -X (yaw 270).
+  WalkTrack turning;
+  turning.name = "turning";
+  turning.kind = TrackKind::kBody;
+  const Quat tilt = multiply(axis_angle({1, 0, 0}, 4), axis_angle({0, 0, 1}, 3));
+  for (int i = 0; i <= 110; ++i) {
+    WalkKey key;
+    key.frame = 1 + i;
+    turning.keys.push_back(key);
+    turning.rotations.push_back(multiply(tilt, axis_angle({0, 1, 0}, 60 + 2 * i)));
+  }
+  // Any rotations at all, not unit length.
+  WalkTrack tumbling;
+  tumbling.name = "tumbling";
+  tumbling.kind = TrackKind::kBody;
+  std::mt19937 rng(17);
+  std::normal_distribution<double> normal;
+  for (int i = 0; i < 200; ++i) {
+    WalkKey key;
+    key.frame = 1 + i;
+    tumbling.keys.push_back(key);
+    tumbling.rotations.push_back({normal(rng), normal(rng), normal(rng), normal(rng)});
+  }
+  walk.tracks = {turning, tumbling};
+  const std::string path = WriteAndKeep(walk, "zxy.mel");
+  const MelScript script = ParseMel(path);
+  CHECK(script.rotate_order.at("turning") == 2);
+  CHECK(script.rotate_order.at("tumbling") == 2);
+  const std::vector<Vec3> turning_euler = BodyEuler(script, "turning");
+  CheckReproduces(turning_euler, {turning.rotations.begin(), turning.rotations.end()});
+  CheckReproduces(BodyEuler(script, "tumbling"),
+                  {tumbling.rotations.begin(), tumbling.rotations.end()});
+  // A 2 degree turn moves no channel by more than a few degrees (XYZ swung them by ~80).
+  for (size_t i = 1; i < turning_euler.size(); ++i) {
+    INFO("key " << i);
+    CHECK(std::abs(turning_euler[i].x - turning_euler[i - 1].x) < 3);
+    CHECK(std::abs(turning_euler[i].y - turning_euler[i - 1].y) < 3);
+    CHECK(std::abs(turning_euler[i].z - turning_euler[i - 1].z) < 3);
+  }
+  std::remove(path.c_str());
+}
+
 TEST_CASE("WriteMel groups crowd characters and sanitises names", "[export][mel]") {
   Walk walk = test::CrowdWalk();
   walk.tracks[0].name = "3rd leg|x";
@@ -232,6 +337,9 @@ TEST_CASE("WriteMel groups crowd characters and sanitises names", "[export][mel]
     CHECK(script.keys.at(name).at("translateX").size() == 3);
   }
   CHECK(script.keys.at("ant_2_body").at("rotateY").size() == 3);
+  CHECK(script.rotate_order.at("ant_1_body") == 2);
+  CHECK(script.rotate_order.at("ant_2_body") == 2);
+  CHECK(script.rotate_order.count("ant_2_L1") == 0);
   CHECK(script.keys.at("ant_2_L1").count("rotateY") == 0);
   CHECK(script.keys.at("ant_2_L1").at("translateX")[2].value == Approx(1.9));
   std::remove(path.c_str());

@@ -494,6 +494,7 @@ class RotationTest(unittest.TestCase):
                 walk = json.load(f)
             with open(mel_out) as f:
                 mel = f.read()
+        self.assertIn('setAttr ($footfall_node[0] + ".rotateOrder") 2;', mel)  # zxy
         keyed = {}
         for m in __import__("re").finditer(
                 r"setKeyframe -t (\S+) -at rotate([XYZ]) -v (\S+) ", mel):
@@ -502,13 +503,13 @@ class RotationTest(unittest.TestCase):
         self.assertGreater(len(body["keys"]), 20)
         previous = None
         for key in body["keys"]:
-            euler = ff.rotation.quat_to_euler_xyz(key["rotation"])
+            euler = ff.rotation.quat_to_euler_zxy(key["rotation"])
             if previous is not None:
-                euler = ff.rotation.closest_euler(euler, previous)
+                euler = ff.rotation.closest_euler_zxy(euler, previous)
             previous = euler
             want = keyed[float(key["frame"])]
             for axis, value in zip("XYZ", euler):
-                self.assertAlmostEqual(value, want[axis], places=4)
+                self.assertAlmostEqual(value, want[axis], places=9)
 
 
 class GenerateTest(unittest.TestCase):

@@ -219,6 +219,10 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
     mel += "addAttr -longName \"footfallKind\" -dataType \"string\" $footfall_node[0];\n";
     mel += "setAttr -type \"string\" ($footfall_node[0] + \".footfallKind\") " +
            MelString(body ? "body" : "foot") + ";\n";
+    // Bodies turn in rotate order ZXY (enum 2): heading about Y is applied last, so an upright
+    // body is never at gimbal lock whatever its heading (in XYZ, heading +-X is: a small turn
+    // there swung each channel by tens of degrees).
+    if (body) mel += "setAttr ($footfall_node[0] + \".rotateOrder\") 2;\n";
 
     Vec3 previous_euler;
     bool first = true;
@@ -231,8 +235,8 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
                " $footfall_node[0];\n";
       }
       if (body) {
-        Vec3 euler = QuatToEulerXyzDegrees(track.Rotation(index));
-        if (!first) euler = ClosestEulerXyzDegrees(euler, previous_euler);
+        Vec3 euler = QuatToEulerZxyDegrees(track.Rotation(index));
+        if (!first) euler = ClosestEulerZxyDegrees(euler, previous_euler);
         previous_euler = euler;
         const double rotate[] = {euler.x, euler.y, euler.z};
         for (int axis = 0; axis < 3; ++axis) {

@@ -17,9 +17,10 @@ namespace footfall {
 // 2. creates a root transform "footfall_walk" and, for crowd walks, one transform per character
 //    under it;
 // 3. per track, creates a locator (`spaceLocator -n`), parents it, and keys translateX/Y/Z at
-//    every key frame (bodies also rotateX/Y/Z: the quaternion as Euler XYZ degrees, unwrapped so
-//    consecutive keys take the shortest turn). Frames are written as they are in the walk.
-//    Every key has linear in and out tangents, as the glTF export's LINEAR samplers.
+//    every key frame (bodies also rotateX/Y/Z, in rotate order ZXY so that heading is rotateY
+//    alone and an upright body is never at gimbal lock: the quaternion as Euler ZXY degrees,
+//    unwrapped so consecutive keys take the shortest turn). Frames are written as they are in the
+//    walk. Every key has linear in and out tangents, as the glTF export's LINEAR samplers.
 // Frames and values are MEL decimals without exponent, with the fewest digits that read back as
 // the same double (a walk in tiny or huge units keeps full precision).
 // Node names are sanitised to Maya names ([A-Za-z_][A-Za-z0-9_]*; other characters become '_')
