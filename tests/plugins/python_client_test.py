@@ -512,6 +512,74 @@ class RotationTest(unittest.TestCase):
                 self.assertAlmostEqual(value, want[axis], places=9)
 
 
+class MayaKeyWalkTest(unittest.TestCase):
+    """footfall_maya.key_walk against a stand-in for maya.cmds that records the calls (there is
+    no Maya here): the body turns in rotate order ZXY and is keyed with the ZXY angles, as the
+    MEL export keys it."""
+
+    def _key_walk(self, walk, feet, body):
+        import types
+        calls = []
+        cmds = types.ModuleType("maya.cmds")
+        for name in ("setAttr", "xform", "setKeyframe"):
+            setattr(cmds, name, lambda *args, _name=name, **kwargs:
+                    calls.append((_name, args, kwargs)))
+        maya = types.ModuleType("maya")
+        maya.cmds = cmds
+        saved = {name: sys.modules.pop(name, None) for name in ("maya", "maya.cmds",
+                                                                "footfall_maya")}
+        sys.modules.update({"maya": maya, "maya.cmds": cmds})
+        sys.path.insert(0, os.path.join(REPO, "plugins", "maya"))
+        try:
+            import footfall_maya
+            footfall_maya.key_walk(walk, feet, body)
+        finally:
+            sys.path.pop(0)
+            for name, module in saved.items():
+                sys.modules.pop(name, None)
+                if module is not None:
+                    sys.modules[name] = module
+        return calls
+
+    def test_body_turns_in_rotate_order_zxy(self):
+        # Tilted 4 degrees on a slope, turning 2 degrees a key through heading +X (yaw 90: gimbal
+        # lock in XYZ, where the channels swung by tens of degrees a key).
+        tilt = (math.sin(math.radians(2)), 0.0, 0.0, math.cos(math.radians(2)))
+
+        def yawed(deg):
+            h = math.radians(deg) / 2
+            a, b = tilt, (0.0, math.sin(h), 0.0, math.cos(h))  # a * b
+            return (a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1],
+                    a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0],
+                    a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3],
+                    a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2])
+        keys = [{"frame": 1 + i, "position": [0.0, 1.0, 0.1 * i], "rotation": yawed(70 + 2 * i)}
+                for i in range(21)]
+        walk = {"tracks": [{"name": "body", "kind": "body", "keys": keys},
+                           {"name": "L", "kind": "foot",
+                            "keys": [{"frame": 1, "position": [0.1, 0.0, 0.0]}]}]}
+        calls = self._key_walk(walk, {"L": "footL"}, "hips")
+        self.assertEqual([c for c in calls if c[0] == "setAttr"],
+                         [("setAttr", ("hips.rotateOrder", 2), {})])
+        rotations = [c[2]["ro"] for c in calls if c[0] == "xform" and "ro" in c[2]]
+        self.assertLess(calls.index(("setAttr", ("hips.rotateOrder", 2), {})),
+                        [i for i, c in enumerate(calls) if "ro" in c[2]][0])
+        self.assertEqual(len(rotations), len(keys))
+        previous = None
+        self.assertFalse([c for c in calls if c[1][:1] == ("footL",) and "ro" in c[2]])
+        for key, euler in zip(keys, rotations):
+            # The angles rebuild the key's rotation in ZXY order, with no jump between keys.
+            got = RotationTest._matrix_of_euler(euler, "zxy")
+            want = RotationTest._matrix_of_quat(key["rotation"])
+            for i in range(3):
+                for j in range(3):
+                    self.assertAlmostEqual(got[i][j], want[i][j], places=9)
+            if previous is not None:
+                for a, b in zip(euler, previous):
+                    self.assertLess(abs(a - b), 3.0, msg="%s after %s" % (euler, previous))
+            previous = euler
+
+
 class GenerateTest(unittest.TestCase):
     """ffc_generate over RPC gives the same walk JSON as `footfall generate`."""
 

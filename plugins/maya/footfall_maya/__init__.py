@@ -198,16 +198,20 @@ def key_walk(walk, feet, body, from_frame=None):
         node = body if is_body else feet.get(track.get("name"))
         if not node:
             continue
+        if is_body:
+            # Rotate order ZXY, as the MEL export: heading is rotateY alone, so a body heading
+            # +-X is not at gimbal lock (in Maya's default XYZ it is).
+            mc.setAttr(node + ".rotateOrder", 2)
         previous = None
         for key in track.get("keys", []):
             frame = key["frame"]
             euler = None
             if is_body and "rotation" in key:
-                # XYZ Euler degrees as Maya's default rotate order composes them, unwrapped from
-                # the previous key (as the MEL export keys them), keyed or not.
-                euler = ffc.rotation.quat_to_euler_xyz(key["rotation"])
+                # ZXY Euler degrees (R = Ry * Rx * Rz), unwrapped from the previous key (as the
+                # MEL export keys them), keyed or not.
+                euler = ffc.rotation.quat_to_euler_zxy(key["rotation"])
                 if previous is not None:
-                    euler = ffc.rotation.closest_euler(euler, previous)
+                    euler = ffc.rotation.closest_euler_zxy(euler, previous)
                 previous = euler
             if from_frame is not None and frame < from_frame:
                 continue
