@@ -877,6 +877,53 @@ TEST_CASE("The heading follows a path with a 90-degree turn", "[steps][generator
   }
 }
 
+TEST_CASE("A waypoint inside the turning circle is reached with shorter steps, not circled",
+          "[steps][generator]") {
+  // The shipped biped with --path "0,0,3 0.5,0,2.5" turned 30 degrees a step at full stride
+  // about a goal inside its turning circle (radius ~0.67 m) for 10,000 steps, never within half
+  // a step of it. The same with every character and a smaller max_turn_deg, and with the
+  // waypoint beside the corner as an intermediate one.
+  for (const std::string& name : ShippedCharacters()) {
+    for (const double turn : {30.0, 15.0}) {
+      for (const bool intermediate : {false, true}) {
+        Character c = LoadShipped(name);
+        c.max_turn_deg = turn;
+        const double step = c.step_length, spacing = step / 10, margin = 4 * c.reach;
+        const int n = static_cast<int>((10 * step + 2 * margin) / spacing);
+        Terrain t = LoadTerrain(MakeFlat(n, spacing, 0), spacing);
+        INFO(name << ", max_turn_deg " << turn << (intermediate ? ", intermediate" : ""));
+        GenerateOptions o;
+        o.has_start = true;
+        o.start = {margin, 0, margin};
+        const Vec3 corner{margin, 0, margin + 4 * step};
+        const Vec3 beside = corner + Vec3{0.7 * step, 0, -0.7 * step};
+        const Vec3 goal = intermediate ? beside + Vec3{0, 0, 4 * step} : beside;
+        o.path.push_back(corner);
+        o.path.push_back(beside);
+        if (intermediate) o.path.push_back(goal);
+        const Walk w = Generate(t, c, o);
+        INFO(w.stopped);
+        REQUIRE(w.stopped.empty());
+        CheckWalk(t, c, o, w);
+        // About 15 steps of path: well within 80 steps, not 10,000.
+        CHECK(StepsDone(w) < 80);
+        Vec3 centroid;
+        int feet = 0;
+        double nearest_beside = 1e9;
+        for (const WalkTrack& tr : w.tracks) {
+          if (tr.kind != TrackKind::kFoot) continue;
+          centroid += tr.keys.back().position, ++feet;
+        }
+        for (const WalkKey& k : Body(w).keys)
+          nearest_beside =
+              std::min(nearest_beside, Distance(k.position - Vec3{0, c.body_height, 0}, beside));
+        CHECK(Distance(centroid / static_cast<double>(feet), goal) <= 0.5 * step + 1e-9);
+        CHECK(nearest_beside <= step + 1e-9);
+      }
+    }
+  }
+}
+
 TEST_CASE("A path walk that runs out of steps before its goal says so as a stop",
           "[steps][generator]") {
   // Back and forth between two points 4 m apart, 2000 times: more than the 10,000 steps a path

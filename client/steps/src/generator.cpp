@@ -165,6 +165,9 @@ struct Agent {
   std::vector<Vec3> foot, foot_normal;  // planted feet
   std::vector<Vec3> path;
   size_t waypoint = 0;
+  // This step's stride, as a share of a full one (Steer): below 1 while the waypoint lies inside
+  // the circle the body turns on at full stride, 0 to turn on the spot.
+  double stride = 1;
   bool walking = true;  // false once stopped or arrived
   int waits = 0;        // steps in a row its group stepped in place, waiting for a planted foot
   // Where the body was at step `window_step`: a body that stays within half a step of it for
@@ -337,6 +340,9 @@ class Generator {
   Vec3 world_up_;
   int steps_ = 0;
   double lead_ = 0;
+  // The radius of the circle the body turns on at full stride and max_turn_deg a step (its
+  // ground moves step_length over the number of gait groups a step).
+  double turn_radius_ = 0;
   // The farthest a point of the surface may be from its nearest sample, estimated from the
   // grid: twice the mean spacing, cell_size / sqrt(samples per occupied cell). [Units: wu]
   double gap_ = 0;
@@ -454,11 +460,20 @@ void Generator::Steer(Agent& a) const {
     return;
   }
   const Vec3 to = ProjectOnPlane(a.path[a.waypoint] - a.ground, a.up);
+  a.stride = 1;
   if (Length2(to) < 1e-18) return;
   const Vec3 want = Normalize(to);
   const double angle = std::atan2(Dot(Cross(a.forward, want), a.up), Dot(a.forward, want));
   const double max_turn = Radians(c_.max_turn_deg);
   a.forward = Normalize(RotateAround(a.forward, a.up, std::clamp(angle, -max_turn, max_turn)));
+  // A waypoint inside the circle the body turns on at full stride (beside or behind it, nearer
+  // than the turn allows) would be circled for ever: the steps shorten so that the circle the
+  // body turns on, tangent to the new heading, runs through the waypoint, and with the waypoint
+  // behind that heading the character turns on the spot.
+  const double ahead = Dot(to, a.forward);
+  const double aside = Length(to - a.forward * ahead);
+  const double through = Length2(to) / (2 * aside);  // that circle's radius (inf: no circle)
+  if (through < turn_radius_) a.stride = ahead > 0 ? through / turn_radius_ : 0;
 }
 
 class Generator::Progress {
@@ -498,6 +513,7 @@ Status Generator::Run(std::string* error) {
   // centroid, L * (G + 1) / (2G) makes every foot travel exactly L per step once walking
   // (half a step ahead for G -> infinity; 3/4 of a step for two gait groups).
   lead_ = c_.step_length * (groups + 1) / (2.0 * groups);
+  turn_radius_ = c_.step_length / groups / (2 * std::sin(0.5 * Radians(c_.max_turn_deg)));
   // (Past the ends of their ranges the tests hold or fail whatever the rounding of the dots.)
   cos_max_slope_ =
       c_.max_slope_deg >= 180 ? -2.0 : std::cos(Radians(std::max(c_.max_slope_deg, 0.0)));
@@ -1561,6 +1577,12 @@ void Generator::Finish(size_t w, int k) {
   // Every foot of the group steps in place: it waits, as a held group does, for the other
   // groups to move the body on (a hind foot at the terrain's back edge, whose target lies behind
   // it until the front feet step); a whole cycle of groups in place is a dead end.
+  // A character turning on the spot or at a short stride toward a near waypoint may step in
+  // place for as long as its turn takes (the dead-end window allows half a turn).
+  if (in_place && !failed && a.stride < 1) {
+    body_frame_[w] = f1;
+    return;
+  }
   if (in_place && !failed && a.waits + 1 < static_cast<int>(c_.gait.size())) {
     ++a.waits;
     body_frame_[w] = f1;
@@ -1630,8 +1652,8 @@ Status Generator::Step(int k, std::string* error) {
     for (size_t w = b; w < e; ++w) {
       const Agent& a = agents_[walking_[w]];
       for (size_t p = 0; p < locators; ++p)
-        points_[w * locators + p] =
-            Place(a, pair_centre_[pairs[p]]) + a.forward * lead_ + a.up * (0.5 * lead_);
+        points_[w * locators + p] = Place(a, pair_centre_[pairs[p]]) +
+                                    a.forward * (lead_ * a.stride) + a.up * (0.5 * lead_);
       for (size_t j = 0; j < per_agent; ++j) {
         Move& mv = moves_[w * per_agent + j];
         mv = Move{};
