@@ -433,6 +433,55 @@ TEST_CASE("Multipeds walk around a sphere, bipeds stop where it gets too steep",
   }
 }
 
+TEST_CASE("A goal on the far side of a sphere is walked to, not reached where the walk starts",
+          "[steps][generator]") {
+  // A hexapod on top of a sphere given the bottom as its goal made no step: the goal lay within
+  // half a step along its ground, straight below it.
+  for (const std::string& name : ShippedCharacters()) {
+    const Character c = LoadShipped(name);
+    if (!c.align_to_normal) continue;
+    const double radius = 3 * c.reach, spacing = c.step_length / 10;
+    const int count = static_cast<int>(4 * kPi * radius * radius / (spacing * spacing));
+    Terrain t = LoadTerrain(MakeSphere(count, {0, 0, 0}, radius), spacing);
+    for (const Vec3& goal : {Vec3{0, -radius, 0}, Vec3{0, -radius, 0.02 * radius}}) {
+      INFO(name << ", goal " << goal.x << ", " << goal.y << ", " << goal.z);
+      GenerateOptions o;
+      o.has_start = true;
+      o.start = {0, radius, 0};
+      o.path = {goal};
+      const Walk w = Generate(t, c, o);
+      INFO(w.stopped);
+      REQUIRE(w.stopped.empty());
+      CheckWalk(t, c, o, w);
+      CHECK(StepsDone(w) > 10);
+      Vec3 centroid;
+      int feet = 0;
+      for (const WalkTrack& tr : w.tracks)
+        if (tr.kind == TrackKind::kFoot) centroid += tr.keys.back().position, ++feet;
+      CHECK(Distance(centroid / static_cast<double>(feet), goal) < c.step_length);
+    }
+  }
+}
+
+TEST_CASE("A goal on the floor under the table top a biped stands on is not reached there",
+          "[steps][generator]") {
+  // The goal lies straight below, 0.9 m down, with no way down: the walk stops saying so.
+  const Character c = LoadShipped("biped");
+  RawSamples s = MakeFlat(120, 0.05, 0);
+  for (int k = 0; k <= 40; ++k)
+    for (int i = 0; i <= 40; ++i) s.push_back({2 + i * 0.05, 0.9, 2 + k * 0.05}, {0, 1, 0});
+  Terrain t = LoadTerrain(s, 0.05);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {3, 1, 3};
+  o.path = {{3.1, 0, 3}};
+  const Walk w = Generate(t, c, o);
+  CHECK(StepsDone(w) > 0);
+  CHECK_THAT(w.stopped, Catch::Contains("no way to the path's goal (3.1000, 0.0000, 3.0000): "
+                                        "the body has come no nearer to it than"));
+  CheckWalk(t, c, o, w);
+}
+
 TEST_CASE("A stop shows the value that broke a limit, never rounded onto the limit",
           "[steps][generator]") {
   // Flat ground up to z = 0, then a 20-degree ramp; the biped allows 19.99999 degrees.

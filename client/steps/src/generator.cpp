@@ -164,7 +164,16 @@ struct Agent {
   Vec3 forward;                         // the body's heading, unit, perpendicular to up
   std::vector<Vec3> foot, foot_normal;  // planted feet
   std::vector<Vec3> path;
+  // Each waypoint's distance from the terrain (its nearest sample; infinite for one beyond the
+  // reach of terrain queries): one lying on the terrain is reached only when near in 3D too.
+  std::vector<double> path_off;
   size_t waypoint = 0;
+  // The nearest the ground has come to the current waypoint (in 3D), by a quarter step at a
+  // time, and the step it did: a walk that comes no nearer for Generator::window_steps_ steps
+  // has no way there.
+  size_t nearest_waypoint = SIZE_MAX;
+  double nearest = 0;
+  int nearest_step = 0;
   // This step's stride, as a share of a full one (Steer): below 1 while the waypoint lies inside
   // the circle the body turns on at full stride, 0 to turn on the spot.
   double stride = 1;
@@ -291,6 +300,14 @@ class Generator {
     pool_->Run(count, chunk, fn);
   }
   void Steer(Agent& a) const;
+  // Whether a's waypoint i counts as reached, within `radius` of its ground: along the ground,
+  // whatever the waypoint's height above or below it (a biped's waypoint in the air), unless
+  // the waypoint lies on the terrain (within half the radius of a sample) farther than the
+  // radius along a's up: the far side of a sphere, a floor under a table top, a ceiling.
+  bool Reached(const Agent& a, size_t i, double radius) const;
+  // At step k: false once a has come no nearer (Agent::nearest) to its current waypoint for
+  // window_steps_ steps.
+  bool Nearing(Agent& a, int k) const;
   Vec3 Left(const Agent& a) const { return Cross(a.up, a.forward); }
   Vec3 Place(const Agent& a, const Vec3& rest) const {
     return a.ground + Left(a) * rest.x + a.up * rest.y + a.forward * rest.z;
@@ -445,14 +462,32 @@ void Generator::Stop(Agent& a, int step, const std::string& why) {
   a.stopped_step = step;
 }
 
+bool Generator::Nearing(Agent& a, int k) const {
+  if (a.path.empty()) return true;
+  const double d = Distance(a.path[a.waypoint], a.ground);
+  if (a.nearest_waypoint != a.waypoint || d < a.nearest - 0.25 * c_.step_length) {
+    a.nearest_waypoint = a.waypoint, a.nearest = d, a.nearest_step = k;
+    return true;
+  }
+  return k - a.nearest_step < window_steps_;
+}
+
+bool Generator::Reached(const Agent& a, size_t i, double radius) const {
+  const Vec3 to = a.path[i] - a.ground;
+  const double along = Dot(to, a.up);
+  if (Length2(to - a.up * along) > radius * radius) return false;
+  return !(a.path_off[i] <= 0.5 * radius) || std::fabs(along) <= radius;
+}
+
 // Turns the heading toward the current waypoint, at most max_turn_deg per step; marks the
 // agent arrived at the last waypoint.
 void Generator::Steer(Agent& a) const {
   if (a.path.empty()) return;
+  double radius = 0;
   while (a.waypoint < a.path.size()) {
-    const Vec3 to = ProjectOnPlane(a.path[a.waypoint] - a.ground, a.up);
     const bool last = a.waypoint + 1 == a.path.size();
-    if (Length(to) > (last ? 0.5 : 1.0) * c_.step_length) break;
+    radius = (last ? 0.5 : 1.0) * c_.step_length;
+    if (!Reached(a, a.waypoint, radius)) break;
     ++a.waypoint;
   }
   if (a.waypoint == a.path.size()) {
@@ -461,7 +496,9 @@ void Generator::Steer(Agent& a) const {
   }
   const Vec3 to = ProjectOnPlane(a.path[a.waypoint] - a.ground, a.up);
   a.stride = 1;
-  if (Length2(to) < 1e-18) return;
+  // A waypoint on the terrain straight above or below (the far side of a sphere): any way on
+  // along the ground leads toward it, so the heading is kept until it lies farther aside.
+  if (Length(to) <= radius) return;
   const Vec3 want = Normalize(to);
   const double angle = std::atan2(Dot(Cross(a.forward, want), a.up), Dot(a.forward, want));
   const double max_turn = Radians(c_.max_turn_deg);
@@ -799,6 +836,31 @@ Status Generator::Setup(std::string* error) {
       << "'s do (the grid runs off the terrain there): left out of the walk";
     a.walking = false, a.left_out = true;
     a.stopped = m.str(), a.stopped_step = 1;
+  }
+  // 5 (set-up). How far each waypoint lies from the terrain (one batch of snaps), for Reached.
+  const size_t waypoints = o_.path.size();
+  if (waypoints > 0) {
+    points_.resize(static_cast<size_t>(n) * waypoints);
+    for (int i = 0; i < n; ++i)
+      std::copy(agents_[i].path.begin(), agents_[i].path.end(), &points_[i * waypoints]);
+    // Points beyond the reach of terrain queries are farther from it than anything.
+    std::vector<size_t> asked;
+    std::vector<Vec3> queries;
+    for (size_t j = 0; j < points_.size(); ++j) {
+      const Vec3& p = points_[j];
+      if (std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) <= terrain::kMaxCoordinate)
+        asked.push_back(j), queries.push_back(p);
+    }
+    answers_.resize(queries.size());
+    s = Check(session_.Snap(terrain_, queries.data(), queries.size(), answers_.data()),
+              "snap waypoints", error);
+    if (s != Status::kOk) return s;
+    for (int i = 0; i < n; ++i)
+      agents_[i].path_off.assign(waypoints, std::numeric_limits<double>::infinity());
+    for (size_t q = 0; q < asked.size(); ++q)
+      if (answers_[q].status == Status::kOk)
+        agents_[asked[q] / waypoints].path_off[asked[q] % waypoints] =
+            Distance(answers_[q].point, queries[q]);
   }
   return Status::kOk;
 }
@@ -1635,6 +1697,18 @@ Status Generator::Step(int k, std::string* error) {
   for (size_t i = pass_begin_; i < pass_end_; ++i) {
     if (!agents_[i].walking) continue;
     Steer(agents_[i]);
+    if (agents_[i].walking && !Nearing(agents_[i], k)) {
+      Agent& a = agents_[i];
+      const Vec3& p = a.path[a.waypoint];
+      std::ostringstream why;
+      why.precision(4);
+      why << "no way to " << (a.waypoint + 1 == a.path.size() ? "the path's goal " : "waypoint ")
+          << (a.waypoint + 1 == a.path.size() ? "" : std::to_string(a.waypoint + 1) + " ")
+          << Point(p) << ": the body has come no nearer to it than " << a.nearest << " for "
+          << window_steps_ << " steps (it lies " << Dot(p - a.ground, a.up)
+          << " along the up from the ground under the body)";
+      Stop(a, k + 1, why.str());
+    }
     if (agents_[i].walking) walking_.push_back(i);
   }
   // 6. Central locators: one per foot pair stepping now, `lead` ahead of the pair's rest centre
