@@ -300,11 +300,19 @@ class Generator {
     pool_->Run(count, chunk, fn);
   }
   void Steer(Agent& a) const;
-  // Whether a's waypoint i counts as reached, within `radius` of its ground: along the ground,
+  // The radius within which a's waypoint i counts as reached: half a step for the last, a
+  // step for the others.
+  double Radius(const Agent& a, size_t i) const;
+  // Whether a's waypoint i lies on the terrain: within half its radius of a sample.
+  bool OnTerrain(const Agent& a, size_t i) const;
+  // Whether a's waypoint i counts as reached, within its radius of a's ground: along the ground,
   // whatever the waypoint's height above or below it (a biped's waypoint in the air), unless
-  // the waypoint lies on the terrain (within half the radius of a sample) farther than the
-  // radius along a's up: the far side of a sphere, a floor under a table top, a ceiling.
-  bool Reached(const Agent& a, size_t i, double radius) const;
+  // the waypoint lies on the terrain farther than the radius along a's up: the far side of a
+  // sphere, a floor under a table top, a ceiling.
+  bool Reached(const Agent& a, size_t i) const;
+  // How far a's waypoint i still is, as Reached measures it: in 3D when it lies on the terrain,
+  // else along the ground.
+  double Remaining(const Agent& a, size_t i) const;
   // At step k: false once a has come no nearer (Agent::nearest) to its current waypoint for
   // window_steps_ steps.
   bool Nearing(Agent& a, int k) const;
@@ -464,7 +472,7 @@ void Generator::Stop(Agent& a, int step, const std::string& why) {
 
 bool Generator::Nearing(Agent& a, int k) const {
   if (a.path.empty()) return true;
-  const double d = Distance(a.path[a.waypoint], a.ground);
+  const double d = Remaining(a, a.waypoint);
   if (a.nearest_waypoint != a.waypoint || d < a.nearest - 0.25 * c_.step_length) {
     a.nearest_waypoint = a.waypoint, a.nearest = d, a.nearest_step = k;
     return true;
@@ -472,24 +480,31 @@ bool Generator::Nearing(Agent& a, int k) const {
   return k - a.nearest_step < window_steps_;
 }
 
-bool Generator::Reached(const Agent& a, size_t i, double radius) const {
+double Generator::Radius(const Agent& a, size_t i) const {
+  return (i + 1 == a.path.size() ? 0.5 : 1.0) * c_.step_length;
+}
+
+bool Generator::OnTerrain(const Agent& a, size_t i) const {
+  return a.path_off[i] <= 0.5 * Radius(a, i);
+}
+
+double Generator::Remaining(const Agent& a, size_t i) const {
   const Vec3 to = a.path[i] - a.ground;
-  const double along = Dot(to, a.up);
+  return OnTerrain(a, i) ? Length(to) : Length(ProjectOnPlane(to, a.up));
+}
+
+bool Generator::Reached(const Agent& a, size_t i) const {
+  const Vec3 to = a.path[i] - a.ground;
+  const double along = Dot(to, a.up), radius = Radius(a, i);
   if (Length2(to - a.up * along) > radius * radius) return false;
-  return !(a.path_off[i] <= 0.5 * radius) || std::fabs(along) <= radius;
+  return !OnTerrain(a, i) || std::fabs(along) <= radius;
 }
 
 // Turns the heading toward the current waypoint, at most max_turn_deg per step; marks the
 // agent arrived at the last waypoint.
 void Generator::Steer(Agent& a) const {
   if (a.path.empty()) return;
-  double radius = 0;
-  while (a.waypoint < a.path.size()) {
-    const bool last = a.waypoint + 1 == a.path.size();
-    radius = (last ? 0.5 : 1.0) * c_.step_length;
-    if (!Reached(a, a.waypoint, radius)) break;
-    ++a.waypoint;
-  }
+  while (a.waypoint < a.path.size() && Reached(a, a.waypoint)) ++a.waypoint;
   if (a.waypoint == a.path.size()) {
     a.walking = false;  // arrived: not an early stop
     return;
@@ -498,7 +513,7 @@ void Generator::Steer(Agent& a) const {
   a.stride = 1;
   // A waypoint on the terrain straight above or below (the far side of a sphere): any way on
   // along the ground leads toward it, so the heading is kept until it lies farther aside.
-  if (Length(to) <= radius) return;
+  if (Length(to) <= Radius(a, a.waypoint)) return;
   const Vec3 want = Normalize(to);
   const double angle = std::atan2(Dot(Cross(a.forward, want), a.up), Dot(a.forward, want));
   const double max_turn = Radians(c_.max_turn_deg);
@@ -604,7 +619,7 @@ Status Generator::Run(std::string* error) {
   if (o_.steps < 0 && !o_.path.empty()) {
     for (Agent& a : agents_) {
       if (!a.walking || !a.stopped.empty() || a.path.empty()) continue;
-      const double left = Length(ProjectOnPlane(a.path.back() - a.ground, a.up));
+      const double left = Remaining(a, a.path.size() - 1);
       std::ostringstream why;
       why.precision(4);
       why << "the path's goal " << Point(a.path.back()) << " is still " << left << " away after "
@@ -1705,8 +1720,7 @@ Status Generator::Step(int k, std::string* error) {
       why << "no way to " << (a.waypoint + 1 == a.path.size() ? "the path's goal " : "waypoint ")
           << (a.waypoint + 1 == a.path.size() ? "" : std::to_string(a.waypoint + 1) + " ")
           << Point(p) << ": the body has come no nearer to it than " << a.nearest << " for "
-          << window_steps_ << " steps (it lies " << Dot(p - a.ground, a.up)
-          << " along the up from the ground under the body)";
+          << window_steps_ << " steps";
       Stop(a, k + 1, why.str());
     }
     if (agents_[i].walking) walking_.push_back(i);
