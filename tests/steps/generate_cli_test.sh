@@ -90,6 +90,13 @@ check "goal above the start: the note" grep -q "no steps: the path's goal is alr
 "$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,1 \
   --path 2.5,0,4 --steps 0 --out "$work/steps0.json" 2> "$work/steps0.err"
 check "--steps 0 with a path: no note about the goal" bash -c "! grep -q 'goal is already reached' '$work/steps0.err'"
+# --steps too few for the path: the steps asked for (exit 0, no stop), and a note of how far the
+# goal still is (it used to end short of it saying nothing).
+"$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,1 \
+  --path 2.5,0,4 --steps 2 --out "$work/short.json" 2> "$work/short.err"
+check "--steps short of the goal: exit 0" [ $? -eq 0 ]
+check "--steps short of the goal: no stop" grep -q '"stopped":""' "$work/short.json"
+check "--steps short of the goal: the note" grep -qE "^footfall generate: note: the path's goal \(2.5000, 0.0000, 4.0000\) is still [0-9.]+ away after the 2 steps asked for" "$work/short.err"
 # A glTF output that cannot hold the walk's times is named; the JSON beside it is written (it
 # keeps every key).
 "$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,1 \

@@ -989,9 +989,27 @@ TEST_CASE("A path walk that runs out of steps before its goal says so as a stop"
                             Catch::Contains("after 10000 steps, the most a path walk takes "
                                             "without --steps"));
   CHECK(StepsDone(w) == 10000);
-  // With --steps the walk is as asked: no stop.
+  // With --steps the walk is as asked: no stop, but a note of how far the goal still is (it
+  // ended short of it saying nothing).
   o.steps = 50;
-  CHECK(Generate(t, c, o).stopped.empty());
+  const Walk asked = Generate(t, c, o);
+  CHECK(asked.stopped.empty());
+  REQUIRE(asked.notes.size() == 1);
+  CHECK_THAT(asked.notes[0],
+             Catch::StartsWith("the path's goal (5.0000, 0.0000, 2.0000) is still ") &&
+                 Catch::EndsWith(" away after the 50 steps asked for (without "
+                                 "--steps a path walk goes on to its goal, up to "
+                                 "10000 steps)"));
+  // Steps enough to arrive: nothing to say.
+  o.path = {{5, 0, 4}};
+  CHECK(Generate(t, c, o).notes.empty());
+  // Arriving with the last step asked for: nothing either.
+  o.steps = static_cast<int>(StepsDone(Generate(t, c, o)));
+  const Walk just = Generate(t, c, o);
+  CHECK(just.stopped.empty());
+  CHECK(just.notes.empty());
+  o.steps -= 1;
+  CHECK(Generate(t, c, o).notes.size() == 1);
 }
 
 TEST_CASE("A cliff stops the walk with the step, the position and the keys so far",

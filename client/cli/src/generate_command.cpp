@@ -335,6 +335,14 @@ int RunGenerate(const GenerateFlags& flags) {
         code = 1;
       }
     }
+    // A path walk whose --steps ended short of its goal: not a stop, but said (up to a
+    // screenful).
+    constexpr size_t kMaxNotes = 20;
+    for (size_t i = 0; i < walk.notes.size() && i < kMaxNotes; ++i)
+      std::cerr << "footfall generate: note: " << walk.notes[i] << '\n';
+    if (walk.notes.size() > kMaxNotes)
+      std::cerr << "footfall generate: note: ... and " << walk.notes.size() - kMaxNotes
+                << " more characters short of their goals\n";
     if (!walk.stopped.empty()) {
       std::cerr << "footfall generate: stopped early: " << walk.stopped << '\n';
       // A crowd: every character's reason, up to a screenful.

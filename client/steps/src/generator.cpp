@@ -628,6 +628,25 @@ Status Generator::Run(std::string* error) {
       Stop(a, steps_ + 1, why.str());
     }
   }
+  // A path walk given its number of steps that took them all short of its goal did as asked
+  // (no stop), but says how far the goal still is.
+  walk_.notes.clear();
+  if (o_.steps >= 0 && !o_.path.empty()) {
+    for (Agent& a : agents_) {
+      if (!a.walking || !a.stopped.empty() || a.path.empty()) continue;
+      size_t next = a.waypoint;  // arrived with the last step?
+      while (next < a.path.size() && Reached(a, next)) ++next;
+      if (next == a.path.size()) continue;
+      std::ostringstream note;
+      note.precision(4);
+      if (!a.id.empty()) note << a.id << ": ";
+      note << "the path's goal " << Point(a.path.back()) << " is still "
+           << Remaining(a, a.path.size() - 1) << " away after the " << steps_
+           << " steps asked for (without --steps a path walk goes on to its goal, up to "
+           << kMaxPathSteps << " steps)";
+      walk_.notes.push_back(note.str());
+    }
+  }
   // The walk's stop message: the earliest stop (the first character's among those of that
   // step), and how many others stopped; Walk::stops has every one.
   std::vector<const Agent*> stopped;

@@ -83,6 +83,10 @@ struct Walk {
   // Every stopped character's reason, earliest step first (not written to files: the walk JSON
   // carries `stopped` alone).
   std::vector<std::string> stops;
+  // What is worth saying of a walk that did every step asked, one line per character, earliest
+  // first (not written to files either): a path walk given its number of steps that ended short
+  // of its goal says how far the goal still is.
+  std::vector<std::string> notes;
 };
 
 const char* PhaseName(KeyPhase phase);  // "start", "mid", "end" or ""
