@@ -299,6 +299,31 @@ TEST_CASE("screenshot of a walk shows the feet where the JSON puts them at that 
   }
 }
 
+TEST_CASE("a walk's rotations with huge components are drawn as unit quaternions",
+          "[viewer][walk]") {
+  // (Squaring 1e300 overflowed: the rotation was normalised to zero, and the body drawn
+  // without axes.)
+  const std::string dir = test::TempDir();
+  std::string walk = WalkJson();
+  walk.replace(walk.find("[0, 0, 0, 1]"), 12, "[0, 0, 0, 1e300]");
+  walk.replace(walk.find("[0, 0, 0, 2]"), 12, "[1e300, 0, 0, 1e300]");
+  test::WriteFile(dir + "/walk.json", walk);
+  for (const int frame : {1, 25}) {
+    const RunResult r =
+        View({"--walk", dir + "/walk.json", "--frame", std::to_string(frame), "--size", "160x100",
+              "--screenshot", dir + "/shot.png", "--dump-state", dir + "/state.json"});
+    INFO("frame " << frame << ": " << r.err);
+    REQUIRE(r.exit_code == 0);
+    const json state = json::parse(test::ReadFile(dir + "/state.json"));
+    const json& q = state["walk"]["tracks"][2]["rotation"];
+    const double half = std::sqrt(0.5);
+    CHECK(q[0].get<double>() == Approx(frame == 1 ? 0 : half).margin(1e-12));
+    CHECK(q[1].get<double>() == Approx(0).margin(1e-12));
+    CHECK(q[2].get<double>() == Approx(0).margin(1e-12));
+    CHECK(q[3].get<double>() == Approx(frame == 1 ? 1 : half).margin(1e-12));
+  }
+}
+
 TEST_CASE("why a walk stopped is shown in full, wrapped to the window", "[viewer][walk]") {
   // (The reason ran off the right edge of the window in one line.)
   const std::string dir = test::TempDir();
