@@ -567,6 +567,10 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     r = View({"--screenshot", shot});
     CHECK(r.exit_code == 2);
     CHECK_THAT(r.err, Catch::Contains("nothing to show"));
+    // (--live-wait without --live was ignored: the screenshot was taken at once.)
+    r = View({"--terrain", kTerrain, "--live-wait", "2", "--screenshot", shot});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("--live-wait needs --live"));
     r = View({"--terrain", kTerrain, "--frame", "nan", "--screenshot", shot});
     CHECK(r.exit_code == 2);
     CHECK_THAT(r.err,

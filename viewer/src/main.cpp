@@ -54,9 +54,11 @@ int main(int argc, char** argv) {
   app.add_option("--walk", o.walk, "Walk JSON file from the step generator");
   app.add_option("--server", o.server, "footfalld HOST:PORT, with --live");
   app.add_flag("--live", o.live, "Draw the queries the server answers, as they arrive");
-  app.add_option("--live-wait", o.live_wait,
-                 "With --screenshot: wait for this many live queries before rendering")
-      ->check(CLI::NonNegativeNumber);
+  auto* live_wait_opt =
+      app.add_option("--live-wait", o.live_wait,
+                     "With --live and --screenshot: wait for this many live queries before "
+                     "rendering")
+          ->check(CLI::NonNegativeNumber);
   app.add_option("--timeout", o.timeout_s, "Bound on waits for the server (s)")
       ->check(footfall::cli::FiniteRange(0.001, 1e6));
   app.add_option("--screenshot", o.screenshot, "Render one frame off screen to this PNG and exit")
@@ -76,6 +78,12 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;  // a refused flag: 2, as for --size and --camera
+  }
+  // (Without --live it was ignored: the screenshot was taken at once.)
+  if (live_wait_opt->count() > 0 && !o.live) {
+    std::cerr << "footfall-view: --live-wait needs --live (it waits for queries the --server "
+                 "answers)\n";
+    return 2;
   }
   if (!size.empty()) {
     const size_t x = size.find_first_of("xX");
