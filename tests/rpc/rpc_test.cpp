@@ -905,15 +905,99 @@ TEST_CASE("A server-side load does not hold up the other clients", "[rpc]") {
     CLIENT* late = RawClient(server.port());
     ff_load_reply reply{};
     REQUIRE(send_load(late, &reply, timeval{5, 0}) == RPC_SUCCESS);
-    CHECK(reply.status == FF_LIMIT_EXCEEDED);
+    CHECK(reply.status == FF_UNAVAILABLE);
     CHECK_THAT(std::string(reply.message),
-               Catch::Contains("16 loads and uploads are being built, the most footfalld queues"));
+               Catch::Contains("footfalld is busy: 16 mesh and height map loads are being built, "
+                               "the most it queues: try again"));
     xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&reply));
     CHECK(snap_ok());  // and the others are still served
+    // An upload has a lane of its own: it is not refused.
+    TerrainHandle uploaded = 0;
+    CHECK(b->LoadSamples(MakeFlat(10, 1, 0), "beside", &uploaded) == Status::kOk);
     clnt_destroy(late);
     for (CLIENT* c : clients) clnt_destroy(c);
     CHECK(WIFEXITED(server.Terminate()));
   }
+}
+
+TEST_CASE("The client library waits while footfalld's load queue is full, then loads", "[rpc]") {
+  const TempRoot temp;
+  std::ofstream(temp.path + "/corner.obj") << kCornerObj;
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", temp.path});
+  // Two slow loads run, fourteen quick ones wait behind them: the queue is full (16) until the
+  // first slow one ends.
+  std::vector<CLIENT*> clients;
+  auto send_load = [&](double separation) {
+    ff_load_options_args args = DefaultLoadOptionsArgs("corner.obj");
+    args.separation = separation;
+    ff_load_reply reply{};
+    const timeval brief{0, 20000};  // sent, not waited for
+    clients.push_back(RawClient(server.port()));
+    return clnt_call(clients.back(), FF_LOAD_OPTIONS,
+                     reinterpret_cast<xdrproc_t>(xdr_ff_load_options_args),
+                     reinterpret_cast<char*>(&args), reinterpret_cast<xdrproc_t>(xdr_ff_load_reply),
+                     reinterpret_cast<char*>(&reply), brief);
+  };
+  for (int i = 0; i < 16; ++i) CHECK(send_load(i < 2 ? 0.004 : 0.1) == RPC_TIMEDOUT);
+  RpcOptions o;
+  o.port = server.port();
+  SECTION("a session's load waits its turn and succeeds") {
+    auto late = MakeRpcSession(o);
+    TerrainHandle t = 0;
+    const Status loaded = late->LoadServerFile("corner.obj", Separation(0.1), &t);
+    INFO(late->last_error());
+    CHECK(loaded == Status::kOk);
+  }
+  SECTION("past busy_timeout_s it fails, saying the server stayed busy") {
+    o.busy_timeout_s = 0;
+    auto hasty = MakeRpcSession(o);
+    TerrainHandle t = 0;
+    CHECK(hasty->LoadServerFile("corner.obj", Separation(0.1), &t) == Status::kUnavailable);
+    CHECK_THAT(hasty->last_error(),
+               Catch::Contains("load: footfalld at 127.0.0.1:" + std::to_string(server.port()) +
+                               " stayed busy for 0 s (RpcOptions::busy_timeout_s): footfalld is "
+                               "busy: 16 mesh and height map loads"));
+  }
+  for (CLIENT* c : clients) clnt_destroy(c);
+}
+
+TEST_CASE("Uploads and point files are not held up by slow server-side loads queued before them",
+          "[rpc]") {
+  const TempRoot temp;
+  std::ofstream(temp.path + "/corner.obj") << kCornerObj;
+  std::ofstream(temp.path + "/few.pts") << "0 0 0 0 1 0\n1 0 0 0 1 0\n0 0 1 0 1 0\n";
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", temp.path});
+  // Four slow loads, each seconds of resampling: two run, two wait (two load threads).
+  constexpr int kSlow = 4;
+  std::atomic<int> sent{0}, finished{0};
+  std::vector<std::thread> loaders;
+  for (int i = 0; i < kSlow; ++i) {
+    loaders.emplace_back([&] {
+      auto session = Connect(server.port(), 600);
+      TerrainHandle big = 0;
+      ++sent;
+      session->LoadServerFile("corner.obj", SlowLoad(), &big);
+      ++finished;
+    });
+  }
+  while (sent < kSlow) std::this_thread::yield();
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the loads reach footfalld
+  // An upload and a point file, with the default call timeout: their grids are built at once,
+  // not after the loads (the upload timed out behind them), and most loads are still running
+  // when they are done.
+  auto uploader = Connect(server.port(), 10);
+  TerrainHandle t = 0, few = 0;
+  const Status uploaded = uploader->LoadSamples(MakeFlat(30, 1, 0), "small", &t);
+  const std::string upload_error = uploader->last_error();
+  const Status read = uploader->LoadServerFile("few.pts", TerrainLoadOptions{}, &few);
+  INFO(upload_error);
+  INFO(uploader->last_error());
+  const int done_before = finished;
+  CHECK(uploaded == Status::kOk);
+  CHECK(read == Status::kOk);
+  CHECK(done_before <= 1);
+  for (std::thread& l : loaders) l.join();
+  CHECK(finished == kSlow);
 }
 
 TEST_CASE("SIGTERM during a load leaves no private file name behind", "[rpc]") {

@@ -6,11 +6,13 @@
 #include <rpc/rpc.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstring>
 #include <map>
 #include <sstream>
+#include <thread>
 
 #include "footfall.h"
 #include "footfall/client/terrain_session.h"
@@ -330,19 +332,9 @@ class RpcSession final : public TerrainSession {
       args.cell_size = o.cell_size;
       args.height_scale = o.height_scale;
       args.max_samples = o.max_samples;
-      Reply<ff_load_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply));
-      const double wait_s = std::max(options_.call_timeout_s, options_.load_timeout_s);
-      SetCallTimeout(client_, wait_s);
-      const clnt_stat sent = ff_load_options_1(&args, &reply.value, client_);
-      SetCallTimeout(client_, options_.call_timeout_s);
-      const Status s = Call(sent, "load", wait_s);
-      if (s != Status::kOk) return s;
-      if (reply.value.status != FF_OK)
-        return Fail(FromWire(reply.value.status),
-                    reply.value.message ? reply.value.message : "load failed");
-      source->server_handle = reply.value.terrain;
-      source->loaded = true;
-      return Status::kOk;
+      return BuildCall("load", source, [&](ff_load_reply* reply) {
+        return ff_load_options_1(&args, reply, client_);
+      });
     }
     const RawSamples& samples = source->samples;
     ff_upload_begin_args begin;
@@ -373,15 +365,48 @@ class RpcSession final : public TerrainSession {
                     reply.value.message ? reply.value.message : "upload failed");
     }
     ff_upload_args finish{upload};
-    Reply<ff_load_reply> done(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply));
-    s = Call(ff_upload_finish_1(&finish, &done.value, client_), "upload");
-    if (s != Status::kOk) return s;
-    if (done.value.status != FF_OK)
-      return Fail(FromWire(done.value.status),
-                  done.value.message ? done.value.message : "upload failed");
-    source->server_handle = done.value.terrain;
-    source->loaded = true;
-    return Status::kOk;
+    return BuildCall("upload", source, [&](ff_load_reply* reply) {
+      return ff_upload_finish_1(&finish, reply, client_);
+    });
+  }
+
+  // A call whose terrain footfalld builds before it answers (FF_LOAD_OPTIONS, FF_UPLOAD_FINISH):
+  // `send(reply)` makes it, waiting up to load_timeout_s (the build may wait its turn behind
+  // others'), and again while footfalld answers that it is busy (FF_UNAVAILABLE: its queue is
+  // full), for up to busy_timeout_s. On success the terrain is the source's.
+  template <typename SendFn>
+  Status BuildCall(const char* what, TerrainSource* source, SendFn&& send) {
+    const double wait_s = std::max(options_.call_timeout_s, options_.load_timeout_s);
+    const auto give_up = std::chrono::steady_clock::now() +
+                         std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                             std::chrono::duration<double>(std::max(0.0, options_.busy_timeout_s)));
+    double pause_s = 0.05;
+    for (;;) {
+      Reply<ff_load_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply));
+      SetCallTimeout(client_, wait_s);
+      const clnt_stat sent = send(&reply.value);
+      if (client_) SetCallTimeout(client_, options_.call_timeout_s);
+      const Status s = Call(sent, what, wait_s);
+      if (s != Status::kOk) return s;
+      const std::string message = reply.value.message ? reply.value.message : "";
+      if (reply.value.status == FF_UNAVAILABLE) {
+        if (std::chrono::steady_clock::now() + std::chrono::duration<double>(pause_s) > give_up) {
+          std::ostringstream text;
+          text << what << ": footfalld at " << Address() << " stayed busy for "
+               << options_.busy_timeout_s << " s (RpcOptions::busy_timeout_s): " << message;
+          return Fail(Status::kUnavailable, text.str());
+        }
+        std::this_thread::sleep_for(std::chrono::duration<double>(pause_s));
+        pause_s = std::min(1.0, pause_s * 2);
+        continue;
+      }
+      if (reply.value.status != FF_OK)
+        return Fail(FromWire(reply.value.status),
+                    message.empty() ? std::string(what) + " failed" : message);
+      source->server_handle = reply.value.terrain;
+      source->loaded = true;
+      return Status::kOk;
+    }
   }
 
   Status ServerFail(ff_status status, const char* what) {

@@ -257,10 +257,11 @@ bool QueueLoad(SVCXPRT* transport, std::unique_ptr<PendingLoad>* load) {
   return true;
 }
 
-std::string QueueFullMessage() {
-  return std::to_string(kMaxQueuedLoads) +
-         " loads and uploads are being built, the most footfalld queues: try again when one "
-         "has finished";
+std::string QueueFullMessage(LoadQueue::Lane lane) {
+  return std::string("footfalld is busy: ") + std::to_string(kMaxQueuedLoads) +
+         (lane == LoadQueue::kSampling ? " mesh and height map loads"
+                                       : " point file loads and upload grids") +
+         " are being built, the most it queues: try again when one has finished";
 }
 
 // FF_LOAD and FF_LOAD_OPTIONS: what needs no reading is checked at once (an error is answered
@@ -273,8 +274,8 @@ bool StartLoad(SVCXPRT* transport, const std::string& path, const TerrainLoadOpt
   Status s = g_state->registry.PrepareLoad(path, options, client, load.get(), &message);
   if (s == Status::kOk) {
     if (QueueLoad(transport, &load)) return true;
-    s = Status::kLimitExceeded;
-    message = QueueFullMessage();
+    s = Status::kUnavailable;
+    message = QueueFullMessage(LoadQueue::LaneOf(*load));
   }
   ReplyLoaded(s, 0, path, false, message, r);
   return false;
@@ -311,12 +312,19 @@ bool StartUploadFinish(SVCXPRT* transport, const ff_upload_args& a, uint64_t cli
                        ff_load_reply* r) {
   auto load = std::make_unique<PendingLoad>();
   std::string message;
-  Status s = g_state->registry.PrepareFinishUpload(a.upload, client, load.get(), &message);
+  Status s = Status::kOk;
+  if (g_state->loads->Full(LoadQueue::kBuilding)) {
+    // Refused before the upload is touched: the client may ask to finish it again.
+    s = Status::kUnavailable;
+    message = QueueFullMessage(LoadQueue::kBuilding);
+  } else {
+    s = g_state->registry.PrepareFinishUpload(a.upload, client, load.get(), &message);
+  }
   if (s == Status::kOk) {
     if (QueueLoad(transport, &load)) return true;
-    g_state->registry.DropLoad(load.get());
-    s = Status::kLimitExceeded;
-    message = QueueFullMessage();
+    g_state->registry.DropLoad(load.get());  // not reached: the lane was not full
+    s = Status::kUnavailable;
+    message = QueueFullMessage(LoadQueue::kBuilding);
   }
   ReplyLoaded(s, 0, "", true, message, r);
   return false;

@@ -30,11 +30,14 @@ struct ServiceState {
   std::unique_ptr<LoadQueue> loads;  // server-side loads in progress (set by InstallDispatcher)
 };
 
-// [Units: loads] Server-side loads queued or running at once; one more is refused
-// (FF_LIMIT_EXCEEDED). Each connection has at most one: it waits for its reply.
+// [Units: loads] Server-side loads queued or running at once in each lane of the LoadQueue
+// (meshes and height maps; point files and upload grids); one more is refused FF_UNAVAILABLE,
+// "busy: try again" (the client library waits and tries again). Each connection has at most one:
+// it waits for its reply.
 constexpr size_t kMaxQueuedLoads = 16;
-// Loads and upload grids built at once (each on a thread of its own).
-constexpr int kLoadWorkers = 2;
+// Threads per lane: meshes and height maps sampled at once (MaxSamplesPerLoad sizes each for
+// two), and point files and upload grids built at once.
+constexpr int kLoadWorkers[LoadQueue::kLanes] = {2, 1};
 
 using DispatchFn = void (*)(svc_req*, SVCXPRT*);
 

@@ -7,42 +7,57 @@
 #include <new>
 #include <stdexcept>
 
+#include "footfall/import/terrain_loader.h"
+#include "footfall/terrain/file_extension.h"
+
 namespace footfall {
 
 LoadQueue::State::~State() {
   if (wake_fd >= 0) close(wake_fd);
 }
 
-LoadQueue::LoadQueue(size_t capacity, int workers)
+LoadQueue::LoadQueue(size_t capacity, const int (&workers)[kLanes])
     : capacity_(capacity), state_(std::make_shared<State>()) {
   state_->wake_fd = eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
   if (state_->wake_fd < 0) throw std::runtime_error("cannot create the load queue's eventfd");
-  for (int i = 0; i < workers; ++i) workers_.emplace_back([state = state_] { Work(state); });
+  for (int lane = 0; lane < kLanes; ++lane)
+    for (int i = 0; i < workers[lane]; ++i)
+      workers_.emplace_back([state = state_, lane] { Work(state, static_cast<Lane>(lane)); });
 }
 
 LoadQueue::~LoadQueue() {
   {
     std::lock_guard<std::mutex> lock(state_->mutex);
     state_->stop = true;
-    state_->waiting.clear();
+    for (auto& waiting : state_->waiting) waiting.clear();
   }
-  state_->wake_worker.notify_all();
+  for (auto& wake : state_->wake_worker) wake.notify_all();
   for (std::thread& worker : workers_)
     if (worker.joinable()) worker.join();
 }
 
 int LoadQueue::wake_fd() const { return state_->wake_fd; }
 
+LoadQueue::Lane LoadQueue::LaneOf(const PendingLoad& load) {
+  if (!load.pinned) return kBuilding;  // an upload's samples
+  return IsPointFileExtension(FileExtension(load.pinned->path())) ? kBuilding : kSampling;
+}
+
+bool LoadQueue::Full(Lane lane) const {
+  std::lock_guard<std::mutex> lock(state_->mutex);
+  return state_->stop || state_->in_lane[lane] >= capacity_;
+}
+
 bool LoadQueue::Submit(std::unique_ptr<PendingLoad>* load) {
   State& s = *state_;
+  const Lane lane = LaneOf(**load);
   {
     std::lock_guard<std::mutex> lock(s.mutex);
-    if (s.stop ||
-        s.waiting.size() + s.finished.size() + static_cast<size_t>(s.running) >= capacity_)
-      return false;
-    s.waiting.push_back(std::move(*load));
+    if (s.stop || s.in_lane[lane] >= capacity_) return false;
+    s.waiting[lane].push_back(std::move(*load));
+    ++s.in_lane[lane];
   }
-  s.wake_worker.notify_one();
+  s.wake_worker[lane].notify_one();
   return true;
 }
 
@@ -53,7 +68,10 @@ std::vector<std::unique_ptr<PendingLoad>> LoadQueue::TakeFinished() {
   }
   std::lock_guard<std::mutex> lock(s.mutex);
   std::vector<std::unique_ptr<PendingLoad>> done;
-  for (auto& load : s.finished) done.push_back(std::move(load));
+  for (auto& load : s.finished) {
+    --s.in_lane[load.second];
+    done.push_back(std::move(load.first));
+  }
   s.finished.clear();
   return done;
 }
@@ -62,22 +80,22 @@ bool LoadQueue::Abandon() {
   State& s = *state_;
   std::lock_guard<std::mutex> lock(s.mutex);
   s.stop = true;
-  s.waiting.clear();
-  s.wake_worker.notify_all();
+  for (auto& waiting : s.waiting) waiting.clear();
+  for (auto& wake : s.wake_worker) wake.notify_all();
   const bool running = s.running > 0;
   for (std::thread& worker : workers_)
     if (worker.joinable()) worker.detach();  // the idle ones end at once
   return running;
 }
 
-void LoadQueue::Work(const std::shared_ptr<State>& state) {
+void LoadQueue::Work(const std::shared_ptr<State>& state, Lane lane) {
   State& s = *state;
   std::unique_lock<std::mutex> lock(s.mutex);
   for (;;) {
-    s.wake_worker.wait(lock, [&s] { return s.stop || !s.waiting.empty(); });
+    s.wake_worker[lane].wait(lock, [&s, lane] { return s.stop || !s.waiting[lane].empty(); });
     if (s.stop) return;
-    std::unique_ptr<PendingLoad> load = std::move(s.waiting.front());
-    s.waiting.pop_front();
+    std::unique_ptr<PendingLoad> load = std::move(s.waiting[lane].front());
+    s.waiting[lane].pop_front();
     ++s.running;
     lock.unlock();
     try {
@@ -92,7 +110,7 @@ void LoadQueue::Work(const std::shared_ptr<State>& state) {
     lock.lock();
     --s.running;
     if (s.stop) return;  // abandoned, or the queue is going: nobody takes it back
-    s.finished.push_back(std::move(load));
+    s.finished.emplace_back(std::move(load), lane);
     const uint64_t one = 1;
     if (write(s.wake_fd, &one, sizeof one) < 0) {
       // Only on counter overflow, after 2^64 - 2 loads untaken: the flag is already up.

@@ -4,8 +4,13 @@
 // Reading and resampling a large mesh or height map takes seconds; done on the RPC thread, it
 // would hold up every other client meanwhile. The RPC thread submits a prepared load
 // (TerrainRegistry::PrepareLoad), polls wake_fd() beside its sockets, and takes the finished
-// loads back to add them to the registry and reply. Loads start in the order submitted, as many
-// at once as there are workers.
+// loads back to add them to the registry and reply.
+//
+// Two lanes, each with threads of its own: meshes and height maps (resampled: seconds each, and
+// memory bound) go to the sampling lane; point files and the grids of finished uploads (no
+// resampling: a grid of a million samples is a fraction of a second) go to the build lane, so
+// that a client's upload is never queued behind other clients' slow mesh loads. Within a lane,
+// loads start in the order submitted, as many at once as the lane has workers.
 #pragma once
 
 #include <condition_variable>
@@ -14,6 +19,7 @@
 #include <memory>
 #include <mutex>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "footfall/service/terrain_registry.h"
@@ -22,14 +28,22 @@ namespace footfall {
 
 class LoadQueue {
  public:
-  // At most `capacity` loads waiting or running at once, on `workers` threads.
-  LoadQueue(size_t capacity, int workers);
+  enum Lane { kSampling = 0, kBuilding = 1 };
+  static constexpr int kLanes = 2;
+
+  // At most `capacity` loads waiting, running or finished untaken in each lane, which has
+  // `workers[lane]` threads.
+  LoadQueue(size_t capacity, const int (&workers)[kLanes]);
   // Waits for the loads running, if any (unless abandoned).
   ~LoadQueue();
   LoadQueue(const LoadQueue&) = delete;
   LoadQueue& operator=(const LoadQueue&) = delete;
 
-  // Queues a load; false (the load untouched) when `capacity` loads are already in the queue.
+  // The lane of a prepared load: kBuilding for an upload or a point file, else kSampling.
+  static Lane LaneOf(const PendingLoad& load);
+  // Whether `lane` holds `capacity` loads (a Submit to it would fail).
+  bool Full(Lane lane) const;
+  // Queues a load in its lane; false (the load untouched) when that lane is full.
   bool Submit(std::unique_ptr<PendingLoad>* load);
   // The loads finished since the last call, in the order they finished; clears wake_fd().
   std::vector<std::unique_ptr<PendingLoad>> TakeFinished();
@@ -45,13 +59,15 @@ class LoadQueue {
   struct State {
     ~State();
     int wake_fd = -1;
-    std::mutex mutex;
-    std::condition_variable wake_worker;
-    std::deque<std::unique_ptr<PendingLoad>> waiting, finished;
-    int running = 0;  // loads the workers hold
+    mutable std::mutex mutex;
+    std::condition_variable wake_worker[kLanes];
+    std::deque<std::unique_ptr<PendingLoad>> waiting[kLanes];
+    std::deque<std::pair<std::unique_ptr<PendingLoad>, Lane>> finished;
+    size_t in_lane[kLanes] = {0, 0};  // waiting, running or finished untaken
+    int running = 0;                  // loads the workers hold, over both lanes
     bool stop = false;
   };
-  static void Work(const std::shared_ptr<State>& state);
+  static void Work(const std::shared_ptr<State>& state, Lane lane);
 
   size_t capacity_;
   std::shared_ptr<State> state_;

@@ -85,6 +85,10 @@ struct RpcOptions {
   // [Units: s] per load of a server-side file, when longer than call_timeout_s: resampling a
   // large mesh or height map finely takes longer than any query.
   double load_timeout_s = 300;
+  // [Units: s] How long a load or upload keeps trying while footfalld answers that it is busy
+  // (its queue of loads and upload grids is full: FF_UNAVAILABLE), waiting 0.05 s, then twice as
+  // long each time up to 1 s, between tries; past it the call fails kUnavailable, saying so.
+  double busy_timeout_s = 120;
   // Destroying the session unloads its terrains from footfalld (best effort, while connected;
   // each call waits at most 2 s). False leaves them to footfalld as orphans, which any client
   // may query until --orphan-timeout passes without a query (a loader that exits while others
