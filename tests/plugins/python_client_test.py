@@ -402,6 +402,95 @@ class RpcTest(unittest.TestCase):
             ff.Session.rpc("127.0.0.1", 70000)
 
 
+class BusyServer:
+    """A stand-in for a footfalld busy building others' terrains: it answers the RPC NULL
+    procedure and FF_ASK_AGAIN, and every other call FF_UNAVAILABLE ("footfalld is busy"), as
+    footfalld answers a load or an upload when its queue is full. Counts the calls it gets."""
+
+    PROG, NULL, ASK_AGAIN, UNAVAILABLE = 0x2F00F007, 0, 16, 8
+
+    def __init__(self):
+        import socket
+        import threading
+        self.listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        self.listener.bind(("127.0.0.1", 0))
+        self.listener.listen(16)
+        self.port = self.listener.getsockname()[1]
+        self.calls = []  # procedure numbers, in order
+        self._stop = False
+        self._thread = threading.Thread(target=self._serve, daemon=True)
+        self._thread.start()
+
+    def _serve(self):
+        import select
+        import struct
+        conns, buffers = [], {}
+        while not self._stop:
+            ready, _, _ = select.select([self.listener] + conns, [], [], 0.05)
+            for sock in ready:
+                if sock is self.listener:
+                    conn, _ = sock.accept()
+                    conns.append(conn)
+                    buffers[conn] = b""
+                    continue
+                data = sock.recv(65536)
+                if not data:
+                    conns.remove(sock)
+                    sock.close()
+                    continue
+                buffers[sock] += data
+                while len(buffers[sock]) >= 4:
+                    length = struct.unpack(">I", buffers[sock][:4])[0] & 0x7FFFFFFF
+                    if len(buffers[sock]) < 4 + length:
+                        break
+                    record, buffers[sock] = buffers[sock][4:4 + length], buffers[sock][4 + length:]
+                    xid, _, _, _, _, proc = struct.unpack(">6I", record[:24])
+                    self.calls.append(proc)
+                    # REPLY, MSG_ACCEPTED, AUTH_NONE verifier, SUCCESS
+                    body = struct.pack(">6I", xid, 1, 0, 0, 0, 0)
+                    if proc == self.ASK_AGAIN:
+                        body += struct.pack(">2I", 0, 0)  # FF_OK, empty message
+                    elif proc != self.NULL:
+                        # Every reply but FF_NULL's starts with its status; a message follows in
+                        # those the library decodes here (status, [upload or terrain], message).
+                        text = b"footfalld is busy: try again"
+                        pad = b"\0" * (-len(text) % 4)
+                        body += struct.pack(">2I", self.UNAVAILABLE, 0)
+                        body += struct.pack(">I", len(text)) + text + pad
+                    sock.sendall(struct.pack(">I", 0x80000000 | len(body)) + body)
+        for conn in conns:
+            conn.close()
+
+    def stop(self):
+        self._stop = True
+        self._thread.join()
+        self.listener.close()
+
+
+class BusyServerTest(unittest.TestCase):
+    def setUp(self):
+        self.busy = BusyServer()
+
+    def tearDown(self):
+        self.busy.stop()
+
+    def test_a_busy_server_answers_a_ping(self):
+        with ff.Session.rpc("127.0.0.1", self.busy.port, timeout=5.0) as s:
+            self.assertTrue(s.ping())
+        # The ping asks with the NULL procedure: it loads nothing on the server.
+        self.assertIn(BusyServer.NULL, self.busy.calls)
+        self.assertNotIn(2, self.busy.calls)  # FF_UPLOAD_BEGIN
+
+    def test_connection_uses_a_busy_shared_server_rather_than_starting_its_own(self):
+        c = ff.Connection()
+        try:
+            s = c.get("127.0.0.1", self.busy.port, start_local=True)
+            self.assertIsNone(c.local)  # no private footfalld started
+            self.assertIn(str(self.busy.port), s.description)
+        finally:
+            c.shutdown()
+
+
 class RotationTest(unittest.TestCase):
     """Rotations as Maya's XYZ and ZXY Euler angles (the Maya plugin keys bodies in ZXY)."""
 

@@ -170,6 +170,10 @@ int32_t ffc_load_samples(ffc_session* s, const double* samples, size_t count, co
   });
 }
 
+int32_t ffc_ping(ffc_session* s) {
+  return Guard(s, [&]() -> int32_t { return Result(s, s->session->Ping()); });
+}
+
 int32_t ffc_unload(ffc_session* s, uint32_t terrain) {
   return Guard(s, [&]() -> int32_t { return Result(s, s->session->Unload(terrain)); });
 }

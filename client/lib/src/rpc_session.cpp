@@ -177,6 +177,13 @@ class RpcSession final : public TerrainSession {
     return Status::kOk;
   }
 
+  Status Ping() override {
+    const Status s = EnsureConnected();
+    if (s != Status::kOk) return s;
+    char nothing = 0;
+    return Call(ff_null_1(nullptr, &nothing, client_), "ping");
+  }
+
   std::string Describe() const override {
     return "rpc " + options_.host + ":" + std::to_string(options_.port);
   }

@@ -77,6 +77,7 @@ def _declare(lib):
         "ffc_generate": (c.c_int32, [sess, c.c_uint32, c.c_char_p, c.POINTER(c.c_void_p)]),
         "ffc_free_string": (None, [c.c_void_p]),
         "ffc_check_character": (c.c_int32, [sess, c.c_char_p]),
+        "ffc_ping": (c.c_int32, [sess]),
     }
     missing = []
     for name, (restype, argtypes) in sigs.items():

@@ -253,10 +253,15 @@ class Session:
         return count.value, tuple(bounds)
 
     def ping(self):
-        """True when the server answers (any reply), False when it is unavailable. Makes one
-        round trip (loads and unloads a one-sample terrain); never raises for a missing server."""
+        """True when the server answers, False when it is unavailable; never raises for a
+        missing server. Calls the RPC NULL procedure (ffc_ping), which footfalld answers however
+        busy it is building other clients' terrains, and loads nothing. (A library without
+        ffc_ping, an older one: loads and unloads a one-sample terrain, where any answer but
+        'unavailable' counts as alive.)"""
         if self._h is None:
             return False  # closed: nothing answers
+        if self._lib.has("ffc_ping"):
+            return self._lib.lib.ffc_ping(self._h) != UNAVAILABLE
         try:
             t = self.load_samples([(0.0, 0.0, 0.0, 0.0, 1.0, 0.0)], "ping")
         except FootfallError as e:

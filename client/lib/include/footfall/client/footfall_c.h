@@ -58,6 +58,10 @@ void ffc_close(ffc_session* session);
 /* The reason for the session's last failed call (from any thread), as a copy that stays valid
  * until this thread calls ffc_last_error again. Not cleared by calls that succeed. Never NULL. */
 const char* ffc_last_error(const ffc_session* session);
+/* Whether the session's engine answers: FF_C_OK, or FF_C_UNAVAILABLE (ffc_last_error says why)
+ * when no footfalld answers within the call timeout. An RPC session calls the RPC NULL
+ * procedure, which footfalld answers however busy it is with loads; it loads nothing. */
+int32_t ffc_ping(ffc_session* s);
 /* A stable name for a status, e.g. "no_foothold". */
 const char* ffc_status_name(int32_t status);
 

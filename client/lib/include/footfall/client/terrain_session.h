@@ -54,6 +54,11 @@ class TerrainSession {
   Foothold Snap(TerrainHandle terrain, const Vec3& point);
   Foothold Next(TerrainHandle terrain, const StepQuery& query, double tolerance = 0);
 
+  // Whether the serving engine answers: an RPC session connects if needed and makes one call of
+  // the RPC NULL procedure, which footfalld answers at once however busy its load queue is
+  // (kUnavailable, with the reason, when nothing answers within the call timeout); it loads
+  // nothing. The embedded engine always answers.
+  virtual Status Ping() { return Status::kOk; }
   // "embedded" or "rpc HOST:PORT".
   virtual std::string Describe() const = 0;
   // True when queries are answered in this process (no round trip per call): callers may then
