@@ -561,9 +561,17 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     RunResult r = View({"--terrain", kTerrain, "--size", "12by4", "--screenshot", shot});
     CHECK(r.exit_code == 2);
     CHECK_THAT(r.err, Catch::Contains("--size \"12by4\": expected WIDTHxHEIGHT"));
-    r = View({"--terrain", kTerrain, "--size", "20000x20000", "--screenshot", shot});
+    r = View({"--terrain", kTerrain, "--size", "70000x20", "--screenshot", shot});
     CHECK(r.exit_code == 2);
-    CHECK_THAT(r.err, Catch::Contains("in whole pixels from 1 to 16384"));
+    CHECK_THAT(r.err, Catch::Contains("in whole pixels from 1 to 65536"));
+    // Within that, the OpenGL's own limits, named. (Beyond GL_MAX_RENDERBUFFER_SIZE it was
+    // "image size 20000x20 exceeds the GL limit of 16384", without the flag.)
+    r = View({"--terrain", kTerrain, "--size", "20000x20", "--screenshot", shot});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("footfall-view: --size 20000x20: larger than this OpenGL "
+                                      "draws, at most ") &&
+                          Catch::Contains("(GL_MAX_RENDERBUFFER_SIZE ") &&
+                          Catch::Contains(", GL_MAX_VIEWPORT_DIMS "));
     r = View({"--screenshot", shot});
     CHECK(r.exit_code == 2);
     CHECK_THAT(r.err, Catch::Contains("nothing to show"));
@@ -587,6 +595,24 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
   }
   std::ifstream none(shot);
   CHECK_FALSE(none.good());  // no failed run leaves a screenshot
+}
+
+TEST_CASE("a screenshot larger than the memory allows says so", "[viewer][errors]") {
+  // 16384 x 16384 is within the GL limits but takes some 4 GB of memory; under a 1.5 GB
+  // address space it ended in "offscreen framebuffer incomplete (status 36054)" or
+  // "std::bad_alloc".
+  const std::string dir = test::TempDir();
+  const RunResult r =
+      Run({"/bin/sh", "-c", "ulimit -v 1500000 && exec \"$0\" \"$@\"", kView, "--terrain", kTerrain,
+           "--size", "16384x16384", "--screenshot", dir + "/big.png"},
+          {test::XDisplay()}, kTimeout);
+  INFO(r.err);
+  REQUIRE_FALSE(r.timed_out);
+  CHECK(r.exit_code == 1);
+  CHECK_THAT(r.err, Catch::StartsWith("footfall-view: --size 16384x16384: ") &&
+                        Catch::Contains("; try a smaller --size"));
+  std::ifstream none(dir + "/big.png");
+  CHECK_FALSE(none.good());
 }
 
 TEST_CASE("comma-separated --query numbers are drawn like spaced ones", "[viewer][query]") {

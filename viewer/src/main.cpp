@@ -91,9 +91,10 @@ int main(int argc, char** argv) {
     if (x == std::string::npos ||
         !ParseNumbers(size.substr(0, x) + " " + size.substr(x + 1), 2, &wh) ||
         wh[0] != std::floor(wh[0]) || wh[1] != std::floor(wh[1]) || wh[0] < 1 || wh[1] < 1 ||
-        wh[0] > 16384 || wh[1] > 16384) {
+        wh[0] > 65536 || wh[1] > 65536) {
       std::cerr << "footfall-view: --size \"" << size
-                << "\": expected WIDTHxHEIGHT in whole pixels from 1 to 16384, e.g. 1280x800\n";
+                << "\": expected WIDTHxHEIGHT in whole pixels from 1 to 65536 (and within what "
+                   "the OpenGL draws), e.g. 1280x800\n";
       return 2;
     }
     o.width = static_cast<int>(wh[0]), o.height = static_cast<int>(wh[1]);

@@ -3,8 +3,8 @@
 
 #include <GL/glcorearb.h>
 
+#include <algorithm>
 #include <cstddef>
-#include <cstring>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -170,6 +170,20 @@ void Renderer::DrawScreen(const DrawList& list, int width, int height) {
   gl_->Draw(GL_POINTS, list.points());
 }
 
+void MaxImageSize(bool offscreen, int* width, int* height, std::string* source) {
+  GLint viewport[2] = {0, 0}, renderbuffer = 0;
+  glGetIntegerv(GL_MAX_VIEWPORT_DIMS, viewport);
+  *width = viewport[0], *height = viewport[1];
+  *source =
+      "GL_MAX_VIEWPORT_DIMS " + std::to_string(viewport[0]) + "x" + std::to_string(viewport[1]);
+  if (offscreen) {
+    glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &renderbuffer);
+    *width = std::min(*width, static_cast<int>(renderbuffer));
+    *height = std::min(*height, static_cast<int>(renderbuffer));
+    *source = "GL_MAX_RENDERBUFFER_SIZE " + std::to_string(renderbuffer) + ", " + *source;
+  }
+}
+
 OffscreenTarget::OffscreenTarget() = default;
 
 OffscreenTarget::~OffscreenTarget() {
@@ -180,12 +194,7 @@ OffscreenTarget::~OffscreenTarget() {
 
 bool OffscreenTarget::Create(int width, int height, std::string* error) {
   width_ = width, height_ = height;
-  GLint max_size = 0;
-  glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_size);
-  if (width > max_size || height > max_size) {
-    *error = "image size " + std::to_string(width) + "x" + std::to_string(height) +
-             " exceeds the GL limit of " + std::to_string(max_size);
-    return false;
+  while (glGetError() != GL_NO_ERROR) {
   }
   glGenFramebuffers(1, &framebuffer_);
   glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_);
@@ -197,24 +206,36 @@ bool OffscreenTarget::Create(int width, int height, std::string* error) {
   glBindRenderbuffer(GL_RENDERBUFFER, depth_);
   glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_);
+  // (Out of memory, the framebuffer was "incomplete (status 36054)".)
+  if (glGetError() == GL_OUT_OF_MEMORY) {
+    *error = "the OpenGL has not the memory for a " + std::to_string(width) + "x" +
+             std::to_string(height) + " image";
+    return false;
+  }
   const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE) {
-    *error = "offscreen framebuffer incomplete (status " + std::to_string(status) + ")";
+    *error = "the OpenGL could not make a " + std::to_string(width) + "x" + std::to_string(height) +
+             " offscreen image (framebuffer status " + std::to_string(status) +
+             (status == GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT ? ", an incomplete attachment: "
+                                                               "out of memory?)"
+                                                             : ")");
     return false;
   }
   return true;
 }
 
 void OffscreenTarget::Read(std::vector<uint8_t>* rgba) const {
+  // Read bottom row first, then turned over in place (no second copy of a large image).
   const size_t row = static_cast<size_t>(width_) * 4;
-  std::vector<uint8_t> bottom_up(row * static_cast<size_t>(height_));
+  rgba->resize(row * static_cast<size_t>(height_));
   glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer_);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, bottom_up.data());
-  rgba->resize(bottom_up.size());
-  for (int y = 0; y < height_; ++y) {
-    std::memcpy(rgba->data() + static_cast<size_t>(y) * row,
-                bottom_up.data() + static_cast<size_t>(height_ - 1 - y) * row, row);
+  glReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, rgba->data());
+  for (size_t top = 0, bottom = static_cast<size_t>(height_); top + 1 < bottom; ++top) {
+    --bottom;
+    std::swap_ranges(rgba->begin() + static_cast<std::ptrdiff_t>(top * row),
+                     rgba->begin() + static_cast<std::ptrdiff_t>((top + 1) * row),
+                     rgba->begin() + static_cast<std::ptrdiff_t>(bottom * row));
   }
 }
 

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iostream>
 #include <mutex>
+#include <new>
 #include <sstream>
 #include <thread>
 
@@ -394,10 +395,15 @@ struct App {
     return WriteDump(width, height) ? 0 : 1;
   }
 
+  std::string SizeText() const {
+    return std::to_string(options.width) + "x" + std::to_string(options.height);
+  }
+
   int Screenshot() {
     std::string error;
     OffscreenTarget target;
-    if (!target.Create(options.width, options.height, &error)) return Fail(error);
+    if (!target.Create(options.width, options.height, &error))
+      return Fail("--size " + SizeText() + ": " + error + "; try a smaller --size");
     if (live && options.live_wait > 0) {
       const Clock::time_point deadline =
           Clock::now() + std::chrono::duration_cast<Clock::duration>(
@@ -415,10 +421,18 @@ struct App {
     }
     PullLive();
     Render(options.width, options.height);
-    std::vector<uint8_t> rgba;
-    target.Read(&rgba);
-    if (!WritePng(options.screenshot, options.width, options.height, rgba, &error))
-      return Fail(error);
+    try {
+      std::vector<uint8_t> rgba;
+      target.Read(&rgba);
+      if (!WritePng(options.screenshot, options.width, options.height, rgba, &error))
+        return Fail(error);
+    } catch (const std::bad_alloc&) {
+      // (It ended in "footfall-view: std::bad_alloc".)
+      const double mib = static_cast<double>(options.width) * options.height * 7 / (1 << 20);
+      return Fail("--size " + SizeText() + ": not enough memory to read back and encode the " +
+                  "image (about " + std::to_string(static_cast<long long>(mib)) +
+                  " MiB); try a smaller --size");
+    }
     return WriteDump(options.width, options.height) ? 0 : 1;
   }
 };
@@ -453,8 +467,8 @@ int RunViewer(const ViewerOptions& options) {
   if (!options.screenshot.empty() && !options.dump_state.empty() &&
       SameFile(options.screenshot, options.dump_state))
     return Fail("--screenshot and --dump-state name the same file; give each its own", 2);
-  if (options.width <= 0 || options.height <= 0 || options.width > 16384 || options.height > 16384)
-    return Fail("--size: width and height must be within 1..16384", 2);
+  if (options.width <= 0 || options.height <= 0 || options.width > 65536 || options.height > 65536)
+    return Fail("--size: width and height must be within 1..65536", 2);
   if (options.has_camera) {
     // (A target 2e19 away put the camera at NaN: a blank image and exit 0.)
     for (const Vec3& p : {options.eye, options.target}) {
@@ -559,6 +573,18 @@ int RunViewer(const ViewerOptions& options) {
   glfwMakeContextCurrent(app.window);
   app.renderer = std::make_unique<Renderer>();
   if (!app.renderer->Init(&error)) return Fail(error);
+  {
+    // (Beyond them, a screenshot failed as "framebuffer incomplete", and a window was drawn in
+    // part.)
+    int max_width = 0, max_height = 0;
+    std::string limits;
+    MaxImageSize(headless, &max_width, &max_height, &limits);
+    if (options.width > max_width || options.height > max_height)
+      return Fail("--size " + app.SizeText() + ": larger than this OpenGL draws, at most " +
+                      std::to_string(max_width) + "x" + std::to_string(max_height) + " (" + limits +
+                      ")",
+                  2);
+  }
 
   // 4. Follow the server, then draw.
   if (options.live) {

@@ -42,6 +42,11 @@ class Renderer {
   std::unique_ptr<Gl> gl_;
 };
 
+// The largest image the current context draws into whole [Units: px]: GL_MAX_VIEWPORT_DIMS,
+// and for an offscreen target GL_MAX_RENDERBUFFER_SIZE too. *source names the limits and
+// their values, for messages.
+void MaxImageSize(bool offscreen, int* width, int* height, std::string* source);
+
 // A framebuffer object of fixed size to render into without a visible window.
 class OffscreenTarget {
  public:
@@ -50,9 +55,10 @@ class OffscreenTarget {
   OffscreenTarget(const OffscreenTarget&) = delete;
   OffscreenTarget& operator=(const OffscreenTarget&) = delete;
 
-  // Creates an RGBA8 colour and 24-bit depth target of width x height and binds it.
+  // Creates an RGBA8 colour and 24-bit depth target of width x height (within MaxImageSize)
+  // and binds it. False with a message when the GL cannot (out of memory).
   bool Create(int width, int height, std::string* error);
-  // Reads the pixels back as RGBA rows, top row first.
+  // Reads the pixels back as RGBA rows, top row first. Throws std::bad_alloc.
   void Read(std::vector<uint8_t>* rgba) const;
 
  private:
