@@ -973,6 +973,58 @@ TEST_CASE("A waypoint inside the turning circle is reached with shorter steps, n
   }
 }
 
+// The least gap across the body's heading between the feet of a pair, over every body key, as
+// a share of their gap at rest (below 0: a pair's feet crossed under the body).
+double LeastPairGap(const Character& c, const Walk& w) {
+  const std::vector<const WalkTrack*> tracks = TracksOf(w, "");
+  const WalkTrack& body = *tracks.back();
+  double least = 1e9;
+  for (size_t i = 0; i < body.keys.size(); ++i) {
+    const Quat q = body.Rotation(i);
+    const Vec3 left = Cross(BodyUp(q), BodyForward(q));
+    for (const std::vector<int>& pair : c.pairs) {
+      if (pair.size() != 2) continue;
+      const double rest_gap = c.feet[pair[0]].rest.x - c.feet[pair[1]].rest.x;
+      const Vec3 a = FootAt(*tracks[pair[0]], body.keys[i].frame);
+      const Vec3 b = FootAt(*tracks[pair[1]], body.keys[i].frame);
+      least = std::min(least, Dot(a - b, left) / rest_gap);
+    }
+  }
+  return least;
+}
+
+TEST_CASE("Feet keep to their sides in sharp turns as the body turns no faster than they follow",
+          "[steps][generator]") {
+  // Turning max_turn_deg a step, a multiped's feet (a step_length a step, each foot every other
+  // step) fell behind the body until a pair's feet crossed under it: the shipped hexapod at its
+  // 30 degrees, about a hairpin; a biped or quadruped allowed 60 to 180 degrees a step crossed
+  // its feet at a right-angle corner.
+  for (const std::string& name : ShippedCharacters()) {
+    for (const double turn : {30.0, 90.0, 180.0}) {
+      for (const bool hairpin : {true, false}) {
+        Character c = LoadShipped(name);
+        c.max_turn_deg = turn;
+        const double step = c.step_length, spacing = step / 10, margin = 4 * c.reach;
+        const int n = static_cast<int>((8 * step + 2 * margin) / spacing);
+        Terrain t = LoadTerrain(MakeFlat(n, spacing, 0), spacing);
+        INFO(name << ", max_turn_deg " << turn << (hairpin ? ", hairpin" : ", right angle"));
+        GenerateOptions o;
+        o.has_start = true;
+        o.start = {margin + 4 * step, 0, margin};
+        const Vec3 corner = o.start + Vec3{0, 0, (hairpin ? 6 : 3) * step};
+        o.path.push_back(corner);
+        o.path.push_back(hairpin ? o.start + Vec3{0.3 * step, 0, 0}
+                                 : corner + Vec3{4 * step, 0, 0});
+        const Walk w = Generate(t, c, o);
+        INFO(w.stopped);
+        REQUIRE(w.stopped.empty());
+        CheckWalk(t, c, o, w);
+        CHECK(LeastPairGap(c, w) > 0.1);
+      }
+    }
+  }
+}
+
 TEST_CASE("A path walk that runs out of steps before its goal says so as a stop",
           "[steps][generator]") {
   // Back and forth between two points 4 m apart, 2000 times: more than the 10,000 steps a path

@@ -84,6 +84,10 @@ double ArcS(size_t j, size_t checks) {
 // Required clearance at each check point, as a fraction of the arc's nominal clearance there
 // (the step height at the mid key, falling linearly to 0 at the start and end keys).
 constexpr double kClearanceFraction = 0.25;
+// Steer: a turn is tried at its whole and then in kTurnShares - 1 smaller shares, and the
+// largest that keeps every pair's feet at least kMinPairGap of their rest gap apart is taken.
+constexpr int kTurnShares = 8;
+constexpr double kMinPairGap = 0.5;
 // A step shorter than this fraction of step_length is a step in place: no foothold query.
 constexpr double kInPlace = 0.02;
 // Move::query of a move not asked this round.
@@ -179,6 +183,7 @@ struct Agent {
   double stride = 1;
   bool walking = true;  // false once stopped or arrived
   int waits = 0;        // steps in a row its group stepped in place, waiting for a planted foot
+  int still = 0;        // steps in a row no foot of it moved (waits, turns on the spot included)
   // Where the body was at step `window_step`: a body that stays within half a step of it for
   // Generator::window_steps_ steps is milling about at a dead end.
   Vec3 window_from;
@@ -279,9 +284,10 @@ class Generator {
     return mv.reason.empty() || (mv.reason_is_gap && !gap);
   }
   // 8 (end). A foot refused every foothold toward a target behind it along the heading (a hind
-  // foot standing at a terrain's back edge, ahead of its rest) keeps its place: a step in place,
-  // so its group waits for the body to move on rather than stop the walk.
-  void KeepPlaceIfBehind(Move& mv) const;
+  // foot standing at a terrain's back edge, ahead of its rest), or while its character turns at
+  // a short stride (a foot on a stair's nose turning on the spot), keeps its place: a step in
+  // place, so its group waits for the body to move on or turn rather than stop the walk.
+  void KeepPlace(Move& mv) const;
   // Gives up on mv's foothold after its last try; its reason says how many were refused.
   static void Fail(Move& mv);
   Status ClearArcs(int k, std::string* error);
@@ -299,7 +305,18 @@ class Generator {
     const size_t chunk = std::max<size_t>(1, count / (8 * static_cast<size_t>(threads_)));
     pool_->Run(count, chunk, fn);
   }
-  void Steer(Agent& a) const;
+  // 5. Turns a's heading toward its current waypoint (at most max_turn_deg, and no farther
+  // than keeps every pair's feet apart across it when gait group `group` steps next) and sets
+  // a's stride; marks a arrived at the last waypoint.
+  void Steer(Agent& a, int group) const;
+  // The share of a full stride a body heading `forward` takes toward a waypoint `to` away along
+  // the ground: below 1 for a waypoint inside the circle it turns on at full stride.
+  double StrideToward(const Vec3& to, const Vec3& forward) const;
+  // The least gap across the heading between the feet of a pair, as a share of their gap at
+  // rest, once a heading `forward` at `stride` has been taken and gait group `group` has
+  // stepped (each of its feet at most step_length toward its target on ground as level as a's):
+  // below 0 when feet cross.
+  double PairGap(const Agent& a, const Vec3& forward, double stride, int group) const;
   // The radius within which a's waypoint i counts as reached: half a step for the last, a
   // step for the others.
   double Radius(const Agent& a, size_t i) const;
@@ -500,9 +517,43 @@ bool Generator::Reached(const Agent& a, size_t i) const {
   return !OnTerrain(a, i) || std::fabs(along) <= radius;
 }
 
-// Turns the heading toward the current waypoint, at most max_turn_deg per step; marks the
-// agent arrived at the last waypoint.
-void Generator::Steer(Agent& a) const {
+double Generator::StrideToward(const Vec3& to, const Vec3& forward) const {
+  // A waypoint inside the circle the body turns on at full stride (beside or behind it, nearer
+  // than the turn allows) would be circled for ever: the steps shorten so that the circle the
+  // body turns on, tangent to the heading, runs through the waypoint, and with the waypoint
+  // behind that heading the character turns on the spot.
+  const double ahead = Dot(to, forward);
+  const double aside = Length(to - forward * ahead);
+  const double through = Length2(to) / (2 * aside);  // that circle's radius (inf: no circle)
+  if (through >= turn_radius_) return 1;
+  return ahead > 0 ? through / turn_radius_ : 0;
+}
+
+double Generator::PairGap(const Agent& a, const Vec3& forward, double stride, int group) const {
+  const Vec3 left = Cross(a.up, forward);
+  const std::vector<int>& stepping = c_.gait[group];
+  double least = std::numeric_limits<double>::infinity();
+  for (const std::vector<int>& pair : c_.pairs) {
+    if (pair.size() != 2) continue;
+    const double rest_gap = rest_[pair[0]].x - rest_[pair[1]].x;
+    if (std::fabs(rest_gap) < 1e-9) continue;  // one foot ahead of the other: no sides
+    Vec3 at[2];
+    for (int i = 0; i < 2; ++i) {
+      const int f = pair[i];
+      at[i] = a.foot[f];
+      if (std::find(stepping.begin(), stepping.end(), f) == stepping.end()) continue;
+      const Vec3 target = a.ground + left * rest_[f].x + forward * (rest_[f].z + lead_ * stride);
+      Vec3 v = ProjectOnPlane(target - a.foot[f], a.up);
+      const double len = Length(v);
+      if (len > c_.step_length) v = v * (c_.step_length / len);
+      at[i] += v;
+    }
+    least = std::min(least, Dot(at[0] - at[1], left) / rest_gap);
+  }
+  return least;
+}
+
+void Generator::Steer(Agent& a, int group) const {
   if (a.path.empty()) return;
   while (a.waypoint < a.path.size() && Reached(a, a.waypoint)) ++a.waypoint;
   if (a.waypoint == a.path.size()) {
@@ -517,15 +568,32 @@ void Generator::Steer(Agent& a) const {
   const Vec3 want = Normalize(to);
   const double angle = std::atan2(Dot(Cross(a.forward, want), a.up), Dot(a.forward, want));
   const double max_turn = Radians(c_.max_turn_deg);
-  a.forward = Normalize(RotateAround(a.forward, a.up, std::clamp(angle, -max_turn, max_turn)));
-  // A waypoint inside the circle the body turns on at full stride (beside or behind it, nearer
-  // than the turn allows) would be circled for ever: the steps shorten so that the circle the
-  // body turns on, tangent to the new heading, runs through the waypoint, and with the waypoint
-  // behind that heading the character turns on the spot.
-  const double ahead = Dot(to, a.forward);
-  const double aside = Length(to - a.forward * ahead);
-  const double through = Length2(to) / (2 * aside);  // that circle's radius (inf: no circle)
-  if (through < turn_radius_) a.stride = ahead > 0 ? through / turn_radius_ : 0;
+  const double turn = std::clamp(angle, -max_turn, max_turn);
+  // A turn faster than the feet can follow (a foot moves at most step_length a step, and only
+  // in its group's turn) leaves the planted feet behind, until a pair's feet cross under the
+  // body: the turn is cut to the largest share of it (in eighths) that keeps every pair's feet
+  // at least half their rest gap apart, or failing that to the one keeping them farthest apart.
+  // Feet that have not moved for a whole gait cycle will not catch up by waiting: the whole
+  // turn is taken, so that the targets it gives may find footholds.
+  if (a.still >= static_cast<int>(c_.gait.size())) {
+    a.forward = Normalize(RotateAround(a.forward, a.up, turn));
+    a.stride = StrideToward(to, a.forward);
+    return;
+  }
+  double best_gap = -std::numeric_limits<double>::infinity();
+  Vec3 best_forward = a.forward;
+  double best_stride = 1;
+  for (int eighths = kTurnShares; eighths >= 0; --eighths) {
+    const Vec3 forward = Normalize(RotateAround(a.forward, a.up, turn * eighths / kTurnShares));
+    const double stride = StrideToward(to, forward);
+    const double gap = PairGap(a, forward, stride, group);
+    if (gap > best_gap) best_gap = gap, best_forward = forward, best_stride = stride;
+    if (gap >= kMinPairGap) {
+      best_forward = forward, best_stride = stride;
+      break;
+    }
+  }
+  a.forward = best_forward, a.stride = best_stride;
 }
 
 class Generator::Progress {
@@ -1373,7 +1441,7 @@ Status Generator::QueryFootholds(std::string* error) {
         for (size_t j = m; j < e; ++j) {
           if (moves[j].query != kNoQuery) {
             Judge(moves[j], next_answers_[moves[j].query]), moves[j].query = kNoQuery;
-            if (!moves[j].done && moves[j].attempts >= kMaxAttempts) KeepPlaceIfBehind(moves[j]);
+            if (!moves[j].done && moves[j].attempts >= kMaxAttempts) KeepPlace(moves[j]);
           }
           all_done &= moves[j].done;
         }
@@ -1448,10 +1516,10 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
   mv.reason = why.str(), mv.reason_is_gap = !found;
 }
 
-void Generator::KeepPlaceIfBehind(Move& mv) const {
+void Generator::KeepPlace(Move& mv) const {
   const Agent& a = agents_[mv.agent];
   const Vec3 intended = mv.step + a.up * (mv.attempt.drop * c_.max_rise);
-  if (Dot(intended, a.forward) >= 0) return;
+  if (Dot(intended, a.forward) >= 0 && a.stride >= 1) return;
   mv.done = true, mv.end = a.foot[mv.foot], mv.end_normal = a.foot_normal[mv.foot];
 }
 
@@ -1676,11 +1744,12 @@ void Generator::Finish(size_t w, int k) {
   // A character turning on the spot or at a short stride toward a near waypoint may step in
   // place for as long as its turn takes (the dead-end window allows half a turn).
   if (in_place && !failed && a.stride < 1) {
+    ++a.still;
     body_frame_[w] = f1;
     return;
   }
   if (in_place && !failed && a.waits + 1 < static_cast<int>(c_.gait.size())) {
-    ++a.waits;
+    ++a.waits, ++a.still;
     body_frame_[w] = f1;
     return;
   }
@@ -1696,7 +1765,7 @@ void Generator::Finish(size_t w, int k) {
   bool held = failed != nullptr;
   for (size_t i = m; i < e && held; ++i) held = moves_[i].done || moves_[i].held_by_planted;
   if (held && a.waits + 1 < static_cast<int>(c_.gait.size())) {
-    ++a.waits;
+    ++a.waits, ++a.still;
     body_frame_[w] = f1;
     return;
   }
@@ -1706,7 +1775,7 @@ void Generator::Finish(size_t w, int k) {
              failed->reason);
     return;
   }
-  a.waits = 0;
+  a.waits = 0, a.still = 0;
   for (size_t i = m; i < e; ++i) {
     const Move& mv = moves_[i];
     KeyFoot(a, mv.foot, f0, KeyPhase::kStart, a.foot[mv.foot], a.foot_normal[mv.foot]);
@@ -1730,7 +1799,7 @@ Status Generator::Step(int k, std::string* error) {
   walking_.clear();
   for (size_t i = pass_begin_; i < pass_end_; ++i) {
     if (!agents_[i].walking) continue;
-    Steer(agents_[i]);
+    Steer(agents_[i], group_);
     if (agents_[i].walking && !Nearing(agents_[i], k)) {
       Agent& a = agents_[i];
       const Vec3& p = a.path[a.waypoint];
