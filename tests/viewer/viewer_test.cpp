@@ -262,6 +262,60 @@ std::string DescendingWalkJson() {
       {"frame": 2, "phase": "end", "position": [1, 0, 0]}]}]})";
 }
 
+TEST_CASE("scenes a few centimetres across are framed to their size", "[viewer][camera]") {
+  // (Framing took a radius of at least 0.5 m: a terrain or a walk of 4 cm was a dot.)
+  const std::string dir = test::TempDir();
+  SECTION("a terrain 4 cm across, sampled every 2 mm") {
+    std::string tiny;  // y = 0, normals up (drawn 128, 255, 128)
+    for (int k = 0; k <= 20; ++k) {
+      for (int i = 0; i <= 20; ++i)
+        tiny += std::to_string(i * 0.002) + " 0 " + std::to_string(k * 0.002) + " 0 1 0\n";
+    }
+    test::WriteFile(dir + "/tiny.pts", tiny);
+    const RunResult r =
+        View({"--terrain", dir + "/tiny.pts", "--size", "320x200", "--screenshot", dir + "/t.png"});
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    const int terrain = CountColor(ReadPng(dir + "/t.png"), {128, 255, 128});
+    INFO("terrain pixels: " << terrain);
+    CHECK(terrain > 320 * 200 / 10);
+  }
+  SECTION("a walk 2 cm long") {
+    std::string walk = WalkJson();  // scaled by 1/100: feet 2 cm apart, stepping 2 cm
+    for (const auto& [from, to] :
+         std::vector<std::pair<std::string, std::string>>{{"[2, 0, 2]", "[0.02, 0, 0.02]"},
+                                                          {"[3, 0.5, 2]", "[0.03, 0.005, 0.02]"},
+                                                          {"[4, 0, 2]", "[0.04, 0, 0.02]"},
+                                                          {"[2, 0, 0]", "[0.02, 0, 0]"},
+                                                          {"[3, 0.5, 0]", "[0.03, 0.005, 0]"},
+                                                          {"[4, 0, 0]", "[0.04, 0, 0]"},
+                                                          {"[2, 1, 1]", "[0.02, 0.01, 0.01]"},
+                                                          {"[4, 1, 1]", "[0.04, 0.01, 0.01]"}}) {
+      REQUIRE(walk.find(from) != std::string::npos);
+      walk.replace(walk.find(from), from.size(), to);
+    }
+    test::WriteFile(dir + "/walk.json", walk);
+    const RunResult r = View({"--walk", dir + "/walk.json", "--size", "320x200", "--screenshot",
+                              dir + "/w.png", "--dump-state", dir + "/w.json"});
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    const json state = json::parse(test::ReadFile(dir + "/w.json"));
+    const json& tracks = state["walk"]["tracks"];
+    const glm::vec2 l1(tracks[0]["pixel"][0].get<float>(), tracks[0]["pixel"][1].get<float>());
+    const glm::vec2 r1(tracks[1]["pixel"][0].get<float>(), tracks[1]["pixel"][1].get<float>());
+    INFO("L1 at " << l1.x << "," << l1.y << "  R1 at " << r1.x << "," << r1.y);
+    CHECK(tracks[0]["visible"] == true);
+    CHECK(tracks[1]["visible"] == true);
+    CHECK(glm::length(l1 - r1) > 40);
+    // The body's axes are sized after the walk, not 16 cm long across the picture.
+    const Image image = ReadPng(dir + "/w.png");
+    const int axes = CountColor(image, {255, 60, 60}) + CountColor(image, {60, 255, 60}) +
+                     CountColor(image, {60, 60, 255});
+    INFO("body axes pixels: " << axes);
+    CHECK(axes < 40);
+  }
+}
+
 TEST_CASE("screenshot of a walk shows the feet where the JSON puts them at that frame",
           "[viewer][walk]") {
   const std::string dir = test::TempDir();

@@ -35,9 +35,10 @@ void OrbitCamera::PlaceEye() {
   eye_ = target_ + distance_ * dir;
 }
 
-void OrbitCamera::Frame(const glm::dvec3& lo, const glm::dvec3& hi) {
+void OrbitCamera::Frame(const glm::dvec3& lo, const glm::dvec3& hi, double min_radius) {
   target_ = 0.5 * (lo + hi);
-  const double radius = std::max(0.5 * glm::length(hi - lo), 0.5);
+  // (At least 0.5 units, whatever the scene: a terrain a few centimetres across was a dot.)
+  const double radius = std::max(0.5 * glm::length(hi - lo), min_radius);
   const double half_fov = glm::radians(kFovYDegrees) * 0.5;
   // The bounding sphere just fits the vertical field of view (so all of the box does).
   distance_ = radius / std::sin(half_fov) * 1.02;

@@ -177,8 +177,17 @@ void Scene::Finalize() {
     Grow(lo_, &drawn_lo_, &drawn_hi_, &has_drawn_);
     Grow(hi_, &drawn_lo_, &drawn_hi_, &has_drawn_);
   }
-  // Without samples, size markers after the scene: a walk of a few metres or of a kilometre.
-  if (!has_terrain() && has_bounds_) spacing_ = std::max(Distance(lo_, hi_) / 300, 1e-3);
+  // Without samples, size markers after the scene: a walk of a few centimetres, metres or
+  // kilometres. (At least 1 mm: a walk of 4 cm had markers of a tenth of its size.)
+  if (!has_terrain() && has_bounds_) {
+    const double diagonal = Distance(lo_, hi_);
+    spacing_ = diagonal > 0 ? diagonal / 300 : 1e-3;
+  }
+}
+
+double Scene::MarkerUnit() const {
+  const double diagonal = has_bounds_ ? Distance(lo_, hi_) : 0;
+  return std::max(spacing_, std::min(0.02, diagonal / 300));
 }
 
 glm::vec3 Scene::ToRender(const Vec3& world) const {
@@ -211,7 +220,7 @@ void Scene::DrawnBounds(glm::dvec3* lo, glm::dvec3* hi) const {
   *lo = ToRenderDouble(drawn_lo_), *hi = ToRenderDouble(drawn_hi_);
   // Room for markers drawn around points (normals and body axes up to 8 sample spacings long,
   // crosses, arrow heads) and for the grid cells around the samples.
-  double margin = 0.05 * glm::length(*hi - *lo) + 16 * std::max(spacing_, 0.02);
+  double margin = 0.05 * glm::length(*hi - *lo) + 16 * MarkerUnit();
   if (has_terrain()) margin += grid_.stats().cell_size;
   *lo -= glm::dvec3(margin), *hi += glm::dvec3(margin);
 }
@@ -279,7 +288,7 @@ void Scene::DrawQuery(const QueryView& q, bool latest, DrawList* depth_tested,
 void Scene::DrawWalk(const ViewState& view, DrawList* on_top) const {
   size_t foot_index = 0;
   std::vector<glm::vec3> body_path;
-  const float unit = static_cast<float>(std::max(spacing_, 0.02));
+  const float unit = static_cast<float>(MarkerUnit());
   for (const WalkTrack& track : walk_.tracks) {
     if (track.keys.empty()) continue;
     if (track.kind == TrackKind::kBody) {

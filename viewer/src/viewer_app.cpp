@@ -174,7 +174,7 @@ struct App {
   void FrameAll() {
     glm::dvec3 lo, hi;
     scene.RenderBounds(&lo, &hi);
-    camera.Frame(lo, hi);
+    camera.Frame(lo, hi, scene.MinFrameRadius());
   }
 
   void SetFrame(double frame) {

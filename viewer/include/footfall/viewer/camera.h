@@ -14,8 +14,9 @@ class OrbitCamera {
   static constexpr double kFovYDegrees = 45.0;
 
   // Looks at the box [lo, hi] (render space) from the current direction, far enough to see
-  // all of it. An empty or degenerate box is treated as a 1-unit box around its centre.
-  void Frame(const glm::dvec3& lo, const glm::dvec3& hi);
+  // all of it. A box whose bounding sphere is smaller than `min_radius` (> 0, render units) is
+  // framed as a sphere of that radius around its centre.
+  void Frame(const glm::dvec3& lo, const glm::dvec3& hi, double min_radius);
   // Places the eye and the target (render space). eye != target. The eye is kept as given
   // unless the view is within a degree of vertical, which is tilted to 89 degrees about the
   // target.

@@ -94,6 +94,11 @@ class Scene {
   std::vector<DrawVertex> TerrainPoints(ColorMode mode) const;
   // Terrain splat size. [Units: wu]
   double SampleSpacing() const { return spacing_; }
+  // The length unit of the walk's markers (body axes, foot normals): the sample spacing, and
+  // at least 2 cm in a scene of 6 m or more (1/300 of its diagonal in a smaller one). [Units: wu]
+  double MarkerUnit() const;
+  // The smallest radius the camera frames: a few sample spacings. [Units: wu]
+  double MinFrameRadius() const { return 2 * spacing_; }
 
   // Fills `depth_tested` (grid cells) and `on_top` (queries, walk) for one frame.
   void Draw(const ViewState& view, DrawList* depth_tested, DrawList* on_top) const;
