@@ -262,6 +262,45 @@ std::string DescendingWalkJson() {
       {"frame": 2, "phase": "end", "position": [1, 0, 0]}]}]})";
 }
 
+// The pixel of `state`'s dumped camera (eye, target) for world point p, by the test's own
+// projection.
+glm::vec2 ProjectWithDumpedCamera(const json& state, const glm::dvec3& p) {
+  const json& c = state["camera"];
+  const glm::dvec3 eye(c["eye"][0].get<double>(), c["eye"][1].get<double>(),
+                       c["eye"][2].get<double>());
+  const glm::dvec3 target(c["target"][0].get<double>(), c["target"][1].get<double>(),
+                          c["target"][2].get<double>());
+  return Project(eye, target, state["image"]["width"].get<int>(),
+                 state["image"]["height"].get<int>(), p);
+}
+
+TEST_CASE("framing takes in a query's candidate ring", "[viewer][camera]") {
+  // (The terrain and the query's points were framed: a ring reaching beyond them was cut off
+  // at the image's edge.)
+  const std::string dir = test::TempDir();
+  const int width = 640, height = 400;
+  const RunResult r =
+      View({"--terrain", kTerrain, "--query", "next 20 0 20 30 0 0", "--size", "640x400",
+            "--screenshot", dir + "/shot.png", "--dump-state", dir + "/state.json"});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const json state = json::parse(test::ReadFile(dir + "/state.json"));
+  REQUIRE(state["queries"].size() == 1);
+  const double radius = state["queries"][0]["radius"].get<double>();
+  CHECK(radius == Approx(30));
+  const glm::dvec3 ideal(50, 0, 20);
+  for (int i = 0; i < 48; ++i) {
+    const double a = 6.283185307179586 * i / 48;
+    const glm::vec2 px =
+        ProjectWithDumpedCamera(state, ideal + radius * glm::dvec3(std::cos(a), 0, std::sin(a)));
+    INFO("ring point " << i << " at " << px.x << ", " << px.y);
+    CHECK(px.x >= 0);
+    CHECK(px.x < width);
+    CHECK(px.y >= 0);
+    CHECK(px.y < height);
+  }
+}
+
 TEST_CASE("scenes a few centimetres across are framed to their size", "[viewer][camera]") {
   // (Framing took a radius of at least 0.5 m: a terrain or a walk of 4 cm was a dot.)
   const std::string dir = test::TempDir();

@@ -75,8 +75,20 @@ void Scene::GrowDrawn(const QueryView& q) {
   if (q.spec.op == QueryOp::kNext) {
     const Vec3 ideal = q.spec.point + q.spec.direction;
     const double r = RingRadius(q);
-    Grow(ideal - Vec3{r, r, r}, &drawn_lo_, &drawn_hi_, &has_drawn_);
-    Grow(ideal + Vec3{r, r, r}, &drawn_lo_, &drawn_hi_, &has_drawn_);
+    // The ring, and the arrow's head (as long as DrawQuery draws it, spread to half that).
+    const double head = std::max(Length(q.spec.direction) * 0.15, spacing_);
+    for (const double d : {r, head}) {
+      Grow(ideal - Vec3{d, d, d}, &drawn_lo_, &drawn_hi_, &has_drawn_);
+      Grow(ideal + Vec3{d, d, d}, &drawn_lo_, &drawn_hi_, &has_drawn_);
+    }
+  }
+  if (q.traced) {
+    for (const uint32_t cell : q.trace.cells) {
+      Vec3 lo, hi;
+      grid_.CellBox(cell, &lo, &hi);
+      Grow(lo, &drawn_lo_, &drawn_hi_, &has_drawn_);
+      Grow(hi, &drawn_lo_, &drawn_hi_, &has_drawn_);
+    }
   }
   if (q.result.status == Status::kOk) Grow(q.result.point, &drawn_lo_, &drawn_hi_, &has_drawn_);
 }
@@ -112,6 +124,13 @@ Status Scene::LoadTerrain(const std::string& path, const TerrainLoadOptions& opt
                std::sqrt(static_cast<double>(st.occupied_cells) / static_cast<double>(st.samples));
   }
   for (const Vec3& p : samples_.points) Grow(p, &lo_, &hi_, &has_bounds_);
+  bool any_cell = false;
+  for (const uint32_t cell : grid_.OccupiedCells()) {
+    Vec3 lo, hi;
+    grid_.CellBox(cell, &lo, &hi);
+    Grow(lo, &cells_lo_, &cells_hi_, &any_cell);
+    Grow(hi, &cells_lo_, &cells_hi_, &any_cell);
+  }
   return Status::kOk;
 }
 
@@ -210,6 +229,28 @@ void Scene::RenderBounds(glm::dvec3* lo, glm::dvec3* hi) const {
     return;
   }
   *lo = ToRenderDouble(lo_), *hi = ToRenderDouble(hi_);
+}
+
+void Scene::FrameBounds(const ViewState& view, glm::dvec3* lo, glm::dvec3* hi) const {
+  if (!has_drawn_) {
+    RenderBounds(lo, hi);
+    return;
+  }
+  // (The loaded bounds alone: a candidate ring, a chosen sample's normal or the body's axes
+  // could lie outside the picture.)
+  Vec3 world_lo = drawn_lo_, world_hi = drawn_hi_;
+  if (view.show_cells && has_terrain()) {
+    bool any = true;
+    Grow(cells_lo_, &world_lo, &world_hi, &any);
+    Grow(cells_hi_, &world_lo, &world_hi, &any);
+  }
+  *lo = ToRenderDouble(world_lo), *hi = ToRenderDouble(world_hi);
+  // Markers drawn from points: a query's cross and normal (4 spacings), a walk's body axes and
+  // foot normals (8 marker units).
+  double margin = 0;
+  if (!queries_.empty() || !live_.empty()) margin = 4 * spacing_;
+  if (has_walk()) margin = std::max(margin, 8 * MarkerUnit());
+  *lo -= glm::dvec3(margin), *hi += glm::dvec3(margin);
 }
 
 void Scene::DrawnBounds(glm::dvec3* lo, glm::dvec3* hi) const {
@@ -366,6 +407,7 @@ ordered_json Scene::Describe(const ViewState& view, const OrbitCamera& camera, i
     j["query"] = FormatQueryText(q.spec);
     j["op"] = QueryOpName(q.spec.op);
     if (q.live) j["sequence"] = q.sequence;
+    if (q.spec.op == QueryOp::kNext) j["radius"] = RingRadius(q);
     j["status"] = StatusName(q.result.status);
     j["found"] = q.result.status == Status::kOk;
     if (q.result.status == Status::kOk) {

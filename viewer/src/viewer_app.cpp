@@ -173,7 +173,7 @@ struct App {
 
   void FrameAll() {
     glm::dvec3 lo, hi;
-    scene.RenderBounds(&lo, &hi);
+    scene.FrameBounds(view, &lo, &hi);
     camera.Frame(lo, hi, scene.MinFrameRadius());
   }
 

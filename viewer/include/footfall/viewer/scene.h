@@ -85,6 +85,10 @@ class Scene {
   // The render-space bounds of everything loaded (a unit box when nothing is): what the
   // camera frames.
   void RenderBounds(glm::dvec3* lo, glm::dvec3* hi) const;
+  // The render-space bounds of everything a frame of `view` draws: what is loaded, the live
+  // queries received, the candidate rings, arrows, cells and markers around them: what the
+  // camera frames.
+  void FrameBounds(const ViewState& view, glm::dvec3* lo, glm::dvec3* hi) const;
   // The render-space bounds of everything drawn: what is loaded, the live queries received,
   // and room for the markers around them (rings, normals, cells). The camera keeps all of it
   // between its clip planes.
@@ -110,7 +114,7 @@ class Scene {
  private:
   void DrawQuery(const QueryView& q, bool latest, DrawList* depth_tested, DrawList* on_top) const;
   void DrawWalk(const ViewState& view, DrawList* on_top) const;
-  // Grows the drawn bounds by a query's points and its candidate ring.
+  // Grows the drawn bounds by a query's points, its arrow, cells and candidate ring.
   void GrowDrawn(const QueryView& q);
 
   std::string terrain_path_, walk_path_;
@@ -126,6 +130,7 @@ class Scene {
   bool has_bounds_ = false;
   Vec3 drawn_lo_, drawn_hi_;  // lo_, hi_ and what only adds to the picture (world space)
   bool has_drawn_ = false;
+  Vec3 cells_lo_, cells_hi_;  // the occupied grid cells' bounds (world space)
 };
 
 }  // namespace footfall::viewer
