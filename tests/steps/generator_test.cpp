@@ -1025,6 +1025,24 @@ TEST_CASE("Feet keep to their sides in sharp turns as the body turns no faster t
   }
 }
 
+TEST_CASE("A foot with no foothold while its character turns on the spot keeps its place",
+          "[steps][generator]") {
+  // The shipped octopod turning about a goal behind it at the foot of the shipped stairs: a hind
+  // foot by the first riser, its target below the floor at the riser's foot, found no foothold
+  // and stopped the walk at step 168; it stands where it is until the turn takes it on.
+  Terrain t = LoadTerrain(LoadShippedTerrain("stairs"), 0.03);
+  const Character c = LoadShipped("octopod");
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {0.434568, 5, 0.668211};
+  o.path.push_back({1.04996, 0, 0.823702});
+  o.path.push_back({0.525957, 0, 0.261477});
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CHECK(w.stopped.empty());
+  CheckWalk(t, c, o, w);
+}
+
 TEST_CASE("A path walk that runs out of steps before its goal says so as a stop",
           "[steps][generator]") {
   // Back and forth between two points 4 m apart, 2000 times: more than the 10,000 steps a path

@@ -218,6 +218,13 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
   const size_t steps = body.keys.size() - 1;
   const int groups = static_cast<int>(c.gait.size());
   int waits = 0;
+  size_t waits_from = 0;  // the body key the current run of waits starts at
+  // A run of more than a cycle of waits is a character turning on the spot toward a waypoint,
+  // its feet kept in place until the turn takes them on: its body turns during the run.
+  const auto turned_since = [&](size_t from, size_t to) {
+    const Quat a = body.rotations[from], b = body.rotations[to];
+    return a.x != b.x || a.y != b.y || a.z != b.z || a.w != b.w;
+  };
   for (size_t k = 0; k < steps; ++k) {
     const double f0 = o.start_frame + static_cast<double>(k) * c.frames_per_step;
     const auto& group = c.gait[k % groups];
@@ -230,8 +237,13 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
       INFO("step " << k + 1 << ": no foot lifts");
       CHECK(body.keys[k + 1].position == body.keys[k].position);
       CHECK(body.keys[k + 1].frame == f0 + c.frames_per_step);
-      CHECK(++waits < groups);  // never a whole cycle of waits in a row
+      if (waits++ == 0) waits_from = k;
+      if (waits >= groups) CHECK(!o.path.empty());  // a whole cycle of waits: a turn on the spot
       continue;
+    }
+    if (waits >= groups) {
+      INFO("steps " << waits_from + 1 << " to " << k << ": no foot lifts");
+      CHECK(turned_since(waits_from, k));
     }
     waits = 0;
     for (size_t f = 0; f < c.feet.size(); ++f) {

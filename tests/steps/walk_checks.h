@@ -43,7 +43,9 @@ Vec3 FootAt(const WalkTrack& track, double frame);
 //    0.1 .. 0.9) by more than one sample spacing below it;
 //  - every body key sits body_height along its up above the centroid of the feet at that frame,
 //    and every foot is within reach of it;
-//  - the feet step in the declared gait order, one group per step.
+//  - the feet step in the declared gait order, one group per step, a group waiting (no foot
+//    lifting, the body still) at most a cycle less one in a row, unless its character turns on
+//    the spot toward a waypoint (its body turning during the run of waits).
 void CheckWalk(Terrain& t, const Character& c, const GenerateOptions& o, const Walk& w);
 
 // Tracks of one character ("" for a single one): feet in file order, then the body.
