@@ -668,6 +668,22 @@ class MayaKeyWalkTest(unittest.TestCase):
                     self.assertLess(abs(a - b), 3.0, msg="%s after %s" % (euler, previous))
             previous = euler
 
+    def test_keys_have_linear_tangents(self):
+        # As the MEL export: Maya's default tangent (auto or spline) overshoots between a foot's
+        # start, mid and end keys, dipping it into the ground.
+        keys = [{"frame": f, "position": [0.0, 1.0, 0.1 * f], "rotation": (0.0, 0.0, 0.0, 1.0)}
+                for f in (1, 7, 13)]
+        walk = {"tracks": [{"name": "body", "kind": "body", "keys": keys},
+                           {"name": "L", "kind": "foot",
+                            "keys": [{"frame": 1, "position": [0.1, 0.0, 0.0]},
+                                     {"frame": 4, "position": [0.1, 0.2, 0.1]}]}]}
+        calls = self._key_walk(walk, {"L": "footL"}, "hips")
+        keyed = [c for c in calls if c[0] == "setKeyframe"]
+        self.assertEqual(len(keyed), 3 * 2 + 2)
+        for call in keyed:
+            self.assertEqual(call[2].get("inTangentType"), "linear", msg=str(call))
+            self.assertEqual(call[2].get("outTangentType"), "linear", msg=str(call))
+
 
 class GenerateTest(unittest.TestCase):
     """ffc_generate over RPC gives the same walk JSON as `footfall generate`."""

@@ -215,11 +215,15 @@ def key_walk(walk, feet, body, from_frame=None):
                 previous = euler
             if from_frame is not None and frame < from_frame:
                 continue
+            # Linear in and out tangents, as the MEL and glTF exports (the user's default
+            # tangent would overshoot between a foot's keys, through the ground).
             mc.xform(node, ws=True, t=key["position"])
-            mc.setKeyframe(node, attribute="translate", time=frame)
+            mc.setKeyframe(node, attribute="translate", time=frame,
+                           inTangentType="linear", outTangentType="linear")
             if euler is not None:
                 mc.xform(node, ws=True, ro=euler)
-                mc.setKeyframe(node, attribute="rotate", time=frame)
+                mc.setKeyframe(node, attribute="rotate", time=frame,
+                               inTangentType="linear", outTangentType="linear")
             count += 1
     return count
 
