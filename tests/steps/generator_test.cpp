@@ -1625,6 +1625,30 @@ TEST_CASE("A character milling about at a dead end stops", "[steps][generator][s
   CheckWalk(t, asym, o, w);
 }
 
+TEST_CASE("A walk along a loop that comes back to where it was a dead-end window before goes on",
+          "[steps][generator]") {
+  // The shipped biped around a square of 8.8 m sides and up its first side again: at step 100,
+  // the dead-end window's length, its body was back within half a step of its start, and the
+  // walk stopped as milling about at a dead end.
+  const Character c = LoadShipped("biped");
+  const double spacing = 0.05;
+  Terrain t = LoadTerrain(MakeFlat(361, spacing, 0), spacing);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {5, 0, 5};
+  const double far = 5 + 8.8;
+  o.path.push_back({5, 0, far});
+  o.path.push_back({far, 0, far});
+  o.path.push_back({far, 0, 5});
+  o.path.push_back({5, 0, 5});
+  o.path.push_back({5, 0, far});
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CHECK(w.stopped.empty());
+  CHECK(StepsDone(w) > 100);
+  CheckWalk(t, c, o, w);
+}
+
 TEST_CASE("A multiped walks over the Spot mesh, a closed surface with overhangs",
           "[steps][generator][shared-data]") {
   // Real data from ../shared/data: Keenan Crane's Spot (public domain), resampled by

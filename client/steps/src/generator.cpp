@@ -185,9 +185,11 @@ struct Agent {
   int waits = 0;        // steps in a row its group stepped in place, waiting for a planted foot
   int still = 0;        // steps in a row no foot of it moved (waits, turns on the spot included)
   // Where the body was at step `window_step`: a body that stays within half a step of it for
-  // Generator::window_steps_ steps is milling about at a dead end.
+  // Generator::window_steps_ steps is milling about at a dead end (`window_left`: it has been
+  // farther since, as a walk along a loop that comes back there is).
   Vec3 window_from;
   int window_step = -1;
+  bool window_left = false;
   std::string stopped;   // why it stopped early ("" when it did not)
   int stopped_step = 0;  // the step it stopped at
   size_t first_track = 0;
@@ -1721,8 +1723,10 @@ void Generator::Finish(size_t w, int k) {
   const double f1 = f0 + c_.frames_per_step;
   const size_t m = w * per_agent, e = m + per_agent;
   Agent& a = agents_[walking_[w]];
+  const bool near_window_from = Distance(a.ground, a.window_from) < 0.5 * c_.step_length;
+  a.window_left |= !near_window_from;
   if (a.window_step < 0 || k - a.window_step >= window_steps_) {
-    if (a.window_step >= 0 && Distance(a.ground, a.window_from) < 0.5 * c_.step_length) {
+    if (a.window_step >= 0 && near_window_from && !a.window_left) {
       std::ostringstream why;
       why.precision(4);
       why << "no way forward from " << Point(a.ground) << ": the body has stayed within half a "
@@ -1730,7 +1734,7 @@ void Generator::Finish(size_t w, int k) {
       Stop(a, k + 1, why.str());
       return;
     }
-    a.window_from = a.ground, a.window_step = k;
+    a.window_from = a.ground, a.window_step = k, a.window_left = false;
   }
   const Move* failed = nullptr;
   for (size_t i = m; i < e && !failed; ++i)
