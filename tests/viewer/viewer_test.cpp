@@ -301,6 +301,47 @@ TEST_CASE("framing takes in a query's candidate ring", "[viewer][camera]") {
   }
 }
 
+TEST_CASE("framing leaves the overlay's bands clear", "[viewer][camera]") {
+  // (The bounding sphere filled the whole height: a column 20 m tall on a 2 m floor reached
+  // under the line of text at the top.)
+  const std::string dir = test::TempDir();
+  std::string tall;  // a 2 x 2 m floor with a column 20 m tall at its centre
+  for (int k = 0; k <= 20; ++k) {
+    for (int i = 0; i <= 20; ++i)
+      tall += std::to_string(i * 0.1) + " 0 " + std::to_string(k * 0.1) + " 0 1 0\n";
+  }
+  for (int j = 0; j <= 200; ++j) tall += "1 " + std::to_string(j * 0.1) + " 1 1 0 0\n";
+  test::WriteFile(dir + "/tall.pts", tall);
+  for (const std::string size : {"640x400", "320x480"}) {
+    const RunResult r = View({"--terrain", dir + "/tall.pts", "--size", size, "--screenshot",
+                              dir + "/shot.png", "--dump-state", dir + "/state.json"});
+    INFO(size << ": " << r.err);
+    REQUIRE(r.exit_code == 0);
+    const json state = json::parse(test::ReadFile(dir + "/state.json"));
+    const int width = state["image"]["width"], height = state["image"]["height"];
+    // The info line's band at the top (its line of 12 px and 6 px more), the help lines' at
+    // the bottom (from 4 px above their first line).
+    const json& hud = state["hud"];
+    REQUIRE(hud.size() >= 2);
+    const double top_band = hud[0]["y"].get<double>() + 14;
+    double bottom_band = height;
+    for (const json& line : hud) {
+      if (line["y"].get<double>() > height / 2.0)
+        bottom_band = std::min(bottom_band, line["y"].get<double>() - 4);
+    }
+    for (const glm::dvec3 p : {glm::dvec3(1, 20, 1), glm::dvec3(0, 0, 0), glm::dvec3(2, 0, 0),
+                               glm::dvec3(0, 0, 2), glm::dvec3(2, 0, 2)}) {
+      const glm::vec2 px = ProjectWithDumpedCamera(state, p);
+      INFO("(" << p.x << ", " << p.y << ", " << p.z << ") at " << px.x << ", " << px.y
+               << "; bands end at " << top_band << " and begin at " << bottom_band);
+      CHECK(px.y > top_band);
+      CHECK(px.y < bottom_band);
+      CHECK(px.x > 0);
+      CHECK(px.x < width);
+    }
+  }
+}
+
 TEST_CASE("scenes a few centimetres across are framed to their size", "[viewer][camera]") {
   // (Framing took a radius of at least 0.5 m: a terrain or a walk of 4 cm was a dot.)
   const std::string dir = test::TempDir();
@@ -317,7 +358,7 @@ TEST_CASE("scenes a few centimetres across are framed to their size", "[viewer][
     REQUIRE(r.exit_code == 0);
     const int terrain = CountColor(ReadPng(dir + "/t.png"), {128, 255, 128});
     INFO("terrain pixels: " << terrain);
-    CHECK(terrain > 320 * 200 / 10);
+    CHECK(terrain > 320 * 200 / 20);  // (it was a dot)
   }
   SECTION("a walk 2 cm long") {
     std::string walk = WalkJson();  // scaled by 1/100: feet 2 cm apart, stepping 2 cm
@@ -334,7 +375,7 @@ TEST_CASE("scenes a few centimetres across are framed to their size", "[viewer][
       walk.replace(walk.find(from), from.size(), to);
     }
     test::WriteFile(dir + "/walk.json", walk);
-    const RunResult r = View({"--walk", dir + "/walk.json", "--size", "320x200", "--screenshot",
+    const RunResult r = View({"--walk", dir + "/walk.json", "--size", "640x400", "--screenshot",
                               dir + "/w.png", "--dump-state", dir + "/w.json"});
     INFO(r.err);
     REQUIRE(r.exit_code == 0);

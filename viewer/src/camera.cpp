@@ -35,14 +35,31 @@ void OrbitCamera::PlaceEye() {
   eye_ = target_ + distance_ * dir;
 }
 
-void OrbitCamera::Frame(const glm::dvec3& lo, const glm::dvec3& hi, double min_radius) {
+void OrbitCamera::Frame(const glm::dvec3& lo, const glm::dvec3& hi, double min_radius,
+                        double aspect, double top_band, double bottom_band) {
   target_ = 0.5 * (lo + hi);
   // (At least 0.5 units, whatever the scene: a terrain a few centimetres across was a dot.)
   const double radius = std::max(0.5 * glm::length(hi - lo), min_radius);
-  const double half_fov = glm::radians(kFovYDegrees) * 0.5;
-  // The bounding sphere just fits the vertical field of view (so all of the box does).
-  distance_ = radius / std::sin(half_fov) * 1.02;
+  // The bounding sphere just fits the clear part of the view, vertically and horizontally (so
+  // all of the box does). (It filled the whole height: tall terrain reached under the overlay,
+  // and a window narrower than high cut the sides off.)
+  // The clear part in normalized device y: its middle and half height.
+  const double top = 1 - 2 * std::clamp(top_band, 0.0, 0.45);
+  const double bottom = -1 + 2 * std::clamp(bottom_band, 0.0, 0.45);
+  const double middle = 0.5 * (top + bottom), half = 0.5 * (top - bottom);
+  const double t = std::tan(glm::radians(kFovYDegrees) * 0.5);
+  const double centre = std::atan(middle * t);  // the angle the centre is seen at, below/above
+  const double half_angle =
+      std::min({std::atan((middle + half) * t) - centre, centre - std::atan((middle - half) * t),
+                std::atan(std::max(aspect, 0.05) * t)});
+  distance_ = radius / std::sin(half_angle) * 1.02;
   PlaceEye();
+  // The centre shown at `middle`: the target (and the eye) lowered by as much in the view.
+  const glm::dmat4 view = View();
+  const glm::dvec3 up(view[0][1], view[1][1], view[2][1]);
+  const glm::dvec3 shift = -up * (middle * t * distance_);
+  target_ += shift;
+  eye_ += shift;
 }
 
 void OrbitCamera::LookAt(const glm::dvec3& eye, const glm::dvec3& target) {

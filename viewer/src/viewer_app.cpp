@@ -165,16 +165,31 @@ struct App {
     float x, y, width;
   };
   std::vector<HudLine> hud_lines;
+  // How far the overlay's bands reach into the window from its top and from its bottom, as
+  // last laid out. [Units: px]
+  float hud_top = 0, hud_bottom = 0;
   // Mouse drag state.
   bool rotating = false, panning = false;
   double last_x = 0, last_y = 0;
 
   explicit App(const ViewerOptions& o) : options(o) {}
 
-  void FrameAll() {
+  // Frames everything drawn in a width x height viewport, clear of the overlay's bands.
+  void FrameAll(int width, int height) {
+    width = std::max(width, 1), height = std::max(height, 1);
+    DrawList layout;
+    DrawOverlay(width, height, &layout);  // measures the bands
     glm::dvec3 lo, hi;
     scene.FrameBounds(view, &lo, &hi);
-    camera.Frame(lo, hi, scene.MinFrameRadius());
+    camera.Frame(lo, hi, scene.MinFrameRadius(), static_cast<double>(width) / height,
+                 (hud_top + 4) / height, (hud_bottom + 4) / height);
+  }
+
+  // Frames everything, or looks as --camera says.
+  void PlaceCamera(int width, int height) {
+    FrameAll(width, height);
+    if (options.has_camera)
+      camera.LookAt(scene.ToRenderDouble(options.eye), scene.ToRenderDouble(options.target));
   }
 
   void SetFrame(double frame) {
@@ -242,8 +257,8 @@ struct App {
       }
     };
     const std::vector<std::string> info = WrapText(InfoText(), "   ", scale, max_width);
-    screen->Rect(0, 0, static_cast<float>(width), static_cast<float>(info.size()) * line + 6,
-                 Rgba{0, 0, 0, 140});
+    hud_top = static_cast<float>(info.size()) * line + 6;
+    screen->Rect(0, 0, static_cast<float>(width), hud_top, Rgba{0, 0, 0, 140});
     draw_lines(6, 4, info);
     // The help line, wrapped at its item separators.
     const std::vector<std::string> lines = WrapText(HelpText(), "   ", scale, max_width);
@@ -251,6 +266,7 @@ struct App {
     screen->Rect(0, top - 4, static_cast<float>(width), static_cast<float>(height),
                  Rgba{0, 0, 0, 140});
     draw_lines(6, top, lines);
+    hud_bottom = static_cast<float>(height) - (top - 4);
     if (scene.has_walk()) {
       // The timeline: a bar over the walk's frames with a marker at the current frame.
       const float bar_y = top - 14;
@@ -267,7 +283,9 @@ struct App {
       if (!scene.walk().stopped.empty()) f << "   stopped: " << scene.walk().stopped;
       const std::vector<std::string> frame_lines =
           WrapText(f.str(), "   ", scale, static_cast<float>(width) - 2 * x0);
-      draw_lines(x0, bar_y - static_cast<float>(frame_lines.size()) * line - 6, frame_lines);
+      const float frame_top = bar_y - static_cast<float>(frame_lines.size()) * line - 6;
+      draw_lines(x0, frame_top, frame_lines);
+      hud_bottom = static_cast<float>(height) - frame_top;
     }
   }
 
@@ -308,9 +326,12 @@ struct App {
       case GLFW_KEY_Q:
         glfwSetWindowShouldClose(w, GLFW_TRUE);
         break;
-      case GLFW_KEY_F:
-        app->FrameAll();
+      case GLFW_KEY_F: {
+        int width = 0, height = 0;
+        glfwGetFramebufferSize(w, &width, &height);
+        app->FrameAll(width, height);
         break;
+      }
       case GLFW_KEY_C:
         app->view.color =
             app->view.color == ColorMode::kNormal ? ColorMode::kHeight : ColorMode::kNormal;
@@ -542,10 +563,6 @@ int RunViewer(const ViewerOptions& options) {
               << app.scene.first_frame() << "-" << app.scene.last_frame() << "; showing "
               << app.view.frame << '\n';
   }
-  app.FrameAll();
-  if (options.has_camera)
-    app.camera.LookAt(app.scene.ToRenderDouble(options.eye),
-                      app.scene.ToRenderDouble(options.target));
 
   // 3. Open a window (hidden for screenshots) with an OpenGL 3.3 core context.
   glfwSetErrorCallback(OnGlfwError);
@@ -592,6 +609,13 @@ int RunViewer(const ViewerOptions& options) {
     if (!app.live->Start()) return Fail(app.live->error());
     std::cout << "footfall-view: live: following footfalld at " << app.live->Address()
               << " after query " << app.live->start_after() << std::endl;
+  }
+  if (headless) {
+    app.PlaceCamera(options.width, options.height);
+  } else {
+    int width = 0, height = 0;
+    glfwGetFramebufferSize(app.window, &width, &height);
+    app.PlaceCamera(width, height);
   }
   const int code = headless ? app.Screenshot() : app.Interactive();
   if (app.live) app.live->Stop();

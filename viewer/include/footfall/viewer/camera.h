@@ -14,9 +14,13 @@ class OrbitCamera {
   static constexpr double kFovYDegrees = 45.0;
 
   // Looks at the box [lo, hi] (render space) from the current direction, far enough to see
-  // all of it. A box whose bounding sphere is smaller than `min_radius` (> 0, render units) is
-  // framed as a sphere of that radius around its centre.
-  void Frame(const glm::dvec3& lo, const glm::dvec3& hi, double min_radius);
+  // all of it in a viewport of this aspect ratio (width / height) between bands left to
+  // overlays at its top and bottom (fractions of its height, [0, 0.45]); the target is moved
+  // off the box's centre so that it shows in the middle of what is clear. A box whose bounding
+  // sphere is smaller than `min_radius` (> 0, render units) is framed as a sphere of that
+  // radius around its centre.
+  void Frame(const glm::dvec3& lo, const glm::dvec3& hi, double min_radius, double aspect = 1,
+             double top_band = 0, double bottom_band = 0);
   // Places the eye and the target (render space). eye != target. The eye is kept as given
   // unless the view is within a degree of vertical, which is tilted to 89 degrees about the
   // target.
