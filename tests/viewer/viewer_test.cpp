@@ -536,6 +536,41 @@ TEST_CASE("live: the viewer shows a query another client sends to footfalld", "[
   CHECK(CountColorNear(image, pixel, 4, kChosen) >= 40);
 }
 
+TEST_CASE("live: without a terrain, the picture is framed on the queries received",
+          "[viewer][live]") {
+  // (The camera framed the unit box at the origin before any query came: a blank picture.)
+  const std::string dir = test::TempDir();
+  test::Child server(
+      {FOOTFALLD, "--listen", "127.0.0.1:0", "--port-file", dir + "/port", "--no-rpcbind"}, {});
+  const std::string port = WaitForPort(dir + "/port");
+  INFO("footfalld stderr: " << server.Err());
+  REQUIRE_FALSE(port.empty());
+  const std::string address = "127.0.0.1:" + port;
+  test::Child viewer(
+      {kView, "--server", address, "--live", "--live-wait", "2", "--timeout", "30", "--size",
+       "640x400", "--screenshot", dir + "/live.png", "--dump-state", dir + "/state.json"},
+      {test::XDisplay()});
+  INFO("viewer stderr: " << viewer.Err());
+  REQUIRE(viewer.WaitForOutput("live: following footfalld at " + address, kTimeout));
+  const RunResult client = Run({FOOTFALL_CLI, "query", "--terrain", kTerrain, "--server", address},
+                               {}, kTimeout, "next 10 1 10 1.2 0 0.3\nsnap 16 1 11\n");
+  INFO("footfall query: " << client.out << client.err);
+  REQUIRE(client.exit_code == 0);
+  int code = -1;
+  REQUIRE(viewer.Wait(kTimeout, &code));
+  REQUIRE(code == 0);
+  const json state = json::parse(test::ReadFile(dir + "/state.json"));
+  REQUIRE(state["live"]["queries"].size() == 2);
+  const Image image = ReadPng(dir + "/live.png");
+  for (const json& q : state["live"]["queries"]) {
+    INFO(q.dump());
+    REQUIRE(q["found"] == true);
+    CHECK(q["visible"] == true);
+    const glm::vec2 pixel(q["pixel"][0].get<float>(), q["pixel"][1].get<float>());
+    CHECK(CountColorNear(image, pixel, 4, kChosen) >= 40);
+  }
+}
+
 TEST_CASE("live: a server that never sees a query ends the wait with a message", "[viewer][live]") {
   const std::string dir = test::TempDir();
   test::Child server(

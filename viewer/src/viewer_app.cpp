@@ -168,6 +168,8 @@ struct App {
   // How far the overlay's bands reach into the window from its top and from its bottom, as
   // last laid out. [Units: px]
   float hud_top = 0, hud_bottom = 0;
+  int frame_width = 1, frame_height = 1;  // the viewport last framed for [Units: px]
+  bool follow_live = false;               // frame the live queries as they arrive
   // Mouse drag state.
   bool rotating = false, panning = false;
   double last_x = 0, last_y = 0;
@@ -187,6 +189,10 @@ struct App {
 
   // Frames everything, or looks as --camera says.
   void PlaceCamera(int width, int height) {
+    frame_width = width, frame_height = height;
+    // With nothing loaded, the live queries are the scene: framed as they arrive, until the
+    // camera is moved.
+    follow_live = live && !scene.has_loaded() && !options.has_camera;
     FrameAll(width, height);
     if (options.has_camera)
       camera.LookAt(scene.ToRenderDouble(options.eye), scene.ToRenderDouble(options.target));
@@ -293,7 +299,10 @@ struct App {
     if (!live) return;
     std::vector<RecentQuery> got;
     live->Take(&got);
-    if (!got.empty()) scene.AddLive(got);
+    if (got.empty()) return;
+    scene.AddLive(got);
+    // (The camera framed the unit box before any query came: a blank picture.)
+    if (follow_live) FrameAll(frame_width, frame_height);
   }
 
   bool WriteDump(int width, int height) {
@@ -329,6 +338,7 @@ struct App {
       case GLFW_KEY_F: {
         int width = 0, height = 0;
         glfwGetFramebufferSize(w, &width, &height);
+        app->frame_width = width, app->frame_height = height;
         app->FrameAll(width, height);
         break;
       }
@@ -365,6 +375,7 @@ struct App {
   static void OnButton(GLFWwindow* w, int button, int action, int) {
     App* app = From(w);
     glfwGetCursorPos(w, &app->last_x, &app->last_y);
+    if (action == GLFW_PRESS) app->follow_live = false;  // the user takes the camera
     if (button == GLFW_MOUSE_BUTTON_LEFT) app->rotating = action == GLFW_PRESS;
     if (button == GLFW_MOUSE_BUTTON_RIGHT || button == GLFW_MOUSE_BUTTON_MIDDLE)
       app->panning = action == GLFW_PRESS;
@@ -384,6 +395,7 @@ struct App {
   }
 
   static void OnScroll(GLFWwindow* w, double, double dy) {
+    From(w)->follow_live = false;
     From(w)->camera.Zoom(std::pow(0.9f, static_cast<float>(dy)));
   }
 

@@ -69,6 +69,8 @@ class Scene {
 
   bool has_terrain() const { return !terrain_path_.empty(); }
   bool has_walk() const { return !walk_path_.empty(); }
+  // Whether anything was loaded (a terrain, queries or a walk), not only received live.
+  bool has_loaded() const { return has_bounds_; }
   const TerrainGrid& grid() const { return grid_; }
   const Walk& walk() const { return walk_; }
   double first_frame() const { return first_frame_; }
