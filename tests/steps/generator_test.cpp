@@ -1025,6 +1025,30 @@ TEST_CASE("Feet keep to their sides in sharp turns as the body turns no faster t
   }
 }
 
+TEST_CASE("Feet on ground sampled about as far apart as they stand keep to their own sides",
+          "[steps][generator]") {
+  // The main job's biped (feet 0.2 m apart) on the bundled hills' 0.25 m lattice: walking along
+  // a column of samples both feet took it, and on the diagonal leg a foot often took a sample
+  // across the other's (34 of 130 body keys). Each foothold lined up so is asked again aimed
+  // outward by half the spacing.
+  const Character c = LoadShipped("biped");
+  const double spacing = 0.25;
+  Terrain t = LoadTerrain(MakeFlat(121, spacing, 0), spacing);
+  for (const bool diagonal : {false, true}) {
+    INFO((diagonal ? "diagonal" : "along a column"));
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {8, 0, 8};
+    o.path.push_back({8, 0, 20});
+    if (diagonal) o.path.push_back({20, 0, 28});
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    REQUIRE(w.stopped.empty());
+    CheckWalk(t, c, o, w);
+    CHECK(LeastPairGap(c, w) > 0.25);
+  }
+}
+
 TEST_CASE("A foot with no foothold while its character turns on the spot keeps its place",
           "[steps][generator]") {
   // The shipped octopod turning about a goal behind it at the foot of the shipped stairs: a hind

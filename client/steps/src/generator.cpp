@@ -216,6 +216,13 @@ struct Move {
   Vec3 ideal;               // the last query's ideal point
   Vec3 step;                // the last query's step vector
   size_t query = kNoQuery;  // index of this round's foothold answer, or kNoQuery
+  // A foothold accepted but lined up with (or across) its pair's other foot, samples lying
+  // about as far apart as the feet: the query is asked again aimed outward (`outward`), and
+  // this one (`lined_up`, its gap as a share of the rest gap) is kept unless that does better.
+  bool outward = false;
+  bool lined_up = false;
+  double lined_up_gap = 0;
+  Vec3 lined_up_point, lined_up_normal;
 };
 
 class Generator {
@@ -277,6 +284,13 @@ class Generator {
   Status QueryFootholds(std::string* error);
   // Accepts the answer h to mv's foothold query, or records why it is refused.
   void Judge(Move& mv, const Foothold& h) const;
+  // The gap across the heading between the foothold p of mv's foot and its pair's other foot,
+  // as a share of their rest gap (1 as at rest, below 0 crossed); 1 for a foot without a pair.
+  double GapToMate(const Move& mv, const Vec3& p) const;
+  // Judge's side test: true when the accepted foothold p may stand (kept, or kept as the
+  // better of a lined-up first answer and its outward retry); false when it is asked again,
+  // aimed outward.
+  bool KeepsSide(Move& mv, const Vec3& p, const Vec3& normal) const;
   // The reach limit for one character whose moves moves_[m, e) all have a foothold: refuses
   // the footholds beyond reach of the body they lead to, or all of them when a planted foot
   // would be left beyond reach.
@@ -1400,6 +1414,14 @@ Status Generator::QueryFootholds(std::string* error) {
         if ((mv.attempt.scale > 1 || mv.attempt.drop > 0) && len > kInPlace * c_.step_length)
           v = v * (max_len / Length(v));
         v = v * mv.attempt.scale;  // retries step shorter or longer
+        // A foothold lined up with its pair's other foot is asked again with the step aimed
+        // outward by half the samples' spacing, toward the sample on the foot's own side.
+        if (mv.outward) {
+          const std::vector<int>& pair = c_.pairs[p];
+          const int mate = pair[0] == mv.foot ? pair[1] : pair[0];
+          const double side = rest_[mv.foot].x > rest_[mate].x ? 1.0 : -1.0;
+          v += Left(a) * (side * 0.25 * gap_);
+        }
         if (Length(v) < kInPlace * c_.step_length) {
           if (mv.attempt.drop > 0) {
             Fail(mv);  // nothing ahead to aim down at
@@ -1483,7 +1505,11 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
   const bool found = h.status == Status::kOk && progress >= 0.5;
   const double rise = found ? Dot(h.point - foot, a.up) : 0;
   if (found && std::fabs(rise) <= c_.max_rise && Dot(h.normal, a.up) >= cos_max_slope_) {
-    mv.done = true, mv.end = h.point, mv.end_normal = h.normal;
+    if (KeepsSide(mv, h.point, h.normal)) mv.done = true;
+    return;
+  }
+  if (mv.lined_up) {  // the outward retry was refused: the lined-up foothold it tried to better
+    mv.done = true, mv.end = mv.lined_up_point, mv.end_normal = mv.lined_up_normal;
     return;
   }
   if (!KeepsReason(mv, !found)) return;  // mv already has a better reason
@@ -1516,6 +1542,38 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
         << FacingDownHint(slope);
   }
   mv.reason = why.str(), mv.reason_is_gap = !found;
+}
+
+double Generator::GapToMate(const Move& mv, const Vec3& p) const {
+  const std::vector<int>& pair = c_.pairs[pair_of_foot_[mv.foot]];
+  if (pair.size() != 2) return 1;
+  const int mate = pair[0] == mv.foot ? pair[1] : pair[0];
+  const double rest_gap = rest_[mv.foot].x - rest_[mate].x;
+  if (std::fabs(rest_gap) < 1e-9) return 1;  // one foot ahead of the other: no sides
+  const Agent& a = agents_[mv.agent];
+  return Dot(p - a.foot[mate], Left(a)) / rest_gap;
+}
+
+bool Generator::KeepsSide(Move& mv, const Vec3& p, const Vec3& normal) const {
+  const double gap = GapToMate(mv, p);
+  if (mv.lined_up) {  // the outward retry: the better of the two
+    if (std::fabs(gap - 1) >= std::fabs(mv.lined_up_gap - 1))
+      mv.end = mv.lined_up_point, mv.end_normal = mv.lined_up_normal;
+    else
+      mv.end = p, mv.end_normal = normal;
+    return true;
+  }
+  mv.end = p, mv.end_normal = normal;
+  // Lined up: under half the rest gap, with samples at least a quarter of it apart (nearer
+  // samples would have given a foothold on the foot's own side).
+  if (gap >= kMinPairGap || mv.outward) return true;
+  const std::vector<int>& pair = c_.pairs[pair_of_foot_[mv.foot]];
+  const double rest_gap = std::fabs(rest_[pair[0]].x - rest_[pair[1]].x);
+  if (0.5 * gap_ < 0.25 * rest_gap) return true;
+  mv.outward = true, mv.lined_up = true, mv.lined_up_gap = gap;
+  mv.lined_up_point = p, mv.lined_up_normal = normal;
+  --mv.attempts;  // the same attempt again, aimed outward
+  return false;
 }
 
 void Generator::KeepPlace(Move& mv) const {
