@@ -1419,6 +1419,30 @@ TEST_CASE("thousands of idle connections cost footfalld little while the others 
   setrlimit(RLIMIT_NOFILE, &files);
 }
 
+TEST_CASE("at the open descriptor limit footfalld says which connections it closes, and serves on",
+          "[rpc][robustness]") {
+  // 64 descriptors: libtirpc closes the least recently active connections (the idle owner's
+  // first) to take new ones.
+  ServerProcess server(0, {"--no-rpcbind"}, 64);
+  auto owner = ConnectLeavingOrphans(server.port());
+  TerrainHandle owned = 0;
+  REQUIRE(owner->LoadSamples(MakeFlat(10, 1, 0), "owned", &owned) == Status::kOk);
+  std::vector<int> idle;
+  for (int i = 0; i < 100; ++i) idle.push_back(RawConnect(server.port()));
+  auto late = Connect(server.port(), 30);
+  TerrainHandle late_own = 0;
+  CHECK(late->LoadSamples(MakeFlat(10, 1, 0), "late", &late_own) == Status::kOk);
+  CHECK(late->Snap(late_own, Vec3{3.2, 1, 4.7}).point == Vec3{3, 0, 5});
+  for (const int fd : idle) close(fd);
+  const std::string log = server.Log();
+  CHECK_THAT(log, Catch::Contains("at the open descriptor limit (64): closed the least recently "
+                                  "active connection, from 127.0.0.1:"));
+  CHECK_THAT(log, Catch::Contains("closed this way so far; raise the limit"));
+  CHECK_THAT(log, Catch::Contains("orphaned: footfalld closed the connection that loaded it, the "
+                                  "least recently active, at the open descriptor limit"));
+  CHECK_THAT(log, !Catch::Contains("orphaned: the connection that loaded it closed"));
+}
+
 TEST_CASE("footfalld closes a connection whose replies go unread past --unread-timeout",
           "[rpc][robustness]") {
   ServerProcess server(0, {"--no-rpcbind", "--unread-timeout", "1"});

@@ -1,6 +1,7 @@
 #include "server_process.h"
 
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -18,7 +19,7 @@
 
 namespace footfall::test {
 
-ServerProcess::ServerProcess(int port, std::vector<std::string> extra_args) {
+ServerProcess::ServerProcess(int port, std::vector<std::string> extra_args, long max_open_files) {
   char tmpl[] = "/tmp/footfalld-test-XXXXXX";
   if (!mkdtemp(tmpl)) throw std::runtime_error("mkdtemp failed");
   dir_ = tmpl;
@@ -32,6 +33,10 @@ ServerProcess::ServerProcess(int port, std::vector<std::string> extra_args) {
   if (pid_ == 0) {
     FILE* log = std::fopen(log_file.c_str(), "w");
     if (log) dup2(fileno(log), STDERR_FILENO);
+    if (max_open_files > 0) {
+      const rlimit files{static_cast<rlim_t>(max_open_files), static_cast<rlim_t>(max_open_files)};
+      if (setrlimit(RLIMIT_NOFILE, &files) != 0) _exit(126);
+    }
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
     argv.push_back(nullptr);

@@ -13,7 +13,9 @@ class ServerProcess {
  public:
   // Starts footfalld with --listen 127.0.0.1:PORT (0: any free port) and extra arguments, and
   // waits until it listens. Throws std::runtime_error if it does not start within 10 s.
-  explicit ServerProcess(int port = 0, std::vector<std::string> extra_args = {"--no-rpcbind"});
+  // `max_open_files` > 0: the server runs with RLIMIT_NOFILE (soft and hard) at that many.
+  explicit ServerProcess(int port = 0, std::vector<std::string> extra_args = {"--no-rpcbind"},
+                         long max_open_files = 0);
   ~ServerProcess();
   ServerProcess(const ServerProcess&) = delete;
   ServerProcess& operator=(const ServerProcess&) = delete;

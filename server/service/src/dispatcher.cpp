@@ -2,7 +2,9 @@
 #include "dispatcher.h"
 
 #include <poll.h>
+#include <sys/resource.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -122,11 +124,12 @@ std::string SecondsText(double seconds) {
   return text;
 }
 
-// Forgets a client that went away: ends its uploads and orphans its terrains.
-void DropClient(const Connection& connection) {
+// Forgets a client that went away: ends its uploads and orphans its terrains. `how` says how the
+// connection ended, for the log.
+void DropClient(const Connection& connection,
+                const char* how = "the connection that loaded it closed") {
   for (const uint32_t handle : g_state->registry.DropClient(connection.id))
-    Log("terrain " + std::to_string(handle) +
-        " orphaned: the connection that loaded it closed; it is freed after " +
+    Log("terrain " + std::to_string(handle) + " orphaned: " + how + "; it is freed after " +
         SecondsText(g_state->registry.limits().orphan_idle_s) + " without queries");
 }
 
@@ -684,7 +687,67 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
   }
 }
 
+// --- connections closed at the descriptor limit -------------------------------------------
+
+using TransportOps = std::remove_const_t<std::remove_pointer_t<decltype(SVCXPRT::xp_ops)>>;
+const TransportOps* g_listener_original = nullptr;
+TransportOps g_listener_watched{};
+std::map<int, std::string> g_peers;  // by socket: the peer of each connection, taken at accept
+uint64_t g_closed_at_limit = 0;      // connections libtirpc closed at the descriptor limit
+
+// The listening transport's receive: libtirpc's accept, watched. When accept fails for want of a
+// descriptor, libtirpc closes the least recently active connection (its idle sweep), inside this
+// call and without a word: the sockets open before and gone after are those, and are logged
+// (with the terrains they orphan) rather than taken for clients that went away.
+bool_t ListenerReceived(SVCXPRT* listener, rpc_msg* message) {
+  static std::vector<char> before, after;  // by socket number: open before, after the call
+  auto mark = [](std::vector<char>* open) {
+    open->assign(open->size(), 0);
+    for (int i = 0; i < svc_max_pollfd; ++i) {
+      const int fd = svc_pollfd[i].fd;
+      if (fd < 0) continue;
+      if (static_cast<size_t>(fd) >= open->size()) open->resize(static_cast<size_t>(fd) + 1, 0);
+      (*open)[static_cast<size_t>(fd)] = 1;
+    }
+  };
+  mark(&before);
+  const bool_t result = g_listener_original->xp_recv(listener, message);
+  mark(&after);
+  after.resize(std::max(after.size(), before.size()), 0);
+  for (size_t fd = 0; fd < after.size(); ++fd) {
+    const bool was = fd < before.size() && before[fd];
+    if (!was && after[fd]) g_peers[static_cast<int>(fd)] = PeerOf(static_cast<int>(fd));
+    if (!was || after[fd]) continue;
+    // Closed inside accept: the idle sweep.
+    ++g_closed_at_limit;
+    const auto peer = g_peers.find(static_cast<int>(fd));
+    rlimit files{};
+    getrlimit(RLIMIT_NOFILE, &files);
+    Log("at the open descriptor limit (" + std::to_string(files.rlim_cur) +
+        "): closed the least recently active connection, from " +
+        (peer != g_peers.end() ? peer->second : std::string("an unknown peer")) +
+        ", to take new ones (" + std::to_string(g_closed_at_limit) +
+        " closed this way so far; raise the limit, ulimit -n, to keep more clients)");
+    if (peer != g_peers.end()) g_peers.erase(peer);
+    const auto it = g_state->connections.find(static_cast<int>(fd));
+    if (it != g_state->connections.end()) {
+      DropClient(it->second,
+                 "footfalld closed the connection that loaded it, the least recently active, at "
+                 "the open descriptor limit");
+      g_state->connections.erase(it);
+    }
+  }
+  return result;
+}
+
 }  // namespace
+
+void WatchListener(SVCXPRT* listener) {
+  g_listener_original = listener->xp_ops;
+  g_listener_watched = *listener->xp_ops;
+  g_listener_watched.xp_recv = ListenerReceived;
+  listener->xp_ops = &g_listener_watched;
+}
 
 void ReapConnections() {
   if (!g_state || g_state->connections.empty()) return;

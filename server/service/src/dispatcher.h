@@ -45,6 +45,11 @@ using DispatchFn = void (*)(svc_req*, SVCXPRT*);
 // svc_register. One state per process (libtirpc's svc layer is process-global).
 DispatchFn InstallDispatcher(ServiceState* state);
 
+// Watches the listening transport `listener` (before it serves): the connections libtirpc closes
+// at the open descriptor limit, to accept new ones, are logged as such, with the terrains they
+// orphan.
+void WatchListener(SVCXPRT* listener);
+
 // Forgets the connections libtirpc has closed, ending their uploads and orphaning their
 // terrains. Call after every svc_getreq_poll, so a closed socket is noticed before its number
 // can be reused.

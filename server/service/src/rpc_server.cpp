@@ -139,6 +139,7 @@ bool RpcServer::Start(std::string* error) {
                    1,
                    {}});
   const DispatchFn dispatch = InstallDispatcher(g_state.get());
+  WatchListener(transport);
   if (!svc_register(transport, FOOTFALL_PROG, FOOTFALL_V1, dispatch, 0)) {
     *error = "cannot register the RPC program";
     return false;
