@@ -124,6 +124,20 @@ TEST_CASE("QuatToEulerZxyDegrees rebuilds the rotation", "[export][euler]") {
       CHECK(AbsDot(FromEulerZxy(e), q) == Approx(1).margin(1e-9));
     }
   }
+  SECTION("lengths whose squares overflow or underflow") {
+    const Quat q = FromEulerZxy({-5, 90, 3});
+    for (double k : {1e300, 1e-200}) {
+      INFO(k);
+      const Vec3 e = QuatToEulerZxyDegrees({q.x * k, q.y * k, q.z * k, q.w * k});
+      CHECK(e.x == Approx(-5));
+      CHECK(e.y == Approx(90));
+      CHECK(e.z == Approx(3));
+      const Vec3 xyz = QuatToEulerXyzDegrees({q.x * k, q.y * k, q.z * k, q.w * k});
+      CHECK(std::isfinite(xyz.x));
+      CHECK(std::isfinite(xyz.y));
+      CHECK(std::isfinite(xyz.z));
+    }
+  }
   SECTION("gimbal lock") {
     for (double pitch : {90.0, -90.0}) {
       const Quat q = FromEulerZxy({pitch, 25, 40});

@@ -165,6 +165,36 @@ TEST_CASE("WriteGltf writes a node per track with keyed channels", "[export][glt
   std::remove(path.c_str());
 }
 
+TEST_CASE("WriteGltf writes unit rotations for keys of any length", "[export][gltf]") {
+  // A walk read from JSON keeps its rotations as given: components of 1e300 overflowed their
+  // squares (a zero rotation out), 1e-200 underflowed them.
+  Walk walk = test::BipedWalk();
+  WalkTrack& body = walk.tracks[2];
+  const double scales[] = {1e300, 1e-200, 3, 1, 1};
+  for (size_t i = 0; i < body.rotations.size(); ++i) {
+    Quat& q = body.rotations[i];
+    const double k = scales[i % 5];
+    q = {q.x * k, q.y * k, q.z * k, q.w * k};
+  }
+  const std::string path = test::ScratchPath("scaled.gltf");
+  std::string error;
+  REQUIRE(WriteGltf(walk, path, &error) == Status::kOk);
+  const tinygltf::Model model = Load(path, false);
+  auto channels = Channels(model);
+  const Channel& rotation = channels["body"]["rotation"];
+  REQUIRE(rotation.values.size() == 5 * 4);
+  const double yaw[] = {0, 60, 150, 170, 190};
+  for (size_t i = 0; i < 5; ++i) {
+    INFO("key " << i);
+    const float* q = &rotation.values[4 * i];
+    const Quat expected = test::YawQuat(yaw[i]);
+    const double dot =
+        q[0] * expected.x + q[1] * expected.y + q[2] * expected.z + q[3] * expected.w;
+    CHECK(std::abs(dot) == Approx(1).margin(1e-6));
+  }
+  std::remove(path.c_str());
+}
+
 TEST_CASE("WriteGltf names crowd nodes character/track", "[export][gltf]") {
   const Walk walk = test::CrowdWalk();
   const std::string path = test::ScratchPath("crowd.glb");

@@ -201,6 +201,16 @@ TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]")
       {R"({"format":"footfall-walk","version":1,"fps":24,"fps":30,"tracks":[]})",
        "w.json:1:48: malformed JSON: the key 'fps' appears twice"},
   };
+  // Rotations of any non-zero length are read (readers normalise them): 1e-10 components
+  // were refused as zero.
+  for (const char* q : {"[0,1e-10,0,1e-10]", "[0,1e300,0,1e300]"}) {
+    INFO(q);
+    const std::string text =
+        std::string(
+            R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"b","kind":"body","keys":[{"frame":1,"position":[0,0,0],"rotation":)") +
+        q + "}]}]}";
+    CHECK(ParseWalkJson(text, "w.json", &back, &error) == Status::kOk);
+  }
   for (const auto& [input, message] : bad) {
     INFO(message);
     CHECK(ParseWalkJson(input, "w.json", &back, &error) == Status::kParseError);

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "walk_prep.h"
+
 namespace footfall {
 namespace {
 
@@ -25,8 +27,8 @@ double L1(const Vec3& a, const Vec3& b) {
 }  // namespace
 
 Vec3 QuatToEulerXyzDegrees(const Quat& q_in) {
-  const double n = std::sqrt(q_in.x * q_in.x + q_in.y * q_in.y + q_in.z * q_in.z + q_in.w * q_in.w);
-  const double x = q_in.x / n, y = q_in.y / n, z = q_in.z / n, w = q_in.w / n;
+  const Quat q = walk_export::Normalized(q_in);
+  const double x = q.x, y = q.y, z = q.z, w = q.w;
   // Rotation matrix entries (column vectors) needed for R = Rz(c) * Ry(b) * Rx(a).
   const double m00 = 1 - 2 * (y * y + z * z);
   const double m01 = 2 * (x * y - z * w);
@@ -56,8 +58,8 @@ Vec3 ClosestEulerXyzDegrees(const Vec3& euler, const Vec3& previous) {
 }
 
 Vec3 QuatToEulerZxyDegrees(const Quat& q_in) {
-  const double n = std::sqrt(q_in.x * q_in.x + q_in.y * q_in.y + q_in.z * q_in.z + q_in.w * q_in.w);
-  const double x = q_in.x / n, y = q_in.y / n, z = q_in.z / n, w = q_in.w / n;
+  const Quat q = walk_export::Normalized(q_in);
+  const double x = q.x, y = q.y, z = q.z, w = q.w;
   // Rotation matrix entries (column vectors) needed for R = Ry(b) * Rx(a) * Rz(c):
   // m12 = -sin a; m02, m22 = sin b cos a, cos b cos a; m10, m11 = cos a sin c, cos a cos c.
   const double m00 = 1 - 2 * (y * y + z * z);

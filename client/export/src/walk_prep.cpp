@@ -18,6 +18,10 @@ bool Finite(const Quat& q) {
 
 double Norm2(const Quat& q) { return q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w; }
 
+double MaxAbs(const Quat& q) {
+  return std::max({std::fabs(q.x), std::fabs(q.y), std::fabs(q.z), std::fabs(q.w)});
+}
+
 }  // namespace
 
 void SetError(std::string* error, const std::string& message) {
@@ -50,7 +54,7 @@ Status CheckWalk(const Walk& walk, std::string* error) {
         what = "a non-finite position";
       } else if (track.kind == TrackKind::kBody && !Finite(track.rotations[k])) {
         what = "a non-finite rotation";
-      } else if (track.kind == TrackKind::kBody && !(Norm2(track.rotations[k]) > 1e-24)) {
+      } else if (track.kind == TrackKind::kBody && MaxAbs(track.rotations[k]) == 0) {
         what = "a zero rotation quaternion";
       }
       if (what != nullptr) {
@@ -108,8 +112,11 @@ std::vector<std::string> UniqueNames(const std::vector<std::string>& names) {
 }
 
 Quat Normalized(const Quat& q) {
-  const double n = std::sqrt(Norm2(q));
-  return {q.x / n, q.y / n, q.z / n, q.w / n};
+  // Scaled by its largest component first, so that no square overflows or underflows.
+  const double m = MaxAbs(q);
+  const Quat s{q.x / m, q.y / m, q.z / m, q.w / m};
+  const double n = std::sqrt(Norm2(s));
+  return {s.x / n, s.y / n, s.z / n, s.w / n};
 }
 
 }  // namespace walk_export

@@ -235,7 +235,8 @@ Status ParseWalkJson(const std::string& text, const std::string& source, Walk* o
         } else {
           double q[4] = {0, 0, 0, 1};
           if (k.contains("rotation") && !r.Array(k["rotation"], 4, kw + ".rotation", q)) break;
-          if (!(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] > 1e-18)) {
+          // Any non-zero length (1e-10 or 1e300 components alike): readers normalise it.
+          if (std::max({std::fabs(q[0]), std::fabs(q[1]), std::fabs(q[2]), std::fabs(q[3])}) == 0) {
             r.Fail(kw + ".rotation", "expected a non-zero quaternion [qx, qy, qz, qw]");
             break;
           }
