@@ -1443,6 +1443,96 @@ TEST_CASE("at the open descriptor limit footfalld says which connections it clos
   CHECK_THAT(log, !Catch::Contains("orphaned: the connection that loaded it closed"));
 }
 
+TEST_CASE("footfalld listens on IPv6 addresses and logs them in brackets", "[rpc]") {
+  SECTION("[::1]:0") {
+    ServerProcess server(0, {"--no-rpcbind", "--listen", "[::1]:0"});
+    CHECK_THAT(server.Log(),
+               Catch::Contains("listening on [::1]:" + std::to_string(server.port()) + " "));
+    RpcOptions o;
+    o.host = "::1";
+    o.port = server.port();
+    auto rpc = MakeRpcSession(o);
+    TerrainHandle t = 0;
+    REQUIRE(rpc->LoadSamples(MakeFlat(10, 1, 0), "v6", &t) == Status::kOk);
+    CHECK(rpc->Snap(t, Vec3{3.2, 1, 4.7}).point == Vec3{3, 0, 5});
+  }
+  const TempRoot temp;
+  auto run = [&](const std::string& listen) {
+    const std::string log = temp.path + "/log";
+    const int status = std::system(("timeout 2 " + std::string(ServerProcess::Path()) +
+                                    " --no-rpcbind --listen '" + listen + "' 2>'" + log + "'")
+                                       .c_str());
+    std::ifstream in(log);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    return std::make_pair(WEXITSTATUS(status), text);
+  };
+  SECTION("a bare IPv6 address takes the default port") {
+    // Listens on [::1]:7407 until `timeout` stops it, or finds that port taken.
+    const auto [status, log] = run("::1");
+    INFO(log);
+    CHECK(status != 2);
+    CHECK_THAT(log, Catch::Contains("listening on [::1]:7407 ") ||
+                        Catch::Contains("cannot listen on [::1]:7407: "));
+    CHECK_THAT(log, !Catch::Contains("cannot resolve"));
+  }
+  SECTION("malformed bracketed addresses are refused") {
+    for (const char* bad : {"[::1", "[]:7", "[::1]x", "[::1]:", "[::1]:70000"}) {
+      const auto [status, log] = run(bad);
+      INFO(bad << ": " << log);
+      CHECK(status == 2);
+      CHECK_THAT(log, Catch::Contains("expected ADDR:PORT with a port from 0 to 65535 (an IPv6 "
+                                      "address in brackets: [::1]:7407)"));
+    }
+  }
+}
+
+TEST_CASE("footfalld logs unknown terrains and uploads dropped for idleness", "[rpc]") {
+  ServerProcess server(0, {"--no-rpcbind", "--upload-timeout", "0.2"});
+  CLIENT* c = RawClient(server.port());
+  CHECK(RawInfo(c, 12345) == FF_UNKNOWN_TERRAIN);
+  CHECK(RawSnap(c, 12346) == FF_UNKNOWN_TERRAIN);
+  std::string message;
+  CHECK(RawUnload(c, 12347, &message) == FF_UNKNOWN_TERRAIN);
+  uint32_t upload = 0;
+  REQUIRE(BeginUpload(c, 10, &upload, &message) == FF_OK);
+  CHECK(WaitFor([&] { return server.Log().find("dropped: no samples") != std::string::npos; }));
+  const std::string log = server.Log();
+  CHECK_THAT(log, Catch::Contains("error: info: unknown_terrain: no terrain 12345 (never loaded "
+                                  "here, unloaded, or freed as an orphan)"));
+  CHECK_THAT(log, Catch::Contains("error: snap: unknown_terrain: no terrain 12346"));
+  CHECK_THAT(log, Catch::Contains("error: unload: unknown_terrain: no terrain 12347"));
+  CHECK_THAT(log, Catch::Contains("upload " + std::to_string(upload) +
+                                  " 'raw' (0 of 10 samples received) dropped: no samples for "
+                                  "0.2 s (--upload-timeout)"));
+  clnt_destroy(c);
+}
+
+TEST_CASE("SIGTERM during a raw client's whole batch says that stopping waits for it", "[rpc]") {
+  ServerProcess server(0, {"--no-rpcbind", "--threads", "1"});
+  // Snaps from 1e10 above 1M flat samples: each compares every sample (seconds for a batch).
+  auto rpc = Connect(server.port(), 120);
+  TerrainHandle t = 0;
+  REQUIRE(rpc->LoadSamples(MakeFlat(1000, 0.01, 0), "flat", &t) == Status::kOk);
+  const uint32_t handle = OnlyServerTerrain(server.port());
+  std::vector<unsigned char> batch;
+  Put32(&batch, handle);
+  Put32(&batch, FF_MAX_BATCH);
+  for (int i = 0; i < FF_MAX_BATCH; ++i)
+    PutDouble(&batch, 0.007 * i), PutDouble(&batch, 1e10), PutDouble(&batch, 0.003 * i);
+  const std::vector<unsigned char> record = CallRecord(7, FF_SNAP_BATCH, batch);
+  const int raw = RawConnect(server.port());  // never asks again: gets whole batches
+  REQUIRE(SendSome(raw, record) == record.size());
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the batch under way
+  REQUIRE(kill(server.pid(), SIGTERM) == 0);
+  CHECK(WaitFor([&] {
+    return server.Log().find("stopping: waiting for 1 batch in progress") != std::string::npos;
+  }));
+  CHECK_THAT(server.Log(), Catch::Contains("footfalld: stopping: waiting for 1 batch in progress "
+                                           "(to its end; to --batch-time-limit for a client that "
+                                           "asks again)"));
+  close(raw);
+}
+
 TEST_CASE("footfalld closes a connection whose replies go unread past --unread-timeout",
           "[rpc][robustness]") {
   ServerProcess server(0, {"--no-rpcbind", "--unread-timeout", "1"});

@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
@@ -19,14 +20,17 @@
 
 namespace footfall::test {
 
+const char* ServerProcess::Path() { return FOOTFALLD_PATH; }
+
 ServerProcess::ServerProcess(int port, std::vector<std::string> extra_args, long max_open_files) {
   char tmpl[] = "/tmp/footfalld-test-XXXXXX";
   if (!mkdtemp(tmpl)) throw std::runtime_error("mkdtemp failed");
   dir_ = tmpl;
   const std::string port_file = dir_ + "/port";
   const std::string log_file = dir_ + "/log";
-  std::vector<std::string> args = {FOOTFALLD_PATH, "--listen", "127.0.0.1:" + std::to_string(port),
-                                   "--port-file", port_file};
+  std::vector<std::string> args = {FOOTFALLD_PATH, "--port-file", port_file};
+  if (std::find(extra_args.begin(), extra_args.end(), "--listen") == extra_args.end())
+    args.insert(args.end(), {"--listen", "127.0.0.1:" + std::to_string(port)});
   args.insert(args.end(), extra_args.begin(), extra_args.end());
   pid_ = fork();
   if (pid_ < 0) throw std::runtime_error("fork failed");

@@ -11,7 +11,10 @@ namespace footfall::test {
 
 class ServerProcess {
  public:
-  // Starts footfalld with --listen 127.0.0.1:PORT (0: any free port) and extra arguments, and
+  // The footfalld binary under test.
+  static const char* Path();
+  // Starts footfalld with --listen 127.0.0.1:PORT (0: any free port; an --listen among the extra
+  // arguments replaces it) and extra arguments, and
   // waits until it listens. Throws std::runtime_error if it does not start within 10 s.
   // `max_open_files` > 0: the server runs with RLIMIT_NOFILE (soft and hard) at that many.
   explicit ServerProcess(int port = 0, std::vector<std::string> extra_args = {"--no-rpcbind"},

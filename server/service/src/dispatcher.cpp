@@ -221,6 +221,14 @@ bool_t XdrLoadOptionsArgs(XDR* xdrs, LoadOptionsArgs* a) {
          xdr_double(xdrs, &a->height_scale) && xdr_u_quad_t(xdrs, &a->max_samples);
 }
 
+// Logs the uploads the registry dropped for receiving no samples for --upload-timeout.
+void LogExpiredUploads() {
+  for (const std::string& upload : g_state->registry.TakeExpiredUploads())
+    Log(upload + " dropped: no samples for " +
+        SecondsText(g_state->registry.limits().upload_idle_s) +
+        " (--upload-timeout); its samples are freed and its client must upload again");
+}
+
 // Logs the orphans the registry freed early to make room for a new terrain or upload.
 void LogEvicted() {
   for (const uint32_t handle : g_state->registry.TakeEvicted())
@@ -289,6 +297,7 @@ void UploadBegin(const ff_upload_begin_args& a, uint64_t client, ff_upload_reply
   uint32_t upload = 0;
   const Status s =
       g_state->registry.BeginUpload(a.name ? a.name : "", a.total, client, &upload, &message);
+  LogExpiredUploads();
   LogEvicted();
   if (s != Status::kOk) LogError("upload", s, message);
   r->status = Wire(s);
@@ -333,11 +342,20 @@ bool StartUploadFinish(SVCXPRT* transport, const ff_upload_args& a, uint64_t cli
   return false;
 }
 
+// A request naming a terrain footfalld does not hold (never loaded, unloaded, freed, or a
+// handle of another server): answered FF_UNKNOWN_TERRAIN, and logged.
+void LogUnknownTerrain(const char* proc, uint32_t handle) {
+  LogError(proc, Status::kUnknownTerrain,
+           "no terrain " + std::to_string(handle) +
+               " (never loaded here, unloaded, or freed as an orphan)");
+}
+
 void Info(const ff_terrain_args& a, ff_info_reply* r) {
   const LoadedTerrain* t = g_state->registry.Find(a.terrain);
   g_storage.name.clear();
   r->name = const_cast<char*>(g_storage.name.c_str());
   if (!t) {
+    LogUnknownTerrain("info", a.terrain);
     r->status = FF_UNKNOWN_TERRAIN;
     return;
   }
@@ -358,7 +376,7 @@ void Unload(const ff_terrain_args& a, uint64_t client, ff_status_reply* r) {
   std::string message;
   const Status s = g_state->registry.Unload(a.terrain, client, &message);
   if (s == Status::kOk) Log("unloaded terrain " + std::to_string(a.terrain));
-  if (s == Status::kAccessDenied) LogError("unload", s, message);
+  if (s != Status::kOk) LogError("unload", s, message);
   r->status = Wire(s);
   r->message = Message(s == Status::kOk ? "" : message);
 }
@@ -382,6 +400,7 @@ void Record(uint32_t terrain, int op, const Vec3& point, const Vec3& direction, 
 void Point(const ff_point_args& a, ff_result* r, int op) {
   const LoadedTerrain* t = g_state->registry.Use(a.terrain);
   if (!t) {
+    LogUnknownTerrain(op == FF_OP_SNAP ? "snap" : "normal", a.terrain);
     r->status = FF_UNKNOWN_TERRAIN;
     return;
   }
@@ -394,6 +413,7 @@ void Point(const ff_point_args& a, ff_result* r, int op) {
 void NextOne(const ff_next_args& a, ff_result* r) {
   const LoadedTerrain* t = g_state->registry.Use(a.terrain);
   if (!t) {
+    LogUnknownTerrain("next", a.terrain);
     r->status = FF_UNKNOWN_TERRAIN;
     return;
   }
@@ -415,6 +435,16 @@ void ClearFailed(Foothold* f) {
   *f = cleared;
 }
 
+std::atomic<int> g_batches_in_progress{0};
+
+// Counts a batch in progress while it lives (BatchesInProgress).
+struct BatchInProgress {
+  BatchInProgress() { ++g_batches_in_progress; }
+  ~BatchInProgress() { --g_batches_in_progress; }
+  BatchInProgress(const BatchInProgress&) = delete;
+  BatchInProgress& operator=(const BatchInProgress&) = delete;
+};
+
 // Answers queries [0, n) of a batch into g_storage.answers on the batch threads; `answer(b, e)`
 // fills answers [b, e). For a connection that asks again (`in_parts`), chunks taken after the
 // batch's time limit are answered kLimitExceeded (the first always is answered: every call makes
@@ -428,6 +458,7 @@ void RunBatch(size_t n, BatchReplyView<Foothold>* r, bool in_parts, Fn&& answer)
                                       std::chrono::duration<double>(g_state->batch_time_limit_s))
                             : std::chrono::steady_clock::time_point::max();
   std::atomic<size_t> late{0};
+  const BatchInProgress counted;
   g_pool->Run(n, BatchPool::kQueryChunk, [&](size_t begin, size_t end) {
     // One call may cover the whole batch (one thread): the limit is checked every chunk.
     for (size_t b = begin; b < end; b += BatchPool::kQueryChunk) {
@@ -454,6 +485,7 @@ void RunBatch(size_t n, BatchReplyView<Foothold>* r, bool in_parts, Fn&& answer)
 void PointBatch(const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r, int op, bool in_parts) {
   const LoadedTerrain* t = g_state->registry.Use(a.terrain);
   if (!t) {
+    LogUnknownTerrain(op == FF_OP_SNAP ? "snap batch" : "normal batch", a.terrain);
     r->status = FF_UNKNOWN_TERRAIN;
     return;
   }
@@ -469,6 +501,7 @@ void PointBatch(const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r, int 
 void NextBatch(const NextBatchView<StepQuery>& a, BatchReplyView<Foothold>* r, bool in_parts) {
   const LoadedTerrain* t = g_state->registry.Use(a.terrain);
   if (!t) {
+    LogUnknownTerrain("next batch", a.terrain);
     r->status = FF_UNKNOWN_TERRAIN;
     return;
   }
@@ -742,6 +775,8 @@ bool_t ListenerReceived(SVCXPRT* listener, rpc_msg* message) {
 
 }  // namespace
 
+int BatchesInProgress() { return g_batches_in_progress.load(); }
+
 void WatchListener(SVCXPRT* listener) {
   g_listener_original = listener->xp_ops;
   g_listener_watched = *listener->xp_ops;
@@ -800,6 +835,7 @@ void FinishLoads() {
 void ExpireIdle() {
   if (!g_state) return;
   g_state->registry.ExpireUploads();
+  LogExpiredUploads();
   for (const uint32_t handle : g_state->registry.ExpireOrphans())
     Log("freed orphaned terrain " + std::to_string(handle) + " after " +
         SecondsText(g_state->registry.limits().orphan_idle_s) + " without queries");

@@ -45,6 +45,9 @@ using DispatchFn = void (*)(svc_req*, SVCXPRT*);
 // svc_register. One state per process (libtirpc's svc layer is process-global).
 DispatchFn InstallDispatcher(ServiceState* state);
 
+// Batches being answered now (0 or 1: one thread serves requests). Async-signal-safe.
+int BatchesInProgress();
+
 // Watches the listening transport `listener` (before it serves): the connections libtirpc closes
 // at the open descriptor limit, to accept new ones, are logged as such, with the terrains they
 // orphan.

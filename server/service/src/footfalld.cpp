@@ -26,15 +26,33 @@ void OnStopSignal(int) {
   if (g_server) g_server->Stop();
 }
 
-// "ADDR:PORT", ":PORT" or "PORT"; IPv6 addresses in brackets.
+// "ADDR:PORT", ":PORT" or "PORT"; an IPv6 address in brackets ("[::1]:7407", "[::1]") or bare
+// ("::1", with more than one colon), which takes the default port 7407.
 bool ParseListen(const std::string& text, std::string* host, int* port) {
-  const size_t colon = text.rfind(':');
-  std::string h = colon == std::string::npos ? "" : text.substr(0, colon);
-  const std::string p = colon == std::string::npos ? text : text.substr(colon + 1);
+  std::string h, p;
+  if (!text.empty() && text.front() == '[') {
+    const size_t close = text.find(']');
+    if (close == std::string::npos || close == 1) return false;
+    h = text.substr(1, close - 1);
+    const std::string rest = text.substr(close + 1);
+    if (rest.empty()) {
+      p = "7407";
+    } else if (rest.front() == ':') {
+      p = rest.substr(1);
+    } else {
+      return false;
+    }
+  } else if (std::count(text.begin(), text.end(), ':') > 1) {
+    h = text;  // a bare IPv6 address: its last group is no port
+    p = "7407";
+  } else {
+    const size_t colon = text.rfind(':');
+    h = colon == std::string::npos ? "" : text.substr(0, colon);
+    p = colon == std::string::npos ? text : text.substr(colon + 1);
+  }
   char* end = nullptr;
   const long value = std::strtol(p.c_str(), &end, 10);
   if (p.empty() || *end != '\0' || value < 0 || value > 65535) return false;
-  if (h.size() >= 2 && h.front() == '[' && h.back() == ']') h = h.substr(1, h.size() - 2);
   *host = h.empty() ? "127.0.0.1" : h;
   *port = static_cast<int>(value);
   return true;
@@ -136,9 +154,11 @@ int main(int argc, char** argv) {
   }
   std::string error;
   if (!ParseListen(listen, &options.listen_host, &options.port)) {
-    std::fprintf(stderr,
-                 "footfalld: --listen '%s': expected ADDR:PORT with a port from 0 to 65535\n",
-                 listen.c_str());
+    std::fprintf(
+        stderr,
+        "footfalld: --listen '%s': expected ADDR:PORT with a port from 0 to 65535 (an IPv6 "
+        "address in brackets: [::1]:7407)\n",
+        listen.c_str());
     return 2;
   }
   options.use_rpcbind = !no_rpcbind;

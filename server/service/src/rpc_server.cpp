@@ -103,7 +103,9 @@ bool RpcServer::Start(std::string* error) {
   }
   freeaddrinfo(found);
   if (listen_fd_ < 0) {
-    *error = "cannot listen on " + options_.listen_host + ":" + port + ": " + reason;
+    const bool v6 = options_.listen_host.find(':') != std::string::npos;
+    *error = "cannot listen on " + (v6 ? "[" + options_.listen_host + "]" : options_.listen_host) +
+             ":" + port + ": " + reason;
     return false;
   }
   sockaddr_storage bound{};
@@ -144,9 +146,10 @@ bool RpcServer::Start(std::string* error) {
     *error = "cannot register the RPC program";
     return false;
   }
-  std::fprintf(stderr, "footfalld: listening on %s:%d (program %u version %u)\n",
-               options_.listen_host.c_str(), port_, static_cast<unsigned>(FOOTFALL_PROG),
-               static_cast<unsigned>(FOOTFALL_V1));
+  const bool v6 = options_.listen_host.find(':') != std::string::npos;
+  std::fprintf(stderr, "footfalld: listening on %s%s%s:%d (program %u version %u)\n", v6 ? "[" : "",
+               options_.listen_host.c_str(), v6 ? "]" : "", port_,
+               static_cast<unsigned>(FOOTFALL_PROG), static_cast<unsigned>(FOOTFALL_V1));
   if (options_.use_rpcbind) {
     const int other = RpcbindRunning() ? LiveRegisteredPort() : 0;
     if (other != 0 && other != port_) {
@@ -168,6 +171,26 @@ bool RpcServer::Start(std::string* error) {
   if (!options_.data_root.empty())
     std::fprintf(stderr, "footfalld: data root %s\n", options_.data_root.c_str());
   return true;
+}
+
+void RpcServer::Stop() {
+  if (stop_.exchange(true)) return;
+  const int batches = BatchesInProgress();
+  if (batches <= 0) return;
+  // Only async-signal-safe calls from here: this runs in a signal handler.
+  char text[192] = "footfalld: stopping: waiting for ";
+  size_t at = std::strlen(text);
+  char digits[12];
+  int n = 0;
+  for (int b = batches; b > 0 && n < 11; b /= 10) digits[n++] = static_cast<char>('0' + b % 10);
+  while (n > 0) text[at++] = digits[--n];
+  const char* rest = batches == 1 ? " batch in progress" : " batches in progress";
+  for (; *rest && at + 1 < sizeof text; ++rest) text[at++] = *rest;
+  rest = " (to its end; to --batch-time-limit for a client that asks again)\n";
+  for (; *rest && at + 1 < sizeof text; ++rest) text[at++] = *rest;
+  if (write(STDERR_FILENO, text, at) < 0) {
+    // Nothing to do: stderr is gone.
+  }
 }
 
 void RpcServer::Run() {

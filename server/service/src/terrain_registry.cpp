@@ -505,8 +505,21 @@ void TerrainRegistry::ExpireUploads() {
   const auto now = std::chrono::steady_clock::now();
   for (auto it = uploads_.begin(); it != uploads_.end();) {
     const double idle = std::chrono::duration<double>(now - it->second.touched).count();
-    it = idle > limits_.upload_idle_s ? uploads_.erase(it) : std::next(it);
+    if (idle <= limits_.upload_idle_s) {
+      ++it;
+      continue;
+    }
+    expired_uploads_.push_back("upload " + std::to_string(it->first) + " '" + it->second.name +
+                               "' (" + std::to_string(it->second.samples.size()) + " of " +
+                               std::to_string(it->second.total) + " samples received)");
+    it = uploads_.erase(it);
   }
+}
+
+std::vector<std::string> TerrainRegistry::TakeExpiredUploads() {
+  std::vector<std::string> expired;
+  expired.swap(expired_uploads_);
+  return expired;
 }
 
 void TerrainRegistry::Record(const RecentQuery& query) {

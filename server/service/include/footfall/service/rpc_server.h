@@ -44,7 +44,9 @@ class RpcServer {
   int port() const { return port_; }
   // Serves until Stop() is called (from a signal handler or another thread).
   void Run();
-  void Stop() { stop_.store(true); }
+  // Async-signal-safe. When a batch is being answered, says (on stderr) that stopping waits for
+  // it: a client that did not ask for batches in parts (FF_ASK_AGAIN) gets its whole batch.
+  void Stop();
   // After Run: a server-side load was still running, and was left to its thread. The process
   // must end with _exit (the loaders' static data must outlive it).
   bool abandoned_load() const { return abandoned_load_; }

@@ -128,8 +128,11 @@ class TerrainRegistry {
   std::vector<uint32_t> Handles() const;
   const RegistryLimits& limits() const { return limits_; }
 
-  // Drops uploads idle longer than the limit.
+  // Drops uploads idle longer than the limit (each noted for TakeExpiredUploads).
   void ExpireUploads();
+  // The uploads dropped for idleness since the last call, each as "upload ID 'NAME' (R of T
+  // samples received)", for the log.
+  std::vector<std::string> TakeExpiredUploads();
   // Frees orphaned terrains without a query for RegistryLimits::orphan_idle_s; returns their
   // handles.
   std::vector<uint32_t> ExpireOrphans();
@@ -172,7 +175,8 @@ class TerrainRegistry {
   uint32_t next_handle_;
   uint32_t next_upload_ = 1;
   std::map<uint32_t, std::unique_ptr<LoadedTerrain>> terrains_;
-  std::vector<uint32_t> evicted_;  // orphans freed to make room, until TakeEvicted
+  std::vector<uint32_t> evicted_;             // orphans freed to make room, until TakeEvicted
+  std::vector<std::string> expired_uploads_;  // until TakeExpiredUploads
   std::map<uint32_t, Upload> uploads_;
   uint64_t building_ = 0;  // samples of finished uploads whose grids are being built
   std::deque<RecentQuery> recent_;
