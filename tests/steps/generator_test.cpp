@@ -433,6 +433,44 @@ TEST_CASE("Multipeds walk around a sphere, bipeds stop where it gets too steep",
   }
 }
 
+TEST_CASE("A goal off the terrain is reached across the ground whatever its height",
+          "[steps][generator]") {
+  // Multipeds' up leans with the ground: their goals were judged along it, so on a 15-degree
+  // ramp a goal 5 m above the ground was reached a metre past it, and on a DEM 537 m up a 2D
+  // path at y = 0 led nowhere (a dead end). The same goal at any height ends the walk at the
+  // same place across the ground, for every character.
+  for (const std::string& name : ShippedCharacters()) {
+    const Character c = LoadShipped(name);
+    const double slope = 15, spacing = c.step_length / 10, rad = slope * kPi / 180;
+    const int nx = static_cast<int>(10 * c.step_length / spacing);
+    const int nz = static_cast<int>((14 * c.step_length + 6 * c.reach) / spacing);
+    Terrain t = LoadTerrain(MakeRamp(nx, nz, spacing, slope), spacing);
+    const double d0 = 2 * c.reach, d1 = d0 + 8 * c.step_length;
+    const double x = nx * spacing / 2, z1 = std::cos(rad) * d1, ground = std::sin(rad) * d1;
+    for (const double height : {0.1 * c.step_length + 5 * c.reach, 500.0, -ground - 500}) {
+      INFO(name << ", goal " << height << " above the ground");
+      GenerateOptions o;
+      o.has_start = true;
+      o.start = {x, std::sin(rad) * d0, std::cos(rad) * d0};
+      const Vec3 goal{x + 2 * c.step_length, ground + height, z1};
+      o.path.push_back(goal);
+      const Walk w = Generate(t, c, o);
+      INFO(w.stopped);
+      REQUIRE(w.stopped.empty());
+      CheckWalk(t, c, o, w);
+      Vec3 centroid;
+      int feet = 0;
+      for (const WalkTrack& tr : w.tracks) {
+        if (tr.kind != TrackKind::kFoot) continue;
+        centroid += tr.keys.back().position, ++feet;
+      }
+      centroid = centroid / static_cast<double>(feet);
+      const double across = std::hypot(centroid.x - goal.x, centroid.z - goal.z);
+      CHECK(across <= 0.5 * c.step_length / std::cos(rad) + 1e-9);
+    }
+  }
+}
+
 TEST_CASE("A goal on the far side of a sphere is walked to, not reached where the walk starts",
           "[steps][generator]") {
   // A hexapod on top of a sphere given the bottom as its goal made no step: the goal lay within
@@ -1607,10 +1645,26 @@ TEST_CASE("Bad options are refused with a message", "[steps][generator]") {
   CHECK_THAT(error, Catch::Contains("handle"));
 }
 
-TEST_CASE("A character milling about at a dead end stops", "[steps][generator][shared-data]") {
-  // Real data from ../shared/data: the Kootenai DEM resampled at 0.175. An asymmetric
-  // three-legged character on a path shuffles its feet about the same spot: with in-place
-  // groups waiting, it did so for every step it was given.
+// A three-legged character with its feet off the body's centre line, each in a gait group of
+// its own (a dead end's test subject: it shuffles its feet about a spot easily).
+Character Asymmetric() {
+  Character asym;
+  std::string error;
+  REQUIRE(ParseCharacter(R"({"format": "footfall-character", "version": 1, "name": "asym",
+    "feet": [{"name": "L", "rest": [0.3, 0, 0.1]}, {"name": "R", "rest": [-0.1, 0, -0.2]},
+             {"name": "T", "rest": [0.05, 0, -0.6]}],
+    "gait": [["L"], ["R"], ["T"]], "step_length": 0.4, "step_height": 0.1, "body_height": 0.45,
+    "frames_per_step": 8, "align_to_normal": true, "max_rise": 0.25, "reach": 1.0,
+    "max_slope_deg": 50})",
+                         "asym", &asym, &error) == Status::kOk);
+  return asym;
+}
+
+TEST_CASE("A path given at y = 0 is followed over a DEM hundreds of metres up",
+          "[steps][generator][shared-data]") {
+  // Real data from ../shared/data: the Kootenai DEM (537 to 560 m) resampled at 0.175. The
+  // three-legged character's up leans with the ground, and its waypoints at y = 0 were aimed
+  // at along it: it shuffled its feet about the same spot until a dead end stopped it.
   const std::string path =
       FOOTFALL_SOURCE_DIR "/../shared/data/terrain/terrain_kootenai_1m_50x37.asc";
   std::ifstream probe(path);
@@ -1625,14 +1679,7 @@ TEST_CASE("A character milling about at a dead end stops", "[steps][generator][s
   lo.separation = 0.175;
   REQUIRE(footfall::LoadTerrain(path, lo, &dem, &error) == Status::kOk);
   Terrain t = LoadTerrain(dem, 0.175);
-  Character asym;
-  REQUIRE(ParseCharacter(R"({"format": "footfall-character", "version": 1, "name": "asym",
-    "feet": [{"name": "L", "rest": [0.3, 0, 0.1]}, {"name": "R", "rest": [-0.1, 0, -0.2]},
-             {"name": "T", "rest": [0.05, 0, -0.6]}],
-    "gait": [["L"], ["R"], ["T"]], "step_length": 0.4, "step_height": 0.1, "body_height": 0.45,
-    "frames_per_step": 8, "align_to_normal": true, "max_rise": 0.25, "reach": 1.0,
-    "max_slope_deg": 50})",
-                         "asym", &asym, &error) == Status::kOk);
+  const Character asym = Asymmetric();
   GenerateOptions o;
   o.has_start = true;
   o.start = {14.7, 0, 9};
@@ -1640,10 +1687,33 @@ TEST_CASE("A character milling about at a dead end stops", "[steps][generator][s
   o.steps = 5000;
   const Walk w = Generate(t, asym, o);
   INFO(w.stopped);
-  // Stopped as a dead end, or, first, as a walk that comes no nearer to its waypoint.
+  CHECK(w.stopped.empty());
+  CheckWalk(t, asym, o, w);
+  Vec3 centroid;
+  for (const WalkTrack& tr : w.tracks)
+    if (tr.kind == TrackKind::kFoot) centroid += tr.keys.back().position / 3.0;
+  CHECK(std::hypot(centroid.x - 22.05, centroid.z - 16.2) <= 0.5 * asym.step_length + 1e-9);
+}
+
+TEST_CASE("A character milling about at a dead end stops", "[steps][generator]") {
+  // The three-legged character on a table top, its goal on the floor 0.9 m below it with no way
+  // down: it turns and shuffles about on the top, coming no nearer, and stops within a few
+  // hundred steps, not after every step it was given.
+  const Character asym = Asymmetric();
+  RawSamples s = MakeFlat(160, 0.05, 0);
+  for (int k = 0; k <= 60; ++k)
+    for (int i = 0; i <= 60; ++i) s.push_back({2 + i * 0.05, 0.9, 2 + k * 0.05}, {0, 1, 0});
+  Terrain t = LoadTerrain(s, 0.05);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {3.5, 1, 3.5};
+  o.path = {{3.6, 0, 3.5}};
+  o.steps = 5000;
+  const Walk w = Generate(t, asym, o);
+  INFO(w.stopped);
   CHECK_THAT(w.stopped, Catch::Contains("the body has stayed within half a step of it for 100 "
                                         "steps (a dead end)") ||
-                            Catch::Contains("no way to waypoint 1 (14.7000, 0.0000, 25.2000): "
+                            Catch::Contains("no way to the path's goal (3.6000, 0.0000, 3.5000): "
                                             "the body has come no nearer to it than"));
   CHECK(StepsDone(w) < 2000);
   CheckWalk(t, asym, o, w);

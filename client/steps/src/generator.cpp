@@ -87,6 +87,9 @@ constexpr double kClearanceFraction = 0.25;
 // Steer: a turn is tried at its whole and then in kTurnShares - 1 smaller shares, and the
 // largest that keeps every pair's feet at least kMinPairGap of their rest gap apart is taken.
 constexpr int kTurnShares = 8;
+// Ground whose up lies within this many degrees of the world up is a floor for path walks:
+// waypoints off the terrain are aimed at across it, their height along the world up ignored.
+constexpr double kFloorUpDeg = 60;
 constexpr double kMinPairGap = 0.5;
 // A step shorter than this fraction of step_length is a step in place: no foothold query.
 constexpr double kInPlace = 0.02;
@@ -346,6 +349,16 @@ class Generator {
   // How far a's waypoint i still is, as Reached measures it: in 3D when it lies on the terrain,
   // else along the ground.
   double Remaining(const Agent& a, size_t i) const;
+  // The offset from a's ground to a point `p` of its path, as the walk aims at it: with p's
+  // height along the world up taken off while a stands on ground facing up (within
+  // kFloorUpDeg of the world up), unless p lies on the terrain (`on_terrain`): a path given at
+  // any height, a 2D path at y = 0 over a DEM 537 m up, is followed across the ground by
+  // multipeds too, whose up leans with the ground (on a 15-degree slope a goal 5 m up was
+  // reached a metre past it). On walls and ceilings the height is along a's up.
+  Vec3 ToPathPoint(const Agent& a, const Vec3& p, bool on_terrain) const;
+  Vec3 ToWaypoint(const Agent& a, size_t i) const {
+    return ToPathPoint(a, a.path[i], OnTerrain(a, i));
+  }
   // At step k: false once a has come no nearer (Agent::nearest) to its current waypoint for
   // window_steps_ steps.
   bool Nearing(Agent& a, int k) const;
@@ -521,13 +534,20 @@ bool Generator::OnTerrain(const Agent& a, size_t i) const {
   return a.path_off[i] <= 0.5 * Radius(a, i);
 }
 
+Vec3 Generator::ToPathPoint(const Agent& a, const Vec3& p, bool on_terrain) const {
+  Vec3 to = p - a.ground;
+  if (!on_terrain && Dot(a.up, world_up_) >= std::cos(Radians(kFloorUpDeg)))
+    to -= world_up_ * Dot(to, world_up_);
+  return to;
+}
+
 double Generator::Remaining(const Agent& a, size_t i) const {
-  const Vec3 to = a.path[i] - a.ground;
+  const Vec3 to = ToWaypoint(a, i);
   return OnTerrain(a, i) ? Length(to) : Length(ProjectOnPlane(to, a.up));
 }
 
 bool Generator::Reached(const Agent& a, size_t i) const {
-  const Vec3 to = a.path[i] - a.ground;
+  const Vec3 to = ToWaypoint(a, i);
   const double along = Dot(to, a.up), radius = Radius(a, i);
   if (Length2(to - a.up * along) > radius * radius) return false;
   return !OnTerrain(a, i) || std::fabs(along) <= radius;
@@ -576,7 +596,7 @@ void Generator::Steer(Agent& a, int group) const {
     a.walking = false;  // arrived: not an early stop
     return;
   }
-  const Vec3 to = ProjectOnPlane(a.path[a.waypoint] - a.ground, a.up);
+  const Vec3 to = ProjectOnPlane(ToWaypoint(a, a.waypoint), a.up);
   a.stride = 1;
   // A waypoint on the terrain straight above or below (the far side of a sphere): any way on
   // along the ground leads toward it, so the heading is kept until it lies farther aside.
@@ -1321,7 +1341,8 @@ void Generator::Orient(Agent& a, const Foothold& ground, const Vec3& up0, const 
   a.up = c_.align_to_normal ? ground.normal : world_up_;
   a.forward = TangentForward(o_.heading, fwd0, up0, a.up);
   if (!a.path.empty()) {
-    const Vec3 to = ProjectOnPlane(a.path[0] - a.ground, a.up);
+    // (Before the waypoints' distances from the terrain are known: taken as off it.)
+    const Vec3 to = ProjectOnPlane(ToPathPoint(a, a.path[0], false), a.up);
     if (Length2(to) > 1e-18) a.forward = Normalize(to);
   }
 }
