@@ -287,8 +287,8 @@ class Generator {
   Status QueryFootholds(std::string* error);
   // Accepts the answer h to mv's foothold query, or records why it is refused.
   void Judge(Move& mv, const Foothold& h) const;
-  // The gap across the heading between the foothold p of mv's foot and its pair's other foot,
-  // as a share of their rest gap (1 as at rest, below 0 crossed); 1 for a foot without a pair.
+  // The gap across the heading between the foothold p of mv's foot and its mate (mate_), as a
+  // share of their rest gap (1 as at rest, below 0 crossed); 1 for a foot without a mate.
   double GapToMate(const Move& mv, const Vec3& p) const;
   // Judge's side test: true when the accepted foothold p may stand (kept, or kept as the
   // better of a lined-up first answer and its outward retry); false when it is asked again,
@@ -331,8 +331,8 @@ class Generator {
   // The share of a full stride a body heading `forward` takes toward a waypoint `to` away along
   // the ground: below 1 for a waypoint inside the circle it turns on at full stride.
   double StrideToward(const Vec3& to, const Vec3& forward) const;
-  // The least gap across the heading between the feet of a pair, as a share of their gap at
-  // rest, once a heading `forward` at `stride` has been taken and gait group `group` has
+  // The least gap across the heading between a foot and its mate (mate_), as a share of their
+  // gap at rest, once a heading `forward` at `stride` has been taken and gait group `group` has
   // stepped (each of its feet at most step_length toward its target on ground as level as a's):
   // below 0 when feet cross.
   double PairGap(const Agent& a, const Vec3& forward, double stride, int group) const;
@@ -423,6 +423,10 @@ class Generator {
   size_t pass_begin_ = 0, pass_end_ = 0;  // the agents walking in this pass
   std::shared_ptr<BatchPool> pool_;
   std::vector<int> pair_of_foot_;
+  // Each foot's other foot across the body, whose side it keeps to (PairGap, GapToMate): its
+  // pair's other foot, or for a foot paired with none the foot on the other side whose rest
+  // lies nearest its own mirrored across the body; -1 for none (a foot on the centre line).
+  std::vector<int> mate_;
   std::vector<Vec3> rest_;         // each foot's rest less RestCentroid, character space
   std::vector<Vec3> pair_centre_;  // rest centre of each pair, as rest_
   std::vector<std::vector<int>> pairs_of_group_;  // pairs with a foot in each gait group
@@ -568,23 +572,21 @@ double Generator::StrideToward(const Vec3& to, const Vec3& forward) const {
 double Generator::PairGap(const Agent& a, const Vec3& forward, double stride, int group) const {
   const Vec3 left = Cross(a.up, forward);
   const std::vector<int>& stepping = c_.gait[group];
+  // Where each foot stands once the group has stepped: planted feet where they are, stepping
+  // ones a step toward their targets.
+  thread_local std::vector<Vec3> at;
+  at.assign(a.foot.begin(), a.foot.end());
+  for (int f : stepping) {
+    const Vec3 target = a.ground + left * rest_[f].x + forward * (rest_[f].z + lead_ * stride);
+    Vec3 v = ProjectOnPlane(target - a.foot[f], a.up);
+    const double len = Length(v);
+    if (len > c_.step_length) v = v * (c_.step_length / len);
+    at[f] += v;
+  }
   double least = std::numeric_limits<double>::infinity();
-  for (const std::vector<int>& pair : c_.pairs) {
-    if (pair.size() != 2) continue;
-    const double rest_gap = rest_[pair[0]].x - rest_[pair[1]].x;
-    if (std::fabs(rest_gap) < 1e-9) continue;  // one foot ahead of the other: no sides
-    Vec3 at[2];
-    for (int i = 0; i < 2; ++i) {
-      const int f = pair[i];
-      at[i] = a.foot[f];
-      if (std::find(stepping.begin(), stepping.end(), f) == stepping.end()) continue;
-      const Vec3 target = a.ground + left * rest_[f].x + forward * (rest_[f].z + lead_ * stride);
-      Vec3 v = ProjectOnPlane(target - a.foot[f], a.up);
-      const double len = Length(v);
-      if (len > c_.step_length) v = v * (c_.step_length / len);
-      at[i] += v;
-    }
-    least = std::min(least, Dot(at[0] - at[1], left) / rest_gap);
+  for (size_t f = 0; f < at.size(); ++f) {
+    const int m = mate_[f];
+    if (m >= 0) least = std::min(least, Dot(at[f] - at[m], left) / (rest_[f].x - rest_[m].x));
   }
   return least;
 }
@@ -685,6 +687,21 @@ Status Generator::Run(std::string* error) {
     Vec3 centre;
     for (int f : c_.pairs[p]) pair_of_foot_[f] = static_cast<int>(p), centre += rest_[f];
     pair_centre_.push_back(centre / static_cast<double>(c_.pairs[p].size()));
+  }
+  mate_.assign(c_.feet.size(), -1);
+  for (size_t f = 0; f < c_.feet.size(); ++f) {
+    const std::vector<int>& pair = c_.pairs[pair_of_foot_[f]];
+    if (pair.size() == 2) {
+      const int other = pair[0] == static_cast<int>(f) ? pair[1] : pair[0];
+      if (std::fabs(rest_[f].x - rest_[other].x) > 1e-9) mate_[f] = other;
+      continue;
+    }
+    const Vec3 mirrored{-rest_[f].x, rest_[f].y, rest_[f].z};
+    double nearest = std::numeric_limits<double>::infinity();
+    for (size_t g = 0; g < c_.feet.size(); ++g) {
+      if (rest_[g].x * rest_[f].x >= 0 || Distance(rest_[g], mirrored) >= nearest) continue;
+      nearest = Distance(rest_[g], mirrored), mate_[f] = static_cast<int>(g);
+    }
   }
   pairs_of_group_.assign(groups, {});
   slot_of_foot_.assign(groups, {});
@@ -1438,9 +1455,7 @@ Status Generator::QueryFootholds(std::string* error) {
         // A foothold lined up with its pair's other foot is asked again with the step aimed
         // outward by half the samples' spacing, toward the sample on the foot's own side.
         if (mv.outward) {
-          const std::vector<int>& pair = c_.pairs[p];
-          const int mate = pair[0] == mv.foot ? pair[1] : pair[0];
-          const double side = rest_[mv.foot].x > rest_[mate].x ? 1.0 : -1.0;
+          const double side = rest_[mv.foot].x > rest_[mate_[mv.foot]].x ? 1.0 : -1.0;
           v += Left(a) * (side * 0.25 * gap_);
         }
         if (Length(v) < kInPlace * c_.step_length) {
@@ -1566,13 +1581,10 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
 }
 
 double Generator::GapToMate(const Move& mv, const Vec3& p) const {
-  const std::vector<int>& pair = c_.pairs[pair_of_foot_[mv.foot]];
-  if (pair.size() != 2) return 1;
-  const int mate = pair[0] == mv.foot ? pair[1] : pair[0];
-  const double rest_gap = rest_[mv.foot].x - rest_[mate].x;
-  if (std::fabs(rest_gap) < 1e-9) return 1;  // one foot ahead of the other: no sides
+  const int mate = mate_[mv.foot];
+  if (mate < 0) return 1;
   const Agent& a = agents_[mv.agent];
-  return Dot(p - a.foot[mate], Left(a)) / rest_gap;
+  return Dot(p - a.foot[mate], Left(a)) / (rest_[mv.foot].x - rest_[mate].x);
 }
 
 bool Generator::KeepsSide(Move& mv, const Vec3& p, const Vec3& normal) const {
@@ -1588,8 +1600,7 @@ bool Generator::KeepsSide(Move& mv, const Vec3& p, const Vec3& normal) const {
   // Lined up: under half the rest gap, with samples at least a quarter of it apart (nearer
   // samples would have given a foothold on the foot's own side).
   if (gap >= kMinPairGap || mv.outward) return true;
-  const std::vector<int>& pair = c_.pairs[pair_of_foot_[mv.foot]];
-  const double rest_gap = std::fabs(rest_[pair[0]].x - rest_[pair[1]].x);
+  const double rest_gap = std::fabs(rest_[mv.foot].x - rest_[mate_[mv.foot]].x);
   if (0.5 * gap_ < 0.25 * rest_gap) return true;
   mv.outward = true, mv.lined_up = true, mv.lined_up_gap = gap;
   mv.lined_up_point = p, mv.lined_up_normal = normal;
