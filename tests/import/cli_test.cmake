@@ -168,6 +168,23 @@ execute_process(COMMAND "${FOOTFALL}" query --terrain "${WORK}/down.pts" INPUT_F
 if(NOT rc EQUAL 0 OR NOT riser MATCHES "\"normal\":\\[0\\.0,0\\.0,1\\.0\\]")
   message(FATAL_ERROR "the riser of stairs going down does not face +z: ${riser}")
 endif()
+# terrain make hills makes the same hills at any spacing: the sample at (2, 2) of a 0.05 m and a
+# 0.2 m lattice has the same height and normal (the relief was laid in sample units: 0.14 m at
+# one spacing, -0.12, -0.95 and 0.49 at others).
+foreach(spacing 0.05 0.2)
+  expect(EXIT_ZERO "wrote" terrain make hills --size 4 --spacing ${spacing} -o "${WORK}/hills${spacing}.pts")
+  file(STRINGS "${WORK}/hills${spacing}.pts" at22 REGEX "^2 [^ ]+ 2 ")
+  list(LENGTH at22 found)
+  if(NOT found EQUAL 1)
+    message(FATAL_ERROR "hills at ${spacing}: no single sample at x = 2, z = 2: ${at22}")
+  endif()
+  string(REPLACE " " ";" fields "${at22}")
+  list(GET fields 1 y${spacing})
+  list(GET fields 4 ny${spacing})
+endforeach()
+if(NOT y0.05 STREQUAL y0.2 OR NOT ny0.05 STREQUAL ny0.2)
+  message(FATAL_ERROR "hills differ with the spacing at (2, 2): y ${y0.05} / ${y0.2}, ny ${ny0.05} / ${ny0.2}")
+endif()
 # Seeds are whole numbers from 0 to 2^64 - 1 everywhere (make read -1 and 1e23 as 2^64 - 1).
 foreach(seed "-1" "18446744073709551616" "1.5")
   expect(EXIT_NONZERO "--seed: '${seed}' is not a whole number from 0 to 18446744073709551615"

@@ -195,7 +195,7 @@ int RunMake(const MakeFlags& f) {
     samples = MakeFlat(static_cast<int>(f.size / f.spacing) + 1, f.spacing, 0);
   } else if (k == "hills") {
     const int n = static_cast<int>(f.size / f.spacing) + 1;
-    samples = MakeHeightField(n, n, f.spacing, f.amplitude, f.seed);
+    samples = MakeHills(n, f.spacing, f.amplitude, f.seed);
   }
   std::string error;
   if (samples.size() == 0) {
@@ -294,7 +294,8 @@ void AddTerrainCommand(CLI::App& app, int* exit_code) {
   m->add_option("--max-height", make->max_height, "blocks: tallest pile in unit cubes")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  m->add_option("--amplitude", make->amplitude, "rocks, hills: height of the relief")
+  m->add_option("--amplitude", make->amplitude,
+                "rocks, hills: height of the relief (hills: the same hills at any --spacing)")
       ->check(Finite())
       ->capture_default_str();
   m->add_option("--slope", make->slopes, "ramp: slope of each segment in degrees (repeatable)")

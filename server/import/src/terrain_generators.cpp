@@ -35,20 +35,35 @@ struct Waves {
 
 }  // namespace
 
-RawSamples MakeHeightField(int nx, int nz, double spacing, double amplitude, uint64_t seed) {
+namespace {
+
+// y = amplitude * noise(x / unit, z / unit) on an nx x nz lattice of `spacing`.
+RawSamples NoiseField(int nx, int nz, double spacing, double unit, double amplitude,
+                      uint64_t seed) {
   RawSamples s;
   const Waves w(seed);
   const double e = 1e-4;
+  const double scale = spacing / unit;  // noise units per sample
   for (int k = 0; k < nz; ++k) {
     for (int i = 0; i < nx; ++i) {
-      const double u = i, v = k;  // noise in sample units, so features scale with spacing
+      const double u = i * scale, v = k * scale;
       const double h = amplitude * w.Height(u, v);
-      const double dhdx = amplitude * (w.Height(u + e, v) - w.Height(u - e, v)) / (2 * e) / spacing;
-      const double dhdz = amplitude * (w.Height(u, v + e) - w.Height(u, v - e)) / (2 * e) / spacing;
+      const double dhdx = amplitude * (w.Height(u + e, v) - w.Height(u - e, v)) / (2 * e) / unit;
+      const double dhdz = amplitude * (w.Height(u, v + e) - w.Height(u, v - e)) / (2 * e) / unit;
       s.push_back({i * spacing, h, k * spacing}, Normalize(Vec3{-dhdx, 1, -dhdz}));
     }
   }
   return s;
+}
+
+}  // namespace
+
+RawSamples MakeHeightField(int nx, int nz, double spacing, double amplitude, uint64_t seed) {
+  return NoiseField(nx, nz, spacing, spacing, amplitude, seed);
+}
+
+RawSamples MakeHills(int n, double spacing, double amplitude, uint64_t seed) {
+  return NoiseField(n, n, spacing, kHillsUnit, amplitude, seed);
 }
 
 RawSamples MakeSphere(int count, const Vec3& centre, double radius) {
