@@ -74,6 +74,16 @@ check "heading 1e300,0,1e300: the walk of 1,0,1" cmp -s "$work/huge-heading.json
 check "cliff: message on stderr" grep -qE 'stopped early: step [0-9]+: foot [LR] at \([0-9.]+, [0-9.-]+, [0-9.]+\): .*cliff' "$work/biped-cliff-embedded.err"
 check "cliff: message in the walk" grep -qE '"stopped":"step [0-9]+: foot' "$work/biped-cliff-embedded.json"
 check "cliff: keys kept" [ "$(grep -c '"phase":"end"' "$work/biped-cliff-embedded.json")" -gt 8 ]
+# A biped on a Z-up floor with the default world up (Y): it cannot stand there, and the stop
+# says how to give the terrain's up.
+awk 'BEGIN { for (k = 0; k < 60; k++) for (i = 0; i < 60; i++) printf "%.2f %.2f 0 0 0 1\n", i * 0.05, k * 0.05 }' > "$work/zup.pts"
+"$footfall" generate --terrain "$work/zup.pts" --character "$chars/biped.json" --start 1.5,1.5,0 \
+  --steps 4 --out "$work/zup.json" 2> "$work/zup.err"
+check "Z-up terrain with the default up: exit 2" [ $? -eq 2 ]
+check "Z-up terrain with the default up: the stop names --up" grep -q 'give the world up with --up (Z up: --up 0,0,1)' "$work/zup.err"
+"$footfall" generate --terrain "$work/zup.pts" --character "$chars/biped.json" --start 1.5,1.5,0 \
+  --up 0,0,1 --heading 0,1,0 --steps 4 --out "$work/zup.json" 2> "$work/zup.err"
+check "Z-up terrain with --up 0,0,1: walks" [ $? -eq 0 ]
 # A crowd walking toward the cliff: its front row (c4-c6) stops first. The walk names the
 # earliest stop; stderr lists every character's.
 "$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --crowd 6 \

@@ -1385,6 +1385,11 @@ std::string Generator::Plant(Agent& a, const Foothold* feet) const {
       m << "foot " << c_.feet[f].name << " cannot stand at " << Point(a.foot[f])
         << ": ground leans " << Beyond(slope, c_.max_slope_deg) << " deg, more than max_slope_deg "
         << NumberText(c_.max_slope_deg) << FacingDownHint(slope);
+      // An upright character starting on ground across its up: a terrain whose up is another
+      // axis (a height map read with --up-axis z) with the default world up.
+      if (!c_.align_to_normal && slope > 60 && slope < 120)
+        m << "; if the terrain's up is not " << Point(world_up_)
+          << ", give the world up with --up (Z up: --up 0,0,1)";
       return m.str();
     }
   }
