@@ -554,7 +554,11 @@ bool Generator::Reached(const Agent& a, size_t i) const {
   const Vec3 to = ToWaypoint(a, i);
   const double along = Dot(to, a.up), radius = Radius(a, i);
   if (Length2(to - a.up * along) > radius * radius) return false;
-  return !OnTerrain(a, i) || std::fabs(along) <= radius;
+  // On the terrain: no farther below the ground than the radius, nor above it than the radius
+  // over the body's height (the feet's centroid lies inside a convex nose or ridge they stand
+  // around: an octopod on the Spot mesh's nose came within 2 cm of its goal with its body,
+  // never within its radius with its ground, and turned about it until it stopped).
+  return !OnTerrain(a, i) || (along >= -radius && along <= radius + c_.body_height);
 }
 
 double Generator::StrideToward(const Vec3& to, const Vec3& forward) const {
