@@ -969,6 +969,44 @@ class BlenderAddonTest(unittest.TestCase):
         self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
         self.assert_keys_equal_walk(self.cli_walk(rig, 4, "biped_4_after_import")[0], feet, body)
 
+    def test_8c_keys_after_a_walk_that_ends_early_stay(self):
+        # A path walk that reaches its goal long before Steps end: its end was taken as the
+        # start plus Steps, and the user's keys up to there were removed (and that end kept for
+        # the next walk).
+        rig = bpy.data.objects["biped_rig"]
+        feet = {f.name: f.target for f in rig.footfall_rig.feet}
+        body = rig.footfall_rig.body
+        settings = bpy.context.scene.footfall
+        settings.rig, settings.steps, settings.start_frame = rig, 40, 1
+        self.select([rig], rig)
+        start = body.matrix_world.translation.copy()
+        data = bpy.data.curves.new("short_path", "CURVE")
+        data.dimensions = "3D"
+        spline = data.splines.new("POLY")
+        spline.points.add(1)
+        spline.points[0].co = (start.x, start.y, start.z, 1.0)
+        spline.points[1].co = (start.x, start.y + 2.0, start.z, 1.0)
+        path = bpy.data.objects.new("short_path", data)
+        bpy.context.scene.collection.objects.link(path)
+        settings.path = path
+        user_frame = 400
+        try:
+            body.keyframe_insert("location", frame=user_frame)
+            feet["L"].keyframe_insert("location", frame=user_frame)
+            self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
+            walk = json.loads(bpy.data.texts["footfall_walk.json"].as_string())
+            last = max(k["frame"] for t in walk["tracks"] for k in t["keys"])
+            self.assertLess(last, user_frame - 50)  # the goal was reached early
+            for obj in (body, feet["L"]):
+                frames = [kp.co[0] for fc in obj.animation_data.action.fcurves
+                          if fc.data_path == "location" for kp in fc.keyframe_points]
+                self.assertIn(float(user_frame), frames, obj.name)
+            self.assertEqual(rig.footfall_rig.walk_end, last)
+        finally:
+            settings.path = None
+            bpy.data.objects.remove(path)
+            bpy.data.curves.remove(data)
+
     def test_9_server_killed_mid_walk(self):
         rig = bpy.data.objects["biped_rig"]
         feet = {f.name: f.target for f in rig.footfall_rig.feet}

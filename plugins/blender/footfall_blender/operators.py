@@ -601,17 +601,24 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
                 if walk_text_new is not None:
                     walk = json.loads(walk_text_new)
                     keying.check_frames(walk)
+                    frames = [k["frame"] for t in walk.get("tracks", []) for k in t.get("keys", [])]
+                    walk_last = max(frames) if frames else settings.start_frame
+                    rig = rig_obj.footfall_rig
+                    objects = list(feet.values()) + [body]
                     if walk_text is None:
                         # The previous walk's keys (up to its end, or on to the last key for a
-                        # rig of an older version); the user's keys after both walks stay.
-                        rig = rig_obj.footfall_rig
-                        to_frame = max(last, rig.walk_end) if rig.walk_end_known else None
-                        keying.clear_keys(list(feet.values()) + [body], settings.start_frame,
-                                          body, to_frame)
-                        rig.walk_end_known, rig.walk_end = True, last
+                        # rig of an older version).
+                        keying.clear_keys(objects, settings.start_frame, body,
+                                          rig.walk_end if rig.walk_end_known else None)
+                    # Keys within this walk's frames so far go as it is keyed there; the user's
+                    # keys after both walks stay (the walk's end is its last key, not its start
+                    # plus Steps: a path walk that reached its goal early removed the user's
+                    # later keys).
+                    keying.clear_keys(objects, settings.start_frame if last_frame is None
+                                      else last_frame + 1e-3, body, walk_last)
+                    rig.walk_end_known, rig.walk_end = True, walk_last
                     keying.key_walk(walk, feet, body, from_frame=last_frame)
-                    frames = [k["frame"] for t in walk.get("tracks", []) for k in t.get("keys", [])]
-                    last_frame = max(frames) if frames else last_frame
+                    last_frame = walk_last if frames else last_frame
                     keyed = sum(len(t.get("keys", [])) for t in walk.get("tracks", [])
                                 if (t.get("kind") == "body" and body) or t.get("name") in feet)
                     walk_text = walk_text_new
