@@ -1011,6 +1011,8 @@ TEST_CASE("A waypoint inside the turning circle is reached with shorter steps, n
   }
 }
 
+namespace {
+
 // The least gap across the body's heading between the feet of a pair, over every body key, as
 // a share of their gap at rest (below 0: a pair's feet crossed under the body).
 double LeastPairGap(const Character& c, const Walk& w) {
@@ -1030,6 +1032,8 @@ double LeastPairGap(const Character& c, const Walk& w) {
   }
   return least;
 }
+
+}  // namespace
 
 TEST_CASE("Feet keep to their sides in sharp turns as the body turns no faster than they follow",
           "[steps][generator]") {
@@ -1654,6 +1658,8 @@ TEST_CASE("Bad options are refused with a message", "[steps][generator]") {
   CHECK_THAT(error, Catch::Contains("handle"));
 }
 
+namespace {
+
 // A three-legged character with its feet off the body's centre line, each in a gait group of
 // its own (a dead end's test subject: it shuffles its feet about a spot easily).
 Character Asymmetric() {
@@ -1668,6 +1674,8 @@ Character Asymmetric() {
                          "asym", &asym, &error) == Status::kOk);
   return asym;
 }
+
+}  // namespace
 
 TEST_CASE("A path given at y = 0 is followed over a DEM hundreds of metres up",
           "[steps][generator][shared-data]") {
@@ -1752,27 +1760,38 @@ TEST_CASE("A walk along a loop that comes back to where it was a dead-end window
   CheckWalk(t, c, o, w);
 }
 
-TEST_CASE("A multiped walks over the Spot mesh, a closed surface with overhangs",
-          "[steps][generator][shared-data]") {
-  // Real data from ../shared/data: Keenan Crane's Spot (public domain), resampled by
-  // footfall::import and scaled by 2 to a 3.4 m cow for a 30 cm insect.
+namespace {
+
+// Real data from ../shared/data: Keenan Crane's Spot (public domain), resampled by
+// footfall::import at `spacing` / `scale` and scaled by `scale`; none when the data is missing
+// outside CI (a warning; in CI a failure).
+std::optional<Terrain> ScaledSpot(double scale, double spacing) {
   const std::string path = FOOTFALL_SOURCE_DIR "/../shared/data/terrain/mesh_spot_triangulated.obj";
   std::ifstream probe(path);
   if (!probe) {
     if (std::getenv("CI")) FAIL("shared data missing in CI: " << path);
     WARN("skipped: shared data not found at " << path << " (CI is unset)");
-    return;
+    return std::nullopt;
   }
-  const Character c = LoadShipped("hexapod");
-  constexpr double kScale = 2;
-  const double spacing = c.step_length / 10;
   TerrainLoadOptions load;
-  load.separation = spacing / kScale;
+  load.separation = spacing / scale;
   RawSamples samples;
   std::string error;
   REQUIRE(footfall::LoadTerrain(path, load, &samples, &error) == Status::kOk);
-  for (Vec3& p : samples.points) p = p * kScale;
-  Terrain t = test::LoadTerrain(samples, spacing);
+  for (Vec3& p : samples.points) p = p * scale;
+  return test::LoadTerrain(samples, spacing);
+}
+
+}  // namespace
+
+TEST_CASE("A multiped walks over the Spot mesh, a closed surface with overhangs",
+          "[steps][generator][shared-data]") {
+  // Real data from ../shared/data: Keenan Crane's Spot (public domain), resampled by
+  // footfall::import and scaled by 2 to a 3.4 m cow for a 30 cm insect.
+  const Character c = LoadShipped("hexapod");
+  std::optional<Terrain> spot = ScaledSpot(2, c.step_length / 10);
+  if (!spot) return;
+  Terrain& t = *spot;
   GenerateOptions o;
   o.has_start = true;
   o.start = {0, 1.4, -0.2};  // on the back
@@ -1793,22 +1812,10 @@ TEST_CASE("A goal on the Spot mesh's nose is reached by a multiped standing arou
   // Real data from ../shared/data: Spot scaled by 3. The octopod's feet stand around the nose,
   // so their centroid lies inside it, 7 cm below the goal: the goal was never within its
   // radius (5 cm) of the ground, and the octopod turned about it until it stopped.
-  const std::string path = FOOTFALL_SOURCE_DIR "/../shared/data/terrain/mesh_spot_triangulated.obj";
-  std::ifstream probe(path);
-  if (!probe) {
-    if (std::getenv("CI")) FAIL("shared data missing in CI: " << path);
-    WARN("skipped: shared data not found at " << path << " (CI is unset)");
-    return;
-  }
   const Character c = LoadShipped("octopod");
-  constexpr double kScale = 3;
-  TerrainLoadOptions load;
-  load.separation = 0.03 / kScale;
-  RawSamples samples;
-  std::string error;
-  REQUIRE(footfall::LoadTerrain(path, load, &samples, &error) == Status::kOk);
-  for (Vec3& p : samples.points) p = p * kScale;
-  Terrain t = test::LoadTerrain(samples, 0.03);
+  std::optional<Terrain> spot = ScaledSpot(3, 0.03);
+  if (!spot) return;
+  Terrain& t = *spot;
   GenerateOptions o;
   const Vec3 goal{0.0069, -0.221, 3.144};
   o.path.push_back(goal);
