@@ -359,6 +359,26 @@ bool WaitFor(const std::function<bool()>& done) {
 
 }  // namespace
 
+TEST_CASE("Server addresses are read as footfalld's --listen writes them", "[rpc]") {
+  const std::pair<std::string, std::pair<std::string, int>> good[] = {
+      {"10.0.0.2:7000", {"10.0.0.2", 7000}}, {":7001", {"127.0.0.1", 7001}},
+      {"7002", {"127.0.0.1", 7002}},         {"[::1]:7003", {"::1", 7003}},
+      {"::1:7004", {"::1", 7004}},           {"::1", {"::1", 7407}},
+      {"fe80::2", {"fe80::2", 7407}},        {"2001:db8::1", {"2001:db8::1", 7407}}};
+  for (const auto& [text, want] : good) {
+    INFO(text);
+    RpcOptions o;
+    std::string error;
+    REQUIRE(ParseHostPort(text, &o, &error) == Status::kOk);
+    CHECK(o.host == want.first);
+    CHECK(o.port == want.second);
+  }
+  RpcOptions o;
+  std::string error;
+  CHECK(ParseHostPort("host:0", &o, &error) == Status::kInvalidArgument);
+  CHECK(ParseHostPort("host:x", &o, &error) == Status::kInvalidArgument);
+}
+
 TEST_CASE("RPC answers equal the embedded engine", "[rpc]") {
   ServerProcess server;
   auto rpc = Connect(server.port());

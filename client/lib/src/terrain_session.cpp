@@ -1,5 +1,7 @@
 #include "footfall/client/terrain_session.h"
 
+#include <arpa/inet.h>
+
 #include <cstdlib>
 
 namespace footfall {
@@ -27,8 +29,24 @@ Foothold TerrainSession::Next(TerrainHandle terrain, const StepQuery& query, dou
   return f;
 }
 
+namespace {
+
+bool IsIpv6Address(const std::string& text) {
+  in6_addr address;
+  return inet_pton(AF_INET6, text.c_str(), &address) == 1;
+}
+
+}  // namespace
+
 Status ParseHostPort(const std::string& text, RpcOptions* options, std::string* error) {
   const size_t colon = text.rfind(':');
+  // A bare IPv6 address (`::1`, `fe80::1`), as footfalld's --listen takes it: its default port.
+  // (`::1:7407` is ::1 at port 7407: what precedes its last colon is an address.)
+  if (colon != std::string::npos && IsIpv6Address(text) && !IsIpv6Address(text.substr(0, colon))) {
+    options->host = text;
+    options->port = RpcOptions{}.port;
+    return Status::kOk;
+  }
   std::string host = colon == std::string::npos ? "" : text.substr(0, colon);
   const std::string port_text = colon == std::string::npos ? text : text.substr(colon + 1);
   char* end = nullptr;

@@ -107,7 +107,8 @@ struct RpcOptions {
 // kept), so handles stay valid across a server restart.
 std::unique_ptr<TerrainSession> MakeRpcSession(const RpcOptions& options);
 
-// Parses "HOST:PORT" (or ":PORT", or "PORT") into options->host and options->port.
+// Parses "HOST:PORT" (or ":PORT", "PORT", "[IPV6]:PORT", or a bare IPv6 address at the default
+// port, as footfalld's --listen takes it) into options->host and options->port.
 Status ParseHostPort(const std::string& text, RpcOptions* options, std::string* error);
 
 }  // namespace footfall
