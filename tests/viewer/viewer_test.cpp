@@ -109,6 +109,18 @@ std::string WaitForPort(const std::string& path) {
   return port;
 }
 
+// A real footfalld on a free loopback port, its port file in `dir` (stopped when destroyed).
+struct LocalServer {
+  explicit LocalServer(const std::string& dir)
+      : child({FOOTFALLD, "--listen", "127.0.0.1:0", "--port-file", dir + "/port", "--no-rpcbind"},
+              {}),
+        port(WaitForPort(dir + "/port")),
+        address("127.0.0.1:" + port) {}
+  test::Child child;
+  const std::string port;     // "" when it did not start listening
+  const std::string address;  // 127.0.0.1:port
+};
+
 TEST_CASE("screenshot of a next query shows the chosen sample where it projects",
           "[viewer][screenshot]") {
   const std::string dir = test::TempDir();
@@ -496,12 +508,10 @@ TEST_CASE("why a walk stopped is shown in full, wrapped to the window", "[viewer
 
 TEST_CASE("live: the viewer shows a query another client sends to footfalld", "[viewer][live]") {
   const std::string dir = test::TempDir();
-  test::Child server(
-      {FOOTFALLD, "--listen", "127.0.0.1:0", "--port-file", dir + "/port", "--no-rpcbind"}, {});
-  const std::string port = WaitForPort(dir + "/port");
-  INFO("footfalld stderr: " << server.Err());
-  REQUIRE_FALSE(port.empty());
-  const std::string address = "127.0.0.1:" + port;
+  const LocalServer server(dir);
+  INFO("footfalld stderr: " << server.child.Err());
+  REQUIRE_FALSE(server.port.empty());
+  const std::string& address = server.address;
 
   test::Child viewer({kView, "--terrain", kTerrain, "--server", address, "--live", "--live-wait",
                       "2", "--timeout", "30", "--size", "640x400", "--screenshot",
@@ -540,12 +550,10 @@ TEST_CASE("live: without a terrain, the picture is framed on the queries receive
           "[viewer][live]") {
   // (The camera framed the unit box at the origin before any query came: a blank picture.)
   const std::string dir = test::TempDir();
-  test::Child server(
-      {FOOTFALLD, "--listen", "127.0.0.1:0", "--port-file", dir + "/port", "--no-rpcbind"}, {});
-  const std::string port = WaitForPort(dir + "/port");
-  INFO("footfalld stderr: " << server.Err());
-  REQUIRE_FALSE(port.empty());
-  const std::string address = "127.0.0.1:" + port;
+  const LocalServer server(dir);
+  INFO("footfalld stderr: " << server.child.Err());
+  REQUIRE_FALSE(server.port.empty());
+  const std::string& address = server.address;
   test::Child viewer(
       {kView, "--server", address, "--live", "--live-wait", "2", "--timeout", "30", "--size",
        "640x400", "--screenshot", dir + "/live.png", "--dump-state", dir + "/state.json"},
@@ -573,12 +581,10 @@ TEST_CASE("live: without a terrain, the picture is framed on the queries receive
 
 TEST_CASE("live: a server that never sees a query ends the wait with a message", "[viewer][live]") {
   const std::string dir = test::TempDir();
-  test::Child server(
-      {FOOTFALLD, "--listen", "127.0.0.1:0", "--port-file", dir + "/port", "--no-rpcbind"}, {});
-  const std::string port = WaitForPort(dir + "/port");
-  REQUIRE_FALSE(port.empty());
-  const RunResult r = View({"--server", "127.0.0.1:" + port, "--live", "--live-wait", "1",
-                            "--timeout", "1", "--screenshot", dir + "/x.png"});
+  const LocalServer server(dir);
+  REQUIRE_FALSE(server.port.empty());
+  const RunResult r = View({"--server", server.address, "--live", "--live-wait", "1", "--timeout",
+                            "1", "--screenshot", dir + "/x.png"});
   CHECK(r.exit_code == 1);
   CHECK_THAT(r.err, Catch::Contains("received 0 of 1 queries"));
 }
