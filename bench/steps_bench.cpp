@@ -69,8 +69,9 @@ Backend& Rpc() {
   return b;
 }
 
-// The crowd walks in passes as GenerateOptions sets them by default (embedded: 1000 characters
-// at a time; RPC: the whole crowd, one call per round of queries).
+// The crowd walks in passes as GenerateOptions sets them by default (embedded:
+// kInProcessCharactersPerPass characters at a time, one pass per thread; RPC: the whole crowd,
+// one call per round of queries).
 void Walks(benchmark::State& state, Backend& (*backend)()) {
   Backend& b = backend();
   GenerateOptions o;
