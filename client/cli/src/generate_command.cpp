@@ -25,6 +25,7 @@
 #include "footfall/steps/walk_terrain.h"
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/output_file.h"
+#include "footfall/terrain/point_file.h"
 #include "footfall/terrain/shown_text.h"
 #include "terrain_flags.h"
 
@@ -136,6 +137,18 @@ void ReportResampling(const std::string& path, const Character& character, const
   std::cerr << o.str();
 }
 
+// Writes the samples the walk was placed on as a point file at `out`: `resampled` when the
+// terrain was resampled for the character, else the --terrain file read again with its flags
+// (its samples are then exactly those the session loaded).
+Status WriteWalkTerrain(const TerrainFlags& flags, const RawSamples* resampled,
+                        const std::string& out, std::string* error) {
+  if (resampled) return WritePointFile(out, *resampled, error);
+  RawSamples samples;
+  const Status read = LoadTerrain(flags.terrain, flags.load, &samples, error);
+  if (read != Status::kOk) return read;
+  return WritePointFile(out, samples, error);
+}
+
 int RunGenerate(const GenerateFlags& flags) {
   std::string error;
   GenerateOptions options;
@@ -157,9 +170,19 @@ int RunGenerate(const GenerateFlags& flags) {
   }
   for (const std::string& out : flags.out) {
     const std::string ext = FileExtension(out);
-    if (ext != "json" && ext != "gltf" && ext != "glb" && ext != "mel") {
-      error =
-          "--out " + out + ": unsupported output extension (expected .json, .gltf, .glb or .mel)";
+    if (ext != "json" && ext != "gltf" && ext != "glb" && ext != "mel" &&
+        !IsPointFileExtension(ext)) {
+      error = "--out " + out +
+              ": unsupported output extension (expected .json, .gltf, .glb, .mel, or .pts for "
+              "the terrain's samples)";
+      goto bad_flag;
+    }
+    // The samples of a --server-terrain are footfalld's: this side never has them.
+    if (IsPointFileExtension(ext) && !flags.terrain.server_terrain.empty()) {
+      error = "--out " + out +
+              ": the terrain is read by footfalld (--server-terrain), so its samples are not "
+              "here to write; give the file with --terrain, or convert it with footfall "
+              "terrain convert";
       goto bad_flag;
     }
     // Refused before anything is generated or written (glTF times are >= 0).
@@ -313,7 +336,10 @@ int RunGenerate(const GenerateFlags& flags) {
       }
       Status written;
       try {
-        written = WriteOutput(walk, out, &error);
+        written = IsPointFileExtension(ext)
+                      ? WriteWalkTerrain(terrain_flags, resample ? &prepared.samples : nullptr, out,
+                                         &error)
+                      : WriteOutput(walk, out, &error);
       } catch (const std::bad_alloc&) {
         error =
             "out of memory writing it (the outputs before it are written; the walk JSON "
@@ -413,7 +439,10 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
       ->check(CLI::Range(1, 256));
   cmd->add_flag("--progress", flags->progress,
                 "Show a progress bar on stderr (shown anyway for long runs on a terminal)");
-  cmd->add_option("--out", flags->out, "Output file: .json, .gltf, .glb or .mel (repeatable)")
+  cmd->add_option("--out", flags->out,
+                  "Output file: .json, .gltf, .glb or .mel (repeatable); .pts: the terrain's "
+                  "samples the walk was placed on (as resampled for the character), for "
+                  "footfall-view or a plugin")
       ->required();
   cmd->footer(
       "Exit status: 0 when every step was generated, 2 when the walk stopped early (at a cliff, "
