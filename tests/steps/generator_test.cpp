@@ -2164,6 +2164,22 @@ TEST_CASE("Options no walk can follow are refused with the reason", "[steps][gen
     CHECK(GenerateWalk(*t.session, t.handle, LoadShipped("hexapod"), o, &w, &error) ==
           Status::kInvalidArgument);
     CHECK_THAT(error, Catch::Contains("the heading (0.0000, 1.0000, 0.0000) is along the up"));
+    // A few degrees off the up, what is left on the ground is noise or the ground's tilt (the
+    // default +Z heading on a Z-up terrain walked an insect downhill): refused too.
+    const double rad = 3.14159265358979323846 / 180;
+    o.heading = {std::sin(8 * rad), std::cos(8 * rad), 0};
+    CHECK(GenerateWalk(*t.session, t.handle, LoadShipped("hexapod"), o, &w, &error) ==
+          Status::kInvalidArgument);
+    CHECK_THAT(error, Catch::Contains("within 10 deg of it"));
+    // Past the threshold the heading's ground part is the direction walked.
+    o.heading = {std::sin(12 * rad), std::cos(12 * rad), 0};
+    REQUIRE(GenerateWalk(*t.session, t.handle, LoadShipped("hexapod"), o, &w, &error) ==
+            Status::kOk);
+    const WalkTrack& body = w.tracks.back();
+    REQUIRE(body.keys.size() > 2);
+    const Vec3 moved = body.keys.back().position - body.keys.front().position;
+    CHECK(moved.x > 0.1);
+    CHECK(std::fabs(moved.z) < 0.25 * moved.x);
     // With a path, the heading is not used.
     o.path = {{1.5, 0, 1.5}};
     CHECK(GenerateWalk(*t.session, t.handle, LoadShipped("hexapod"), o, &w, &error) == Status::kOk);

@@ -914,14 +914,19 @@ Status Generator::Setup(std::string* error) {
   const bool exact = o_.steps >= 0 && 3 * steps_of_foot + 1 <= kMaxReserved &&
                      static_cast<size_t>(steps_) + 1 <= kMaxReserved;
   // A heading along the up where the character starts gives no direction on the ground (it
-  // used to fall back to another direction silently).
+  // used to fall back to another direction silently). Within a few degrees of the up, what is
+  // left on the ground is the terrain's tilt, not a direction the user chose: the default +Z
+  // heading on a Z-up terrain would walk a multiped downhill.
   if (o_.path.empty() && n > 0) {
+    constexpr double kMinDegreesFromUp = 10;
+    const double min_sin = std::sin(Radians(kMinDegreesFromUp));
     const Vec3 up = c_.align_to_normal ? answers_[0].normal : world_up_;
-    if (Length2(ProjectOnPlane(o_.heading, up)) <= 1e-8 * Length2(o_.heading)) {
+    if (Length2(ProjectOnPlane(o_.heading, up)) <= min_sin * min_sin * Length2(o_.heading)) {
       std::ostringstream m;
       m << "the heading " << Point(o_.heading) << " is along the up " << Point(up)
-        << " where the character starts: it gives no direction on the ground; give a heading "
-           "along the ground";
+        << " where the character starts (within " << kMinDegreesFromUp
+        << " deg of it): it gives no clear direction on the ground; give a heading along the "
+           "ground with --heading";
       *error = m.str();
       return Status::kInvalidArgument;
     }
