@@ -964,6 +964,30 @@ TEST_CASE("The heading follows a path with a 90-degree turn", "[steps][generator
   }
 }
 
+TEST_CASE("A path drawn from where the character stands starts facing its next waypoint",
+          "[steps][generator]") {
+  // A path whose first waypoint is the start gave no direction there: the walk set off along
+  // the default heading (+Z) and turned round toward the goal behind it.
+  for (const std::string& name : ShippedCharacters()) {
+    const Character c = LoadShipped(name);
+    const double leg = 8 * c.step_length, margin = 4 * c.reach, spacing = c.step_length / 10;
+    const int n = static_cast<int>((leg + 2 * margin) / spacing);
+    Terrain t = LoadTerrain(MakeFlat(n, spacing, 0), spacing);
+    INFO(name);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {margin + leg, 0, margin};
+    o.path = {o.start, Vec3{margin, 0, margin}};
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    REQUIRE(w.stopped.empty());
+    CheckWalk(t, c, o, w);
+    // Every key of the body faces -X, the first too.
+    for (size_t i = 0; i < Body(w).keys.size(); ++i)
+      CHECK(BodyForward(Body(w).Rotation(i)).x < -0.99);
+  }
+}
+
 TEST_CASE("A waypoint inside the turning circle is reached with shorter steps, not circled",
           "[steps][generator]") {
   // The shipped biped with --path "0,0,3 0.5,0,2.5" turned 30 degrees a step at full stride

@@ -264,7 +264,7 @@ class Generator {
     return TangentForward(o_.heading, AnyPerpendicular(world_up_), world_up_, up0);
   }
   // 2. Stands a on `ground` in the start's frame (up0, fwd0): its up and its heading, turned
-  //    toward its path's first waypoint when it has one.
+  //    toward its path's first waypoint beyond that waypoint's radius when it has one.
   void Orient(Agent& a, const Foothold& ground, const Vec3& up0, const Vec3& fwd0) const;
   // 3-4. Plants a's feet on `feet`, the snaps of their rest positions (Place), and moves its
   //    frame and ground to them. Returns why a foot cannot stand there, or "".
@@ -1366,10 +1366,23 @@ void Generator::Orient(Agent& a, const Foothold& ground, const Vec3& up0, const 
   a.ground = ground.point;
   a.up = c_.align_to_normal ? ground.normal : world_up_;
   a.forward = TangentForward(o_.heading, fwd0, up0, a.up);
-  if (!a.path.empty()) {
-    // (Before the waypoints' distances from the terrain are known: taken as off it.)
-    const Vec3 to = ProjectOnPlane(ToPathPoint(a, a.path[0], false), a.up);
-    if (Length2(to) > 1e-18) a.forward = Normalize(to);
+  // Facing the first waypoint beyond its radius along the ground: one at the start (a path
+  // drawn from where the character stands) counts as reached on the first step, so it gives no
+  // direction. (Before the waypoints' distances from the terrain are known: taken as off it.)
+  for (size_t i = 0; i < a.path.size(); ++i) {
+    const Vec3 to = ProjectOnPlane(ToPathPoint(a, a.path[i], false), a.up);
+    if (Length(to) > Radius(a, i)) {
+      a.forward = Normalize(to);
+      return;
+    }
+  }
+  // Every waypoint within its radius: toward the first that is off the start at all.
+  for (const Vec3& p : a.path) {
+    const Vec3 to = ProjectOnPlane(ToPathPoint(a, p, false), a.up);
+    if (Length2(to) > 1e-18) {
+      a.forward = Normalize(to);
+      return;
+    }
   }
 }
 
