@@ -977,7 +977,8 @@ TEST_CASE("A path drawn from where the character stands starts facing its next w
     GenerateOptions o;
     o.has_start = true;
     o.start = {margin + leg, 0, margin};
-    o.path = {o.start, Vec3{margin, 0, margin}};
+    o.path.push_back(o.start);
+    o.path.push_back(Vec3{margin, 0, margin});
     const Walk w = Generate(t, c, o);
     INFO(w.stopped);
     REQUIRE(w.stopped.empty());
@@ -985,6 +986,30 @@ TEST_CASE("A path drawn from where the character stands starts facing its next w
     // Every key of the body faces -X, the first too.
     for (size_t i = 0; i < Body(w).keys.size(); ++i)
       CHECK(BodyForward(Body(w).Rotation(i)).x < -0.99);
+  }
+}
+
+TEST_CASE("A character that turns slowly reaches a goal behind it by most of a circle",
+          "[steps][generator]") {
+  // At 2 degrees a step, a goal ten steps behind is neared again only after some 150 steps
+  // round a circle of ~29 steps' radius: the walk stopped as a dead end after 100.
+  for (const std::string& name : ShippedCharacters()) {
+    Character c = LoadShipped(name);
+    c.max_turn_deg = 2;
+    const double step = c.step_length, spacing = step / 3, side = 140 * step;
+    Terrain t = LoadTerrain(MakeFlat(static_cast<int>(side / spacing), spacing, 0), spacing);
+    INFO(name);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {side / 2, 0, side / 2};
+    const Vec3 goal = o.start;
+    o.path.push_back(o.start + Vec3{0, 0, 10 * step});
+    o.path.push_back(goal);
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    REQUIRE(w.stopped.empty());
+    const Vec3 ground_end = Body(w).keys.back().position - Vec3{0, c.body_height, 0};
+    CHECK(Distance(ground_end, goal) <= step);
   }
 }
 

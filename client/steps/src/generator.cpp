@@ -667,10 +667,11 @@ Status Generator::Run(std::string* error) {
   steps_ = o_.steps >= 0 ? o_.steps : (o_.path.empty() ? kDefaultSteps : kMaxPathSteps);
   // Far longer than any stall of a walk that goes on (characters turning about a waypoint on
   // stairs stood within half a step for 32 steps, then walked on): 100 steps, 16 gait cycles,
-  // or a half turn at max_turn_deg and four cycles, whichever is longest.
+  // or a whole turn at max_turn_deg and four cycles, whichever is longest. (A goal just behind
+  // a character that turns 1 degree a step is neared again only most of a circle later.)
   window_steps_ =
       std::max({100, 16 * groups,
-                static_cast<int>(std::min(1000.0, std::ceil(180 / c_.max_turn_deg))) + 4 * groups});
+                static_cast<int>(std::min(1000.0, std::ceil(360 / c_.max_turn_deg))) + 4 * groups});
   // The target locator's lead over the foot's rest position: with the body at the feet's
   // centroid, L * (G + 1) / (2G) makes every foot travel exactly L per step once walking
   // (half a step ahead for G -> infinity; 3/4 of a step for two gait groups).
