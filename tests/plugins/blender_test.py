@@ -1007,6 +1007,85 @@ class BlenderAddonTest(unittest.TestCase):
             bpy.data.objects.remove(path)
             bpy.data.curves.remove(data)
 
+    def test_8d_character_setup_again_replaces_the_rig(self):
+        # Character Setup again on the same picked body and IK targets made a second rig next
+        # to the first: the body then belonged to both, Generate Walk keyed the old one (its
+        # start, its character), and picking with the old rig selected too took its central
+        # locator (named after both feet) as an IK target.
+        with open(os.path.join(CHARACTERS, "biped.json")) as f:
+            names = [foot["name"] for foot in json.load(f)["feet"]]
+        settings = bpy.context.scene.footfall
+        bpy.context.scene.frame_set(1)
+        body = new_empty("again_body", location=(2.0, 2.0, 1.0))
+        targets = [new_empty("again_IK_" + n, location=(2.0 + (0.2 if i == 0 else -0.2), 2.0, 0.0))
+                   for i, n in enumerate(names)]
+        character_file = os.path.join(CHARACTERS, "biped.json")
+
+        def setup(selected):
+            self.select(selected, body)
+            self.assertEqual(bpy.ops.footfall.character_setup(
+                character_file=character_file, mode="PICK", name="again"), {"FINISHED"})
+            return settings.rig
+
+        def rigs_of_body():
+            return [o for o in bpy.context.scene.objects
+                    if o.footfall_rig.is_rig and o.footfall_rig.body == body]
+
+        first = setup(targets + [body])
+        first_parts = [o for o in bpy.context.scene.objects if o.name.startswith("again_") and
+                       o.name.endswith(("_center", "_target"))]
+        self.assertEqual(len(first_parts), 3)  # one central locator, two target locators
+        # The user's own object under the rig stays, where it is.
+        note = new_empty("again_note", parent=first_parts[0], location=(0.0, 0.0, 0.5))
+        bpy.context.view_layer.update()
+        note_world = note.matrix_world.copy()
+        settings.steps, settings.start_frame = 6, 1
+        self.select([first], first)
+        self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
+        long_walk = json.loads(bpy.data.texts["footfall_walk.json"].as_string())
+        long_end = max(k["frame"] for t in long_walk["tracks"] for k in t["keys"])
+        # The body has walked on: set up again where it stands at the walk's end, with the whole
+        # old rig selected (its locators first).
+        bpy.context.scene.frame_set(int(long_end))
+        objects_before = set(bpy.context.scene.objects)
+        rig = setup(first_parts + [first] + targets + [body])
+        self.assertEqual(rig.name, "again_rig")
+        self.assertEqual(rigs_of_body(), [rig])
+        self.assertEqual({f.name: f.target for f in rig.footfall_rig.feet},
+                         dict(zip(names, targets)))
+        self.assertIs(rig.footfall_rig.body, body)
+        for obj in targets + [body, note]:
+            self.assertIn(obj, list(bpy.context.scene.objects), obj.name)
+        self.assertTrue(note.matrix_world.translation.to_tuple(6) ==
+                        note_world.translation.to_tuple(6))
+        made = [o for o in bpy.context.scene.objects if o.name.startswith("again_") and
+                o.name.endswith(("_center", "_target"))]
+        self.assertEqual(sorted(o.name for o in made),
+                         sorted(["again_L_R_center", "again_L_target", "again_R_target"]))
+        self.assertEqual(len(bpy.context.scene.objects), len(objects_before))
+        # Generate Walk from the body walks the new rig, and replaces the old rig's longer walk.
+        settings.steps = 4
+        self.select([body], body)
+        self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
+        walk, _ = self.cli_walk(rig, 4, "again_4")
+        self.assert_keys_equal_walk(walk, dict(zip(names, targets)), body)
+        # With the rig itself active, its body and IK targets are set up again (the root was
+        # taken as the body, and removed with the rig).
+        self.select([rig], rig)
+        self.assertEqual(bpy.ops.footfall.character_setup(
+            character_file=character_file, mode="PICK", name="again"), {"FINISHED"})
+        rig = settings.rig
+        self.assertEqual(rigs_of_body(), [rig])
+        self.assertEqual({f.name: f.target for f in rig.footfall_rig.feet},
+                         dict(zip(names, targets)))
+        made = [o for o in bpy.context.scene.objects if o.name.startswith("again_") and
+                o.name.endswith(("_center", "_target"))]
+        self.assertEqual(len(made), 3)
+        for obj in [body, note] + targets + made + [rig]:
+            bpy.data.objects.remove(obj)
+        settings.rig = bpy.data.objects["biped_rig"]
+        bpy.context.scene.frame_set(1)
+
     def test_9_server_killed_mid_walk(self):
         rig = bpy.data.objects["biped_rig"]
         feet = {f.name: f.target for f in rig.footfall_rig.feet}

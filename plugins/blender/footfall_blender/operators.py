@@ -363,14 +363,33 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
         body = context.active_object
         if body is None:
             raise ValueError("select the body (active) and the foot IK targets")
+        scene = context.scene
+        # A rig's root and locators are never its body or IK targets (a central locator is named
+        # after both its feet): with one of them active, Character Setup runs again on that
+        # rig's body and IK targets (those not picked in their stead).
+        parts = set()
+        for o in scene.objects:
+            if o.footfall_rig.is_rig:
+                parts.update(rig_parts(o))
+        known = {}
+        if body in parts:
+            rig = rig_of(scene, body).footfall_rig
+            body = rig.body
+            if body is None or not in_scene(scene, body):
+                raise ValueError("the active rig has no body in the scene: select the body "
+                                 "(active) and the foot IK targets")
+            known = {f.name: f.target for f in rig.feet if in_scene(scene, f.target)}
         chosen = {}
-        candidates = [o for o in context.selected_objects if o is not body]
+        candidates = [o for o in context.selected_objects if o is not body and o not in parts]
         for name, _ in feet:
             for o in candidates:
                 n = o.name
                 if n == name or n.endswith(("_" + name, "." + name, "-" + name, ":" + name)):
                     chosen[name] = o
                     break
+            else:
+                if name in known:
+                    chosen[name] = known[name]
         missing = [n for n, _ in feet if n not in chosen]
         if missing:
             raise ValueError("no selected object named after foot %s" % ", ".join(missing))
@@ -403,11 +422,20 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
             centre = sum((foot_points[m] for m in members), Vector()) / len(members)
             centres.append((pair_name, members) + _snap(s, terrain, centre))
 
+        # Character Setup again on a rig's body or IK targets replaces that rig (a second rig
+        # on the same objects had Generate Walk key the old one). Its walk is the new rig's
+        # previous walk, whose keys the next Generate Walk replaces.
+        walk_end_known, walk_end = True, -keying.MAX_FRAME - 1  # no walk yet
+        replaced = replace_rigs(context.scene, [body] + list(targets.values()))
+        for known, end in replaced:
+            walk_end_known = walk_end_known and known
+            walk_end = max(walk_end, end)
+
         root = _empty(context, rig_name + "_rig", "ARROWS", 0.5)
         root.matrix_world = Matrix.Translation(ground) @ rot.to_4x4()
         rig = root.footfall_rig
         rig.is_rig = True
-        rig.walk_end_known, rig.walk_end = True, -keying.MAX_FRAME - 1  # no walk yet
+        rig.walk_end_known, rig.walk_end = walk_end_known, walk_end
         rig.character_path = self.character_file
         rig.character_json = json.dumps(data)
         if body is None:  # a picked body keeps its rotation mode (the user's keys use it)
@@ -434,15 +462,70 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
             central = _empty(context, "%s_%s_center" % (rig_name, pair_name), "CIRCLE", 0.3,
                              parent=root)
             central.matrix_world = Matrix.Translation(point) @ _frame(normal, fwd).to_4x4()
+            central.footfall_rig.is_locator = True
             for m in members:
                 target = _empty(context, "%s_%s_target" % (rig_name, m), "CONE", 0.06,
                                 parent=central)
+                target.footfall_rig.is_locator = True
                 target.matrix_world = Matrix.Translation(
                     placed[m][1] + _frame(normal, fwd) @ Vector((0, -step / 2, 0)))
         context.scene.footfall.rig = root
         context.view_layer.update()
         self.report({"INFO"}, "footfall: %s set up with %d feet" % (rig_name, len(feet)))
         return {"FINISHED"}
+
+
+def _is_locator(obj):
+    """True for a central or target locator Character Setup made (older versions did not mark
+    them: an empty named ..._center or ..._target, with Blender's .001 suffix or not)."""
+    if obj.footfall_rig.is_locator:
+        return True
+    if obj.type != "EMPTY" or obj.footfall_rig.is_rig:
+        return False
+    head, dot, tail = obj.name.rpartition(".")
+    return (head if dot and tail.isdigit() else obj.name).endswith(("_center", "_target"))
+
+
+def rig_parts(rig_obj):
+    """The objects Character Setup made for the rig `rig_obj`: its root and the locators under
+    it (not its body or IK targets, nor anything else under it)."""
+    rig = rig_obj.footfall_rig
+    own = {rig.body} | {f.target for f in rig.feet}
+    parts, stack = [rig_obj], list(rig_obj.children)
+    while stack:
+        obj = stack.pop()
+        if obj not in own and _is_locator(obj):
+            parts.append(obj)
+            stack.extend(obj.children)
+    return parts
+
+
+def replace_rigs(scene, objects):
+    """Removes the rigs of `scene` whose body or IK targets are among `objects` (a rig about to
+    be made for them): their roots and locators. The bodies, the IK targets and anything else
+    under the removed objects stay, where they are in the world. Returns (walk_end_known,
+    walk_end) of each removed rig."""
+    objects = {o for o in objects if o is not None}
+    rigs = [o for o in scene.objects if o.footfall_rig.is_rig and
+            ({o.footfall_rig.body} | {f.target for f in o.footfall_rig.feet}) & objects]
+    if not rigs:
+        return []
+    removed = set()
+    for rig_obj in rigs:
+        removed.update(rig_parts(rig_obj))
+    removed -= objects
+    for obj in bpy.data.objects:
+        if obj not in removed and obj.parent in removed:
+            world = obj.matrix_world.copy()
+            parent = obj.parent
+            while parent in removed:
+                parent = parent.parent
+            obj.parent = parent
+            obj.matrix_world = world
+    ends = [(r.footfall_rig.walk_end_known, r.footfall_rig.walk_end) for r in rigs]
+    for obj in removed:
+        bpy.data.objects.remove(obj)
+    return ends
 
 
 # -- Generate Walk ------------------------------------------------------------------------------

@@ -47,6 +47,9 @@ class FootfallFoot(bpy.types.PropertyGroup):
 class FootfallRig(bpy.types.PropertyGroup):
     """On the rig's root empty: which character, which body and which foot targets."""
     is_rig: BoolProperty(default=False)
+    # On the central and target locators Character Setup makes under the root: the rig's own,
+    # removed with it when Character Setup is run again on its body or IK targets.
+    is_locator: BoolProperty(default=False)
     character_path: StringProperty(name="Character file", subtype="FILE_PATH")
     character_json: StringProperty(name="Character", description="The character file's JSON")
     body: PointerProperty(type=bpy.types.Object, name="Body")
