@@ -402,6 +402,78 @@ class RpcTest(unittest.TestCase):
             ff.Session.rpc("127.0.0.1", 70000)
 
 
+class ConnectionTest(unittest.TestCase):
+    """Connection, as the plugins keep it between commands, against real footfalld servers."""
+
+    def setUp(self):
+        self.server = ff.LocalServer().start()
+        gone = ff.LocalServer().start()  # a port where nothing answers
+        gone.stop()
+        self.dead_port = gone.port
+        self.c = ff.Connection()
+
+    def tearDown(self):
+        self.c.shutdown()
+        self.server.stop()
+
+    def test_changed_preferences_leave_the_private_server(self):
+        # Once a local footfalld was started, every later call went to it, whatever server the
+        # preferences named from then on.
+        c = self.c
+        c.get("127.0.0.1", self.dead_port, start_local=True)
+        first = c.local
+        self.assertTrue(first is not None and first.running())
+        s = c.get("127.0.0.1", self.server.port, start_local=True)
+        self.assertEqual(s.description, "rpc 127.0.0.1:%d" % self.server.port)
+        self.assertIsNone(c.local)
+        self.assertFalse(first.running())  # stopped, not left behind
+        # Local servers no longer allowed: the configured server (none) is asked, and the
+        # private one is not used.
+        c.get("127.0.0.1", self.dead_port, start_local=True)
+        second = c.local
+        with self.assertRaises(ff.FootfallError) as e:
+            c.get("127.0.0.1", self.dead_port, start_local=False)
+        self.assertEqual(e.exception.status_name, "unavailable")
+        self.assertIn("no footfalld answers at 127.0.0.1:%d" % self.dead_port,
+                      e.exception.message)
+        self.assertFalse(second.running())
+        # Another footfalld to start: a server of that one.
+        c.get("127.0.0.1", self.dead_port, start_local=True)
+        third = c.local
+        c.get("127.0.0.1", self.dead_port, start_local=True, footfalld=ff.find_footfalld())
+        self.assertFalse(third.running())
+        self.assertTrue(c.local.running())
+        self.assertEqual(c.local.executable, ff.find_footfalld())
+        # The same preferences keep the same server.
+        fourth = c.local
+        self.assertIs(c.get("127.0.0.1", self.dead_port, start_local=True,
+                            footfalld=ff.find_footfalld()), c.session)
+        self.assertIs(c.local, fourth)
+
+    def test_a_terrain_is_replaced_once_its_successor_is_loaded(self):
+        # Loading a terrain again under the same name unloaded the old one first: a new upload
+        # that failed left no terrain at all.
+        c = self.c
+        s = c.get("127.0.0.1", self.server.port, start_local=False)
+        old = c.load_samples("ground", flat_grid())
+        with self.assertRaises(ff.FootfallError) as e:
+            c.load_file("ground", os.path.join(tempfile.gettempdir(), "no-such-terrain.pts"))
+        self.assertEqual(e.exception.status_name, "io_error")
+        self.assertEqual(c.terrain("ground"), old)
+        self.assertEqual(s.info(old)[0], 21 * 21)
+        self.assertTrue(s.snap(c.terrain("ground"), [(1.0, 1.0, 1.0)])[0].ok)
+        # Replaced: the new one loaded, then the old one unloaded (the server keeps one).
+        ids = [old]
+        for height in range(1, 4):
+            ids.append(c.load_samples("ground", flat_grid(height=float(height))))
+            self.assertEqual(c.terrain("ground"), ids[-1])
+            self.assertEqual(s.info(ids[-1])[0], 21 * 21)
+            for gone in ids[:-1]:
+                with self.assertRaises(ff.FootfallError) as e:
+                    s.info(gone)
+                self.assertEqual(e.exception.status_name, "unknown_terrain")
+
+
 class BusyServer:
     """A stand-in for a footfalld busy building others' terrains: it answers the RPC NULL
     procedure and FF_ASK_AGAIN, and every other call FF_UNAVAILABLE ("footfalld is busy"), as

@@ -10,6 +10,7 @@ class Connection:
     def __init__(self):
         self.session = None
         self.local = None          # LocalServer this connection started, if any
+        self._local_for = None     # ((host, port), footfalld) it was started in place of
         self._target = None        # (host, port) the session talks to
         self._timeout = None       # its call timeout [s]
         self._terrains = {}        # name -> [source, terrain id, session]
@@ -25,8 +26,14 @@ class Connection:
         nothing answers and start_local is set, starts footfalld on a free loopback port.
         Raises FootfallError('unavailable') with what to do when no server can be had."""
         target = (host or "127.0.0.1", int(port))
-        if self.local is not None and self.local.running():
-            target = ("127.0.0.1", self.local.port)
+        wanted = (target, footfalld or None)
+        if self.local is not None:
+            if start_local and self.local.running() and self._local_for == wanted:
+                target = ("127.0.0.1", self.local.port)
+            else:
+                # Stopped, or started for other preferences (another server, another footfalld,
+                # or local servers no longer allowed): the configured server is asked again.
+                self._stop_local()
         if self.session is None or self._target != target or self._timeout != timeout:
             self._open(target, timeout)  # (a changed timeout was ignored until host or port changed)
         # A server restarted on the same port since the last call: the first call finds the
@@ -36,10 +43,10 @@ class Connection:
         if not start_local:
             raise FootfallError(UNAVAILABLE, "no footfalld answers at %s:%d: start one there or "
                                 "allow starting a local footfalld" % target, "connect")
-        if self.local is not None:
-            self.local.stop()
+        self._stop_local()
         try:
             self.local = LocalServer(executable=footfalld or None).start()
+            self._local_for = wanted
         except ServerError as e:
             self.local = None
             raise FootfallError(UNAVAILABLE, "no footfalld answers at %s:%d and a local one "
@@ -49,6 +56,18 @@ class Connection:
             raise FootfallError(UNAVAILABLE, "the local footfalld on port %d does not answer"
                                 % self.local.port, "connect")
         return self.session
+
+    def _stop_local(self):
+        """Stops the server this connection started, closing the session to it first."""
+        if self.local is None:
+            return
+        if self.session is not None and self._target == ("127.0.0.1", self.local.port):
+            self.session.close()
+            self.session = None
+            self._target = None
+        self.local.stop()
+        self.local = None
+        self._local_for = None
 
     def _open(self, target, timeout):
         if self.session is not None:
@@ -69,14 +88,15 @@ class Connection:
     def _load(self, name, source):
         if self.session is None:
             raise FootfallError(UNAVAILABLE, "not connected", "load")
-        old = self._terrains.pop(name, None)
-        if old and old[2] is self.session:
+        # The new terrain first: when its upload fails, the old one stays loaded and in use.
+        terrain = self._upload(source)
+        old = self._terrains.get(name)
+        self._terrains[name] = [source, terrain, self.session]
+        if old and old[2] is self.session and old[1] != terrain:
             try:
                 self.session.unload(old[1])
             except FootfallError:
                 pass
-        terrain = self._upload(source)
-        self._terrains[name] = [source, terrain, self.session]
         return terrain
 
     def _upload(self, source):
