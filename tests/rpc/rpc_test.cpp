@@ -892,6 +892,57 @@ TEST_CASE("A server-side load does not hold up the other clients", "[rpc]") {
     CHECK(snap_ok());
     CHECK(ServerTerrains(server.port()).size() == 1);  // b's only
   }
+  SECTION("clients that go away while their loads wait: the loads leave the queue at once") {
+    // Sixteen slow loads fill the queue (two run, fourteen wait); the fourteen waiting clients
+    // go away: their loads are cancelled, and the queue takes new loads while the two still run.
+    ff_load_options_args args = DefaultLoadOptionsArgs("corner.obj");
+    args.separation = 0.004;
+    auto send_load = [&](CLIENT* c, ff_load_reply* reply, timeval wait) {
+      return clnt_call(c, FF_LOAD_OPTIONS, reinterpret_cast<xdrproc_t>(xdr_ff_load_options_args),
+                       reinterpret_cast<char*>(&args),
+                       reinterpret_cast<xdrproc_t>(xdr_ff_load_reply),
+                       reinterpret_cast<char*>(reply), wait);
+    };
+    std::vector<CLIENT*> running, waiting;
+    for (int i = 0; i < 16; ++i) {
+      CLIENT* c = RawClient(server.port());
+      (i < 2 ? running : waiting).push_back(c);
+      ff_load_reply reply{};
+      CHECK(send_load(c, &reply, timeval{0, 20000}) == RPC_TIMEDOUT);
+    }
+    for (CLIENT* c : waiting) clnt_destroy(c);
+    // Within a second (the running loads take seconds), a new load is queued, its reply waiting
+    // for theirs, rather than refused as busy.
+    CLIENT* late = RawClient(server.port());
+    clnt_stat sent = RPC_SUCCESS;
+    std::string refusal;
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+    while (sent == RPC_SUCCESS && std::chrono::steady_clock::now() < until) {
+      ff_load_reply reply{};
+      sent = send_load(late, &reply, timeval{0, 200000});
+      if (sent != RPC_SUCCESS) break;
+      refusal = reply.message ? reply.message : "";
+      xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&reply));
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    INFO(refusal);
+    CHECK(sent == RPC_TIMEDOUT);
+    const auto cancelled = [&] {
+      size_t n = 0;
+      const std::string log = server.Log();
+      for (size_t at = 0; (at = log.find("load of 'corner.obj' cancelled: its connection closed "
+                                         "while it waited its turn",
+                                         at)) != std::string::npos;
+           ++at)
+        ++n;
+      return n;
+    };
+    CHECK(WaitFor([&] { return cancelled() == waiting.size(); }));
+    CHECK(snap_ok());
+    clnt_destroy(late);
+    for (CLIENT* c : running) clnt_destroy(c);
+    CHECK(WIFEXITED(server.Terminate()));
+  }
   SECTION("SIGTERM during a load stops the server at once") {
     std::thread a([&] {
       auto session = Connect(server.port(), 60);

@@ -257,12 +257,37 @@ void ReplyLoaded(Status s, uint32_t handle, const std::string& path, bool upload
 }
 
 // The reply ticket of each load in the LoadQueue.
-std::map<const PendingLoad*, uint64_t> g_load_tickets;
+std::map<PendingLoad*, uint64_t> g_load_tickets;
+
+// Withdraws the loads whose connection has closed: those still waiting leave the queue at once
+// (their reservations released), those running stop at their next stage. Either way nothing is
+// built or kept for a client that has gone.
+void CancelAbandonedLoads() {
+  for (auto it = g_load_tickets.begin(); it != g_load_tickets.end();) {
+    PendingLoad* load = it->first;
+    const uint64_t ticket = it->second;
+    if (HeldReplyOpen(ticket) || load->cancelled.load()) {
+      ++it;
+      continue;
+    }
+    const std::unique_ptr<PendingLoad> withdrawn = g_state->loads->Cancel(load);
+    if (!withdrawn) {
+      ++it;  // running: FinishLoads drops it when it comes back
+      continue;
+    }
+    // Releases the ticket; nothing is sent, the connection being closed.
+    SendHeldReply(ticket, reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), nullptr);
+    g_state->registry.DropLoad(withdrawn.get());
+    Log(std::string(withdrawn->upload ? "upload" : "load of") + " '" + withdrawn->relative_path +
+        "' cancelled: its connection closed while it waited its turn");
+    it = g_load_tickets.erase(it);
+  }
+}
 
 // Queues a prepared load and holds the request's reply for it; false (the load untouched) when
 // the queue is full.
 bool QueueLoad(SVCXPRT* transport, std::unique_ptr<PendingLoad>* load) {
-  const PendingLoad* key = load->get();
+  PendingLoad* key = load->get();
   if (!g_state->loads->Submit(load)) return false;
   g_load_tickets[key] = HoldReply(transport);
   return true;
@@ -785,7 +810,9 @@ void WatchListener(SVCXPRT* listener) {
 }
 
 void ReapConnections() {
-  if (!g_state || g_state->connections.empty()) return;
+  if (!g_state) return;
+  if (!g_load_tickets.empty()) CancelAbandonedLoads();
+  if (g_state->connections.empty()) return;
   // Which sockets are open, by number (one pass, no allocation once grown: this runs after
   // every request, with thousands of connections open).
   static std::vector<char> open;

@@ -54,8 +54,9 @@ int BatchesInProgress();
 void WatchListener(SVCXPRT* listener);
 
 // Forgets the connections libtirpc has closed, ending their uploads and orphaning their
-// terrains. Call after every svc_getreq_poll, so a closed socket is noticed before its number
-// can be reused.
+// terrains, and cancels their server-side loads (those waiting leave the queue at once, those
+// running stop at their next stage). Call after every svc_getreq_poll, so a closed socket is
+// noticed before its number can be reused.
 void ReapConnections();
 
 // Replies to the server-side loads that have finished (LoadQueue::wake_fd() is readable),

@@ -3,6 +3,7 @@
 #include <sys/eventfd.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <new>
 #include <stdexcept>
@@ -59,6 +60,24 @@ bool LoadQueue::Submit(std::unique_ptr<PendingLoad>* load) {
   }
   s.wake_worker[lane].notify_one();
   return true;
+}
+
+std::unique_ptr<PendingLoad> LoadQueue::Cancel(PendingLoad* load) {
+  State& s = *state_;
+  std::lock_guard<std::mutex> lock(s.mutex);
+  for (int lane = 0; lane < kLanes; ++lane) {
+    auto& waiting = s.waiting[lane];
+    const auto it = std::find_if(waiting.begin(), waiting.end(),
+                                 [load](const auto& w) { return w.get() == load; });
+    if (it == waiting.end()) continue;
+    std::unique_ptr<PendingLoad> withdrawn = std::move(*it);
+    waiting.erase(it);
+    --s.in_lane[lane];
+    return withdrawn;
+  }
+  // Running or finished: the worker or TakeFinished holds it, and it lives until taken.
+  load->cancelled = true;
+  return nullptr;
 }
 
 std::vector<std::unique_ptr<PendingLoad>> LoadQueue::TakeFinished() {

@@ -45,6 +45,11 @@ class LoadQueue {
   bool Full(Lane lane) const;
   // Queues a load in its lane; false (the load untouched) when that lane is full.
   bool Submit(std::unique_ptr<PendingLoad>* load);
+  // Withdraws a load whose client has gone: one still waiting leaves its lane at once and is
+  // returned (for its owner to release what it reserved); one running is marked
+  // (PendingLoad::cancelled), ends at its next stage and comes back through TakeFinished, as
+  // does one already finished (nullptr for both).
+  std::unique_ptr<PendingLoad> Cancel(PendingLoad* load);
   // The loads finished since the last call, in the order they finished; clears wake_fd().
   std::vector<std::unique_ptr<PendingLoad>> TakeFinished();
   // Readable (POLLIN) while finished loads wait to be taken.

@@ -280,10 +280,17 @@ void RunLoad(PendingLoad* load) {
   std::string error;
   const std::string pinned = load->pinned ? load->pinned->path() : "";
   load->status = Status::kOk;
-  if (load->pinned) load->status = LoadTerrain(pinned, load->options, &samples, &error);
-  if (load->status == Status::kOk) load->status = ValidateAndNormalize(&samples, &error);
-  if (load->status == Status::kOk)
-    load->status = TerrainGrid::Build(samples, GridOptions{}, &load->grid, &error);
+  // Between stages: a client gone meanwhile has its load stopped, its samples freed.
+  auto go_on = [load, &error] {
+    if (load->status != Status::kOk) return false;
+    if (!load->cancelled.load()) return true;
+    load->status = Status::kUnavailable;
+    error = "'" + load->relative_path + "': cancelled, its client has gone";
+    return false;
+  };
+  if (load->pinned && go_on()) load->status = LoadTerrain(pinned, load->options, &samples, &error);
+  if (go_on()) load->status = ValidateAndNormalize(&samples, &error);
+  if (go_on()) load->status = TerrainGrid::Build(samples, GridOptions{}, &load->grid, &error);
   // Report the path as the client gave it, not the server's layout.
   const size_t at = pinned.empty() ? std::string::npos : error.find(pinned);
   if (at != std::string::npos) error.replace(at, pinned.size(), load->relative_path);

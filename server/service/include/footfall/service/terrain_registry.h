@@ -2,6 +2,7 @@
 // ring of recently answered queries (for live viewers). Not thread-safe: the RPC loop owns it.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <deque>
@@ -53,18 +54,22 @@ struct PendingLoad {
   RawSamples samples;                  // an upload's samples (kept in the budget: `reserved`)
   uint64_t reserved = 0;
   bool upload = false;  // an upload's samples (FF_UPLOAD_FINISH), not a file
+  // Set (from any thread) when the client that asked has gone: RunLoad stops at its next stage
+  // with kUnavailable, and nothing more is built for nobody.
+  std::atomic<bool> cancelled{false};
   // RunLoad's result: on kOk the built grid, else the error (naming relative_path).
   Status status = Status::kInternalError;
   std::string message;
   TerrainGrid grid;
 };
 
-// The middle stage of a load: reads and resamples the pinned file, validates the samples and
-// builds the grid into `load`, whose status and message say how it went.
 // The most samples one server-side load of a mesh or height map may be sampled to: 20,000,000,
 // or fewer when this machine's memory could not hold two such loads sampling at once.
 uint64_t MaxSamplesPerLoad();
 
+// The middle stage of a load: reads and resamples the pinned file, validates the samples and
+// builds the grid into `load`, whose status and message say how it went. A load cancelled
+// meanwhile (PendingLoad::cancelled) ends at the next stage, kUnavailable.
 void RunLoad(PendingLoad* load);
 
 // One answered query, as the live view shows it.
