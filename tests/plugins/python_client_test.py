@@ -805,6 +805,42 @@ class GenerateTest(unittest.TestCase):
         bodies = [tr for tr in walk["tracks"] if tr["kind"] == "body"]
         self.assertEqual(len(bodies), 4)
 
+    def test_a_walk_in_chunks_keeps_its_steps_when_the_server_dies(self):
+        # A server gone in the middle of a walk lost every step made, with a message naming no
+        # step: asked for in chunks, the steps made before the failure are kept.
+        request = {"character_file": self.character, "start": [20.0, 0.0, 12.0],
+                   "heading": [0.0, 0.0, 1.0], "steps": 10, "start_frame": 1}
+        with ff.Session.rpc("127.0.0.1", self.server.port) as s:
+            t = s.load_file(HILLS)
+            whole = s.generate(t, request)
+            done = []
+            self.assertEqual(s.generate(t, request, chunk_steps=3,
+                                        progress=lambda d, n: done.append((d, n))), whole)
+            self.assertEqual(done, [(3, 10), (6, 10), (9, 10), (10, 10)])
+            four = s.generate(t, dict(request, steps=4))
+        dying = ff.LocalServer().start()
+        try:
+            with ff.Session.rpc("127.0.0.1", dying.port, timeout=5.0) as s:
+                t = s.load_file(HILLS)
+
+                def kill_after_second_chunk(done, total):
+                    if done == 4:
+                        dying.kill()
+                with self.assertRaises(ff.WalkStopped) as e:
+                    s.generate(t, request, chunk_steps=2, progress=kill_after_second_chunk)
+                self.assertEqual(e.exception.status_name, "unavailable")
+                self.assertIn("(generating steps 5 to 6); walk stopped, keys up to step 4 kept",
+                              e.exception.message)
+                self.assertEqual(e.exception.walk, four)
+                # In one call, nothing is kept, and the message says so.
+                with self.assertRaises(ff.FootfallError) as e:
+                    s.generate(t, request)
+                self.assertNotIsInstance(e.exception, ff.WalkStopped)
+                self.assertEqual(e.exception.status_name, "unavailable")
+                self.assertIn("no key of the walk was kept", e.exception.message)
+        finally:
+            dying.stop()
+
     def test_generate_bad_request_raises(self):
         with ff.Session.rpc("127.0.0.1", self.server.port) as s:
             t = s.load_file(HILLS)

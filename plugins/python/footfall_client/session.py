@@ -345,9 +345,62 @@ class Session:
         message = self.last_error() if (status != OK or walk is None) else ""
         return status, walk, message
 
-    def generate(self, terrain, request):
+    def generate(self, terrain, request, chunk_steps=0, progress=None):
         """The walk as a dict (footfall's walk JSON). Raises WalkStopped (with .walk holding the
-        keys made so far) when the walk stopped early, FootfallError when nothing was made."""
+        keys made so far) when the walk stopped early, FootfallError when nothing was made.
+
+        The library keeps nothing of a call that fails (the server gone in the middle of a
+        walk): chunk_steps > 0 asks for the walk that many steps at a time, as the plugins key
+        it (the generator is deterministic, so each call's walk starts with the one before;
+        the calls together cost about steps / chunk_steps / 2 walks), and a call that fails
+        after another gave a walk raises WalkStopped with that walk, its message naming the
+        steps that failed. Chunks need the request's "steps" (an integer from 1); without it
+        the walk is asked for in one call. progress(done, total) is called after each chunk."""
+        if isinstance(chunk_steps, bool) or not isinstance(chunk_steps, int) or chunk_steps < 0:
+            raise FootfallError(INVALID_ARGUMENT, "chunk_steps %r: expected a whole number of "
+                                "steps from 0 (one call)" % (chunk_steps,), "ffc_generate")
+        fields = request
+        if isinstance(request, str):
+            try:
+                fields = json.loads(request)
+            except (ValueError, RecursionError):
+                fields = None  # the library says what is wrong with it
+        total = fields.get("steps") if isinstance(fields, dict) else None
+        if (not chunk_steps or isinstance(total, bool) or not isinstance(total, int) or
+                total < 1):
+            try:
+                return self._generate_once(terrain, request)
+            except WalkStopped:
+                raise
+            except FootfallError as e:
+                if e.status != UNAVAILABLE:
+                    raise
+                raise FootfallError(e.status, "%s; no key of the walk was kept (ask for it in "
+                                    "chunks, chunk_steps, to keep the steps made before a "
+                                    "failure)" % e.message, e.call) from None
+        walk, done, keys = None, 0, None
+        while done < total:
+            ask = min(total, done + chunk_steps)
+            try:
+                part = self._generate_once(terrain, dict(fields, steps=ask))
+            except WalkStopped:
+                raise  # stopped (no foothold): its walk holds every key up to the stop
+            except FootfallError as e:
+                if walk is None:
+                    raise
+                raise WalkStopped(e.status, "%s (generating steps %d to %d); walk stopped, keys "
+                                  "up to step %d kept" % (e.message, done + 1, ask, done),
+                                  walk) from None
+            walk, done = part, ask
+            if progress is not None:
+                progress(done, total)
+            count = sum(len(t.get("keys", [])) for t in walk.get("tracks", []))
+            if count == keys:
+                break  # no new step: the walk ended (a path's goal reached) before `total`
+            keys = count
+        return walk
+
+    def _generate_once(self, terrain, request):
         status, text, message = self.generate_json(terrain, request)
         walk = None
         if text is not None:
