@@ -470,32 +470,59 @@ struct BatchInProgress {
   BatchInProgress& operator=(const BatchInProgress&) = delete;
 };
 
+// [Units: s] How long a batch answers between looks at the clock, at most: a query that takes
+// longer is followed by a look of its own. The time limit is held to within this (or one
+// query), while cheap queries are answered in runs long enough that the clock costs nothing.
+constexpr double kLimitCheckS = 0.002;
+
 // Answers queries [0, n) of a batch into g_storage.answers on the batch threads; `answer(b, e)`
-// fills answers [b, e). For a connection that asks again (`in_parts`), chunks taken after the
+// fills answers [b, e). For a connection that asks again (`in_parts`), queries taken after the
 // batch's time limit are answered kLimitExceeded (the first always is answered: every call makes
 // progress).
 template <typename Fn>
 void RunBatch(size_t n, BatchReplyView<Foothold>* r, bool in_parts, Fn&& answer) {
   Foothold* answers = g_storage.answers.data();
-  const auto deadline = in_parts
-                            ? std::chrono::steady_clock::now() +
-                                  std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                      std::chrono::duration<double>(g_state->batch_time_limit_s))
-                            : std::chrono::steady_clock::time_point::max();
+  using Clock = std::chrono::steady_clock;
+  const auto deadline =
+      in_parts ? Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                    std::chrono::duration<double>(g_state->batch_time_limit_s))
+               : Clock::time_point::max();
+  const auto check_every = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(std::min(kLimitCheckS, g_state->batch_time_limit_s / 8)));
   std::atomic<size_t> late{0};
   const BatchInProgress counted;
   g_pool->Run(n, BatchPool::kQueryChunk, [&](size_t begin, size_t end) {
-    // One call may cover the whole batch (one thread): the limit is checked every chunk.
-    for (size_t b = begin; b < end; b += BatchPool::kQueryChunk) {
-      const size_t e = std::min(end, b + BatchPool::kQueryChunk);
-      if (b > 0 && std::chrono::steady_clock::now() > deadline) {
-        for (size_t i = b; i < e; ++i)
-          answers[i] = Foothold{}, answers[i].status = Status::kLimitExceeded;
-        late += e - b;
-        continue;
+    if (!in_parts) {
+      for (size_t b = begin; b < end; b += BatchPool::kQueryChunk) {
+        const size_t e = std::min(end, b + BatchPool::kQueryChunk);
+        answer(b, e, answers);
+        for (size_t i = b; i < e; ++i) ClearFailed(&answers[i]);
       }
+      return;
+    }
+    // One call may cover the whole batch (one thread). Queries are answered in runs sized to
+    // the time they take: a run starts at one query and doubles while it takes under half of
+    // check_every, so costly queries (a `next` of huge tolerance on a large terrain) see the
+    // clock after each one, and cheap ones every kQueryChunk.
+    size_t run = 1;
+    auto now = Clock::now();
+    for (size_t b = begin; b < end;) {
+      if (b > 0 && now > deadline) {
+        for (size_t i = b; i < end; ++i)
+          answers[i] = Foothold{}, answers[i].status = Status::kLimitExceeded;
+        late += end - b;
+        return;
+      }
+      const size_t e = std::min(end, b + run);
       answer(b, e, answers);
       for (size_t i = b; i < e; ++i) ClearFailed(&answers[i]);
+      const auto then = now;
+      now = Clock::now();
+      if (now - then < check_every / 2 && run < BatchPool::kQueryChunk)
+        run *= 2;
+      else if (now - then > check_every && run > 1)
+        run /= 2;
+      b = e;
     }
   });
   if (late > 0)
