@@ -931,6 +931,55 @@ class BlenderAddonTest(unittest.TestCase):
             bpy.data.objects.remove(path)
             bpy.data.curves.remove(data)
 
+    def test_7g_byte_order_marks_and_deep_nesting_in_files(self):
+        # A walk or character file starting with a UTF-8 byte order mark was refused (the
+        # command line reads it); one nested some thousands of levels deep raised
+        # RecursionError through the operator.
+        settings = bpy.context.scene.footfall
+        path = os.path.join(ARGS.work_dir, "hexapod_rig_cli.json")
+        with open(path, "rb") as f:
+            text = f.read()
+        walk = json.loads(text)
+        marked = os.path.join(ARGS.work_dir, "hexapod_bom.json")
+        with open(marked, "wb") as f:
+            f.write(b"\xef\xbb\xbf" + text)
+        saved_rig = settings.rig
+        settings.rig = None
+        self.select([], None)
+        objects = set(bpy.data.objects)
+        try:
+            self.assertEqual(bpy.ops.footfall.import_walk(filepath=marked), {"FINISHED"})
+            feet = {t["name"]: bpy.data.objects["hexapod_bom_" + t["name"]]
+                    for t in walk["tracks"] if t["kind"] == "foot"}
+            self.assert_keys_equal_walk(walk, feet, bpy.data.objects["hexapod_bom_body"])
+            for obj in set(bpy.data.objects) - objects:
+                bpy.data.objects.remove(obj)
+            with open(os.path.join(CHARACTERS, "biped.json"), "rb") as f:
+                character_text = f.read()
+            marked_character = os.path.join(ARGS.work_dir, "biped_bom.json")
+            with open(marked_character, "wb") as f:
+                f.write(b"\xef\xbb\xbf" + character_text)
+            bpy.context.scene.cursor.location = (-2.0, -2.0, 0.0)
+            self.assertEqual(bpy.ops.footfall.character_setup(
+                character_file=marked_character, mode="CREATE", name="marked"), {"FINISHED"})
+            self.assertEqual(len(bpy.data.objects["marked_rig"].footfall_rig.feet), 2)
+            for obj in set(bpy.data.objects) - objects:
+                bpy.data.objects.remove(obj)
+            deep = os.path.join(ARGS.work_dir, "deep.json")
+            with open(deep, "w") as f:
+                f.write('{"tracks": ' + "[" * 100000 + "]" * 100000 + "}")
+            with self.assertRaises(RuntimeError) as e:
+                bpy.ops.footfall.import_walk(filepath=deep)
+            self.assertIn("cannot import %s: %s: nested deeper than 64 levels" % (deep, deep),
+                          str(e.exception))
+            with self.assertRaises(RuntimeError) as e:
+                bpy.ops.footfall.character_setup(character_file=deep, mode="CREATE")
+            self.assertIn("nested deeper than 64 levels", str(e.exception))
+            self.assertNotIn("Traceback", str(e.exception))
+            self.assertEqual(set(bpy.data.objects), objects)
+        finally:
+            settings.rig = saved_rig
+
     def test_8_import_gltf_walk(self):
         out = os.path.join(ARGS.work_dir, "biped_cli.gltf")
         rig = bpy.data.objects["biped_rig"]

@@ -315,6 +315,68 @@ class SharedLogicTest(unittest.TestCase):
                 ff.character.parse(text, "c.json")
             self.assertIn("c.json: " + message, e.exception.message)
 
+    def test_json_files_with_a_byte_order_mark_or_deep_nesting(self):
+        # A character or walk file starting with a UTF-8 byte order mark (as some Windows
+        # editors save) was refused, while `footfall generate` reads it; JSON nested some
+        # hundreds of levels deep raised RecursionError through the plugin.
+        cli = os.environ.get("FOOTFALL_CLI") or os.path.join(REPO, "build", "client", "cli",
+                                                               "footfall")
+        folder = tempfile.mkdtemp()
+        try:
+            plain = os.path.join(CHARACTERS, "biped.json")
+            with open(plain, "rb") as f:
+                text = f.read()
+            marked = os.path.join(folder, "biped_bom.json")
+            with open(marked, "wb") as f:
+                f.write(b"\xef\xbb\xbf" + text)
+            self.assertEqual(ff.character.load(marked), ff.character.load(plain))
+            walks = []
+            for character in (plain, marked):  # the command line reads both alike
+                out = os.path.join(folder, "walk.json")
+                subprocess.run([cli, "generate", "--terrain", HILLS, "--character", character,
+                                "--steps", "2", "--out", out], check=True, capture_output=True)
+                with open(out, "rb") as f:
+                    walks.append(f.read())
+            self.assertEqual(walks[0], walks[1])
+            walk_file = os.path.join(folder, "walk_bom.json")
+            with open(walk_file, "wb") as f:
+                f.write(b"\xef\xbb\xbf" + walks[0])
+            walk = ff.character.read_json(walk_file, "walk file")
+            self.assertEqual(walk, json.loads(walks[0]))
+            ff.character.check_walk(walk, walk_file)
+            # Deep nesting: closed, never closed, inside a character, inside a walk file.
+            depth = ff.character.MAX_JSON_DEPTH
+            for text in ("[" * 100000 + "]" * 100000, "[" * 100000, "{\"a\":" * 5000 + "1" +
+                         "}" * 5000, "[" * (depth + 1) + "]" * (depth + 1)):
+                with self.assertRaises(ff.FootfallError) as e:
+                    ff.character.parse_json(text, "deep.json")
+                self.assertEqual(e.exception.status_name, "parse_error")
+                self.assertEqual(e.exception.message,
+                                 "deep.json: nested deeper than %d levels" % depth)
+            nested = [[]]
+            for _ in range(depth - 2):
+                nested = [nested]
+            self.assertEqual(ff.character.parse_json(json.dumps(nested)), nested)
+            # Brackets inside strings are text, not nesting.
+            self.assertEqual(ff.character.parse_json('{"name": "%s"}' % ("[" * 1000)),
+                             {"name": "[" * 1000})
+            deep_character = os.path.join(folder, "deep.json")
+            with open(deep_character, "w") as f:
+                f.write('{"feet": ' + "[" * 5000 + "]" * 5000 + "}")
+            with self.assertRaises(ff.FootfallError) as e:
+                ff.character.load(deep_character)
+            self.assertIn("nested deeper than %d levels" % depth, e.exception.message)
+            with open(walk_file, "w") as f:
+                f.write('{"tracks": ' + "[" * 5000 + "]" * 5000 + "}")
+            with self.assertRaises(ff.FootfallError) as e:
+                ff.character.read_json(walk_file, "walk file")
+            self.assertEqual(e.exception.message, "%s: nested deeper than %d levels"
+                             % (walk_file, depth))
+        finally:
+            for name in os.listdir(folder):
+                os.unlink(os.path.join(folder, name))
+            os.rmdir(folder)
+
     def test_walk_files_are_checked_before_anything_is_keyed(self):
         good = {"tracks": [{"name": "L", "kind": "foot", "keys": [
             {"frame": 1, "position": [0, 0, 0]}]}, {"name": "body", "kind": "body", "keys": [

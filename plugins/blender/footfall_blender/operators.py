@@ -748,7 +748,7 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
             if path.lower().endswith((".gltf", ".glb")):
                 walk = self._walk_from_gltf(context, path)
             else:
-                walk = json.loads(character.read_text(path, "walk file"))
+                walk = character.read_json(path, "walk file")
             character.check_walk(walk, path)  # before anything is made
             keying.check_frames(walk)
             crowd = sorted({t.get("character", "") for t in walk["tracks"]})

@@ -302,7 +302,7 @@ def _main_progress_bar():
 def import_walk(path, rig=None):
     """Keys a footfall walk JSON file onto `rig` (or new locators, one set per character of a
     crowd). Nothing is changed unless the walk keys something."""
-    walk = json.loads(ffc.character.read_text(path, "walk file"))
+    walk = ffc.character.read_json(path, "walk file")
     ffc.character.check_walk(walk, path)  # before any locator is made
     crowd = sorted({t.get("character", "") for t in walk["tracks"]})
     if rig:

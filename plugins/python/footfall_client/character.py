@@ -5,6 +5,7 @@ Pure Python; footfall's frame (Y up, the character facing +Z, +X its left)."""
 import json
 import math
 import os
+import re
 import stat
 
 from .session import INVALID_ARGUMENT, FootfallError
@@ -33,16 +34,67 @@ def read_text(path, what="file"):
         raise FootfallError(6, "%s: not UTF-8 text (byte %d)" % (shown, e.start), what) from None
 
 
+# Nesting deeper than this is refused in character and walk files (theirs is 4 or 5 levels):
+# Python's JSON reader recurses once a level, and ran out of stack (RecursionError) on a file
+# nested some hundreds of levels deep, fewer on the deeper stack of a DCC's command.
+MAX_JSON_DEPTH = 64
+
+_JSON_STRING = re.compile(r'"(?:[^"\\]|\\.)*"', re.S)
+_NOT_BRACKET = re.compile(r"[^\[\]{}]+")
+_INNERMOST = re.compile(r"\[\]|\{\}")
+
+
+def _deeper(brackets, levels):
+    """True when `brackets` (a JSON text's brackets only) nest more than `levels` deep. Each
+    pass removes the innermost pairs in one regular-expression substitution: a long walk file
+    costs a few passes, not a Python loop over its text."""
+    for _ in range(levels):
+        brackets, removed = _INNERMOST.subn("", brackets)
+        if not removed:
+            return False
+    return bool(_INNERMOST.search(brackets))
+
+
+def _nested_deeper_than(text, levels):
+    """True when the JSON text nests arrays and objects more than `levels` deep. Its brackets
+    are counted first strings and all (fast), and a text that looks too deep is looked at
+    again without its strings (skipping strings takes a tenth of a second for 4 MB of walk).
+    (Brackets in strings may hide nesting from the first look: json.loads's RecursionError
+    is the backstop.)"""
+    if not _deeper(_NOT_BRACKET.sub("", text), levels):
+        return False
+    return _deeper(_NOT_BRACKET.sub("", _JSON_STRING.sub("", text)), levels)
+
+
+def parse_json(text, name="JSON", call="json"):
+    """JSON text as Python values, read as footfall's C++ reader reads it: a UTF-8 byte order
+    mark at the start is skipped. FootfallError parse_error naming `name` for malformed JSON
+    or JSON nested deeper than MAX_JSON_DEPTH levels."""
+    if text.startswith("\ufeff"):
+        text = text[1:]
+    too_deep = FootfallError(6, "%s: nested deeper than %d levels" % (name, MAX_JSON_DEPTH), call)
+    if _nested_deeper_than(text, MAX_JSON_DEPTH):
+        raise too_deep
+    try:
+        return json.loads(text)
+    except ValueError as e:
+        raise FootfallError(6, "%s: %s" % (name, e), call) from None
+    except RecursionError:  # (malformed: brackets never closed)
+        raise too_deep from None
+
+
+def read_json(path, what="file"):
+    """The JSON value of the file at `path` (see read_text and parse_json)."""
+    return parse_json(read_text(path, what), path, what)
+
+
 def load(path):
     """The character file at `path` as a dict; FootfallError (io_error/parse_error) otherwise."""
     return parse(read_text(path, "character file"), path)
 
 
 def parse(text, name="character"):
-    try:
-        data = json.loads(text)
-    except ValueError as e:
-        raise FootfallError(6, "%s: %s" % (name, e), "character") from None
+    data = parse_json(text, name, "character")
     pairs(data, name)  # validates the feet and the pairs
     return data
 
