@@ -189,6 +189,35 @@ TEST_CASE("Walks up and down a 20-degree ramp", "[steps][generator]") {
   }
 }
 
+TEST_CASE("A walk across a slope keeps its line and does not drift uphill", "[steps][generator]") {
+  // The central locators are placed lead/2 above the ground and snapped: on ground leaning
+  // across the heading they slid uphill, and a biped crossing a 25-degree slope climbed 2 m
+  // over 10 m walked.
+  for (const std::string& name : ShippedCharacters()) {
+    const Character c = LoadShipped(name);
+    for (const double slope : {15.0, 25.0, 35.0}) {
+      INFO(name << ", " << slope << " degrees");
+      const double spacing = c.step_length / 10, rad = slope * kPi / 180;
+      const int nx = static_cast<int>((20 * c.step_length + 4 * c.reach) / spacing);
+      const int nz = static_cast<int>(8 * c.reach / spacing);
+      Terrain t = LoadTerrain(MakeRamp(nx, nz, spacing, slope), spacing);
+      const double d = nz * spacing / 2;  // along the ramp's surface
+      GenerateOptions o;
+      o.has_start = true;
+      o.start = {2 * c.reach, std::sin(rad) * d, std::cos(rad) * d};
+      o.heading = {1, 0, 0};
+      o.steps = 30;
+      const Walk w = Generate(t, c, o);
+      INFO(w.stopped);
+      REQUIRE(w.stopped.empty());
+      CheckWalk(t, c, o, w);
+      const Vec3 moved = Body(w).keys.back().position - Body(w).keys.front().position;
+      CHECK(moved.x > 5 * c.step_length);
+      CHECK(std::fabs(moved.z) < 0.03 * moved.x);
+    }
+  }
+}
+
 TEST_CASE("Steps are shorter on a slope past the threshold", "[steps][generator]") {
   const Character c = LoadShipped("biped");
   const double spacing = 0.05;

@@ -1452,12 +1452,24 @@ Status Generator::QueryFootholds(std::string* error) {
             // it drew the feet sideways into the wall), and on a face across the heading (a wall
             // beside the body, rather than a riser ahead) its height too, as over a gap (aimed at
             // the wall's height, steps beside it were a third of step_length).
+            const Vec3 left = Left(a);
             if (Dot(h.normal, a.up) < cos_max_slope_) {
-              const Vec3 left = Left(a);
               if (std::fabs(Dot(h.normal, left)) > std::fabs(Dot(h.normal, a.forward)))
                 locator_[m] = placed - a.up * (0.5 * lead_), locator_normal_[m] = a.up;
               else
                 locator_[m] -= left * Dot(h.point - placed, left);
+            } else if (!c_.align_to_normal) {
+              // Snapped from lead/2 above along the world up, onto ground leaning across the
+              // heading, it slid toward the high side by up to lead/4 (a biped crossing a
+              // 25-degree slope climbed 2 m in 10): it slides back along the ground to where
+              // it was placed across the heading. (Not past what the lean explains: an edge
+              // beside it. Multipeds' up is the ground's normal: they slide along it.)
+              const Vec3 across = ProjectOnPlane(left, h.normal);
+              const double lean = std::fabs(Dot(h.normal, left));
+              const double off = Dot(h.point - placed, left);
+              const double keep = Dot(across, left);  // 1 - lean^2
+              if (keep > 0.25 && std::fabs(off) <= 0.5 * lead_ * lean + 0.5 * gap_)
+                locator_[m] -= across * (off / keep);
             }
           } else {
             locator_[m] = placed - a.up * (0.5 * lead_), locator_normal_[m] = a.up;
