@@ -29,6 +29,7 @@
 #include <catch2/catch.hpp>
 
 #include "footfall.h"
+#include "footfall/client/recent_queries.h"
 #include "footfall/client/terrain_session.h"
 #include "footfall/import/terrain_generators.h"
 #include "server_process.h"
@@ -1567,6 +1568,19 @@ TEST_CASE("footfalld listens on IPv6 addresses and logs them in brackets", "[rpc
     TerrainHandle t = 0;
     REQUIRE(rpc->LoadSamples(MakeFlat(10, 1, 0), "v6", &t) == Status::kOk);
     CHECK(rpc->Snap(t, Vec3{3.2, 1, 4.7}).point == Vec3{3, 0, 5});
+    // Messages name the server as --listen and --server read it: in brackets.
+    const std::string address = "[::1]:" + std::to_string(server.port());
+    CHECK(rpc->Describe() == "rpc " + address);
+    RecentQueryFeed feed(o);
+    CHECK(feed.Address() == address);
+    server.Kill();
+    CHECK(rpc->Snap(t, Vec3{3.2, 1, 4.7}).status == Status::kUnavailable);
+    CHECK_THAT(rpc->last_error(), Catch::Contains("footfalld at " + address + ": "));
+    CHECK(rpc->Snap(t, Vec3{3.2, 1, 4.7}).status == Status::kUnavailable);
+    CHECK_THAT(rpc->last_error(), Catch::Contains("footfalld at " + address + ": "));
+    std::vector<RecentQuery> recent;
+    CHECK(feed.Poll(&recent) == Status::kUnavailable);
+    CHECK_THAT(feed.last_error(), Catch::Contains(address));
   }
   const TempRoot temp;
   auto run = [&](const std::string& listen) {

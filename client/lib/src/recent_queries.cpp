@@ -33,7 +33,7 @@ RecentQueryFeed::RecentQueryFeed(const RpcOptions& options)
 RecentQueryFeed::~RecentQueryFeed() { Disconnect(); }
 
 std::string RecentQueryFeed::Address() const {
-  return options_.host + ":" + std::to_string(options_.port);
+  return FormatHostPort(options_.host, options_.port);
 }
 
 Status RecentQueryFeed::Fail(Status status, std::string message) {

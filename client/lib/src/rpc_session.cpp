@@ -185,7 +185,7 @@ class RpcSession final : public TerrainSession {
   }
 
   std::string Describe() const override {
-    return "rpc " + options_.host + ":" + std::to_string(options_.port);
+    return "rpc " + FormatHostPort(options_.host, options_.port);
   }
   bool InProcess() const override { return false; }
 
@@ -444,7 +444,7 @@ class RpcSession final : public TerrainSession {
                 std::string(what) + ": footfalld at " + Address() + ": " + reason);
   }
 
-  std::string Address() const { return options_.host + ":" + std::to_string(options_.port); }
+  std::string Address() const { return FormatHostPort(options_.host, options_.port); }
 
   void Disconnect() {
     if (client_) {

@@ -62,4 +62,10 @@ Status ParseHostPort(const std::string& text, RpcOptions* options, std::string* 
   return Status::kOk;
 }
 
+std::string FormatHostPort(const std::string& host, int port) {
+  // Only IPv6 addresses hold colons (host names and IPv4 addresses never do).
+  const bool v6 = host.find(':') != std::string::npos;
+  return (v6 ? "[" + host + "]" : host) + ":" + std::to_string(port);
+}
+
 }  // namespace footfall

@@ -47,7 +47,7 @@ class RecentQueryFeed {
   uint64_t after() const { return after_; }
   // Queries the server recorded but dropped from its ring before they were polled.
   uint64_t missed() const { return missed_; }
-  // "HOST:PORT".
+  // "HOST:PORT", an IPv6 address in brackets ("[::1]:7407").
   std::string Address() const;
   // Why the last call failed, one line naming the server.
   const std::string& last_error() const { return last_error_; }

@@ -111,4 +111,8 @@ std::unique_ptr<TerrainSession> MakeRpcSession(const RpcOptions& options);
 // port, as footfalld's --listen takes it) into options->host and options->port.
 Status ParseHostPort(const std::string& text, RpcOptions* options, std::string* error);
 
+// "HOST:PORT" for messages, an IPv6 address in brackets ("[::1]:7407"), as ParseHostPort and
+// footfalld's --listen read it back.
+std::string FormatHostPort(const std::string& host, int port);
+
 }  // namespace footfall
