@@ -395,6 +395,9 @@ class Generator {
   void Stop(Agent& a, int step, const std::string& why);
   // Takes back the foot keys of a step that started at frame f0 (its body not yet keyed).
   void UnkeyStep(const Agent& a, double f0);
+  // A call that failed during step k (footfalld gone): every character of the pass still
+  // walking stops at that step with `why`, its keys of the step taken back, body's too.
+  void StopPassAt(int k, const std::string& why);
   // A failed batch call: the session's status, and its message prefixed with `what`.
   Status Check(Status status, const char* what, std::string* error) {
     if (status != Status::kOk) *error = std::string(what) + ": " + session_.last_error();
@@ -421,6 +424,9 @@ class Generator {
   // cos(max_slope_deg), sin(slope_threshold_deg): slope tests on dot products of unit vectors.
   double cos_max_slope_ = -1, sin_slope_threshold_ = 1;
   size_t pass_begin_ = 0, pass_end_ = 0;  // the agents walking in this pass
+  // One pass walks every character: a call failing after the first step stops the walk there,
+  // its keys so far kept (with several passes, later ones would have no keys at all).
+  bool keep_on_failure_ = false;
   std::shared_ptr<BatchPool> pool_;
   std::vector<int> pair_of_foot_;
   // Each foot's other foot across the body, whose side it keeps to (PairGap, GapToMate): its
@@ -732,6 +738,7 @@ Status Generator::Run(std::string* error) {
     per_pass_option = session_.InProcess() ? kInProcessCharactersPerPass : -1;
   const size_t per_pass = per_pass_option > 0 ? static_cast<size_t>(per_pass_option) : n;
   const size_t passes = (n + per_pass - 1) / per_pass;
+  keep_on_failure_ = passes == 1;
   Progress progress(o_.progress, int64_t{steps_} * static_cast<int64_t>(passes));
   if (session_.InProcess() && threads_ > 1 && passes > 1) {
     s = WalkPassesInParallel(passes, per_pass, &progress, error);
@@ -813,7 +820,12 @@ Status Generator::WalkPass(size_t begin, size_t end, Progress* progress, std::st
     for (size_t i = begin; i < end && !any; ++i) any = agents_[i].walking;
     if (!any) break;
     const Status s = Step(k, error);
-    if (s != Status::kOk) return s;
+    if (s != Status::kOk) {
+      if (k == 0 || !keep_on_failure_) return s;
+      StopPassAt(k, *error);
+      error->clear();
+      break;
+    }
     progress->Add(1);
   }
   progress->Add(steps_ - k);  // the steps left when every character stopped or arrived
@@ -1218,6 +1230,19 @@ void Generator::UnkeyStep(const Agent& a, double f0) {
       keys.back().phase = KeyPhase::kEnd;
     else
       keys.pop_back();
+  }
+}
+
+void Generator::StopPassAt(int k, const std::string& why) {
+  const double f0 = o_.start_frame + static_cast<double>(k) * c_.frames_per_step;
+  for (size_t i = pass_begin_; i < pass_end_; ++i) {
+    Agent& a = agents_[i];
+    if (!a.walking) continue;
+    UnkeyStep(a, f0);
+    WalkTrack& body = walk_.tracks[a.first_track + c_.feet.size()];
+    while (!body.keys.empty() && body.keys.back().frame > f0) body.keys.pop_back();
+    if (body.rotations.size() > body.keys.size()) body.rotations.resize(body.keys.size());
+    Stop(a, k + 1, why);
   }
 }
 
