@@ -1239,6 +1239,80 @@ TEST_CASE("one connection holds at most 4 uploads, and an upload without samples
   RequireServed(server.port());
 }
 
+TEST_CASE("an upload whose finish is refused as busy is kept while its client asks again",
+          "[rpc]") {
+  // Sixteen loads of a large point file fill the lane that builds point files and upload grids
+  // past --upload-timeout: each finish refused as busy keeps the upload, which the client library
+  // finishes again until footfalld has room.
+  const TempRoot temp;
+  {
+    std::ofstream big(temp.path + "/big.pts");
+    for (int i = 0; i < 600000; ++i)
+      big << i % 600 << " " << (i * 7) % 13 << " " << i / 600 << " 0 1 0\n";
+  }
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", temp.path, "--upload-timeout", "0.25"});
+  CLIENT* c = RawClient(server.port());
+  std::string message;
+  uint32_t upload = 0;
+  REQUIRE(BeginUpload(c, 3, &upload, &message) == FF_OK);
+  REQUIRE(SendChunk(c, upload,
+                    {ff_sample{{0, 0, 0}, {0, 1, 0}}, ff_sample{{1, 0, 0}, {0, 1, 0}},
+                     ff_sample{{0, 0, 1}, {0, 1, 0}}},
+                    &message) == FF_OK);
+  // Sent at once on raw sockets, replies not read: the lane is full before the first is built.
+  std::vector<unsigned char> args;
+  Put32(&args, 7);
+  for (const char ch : std::string("big.pts\0", 8)) args.push_back(static_cast<unsigned char>(ch));
+  PutDouble(&args, 0);
+  const std::vector<unsigned char> record = CallRecord(1, FF_LOAD, args);
+  std::vector<int> loaders;
+  for (int i = 0; i < 16; ++i) {
+    loaders.push_back(RawConnect(server.port()));
+    REQUIRE(SendSome(loaders.back(), record) == record.size());
+  }
+  // A seventeenth is refused: the lane is full.
+  CLIENT* probe = RawClient(server.port());
+  ff_load_args load{const_cast<char*>("big.pts"), 0};
+  ff_load_reply refused{};
+  REQUIRE(ff_load_1(&load, &refused, probe) == RPC_SUCCESS);
+  CHECK(refused.status == FF_UNAVAILABLE);
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&refused));
+  clnt_destroy(probe);
+  // Asks to finish, refused as busy, for longer than --upload-timeout; another client's new
+  // upload then drops the uploads idle that long.
+  auto finish = [&] {
+    ff_upload_args args{upload};
+    ff_load_reply loaded{};
+    REQUIRE(ff_upload_finish_1(&args, &loaded, c) == RPC_SUCCESS);
+    message = loaded.message ? loaded.message : "";
+    const ff_status status = loaded.status;
+    xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&loaded));
+    return status;
+  };
+  for (int i = 0; i < 3; ++i) {
+    if (i > 0) std::this_thread::sleep_for(std::chrono::milliseconds(150));
+    INFO("finish " << i);
+    CHECK(finish() == FF_UNAVAILABLE);
+  }
+  CLIENT* other = RawClient(server.port());
+  uint32_t unused = 0;
+  std::string other_message;
+  CHECK(BeginUpload(other, 3, &unused, &other_message) == FF_OK);
+  clnt_destroy(other);
+  ff_status status = FF_UNAVAILABLE;
+  const auto begin = std::chrono::steady_clock::now();
+  while (status == FF_UNAVAILABLE &&
+         std::chrono::steady_clock::now() - begin < std::chrono::seconds(60)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    status = finish();
+  }
+  INFO(message);
+  CHECK(status == FF_OK);
+  CHECK_THAT(server.Log(), !Catch::Contains("' dropped: no samples"));
+  for (const int l : loaders) close(l);
+  clnt_destroy(c);
+}
+
 TEST_CASE("footfalld refuses uploaded samples out of range, per chunk", "[rpc]") {
   ServerProcess server;
   CLIENT* c = RawClient(server.port());

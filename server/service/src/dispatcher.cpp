@@ -351,7 +351,9 @@ bool StartUploadFinish(SVCXPRT* transport, const ff_upload_args& a, uint64_t cli
   std::string message;
   Status s = Status::kOk;
   if (g_state->loads->Full(LoadQueue::kBuilding)) {
-    // Refused before the upload is touched: the client may ask to finish it again.
+    // Refused before the upload is taken: the client may ask to finish it again, and asking
+    // keeps it from being dropped as idle meanwhile.
+    g_state->registry.TouchUpload(a.upload, client);
     s = Status::kUnavailable;
     message = QueueFullMessage(LoadQueue::kBuilding);
   } else {

@@ -413,6 +413,12 @@ Status TerrainRegistry::PrepareFinishUpload(uint32_t upload, uint64_t owner, Pen
   return Status::kOk;
 }
 
+void TerrainRegistry::TouchUpload(uint32_t upload, uint64_t owner) {
+  const auto it = uploads_.find(upload);
+  if (it != uploads_.end() && it->second.owner == owner)
+    it->second.touched = std::chrono::steady_clock::now();
+}
+
 Status TerrainRegistry::Unload(uint32_t handle, uint64_t requester, std::string* message) {
   auto it = terrains_.find(handle);
   if (it == terrains_.end()) {

@@ -25,7 +25,7 @@ struct RegistryLimits {
   size_t max_uploads = 32;              // in progress at once
   size_t max_client_uploads = 4;        // in progress at once on one connection
   // [Units: s] an upload that receives no samples this long is dropped (empty chunks do not
-  // count)
+  // count; asking to finish it while footfalld is too busy to build it does)
   double upload_idle_s = 120;
   size_t recent_capacity = 4096;  // queries kept for FF_RECENT
 };
@@ -119,6 +119,9 @@ class TerrainRegistry {
                              std::string* message);
   // Forgets a prepared load that will not be finished (its client went away).
   void DropLoad(PendingLoad* load);
+  // Counts as activity on `owner`'s complete upload, for RegistryLimits::upload_idle_s: its
+  // finish was refused because footfalld was busy, and the client will ask again.
+  void TouchUpload(uint32_t upload, uint64_t owner);
   // Ends the uploads of a client that went away, releasing their reservations, and orphans its
   // terrains (they stay queryable until RegistryLimits::orphan_idle_s pass without a query).
   // Returns the handles orphaned.
