@@ -349,12 +349,12 @@ class Session:
         """The walk as a dict (footfall's walk JSON). Raises WalkStopped (with .walk holding the
         keys made so far) when the walk stopped early, FootfallError when nothing was made.
 
-        The library keeps nothing of a call that fails (the server gone in the middle of a
-        walk): chunk_steps > 0 asks for the walk that many steps at a time, as the plugins key
-        it (the generator is deterministic, so each call's walk starts with the one before;
-        the calls together cost about steps / chunk_steps / 2 walks), and a call that fails
-        after another gave a walk raises WalkStopped with that walk, its message naming the
-        steps that failed. Chunks need the request's "steps" (an integer from 1); without it
+        A server that dies after the walk's first step stops it there (WalkStopped, its walk
+        kept by the library); one gone before it fails the call. chunk_steps > 0 asks for the
+        walk that many steps at a time, as the plugins key it (the generator is deterministic,
+        so each call's walk starts with the one before; the calls together cost about
+        steps / chunk_steps / 2 walks), and a call that fails after another gave a walk raises
+        WalkStopped with that walk, its message naming the steps that failed. Chunks need the request's "steps" (an integer from 1); without it
         the walk is asked for in one call. progress(done, total) is called after each chunk."""
         if isinstance(chunk_steps, bool) or not isinstance(chunk_steps, int) or chunk_steps < 0:
             raise FootfallError(INVALID_ARGUMENT, "chunk_steps %r: expected a whole number of "
