@@ -236,6 +236,14 @@ ff_load_options_args DefaultLoadOptionsArgs(const char* path) {
   return args;
 }
 
+// Calls FF_LOAD_OPTIONS with `args` on c, waiting at most `wait` for the reply (a short wait
+// sends the load and leaves its reply unread).
+clnt_stat CallLoad(CLIENT* c, ff_load_options_args* args, ff_load_reply* reply, timeval wait) {
+  return clnt_call(c, FF_LOAD_OPTIONS, reinterpret_cast<xdrproc_t>(xdr_ff_load_options_args),
+                   reinterpret_cast<char*>(args), reinterpret_cast<xdrproc_t>(xdr_ff_load_reply),
+                   reinterpret_cast<char*>(reply), wait);
+}
+
 // The handles of the terrains footfalld holds, in its order (FF_LIST).
 std::vector<uint32_t> ServerTerrains(int port) {
   CLIENT* c = RawClient(port);
@@ -921,9 +929,7 @@ TEST_CASE("A server-side load does not hold up the other clients", "[rpc]") {
     args.separation = 0.004;
     ff_load_reply reply{};
     timeval brief{0, 200000};
-    CHECK(clnt_call(a, FF_LOAD_OPTIONS, reinterpret_cast<xdrproc_t>(xdr_ff_load_options_args),
-                    reinterpret_cast<char*>(&args), reinterpret_cast<xdrproc_t>(xdr_ff_load_reply),
-                    reinterpret_cast<char*>(&reply), brief) == RPC_TIMEDOUT);
+    CHECK(CallLoad(a, &args, &reply, brief) == RPC_TIMEDOUT);
     clnt_destroy(a);
     CHECK(snap_ok());
     for (int i = 0; i < 600 && server.Log().find("dropped") == std::string::npos; ++i)
@@ -940,10 +946,7 @@ TEST_CASE("A server-side load does not hold up the other clients", "[rpc]") {
     ff_load_options_args args = DefaultLoadOptionsArgs("corner.obj");
     args.separation = 0.004;
     auto send_load = [&](CLIENT* c, ff_load_reply* reply, timeval wait) {
-      return clnt_call(c, FF_LOAD_OPTIONS, reinterpret_cast<xdrproc_t>(xdr_ff_load_options_args),
-                       reinterpret_cast<char*>(&args),
-                       reinterpret_cast<xdrproc_t>(xdr_ff_load_reply),
-                       reinterpret_cast<char*>(reply), wait);
+      return CallLoad(c, &args, reply, wait);
     };
     std::vector<CLIENT*> running, waiting;
     for (int i = 0; i < 16; ++i) {
@@ -1005,10 +1008,7 @@ TEST_CASE("A server-side load does not hold up the other clients", "[rpc]") {
     ff_load_options_args args = DefaultLoadOptionsArgs("corner.obj");
     args.separation = 0.004;
     auto send_load = [&](CLIENT* c, ff_load_reply* reply, timeval wait) {
-      return clnt_call(c, FF_LOAD_OPTIONS, reinterpret_cast<xdrproc_t>(xdr_ff_load_options_args),
-                       reinterpret_cast<char*>(&args),
-                       reinterpret_cast<xdrproc_t>(xdr_ff_load_reply),
-                       reinterpret_cast<char*>(reply), wait);
+      return CallLoad(c, &args, reply, wait);
     };
     for (int i = 0; i < 16; ++i) {
       clients.push_back(RawClient(server.port()));
@@ -1046,10 +1046,7 @@ TEST_CASE("The client library waits while footfalld's load queue is full, then l
     ff_load_reply reply{};
     const timeval brief{0, 20000};  // sent, not waited for
     clients.push_back(RawClient(server.port()));
-    return clnt_call(clients.back(), FF_LOAD_OPTIONS,
-                     reinterpret_cast<xdrproc_t>(xdr_ff_load_options_args),
-                     reinterpret_cast<char*>(&args), reinterpret_cast<xdrproc_t>(xdr_ff_load_reply),
-                     reinterpret_cast<char*>(&reply), brief);
+    return CallLoad(clients.back(), &args, &reply, brief);
   };
   for (int i = 0; i < 16; ++i) CHECK(send_load(i < 2 ? 0.004 : 0.1) == RPC_TIMEDOUT);
   RpcOptions o;

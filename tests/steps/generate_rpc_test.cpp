@@ -1,5 +1,6 @@
 // The step generator over RPC against a real footfalld on loopback: a server that dies in the
 // middle of a walk leaves the walk made so far, stopped at the step it died in.
+#include <memory>
 #include <string>
 
 #include <catch2/catch.hpp>
@@ -38,6 +39,21 @@ bool SameKeys(const Walk& a, const Walk& b) {
   return true;
 }
 
+// `samples` loaded into a real footfalld through an RPC session with short timeouts.
+struct ServedTerrain {
+  explicit ServedTerrain(const RawSamples& samples) {
+    RpcOptions ro;
+    ro.port = server.port();
+    ro.call_timeout_s = 2;
+    ro.connect_timeout_s = 0.5;
+    rpc = MakeRpcSession(ro);
+    REQUIRE(rpc->LoadSamples(samples, "flat", &handle) == Status::kOk);
+  }
+  ServerProcess server;
+  std::unique_ptr<TerrainSession> rpc;
+  TerrainHandle handle = 0;
+};
+
 }  // namespace
 
 TEST_CASE("A walk over RPC whose server dies keeps its steps up to the one it died in",
@@ -48,14 +64,7 @@ TEST_CASE("A walk over RPC whose server dies keeps its steps up to the one it di
     const double spacing = c.step_length / 10;
     const RawSamples samples =
         MakeFlat(static_cast<int>((60 * c.step_length + 8 * c.reach) / spacing), spacing, 0);
-    ServerProcess server;
-    RpcOptions ro;
-    ro.port = server.port();
-    ro.call_timeout_s = 2;
-    ro.connect_timeout_s = 0.5;
-    auto rpc = MakeRpcSession(ro);
-    TerrainHandle handle = 0;
-    REQUIRE(rpc->LoadSamples(samples, "flat", &handle) == Status::kOk);
+    ServedTerrain served(samples);
 
     // The server is killed once the walk has done `kill_after` steps.
     constexpr int kill_after = 7;
@@ -64,11 +73,11 @@ TEST_CASE("A walk over RPC whose server dies keeps its steps up to the one it di
     o.start = {4 * c.reach, 0, 4 * c.reach};
     o.steps = 40;
     o.progress = [&](int done, int) {
-      if (done == kill_after) server.Kill();
+      if (done == kill_after) served.server.Kill();
     };
     Walk w;
     std::string error;
-    REQUIRE(GenerateWalk(*rpc, handle, c, o, &w, &error) == Status::kOk);
+    REQUIRE(GenerateWalk(*served.rpc, served.handle, c, o, &w, &error) == Status::kOk);
     INFO(w.stopped);
     // Stopped at the next step, with the failed call named, its keys those of a walk of
     // kill_after steps.
@@ -90,20 +99,13 @@ TEST_CASE("A walk over RPC whose server is gone before its first step fails with
           "[steps][rpc]") {
   const Character c = LoadShipped("biped");
   const RawSamples samples = MakeFlat(200, 0.07, 0);
-  ServerProcess server;
-  RpcOptions ro;
-  ro.port = server.port();
-  ro.call_timeout_s = 2;
-  ro.connect_timeout_s = 0.5;
-  auto rpc = MakeRpcSession(ro);
-  TerrainHandle handle = 0;
-  REQUIRE(rpc->LoadSamples(samples, "flat", &handle) == Status::kOk);
-  server.Kill();
+  ServedTerrain served(samples);
+  served.server.Kill();
   GenerateOptions o;
   o.steps = 10;
   Walk w;
   std::string error;
-  CHECK(GenerateWalk(*rpc, handle, c, o, &w, &error) == Status::kUnavailable);
+  CHECK(GenerateWalk(*served.rpc, served.handle, c, o, &w, &error) == Status::kUnavailable);
   CHECK_THAT(error, Catch::Contains("footfalld at 127.0.0.1:"));
   CHECK(w.tracks.empty());
 }

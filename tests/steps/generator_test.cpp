@@ -160,6 +160,12 @@ GenerateOptions StartOptions(const Vec3& start, int steps) {
   return o;
 }
 
+// A flat square `side` wide at y = 0, sampled at a tenth of c's step, loaded.
+Terrain FlatFor(const Character& c, double side) {
+  const double spacing = c.step_length / 10;
+  return LoadTerrain(MakeFlat(static_cast<int>(side / spacing), spacing, 0), spacing);
+}
+
 // A crowd of `crowd` characters `spacing` apart around `start`, walking `steps` steps.
 GenerateOptions CrowdOptions(const Vec3& start, int steps, int crowd, double spacing) {
   GenerateOptions o = StartOptions(start, steps);
@@ -956,9 +962,8 @@ TEST_CASE("Any heading, not only +Z", "[steps][generator]") {
 TEST_CASE("The heading follows a path with a 90-degree turn", "[steps][generator]") {
   for (const std::string& name : ShippedCharacters()) {
     const Character c = LoadShipped(name);
-    const double leg = 10 * c.step_length, margin = 4 * c.reach, spacing = c.step_length / 10;
-    const int n = static_cast<int>((leg + 2 * margin) / spacing);
-    Terrain t = LoadTerrain(MakeFlat(n, spacing, 0), spacing);
+    const double leg = 10 * c.step_length, margin = 4 * c.reach;
+    Terrain t = FlatFor(c, leg + 2 * margin);
     INFO(name);
     GenerateOptions o;
     o.has_start = true;
@@ -999,9 +1004,8 @@ TEST_CASE("A path drawn from where the character stands starts facing its next w
   // the default heading (+Z) and turned round toward the goal behind it.
   for (const std::string& name : ShippedCharacters()) {
     const Character c = LoadShipped(name);
-    const double leg = 8 * c.step_length, margin = 4 * c.reach, spacing = c.step_length / 10;
-    const int n = static_cast<int>((leg + 2 * margin) / spacing);
-    Terrain t = LoadTerrain(MakeFlat(n, spacing, 0), spacing);
+    const double leg = 8 * c.step_length, margin = 4 * c.reach;
+    Terrain t = FlatFor(c, leg + 2 * margin);
     INFO(name);
     GenerateOptions o;
     o.has_start = true;
