@@ -203,6 +203,34 @@ TEST_CASE("Height maps: a UTF-8 byte order mark is skipped", "[import][heightmap
   CHECK(map.heights[1] == 2);
 }
 
+TEST_CASE("ReadPgm: bytes after a binary image's pixels are refused", "[import][heightmap]") {
+  test::TempDir dir;
+  HeightMap map;
+  std::string error;
+  const std::string pixels("\x01\x02\x03\x04\x05\x06", 6);
+  SECTION("a header ended in CR LF is refused: its LF would be read as the first pixel") {
+    CHECK(ReadPgm(dir.Write("crlf.pgm", "P5\r\n3 2\r\n255\r\n" + pixels), &map, &error) ==
+          Status::kParseError);
+    CHECK(Contains(error, "crlf.pgm:3: the maxval is followed by CR LF"));
+  }
+  SECTION("a second image or other data after the pixels is refused") {
+    CHECK(ReadPgm(dir.Write("two.pgm", "P5\n3 2\n255\n" + pixels + "P5\n3 2\n255\n" + pixels), &map,
+                  &error) == Status::kParseError);
+    CHECK(Contains(error, "two.pgm: 17 bytes after the 3 x 2 pixels' 6 bytes of data"));
+  }
+  SECTION("a line break after the pixels is read past") {
+    REQUIRE(ReadPgm(dir.Write("nl.pgm", "P5\n3 2\n255\n" + pixels + "\n"), &map, &error) ==
+            Status::kOk);
+    CHECK(map.heights == std::vector<double>{1, 2, 3, 4, 5, 6});
+  }
+  SECTION("a CR LF header whose file holds exactly the pixels is read as written") {
+    // The byte after the maxval's CR is the first pixel (10, a LF), as the format says.
+    REQUIRE(ReadPgm(dir.Write("exact.pgm", "P5\n3 2\n255\r\n" + pixels.substr(1)), &map, &error) ==
+            Status::kOk);
+    CHECK(map.heights == std::vector<double>{10, 2, 3, 4, 5, 6});
+  }
+}
+
 TEST_CASE("LoadTerrain: height maps with NODATA are resampled over the valid cells",
           "[import][heightmap]") {
   test::TempDir dir;

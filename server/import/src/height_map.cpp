@@ -324,6 +324,27 @@ Status ReadPgm(const std::string& path, HeightMap* out, std::string* error) {
                   error);
     }
     status = CheckGridSize(path, header, cells, declared, available / bytes, 0, error);
+    if (status != Status::kOk) return status;
+    // Bytes after the pixels: a header written with CR LF line ends (its LF read as the first
+    // pixel, the image shifted by a byte), or a second image; a line break alone is read past.
+    const size_t data = static_cast<size_t>(cells) * bytes;
+    if (available > data) {
+      if (text[start - 1] == '\r' && text[start] == '\n') {
+        return Fail(path + ":" + std::to_string(reader.line()),
+                    "the maxval is followed by CR LF, and the file holds one byte more than the "
+                    "pixels: a P5 header has exactly one white-space byte after the maxval, so "
+                    "the LF would be read as the first pixel (save the header with LF line ends)",
+                    error);
+      }
+      const size_t extra = available - data;
+      if (text.find_first_not_of(" \t\r\n", start + data) != std::string::npos) {
+        return Fail(path,
+                    std::to_string(extra) + " bytes after the " + declared + "' " +
+                        std::to_string(data) +
+                        " bytes of data (expected the end of the file: one image per file)",
+                    error);
+      }
+    }
   } else {
     size_t last_line;
     const size_t present = CountValues(reader, cells, &last_line);
