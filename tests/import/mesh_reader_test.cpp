@@ -647,4 +647,54 @@ TEST_CASE("ReadMesh: a face wound against its neighbours is turned to match them
   for (size_t t = 0; t < mesh.triangles.size(); ++t) CHECK(TriangleCross(mesh, t).y > 0);
 }
 
+TEST_CASE("ReadMesh: binary PLY list counts and vertex indices are whole numbers",
+          "[import][mesh]") {
+  // A float count of 3.5 read four indices (the next face's count among them), and a float
+  // index of 1.5 was taken as vertex 1, silently.
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  auto ply = [](const char* count_type, const char* index_type, float count, float index) {
+    std::string s = std::string(
+                        "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float "
+                        "x\nproperty float y\nproperty float z\nelement face 1\nproperty list ") +
+                    count_type + " " + index_type + " vertex_indices\nend_header\n";
+    const float v[9] = {0, 0, 0, 1, 0, 0, 1, 0, 1};
+    s.append(reinterpret_cast<const char*>(v), sizeof v);
+    s.append(reinterpret_cast<const char*>(&count), 4);
+    const float indices[3] = {0, index, 2};
+    s.append(reinterpret_cast<const char*>(indices), sizeof indices);
+    return s;
+  };
+  REQUIRE(Read(dir.Write("good.ply", ply("float", "float", 3, 1)), &mesh, &error) == Status::kOk);
+  CHECK(mesh.triangles.size() == 1);
+  CHECK(Read(dir.Write("count.ply", ply("float", "float", 3.5f, 1)), &mesh, &error) ==
+        Status::kParseError);
+  CHECK(
+      Contains(error, "count.ply: face 1: list 'vertex_indices' count 3.5 is not a whole number"));
+  CHECK(Read(dir.Write("index.ply", ply("float", "float", 3, 1.5f)), &mesh, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error, "index.ply: face 1: vertex index 1.5 is not an index below 3"));
+}
+
+TEST_CASE("ReadMesh: PLY element counts too large to add up are refused as truncated",
+          "[import][mesh]") {
+  // Two counts near 2^63 added up to a negative number of records: a file of one record read
+  // as "1 vertices but no faces".
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  const std::string header =
+      "element vertex 9223372036854775807\nproperty float x\nproperty float y\nproperty float "
+      "z\nelement face 9223372036854775807\nproperty list uchar int vertex_indices\n"
+      "end_header\n";
+  CHECK(Read(dir.Write("a.ply", "ply\nformat ascii 1.0\n" + header + "0 0 0\n"), &mesh, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error, "a.ply: truncated: the header declares"));
+  CHECK(Read(dir.Write("b.ply",
+                       "ply\nformat binary_little_endian 1.0\n" + header + std::string(12, '\0')),
+             &mesh, &error) == Status::kParseError);
+  CHECK(Contains(error, "b.ply: truncated: the header's elements need at least"));
+}
+
 }  // namespace footfall

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <climits>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -123,6 +124,17 @@ Status CheckCoordinate(const std::string& where, const std::string& token, doubl
     return Fail(where, m.str(), error);
   }
   return Status::kOk;
+}
+
+// a + b and a * b for counts >= 0, held at LLONG_MAX where they would overflow (element counts
+// near 2^63 added up to a negative total).
+long long SaturatingAdd(long long a, long long b) {
+  long long sum;
+  return __builtin_add_overflow(a, b, &sum) ? LLONG_MAX : sum;
+}
+long long SaturatingMultiply(long long a, long long b) {
+  long long product;
+  return __builtin_mul_overflow(a, b, &product) ? LLONG_MAX : product;
 }
 
 bool ParseInteger(const std::string& token, long long* value) {
@@ -450,7 +462,7 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
   };
   if (format == "ascii") {
     long long records = 0;
-    for (const Element& e : elements) records += e.count;
+    for (const Element& e : elements) records = SaturatingAdd(records, e.count);
     // One record per line, checked against its element: vertices' x, y, z finite; faces'
     // index lists of 3 or more indices of declared vertices.
     long long found = 0;
@@ -551,7 +563,8 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
   in.seekg(0, std::ios::end);
   const long long data_bytes = static_cast<long long>(in.tellg() - data_start);
   long long need = 0;
-  for (const Element& e : elements) need += e.count * (e.fixed_bytes + e.list_min_bytes);
+  for (const Element& e : elements)
+    need = SaturatingAdd(need, SaturatingMultiply(e.count, e.fixed_bytes + e.list_min_bytes));
   if (data_bytes < need) {
     return Fail(path,
                 "truncated: the header's elements need at least " + std::to_string(need) +
@@ -591,6 +604,12 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
         }
         double n = 0;
         if (!values.Next(e.count_types[p], &n)) return truncated(e, r);
+        if (!(n >= 0 && n == std::floor(n))) {  // a float count: the rest of the data misread
+          std::ostringstream m;
+          m << ShownText(e.name) << " " << r + 1 << ": list '" << ShownText(name) << "' count " << n
+            << " is not a whole number >= 0";
+          return Fail(path, m.str(), error);
+        }
         const bool indices = is_indices(e, p) && !face;
         if (indices && n < 3) {
           return Fail(path,
@@ -601,10 +620,10 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
         }
         for (double i = 0; i < n; ++i) {
           if (!values.Next(e.types[p], &v)) return truncated(e, r);
-          if (indices && !(v >= 0 && v < static_cast<double>(vertices))) {
+          if (indices && !(v >= 0 && v < static_cast<double>(vertices) && v == std::floor(v))) {
             std::ostringstream m;
             m << "face " << r + 1 << ": vertex index ";
-            if (std::fabs(v) < 1e18)
+            if (std::fabs(v) < 1e18 && v == std::floor(v))
               m << static_cast<long long>(v);
             else
               m << v;
