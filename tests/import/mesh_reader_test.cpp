@@ -697,4 +697,29 @@ TEST_CASE("ReadMesh: PLY element counts too large to add up are refused as trunc
   CHECK(Contains(error, "b.ply: truncated: the header's elements need at least"));
 }
 
+TEST_CASE("ReadMesh: an ASCII STL facet loop left open is refused at its line", "[import][mesh]") {
+  // Such a facet was dropped, silently, and the rest of the mesh loaded as if whole.
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  const std::string whole =
+      "facet normal 0 1 0\nouter loop\nvertex 0 0 0\nvertex 0 0 1\nvertex 1 0 0\nendloop\n"
+      "endfacet\n";
+  const std::string open =
+      "facet normal 0 1 0\nouter loop\nvertex 1 0 0\nvertex 0 0 1\nvertex 1 0 1\nendfacet\n";
+  REQUIRE(Read(dir.Write("good.stl", "solid s\n" + whole + "endsolid s\n"), &mesh, &error) ==
+          Status::kOk);
+  CHECK(mesh.triangles.size() == 1);
+  CHECK(Read(dir.Write("open.stl", "solid s\n" + open + whole + "endsolid s\n"), &mesh, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error, "open.stl:7: 'endfacet' inside the facet loop opened on line 3"));
+  CHECK(Read(dir.Write("last.stl", "solid s\n" + whole + "facet normal 0 1 0\nouter loop\n" +
+                                       "vertex 1 0 0\nendsolid s\n"),
+             &mesh, &error) == Status::kParseError);
+  CHECK(Contains(error, "last.stl:12: 'endsolid' inside the facet loop opened on line 10"));
+  CHECK(Read(dir.Write("loose.stl", "solid s\n" + whole + "vertex 5 0 0\nendsolid s\n"), &mesh,
+             &error) == Status::kParseError);
+  CHECK(Contains(error, "loose.stl:9: vertex outside a facet loop"));
+}
+
 }  // namespace footfall

@@ -738,16 +738,21 @@ Status ParseStlFile(const std::string& path, ParsedMesh* out, std::string* error
   in.seekg(0);
   std::string line;
   bool closed = false;
-  int in_loop = -1;  // vertices of the open loop; -1 outside one
+  int in_loop = -1;      // vertices of the open loop; -1 outside one
+  size_t loop_line = 0;  // the line of the open loop's 'outer loop'
   LineReader lines(in);
   for (size_t number = 1; lines.Next(&line); ++number) {
     const std::vector<std::string> t = Tokens(line);
     if (t.empty()) continue;
-    if (t[0] == "endsolid") closed = true;
-    if (t[0] == "outer") {
-      in_loop = 0;
-      out->corners.resize(out->face_start.back());  // a loop left open before: dropped
+    // A loop left open (its facet was dropped, silently) before the next one or the end.
+    if (in_loop >= 0 && (t[0] == "outer" || t[0] == "endfacet" || t[0] == "endsolid")) {
+      return Fail(At(path, number),
+                  "'" + ShownText(t[0]) + "' inside the facet loop opened on line " +
+                      std::to_string(loop_line) + " (expected 'endloop' after its 3 vertices)",
+                  error);
     }
+    if (t[0] == "endsolid") closed = true;
+    if (t[0] == "outer") in_loop = 0, loop_line = number;
     if (t[0] == "endloop") {
       if (in_loop >= 0 && in_loop != 3) {
         return Fail(At(path, number),
@@ -760,14 +765,18 @@ Status ParseStlFile(const std::string& path, ParsedMesh* out, std::string* error
       in_loop = -1;
     }
     if (t[0] == "vertex") {
-      if (in_loop >= 0) ++in_loop;
+      if (in_loop < 0) {
+        return Fail(At(path, number),
+                    "vertex outside a facet loop (expected 'outer loop' before it)", error);
+      }
+      ++in_loop;
       if (t.size() < 4) return Fail(At(path, number), "vertex needs 3 coordinates", error);
       double c[3];
       for (int i = 1; i <= 3; ++i) {
         const Status s = CheckCoordinate(At(path, number), t[i], &c[i - 1], error);
         if (s != Status::kOk) return s;
       }
-      if (in_loop >= 1 && in_loop <= 3) out->corners.push_back(merged.Add({c[0], c[1], c[2]}));
+      if (in_loop <= 3) out->corners.push_back(merged.Add({c[0], c[1], c[2]}));
     }
   }
   if (lines.too_long()) return TooLongLine(path, lines, error);
