@@ -233,6 +233,34 @@ TEST_CASE("WriteGltf makes repeated and empty track names unique", "[export][glt
   std::remove(path.c_str());
 }
 
+TEST_CASE("WriteGltf writes names that are not UTF-8 with U+FFFD", "[export][gltf]") {
+  Walk walk = test::CrowdWalk();
+  walk.tracks[0].name =
+      "L\xff"
+      "1";                                // a byte that never starts a sequence
+  walk.tracks[0].character = "ant \xc3";  // a sequence cut short
+  walk.tracks[1].character = walk.tracks[0].character;
+  walk.tracks[2].character = walk.tracks[0].character;
+  walk.stopped = "step 2: \xed\xa0\x80";  // a surrogate, not allowed in UTF-8
+  const std::string replacement = "\xEF\xBF\xBD";
+  for (const bool binary : {false, true}) {
+    INFO("binary " << binary);
+    const std::string path = test::ScratchPath(binary ? "utf8.glb" : "utf8.gltf");
+    std::string error;
+    REQUIRE(WriteGltf(walk, path, &error) == Status::kOk);
+    const tinygltf::Model model = Load(path, binary);
+    REQUIRE(model.nodes.size() == 6);
+    CHECK(model.nodes[0].name == "ant " + replacement + "/L" + replacement + "1");
+    CHECK(model.nodes[0].extras.Get("track").Get<std::string>() == "L" + replacement + "1");
+    CHECK(model.nodes[1].extras.Get("character").Get<std::string>() == "ant " + replacement);
+    CHECK(model.nodes[3].name == "ant-2/L1");  // valid names are kept as they are
+    REQUIRE(model.animations.size() == 1);
+    CHECK(model.animations[0].extras.Get("stopped").Get<std::string>() ==
+          "step 2: " + replacement + replacement + replacement);
+    std::remove(path.c_str());
+  }
+}
+
 TEST_CASE("WriteGltf rejects walks glTF cannot hold", "[export][gltf]") {
   const std::string path = test::ScratchPath("bad.gltf");
   std::string error;

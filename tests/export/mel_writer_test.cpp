@@ -393,6 +393,22 @@ TEST_CASE("WriteMel names without a Maya time unit and special characters", "[ex
   std::remove(path.c_str());
 }
 
+TEST_CASE("WriteMel writes names that are not UTF-8 with U+FFFD", "[export][mel]") {
+  Walk walk = test::BipedWalk();
+  walk.tracks[0].name = "f\xc3\xbc\xff";  // a valid two-byte sequence, then a stray byte
+  walk.stopped = "cut \xe2\x82";
+  const std::string path = WriteAndKeep(walk, "utf8.mel");
+  const MelScript script = ParseMel(path);
+  CHECK(script.track_attr.at("f___") == "f\xc3\xbc\xEF\xBF\xBD");
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  CHECK_THAT(text.str(),
+             Catch::Contains("// The walk stopped early: cut \xEF\xBF\xBD\xEF\xBF\xBD\n"));
+  CHECK(text.str().find('\xff') == std::string::npos);
+  std::remove(path.c_str());
+}
+
 TEST_CASE("WriteMel keeps comments to one line and names Maya's second and millisecond units",
           "[export][mel]") {
   Walk walk = test::BipedWalk();

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstring>
+#include <exception>
 #include <sstream>
 #include <vector>
 
@@ -80,8 +81,8 @@ Status TrackSamples(const WalkTrack& track, size_t track_index, double fps, Samp
 tinygltf::Value NodeExtras(const WalkTrack& track) {
   tinygltf::Value::Object extras;
   extras["kind"] = tinygltf::Value(std::string(track.kind == TrackKind::kBody ? "body" : "foot"));
-  extras["character"] = tinygltf::Value(track.character);
-  extras["track"] = tinygltf::Value(track.name);
+  extras["character"] = tinygltf::Value(walk_export::ValidUtf8(track.character));
+  extras["track"] = tinygltf::Value(walk_export::ValidUtf8(track.name));
   return tinygltf::Value(std::move(extras));
 }
 
@@ -137,7 +138,7 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
   std::vector<std::string> names;
   names.reserve(walk.tracks.size());
   for (size_t t = 0; t < walk.tracks.size(); ++t) {
-    names.push_back(walk_export::QualifiedTrackName(walk.tracks[t], t));
+    names.push_back(walk_export::ValidUtf8(walk_export::QualifiedTrackName(walk.tracks[t], t)));
   }
   names = walk_export::UniqueNames(names);
 
@@ -244,7 +245,8 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
 
   tinygltf::Value::Object animation_extras;
   animation_extras["fps"] = tinygltf::Value(walk.fps);
-  if (!walk.stopped.empty()) animation_extras["stopped"] = tinygltf::Value(walk.stopped);
+  if (!walk.stopped.empty())
+    animation_extras["stopped"] = tinygltf::Value(walk_export::ValidUtf8(walk.stopped));
   animation.extras = tinygltf::Value(std::move(animation_extras));
   // An animation needs at least one channel; a walk without keys has none.
   if (!animation.channels.empty()) model.animations.push_back(std::move(animation));
@@ -253,7 +255,15 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
 
   std::ostringstream out;
   tinygltf::TinyGLTF gltf;
-  if (!gltf.WriteGltfSceneToStream(&model, out, /*prettyPrint=*/true, options.binary)) {
+  bool serialised = false;
+  try {
+    // Its JSON library throws on what it cannot write; no exception leaves this function.
+    serialised = gltf.WriteGltfSceneToStream(&model, out, /*prettyPrint=*/true, options.binary);
+  } catch (const std::exception& e) {
+    SetError(error, "tinygltf could not serialise the walk for '" + path + "': " + e.what());
+    return Status::kInternalError;
+  }
+  if (!serialised) {
     SetError(error, "tinygltf could not serialise the walk for '" + path + "'");
     return Status::kInternalError;
   }

@@ -68,7 +68,7 @@ std::string MayaName(const std::string& name) {
 // A double-quoted MEL string literal holding `text`.
 std::string MelString(const std::string& text) {
   std::string out = "\"";
-  for (char c : text) {
+  for (char c : walk_export::ValidUtf8(text)) {
     switch (c) {
       case '"':
         out += "\\\"";
@@ -96,7 +96,7 @@ std::string MelString(const std::string& text) {
 // Text safe inside a `//` comment line: no line breaks or other control bytes, and no
 // backslash (one at the end of the line could join the next line to the comment).
 std::string CommentText(const std::string& text) {
-  std::string out = text;
+  std::string out = walk_export::ValidUtf8(text);
   for (char& c : out) {
     if (c == '\n' || c == '\r' || c == '\t')
       c = ' ';

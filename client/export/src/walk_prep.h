@@ -30,6 +30,11 @@ std::string QualifiedTrackName(const WalkTrack& track, size_t index);
 // `names` with repeats renamed "<name>_2", "<name>_3"... (never colliding with another name).
 std::vector<std::string> UniqueNames(const std::vector<std::string>& names);
 
+// `text` with every byte that does not belong to a well-formed UTF-8 sequence replaced by
+// U+FFFD, as the walk JSON writes it: glTF is JSON and must hold valid UTF-8 (a library caller's
+// names may be any bytes).
+std::string ValidUtf8(const std::string& text);
+
 // q / |q|; q must be finite and non-zero (CheckWalk).
 Quat Normalized(const Quat& q);
 

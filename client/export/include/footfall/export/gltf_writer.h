@@ -19,6 +19,8 @@ struct GltfOptions {
 // Writes `walk` to `path` as glTF 2.0.
 // - Nodes: one per track, in track order, all roots of the single scene. Names are the track
 //   name, or "character/name" for crowd tracks; a repeated name gets a "_2", "_3"... suffix.
+//   Names and the stop reason are written as valid UTF-8, as in the walk JSON: a byte that
+//   belongs to no well-formed UTF-8 sequence becomes U+FFFD.
 //   Each node's rest translation (and rotation for bodies) is its first key.
 // - Channels: feet animate translation; bodies translation and rotation (normalised
 //   quaternions). Times in seconds = frame / fps. glTF needs strictly increasing times: keys are

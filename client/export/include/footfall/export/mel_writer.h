@@ -25,10 +25,12 @@ namespace footfall {
 // the same double (a walk in tiny or huge units keeps full precision).
 // Node names are sanitised to Maya names ([A-Za-z_][A-Za-z0-9_]*; other characters become '_')
 // and made unique in the file and against the root group's name (a foot named footfall_walk
-// becomes footfall_walk_2). The script uses the names Maya returns, so it still works when
-// the scene already holds nodes of the same names. Keys on the same frame: the last one wins.
-// Returns kInvalidArgument (with `*error` set) for fps <= 0, NaN/Inf values or a zero quaternion;
-// kIoError naming `path` when the file cannot be written. `error` may be null.
+// becomes footfall_walk_2). Strings and comments are valid UTF-8 (a byte outside any
+// well-formed UTF-8 sequence becomes U+FFFD, as in the walk JSON). The script uses the names Maya
+// returns, so it still works when the scene already holds nodes of the same names. Keys on the same
+// frame: the last one wins. Returns kInvalidArgument (with `*error` set) for fps <= 0, NaN/Inf
+// values or a zero quaternion; kIoError naming `path` when the file cannot be written. `error` may
+// be null.
 Status WriteMel(const Walk& walk, const std::string& path, std::string* error);
 
 }  // namespace footfall
