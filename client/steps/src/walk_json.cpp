@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -41,6 +42,32 @@ void String(std::string& out, const std::string& s) {
 }
 
 const char* KindName(TrackKind kind) { return kind == TrackKind::kFoot ? "foot" : "body"; }
+
+// Which keys of `track` are written, in order: all of them when their frames increase (every
+// generated walk), else ascending frames (stable) with only the last of the keys sharing a frame,
+// as the glTF and MEL exporters key them, so that the file reads back. `order` is left empty for
+// the first case.
+void KeyOrder(const WalkTrack& track, std::vector<size_t>* order) {
+  order->clear();
+  const auto& keys = track.keys;
+  bool increasing = true;
+  for (size_t i = 1; i < keys.size() && increasing; ++i)
+    increasing = keys[i - 1].frame < keys[i].frame;
+  // A NaN frame (written as null, refused on reading) has no place in any order.
+  const bool finite = std::all_of(keys.begin(), keys.end(),
+                                  [](const WalkKey& k) { return std::isfinite(k.frame); });
+  if (increasing || !finite) return;
+  std::vector<size_t> sorted(keys.size());
+  for (size_t i = 0; i < sorted.size(); ++i) sorted[i] = i;
+  std::stable_sort(sorted.begin(), sorted.end(),
+                   [&keys](size_t a, size_t b) { return keys[a].frame < keys[b].frame; });
+  for (size_t index : sorted) {
+    if (!order->empty() && keys[order->back()].frame == keys[index].frame)
+      order->back() = index;  // same frame: the later key wins
+    else
+      order->push_back(index);
+  }
+}
 
 struct Reader {
   std::string source;
@@ -93,8 +120,11 @@ std::string WalkToJson(const Walk& walk) {
   out += ",\"stopped\":";
   String(out, walk.stopped);
   out += ",\"tracks\":[";
+  std::vector<size_t> order;
   for (size_t ti = 0; ti < walk.tracks.size(); ++ti) {
     const WalkTrack& t = walk.tracks[ti];
+    KeyOrder(t, &order);
+    const size_t count = order.empty() ? t.keys.size() : order.size();
     out += ti ? ",\n" : "\n";
     out += "{\"name\":";
     String(out, t.name);
@@ -102,9 +132,10 @@ std::string WalkToJson(const Walk& walk) {
     out += ",\"kind\":\"";
     out += KindName(t.kind);
     out += "\",\"keys\":[";
-    for (size_t ki = 0; ki < t.keys.size(); ++ki) {
+    for (size_t i = 0; i < count; ++i) {
+      const size_t ki = order.empty() ? i : order[i];
       const WalkKey& k = t.keys[ki];
-      out += ki ? ",\n " : "\n ";
+      out += i ? ",\n " : "\n ";
       out += "{\"frame\":";
       Number(out, k.frame);
       if (t.kind == TrackKind::kFoot) {

@@ -17,7 +17,9 @@ namespace footfall {
 
 constexpr int kWalkFormatVersion = 1;
 
-// The walk as JSON text (one line per key, ending in a newline).
+// The walk as JSON text (one line per key, ending in a newline). Keys are written in ascending
+// frames; of keys on the same frame only the last is written (as the glTF and MEL exporters key
+// them), so the text always reads back with ParseWalkJson.
 std::string WalkToJson(const Walk& walk);
 
 // Writes WalkToJson(walk) to `path`. kIoError with a message naming the file on failure.
