@@ -1,6 +1,6 @@
 // The step generator: places every footstep of one or many characters on a terrain and keys the
 // walk (foot IK targets and the body). The algorithm is listed as numbered steps in the
-// top-level README.md ("The algorithm"); generator.cpp repeats the numbers in comments.
+// top-level README.md ("The algorithm"); the generator's sources repeat the numbers in comments.
 //
 // It asks the terrain only through a TerrainSession, so the embedded engine and footfalld give
 // the same walk. Each round of queries of a step is one batch call for all the characters of a

@@ -1,0 +1,432 @@
+// The step generator's steering and footholds (5-8): the heading turned along the path, the
+// target locators, the foothold queries of every moving foot in one batch, and their judging
+// (slope, rise, reach, side).
+#include "step_generator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "footfall/terrain/shown_text.h"
+
+namespace footfall::steps_detail {
+namespace {
+
+// The distance from p to the box [lo, hi] (0 inside).
+double BoxDistance(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  const Vec3 out{std::max({lo.x - p.x, 0.0, p.x - hi.x}), std::max({lo.y - p.y, 0.0, p.y - hi.y}),
+                 std::max({lo.z - p.z, 0.0, p.z - hi.z})};
+  return Length(out);
+}
+
+}  // namespace
+
+bool Generator::Nearing(Agent& a, int k) const {
+  if (a.path.empty()) return true;
+  const double d = Remaining(a, a.waypoint);
+  if (a.nearest_waypoint != a.waypoint || d < a.nearest - 0.25 * c_.step_length) {
+    a.nearest_waypoint = a.waypoint, a.nearest = d, a.nearest_step = k;
+    return true;
+  }
+  return k - a.nearest_step < window_steps_;
+}
+
+double Generator::Radius(const Agent& a, size_t i) const {
+  return (i + 1 == a.path.size() ? 0.5 : 1.0) * c_.step_length;
+}
+
+bool Generator::OnTerrain(const Agent& a, size_t i) const {
+  return a.path_off[i] <= 0.5 * Radius(a, i);
+}
+
+Vec3 Generator::ToPathPoint(const Agent& a, const Vec3& p, bool on_terrain) const {
+  Vec3 to = p - a.ground;
+  if (!on_terrain && Dot(a.up, world_up_) >= std::cos(Radians(kFloorUpDeg)))
+    to -= world_up_ * Dot(to, world_up_);
+  return to;
+}
+
+double Generator::Remaining(const Agent& a, size_t i) const {
+  const Vec3 to = ToWaypoint(a, i);
+  return OnTerrain(a, i) ? Length(to) : Length(ProjectOnPlane(to, a.up));
+}
+
+bool Generator::Reached(const Agent& a, size_t i) const {
+  const Vec3 to = ToWaypoint(a, i);
+  const double along = Dot(to, a.up), radius = Radius(a, i);
+  if (Length2(to - a.up * along) > radius * radius) return false;
+  // On the terrain: no farther below the ground than the radius, nor above it than the radius
+  // over the body's height (the feet's centroid lies inside a convex nose or ridge they stand
+  // around: an octopod on the Spot mesh's nose came within 2 cm of its goal with its body,
+  // never within its radius with its ground, and turned about it until it stopped).
+  return !OnTerrain(a, i) || (along >= -radius && along <= radius + c_.body_height);
+}
+
+double Generator::StrideToward(const Vec3& to, const Vec3& forward) const {
+  // A waypoint inside the circle the body turns on at full stride (beside or behind it, nearer
+  // than the turn allows) would be circled for ever: the steps shorten so that the circle the
+  // body turns on, tangent to the heading, runs through the waypoint, and with the waypoint
+  // behind that heading the character turns on the spot.
+  const double ahead = Dot(to, forward);
+  const double aside = Length(to - forward * ahead);
+  const double through = Length2(to) / (2 * aside);  // that circle's radius (inf: no circle)
+  if (through >= turn_radius_) return 1;
+  return ahead > 0 ? through / turn_radius_ : 0;
+}
+
+double Generator::PairGap(const Agent& a, const Vec3& forward, double stride, int group) const {
+  const Vec3 left = Cross(a.up, forward);
+  const std::vector<int>& stepping = c_.gait[group];
+  // Where each foot stands once the group has stepped: planted feet where they are, stepping
+  // ones a step toward their targets.
+  thread_local std::vector<Vec3> at;
+  at.assign(a.foot.begin(), a.foot.end());
+  for (int f : stepping) {
+    const Vec3 target = a.ground + left * rest_[f].x + forward * (rest_[f].z + lead_ * stride);
+    Vec3 v = ProjectOnPlane(target - a.foot[f], a.up);
+    const double len = Length(v);
+    if (len > c_.step_length) v = v * (c_.step_length / len);
+    at[f] += v;
+  }
+  double least = std::numeric_limits<double>::infinity();
+  for (size_t f = 0; f < at.size(); ++f) {
+    const int m = mate_[f];
+    if (m >= 0) least = std::min(least, Dot(at[f] - at[m], left) / (rest_[f].x - rest_[m].x));
+  }
+  return least;
+}
+
+void Generator::Steer(Agent& a, int group) const {
+  if (a.path.empty()) return;
+  while (a.waypoint < a.path.size() && Reached(a, a.waypoint)) ++a.waypoint;
+  if (a.waypoint == a.path.size()) {
+    a.walking = false;  // arrived: not an early stop
+    return;
+  }
+  const Vec3 to = ProjectOnPlane(ToWaypoint(a, a.waypoint), a.up);
+  a.stride = 1;
+  // A waypoint on the terrain straight above or below (the far side of a sphere): any way on
+  // along the ground leads toward it, so the heading is kept until it lies farther aside.
+  if (Length(to) <= Radius(a, a.waypoint)) return;
+  const Vec3 want = Normalize(to);
+  const double angle = std::atan2(Dot(Cross(a.forward, want), a.up), Dot(a.forward, want));
+  const double max_turn = Radians(c_.max_turn_deg);
+  const double turn = std::clamp(angle, -max_turn, max_turn);
+  // A turn faster than the feet can follow (a foot moves at most step_length a step, and only
+  // in its group's turn) leaves the planted feet behind, until a pair's feet cross under the
+  // body: the turn is cut to the largest share of it (in eighths) that keeps every pair's feet
+  // at least half their rest gap apart, or failing that to the one keeping them farthest apart.
+  // Feet that have not moved for a whole gait cycle will not catch up by waiting: the whole
+  // turn is taken, so that the targets it gives may find footholds.
+  if (a.still >= static_cast<int>(c_.gait.size())) {
+    a.forward = Normalize(RotateAround(a.forward, a.up, turn));
+    a.stride = StrideToward(to, a.forward);
+    return;
+  }
+  double best_gap = -std::numeric_limits<double>::infinity();
+  Vec3 best_forward = a.forward;
+  double best_stride = 1;
+  for (int eighths = kTurnShares; eighths >= 0; --eighths) {
+    const Vec3 forward = Normalize(RotateAround(a.forward, a.up, turn * eighths / kTurnShares));
+    const double stride = StrideToward(to, forward);
+    const double gap = PairGap(a, forward, stride, group);
+    if (gap > best_gap) best_gap = gap, best_forward = forward, best_stride = stride;
+    if (gap >= kMinPairGap) {
+      best_forward = forward, best_stride = stride;
+      break;
+    }
+  }
+  a.forward = best_forward, a.stride = best_stride;
+}
+
+Status Generator::QueryFootholds(std::string* error) {
+  const size_t feet = c_.feet.size();
+  std::vector<Move>& moves = moves_;
+  const size_t per_agent = walking_.empty() ? 0 : moves.size() / walking_.size();
+  const size_t locators = pairs_of_group_[group_].size();
+  const std::vector<size_t>& slot = slot_of_foot_[group_];
+  // The moves of this pass's characters still without a foothold (all of them in the first pass).
+  pending_.clear();
+  for (size_t w : walkers_)
+    for (size_t m = w * per_agent; m < (w + 1) * per_agent; ++m)
+      if (!moves[m].done && !moves[m].failed) pending_.push_back(m);
+  for (int round = 0; !pending_.empty(); ++round) {
+    // 7. Target locators: the foot's rest offset from its pair's centre, in the frame of the
+    //    central locator (aligned to the terrain normal under it). The step vector runs from
+    //    the foot to its target; slope awareness and the reach limit shorten it.
+    Parallel(pending_.size(), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        Move& mv = moves[pending_[i]];
+        const Agent& a = agents_[mv.agent];
+        if (round == 0) {
+          // 6 (end). A locator that snapped farther than `lead` from where it was placed hangs
+          // over a gap or a cliff: it keeps its place (the body's frame), so the foothold query
+          // looks over the void. Round 0 holds every move, and answers_ the locator snaps.
+          const size_t m = pending_[i];
+          const size_t l = (m / per_agent) * locators + slot[m % per_agent];
+          const Foothold& h = answers_[l];
+          const Vec3& placed = points_[l];
+          if (Distance(h.point, placed) <= lead_) {
+            locator_[m] = h.point, locator_normal_[m] = h.normal;
+            // On a face past max_slope_deg it keeps its place across the heading (a wall beside
+            // it drew the feet sideways into the wall), and on a face across the heading (a wall
+            // beside the body, rather than a riser ahead) its height too, as over a gap (aimed at
+            // the wall's height, steps beside it were a third of step_length).
+            const Vec3 left = Left(a);
+            if (Dot(h.normal, a.up) < cos_max_slope_) {
+              if (std::fabs(Dot(h.normal, left)) > std::fabs(Dot(h.normal, a.forward)))
+                locator_[m] = placed - a.up * (0.5 * lead_), locator_normal_[m] = a.up;
+              else
+                locator_[m] -= left * Dot(h.point - placed, left);
+            } else if (!c_.align_to_normal) {
+              // Snapped from lead/2 above along the world up, onto ground leaning across the
+              // heading, it slid toward the high side by up to lead/4 (a biped crossing a
+              // 25-degree slope climbed 2 m in 10): it slides back along the ground to where
+              // it was placed across the heading. (Not past what the lean explains: an edge
+              // beside it. Multipeds' up is the ground's normal: they slide along it.)
+              const Vec3 across = ProjectOnPlane(left, h.normal);
+              const double lean = std::fabs(Dot(h.normal, left));
+              const double off = Dot(h.point - placed, left);
+              const double keep = Dot(across, left);  // 1 - lean^2
+              if (keep > 0.25 && std::fabs(off) <= 0.5 * lead_ * lean + 0.5 * gap_)
+                locator_[m] -= across * (off / keep);
+            }
+          } else {
+            locator_[m] = placed - a.up * (0.5 * lead_), locator_normal_[m] = a.up;
+          }
+        }
+        const int p = pair_of_foot_[mv.foot];
+        Vec3 n = locator_normal_[pending_[i]];
+        if (Dot(n, a.up) < cos_max_slope_) n = a.up;  // leans past max_slope_deg: an edge
+        const Vec3 f = TangentForward(a.forward, a.forward, a.up, n);
+        const Vec3 l = Cross(n, f);
+        const Vec3 d = rest_[mv.foot] - pair_centre_[p];
+        const Vec3 target = locator_[pending_[i]] + l * d.x + n * d.y + f * d.z;
+        double max_len = c_.step_length;  // shorter where the heading climbs or falls steeply
+        if (std::fabs(Dot(f, a.up)) > sin_slope_threshold_) max_len *= c_.slope_step_scale;
+        Vec3 v = target - a.foot[mv.foot];
+        const double len = Length(v);
+        if (len > max_len) v = v * (max_len / len);
+        // Longer and aimed-down retries reach a full step along the target's direction: a
+        // target locator caught on a stair's nose lies just ahead of a foot standing there.
+        if ((mv.attempt.scale > 1 || mv.attempt.drop > 0) && len > kInPlace * c_.step_length)
+          v = v * (max_len / Length(v));
+        v = v * mv.attempt.scale;  // retries step shorter or longer
+        // A foothold lined up with its pair's other foot is asked again with the step aimed
+        // outward by half the samples' spacing, toward the sample on the foot's own side.
+        if (mv.outward) {
+          const double side = rest_[mv.foot].x > rest_[mate_[mv.foot]].x ? 1.0 : -1.0;
+          v += Left(a) * (side * 0.25 * gap_);
+        }
+        if (Length(v) < kInPlace * c_.step_length) {
+          if (mv.attempt.drop > 0) {
+            Fail(mv);  // nothing ahead to aim down at
+          } else {
+            mv.done = true, mv.end = a.foot[mv.foot], mv.end_normal = a.foot_normal[mv.foot];
+          }
+          continue;
+        }
+        // No target beyond reach of the body where the step will put it (the feet's centroid
+        // moves by this foot's displacement over the number of feet).
+        for (int shrink = 0; shrink < 8; ++shrink) {
+          const Vec3 ground = a.ground + v / static_cast<double>(feet);
+          const Vec3 body = ground + a.body_up * c_.body_height;
+          if (Distance(a.foot[mv.foot] + v, body) <= c_.reach) break;
+          v = v * 0.75;
+        }
+        v -= a.up * (mv.attempt.drop * c_.max_rise);  // the last retries aim down
+        mv.ideal = a.foot[mv.foot] + v, mv.step = v;
+      }
+    });
+    queries_.clear();
+    for (size_t m : pending_) {
+      if (moves[m].done || moves[m].failed) continue;  // a step in place; nothing to aim at
+      moves[m].query = queries_.size();
+      queries_.push_back({agents_[moves[m].agent].foot[moves[m].foot], moves[m].step});
+    }
+    // 8. Query the next foothold of every pending foot of every character: one batch. The
+    //    answer carries the end normal; the start normal is the planted foot's.
+    if (queries_.empty()) break;
+    next_answers_.resize(queries_.size());
+    const Status s = Check(session_.Next(terrain_, queries_.data(), queries_.size(),
+                                         kFootholdTolerance * c_.step_length, next_answers_.data()),
+                           "next foothold", error);
+    if (s != Status::kOk) return s;
+    // Per character (its moves are contiguous): accept or refuse each answered foot, then the
+    // reach limit on the body where the accepted footholds put it; feet beyond it retry.
+    Parallel(walkers_.size(), [&](size_t wb, size_t we) {
+      for (size_t i = wb; i < we; ++i) {
+        const size_t m = walkers_[i] * per_agent, e = m + per_agent;
+        bool all_done = true;
+        for (size_t j = m; j < e; ++j) {
+          if (moves[j].query != kNoQuery) {
+            Judge(moves[j], next_answers_[moves[j].query]), moves[j].query = kNoQuery;
+            if (!moves[j].done && moves[j].attempts >= kMaxAttempts) KeepPlace(moves[j]);
+          }
+          all_done &= moves[j].done;
+        }
+        if (all_done) CheckReach(m, e);
+      }
+    });
+    pending_.clear();
+    for (size_t w : walkers_) {
+      for (size_t m = w * per_agent; m < (w + 1) * per_agent; ++m) {
+        Move& mv = moves[m];
+        if (mv.done || mv.failed) continue;
+        if (mv.attempts >= kMaxAttempts)
+          Fail(mv);
+        else
+          mv.attempt = kAttempts[mv.attempts], pending_.push_back(m);
+      }
+    }
+  }
+  return Status::kOk;
+}
+
+void Generator::Judge(Move& mv, const Foothold& h) const {
+  const Agent& a = agents_[mv.agent];
+  const Vec3& foot = a.foot[mv.foot];
+  ++mv.attempts;
+  // A foothold must make half the intended progress along the ground it lands on (the step
+  // vector projected onto its tangent plane), so no foot creeps sideways along a cliff's edge.
+  // Steps mostly along the foothold's normal (onto a wall ahead) are exempt.
+  // A step aimed down is judged on the progress it was aimed to make.
+  const Vec3 intended = mv.step + a.up * (mv.attempt.drop * c_.max_rise);
+  double progress = 1;
+  if (h.status == Status::kOk) {
+    const Vec3 along = ProjectOnPlane(intended, h.normal);
+    if (Length2(along) >= 0.25 * Length2(intended))
+      progress = Dot(h.point - foot, along) / Length2(along);
+  }
+  const bool found = h.status == Status::kOk && progress >= 0.5;
+  const double rise = found ? Dot(h.point - foot, a.up) : 0;
+  if (found && std::fabs(rise) <= c_.max_rise && Dot(h.normal, a.up) >= cos_max_slope_) {
+    if (KeepsSide(mv, h.point, h.normal)) mv.done = true;
+    return;
+  }
+  if (mv.lined_up) {  // the outward retry was refused: the lined-up foothold it tried to better
+    mv.done = true, mv.end = mv.lined_up_point, mv.end_normal = mv.lined_up_normal;
+    return;
+  }
+  if (!KeepsReason(mv, !found)) return;  // mv already has a better reason
+  std::ostringstream why;                // refused: say why (only built on this rare path)
+  why.precision(3);
+  if (!found) {
+    // Past the terrain's bounds by more than the radius, no sample can be a foothold.
+    const double radius = kFootholdTolerance * c_.step_length;
+    const bool beyond = BoxDistance(mv.ideal, bounds_min_, bounds_max_) > radius;
+    why << "no foothold within " << radius << " of " << Point(mv.ideal)
+        << (beyond ? " (the terrain ends, or rises as a wall at its bounds, before it)"
+                   : " (a gap or a cliff)");
+    // Samples spread wider than half that radius leave gaps everywhere: say so, unless the
+    // terrain simply ends there or resampling would not bring them closer.
+    const double spacing = 0.5 * gap_;
+    if (!beyond && spacing > 0.5 * kFootholdTolerance * c_.step_length &&
+        kSeparationPerStep * c_.step_length < 0.8 * spacing) {
+      why << "; the terrain's samples lie about " << spacing
+          << " apart, too far for this character: resample it at a separation of "
+          << kSeparationPerStep * c_.step_length;
+    }
+  } else if (std::fabs(rise) > c_.max_rise) {
+    why << "the foothold at " << Point(h.point) << (rise > 0 ? " rises " : " drops ")
+        << Beyond(std::fabs(rise), c_.max_rise) << ", more than max_rise "
+        << NumberText(c_.max_rise) << " (a cliff)";
+  } else {
+    const double slope = Degrees(AngleBetween(h.normal, a.up));
+    why << "the foothold at " << Point(h.point) << " leans " << Beyond(slope, c_.max_slope_deg)
+        << " deg, more than max_slope_deg " << NumberText(c_.max_slope_deg) << " (too steep)"
+        << FacingDownHint(slope);
+  }
+  mv.reason = why.str(), mv.reason_is_gap = !found;
+}
+
+double Generator::GapToMate(const Move& mv, const Vec3& p) const {
+  const int mate = mate_[mv.foot];
+  if (mate < 0) return 1;
+  const Agent& a = agents_[mv.agent];
+  return Dot(p - a.foot[mate], Left(a)) / (rest_[mv.foot].x - rest_[mate].x);
+}
+
+bool Generator::KeepsSide(Move& mv, const Vec3& p, const Vec3& normal) const {
+  const double gap = GapToMate(mv, p);
+  if (mv.lined_up) {  // the outward retry: the better of the two
+    if (std::fabs(gap - 1) >= std::fabs(mv.lined_up_gap - 1))
+      mv.end = mv.lined_up_point, mv.end_normal = mv.lined_up_normal;
+    else
+      mv.end = p, mv.end_normal = normal;
+    return true;
+  }
+  mv.end = p, mv.end_normal = normal;
+  // Lined up: under half the rest gap, with samples at least a quarter of it apart (nearer
+  // samples would have given a foothold on the foot's own side).
+  if (gap >= kMinPairGap || mv.outward) return true;
+  const double rest_gap = std::fabs(rest_[mv.foot].x - rest_[mate_[mv.foot]].x);
+  if (0.5 * gap_ < 0.25 * rest_gap) return true;
+  mv.outward = true, mv.lined_up = true, mv.lined_up_gap = gap;
+  mv.lined_up_point = p, mv.lined_up_normal = normal;
+  --mv.attempts;  // the same attempt again, aimed outward
+  return false;
+}
+
+void Generator::KeepPlace(Move& mv) const {
+  const Agent& a = agents_[mv.agent];
+  const Vec3 intended = mv.step + a.up * (mv.attempt.drop * c_.max_rise);
+  if (Dot(intended, a.forward) >= 0 && a.stride >= 1) return;
+  mv.done = true, mv.end = a.foot[mv.foot], mv.end_normal = a.foot_normal[mv.foot];
+}
+
+void Generator::Fail(Move& mv) {
+  mv.failed = true;
+  if (mv.attempts > 1)
+    mv.reason += " (" + std::to_string(mv.attempts - 1) +
+                 " more tries, shorter, longer or aimed down, refused too)";
+}
+
+void Generator::CheckReach(size_t m, size_t e) {
+  std::vector<Move>& moves = moves_;
+  const size_t feet = c_.feet.size();
+  const Agent& a = agents_[moves[m].agent];
+  const std::vector<int>& slot = move_of_foot_[group_];  // foot -> its move's offset, or -1
+  // The feet and normals after this step, each moving foot at its foothold (per-thread
+  // scratch: characters are judged in parallel).
+  thread_local std::vector<Vec3> after, after_normals;
+  after.resize(feet), after_normals.resize(feet);
+  Vec3 centroid;
+  for (size_t f = 0; f < feet; ++f) {
+    const bool moving = slot[f] >= 0;
+    after[f] = moving ? moves[m + slot[f]].end : a.foot[f];
+    after_normals[f] = moving ? moves[m + slot[f]].end_normal : a.foot_normal[f];
+    centroid += after[f];
+  }
+  const Vec3 up = BodyUp(FeetUp(a.up, after, after_normals), after);
+  const Vec3 body = centroid / static_cast<double>(feet) + up * c_.body_height;
+  for (size_t i = m; i < e; ++i) {
+    const double dist = Distance(moves[i].end, body);
+    if (dist > c_.reach) {
+      std::ostringstream why;
+      why.precision(3);
+      why << "the foothold at " << Point(moves[i].end) << " is " << Beyond(dist, c_.reach)
+          << " from the body, beyond reach " << NumberText(c_.reach);
+      moves[i].done = false;
+      if (KeepsReason(moves[i], false)) moves[i].reason = why.str(), moves[i].reason_is_gap = false;
+    }
+  }
+  // A planted foot the body would leave beyond reach: every moving foot steps shorter.
+  for (size_t f = 0; f < feet; ++f) {
+    const double dist = Distance(a.foot[f], body);
+    if (slot[f] >= 0 || dist <= c_.reach) continue;
+    std::ostringstream why;
+    why.precision(3);
+    why << "the step would leave foot " << c_.feet[f].name << " " << Beyond(dist, c_.reach)
+        << " from the body, beyond reach " << NumberText(c_.reach);
+    for (size_t i = m; i < e; ++i) {
+      if (!moves[i].done) continue;
+      moves[i].done = false, moves[i].held_by_planted = true;
+      if (KeepsReason(moves[i], false)) moves[i].reason = why.str(), moves[i].reason_is_gap = false;
+    }
+    break;
+  }
+}
+
+}  // namespace footfall::steps_detail

@@ -1,0 +1,437 @@
+// The step generator's setup (1-4): the start and its heading, each character of a crowd
+// placed on its own ground, its feet snapped and planted, its body over them.
+#include "step_generator.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <unordered_map>
+
+#include "footfall/terrain/shown_text.h"
+#include "key_arena.h"
+
+namespace footfall::steps_detail {
+
+Status Generator::Setup(std::string* error) {
+  const size_t feet = c_.feet.size();
+  TerrainInfo info;
+  Status s = Check(session_.Info(terrain_, &info), "terrain info", error);
+  if (s != Status::kOk) return s;
+  const GridStats& g = info.stats;
+  bounds_min_ = g.bounds_min, bounds_max_ = g.bounds_max;
+  gap_ = g.samples > 0
+             ? 2 * g.cell_size *
+                   std::sqrt(static_cast<double>(g.occupied_cells) / static_cast<double>(g.samples))
+             : 0;
+  // 1. The start: --start, or the centre of the top of the bounds; either may move to where
+  //    the character can stand.
+  const Vec3 start =
+      o_.has_start ? o_.start : TopCentre(info.stats.bounds_min, info.stats.bounds_max, world_up_);
+  Foothold first;
+  s = FindStart(start, !o_.has_start || o_.start_may_move, &first, error);
+  if (s != Status::kOk) return s;
+  // 2. The start frame: up (terrain normal for multipeds, world up for bipeds) and the heading
+  //    projected onto the plane perpendicular to it. Crowds stand on a grid in that plane, or,
+  //    on ground within 45 degrees of world up, across world up: one bump's normal tilted a
+  //    large grid metres above and below the ground, and its places snapped onto the bumps'
+  //    tops together (826 of 10,000 insects on gentle bumps started on another's sample).
+  const Vec3 up0 = c_.align_to_normal ? first.normal : world_up_;
+  const Vec3 fwd0 = StartHeading(up0);
+  const Vec3 grid_up = Dot(up0, world_up_) >= std::sqrt(0.5) ? world_up_ : up0;
+  const Vec3 grid_fwd = Normalize(ProjectOnPlane(fwd0, grid_up));
+  const Vec3 grid_left = Cross(grid_up, grid_fwd);
+  const int n = std::max(1, o_.crowd);
+  const int cols = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n))));
+  const int rows = (n + cols - 1) / cols;
+  const double spacing = o_.crowd_spacing > 0 ? o_.crowd_spacing : 2 * c_.reach;
+  std::vector<Vec3> offsets(n);
+  points_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const double x = (i % cols - (cols - 1) / 2.0) * spacing;
+    const double z = (i / cols - (rows - 1) / 2.0) * spacing;
+    offsets[i] = n == 1 ? Vec3{} : grid_left * x + grid_fwd * z;
+    points_[i] = first.point + offsets[i];
+  }
+  answers_.resize(n);
+  s = Check(session_.Snap(terrain_, points_.data(), n, answers_.data()), "snap start", error);
+  if (s != Status::kOk) return s;
+  // Where the grid runs off the terrain (or past a narrow one), several places snap onto one
+  // edge: a character starting within half the spacing of another stays out (CrowdedStarts).
+  const std::vector<int> crowded = CrowdedStarts(points_.data(), answers_.data(), n, 0.5 * spacing);
+  std::vector<Vec3> snapped_start(n);
+  for (int i = 0; i < n; ++i) snapped_start[i] = answers_[i].point;
+  agents_.resize(n);
+  walk_.tracks.clear();
+  walk_.tracks.reserve(n * (feet + 1));
+  // Every track reserves the keys it will have if it walks every step (up to a cap), all in
+  // one arena. (Exactly those keys when the steps are given and under the cap; a path walk's
+  // steps are only a bound.)
+  const size_t groups = c_.gait.size();
+  const size_t steps_of_foot = static_cast<size_t>(steps_) / groups + 1;
+  constexpr size_t kMaxReserved = 4096;
+  const size_t foot_keys = std::min<size_t>(3 * steps_of_foot + 1, kMaxReserved);
+  const size_t body_keys = std::min<size_t>(steps_ + 1, kMaxReserved);
+  const size_t character_bytes =
+      feet * foot_keys * sizeof(WalkKey) + body_keys * (sizeof(WalkKey) + sizeof(Quat));
+  const bool exact = o_.steps >= 0 && 3 * steps_of_foot + 1 <= kMaxReserved &&
+                     static_cast<size_t>(steps_) + 1 <= kMaxReserved;
+  // A heading along the up where the character starts gives no direction on the ground (it
+  // used to fall back to another direction silently). Within a few degrees of the up, what is
+  // left on the ground is the terrain's tilt, not a direction the user chose: the default +Z
+  // heading on a Z-up terrain would walk a multiped downhill.
+  if (o_.path.empty() && n > 0) {
+    constexpr double kMinDegreesFromUp = 10;
+    const double min_sin = std::sin(Radians(kMinDegreesFromUp));
+    const Vec3 up = c_.align_to_normal ? answers_[0].normal : world_up_;
+    if (Length2(ProjectOnPlane(o_.heading, up)) <= min_sin * min_sin * Length2(o_.heading)) {
+      std::ostringstream m;
+      m << "the heading " << Point(o_.heading) << " is along the up " << Point(up)
+        << " where the character starts (within " << kMinDegreesFromUp
+        << " deg of it): it gives no clear direction on the ground; give a heading along the "
+           "ground with --heading";
+      *error = m.str();
+      return Status::kInvalidArgument;
+    }
+  }
+  auto arena = std::make_shared<KeyArena>(n * character_bytes, exact);
+  for (int i = 0; i < n; ++i) {
+    Agent& a = agents_[i];
+    if (n > 1) a.id = "c" + std::to_string(i + 1);
+    for (const Vec3& p : o_.path) a.path.push_back(p + offsets[i]);
+    Orient(a, answers_[i], up0, fwd0);
+    a.first_track = walk_.tracks.size();
+    for (size_t f = 0; f <= feet; ++f) {
+      const bool body = f == feet;
+      WalkTrack t{body ? "body" : c_.feet[f].name,
+                  a.id,
+                  body ? TrackKind::kBody : TrackKind::kFoot,
+                  KeyMemory(arena),
+                  std::pmr::vector<WalkKey>(arena.get()),
+                  std::pmr::vector<Quat>(arena.get())};
+      t.keys.reserve(body ? body_keys : foot_keys);
+      if (body) t.rotations.reserve(body_keys);
+      walk_.tracks.push_back(std::move(t));
+    }
+  }
+  // 3. Snap the feet at their rest positions around each start.
+  points_.resize(n * feet);
+  for (int i = 0; i < n; ++i)
+    for (size_t f = 0; f < feet; ++f) points_[i * feet + f] = Place(agents_[i], rest_[f]);
+  answers_.resize(points_.size());
+  s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()), "snap feet",
+            error);
+  if (s == Status::kOk)
+    s = SeparateSharedFeet(points_.data(), answers_.data(), points_.size(), feet, error);
+  if (s != Status::kOk) return s;
+  // 4. The body at the feet's centroid, raised by body_height along its up (multipeds: BodyUp;
+  //    the feet's frame from their averaged normal). (Keyed at the start of their pass.)
+  for (int i = 0; i < n; ++i) {
+    Agent& a = agents_[i];
+    const std::string fault = Plant(a, &answers_[i * feet]);
+    if (!fault.empty()) {
+      Stop(a, 1, fault);
+    } else if (crowded[i] >= 0) {
+      const Agent& other = agents_[crowded[i]];
+      std::ostringstream m;
+      m.precision(3);
+      m << "step 1 of " << a.id << ": its place on the crowd's grid, "
+        << Point(first.point + offsets[i]) << ", snaps to " << Point(snapped_start[i])
+        << ", within " << Distance(snapped_start[i], snapped_start[crowded[i]]) << " of "
+        << other.id << "'s start (the grid runs off the terrain there): left out of the walk";
+      a.walking = false, a.left_out = true;
+      a.stopped = m.str(), a.stopped_step = 1;
+    }
+  }
+  // Feet planted exactly where another character's are (places on a terrain's edge whose snaps
+  // differ but whose feet snap alike): one of them is left out, as for starts. (Within the gap,
+  // characters stopped at step 1 kept neighbours that would have stood apart off.)
+  std::vector<Foothold> grounds(static_cast<size_t>(n));
+  std::vector<Vec3> places(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    places[i] = first.point + offsets[i];
+    grounds[i].point = agents_[i].ground;
+    grounds[i].status = agents_[i].left_out ? Status::kNoFoothold : Status::kOk;
+  }
+  const std::vector<int> stacked = CrowdedStarts(places.data(), grounds.data(), n, 1e-9 * spacing);
+  for (int i = 0; i < n; ++i) {
+    Agent& a = agents_[i];
+    if (stacked[i] < 0 || a.left_out) continue;
+    std::ostringstream m;
+    m << "step 1 of " << a.id << ": its feet, around " << Point(a.ground) << ", stand where "
+      << agents_[stacked[i]].id
+      << "'s do (the grid runs off the terrain there): left out of the walk";
+    a.walking = false, a.left_out = true;
+    a.stopped = m.str(), a.stopped_step = 1;
+  }
+  // 5 (set-up). How far each waypoint lies from the terrain (one batch of snaps), for Reached.
+  const size_t waypoints = o_.path.size();
+  if (waypoints > 0) {
+    points_.resize(static_cast<size_t>(n) * waypoints);
+    for (int i = 0; i < n; ++i)
+      std::copy(agents_[i].path.begin(), agents_[i].path.end(), &points_[i * waypoints]);
+    // Points beyond the reach of terrain queries are farther from it than anything.
+    std::vector<size_t> asked;
+    std::vector<Vec3> queries;
+    for (size_t j = 0; j < points_.size(); ++j) {
+      const Vec3& p = points_[j];
+      if (std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) <= terrain::kMaxCoordinate)
+        asked.push_back(j), queries.push_back(p);
+    }
+    answers_.resize(queries.size());
+    s = Check(session_.Snap(terrain_, queries.data(), queries.size(), answers_.data()),
+              "snap waypoints", error);
+    if (s != Status::kOk) return s;
+    for (int i = 0; i < n; ++i)
+      agents_[i].path_off.assign(waypoints, std::numeric_limits<double>::infinity());
+    for (size_t q = 0; q < asked.size(); ++q)
+      if (answers_[q].status == Status::kOk)
+        agents_[asked[q] / waypoints].path_off[asked[q] % waypoints] =
+            Distance(answers_[q].point, queries[q]);
+  }
+  return Status::kOk;
+}
+
+std::vector<int> Generator::CrowdedStarts(const Vec3* places, const Foothold* starts, int n,
+                                          double apart) {
+  // A hash of cells `apart` wide: only the 27 cells around a start can hold one nearer.
+  std::vector<int> crowded(static_cast<size_t>(n), -1);
+  if (n < 2 || !(apart > 0)) return crowded;
+  struct CellHash {
+    size_t operator()(const std::array<int64_t, 3>& c) const {
+      return static_cast<size_t>(c[0] * 73856093 ^ c[1] * 19349663 ^ c[2] * 83492791);
+    }
+  };
+  std::unordered_map<std::array<int64_t, 3>, std::vector<int>, CellHash> cells;
+  auto cell_of = [apart](const Vec3& p) {
+    auto index = [apart](double v) {  // clamped: a tiny spacing must not overflow the cast
+      return static_cast<int64_t>(std::clamp(std::floor(v / apart), -9e18, 9e18));
+    };
+    return std::array<int64_t, 3>{index(p.x), index(p.y), index(p.z)};
+  };
+  // The characters that snapped nearest their places first (those on the terrain before those
+  // pushed onto its edge), in grid order among equals.
+  std::vector<int> order(static_cast<size_t>(n));
+  std::vector<double> moved(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) order[i] = i, moved[i] = Distance(places[i], starts[i].point);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return moved[a] < moved[b]; });
+  for (int i : order) {
+    if (starts[i].status != Status::kOk) continue;
+    const Vec3& p = starts[i].point;
+    const std::array<int64_t, 3> c = cell_of(p);
+    for (int64_t dz = -1; dz <= 1 && crowded[i] < 0; ++dz)
+      for (int64_t dy = -1; dy <= 1 && crowded[i] < 0; ++dy)
+        for (int64_t dx = -1; dx <= 1 && crowded[i] < 0; ++dx) {
+          const auto it = cells.find({c[0] + dx, c[1] + dy, c[2] + dz});
+          if (it == cells.end()) continue;
+          for (int j : it->second)
+            if (Distance(starts[j].point, p) < apart) {
+              crowded[i] = j;
+              break;
+            }
+        }
+    if (crowded[i] < 0) cells[c].push_back(i);  // only characters that walk keep others off
+  }
+  return crowded;
+}
+
+Status Generator::SeparateSharedFeet(const Vec3* places, Foothold* feet, size_t total, size_t count,
+                                     std::string* error) {
+  if (count < 2) return Status::kOk;
+  std::vector<size_t> movers;
+  for (size_t c = 0; c < total; c += count) {
+    for (size_t f = c; f < c + count; ++f) {
+      if (feet[f].status != Status::kOk) continue;
+      // f moves when another foot of its character shares its sample and is nearer it (or as
+      // near, and earlier).
+      const double mine = Distance(places[f], feet[f].point);
+      for (size_t g = c; g < c + count; ++g) {
+        if (g == f || feet[g].status != Status::kOk || feet[g].index != feet[f].index) continue;
+        const double theirs = Distance(places[g], feet[g].point);
+        if (theirs < mine || (theirs == mine && g < f)) {
+          movers.push_back(f);
+          break;
+        }
+      }
+    }
+  }
+  if (movers.empty()) return Status::kOk;
+  std::vector<Vec3> far(movers.size());
+  for (size_t i = 0; i < movers.size(); ++i) {
+    const size_t f = movers[i];
+    far[i] = places[f] * 2.0 - feet[f].point;
+  }
+  std::vector<Foothold> again(movers.size());
+  const Status s =
+      Check(session_.Snap(terrain_, far.data(), far.size(), again.data()), "snap feet", error);
+  if (s != Status::kOk) return s;
+  for (size_t i = 0; i < movers.size(); ++i) {
+    const size_t f = movers[i], c = f - f % count;
+    const Foothold& h = again[i];
+    if (h.status != Status::kOk ||
+        Distance(places[f], h.point) > Distance(places[f], feet[f].point) + gap_)
+      continue;
+    bool taken = false;
+    for (size_t g = c; g < c + count; ++g) taken |= g != f && feet[g].index == h.index;
+    if (!taken) feet[f] = h;
+  }
+  return Status::kOk;
+}
+
+Status Generator::FindStart(const Vec3& start, bool may_move, Foothold* first, std::string* error) {
+  Status s = Check(session_.Snap(terrain_, &start, 1, first), "snap start", error);
+  if (s != Status::kOk) return s;
+  if (first->status != Status::kOk) {
+    *error = first->status == Status::kInvalidArgument
+                 ? "the start is too far from the terrain to snap (queries reach 1e15 from it)"
+                 : "the terrain is empty: no sample to start on";
+    return Status::kInvalidArgument;
+  }
+  if (!may_move) {
+    // A start beside the foot of a wall (a box's face nearer than the lattice's next floor
+    // sample) takes the ground below it, when that lies within half a step and leans within
+    // max_slope_deg of world up: a crowd started 2 cm in front of a box stood on a grid up its
+    // face. A start up a wall or on a ceiling (even a thin one: not the ground above) stays.
+    if (Dot(first->normal, world_up_) >= cos_max_slope_) return Status::kOk;
+    const double beside = kFootholdTolerance * c_.step_length;
+    const Vec3 below = start - world_up_ * beside;
+    Foothold ground;
+    s = Check(session_.Snap(terrain_, &below, 1, &ground), "snap start", error);
+    if (s == Status::kOk && ground.status == Status::kOk &&
+        Dot(ground.normal, world_up_) >= cos_max_slope_ &&
+        Dot(start - ground.point, world_up_) >= 0 && Distance(ground.point, start) <= beside)
+      *first = ground;
+    return s;
+  }
+  // Candidates on a grid of half a step across world up through the start's sample, nearest
+  // it first (the start itself first), each snapped; then the feet of one character standing
+  // on each. (A candidate snaps to the nearest sample: beside a tall feature it may snap to
+  // the feature's side rather than the ground below, and the search goes on farther out.)
+  const Vec3 centre = first->point;
+  const double cell = 0.5 * c_.step_length;
+  const int k = 2 * kStartSearchSteps;
+  std::vector<std::pair<int, int>> grid;
+  for (int j = -k; j <= k; ++j)
+    for (int i = -k; i <= k; ++i)
+      if (i * i + j * j <= k * k) grid.emplace_back(i, j);
+  std::stable_sort(grid.begin(), grid.end(), [](const auto& a, const auto& b) {
+    return a.first * a.first + a.second * a.second < b.first * b.first + b.second * b.second;
+  });
+  const Vec3 u = AnyPerpendicular(world_up_), v = Cross(world_up_, u);
+  const size_t feet = c_.feet.size();
+  const double beside = kFootholdTolerance * c_.step_length;
+  std::vector<Vec3> points;
+  std::vector<Foothold> grounds, snapped;
+  std::vector<Agent> stand;
+  bool level_feet = true;  // the first search: every foot on ground within max_slope_deg
+  // Candidates [b, e): sets *found to the first where the character can stand.
+  auto search = [&](size_t b, size_t e, bool* found) -> Status {
+    points.resize(e - b);
+    for (size_t m = b; m < e; ++m)
+      points[m - b] = centre + u * (grid[m].first * cell) + v * (grid[m].second * cell);
+    grounds.resize(points.size());
+    Status st = Check(session_.Snap(terrain_, points.data(), points.size(), grounds.data()),
+                      "snap start", error);
+    if (st != Status::kOk) return st;
+    stand.assign(grounds.size(), Agent{});
+    points.assign(grounds.size() * feet, Vec3{});
+    for (size_t m = 0; m < grounds.size(); ++m) {
+      if (grounds[m].status != Status::kOk) continue;
+      const Vec3 up0 = c_.align_to_normal ? grounds[m].normal : world_up_;
+      stand[m].path = o_.path;
+      Orient(stand[m], grounds[m], up0, StartHeading(up0));
+      for (size_t f = 0; f < feet; ++f) points[m * feet + f] = Place(stand[m], rest_[f]);
+    }
+    snapped.resize(points.size());
+    st = Check(session_.Snap(terrain_, points.data(), points.size(), snapped.data()), "snap feet",
+               error);
+    if (st != Status::kOk) return st;
+    for (size_t m = 0; m < grounds.size() && !*found; ++m) {
+      if (grounds[m].status != Status::kOk) continue;
+      Agent& a = stand[m];
+      bool near = true;  // every foot near its rest position, along up and across it
+      for (size_t f = 0; f < feet && near; ++f) {
+        const Foothold& h = snapped[m * feet + f];
+        const Vec3 d = h.point - points[m * feet + f];
+        // ... and, in the first search, on ground within max_slope_deg of the up it was placed
+        // with (Plant judges the feet's averaged normal: two paws on a stair's riser and two on
+        // its tread averaged 45 degrees, and the default start stood them there).
+        near = h.status == Status::kOk && std::fabs(Dot(d, a.up)) <= c_.max_rise &&
+               Length(ProjectOnPlane(d, a.up)) <= beside &&
+               (!level_feet || Dot(h.normal, a.up) >= cos_max_slope_);
+      }
+      if (near && Plant(a, &snapped[m * feet]).empty()) *found = true, *first = grounds[m];
+    }
+    return Status::kOk;
+  };
+  // The start alone first: usually the character stands there, and nothing more is asked. A
+  // place with every foot on level enough ground first; else one where Plant accepts the feet
+  // (a diagonal across a flight of stairs has no place of the first kind within reach).
+  bool found = false;
+  for (bool level : {true, false}) {
+    level_feet = level;
+    s = search(0, 1, &found);
+    if (s == Status::kOk && !found) s = search(1, grid.size(), &found);
+    if (s != Status::kOk || found) break;
+  }
+  return s;  // found nowhere: the start's own sample, where Setup says why it cannot stand
+}
+
+void Generator::Orient(Agent& a, const Foothold& ground, const Vec3& up0, const Vec3& fwd0) const {
+  a.ground = ground.point;
+  a.up = c_.align_to_normal ? ground.normal : world_up_;
+  a.forward = TangentForward(o_.heading, fwd0, up0, a.up);
+  // Facing the first waypoint beyond its radius along the ground: one at the start (a path
+  // drawn from where the character stands) counts as reached on the first step, so it gives no
+  // direction. (Before the waypoints' distances from the terrain are known: taken as off it.)
+  for (size_t i = 0; i < a.path.size(); ++i) {
+    const Vec3 to = ProjectOnPlane(ToPathPoint(a, a.path[i], false), a.up);
+    if (Length(to) > Radius(a, i)) {
+      a.forward = Normalize(to);
+      return;
+    }
+  }
+  // Every waypoint within its radius: toward the first that is off the start at all.
+  for (const Vec3& p : a.path) {
+    const Vec3 to = ProjectOnPlane(ToPathPoint(a, p, false), a.up);
+    if (Length2(to) > 1e-18) {
+      a.forward = Normalize(to);
+      return;
+    }
+  }
+}
+
+std::string Generator::Plant(Agent& a, const Foothold* feet) const {
+  const size_t n = c_.feet.size();
+  a.foot.resize(n), a.foot_normal.resize(n);
+  Vec3 centroid;
+  for (size_t f = 0; f < n; ++f) {
+    a.foot[f] = feet[f].point, a.foot_normal[f] = feet[f].normal;
+    centroid += a.foot[f];
+  }
+  const Vec3 old_up = a.up;
+  a.up = AveragedUp(a.up, a.foot_normal);
+  a.body_up = BodyUp(a.up, a.foot);
+  a.forward = TangentForward(a.forward, a.forward, old_up, a.up);
+  a.ground = centroid / static_cast<double>(n);
+  for (size_t f = 0; f < n; ++f) {
+    const double slope = Degrees(AngleBetween(a.foot_normal[f], a.up));
+    if (slope > c_.max_slope_deg) {
+      std::ostringstream m;
+      m.precision(3);
+      m << "foot " << c_.feet[f].name << " cannot stand at " << Point(a.foot[f])
+        << ": ground leans " << Beyond(slope, c_.max_slope_deg) << " deg, more than max_slope_deg "
+        << NumberText(c_.max_slope_deg) << FacingDownHint(slope);
+      // An upright character starting on ground across its up: a terrain whose up is another
+      // axis (a height map read with --up-axis z) with the default world up.
+      if (!c_.align_to_normal && slope > 60 && slope < 120)
+        m << "; if the terrain's up is not " << Point(world_up_)
+          << ", give the world up with --up (Z up: --up 0,0,1)";
+      return m.str();
+    }
+  }
+  return "";
+}
+
+}  // namespace footfall::steps_detail

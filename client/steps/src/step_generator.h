@@ -1,0 +1,420 @@
+// The step generator's internals, shared by its source files: the tuning constants, a walking
+// character (Agent), one foot's move in a step (Move) and the Generator that walks them. The
+// numbered comments match the numbered list of "The algorithm" in the top-level README.md;
+// each step lives in one file:
+//   generator.cpp            the run: passes of characters, one step at a time (5-11 in order)
+//   generator_setup.cpp      1-4: start, heading, feet and body snapped to the terrain
+//   generator_footholds.cpp  5-8: steering along the path, foothold queries and their judging
+//   generator_keys.cpp       9-11: swing arcs, foot and body keys
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "footfall/steps/generator.h"
+#include "footfall/terrain/batch_pool.h"
+#include "frame_math.h"
+
+namespace footfall::steps_detail {
+
+// Foothold queries per foot and step, in turn: the step vector scaled (shorter, then longer:
+// over a stair's riser, then shorter still), then aimed down by `drop` times max_rise along the
+// body's up (down a stair's nose, or over a convex edge onto the face below it).
+struct Attempt {
+  double scale, drop;
+};
+inline constexpr int kMaxAttempts = 7;
+inline constexpr Attempt kAttempts[kMaxAttempts] = {{1.0, 0},   {0.6, 0},   {1.35, 0}, {0.3, 0},
+                                                    {1.0, 0.5}, {0.6, 0.5}, {0.3, 0.5}};
+// A foothold is looked for within this fraction of step_length of where the foot aims.
+inline constexpr double kFootholdTolerance = 0.5;
+inline constexpr int kMaxRaises = 8;    // swing arc raises before giving up
+inline constexpr double kRaise = 0.5;   // raise per round, in step heights
+inline constexpr double kSlide = 0.25;  // slide per round toward a blocked half's end (of the way)
+inline constexpr double kAlikeCos = 0.7071;  // footholds whose normals are within 45 deg face alike
+// A body key keeps at least this fraction of body_height from the terrain (measured as arcs
+// are, from its nearest sample); nearer, it is raised along its up, in up to kBodyRounds rounds
+// of at most body_height each, and never beyond reach of a foot.
+inline constexpr double kBodyClearance = 0.5;
+inline constexpr int kBodyRounds = 3;
+// Room for an upright body (bipeds): points of its spine, from half body_height above the
+// feet's centroid up to the body, at most this many and no farther apart than the terrain's
+// gap, are snapped; a nearest sample on the spine's line (within the gap), above every foot by
+// more than the gap and below the body is terrain between the feet and the body, and the walk
+// stops before that step (a biped walking under a slab lower than its body had its feet under
+// it and its body over it). Not tried for multipeds, whose bodies lean with the terrain and
+// whose feet wrap around edges.
+inline constexpr size_t kMaxSpineChecks = 17;
+// Points checked along each start-mid-end arc, evenly spaced: at least kMinArcChecks, and as many
+// more as keep them no farther apart than the terrain's gap (about twice its sample spacing), up
+// to kMaxArcChecks (ArcChecks). Between two check points an arc may graze a sharp edge by about
+// their spacing: seven points on a 1.8 m stride over stairs sampled every 2 cm let its last stretch
+// pass 7.5 cm through a nose. Each point is snapped: its clearance is measured along the normal
+// of its nearest sample, and a Snap answer elsewhere proves only that no sample lies closer to
+// that point than the answer, which bounds neither which sample is nearest here nor its normal.
+// (A point between two points of the same straight half that share a nearest sample shares it
+// too, Voronoi cells being convex; but measured on the bench's ground, samples a third of a step
+// apart, that would spare at most one query in seven, for an extra round of queries.)
+inline constexpr size_t kMinArcChecks = 7;
+inline constexpr size_t kMaxArcChecks = 63;
+
+// The number of points checked along an arc of `length` (its longer half twice), no farther
+// apart than `gap`: 7, 15, 23, ... 63, so that the seven points of the shortest arcs (at
+// eighths) are always among them.
+// [Units: length, gap in wu]
+inline size_t ArcChecks(double length, double gap) {
+  static_assert((kMaxArcChecks + 1) % 8 == 0 && (kMinArcChecks + 1) == 8, "checks at eighths");
+  if (!(gap > 0) || !std::isfinite(length)) return kMinArcChecks;
+  const double eighths = std::ceil(length / gap / 8);
+  constexpr double kMost = (kMaxArcChecks + 1) / 8.0;
+  return 8 * static_cast<size_t>(eighths > 1 ? std::min(eighths, kMost) : 1.0) - 1;
+}
+
+// The j-th of an arc's `checks` points, as a fraction of the arc (0: its start key, 0.5: its
+// mid key, 1: its end key).
+inline double ArcS(size_t j, size_t checks) {
+  return static_cast<double>(j + 1) / static_cast<double>(checks + 1);
+}
+// Required clearance at each check point, as a fraction of the arc's nominal clearance there
+// (the step height at the mid key, falling linearly to 0 at the start and end keys).
+inline constexpr double kClearanceFraction = 0.25;
+// Steer: a turn is tried at its whole and then in kTurnShares - 1 smaller shares, and the
+// largest that keeps every pair's feet at least kMinPairGap of their rest gap apart is taken.
+inline constexpr int kTurnShares = 8;
+// Ground whose up lies within this many degrees of the world up is a floor for path walks:
+// waypoints off the terrain are aimed at across it, their height along the world up ignored.
+inline constexpr double kFloorUpDeg = 60;
+inline constexpr double kMinPairGap = 0.5;
+// A step shorter than this fraction of step_length is a step in place: no foothold query.
+inline constexpr double kInPlace = 0.02;
+// Move::query of a move not asked this round.
+inline constexpr size_t kNoQuery = ~size_t{0};
+// Per-character loops split across threads only from this many items (a hand-over costs
+// ~20 us).
+inline constexpr size_t kMinParallel = 512;
+
+// "(x, y, z)" to 4 decimals, for messages.
+std::string Point(const Vec3& p);
+// `value` to 3 significant digits, or to as many more as it takes to differ from `limit`, which
+// it breaks: "leans 100.0001 deg, more than max_slope_deg 100", never "leans 100 ... 100".
+std::string Beyond(double value, double limit);
+// For ground facing away from the character's up (more than 120 degrees): what would make it
+// so where the ground should face up (an underside is often just that: a log's, a beam's).
+std::string FacingDownHint(double slope_deg);
+
+// One walking character.
+struct Agent {
+  std::string id;                       // "" for a single character, else "c1".."cN"
+  bool left_out = false;                // a crowd's character starting on another: no tracks
+  Vec3 ground;                          // the body's ground point: centroid of the planted feet
+  Vec3 up;                              // the up of the feet's frame (FeetUp)
+  Vec3 body_up;                         // the body's up (BodyUp)
+  Vec3 forward;                         // the body's heading, unit, perpendicular to up
+  std::vector<Vec3> foot, foot_normal;  // planted feet
+  std::vector<Vec3> path;
+  // Each waypoint's distance from the terrain (its nearest sample; infinite for one beyond the
+  // reach of terrain queries): one lying on the terrain is reached only when near in 3D too.
+  std::vector<double> path_off;
+  size_t waypoint = 0;
+  // The nearest the ground has come to the current waypoint (in 3D), by a quarter step at a
+  // time, and the step it did: a walk that comes no nearer for Generator::window_steps_ steps
+  // has no way there.
+  size_t nearest_waypoint = SIZE_MAX;
+  double nearest = 0;
+  int nearest_step = 0;
+  // This step's stride, as a share of a full one (Steer): below 1 while the waypoint lies inside
+  // the circle the body turns on at full stride, 0 to turn on the spot.
+  double stride = 1;
+  bool walking = true;  // false once stopped or arrived
+  int waits = 0;        // steps in a row its group stepped in place, waiting for a planted foot
+  int still = 0;        // steps in a row no foot of it moved (waits, turns on the spot included)
+  // Where the body was at step `window_step`: a body that stays within half a step of it for
+  // Generator::window_steps_ steps is milling about at a dead end (`window_left`: it has been
+  // farther since, as a walk along a loop that comes back there is).
+  Vec3 window_from;
+  int window_step = -1;
+  bool window_left = false;
+  std::string stopped;   // why it stopped early ("" when it did not)
+  int stopped_step = 0;  // the step it stopped at
+  size_t first_track = 0;
+};
+
+// One foot of one agent in the current step.
+struct Move {
+  size_t agent;
+  int foot;
+  Attempt attempt = kAttempts[0];  // how this round aims the step (retries change it)
+  int attempts = 0;
+  bool done = false;
+  bool failed = false;
+  // Why the foot was refused: the first foothold refused (the step as meant), or, when every
+  // foothold before was a gap, the first one found but refused (steep, high, out of reach, an
+  // arc that cannot clear), which says more.
+  std::string reason;
+  bool reason_is_gap = false;
+  // A try found a foothold refused only because a planted foot would be left beyond reach: the
+  // character may wait for that foot (Finish).
+  bool held_by_planted = false;
+  Vec3 end, end_normal;  // the accepted foothold
+  Vec3 mid, mid_normal;
+  Vec3 ideal;               // the last query's ideal point
+  Vec3 step;                // the last query's step vector
+  size_t query = kNoQuery;  // index of this round's foothold answer, or kNoQuery
+  // A foothold accepted but lined up with (or across) its pair's other foot, samples lying
+  // about as far apart as the feet: the query is asked again aimed outward (`outward`), and
+  // this one (`lined_up`, its gap as a share of the rest gap) is kept unless that does better.
+  bool outward = false;
+  bool lined_up = false;
+  double lined_up_gap = 0;
+  Vec3 lined_up_point, lined_up_normal;
+};
+
+class Generator {
+ public:
+  // Walks `agents` (filled by Setup) into *walk.
+  Generator(TerrainSession& session, TerrainHandle terrain, const Character& c,
+            const GenerateOptions& o, std::vector<Agent>* agents, Walk* walk)
+      : session_(session),
+        terrain_(terrain),
+        c_(c),
+        o_(o),
+        walk_(*walk),
+        agents_(*agents),
+        threads_(o.threads) {}
+
+  // A copy walks passes of its own, sharing the agents and the walk (WalkPassesInParallel).
+  Generator(const Generator&) = default;
+
+  Status Run(std::string* error);
+
+ private:
+  // Counts the work done across passes and reports it through GenerateOptions::progress.
+  class Progress;
+  Status Setup(std::string* error);
+  // Walks the characters [begin, end) every step, counting each step done in *progress.
+  Status WalkPass(size_t begin, size_t end, Progress* progress, std::string* error);
+  // Walks `passes` passes of `per_pass` characters, in parallel: one pass at a time per thread,
+  // each thread with a copy of this generator. Returns the failure of the first pass that failed.
+  Status WalkPassesInParallel(size_t passes, size_t per_pass, Progress* progress,
+                              std::string* error);
+  // 1. The start's sample: where `start` snaps, or, when it may move and the character cannot
+  //    stand there, the nearest candidate around it where it can (GenerateOptions).
+  Status FindStart(const Vec3& start, bool may_move, Foothold* first, std::string* error);
+  // 2. The heading at a start whose up is up0: GenerateOptions::heading projected across it.
+  Vec3 StartHeading(const Vec3& up0) const {
+    return TangentForward(o_.heading, AnyPerpendicular(world_up_), world_up_, up0);
+  }
+  // 2. Stands a on `ground` in the start's frame (up0, fwd0): its up and its heading, turned
+  //    toward its path's first waypoint beyond that waypoint's radius when it has one.
+  void Orient(Agent& a, const Foothold& ground, const Vec3& up0, const Vec3& fwd0) const;
+  // 3-4. Plants a's feet on `feet`, the snaps of their rest positions (Place), and moves its
+  //    frame and ground to them. Returns why a foot cannot stand there, or "".
+  std::string Plant(Agent& a, const Foothold* feet) const;
+  // 3. Feet of one character that snapped onto one sample (a terrain coarser than the stance,
+  //    the start on a sample between two rests): each but the one nearest it snaps again from
+  //    the far side of its rest, and takes that sample when no other foot has it and it lies
+  //    within a sample spacing as near its rest. (On a beam narrower than the stance the far
+  //    side gives the same sample: they share it.) `places` are the rest positions of `total`
+  //    feet, `count` a character, `feet` their snaps, updated.
+  Status SeparateSharedFeet(const Vec3* places, Foothold* feet, size_t total, size_t count,
+                            std::string* error);
+  // For each of the n crowd starts (places on the grid, and their snaps), another start nearer
+  // than `apart` that keeps it out, or -1. Starts that snapped nearer their places keep out
+  // those that moved farther (then those earlier in the grid the later); a start kept out keeps
+  // no other out.
+  static std::vector<int> CrowdedStarts(const Vec3* places, const Foothold* starts, int n,
+                                        double apart);
+  Status Step(int k, std::string* error);
+  Status QueryFootholds(std::string* error);
+  // Accepts the answer h to mv's foothold query, or records why it is refused.
+  void Judge(Move& mv, const Foothold& h) const;
+  // The gap across the heading between the foothold p of mv's foot and its mate (mate_), as a
+  // share of their rest gap (1 as at rest, below 0 crossed); 1 for a foot without a mate.
+  double GapToMate(const Move& mv, const Vec3& p) const;
+  // Judge's side test: true when the accepted foothold p may stand (kept, or kept as the
+  // better of a lined-up first answer and its outward retry); false when it is asked again,
+  // aimed outward.
+  bool KeepsSide(Move& mv, const Vec3& p, const Vec3& normal) const;
+  // The reach limit for one character whose moves moves_[m, e) all have a foothold: refuses
+  // the footholds beyond reach of the body they lead to, or all of them when a planted foot
+  // would be left beyond reach.
+  void CheckReach(size_t m, size_t e);
+  // Whether a refusal (a gap or not) becomes mv's reason (see Move::reason).
+  static bool KeepsReason(const Move& mv, bool gap) {
+    return mv.reason.empty() || (mv.reason_is_gap && !gap);
+  }
+  // 8 (end). A foot refused every foothold toward a target behind it along the heading (a hind
+  // foot standing at a terrain's back edge, ahead of its rest), or while its character turns at
+  // a short stride (a foot on a stair's nose turning on the spot), keeps its place: a step in
+  // place, so its group waits for the body to move on or turn rather than stop the walk.
+  void KeepPlace(Move& mv) const;
+  // Gives up on mv's foothold after its last try; its reason says how many were refused.
+  static void Fail(Move& mv);
+  Status ClearArcs(int k, std::string* error);
+  // Keys (or stops) the w-th walking character at step k once its moves are final.
+  void Finish(size_t w, int k);
+  int window_steps_ = 100;  // steps a body must get half a step in (Agent::window_from)
+  // fn(begin, end) over [0, count), split across the pool's threads for large counts. Each
+  // item's result must not depend on the split.
+  template <typename Fn>
+  void Parallel(size_t count, Fn&& fn) {
+    if (threads_ <= 1 || count < kMinParallel) return fn(size_t{0}, count);
+    if (!pool_) pool_ = SharedBatchPool(threads_);  // the engine's threads, on first use
+    // Chunks of about count / (8 threads), taken in turn: a thread the system holds up delays
+    // the others little.
+    const size_t chunk = std::max<size_t>(1, count / (8 * static_cast<size_t>(threads_)));
+    pool_->Run(count, chunk, fn);
+  }
+  // 5. Turns a's heading toward its current waypoint (at most max_turn_deg, and no farther
+  // than keeps every pair's feet apart across it when gait group `group` steps next) and sets
+  // a's stride; marks a arrived at the last waypoint.
+  void Steer(Agent& a, int group) const;
+  // The share of a full stride a body heading `forward` takes toward a waypoint `to` away along
+  // the ground: below 1 for a waypoint inside the circle it turns on at full stride.
+  double StrideToward(const Vec3& to, const Vec3& forward) const;
+  // The least gap across the heading between a foot and its mate (mate_), as a share of their
+  // gap at rest, once a heading `forward` at `stride` has been taken and gait group `group` has
+  // stepped (each of its feet at most step_length toward its target on ground as level as a's):
+  // below 0 when feet cross.
+  double PairGap(const Agent& a, const Vec3& forward, double stride, int group) const;
+  // The radius within which a's waypoint i counts as reached: half a step for the last, a
+  // step for the others.
+  double Radius(const Agent& a, size_t i) const;
+  // Whether a's waypoint i lies on the terrain: within half its radius of a sample.
+  bool OnTerrain(const Agent& a, size_t i) const;
+  // Whether a's waypoint i counts as reached, within its radius of a's ground: along the ground,
+  // whatever the waypoint's height above or below it (a biped's waypoint in the air), unless
+  // the waypoint lies on the terrain farther than the radius along a's up: the far side of a
+  // sphere, a floor under a table top, a ceiling.
+  bool Reached(const Agent& a, size_t i) const;
+  // How far a's waypoint i still is, as Reached measures it: in 3D when it lies on the terrain,
+  // else along the ground.
+  double Remaining(const Agent& a, size_t i) const;
+  // The offset from a's ground to a point `p` of its path, as the walk aims at it: with p's
+  // height along the world up taken off while a stands on ground facing up (within
+  // kFloorUpDeg of the world up), unless p lies on the terrain (`on_terrain`): a path given at
+  // any height, a 2D path at y = 0 over a DEM 537 m up, is followed across the ground by
+  // multipeds too, whose up leans with the ground (on a 15-degree slope a goal 5 m up was
+  // reached a metre past it). On walls and ceilings the height is along a's up.
+  Vec3 ToPathPoint(const Agent& a, const Vec3& p, bool on_terrain) const;
+  Vec3 ToWaypoint(const Agent& a, size_t i) const {
+    return ToPathPoint(a, a.path[i], OnTerrain(a, i));
+  }
+  // At step k: false once a has come no nearer (Agent::nearest) to its current waypoint for
+  // window_steps_ steps.
+  bool Nearing(Agent& a, int k) const;
+  Vec3 Left(const Agent& a) const { return Cross(a.up, a.forward); }
+  Vec3 Place(const Agent& a, const Vec3& rest) const {
+    return a.ground + Left(a) * rest.x + a.up * rest.y + a.forward * rest.z;
+  }
+  // World up for bipeds, else the feet's averaged normal (`previous` when they cancel).
+  Vec3 AveragedUp(const Vec3& previous, const std::vector<Vec3>& normals) const;
+  // The up of the feet's frame, in which steps are aimed and footholds judged, for feet at
+  // `feet` on ground of `normals`: world up for bipeds, else halfway between their averaged
+  // normal and BodyUp (on stairs, between a tread's and the flight's, so steps lead up or down
+  // the flight rather than into its risers).
+  Vec3 FeetUp(const Vec3& previous, const std::vector<Vec3>& feet,
+              const std::vector<Vec3>& normals) const;
+  // The body's up over feet standing at `feet`: world up for bipeds; for multipeds the normal
+  // of the plane fitted to the feet, the terrain's at the body's scale (on stairs the flight's,
+  // not a tread's or a riser's), on the side of `feet_up`, which it falls back to for feet in a
+  // line or a plane leaning more than 60 degrees from it.
+  Vec3 BodyUp(const Vec3& feet_up, const std::vector<Vec3>& feet) const;
+  void KeyFoot(const Agent& a, int foot, double frame, KeyPhase phase, const Vec3& p,
+               const Vec3& n);
+  // Keys a's body at `frame`, `raise` above its place along its up.
+  void KeyBody(const Agent& a, double frame, double raise);
+  // Keys the bodies in body_due_ (agent, frame), each raised where the terrain comes nearer
+  // than kBodyClearance (a body over a block's edge as the feet wrap around it, a ridge between
+  // the feet); their points are snapped in one batch per round. Empties body_due_.
+  Status KeyBodies(std::string* error);
+  // The most `a`'s body may rise along its up with every foot still within reach, and at most
+  // kBodyRounds body heights.
+  double MaxBodyRaise(const Agent& a) const;
+  // Keys a's feet where they stand at the start frame, and asks for its body (body_due_).
+  void KeyStart(const Agent& a);
+  void Stop(Agent& a, int step, const std::string& why);
+  // Takes back the foot keys of a step that started at frame f0 (its body not yet keyed).
+  void UnkeyStep(const Agent& a, double f0);
+  // A call that failed during step k (footfalld gone): every character of the pass still
+  // walking stops at that step with `why`, its keys of the step taken back, body's too.
+  void StopPassAt(int k, const std::string& why);
+  // A failed batch call: the session's status, and its message prefixed with `what`.
+  Status Check(Status status, const char* what, std::string* error) {
+    if (status != Status::kOk) *error = std::string(what) + ": " + session_.last_error();
+    return status;
+  }
+
+  TerrainSession& session_;
+  TerrainHandle terrain_;
+  const Character& c_;
+  const GenerateOptions& o_;
+  Walk& walk_;
+  std::vector<Agent>& agents_;
+  int threads_;  // for Parallel; 1 in the copies that walk passes in parallel
+  Vec3 world_up_;
+  int steps_ = 0;
+  double lead_ = 0;
+  // The radius of the circle the body turns on at full stride and max_turn_deg a step (its
+  // ground moves step_length over the number of gait groups a step).
+  double turn_radius_ = 0;
+  // The farthest a point of the surface may be from its nearest sample, estimated from the
+  // grid: twice the mean spacing, cell_size / sqrt(samples per occupied cell). [Units: wu]
+  double gap_ = 0;
+  Vec3 bounds_min_, bounds_max_;  // the terrain's samples' bounds
+  // cos(max_slope_deg), sin(slope_threshold_deg): slope tests on dot products of unit vectors.
+  double cos_max_slope_ = -1, sin_slope_threshold_ = 1;
+  size_t pass_begin_ = 0, pass_end_ = 0;  // the agents walking in this pass
+  // One pass walks every character: a call failing after the first step stops the walk there,
+  // its keys so far kept (with several passes, later ones would have no keys at all).
+  bool keep_on_failure_ = false;
+  std::shared_ptr<BatchPool> pool_;
+  std::vector<int> pair_of_foot_;
+  // Each foot's other foot across the body, whose side it keeps to (PairGap, GapToMate): its
+  // pair's other foot, or for a foot paired with none the foot on the other side whose rest
+  // lies nearest its own mirrored across the body; -1 for none (a foot on the centre line).
+  std::vector<int> mate_;
+  std::vector<Vec3> rest_;         // each foot's rest less RestCentroid, character space
+  std::vector<Vec3> pair_centre_;  // rest centre of each pair, as rest_
+  std::vector<std::vector<int>> pairs_of_group_;  // pairs with a foot in each gait group
+  // slot_of_foot_[g][j]: index in pairs_of_group_[g] of the pair of foot gait[g][j]
+  std::vector<std::vector<size_t>> slot_of_foot_;
+  // move_of_foot_[g][f]: j when foot f is gait[g][j] (its move is the j-th of its character's
+  // moves in a step of group g), else -1
+  std::vector<std::vector<int>> move_of_foot_;
+  // Buffers reused every step. The moves of the w-th walking character of a step are
+  // moves_[w * G .. (w + 1) * G) for G feet in the stepping group.
+  std::vector<size_t> walking_;  // agents walking this step
+  std::vector<size_t> walkers_;  // indices in walking_ of the characters placing feet this pass
+  std::vector<char> retry_;      // per walking character: a foot to place again
+  std::vector<Move> moves_;
+  std::vector<Vec3> locator_, locator_normal_;  // per move
+  std::vector<size_t> pending_, still_;
+  std::vector<char> verdict_, raised_;
+  // A character in a round of arc checks: the w-th walking one, its arcs pending_[begin, end).
+  struct ArcAgent {
+    size_t walking, begin, end;
+  };
+  std::vector<ArcAgent> arc_agents_, next_agents_;
+  int group_ = 0;  // the gait group stepping now
+  // Query points and answers of each round, one buffer per kind of round so that their sizes
+  // stay the same from step to step (no refill on resize).
+  std::vector<Vec3> points_, arc_points_;  // setup and locators; arc check points
+  std::vector<size_t> arc_first_;          // per pending move: its first arc check point
+  std::vector<StepQuery> queries_;
+  std::vector<Foothold> answers_, next_answers_, arc_answers_;
+  // Bodies to key (KeyBodies): (agent, frame); per walking character the frame its body is due
+  // at this step (NaN: none).
+  std::vector<std::pair<size_t, double>> body_due_;
+  std::vector<double> body_frame_, body_raise_;
+  std::vector<size_t> body_pending_, body_still_;
+  std::vector<Vec3> body_points_;
+  std::vector<size_t> spine_first_;  // per due body: its first spine point (KeyBodies)
+};
+
+}  // namespace footfall::steps_detail
