@@ -230,6 +230,7 @@ TEST_CASE("WriteMel writes frames and values that read back exactly, without exp
   left.keys[3].frame = 24.999999999999996;
   walk.tracks[2].keys[0].frame = 1.0000004;
   walk.tracks[2].keys[0].position = {-1e-12, 1e22, 1234.5};
+  walk.tracks[2].keys[1].position = {-2147483648.0, 2147483647.0, 0.5};
   const std::string path = WriteAndKeep(walk, "precision.mel");
   const MelScript script = ParseMel(path);  // fails on any key line with an exponent
   CHECK(script.min_time == 1.0000004);
@@ -255,10 +256,13 @@ TEST_CASE("WriteMel writes frames and values that read back exactly, without exp
              Catch::Contains("setKeyframe -t 1.0000004 -at translateX -v 0.000000001 "));
   CHECK_THAT(text.str(), Catch::Contains("-at translateY -v 123456.789012345 "));
   CHECK_THAT(text.str(), Catch::Contains("-at translateZ -v -0.000025 "));
-  CHECK_THAT(text.str(), Catch::Contains("-at translateX -v 1000000000000000 "));
+  // Whole numbers beyond a 32-bit int keep a point: MEL would read them as an int.
+  CHECK_THAT(text.str(), Catch::Contains("-at translateX -v 1000000000000000.0 "));
   CHECK_THAT(text.str(), Catch::Contains("-at translateY -v 0.30000000000000004 "));
   CHECK_THAT(text.str(), Catch::Contains("-at translateZ -v 0 "));
-  CHECK_THAT(text.str(), Catch::Contains("-at translateY -v 10000000000000000000000 "));
+  CHECK_THAT(text.str(), Catch::Contains("-at translateY -v 10000000000000000000000.0 "));
+  CHECK_THAT(text.str(), Catch::Contains("-at translateX -v -2147483648.0 "));
+  CHECK_THAT(text.str(), Catch::Contains("-at translateY -v 2147483647 "));
   CHECK_THAT(text.str(), Catch::Contains("-at translateZ -v 1234.5 "));
   std::remove(path.c_str());
 }

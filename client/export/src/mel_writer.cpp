@@ -19,7 +19,8 @@ namespace {
 
 // A decimal MEL literal without exponent that reads back as `value` exactly: the fewest
 // significant digits that round-trip, written in fixed notation, trailing zeros trimmed, "-0"
-// as "0". `value` must be finite.
+// as "0". A whole number beyond MEL's 32-bit int keeps a ".0": MEL reads a literal without a
+// point as an int. `value` must be finite.
 std::string Number(double value) {
   // The shortest "%.{p}e" form that reads back to the same double (17 digits always do).
   char text[64];
@@ -51,6 +52,7 @@ std::string Number(double value) {
     if (s.back() == '.') s.pop_back();
   }
   if (s == "0") return s;
+  if (s.find('.') == std::string::npos && std::fabs(value) > 2147483647.0) s += ".0";
   return negative ? "-" + s : s;
 }
 
