@@ -1,0 +1,422 @@
+// The step generator's heading and paths: any heading, a path with a 90-degree turn, goals
+// behind and inside the turning circle, feet keeping their sides in turns, dead ends.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <optional>
+#include <set>
+#include <string>
+
+#include <catch2/catch.hpp>
+
+#include "footfall/import/mesh_generators.h"
+#include "footfall/import/mesh_sampler.h"
+#include "footfall/import/terrain_generators.h"
+#include "footfall/import/terrain_loader.h"
+#include "generator_fixtures.h"
+#include "walk_checks.h"
+
+using namespace footfall;
+using namespace footfall::test;
+
+TEST_CASE("Any heading, not only +Z", "[steps][generator]") {
+  const Character c = LoadShipped("biped");
+  Terrain t = LoadTerrain(MakeFlat(200, 0.05, 0), 0.05);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {3, 0, 3};
+  o.heading = {1, 0.5, -1};  // projected onto the ground: (1, 0, -1)
+  o.steps = 8;
+  const Walk w = Generate(t, c, o);
+  REQUIRE(w.stopped.empty());
+  CheckWalk(t, c, o, w);
+  const auto& body = Body(w).keys;
+  const Vec3 moved = body.back().position - body.front().position;
+  const Vec3 want = Normalize(Vec3{1, 0, -1});
+  CHECK(Dot(Normalize(moved), want) > 0.99);
+  CHECK(Dot(BodyForward(Body(w).rotations.back()), want) > 0.999);
+}
+
+TEST_CASE("The heading follows a path with a 90-degree turn", "[steps][generator]") {
+  for (const std::string& name : ShippedCharacters()) {
+    const Character c = LoadShipped(name);
+    const double leg = 10 * c.step_length, margin = 4 * c.reach;
+    Terrain t = FlatFor(c, leg + 2 * margin);
+    INFO(name);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {margin, 0, margin};
+    o.heading = {0, 0, 1};
+    const Vec3 corner{margin, 0, margin + leg}, goal{margin + leg, 0, margin + leg};
+    o.path = {corner, goal};
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    REQUIRE(w.stopped.empty());
+    CheckWalk(t, c, o, w);
+    const auto& body = Body(w).keys;
+    const Vec3 ground_end = body.back().position - Vec3{0, c.body_height, 0};
+    CHECK(Distance(ground_end, goal) <= c.step_length);
+    bool faced_z = false, faced_x = false;
+    double nearest_corner = 1e9;
+    for (size_t i = 0; i < body.size(); ++i) {
+      const WalkKey& k = body[i];
+      const Vec3 f = BodyForward(Body(w).Rotation(i));
+      faced_z |= f.z > 0.99;
+      faced_x |= f.x > 0.99;
+      nearest_corner =
+          std::min(nearest_corner, Distance(k.position - Vec3{0, c.body_height, 0}, corner));
+      // Before the corner it walks +Z; after, +X; never back (small corrections aside).
+      CHECK(f.x > -0.1);
+      CHECK(f.z > -0.1);
+    }
+    CHECK(faced_z);
+    CHECK(faced_x);
+    CHECK(BodyForward(Body(w).rotations.back()).x > 0.99);
+    CHECK(nearest_corner < 2 * c.step_length);
+  }
+}
+
+TEST_CASE("A path drawn from where the character stands starts facing its next waypoint",
+          "[steps][generator]") {
+  // A path whose first waypoint is the start gave no direction there: the walk set off along
+  // the default heading (+Z) and turned round toward the goal behind it.
+  for (const std::string& name : ShippedCharacters()) {
+    const Character c = LoadShipped(name);
+    const double leg = 8 * c.step_length, margin = 4 * c.reach;
+    Terrain t = FlatFor(c, leg + 2 * margin);
+    INFO(name);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {margin + leg, 0, margin};
+    o.path.push_back(o.start);
+    o.path.push_back(Vec3{margin, 0, margin});
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    REQUIRE(w.stopped.empty());
+    CheckWalk(t, c, o, w);
+    // Every key of the body faces -X, the first too.
+    for (size_t i = 0; i < Body(w).keys.size(); ++i)
+      CHECK(BodyForward(Body(w).Rotation(i)).x < -0.99);
+  }
+}
+
+TEST_CASE("A character that turns slowly reaches a goal behind it by most of a circle",
+          "[steps][generator]") {
+  // At 2 degrees a step, a goal ten steps behind is neared again only after some 150 steps
+  // round a circle of ~29 steps' radius: the walk stopped as a dead end after 100.
+  for (const std::string& name : ShippedCharacters()) {
+    Character c = LoadShipped(name);
+    c.max_turn_deg = 2;
+    const double step = c.step_length, spacing = step / 3, side = 140 * step;
+    Terrain t = LoadTerrain(MakeFlat(static_cast<int>(side / spacing), spacing, 0), spacing);
+    INFO(name);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {side / 2, 0, side / 2};
+    const Vec3 goal = o.start;
+    o.path.push_back(o.start + Vec3{0, 0, 10 * step});
+    o.path.push_back(goal);
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    REQUIRE(w.stopped.empty());
+    const Vec3 ground_end = Body(w).keys.back().position - Vec3{0, c.body_height, 0};
+    CHECK(Distance(ground_end, goal) <= step);
+  }
+}
+
+TEST_CASE("A waypoint inside the turning circle is reached with shorter steps, not circled",
+          "[steps][generator]") {
+  // The shipped biped with --path "0,0,3 0.5,0,2.5" turned 30 degrees a step at full stride
+  // about a goal inside its turning circle (radius ~0.67 m) for 10,000 steps, never within half
+  // a step of it. The same with every character and a smaller max_turn_deg, and with the
+  // waypoint beside the corner as an intermediate one.
+  for (const std::string& name : ShippedCharacters()) {
+    for (const double turn : {30.0, 15.0}) {
+      for (const bool intermediate : {false, true}) {
+        Character c = LoadShipped(name);
+        c.max_turn_deg = turn;
+        const double step = c.step_length, spacing = step / 10, margin = 4 * c.reach;
+        const int n = static_cast<int>((10 * step + 2 * margin) / spacing);
+        Terrain t = LoadTerrain(MakeFlat(n, spacing, 0), spacing);
+        INFO(name << ", max_turn_deg " << turn << (intermediate ? ", intermediate" : ""));
+        GenerateOptions o;
+        o.has_start = true;
+        o.start = {margin, 0, margin};
+        const Vec3 corner{margin, 0, margin + 4 * step};
+        const Vec3 beside = corner + Vec3{0.7 * step, 0, -0.7 * step};
+        const Vec3 goal = intermediate ? beside + Vec3{0, 0, 4 * step} : beside;
+        o.path.push_back(corner);
+        o.path.push_back(beside);
+        if (intermediate) o.path.push_back(goal);
+        const Walk w = Generate(t, c, o);
+        INFO(w.stopped);
+        REQUIRE(w.stopped.empty());
+        CheckWalk(t, c, o, w);
+        // About 15 steps of path: well within 80 steps, not 10,000.
+        CHECK(StepsDone(w) < 80);
+        Vec3 centroid;
+        int feet = 0;
+        double nearest_beside = 1e9;
+        for (const WalkTrack& tr : w.tracks) {
+          if (tr.kind != TrackKind::kFoot) continue;
+          centroid += tr.keys.back().position, ++feet;
+        }
+        for (const WalkKey& k : Body(w).keys)
+          nearest_beside =
+              std::min(nearest_beside, Distance(k.position - Vec3{0, c.body_height, 0}, beside));
+        CHECK(Distance(centroid / static_cast<double>(feet), goal) <= 0.5 * step + 1e-9);
+        CHECK(nearest_beside <= step + 1e-9);
+      }
+    }
+  }
+}
+
+namespace {
+
+// The least gap across the body's heading between the feet of a pair, over every body key, as
+// a share of their gap at rest (below 0: a pair's feet crossed under the body).
+double LeastPairGap(const Character& c, const Walk& w) {
+  const std::vector<const WalkTrack*> tracks = TracksOf(w, "");
+  const WalkTrack& body = *tracks.back();
+  double least = 1e9;
+  for (size_t i = 0; i < body.keys.size(); ++i) {
+    const Quat q = body.Rotation(i);
+    const Vec3 left = Cross(BodyUp(q), BodyForward(q));
+    for (const std::vector<int>& pair : c.pairs) {
+      if (pair.size() != 2) continue;
+      const double rest_gap = c.feet[pair[0]].rest.x - c.feet[pair[1]].rest.x;
+      const Vec3 a = FootAt(*tracks[pair[0]], body.keys[i].frame);
+      const Vec3 b = FootAt(*tracks[pair[1]], body.keys[i].frame);
+      least = std::min(least, Dot(a - b, left) / rest_gap);
+    }
+  }
+  return least;
+}
+
+}  // namespace
+
+TEST_CASE("Feet keep to their sides in sharp turns as the body turns no faster than they follow",
+          "[steps][generator]") {
+  // Turning max_turn_deg a step, a multiped's feet (a step_length a step, each foot every other
+  // step) fell behind the body until a pair's feet crossed under it: the shipped hexapod at its
+  // 30 degrees, about a hairpin; a biped or quadruped allowed 60 to 180 degrees a step crossed
+  // its feet at a right-angle corner.
+  for (const std::string& name : ShippedCharacters()) {
+    for (const double turn : {30.0, 90.0, 180.0}) {
+      for (const int shape : {0, 1, 2, 3}) {
+        // A hairpin or a right angle, with the shipped pairs or without (each foot its own):
+        // then each foot keeps to its side of the foot whose rest mirrors its own.
+        const bool hairpin = shape % 2 == 0, paired = shape < 2;
+        const Character shipped = LoadShipped(name);
+        Character c = shipped;
+        c.max_turn_deg = turn;
+        if (!paired) {
+          c.pairs.clear();
+          for (int f = 0; f < static_cast<int>(c.feet.size()); ++f) c.pairs.push_back({f});
+        }
+        const double step = c.step_length, spacing = step / 10, margin = 4 * c.reach;
+        const int n = static_cast<int>((8 * step + 2 * margin) / spacing);
+        Terrain t = LoadTerrain(MakeFlat(n, spacing, 0), spacing);
+        INFO(name << ", max_turn_deg " << turn << (hairpin ? ", hairpin" : ", right angle")
+                  << (paired ? "" : ", no pairs"));
+        GenerateOptions o;
+        o.has_start = true;
+        o.start = {margin + 4 * step, 0, margin};
+        const Vec3 corner = o.start + Vec3{0, 0, (hairpin ? 6 : 3) * step};
+        o.path.push_back(corner);
+        o.path.push_back(hairpin ? o.start + Vec3{0.3 * step, 0, 0}
+                                 : corner + Vec3{4 * step, 0, 0});
+        const Walk w = Generate(t, c, o);
+        INFO(w.stopped);
+        REQUIRE(w.stopped.empty());
+        CheckWalk(t, c, o, w);
+        CHECK(LeastPairGap(shipped, w) > 0.1);
+      }
+    }
+  }
+}
+
+TEST_CASE("Feet on ground sampled about as far apart as they stand keep to their own sides",
+          "[steps][generator]") {
+  // The main job's biped (feet 0.2 m apart) on the bundled hills' 0.25 m lattice: walking along
+  // a column of samples both feet took it, and on the diagonal leg a foot often took a sample
+  // across the other's (34 of 130 body keys). Each foothold lined up so is asked again aimed
+  // outward by half the spacing.
+  const Character c = LoadShipped("biped");
+  const double spacing = 0.25;
+  Terrain t = LoadTerrain(MakeFlat(121, spacing, 0), spacing);
+  for (const bool diagonal : {false, true}) {
+    INFO((diagonal ? "diagonal" : "along a column"));
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {8, 0, 8};
+    o.path.push_back({8, 0, 20});
+    if (diagonal) o.path.push_back({20, 0, 28});
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    REQUIRE(w.stopped.empty());
+    CheckWalk(t, c, o, w);
+    CHECK(LeastPairGap(c, w) > 0.25);
+  }
+}
+
+TEST_CASE("A foot with no foothold while its character turns on the spot keeps its place",
+          "[steps][generator]") {
+  // The shipped octopod turning about a goal behind it at the foot of the shipped stairs: a hind
+  // foot by the first riser, its target below the floor at the riser's foot, found no foothold
+  // and stopped the walk at step 168; it stands where it is until the turn takes it on.
+  Terrain t = LoadTerrain(LoadShippedTerrain("stairs"), 0.03);
+  const Character c = LoadShipped("octopod");
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {0.434568, 5, 0.668211};
+  o.path.push_back({1.04996, 0, 0.823702});
+  o.path.push_back({0.525957, 0, 0.261477});
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CHECK(w.stopped.empty());
+  CheckWalk(t, c, o, w);
+}
+
+TEST_CASE("A path walk that runs out of steps before its goal says so as a stop",
+          "[steps][generator]") {
+  // Back and forth between two points 4 m apart, 2000 times: more than the 10,000 steps a path
+  // walk takes without --steps (it ended there with no word, as if it had arrived).
+  const Character c = LoadShipped("biped");
+  Terrain t = LoadTerrain(MakeFlat(200, 0.05, 0), 0.05);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {5, 0, 2};
+  for (int i = 0; i < 2000; ++i) o.path.push_back({5, 0, i % 2 ? 2.0 : 8.0});
+  const Walk w = Generate(t, c, o);
+  CHECK_THAT(w.stopped, Catch::StartsWith("step 10001: the path's goal (5.0000, 0.0000, 2.0000) "
+                                          "is still ") &&
+                            Catch::Contains("after 10000 steps, the most a path walk takes "
+                                            "without --steps"));
+  CHECK(StepsDone(w) == 10000);
+  // With --steps the walk is as asked: no stop, but a note of how far the goal still is (it
+  // ended short of it saying nothing).
+  o.steps = 50;
+  const Walk asked = Generate(t, c, o);
+  CHECK(asked.stopped.empty());
+  REQUIRE(asked.notes.size() == 1);
+  CHECK_THAT(asked.notes[0],
+             Catch::StartsWith("the path's goal (5.0000, 0.0000, 2.0000) is still ") &&
+                 Catch::EndsWith(" away after the 50 steps asked for (without "
+                                 "--steps a path walk goes on to its goal, up to "
+                                 "10000 steps)"));
+  // Steps enough to arrive: nothing to say.
+  o.path = {{5, 0, 4}};
+  CHECK(Generate(t, c, o).notes.empty());
+  // Arriving with the last step asked for: nothing either.
+  o.steps = static_cast<int>(StepsDone(Generate(t, c, o)));
+  const Walk just = Generate(t, c, o);
+  CHECK(just.stopped.empty());
+  CHECK(just.notes.empty());
+  o.steps -= 1;
+  CHECK(Generate(t, c, o).notes.size() == 1);
+}
+
+namespace {
+
+// A three-legged character with its feet off the body's centre line, each in a gait group of
+// its own (a dead end's test subject: it shuffles its feet about a spot easily).
+Character Asymmetric() {
+  Character asym;
+  std::string error;
+  REQUIRE(ParseCharacter(R"({"format": "footfall-character", "version": 1, "name": "asym",
+    "feet": [{"name": "L", "rest": [0.3, 0, 0.1]}, {"name": "R", "rest": [-0.1, 0, -0.2]},
+             {"name": "T", "rest": [0.05, 0, -0.6]}],
+    "gait": [["L"], ["R"], ["T"]], "step_length": 0.4, "step_height": 0.1, "body_height": 0.45,
+    "frames_per_step": 8, "align_to_normal": true, "max_rise": 0.25, "reach": 1.0,
+    "max_slope_deg": 50})",
+                         "asym", &asym, &error) == Status::kOk);
+  return asym;
+}
+
+}  // namespace
+
+TEST_CASE("A path given at y = 0 is followed over a DEM hundreds of metres up",
+          "[steps][generator][shared-data]") {
+  // Real data from ../shared/data: the Kootenai DEM (537 to 560 m) resampled at 0.175. The
+  // three-legged character's up leans with the ground, and its waypoints at y = 0 were aimed
+  // at along it: it shuffled its feet about the same spot until a dead end stopped it.
+  const std::string path =
+      FOOTFALL_SOURCE_DIR "/../shared/data/terrain/terrain_kootenai_1m_50x37.asc";
+  std::ifstream probe(path);
+  if (!probe) {
+    if (std::getenv("CI")) FAIL("shared data missing in CI: " << path);
+    WARN("skipped: shared data not found at " << path << " (CI is unset)");
+    return;
+  }
+  RawSamples dem;
+  std::string error;
+  TerrainLoadOptions lo;
+  lo.separation = 0.175;
+  REQUIRE(footfall::LoadTerrain(path, lo, &dem, &error) == Status::kOk);
+  Terrain t = LoadTerrain(dem, 0.175);
+  const Character asym = Asymmetric();
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {14.7, 0, 9};
+  o.path = {{14.7, 0, 25.2}, {34.3, 0, 25.2}, {34.3, 0, 10.8}, {22.05, 0, 16.2}};
+  o.steps = 5000;
+  const Walk w = Generate(t, asym, o);
+  INFO(w.stopped);
+  CHECK(w.stopped.empty());
+  CheckWalk(t, asym, o, w);
+  Vec3 centroid;
+  for (const WalkTrack& tr : w.tracks)
+    if (tr.kind == TrackKind::kFoot) centroid += tr.keys.back().position / 3.0;
+  CHECK(std::hypot(centroid.x - 22.05, centroid.z - 16.2) <= 0.5 * asym.step_length + 1e-9);
+}
+
+TEST_CASE("A character milling about at a dead end stops", "[steps][generator]") {
+  // The three-legged character on a table top, its goal on the floor 0.9 m below it with no way
+  // down: it turns and shuffles about on the top, coming no nearer, and stops within a few
+  // hundred steps, not after every step it was given.
+  const Character asym = Asymmetric();
+  RawSamples s = MakeFlat(160, 0.05, 0);
+  for (int k = 0; k <= 60; ++k)
+    for (int i = 0; i <= 60; ++i) s.push_back({2 + i * 0.05, 0.9, 2 + k * 0.05}, {0, 1, 0});
+  Terrain t = LoadTerrain(s, 0.05);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {3.5, 1, 3.5};
+  o.path = {{3.6, 0, 3.5}};
+  o.steps = 5000;
+  const Walk w = Generate(t, asym, o);
+  INFO(w.stopped);
+  CHECK_THAT(w.stopped, Catch::Contains("the body has stayed within half a step of it for 100 "
+                                        "steps (a dead end)") ||
+                            Catch::Contains("no way to the path's goal (3.6000, 0.0000, 3.5000): "
+                                            "the body has come no nearer to it than"));
+  CHECK(StepsDone(w) < 2000);
+  CheckWalk(t, asym, o, w);
+}
+
+TEST_CASE("A walk along a loop that comes back to where it was a dead-end window before goes on",
+          "[steps][generator]") {
+  // The shipped biped around a square of 8.8 m sides and up its first side again: at step 100,
+  // the dead-end window's length, its body was back within half a step of its start, and the
+  // walk stopped as milling about at a dead end.
+  const Character c = LoadShipped("biped");
+  const double spacing = 0.05;
+  Terrain t = LoadTerrain(MakeFlat(361, spacing, 0), spacing);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {5, 0, 5};
+  const double far = 5 + 8.8;
+  o.path.push_back({5, 0, far});
+  o.path.push_back({far, 0, far});
+  o.path.push_back({far, 0, 5});
+  o.path.push_back({5, 0, 5});
+  o.path.push_back({5, 0, far});
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CHECK(w.stopped.empty());
+  CHECK(StepsDone(w) > 100);
+  CheckWalk(t, c, o, w);
+}

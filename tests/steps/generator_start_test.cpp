@@ -1,0 +1,183 @@
+// The step generator's start: the default start, a start moved to where the character can
+// stand, feet that snap onto one sample, a crowd's grid across a box.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <optional>
+#include <set>
+#include <string>
+
+#include <catch2/catch.hpp>
+
+#include "footfall/import/mesh_generators.h"
+#include "footfall/import/mesh_sampler.h"
+#include "footfall/import/terrain_generators.h"
+#include "footfall/import/terrain_loader.h"
+#include "generator_fixtures.h"
+#include "walk_checks.h"
+
+using namespace footfall;
+using namespace footfall::test;
+
+TEST_CASE("Feet that snap onto one sample at the start take their own", "[steps][generator]") {
+  // Ground sampled 0.25 apart, coarser than the biped's stance (0.24): started on a sample,
+  // both feet snapped onto it (the bundled hills walk began so). On a beam one sample wide they
+  // still share it (the stance narrows).
+  const Character c = LoadShipped("biped");
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {5, 0, 5};
+  o.steps = 4;
+  {
+    Terrain t = LoadTerrain(MakeFlat(41, 0.25, 0), 0.25);
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    std::vector<Vec3> starts;
+    for (const WalkTrack& track : w.tracks)
+      if (track.kind == TrackKind::kFoot) starts.push_back(track.keys.front().position);
+    REQUIRE(starts.size() == 2);
+    CHECK(Distance(starts[0], starts[1]) == Approx(0.25));
+  }
+  {
+    RawSamples beam;
+    for (int k = 0; k <= 80; ++k) beam.push_back({5, 0, 0.125 * k}, {0, 1, 0});
+    Terrain t = LoadTerrain(beam, 0.125);
+    const Walk w = Generate(t, c, o);
+    std::vector<Vec3> starts;
+    for (const WalkTrack& track : w.tracks)
+      if (track.kind == TrackKind::kFoot) starts.push_back(track.keys.front().position);
+    REQUIRE(starts.size() == 2);
+    CHECK(Distance(starts[0], starts[1]) == 0);
+  }
+}
+
+TEST_CASE("A start beside a box's foot stands on the floor, a crowd's grid across it",
+          "[steps][generator]") {
+  // A floor sampled every 4 cm and a box (0.25 m tall, from z = 2) whose front face, sampled
+  // every 2 cm up, is 5 mm from the start: its samples lie nearer the start than the floor's. The
+  // start took the face, and a crowd stood on a grid up it, six of nine left out; now on the floor
+  // and the box's top.
+  const double s = 0.04;
+  const RawSamples ground = FloorWithBlock(s, 75, 150, 2, 3, 0.25, 12, true);
+  Terrain t = LoadTerrain(ground, s);
+  const Character c = LoadShipped("quadruped");
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {1.48, 0.01, 1.995};
+  o.heading = {0, 0, -1};
+  o.crowd = 9;
+  o.crowd_spacing = 0.7;
+  o.steps = 2;
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CHECK_THAT(w.stopped, !Catch::Contains("left out"));
+  size_t feet = 0;
+  for (const WalkTrack& track : w.tracks) {
+    if (track.kind != TrackKind::kFoot) continue;
+    ++feet;
+    CHECK(track.keys.front().normal == Vec3{0, 1, 0});  // on the floor or the box's top
+  }
+  CHECK(feet == 9 * c.feet.size());
+}
+
+TEST_CASE("The default start is the sample nearest the top centre of the bounds",
+          "[steps][generator]") {
+  const Character c = LoadShipped("biped");
+  Terrain t = LoadTerrain(MakeFlat(100, 0.05, 2), 0.05);
+  GenerateOptions o;
+  o.steps = 2;
+  const Walk w = Generate(t, c, o);
+  const WalkKey& b = Body(w).keys.front();
+  CHECK(b.position.x == Approx(2.475).margin(0.05));
+  CHECK(b.position.z == Approx(2.475).margin(0.05));
+  CHECK(b.position.y == Approx(2 + c.body_height));
+}
+
+namespace {
+
+// A floor (y = 0, `n` x `n` samples) with a cone of 70-degree sides standing on its centre, base
+// radius `radius`: the top centre of the bounds is the cone's tip, where no character stands.
+// Without the floor, only the cone.
+RawSamples FloorWithCone(int n, double spacing, double radius, bool floor) {
+  const double side = (n - 1) * spacing, cx = 0.5 * side, cz = 0.5 * side;
+  const double tan_side = std::tan(70 * kPi / 180), height = radius * tan_side;
+  RawSamples s;
+  if (floor) {
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) {
+        const double x = i * spacing, z = j * spacing;
+        if (std::hypot(x - cx, z - cz) < radius) continue;  // under the cone
+        s.points.push_back({x, 0, z}), s.normals.push_back({0, 1, 0});
+      }
+    }
+  }
+  // Rings up the cone's side, samples about `spacing` apart along and around it.
+  const double along = spacing * std::sin(70 * kPi / 180);
+  for (double y = 0; y <= height; y += along) {
+    const double r = (height - y) / tan_side;
+    const int around = std::max(1, static_cast<int>(2 * kPi * r / spacing));
+    for (int k = 0; k < around; ++k) {
+      const double a = 2 * kPi * k / around;
+      const Vec3 n{std::cos(a) * std::sin(70 * kPi / 180), std::cos(70 * kPi / 180),
+                   std::sin(a) * std::sin(70 * kPi / 180)};
+      s.points.push_back({cx + r * std::cos(a), y, cz + r * std::sin(a)}), s.normals.push_back(n);
+    }
+  }
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("A start where the character cannot stand moves to the nearest place where it can",
+          "[steps][generator]") {
+  // The characters that cannot stand on the cone's sides: upright ones (those aligned to the
+  // terrain's normal stand on one side of it, their up along its normal).
+  int tested = 0;
+  for (const std::string& name : ShippedCharacters()) {
+    INFO(name);
+    const Character c = LoadShipped(name);
+    if (c.align_to_normal || c.max_slope_deg >= 70) continue;
+    ++tested;
+    const double spacing = 0.15 * c.step_length, radius = 2 * c.step_length;
+    const int n = static_cast<int>(8 * radius / spacing);
+    Terrain t = LoadTerrain(FloorWithCone(n, spacing, radius, true), spacing);
+    const double centre = 0.5 * (n - 1) * spacing;
+    GenerateOptions o;
+    o.steps = 2;
+    // The default start: the cone's tip, which moves down to the floor beside the cone.
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    CHECK(w.stopped.find("cannot stand") == std::string::npos);
+    const WalkKey& b = Body(w).keys.front();
+    CHECK(b.position.y == Approx(c.body_height).margin(1e-9));
+    for (const WalkTrack& tr : w.tracks)
+      if (tr.kind == TrackKind::kFoot) CHECK(tr.keys.front().position.y == Approx(0).margin(1e-6));
+    // The nearest such place: the candidates lie at the tip's height, and snap to the floor
+    // from radius / cos(70 deg) out (nearer, to the cone's side); the start lies within a
+    // grid cell and a foot's spread of there.
+    const double off = std::hypot(b.position.x - centre, b.position.z - centre);
+    double spread = 0;
+    for (const FootSpec& f : c.feet) spread = std::max(spread, Length(f.rest));
+    CHECK(off > radius);
+    CHECK(off < radius / std::cos(70 * kPi / 180) + spread + c.step_length);
+
+    // A start given on the tip stands there, and the walk stops at once saying why...
+    o.has_start = true;
+    o.start = {centre, 10 * radius, centre};
+    const Walk given = Generate(t, c, o);
+    CHECK_THAT(given.stopped, Catch::Contains("step 1: foot") && Catch::Contains("cannot stand"));
+    // ... unless it may move: then as the default start.
+    o.start_may_move = true;
+    const Walk moved = Generate(t, c, o);
+    CHECK(moved.stopped.find("cannot stand") == std::string::npos);
+    CHECK(Body(moved).keys.front().position.y == Approx(c.body_height).margin(1e-9));
+
+    // Nowhere to stand (the cone alone): the walk stops at its tip, as before.
+    Terrain cone = LoadTerrain(FloorWithCone(n, spacing, radius, false), spacing);
+    const Walk nowhere = Generate(cone, c, GenerateOptions{});
+    CHECK_THAT(nowhere.stopped, Catch::Contains("step 1: foot") && Catch::Contains("cannot stand"));
+  }
+  CHECK(tested >= 1);
+}
