@@ -2,6 +2,7 @@
 // samplers with times frame / fps, and bad input or unwritable paths give clear errors.
 #include <tiny_gltf.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -9,6 +10,7 @@
 #include <iterator>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <catch2/catch.hpp>
@@ -261,6 +263,126 @@ TEST_CASE("WriteGltf writes names that are not UTF-8 with U+FFFD", "[export][glt
   }
 }
 
+TEST_CASE("WriteGltf keeps a far walk precise under a root origin node", "[export][gltf]") {
+  // A walk on a UTM terrain: float32 near 5e5 steps by 1/32, so keys a few millimetres apart
+  // would land on the same float and planted feet slide. The root's double translation plus the
+  // children's small floats keep every key.
+  const Walk walk = test::FarWalk();
+  const Vec3 origin = GltfOrigin(walk);
+  CHECK(origin == Vec3{500000, 0, -300000});  // y, within 1024, keeps its values
+  CHECK(MaxFloatRounding(walk) < 1e-4);
+  const bool binary = GENERATE(false, true);
+  const std::string path = test::ScratchPath(binary ? "far.glb" : "far.gltf");
+  std::string error;
+  REQUIRE(WriteGltf(walk, path, &error) == Status::kOk);
+  INFO(path);
+  const tinygltf::Model model = Load(path, binary);
+
+  // The track nodes keep their indices; the root comes last and is the scene's only root.
+  REQUIRE(model.nodes.size() == 4);
+  CHECK(model.nodes[0].name == "L");
+  CHECK(model.nodes[2].name == "body");
+  const tinygltf::Node& root = model.nodes[3];
+  CHECK(root.name == "footfall_origin");
+  CHECK(root.children == std::vector<int>{0, 1, 2});
+  CHECK(root.rotation.empty());
+  CHECK(root.scale.empty());
+  CHECK(root.matrix.empty());
+  REQUIRE(model.scenes.size() == 1);
+  CHECK(model.scenes[0].nodes == std::vector<int>{3});
+  CHECK(root.translation == std::vector<double>{origin.x, origin.y, origin.z});
+  CHECK(root.extras.Get("kind").Get<std::string>() == "origin");
+  const tinygltf::Value& extra_origin = root.extras.Get("origin");
+  REQUIRE(extra_origin.ArrayLen() == 3);
+  for (int a = 0; a < 3; ++a)
+    CHECK(extra_origin.Get(a).GetNumberAsDouble() == root.translation[static_cast<size_t>(a)]);
+  if (!binary) {
+    // Written as plain JSON numbers (the origin is whole units).
+    CHECK(ReadBytes(path).find("500000") != std::string::npos);
+  }
+
+  auto channels = Channels(model);
+  const std::pair<const char*, std::vector<size_t>> tracks[] = {
+      {"L", {0, 1, 2, 3, 4, 5}}, {"R", {0, 1, 3, 4, 5}}, {"body", {0, 1, 2, 3, 4}}};
+  double float_only_worst = 0;
+  for (size_t t = 0; t < 3; ++t) {
+    const WalkTrack& track = walk.tracks[t];
+    const std::vector<size_t>& keys = tracks[t].second;
+    const Channel& channel = channels[tracks[t].first]["translation"];
+    REQUIRE(channel.values.size() == keys.size() * 3);
+    for (size_t i = 0; i < keys.size(); ++i) {
+      INFO("track " << track.name << " key " << keys[i]);
+      const Vec3& want = track.keys[keys[i]].position;
+      const float* local = &channel.values[3 * i];
+      // The children's floats are offsets of at most a few units on the far axes, and the
+      // height (about 120, within 1024) as it is.
+      CHECK(std::fabs(local[0]) < 2);
+      CHECK(local[1] == static_cast<float>(want.y));
+      CHECK(std::fabs(local[2]) < 2);
+      const Vec3 world{root.translation[0] + local[0], root.translation[1] + local[1],
+                       root.translation[2] + local[2]};
+      CHECK(Distance(world, want) < 1e-4);
+      // Without the root the same key as float32 misses by more than that.
+      const Vec3 float_only{static_cast<float>(want.x), static_cast<float>(want.y),
+                            static_cast<float>(want.z)};
+      CHECK(Distance(float_only, want) > 1e-4);
+      float_only_worst = std::max(float_only_worst, Distance(float_only, want));
+    }
+    // The rest pose is the first key, relative to the root too.
+    const std::vector<double>& rest = model.nodes[t].translation;
+    REQUIRE(rest.size() == 3);
+    const Vec3 rest_world{root.translation[0] + rest[0], root.translation[1] + rest[1],
+                          root.translation[2] + rest[2]};
+    CHECK(Distance(rest_world, track.keys[0].position) < 1e-4);
+  }
+  CHECK(float_only_worst > 0.01);
+  CHECK(channels["body"].count("rotation") == 1);
+  std::remove(path.c_str());
+}
+
+TEST_CASE("WriteGltf adds no root node to a walk near the origin", "[export][gltf]") {
+  Walk walk = test::BipedWalk();
+  std::string error;
+  SECTION("keys within 1024 units keep the flat layout and world floats") {
+    for (WalkTrack& t : walk.tracks)
+      for (WalkKey& k : t.keys) k.position = k.position + Vec3{-1023, 100, 1023};
+    CHECK(GltfOrigin(walk) == Vec3{});
+    const std::string path = test::ScratchPath("near.gltf");
+    REQUIRE(WriteGltf(walk, path, &error) == Status::kOk);
+    const tinygltf::Model model = Load(path, false);
+    REQUIRE(model.nodes.size() == 3);
+    CHECK(model.scenes[0].nodes == std::vector<int>{0, 1, 2});
+    for (const tinygltf::Node& node : model.nodes) CHECK(node.children.empty());
+    auto channels = Channels(model);
+    CheckPositions(channels["L"]["translation"], walk.tracks[0], {0, 1, 2, 3, 4, 5}, 24);
+    CHECK(ReadBytes(path).find("footfall_origin") == std::string::npos);
+    std::remove(path.c_str());
+  }
+  SECTION("keys spread either side of the origin: the origin would be 0, so no root") {
+    walk.tracks[0].keys[0].position.x = -2000;
+    walk.tracks[0].keys[5].position.x = 2000;
+    CHECK(GltfOrigin(walk) == Vec3{});
+  }
+  SECTION("one coordinate beyond 1024 offsets its axis by the rounded centre of the bounds") {
+    walk.tracks[2].keys[4].position.y = 1025;     // y bounds [0, 1025]
+    CHECK(GltfOrigin(walk) == Vec3{0, 513, 0});   // x and z are within 1024
+    walk.tracks[2].keys[4].position.y = -1024.5;  // y bounds [-1024.5, 0.93]
+    CHECK(GltfOrigin(walk) == Vec3{0, -512, 0});  // -511.785 rounds to -512
+  }
+  SECTION("a track named footfall_origin keeps its name; the root is suffixed") {
+    walk = test::FarWalk();
+    walk.tracks[0].name = "footfall_origin";
+    const std::string path = test::ScratchPath("named.glb");
+    REQUIRE(WriteGltf(walk, path, &error) == Status::kOk);
+    const tinygltf::Model model = Load(path, true);
+    REQUIRE(model.nodes.size() == 4);
+    CHECK(model.nodes[0].name == "footfall_origin");
+    CHECK(model.nodes[3].name == "footfall_origin_2");
+    CHECK(model.nodes[3].extras.Get("kind").Get<std::string>() == "origin");
+    std::remove(path.c_str());
+  }
+}
+
 TEST_CASE("WriteGltf rejects walks glTF cannot hold", "[export][gltf]") {
   const std::string path = test::ScratchPath("bad.gltf");
   std::string error;
@@ -307,9 +429,15 @@ TEST_CASE("WriteGltf rejects walks glTF cannot hold", "[export][gltf]") {
 TEST_CASE("MaxFloatRounding: how far glTF's float positions move a walk's keys", "[export][gltf]") {
   Walk walk = test::BipedWalk();
   CHECK(MaxFloatRounding(walk) < 1e-7);
-  // At UTM-like coordinates floats are a quarter unit apart.
+  // At UTM-like coordinates floats are a quarter unit apart, but the keys are written relative
+  // to the root origin node.
   for (WalkTrack& t : walk.tracks)
     for (WalkKey& k : t.keys) k.position = k.position + Vec3{5e5, 0, 4e6};
+  CHECK(GltfOrigin(walk) == Vec3{500000, 0, 4000001});  // z bounds [4e6, 4e6 + 1]
+  CHECK(MaxFloatRounding(walk) < 1e-4);
+  // A walk spanning 4e6 units: its keys are 2e6 from any one origin, where floats are a quarter
+  // unit apart.
+  walk.tracks[0].keys[0].position.z = 0.3;
   CHECK(MaxFloatRounding(walk) > 0.01);
   CHECK(MaxFloatRounding(walk) <= 0.25);
 }

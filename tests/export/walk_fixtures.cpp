@@ -96,6 +96,18 @@ Walk CrowdWalk() {
   return walk;
 }
 
+Walk FarWalk() {
+  Walk walk = BipedWalk();
+  const Vec3 shift{500000.0004, 120.0007, -300000.0009};
+  for (WalkTrack& track : walk.tracks) {
+    for (size_t i = 0; i < track.keys.size(); ++i) {
+      const double mm = 0.0013 * static_cast<double>(i);
+      track.keys[i].position = track.keys[i].position + shift + Vec3{mm, mm, -mm};
+    }
+  }
+  return walk;
+}
+
 std::string ScratchPath(const std::string& name) {
   return (std::filesystem::temp_directory_path() /
           ("footfall_export_" + std::to_string(::getpid()) + "_" + name))

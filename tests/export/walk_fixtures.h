@@ -22,6 +22,11 @@ Walk BipedWalk();
 // offset 2 units apart along X.
 Walk CrowdWalk();
 
+// BipedWalk at real-world coordinates, near (5e5, 120, -3e5) as in a UTM terrain: every key
+// moved by (500000.0004, 120.0007, -300000.0009) plus 1.3 mm * its index along (1, 1, -1), so
+// keys differ by millimetres that a float at 5e5 (a step of 1/32) cannot hold.
+Walk FarWalk();
+
 // A scratch file path unique to this process: <tmp>/footfall_export_<pid>_<name>.
 std::string ScratchPath(const std::string& name);
 

@@ -2,6 +2,7 @@
 // validator tests and for a look in Maya.
 // Usage: export_samples DIR
 // Creates DIR if needed and writes walk.gltf, walk.glb, crowd.gltf, crowd.glb, empty.gltf,
+// far.gltf and far.glb (the biped at UTM-like coordinates: tracks under a root origin node),
 // walk.mel, crowd.mel and broken.gltf: walk.gltf with its samplers switched to CUBICSPLINE
 // without the tangents that needs, which a working validator must reject.
 #include <cstdio>
@@ -28,13 +29,14 @@ int main(int argc, char** argv) {
   }
   const footfall::Walk biped = footfall::test::BipedWalk();
   const footfall::Walk crowd = footfall::test::CrowdWalk();
+  const footfall::Walk far = footfall::test::FarWalk();
   const footfall::Walk empty;
   const struct {
     const footfall::Walk* walk;
     const char* file;
   } samples[] = {{&biped, "walk.gltf"}, {&biped, "walk.glb"},   {&crowd, "crowd.gltf"},
-                 {&crowd, "crowd.glb"}, {&empty, "empty.gltf"}, {&biped, "walk.mel"},
-                 {&crowd, "crowd.mel"}};
+                 {&crowd, "crowd.glb"}, {&empty, "empty.gltf"}, {&far, "far.gltf"},
+                 {&far, "far.glb"},     {&biped, "walk.mel"},   {&crowd, "crowd.mel"}};
   for (const auto& sample : samples) {
     const std::string path = dir + "/" + sample.file;
     std::string error;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstring>
 #include <exception>
 #include <sstream>
@@ -104,6 +105,15 @@ int AddAccessor(std::vector<PendingAccessor>* pending, Streams* streams, StreamI
 
 bool EndsWithGlb(const std::string& path) { return FileExtension(path) == "glb"; }
 
+// The name and extras kind of the root node that holds a far walk's origin.
+constexpr const char* kOriginNodeName = "footfall_origin";
+
+// What glTF stores for position `p`: a float relative to `origin`.
+Vec3 StoredFloats(const Vec3& p, const Vec3& origin) {
+  return {static_cast<float>(p.x - origin.x), static_cast<float>(p.y - origin.y),
+          static_cast<float>(p.z - origin.z)};
+}
+
 }  // namespace
 
 Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& options,
@@ -140,6 +150,10 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
   for (size_t t = 0; t < walk.tracks.size(); ++t) {
     names.push_back(walk_export::ValidUtf8(walk_export::QualifiedTrackName(walk.tracks[t], t)));
   }
+  // A far walk's tracks are children of one root at its origin (the header says why).
+  const Vec3 origin = GltfOrigin(walk);
+  const bool has_root = origin != Vec3{};
+  if (has_root) names.push_back(kOriginNodeName);  // last: a track keeps its own name
   names = walk_export::UniqueNames(names);
 
   Streams streams;
@@ -167,10 +181,10 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
       translations.reserve(count * 3);
       Quat previous;
       for (size_t i = 0; i < count; ++i) {
-        const WalkKey& key = track.keys[samples.keys[i]];
+        const Vec3 stored = StoredFloats(track.keys[samples.keys[i]].position, origin);
         translations.insert(translations.end(),
-                            {static_cast<float>(key.position.x), static_cast<float>(key.position.y),
-                             static_cast<float>(key.position.z)});
+                            {static_cast<float>(stored.x), static_cast<float>(stored.y),
+                             static_cast<float>(stored.z)});
         if (body) {
           Quat q = walk_export::Normalized(track.Rotation(samples.keys[i]));
           // q and -q are the same rotation; keep neighbours in one hemisphere so that
@@ -214,8 +228,22 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
                     "rotation");
       }
     }
-    scene.nodes.push_back(static_cast<int>(model.nodes.size()));
+    if (!has_root) scene.nodes.push_back(static_cast<int>(model.nodes.size()));
     model.nodes.push_back(std::move(node));
+  }
+  if (has_root) {
+    tinygltf::Node root;
+    root.name = names.back();
+    // JSON numbers, written with full double precision (GltfOrigin makes them integers).
+    root.translation = {origin.x, origin.y, origin.z};
+    for (size_t t = 0; t < walk.tracks.size(); ++t) root.children.push_back(static_cast<int>(t));
+    tinygltf::Value::Object extras;
+    extras["kind"] = tinygltf::Value(std::string("origin"));
+    extras["origin"] = tinygltf::Value(tinygltf::Value::Array{
+        tinygltf::Value(origin.x), tinygltf::Value(origin.y), tinygltf::Value(origin.z)});
+    root.extras = tinygltf::Value(std::move(extras));
+    scene.nodes.push_back(static_cast<int>(model.nodes.size()));
+    model.nodes.push_back(std::move(root));
   }
 
   // One buffer holding the three streams back to back, one buffer view per non-empty stream.
@@ -296,15 +324,40 @@ double MaxTimeRounding(const Walk& walk) {
 }
 
 double MaxFloatRounding(const Walk& walk) {
+  const Vec3 origin = GltfOrigin(walk);
   double worst = 0;
   for (const WalkTrack& track : walk.tracks) {
     for (const WalkKey& key : track.keys) {
       const Vec3& p = key.position;
-      const Vec3 kept{static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)};
-      worst = std::max(worst, Distance(kept, p));
+      worst = std::max(worst, Distance(origin + StoredFloats(p, origin), p));
     }
   }
   return worst;
+}
+
+Vec3 GltfOrigin(const Walk& walk) {
+  double low[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL};
+  double high[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  bool far[3] = {false, false, false};
+  for (const WalkTrack& track : walk.tracks) {
+    for (const WalkKey& key : track.keys) {
+      const double p[3] = {key.position.x, key.position.y, key.position.z};
+      for (int a = 0; a < 3; ++a) {
+        if (!std::isfinite(p[a])) continue;
+        low[a] = std::min(low[a], p[a]);
+        high[a] = std::max(high[a], p[a]);
+        far[a] = far[a] || std::fabs(p[a]) > kGltfLocalExtent;
+      }
+    }
+  }
+  double origin[3] = {0, 0, 0};
+  for (int a = 0; a < 3; ++a) {
+    if (!far[a]) continue;
+    // Halves first: the sum of two coordinates near the double limit would overflow.
+    origin[a] = std::round(low[a] / 2 + high[a] / 2);
+    if (origin[a] == 0) origin[a] = 0;  // never -0 (it would read "-0.0")
+  }
+  return {origin[0], origin[1], origin[2]};
 }
 
 }  // namespace footfall

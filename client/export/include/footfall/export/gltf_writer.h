@@ -1,11 +1,21 @@
 // glTF 2.0 export of a walk: one node per track (foot IK targets and bodies), animated by one
 // animation named "walk" with LINEAR samplers. Passes the Khronos glTF validator.
+//
+// Precision at real-world coordinates: glTF animation data is float32, which near 1e5 keeps
+// positions only to about 8 mm and near 5e5 to 3-6 cm (feet would jitter and planted feet
+// slide). A walk with any key coordinate beyond +-kGltfLocalExtent therefore gets one root node,
+// "footfall_origin", whose translation (a JSON number, full double precision) is the walk's
+// origin (GltfOrigin); the track nodes are its children and their keys are relative to it, so
+// their floats are small and precise: origin + key reads back within 1e-4 of the walk's position
+// (for walks spanning up to 2 * kGltfLocalExtent). A walk near the origin is written as before,
+// without a root node.
 #pragma once
 
 #include <string>
 
 #include "footfall/steps/walk.h"
 #include "footfall/terrain/status.h"
+#include "footfall/terrain/vec3.h"
 
 namespace footfall {
 
@@ -16,9 +26,29 @@ struct GltfOptions {
   bool binary = false;
 };
 
+// [Units: wu] [Limit: > 0] Beyond this |coordinate| a walk's glTF gets a root origin node: below
+// it a float keeps every coordinate within 2^-15 (3.1e-5), so a 3D key within 5.3e-5, of its
+// double value; at twice it a float's step is already 2.4e-4.
+constexpr double kGltfLocalExtent = 1024;
+
+// [Units: wu] [(x, y, z), world] The translation of the root node WriteGltf gives `walk`; (0, 0,
+// 0) when it writes none. Per axis: 0 when the keys' coordinates on that axis are all within
+// +-kGltfLocalExtent (so a walk near the origin gets no root, and an axis that needs no offset,
+// often the height, keeps its values as they are); otherwise the centre of the keys' bounds on
+// that axis rounded to the nearest integer: exact and short in JSON, and exact as a float up to
+// 2^24 (1.7e7, beyond any UTM coordinate), so readers that hold node translations as floats
+// (Blender, most engines) keep the origin exact too. Non-finite coordinates are ignored.
+Vec3 GltfOrigin(const Walk& walk);
+
 // Writes `walk` to `path` as glTF 2.0.
-// - Nodes: one per track, in track order, all roots of the single scene. Names are the track
-//   name, or "character/name" for crowd tracks; a repeated name gets a "_2", "_3"... suffix.
+// - Nodes: one per track, in track order (node i is track i). Names are the track name, or
+//   "character/name" for crowd tracks; a repeated name gets a "_2", "_3"... suffix. When
+//   GltfOrigin(walk) is (0, 0, 0) they are the roots of the single scene (the layout of files
+//   near the origin). Otherwise one more node, last, named "footfall_origin" (suffixed if a
+//   track has that name), is the scene's only root: its translation is GltfOrigin(walk), its
+//   children are the track nodes, whose translations (rest pose and keys) are relative to it,
+//   and its extras hold {"kind": "origin", "origin": [x, y, z]} (the same numbers). A key's
+//   world position is the root's translation (double) + the child's key (float).
 //   Names and the stop reason are written as valid UTF-8, as in the walk JSON: a byte that
 //   belongs to no well-formed UTF-8 sequence becomes U+FFFD.
 //   Each node's rest translation (and rotation for bodies) is its first key.
@@ -26,8 +56,8 @@ struct GltfOptions {
 //   quaternions). Times in seconds = frame / fps. glTF needs strictly increasing times: keys are
 //   ordered by frame (stable) and of several keys on the same frame only the last one is kept;
 //   distinct frames whose times are the same float (a start frame far from 0 at a high fps) are
-//   refused (kInvalidArgument), as merging them would lose keys. Positions are floats too: at
-//   coordinates near 4e6 they move by up to 0.25 (MaxFloatRounding).
+//   refused (kInvalidArgument), as merging them would lose keys. Positions are floats too,
+//   relative to the origin node if any: a walk spanning kilometres still moves (MaxFloatRounding).
 // - Node extras hold {"kind", "character", "track"}; the animation's extras hold {"fps"} and
 //   {"stopped"} when the walk stopped early. World units are written unchanged (glTF metres).
 // Returns kInvalidArgument (with `*error` set) for fps <= 0, a negative frame, NaN/Inf values or
@@ -41,7 +71,9 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
 Status WriteGltf(const Walk& walk, const std::string& path, std::string* error);
 
 // [Units: wu] The farthest any key of `walk` moves once its position is rounded to float, as
-// glTF stores it (0 for a walk near the origin at ordinary spacings).
+// glTF stores it: relative to GltfOrigin(walk), added back in double. Below 1e-4 for a walk
+// near the origin or within 2 * kGltfLocalExtent of its own centre; more for a walk spanning
+// kilometres (about 0.25 across 4e6).
 double MaxFloatRounding(const Walk& walk);
 
 // [Units: frames] The farthest any key of `walk` moves in time once its time (frame / fps) is
