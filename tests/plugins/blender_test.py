@@ -1004,6 +1004,108 @@ class BlenderAddonTest(unittest.TestCase):
         # glTF holds 32-bit floats and times in seconds: the same keys as the JSON walk.
         self.assert_keys_equal_walk(walk, feet, body)
 
+    def test_8a_import_a_far_gltf_walk(self):
+        # On a UTM-like terrain footfall's glTF puts the tracks under a root node,
+        # footfall_origin, at the walk's origin: the keys read back from the child nodes alone
+        # were that far off, and as absolute floats they would move by centimetres.
+        shift = (500000.0, 0.0, -300000.0)
+        far_pts = os.path.join(ARGS.work_dir, "far_terrain.pts")
+        with open(self.pts) as f, open(far_pts, "w") as out:
+            for line in f:
+                v = line.split()
+                if len(v) == 6 and not line.startswith("#"):
+                    v[0], v[2] = repr(float(v[0]) + shift[0]), repr(float(v[2]) + shift[2])
+                    line = " ".join(v) + "\n"
+                out.write(line)
+        rig = bpy.data.objects["biped_rig"]
+        mw = rig.matrix_world
+        start = [c + d for c, d in zip(to_ff(mw.translation), shift)]
+        out = os.path.join(ARGS.work_dir, "far_walk.gltf")
+        run_cli("generate", "--terrain", far_pts, "--character", rig.footfall_rig.character_path,
+                "--start", csv(start), "--heading", csv(to_ff(mw.to_3x3() @ Vector((0, -1, 0)))),
+                "--steps", 4, "--out", out, "--out", out[:-5] + ".json")
+        with open(out[:-5] + ".json") as f:
+            walk = json.load(f)
+        with open(out) as f:
+            gltf = json.load(f)
+        roots = [n for n in gltf["nodes"] if n.get("name") == "footfall_origin"]
+        self.assertEqual(len(roots), 1, "the far walk's glTF has a root origin node")
+        self.assertNotEqual(roots[0]["translation"], [0, 0, 0])
+
+        # What the add-on reads back, in double: every key within 1e-4 of the JSON walk's.
+        read = self.ops.FOOTFALL_OT_import_walk._read_gltf(None, out)
+        got = {t["name"]: t for t in read["tracks"]}
+        checked = 0
+        for track in walk["tracks"]:
+            keys = {round(k["frame"]): k["position"] for k in got[track["name"]]["keys"]}
+            for k in track["keys"]:
+                p = keys[round(k["frame"])]
+                self.assertLess(max(abs(a - b) for a, b in zip(p, k["position"])), 1e-4,
+                                "%s frame %s: %s vs %s" % (track["name"], k["frame"], p,
+                                                           k["position"]))
+                self.assertGreater(abs(p[0]), 4e5)
+                checked += 1
+        self.assertGreater(checked, 8)
+
+        # Imported onto new empties: their world keys are the walk's (to Blender's 32-bit
+        # floats, 1/32 apart at 5e5), the root's translation included.
+        settings = bpy.context.scene.footfall
+        saved_rig = settings.rig
+        objects = set(bpy.data.objects)
+        try:
+            settings.rig = None
+            self.select([], None)
+            self.assertEqual(bpy.ops.footfall.import_walk(filepath=out), {"FINISHED"})
+            self.assertNotIn("footfall_origin", bpy.data.objects)  # the importer's are removed
+            for track in walk["tracks"]:
+                if track["kind"] != "foot":
+                    continue
+                keys = fcurve_keys(bpy.data.objects["far_walk_%s" % track["name"]], "location", 3)
+                for k in track["keys"]:
+                    for g, w in zip(keys[float(k["frame"])], from_ff(k["position"])):
+                        self.assertAlmostEqual(g, w, delta=0.02, msg="%s frame %s"
+                                               % (track["name"], k["frame"]))
+        finally:
+            settings.rig = saved_rig
+            for obj in set(bpy.data.objects) - objects:
+                bpy.data.objects.remove(obj)
+
+    def test_8aa_a_foreign_gltfs_parent_nodes_are_applied(self):
+        # A glTF from elsewhere: an animated node under a parent that moves and turns it (90
+        # degrees about +Y). Its local keys alone were read as world positions.
+        import base64
+        import struct
+        data = struct.pack("<2f6f", 0.0, 1.0, 1, 0, 0, 1, 0, 1)
+        half = math.sqrt(0.5)
+        gltf = {
+            "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [1]}],
+            "nodes": [{"name": "F", "translation": [1, 0, 0]},
+                      {"name": "P", "translation": [1, 2, 3], "rotation": [0, half, 0, half],
+                       "children": [0]}],
+            "buffers": [{"byteLength": len(data), "uri": "data:application/octet-stream;base64,"
+                         + base64.b64encode(data).decode()}],
+            "bufferViews": [{"buffer": 0, "byteLength": 8},
+                            {"buffer": 0, "byteOffset": 8, "byteLength": 24}],
+            "accessors": [{"bufferView": 0, "componentType": 5126, "count": 2, "type": "SCALAR",
+                           "min": [0], "max": [1]},
+                          {"bufferView": 1, "componentType": 5126, "count": 2, "type": "VEC3"}],
+            "animations": [{"samplers": [{"input": 0, "output": 1}],
+                            "channels": [{"sampler": 0,
+                                          "target": {"node": 0, "path": "translation"}}]}]}
+        path = os.path.join(ARGS.work_dir, "parented.gltf")
+        with open(path, "w") as f:
+            json.dump(gltf, f)
+        objects = set(bpy.data.objects)
+        read = self.ops.FOOTFALL_OT_import_walk._read_gltf(None, path)
+        self.assertEqual(set(bpy.data.objects), objects)
+        self.assertEqual([t["name"] for t in read["tracks"]], ["F"])
+        got = [k["position"] for k in sorted(read["tracks"][0]["keys"], key=lambda k: k["frame"])]
+        # The parent turns local (x, y, z) into (z, y, -x), then moves it by (1, 2, 3).
+        for p, want in zip(got, [(1, 2, 2), (2, 2, 2)]):
+            for g, w in zip(p, want):
+                self.assertAlmostEqual(g, w, delta=1e-5, msg="%s vs %s" % (got, want))
+        self.assertEqual(len(got), 2)
+
     def test_8b_a_walk_after_an_import_replaces_it(self):
         # Import left the rig's walk end where it was: a shorter Generate Walk afterwards kept
         # the imported walk's later keys.

@@ -11,7 +11,7 @@ import uuid
 import bpy
 from bpy.props import EnumProperty, IntProperty, StringProperty
 from bpy_extras.io_utils import ImportHelper
-from mathutils import Matrix, Vector
+from mathutils import Matrix, Quaternion, Vector
 
 from . import keying
 from .axes import from_ff, to_ff
@@ -826,23 +826,31 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
         if "FINISHED" not in result:
             raise ValueError("Blender's glTF importer failed")
         made = [o for o in bpy.data.objects if o not in before]
+        bpy.context.view_layer.update()  # the parents' world matrices, for _parent_transform
         tracks = []
         for obj in made:
             action = obj.animation_data.action if obj.animation_data else None
             if action is None:
                 continue
+            origin, parent_matrix = _parent_transform(obj)
             curves = {(fc.data_path, fc.array_index): fc for fc in action.fcurves}
             frames = sorted({kp.co[0] for fc in action.fcurves for kp in fc.keyframe_points})
             keys = []
             for f in frames:
                 key = {"frame": f}
                 if ("location", 0) in curves:
-                    key["position"] = list(to_ff([curves[("location", i)].evaluate(f)
-                                                  for i in range(3)]))
+                    local = [curves[("location", i)].evaluate(f) for i in range(3)]
+                    if parent_matrix is not None:
+                        local = parent_matrix @ Vector(local)
+                    # Added in double: the origin of a far walk is what keeps it precise.
+                    key["position"] = [o + c for o, c in zip(origin, to_ff(local))]
                 if ("rotation_quaternion", 0) in curves:
                     from .axes import quat_to_ff
-                    key["rotation"] = list(quat_to_ff([curves[("rotation_quaternion", i)]
-                                                       .evaluate(f) for i in range(4)]))
+                    q = Quaternion([curves[("rotation_quaternion", i)].evaluate(f)
+                                    for i in range(4)])
+                    if parent_matrix is not None:
+                        q = parent_matrix.to_quaternion() @ q
+                    key["rotation"] = list(quat_to_ff(q))
                 keys.append(key)
             # footfall's glTF names each node's track and kind in its extras (custom properties
             # once imported); a glTF from elsewhere falls back to the node name.
@@ -861,6 +869,28 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
         for action in set(bpy.data.actions) - actions_before:
             bpy.data.actions.remove(action)
         return {"tracks": tracks}
+
+
+def _parent_transform(obj):
+    """How an imported glTF node's local keys become world ones: (origin, matrix). A footfall
+    glTF of a far walk parents the track nodes to one root node, "footfall_origin" (custom
+    property kind "origin"), that only translates: the origin is its translation in footfall's
+    frame, in double precision (its "origin" property, else its location), added to each key
+    in double; matrix is None. Any other parent (a glTF from elsewhere): origin 0 and its world
+    matrix (32-bit, as Blender holds it). No parent: origin 0, matrix None."""
+    zero = (0.0, 0.0, 0.0)
+    parent = obj.parent
+    if parent is None:
+        return zero, None
+    if parent.get("kind") == "origin" and parent.parent is None:
+        try:
+            origin = tuple(float(c) for c in parent["origin"])
+        except (KeyError, TypeError, ValueError):
+            origin = ()
+        if len(origin) != 3 or not all(math.isfinite(c) for c in origin):
+            origin = to_ff(parent.location)
+        return origin, None
+    return zero, parent.matrix_world @ obj.matrix_parent_inverse
 
 
 classes = [FOOTFALL_OT_terrain_setup, FOOTFALL_OT_character_setup, FOOTFALL_OT_generate_walk,
