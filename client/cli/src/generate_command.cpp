@@ -318,7 +318,8 @@ int RunGenerate(const GenerateFlags& flags) {
     for (const std::string& out : flags.out) {
       const std::string ext = FileExtension(out);
       if (ext == "gltf" || ext == "glb") {
-        // Visible in a DCC's viewport at real-world (UTM) coordinates.
+        // Keys are stored relative to the walk's origin (GltfOrigin): only a walk spanning
+        // kilometres moves visibly.
         const double rounding = MaxFloatRounding(walk);
         if (rounding > 1e-4) {
           std::cerr << "footfall generate: warning: " << out
