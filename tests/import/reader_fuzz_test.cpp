@@ -952,3 +952,23 @@ TEST_CASE("Reader fuzz: every terrain file under every other extension fails cle
 
 }  // namespace footfall
 
+// Cases the sweep found, kept by name.
+namespace footfall {
+
+TEST_CASE("Reader fuzz: a binary PLY element without properties is skipped at once",
+          "[import][fuzz]") {
+  // Its records hold no bytes: 2^63 - 1 of them were counted through one by one (a hang).
+  test::TempDir dir;
+  std::string error;
+  for (const char* count : {"9223372036854775807", "99999999999999999999999"}) {
+    std::string ply = BinaryPly(false);
+    ply.insert(ply.find("element face"), std::string("element junk ") + count + "\n");
+    TriangleMesh mesh;
+    const auto start = std::chrono::steady_clock::now();
+    CHECK(ReadMesh(dir.Write("junk.ply", ply), &mesh, &error) == Status::kOk);
+    CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(2));
+    CHECK(mesh.triangles.size() == 4);
+  }
+}
+
+}  // namespace footfall

@@ -584,6 +584,9 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
                 error);
   };
   for (const Element& e : elements) {
+    // An element without properties has no bytes to read: its records, up to 2^63 of them in
+    // the header, were counted through one by one (the load hung).
+    if (e.properties.empty()) continue;
     for (long long r = 0; r < e.count; ++r) {
       Vec3 point;
       bool face = false;
