@@ -53,6 +53,27 @@ const char* const kTetraObj =
     "o tetra\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\nvn 0 0 1\n"
     "f 1/1/1 3/1/1 2/1/1\nf 1//1 2//1 4//1\nf 1 4 3\nf -3 -2 -1\n";
 
+// A wavy 5 x 5 grid of quads, with a concave hexagon beside it and coordinates far from the
+// origin: enough faces for the winding, manifold and triangulation steps to meet damage.
+std::string GridObj() {
+  std::string text = "# grid\n";
+  char line[128];
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < 6; ++c) {
+      std::snprintf(line, sizeof line, "v %.17g %.17g %.17g\n", 1e5 + 0.5 * c, 0.1 * ((r * c) % 3),
+                    -2e5 + 0.5 * r);
+      text += line;
+    }
+  for (int r = 0; r < 5; ++r)
+    for (int c = 0; c < 5; ++c) {
+      const int a = 1 + r * 6 + c;
+      std::snprintf(line, sizeof line, "f %d %d %d %d\n", a, a + 6, a + 7, a + 1);
+      text += line;
+    }
+  text += "v 0 0 0\nv 2 0 0\nv 2 0 2\nv 1 0 1\nv 0 0 2\nv -1 0 1\nf -6 -1 -2 -3 -4 -5\n";
+  return text;
+}
+
 const char* const kCubeOff =
     "OFF\n8 6 12\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
     "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7 255 0 0\n";
@@ -403,10 +424,19 @@ class Mutator {
         }
         // Deep nesting in place of a value.
         const size_t depth = Below(4) == 0 ? 100000 + Below(100000) : 1 + Below(2000);
-        const std::string nest = std::string(depth, '[') + "1" + std::string(depth, ']');
+        std::string nest;
+        const size_t how = Below(3);
+        if (how == 0) {
+          nest = std::string(depth, '[') + "1" + std::string(depth, ']') + ", \"x\": ";
+        } else if (how == 1) {
+          for (size_t d = 0; d < depth; ++d) nest += "{\"a\": ";
+          nest += "1" + std::string(depth, '}') + ", \"x\": ";
+        } else {
+          nest = std::string(depth, '[');  // never closed
+        }
         const size_t colon = s->find(':', Below(s->size() + 1));
         if (colon == std::string::npos) return "no value";
-        s->insert(colon + 1, Below(4) == 0 ? std::string(depth, '{') : nest + ", \"x\": ");
+        s->insert(colon + 1, nest);
         return "nesting of " + std::to_string(depth);
       }
       default:
@@ -818,7 +848,8 @@ Status LoadCoarsely(const std::string& path, std::string* error, std::string* ba
 
 // Reads `content` as `path` and returns what is wrong, or "".
 std::string RunCase(const test::TempDir& dir, const std::string& file, const std::string& content,
-                    const Read& read, bool lines_promised, std::string* message = nullptr) {
+                    const Read& read, bool lines_promised, std::string* message = nullptr,
+                    Status* result = nullptr) {
   const std::string path = dir.Write(file, content);
   std::string local, bad;
   std::string& error = message ? *message : local;
@@ -834,6 +865,7 @@ std::string RunCase(const test::TempDir& dir, const std::string& file, const std
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (seconds > 2) return "took " + std::to_string(seconds) + " s";
+  if (result) *result = status;
   if (status == Status::kOk) return bad;
   return CheckMessage(path, content, status, error, lines_promised);
 }
@@ -875,7 +907,7 @@ void Sweep(const Format& format, uint32_t seed) {
   for (int i = 0; i < cases; ++i) {
     std::string content = format.seeds[m.Below(format.seeds.size())];
     std::string how;
-    for (size_t n = 0, count = 1 + m.Below(3); n < count; ++n)
+    for (size_t n = 0, count = 1 + m.Below(4); n < count; ++n)
       how += (n ? ", " : "") + m.Mutate(&content, format.kind, format.special);
     const std::string file = "case" + std::to_string(i) + "." + format.extension;
     std::string error;
@@ -901,7 +933,7 @@ std::vector<Format> Formats() {
   const Read mesh = MeshReader();
   return {
       {"points", "pts", Kind::kText, {kPoints, kPointsCrlf}, nullptr, PointReader(), true},
-      {"OBJ", "obj", Kind::kText, {kCubeObj, kTetraObj}, ObjSpecial, mesh},
+      {"OBJ", "obj", Kind::kText, {kCubeObj, kTetraObj, GridObj()}, ObjSpecial, mesh},
       {"OFF", "off", Kind::kText, {kCubeOff}, OffSpecial, mesh},
       {"text PLY", "ply", Kind::kText, {kTetraPly}, PlySpecial, mesh},
       {"binary PLY", "ply", Kind::kBinary, {BinaryPly(false), BinaryPly(true)}, PlySpecial, mesh},
@@ -928,6 +960,53 @@ TEST_CASE("Reader fuzz: damaged files of every format fail cleanly or read valid
   for (size_t f = 0; f < formats.size(); ++f) {
     SECTION(formats[f].name) { Sweep(formats[f], 20261204u + uint32_t(f)); }
   }
+}
+
+TEST_CASE("Reader fuzz: a file cut short never reads as a valid file", "[import][fuzz]") {
+  // Where each seed may end early and still be a whole file: files with counts, an end marker
+  // or closing brackets must fail when cut before it; point files and OBJ may end at any line.
+  auto last_token = [](const std::string& s) { return Tokens(s).back().at; };
+  auto all = [](const std::string& s) { return s.size(); };
+  const std::vector<std::pair<std::string, std::function<size_t(const std::string&)>>> bounds = {
+      {"OFF", [](const std::string& s) { return s.rfind(" 255 0 0"); }},  // the colour is optional
+      {"text PLY", last_token},
+      {"binary PLY", all},
+      {"text STL", [](const std::string& s) { return s.rfind("endsolid"); }},
+      {"binary STL", all},
+      {"ASC", last_token},
+      {"P2 PGM", last_token},
+      {"P5 PGM", all},
+      {"character", [](const std::string& s) { return s.rfind('}'); }},
+      {"walk", [](const std::string& s) { return s.rfind('}'); }},
+  };
+  test::TempDir dir;
+  std::vector<std::string> failures;
+  size_t cases = 0;
+  for (const Format& format : Formats()) {
+    for (const auto& [name, bound] : bounds) {
+      if (name != format.name) continue;
+      for (const std::string& seed : format.seeds) {
+        const size_t end = bound(seed);
+        REQUIRE(end <= seed.size());
+        for (size_t cut = 0; cut < end; ++cut) {
+          ++cases;
+          const std::string content = seed.substr(0, cut);
+          std::string error;
+          Status status = Status::kOk;
+          std::string what =
+              RunCase(dir, "cut." + format.extension, content, format.read, false, &error, &status);
+          if (what.empty() && status == Status::kOk) what = "read as a valid file";
+          if (!what.empty())
+            failures.push_back(format.name + " cut at " + std::to_string(cut) + " of " +
+                               std::to_string(seed.size()) + ": " + what);
+        }
+      }
+    }
+  }
+  std::string shown;
+  for (size_t i = 0; i < failures.size() && i < 10; ++i) shown += failures[i] + "\n";
+  INFO(failures.size() << " of " << cases << " cuts failed:\n" << shown);
+  CHECK(failures.empty());
 }
 
 TEST_CASE("Reader fuzz: every terrain file under every other extension fails cleanly",
