@@ -1051,3 +1051,36 @@ TEST_CASE("Reader fuzz: a binary PLY element without properties is skipped at on
 }
 
 }  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("Reader fuzz: height map header values out of range are named at their line",
+          "[import][fuzz]") {
+  // The message named the file only ("header needs whole ncols and nrows >= 1", "PGM maxval
+  // above 65535"), though both readers promise "FILE:LINE: what was expected".
+  test::TempDir dir;
+  HeightMap map;
+  std::string error;
+  const std::string asc = "ncols 2\nnrows 2\ncellsize 1\n1 2\n3 4\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {"ncols 2.5", "a.asc:1: ncols 2.5 (expected a whole number >= 1)"},
+      {"ncols -1", "a.asc:1: ncols -1 (expected a whole number >= 1)"},
+      {"nrows 0", "a.asc:2: nrows 0 (expected a whole number >= 1)"},
+  };
+  for (const auto& [replace, expected] : cases) {
+    std::string text = asc;
+    text.replace(text.find(replace.substr(0, 5)), 7, replace);
+    CHECK(ReadAscGrid(dir.Write("a.asc", text), &map, &error) == Status::kParseError);
+    CHECK(error.find(expected) != std::string::npos);
+  }
+  CHECK(ReadAscGrid(dir.Write("a.asc", "ncols 2\ncellsize 1\n1 2\n"), &map, &error) ==
+        Status::kParseError);
+  CHECK(error.find("a.asc: header needs whole ncols and nrows >= 1") != std::string::npos);
+  for (const char* magic : {"P2", "P5"}) {
+    CHECK(ReadPgm(dir.Write("p.pgm", std::string(magic) + "\n# c\n2 1\n70000\n0 0\n"), &map,
+                  &error) == Status::kParseError);
+    CHECK(error.find("p.pgm:4: PGM maxval above 65535") != std::string::npos);
+  }
+}
+
+}  // namespace footfall

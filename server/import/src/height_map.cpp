@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iterator>
 #include <sstream>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -189,8 +190,9 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
   std::string key, value;
   double ncols = -1, nrows = -1, cellsize = -1, nodata = NAN;
   bool has_nodata = false;
-  size_t size_line = 1;      // the line of ncols or nrows, whichever comes last
-  size_t cellsize_line = 0;  // 0: no cellsize
+  size_t size_line = 1;                   // the line of ncols or nrows, whichever comes last
+  size_t ncols_line = 0, nrows_line = 0;  // 0: not given
+  size_t cellsize_line = 0;               // 0: no cellsize
   std::vector<std::pair<std::string, size_t>> seen;  // header keys (lower case) and their lines
   // Header: KEY VALUE pairs until the first token that is a number.
   for (;;) {
@@ -218,9 +220,9 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
     }
     seen.emplace_back(k, line);
     if (k == "ncols") {
-      ncols = number, size_line = line;
+      ncols = number, size_line = ncols_line = line;
     } else if (k == "nrows") {
-      nrows = number, size_line = line;
+      nrows = number, size_line = nrows_line = line;
     } else if (k == "cellsize") {
       cellsize = number, cellsize_line = line;
     } else if (k == "nodata_value") {
@@ -232,7 +234,17 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
                   error);
     }
   }
-  if (!(ncols >= 1 && nrows >= 1 && ncols == std::floor(ncols) && nrows == std::floor(nrows))) {
+  // A count given but not a whole number >= 1 is named at its line; a missing one in the file.
+  auto bad_count = [](double n) { return !(n >= 1 && n == std::floor(n)); };
+  for (const auto& [value, at, name] :
+       {std::make_tuple(ncols, ncols_line, "ncols"), std::make_tuple(nrows, nrows_line, "nrows")}) {
+    if (at != 0 && bad_count(value)) {
+      return Fail(path + ":" + std::to_string(at),
+                  std::string(name) + " " + NumberText(value) + " (expected a whole number >= 1)",
+                  error);
+    }
+  }
+  if (ncols_line == 0 || nrows_line == 0) {
     return Fail(path, "header needs whole ncols and nrows >= 1", error);
   }
   if (cellsize_line == 0) return Fail(path, "header needs cellsize (a number > 0)", error);
@@ -308,7 +320,9 @@ Status ReadPgm(const std::string& path, HeightMap* out, std::string* error) {
     }
     if (i == 1) size_line = reader.line();
   }
-  if (fields[2] > 65535) return Fail(path, "PGM maxval above 65535", error);
+  if (fields[2] > 65535) {
+    return Fail(path + ":" + std::to_string(reader.line()), "PGM maxval above 65535", error);
+  }
   const double cells = fields[0] * fields[1];
   const std::string header = path + ":" + std::to_string(size_line);
   const size_t bytes = fields[2] < 256 ? 1 : 2;  // per P5 pixel
