@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cerrno>
 #include <climits>
 #include <cmath>
 #include <cstdint>
@@ -144,6 +145,14 @@ bool ParseInteger(const std::string& token, long long* value) {
   return end != begin && *end == '\0';
 }
 
+// ParseInteger for a count the file declares: false beyond long long too (strtoll held
+// 99999999999999999999 at 2^63 - 1, and "header declares 9223372036854775807 faces" named a
+// count the file does not hold).
+bool ParseCount(const std::string& token, long long* value) {
+  errno = 0;
+  return ParseInteger(token, value) && errno != ERANGE;
+}
+
 std::string StripComment(const std::string& line) {
   std::string s = line.substr(0, line.find('#'));
   if (!s.empty() && s.back() == '\r') s.pop_back();
@@ -277,7 +286,7 @@ Status ParseOffLines(const std::string& path, LineReader& lines, ParsedMesh* out
   }
   if (t.empty() && !next(&t)) return Fail(path, "truncated: expected the OFF counts", error);
   long long nv = 0, nf = 0;
-  if (t.size() < 2 || !ParseInteger(t[0], &nv) || !ParseInteger(t[1], &nf) || nv < 0 || nf < 0) {
+  if (t.size() < 2 || !ParseCount(t[0], &nv) || !ParseCount(t[1], &nf) || nv < 0 || nf < 0) {
     return Fail(At(path, number), "expected counts 'VERTICES FACES EDGES'", error);
   }
   for (long long v = 0; v < nv; ++v) {
@@ -303,7 +312,7 @@ Status ParseOffLines(const std::string& path, LineReader& lines, ParsedMesh* out
           error);
     }
     long long n = 0;
-    if (!ParseInteger(t[0], &n) || n < 3) {
+    if (!ParseCount(t[0], &n) || n < 3) {
       return Fail(At(path, number), "face must start with its vertex count (3 or more)", error);
     }
     if (static_cast<long long>(t.size()) < n + 1) {
@@ -404,7 +413,7 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
     } else if (t[0] == "element" && t.size() >= 3) {
       Element e;
       e.name = t[1];
-      if (!ParseInteger(t[2], &e.count) || e.count < 0) {
+      if (!ParseCount(t[2], &e.count) || e.count < 0) {
         return Fail(At(path, number), "element count '" + ShownText(t[2]) + "' is not a count",
                     error);
       }
