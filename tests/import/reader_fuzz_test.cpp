@@ -231,6 +231,11 @@ const char* const kSpecialTokens[] = {"nan",
                                       "1e-400",
                                       "6e14",
                                       "1e15",
+                                      "4e14",
+                                      "-4.9e14",
+                                      "1e-300",
+                                      "4.9e-324",
+                                      "123456789.123456789",
                                       "4294967295",
                                       "4294967296",
                                       "2147483647",
@@ -1111,6 +1116,51 @@ TEST_CASE("Reader fuzz: OFF and PLY counts beyond 2^63 are refused as written", 
     CHECK(error.find(expected) != std::string::npos);
     CHECK(error.find("9223372036854775807") == std::string::npos);
   }
+}
+
+}  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("Reader fuzz: numbers are decimal with one sign in every text terrain format",
+          "[import][fuzz]") {
+  // strtod read "0x10" as 16 in meshes and height maps, and the point file's reader, skipping a
+  // '+' before from_chars, read "+-1" as -1.
+  test::TempDir dir;
+  std::string error;
+  TriangleMesh mesh;
+  HeightMap map;
+  RawSamples samples;
+  for (const std::string token : {"0x10", "0X1p3", "-0x1", "0x"}) {
+    INFO(token);
+    CHECK(ReadMesh(dir.Write("h.obj", "v " + token + " 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), &mesh,
+                   &error) == Status::kParseError);
+    CHECK(error.find("h.obj:1: vertex coordinate") != std::string::npos);
+    CHECK(ReadMesh(dir.Write("h.off", "OFF\n3 1 0\n0 0 0\n1 " + token + " 0\n0 1 0\n3 0 1 2\n"),
+                   &mesh, &error) == Status::kParseError);
+    CHECK(error.find("h.off:4: vertex coordinate") != std::string::npos);
+    CHECK(ReadAscGrid(dir.Write("h.asc", "ncols 2\nnrows 1\ncellsize 1\n1 " + token + "\n"), &map,
+                      &error) == Status::kParseError);
+    CHECK(error.find("h.asc:4: value") != std::string::npos);
+    CHECK(ReadPgm(dir.Write("h.pgm", "P2\n2 1\n255\n1 " + token + "\n"), &map, &error) ==
+          Status::kParseError);
+    CHECK(error.find("h.pgm:4: grey level") != std::string::npos);
+  }
+  for (const std::string token : {"+-1", "+-0", "-+1", "++1"}) {
+    INFO(token);
+    CHECK(ReadPointFile(dir.Write("s.pts", "0 0 0 0 1 0\n" + token + " 0 0 0 1 0\n"), &samples,
+                        &error) == Status::kParseError);
+    CHECK(error.find("s.pts:2: column 1: '" + token + "' is not a number") != std::string::npos);
+  }
+  // One sign is a number, in every reader.
+  REQUIRE(ReadPointFile(dir.Write("s.pts", "+1 -1 +.5 0 +1 0\n"), &samples, &error) == Status::kOk);
+  CHECK(samples.points[0] == Vec3{1, -1, 0.5});
+  REQUIRE(ReadMesh(dir.Write("s.obj", "v +1 -0 +.5\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), &mesh, &error) ==
+          Status::kOk);
+  CHECK(mesh.vertices[0] == Vec3{1, 0, 0.5});
+  REQUIRE(ReadAscGrid(dir.Write("s.asc", "ncols 2\nnrows 1\ncellsize +1\n+1 -2.5e0\n"), &map,
+                      &error) == Status::kOk);
+  CHECK(map.heights[1] == -2.5);
 }
 
 }  // namespace footfall

@@ -30,11 +30,14 @@ std::string Lower(std::string s) {
   return s;
 }
 
+// True when `token` is entirely a finite decimal number (strtod also reads hexadecimal, "0x10"
+// as 16, which neither format writes).
 bool ParseDouble(const std::string& token, double* value) {
   const char* begin = token.c_str();
   char* end = nullptr;
   *value = std::strtod(begin, &end);
-  return end != begin && *end == '\0' && std::isfinite(*value);
+  return end != begin && *end == '\0' && std::isfinite(*value) &&
+         token.find_first_of("xX") == std::string::npos;
 }
 
 // A number as people write it: "5e+14", "0.25".

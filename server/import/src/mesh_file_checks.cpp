@@ -115,7 +115,9 @@ Status CheckCoordinate(const std::string& where, const std::string& token, doubl
   char* end = nullptr;
   const double value = std::strtod(begin, &end);
   *value_out = value;
-  if (end == begin || *end != '\0' || !std::isfinite(value))
+  // strtod also reads hexadecimal ("0x10" as 16, "0x1p3" as 8), which no mesh format writes.
+  const bool hex = token.find_first_of("xX") != std::string::npos;
+  if (end == begin || *end != '\0' || !std::isfinite(value) || hex)
     return Fail(where, "vertex coordinate '" + ShownText(token) + "' is not a finite number",
                 error);
   if (std::fabs(value) > terrain::kMaxCoordinate) {

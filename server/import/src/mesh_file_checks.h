@@ -30,9 +30,9 @@ struct ParsedMesh {
 
 // Each returns kOk, or kParseError with "FILE:LINE: what was expected" (or "FILE: ..." for binary
 // data) in *error. Faces have 3 or more indices of existing vertices; coordinates are finite
-// numbers within +-terrain::kMaxCoordinate, read in double (binary PLY and STL store floats).
-// Normals, texture coordinates and colours are checked as far as the format needs to find the
-// next value, and dropped.
+// decimal numbers within +-terrain::kMaxCoordinate, read in double (binary PLY and STL store
+// floats). Normals, texture coordinates and colours are checked as far as the format needs to find
+// the next value, and dropped.
 Status ParseObjFile(const std::string& path, ParsedMesh* out, std::string* error);
 Status ParseOffFile(const std::string& path, ParsedMesh* out, std::string* error);
 Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error);

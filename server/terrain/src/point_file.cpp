@@ -62,7 +62,8 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
       if (count < 6) {
         const char* first = token.data();
         const char* last = first + token.size();
-        if (*first == '+') ++first;  // from_chars rejects a leading '+'
+        // from_chars rejects a leading '+' (but reads "+-1" as -1 once it is skipped).
+        if (*first == '+' && token.size() > 1 && first[1] != '-') ++first;
         double value = 0;
         const auto [ptr, ec] = std::from_chars(first, last, value);
         // Too small for a double (1e-400, 0.000...) reads as 0, as other readers have it; too

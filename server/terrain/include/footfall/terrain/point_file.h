@@ -1,4 +1,5 @@
-// The terrain point file: ASCII, one sample per line "x y z nx ny nz", whitespace separated.
+// The terrain point file: ASCII, one sample per line "x y z nx ny nz", whitespace separated
+// decimal numbers (each with at most one sign: "+-1" is not a number).
 // '#' starts a comment; blank lines are skipped; CRLF line ends and a leading UTF-8 byte order
 // mark are accepted. Coordinates must be within +-terrain::kMaxCoordinate. A sample's index is its
 // 0-based order among data lines. Normals are normalised on load.
