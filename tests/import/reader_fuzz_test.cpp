@@ -6,6 +6,8 @@
 // changed) and read back through the public API. Every case must return without an exception,
 // and either succeed with finite, valid output or fail with a message naming the file (and, where
 // the message names a line, a line the file has).
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -1161,6 +1163,40 @@ TEST_CASE("Reader fuzz: numbers are decimal with one sign in every text terrain 
   REQUIRE(ReadAscGrid(dir.Write("s.asc", "ncols 2\nnrows 1\ncellsize +1\n+1 -2.5e0\n"), &map,
                       &error) == Status::kOk);
   CHECK(map.heights[1] == -2.5);
+}
+
+}  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("Reader fuzz: a directory or FIFO named as a mesh or height map is refused",
+          "[import][fuzz]") {
+  // ReadAscGrid and ReadPgm threw std::ios_base::failure reading a directory, ReadMesh called it
+  // an empty file, and all three waited on a FIFO for a writer.
+  test::TempDir dir;
+  std::string error;
+  TriangleMesh mesh;
+  HeightMap map;
+  for (const char* name : {"d.obj", "d.ply", "d.stl", "d.off", "d.asc", "d.pgm"}) {
+    INFO(name);
+    const std::string path = dir.File(name);
+    REQUIRE(mkdir(path.c_str(), 0700) == 0);
+    const std::string ext = path.substr(path.size() - 3);
+    Status status = Status::kOk;
+    REQUIRE_NOTHROW(status = ext == "asc"   ? ReadAscGrid(path, &map, &error)
+                             : ext == "pgm" ? ReadPgm(path, &map, &error)
+                                            : ReadMesh(path, &mesh, &error));
+    CHECK(status == Status::kInvalidArgument);
+    CHECK(error == path + ": cannot open " +
+                       (ext == "asc" || ext == "pgm" ? "height map" : "mesh") + ": a directory");
+    const std::string fifo = dir.File(std::string("f.") + ext);
+    REQUIRE(mkfifo(fifo.c_str(), 0600) == 0);
+    status = ext == "asc"   ? ReadAscGrid(fifo, &map, &error)
+             : ext == "pgm" ? ReadPgm(fifo, &map, &error)
+                            : ReadMesh(fifo, &mesh, &error);
+    CHECK(status == Status::kInvalidArgument);
+    CHECK(error.find("a FIFO, not a regular file") != std::string::npos);
+  }
 }
 
 }  // namespace footfall

@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "footfall/terrain/input_file.h"
 #include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/samples.h"
 #include "footfall/terrain/shown_text.h"
@@ -100,6 +101,9 @@ std::string FirstWord(std::istream& in) {
 template <typename StartsOk>
 Status ReadWhole(const std::string& path, std::string* text, std::string* error,
                  const StartsOk& starts_ok, const char* expected) {
+  // A directory opened as a file threw out of the read below (EISDIR); a FIFO waited.
+  const Status input = CheckInputFile(path, "height map", error);
+  if (input != Status::kOk) return input;
   errno = 0;
   std::ifstream in(path, std::ios::binary);
   if (!in) {

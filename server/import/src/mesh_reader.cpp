@@ -15,6 +15,7 @@
 #include <OpenMesh/Core/System/omstream.hh>
 
 #include "footfall/terrain/file_extension.h"
+#include "footfall/terrain/input_file.h"
 #include "footfall/terrain/samples.h"
 #include "mesh_file_checks.h"
 
@@ -84,6 +85,9 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
     return Status::kInvalidArgument;
   }
   {
+    // A directory read as an empty file; a FIFO waited for a writer.
+    const Status input = CheckInputFile(path, "mesh", error);
+    if (input != Status::kOk) return input;
     errno = 0;
     std::ifstream probe(path, std::ios::binary);
     if (!probe) {

@@ -32,9 +32,9 @@ struct HeightMap {
 // Reads an ESRI ASCII grid: a header (ncols, nrows, xllcorner|xllcenter, yllcorner|yllcenter,
 // cellsize, optional NODATA_value; any case) then nrows * ncols numbers. Cells equal to
 // NODATA_value are marked invalid. A leading UTF-8 byte order mark is skipped. Errors: kIoError
-// (cannot open), kParseError with "FILE:LINE: what was expected" (bad header, more cells than
-// kMaxHeightMapCells or than the file has data for, a value that is not a finite decimal
-// number, truncated data).
+// (cannot open), kInvalidArgument (a directory, FIFO or device: CheckInputFile), kParseError with
+// "FILE:LINE: what was expected" (bad header, more cells than kMaxHeightMapCells or than the file
+// has data for, a value that is not a finite decimal number, truncated data).
 Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error);
 
 // Reads a PGM image, binary (P5, 8 or 16 bit big-endian by maxval) or ASCII (P2). Heights are

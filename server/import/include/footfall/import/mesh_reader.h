@@ -27,7 +27,7 @@ bool IsMeshExtension(const std::string& lower_extension);
 // Reads `path` into *out. Errors, each with a message naming the file (and the line where the
 // format is text): kIoError (cannot open), kParseError (empty file, no faces, truncated data,
 // a non-finite coordinate, a face using a missing vertex, a non-manifold edge or vertex),
-// kInvalidArgument (not a mesh extension).
+// kInvalidArgument (not a mesh extension; a directory, FIFO or device: CheckInputFile).
 Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
                 MeshReadReport* report = nullptr);
 
