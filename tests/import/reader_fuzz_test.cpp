@@ -764,8 +764,11 @@ std::string CheckMessage(const std::string& path, const std::string& content, St
   const size_t at = error.find(path + ":");
   if (at == std::string::npos) return "";
   const char* p = error.c_str() + at + path.size() + 1;
+  // Text that is not JSON is located: "FILE:LINE:COLUMN: malformed JSON: ...".
+  const bool malformed_json = error.find(": malformed JSON: ") != std::string::npos;
   if (!std::isdigit(static_cast<unsigned char>(*p))) {
     if (lines_promised && status == Status::kParseError) return "message names no line";
+    if (malformed_json) return "malformed JSON without its line and column";
     return "";
   }
   const unsigned long long line = std::strtoull(p, nullptr, 10);
