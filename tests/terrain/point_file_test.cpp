@@ -10,6 +10,7 @@
 
 #include <catch2/catch.hpp>
 
+#include "footfall/terrain/decimal_number.h"
 #include "footfall/terrain/point_file.h"
 
 #include "footfall/terrain/input_file.h"
@@ -169,4 +170,31 @@ TEST_CASE("WritePointFile writes every sample exactly", "[terrain][point_file]")
   }
   std::remove(path.c_str());
   rmdir(dir);
+}
+
+TEST_CASE("ReadDecimal reads decimal numbers only, tiny ones as zero", "[terrain][decimal]") {
+  double v = -1;
+  CHECK(ReadDecimal("0.25", &v) == DecimalRead::kNumber);
+  CHECK(v == 0.25);
+  CHECK(ReadDecimal("+5e-1", &v) == DecimalRead::kNumber);
+  CHECK(v == 0.5);
+  CHECK(ReadDecimal("-.5", &v) == DecimalRead::kNumber);
+  CHECK(v == -0.5);
+  CHECK(ReadDecimal("1.", &v) == DecimalRead::kNumber);
+  CHECK(v == 1);
+  CHECK(ReadDecimal("-1e-400", &v) == DecimalRead::kNumber);
+  CHECK(v == 0);
+  CHECK(std::signbit(v));
+  CHECK(ReadDecimal("1e400", &v) == DecimalRead::kTooLarge);
+  for (const char* bad : {"0x10", "0X1p3", "+-1", "++1", "1,5", "1.5.", "", "+", "-", "e5", "1e"}) {
+    INFO(bad);
+    CHECK(ReadDecimal(bad, &v) == DecimalRead::kNotANumber);
+  }
+  CHECK_FALSE(ParseFiniteDecimal("inf", &v));
+  CHECK_FALSE(ParseFiniteDecimal("nan", &v));
+  v = 7;
+  CHECK_FALSE(ParseFiniteDecimal("12abc", &v));
+  CHECK(v == 7);
+  CHECK(ParseFiniteDecimal("-3.5e2", &v));
+  CHECK(v == -350);
 }

@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "footfall/terrain/decimal_number.h"
 #include "footfall/terrain/input_file.h"
 #include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/samples.h"
@@ -29,16 +30,6 @@ Status Fail(const std::string& where, const std::string& what, std::string* erro
 std::string Lower(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return s;
-}
-
-// True when `token` is entirely a finite decimal number (strtod also reads hexadecimal, "0x10"
-// as 16, which neither format writes).
-bool ParseDouble(const std::string& token, double* value) {
-  const char* begin = token.c_str();
-  char* end = nullptr;
-  *value = std::strtod(begin, &end);
-  return end != begin && *end == '\0' && std::isfinite(*value) &&
-         token.find_first_of("xX") == std::string::npos;
 }
 
 // A number as people write it: "5e+14", "0.25".
@@ -207,12 +198,12 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
     if (!reader.Next(&key)) return Fail(path, "truncated: the grid header has no data", error);
     const size_t line = reader.line();
     double number;
-    if (ParseDouble(key, &number)) {
+    if (ParseFiniteDecimal(key, &number)) {
       reader = before;  // the first data value
       break;
     }
     // The value on the key's own line: a key alone is not given the first data value.
-    if (!reader.Next(&value) || reader.line() != line || !ParseDouble(value, &number)) {
+    if (!reader.Next(&value) || reader.line() != line || !ParseFiniteDecimal(value, &number)) {
       return Fail(path + ":" + std::to_string(line),
                   "header '" + ShownText(key) + "' needs a number on its line", error);
     }
@@ -281,7 +272,7 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
                   error);
     }
     double h;
-    if (!ParseDouble(value, &h)) {
+    if (!ParseFiniteDecimal(value, &h)) {
       return Fail(path + ":" + std::to_string(reader.line()),
                   "value '" + ShownText(value) + "' is not a finite number", error);
     }
@@ -320,7 +311,7 @@ Status ReadPgm(const std::string& path, HeightMap* out, std::string* error) {
   size_t size_line = 1;
   const char* names[3] = {"width", "height", "maxval"};
   for (int i = 0; i < 3; ++i) {
-    if (!reader.Next(&token) || !ParseDouble(token, &fields[i]) || fields[i] < 1 ||
+    if (!reader.Next(&token) || !ParseFiniteDecimal(token, &fields[i]) || fields[i] < 1 ||
         fields[i] != std::floor(fields[i])) {
       return Fail(path + ":" + std::to_string(reader.line()),
                   std::string("expected the PGM ") + names[i] + " as a whole number >= 1", error);
@@ -404,7 +395,7 @@ Status ReadPgm(const std::string& path, HeightMap* out, std::string* error) {
                       std::to_string(i),
                   error);
     }
-    if (!ParseDouble(token, &h) || h < 0 || h > fields[2] || h != std::floor(h)) {
+    if (!ParseFiniteDecimal(token, &h) || h < 0 || h > fields[2] || h != std::floor(h)) {
       return Fail(path + ":" + std::to_string(reader.line()),
                   "grey level '" + ShownText(token) + "' is not a whole number from 0 to maxval",
                   error);

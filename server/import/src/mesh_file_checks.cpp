@@ -16,6 +16,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "footfall/terrain/decimal_number.h"
 #include "footfall/terrain/input_file.h"
 #include "footfall/terrain/samples.h"
 #include "footfall/terrain/shown_text.h"
@@ -111,15 +112,11 @@ std::vector<std::string> Tokens(const std::string& line) {
 // +-terrain::kMaxCoordinate; otherwise kParseError with "WHERE: what was expected".
 Status CheckCoordinate(const std::string& where, const std::string& token, double* value_out,
                        std::string* error) {
-  const char* begin = token.c_str();
-  char* end = nullptr;
-  const double value = std::strtod(begin, &end);
-  *value_out = value;
-  // strtod also reads hexadecimal ("0x10" as 16, "0x1p3" as 8), which no mesh format writes.
-  const bool hex = token.find_first_of("xX") != std::string::npos;
-  if (end == begin || *end != '\0' || !std::isfinite(value) || hex)
+  double value = 0;
+  if (!ParseFiniteDecimal(token, &value))
     return Fail(where, "vertex coordinate '" + ShownText(token) + "' is not a finite number",
                 error);
+  *value_out = value;
   if (std::fabs(value) > terrain::kMaxCoordinate) {
     std::ostringstream m;
     m << "vertex coordinate " << ShownText(token)
@@ -344,9 +341,8 @@ Status ParseOffLines(const std::string& path, LineReader& lines, ParsedMesh* out
                   error);
     }
     for (size_t i = static_cast<size_t>(n) + 1; i < t.size(); ++i) {
-      char* end = nullptr;
-      const double value = std::strtod(t[i].c_str(), &end);
-      if (end == t[i].c_str() || *end != '\0' || !std::isfinite(value)) {
+      double value = 0;
+      if (!ParseFiniteDecimal(t[i], &value)) {
         return Fail(At(path, number),
                     "face colour value '" + ShownText(t[i]) + "' is not a number (expected " +
                         std::to_string(n) + " vertex indices, then nothing or R G B [A])",

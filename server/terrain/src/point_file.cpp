@@ -1,7 +1,6 @@
 #include "footfall/terrain/point_file.h"
 
 #include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -9,8 +8,8 @@
 #include <istream>
 #include <sstream>
 #include <string_view>
-#include <system_error>
 
+#include "footfall/terrain/decimal_number.h"
 #include "footfall/terrain/input_file.h"
 #include "footfall/terrain/output_file.h"
 #include "footfall/terrain/shown_text.h"
@@ -19,15 +18,6 @@ namespace footfall {
 namespace {
 
 bool IsSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-
-// For a number out of a double's range: true when it is too small (a negative exponent, or no
-// exponent and no whole part, as 0.000...1), false when too large.
-bool Underflows(std::string_view number) {
-  const size_t e = number.find_first_of("eE");
-  if (e != std::string_view::npos) return e + 1 < number.size() && number[e + 1] == '-';
-  if (!number.empty() && (number[0] == '-' || number[0] == '+')) number.remove_prefix(1);
-  return number.substr(0, 2) == "0." || number.substr(0, 1) == ".";
-}
 
 Status Fail(const std::string& name, size_t line, const std::string& what, RawSamples* out,
             std::string* error) {
@@ -60,23 +50,15 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
       while (end < line.size() && !IsSpace(line[end])) ++end;
       const std::string_view token = line.substr(pos, end - pos);
       if (count < 6) {
-        const char* first = token.data();
-        const char* last = first + token.size();
-        // from_chars rejects a leading '+' (but reads "+-1" as -1 once it is skipped).
-        if (*first == '+' && token.size() > 1 && first[1] != '-') ++first;
         double value = 0;
-        const auto [ptr, ec] = std::from_chars(first, last, value);
-        // Too small for a double (1e-400, 0.000...) reads as 0, as other readers have it; too
-        // large is refused.
-        const bool tiny = ec == std::errc::result_out_of_range && ptr == last && Underflows(token);
-        if (tiny) value = token[0] == '-' ? -0.0 : 0.0;
-        if (ec == std::errc::result_out_of_range && ptr == last && !tiny) {
+        const DecimalRead read = ReadDecimal(token, &value);
+        if (read == DecimalRead::kTooLarge) {
           return Fail(name, line_no,
                       "column " + std::to_string(count + 1) + ": '" + ShownText(token) +
                           "' is out of range (expected a finite number)",
                       out, error);
         }
-        if (!tiny && (ec != std::errc() || ptr != last)) {
+        if (read == DecimalRead::kNotANumber) {
           return Fail(name, line_no,
                       "column " + std::to_string(count + 1) + ": '" + ShownText(token) +
                           "' is not a number (expected x y z nx ny nz)",
