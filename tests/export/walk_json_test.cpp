@@ -46,3 +46,69 @@ TEST_CASE("WalkToJson writes keys that read back whatever their order", "[export
     CHECK(back.tracks[0].keys.size() == walk.tracks[0].keys.size());
   }
 }
+
+TEST_CASE("ParseWalkJson refuses zero and non-finite foot normals and body rotations",
+          "[export][walk_json]") {
+  const std::string head =
+      R"({"format": "footfall-walk", "version": 1, "fps": 24, "tracks": [{"name": "body", )"
+      R"("kind": "body", "keys": [{"frame": 1, "position": [0, 0, 0], "rotation": [0, 0, 0, 1]}]},)"
+      "\n"
+      R"({"name": "L", "kind": "foot", "keys": [)"
+      R"({"frame": 1, "phase": "end", "position": [0, 0, 0], "normal": [0, 1, 0]},)"
+      "\n";
+  auto parse = [&head](const std::string& second_key, std::string* error) {
+    Walk walk;
+    return ParseWalkJson(head + second_key + "]}]}", "w.json", &walk, error);
+  };
+  std::string error;
+
+  SECTION("a foot normal of zero length") {
+    for (const char* normal : {"[0, 0, 0]", "[-0, 0, -0.0]", "[0.0, 0e10, 0]"}) {
+      INFO(normal);
+      error.clear();
+      CHECK(parse(std::string(R"({"frame": 2, "phase": "start", "position": [0, 0, 0], )") +
+                      R"("normal": )" + normal + "}",
+                  &error) == Status::kParseError);
+      CHECK(error == "w.json: tracks[1].keys[1].normal: expected a non-zero normal [nx, ny, nz]");
+    }
+  }
+  SECTION("a foot normal with a number that is not finite") {
+    // JSON has no NaN or Inf: 1e999, the one way to write one, is refused where it stands.
+    CHECK(parse(R"({"frame": 2, "phase": "start", "position": [0, 0, 0], "normal": [0, 1e999, 0]})",
+                &error) == Status::kParseError);
+    CHECK(error ==
+          "w.json:3:69: malformed JSON: number overflow parsing '1e999' (beyond the range of a "
+          "double)");
+  }
+  SECTION("a tiny or huge foot normal is read as written") {
+    for (const char* normal : {"[0, 1e-300, 0]", "[5e-324, 0, 0]", "[0, 0, -1e300]"}) {
+      INFO(normal);
+      CHECK(parse(std::string(R"({"frame": 2, "phase": "start", "position": [0, 0, 0], )") +
+                      R"("normal": )" + normal + "}",
+                  &error) == Status::kOk);
+    }
+  }
+  SECTION("a foot key without a normal keeps the default up") {
+    Walk walk;
+    REQUIRE(ParseWalkJson(head + R"({"frame": 2, "phase": "start", "position": [0, 0, 0]}]}]})",
+                          "w.json", &walk, &error) == Status::kOk);
+    CHECK(walk.tracks[1].keys[1].normal == Vec3{0, 1, 0});
+  }
+  SECTION("body rotations: zero and not finite") {
+    const std::string body_head =
+        R"({"format": "footfall-walk", "version": 1, "fps": 24, "tracks": [{"name": "body", )"
+        R"("kind": "body", "keys": [{"frame": 1, "position": [0, 0, 0], "rotation": )";
+    Walk walk;
+    CHECK(ParseWalkJson(body_head + "[0, 0, -0, 0]}]}]}", "w.json", &walk, &error) ==
+          Status::kParseError);
+    CHECK(error ==
+          "w.json: tracks[0].keys[0].rotation: expected a non-zero quaternion "
+          "[qx, qy, qz, qw]");
+    error.clear();
+    CHECK(ParseWalkJson(body_head + "[0, 0, 0, -1e999]}]}]}", "w.json", &walk, &error) ==
+          Status::kParseError);
+    CHECK(error ==
+          "w.json:1:165: malformed JSON: number overflow parsing '-1e999' (beyond the range of a "
+          "double)");
+  }
+}

@@ -262,7 +262,15 @@ Status ParseWalkJson(const std::string& text, const std::string& source, Walk* o
             r.Fail(kw + ".phase", "expected \"start\", \"mid\" or \"end\"");
             break;
           }
-          if (k.contains("normal") && !r.Vec(k["normal"], kw + ".normal", &key.normal)) break;
+          if (k.contains("normal")) {
+            if (!r.Vec(k["normal"], kw + ".normal", &key.normal)) break;
+            // Any non-zero length, as samples' normals and body rotations (zero has no direction).
+            if (std::max({std::fabs(key.normal.x), std::fabs(key.normal.y),
+                          std::fabs(key.normal.z)}) == 0) {
+              r.Fail(kw + ".normal", "expected a non-zero normal [nx, ny, nz]");
+              break;
+            }
+          }
         } else {
           double q[4] = {0, 0, 0, 1};
           if (k.contains("rotation") && !r.Array(k["rotation"], 4, kw + ".rotation", q)) break;

@@ -32,8 +32,9 @@ constexpr double kMaxKeyCoordinate = 1e15;
 // Parses walk JSON. `source` names it in errors: "SOURCE:LINE:COLUMN: malformed JSON: ..." for
 // text that is not JSON, "SOURCE: tracks[2].keys[5].position: expected an array of 3 numbers"
 // for a wrong structure. Frames must increase along each track, positions lie within
-// +-kMaxKeyCoordinate and body rotations must be non-zero quaternions (read as written, not
-// normalised). kParseError for malformed or unsupported input.
+// +-kMaxKeyCoordinate, foot normals must be non-zero vectors and body rotations non-zero
+// quaternions (both finite, read as written, not normalised). kParseError for malformed or
+// unsupported input.
 Status ParseWalkJson(const std::string& text, const std::string& source, Walk* out,
                      std::string* error);
 
