@@ -6,7 +6,7 @@ set -euo pipefail
 # python3 packs the Blender add-on's zip, which every build makes.
 core=(cmake g++ make pkg-config cpp libtirpc-dev rpcsvc-proto nlohmann-json3-dev libcli11-dev
       libopenmesh-dev libtinygltf-dev libstb-dev python3)
-test=(catch2 libbenchmark-dev libnanoflann-dev rpcbind nodejs npm clang-format git)
+test=(catch2 libbenchmark-dev libnanoflann-dev rpcbind nodejs npm clang-format git locales)
 viewer=(libglfw3-dev libglm-dev libgl-dev libgl1-mesa-dri xvfb xauth)
 blender=(blender python3 python3-numpy)
 
@@ -42,4 +42,14 @@ if [ ${#missing[@]} -gt 0 ]; then
   SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# The export tests write files with the C and C++ locales set to a decimal-comma locale, which
+# must be installed: de_DE.UTF-8, generated when the test packages are wanted.
+if [[ " ${wanted[*]} " == *" locales "* ]] && ! locale -a 2>/dev/null | grep -qix 'de_DE\.utf-\?8'; then
+  echo "install-deps: generating the de_DE.UTF-8 locale"
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  grep -qx 'de_DE.UTF-8 UTF-8' /etc/locale.gen 2>/dev/null ||
+    echo 'de_DE.UTF-8 UTF-8' | $SUDO tee -a /etc/locale.gen >/dev/null
+  $SUDO locale-gen >/dev/null
 fi

@@ -2,9 +2,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <string>
 #include <unordered_map>
@@ -20,23 +19,27 @@ namespace {
 // A decimal MEL literal without exponent that reads back as `value` exactly: the fewest
 // significant digits that round-trip, written in fixed notation, trailing zeros trimmed, "-0"
 // as "0". A whole number beyond MEL's 32-bit int keeps a ".0": MEL reads a literal without a
-// point as an int. `value` must be finite.
+// point as an int. `value` must be finite. std::to_chars, unlike printf, ignores the C locale:
+// a host that sets a decimal-comma LC_NUMERIC (Maya, Blender) still gets points.
 std::string Number(double value) {
-  // The shortest "%.{p}e" form that reads back to the same double (17 digits always do).
+  // The shortest scientific form that reads back to the same double: what the shortest
+  // "%.{p}e" in the "C" locale gives (the correctly rounded digits, ties to even).
   char text[64];
-  for (int precision = 1; precision <= 17; ++precision) {
-    std::snprintf(text, sizeof text, "%.*e", precision - 1, value);
-    if (std::strtod(text, nullptr) == value) break;
-  }
-  // text is "[-]d[.ddd]e<exp>": split into sign, digits and the power of ten of the first digit.
-  const std::string scientific = text;
+  const std::to_chars_result written =
+      std::to_chars(text, text + sizeof text, value, std::chars_format::scientific);
+  // text is "[-]d[.ddd]e<sign><exp>": split into sign, digits and the power of ten of the first
+  // digit.
+  const std::string scientific(text, written.ptr);
   const size_t e = scientific.find('e');
   const bool negative = scientific[0] == '-';
   std::string digits;
   for (size_t i = negative ? 1 : 0; i < e; ++i) {
     if (scientific[i] != '.') digits += scientific[i];
   }
-  const int exponent = std::atoi(scientific.c_str() + e + 1);
+  int exponent = 0;
+  const char* exponent_text = scientific.c_str() + e + 1;
+  if (*exponent_text == '+') ++exponent_text;  // from_chars takes '-' but not '+'
+  std::from_chars(exponent_text, scientific.c_str() + scientific.size(), exponent);
   const int count = static_cast<int>(digits.size());
   std::string s;
   if (exponent < 0) {
