@@ -11,8 +11,11 @@
 
 #include <catch2/catch.hpp>
 
+#include "footfall/client/terrain_session.h"
 #include "footfall/export/gltf_writer.h"
 #include "footfall/export/mel_writer.h"
+#include "footfall/steps/character.h"
+#include "footfall/steps/generator.h"
 #include "footfall/steps/walk_json.h"
 #include "footfall/terrain/point_file.h"
 #include "walk_fixtures.h"
@@ -103,7 +106,59 @@ std::vector<std::pair<std::string, std::string>> WriteAll(const Walk& walk,
   return files;
 }
 
+// A biped walking 12 steps along +Z across a 2 x 3 m plateau (5 cm samples) that ends in a
+// cliff: it stops at the edge, after 1,000.5 frames' worth of start frame.
+Walk CliffWalk() {
+  RawSamples ground;
+  for (int i = 0; i <= 40; ++i)
+    for (int k = 0; k <= 60; ++k) ground.push_back({-1 + 0.05 * i, 0.125, 0.05 * k}, {0, 1, 0});
+  const char* const biped = R"({"format": "footfall-character", "version": 1, "name": "biped",
+    "feet": [{"name": "L", "rest": [0.12, 0, 0]}, {"name": "R", "rest": [-0.12, 0, 0]}],
+    "gait": [["L"], ["R"]], "pairs": [["L", "R"]], "step_length": 0.7, "step_height": 0.15,
+    "body_height": 0.95, "frames_per_step": 12, "align_to_normal": false,
+    "slope_threshold_deg": 15, "slope_step_scale": 0.6, "max_slope_deg": 45, "max_rise": 0.4,
+    "reach": 1.2, "max_turn_deg": 30})";
+  Character character;
+  std::string error;
+  if (ParseCharacter(biped, "biped", &character, &error) != Status::kOk) FAIL(error);
+  auto session = MakeEmbeddedSession(1);
+  TerrainHandle terrain = 0;
+  REQUIRE(session->LoadSamples(ground, "plateau", &terrain) == Status::kOk);
+  GenerateOptions options;
+  options.has_start = true;
+  options.start = {0, 0.125, 0.5};
+  options.steps = 12;
+  options.start_frame = 1000.5;
+  Walk walk;
+  REQUIRE(GenerateWalk(*session, terrain, character, options, &walk, &error) == Status::kOk);
+  return walk;
+}
+
 }  // namespace
+
+TEST_CASE("A walk's stop reason reads the same in a decimal-comma locale", "[export][locale]") {
+  const std::string comma = FindCommaLocale();
+  if (comma.empty()) {
+    FAIL(
+        "no decimal-comma locale is installed (tried de_DE.UTF-8, fr_FR.UTF-8 and others): "
+        "run scripts/install-deps.sh test, which generates de_DE.UTF-8");
+  }
+  const Walk in_c = CliffWalk();
+  REQUIRE_FALSE(in_c.stopped.empty());
+  INFO("stopped: " << in_c.stopped);
+  // Its position, with decimals.
+  CHECK_THAT(in_c.stopped, Catch::Contains("."));
+  Walk in_comma;
+  {
+    LocaleScope scope(comma);
+    std::ostringstream stream;
+    stream << 1.5 << ' ' << 1000;
+    REQUIRE(stream.str() == "1,5 1.000");
+    in_comma = CliffWalk();
+  }
+  CHECK(in_comma.stopped == in_c.stopped);
+  CHECK(in_comma.stops == in_c.stops);
+}
 
 TEST_CASE("Walk exports and point files are the same bytes in a decimal-comma locale",
           "[export][locale]") {

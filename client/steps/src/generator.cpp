@@ -13,8 +13,7 @@
 namespace footfall::steps_detail {
 
 std::string Point(const Vec3& p) {
-  std::ostringstream o;
-  o.precision(4);
+  Text o(4);
   o << std::fixed << "(" << p.x << ", " << p.y << ", " << p.z << ")";
   return o.str();
 }
@@ -23,8 +22,7 @@ std::string Point(const Vec3& p) {
 // it breaks: "leans 100.0001 deg, more than max_slope_deg 100", never "leans 100 ... 100".
 std::string Beyond(double value, double limit) {
   for (int digits = 3;; ++digits) {
-    std::ostringstream a, b;
-    a.precision(digits), b.precision(digits);
+    Text a(digits), b(digits);
     a << value, b << limit;
     if (a.str() != b.str() || digits >= 17) return a.str();
   }
@@ -167,8 +165,7 @@ Status Generator::Run(std::string* error) {
     for (Agent& a : agents_) {
       if (!a.walking || !a.stopped.empty() || a.path.empty()) continue;
       const double left = Remaining(a, a.path.size() - 1);
-      std::ostringstream why;
-      why.precision(4);
+      Text why(4);
       why << "the path's goal " << Point(a.path.back()) << " is still " << left << " away after "
           << steps_
           << " steps, the most a path walk takes without --steps (give --steps to walk farther)";
@@ -184,8 +181,7 @@ Status Generator::Run(std::string* error) {
       size_t next = a.waypoint;  // arrived with the last step?
       while (next < a.path.size() && Reached(a, next)) ++next;
       if (next == a.path.size()) continue;
-      std::ostringstream note;
-      note.precision(4);
+      Text note(4);
       if (!a.id.empty()) note << a.id << ": ";
       note << "the path's goal " << Point(a.path.back()) << " is still "
            << Remaining(a, a.path.size() - 1) << " away after the " << steps_
@@ -287,8 +283,7 @@ Status Generator::Step(int k, std::string* error) {
     if (agents_[i].walking && !Nearing(agents_[i], k)) {
       Agent& a = agents_[i];
       const Vec3& p = a.path[a.waypoint];
-      std::ostringstream why;
-      why.precision(4);
+      Text why(4);
       why << "no way to " << (a.waypoint + 1 == a.path.size() ? "the path's goal " : "waypoint ")
           << (a.waypoint + 1 == a.path.size() ? "" : std::to_string(a.waypoint + 1) + " ")
           << Point(p) << ": the body has come no nearer to it than " << a.nearest << " for "
@@ -343,7 +338,7 @@ Status Generator::Step(int k, std::string* error) {
 
 void Generator::Stop(Agent& a, int step, const std::string& why) {
   a.walking = false;
-  std::ostringstream m;
+  Text m;
   m << "step " << step;
   if (!a.id.empty()) m << " of " << a.id;
   m << ": " << why << "; walk stopped, keys up to step " << step - 1 << " kept";
@@ -408,7 +403,7 @@ Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Charac
   }
   if (!IsFinite(options.start) || !(std::fabs(options.start_frame) <= kMaxStartFrame) ||
       !(options.fps > 0) || !(options.fps <= kMaxFps)) {
-    std::ostringstream m;
+    Text m;
     m << "start must be finite, the start frame within +-" << kMaxStartFrame
       << " and fps above 0 and at most " << kMaxFps;
     *error = m.str();
@@ -420,7 +415,7 @@ Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Charac
   for (size_t i = 0; i < options.path.size(); ++i) {
     const Vec3& p = options.path[i];
     if (!IsFinite(p) || std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) > kMaxWaypoint) {
-      std::ostringstream m;
+      Text m;
       m << "path waypoint " << i + 1 << " (" << p.x << ", " << p.y << ", " << p.z
         << ") is not a finite point with each coordinate within +-" << kMaxWaypoint
         << " (the reach of terrain queries)";

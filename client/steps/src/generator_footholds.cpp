@@ -310,8 +310,7 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
     return;
   }
   if (!KeepsReason(mv, !found)) return;  // mv already has a better reason
-  std::ostringstream why;                // refused: say why (only built on this rare path)
-  why.precision(3);
+  Text why(3);                           // refused: say why (only built on this rare path)
   if (!found) {
     // Past the terrain's bounds by more than the radius, no sample can be a foothold.
     const double radius = kFootholdTolerance * c_.step_length;
@@ -404,8 +403,7 @@ void Generator::CheckReach(size_t m, size_t e) {
   for (size_t i = m; i < e; ++i) {
     const double dist = Distance(moves[i].end, body);
     if (dist > c_.reach) {
-      std::ostringstream why;
-      why.precision(3);
+      Text why(3);
       why << "the foothold at " << Point(moves[i].end) << " is " << Beyond(dist, c_.reach)
           << " from the body, beyond reach " << NumberText(c_.reach);
       moves[i].done = false;
@@ -416,8 +414,7 @@ void Generator::CheckReach(size_t m, size_t e) {
   for (size_t f = 0; f < feet; ++f) {
     const double dist = Distance(a.foot[f], body);
     if (slot[f] >= 0 || dist <= c_.reach) continue;
-    std::ostringstream why;
-    why.precision(3);
+    Text why(3);
     why << "the step would leave foot " << c_.feet[f].name << " " << Beyond(dist, c_.reach)
         << " from the body, beyond reach " << NumberText(c_.reach);
     for (size_t i = m; i < e; ++i) {

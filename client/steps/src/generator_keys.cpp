@@ -124,8 +124,7 @@ Status Generator::ClearArcs(int k, std::string* error) {
           if (round + 1 >= kMaxRaises) {
             // The foot asks for another foothold (its next try), or gives up after the last.
             if (KeepsReason(mv, false)) {
-              std::ostringstream why;
-              why.precision(3);
+              Text why(3);
               why << "the swing arc to " << Point(mv.end)
                   << " cannot clear the terrain (mid key raised " << kMaxRaises * kRaise
                   << " step heights)";
@@ -190,8 +189,7 @@ void Generator::Finish(size_t w, int k) {
   a.window_left |= !near_window_from;
   if (a.window_step < 0 || k - a.window_step >= window_steps_) {
     if (a.window_step >= 0 && near_window_from && !a.window_left) {
-      std::ostringstream why;
-      why.precision(4);
+      Text why(4);
       why << "no way forward from " << Point(a.ground) << ": the body has stayed within half a "
           << "step of it for " << window_steps_ << " steps (a dead end)";
       Stop(a, k + 1, why.str());
@@ -408,7 +406,7 @@ Status Generator::KeyBodies(std::string* error) {
       KeyBody(a, frame, body_raise_[i]);
       continue;
     }
-    std::ostringstream why;
+    Text why;
     why << "no room for the body at " << Point(body_points_[spine_first_[i + 1] - 1])
         << ": the terrain at " << Point(crossing->point)
         << " lies between it and its feet (an overhang or a ceiling lower than body_height)";

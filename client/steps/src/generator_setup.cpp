@@ -86,7 +86,7 @@ Status Generator::Setup(std::string* error) {
     const double min_sin = std::sin(Radians(kMinDegreesFromUp));
     const Vec3 up = c_.align_to_normal ? answers_[0].normal : world_up_;
     if (Length2(ProjectOnPlane(o_.heading, up)) <= min_sin * min_sin * Length2(o_.heading)) {
-      std::ostringstream m;
+      Text m;
       m << "the heading " << Point(o_.heading) << " is along the up " << Point(up)
         << " where the character starts (within " << kMinDegreesFromUp
         << " deg of it): it gives no clear direction on the ground; give a heading along the "
@@ -134,8 +134,7 @@ Status Generator::Setup(std::string* error) {
       Stop(a, 1, fault);
     } else if (crowded[i] >= 0) {
       const Agent& other = agents_[crowded[i]];
-      std::ostringstream m;
-      m.precision(3);
+      Text m(3);
       m << "step 1 of " << a.id << ": its place on the crowd's grid, "
         << Point(first.point + offsets[i]) << ", snaps to " << Point(snapped_start[i])
         << ", within " << Distance(snapped_start[i], snapped_start[crowded[i]]) << " of "
@@ -158,7 +157,7 @@ Status Generator::Setup(std::string* error) {
   for (int i = 0; i < n; ++i) {
     Agent& a = agents_[i];
     if (stacked[i] < 0 || a.left_out) continue;
-    std::ostringstream m;
+    Text m;
     m << "step 1 of " << a.id << ": its feet, around " << Point(a.ground) << ", stand where "
       << agents_[stacked[i]].id
       << "'s do (the grid runs off the terrain there): left out of the walk";
@@ -418,8 +417,7 @@ std::string Generator::Plant(Agent& a, const Foothold* feet) const {
   for (size_t f = 0; f < n; ++f) {
     const double slope = Degrees(AngleBetween(a.foot_normal[f], a.up));
     if (slope > c_.max_slope_deg) {
-      std::ostringstream m;
-      m.precision(3);
+      Text m(3);
       m << "foot " << c_.feet[f].name << " cannot stand at " << Point(a.foot[f])
         << ": ground leans " << Beyond(slope, c_.max_slope_deg) << " deg, more than max_slope_deg "
         << NumberText(c_.max_slope_deg) << FacingDownHint(slope);
