@@ -79,7 +79,11 @@ int32_t ffc_unload(ffc_session* s, uint32_t terrain);
 int32_t ffc_info(ffc_session* s, uint32_t terrain, uint64_t* samples, double bounds[6]);
 
 /* Batch queries: points are 3 doubles each; steps are 6 doubles each (foot xyz, direction xyz).
- * out[i] answers item i. tolerance <= 0: the candidate radius is the step length. */
+ * out[i] answers item i. tolerance <= 0: the candidate radius is the step length.
+ * A call that returns FF_C_OK answers every item: out[i].status is FF_C_OK, FF_C_NO_FOOTHOLD,
+ * or FF_C_INVALID_ARGUMENT for a non-finite point, foot or direction or a zero direction
+ * (ffc_last_error is not set for an item). A NaN or infinite tolerance fails the whole call
+ * with FF_C_INVALID_ARGUMENT. count 0 is allowed, with NULL arrays. */
 int32_t ffc_snap(ffc_session* s, uint32_t terrain, const double* points, size_t count,
                  ffc_foothold* out);
 int32_t ffc_normal(ffc_session* s, uint32_t terrain, const double* points, size_t count,
