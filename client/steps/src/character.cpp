@@ -1,14 +1,11 @@
 #include "footfall/steps/character.h"
 
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <set>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
-#include "footfall/terrain/input_file.h"
 #include "footfall/terrain/shown_text.h"
 #include "json_input.h"
 
@@ -289,16 +286,10 @@ Vec3 RestCentroid(const Character& c) {
 }
 
 Status LoadCharacter(const std::string& path, Character* out, std::string* error) {
-  const Status status = CheckInputFile(path, "character file", error);
+  std::string text;
+  const Status status = detail::ReadJsonFile(path, "character file", &text, error);
   if (status != Status::kOk) return status;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    *error = path + ": cannot open character file";
-    return Status::kIoError;
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
-  return ParseCharacter(text.str(), path, out, error);
+  return ParseCharacter(text, path, out, error);
 }
 
 }  // namespace footfall

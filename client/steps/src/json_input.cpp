@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
 #include <set>
+#include <sstream>
 #include <vector>
 
+#include "footfall/terrain/input_file.h"
 #include "footfall/terrain/shown_text.h"
 
 namespace footfall::detail {
@@ -176,6 +179,21 @@ std::string UnknownFieldMessage(const std::string& key, const std::set<std::stri
   std::string list;
   for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
   return "unknown field '" + ShownText(key) + "' (known fields: " + list + ")";
+}
+
+Status ReadJsonFile(const std::string& path, const char* what, std::string* text,
+                    std::string* error) {
+  const Status status = CheckInputFile(path, what, error);
+  if (status != Status::kOk) return status;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    *error = path + ": cannot open " + what;
+    return Status::kIoError;
+  }
+  std::ostringstream whole;
+  whole << in.rdbuf();
+  *text = whole.str();
+  return Status::kOk;
 }
 
 }  // namespace footfall::detail

@@ -9,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "footfall/terrain/status.h"
+
 namespace footfall::detail {
 
 // Parses `text` (a leading UTF-8 byte order mark is skipped) into *out. On malformed JSON returns
@@ -18,6 +20,11 @@ namespace footfall::detail {
 // max_depth > 0) nesting deeper than max_depth.
 bool ParseJsonText(const std::string& text, const std::string& source, nlohmann::json* out,
                    std::string* error, int max_depth = 0);
+
+// Reads the whole of the file at `path` into *text, after CheckInputFile (a regular file);
+// `what` names it in errors ("character file": "PATH: cannot open character file").
+Status ReadJsonFile(const std::string& path, const char* what, std::string* text,
+                    std::string* error);
 
 // When `name` holds a control character (a byte below 0x20, or 0x7f: NUL, newline, escape...),
 // which no exporter or DCC can keep in a name: "a name without control characters (byte 0xNN

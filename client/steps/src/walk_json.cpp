@@ -3,13 +3,10 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "footfall/terrain/input_file.h"
 #include "footfall/terrain/output_file.h"
 #include "json_input.h"
 
@@ -295,16 +292,10 @@ Status ParseWalkJson(const std::string& text, const std::string& source, Walk* o
 }
 
 Status ReadWalkJson(const std::string& path, Walk* out, std::string* error) {
-  const Status status = CheckInputFile(path, "walk file", error);
+  std::string text;
+  const Status status = detail::ReadJsonFile(path, "walk file", &text, error);
   if (status != Status::kOk) return status;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    *error = path + ": cannot open walk file";
-    return Status::kIoError;
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
-  return ParseWalkJson(text.str(), path, out, error);
+  return ParseWalkJson(text, path, out, error);
 }
 
 }  // namespace footfall
