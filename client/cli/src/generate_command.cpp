@@ -149,250 +149,294 @@ Status WriteWalkTerrain(const TerrainFlags& flags, const RawSamples* resampled,
   return WritePointFile(out, samples, error);
 }
 
-int RunGenerate(const GenerateFlags& flags) {
-  std::string error;
-  GenerateOptions options;
-  // Flags first, so a typo fails before the terrain loads.
+// Reads the flags that shape the walk into *options; false with a message naming the flag.
+bool ReadOptions(const GenerateFlags& flags, GenerateOptions* options, std::string* error) {
   if (!flags.start.empty()) {
-    if (!ParseVec(flags.start, "--start", &options.start, &error)) goto bad_flag;
-    options.has_start = true;
+    if (!ParseVec(flags.start, "--start", &options->start, error)) return false;
+    options->has_start = true;
   }
-  if (!flags.heading.empty() && !ParseVec(flags.heading, "--heading", &options.heading, &error))
-    goto bad_flag;
-  if (!flags.up.empty() && !ParseVec(flags.up, "--up", &options.up, &error)) goto bad_flag;
-  {
-    std::istringstream in(flags.path);
-    for (std::string point; in >> point;) {
-      Vec3 p;
-      if (!ParseVec(point, "--path", &p, &error)) goto bad_flag;
-      options.path.push_back(p);
-    }
+  if (!flags.heading.empty() && !ParseVec(flags.heading, "--heading", &options->heading, error))
+    return false;
+  if (!flags.up.empty() && !ParseVec(flags.up, "--up", &options->up, error)) return false;
+  std::istringstream in(flags.path);
+  for (std::string point; in >> point;) {
+    Vec3 p;
+    if (!ParseVec(point, "--path", &p, error)) return false;
+    options->path.push_back(p);
   }
+  options->steps = flags.steps;
+  options->start_frame = flags.start_frame;
+  options->fps = flags.fps;
+  options->crowd = flags.crowd;
+  options->crowd_spacing = flags.crowd_spacing;
+  options->threads = flags.threads;
+  return true;
+}
+
+// Checks every --out before anything is generated: its extension, that it can be written, and
+// that it is neither another output nor an input. False with a message naming the output.
+bool CheckOutputs(const GenerateFlags& flags, std::string* error) {
   for (const std::string& out : flags.out) {
     const std::string ext = FileExtension(out);
     if (ext != "json" && ext != "gltf" && ext != "glb" && ext != "mel" &&
         !IsPointFileExtension(ext)) {
-      error = "--out " + out +
-              ": unsupported output extension (expected .json, .gltf, .glb, .mel, or .pts for "
-              "the terrain's samples)";
-      goto bad_flag;
+      *error = "--out " + out +
+               ": unsupported output extension (expected .json, .gltf, .glb, .mel, or .pts for "
+               "the terrain's samples)";
+      return false;
     }
     // The samples of a --server-terrain are footfalld's: this side never has them.
     if (IsPointFileExtension(ext) && !flags.terrain.server_terrain.empty()) {
-      error = "--out " + out +
-              ": the terrain is read by footfalld (--server-terrain), so its samples are not "
-              "here to write; give the file with --terrain, or convert it with footfall "
-              "terrain convert";
-      goto bad_flag;
+      *error = "--out " + out +
+               ": the terrain is read by footfalld (--server-terrain), so its samples are not "
+               "here to write; give the file with --terrain, or convert it with footfall "
+               "terrain convert";
+      return false;
     }
     // Refused before anything is generated or written (glTF times are >= 0).
     if ((ext == "gltf" || ext == "glb") && flags.start_frame < 0) {
       std::ostringstream m;
       m << "--out " << out << ": glTF animation times must be >= 0, and --start-frame is "
         << flags.start_frame << "; start at frame 0 or later, or write .json or .mel only";
-      error = m.str();
-      goto bad_flag;
+      *error = m.str();
+      return false;
     }
     // Two outputs naming one file (the same path, or links to one file) would overwrite each
     // other: the last written would win, silently.
     for (const std::string& other : flags.out) {
       if (&other == &out) break;
       if (SameFile(out, other)) {
-        error = "--out " + other + " and --out " + out +
-                " are the same file; give each output its own file";
-        goto bad_flag;
+        *error = "--out " + other + " and --out " + out +
+                 " are the same file; give each output its own file";
+        return false;
       }
     }
     // An output that cannot be written is said now, not after a long walk.
     std::string unwritable;
     if (CheckWritable(out, &unwritable) != Status::kOk) {
-      error = "--out " + out + ": " + unwritable;
-      goto bad_flag;
+      *error = "--out " + out + ": " + unwritable;
+      return false;
     }
     // Never write over what the walk is made from.
     for (const std::string* input : {&flags.character, &flags.terrain.terrain}) {
       if (!input->empty() && SameFile(out, *input)) {
-        error = "--out " + out + " is the " +
-                (input == &flags.character ? "character" : "terrain") +
-                " file this walk reads; choose another output name";
-        goto bad_flag;
+        *error = "--out " + out + " is the " +
+                 (input == &flags.character ? "character" : "terrain") +
+                 " file this walk reads; choose another output name";
+        return false;
       }
     }
   }
-  options.steps = flags.steps;
-  options.start_frame = flags.start_frame;
-  options.fps = flags.fps;
-  options.crowd = flags.crowd;
-  options.crowd_spacing = flags.crowd_spacing;
-  options.threads = flags.threads;
-  {
-    Character character;
-    if (LoadCharacter(flags.character, &character, &error) != Status::kOk) goto bad_flag;
-    std::unique_ptr<TerrainSession> session;
-    TerrainHandle terrain = 0;
-    TerrainFlags terrain_flags = flags.terrain;
-    terrain_flags.threads = flags.threads;
-    WalkTerrain prepared;
-    const bool resample = ResamplesForCharacter(terrain_flags);
-    if (resample) {
-      if (PrepareWalkTerrain(terrain_flags.terrain, terrain_flags.load, character, options,
-                             &prepared, &error) != Status::kOk)
-        goto bad_flag;
-      ReportResampling(terrain_flags.terrain, character, prepared);
-      // The default start, found on the surface before cropping (a --start is snapped as
-      // given); it may still move to where the character can stand, within the crop.
-      if (!options.has_start) {
-        options.start = prepared.start, options.has_start = true;
-        options.start_may_move = true;
+  return true;
+}
+
+// The terrain a walk is generated on, loaded in its session.
+struct LoadedTerrain {
+  TerrainFlags flags;  // the command's, with its thread count
+  std::unique_ptr<TerrainSession> session;
+  TerrainHandle handle = 0;
+  bool resampled = false;  // resampled here for the character: `prepared` holds it
+  WalkTerrain prepared;
+};
+
+// Opens the session and loads the terrain for `character`: a mesh or height map without
+// --separation resampled here for it (and, without --start, the start found on its surface),
+// else the file as the flags say (footfalld resampling a --server-terrain as fine as the
+// character needs). On failure returns false with a message.
+bool LoadWalkTerrain(const GenerateFlags& flags, const Character& character,
+                     GenerateOptions* options, LoadedTerrain* t, std::string* error) {
+  t->flags = flags.terrain;
+  t->flags.threads = flags.threads;
+  TerrainFlags& terrain_flags = t->flags;
+  t->resampled = ResamplesForCharacter(terrain_flags);
+  if (t->resampled) {
+    if (PrepareWalkTerrain(terrain_flags.terrain, terrain_flags.load, character, *options,
+                           &t->prepared, error) != Status::kOk)
+      return false;
+    ReportResampling(terrain_flags.terrain, character, t->prepared);
+    // The default start, found on the surface before cropping (a --start is snapped as given);
+    // it may still move to where the character can stand, within the crop.
+    if (!options->has_start) {
+      options->start = t->prepared.start, options->has_start = true;
+      options->start_may_move = true;
+    }
+    if (OpenSession(terrain_flags, &t->session, error) != Status::kOk) return false;
+    if (t->session->LoadSamples(t->prepared.samples, terrain_flags.terrain, &t->handle) !=
+        Status::kOk) {
+      *error = t->session->last_error();
+      return false;
+    }
+    return true;
+  }
+  // A file footfalld reads: the whole of it, as fine as the character needs within the samples
+  // a walk's terrain may have (and the server's budget), when no separation is given.
+  if (!terrain_flags.server_terrain.empty() && !(terrain_flags.load.separation > 0)) {
+    terrain_flags.load.finest_default = kSeparationPerStep * character.step_length;
+    terrain_flags.load.max_samples = std::min(terrain_flags.load.max_samples, kMaxWalkSamples);
+  }
+  if (OpenTerrain(terrain_flags, &t->session, &t->handle, error) != Status::kOk) return false;
+  // footfalld resampled a mesh or height map itself: say with how many samples, as a local
+  // file's resampling is reported.
+  TerrainInfo info;
+  if (!terrain_flags.server_terrain.empty() &&
+      !IsPointFileExtension(FileExtension(terrain_flags.server_terrain)) &&
+      t->session->Info(t->handle, &info) == Status::kOk) {
+    std::cerr << "footfall generate: footfalld resampled " << terrain_flags.server_terrain << ": "
+              << info.stats.samples << " samples"
+              << (terrain_flags.load.separation > 0
+                      ? std::string(" at --separation ") + NumberText(terrain_flags.load.separation)
+                      : std::string(" as fine as a quarter of the step within 2,000,000 and what "
+                                    "is left of its --max-samples budget"))
+              << "\n";
+  }
+  return true;
+}
+
+// What running out of memory while generating says: about how many keys the walk needed.
+std::string OutOfMemoryMessage(const GenerateFlags& flags, const GenerateOptions& options,
+                               const Character& character) {
+  // Per character and step: start, mid and end keys of a group's feet, and a body key.
+  const double steps = flags.steps < 0 ? kMaxPathSteps : flags.steps;
+  const double keys = static_cast<double>(flags.crowd) * steps *
+                      (3.0 * static_cast<double>(character.feet.size()) /
+                           static_cast<double>(character.gait.size()) +
+                       1);
+  std::ostringstream m;
+  m.precision(3);
+  const bool capped = flags.steps < 0 && !options.path.empty();
+  m << "out of memory generating " << flags.crowd
+    << (flags.crowd == 1 ? " character" : " characters") << " x " << (capped ? "up to " : "")
+    << steps << " steps: " << (capped ? "up to " : "") << "about " << keys << " keys, "
+    << keys * 68 / 1e9 << " GB; nothing was written (give fewer --crowd or --steps)";
+  return m.str();
+}
+
+// Writes every --out, each on its own: one that fails is said (and an older file of its name
+// said to be left as it was) and the others are still written. Returns 1 if any failed, else 0.
+int WriteOutputs(const GenerateFlags& flags, const LoadedTerrain& terrain, const Walk& walk) {
+  int code = 0;
+  std::string error;
+  for (const std::string& out : flags.out) {
+    const std::string ext = FileExtension(out);
+    if (ext == "gltf" || ext == "glb") {
+      // Keys are stored relative to the walk's origin (GltfOrigin): only a walk spanning
+      // kilometres moves visibly.
+      const double rounding = MaxFloatRounding(walk);
+      if (rounding > 1e-4) {
+        std::cerr << "footfall generate: warning: " << out
+                  << ": glTF stores positions as floats, and at these coordinates keys move by "
+                     "up to "
+                  << rounding << " (JSON and MEL keep full precision)\n";
       }
-      if (OpenSession(terrain_flags, &session, &error) != Status::kOk) goto bad_flag;
-      if (session->LoadSamples(prepared.samples, terrain_flags.terrain, &terrain) != Status::kOk) {
-        error = session->last_error();
-        goto bad_flag;
-      }
-    } else {
-      // A file footfalld reads: the whole of it, as fine as the character needs within the
-      // samples a walk's terrain may have (and the server's budget), when no separation is given.
-      if (!terrain_flags.server_terrain.empty() && !(terrain_flags.load.separation > 0)) {
-        terrain_flags.load.finest_default = kSeparationPerStep * character.step_length;
-        terrain_flags.load.max_samples = std::min(terrain_flags.load.max_samples, kMaxWalkSamples);
-      }
-      if (OpenTerrain(terrain_flags, &session, &terrain, &error) != Status::kOk) goto bad_flag;
-      // footfalld resampled a mesh or height map itself: say with how many samples, as a local
-      // file's resampling is reported.
-      TerrainInfo info;
-      if (!terrain_flags.server_terrain.empty() &&
-          !IsPointFileExtension(FileExtension(terrain_flags.server_terrain)) &&
-          session->Info(terrain, &info) == Status::kOk) {
-        std::cerr << "footfall generate: footfalld resampled " << terrain_flags.server_terrain
-                  << ": " << info.stats.samples << " samples"
-                  << (terrain_flags.load.separation > 0
-                          ? std::string(" at --separation ") +
-                                NumberText(terrain_flags.load.separation)
-                          : std::string(" as fine as a quarter of the step within 2,000,000 and "
-                                        "what is left of its --max-samples budget"))
-                  << "\n";
+      const double late = MaxTimeRounding(walk);
+      if (late > 0.01) {
+        std::cerr << "footfall generate: warning: " << out
+                  << ": glTF stores times as float seconds, and at these frames keys move by up "
+                     "to "
+                  << late << " frames (JSON and MEL keep the frames exact)\n";
       }
     }
-    ProgressBar bar;
-    const bool long_run =
-        static_cast<long long>(flags.crowd) * (flags.steps < 0 ? 8 : flags.steps) >= 20000;
-    if (flags.progress || (long_run && isatty(STDERR_FILENO)))
-      options.progress = [&bar](int done, int total) { bar.Update(done, total); };
-    Walk walk;
-    Status status;
+    Status written;
     try {
-      status = GenerateWalk(*session, terrain, character, options, &walk, &error);
+      written = IsPointFileExtension(ext)
+                    ? WriteWalkTerrain(terrain.flags,
+                                       terrain.resampled ? &terrain.prepared.samples : nullptr, out,
+                                       &error)
+                    : WriteOutput(walk, out, &error);
     } catch (const std::bad_alloc&) {
-      bar.Finish();
-      // Per character and step: start, mid and end keys of a group's feet, and a body key.
-      const double steps = flags.steps < 0 ? kMaxPathSteps : flags.steps;
-      const double keys = static_cast<double>(flags.crowd) * steps *
-                          (3.0 * static_cast<double>(character.feet.size()) /
-                               static_cast<double>(character.gait.size()) +
-                           1);
-      std::ostringstream m;
-      m.precision(3);
-      const bool capped = flags.steps < 0 && !options.path.empty();
-      m << "out of memory generating " << flags.crowd
-        << (flags.crowd == 1 ? " character" : " characters") << " x " << (capped ? "up to " : "")
-        << steps << " steps: " << (capped ? "up to " : "") << "about " << keys << " keys, "
-        << keys * 68 / 1e9 << " GB; nothing was written (give fewer --crowd or --steps)";
-      std::cerr << "footfall generate: " << m.str() << '\n';
-      return 1;
+      error =
+          "out of memory writing it (the outputs before it are written; the walk JSON "
+          "takes least)";
+      written = Status::kLimitExceeded;
     }
-    bar.Finish();
-    if (status != Status::kOk) {
-      std::cerr << "footfall generate: " << error << '\n';
-      return 1;
+    if (written != Status::kOk) {
+      // Named by its output (the other outputs are still written).
+      const bool named = error.compare(0, out.size(), out) == 0;
+      std::cerr << "footfall generate: " << (named ? "" : "--out " + out + ": ") << error << '\n';
+      // A file of that name from before stays as it was: say so, as it no longer matches the
+      // other outputs.
+      struct stat st;
+      if (::stat(out.c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
+        std::cerr << "footfall generate: " << out
+                  << " is left as it was, from before this walk (it does not match the other "
+                     "outputs)\n";
+      }
+      code = 1;
     }
-    if (!options.path.empty() && options.steps != 0 && walk.stopped.empty() &&
-        !walk.tracks.empty() &&
-        std::all_of(walk.tracks.begin(), walk.tracks.end(),
-                    [](const WalkTrack& t) { return t.keys.size() <= 1; })) {
-      std::cerr << "footfall generate: note: no steps: the path's goal is already reached where "
-                   "the character starts (a waypoint counts as reached within half a step along "
-                   "the ground, whatever its height above it)\n";
-    }
-    int code = 0;
-    for (const std::string& out : flags.out) {
-      const std::string ext = FileExtension(out);
-      if (ext == "gltf" || ext == "glb") {
-        // Keys are stored relative to the walk's origin (GltfOrigin): only a walk spanning
-        // kilometres moves visibly.
-        const double rounding = MaxFloatRounding(walk);
-        if (rounding > 1e-4) {
-          std::cerr << "footfall generate: warning: " << out
-                    << ": glTF stores positions as floats, and at these coordinates keys move by "
-                       "up to "
-                    << rounding << " (JSON and MEL keep full precision)\n";
-        }
-        const double late = MaxTimeRounding(walk);
-        if (late > 0.01) {
-          std::cerr << "footfall generate: warning: " << out
-                    << ": glTF stores times as float seconds, and at these frames keys move by up "
-                       "to "
-                    << late << " frames (JSON and MEL keep the frames exact)\n";
-        }
-      }
-      Status written;
-      try {
-        written = IsPointFileExtension(ext)
-                      ? WriteWalkTerrain(terrain_flags, resample ? &prepared.samples : nullptr, out,
-                                         &error)
-                      : WriteOutput(walk, out, &error);
-      } catch (const std::bad_alloc&) {
-        error =
-            "out of memory writing it (the outputs before it are written; the walk JSON "
-            "takes least)";
-        written = Status::kLimitExceeded;
-      }
-      if (written != Status::kOk) {
-        // Named by its output (the other outputs are still written).
-        const bool named = error.compare(0, out.size(), out) == 0;
-        std::cerr << "footfall generate: " << (named ? "" : "--out " + out + ": ") << error << '\n';
-        // A file of that name from before stays as it was: say so, as it no longer matches the
-        // other outputs.
-        struct stat st;
-        if (::stat(out.c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
-          std::cerr << "footfall generate: " << out
-                    << " is left as it was, from before this walk (it does not match the other "
-                       "outputs)\n";
-        }
-        code = 1;
-      }
-    }
-    // A path walk whose --steps ended short of its goal: not a stop, but said (up to a
-    // screenful).
-    constexpr size_t kMaxNotes = 20;
-    for (size_t i = 0; i < walk.notes.size() && i < kMaxNotes; ++i)
-      std::cerr << "footfall generate: note: " << walk.notes[i] << '\n';
-    if (walk.notes.size() > kMaxNotes)
-      std::cerr << "footfall generate: note: ... and " << walk.notes.size() - kMaxNotes
-                << " more characters short of their goals\n";
-    if (!walk.stopped.empty()) {
-      std::cerr << "footfall generate: stopped early: " << walk.stopped << '\n';
-      // A crowd: every character's reason, up to a screenful.
-      constexpr size_t kMaxListed = 20;
-      if (walk.stops.size() > 1) {
-        for (size_t i = 0; i < walk.stops.size() && i < kMaxListed; ++i)
-          std::cerr << "  " << walk.stops[i] << '\n';
-        if (walk.stops.size() > kMaxListed)
-          std::cerr << "  ... and " << walk.stops.size() - kMaxListed << " more\n";
-      }
-      if (resample && prepared.cropped && !prepared.region_is_bound) {
-        std::cerr << "footfall generate: the terrain was resampled only within "
-                  << Box(prepared.region_min, prepared.region_max)
-                  << ", around the path; a stop at its edge is that edge: give --steps or "
-                     "--separation\n";
-      }
-      return code != 0 ? code : 2;  // an output not written is an error before a stop
-    }
-    return code;
   }
-bad_flag:
-  std::cerr << "footfall generate: " << error << '\n';
-  return 1;
+  return code;
+}
+
+// Says on stderr what is worth knowing of a finished walk: path walks short of their goals, and
+// why the walk stopped early (every character's reason, up to a screenful). True if it stopped.
+bool ReportWalkEnd(const Walk& walk, const LoadedTerrain& terrain) {
+  constexpr size_t kMaxNotes = 20;
+  for (size_t i = 0; i < walk.notes.size() && i < kMaxNotes; ++i)
+    std::cerr << "footfall generate: note: " << walk.notes[i] << '\n';
+  if (walk.notes.size() > kMaxNotes)
+    std::cerr << "footfall generate: note: ... and " << walk.notes.size() - kMaxNotes
+              << " more characters short of their goals\n";
+  if (walk.stopped.empty()) return false;
+  std::cerr << "footfall generate: stopped early: " << walk.stopped << '\n';
+  constexpr size_t kMaxListed = 20;
+  if (walk.stops.size() > 1) {
+    for (size_t i = 0; i < walk.stops.size() && i < kMaxListed; ++i)
+      std::cerr << "  " << walk.stops[i] << '\n';
+    if (walk.stops.size() > kMaxListed)
+      std::cerr << "  ... and " << walk.stops.size() - kMaxListed << " more\n";
+  }
+  const WalkTerrain& prepared = terrain.prepared;
+  if (terrain.resampled && prepared.cropped && !prepared.region_is_bound) {
+    std::cerr << "footfall generate: the terrain was resampled only within "
+              << Box(prepared.region_min, prepared.region_max)
+              << ", around the path; a stop at its edge is that edge: give --steps or "
+                 "--separation\n";
+  }
+  return true;
+}
+
+int RunGenerate(const GenerateFlags& flags) {
+  std::string error;
+  GenerateOptions options;
+  Character character;
+  LoadedTerrain terrain;
+  // Flags first, so a typo fails before the terrain loads.
+  if (!ReadOptions(flags, &options, &error) || !CheckOutputs(flags, &error) ||
+      LoadCharacter(flags.character, &character, &error) != Status::kOk ||
+      !LoadWalkTerrain(flags, character, &options, &terrain, &error)) {
+    std::cerr << "footfall generate: " << error << '\n';
+    return 1;
+  }
+  ProgressBar bar;
+  const bool long_run =
+      static_cast<long long>(flags.crowd) * (flags.steps < 0 ? 8 : flags.steps) >= 20000;
+  if (flags.progress || (long_run && isatty(STDERR_FILENO)))
+    options.progress = [&bar](int done, int total) { bar.Update(done, total); };
+  Walk walk;
+  Status status;
+  try {
+    status = GenerateWalk(*terrain.session, terrain.handle, character, options, &walk, &error);
+  } catch (const std::bad_alloc&) {
+    bar.Finish();
+    std::cerr << "footfall generate: " << OutOfMemoryMessage(flags, options, character) << '\n';
+    return 1;
+  }
+  bar.Finish();
+  if (status != Status::kOk) {
+    std::cerr << "footfall generate: " << error << '\n';
+    return 1;
+  }
+  if (!options.path.empty() && options.steps != 0 && walk.stopped.empty() && !walk.tracks.empty() &&
+      std::all_of(walk.tracks.begin(), walk.tracks.end(),
+                  [](const WalkTrack& t) { return t.keys.size() <= 1; })) {
+    std::cerr << "footfall generate: note: no steps: the path's goal is already reached where "
+                 "the character starts (a waypoint counts as reached within half a step along "
+                 "the ground, whatever its height above it)\n";
+  }
+  const int code = WriteOutputs(flags, terrain, walk);
+  const bool stopped = ReportWalkEnd(walk, terrain);
+  // An output not written is an error before a stop.
+  return code != 0 ? code : stopped ? 2 : 0;
 }
 
 }  // namespace
