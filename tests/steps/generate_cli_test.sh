@@ -55,6 +55,76 @@ both big-crowd 0 --terrain "$work/floor.pts" --character "$chars/hexapod.json" -
 check "big crowd: 1100 characters" [ "$(grep -o '"name":"body","character":"c[0-9]*"' "$work/big-crowd-embedded.json" | wc -l)" -eq 1100 ]
 check "big crowd: progress bar reaches 100%" grep -q '100%' "$work/big-crowd-embedded.err"
 
+# Scene files: several characters in one walk, each with its own character file (beside the
+# scene), start, path, steps, crowd and start frame; embedded and RPC identical, and each
+# character walks exactly as it would alone.
+mkdir -p "$work/scene"
+cp "$chars/biped.json" "$chars/hexapod.json" "$work/scene/"
+cat > "$work/scene/scene.json" <<JSON
+{"format": "footfall-scene", "version": 1,
+ "characters": [
+  {"name": "walker", "character_file": "biped.json", "start": [0.6, 0, 0.4], "path": [[0.6, 0, 2]]},
+  {"name": "bugs", "character_file": "hexapod.json", "start": [1.6, 0, 0.8], "steps": 8,
+   "crowd": 4, "crowd_spacing": 0.5},
+  {"character_file": "$chars/octopod.json", "start": [1.2, 0, 1.8], "heading": [1, 0, 0],
+   "steps": 6, "start_frame": 11}
+ ]}
+JSON
+both scene 0 --terrain "$work/floor.pts" --scene "$work/scene/scene.json"
+"$footfall" generate --terrain "$work/floor.pts" --character "$chars/biped.json" --start 0.6,0,0.4 \
+  --path 0.6,0,2 --out "$work/scene-walker-alone.json" 2> /dev/null
+"$footfall" generate --terrain "$work/floor.pts" --character "$chars/hexapod.json" --start 1.6,0,0.8 \
+  --steps 8 --crowd 4 --crowd-spacing 0.5 --out "$work/scene-bugs-alone.json" 2> /dev/null
+scene_check() {  # scene_check SCENE.json: each character's tracks are its walk alone
+  python3 - "$@" <<'PY'
+import json, sys
+scene = json.load(open(sys.argv[1]))
+walker = json.load(open(sys.argv[2]))
+bugs = json.load(open(sys.argv[3]))
+names = sorted({t.get("character") for t in scene["tracks"]})
+assert names == ["bugs/c1", "bugs/c2", "bugs/c3", "bugs/c4", "octopod3", "walker"], names
+def tracks(walk, character, prefix=""):
+    return [(t["name"], t["kind"], t["keys"]) for t in walk["tracks"]
+            if t.get("character", "") == character]
+assert tracks(scene, "walker") == tracks(walker, ""), "walker differs from the biped alone"
+for c in ("c1", "c2", "c3", "c4"):
+    assert tracks(scene, "bugs/" + c) == tracks(bugs, c), "bugs/" + c + " differs"
+octopod = [t for t in scene["tracks"] if t.get("character") == "octopod3"]
+assert len(octopod) == 9 and all(t["keys"][0]["frame"] == 11 for t in octopod), "octopod"
+PY
+}
+check "scene: every character walks as it would alone" scene_check "$work/scene-embedded.json" "$work/scene-walker-alone.json" "$work/scene-bugs-alone.json"
+"$footfall" generate --terrain "$work/floor.pts" --scene "$work/scene/scene.json" \
+  --out "$work/scene.mel" --out "$work/scene.gltf" --out "$work/scene.pts" 2> /dev/null
+check "scene: MEL, glTF and the terrain written" [ -s "$work/scene.mel" -a -s "$work/scene.gltf" -a -s "$work/scene.pts" ]
+check "scene: a MEL group per character" [ "$(grep -c '^$footfall_groups\[' "$work/scene.mel")" -eq 6 ]
+# A scene character walking off the cliff: exit 2, its stop named, every character's keys kept.
+cat > "$work/scene/cliff.json" <<JSON
+{"format": "footfall-scene", "version": 1,
+ "characters": [{"name": "safe", "character_file": "biped.json", "start": [2.5, 0, 1], "steps": 2},
+                {"name": "faller", "character_file": "biped.json", "start": [2.5, 0, 2], "steps": 100}]}
+JSON
+both scene-cliff 2 --terrain "$work/cliff.pts" --scene "$work/scene/cliff.json"
+check "scene cliff: the faller's stop named" grep -qE '"stopped":"faller: step [0-9]+: foot' "$work/scene-cliff-embedded.json"
+check "scene cliff: the other character's keys kept" grep -q '"character":"safe"' "$work/scene-cliff-embedded.json"
+# Bad uses: per-character flags with --scene, neither --scene nor --character, a resampled
+# mesh's samples (one per character), a bad scene file named with its character and field.
+"$footfall" generate --terrain "$work/floor.pts" --scene "$work/scene/scene.json" --start 1,0,1 \
+  --out "$work/bad.json" 2> "$work/bad.err"
+check "scene with --start: refused" [ $? -ne 0 -a ! -e "$work/bad.json" ]
+check "scene with --start: said" grep -q -- '--scene excludes --start' "$work/bad.err"
+"$footfall" generate --terrain "$work/floor.pts" --out "$work/bad.json" 2> "$work/bad.err"
+check "no --character or --scene: exit 1" [ $? -eq 1 -a ! -e "$work/bad.json" ]
+check "no --character or --scene: said" grep -q 'give --character FILE .* or --scene FILE' "$work/bad.err"
+printf 'v -3 0 -3\nv 3 0 -3\nv 3 0 3\nv -3 0 3\nf 1 4 3 2\n' > "$work/plane.obj"
+"$footfall" generate --terrain "$work/plane.obj" --scene "$work/scene/cliff.json" --out "$work/bad.pts" 2> "$work/bad.err"
+check "scene on a mesh with --out .pts: exit 1" [ $? -eq 1 -a ! -e "$work/bad.pts" ]
+check "scene on a mesh with --out .pts: said" grep -q 'resampled for each character; give --separation' "$work/bad.err"
+printf '{"format": "footfall-scene", "version": 1, "characters": [{"character_file": "biped.json", "fps": 30}]}' > "$work/scene/bad.json"
+"$footfall" generate --terrain "$work/floor.pts" --scene "$work/scene/bad.json" --out "$work/bad.json" 2> "$work/bad.err"
+check "bad scene file: exit 1" [ $? -eq 1 -a ! -e "$work/bad.json" ]
+check "bad scene file: the character and field named" grep -qF "$work/scene/bad.json: characters[0]: unknown field 'fps'" "$work/bad.err"
+
 # The default start moves to where the character can stand: the top centre of the bundled
 # blocks is on a pile's edge (a foot on a vertical face, which stopped them at step 1); the
 # biped and the quadruped start on a flat top nearby and walk on (until a 1 m block's face).

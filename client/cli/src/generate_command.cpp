@@ -21,6 +21,7 @@
 #include "footfall/export/walk_writer.h"
 #include "footfall/import/terrain_loader.h"
 #include "footfall/steps/generator.h"
+#include "footfall/steps/scene.h"
 #include "footfall/steps/walk_json.h"
 #include "footfall/steps/walk_terrain.h"
 #include "footfall/terrain/file_extension.h"
@@ -35,6 +36,7 @@ namespace {
 struct GenerateFlags {
   TerrainFlags terrain;
   std::string character;
+  std::string scene;
   std::string start, heading, path, up;
   int steps = -1;
   double start_frame = 1;
@@ -175,7 +177,8 @@ bool ReadOptions(const GenerateFlags& flags, GenerateOptions* options, std::stri
 
 // Checks every --out before anything is generated: its extension, that it can be written, and
 // that it is neither another output nor an input. False with a message naming the output.
-bool CheckOutputs(const GenerateFlags& flags, std::string* error) {
+bool CheckOutputs(const GenerateFlags& flags, const std::vector<std::string>& inputs,
+                  std::string* error) {
   for (const std::string& out : flags.out) {
     const std::string ext = FileExtension(out);
     if (ext != "json" && ext != "gltf" && ext != "glb" && ext != "mel" &&
@@ -218,10 +221,12 @@ bool CheckOutputs(const GenerateFlags& flags, std::string* error) {
       return false;
     }
     // Never write over what the walk is made from.
-    for (const std::string* input : {&flags.character, &flags.terrain.terrain}) {
-      if (!input->empty() && SameFile(out, *input)) {
+    for (const std::string& input : inputs) {
+      if (!input.empty() && SameFile(out, input)) {
         *error = "--out " + out + " is the " +
-                 (input == &flags.character ? "character" : "terrain") +
+                 (&input == &inputs.front() ? "terrain"
+                  : &input == &inputs[1]    ? (flags.scene.empty() ? "character" : "scene")
+                                            : "character") +
                  " file this walk reads; choose another output name";
         return false;
       }
@@ -395,13 +400,114 @@ bool ReportWalkEnd(const Walk& walk, const LoadedTerrain& terrain) {
   return true;
 }
 
+// `footfall generate --scene`: every character of the scene file walked in turn on the terrain
+// (loaded once, or resampled for each character that needs it), their walks written as one.
+int RunScene(const GenerateFlags& flags) {
+  std::string error;
+  GenerateOptions base;
+  std::vector<SceneCharacter> scene;
+  if (!ReadOptions(flags, &base, &error) || LoadScene(flags.scene, &scene, &error) != Status::kOk) {
+    std::cerr << "footfall generate: " << error << '\n';
+    return 1;
+  }
+  std::vector<std::string> inputs = {flags.terrain.terrain, flags.scene};
+  for (const SceneCharacter& c : scene) inputs.push_back(c.character_file);
+  const bool per_character = ResamplesForCharacter(flags.terrain);
+  for (const std::string& out : flags.out) {
+    const std::string ext = FileExtension(out);
+    if (IsPointFileExtension(ext) && per_character) {
+      error = "--out " + out +
+              ": with --scene, a mesh or height map is resampled for each character; give "
+              "--separation (or a point file) to write the terrain's samples";
+      break;
+    }
+    for (const SceneCharacter& c : scene) {
+      if ((ext == "gltf" || ext == "glb") && c.has_start_frame && c.options.start_frame < 0)
+        error = "--out " + out + ": glTF animation times must be >= 0, and " + c.name +
+                " starts at frame " + NumberText(c.options.start_frame) + "; write .json or .mel";
+    }
+  }
+  if (!error.empty() || !CheckOutputs(flags, inputs, &error)) {
+    std::cerr << "footfall generate: " << error << '\n';
+    return 1;
+  }
+  // A terrain read as it is (a point file, a --separation, footfalld's file) is loaded once, as
+  // fine as the character with the shortest step needs.
+  LoadedTerrain shared;
+  if (!per_character) {
+    const SceneCharacter* finest = &scene.front();
+    for (const SceneCharacter& c : scene)
+      if (c.character.step_length < finest->character.step_length) finest = &c;
+    GenerateOptions options = base;
+    if (!LoadWalkTerrain(flags, finest->character, &options, &shared, &error)) {
+      std::cerr << "footfall generate: " << error << '\n';
+      return 1;
+    }
+  }
+  Walk walk;
+  walk.fps = flags.fps;
+  int code = 0;
+  for (SceneCharacter& c : scene) {
+    GenerateOptions options = c.options;
+    options.fps = flags.fps;
+    options.threads = flags.threads;
+    if (!c.has_up) options.up = base.up;
+    if (!c.has_start_frame) options.start_frame = flags.start_frame;
+    LoadedTerrain own;
+    if (per_character && !LoadWalkTerrain(flags, c.character, &options, &own, &error)) {
+      error = c.name + ": " + error;
+      code = 1;
+      break;
+    }
+    const LoadedTerrain& terrain = per_character ? own : shared;
+    ProgressBar bar;
+    if (flags.progress) options.progress = [&bar](int done, int total) { bar.Update(done, total); };
+    Walk one;
+    Status status;
+    try {
+      status = GenerateWalk(*terrain.session, terrain.handle, c.character, options, &one, &error);
+    } catch (const std::bad_alloc&) {
+      bar.Finish();
+      std::cerr << "footfall generate: " << c.name << ": out of memory generating its walk; "
+                << "nothing was written (give fewer characters, crowds or steps)\n";
+      return 1;
+    }
+    bar.Finish();
+    if (status != Status::kOk) {
+      error = c.name + ": " + error;
+      code = 1;
+      break;
+    }
+    AddToSceneWalk(c.name, std::move(one), &walk);
+  }
+  if (code != 0) {
+    // The characters walked so far are kept: written, then the failure said.
+    std::cerr << "footfall generate: " << error << '\n';
+    if (!walk.tracks.empty()) {
+      std::cerr << "footfall generate: the walks of the characters before it are written\n";
+      WriteOutputs(flags, shared, walk);
+    }
+    return 1;
+  }
+  const int written = WriteOutputs(flags, shared, walk);
+  const bool stopped = ReportWalkEnd(walk, LoadedTerrain{});
+  return written != 0 ? written : stopped ? 2 : 0;
+}
+
 int RunGenerate(const GenerateFlags& flags) {
+  if (!flags.scene.empty()) return RunScene(flags);
+  if (flags.character.empty()) {
+    std::cerr << "footfall generate: give --character FILE (one character, or a crowd of it) or "
+                 "--scene FILE (several)\n";
+    return 1;
+  }
   std::string error;
   GenerateOptions options;
   Character character;
   LoadedTerrain terrain;
   // Flags first, so a typo fails before the terrain loads.
-  if (!ReadOptions(flags, &options, &error) || !CheckOutputs(flags, &error) ||
+  if (!ReadOptions(flags, &options, &error) ||
+      !CheckOutputs(flags, {flags.terrain.terrain, flags.character}, &error) ||
       LoadCharacter(flags.character, &character, &error) != Status::kOk ||
       !LoadWalkTerrain(flags, character, &options, &terrain, &error)) {
     std::cerr << "footfall generate: " << error << '\n';
@@ -448,36 +554,47 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
       "Place every footstep of a character on a terrain and key the walk (foot IK targets and "
       "body) into JSON, glTF or MEL files");
   AddTerrainFlags(cmd, &flags->terrain);
-  cmd->add_option("--character", flags->character, "Character file (JSON, see the README)")
-      ->required();
-  cmd->add_option("--start", flags->start,
-                  "X,Y,Z where the character starts (default: the sample nearest the centre of "
-                  "the top of the terrain's bounds, or the nearest place within 12 steps where "
-                  "the character can stand)")
-      ->check(NotBlank("X,Y,Z"));
-  cmd->add_option("--heading", flags->heading,
-                  "DX,DY,DZ facing direction, projected onto the ground (default 0,0,1)")
-      ->check(NotBlank("DX,DY,DZ"));
-  cmd->add_option("--path", flags->path,
-                  "Waypoints \"X,Y,Z X,Y,Z ...\" to follow (one point: a goal); the walk ends "
-                  "at the last one")
-      ->check(NotBlank("at least one waypoint X,Y,Z"));
-  cmd->add_option("--steps", flags->steps,
-                  "Steps per character, one gait group each (default 8; with --path, until "
-                  "the goal)")
-      ->check(CLI::Range(0, 1000000));
+  CLI::Option* character =
+      cmd->add_option("--character", flags->character, "Character file (JSON, see the README)");
+  CLI::Option* scene = cmd->add_option(
+      "--scene", flags->scene,
+      "Scene file (JSON, see the README): several characters, each with its own character "
+      "file, start, heading, path, steps and crowd, walked on the terrain into one walk");
+  scene->excludes(character);
+  CLI::Option* start =
+      cmd->add_option("--start", flags->start,
+                      "X,Y,Z where the character starts (default: the sample nearest the centre of "
+                      "the top of the terrain's bounds, or the nearest place within 12 steps where "
+                      "the character can stand)")
+          ->check(NotBlank("X,Y,Z"));
+  CLI::Option* heading =
+      cmd->add_option("--heading", flags->heading,
+                      "DX,DY,DZ facing direction, projected onto the ground (default 0,0,1)")
+          ->check(NotBlank("DX,DY,DZ"));
+  CLI::Option* path_opt =
+      cmd->add_option("--path", flags->path,
+                      "Waypoints \"X,Y,Z X,Y,Z ...\" to follow (one point: a goal); the walk ends "
+                      "at the last one")
+          ->check(NotBlank("at least one waypoint X,Y,Z"));
+  CLI::Option* steps =
+      cmd->add_option("--steps", flags->steps,
+                      "Steps per character, one gait group each (default 8; with --path, until "
+                      "the goal)")
+          ->check(CLI::Range(0, 1000000));
   cmd->add_option("--start-frame", flags->start_frame, "Frame of the first keys (default 1)")
       ->check(FiniteRange(-kMaxStartFrame, kMaxStartFrame));
   cmd->add_option("--fps", flags->fps, "Frames per second of the walk (default 24)")
       ->check(FiniteRange(0.001, kMaxFps));
   cmd->add_option("--up", flags->up, "X,Y,Z world up of bipeds (default 0,1,0, as in Maya)")
       ->check(NotBlank("X,Y,Z"));
-  cmd->add_option("--crowd", flags->crowd,
-                  "Generate this many characters at once on a grid around --start")
-      ->check(CLI::Range(1, 1000000));
-  cmd->add_option("--crowd-spacing", flags->crowd_spacing,
-                  "Distance between crowd characters (default: twice the character's reach)")
-      ->check(FiniteAboveUpTo(0, 1e6));
+  CLI::Option* crowd =
+      cmd->add_option("--crowd", flags->crowd,
+                      "Generate this many characters at once on a grid around --start")
+          ->check(CLI::Range(1, 1000000));
+  CLI::Option* crowd_spacing =
+      cmd->add_option("--crowd-spacing", flags->crowd_spacing,
+                      "Distance between crowd characters (default: twice the character's reach)")
+          ->check(FiniteAboveUpTo(0, 1e6));
   cmd->add_option("--threads", flags->threads,
                   "Threads for the embedded engine's queries and the generator's own work "
                   "(default: the hardware's; the walk is the same whatever the count)")
@@ -489,6 +606,7 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
                   "samples the walk was placed on (as resampled for the character), for "
                   "footfall-view or a plugin")
       ->required();
+  for (CLI::Option* o : {start, heading, path_opt, steps, crowd, crowd_spacing}) scene->excludes(o);
   cmd->footer(
       "Exit status: 0 when every step was generated, 2 when the walk stopped early (at a cliff, "
       "a gap, a wall too steep; the outputs then hold every key up to that step), 1 on errors.");

@@ -7,21 +7,23 @@
 
 #include "footfall/terrain/shown_text.h"
 #include "json_input.h"
+#include "request_fields.h"
 
 namespace footfall {
 namespace {
 
 using nlohmann::json;
 
-bool ReadVec(const json& j, const char* key, Vec3* out, std::string* error) {
+bool ReadVec(const json& j, const std::string& source, const char* key, Vec3* out,
+             std::string* error) {
   if (!j.is_array() || j.size() != 3) {
-    *error = std::string("request: '") + key + "': expected [x, y, z]";
+    *error = source + ": '" + key + "': expected [x, y, z]";
     return false;
   }
   double v[3];
   for (int i = 0; i < 3; ++i) {
     if (!j[i].is_number() || !std::isfinite(j[i].get<double>())) {
-      *error = std::string("request: '") + key + "': expected finite numbers";
+      *error = source + ": '" + key + "': expected finite numbers";
       return false;
     }
     v[i] = j[i].get<double>();
@@ -30,9 +32,10 @@ bool ReadVec(const json& j, const char* key, Vec3* out, std::string* error) {
   return true;
 }
 
-bool ReadNumber(const json& j, const char* key, double* out, std::string* error) {
+bool ReadNumber(const json& j, const std::string& source, const char* key, double* out,
+                std::string* error) {
   if (!j.is_number() || !std::isfinite(j.get<double>())) {
-    *error = std::string("request: '") + key + "': expected a finite number";
+    *error = source + ": '" + key + "': expected a finite number";
     return false;
   }
   *out = j.get<double>();
@@ -48,8 +51,16 @@ Status ParseGenerateRequest(const std::string& text, Character* character, Gener
   constexpr int kMaxDepth = 32;
   json j;
   if (!detail::ParseJsonText(text, "request", &j, error, kMaxDepth)) return Status::kParseError;
+  return detail::ReadGenerateRequest(j, "request", "", {}, character, options, error);
+}
+
+namespace detail {
+
+Status ReadGenerateRequest(const json& j, const std::string& source, const std::string& folder,
+                           const std::set<std::string>& refused, Character* character,
+                           GenerateOptions* options, std::string* error) {
   if (!j.is_object()) {
-    *error = "request: not a JSON object";
+    *error = source + ": not a JSON object";
     return Status::kParseError;
   }
   static const std::set<std::string> kKnown = {
@@ -57,58 +68,61 @@ Status ParseGenerateRequest(const std::string& text, Character* character, Gener
       "path",      "steps",          "start_frame",  "up",
       "fps",       "crowd",          "crowd_spacing"};
   for (auto it = j.begin(); it != j.end(); ++it) {
-    if (!kKnown.count(it.key())) {
-      *error = "request: unknown field '" + ShownText(it.key()) + "'";
+    if (!kKnown.count(it.key()) || refused.count(it.key())) {
+      *error = source + ": unknown field '" + ShownText(it.key()) + "'";
       return Status::kParseError;
     }
   }
   GenerateOptions o;
   Status s;
   if (j.contains("character") == j.contains("character_file")) {
-    *error = "request: give exactly one of 'character' (an object) or 'character_file' (a path)";
+    *error = source + ": give exactly one of 'character' (an object) or 'character_file' (a path)";
     return Status::kInvalidArgument;
   }
   if (j.contains("character")) {
     if (!j["character"].is_object()) {
-      *error = "request: 'character': expected a character file's object";
+      *error = source + ": 'character': expected a character file's object";
       return Status::kParseError;
     }
-    s = ParseCharacter(j["character"].dump(), "request character", character, error);
+    s = ParseCharacter(j["character"].dump(), source + " character", character, error);
   } else {
     if (!j["character_file"].is_string() ||
         j["character_file"].get<std::string>().find('\0') != std::string::npos) {
-      *error = "request: 'character_file': expected a path (without NUL bytes)";
+      *error = source + ": 'character_file': expected a path (without NUL bytes)";
       return Status::kParseError;
     }
-    s = LoadCharacter(j["character_file"].get<std::string>(), character, error);
+    // A relative path is read from `folder` (the scene file's), if one is given.
+    const std::string file = j["character_file"].get<std::string>();
+    const bool relative = !file.empty() && file[0] != '/';
+    s = LoadCharacter(relative && !folder.empty() ? folder + "/" + file : file, character, error);
   }
   if (s != Status::kOk) return s;
   bool ok = true;
   if (ok && j.contains("start"))
-    ok = ReadVec(j["start"], "start", &o.start, error), o.has_start = true;
-  if (ok && j.contains("heading")) ok = ReadVec(j["heading"], "heading", &o.heading, error);
-  if (ok && j.contains("up")) ok = ReadVec(j["up"], "up", &o.up, error);
+    ok = ReadVec(j["start"], source, "start", &o.start, error), o.has_start = true;
+  if (ok && j.contains("heading")) ok = ReadVec(j["heading"], source, "heading", &o.heading, error);
+  if (ok && j.contains("up")) ok = ReadVec(j["up"], source, "up", &o.up, error);
   if (ok && j.contains("start_frame"))
-    ok = ReadNumber(j["start_frame"], "start_frame", &o.start_frame, error);
+    ok = ReadNumber(j["start_frame"], source, "start_frame", &o.start_frame, error);
   // The bounds of `footfall generate`'s flags.
   if (ok && j.contains("fps")) {
-    ok = ReadNumber(j["fps"], "fps", &o.fps, error);
+    ok = ReadNumber(j["fps"], source, "fps", &o.fps, error);
     if (ok && !(o.fps >= 0.001 && o.fps <= kMaxFps)) {
-      *error = "request: 'fps': expected a number from 0.001 to 1e+06";
+      *error = source + ": 'fps': expected a number from 0.001 to 1e+06";
       ok = false;
     }
   }
   if (ok && j.contains("crowd_spacing")) {
-    ok = ReadNumber(j["crowd_spacing"], "crowd_spacing", &o.crowd_spacing, error);
+    ok = ReadNumber(j["crowd_spacing"], source, "crowd_spacing", &o.crowd_spacing, error);
     if (ok && !(o.crowd_spacing >= 0 && o.crowd_spacing <= 1e6)) {
-      *error = "request: 'crowd_spacing': expected a number from 0 (the default) to 1e+06";
+      *error = source + ": 'crowd_spacing': expected a number from 0 (the default) to 1e+06";
       ok = false;
     }
   }
   for (const char* key : {"steps", "crowd"}) {
     if (!ok || !j.contains(key)) continue;
     if (!j[key].is_number_integer()) {
-      *error = std::string("request: '") + key + "': expected an integer";
+      *error = source + ": '" + key + "': expected an integer";
       ok = false;
     } else {
       // (An unsigned number above 2^63 would read as negative.)
@@ -117,8 +131,8 @@ Status ParseGenerateRequest(const std::string& text, Character* character, Gener
                               : j[key].get<long long>();
       const long long lo = std::string(key) == "steps" ? 0 : 1;
       if (v < lo || v > 1000000) {
-        *error = std::string("request: '") + key + "': out of range (expected " +
-                 std::to_string(lo) + " to 1000000)";
+        *error = source + ": '" + key + "': out of range (expected " + std::to_string(lo) +
+                 " to 1000000)";
         ok = false;
       } else {
         (std::string(key) == "steps" ? o.steps : o.crowd) = static_cast<int>(v);
@@ -127,12 +141,12 @@ Status ParseGenerateRequest(const std::string& text, Character* character, Gener
   }
   if (ok && j.contains("path")) {
     if (!j["path"].is_array()) {
-      *error = "request: 'path': expected an array of [x, y, z]";
+      *error = source + ": 'path': expected an array of [x, y, z]";
       ok = false;
     }
     for (size_t i = 0; ok && i < j["path"].size(); ++i) {
       Vec3 p;
-      ok = ReadVec(j["path"][i], "path", &p, error);
+      ok = ReadVec(j["path"][i], source, "path", &p, error);
       o.path.push_back(p);
     }
   }
@@ -141,4 +155,5 @@ Status ParseGenerateRequest(const std::string& text, Character* character, Gener
   return Status::kOk;
 }
 
+}  // namespace detail
 }  // namespace footfall

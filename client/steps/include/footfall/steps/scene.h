@@ -1,0 +1,49 @@
+// A scene file: several characters on one terrain, each with its own character file, start,
+// heading, path, steps and crowd, for `footfall generate --scene`. JSON, versioned:
+//   {"format": "footfall-scene", "version": 1, "comment": "...",
+//    "characters": [{"name": "spider", "character_file": "octopod.json", "start": [x, y, z],
+//                    "heading": [x, y, z], "path": [[x, y, z], ...], "steps": N,
+//                    "start_frame": F, "up": [x, y, z], "crowd": N, "crowd_spacing": D}, ...]}
+// Each character takes the fields of a generate request (generate_request.h) but "fps", which
+// is the whole walk's; "name" names its tracks (default: its character's name and its place in
+// the list, "biped1"); a relative character_file is read from the scene file's folder.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "footfall/steps/character.h"
+#include "footfall/steps/generator.h"
+#include "footfall/steps/walk.h"
+
+namespace footfall {
+
+constexpr int kSceneFormatVersion = 1;
+constexpr size_t kMaxSceneCharacters = 10000;
+
+struct SceneCharacter {
+  std::string name;  // unique within the scene
+  Character character;
+  // Its start, heading, path, steps, crowd and spacing as given; start_frame and up as given
+  // when has_start_frame / has_up, else the command's.
+  GenerateOptions options;
+  bool has_start_frame = false;
+  bool has_up = false;
+  std::string character_file;  // as read (resolved against the scene's folder), or ""
+};
+
+// Reads the scene file at `path`. kParseError / kInvalidArgument with "PATH: ..." naming the
+// field (characters[i] and its key); a character file's own errors as LoadCharacter gives them.
+Status LoadScene(const std::string& path, std::vector<SceneCharacter>* out, std::string* error);
+
+// The same from text; `source` names it in errors, `folder` is where relative character files
+// are read from.
+Status ParseScene(const std::string& text, const std::string& source, const std::string& folder,
+                  std::vector<SceneCharacter>* out, std::string* error);
+
+// Adds the walk of scene character `name` to the scene's walk: its tracks, their `character`
+// set to the name (a crowd's "NAME/c1" ...), and its stop reasons and notes prefixed with the
+// name. The scene's `stopped` is the first character's to stop, with a count of the others.
+void AddToSceneWalk(const std::string& name, Walk&& walk, Walk* scene);
+
+}  // namespace footfall

@@ -1,0 +1,23 @@
+// The fields of a generate request (generate_request.h), read from an object already parsed:
+// shared by the C ABI's requests and the characters of a scene file (scene.h). Private to
+// footfall::steps.
+#pragma once
+
+#include <set>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "footfall/steps/character.h"
+#include "footfall/steps/generator.h"
+
+namespace footfall::detail {
+
+// Fills *character and *options from the request object `j`, naming errors after `source`
+// ("request", "scene.json: characters[2]"); a relative character_file is read from `folder`
+// when it is not empty. Fields in `refused` are unknown here. Statuses as ParseGenerateRequest.
+Status ReadGenerateRequest(const nlohmann::json& j, const std::string& source,
+                           const std::string& folder, const std::set<std::string>& refused,
+                           Character* character, GenerateOptions* options, std::string* error);
+
+}  // namespace footfall::detail

@@ -1,0 +1,114 @@
+#include "footfall/steps/scene.h"
+
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "footfall/terrain/shown_text.h"
+#include "json_input.h"
+#include "request_fields.h"
+
+namespace footfall {
+
+Status ParseScene(const std::string& text, const std::string& source, const std::string& folder,
+                  std::vector<SceneCharacter>* out, std::string* error) {
+  // Nesting as deep as a request's (a character object inside a scene's list).
+  constexpr int kMaxDepth = 34;
+  nlohmann::json j;
+  if (!detail::ParseJsonText(text, source, &j, error, kMaxDepth)) return Status::kParseError;
+  auto fail = [&](Status status, const std::string& what) {
+    *error = source + ": " + what;
+    return status;
+  };
+  if (!j.is_object()) return fail(Status::kParseError, "not a JSON object (expected a scene file)");
+  static const std::set<std::string> kKnown = {"format", "version", "comment", "characters"};
+  std::string unknown;
+  if (detail::FindUnknownKey(j, kKnown, &unknown))
+    return fail(Status::kParseError, detail::UnknownFieldMessage(unknown, kKnown));
+  if (!j.contains("format") || j["format"] != "footfall-scene")
+    return fail(Status::kParseError, "'format' must be \"footfall-scene\"");
+  if (!j.contains("version") || !detail::IsInteger(j["version"], kSceneFormatVersion))
+    return fail(Status::kParseError, "'version' must be " + std::to_string(kSceneFormatVersion));
+  if (j.contains("comment") && !j["comment"].is_string())
+    return fail(Status::kParseError, "'comment' must be a string");
+  if (!j.contains("characters") || !j["characters"].is_array() || j["characters"].empty() ||
+      j["characters"].size() > kMaxSceneCharacters) {
+    return fail(Status::kParseError, "'characters' must be an array of 1 to " +
+                                         std::to_string(kMaxSceneCharacters) + " objects");
+  }
+  std::vector<SceneCharacter> scene;
+  std::set<std::string> names;
+  for (size_t i = 0; i < j["characters"].size(); ++i) {
+    const std::string where = source + ": characters[" + std::to_string(i) + "]";
+    nlohmann::json entry = j["characters"][i];
+    if (!entry.is_object()) {
+      *error = where + ": expected an object";
+      return Status::kParseError;
+    }
+    SceneCharacter c;
+    std::string name;
+    if (entry.contains("name")) {
+      if (!entry["name"].is_string() || entry["name"].get<std::string>().empty()) {
+        *error = where + ": 'name' must be a non-empty string";
+        return Status::kParseError;
+      }
+      name = entry["name"].get<std::string>();
+      const std::string control = detail::ControlCharacterIn(name);
+      if (!control.empty() || name.find('/') != std::string::npos) {
+        *error =
+            where + ": 'name': " +
+            (control.empty() ? "a name without '/' (it separates a crowd's characters)" : control);
+        return Status::kInvalidArgument;
+      }
+      entry.erase("name");
+    }
+    // "fps" is the whole walk's (--fps).
+    const Status read =
+        detail::ReadGenerateRequest(entry, where, folder, {"fps"}, &c.character, &c.options, error);
+    if (read != Status::kOk) return read;
+    c.has_start_frame = entry.contains("start_frame");
+    c.has_up = entry.contains("up");
+    if (entry.contains("character_file")) {
+      const std::string file = entry["character_file"];  // read above: a string
+      c.character_file = !folder.empty() && file[0] != '/' ? folder + "/" + file : file;
+    }
+    c.name = name.empty() ? c.character.name + std::to_string(i + 1) : name;
+    if (!names.insert(c.name).second) {
+      *error = where + ": the name '" + ShownText(c.name) +
+               "' is another character's (give each a name of its own)";
+      return Status::kInvalidArgument;
+    }
+    scene.push_back(std::move(c));
+  }
+  *out = std::move(scene);
+  return Status::kOk;
+}
+
+Status LoadScene(const std::string& path, std::vector<SceneCharacter>* out, std::string* error) {
+  std::string text;
+  const Status status = detail::ReadJsonFile(path, "scene file", &text, error);
+  if (status != Status::kOk) return status;
+  const size_t slash = path.rfind('/');
+  const std::string folder = slash == std::string::npos ? "."
+                             : slash == 0               ? "/"
+                                                        : path.substr(0, slash);
+  return ParseScene(text, path, folder, out, error);
+}
+
+void AddToSceneWalk(const std::string& name, Walk&& walk, Walk* scene) {
+  for (WalkTrack& track : walk.tracks) {
+    track.character = track.character.empty() ? name : name + "/" + track.character;
+    scene->tracks.push_back(std::move(track));
+  }
+  for (const std::string& stop : walk.stops) scene->stops.push_back(name + ": " + stop);
+  if (walk.stops.empty() && !walk.stopped.empty())
+    scene->stops.push_back(name + ": " + walk.stopped);
+  for (const std::string& note : walk.notes) scene->notes.push_back(name + ": " + note);
+  if (!scene->stops.empty()) {
+    scene->stopped = scene->stops.front();
+    if (scene->stops.size() > 1)
+      scene->stopped += " (and " + std::to_string(scene->stops.size() - 1) + " more stopped)";
+  }
+}
+
+}  // namespace footfall

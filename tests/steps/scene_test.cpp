@@ -1,0 +1,149 @@
+// Scene files (scene.h): what they read, the errors they name, and how their characters' walks
+// become one walk.
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include "footfall/steps/scene.h"
+
+using namespace footfall;
+
+namespace {
+
+const std::string kCharacters = std::string(FOOTFALL_SOURCE_DIR) + "/data/characters";
+
+// ParseScene of `text` with the shipped characters' folder; the message, or "" when it reads.
+std::string SceneError(const std::string& text, std::vector<SceneCharacter>* scene = nullptr) {
+  std::vector<SceneCharacter> read;
+  std::string error;
+  const Status status = ParseScene(text, "s.json", kCharacters, scene ? scene : &read, &error);
+  if (status == Status::kOk) return "";
+  CHECK_FALSE(error.empty());
+  return error;
+}
+
+std::string Scene(const std::string& characters) {
+  return R"({"format": "footfall-scene", "version": 1, "characters": [)" + characters + "]}";
+}
+
+}  // namespace
+
+TEST_CASE("A scene file reads each character with its own options", "[steps][scene]") {
+  std::vector<SceneCharacter> scene;
+  REQUIRE(SceneError(Scene(R"({"name": "walker", "character_file": "biped.json",
+                                "start": [1, 2, 3], "path": [[1, 0, 5], [5, 0, 5]]},
+                               {"character_file": "hexapod.json", "steps": 12, "crowd": 4,
+                                "crowd_spacing": 0.5, "start_frame": 25, "up": [0, 0, 1]},
+                               {"character_file": ")" +
+                           kCharacters + R"(/octopod.json", "heading": [1, 0, 0]})"),
+                     &scene) == "");
+  REQUIRE(scene.size() == 3);
+  CHECK(scene[0].name == "walker");
+  CHECK(scene[0].character.name == "biped");
+  CHECK(scene[0].character_file == kCharacters + "/biped.json");
+  CHECK(scene[0].options.has_start);
+  CHECK(scene[0].options.start.z == 3);
+  CHECK(scene[0].options.path.size() == 2);
+  CHECK_FALSE(scene[0].has_start_frame);
+  CHECK_FALSE(scene[0].has_up);
+  // Unnamed characters take their character's name and their place in the list.
+  CHECK(scene[1].name == "hexapod2");
+  CHECK(scene[1].options.steps == 12);
+  CHECK(scene[1].options.crowd == 4);
+  CHECK(scene[1].options.crowd_spacing == 0.5);
+  CHECK(scene[1].has_start_frame);
+  CHECK(scene[1].options.start_frame == 25);
+  CHECK(scene[1].has_up);
+  CHECK(scene[2].name == "octopod3");
+  CHECK(scene[2].character_file == kCharacters + "/octopod.json");  // absolute: as given
+  CHECK(scene[2].options.heading.x == 1);
+}
+
+TEST_CASE("Scene file errors name the file the character and the field", "[steps][scene]") {
+  CHECK_THAT(SceneError("[]"), Catch::StartsWith("s.json: not a JSON object"));
+  CHECK_THAT(SceneError(R"({"format": "footfall-walk", "version": 1, "characters": []})"),
+             Catch::Contains("'format' must be \"footfall-scene\""));
+  CHECK_THAT(SceneError(R"({"format": "footfall-scene", "version": 2, "characters": []})"),
+             Catch::Contains("'version' must be 1"));
+  CHECK_THAT(SceneError(R"({"format": "footfall-scene", "version": 1, "characters": []})"),
+             Catch::Contains("'characters' must be an array of 1 to"));
+  CHECK_THAT(SceneError(R"({"format": "footfall-scene", "version": 1, "characters": [],
+                            "speed": 2})"),
+             Catch::Contains("unknown field 'speed'"));
+  CHECK_THAT(SceneError(Scene("3")), Catch::Contains("s.json: characters[0]: expected an object"));
+  CHECK_THAT(SceneError(Scene(R"({"start": [0, 0, 0]})")),
+             Catch::Contains("characters[0]: give exactly one of 'character'"));
+  CHECK_THAT(SceneError(Scene(R"({"character_file": "biped.json"},
+                                 {"character_file": "biped.json", "start": [0, 0]})")),
+             Catch::Contains("s.json: characters[1]: 'start': expected [x, y, z]"));
+  // The walk has one frame rate: --fps.
+  CHECK_THAT(SceneError(Scene(R"({"character_file": "biped.json", "fps": 30})")),
+             Catch::Contains("characters[0]: unknown field 'fps'"));
+  CHECK_THAT(SceneError(Scene(R"({"character_file": "biped.json", "crowd": 0})")),
+             Catch::Contains("characters[0]: 'crowd': out of range"));
+  CHECK_THAT(SceneError(Scene(R"({"character_file": "nothere.json"})")),
+             Catch::Contains("nothere.json"));
+  CHECK_THAT(SceneError(Scene(R"({"name": "a", "character_file": "biped.json"},
+                                 {"name": "a", "character_file": "quadruped.json"})")),
+             Catch::Contains("characters[1]: the name 'a' is another character's"));
+  CHECK_THAT(SceneError(Scene(R"({"name": "a/b", "character_file": "biped.json"})")),
+             Catch::Contains("'name': a name without '/'"));
+  CHECK_THAT(SceneError(Scene(R"({"name": "", "character_file": "biped.json"})")),
+             Catch::Contains("'name' must be a non-empty string"));
+  CHECK_THAT(SceneError(Scene(R"({"name": "a\nb", "character_file": "biped.json"})")),
+             Catch::Contains("control characters"));
+}
+
+TEST_CASE("LoadScene reads character files beside the scene file", "[steps][scene]") {
+  std::vector<SceneCharacter> scene;
+  std::string error;
+  CHECK(LoadScene(kCharacters + "/no-such-scene.json", &scene, &error) != Status::kOk);
+  CHECK_THAT(error, Catch::Contains("no-such-scene.json"));
+  // A scene in a folder of its own, naming a character file beside it.
+  const std::string folder = std::string(FOOTFALL_BINARY_DIR) + "/scene-test";
+  REQUIRE(std::system(("mkdir -p '" + folder + "' && cp '" + kCharacters + "/quadruped.json' '" +
+                       folder + "/four.json'")
+                          .c_str()) == 0);
+  {
+    std::ofstream out(folder + "/scene.json");
+    out << Scene(R"({"character_file": "four.json", "steps": 3})");
+  }
+  REQUIRE(LoadScene(folder + "/scene.json", &scene, &error) == Status::kOk);
+  REQUIRE(scene.size() == 1);
+  CHECK(scene[0].character.name == "quadruped");
+  CHECK(scene[0].character_file == folder + "/four.json");
+  CHECK(scene[0].name == "quadruped1");
+}
+
+TEST_CASE("A scene's walk holds every character's tracks under its name", "[steps][scene]") {
+  Walk one;
+  one.tracks.resize(2);
+  one.tracks[0].name = "L";
+  one.tracks[1].name = "body", one.tracks[1].kind = TrackKind::kBody;
+  Walk crowd;
+  crowd.tracks.resize(2);
+  crowd.tracks[0].name = "L1", crowd.tracks[0].character = "c1";
+  crowd.tracks[1].name = "L1", crowd.tracks[1].character = "c2";
+  crowd.stopped = "step 3 of c2: no foothold";
+  crowd.stops = {"step 3 of c2: no foothold"};
+  crowd.notes = {"c1: the goal is 2 away"};
+  Walk scene;
+  AddToSceneWalk("walker", std::move(one), &scene);
+  CHECK(scene.stopped.empty());
+  AddToSceneWalk("bugs", std::move(crowd), &scene);
+  REQUIRE(scene.tracks.size() == 4);
+  CHECK(scene.tracks[0].character == "walker");
+  CHECK(scene.tracks[1].character == "walker");
+  CHECK(scene.tracks[2].character == "bugs/c1");
+  CHECK(scene.tracks[3].character == "bugs/c2");
+  CHECK(scene.stopped == "bugs: step 3 of c2: no foothold");
+  CHECK(scene.notes == std::vector<std::string>{"bugs: c1: the goal is 2 away"});
+  Walk stopped;
+  stopped.stopped = "step 1: a cliff";
+  AddToSceneWalk("third", std::move(stopped), &scene);
+  CHECK(scene.stops.size() == 2);
+  CHECK(scene.stopped == "bugs: step 3 of c2: no foothold (and 1 more stopped)");
+}
