@@ -16,6 +16,7 @@
 #include <cstring>
 #include <functional>
 #include <random>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,7 @@
 #include "footfall/import/mesh_reader.h"
 #include "footfall/import/terrain_loader.h"
 #include "footfall/steps/character.h"
+#include "footfall/steps/scene.h"
 #include "footfall/steps/walk_json.h"
 #include "footfall/terrain/point_file.h"
 #include "footfall/terrain/samples.h"
@@ -183,6 +185,18 @@ const char* const kQuadruped = R"({
   "reach": 1.0
 }
 )";
+
+// A scene of two characters, one given inline (a file beside it would not be damaged).
+std::string SeedScene() {
+  return std::string(R"({"format": "footfall-scene", "version": 1, "comment": "seed",
+  "characters": [
+    {"name": "walker", "character": )") +
+         kBiped + R"(, "start": [1, 0, 2], "heading": [0, 0, 1],
+     "path": [[1, 0, 4], [3, 0.5, 4]], "steps": 12, "start_frame": 5, "up": [0, 1, 0]},
+    {"character": )" +
+         kQuadruped + R"(, "crowd": 3, "crowd_spacing": 0.5}]}
+)";
+}
 
 std::string SeedWalk() {
   Walk walk;
@@ -836,6 +850,34 @@ Read CharacterReader() {
   };
 }
 
+std::string CheckScene(const std::vector<SceneCharacter>& scene) {
+  if (scene.empty()) return "no characters";
+  std::set<std::string> names;
+  for (const SceneCharacter& c : scene) {
+    if (c.name.empty() || c.name.find('/') != std::string::npos) return "bad name";
+    if (!names.insert(c.name).second) return "two characters of one name";
+    const std::string character = CheckCharacter(c.character);
+    if (!character.empty()) return character;
+    const GenerateOptions& o = c.options;
+    if (!Finite(o.start) || !Finite(o.heading) || !Finite(o.up) || !std::isfinite(o.start_frame))
+      return "a start, heading, up or start frame not finite";
+    for (const Vec3& p : o.path)
+      if (!Finite(p)) return "a waypoint not finite";
+    if (o.steps > 1000000 || o.crowd < 1 || o.crowd > 1000000) return "steps or crowd out of range";
+    if (!(std::isfinite(o.crowd_spacing) && o.crowd_spacing >= 0)) return "bad crowd spacing";
+  }
+  return "";
+}
+
+Read SceneReader() {
+  return [](const std::string& path, std::string* error, std::string* bad) {
+    std::vector<SceneCharacter> scene;
+    const Status status = LoadScene(path, &scene, error);
+    if (status == Status::kOk) *bad = CheckScene(scene);
+    return status;
+  };
+}
+
 Read WalkReader() {
   return [](const std::string& path, std::string* error, std::string* bad) {
     Walk w;
@@ -959,6 +1001,7 @@ std::vector<Format> Formats() {
        PgmReader()},
       {"character", "json", Kind::kJson, {kBiped, kQuadruped}, JsonSpecial, CharacterReader()},
       {"walk", "json", Kind::kJson, {SeedWalk()}, JsonSpecial, WalkReader()},
+      {"scene", "json", Kind::kJson, {SeedScene()}, JsonSpecial, SceneReader()},
   };
 }
 
@@ -988,6 +1031,7 @@ TEST_CASE("Reader fuzz: a file cut short never reads as a valid file", "[import]
       {"P5 PGM", all},
       {"character", [](const std::string& s) { return s.rfind('}'); }},
       {"walk", [](const std::string& s) { return s.rfind('}'); }},
+      {"scene", [](const std::string& s) { return s.rfind('}'); }},
   };
   test::TempDir dir;
   std::vector<std::string> failures;
