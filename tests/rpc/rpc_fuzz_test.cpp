@@ -983,6 +983,20 @@ std::vector<std::string> FuzzServerArgs(const DataRoot& root) {
   return args;
 }
 
+// A footfalld for one test case, and a normal client that uploaded the fuzz terrain to it.
+struct FuzzServer {
+  DataRoot root;
+  ServerProcess server{0, FuzzServerArgs(root)};
+  std::unique_ptr<TerrainSession> rpc = [this] {
+    RpcOptions o;
+    o.port = server.port();
+    return MakeRpcSession(o);
+  }();
+  TerrainHandle remote = 0;
+
+  FuzzServer() { REQUIRE(rpc->LoadSamples(FuzzTerrain(), "fuzz", &remote) == Status::kOk); }
+};
+
 // The server's handle for the one terrain it holds, through a raw FF_LIST call.
 uint32_t OnlyTerrain(int port) {
   const int fd = Connect(port);
@@ -1349,15 +1363,10 @@ TEST_CASE("RPC fuzz: damaged and random calls to every procedure get well-formed
 
 TEST_CASE("RPC fuzz: arguments cut short at any length are refused with GARBAGE_ARGS",
           "[rpc][fuzz]") {
-  DataRoot root;
-  ServerProcess server(0, FuzzServerArgs(root));
-  auto rpc = [&] {
-    RpcOptions o;
-    o.port = server.port();
-    return MakeRpcSession(o);
-  }();
-  TerrainHandle remote = 0;
-  REQUIRE(rpc->LoadSamples(FuzzTerrain(), "fuzz", &remote) == Status::kOk);
+  FuzzServer fuzz;
+  const ServerProcess& server = fuzz.server;
+  TerrainSession* rpc = fuzz.rpc.get();
+  const TerrainHandle remote = fuzz.remote;
   Context context;
   context.main_terrain = OnlyTerrain(server.port());
   RawConnection raw(server.port());
@@ -1441,15 +1450,10 @@ TEST_CASE("RPC fuzz: array and string lengths past their bounds are refused and 
 
 TEST_CASE("RPC fuzz: a non-finite double in any query or load field answers FF_INVALID_ARGUMENT",
           "[rpc][fuzz]") {
-  DataRoot root;
-  ServerProcess server(0, FuzzServerArgs(root));
-  auto rpc = [&] {
-    RpcOptions o;
-    o.port = server.port();
-    return MakeRpcSession(o);
-  }();
-  TerrainHandle remote = 0;
-  REQUIRE(rpc->LoadSamples(FuzzTerrain(), "fuzz", &remote) == Status::kOk);
+  FuzzServer fuzz;
+  const ServerProcess& server = fuzz.server;
+  TerrainSession* rpc = fuzz.rpc.get();
+  const TerrainHandle remote = fuzz.remote;
   const uint32_t terrain = OnlyTerrain(server.port());
   const double bad[] = {
       std::numeric_limits<double>::quiet_NaN(), -std::numeric_limits<double>::quiet_NaN(),
@@ -1587,15 +1591,10 @@ TEST_CASE("RPC fuzz: a call in several fragments is dropped or answered and othe
   // footfall.x asks clients to keep each request in one fragment: libtirpc's non-blocking server
   // drops one in several. Here, what dropping means: GARBAGE_ARGS or a closed connection (at
   // once or at a later call), never a wrong SUCCESS, a hang or harm to other clients.
-  DataRoot root;
-  ServerProcess server(0, FuzzServerArgs(root));
-  auto rpc = [&] {
-    RpcOptions o;
-    o.port = server.port();
-    return MakeRpcSession(o);
-  }();
-  TerrainHandle remote = 0;
-  REQUIRE(rpc->LoadSamples(FuzzTerrain(), "fuzz", &remote) == Status::kOk);
+  FuzzServer fuzz;
+  const ServerProcess& server = fuzz.server;
+  TerrainSession* rpc = fuzz.rpc.get();
+  const TerrainHandle remote = fuzz.remote;
   const uint32_t terrain = OnlyTerrain(server.port());
   ff_point_args point{terrain, {5, 1, 5}};
   const Bytes args = Encode(FF_XDR(ff_point_args), &point);
