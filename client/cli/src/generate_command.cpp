@@ -461,7 +461,10 @@ int RunScene(const GenerateFlags& flags) {
     }
     const LoadedTerrain& terrain = per_character ? own : shared;
     ProgressBar bar;
-    if (flags.progress) options.progress = [&bar](int done, int total) { bar.Update(done, total); };
+    const bool long_run =
+        static_cast<long long>(options.crowd) * (options.steps < 0 ? 8 : options.steps) >= 20000;
+    if (flags.progress || (long_run && isatty(STDERR_FILENO)))
+      options.progress = [&bar](int done, int total) { bar.Update(done, total); };
     Walk one;
     Status status;
     try {
