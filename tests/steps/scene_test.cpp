@@ -84,8 +84,11 @@ TEST_CASE("Scene file errors name the file the character and the field", "[steps
              Catch::Contains("characters[0]: unknown field 'fps'"));
   CHECK_THAT(SceneError(Scene(R"({"character_file": "biped.json", "crowd": 0})")),
              Catch::Contains("characters[0]: 'crowd': out of range"));
-  CHECK_THAT(SceneError(Scene(R"({"character_file": "nothere.json"})")),
-             Catch::Contains("nothere.json"));
+  CHECK_THAT(
+      SceneError(Scene(R"({"character_file": "biped.json"}, {"character_file": "nothere.json"})")),
+      Catch::StartsWith("s.json: characters[1]: " + kCharacters + "/nothere.json: cannot open"));
+  CHECK_THAT(SceneError(Scene(R"({"character_file": ""})")),
+             Catch::Contains("characters[0]: 'character_file': expected a path (not empty"));
   CHECK_THAT(SceneError(Scene(R"({"name": "a", "character_file": "biped.json"},
                                  {"name": "a", "character_file": "quadruped.json"})")),
              Catch::Contains("characters[1]: the name 'a' is another character's"));

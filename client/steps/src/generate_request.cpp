@@ -86,15 +86,17 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
     }
     s = ParseCharacter(j["character"].dump(), source + " character", character, error);
   } else {
-    if (!j["character_file"].is_string() ||
+    if (!j["character_file"].is_string() || j["character_file"].get<std::string>().empty() ||
         j["character_file"].get<std::string>().find('\0') != std::string::npos) {
-      *error = source + ": 'character_file': expected a path (without NUL bytes)";
+      *error = source + ": 'character_file': expected a path (not empty, without NUL bytes)";
       return Status::kParseError;
     }
-    // A relative path is read from `folder` (the scene file's), if one is given.
+    // A relative path is read from `folder` (the scene file's), if one is given; the file's
+    // errors then also name the scene's character.
     const std::string file = j["character_file"].get<std::string>();
-    const bool relative = !file.empty() && file[0] != '/';
-    s = LoadCharacter(relative && !folder.empty() ? folder + "/" + file : file, character, error);
+    s = LoadCharacter(!folder.empty() && file[0] != '/' ? folder + "/" + file : file, character,
+                      error);
+    if (s != Status::kOk && !folder.empty()) *error = source + ": " + *error;
   }
   if (s != Status::kOk) return s;
   bool ok = true;

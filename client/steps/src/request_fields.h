@@ -15,7 +15,8 @@ namespace footfall::detail {
 
 // Fills *character and *options from the request object `j`, naming errors after `source`
 // ("request", "scene.json: characters[2]"); a relative character_file is read from `folder`
-// when it is not empty. Fields in `refused` are unknown here. Statuses as ParseGenerateRequest.
+// when it is not empty, and that file's errors are then prefixed with `source` too. Fields in
+// `refused` are unknown here. Statuses as ParseGenerateRequest.
 Status ReadGenerateRequest(const nlohmann::json& j, const std::string& source,
                            const std::string& folder, const std::set<std::string>& refused,
                            Character* character, GenerateOptions* options, std::string* error);
