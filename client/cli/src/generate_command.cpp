@@ -103,6 +103,14 @@ class ProgressBar {
   bool shown_ = false;
 };
 
+// Draws `bar` as the walk advances when asked (--progress), or for a long run on a terminal.
+void ShowProgress(const GenerateFlags& flags, ProgressBar* bar, GenerateOptions* options) {
+  const long long steps = options->steps < 0 ? kDefaultSteps : options->steps;
+  const bool long_run = static_cast<long long>(options->crowd) * steps >= 20000;
+  if (flags.progress || (long_run && isatty(STDERR_FILENO)))
+    options->progress = [bar](int done, int total) { bar->Update(done, total); };
+}
+
 // True when the terrain is read here, not as a point file, with no --separation: it is then
 // resampled for the character (walk_terrain.h; an unknown extension fails there).
 bool ResamplesForCharacter(const TerrainFlags& flags) {
@@ -461,10 +469,7 @@ int RunScene(const GenerateFlags& flags) {
     }
     const LoadedTerrain& terrain = per_character ? own : shared;
     ProgressBar bar;
-    const bool long_run =
-        static_cast<long long>(options.crowd) * (options.steps < 0 ? 8 : options.steps) >= 20000;
-    if (flags.progress || (long_run && isatty(STDERR_FILENO)))
-      options.progress = [&bar](int done, int total) { bar.Update(done, total); };
+    ShowProgress(flags, &bar, &options);
     Walk one;
     Status status;
     try {
@@ -517,10 +522,7 @@ int RunGenerate(const GenerateFlags& flags) {
     return 1;
   }
   ProgressBar bar;
-  const bool long_run =
-      static_cast<long long>(flags.crowd) * (flags.steps < 0 ? 8 : flags.steps) >= 20000;
-  if (flags.progress || (long_run && isatty(STDERR_FILENO)))
-    options.progress = [&bar](int done, int total) { bar.Update(done, total); };
+  ShowProgress(flags, &bar, &options);
   Walk walk;
   Status status;
   try {
