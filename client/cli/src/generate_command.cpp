@@ -474,6 +474,7 @@ int RunScene(const GenerateFlags& flags) {
     Status status;
     try {
       status = GenerateWalk(*terrain.session, terrain.handle, c.character, options, &one, &error);
+      if (status == Status::kOk) AddToSceneWalk(c.name, std::move(one), &walk);
     } catch (const std::bad_alloc&) {
       bar.Finish();
       std::cerr << "footfall generate: " << c.name << ": out of memory generating its walk; "
@@ -486,7 +487,6 @@ int RunScene(const GenerateFlags& flags) {
       code = 1;
       break;
     }
-    AddToSceneWalk(c.name, std::move(one), &walk);
   }
   if (code != 0) {
     // The characters walked so far are kept: written, then the failure said.
