@@ -107,6 +107,11 @@ JSON
 both scene-cliff 2 --terrain "$work/cliff.pts" --scene "$work/scene/cliff.json"
 check "scene cliff: the faller's stop named" grep -qE '"stopped":"faller: step [0-9]+: foot' "$work/scene-cliff-embedded.json"
 check "scene cliff: the other character's keys kept" grep -q '"character":"safe"' "$work/scene-cliff-embedded.json"
+# A scene character whose walk memory cannot hold: said, exit 1, not an abort.
+printf '{"format": "footfall-scene", "version": 1, "characters": [{"character_file": "biped.json", "steps": 5}, {"character_file": "hexapod.json", "crowd": 300000, "steps": 100, "crowd_spacing": 0.01}]}' > "$work/scene/huge.json"
+(ulimit -v 1500000; "$footfall" generate --terrain "$hills" --scene "$work/scene/huge.json" --out "$work/huge.json" 2> "$work/huge.err")
+check "scene beyond memory: exit 1" [ $? -eq 1 ]
+check "scene beyond memory: said" grep -q 'hexapod2: out of memory generating its walk' "$work/huge.err"
 # Bad uses: per-character flags with --scene, neither --scene nor --character, a resampled
 # mesh's samples (one per character), a bad scene file named with its character and field.
 "$footfall" generate --terrain "$work/floor.pts" --scene "$work/scene/scene.json" --start 1,0,1 \
