@@ -51,14 +51,15 @@ Status ParseGenerateRequest(const std::string& text, Character* character, Gener
   constexpr int kMaxDepth = 32;
   json j;
   if (!detail::ParseJsonText(text, "request", &j, error, kMaxDepth)) return Status::kParseError;
-  return detail::ReadGenerateRequest(j, "request", "", {}, character, options, error);
+  return detail::ReadGenerateRequest(j, "request", "", {}, character, options, nullptr, error);
 }
 
 namespace detail {
 
 Status ReadGenerateRequest(const json& j, const std::string& source, const std::string& folder,
                            const std::set<std::string>& refused, Character* character,
-                           GenerateOptions* options, std::string* error) {
+                           GenerateOptions* options, std::string* character_file,
+                           std::string* error) {
   if (!j.is_object()) {
     *error = source + ": not a JSON object";
     return Status::kParseError;
@@ -84,6 +85,7 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
       *error = source + ": 'character': expected a character file's object";
       return Status::kParseError;
     }
+    if (character_file) character_file->clear();
     s = ParseCharacter(j["character"].dump(), source + " character", character, error);
   } else {
     if (!j["character_file"].is_string() || j["character_file"].get<std::string>().empty() ||
@@ -93,9 +95,10 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
     }
     // A relative path is read from `folder` (the scene file's), if one is given; the file's
     // errors then also name the scene's character.
-    const std::string file = j["character_file"].get<std::string>();
-    s = LoadCharacter(!folder.empty() && file[0] != '/' ? folder + "/" + file : file, character,
-                      error);
+    const std::string given = j["character_file"].get<std::string>();
+    const std::string file = !folder.empty() && given[0] != '/' ? folder + "/" + given : given;
+    if (character_file) *character_file = file;
+    s = LoadCharacter(file, character, error);
     if (s != Status::kOk && !folder.empty()) *error = source + ": " + *error;
   }
   if (s != Status::kOk) return s;

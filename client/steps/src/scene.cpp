@@ -63,15 +63,11 @@ Status ParseScene(const std::string& text, const std::string& source, const std:
       entry.erase("name");
     }
     // "fps" is the whole walk's (--fps).
-    const Status read =
-        detail::ReadGenerateRequest(entry, where, folder, {"fps"}, &c.character, &c.options, error);
+    const Status read = detail::ReadGenerateRequest(entry, where, folder, {"fps"}, &c.character,
+                                                    &c.options, &c.character_file, error);
     if (read != Status::kOk) return read;
     c.has_start_frame = entry.contains("start_frame");
     c.has_up = entry.contains("up");
-    if (entry.contains("character_file")) {
-      const std::string file = entry["character_file"];  // read above: a string
-      c.character_file = !folder.empty() && file[0] != '/' ? folder + "/" + file : file;
-    }
     c.name = name.empty() ? c.character.name + std::to_string(i + 1) : name;
     if (!names.insert(c.name).second) {
       *error = where + ": the name '" + ShownText(c.name) +
