@@ -87,3 +87,26 @@ TEST_CASE("PinnedFile reads the file it checked, whatever its path leads to afte
   PinnedFile fifo;
   CHECK(fifo.Open(root, root + "/fifo.pts", "fifo.pts", &message) == Status::kInvalidArgument);
 }
+
+TEST_CASE("PinnedFile names the file for the loaders by the extension the client gave",
+          "[service]") {
+  // A client's "hills.pts" may be a link into a store whose files have no extension (or another
+  // one): the format is the one the client's name says, as for a local file of that name.
+  ScratchDir scratch;
+  const std::string root = scratch.path;
+  REQUIRE(mkdir((root + "/store").c_str(), 0700) == 0);
+  Write(root + "/store/0a1b2c", "0 0 0 0 1 0\n");
+  Write(root + "/store/mesh.obj", "0 0 0 0 1 0\n");
+  std::string message;
+  PinnedFile blob;
+  REQUIRE(blob.Open(root, root + "/store/0a1b2c", "hills.pts", &message) == Status::kOk);
+  CHECK(blob.path().substr(blob.path().rfind('/')) == "/terrain.pts");
+  CHECK(Read(blob.path()) == "0 0 0 0 1 0\n");
+  PinnedFile renamed;
+  REQUIRE(renamed.Open(root, root + "/store/mesh.obj", "sub.d/points.xyz", &message) ==
+          Status::kOk);
+  CHECK(renamed.path().substr(renamed.path().rfind('/')) == "/terrain.xyz");
+  PinnedFile bare;
+  REQUIRE(bare.Open(root, root + "/store/mesh.obj", "sub.d/points", &message) == Status::kOk);
+  CHECK(bare.path().substr(bare.path().rfind('/')) == "/terrain");
+}

@@ -72,9 +72,11 @@ Status PinnedFile::Open(const std::string& root, const std::string& path, const 
     return Status::kIoError;
   }
   dir_ = dir;
-  const size_t slash = path.rfind('/'), dot = path.rfind('.');
+  // The format is the one the client's name says, as for a local file of that name: not the
+  // resolved target's (a link into an extensionless blob store).
+  const size_t slash = shown.rfind('/'), dot = shown.rfind('.');
   const std::string ext = dot != std::string::npos && (slash == std::string::npos || dot > slash)
-                              ? path.substr(dot)
+                              ? shown.substr(dot)
                               : "";
   const std::string link = dir_ + "/terrain" + ext;
   if (symlink(self.c_str(), link.c_str()) != 0) {

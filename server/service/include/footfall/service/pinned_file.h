@@ -36,8 +36,9 @@ class PinnedFile {
   Status Open(const std::string& root, const std::string& path, const std::string& shown,
               std::string* message);
 
-  // A path that reads the opened file, with the original's extension; empty before Open
-  // succeeds. Valid while this object lives.
+  // A path that reads the opened file, with the extension of `shown` (the name the client
+  // gave, which may be a link to a file named otherwise); empty before Open succeeds. Valid
+  // while this object lives.
   const std::string& path() const { return link_; }
 
  private:
