@@ -2,6 +2,7 @@
 // `footfall-view --query`.
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <string>
 #include <utility>
 
@@ -67,6 +68,7 @@ TEST_CASE("malformed query lines say what was expected", "[client][query_text]")
       {"snap 1 2 1e999", "snap: argument 3 '1e999' is not a finite number"},
       {"snap 1 2 3x", "snap: argument 3 '3x' is not a finite number"},
       {"snap 1 2 ++3", "snap: argument 3 '++3' is not a finite number"},
+      {"snap +-1 2 3", "snap: argument 1 '+-1' is not a finite number"},
       {"next 1 2 3 0 0 0", kZero},
       {"next 1 2 3 0,-0,0", kZero},
       // Bad text is shown short and without control bytes (a 1 MB token was echoed whole).
@@ -92,7 +94,12 @@ TEST_CASE("number tokens are whole finite decimals", "[client][query_text]") {
   CHECK(v == -0.25);
   CHECK(ParseFiniteNumber("+3", &v));
   CHECK(v == 3);
-  for (const char* bad : {"", "+", "x", "3x", " 3", "++3", "nan", "inf", "-inf", "1e999", "0x10"}) {
+  // Too small for a double: zero of its sign, as in terrain files (it was "not a finite number").
+  CHECK(ParseFiniteNumber("-1e-400", &v));
+  CHECK(v == 0);
+  CHECK(std::signbit(v));
+  for (const char* bad :
+       {"", "+", "x", "3x", " 3", "++3", "+-3", "nan", "inf", "-inf", "1e999", "0x10"}) {
     INFO("'" << bad << "'");
     v = 7;
     CHECK_FALSE(ParseFiniteNumber(bad, &v));

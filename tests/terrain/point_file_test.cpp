@@ -186,6 +186,24 @@ TEST_CASE("ReadDecimal reads decimal numbers only, tiny ones as zero", "[terrain
   CHECK(v == 0);
   CHECK(std::signbit(v));
   CHECK(ReadDecimal("1e400", &v) == DecimalRead::kTooLarge);
+  // Too small or too large by the power of ten of the first non-zero digit, whatever the
+  // leading zeros and the exponent's sign ("00.000...1" was said to be out of range).
+  const std::string zeros(400, '0');
+  for (const std::string& tiny : std::initializer_list<std::string>{
+           "00.0" + zeros + "1", "-0.0" + zeros + "1e+5", "." + zeros + "1",
+           "+0" + zeros + ".0" + zeros + "1", "1e-99999999999999999999", "100e-326"}) {
+    INFO(tiny);
+    v = 7;
+    CHECK(ReadDecimal(tiny, &v) == DecimalRead::kNumber);
+    CHECK(v == 0);
+    CHECK(std::signbit(v) == (tiny[0] == '-'));
+  }
+  for (const std::string& huge : std::initializer_list<std::string>{
+           "00" + zeros + "1" + zeros, "0.1e400", "-0.0" + zeros + "1e+800",
+           "1e99999999999999999999", "1" + zeros + "e-10"}) {
+    INFO(huge);
+    CHECK(ReadDecimal(huge, &v) == DecimalRead::kTooLarge);
+  }
   for (const char* bad : {"0x10", "0X1p3", "+-1", "++1", "1,5", "1.5.", "", "+", "-", "e5", "1e"}) {
     INFO(bad);
     CHECK(ReadDecimal(bad, &v) == DecimalRead::kNotANumber);

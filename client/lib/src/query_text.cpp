@@ -1,10 +1,9 @@
 #include "footfall/client/query_text.h"
 
-#include <charconv>
-#include <cmath>
 #include <sstream>
 #include <vector>
 
+#include "footfall/terrain/decimal_number.h"
 #include "footfall/terrain/shown_text.h"
 
 namespace footfall {
@@ -15,14 +14,8 @@ constexpr const char* kForms = "snap X Y Z, normal X Y Z or next X Y Z DX DY DZ"
 }  // namespace
 
 bool ParseFiniteNumber(const std::string& token, double* value) {
-  const char* first = token.data();
-  const char* last = first + token.size();
-  if (first != last && *first == '+') ++first;
-  double v = 0;
-  const auto [ptr, ec] = std::from_chars(first, last, v);
-  if (ec != std::errc() || ptr != last || !std::isfinite(v)) return false;
-  *value = v;
-  return true;
+  // The terrain files' reader: one sign at most ("+-1" is no number), tiny values as zero.
+  return ParseFiniteDecimal(token, value);
 }
 
 const char* QueryOpName(QueryOp op) {

@@ -1,5 +1,6 @@
 #include "footfall/terrain/decimal_number.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <system_error>
@@ -7,13 +8,28 @@
 namespace footfall {
 namespace {
 
-// For a number out of a double's range: true when it is too small (a negative exponent, or no
-// exponent and no whole part, as 0.000...1), false when too large.
+// For a number out of a double's range: true when it is too small, false when too large. Its
+// decimal magnitude (the power of ten of its first non-zero digit: -3 for "0.00125e0", 2 for
+// "00125") is below -300 or above 300 then, so its sign decides ("00.000...1" and
+// "0.000...1e+5" are too small, "0.1e400" too large).
 bool Underflows(std::string_view number) {
-  const size_t e = number.find_first_of("eE");
-  if (e != std::string_view::npos) return e + 1 < number.size() && number[e + 1] == '-';
   if (!number.empty() && (number[0] == '-' || number[0] == '+')) number.remove_prefix(1);
-  return number.substr(0, 2) == "0." || number.substr(0, 1) == ".";
+  const size_t e = number.find_first_of("eE");
+  const std::string_view mantissa = number.substr(0, e);
+  const size_t point = std::min(mantissa.find('.'), mantissa.size());
+  const size_t first = mantissa.find_first_of("123456789");
+  if (first == std::string_view::npos) return true;  // zero
+  long long magnitude = first < point ? static_cast<long long>(point - first) - 1
+                                      : -static_cast<long long>(first - point);
+  if (e != std::string_view::npos) {
+    std::string_view exponent = number.substr(e + 1);
+    const bool negative = !exponent.empty() && exponent[0] == '-';
+    if (!exponent.empty() && (exponent[0] == '-' || exponent[0] == '+')) exponent.remove_prefix(1);
+    long long value = 0;  // saturated: 1e9 is as far beyond range as any larger exponent
+    for (char c : exponent) value = std::min<long long>(value * 10 + (c - '0'), 1000000000);
+    magnitude += negative ? -value : value;
+  }
+  return magnitude < 0;
 }
 
 }  // namespace

@@ -22,7 +22,9 @@ struct QueryText {
 };
 
 // Parses one whole token as a finite decimal number ("1.5", "-2", "+3e1"): false for anything
-// else, including "nan", "inf", out-of-range values and trailing characters.
+// else, including "nan", "inf", values beyond a double's range, a second sign ("+-1") and
+// trailing characters. A value too small for a double ("1e-400") reads as zero, as in terrain
+// files.
 bool ParseFiniteNumber(const std::string& token, double* value);
 
 // `line` without its comment: the text before the first '#'.
