@@ -138,6 +138,15 @@ expect(EXIT_NONZERO "hills: these sizes at --spacing 0.05 give about 40000040000
        terrain make hills --size 100000 -o "${WORK}/x.pts")
 expect(EXIT_NONZERO "flat: these sizes at --spacing 0.001 give about 4e+24 samples"
        terrain make flat --size 2000000000 --spacing 0.001 -o "${WORK}/x.pts")
+# A coarse spacing does not make the work small: a tread takes a sample however coarse it is
+# (this ran out of memory making 4 billion samples), rocks are modelled 0.25 apart and blocks
+# one unit cube at a time whatever the spacing (these ran for minutes, or out of memory).
+expect(EXIT_NONZERO "stairs: these sizes at --spacing 1e+12 give about 4294967294 samples, more than the 20000000 allowed"
+       terrain make stairs --steps 2147483647 --spacing 1e12 -o "${WORK}/x.pts")
+expect(EXIT_NONZERO "rocks: these sizes give a mesh of about 64000000 cells to sample (rocks are modelled 0.25 apart, whatever --spacing), more than the 20000000 allowed"
+       terrain make rocks --size 2000 --spacing 10 -o "${WORK}/x.pts")
+expect(EXIT_NONZERO "blocks: these sizes give a mesh of about 1236950580816 cells to sample (a face per side of a unit cube)"
+       terrain make blocks --max-height 2147483647 --spacing 1e6 -o "${WORK}/x.pts")
 expect(EXIT_NONZERO "--height-scale: 'nan' is not a finite number"
        terrain info "${WORK}/hill.asc" --height-scale nan)
 if(EXISTS "${WORK}/x.pts")

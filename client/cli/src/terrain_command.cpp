@@ -144,7 +144,12 @@ constexpr double kMaxMadeSamples = 20000000;
 double EstimateSamples(const MakeFlags& f) {
   const double per_area = 1 / (f.spacing * f.spacing);
   const std::string& k = f.kind;
-  if (k == "stairs") return f.steps * (f.run + std::fabs(f.rise)) * f.width * per_area;
+  if (k == "stairs") {
+    // As MakeStairs counts them: a tread and a riser take at least one sample each way, however
+    // coarse the spacing (2 billion treads at --spacing 1e12 were "about 0" samples).
+    auto count = [&f](double length) { return std::max(1.0, std::round(length / f.spacing)); };
+    return f.steps * (count(f.width) + 1) * (count(f.run) + count(std::fabs(f.rise)) - 1);
+  }
   if (k == "blocks")
     return static_cast<double>(f.size) * f.size * (1 + 4.0 * f.max_height) * per_area;
   if (k == "ramp") {
@@ -155,6 +160,18 @@ double EstimateSamples(const MakeFlags& f) {
   if (k == "sphere") return 4 * 3.14159265358979323846 * f.radius * f.radius * per_area;
   const double side = f.size / f.spacing + 1;  // rocks, flat, hills
   return side * side;
+}
+
+// About how many cells the mesh that `make` samples has (blocks: a face per exposed side of a
+// unit cube; rocks: cells 0.25 wide, or --spacing if finer), which a coarse --spacing does not
+// make smaller; 0 for the kinds whose work the sample count bounds.
+double EstimateMeshCells(const MakeFlags& f) {
+  if (f.kind == "blocks") return static_cast<double>(f.size) * f.size * (1 + 4.0 * f.max_height);
+  if (f.kind == "rocks") {
+    const double n = std::ceil(f.size / std::min(f.spacing, 0.25));
+    return n * n;
+  }
+  return 0;
 }
 
 // `x` with 3 significant digits ("4e+24"), for counts far beyond any limit.
@@ -175,6 +192,19 @@ int RunMake(const MakeFlags& f) {
       << (estimate < 1e15 ? std::to_string(std::llround(estimate)) : Format3(estimate))
       << " samples, more than the " << std::setprecision(10) << kMaxMadeSamples
       << " allowed (raise --spacing or make it smaller)";
+    std::cerr << m.str() << '\n';
+    return 1;
+  }
+  const double cells = EstimateMeshCells(f);
+  if (!(cells <= kMaxMadeSamples)) {
+    std::ostringstream m;
+    m << "footfall terrain make: " << k << ": these sizes give a mesh of about "
+      << (cells < 1e15 ? std::to_string(std::llround(cells)) : Format3(cells))
+      << " cells to sample ("
+      << (k == "rocks" ? "rocks are modelled 0.25 apart, whatever --spacing"
+                       : "a face per side of a unit cube")
+      << "), more than the " << std::setprecision(10) << kMaxMadeSamples
+      << " allowed (make it smaller)";
     std::cerr << m.str() << '\n';
     return 1;
   }
