@@ -65,6 +65,10 @@ check "long line: four answers" [ "$(wc -l < "$work/long.jsonl")" -eq 4 ]
 check "long line: an error naming the line" grep -qx '{"op":"error","line":2,"message":"line longer than 4096 characters"}' <(sed -n 2p "$work/long.jsonl")
 check "long line: the lines after it are answered" grep -q '"op":"snap","found":true,"index":12' <(sed -n 3p "$work/long.jsonl")
 check "long line: a last line without newline is answered" grep -q '"op":"snap","found":true' <(sed -n 4p "$work/long.jsonl")
+# stdin that cannot be read (a directory) is an error, not an empty input answered with exit 0.
+err=$("$footfall" query --terrain "$work/flat.pts" 2>&1 >/dev/null < "$work")
+check "unreadable stdin: exit 1" [ $? -eq 1 ]
+check "unreadable stdin: message" grep -qF "footfall query: cannot read stdin after line 0: Is a directory" <<< "$err"
 
 # 3. Bad terrain files: the documented message and a non-zero exit, never a crash.
 bad() {  # bad NAME CONTENT EXPECTED_MESSAGE

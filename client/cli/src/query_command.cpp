@@ -2,6 +2,9 @@
 #include <poll.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <limits>
 #include <string>
@@ -178,7 +181,15 @@ int RunQuery(const QueryFlags& flags) {
       block.clear();
     }
   }
+  // A read error ends the input as the end of the file does: say so (stdin a directory, or a
+  // terminal gone, answered nothing and exited 0).
+  const int read_error = !std::ferror(stdin) ? 0 : errno ? errno : EIO;
   if (!block.empty()) ok = RunBlock(*session, terrain, flags.tolerance, block) && ok;
+  if (read_error) {
+    std::cerr << "footfall query: cannot read stdin after line " << line << ": "
+              << std::strerror(read_error) << '\n';
+    return 1;
+  }
   return ok ? 0 : 1;
 }
 
