@@ -69,6 +69,11 @@ check "long line: a last line without newline is answered" grep -q '"op":"snap",
 err=$("$footfall" query --terrain "$work/flat.pts" 2>&1 >/dev/null < "$work")
 check "unreadable stdin: exit 1" [ $? -eq 1 ]
 check "unreadable stdin: message" grep -qF "footfall query: cannot read stdin after line 0: Is a directory" <<< "$err"
+# Answers that cannot be written (a full disk; SIGPIPE is ignored) are an error, not exit 0.
+err=$(printf 'snap 1 0 1\nsnap 2 0 2\n' | "$footfall" query --terrain "$work/flat.pts" 2>&1 > /dev/full)
+check "unwritable stdout: exit 1" [ $? -eq 1 ]
+check "unwritable stdout: message" grep -qF "footfall query: cannot write the answers to stdout (line " <<< "$err"
+check "unwritable stdout: why" grep -qF "No space left on device" <<< "$err"
 
 # 3. Bad terrain files: the documented message and a non-zero exit, never a crash.
 bad() {  # bad NAME CONTENT EXPECTED_MESSAGE

@@ -179,12 +179,20 @@ int RunQuery(const QueryFlags& flags) {
     if (block.size() >= kBlock || (!block.empty() && !InputReady())) {
       ok = RunBlock(*session, terrain, flags.tolerance, block) && ok;
       block.clear();
+      if (!std::cout) break;  // answers that cannot be written: stop reading
     }
   }
   // A read error ends the input as the end of the file does: say so (stdin a directory, or a
   // terminal gone, answered nothing and exited 0).
   const int read_error = !std::ferror(stdin) ? 0 : errno ? errno : EIO;
-  if (!block.empty()) ok = RunBlock(*session, terrain, flags.tolerance, block) && ok;
+  if (!block.empty() && std::cout) ok = RunBlock(*session, terrain, flags.tolerance, block) && ok;
+  // (SIGPIPE is ignored: a reader gone, or a full disk, left every answer lost and exit 0.)
+  if (!std::cout) {
+    const int why = errno ? errno : EIO;
+    std::cerr << "footfall query: cannot write the answers to stdout (line " << line
+              << " read): " << std::strerror(why) << '\n';
+    return 1;
+  }
   if (read_error) {
     std::cerr << "footfall query: cannot read stdin after line " << line << ": "
               << std::strerror(read_error) << '\n';
