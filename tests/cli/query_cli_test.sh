@@ -48,6 +48,12 @@ check "zero direction" grep -q '"line":5,"message":"next: direction DX DY DZ mus
 check "answers after errors" grep -q '"op":"snap","found":true,"index":12' <(sed -n 5p "$work/out.jsonl")
 check "count" grep -qF '{"op":"error","line":7,"message":"normal: expected 3 numbers, found 2"}' <(sed -n 6p "$work/out.jsonl")
 check "commas separate numbers" grep -q '"op":"snap","found":true,"index":12' <(sed -n 7p "$work/out.jsonl")
+# Input that starts with a UTF-8 byte order mark (a file saved by a Windows editor): line 1 is
+# answered (it was "unknown command 'snap'", the mark unseen); a mark on a later line is an error.
+printf '\xEF\xBB\xBFsnap 2 0 2\r\n\xEF\xBB\xBFsnap 2 0 2\r\n' | "$footfall" query --terrain "$work/flat.pts" > "$work/bom.jsonl"
+check "byte order mark: exit 1 for the second line" [ $? -eq 1 ]
+check "byte order mark: the first line answered" grep -q '"op":"snap","found":true,"index":12' <(sed -n 1p "$work/bom.jsonl")
+check "byte order mark: not on a later line" grep -q '"op":"error","line":2,"message":"unknown command' <(sed -n 2p "$work/bom.jsonl")
 # A byte that is not UTF-8 in a line: that line's error (the byte replaced), and the run goes on
 # (the JSON writer threw, and no later line was answered).
 printf 'snap \xff 0 0\nsnap 2 0 2\n' | "$footfall" query --terrain "$work/flat.pts" > "$work/utf8.jsonl"

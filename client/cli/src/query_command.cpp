@@ -54,7 +54,10 @@ bool ReadLine(std::istream& in, std::string* text, bool* too_long) {
 }
 
 bool ParseCommand(const std::string& text, size_t line, Command* out) {
-  const std::string command = WithoutComment(text);
+  // A UTF-8 byte order mark, as every text file footfall reads may start with (one saved by a
+  // Windows editor): else the first command was "unknown command 'snap'", the mark unseen.
+  const bool bom = line == 1 && text.compare(0, 3, "\xEF\xBB\xBF") == 0;
+  const std::string command = WithoutComment(bom ? text.substr(3) : text);
   if (command.find_first_not_of(" \t\r\v\f") == std::string::npos) return false;
   *out = Command{};
   out->line = line;
