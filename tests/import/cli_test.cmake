@@ -34,6 +34,13 @@ file(WRITE "${WORK}/far.pts" "0 0 0 0 1 0\n1e308 0 0 0 1 0\n")
 file(WRITE "${WORK}/tall.asc" "ncols 2\nnrows 2\ncellsize 1\nNODATA_value -3.4e38\n1 -3.4e38\n1e20 2\n")
 file(WRITE "${WORK}/hill.asc" "ncols 3\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 1 1\n1 2 1\n1 1 1\n")
 
+# A description that cannot be written (a full disk) is an error, not exit 0.
+execute_process(COMMAND "${FOOTFALL}" terrain info "${WORK}/hill.asc" RESULT_VARIABLE rc
+                OUTPUT_FILE /dev/full ERROR_VARIABLE err)
+if(rc EQUAL 0 OR NOT err MATCHES "footfall terrain info: cannot write to stdout: No space left")
+  message(FATAL_ERROR "terrain info to a full disk: exit ${rc}, '${err}'")
+endif()
+
 # Good files.
 expect(EXIT_ZERO "faces: 6" terrain info "${WORK}/cube.obj" --separation 0.1)
 expect(EXIT_ZERO "grid:" terrain info "${WORK}/cube.obj" --separation 0.1)

@@ -1,7 +1,9 @@
 // `footfall terrain`: convert meshes and height maps to point files, describe terrain files, and
 // make synthetic test terrain.
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -134,6 +136,12 @@ int RunInfo(const InfoFlags& flags) {
             << g.cell_size << ", " << g.occupied_cells << " occupied, " << g.bytes << " bytes\n"
             << "stored within: " << g.max_rounding
             << " of the given coordinates (float offsets from the centre of the bulk)\n";
+  // (A full disk lost the description with exit 0.)
+  if (!std::cout.flush()) {
+    std::cerr << "footfall terrain info: cannot write to stdout: "
+              << std::strerror(errno ? errno : EIO) << '\n';
+    return 1;
+  }
   return 0;
 }
 
