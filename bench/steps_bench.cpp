@@ -12,6 +12,7 @@
 #include "footfall/import/terrain_generators.h"
 #include "footfall/steps/character.h"
 #include "footfall/steps/generator.h"
+#include "footfall/steps/scene.h"
 #include "server_process.h"
 
 namespace footfall {
@@ -134,6 +135,46 @@ BENCHMARK(BM_WalkRpc)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1)
     ->UseRealTime();
+
+// A scene of characters that are not one crowd (each with its own start and heading: 40
+// hexapods x 50 steps) over RPC: walked at once, their rounds of queries joined into one call
+// (GenerateSceneWalks, Arg 1), against the baseline of one after the other (Arg 0).
+void BM_SceneRpc(benchmark::State& state) {
+  Backend& b = Rpc();
+  constexpr int kCharacters = 40;
+  std::vector<const Character*> characters(kCharacters, &Hexapod());
+  std::vector<GenerateOptions> options(kCharacters);
+  for (int i = 0; i < kCharacters; ++i) {
+    GenerateOptions& o = options[i];
+    o.has_start = true;
+    o.start = {5.0 + 1.2 * (i % 8), 0, 5.0 + 5.0 * (i / 8)};
+    o.heading = {0.1 * (i % 3 - 1), 0, 1};
+    o.steps = 50;
+  }
+  const bool joined = state.range(0) == 1;
+  for (auto _ : state) {
+    std::vector<SceneWalk> walks(kCharacters);
+    if (joined) {
+      GenerateSceneWalks(*b.session, b.terrain, characters, options, &walks);
+    } else {
+      for (int i = 0; i < kCharacters; ++i)
+        walks[i].status = GenerateWalk(*b.session, b.terrain, *characters[i], options[i],
+                                       &walks[i].walk, &walks[i].error);
+    }
+    for (const SceneWalk& w : walks) {
+      if (w.status != Status::kOk || !w.walk.stopped.empty()) {
+        state.SkipWithError(w.status != Status::kOk ? w.error.c_str() : w.walk.stopped.c_str());
+        return;
+      }
+    }
+    benchmark::DoNotOptimize(walks);
+  }
+  state.SetLabel(joined ? "at once, joined calls" : "one after the other");
+  state.counters["per_char_step_us"] =
+      benchmark::Counter(kCharacters * 50 * 1e-6, benchmark::Counter::kIsIterationInvariantRate |
+                                                      benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_SceneRpc)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace footfall

@@ -5,8 +5,10 @@
 
 #include <catch2/catch.hpp>
 
+#include "counting_session.h"
 #include "footfall/client/terrain_session.h"
 #include "footfall/import/terrain_generators.h"
+#include "footfall/steps/scene.h"
 #include "server_process.h"
 #include "walk_checks.h"
 
@@ -108,6 +110,65 @@ TEST_CASE("A walk over RPC whose server is gone before its first step fails with
   CHECK(GenerateWalk(*served.rpc, served.handle, c, o, &w, &error) == Status::kUnavailable);
   CHECK_THAT(error, Catch::Contains("footfalld at 127.0.0.1:"));
   CHECK(w.tracks.empty());
+}
+
+TEST_CASE("A scene over RPC walks its characters at once, each as it walks alone, in fewer calls",
+          "[steps][rpc][scene]") {
+  const double spacing = 0.03;
+  const RawSamples samples = MakeHills(300, spacing, 0.05, 7);
+  ServedTerrain served(samples);
+  Terrain embedded = LoadTerrain(samples, spacing);
+  // Characters of every kind, with their own starts, headings, a path and a crowd; the last
+  // one's heading is zero, so it fails at once while the others walk.
+  std::vector<Character> kinds;
+  std::vector<GenerateOptions> options;
+  auto add = [&](const std::string& name, Vec3 start, Vec3 heading) {
+    kinds.push_back(LoadShipped(name));
+    GenerateOptions o;
+    o.has_start = true, o.start = start, o.heading = heading, o.steps = 10;
+    options.push_back(o);
+  };
+  add("biped", {1.5, 0.3, 1}, {0, 0, 1});
+  add("biped", {3, 0.3, 8}, {0.3, 0, -1});
+  add("quadruped", {4.5, 0.3, 1.5}, {0.2, 0, 1});
+  add("hexapod", {6.5, 0.3, 1}, {-0.3, 0, 1});
+  add("hexapod", {3, 0.3, 5.5}, {1, 0, 0});
+  options.back().crowd = 3, options.back().crowd_spacing = 0.4;
+  add("octopod", {7.5, 0.3, 7.5}, {0, 0, -1});
+  options.back().path = {{7.5, 0, 5.5}, {6, 0, 5.5}};
+  add("biped", {5, 0.3, 5}, {0, 0, 0});
+  std::vector<const Character*> characters;
+  for (const Character& c : kinds) characters.push_back(&c);
+
+  CountingSession joined_calls(*served.rpc);
+  std::vector<SceneWalk> walks;
+  GenerateSceneWalks(joined_calls, served.handle, characters, options, &walks);
+  REQUIRE(walks.size() == characters.size());
+  CountingSession alone_calls(*served.rpc);
+  for (size_t i = 0; i < characters.size(); ++i) {
+    INFO("character " << i << " " << kinds[i].name);
+    CHECK(walks[i].walked);
+    Walk alone, alone_rpc;
+    std::string error;
+    const Status want =
+        GenerateWalk(*embedded.session, embedded.handle, kinds[i], options[i], &alone, &error);
+    CHECK(GenerateWalk(alone_calls, served.handle, kinds[i], options[i], &alone_rpc, &error) ==
+          want);
+    REQUIRE(walks[i].status == want);
+    if (want != Status::kOk) {
+      CHECK(i == characters.size() - 1);
+      CHECK_FALSE(walks[i].error.empty());
+      continue;
+    }
+    CHECK(walks[i].walk.stopped == "");
+    CHECK(SameKeys(walks[i].walk, alone));
+    CheckWalk(embedded, kinds[i], options[i], walks[i].walk);
+  }
+  // One after the other, each character makes its own calls; at once, a round's calls are
+  // shared (fewer than half as many here, with six characters of four kinds walking: footfalld
+  // takes one tolerance per batch of next queries, so only characters alike share those).
+  INFO("joined " << joined_calls.query_calls << " calls, alone " << alone_calls.query_calls);
+  CHECK(2 * joined_calls.query_calls < alone_calls.query_calls);
 }
 
 }  // namespace footfall::test

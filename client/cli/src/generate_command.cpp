@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <mutex>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -101,6 +102,27 @@ class ProgressBar {
  private:
   std::chrono::steady_clock::time_point last_{};
   bool shown_ = false;
+};
+
+// One bar for a scene's characters, walked one after the other or at once: the mean of their
+// shares done. Update may be called from several threads.
+class SceneProgress {
+ public:
+  explicit SceneProgress(size_t characters) : shares_(characters, 0.0) {}
+  void Update(size_t character, int done, int total) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    shares_[character] = total > 0 ? static_cast<double>(done) / total : 1.0;
+    double sum = 0;
+    for (double s : shares_) sum += s;
+    constexpr int kScale = 1000;
+    bar_.Update(static_cast<int>(sum / static_cast<double>(shares_.size()) * kScale), kScale);
+  }
+  void Finish() { bar_.Finish(); }
+
+ private:
+  std::mutex mutex_;
+  std::vector<double> shares_;
+  ProgressBar bar_;
 };
 
 // Draws `bar` as the walk advances when asked (--progress), or for a long run on a terminal.
@@ -408,7 +430,7 @@ bool ReportWalkEnd(const Walk& walk, const LoadedTerrain& terrain) {
   return true;
 }
 
-// `footfall generate --scene`: every character of the scene file walked in turn on the terrain
+// `footfall generate --scene`: every character of the scene file walked on the terrain
 // (loaded once, or resampled for each character that needs it), their walks written as one.
 int RunScene(const GenerateFlags& flags) {
   std::string error;
@@ -452,47 +474,90 @@ int RunScene(const GenerateFlags& flags) {
       return 1;
     }
   }
+  std::vector<const Character*> characters;
+  std::vector<GenerateOptions> options;
+  long long work = 0;  // characters times steps, for the progress bar
+  for (const SceneCharacter& c : scene) {
+    characters.push_back(&c.character);
+    GenerateOptions o = c.options;
+    o.fps = flags.fps;
+    o.threads = flags.threads;
+    if (!c.has_up) o.up = base.up;
+    if (!c.has_start_frame) o.start_frame = flags.start_frame;
+    work += static_cast<long long>(o.crowd) * (o.steps < 0 ? kDefaultSteps : o.steps);
+    options.push_back(std::move(o));
+  }
+  SceneProgress progress(scene.size());
+  if (flags.progress || (work >= 20000 && isatty(STDERR_FILENO))) {
+    for (size_t i = 0; i < options.size(); ++i)
+      options[i].progress = [&progress, i](int done, int total) {
+        progress.Update(i, done, total);
+      };
+  }
+  // The characters walk on the shared terrain together (over footfalld, their queries joined
+  // into one call per round), or one after the other, each on the terrain resampled for it.
+  std::vector<SceneWalk> walks;
+  std::string failed;  // the first failure, named by its character
+  try {
+    if (!per_character) {
+      GenerateSceneWalks(*shared.session, shared.handle, characters, options, &walks);
+    } else {
+      walks.resize(scene.size());
+      for (size_t i = 0; i < scene.size() && failed.empty(); ++i) {
+        LoadedTerrain own;
+        if (!LoadWalkTerrain(flags, scene[i].character, &options[i], &own, &error)) {
+          failed = scene[i].name + ": " + error;
+          break;
+        }
+        std::vector<SceneWalk> one;
+        GenerateSceneWalks(*own.session, own.handle, {characters[i]}, {options[i]}, &one);
+        walks[i] = std::move(one.front());
+        if (walks[i].status != Status::kOk) {
+          if (!walks[i].out_of_memory) failed = scene[i].name + ": " + walks[i].error;
+          break;
+        }
+      }
+    }
+  } catch (const std::bad_alloc&) {
+    walks.clear();
+  }
+  progress.Finish();
   Walk walk;
   walk.fps = flags.fps;
-  int code = 0;
-  for (SceneCharacter& c : scene) {
-    GenerateOptions options = c.options;
-    options.fps = flags.fps;
-    options.threads = flags.threads;
-    if (!c.has_up) options.up = base.up;
-    if (!c.has_start_frame) options.start_frame = flags.start_frame;
-    LoadedTerrain own;
-    if (per_character && !LoadWalkTerrain(flags, c.character, &options, &own, &error)) {
-      error = c.name + ": " + error;
-      code = 1;
-      break;
-    }
-    const LoadedTerrain& terrain = per_character ? own : shared;
-    ProgressBar bar;
-    ShowProgress(flags, &bar, &options);
-    Walk one;
-    Status status;
-    try {
-      status = GenerateWalk(*terrain.session, terrain.handle, c.character, options, &one, &error);
-      if (status == Status::kOk) AddToSceneWalk(c.name, std::move(one), &walk);
-    } catch (const std::bad_alloc&) {
-      bar.Finish();
-      std::cerr << "footfall generate: " << c.name << ": out of memory generating its walk; "
+  size_t walked = 0;
+  for (size_t i = 0; i < walks.size(); ++i) {
+    SceneWalk& w = walks[i];
+    if (w.out_of_memory) {
+      std::cerr << "footfall generate: " << scene[i].name << ": out of memory generating its walk; "
                 << "nothing was written (give fewer characters, crowds or steps)\n";
       return 1;
     }
-    bar.Finish();
-    if (status != Status::kOk) {
-      error = c.name + ": " + error;
-      code = 1;
-      break;
+    if (!w.walked) continue;
+    if (w.status != Status::kOk) {
+      if (failed.empty()) failed = scene[i].name + ": " + w.error;
+      continue;
     }
+    try {
+      AddToSceneWalk(scene[i].name, std::move(w.walk), &walk);
+    } catch (const std::bad_alloc&) {
+      std::cerr << "footfall generate: " << scene[i].name << ": out of memory generating its walk; "
+                << "nothing was written (give fewer characters, crowds or steps)\n";
+      return 1;
+    }
+    ++walked;
   }
-  if (code != 0) {
-    // The characters walked so far are kept: written, then the failure said.
-    std::cerr << "footfall generate: " << error << '\n';
+  if (walks.empty() && failed.empty()) {
+    std::cerr << "footfall generate: out of memory setting out the scene's walks; nothing was "
+                 "written (give fewer characters, crowds or steps)\n";
+    return 1;
+  }
+  if (!failed.empty()) {
+    // The characters that walked are kept: written, then the failure said.
+    std::cerr << "footfall generate: " << failed << '\n';
     if (!walk.tracks.empty()) {
-      std::cerr << "footfall generate: the walks of the characters before it are written\n";
+      std::cerr << "footfall generate: the walks of the " << walked
+                << (walked == 1 ? " character that walked are" : " characters that walked are")
+                << " written\n";
       WriteOutputs(flags, shared, walk);
     }
     return 1;

@@ -46,4 +46,28 @@ Status ParseScene(const std::string& text, const std::string& source, const std:
 // name. The scene's `stopped` is the first character's to stop, with a count of the others.
 void AddToSceneWalk(const std::string& name, Walk&& walk, Walk* scene);
 
+// Scene characters walked at once over a session that is not in process (GenerateSceneWalks).
+constexpr size_t kJoinedSceneCharacters = 64;
+
+// One scene character's walk, as GenerateSceneWalks made it.
+struct SceneWalk {
+  bool walked = false;          // GenerateWalk ran for it (false: an earlier character failed)
+  Status status = Status::kOk;  // GenerateWalk's
+  std::string error;
+  bool out_of_memory = false;  // generating it ran out of memory (status kLimitExceeded)
+  Walk walk;
+};
+
+// Generates the walk of every scene character on one loaded terrain: (*out)[i] for
+// characters[i] with options[i], as GenerateWalk takes them. Over a session that answers in
+// process, they walk one after the other, and a character that fails leaves the rest unwalked.
+// Over any other (RPC), up to kJoinedSceneCharacters walk at once, each on a thread of its own,
+// their rounds of queries joined into one session call per round (JoinedCalls): one round trip
+// for the whole scene, not one per character; a character that fails leaves the others walking.
+// The walks are the same either way. options[i].progress may be called from several threads
+// at once.
+void GenerateSceneWalks(TerrainSession& session, TerrainHandle terrain,
+                        const std::vector<const Character*>& characters,
+                        const std::vector<GenerateOptions>& options, std::vector<SceneWalk>* out);
+
 }  // namespace footfall
