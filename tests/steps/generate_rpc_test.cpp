@@ -1,5 +1,6 @@
 // The step generator over RPC against a real footfalld on loopback: a server that dies in the
 // middle of a walk leaves the walk made so far, stopped at the step it died in.
+#include <atomic>
 #include <memory>
 #include <string>
 
@@ -9,6 +10,7 @@
 #include "footfall/client/terrain_session.h"
 #include "footfall/import/terrain_generators.h"
 #include "footfall/steps/scene.h"
+#include "generator_fixtures.h"
 #include "server_process.h"
 #include "walk_checks.h"
 
@@ -169,6 +171,41 @@ TEST_CASE("A scene over RPC walks its characters at once, each as it walks alone
   // takes one tolerance per batch of next queries, so only characters alike share those).
   INFO("joined " << joined_calls.query_calls << " calls, alone " << alone_calls.query_calls);
   CHECK(2 * joined_calls.query_calls < alone_calls.query_calls);
+}
+
+TEST_CASE("A scene over RPC whose server dies keeps every character's steps so far",
+          "[steps][rpc][scene]") {
+  const Character c = LoadShipped("hexapod");
+  const double spacing = c.step_length / 5;
+  const RawSamples samples = MakeFlat(400, spacing, 0);
+  ServedTerrain served(samples);
+  constexpr int kCharacters = 5;
+  std::vector<const Character*> characters(kCharacters, &c);
+  std::vector<GenerateOptions> options(kCharacters);
+  std::atomic<bool> killed{false};
+  for (int i = 0; i < kCharacters; ++i) {
+    options[i].has_start = true;
+    options[i].start = {1 + 1.5 * i, 0, 1};
+    options[i].steps = 60;
+    // The server is killed once the third character has done six steps.
+    if (i == 2)
+      options[i].progress = [&](int done, int) {
+        if (done == 6 && !killed.exchange(true)) served.server.Kill();
+      };
+  }
+  std::vector<SceneWalk> walks;
+  GenerateSceneWalks(*served.rpc, served.handle, characters, options, &walks);
+  REQUIRE(killed);
+  REQUIRE(walks.size() == static_cast<size_t>(kCharacters));
+  for (int i = 0; i < kCharacters; ++i) {
+    INFO("character " << i);
+    CHECK(walks[i].walked);
+    REQUIRE(walks[i].status == Status::kOk);
+    const Walk& w = walks[i].walk;
+    CHECK_THAT(w.stopped, Catch::Contains("footfalld at 127.0.0.1:"));
+    CHECK(StepsDone(w) >= 5);
+    CHECK(StepsDone(w) < 60);
+  }
 }
 
 }  // namespace footfall::test
