@@ -216,14 +216,15 @@ int RunMake(const MakeFlags& f) {
     std::cerr << m.str() << '\n';
     return 1;
   }
+  std::string why;  // the mesh sampler's, for blocks, ramp and rocks
   if (k == "stairs") {
     samples = MakeStairs(f.steps, f.rise, f.run, f.width, f.spacing);
   } else if (k == "blocks") {
-    samples = MakeBlocks(f.size, f.size, f.max_height, f.spacing, f.seed);
+    samples = MakeBlocks(f.size, f.size, f.max_height, f.spacing, f.seed, &why);
   } else if (k == "ramp") {
-    samples = MakeRamps(f.slopes, f.length, f.width, f.spacing);
+    samples = MakeRamps(f.slopes, f.length, f.width, f.spacing, &why);
   } else if (k == "rocks") {
-    samples = MakeRocks(f.size, f.amplitude, f.spacing, f.seed);
+    samples = MakeRocks(f.size, f.amplitude, f.spacing, f.seed, &why);
   } else if (k == "sphere") {
     // Fibonacci lattice with about one sample per spacing^2 of surface.
     const double area = 4 * 3.14159265358979323846 * f.radius * f.radius;
@@ -237,7 +238,9 @@ int RunMake(const MakeFlags& f) {
   }
   std::string error;
   if (samples.size() == 0) {
-    std::cerr << "footfall terrain make: " << k << ": the parameters give no samples\n";
+    // The sampler's reason, when it refused (rocks 10 km high: "no samples" said nothing).
+    std::cerr << "footfall terrain make: " << k << ": "
+              << (why.empty() ? "the parameters give no samples" : why) << '\n';
     return 1;
   }
   for (const Vec3& p : samples.points) {

@@ -148,30 +148,33 @@ RawSamples MakeRamp(int nx, int nz, double spacing, double slope_deg) {
 
 namespace {
 
-RawSamples Sample(const TriangleMesh& mesh, double spacing, bool smooth, uint64_t seed) {
+RawSamples Sample(const TriangleMesh& mesh, double spacing, bool smooth, uint64_t seed,
+                  std::string* error) {
   MeshSampleOptions options;
   options.separation = spacing;
   options.smooth_normals = smooth;
   options.seed = seed;
   RawSamples s;
-  SampleMesh(mesh, options, &s, nullptr);  // empty on a bad spacing
+  SampleMesh(mesh, options, &s, error);  // empty on a bad spacing
   return s;
 }
 
 }  // namespace
 
-RawSamples MakeBlocks(int nx, int nz, int max_height, double spacing, uint64_t seed) {
-  return Sample(MakeBlocksMesh(nx, nz, max_height, seed), spacing, false, seed);
+RawSamples MakeBlocks(int nx, int nz, int max_height, double spacing, uint64_t seed,
+                      std::string* error) {
+  return Sample(MakeBlocksMesh(nx, nz, max_height, seed), spacing, false, seed, error);
 }
 
 RawSamples MakeRamps(const std::vector<double>& slopes_deg, double length, double width,
-                     double spacing) {
-  return Sample(MakeRampsMesh(slopes_deg, length, width), spacing, false, 1);
+                     double spacing, std::string* error) {
+  return Sample(MakeRampsMesh(slopes_deg, length, width), spacing, false, 1, error);
 }
 
-RawSamples MakeRocks(double size, double amplitude, double spacing, uint64_t seed) {
+RawSamples MakeRocks(double size, double amplitude, double spacing, uint64_t seed,
+                     std::string* error) {
   const int n = std::max(1, static_cast<int>(std::ceil(size / std::min(spacing, 0.25))));
-  return Sample(MakeRocksMesh(n, size / n, amplitude, seed), spacing, true, seed);
+  return Sample(MakeRocksMesh(n, size / n, amplitude, seed), spacing, true, seed, error);
 }
 
 }  // namespace footfall

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "footfall/terrain/samples.h"
@@ -41,10 +42,14 @@ RawSamples MakeRamp(int nx, int nz, double spacing, double slope_deg);
 
 // The meshes of mesh_generators.h resampled at separation `spacing` (mesh_sampler.h) with the
 // given seed: blocks of unit cubes (flat normals), ramps of the given slopes joined by flat
-// landings (flat normals), rocky noise over a square `size` wu wide (smooth normals).
-RawSamples MakeBlocks(int nx, int nz, int max_height, double spacing, uint64_t seed);
+// landings (flat normals), rocky noise over a square `size` wu wide (smooth normals). Empty when
+// the sampler refuses (too many samples for its area, non-finite vertices): *error, when given,
+// then says why.
+RawSamples MakeBlocks(int nx, int nz, int max_height, double spacing, uint64_t seed,
+                      std::string* error = nullptr);
 RawSamples MakeRamps(const std::vector<double>& slopes_deg, double length, double width,
-                     double spacing);
-RawSamples MakeRocks(double size, double amplitude, double spacing, uint64_t seed);
+                     double spacing, std::string* error = nullptr);
+RawSamples MakeRocks(double size, double amplitude, double spacing, uint64_t seed,
+                     std::string* error = nullptr);
 
 }  // namespace footfall
