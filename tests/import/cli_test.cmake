@@ -154,6 +154,10 @@ expect(EXIT_NONZERO "rocks: these sizes give a mesh of about 64000000 cells to s
        terrain make rocks --size 2000 --spacing 10 -o "${WORK}/x.pts")
 expect(EXIT_NONZERO "blocks: these sizes give a mesh of about 1236950580816 cells to sample (a face per side of a unit cube)"
        terrain make blocks --max-height 2147483647 --spacing 1e6 -o "${WORK}/x.pts")
+# Sizes far beyond the grid's range are refused as such, whatever the spacing (a sphere of
+# radius 1e300 at --spacing 1e300 was "about -nan samples").
+expect(EXIT_NONZERO "sphere: the parameters give coordinates beyond 5e+14"
+       terrain make sphere --radius 1e300 --spacing 1e300 -o "${WORK}/x.pts")
 # A mesh the sampler refuses says why (it was "the parameters give no samples").
 expect(EXIT_NONZERO "rocks: separation 0.5 would give about "
        terrain make rocks --size 2 --spacing 0.5 --amplitude 1e15 -o "${WORK}/x.pts")

@@ -148,9 +148,10 @@ int RunInfo(const InfoFlags& flags) {
 // The most samples `terrain make` writes (about 1 GB of point file).
 constexpr double kMaxMadeSamples = 20000000;
 
-// About how many samples `make` would write, in double so that no flag can overflow it.
+// About how many samples `make` would write, in double so that no flag can overflow it (areas
+// in units of spacing^2, measured per side: a 1e300 sphere at --spacing 1e300 was inf * 0,
+// "about -nan samples").
 double EstimateSamples(const MakeFlags& f) {
-  const double per_area = 1 / (f.spacing * f.spacing);
   const std::string& k = f.kind;
   if (k == "stairs") {
     // As MakeStairs counts them: a tread and a riser take at least one sample each way, however
@@ -158,14 +159,14 @@ double EstimateSamples(const MakeFlags& f) {
     auto count = [&f](double length) { return std::max(1.0, std::round(length / f.spacing)); };
     return f.steps * (count(f.width) + 1) * (count(f.run) + count(std::fabs(f.rise)) - 1);
   }
-  if (k == "blocks")
-    return static_cast<double>(f.size) * f.size * (1 + 4.0 * f.max_height) * per_area;
+  if (k == "blocks") return f.size / f.spacing * (f.size / f.spacing) * (1 + 4.0 * f.max_height);
   if (k == "ramp") {
     double run = f.length;  // the landing
     for (double slope : f.slopes) run += f.length / std::cos(slope * 3.14159265358979323846 / 180);
-    return run * f.width * per_area;
+    return run / f.spacing * (f.width / f.spacing);
   }
-  if (k == "sphere") return 4 * 3.14159265358979323846 * f.radius * f.radius * per_area;
+  if (k == "sphere")
+    return 4 * 3.14159265358979323846 * (f.radius / f.spacing) * (f.radius / f.spacing);
   const double side = f.size / f.spacing + 1;  // rocks, flat, hills
   return side * side;
 }
@@ -226,10 +227,9 @@ int RunMake(const MakeFlags& f) {
   } else if (k == "rocks") {
     samples = MakeRocks(f.size, f.amplitude, f.spacing, f.seed, &why);
   } else if (k == "sphere") {
-    // Fibonacci lattice with about one sample per spacing^2 of surface.
-    const double area = 4 * 3.14159265358979323846 * f.radius * f.radius;
-    samples = MakeSphere(static_cast<int>(area / (f.spacing * f.spacing)) + 1, {0, f.radius, 0},
-                         f.radius);
+    // Fibonacci lattice with about one sample per spacing^2 of surface (the estimate: no inf /
+    // inf cast to int for a sphere as large as its spacing).
+    samples = MakeSphere(static_cast<int>(estimate) + 1, {0, f.radius, 0}, f.radius);
   } else if (k == "flat") {
     samples = MakeFlat(static_cast<int>(f.size / f.spacing) + 1, f.spacing, 0);
   } else if (k == "hills") {
