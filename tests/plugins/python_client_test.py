@@ -130,6 +130,9 @@ class EmbeddedTest(unittest.TestCase):
                      lambda: self.s.next(t, [(0, 0, 0, 1, 0, 0)], 10 ** 400),
                      lambda: self.s.snap(t, [(10 ** 400, 0, 0)]),
                      lambda: self.s.load_file("x.pts", 10 ** 400),
+                     # (A NaN separation was taken for the default, an infinite one refused.)
+                     lambda: self.s.load_file(HILLS, float("nan")),
+                     lambda: self.s.load_server_file(HILLS, float("nan")),
                      lambda: self.s.generate(t, deep),
                      lambda: self.s.check_character(deep)):
             with self.assertRaises(ff.FootfallError) as e:
@@ -462,6 +465,19 @@ class RpcTest(unittest.TestCase):
     def test_bad_port_is_rejected(self):
         with self.assertRaises(ff.FootfallError):
             ff.Session.rpc("127.0.0.1", 70000)
+
+    def test_hosts_and_ports_that_are_not_text_and_numbers_raise_footfall_errors(self):
+        # (A host of 123 raised AttributeError; "127.0.0.1\0x" reached 127.0.0.1; a port of
+        # True was port 1.)
+        for host, port in ((123, self.server.port), (b"127.0.0.1", self.server.port),
+                           ("127.0.0.1\0x", self.server.port), ("127.0.0.1", True)):
+            with self.assertRaises(ff.FootfallError) as e:
+                ff.Session.rpc(host, port)
+            self.assertEqual(e.exception.status_name, "invalid_argument")
+        with ff.Session.rpc("h\u00f4st\ud800.invalid", self.server.port, timeout=2.0) as s:
+            self.assertFalse(s.ping())  # an unknown host, not an encoding error
+        with ff.Session.rpc(None, self.server.port) as s:
+            self.assertTrue(s.ping())  # None is 127.0.0.1
 
 
 class ConnectionTest(unittest.TestCase):

@@ -140,7 +140,9 @@ int32_t ffc_load_file(ffc_session* s, const char* path, double separation, uint3
   return Guard(s, [&]() -> int32_t {
     if (!path || !terrain) return BadArgument(s, "path and terrain must not be NULL");
     footfall::TerrainLoadOptions options;
-    options.separation = separation > 0 ? separation : 0;
+    // (<= 0: the default. A NaN is passed on, to be refused as an infinite one is: it was
+    // taken for the default.)
+    options.separation = separation > 0 || std::isnan(separation) ? separation : 0;
     return Result(s, s->session->LoadFile(path, options, terrain));
   });
 }
@@ -150,7 +152,9 @@ int32_t ffc_load_server_file(ffc_session* s, const char* path, double separation
   return Guard(s, [&]() -> int32_t {
     if (!path || !terrain) return BadArgument(s, "path and terrain must not be NULL");
     footfall::TerrainLoadOptions options;
-    options.separation = separation > 0 ? separation : 0;
+    // (<= 0: the default. A NaN is passed on, to be refused as an infinite one is: it was
+    // taken for the default.)
+    options.separation = separation > 0 || std::isnan(separation) ? separation : 0;
     return Result(s, s->session->LoadServerFile(path, options, terrain));
   });
 }

@@ -132,7 +132,13 @@ class Session:
         """A footfalld client at host:port; it connects lazily (the first call may raise
         FootfallError 'unavailable'). `timeout` is per call in seconds."""
         lib = load_library(library)
-        if not isinstance(port, int) or not 1 <= port <= 65535:
+        if host is not None and not isinstance(host, str):
+            raise FootfallError(INVALID_ARGUMENT, "host %r: expected a host name or address as "
+                                "text" % (host,), "ffc_open_rpc")
+        if host and "\0" in host:  # C would read it cut short at the NUL: another host
+            raise FootfallError(INVALID_ARGUMENT, "host %r: holds a NUL byte" % (host,),
+                                "ffc_open_rpc")
+        if isinstance(port, bool) or not isinstance(port, int) or not 1 <= port <= 65535:
             raise FootfallError(INVALID_ARGUMENT, "port %r: expected 1 to 65535" % (port,), "ffc_open_rpc")
         try:
             timeout = float(timeout)
@@ -141,7 +147,7 @@ class Session:
         if not timeout <= 1e6:
             raise FootfallError(INVALID_ARGUMENT, "timeout %r: expected at most 1e6 seconds"
                                 % (timeout,), "ffc_open_rpc")
-        handle = lib.lib.ffc_open_rpc((host or "").encode(), port, timeout)
+        handle = lib.lib.ffc_open_rpc((host or "").encode("utf-8", "replace"), port, timeout)
         if not handle:
             raise FootfallError(INVALID_ARGUMENT, "cannot open a client for %s:%d" % (host, port),
                                 "ffc_open_rpc")
