@@ -278,8 +278,9 @@ TEST_CASE("The C ABI refuses what would crash or hang it, and takes turns betwee
   CHECK(ffc_generate(s, 0, R"({"steps": 3, "steps": 4})", &json) == FF_C_PARSE_ERROR);
   CHECK_THAT(ffc_last_error(s), Catch::Contains("the key 'steps' appears twice"));
   const std::string file = std::string(FOOTFALL_SOURCE_DIR) + "/data/characters/biped.json";
-  for (const char* field : {R"("steps": 18446744073709551615)", R"("steps": -1)", R"("crowd": 0)",
-                            R"("crowd": -1)", R"("fps": 1e-300)", R"("crowd_spacing": 1e308)"}) {
+  for (const char* field :
+       {R"("steps": 18446744073709551615)", R"("steps": -1)", R"("crowd": 0)", R"("crowd": -1)",
+        R"("fps": 1e-300)", R"("crowd_spacing": 1e308)", R"("start_frame": -1e10)"}) {
     const std::string request = R"({"character_file": ")" + file + "\", " + field + "}";
     INFO(request);
     CHECK(ffc_generate(s, 0, request.c_str(), &json) == FF_C_PARSE_ERROR);

@@ -92,6 +92,17 @@ TEST_CASE("Scene file errors name the file the character and the field", "[steps
   CHECK_THAT(SceneError(Scene(R"({"name": "a", "character_file": "biped.json"},
                                  {"name": "a", "character_file": "quadruped.json"})")),
              Catch::Contains("characters[1]: the name 'a' is another character's"));
+  // An unnamed character's name is made up: the message says so, not that it gave that name.
+  CHECK_THAT(SceneError(Scene(R"({"name": "biped2", "character_file": "biped.json"},
+                                 {"character_file": "biped.json"})")),
+             Catch::Contains("characters[1]: the name 'biped2' is another character's (it has "
+                             "no 'name', and is named after its character file's name"));
+  // A start frame beyond the flag's bounds names its field (it was refused later, naming
+  // only the character and every bound of the start, the frame and the fps at once).
+  CHECK_THAT(SceneError(Scene(R"({"character_file": "biped.json", "start_frame": 1e10})")),
+             Catch::Contains("s.json: characters[0]: 'start_frame': expected a number from "
+                             "-1e+09 to 1e+09"));
+  CHECK(SceneError(Scene(R"({"character_file": "biped.json", "start_frame": -1e9})")) == "");
   CHECK_THAT(SceneError(Scene(R"({"name": "a/b", "character_file": "biped.json"})")),
              Catch::Contains("'name': a name without '/'"));
   CHECK_THAT(SceneError(Scene(R"({"name": "", "character_file": "biped.json"})")),

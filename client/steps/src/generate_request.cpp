@@ -107,9 +107,14 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
     ok = ReadVec(j["start"], source, "start", &o.start, error), o.has_start = true;
   if (ok && j.contains("heading")) ok = ReadVec(j["heading"], source, "heading", &o.heading, error);
   if (ok && j.contains("up")) ok = ReadVec(j["up"], source, "up", &o.up, error);
-  if (ok && j.contains("start_frame"))
-    ok = ReadNumber(j["start_frame"], source, "start_frame", &o.start_frame, error);
   // The bounds of `footfall generate`'s flags.
+  if (ok && j.contains("start_frame")) {
+    ok = ReadNumber(j["start_frame"], source, "start_frame", &o.start_frame, error);
+    if (ok && !(std::fabs(o.start_frame) <= kMaxStartFrame)) {
+      *error = source + ": 'start_frame': expected a number from -1e+09 to 1e+09";
+      ok = false;
+    }
+  }
   if (ok && j.contains("fps")) {
     ok = ReadNumber(j["fps"], source, "fps", &o.fps, error);
     if (ok && !(o.fps >= 0.001 && o.fps <= kMaxFps)) {

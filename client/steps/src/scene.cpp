@@ -70,8 +70,10 @@ Status ParseScene(const std::string& text, const std::string& source, const std:
     c.has_up = entry.contains("up");
     c.name = name.empty() ? c.character.name + std::to_string(i + 1) : name;
     if (!names.insert(c.name).second) {
-      *error = where + ": the name '" + ShownText(c.name) +
-               "' is another character's (give each a name of its own)";
+      *error = where + ": the name '" + ShownText(c.name) + "' is another character's " +
+               (name.empty() ? "(it has no 'name', and is named after its character file's name "
+                               "and its place in the list: give it a 'name' of its own)"
+                             : "(give each a name of its own)");
       return Status::kInvalidArgument;
     }
     scene.push_back(std::move(c));
