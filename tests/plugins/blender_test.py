@@ -326,6 +326,15 @@ class BlenderAddonTest(unittest.TestCase):
             bpy.ops.footfall.import_walk(filepath=far_walk)
         self.assertIn("frame -1000000000 is beyond Blender's frame range", str(e.exception))
         self.assertEqual(set(bpy.data.objects), before)
+        # A walk whose tracks have no keys: its empties were made, then "has no keys" reported.
+        no_keys = os.path.join(ARGS.work_dir, "no_keys.json")
+        with open(no_keys, "w") as f:
+            json.dump({"tracks": [{"name": "L1", "kind": "foot", "keys": []},
+                                  {"name": "body", "kind": "body", "keys": []}]}, f)
+        with self.assertRaises(RuntimeError) as e:
+            bpy.ops.footfall.import_walk(filepath=no_keys)
+        self.assertIn("has no keys", str(e.exception))
+        self.assertEqual(set(bpy.data.objects), before)
 
     def test_4_biped_setup_picks_ik_targets(self):
         with open(os.path.join(CHARACTERS, "biped.json")) as f:
@@ -782,6 +791,24 @@ class BlenderAddonTest(unittest.TestCase):
         self.assertIn("no track for this rig", str(e.exception))
         after = {o.name: fcurve_keys(o, "location", 3) for o in list(feet.values()) + [body]}
         self.assertEqual(after, before)
+        # Tracks of this rig without keys (beside another's keyed track, or alone): its keys
+        # were cleared from the walk's first frame (frame 0 when no track had a key) before the
+        # import found nothing to key.
+        for name, tracks in (("empty_tracks.json", [{"name": "L", "kind": "foot", "keys": []}]),
+                             ("empty_rig_tracks.json", [
+                                 {"name": "L", "kind": "foot", "keys": []},
+                                 {"name": "body", "kind": "body", "keys": []},
+                                 {"name": "X1", "kind": "foot", "keys": [
+                                     {"frame": 1, "position": [0, 0, 0]}]}])):
+            empty = os.path.join(ARGS.work_dir, name)
+            with open(empty, "w") as f:
+                json.dump({"tracks": tracks}, f)
+            with self.assertRaises(RuntimeError) as e:
+                bpy.ops.footfall.import_walk(filepath=empty)
+            self.assertTrue("has no keys" in str(e.exception) or
+                            "no track for this rig" in str(e.exception), str(e.exception))
+            after = {o.name: fcurve_keys(o, "location", 3) for o in list(feet.values()) + [body]}
+            self.assertEqual(after, before)
         # Character files the generator refuses, and a "name" that is not text: a report, and
         # nothing made (a version 2 file made a whole rig; a numeric name raised TypeError).
         with open(os.path.join(CHARACTERS, "biped.json")) as f:

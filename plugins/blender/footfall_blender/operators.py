@@ -751,6 +751,10 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
                 walk = character.read_json(path, "walk file")
             character.check_walk(walk, path)  # before anything is made
             keying.check_frames(walk)
+            # (A walk whose tracks had no keys made their empties, or cleared the rig's keys from
+            # frame 0 on, and then reported that it had no keys.)
+            if not any(t.get("keys") for t in walk["tracks"]):
+                return _fail(self, "footfall: %s has no keys" % path)
             crowd = sorted({t.get("character", "") for t in walk["tracks"]})
             if rig_obj is not None:
                 if len(crowd) > 1:
@@ -760,7 +764,8 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
                 feet, body = rig_targets(context.scene, rig_obj)
                 keying.check_parents(list(feet.values()) + [body])
                 # Nothing is cleared unless the walk keys something of this rig.
-                if not any((t.get("kind") == "body" and body) or t["name"] in feet
+                if not any(t.get("keys") and ((t.get("kind") == "body" and body) or
+                                              t["name"] in feet)
                            for t in walk["tracks"]):
                     return _fail(self, "footfall: %s has no track for this rig's feet or body; the "
                                  "rig's keys are unchanged" % path)
