@@ -780,6 +780,55 @@ class MayaKeyWalkTest(unittest.TestCase):
                     sys.modules[name] = module
         return calls
 
+    def test_import_of_tracks_without_keys_changes_nothing(self):
+        # Tracks of the rig without keys (alone, or beside another's keyed track) cut the rig's
+        # keys from the walk's first frame (frame 0 when no track had a key), and with no rig
+        # made their locators, before anything was keyed.
+        import types
+        calls = []
+        cmds = types.ModuleType("maya.cmds")
+        for name in ("setAttr", "xform", "setKeyframe", "cutKey", "spaceLocator", "warning",
+                     "confirmDialog"):
+            setattr(cmds, name, lambda *args, _name=name, **kwargs:
+                    calls.append((_name, args, kwargs)) or ["made"])
+        with open(os.path.join(CHARACTERS, "biped.json")) as f:
+            character_text = f.read()
+        cmds.getAttr = lambda *args, **kwargs: character_text
+        cmds.attributeQuery = lambda *args, **kwargs: True
+        cmds.listConnections = lambda plug, **kwargs: [plug.split(".")[1] + "_target"]
+        maya = types.ModuleType("maya")
+        maya.cmds = cmds
+        saved = {name: sys.modules.pop(name, None) for name in ("maya", "maya.cmds",
+                                                                "footfall_maya")}
+        sys.modules.update({"maya": maya, "maya.cmds": cmds})
+        sys.path.insert(0, os.path.join(REPO, "plugins", "maya"))
+        folder = tempfile.mkdtemp()
+        try:
+            import footfall_maya
+            for tracks in ([{"name": "L", "kind": "foot", "keys": []}],
+                           [{"name": "L", "kind": "foot", "keys": []},
+                            {"name": "body", "kind": "body", "keys": []},
+                            {"name": "X1", "kind": "foot",
+                             "keys": [{"frame": 1, "position": [0, 0, 0]}]}]):
+                path = os.path.join(folder, "walk.json")
+                with open(path, "w") as f:
+                    json.dump({"tracks": tracks}, f)
+                for rig in ("biped_rig", None) if len(tracks) == 1 else ("biped_rig",):
+                    del calls[:]
+                    self.assertIsNone(footfall_maya.import_walk(path, rig))
+                    made = [c[0] for c in calls if c[0] not in ("warning", "confirmDialog")]
+                    self.assertEqual(made, [], (tracks, rig))
+                    self.assertIn("warning", [c[0] for c in calls])
+        finally:
+            sys.path.pop(0)
+            for name, module in saved.items():
+                sys.modules.pop(name, None)
+                if module is not None:
+                    sys.modules[name] = module
+            for name in os.listdir(folder):
+                os.unlink(os.path.join(folder, name))
+            os.rmdir(folder)
+
     def test_body_turns_in_rotate_order_zxy(self):
         # Tilted 4 degrees on a slope, turning 2 degrees a key through heading +X (yaw 90: gimbal
         # lock in XYZ, where the channels swung by tens of degrees a key).

@@ -304,13 +304,16 @@ def import_walk(path, rig=None):
     crowd). Nothing is changed unless the walk keys something."""
     walk = ffc.character.read_json(path, "walk file")
     ffc.character.check_walk(walk, path)  # before any locator is made
+    # (Tracks without keys made their locators, or cut the rig's keys from frame 0 on.)
+    if not any(t.get("keys") for t in walk["tracks"]):
+        raise ValueError("%s has no keys" % path)
     crowd = sorted({t.get("character", "") for t in walk["tracks"]})
     if rig:
         if len(crowd) > 1:
             raise ValueError("a crowd walk (%d characters) goes onto new locators: import it "
                              "without a rig" % len(crowd))
         _, feet, body = _rig_targets(rig)
-        if not any((t.get("kind") == "body" and body) or t["name"] in feet
+        if not any(t.get("keys") and ((t.get("kind") == "body" and body) or t["name"] in feet)
                    for t in walk["tracks"]):
             raise ValueError("%s has no track for this rig's feet or body" % path)
         sets = [(walk, feet, body)]
