@@ -109,7 +109,24 @@ TEST_CASE("Crowd places that snap onto another character's start are left out",
   REQUIRE(w.stops.size() == 5);
   for (const std::string& stop : w.stops) {
     CHECK_THAT(stop, Catch::Contains("its place on the crowd's grid"));
-    CHECK_THAT(stop, Catch::Contains("left out of the walk"));
+    CHECK_THAT(stop, Catch::Contains("(the grid runs off the terrain there): left out"));
+  }
+}
+
+TEST_CASE("Crowd places closer than the terrain's samples are left out for their spacing",
+          "[steps][generator][crowd]") {
+  // A 2 x 2 grid 1 cm apart in the middle of ground sampled every 25 cm: every place snaps onto
+  // one sample, not because the grid runs off the terrain (as the stops said) but because the
+  // spacing is finer than the samples.
+  const Character c = LoadShipped("biped");
+  Terrain t = LoadTerrain(MakeFlat(40, 0.25, 0), 0.25);
+  const Walk w = Generate(t, c, CrowdOptions({5, 0, 5}, 4, 4, 0.01));
+  REQUIRE(w.stops.size() == 3);
+  for (const std::string& stop : w.stops) {
+    CHECK_THAT(stop, Catch::Contains("(the crowd's spacing, 0.01, is finer than the terrain's "
+                                     "samples, about 0.25"));
+    CHECK_THAT(stop, Catch::EndsWith("apart): left out of the walk"));
+    CHECK_THAT(stop, !Catch::Contains("runs off the terrain"));
   }
 }
 

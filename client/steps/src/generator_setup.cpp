@@ -62,6 +62,15 @@ Status Generator::Setup(std::string* error) {
   const std::vector<int> crowded = CrowdedStarts(points_.data(), answers_.data(), n, 0.5 * spacing);
   std::vector<Vec3> snapped_start(n);
   for (int i = 0; i < n; ++i) snapped_start[i] = answers_[i].point;
+  // Why places snap together: a grid finer than the terrain's samples (its neighbours snap onto
+  // one sample anywhere), or one running off the terrain.
+  Text crowded_why(3);
+  if (spacing < 0.5 * gap_) {
+    crowded_why << "the crowd's spacing, " << spacing << ", is finer than the terrain's samples, "
+                << "about " << 0.5 * gap_ << " apart";
+  } else {
+    crowded_why << "the grid runs off the terrain there";
+  }
   agents_.resize(n);
   walk_.tracks.clear();
   walk_.tracks.reserve(n * (feet + 1));
@@ -138,7 +147,7 @@ Status Generator::Setup(std::string* error) {
       m << "step 1 of " << a.id << ": its place on the crowd's grid, "
         << Point(first.point + offsets[i]) << ", snaps to " << Point(snapped_start[i])
         << ", within " << Distance(snapped_start[i], snapped_start[crowded[i]]) << " of "
-        << other.id << "'s start (the grid runs off the terrain there): left out of the walk";
+        << other.id << "'s start (" << crowded_why.str() << "): left out of the walk";
       a.walking = false, a.left_out = true;
       a.stopped = m.str(), a.stopped_step = 1;
     }
@@ -159,8 +168,7 @@ Status Generator::Setup(std::string* error) {
     if (stacked[i] < 0 || a.left_out) continue;
     Text m;
     m << "step 1 of " << a.id << ": its feet, around " << Point(a.ground) << ", stand where "
-      << agents_[stacked[i]].id
-      << "'s do (the grid runs off the terrain there): left out of the walk";
+      << agents_[stacked[i]].id << "'s do (" << crowded_why.str() << "): left out of the walk";
     a.walking = false, a.left_out = true;
     a.stopped = m.str(), a.stopped_step = 1;
   }
