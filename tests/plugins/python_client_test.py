@@ -312,7 +312,9 @@ class SharedLogicTest(unittest.TestCase):
                  '{"feet": [{"name": "L", "rest": [0.1, 0]}]}': "feet[0]: expected",
                  '{"feet": [{"name": "", "rest": [0.1, 0, 0]}]}': "feet[0]: expected",
                  '{"feet": [{"name": "L", "rest": [0, 0, 0]}, {"name": "L", "rest": [1, 0, 0]}]}':
-                     "feet[1]: the name 'L' is used twice"}
+                     "feet[1]: the name 'L' is used twice",
+                 # An integer beyond a double (OverflowError escaped).
+                 '{"feet": [{"name": "L", "rest": [1%s, 0, 0]}]}' % ("0" * 400): "feet[0]: expected"}
         for text, message in cases.items():
             with self.assertRaises(ff.FootfallError, msg=text) as e:
                 ff.character.parse(text, "c.json")
@@ -395,6 +397,17 @@ class SharedLogicTest(unittest.TestCase):
                    {"frame": 1, "position": [0, 0, 0], "rotation": [0, 0, 1]}]}]},
                 "expected \"rotation\""),
                ([], "expected footfall walk JSON")]
+        # Integers beyond a double, as JSON allows them (math.isfinite raised OverflowError,
+        # which Blender's Import showed as a traceback).
+        huge = 10 ** 400
+        bad += [({"tracks": [{"name": "L", "keys": [{"frame": huge, "position": [0, 0, 0]}]}]},
+                 "tracks[0].keys[0]: expected a finite \"frame\""),
+                ({"tracks": [{"name": "L", "keys": [{"frame": 1, "position": [0, -huge, 0]}]}]},
+                 "tracks[0].keys[0]: expected \"position\""),
+                (ff.character.parse_json('{"tracks": [{"name": "b", "kind": "body", "keys": '
+                                         '[{"frame": 1, "position": [0, 0, 0], "rotation": '
+                                         '[0, 0, 0, 1%s]}]}]}' % ("0" * 400)),
+                 "expected \"rotation\"")]
         for walk, message in bad:
             with self.assertRaises(ValueError, msg=str(walk)) as e:
                 ff.character.check_walk(walk, "w.json")

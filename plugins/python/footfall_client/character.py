@@ -121,7 +121,7 @@ def feet(data, name="character"):
                     not all(math.isfinite(c) for c in pos)):
                 raise ValueError
             out.append((foot_name, pos))
-        except (AttributeError, KeyError, TypeError, ValueError):
+        except (AttributeError, KeyError, TypeError, ValueError, OverflowError):
             raise FootfallError(INVALID_ARGUMENT, "%s: feet[%d]: expected {\"name\": NAME, "
                                 "\"rest\": [x, y, z]} (a non-empty name, three finite numbers)"
                                 % (name, i), "character") from None
@@ -154,7 +154,7 @@ def display_name(data, fallback):
 def number(data, key, default):
     try:
         return float(data.get(key, default))
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         return default
 
 
@@ -219,6 +219,17 @@ def with_overrides(data, **values):
     return out
 
 
+def _finite_number(value):
+    """Whether a JSON value is a finite number a double holds (an integer of 400 digits, which
+    JSON allows, is not: math.isfinite raised OverflowError on it)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
+
+
 def check_walk(walk, name="walk"):
     """Raises ValueError naming the first problem of a footfall walk dict (JSON format
     "footfall-walk", as read from a file), before a plugin keys or creates anything: tracks
@@ -229,8 +240,7 @@ def check_walk(walk, name="walk"):
 
     def finite(values, count):
         return (isinstance(values, list) and len(values) == count and
-                all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-                    for v in values))
+                all(_finite_number(v) for v in values))
 
     for t, track in enumerate(walk["tracks"]):
         where = "%s: tracks[%d]" % (name, t)
