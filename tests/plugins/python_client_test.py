@@ -207,6 +207,22 @@ class SharedLogicTest(unittest.TestCase):
         with self.assertRaises(ValueError):
             ff.sampling.sample_triangles([(0, 0, 0)] * 3, [(0, 1, 2)], 0)
 
+    def test_sampling_refuses_vertices_that_are_not_finite(self):
+        # (An infinite vertex, which a huge object scale makes in Blender's floats, or a
+        # separation too small for a double to count its samples, raised OverflowError, and a
+        # NaN vertex "cannot convert float NaN to integer": Terrain Setup showed a traceback.)
+        inf, nan = float("inf"), float("nan")
+        for pts, separation, message in (
+                ([(inf, 0, 0), (1, 0, 0), (0, 0, 1)], 0.1, "triangle 0"),
+                ([(nan, 0, 0), (1, 0, 0), (0, 0, 1)], 0.1, "triangle 0"),
+                ([(1e308, 0, 0), (-1e308, 0, 0), (0, 0, 1)], 0.1, "triangle 0"),
+                ([(1e300, 0, 0), (-1e300, 0, 0), (0, 0, 1e300)], 0.1, "triangle 0"),
+                ([(1e100, 0, 0), (-1e100, 0, 0), (0, 0, 1e100)], 0.1, "would make more than"),
+                ([(0, 0, 0), (1, 0, 0), (0, 0, 1)], 1e-300, "would make more than")):
+            with self.assertRaises(ValueError, msg=str(pts)) as e:
+                ff.sampling.sample_triangles(pts, [(0, 1, 2)], separation)
+            self.assertIn(message, str(e.exception))
+
     def test_sampling_refuses_more_samples_than_a_dcc_can_hold_before_sampling(self):
         # A 10 m square at 1 mm: about 100 million samples (tens of GB in pure Python).
         pts = [(0, 0, 0), (10, 0, 0), (0, 0, 10), (10, 0, 10)]

@@ -62,10 +62,18 @@ def check_sample_count(points, triangles, separation, max_samples=MAX_SAMPLES):
     if not separation > 0:
         raise ValueError("separation must be > 0, got %r" % (separation,))
     total = len(points)
-    for tri in triangles:
+    for t, tri in enumerate(triangles):
         a, b, c = (points[i] for i in tri)
         longest = max(_length(_sub(b, a)), _length(_sub(c, b)), _length(_sub(a, c)))
-        k = max(1, int(math.ceil(longest / separation - 1e-9)))
+        # (A vertex at infinity or NaN, as a huge object scale makes in Blender's floats,
+        # raised OverflowError, or ValueError "cannot convert float NaN to integer".)
+        ratio = longest / separation
+        if not math.isfinite(ratio):
+            raise ValueError("triangle %d (vertices %s): its corners are not finite numbers, or "
+                             "too far apart to measure"
+                             % (t, ", ".join("(%g, %g, %g)" % tuple(p) for p in (a, b, c))))
+        # (At most 1e9 a side, whose 5e17 samples are refused below, so the count stays a float.)
+        k = max(1, int(math.ceil(min(ratio, 1e9) - 1e-9)))
         total += (k - 1) * (k - 2) // 2 + 1.5 * (k - 1)
         if total > max_samples:
             raise ValueError("a separation of %g would make more than %d samples: choose a "
