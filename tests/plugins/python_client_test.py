@@ -858,6 +858,42 @@ class MayaKeyWalkTest(unittest.TestCase):
                 os.unlink(os.path.join(folder, name))
             os.rmdir(folder)
 
+    def test_rotations_of_any_length_are_turned_as_unit_quaternions(self):
+        # The walk reader keeps rotations as written (non-zero); the viewer and exporters scale
+        # them to unit length. Blender keyed [0, 2, 0, 2] as 49 degrees (its matrices take the
+        # quaternion as unit), Maya divided by a norm that underflowed (1e-200: ZeroDivisionError)
+        # or overflowed (1e200: the identity).
+        import importlib.util
+        spec = importlib.util.spec_from_file_location(
+            "footfall_blender_axes", os.path.join(REPO, "plugins", "blender", "footfall_blender",
+                                                  "axes.py"))
+        axes = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(axes)
+        raw = (0.17, 0.33, 0.05, 0.93)  # a turn of 40 degrees, pitched and rolled a little
+        n = math.sqrt(sum(c * c for c in raw))
+        unit = tuple(c / n for c in raw)
+        want = axes.quat_from_ff(unit)
+        self.assertAlmostEqual(sum(c * c for c in want), 1.0, places=15)
+        want_zxy = ff.rotation.quat_to_euler_zxy(unit)
+        want_xyz = ff.rotation.quat_to_euler_xyz(unit)
+        for scale in (2.0, 100.0, 1e-200, 1e200, 1e-310):
+            q = tuple(c * scale for c in raw)
+            for got, expected in ((axes.quat_from_ff(q), want),
+                                  (ff.rotation.quat_to_euler_zxy(q), want_zxy),
+                                  (ff.rotation.quat_to_euler_xyz(q), want_xyz)):
+                for a, b in zip(got, expected):
+                    self.assertAlmostEqual(a, b, places=9, msg=(scale, got, expected))
+        for bad in ((0, 0, 0, 0), (0, float("nan"), 0, 1), (0, float("inf"), 0, 1)):
+            with self.assertRaises(ValueError):
+                axes.quat_from_ff(bad)
+            with self.assertRaises(ValueError):
+                ff.rotation.quat_to_euler_zxy(bad)
+        # A zero rotation is refused before anything is keyed, as the walk reader refuses it.
+        with self.assertRaises(ValueError) as e:
+            ff.character.check_walk({"tracks": [{"name": "b", "kind": "body", "keys": [
+                {"frame": 1, "position": [0, 0, 0], "rotation": [0, 0, 0, 0]}]}]}, "w.json")
+        self.assertIn("tracks[0].keys[0]: expected \"rotation\"", str(e.exception))
+
     def test_body_turns_in_rotate_order_zxy(self):
         # Tilted 4 degrees on a slope, turning 2 degrees a key through heading +X (yaw 90: gimbal
         # lock in XYZ, where the channels swung by tens of degrees a key).

@@ -14,9 +14,17 @@ def from_ff(v):
 
 
 def quat_from_ff(q):
-    """footfall rotation (x, y, z, w) -> Blender quaternion order (w, x, y, z)."""
+    """footfall rotation (x, y, z, w) -> Blender unit quaternion, order (w, x, y, z). Scaled to
+    unit length as footfall's walk reader takes it (Blender's matrices take the quaternion as
+    unit: [0, 2, 0, 2] was keyed as 49 degrees, not 90). ValueError for a zero quaternion."""
     x, y, z, w = (float(c) for c in q)
-    return (w, x, -z, y)
+    m = max(abs(x), abs(y), abs(z), abs(w))
+    if not 0 < m < float("inf") or any(c != c for c in (x, y, z, w)):  # (c != c: a NaN)
+        raise ValueError("rotation %r: expected a non-zero quaternion of finite numbers" % (q,))
+    if not 1e-100 < m < 1e100:  # the squares would lose digits, or be 0 or infinite
+        x, y, z, w = x / m, y / m, z / m, w / m
+    n = (x * x + y * y + z * z + w * w) ** 0.5
+    return (w / n, x / n, -z / n, y / n)
 
 
 def quat_to_ff(q):

@@ -257,5 +257,7 @@ def check_walk(walk, name="walk"):
                 raise ValueError("%s: expected a finite \"frame\"" % at)
             if not finite(key.get("position"), 3):
                 raise ValueError("%s: expected \"position\": [x, y, z] (finite numbers)" % at)
-            if "rotation" in key and not finite(key["rotation"], 4):
-                raise ValueError("%s: expected \"rotation\": [x, y, z, w] (finite numbers)" % at)
+            if "rotation" in key and (not finite(key["rotation"], 4) or
+                                      not any(key["rotation"])):
+                raise ValueError("%s: expected \"rotation\": [x, y, z, w] (finite numbers, not "
+                                 "all zero)" % at)

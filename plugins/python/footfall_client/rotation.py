@@ -9,10 +9,25 @@ import math
 from .vectors import cross, unit
 
 
+def unit_quat(q):
+    """q (x, y, z, w), any non-zero length, as a unit quaternion, as footfall's walk reader
+    takes it: scaled by its largest component first, so that neither tiny (1e-320) nor huge
+    (1e200) components underflow or overflow. ValueError for a zero or non-finite q."""
+    q = tuple(float(c) for c in q)
+    if not all(math.isfinite(c) for c in q) or not any(q):
+        raise ValueError("rotation %r: expected a non-zero quaternion of finite numbers" % (q,))
+    n2 = sum(c * c for c in q)
+    if not 1e-200 < n2 < 1e200:  # its square would lose digits, or be 0 or infinite
+        m = max(abs(c) for c in q)
+        q = tuple(c / m for c in q)
+        n2 = sum(c * c for c in q)
+    n = math.sqrt(n2)
+    return tuple(c / n for c in q)
+
+
 def quat_to_euler_xyz(q):
     """(x, y, z, w) -> (rx, ry, rz) degrees with R = Rz(rz) * Ry(ry) * Rx(rx)."""
-    n = math.sqrt(sum(c * c for c in q))
-    x, y, z, w = (c / n for c in q)
+    x, y, z, w = unit_quat(q)
     m00 = 1 - 2 * (y * y + z * z)
     m01 = 2 * (x * y - z * w)
     m10 = 2 * (x * y + z * w)
@@ -50,8 +65,7 @@ def closest_euler(euler, previous):
 def quat_to_euler_zxy(q):
     """(x, y, z, w) -> (rx, ry, rz) degrees with R = Ry(ry) * Rx(rx) * Rz(rz): Maya's rotate
     order ZXY (rotateOrder 2). rx is in [-90, 90]; at gimbal lock (rx = +-90) rz is 0."""
-    n = math.sqrt(sum(c * c for c in q))
-    x, y, z, w = (c / n for c in q)
+    x, y, z, w = unit_quat(q)
     m00 = 1 - 2 * (y * y + z * z)
     m02 = 2 * (x * z + y * w)
     m10 = 2 * (x * y + z * w)
