@@ -66,7 +66,7 @@ int32_t ffc_ping(ffc_session* s);
 const char* ffc_status_name(int32_t status);
 
 /* Loads a terrain file read on this machine (points, meshes, height maps); separation > 0
- * resamples meshes. */
+ * resamples meshes, <= 0 takes the default; NaN or infinite is FF_C_INVALID_ARGUMENT. */
 int32_t ffc_load_file(ffc_session* s, const char* path, double separation, uint32_t* terrain);
 /* Loads a file under the server's data root (RPC), or a local path (embedded). */
 int32_t ffc_load_server_file(ffc_session* s, const char* path, double separation,
