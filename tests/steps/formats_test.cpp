@@ -108,6 +108,10 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
       // Fields of the wrong JSON type are named with the type found, never thrown.
       {{"\"footfall-character\"", "5"}, "b.json: 'format' must be a string, found number"},
       {{"\"format\": \"footfall-character\",", ""}, "b.json: missing field 'format'"},
+      // Another format's file is named by its format, not by a field it has (a scene file given
+      // as a character was "unknown field 'characters'").
+      {{"\"footfall-character\"", "\"footfall-scene\", \"characters\": []"},
+       "b.json: 'format': expected \"footfall-character\", found \"footfall-scene\""},
       {{"\"version\": 1,", ""}, "b.json: missing field 'version' (expected 1)"},
       {{"\"name\": \"b\"", "\"name\": [1]"}, "b.json: 'name' must be a string, found array"},
       {{"\"step_length\": 0.6", "\"step_length\": \"0.6\""},

@@ -135,8 +135,14 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
                                                "max_turn_deg",
                                                "comment"};
   static const std::set<std::string> kKnownFoot = {"name", "rest", "comment"};
+  // Another format's file (a scene, a walk) is named by its format, not by the first of its
+  // fields a character file does not know.
+  if (j.contains("format") && j["format"].is_string() &&
+      j["format"].get<std::string>() != "footfall-character")
+    r.Fail(Status::kParseError, "'format': expected \"footfall-character\", found \"" +
+                                    ShownText(j["format"].get<std::string>()) + "\"");
   std::string unknown;
-  if (detail::FindUnknownKey(j, kKnown, &unknown))
+  if (r.status == Status::kOk && detail::FindUnknownKey(j, kKnown, &unknown))
     r.Fail(Status::kParseError, detail::UnknownFieldMessage(unknown, kKnown));
   Character c;
   if (r.status == Status::kOk) {
@@ -144,8 +150,6 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
       r.Fail(Status::kParseError, "missing field 'format' (expected \"footfall-character\")");
     else if (!j["format"].is_string())
       r.Mistyped("format", "a string", j["format"]);
-    else if (j["format"].get<std::string>() != "footfall-character")
-      r.Fail(Status::kParseError, "'format': expected \"footfall-character\"");
     else if (!j.contains("version"))
       r.Fail(Status::kParseError, "missing field 'version' (expected 1)");
     else if (!j["version"].is_number())
