@@ -62,7 +62,8 @@ bool ParseVec(const std::string& text, const std::string& flag, Vec3* out, std::
     }
     v.push_back(x);
   }
-  if (v.size() != 3) {
+  if (v.size() != 3 ||
+      (!text.empty() && text.back() == ',')) {  // getline drops a last, empty field
     *error = flag + " '" + text + "': expected X,Y,Z (three numbers separated by commas)";
     return false;
   }
