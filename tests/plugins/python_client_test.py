@@ -5,12 +5,14 @@ Run: FOOTFALL_LIB=build/client/lib/libfootfall.so FOOTFALLD=build/server/service
      PYTHONPATH=plugins/python python3 -m unittest tests/plugins/python_client_test.py
 """
 
+import contextlib
 import json
 import math
 import os
 import subprocess
 import sys
 import tempfile
+import types
 import unittest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -785,13 +787,11 @@ class MayaKeyWalkTest(unittest.TestCase):
     no Maya here): the body turns in rotate order ZXY and is keyed with the ZXY angles, as the
     MEL export keys it."""
 
-    def _key_walk(self, walk, feet, body):
-        import types
-        calls = []
-        cmds = types.ModuleType("maya.cmds")
-        for name in ("setAttr", "xform", "setKeyframe"):
-            setattr(cmds, name, lambda *args, _name=name, **kwargs:
-                    calls.append((_name, args, kwargs)))
+    @staticmethod
+    @contextlib.contextmanager
+    def _footfall_maya(cmds):
+        """footfall_maya imported with the module `cmds` standing in for maya.cmds; the modules
+        and sys.path are as before afterwards."""
         maya = types.ModuleType("maya")
         maya.cmds = cmds
         saved = {name: sys.modules.pop(name, None) for name in ("maya", "maya.cmds",
@@ -800,20 +800,28 @@ class MayaKeyWalkTest(unittest.TestCase):
         sys.path.insert(0, os.path.join(REPO, "plugins", "maya"))
         try:
             import footfall_maya
-            footfall_maya.key_walk(walk, feet, body)
+            yield footfall_maya
         finally:
             sys.path.pop(0)
             for name, module in saved.items():
                 sys.modules.pop(name, None)
                 if module is not None:
                     sys.modules[name] = module
+
+    def _key_walk(self, walk, feet, body):
+        calls = []
+        cmds = types.ModuleType("maya.cmds")
+        for name in ("setAttr", "xform", "setKeyframe"):
+            setattr(cmds, name, lambda *args, _name=name, **kwargs:
+                    calls.append((_name, args, kwargs)))
+        with self._footfall_maya(cmds) as footfall_maya:
+            footfall_maya.key_walk(walk, feet, body)
         return calls
 
     def test_import_of_tracks_without_keys_changes_nothing(self):
         # Tracks of the rig without keys (alone, or beside another's keyed track) cut the rig's
         # keys from the walk's first frame (frame 0 when no track had a key), and with no rig
         # made their locators, before anything was keyed.
-        import types
         calls = []
         cmds = types.ModuleType("maya.cmds")
         for name in ("setAttr", "xform", "setKeyframe", "cutKey", "spaceLocator", "warning",
@@ -825,35 +833,24 @@ class MayaKeyWalkTest(unittest.TestCase):
         cmds.getAttr = lambda *args, **kwargs: character_text
         cmds.attributeQuery = lambda *args, **kwargs: True
         cmds.listConnections = lambda plug, **kwargs: [plug.split(".")[1] + "_target"]
-        maya = types.ModuleType("maya")
-        maya.cmds = cmds
-        saved = {name: sys.modules.pop(name, None) for name in ("maya", "maya.cmds",
-                                                                "footfall_maya")}
-        sys.modules.update({"maya": maya, "maya.cmds": cmds})
-        sys.path.insert(0, os.path.join(REPO, "plugins", "maya"))
         folder = tempfile.mkdtemp()
         try:
-            import footfall_maya
-            for tracks in ([{"name": "L", "kind": "foot", "keys": []}],
-                           [{"name": "L", "kind": "foot", "keys": []},
-                            {"name": "body", "kind": "body", "keys": []},
-                            {"name": "X1", "kind": "foot",
-                             "keys": [{"frame": 1, "position": [0, 0, 0]}]}]):
-                path = os.path.join(folder, "walk.json")
-                with open(path, "w") as f:
-                    json.dump({"tracks": tracks}, f)
-                for rig in ("biped_rig", None) if len(tracks) == 1 else ("biped_rig",):
-                    del calls[:]
-                    self.assertIsNone(footfall_maya.import_walk(path, rig))
-                    made = [c[0] for c in calls if c[0] not in ("warning", "confirmDialog")]
-                    self.assertEqual(made, [], (tracks, rig))
-                    self.assertIn("warning", [c[0] for c in calls])
+            with self._footfall_maya(cmds) as footfall_maya:
+                for tracks in ([{"name": "L", "kind": "foot", "keys": []}],
+                               [{"name": "L", "kind": "foot", "keys": []},
+                                {"name": "body", "kind": "body", "keys": []},
+                                {"name": "X1", "kind": "foot",
+                                 "keys": [{"frame": 1, "position": [0, 0, 0]}]}]):
+                    path = os.path.join(folder, "walk.json")
+                    with open(path, "w") as f:
+                        json.dump({"tracks": tracks}, f)
+                    for rig in ("biped_rig", None) if len(tracks) == 1 else ("biped_rig",):
+                        del calls[:]
+                        self.assertIsNone(footfall_maya.import_walk(path, rig))
+                        made = [c[0] for c in calls if c[0] not in ("warning", "confirmDialog")]
+                        self.assertEqual(made, [], (tracks, rig))
+                        self.assertIn("warning", [c[0] for c in calls])
         finally:
-            sys.path.pop(0)
-            for name, module in saved.items():
-                sys.modules.pop(name, None)
-                if module is not None:
-                    sys.modules[name] = module
             for name in os.listdir(folder):
                 os.unlink(os.path.join(folder, name))
             os.rmdir(folder)
