@@ -432,6 +432,22 @@ TEST_CASE("WriteMel keeps comments to one line and names Maya's second and milli
   }
 }
 
+TEST_CASE("WriteMel names Maya's VR audio and high frame rate units", "[export][mel]") {
+  Walk walk = test::BipedWalk();
+  for (const auto& [fps, unit] : {std::pair<double, std::string>{90, "90fps"},
+                                  {119.88, "119.88fps"},
+                                  {44100, "44100fps"},
+                                  {48000, "48000fps"}}) {
+    INFO(fps);
+    walk.fps = fps;
+    const std::string path = WriteAndKeep(walk, "rare_units.mel");
+    const MelScript script = ParseMel(path);
+    CHECK(script.time_unit == unit);
+    CHECK(script.warnings.empty());
+    std::remove(path.c_str());
+  }
+}
+
 TEST_CASE("WriteMel reports bad walks and unwritable paths", "[export][mel]") {
   std::string error;
   Walk walk = test::BipedWalk();

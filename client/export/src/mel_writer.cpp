@@ -117,18 +117,18 @@ std::string MayaTimeUnit(double fps) {
     double fps;
     const char* unit;
   };
-  static const Named kNamed[] = {{15, "game"},          {24, "film"},          {25, "pal"},
-                                 {30, "ntsc"},          {48, "show"},          {50, "palf"},
-                                 {60, "ntscf"},         {23.976, "23.976fps"}, {29.97, "29.97fps"},
-                                 {47.952, "47.952fps"}, {59.94, "59.94fps"},   {1, "sec"},
-                                 {1000, "millisec"}};
+  static const Named kNamed[] = {
+      {15, "game"},        {24, "film"},          {25, "pal"},         {30, "ntsc"},
+      {48, "show"},        {50, "palf"},          {60, "ntscf"},       {23.976, "23.976fps"},
+      {29.97, "29.97fps"}, {47.952, "47.952fps"}, {59.94, "59.94fps"}, {119.88, "119.88fps"},
+      {1, "sec"},          {1000, "millisec"}};
   for (const Named& named : kNamed) {
     if (std::abs(fps - named.fps) < 1e-3) return named.unit;
   }
-  // Whole rates Maya 2017 and later accept as "<n>fps".
-  static const int kWhole[] = {2,   3,   4,   5,   6,    8,    10,   12,   16,  20,  40,
-                               75,  80,  100, 120, 125,  150,  200,  240,  250, 300, 375,
-                               400, 500, 600, 750, 1200, 1500, 2000, 3000, 6000};
+  // Whole rates Maya accepts as "<n>fps" (90 from Maya 2020, the others from 2017).
+  static const int kWhole[] = {2,   3,   4,   5,    6,    8,    10,   12,   16,    20,   40,  75,
+                               80,  90,  100, 120,  125,  150,  200,  240,  250,   300,  375, 400,
+                               500, 600, 750, 1200, 1500, 2000, 3000, 6000, 44100, 48000};
   for (int rate : kWhole) {
     if (std::abs(fps - rate) < 1e-9) return std::to_string(rate) + "fps";
   }
