@@ -116,6 +116,36 @@ TEST_CASE("ReadPointStream rejects bad lines with file and line", "[terrain][poi
     CHECK(Read("0 0 0 0 0 0\n", &s, &error) == Status::kParseError);
     CHECK(error == "t.pts:1: normal has zero length (expected a non-zero nx ny nz)");
   }
+  SECTION("lines ended by CR alone") {
+    // Classic Mac OS line ends: CR was read as a space, so the samples after a comment on the
+    // first line were dropped without a word (one sample of three, exit 0).
+    CHECK(Read("0 0 0 0 1 0 # first\r1 0 0 0 1 0\r2 0 0 0 1 0\r", &s, &error) ==
+          Status::kParseError);
+    CHECK(error ==
+          "t.pts:1: line ends in CR alone (classic Mac OS): convert line ends to LF or "
+          "CR LF");
+    CHECK(Read("0 0 0 0 1 0\n0 0 0 0 1 0\r1 0 0 0 1 0\n", &s, &error) == Status::kParseError);
+    CHECK(error.find("t.pts:2: line ends in CR alone") == 0);
+    // CR LF, and a CR at the very end of the file, are line ends.
+    REQUIRE(Read("0 0 0 0 1 0\r\n1 0 0 0 1 0\r\r\n2 0 0 0 1 0\r", &s, &error) == Status::kOk);
+    CHECK(s.size() == 3);
+    s.clear();
+  }
+  SECTION("UTF-16 text") {
+    // Was "column 1: '\xff\xfe0?' is not a number".
+    CHECK(Read(std::string("\xff\xfe"
+                           "0\0 \0"
+                           "0\0\n\0",
+                           10),
+               &s, &error) == Status::kParseError);
+    CHECK(error == "t.pts:1: UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)");
+    CHECK(Read(std::string("\xfe\xff\0"
+                           "0\0 \0"
+                           "0\0\n",
+                           10),
+               &s, &error) == Status::kParseError);
+    CHECK(error == "t.pts:1: UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)");
+  }
   SECTION("a line longer than 1 MiB") {
     // A file of NUL bytes, or without line breaks, was read whole into one line (2 to 5 times
     // its size in memory, "out of memory" or "read error" for large ones).

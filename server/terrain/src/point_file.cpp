@@ -38,6 +38,19 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
     ++line_no;
     std::string_view line(text);
     if (line_no == 1 && line.substr(0, 3) == "\xEF\xBB\xBF") line.remove_prefix(3);  // UTF-8 BOM
+    if (line_no == 1 && (line.substr(0, 2) == "\xFF\xFE" || line.substr(0, 2) == "\xFE\xFF")) {
+      return Fail(name, line_no, "UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)",
+                  out, error);
+    }
+    // A CR before the line's end is a classic Mac OS line end: read as a space, it joined lines,
+    // and a comment on the first one hid all the others.
+    const size_t cr = line.find('\r');
+    if (cr != std::string_view::npos &&
+        line.find_first_not_of('\r', cr) != std::string_view::npos) {
+      return Fail(name, line_no,
+                  "line ends in CR alone (classic Mac OS): convert line ends to LF or CR LF", out,
+                  error);
+    }
     const size_t hash = line.find('#');
     if (hash != std::string_view::npos) line = line.substr(0, hash);
     double v[6];
