@@ -159,6 +159,12 @@ check "Z-up terrain with the default up: the stop names --up" grep -q 'give the 
 "$footfall" generate --terrain "$work/zup.pts" --character "$chars/biped.json" --start 1.5,1.5,0 \
   --up 0,0,1 --heading 0,1,0 --steps 4 --out "$work/zup.json" 2> "$work/zup.err"
 check "Z-up terrain with --up 0,0,1: walks" [ $? -eq 0 ]
+# The other way round: a Y-up terrain given --up 0,0,1 is told the up its ground faces, not the
+# Z up it was given.
+"$footfall" generate --terrain "$hills" --character "$chars/biped.json" --up 0,0,1 \
+  --heading 1,0,0 --steps 4 --out "$work/yup.json" 2> "$work/yup.err"
+check "Y-up terrain with --up 0,0,1: exit 2" [ $? -eq 2 ]
+check "Y-up terrain with --up 0,0,1: the stop names --up 0,1,0" grep -q 'give the world up with --up (Y up: --up 0,1,0)' "$work/yup.err"
 # A crowd walking toward the cliff: its front row (c4-c6) stops first. The walk names the
 # earliest stop; stderr lists every character's.
 "$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --crowd 6 \

@@ -14,6 +14,25 @@
 
 namespace footfall::steps_detail {
 
+namespace {
+
+// The --up flag of the world axis nearest `normal`, said as "Z up: --up 0,0,1": the up to give
+// an upright character whose ground there faces across the world up it was given.
+std::string UpFlagNearest(const Vec3& normal) {
+  const double c[3] = {normal.x, normal.y, normal.z};
+  int axis = 0;
+  for (int i = 1; i < 3; ++i) {
+    if (std::abs(c[i]) > std::abs(c[axis])) axis = i;
+  }
+  const bool down = c[axis] < 0;
+  std::string flag = "0,0,0";
+  flag[2 * axis] = '1';
+  if (down) flag.insert(2 * axis, "-");
+  return std::string(down ? "-" : "") + "XYZ"[axis] + " up: --up " + flag;
+}
+
+}  // namespace
+
 Status Generator::Setup(std::string* error) {
   const size_t feet = c_.feet.size();
   TerrainInfo info;
@@ -433,7 +452,7 @@ std::string Generator::Plant(Agent& a, const Foothold* feet) const {
       // axis (a height map read with --up-axis z) with the default world up.
       if (!c_.align_to_normal && slope > 60 && slope < 120)
         m << "; if the terrain's up is not " << Point(world_up_)
-          << ", give the world up with --up (Z up: --up 0,0,1)";
+          << ", give the world up with --up (" << UpFlagNearest(a.foot_normal[f]) << ")";
       return m.str();
     }
   }
