@@ -9,6 +9,7 @@ import contextlib
 import json
 import math
 import os
+import pickle
 import subprocess
 import sys
 import tempfile
@@ -157,6 +158,18 @@ class EmbeddedTest(unittest.TestCase):
 
 class SharedLogicTest(unittest.TestCase):
     """The pure-Python parts both plugins use: mesh resampling and character files."""
+
+    def test_errors_survive_pickling(self):
+        # A multiprocessing pool sends a worker's exception back pickled: one that cannot be
+        # rebuilt kills the pool's result thread and the caller waits forever.
+        for error in (ff.FootfallError(8, "footfalld at 127.0.0.1:1: refused", "ffc_snap"),
+                      ff.WalkStopped(1, "step 3: a cliff", {"tracks": []})):
+            copy = pickle.loads(pickle.dumps(error))
+            self.assertIs(type(copy), type(error))
+            self.assertEqual((copy.status, copy.status_name, copy.message, copy.call, str(copy)),
+                             (error.status, error.status_name, error.message, error.call,
+                              str(error)))
+            self.assertEqual(getattr(copy, "walk", None), getattr(error, "walk", None))
 
     def test_square_resampled_in_halves(self):
         pts = [(0, 0, 0), (1, 0, 0), (1, 0, 1), (0, 0, 1)]

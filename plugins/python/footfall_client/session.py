@@ -35,6 +35,11 @@ class FootfallError(Exception):
         self.call = call
         super().__init__("%s: %s" % (self.status_name, message))
 
+    def __reduce__(self):
+        # Rebuilt from the same arguments, so the error crosses pickling (a multiprocessing
+        # pool's worker raising it): Exception's default passes only the text.
+        return (type(self), (self.status, self.message, self.call))
+
 
 class WalkStopped(FootfallError):
     """generate() stopped before every step was made (a cliff, the server gone). `walk` holds
@@ -43,6 +48,9 @@ class WalkStopped(FootfallError):
     def __init__(self, status, message, walk, call="ffc_generate"):
         super().__init__(status, message, call)
         self.walk = walk
+
+    def __reduce__(self):
+        return (type(self), (self.status, self.message, self.walk, self.call))
 
 
 # One answer of snap/normal/next. point and normal are world-space 3-tuples (None unless ok).
