@@ -194,7 +194,13 @@ bool ReadOptions(const GenerateFlags& flags, GenerateOptions* options, std::stri
   std::istringstream in(flags.path);
   for (std::string point; in >> point;) {
     Vec3 p;
-    if (!ParseVec(point, "--path", &p, error)) return false;
+    if (!ParseVec(point, "--path", &p, error)) {
+      // "20, 0, 25" splits into three waypoints at its spaces: say so, not only that '20,' is
+      // not X,Y,Z.
+      if (flags.path.find(", ") != std::string::npos || flags.path.find(" ,") != std::string::npos)
+        *error += "; write each waypoint X,Y,Z without spaces (spaces separate the waypoints)";
+      return false;
+    }
     options->path.push_back(p);
   }
   options->steps = flags.steps;
