@@ -185,6 +185,13 @@ TEST_CASE("WritePointFile writes every sample exactly", "[terrain][point_file]")
   s.push_back({1e10 + 0.102, -0.0, 1.0 / 3}, Normalize(Vec3{0.1, 1, 0.3}));
   s.push_back({-4.99999999999e14, 5e-324, 123456.789012345678}, {0, 1, 0});
   s.push_back({0.1 + 0.2, 1e-300, -2.5}, Normalize(Vec3{1, 1, 1}));
+  // Unit normals read back as written: normalised again, two in three moved by a bit, so a
+  // point file converted again was not the same file.
+  s.push_back({0, 0, 0}, {0.4783956904506592, -0.8758724092033074, -0.06312753879750849});
+  for (int i = 1; i <= 200; ++i) {
+    s.push_back({1.0 * i, 0, 0},
+                SafeNormalize(Vec3{std::sin(i * 1.7), std::cos(i * 0.3), 0.01 * i}));
+  }
   char dir[] = "/tmp/footfall-points-XXXXXX";
   REQUIRE(mkdtemp(dir));
   const std::string path = std::string(dir) + "/out.pts";

@@ -100,7 +100,7 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
                   "expected 6 numbers (x y z nx ny nz), found " + std::to_string(count), out,
                   error);
     }
-    const Vec3 normal = SafeNormalize({v[3], v[4], v[5]});
+    const Vec3 normal = UnitNormal({v[3], v[4], v[5]});
     if (normal == Vec3{}) {
       return Fail(name, line_no, "normal has zero length (expected a non-zero nx ny nz)", out,
                   error);

@@ -50,7 +50,7 @@ Status ValidateAndNormalize(RawSamples* samples, std::string* error) {
       if (error) *error = "sample " + std::to_string(i) + ": " + what;
       return Status::kInvalidArgument;
     }
-    samples->normals[i] = SafeNormalize(samples->normals[i]);
+    samples->normals[i] = UnitNormal(samples->normals[i]);
   }
   return Status::kOk;
 }

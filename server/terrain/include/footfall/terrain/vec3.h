@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
 
 namespace footfall {
 
@@ -42,6 +43,15 @@ inline Vec3 SafeNormalize(const Vec3& a) {
   const double scale = std::fmax(std::fabs(a.x), std::fmax(std::fabs(a.y), std::fabs(a.z)));
   if (!(scale > 0)) return {};
   return Normalize(a / scale);
+}
+
+// SafeNormalize(a), but a itself when its length is already 1 to within rounding: a unit
+// normal written exactly and read back (a converted point file, samples sent to footfalld)
+// keeps every bit, where normalising it again moved some by one.
+inline Vec3 UnitNormal(const Vec3& a) {
+  if (IsFinite(a) && std::fabs(Length2(a) - 1) <= 4 * std::numeric_limits<double>::epsilon())
+    return a;
+  return SafeNormalize(a);
 }
 
 }  // namespace footfall
