@@ -203,6 +203,23 @@ TEST_CASE("Height maps: a UTF-8 byte order mark is skipped", "[import][heightmap
   CHECK(map.heights[1] == 2);
 }
 
+TEST_CASE("Height maps: UTF-16 text is refused as such", "[import][heightmap]") {
+  // Was "expected the grid header's first key ('ncols N'), found '??n?c?'".
+  test::TempDir dir;
+  HeightMap map;
+  std::string error;
+  CHECK(ReadAscGrid(dir.Write("wide.asc", std::string("\xFF\xFEn\0c\0o\0l\0s\0", 12)), &map,
+                    &error) == Status::kParseError);
+  CHECK(Contains(error,
+                 "/wide.asc:1: UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)"));
+  CHECK(ReadPgm(dir.Write("wide.pgm", std::string("\xFE\xFF\0P\0"
+                                                  "2\0\n",
+                                                  8)),
+                &map, &error) == Status::kParseError);
+  CHECK(Contains(error,
+                 "/wide.pgm:1: UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)"));
+}
+
 TEST_CASE("ReadPgm: bytes after a binary image's pixels are refused", "[import][heightmap]") {
   test::TempDir dir;
   HeightMap map;

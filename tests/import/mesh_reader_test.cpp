@@ -151,6 +151,20 @@ TEST_CASE("ReadMesh: bad meshes give clear errors", "[import][mesh]") {
     CHECK(Read(dir.Write("empty.obj", ""), &mesh, &error) == Status::kParseError);
     CHECK(Contains(error, "empty.obj: the file is empty"));
   }
+  SECTION("UTF-16 text") {
+    // A UTF-16 OBJ read as "no vertices: the mesh is empty".
+    const std::string obj(
+        "\xFF\xFEv\0 \0"
+        "0\0\n\0",
+        10);
+    CHECK(Read(dir.Write("wide.obj", obj), &mesh, &error) == Status::kParseError);
+    CHECK(
+        Contains(error, "wide.obj: UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)"));
+    const std::string off("\xFE\xFF\0O\0F\0F\0\n", 10);
+    CHECK(Read(dir.Write("wide.off", off), &mesh, &error) == Status::kParseError);
+    CHECK(
+        Contains(error, "wide.off: UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)"));
+  }
   SECTION("vertices but no faces") {
     CHECK(Read(dir.Write("points.obj", "v 0 0 0\nv 1 0 0\n"), &mesh, &error) ==
           Status::kParseError);

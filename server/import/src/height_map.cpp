@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iterator>
 #include <sstream>
+#include <string_view>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -101,6 +102,15 @@ Status ReadWhole(const std::string& path, std::string* text, std::string* error,
     if (error) *error = path + ": cannot open: " + std::strerror(errno ? errno : EIO);
     return Status::kIoError;
   }
+  char mark[2] = {};
+  in.read(mark, sizeof mark);
+  const std::string_view start(mark, static_cast<size_t>(in.gcount()));
+  if (start == "\xFF\xFE" || start == "\xFE\xFF") {
+    return Fail(path + ":1", "UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)",
+                error);
+  }
+  in.clear();
+  in.seekg(0);
   const std::string word = FirstWord(in);
   if (in.peek() != std::char_traits<char>::eof() && !starts_ok(word)) {
     const std::string found =

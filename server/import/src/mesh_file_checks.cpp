@@ -159,12 +159,16 @@ std::string StripComment(const std::string& line) {
 }
 
 // What OpenMesh's text readers misread at the start of a file: a UTF-8 byte order mark (an OBJ
-// lost its first vertex to it) and lines ended by CR alone (read as one line).
+// lost its first vertex to it), lines ended by CR alone (read as one line) and UTF-16 text (an
+// OBJ read as empty).
 Status CheckTextStart(const std::string& path, std::string* error) {
   std::ifstream in(path, std::ios::binary);
   char head[65536];
   in.read(head, sizeof head);
   const std::string_view text(head, static_cast<size_t>(in.gcount()));
+  if (text.substr(0, 2) == "\xFF\xFE" || text.substr(0, 2) == "\xFE\xFF") {
+    return Fail(path, "UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)", error);
+  }
   if (text.substr(0, 3) == "\xEF\xBB\xBF") {
     return Fail(path,
                 "starts with a UTF-8 byte order mark, which OpenMesh cannot read: save it "
