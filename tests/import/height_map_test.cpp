@@ -191,6 +191,34 @@ TEST_CASE("Height maps: headers are checked against the data before anything is 
   CHECK(Contains(error, "is 1001, above the maxval 1000"));
 }
 
+TEST_CASE("ReadAscGrid: a NODATA_value of NaN leaves out the NaN cells", "[import][heightmap]") {
+  // As GDAL and R's terra write floating-point grids: was refused, "header 'NODATA_value' needs
+  // a number on its line".
+  test::TempDir dir;
+  HeightMap map;
+  std::string error;
+  REQUIRE(ReadAscGrid(dir.Write("nan.asc",
+                                "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\n"
+                                "cellsize 1\nNODATA_value nan\nNaN 2 3\n4 -nan 6\n"),
+                      &map, &error) == Status::kOk);
+  CHECK(map.ValidCount() == 4);
+  CHECK(map.valid[0] == 0);
+  CHECK(map.valid[4] == 0);
+  CHECK(map.heights[5] == 6);
+  // A NaN cell is still refused when NODATA is a number, or not given.
+  CHECK(ReadAscGrid(dir.Write("num.asc",
+                              "ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\n"
+                              "cellsize 1\nNODATA_value -9999\n1 nan\n"),
+                    &map, &error) == Status::kParseError);
+  CHECK(Contains(error, "num.asc:7: value 'nan' is not a finite number"));
+  // NaN names only NODATA: no other header takes it.
+  CHECK(ReadAscGrid(dir.Write("cell.asc",
+                              "ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\n"
+                              "cellsize nan\n1 1\n"),
+                    &map, &error) == Status::kParseError);
+  CHECK(Contains(error, "cell.asc:5: header 'cellsize' needs a number on its line"));
+}
+
 TEST_CASE("Height maps: a UTF-8 byte order mark is skipped", "[import][heightmap]") {
   test::TempDir dir;
   HeightMap map;

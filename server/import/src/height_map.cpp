@@ -72,6 +72,13 @@ class TokenReader {
   size_t pos_ = 0, line_ = 1;
 };
 
+// Whether an ASCII grid's token spells NaN ("nan", "NaN", "-nan": a NODATA_value of NaN and its
+// cells).
+bool IsNanText(const std::string& token) {
+  const std::string t = Lower(token);
+  return t == "nan" || t == "-nan" || t == "+nan";
+}
+
 // The first word of a text file (after a byte order mark and white space), if it ends within
 // its first 256 bytes; else "".
 std::string FirstWord(std::istream& in) {
@@ -197,7 +204,7 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
   TokenReader reader(text, false);
   std::string key, value;
   double ncols = -1, nrows = -1, cellsize = -1, nodata = NAN;
-  bool has_nodata = false;
+  bool has_nodata = false, nodata_is_nan = false;
   size_t size_line = 1;                   // the line of ncols or nrows, whichever comes last
   size_t ncols_line = 0, nrows_line = 0;  // 0: not given
   size_t cellsize_line = 0;               // 0: no cellsize
@@ -208,12 +215,17 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
     if (!reader.Next(&key)) return Fail(path, "truncated: the grid header has no data", error);
     const size_t line = reader.line();
     double number;
-    if (ParseFiniteDecimal(key, &number)) {
+    if (ParseFiniteDecimal(key, &number) || (nodata_is_nan && IsNanText(key))) {
       reader = before;  // the first data value
       break;
     }
-    // The value on the key's own line: a key alone is not given the first data value.
-    if (!reader.Next(&value) || reader.line() != line || !ParseFiniteDecimal(value, &number)) {
+    // The value on the key's own line: a key alone is not given the first data value. Only
+    // NODATA_value may be NaN (GDAL and R's terra write NaN for float grids).
+    const bool value_on_line = reader.Next(&value) && reader.line() == line;
+    const bool nan_nodata = value_on_line && Lower(key) == "nodata_value" && IsNanText(value);
+    if (nan_nodata) {
+      number = NAN;
+    } else if (!value_on_line || !ParseFiniteDecimal(value, &number)) {
       return Fail(path + ":" + std::to_string(line),
                   "header '" + ShownText(key) + "' needs a number on its line", error);
     }
@@ -234,7 +246,7 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
     } else if (k == "cellsize") {
       cellsize = number, cellsize_line = line;
     } else if (k == "nodata_value") {
-      nodata = number, has_nodata = true;
+      nodata = number, has_nodata = true, nodata_is_nan = nan_nodata;
     } else if (k != "xllcorner" && k != "yllcorner" && k != "xllcenter" && k != "yllcenter") {
       return Fail(path + ":" + std::to_string(line),
                   "unknown header '" + ShownText(key) +
@@ -282,6 +294,10 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
                   error);
     }
     double h;
+    if (nodata_is_nan && IsNanText(value)) {
+      out->heights[i] = 0, out->valid[i] = 0;
+      continue;
+    }
     if (!ParseFiniteDecimal(value, &h)) {
       return Fail(path + ":" + std::to_string(reader.line()),
                   "value '" + ShownText(value) + "' is not a finite number", error);
