@@ -219,6 +219,22 @@ TEST_CASE("ReadAscGrid: a NODATA_value of NaN leaves out the NaN cells", "[impor
   CHECK(Contains(error, "cell.asc:5: header 'cellsize' needs a number on its line"));
 }
 
+TEST_CASE("ReadAscGrid: a bad first value is named as a value", "[import][heightmap]") {
+  // It was taken for a header key: "unknown header '1e999' (expected ncols, ...)".
+  test::TempDir dir;
+  HeightMap map;
+  std::string error;
+  for (const std::string first : {"1e999", "nan", "-inf", "Infinity", "1x", ".5.5"}) {
+    INFO(first);
+    CHECK(ReadAscGrid(dir.Write("first.asc",
+                                "ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\n"
+                                "cellsize 1\n" +
+                                    first + " 1\n"),
+                      &map, &error) == Status::kParseError);
+    CHECK(Contains(error, "first.asc:6: value '" + first + "' is not a finite number"));
+  }
+}
+
 TEST_CASE("Height maps: a UTF-8 byte order mark is skipped", "[import][heightmap]") {
   test::TempDir dir;
   HeightMap map;

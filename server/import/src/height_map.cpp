@@ -79,6 +79,15 @@ bool IsNanText(const std::string& token) {
   return t == "nan" || t == "-nan" || t == "+nan";
 }
 
+// Whether an ASCII grid's token is meant as a value, not a header key: it starts like a number
+// or spells NaN or infinity (a bad first value is then named as a value, not as a header).
+bool IsValueText(const std::string& token) {
+  const char c = token.empty() ? ' ' : token[0];
+  if (std::isdigit(static_cast<unsigned char>(c)) || c == '+' || c == '-' || c == '.') return true;
+  const std::string t = Lower(token);
+  return t == "nan" || t == "inf" || t == "infinity";
+}
+
 // The first word of a text file (after a byte order mark and white space), if it ends within
 // its first 256 bytes; else "".
 std::string FirstWord(std::istream& in) {
@@ -215,7 +224,7 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
     if (!reader.Next(&key)) return Fail(path, "truncated: the grid header has no data", error);
     const size_t line = reader.line();
     double number;
-    if (ParseFiniteDecimal(key, &number) || (nodata_is_nan && IsNanText(key))) {
+    if (ParseFiniteDecimal(key, &number) || IsValueText(key)) {
       reader = before;  // the first data value
       break;
     }
