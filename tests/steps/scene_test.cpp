@@ -62,6 +62,21 @@ TEST_CASE("A scene file reads each character with its own options", "[steps][sce
   CHECK(scene[2].options.heading.x == 1);
 }
 
+TEST_CASE("Scene steps and crowd written as whole decimals read as integers", "[steps][scene]") {
+  // Python's json writes a float 20.0 as "20.0", as character files' frames_per_step may be.
+  std::vector<SceneCharacter> scene;
+  REQUIRE(SceneError(Scene(R"({"character_file": "biped.json", "steps": 20.0, "crowd": 4e0})"),
+                     &scene) == "");
+  CHECK(scene[0].options.steps == 20);
+  CHECK(scene[0].options.crowd == 4);
+  CHECK_THAT(SceneError(Scene(R"({"character_file": "biped.json", "steps": 2.5})")),
+             Catch::Contains("characters[0]: 'steps': expected an integer"));
+  CHECK_THAT(SceneError(Scene(R"({"character_file": "biped.json", "crowd": 1e300})")),
+             Catch::Contains("characters[0]: 'crowd': out of range (expected 1 to 1000000)"));
+  CHECK_THAT(SceneError(Scene(R"({"character_file": "biped.json", "steps": -1.0})")),
+             Catch::Contains("characters[0]: 'steps': out of range (expected 0 to 1000000)"));
+}
+
 TEST_CASE("Scene file errors name the file the character and the field", "[steps][scene]") {
   CHECK_THAT(SceneError("[]"), Catch::StartsWith("s.json: not a JSON object"));
   CHECK_THAT(SceneError(R"({"format": "footfall-walk", "version": 1, "characters": []})"),

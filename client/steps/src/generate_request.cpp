@@ -1,5 +1,6 @@
 #include "footfall/steps/generate_request.h"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -131,14 +132,20 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
   }
   for (const char* key : {"steps", "crowd"}) {
     if (!ok || !j.contains(key)) continue;
-    if (!j[key].is_number_integer()) {
+    // A whole number written with a point or an exponent (20.0, 4e0: Python's floats) is one.
+    const bool whole_float = j[key].is_number_float() && std::isfinite(j[key].get<double>()) &&
+                             j[key].get<double>() == std::floor(j[key].get<double>());
+    if (!j[key].is_number_integer() && !whole_float) {
       *error = source + ": '" + key + "': expected an integer";
       ok = false;
     } else {
-      // (An unsigned number above 2^63 would read as negative.)
-      const long long v = j[key].is_number_unsigned() && j[key].get<uint64_t>() > 1000000
-                              ? 1000001
-                              : j[key].get<long long>();
+      // Clamped before it is converted: an unsigned number above 2^63 would read as negative,
+      // a float beyond long long's range is undefined.
+      long long v = 1000001;
+      if (whole_float)
+        v = static_cast<long long>(std::clamp(j[key].get<double>(), -1.0, 1000001.0));
+      else if (!j[key].is_number_unsigned() || j[key].get<uint64_t>() <= 1000000)
+        v = j[key].get<long long>();
       const long long lo = std::string(key) == "steps" ? 0 : 1;
       if (v < lo || v > 1000000) {
         *error = source + ": '" + key + "': out of range (expected " + std::to_string(lo) +
