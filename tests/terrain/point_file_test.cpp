@@ -124,6 +124,13 @@ TEST_CASE("ReadPointStream rejects bad lines with file and line", "[terrain][poi
     CHECK(error ==
           "t.pts:1: line ends in CR alone (classic Mac OS): convert line ends to LF or "
           "CR LF");
+    // A whole file of them is one line longer than 1 MiB: named for its CRs, not its length.
+    std::string mac;
+    for (int i = 0; i < 100000; ++i) mac += "0 0 0 0 1 0\r";
+    CHECK(Read(mac, &s, &error) == Status::kParseError);
+    CHECK(error ==
+          "t.pts:1: line ends in CR alone (classic Mac OS): convert line ends to LF or "
+          "CR LF");
     CHECK(Read("0 0 0 0 1 0\n0 0 0 0 1 0\r1 0 0 0 1 0\n", &s, &error) == Status::kParseError);
     CHECK(error.find("t.pts:2: line ends in CR alone") == 0);
     // CR LF, and a CR at the very end of the file, are line ends.

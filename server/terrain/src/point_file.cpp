@@ -17,6 +17,16 @@
 namespace footfall {
 namespace {
 
+// Whether a CR stands before the line's end: a classic Mac OS line end (CRs ending a line,
+// before its LF or the file's end, are part of the line end).
+bool HasLoneCr(std::string_view line) {
+  const size_t cr = line.find('\r');
+  return cr != std::string_view::npos && line.find_first_not_of('\r', cr) != std::string_view::npos;
+}
+
+constexpr const char* kLoneCr =
+    "line ends in CR alone (classic Mac OS): convert line ends to LF or CR LF";
+
 bool IsSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
 Status Fail(const std::string& name, size_t line, const std::string& what, RawSamples* out,
@@ -42,15 +52,8 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
       return Fail(name, line_no, "UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)",
                   out, error);
     }
-    // A CR before the line's end is a classic Mac OS line end: read as a space, it joined lines,
-    // and a comment on the first one hid all the others.
-    const size_t cr = line.find('\r');
-    if (cr != std::string_view::npos &&
-        line.find_first_not_of('\r', cr) != std::string_view::npos) {
-      return Fail(name, line_no,
-                  "line ends in CR alone (classic Mac OS): convert line ends to LF or CR LF", out,
-                  error);
-    }
+    // A CR read as a space joined lines, and a comment on the first one hid all the others.
+    if (HasLoneCr(line)) return Fail(name, line_no, kLoneCr, out, error);
     const size_t hash = line.find('#');
     if (hash != std::string_view::npos) line = line.substr(0, hash);
     double v[6];
@@ -108,7 +111,10 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
     out->push_back({v[0], v[1], v[2]}, normal);
   }
   if (lines.too_long()) {
-    return Fail(name, line_no + 1, LineReader::TooLongMessage("x y z nx ny nz"), out, error);
+    return Fail(name, line_no + 1,
+                HasLoneCr(lines.too_long_start()) ? std::string(kLoneCr)
+                                                  : LineReader::TooLongMessage("x y z nx ny nz"),
+                out, error);
   }
   if (in.bad()) {
     out->clear();

@@ -3,6 +3,7 @@
 
 #include <istream>
 #include <string>
+#include <string_view>
 
 #include "footfall/terrain/status.h"
 
@@ -27,6 +28,11 @@ class LineReader {
   // longer than kMaxLineBytes (too_long() then true; the stream is left there).
   bool Next(std::string* line);
   bool too_long() const { return too_long_; }
+  // The first kMaxLineBytes bytes of the line too long (empty unless too_long()): what it holds
+  // (a file of CR-only line ends read as one line) can say more than its length.
+  std::string_view too_long_start() const {
+    return too_long_ ? std::string_view(buffer_.data(), kMaxLineBytes) : std::string_view();
+  }
   // The 1-based number of the line last returned, or of the line too long.
   size_t line_number() const { return number_; }
   // "line longer than 1 MiB (expected text lines ...)": for a message at the line's number.
