@@ -446,6 +446,12 @@ static void TestRpc(const char* character_path) {
   Check(ffc_open_rpc(NULL, 7407, -INFINITY) == NULL, "ffc_open_rpc refuses a -infinite timeout",
         "");
   Check(ffc_open_rpc(NULL, 7407, 2e6) == NULL, "ffc_open_rpc refuses a timeout above 1e6 s", "");
+  Check(ffc_open_rpc(NULL, 7407, 1e-9) == NULL, "ffc_open_rpc refuses a timeout below 0.001 s",
+        "");
+  Check(ffc_open_rpc(NULL, 7407, 0.0009) == NULL, "ffc_open_rpc refuses a timeout of 0.9 ms", "");
+  s = ffc_open_rpc(NULL, 7407, 0.001);
+  Check(s != NULL, "ffc_open_rpc takes a timeout of 0.001 s", "");
+  ffc_close(s);
   s = ffc_open_rpc(NULL, 7407, 0);
   Check(s != NULL, "ffc_open_rpc takes a NULL host and a timeout of 0", "");
   ffc_close(s);

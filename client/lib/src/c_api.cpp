@@ -31,7 +31,9 @@ namespace {
 using footfall::Foothold;
 using footfall::Status;
 
-constexpr double kMaxTimeout = 1e6;  // seconds, as footfall's --timeout
+constexpr double kMaxTimeout = 1e6;    // seconds, as footfall's --timeout
+constexpr double kMinTimeout = 0.001;  // seconds, as footfall's --timeout: shorter ones (below
+                                       // 1 us, none at all) fail every call
 
 int32_t Result(ffc_session* s, Status status) {
   if (status != Status::kOk) s->error = s->session->last_error();
@@ -106,8 +108,9 @@ ffc_session* ffc_open_embedded(void) {
 ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s) {
   std::signal(SIGPIPE, SIG_IGN);
   if (port < 1 || port > 65535) return nullptr;
-  // NaN, infinite either way, or beyond any bound.
+  // NaN, infinite either way, beyond any bound, or too short for any call to be answered.
   if (!std::isfinite(timeout_s) || timeout_s > kMaxTimeout) return nullptr;
+  if (timeout_s > 0 && timeout_s < kMinTimeout) return nullptr;
   try {
     footfall::RpcOptions options;
     if (host && *host) options.host = host;

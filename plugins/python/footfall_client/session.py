@@ -152,9 +152,9 @@ class Session:
             timeout = float(timeout)
         except (TypeError, ValueError, OverflowError):
             timeout = float("nan")
-        if not timeout <= 1e6:
-            raise FootfallError(INVALID_ARGUMENT, "timeout %r: expected at most 1e6 seconds"
-                                % (timeout,), "ffc_open_rpc")
+        if not timeout <= 1e6 or 0 < timeout < 0.001:
+            raise FootfallError(INVALID_ARGUMENT, "timeout %r: expected 0.001 to 1e6 seconds (0 "
+                                "or less: the default)" % (timeout,), "ffc_open_rpc")
         handle = lib.lib.ffc_open_rpc((host or "").encode("utf-8", "replace"), port, timeout)
         if not handle:
             raise FootfallError(INVALID_ARGUMENT, "cannot open a client for %s:%d" % (host, port),

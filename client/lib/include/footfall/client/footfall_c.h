@@ -49,7 +49,8 @@ int ffc_abi_version(void);
 ffc_session* ffc_open_embedded(void);
 /* Opens a footfalld client; it connects lazily (the first call may return FF_C_UNAVAILABLE).
  * host NULL means 127.0.0.1; timeout_s <= 0 means 10 s per call. NULL only on bad arguments:
- * a port outside 1-65535, a timeout above 1e6 s, infinite or NaN. */
+ * a port outside 1-65535, a timeout above 1e6 s, infinite or NaN, or one above 0 but below
+ * 0.001 s (as footfall's --timeout: no call could be answered in it). */
 ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s);
 /* Frees the session and its terrains (an RPC session unloads them from footfalld while it is
  * connected, waiting at most 2 s per terrain): the pointer is invalid afterwards (closing it
