@@ -386,6 +386,8 @@ TEST_CASE("Server addresses are read as footfalld's --listen writes them", "[rpc
   std::string error;
   CHECK(ParseHostPort("host:0", &o, &error) == Status::kInvalidArgument);
   CHECK(ParseHostPort("host:x", &o, &error) == Status::kInvalidArgument);
+  for (const char* bad : {"host: 7407", "host:+7407", "host:-0", " 7407", "host:7407 ", "host:"})
+    CHECK(ParseHostPort(bad, &o, &error) == Status::kInvalidArgument);
 }
 
 TEST_CASE("RPC answers equal the embedded engine", "[rpc]") {
@@ -1672,8 +1674,9 @@ TEST_CASE("footfalld listens on IPv6 addresses and logs them in brackets", "[rpc
                         Catch::Contains("cannot listen on [::1]:7407: "));
     CHECK_THAT(log, !Catch::Contains("cannot resolve"));
   }
-  SECTION("malformed bracketed addresses are refused") {
-    for (const char* bad : {"[::1", "[]:7", "[::1]x", "[::1]:", "[::1]:70000"}) {
+  SECTION("malformed addresses and ports are refused") {
+    for (const char* bad : {"[::1", "[]:7", "[::1]x", "[::1]:", "[::1]:70000", "127.0.0.1: 0",
+                            "127.0.0.1:+0", " 0", "[::1]: 0"}) {
       const auto [status, log] = run(bad);
       INFO(bad << ": " << log);
       CHECK(status == 2);

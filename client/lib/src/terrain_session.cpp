@@ -2,6 +2,7 @@
 
 #include <arpa/inet.h>
 
+#include <algorithm>
 #include <cstdlib>
 
 namespace footfall {
@@ -49,9 +50,12 @@ Status ParseHostPort(const std::string& text, RpcOptions* options, std::string* 
   }
   std::string host = colon == std::string::npos ? "" : text.substr(0, colon);
   const std::string port_text = colon == std::string::npos ? text : text.substr(colon + 1);
-  char* end = nullptr;
-  const long port = std::strtol(port_text.c_str(), &end, 10);
-  if (port_text.empty() || *end != '\0' || port < 1 || port > 65535) {
+  // Digits alone: strtol would also take a leading space or sign ("host: 7407", "host:+7407").
+  const bool digits = !port_text.empty() && port_text.size() <= 5 &&
+                      std::all_of(port_text.begin(), port_text.end(),
+                                  [](unsigned char c) { return c >= '0' && c <= '9'; });
+  const long port = digits ? std::strtol(port_text.c_str(), nullptr, 10) : 0;
+  if (port < 1 || port > 65535) {
     if (error) *error = "'" + text + "': expected HOST:PORT with a port from 1 to 65535";
     return Status::kInvalidArgument;
   }

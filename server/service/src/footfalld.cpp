@@ -50,9 +50,12 @@ bool ParseListen(const std::string& text, std::string* host, int* port) {
     h = colon == std::string::npos ? "" : text.substr(0, colon);
     p = colon == std::string::npos ? text : text.substr(colon + 1);
   }
-  char* end = nullptr;
-  const long value = std::strtol(p.c_str(), &end, 10);
-  if (p.empty() || *end != '\0' || value < 0 || value > 65535) return false;
+  // Digits alone: strtol would also take a leading space or sign (": 80", ":+80").
+  if (p.empty() || p.size() > 5 ||
+      !std::all_of(p.begin(), p.end(), [](unsigned char c) { return c >= '0' && c <= '9'; }))
+    return false;
+  const long value = std::strtol(p.c_str(), nullptr, 10);
+  if (value > 65535) return false;
   *host = h.empty() ? "127.0.0.1" : h;
   *port = static_cast<int>(value);
   return true;
