@@ -691,6 +691,18 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     CHECK_THAT(r.err, Catch::Contains("tracks[0].keys[0].position: expected coordinates within "
                                       "+-1e15"));
   }
+  SECTION("a screenshot named for another image format and a frame without a walk") {
+    // (shot.jpg got PNG bytes and exit 0; --frame without --walk was ignored.)
+    RunResult r = View({"--terrain", kTerrain, "--screenshot", dir + "/shot.jpg"});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("shot.jpg: expected a .png file name"));
+    CHECK_FALSE(std::ifstream(dir + "/shot.jpg").good());
+    r = View({"--terrain", kTerrain, "--frame", "5", "--screenshot", shot});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("--frame needs --walk FILE"));
+    r = View({"--terrain", kTerrain, "--size", "64x40", "--screenshot", dir + "/Upper.PNG"});
+    CHECK(r.exit_code == 0);
+  }
   SECTION("screenshots that cannot be written") {
     // An empty path ran the interactive viewer (a hang under Xvfb); a full disk gave exit 0.
     RunResult r = View({"--terrain", kTerrain, "--screenshot", ""});

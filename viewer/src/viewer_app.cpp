@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -484,6 +485,8 @@ int RunViewer(const ViewerOptions& options) {
     return Fail("--query needs --terrain FILE (queries run on the local terrain)", 2);
   if (options.live_wait > 0 && options.screenshot.empty())
     return Fail("--live-wait is for --screenshot", 2);
+  if (options.has_frame && options.walk.empty())
+    return Fail("--frame needs --walk FILE (it picks the frame of the walk to show)", 2);
   // What the viewer writes never replaces what it reads, nor each other.
   const std::pair<const char*, const std::string*> outputs[] = {
       {"--screenshot", &options.screenshot}, {"--dump-state", &options.dump_state}};
@@ -500,6 +503,17 @@ int RunViewer(const ViewerOptions& options) {
   if (!options.screenshot.empty() && !options.dump_state.empty() &&
       SameFile(options.screenshot, options.dump_state))
     return Fail("--screenshot and --dump-state name the same file; give each its own", 2);
+  // A screenshot is a PNG: a name with another extension (shot.jpg) would hold PNG bytes.
+  const std::string shot_name = options.screenshot.substr(options.screenshot.rfind('/') + 1);
+  const size_t dot = shot_name.rfind('.');
+  if (dot != std::string::npos && dot > 0) {
+    std::string extension = shot_name.substr(dot);
+    for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (extension != ".png")
+      return Fail("--screenshot " + options.screenshot +
+                      ": expected a .png file name (the screenshot is written as PNG)",
+                  2);
+  }
   if (options.width <= 0 || options.height <= 0 || options.width > 65536 || options.height > 65536)
     return Fail("--size: width and height must be within 1..65536", 2);
   if (options.has_camera) {
