@@ -114,11 +114,16 @@ file(WRITE "${WORK}/inside_out.obj" "${inside_out}")
 expect(EXIT_ZERO "faces turned over: 1 of 1 closed shells inside out: 12 faces turned over"
        terrain info "${WORK}/inside_out.obj" --separation 0.1)
 expect(EXIT_ZERO "faces turned over: none" terrain info "${WORK}/cube.obj" --separation 0.1)
+# One face wound against the others is counted in the singular.
+string(REPLACE "f 1 4 3 2\n" "f 2 3 4 1\n" one_turned "${cube}")
+file(WRITE "${WORK}/one_turned.obj" "${one_turned}")
+expect(EXIT_ZERO "faces turned over: 1 face wound against its neighbours turned to match them"
+       terrain info "${WORK}/one_turned.obj" --separation 0.1)
 file(WRITE "${WORK}/stdin.txt" "normal 0.25 1.05 0.25\n")
 expect(EXIT_ZERO "\"normal\":[0.0,1.0,0.0]" query --terrain "${WORK}/inside_out.obj" --separation 0.1)
 file(WRITE "${WORK}/stdin.txt" "snap 0.5 2 0.5\n")
 # Bad files: non-zero exit and a message naming the file and the problem.
-expect(EXIT_NONZERO "empty.obj: the file is empty" terrain info "${WORK}/empty.obj")
+expect(EXIT_NONZERO "empty.obj: the file is empty, expected a mesh (.obj)" terrain info "${WORK}/empty.obj")
 expect(EXIT_NONZERO "nan.obj:2: vertex coordinate 'nan' is not a finite number"
        terrain convert "${WORK}/nan.obj" -o "${WORK}/nan.pts")
 expect(EXIT_NONZERO "fin.obj: the mesh is not manifold" terrain info "${WORK}/fin.obj")
@@ -143,6 +148,8 @@ expect(EXIT_NONZERO "--slope: '1e300' is not a finite number from -80 to 80"
        terrain make ramp --slope 1e300 -o "${WORK}/x.pts")
 expect(EXIT_NONZERO "hills: these sizes at --spacing 0.05 give about 4000004000001 samples, more than the 20000000 allowed"
        terrain make hills --size 100000 -o "${WORK}/x.pts")
+expect(EXIT_NONZERO "flat: these sizes at --spacing 1e-300 give too many samples, more than"
+       terrain make flat --spacing 1e-300 -o "${WORK}/x.pts")
 expect(EXIT_NONZERO "flat: these sizes at --spacing 0.001 give about 4e+24 samples"
        terrain make flat --size 2000000000 --spacing 0.001 -o "${WORK}/x.pts")
 # A coarse spacing does not make the work small: a tread takes a sample however coarse it is

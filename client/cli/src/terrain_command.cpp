@@ -196,9 +196,10 @@ int RunMake(const MakeFlags& f) {
   const double estimate = EstimateSamples(f);
   if (!(estimate <= kMaxMadeSamples)) {
     std::ostringstream m;
-    m << "footfall terrain make: " << k << ": these sizes at --spacing " << f.spacing
-      << " give about "
-      << (estimate < 1e15 ? std::to_string(std::llround(estimate)) : Format3(estimate))
+    m << "footfall terrain make: " << k << ": these sizes at --spacing " << f.spacing << " give "
+      << (estimate < 1e15           ? "about " + std::to_string(std::llround(estimate))
+          : std::isfinite(estimate) ? "about " + Format3(estimate)
+                                    : std::string("too many"))
       << " samples, more than the " << std::setprecision(10) << kMaxMadeSamples
       << " allowed (raise --spacing or make it smaller)";
     std::cerr << m.str() << '\n';

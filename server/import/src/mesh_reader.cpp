@@ -95,7 +95,7 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
       return Status::kIoError;
     }
     if (probe.peek() == std::ifstream::traits_type::eof()) {
-      if (error) *error = path + ": the file is empty, expected a " + ext + " mesh";
+      if (error) *error = path + ": the file is empty, expected a mesh (." + ext + ")";
       return Status::kParseError;
     }
   }

@@ -208,18 +208,21 @@ Status ResampleTerrainMesh(const std::string& path, const TriangleMesh& mesh,
 
 std::string DescribeTurnover(const TerrainLoadReport& report) {
   const MeshTurnover& t = report.turnover;
+  auto faces = [](size_t n) { return std::to_string(n) + (n == 1 ? " face" : " faces"); };
   std::vector<std::string> parts;
   if (report.rewound_faces > 0)
-    parts.push_back(std::to_string(report.rewound_faces) +
-                    " faces wound against their neighbours turned to match them");
+    parts.push_back(faces(report.rewound_faces) +
+                    (report.rewound_faces == 1 ? " wound against its neighbours"
+                                               : " wound against their neighbours") +
+                    " turned to match them");
   if (t.inside_out_shells > 0)
     parts.push_back(std::to_string(t.inside_out_shells) + " of " + std::to_string(t.closed_shells) +
                     " closed shells inside out");
   if (t.open_faced_down)
-    parts.push_back("the " + std::to_string(t.open_faces) + " faces of its open parts faced down");
+    parts.push_back("the " + faces(t.open_faces) + " of its open parts faced down");
   std::string text;
   for (const std::string& part : parts) text += (text.empty() ? "" : "; ") + part;
-  if (t.turned_faces > 0) text += ": " + std::to_string(t.turned_faces) + " faces turned over";
+  if (t.turned_faces > 0) text += ": " + faces(t.turned_faces) + " turned over";
   return text;
 }
 
