@@ -137,6 +137,9 @@ if(EXISTS "${WORK}/cube-out.obj" OR EXISTS "${WORK}/flat.ply")
 endif()
 expect(EXIT_NONZERO "cut.off: truncated: header declares 2 faces, found 1"
        terrain info "${WORK}/cut.off")
+# A grid far narrower than its heights are tall (cells in degrees) is told about --cell-size.
+file(WRITE "${WORK}/degrees.asc" "ncols 3\nnrows 3\nxllcorner -105\nyllcorner 40\ncellsize 0.0001\n0 1000 0\n1000 0 1000\n0 1000 0\n")
+expect(EXIT_NONZERO "give --cell-size in the heights' units" terrain info "${WORK}/degrees.asc")
 # terrain make: every number finite, and a cap on the samples before anything is allocated.
 expect(EXIT_NONZERO "--amplitude: 'nan' is not a finite number"
        terrain make hills --amplitude nan -o "${WORK}/x.pts")

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -192,10 +193,34 @@ Status ResampleTerrainMesh(const std::string& path, const TriangleMesh& mesh,
            std::to_string(static_cast<long long>(memory / (1 << 20))) + " MB)";
   if (status != Status::kOk) {
     if (status == Status::kLimitExceeded && report->format == "heightmap" &&
-        why.find("long and thin") != std::string::npos)
+        why.find("long and thin") != std::string::npos) {
       why +=
           " (a height map's cells are thin when its heights are far larger than its cell "
           "size: check --height-scale and --cell-size)";
+    } else if (status == Status::kLimitExceeded && report->format == "heightmap") {
+      // A grid far narrower than its heights are tall: most likely cells in degrees (a
+      // geographic grid) under heights in metres, whose separation advice makes a spike.
+      const int up = options.up_axis == 'x' ? 0 : options.up_axis == 'z' ? 2 : 1;
+      double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+      for (const Vec3& v : mesh.vertices) {
+        const double p[3] = {v.x, v.y, v.z};
+        for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+      }
+      double across = 0;
+      for (int a = 0; a < 3; ++a)
+        if (a != up) across = std::max(across, hi[a] - lo[a]);
+      const double tall = hi[up] - lo[up];
+      auto shown = [](double x) {  // 3 significant digits, in any locale
+        char text[32];
+        const auto end = std::to_chars(text, text + sizeof text, x, std::chars_format::general, 3);
+        return std::string(text, end.ptr);
+      };
+      if (tall > 10 * across)
+        why += " (but the grid is " + shown(across) + " across under heights spanning " +
+               shown(tall) +
+               ": if its cells are in degrees, as a geographic grid's, give --cell-size in the "
+               "heights' units, for example metres)";
+    }
     if (error) *error = path + ": " + why;
     return status;
   }
