@@ -232,8 +232,13 @@ if(NOT kept MATCHES "# surveyed")
   message(FATAL_ERROR "terrain convert wrote over its input")
 endif()
 foreach(command "terrain;info" "query;--terrain")
-  expect(EXIT_NONZERO "--separation resamples meshes and height maps only"
+  expect(EXIT_NONZERO "two.pts: --separation applies to meshes and height maps, which are resampled; a point file is used as it is (leave --separation out)"
          ${command} "${WORK}/two.pts" --separation 0.1)
+  # The other resampling flags too (they were ignored).
+  expect(EXIT_NONZERO "two.pts: --flat-normals, --crease-angle and --seed apply to meshes and height maps"
+         ${command} "${WORK}/two.pts" --flat-normals --crease-angle 30 --seed 4)
+  expect(EXIT_NONZERO "two.pts: --up-axis applies to meshes and height maps"
+         ${command} "${WORK}/two.pts" --up-axis z)
 endforeach()
 # Bounds far from the origin keep their digits.
 file(WRITE "${WORK}/far_bulk.pts" "10000000.125 0 0 0 1 0\n10000000.5 0 1 0 1 0\n")

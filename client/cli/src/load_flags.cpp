@@ -1,5 +1,8 @@
 #include "footfall/cli/load_flags.h"
 
+#include <string>
+#include <vector>
+
 #include "footfall/cli/number_checks.h"
 #include "footfall/import/terrain_loader.h"
 #include "footfall/terrain/file_extension.h"
@@ -38,12 +41,26 @@ void AddLoadFlags(CLI::App* command, TerrainLoadOptions* load) {
       ->check(Finite());
 }
 
-bool SeparationApplies(const std::string& path, const TerrainLoadOptions& load,
-                       std::string* error) {
-  if (!(load.separation > 0) || !IsPointFileExtension(FileExtension(path))) return true;
-  *error = path +
-           ": --separation resamples meshes and height maps only; a point file is used as it is "
-           "(leave --separation out)";
+bool ResamplingFlagsApply(const std::string& path, const TerrainLoadOptions& load,
+                          std::string* error) {
+  if (!IsPointFileExtension(FileExtension(path))) return true;
+  // The flags of AddLoadFlags that only resampling reads, given other than their defaults.
+  // (--cell-size and --height-scale are refused by the loader itself, for meshes too.)
+  const TerrainLoadOptions defaults;
+  std::vector<std::string> given;
+  if (load.separation > 0) given.push_back("--separation");
+  if (load.smooth_normals != defaults.smooth_normals) given.push_back("--flat-normals");
+  if (load.crease_angle_deg != defaults.crease_angle_deg) given.push_back("--crease-angle");
+  if (load.seed != defaults.seed) given.push_back("--seed");
+  if (load.up_axis != defaults.up_axis) given.push_back("--up-axis");
+  if (given.empty()) return true;
+  std::string names;
+  for (size_t i = 0; i < given.size(); ++i)
+    names += (i == 0 ? "" : i + 1 == given.size() ? " and " : ", ") + given[i];
+  *error = path + ": " + names + (given.size() == 1 ? " applies" : " apply") +
+           " to meshes and height maps, which are resampled; a point file is used as it is "
+           "(leave " +
+           (given.size() == 1 ? given[0] : std::string("them")) + " out)";
   return false;
 }
 

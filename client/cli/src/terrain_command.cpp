@@ -83,7 +83,7 @@ int RunConvert(const ConvertFlags& flags) {
   }
   if (error.empty() && SameFile(flags.input, flags.output))
     error = flags.output + ": the output is the input file (write the points to another file)";
-  if (error.empty()) SeparationApplies(flags.input, load, &error);
+  if (error.empty()) ResamplingFlagsApply(flags.input, load, &error);
   if (!error.empty() || LoadTerrain(flags.input, load, &samples, &error, &report) != Status::kOk) {
     std::cerr << "footfall terrain convert: " << error << '\n';
     return 1;
@@ -102,7 +102,7 @@ int RunInfo(const InfoFlags& flags) {
   RawSamples samples;
   std::string error;
   TerrainLoadReport report;
-  if (!SeparationApplies(flags.input, flags.load, &error) ||
+  if (!ResamplingFlagsApply(flags.input, flags.load, &error) ||
       LoadTerrain(flags.input, flags.load, &samples, &error, &report) != Status::kOk) {
     std::cerr << "footfall terrain info: " << error << '\n';
     return 1;

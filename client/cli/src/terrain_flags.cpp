@@ -39,8 +39,8 @@ Status OpenTerrain(const TerrainFlags& flags, std::unique_ptr<TerrainSession>* s
     *error = "give exactly one of --terrain FILE or --server-terrain PATH";
     return Status::kInvalidArgument;
   }
-  if (!SeparationApplies(flags.terrain.empty() ? flags.server_terrain : flags.terrain, flags.load,
-                         error)) {
+  if (!ResamplingFlagsApply(flags.terrain.empty() ? flags.server_terrain : flags.terrain,
+                            flags.load, error)) {
     return Status::kInvalidArgument;
   }
   if (!flags.server_terrain.empty() && flags.server.empty()) {

@@ -13,8 +13,10 @@ namespace footfall::cli {
 // values are CLI11 validation errors (the command's parse fails with a message naming the flag).
 void AddLoadFlags(CLI::App* command, TerrainLoadOptions* load);
 
-// A --separation given for a point file, which is used as it is (never resampled): false and a
-// message naming the file; true otherwise.
-bool SeparationApplies(const std::string& path, const TerrainLoadOptions& load, std::string* error);
+// Resampling flags (--separation, --flat-normals, --crease-angle, --seed, --up-axis) given for a
+// point file, which is used as it is (never resampled): false and a message naming the file and
+// the flags; true otherwise.
+bool ResamplingFlagsApply(const std::string& path, const TerrainLoadOptions& load,
+                          std::string* error);
 
 }  // namespace footfall::cli
