@@ -648,6 +648,10 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     CHECK(r.exit_code == 2);
     r = View({"--terrain", kTerrain, "--up-axis", "w", "--screenshot", shot});
     CHECK(r.exit_code == 2);
+    // A point file is never resampled: resampling flags are refused for it, as by footfall.
+    r = View({"--terrain", kTerrain, "--seed", "3", "--screenshot", shot});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("--seed applies to meshes and height maps"));
   }
   SECTION("outputs never replace the inputs or each other") {
     // (A screenshot over the terrain file turned it into a PNG.)

@@ -5,6 +5,7 @@
 #include <exception>
 #include <iostream>
 #include <sstream>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
@@ -110,6 +111,11 @@ int main(int argc, char** argv) {
     o.eye = {v[0], v[1], v[2]}, o.target = {v[3], v[4], v[5]};
   }
   if (frame_opt->count() > 0) o.has_frame = true, o.frame = frame;
+  std::string error;
+  if (!o.terrain.empty() && !footfall::cli::ResamplingFlagsApply(o.terrain, o.load, &error)) {
+    std::cerr << "footfall-view: " << error << '\n';  // (they were ignored)
+    return 2;
+  }
   try {
     return footfall::viewer::RunViewer(o);
   } catch (const std::exception& e) {
