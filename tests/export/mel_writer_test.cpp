@@ -377,6 +377,19 @@ TEST_CASE("WriteMel gives no group or locator the root group's name", "[export][
   }
 }
 
+TEST_CASE("WriteMel lets names legal as given keep them before sanitised ones", "[export][mel]") {
+  // (A foot 'left foot', sanitised to left_foot, took the name of the foot named left_foot.)
+  Walk walk = test::BipedWalk();
+  walk.tracks[0].name = "left foot";
+  walk.tracks[1].name = "left_foot";
+  const std::string path = WriteAndKeep(walk, "claims.mel");
+  const MelScript script = ParseMel(path);
+  CHECK(script.locators == std::vector<std::string>{"left_foot_2", "left_foot", "body"});
+  CHECK(script.track_attr.at("left_foot") == "left_foot");
+  CHECK(script.track_attr.at("left_foot_2") == "left foot");
+  std::remove(path.c_str());
+}
+
 TEST_CASE("WriteMel names without a Maya time unit and special characters", "[export][mel]") {
   Walk walk = test::BipedWalk();
   walk.fps = 23;

@@ -156,12 +156,18 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
     if (found.second) characters.push_back(character);
     group_of[t] = found.first->second;
   }
+  // Names that are legal as given claim them before names made legal here (a foot `left_foot`
+  // keeps its name beside a foot `left foot`, which becomes left_foot_2).
   std::vector<std::string> names = {kRootName};
-  for (const std::string& character : characters) names.push_back(MayaName(character));
-  for (size_t t = 0; t < walk.tracks.size(); ++t) {
-    names.push_back(MayaName(walk_export::QualifiedTrackName(walk.tracks[t], t)));
-  }
-  names = walk_export::UniqueNames(names);  // the root, first, keeps its name
+  std::vector<bool> as_given = {true};
+  auto add = [&](const std::string& name) {
+    names.push_back(MayaName(name));
+    as_given.push_back(names.back() == name);
+  };
+  for (const std::string& character : characters) add(character);
+  for (size_t t = 0; t < walk.tracks.size(); ++t)
+    add(walk_export::QualifiedTrackName(walk.tracks[t], t));
+  names = walk_export::UniqueNames(names, as_given);  // the root, first, keeps its name
   names.erase(names.begin());
 
   double first_frame = std::numeric_limits<double>::infinity();

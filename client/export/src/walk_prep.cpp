@@ -92,13 +92,14 @@ std::string QualifiedTrackName(const WalkTrack& track, size_t index) {
   return track.character.empty() ? name : track.character + "/" + name;
 }
 
-std::vector<std::string> UniqueNames(const std::vector<std::string>& names) {
+std::vector<std::string> UniqueNames(const std::vector<std::string>& names,
+                                     const std::vector<bool>& first_claim) {
   std::unordered_set<std::string> taken(names.begin(), names.end());
   std::unordered_set<std::string> used;
   std::unordered_map<std::string, int> next_suffix;  // per name: the first suffix to try
-  std::vector<std::string> unique;
-  unique.reserve(names.size());
-  for (const std::string& name : names) {
+  std::vector<std::string> unique(names.size());
+  auto place = [&](size_t i) {
+    const std::string& name = names[i];
     // A suffixed name never takes a name that another track carries as its own.
     std::string candidate = name;
     int& suffix = next_suffix.emplace(name, 2).first->second;
@@ -106,8 +107,13 @@ std::vector<std::string> UniqueNames(const std::vector<std::string>& names) {
       candidate = name + "_" + std::to_string(suffix++);
     }
     used.insert(candidate);
-    unique.push_back(candidate);
-  }
+    unique[i] = candidate;
+  };
+  auto claims_first = [&](size_t i) { return i < first_claim.size() && first_claim[i]; };
+  for (size_t i = 0; i < names.size(); ++i)
+    if (claims_first(i)) place(i);
+  for (size_t i = 0; i < names.size(); ++i)
+    if (!claims_first(i)) place(i);
   return unique;
 }
 

@@ -28,7 +28,11 @@ std::vector<size_t> KeyOrder(const WalkTrack& track);
 std::string QualifiedTrackName(const WalkTrack& track, size_t index);
 
 // `names` with repeats renamed "<name>_2", "<name>_3"... (never colliding with another name).
-std::vector<std::string> UniqueNames(const std::vector<std::string>& names);
+// Names marked in `first_claim` (names as their tracks gave them, where the others were made
+// legal by the caller) keep their own before any unmarked name does; otherwise the earlier
+// name keeps it.
+std::vector<std::string> UniqueNames(const std::vector<std::string>& names,
+                                     const std::vector<bool>& first_claim = {});
 
 // `text` with every byte that does not belong to a well-formed UTF-8 sequence replaced by
 // U+FFFD, as the walk JSON writes it: glTF is JSON and must hold valid UTF-8 (a library caller's
