@@ -140,18 +140,20 @@ TEST_CASE("ReadPointStream rejects bad lines with file and line", "[terrain][poi
   }
   SECTION("UTF-16 text") {
     // Was "column 1: '\xff\xfe0?' is not a number".
-    CHECK(Read(std::string("\xff\xfe"
-                           "0\0 \0"
-                           "0\0\n\0",
-                           10),
-               &s, &error) == Status::kParseError);
-    CHECK(error == "t.pts:1: UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)");
-    CHECK(Read(std::string("\xfe\xff\0"
-                           "0\0 \0"
-                           "0\0\n",
-                           10),
-               &s, &error) == Status::kParseError);
-    CHECK(error == "t.pts:1: UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)");
+    const std::string little_endian(
+        "\xff\xfe"
+        "0\0 \0"
+        "0\0\n\0",
+        10);
+    const std::string big_endian(
+        "\xfe\xff\0"
+        "0\0 \0"
+        "0\0\n",
+        10);
+    for (const std::string& text : {little_endian, big_endian}) {
+      CHECK(Read(text, &s, &error) == Status::kParseError);
+      CHECK(error == "t.pts:1: UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)");
+    }
   }
   SECTION("a line longer than 1 MiB") {
     // A file of NUL bytes, or without line breaks, was read whole into one line (2 to 5 times
