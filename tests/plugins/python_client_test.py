@@ -13,6 +13,7 @@ import pickle
 import subprocess
 import sys
 import tempfile
+import time
 import types
 import unittest
 
@@ -522,6 +523,38 @@ class RpcTest(unittest.TestCase):
             self.assertFalse(s.ping())  # an unknown host, not an encoding error
         with ff.Session.rpc(None, self.server.port) as s:
             self.assertTrue(s.ping())  # None is 127.0.0.1
+
+
+class LocalServerTest(unittest.TestCase):
+    """LocalServer given a footfalld path that is wrong, as a plugin's preferences may name."""
+
+    def test_wrong_executables_fail_quickly_and_leave_nothing_behind(self):
+        # Each failed start left its temporary folder (port file, log) and an open log file.
+        with tempfile.TemporaryDirectory() as folder:
+            plain = os.path.join(folder, "plain.txt")
+            with open(plain, "w") as f:
+                f.write("not a program\n")
+            silent = os.path.join(folder, "silent.sh")
+            with open(silent, "w") as f:
+                f.write("#!/bin/sh\nexec sleep 30\n")
+            os.chmod(silent, 0o755)
+            scratch = os.path.join(folder, "tmp")
+            os.mkdir(scratch)
+            saved = tempfile.tempdir
+            tempfile.tempdir = scratch
+            try:
+                for exe in (folder, plain, "/bin/sleep", "/bin/true",
+                            os.path.join(folder, "missing"), silent):
+                    server = ff.LocalServer(executable=exe)
+                    began = time.monotonic()
+                    with self.assertRaises(ff.ServerError) as e:
+                        server.start(timeout=1.0)
+                    self.assertLess(time.monotonic() - began, 8.0, exe)
+                    self.assertIn(exe, str(e.exception))  # which program failed
+                    self.assertFalse(server.running(), exe)
+                    self.assertEqual(os.listdir(scratch), [], exe)
+            finally:
+                tempfile.tempdir = saved
 
 
 class ConnectionTest(unittest.TestCase):

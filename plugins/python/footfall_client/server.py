@@ -54,10 +54,18 @@ class LocalServer:
         self._log = None
 
     def start(self, timeout=10.0):
-        """Starts footfalld and waits (up to `timeout` s) until it listens. Returns self."""
+        """Starts footfalld and waits (up to `timeout` s) until it listens. Returns self. When
+        it cannot, raises ServerError, with nothing left running and its files removed."""
         if self.running():
             return self
         exe = self.executable or find_footfalld()
+        try:
+            return self._start(exe, timeout)
+        except ServerError:
+            self.stop()
+            raise
+
+    def _start(self, exe, timeout):
         self._dir = tempfile.mkdtemp(prefix="footfalld-")
         port_file = os.path.join(self._dir, "port")
         args = [exe, "--listen", "%s:%d" % (self.host, self.requested_port),
@@ -70,12 +78,13 @@ class LocalServer:
             self.process = subprocess.Popen(args, stdin=subprocess.DEVNULL, stdout=self._log,
                                             stderr=subprocess.STDOUT)
         except OSError as e:
+            self.process = None
             raise ServerError("cannot run %s: %s" % (exe, e)) from None
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             if self.process.poll() is not None:
-                raise ServerError("footfalld exited with status %d: %s"
-                                  % (self.process.returncode, self._tail(log_path)))
+                raise ServerError("%s exited with status %d: %s"
+                                  % (exe, self.process.returncode, self._tail(log_path)))
             try:
                 with open(port_file) as f:
                     text = f.read().strip()
@@ -85,8 +94,7 @@ class LocalServer:
             except OSError:
                 pass
             time.sleep(0.02)
-        self.stop()
-        raise ServerError("footfalld did not start listening within %.0f s" % timeout)
+        raise ServerError("%s did not start listening within %g s" % (exe, timeout))
 
     @staticmethod
     def _tail(path):
