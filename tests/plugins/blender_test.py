@@ -262,6 +262,28 @@ class BlenderAddonTest(unittest.TestCase):
             bpy.data.objects.remove(ground)
             bpy.data.node_groups.remove(tree)
 
+    def test_1c_a_closed_path_curve_ends_at_its_start(self):
+        # A cyclic spline's path lost its closing segment: the walk ended a segment short.
+        data = bpy.data.curves.new("loop_path", "CURVE")
+        corners = [(0, 0, 0), (2, 0, 0), (2, 2, 0)]
+        for cyclic in (True, False):
+            spline = data.splines.new("POLY")
+            spline.points.add(len(corners) - 1)
+            for p, c in zip(spline.points, corners):
+                p.co = c + (1,)
+            spline.use_cyclic_u = cyclic
+        obj = bpy.data.objects.new("loop_path", data)
+        bpy.context.scene.collection.objects.link(obj)
+        obj.location = (1, 0, 0)
+        bpy.context.view_layer.update()
+        try:
+            pts = [tuple(p) for p in self.ops.curve_points(bpy.context, obj)]
+        finally:
+            bpy.data.objects.remove(obj)
+            bpy.data.curves.remove(data)
+        moved = [(x + 1, y, z) for x, y, z in corners]
+        self.assertEqual(pts, moved + moved[:1] + moved)
+
     def test_2_bad_selection_is_a_report(self):
         self.select([], None)
         with self.assertRaises(RuntimeError) as e:

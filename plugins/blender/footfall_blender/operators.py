@@ -550,7 +550,8 @@ def walk_request(context, rig_obj, steps, start_frame):
 
 def curve_points(context, obj):
     """World points of a path curve's centre line: its splines as Blender evaluates them (at
-    their resolution), without Bevel or Extrude, whose tube or ribbon is not the path."""
+    their resolution), without Bevel or Extrude, whose tube or ribbon is not the path, in the
+    order of their edges: a closed (cyclic) spline ends back at its first point."""
     data = obj.data.copy()
     data.bevel_mode, data.bevel_object = "ROUND", None
     data.bevel_depth, data.extrude = 0.0, 0.0
@@ -559,7 +560,8 @@ def curve_points(context, obj):
     try:
         mesh = line.to_mesh()
         try:
-            pts = [obj.matrix_world @ v.co for v in mesh.vertices] if mesh else []
+            pts = [obj.matrix_world @ mesh.vertices[i].co for i in _edge_chain(mesh)] \
+                if mesh else []
         finally:
             line.to_mesh_clear()
     finally:
@@ -568,6 +570,23 @@ def curve_points(context, obj):
     if len(pts) < 2:
         raise ValueError("path %s has fewer than 2 points" % obj.name)
     return pts
+
+
+def _edge_chain(mesh):
+    """The vertex indices of a curve's mesh along its edges, spline after spline: a cyclic
+    spline's closing edge brings its first vertex back at its end (the vertices alone lost it,
+    and a closed path ended a segment short of its start). Vertices on no edge (a one-point
+    spline) come in their place."""
+    chain, on_edge = [], set()
+    for e in mesh.edges:
+        a, b = e.vertices
+        if not chain or chain[-1] != a:
+            chain.append(a)
+        chain.append(b)
+        on_edge.update((a, b))
+    if not on_edge:
+        return list(range(len(mesh.vertices)))
+    return chain
 
 
 def in_scene(scene, obj):
