@@ -551,6 +551,7 @@ class LocalServerTest(unittest.TestCase):
                         server.start(timeout=1.0)
                     self.assertLess(time.monotonic() - began, 8.0, exe)
                     self.assertIn(exe, str(e.exception))  # which program failed
+                    self.assertNotIn("\n", str(e.exception))  # one line, for a report
                     self.assertFalse(server.running(), exe)
                     self.assertEqual(os.listdir(scratch), [], exe)
             finally:

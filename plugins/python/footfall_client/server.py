@@ -98,11 +98,14 @@ class LocalServer:
 
     @staticmethod
     def _tail(path):
+        """The end of the log at `path`, its lines joined into one (for a one-line report)."""
         try:
             with open(path, "rb") as f:
-                return f.read()[-400:].decode("utf-8", "replace").strip() or "(no output)"
+                text = f.read()[-400:].decode("utf-8", "replace")
         except OSError:
             return "(no log)"
+        return " / ".join(line.strip() for line in text.splitlines() if line.strip()) \
+            or "(no output)"
 
     def running(self):
         return self.process is not None and self.process.poll() is None
