@@ -865,6 +865,49 @@ class MayaKeyWalkTest(unittest.TestCase):
             footfall_maya.key_walk(walk, feet, body)
         return calls
 
+    def test_a_mirrored_mesh_keeps_its_normals_up(self):
+        # A terrain mesh under a negative scale had its triangles wound the other way in world
+        # space, so every sample's normal pointed down (Maya shows it the right way up).
+        class Point:
+            def __init__(self, x, y, z):
+                self.x, self.y, self.z = x, y, z
+
+        class Dag:
+            def inclusiveMatrix(self):  # noqa: N802 (Maya's name)
+                return types.SimpleNamespace(det3x3=lambda: -1.0)  # scale (-1, 1, 1)
+
+        class MFnMesh:
+            def __init__(self, dag):
+                pass
+
+            def getPoints(self, space):  # noqa: N802
+                return [Point(0, 0, 0), Point(0, 0, 1), Point(-1, 0, 0)]  # world, mirrored
+
+            def getTriangles(self):  # noqa: N802
+                return [1], [0, 1, 2]  # wound up in the mesh's own space
+
+        om = types.ModuleType("maya.api.OpenMaya")
+        om.MSelectionList = lambda: types.SimpleNamespace(add=lambda name: None,
+                                                          getDagPath=lambda i: Dag())
+        om.MFnMesh = MFnMesh
+        om.MSpace = types.SimpleNamespace(kWorld=4)
+        api = types.ModuleType("maya.api")
+        api.OpenMaya = om
+        saved = {name: sys.modules.pop(name, None) for name in ("maya.api", "maya.api.OpenMaya")}
+        sys.modules.update({"maya.api": api, "maya.api.OpenMaya": om})
+        try:
+            with self._footfall_maya(types.ModuleType("maya.cmds")) as footfall_maya:
+                sys.modules["maya"].api = api
+                samples = footfall_maya._mesh_samples("ground", 0.25)
+        finally:
+            for name, module in saved.items():
+                sys.modules.pop(name, None)
+                if module is not None:
+                    sys.modules[name] = module
+        self.assertGreater(len(samples), 3)
+        for sample in samples:
+            self.assertAlmostEqual(sample[4], 1.0, places=9)  # the normal's Y: up
+
     def test_import_of_tracks_without_keys_changes_nothing(self):
         # Tracks of the rig without keys (alone, or beside another's keyed track) cut the rig's
         # keys from the walk's first frame (frame 0 when no track had a key), and with no rig

@@ -62,10 +62,14 @@ def _mesh_samples(mesh, separation):
     from maya.api import OpenMaya as om  # noqa: N813 (only here: the API 2.0 mesh reader)
     sel = om.MSelectionList()
     sel.add(mesh)
-    fn = om.MFnMesh(sel.getDagPath(0))
+    dag = sel.getDagPath(0)
+    fn = om.MFnMesh(dag)
     points = [(p.x, p.y, p.z) for p in fn.getPoints(om.MSpace.kWorld)]
     counts, verts = fn.getTriangles()
-    tris = [tuple(verts[i:i + 3]) for i in range(0, len(verts), 3)]
+    # A mirroring transform (a negative scale) turns the winding in world space: wound back,
+    # the normals face as Maya shows them (they pointed into the ground).
+    order = (0, 2, 1) if dag.inclusiveMatrix().det3x3() < 0 else (0, 1, 2)
+    tris = [tuple(verts[i + k] for k in order) for i in range(0, len(verts), 3)]
     # Normals from the geometry, as `footfall generate` samples a mesh file.
     ffc.sampling.check_sample_count(points, tris, separation)  # before the slow corner normals
     normals = ffc.sampling.corner_normals(points, tris)
