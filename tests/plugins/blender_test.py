@@ -348,6 +348,15 @@ class BlenderAddonTest(unittest.TestCase):
             bpy.ops.footfall.import_walk(filepath=far_walk)
         self.assertIn("frame -1000000000 is beyond Blender's frame range", str(e.exception))
         self.assertEqual(set(bpy.data.objects), before)
+        # A coordinate beyond a 32-bit float: keyed as inf and nan, and reported as imported.
+        huge_walk = os.path.join(ARGS.work_dir, "huge_position.json")
+        with open(huge_walk, "w") as f:
+            json.dump({"tracks": [{"name": "L1", "kind": "foot", "keys": [
+                {"frame": 1, "phase": "end", "position": [1e39, 0, 0]}]}]}, f)
+        with self.assertRaises(RuntimeError) as e:
+            bpy.ops.footfall.import_walk(filepath=huge_walk)
+        self.assertIn("coordinate 1e+39 is beyond what a Blender key holds", str(e.exception))
+        self.assertEqual(set(bpy.data.objects), before)
         # A walk whose tracks have no keys: its empties were made, then "has no keys" reported.
         no_keys = os.path.join(ARGS.work_dir, "no_keys.json")
         with open(no_keys, "w") as f:

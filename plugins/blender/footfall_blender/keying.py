@@ -231,10 +231,13 @@ def _changed_from(before, after):
 
 # Blender's frame range (MAXFRAME): keys beyond it land on the wrong frames, or on one.
 MAX_FRAME = 1048574
+# The largest value a key holds (a 32-bit float): beyond it a key is infinite or not a number.
+MAX_KEY_VALUE = 3.4028234663852886e38
 
 
 def check_frames(walk):
-    """Raises ValueError when a key of `walk` lies beyond Blender's frame range."""
+    """Raises ValueError when a key of `walk` lies beyond Blender's frame range, or has a
+    coordinate beyond what a key can hold."""
     for track in walk.get("tracks", []):
         for key in track.get("keys", []):
             frame = float(key["frame"])
@@ -242,6 +245,11 @@ def check_frames(walk):
                 raise ValueError("track '%s': frame %.15g is beyond Blender's frame range (-%d "
                                  "to %d); generate it with a start frame nearer 0"
                                  % (track.get("name"), frame, MAX_FRAME, MAX_FRAME))
+            for value in key.get("position") or ():
+                if not abs(float(value)) <= MAX_KEY_VALUE:
+                    raise ValueError("track '%s': frame %.15g: coordinate %.15g is beyond what "
+                                     "a Blender key holds (32-bit floats, up to %.8g)"
+                                     % (track.get("name"), frame, float(value), MAX_KEY_VALUE))
 
 
 # The property holding an object's rotation in each rotation mode (the Euler orders: the rest).
