@@ -366,6 +366,21 @@ bad heading-up "the heading (0.0000, 1.0000, 0.0000) is along the up (0.0000, 1.
 bad gltf-negative-frame "--out $work/neg.gltf: glTF animation times must be >= 0, and --start-frame is -100" --terrain "$hills" --character "$chars/biped.json" --start-frame -100 --out "$work/neg.json" --out "$work/neg.gltf"
 check "gltf-negative-frame: nothing written" [ ! -e "$work/neg.json" ]
 bad far-start "the start is too far from the terrain to snap" --terrain "$hills" --character "$chars/biped.json" --start 1e20,0,0 --out "$work/x.json"
+bad heading-up-flag "it gives no clear direction on the ground; give a heading along the ground with --heading" --terrain "$hills" --character "$chars/biped.json" --heading 0,1,0 --out "$work/x.json"
+# A scene's character: its start, heading and up named by the scene file and field (--scene
+# refuses those flags).
+scene_with() {  # scene_with FIELDS: a scene of one biped with these extra fields
+  printf '{"format": "footfall-scene", "version": 1, "characters": [{"name": "biped1", "character_file": "%s", %s}]}\n' \
+    "$chars/biped.json" "$1" > "$work/bad-scene.json"
+}
+scene_with '"heading": [0, 1, 0]'
+bad scene-heading-up "biped1: the heading (0.0000, 1.0000, 0.0000) is along the up (0.0000, 1.0000, 0.0000) where the character starts (within 10 deg of it): it gives no clear direction on the ground; give a heading along the ground with $work/bad-scene.json: characters[0]: 'heading'" --terrain "$hills" --scene "$work/bad-scene.json" --out "$work/x.json"
+scene_with '"heading": [0, 0, 0]'
+bad scene-zero-heading "biped1: $work/bad-scene.json: characters[0]: 'heading' must be a non-zero finite vector" --terrain "$hills" --scene "$work/bad-scene.json" --out "$work/x.json"
+scene_with '"up": [0, 0, 0]'
+bad scene-zero-up "biped1: $work/bad-scene.json: characters[0]: 'up' must be a non-zero finite vector" --terrain "$hills" --scene "$work/bad-scene.json" --out "$work/x.json"
+scene_with '"start": [1e300, 0, 0]'
+bad scene-far-start "biped1: $work/bad-scene.json: characters[0]: 'start' is too far from the terrain to snap" --terrain "$hills" --scene "$work/bad-scene.json" --out "$work/x.json"
 # Numbers: finite, within readable bounds, one check for every float flag.
 bad fps-tiny "--fps: '1e-300' is not a finite number from 0.001 to 1e+06" --terrain "$hills" --character "$chars/biped.json" --fps 1e-300 --out "$work/x.json"
 bad start-frame "--start-frame: '-1e300' is not a finite number from -1e+09 to 1e+09" --terrain "$hills" --character "$chars/biped.json" --start-frame -1e300 --out "$work/x.json"

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <optional>
 #include <set>
 #include <string>
@@ -15,6 +16,7 @@
 #include "footfall/import/mesh_sampler.h"
 #include "footfall/import/terrain_generators.h"
 #include "footfall/import/terrain_loader.h"
+#include "footfall/steps/generate_request.h"
 #include "generator_fixtures.h"
 #include "walk_checks.h"
 
@@ -180,4 +182,36 @@ TEST_CASE("A start where the character cannot stand moves to the nearest place w
     CHECK_THAT(nowhere.stopped, Catch::Contains("step 1: foot") && Catch::Contains("cannot stand"));
   }
   CHECK(tested >= 1);
+}
+
+TEST_CASE("A generate request's start heading and up are named by its fields",
+          "[steps][generator]") {
+  // The C ABI's request: its set-up errors named the command line's flags, which a plugin has
+  // not got.
+  std::ifstream in(std::string(FOOTFALL_SOURCE_DIR) + "/data/characters/biped.json");
+  const std::string biped((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  REQUIRE(!biped.empty());
+  Terrain t = LoadTerrain(LoadShippedTerrain("hills"), 0.25);
+  const auto error_of = [&](const std::string& fields) {
+    Character c;
+    GenerateOptions o;
+    std::string error;
+    REQUIRE(ParseGenerateRequest("{\"character\": " + biped + ", " + fields + "}", &c, &o,
+                                 &error) == Status::kOk);
+    Walk w;
+    CHECK(GenerateWalk(*t.session, t.handle, c, o, &w, &error) == Status::kInvalidArgument);
+    return error;
+  };
+  CHECK(error_of("\"heading\": [0, 1, 0]")
+            .find("give a heading along the ground with request: 'heading'") != std::string::npos);
+  CHECK(error_of("\"heading\": [0, 0, 0]") ==
+        "request: 'heading' must be a non-zero finite vector");
+  CHECK(error_of("\"up\": [0, 0, 0]") == "request: 'up' must be a non-zero finite vector");
+  CHECK(error_of("\"start\": [1e300, 0, 0]") ==
+        "request: 'start' is too far from the terrain to snap (queries reach 1e15 from it)");
+  // The command line's options name its flags.
+  GenerateOptions o;
+  CHECK(o.names.heading == "--heading");
+  CHECK(o.names.up == "--up");
+  CHECK(o.names.start == "--start");
 }

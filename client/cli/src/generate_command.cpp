@@ -489,7 +489,7 @@ int RunScene(const GenerateFlags& flags) {
     GenerateOptions o = c.options;
     o.fps = flags.fps;
     o.threads = flags.threads;
-    if (!c.has_up) o.up = base.up;
+    if (!c.has_up) o.up = base.up, o.names.up = base.names.up;
     if (!c.has_start_frame) o.start_frame = flags.start_frame;
     work += static_cast<long long>(o.crowd) * (o.steps < 0 ? kDefaultSteps : o.steps);
     options.push_back(std::move(o));

@@ -386,6 +386,16 @@ double MaxStepTravel(const Character& character) {
   return (scale + kFootholdTolerance) * character.step_length + drop * character.max_rise;
 }
 
+namespace {
+
+// How a message names an input: by its bare `field` for the command line's `flag` (as it always
+// has), else by where it came from (a scene's file and field, a request's field).
+std::string Subject(const std::string& name, const char* flag, const char* field) {
+  return name == flag ? field : name;
+}
+
+}  // namespace
+
 Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Character& character,
                     const GenerateOptions& given, Walk* out, std::string* error) {
   // Directions are normalised here, exactly even for components near 1e300 (their squares
@@ -394,11 +404,12 @@ Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Charac
   options.up = SafeNormalize(given.up);
   options.heading = SafeNormalize(given.heading);
   if (options.up == Vec3{}) {
-    *error = "up must be a non-zero finite vector";
+    *error = Subject(given.names.up, "--up", "up") + " must be a non-zero finite vector";
     return Status::kInvalidArgument;
   }
   if (options.heading == Vec3{}) {
-    *error = "heading must be a non-zero finite vector";
+    *error =
+        Subject(given.names.heading, "--heading", "heading") + " must be a non-zero finite vector";
     return Status::kInvalidArgument;
   }
   if (!IsFinite(options.start) || !(std::fabs(options.start_frame) <= kMaxStartFrame) ||

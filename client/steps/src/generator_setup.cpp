@@ -118,7 +118,8 @@ Status Generator::Setup(std::string* error) {
       m << "the heading " << Point(o_.heading) << " is along the up " << Point(up)
         << " where the character starts (within " << kMinDegreesFromUp
         << " deg of it): it gives no clear direction on the ground; give a heading along the "
-           "ground with --heading";
+           "ground with "
+        << o_.names.heading;
       *error = m.str();
       return Status::kInvalidArgument;
     }
@@ -310,7 +311,8 @@ Status Generator::FindStart(const Vec3& start, bool may_move, Foothold* first, s
   if (s != Status::kOk) return s;
   if (first->status != Status::kOk) {
     *error = first->status == Status::kInvalidArgument
-                 ? "the start is too far from the terrain to snap (queries reach 1e15 from it)"
+                 ? (o_.names.start == "--start" ? std::string("the start") : o_.names.start) +
+                       " is too far from the terrain to snap (queries reach 1e15 from it)"
                  : "the terrain is empty: no sample to start on";
     return Status::kInvalidArgument;
   }
@@ -451,8 +453,8 @@ std::string Generator::Plant(Agent& a, const Foothold* feet) const {
       // An upright character starting on ground across its up: a terrain whose up is another
       // axis (a height map read with --up-axis z) with the default world up.
       if (!c_.align_to_normal && slope > 60 && slope < 120)
-        m << "; if the terrain's up is not " << Point(world_up_)
-          << ", give the world up with --up (" << UpFlagNearest(a.foot_normal[f]) << ")";
+        m << "; if the terrain's up is not " << Point(world_up_) << ", give the world up with "
+          << o_.names.up << " (" << UpFlagNearest(a.foot_normal[f]) << ")";
       return m.str();
     }
   }

@@ -41,7 +41,18 @@ constexpr int kStartSearchSteps = 12;
 constexpr double kMaxStartFrame = 1e9;
 constexpr double kMaxFps = 1e6;
 
+// How the generator's messages refer to the inputs that gave the start, heading and up: the
+// command line's flags by default; a scene names its file and field ("s.json: characters[0]:
+// 'heading'"), the C ABI the request's field ("the request's 'heading'").
+struct GenerateInputNames {
+  std::string start = "--start";
+  std::string heading = "--heading";
+  std::string up = "--up";
+};
+
 struct GenerateOptions {
+  // Where the start, heading and up came from, for messages.
+  GenerateInputNames names;
   // Where the (first) character stands, snapped to the terrain. World space. Unset: the centre
   // of the top of the terrain's bounds (top along `up`), which may move (start_may_move).
   bool has_start = false;
