@@ -366,6 +366,7 @@ bad heading-up "the heading (0.0000, 1.0000, 0.0000) is along the up (0.0000, 1.
 bad gltf-negative-frame "--out $work/neg.gltf: glTF animation times must be >= 0, and --start-frame is -100" --terrain "$hills" --character "$chars/biped.json" --start-frame -100 --out "$work/neg.json" --out "$work/neg.gltf"
 check "gltf-negative-frame: nothing written" [ ! -e "$work/neg.json" ]
 bad far-start "the start is too far from the terrain to snap" --terrain "$hills" --character "$chars/biped.json" --start 1e20,0,0 --out "$work/x.json"
+bad steps-fraction "--steps: '1.5' is not a whole number from 0 to 1000000" --terrain "$hills" --character "$chars/biped.json" --steps 1.5 --out "$work/x.json"
 bad heading-up-flag "it gives no clear direction on the ground; give a heading along the ground with --heading" --terrain "$hills" --character "$chars/biped.json" --heading 0,1,0 --out "$work/x.json"
 # A scene's character: its start, heading and up named by the scene file and field (--scene
 # refuses those flags).
