@@ -657,15 +657,7 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
       cmd->add_option("--steps", flags->steps,
                       "Steps per character, one gait group each (default 8; with --path, until "
                       "the goal)")
-          ->check(CLI::Validator(
-              [](std::string& input) -> std::string {
-                // Digits only: CLI11's range check alone answered "1.5" with "not in range".
-                const bool digits = !input.empty() && input.size() <= 7 &&
-                                    input.find_first_not_of("0123456789") == std::string::npos;
-                if (digits && std::stol(input) <= 1000000) return "";
-                return "'" + input + "' is not a whole number from 0 to 1000000";
-              },
-              "INT in [0 - 1000000]"));
+          ->check(WholeUpTo(1000000));
   cmd->add_option("--start-frame", flags->start_frame, "Frame of the first keys (default 1)")
       ->check(FiniteRange(-kMaxStartFrame, kMaxStartFrame));
   cmd->add_option("--fps", flags->fps, "Frames per second of the walk (default 24)")

@@ -71,4 +71,15 @@ CLI::Validator Seed() {
       "SEED");
 }
 
+CLI::Validator WholeUpTo(long long hi) {
+  return CLI::Validator(
+      [hi](std::string& input) -> std::string {
+        if (!input.empty() && input.size() <= 18 &&
+            input.find_first_not_of("0123456789") == std::string::npos && std::stoll(input) <= hi)
+          return std::string();
+        return "'" + input + "' is not a whole number from 0 to " + std::to_string(hi);
+      },
+      "INT in [0 - " + std::to_string(hi) + "]");
+}
+
 }  // namespace footfall::cli

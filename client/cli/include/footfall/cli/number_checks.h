@@ -20,6 +20,9 @@ CLI::Validator FiniteAboveUpTo(double lo, double hi);
 // A whole number from 0 to 2^64 - 1, written in decimal digits only (CLI11 alone read "-1" as
 // 2^64 - 1 and clamped larger numbers to it).
 CLI::Validator Seed();
+// A whole number written in digits alone, from 0 to hi (hi < 10^18): "1.5", "-1" and "1e3" are
+// refused as not whole numbers, where a range check alone said "not in range".
+CLI::Validator WholeUpTo(long long hi);
 // Text that is not empty or blank ("expected EXPECTED" otherwise): a flag given an unset shell
 // variable.
 CLI::Validator NotBlank(const std::string& expected);
