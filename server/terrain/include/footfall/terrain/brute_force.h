@@ -13,6 +13,11 @@ class BruteForce {
   Foothold Next(const StepQuery& q, double tolerance) const;
 
  private:
+  // The sample nearest the local point `ideal` among those accept(p, d2) keeps, within limit2
+  // (ties: lowest index), or kNoFoothold.
+  template <typename Accept>
+  Foothold Nearest(const double ideal[3], double limit2, const Accept& accept) const;
+
   const TerrainGrid& grid_;
 };
 
