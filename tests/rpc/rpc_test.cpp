@@ -625,6 +625,10 @@ TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
   CHECK(rpc->LoadServerFile("ok.pts", Separation(0), &t) == Status::kOk);
   CHECK(rpc->Snap(t, Vec3{0.9, 0, 0}).index == 1);
   CHECK(rpc->LoadServerFile("/etc/passwd", Separation(0), &t) == Status::kAccessDenied);
+  CHECK(rpc->last_error() == "'/etc/passwd': expected a path relative to the data root");
+  // An empty path is a malformed request, not a path outside the root.
+  CHECK(rpc->LoadServerFile("", Separation(0), &t) == Status::kInvalidArgument);
+  CHECK(rpc->last_error() == "expected a path relative to the data root, got an empty path");
   CHECK(rpc->LoadServerFile("missing.pts", Separation(0), &t) == Status::kIoError);
   CHECK(rpc->LoadServerFile("nowhere/missing.pts", Separation(0), &t) == Status::kIoError);
   REQUIRE(rpc->LoadServerFile("bad.pts", Separation(0), &t) == Status::kParseError);

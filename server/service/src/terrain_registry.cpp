@@ -84,7 +84,11 @@ Status ResolveUnderRoot(const std::string& root, const std::string& relative, st
                ": expected a path without NUL bytes";
     return Status::kInvalidArgument;
   }
-  if (relative.empty() || relative[0] == '/') {
+  if (relative.empty()) {
+    *message = "expected a path relative to the data root, got an empty path";
+    return Status::kInvalidArgument;
+  }
+  if (relative[0] == '/') {
     *message = "'" + relative + "': expected a path relative to the data root";
     return Status::kAccessDenied;
   }

@@ -192,7 +192,8 @@ class TerrainRegistry {
 };
 
 // Resolves `relative` under the canonical directory `root`, refusing escapes: absolute paths,
-// "..", and symlinks leading outside. On success *resolved is the canonical path.
+// "..", and symlinks leading outside (kAccessDenied); an empty path or one with a NUL byte is
+// kInvalidArgument. On success *resolved is the canonical path.
 Status ResolveUnderRoot(const std::string& root, const std::string& relative, std::string* resolved,
                         std::string* message);
 
