@@ -3,6 +3,7 @@
 // recover after a restart; rpcbind registration answers rpcinfo.
 #include <arpa/inet.h>
 #include <fcntl.h>
+#include <iconv.h>
 #include <netinet/in.h>
 #include <signal.h>
 #include <sys/resource.h>
@@ -713,6 +714,55 @@ TEST_CASE("footfalld escapes control characters from clients in its log", "[rpc]
     CHECK(line.rfind("footfalld: ", 0) == 0);
     CHECK(line.rfind("footfalld: forged", 0) != 0);
   }
+}
+
+// True when `text` is well-formed UTF-8, as glibc's iconv decodes it (no overlong forms, no
+// surrogates, nothing past U+10FFFF).
+bool ValidUtf8(const std::string& text) {
+  const iconv_t cd = iconv_open("UTF-32LE", "UTF-8");
+  REQUIRE(cd != reinterpret_cast<iconv_t>(-1));
+  std::string input = text;
+  std::vector<char> output(4 * input.size() + 4);
+  char* in = input.data();
+  char* out = output.data();
+  size_t in_left = input.size(), out_left = output.size();
+  const bool ok = iconv(cd, &in, &in_left, &out, &out_left) != static_cast<size_t>(-1);
+  iconv_close(cd);
+  return ok && in_left == 0;
+}
+
+TEST_CASE("footfalld escapes bytes that are not UTF-8 from clients in its log",
+          "[rpc][robustness]") {
+  const TempRoot temp;
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", temp.path});
+  auto rpc = Connect(server.port());
+  // A stray byte, a valid two- and three-byte character, a surrogate, an overlong '/', a code
+  // point past U+10FFFF, a C1 control (CSI), and a character cut short at the end.
+  const std::string text =
+      "\xff\xfe \xc3\xa9 \xe5\x9c\xb0\xe5\xbd\xa2 \xed\xa0\x80 \xc0\xaf \xf4\x90\x80\x80 "
+      "\xc2\x9b end \xe5\x9c";
+  const std::string escaped =
+      "\\xff\\xfe \xc3\xa9 \xe5\x9c\xb0\xe5\xbd\xa2 \\xed\\xa0\\x80 \\xc0\\xaf "
+      "\\xf4\\x90\\x80\\x80 "
+      "\\xc2\\x9b end \\xe5\\x9c";
+  REQUIRE(!ValidUtf8(text));
+  TerrainHandle t = 0;
+  REQUIRE(rpc->LoadSamples(MakeFlat(4, 1, 0), "name " + text, &t) == Status::kOk);
+  CHECK(rpc->LoadServerFile("path " + text, Separation(0), &t) == Status::kIoError);
+  CHECK(rpc->LoadServerFile("dir/" + text + "\n/x.pts", Separation(0), &t) == Status::kIoError);
+  const std::string log = server.Log();
+  INFO(log);
+  CHECK(ValidUtf8(log));
+  CHECK_THAT(log, Catch::Contains("'name " + escaped + "' (uploaded)"));
+  CHECK_THAT(log, Catch::Contains("'path " + escaped + "': no such file under the data root"));
+  CHECK_THAT(log, Catch::Contains("'dir/" + escaped + "\\n/x.pts': no such file"));
+  std::istringstream lines(log);
+  int loads = 0;
+  for (std::string line; std::getline(lines, line);) {
+    CHECK(line.rfind("footfalld: ", 0) == 0);
+    loads += line.find(escaped) != std::string::npos;
+  }
+  CHECK(loads == 3);  // one line per event
 }
 
 TEST_CASE("footfalld reads server files with every load option, as the embedded engine does",

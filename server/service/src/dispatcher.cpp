@@ -80,13 +80,52 @@ char* Message(const std::string& text) {
   return const_cast<char*>(g_storage.message.c_str());
 }
 
-// `text` with backslashes and control characters escaped (\\n, \\t, \\xHH), so text from a client
-// cannot start a log line of its own nor send terminal escapes.
+// The length of the well-formed UTF-8 sequence at `text[at]` (RFC 3629: no overlong forms, no
+// surrogates, nothing past U+10FFFF), or 0 when the bytes there are not one.
+size_t Utf8Length(const std::string& text, size_t at) {
+  const auto byte = [&](size_t i) {
+    return at + i < text.size() ? static_cast<unsigned char>(text[at + i]) : 0u;
+  };
+  const unsigned lead = byte(0);
+  size_t length = 0;
+  unsigned low = 0x80, high = 0xBF;  // the second byte's range
+  if (lead < 0x80) return 1;
+  if (lead >= 0xC2 && lead <= 0xDF) {
+    length = 2;
+  } else if (lead >= 0xE0 && lead <= 0xEF) {
+    length = 3;
+    if (lead == 0xE0) low = 0xA0;   // overlong
+    if (lead == 0xED) high = 0x9F;  // surrogates
+  } else if (lead >= 0xF0 && lead <= 0xF4) {
+    length = 4;
+    if (lead == 0xF0) low = 0x90;   // overlong
+    if (lead == 0xF4) high = 0x8F;  // past U+10FFFF
+  } else {
+    return 0;  // a continuation byte, an overlong lead (C0, C1), or F5 to FF
+  }
+  if (byte(1) < low || byte(1) > high) return 0;
+  for (size_t i = 2; i < length; ++i)
+    if (byte(i) < 0x80 || byte(i) > 0xBF) return 0;
+  return length;
+}
+
+// `text` with backslashes, control characters (C0, DEL and C1) and bytes that are not UTF-8
+// escaped (\\, \n, \r, \t, \xHH for each byte), so text from a client cannot start a log line of
+// its own nor send terminal escapes, and the log stays UTF-8; other characters are kept as they
+// are.
 std::string EscapeControl(const std::string& text) {
+  static const char kHex[] = "0123456789abcdef";
   std::string out;
   out.reserve(text.size());
-  for (const char c : text) {
+  const auto escape = [&](unsigned char u) {
+    out += "\\x";
+    out += kHex[u >> 4];
+    out += kHex[u & 15];
+  };
+  for (size_t at = 0; at < text.size();) {
+    const char c = text[at];
     const unsigned char u = static_cast<unsigned char>(c);
+    const size_t length = Utf8Length(text, at);
     if (c == '\\') {
       out += "\\\\";
     } else if (c == '\n') {
@@ -96,13 +135,16 @@ std::string EscapeControl(const std::string& text) {
     } else if (c == '\t') {
       out += "\\t";
     } else if (u < 0x20 || u == 0x7F) {
-      static const char kHex[] = "0123456789abcdef";
-      out += "\\x";
-      out += kHex[u >> 4];
-      out += kHex[u & 15];
+      escape(u);
+    } else if (length == 0) {
+      escape(u);  // one byte, then read on from the next: the log stays in step
+    } else if (u == 0xC2 && static_cast<unsigned char>(text[at + 1]) < 0xA0) {
+      escape(u);  // a C1 control (U+0080 to U+009F): CSI is a terminal escape
+      escape(static_cast<unsigned char>(text[at + 1]));
     } else {
-      out += c;
+      out.append(text, at, length);
     }
+    at += std::max<size_t>(length, 1);
   }
   return out;
 }
