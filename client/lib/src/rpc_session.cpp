@@ -150,31 +150,16 @@ class RpcSession final : public TerrainSession {
   Status Next(TerrainHandle terrain, const StepQuery* queries, size_t count, double tolerance,
               Foothold* out) override {
     if (!std::isfinite(tolerance)) return Fail(Status::kInvalidArgument, "tolerance is not finite");
-    auto call = [&](const StepQuery* q, size_t n, Foothold* answers) {
-      return WithTerrain(terrain, [&](uint32_t server) -> Status {
-        // Encoded straight from the caller's queries, answers decoded straight into `answers`.
-        NextBatchView<StepQuery> args;
-        args.terrain = server;
-        args.tolerance = tolerance;
-        args.count = args.capacity = static_cast<u_int>(n);
-        args.queries = const_cast<StepQuery*>(q);  // only read: encoded
-        BatchReplyView<Foothold> reply;
-        reply.results = answers;
-        reply.capacity = static_cast<u_int>(n);
-        const Status cs =
-            Call(CallBatch(FF_NEXT_BATCH, AsXdrProc(XdrNextBatchView<StepQuery>), &args, &reply),
-                 "next");
-        if (cs != Status::kOk) return cs;
-        return TakeBatch(reply, n, answers, "next");
-      });
-    };
-    for (size_t begin = 0; begin < count; begin += FF_MAX_BATCH) {
-      const size_t n = std::min<size_t>(FF_MAX_BATCH, count - begin);
-      Status s = call(queries + begin, n, out + begin);
-      if (s == Status::kOk) s = AskAgain(queries + begin, n, out + begin, "next", call);
-      if (s != Status::kOk) return s;
-    }
-    return Status::kOk;
+    return BatchCalls(
+        terrain, queries, count, out, "next",
+        [&](uint32_t server, const StepQuery* q, size_t n, BatchReplyView<Foothold>* reply) {
+          NextBatchView<StepQuery> args;
+          args.terrain = server;
+          args.tolerance = tolerance;
+          args.count = args.capacity = static_cast<u_int>(n);
+          args.queries = const_cast<StepQuery*>(q);  // only read: encoded
+          return CallBatch(FF_NEXT_BATCH, AsXdrProc(XdrNextBatchView<StepQuery>), &args, reply);
+        });
   }
 
   Status Ping() override {
@@ -192,27 +177,38 @@ class RpcSession final : public TerrainSession {
  private:
   Status PointBatch(TerrainHandle terrain, const Vec3* points, size_t count, Foothold* out,
                     bool normal) {
-    const char* what = normal ? "normal" : "snap";
-    auto call = [&](const Vec3* p, size_t n, Foothold* answers) {
+    return BatchCalls(
+        terrain, points, count, out, normal ? "normal" : "snap",
+        [&](uint32_t server, const Vec3* p, size_t n, BatchReplyView<Foothold>* reply) {
+          PointBatchView<Vec3> args;
+          args.terrain = server;
+          args.count = args.capacity = static_cast<u_int>(n);
+          args.points = const_cast<Vec3*>(p);  // only read: encoded
+          return CallBatch(normal ? FF_NORMAL_BATCH : FF_SNAP_BATCH,
+                           AsXdrProc(XdrPointBatchView<Vec3>), &args, reply);
+        });
+  }
+
+  // Answers `count` queries in calls of at most FF_MAX_BATCH queries, each sent by
+  // send(server handle, queries, n, reply) with its answers decoded straight into `out`, then
+  // sends again what footfalld left for later (AskAgain).
+  template <typename Query, typename SendFn>
+  Status BatchCalls(TerrainHandle terrain, const Query* queries, size_t count, Foothold* out,
+                    const char* what, SendFn&& send) {
+    auto call = [&](const Query* q, size_t n, Foothold* answers) {
       return WithTerrain(terrain, [&](uint32_t server) -> Status {
-        PointBatchView<Vec3> args;
-        args.terrain = server;
-        args.count = args.capacity = static_cast<u_int>(n);
-        args.points = const_cast<Vec3*>(p);  // only read: encoded
         BatchReplyView<Foothold> reply;
         reply.results = answers;
         reply.capacity = static_cast<u_int>(n);
-        const Status st = Call(CallBatch(normal ? FF_NORMAL_BATCH : FF_SNAP_BATCH,
-                                         AsXdrProc(XdrPointBatchView<Vec3>), &args, &reply),
-                               what);
-        if (st != Status::kOk) return st;
+        const Status s = Call(send(server, q, n, &reply), what);
+        if (s != Status::kOk) return s;
         return TakeBatch(reply, n, answers, what);
       });
     };
     for (size_t begin = 0; begin < count; begin += FF_MAX_BATCH) {
       const size_t n = std::min<size_t>(FF_MAX_BATCH, count - begin);
-      Status s = call(points + begin, n, out + begin);
-      if (s == Status::kOk) s = AskAgain(points + begin, n, out + begin, what, call);
+      Status s = call(queries + begin, n, out + begin);
+      if (s == Status::kOk) s = AskAgain(queries + begin, n, out + begin, what, call);
       if (s != Status::kOk) return s;
     }
     return Status::kOk;
