@@ -34,16 +34,6 @@ constexpr int kNeighbourOrder[26][3] = {
 
 }  // namespace
 
-int64_t TerrainGrid::ClampedCell(const double c[3], int64_t ci[3]) const {
-  for (int a = 0; a < 3; ++a) {
-    double t = (c[a] - grid_lo_[a]) * inv_cell_size_;
-    t = t > 0 ? t : 0;  // NaN too
-    t = t < last_cell_[a] ? t : last_cell_[a];
-    ci[a] = static_cast<int64_t>(t);
-  }
-  return ci[0] + (ci[1] + ci[2] * int64_t{dims_[1]}) * dims_[0];
-}
-
 // Cell boxes, in local coordinates. Border cells reach the sample bounds, where they hold
 // samples outside the grid box.
 double TerrainGrid::CellLo(uint32_t i, int axis) const {
@@ -430,7 +420,16 @@ struct NearbySearch {
     }
     // The ball of the own cell's nearest bounds the search: when it reaches two cells away, so
     // might the answer.
-    if (!own_empty && reaches_two_away()) return false;
+    if (!own_empty) {
+      // Most often the ball stays within the own cell: no neighbour to visit (nor any two away:
+      // a face the ball does not reach is not crossed by it either).
+      if (sides[0] + sides[1] + sides[2] == 0) {
+        *cell_out = static_cast<uint32_t>(best_cell);
+        *slot_out = best_slot;
+        return true;
+      }
+      if (reaches_two_away()) return false;
+    }
     // Faces, then edges, then corners: the nearer neighbours usually shrink the ball first.
     for (int a = 0; a < 3; ++a)
       for (int s = 0; s < sides[a]; ++s)

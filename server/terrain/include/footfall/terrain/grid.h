@@ -174,7 +174,16 @@ class TerrainGrid {
   void Prefetch(const Vec3& q, bool samples) const;
   // The linear index of the cell holding local point c, clamped into the grid (NaN counts as
   // below); ci receives its coordinates. Same cell as CellCoord per axis.
-  int64_t ClampedCell(const double c[3], int64_t ci[3]) const;
+  // (Inline: it starts every query, also in the AVX2 search.)
+  int64_t ClampedCell(const double c[3], int64_t ci[3]) const {
+    for (int a = 0; a < 3; ++a) {
+      double t = (c[a] - grid_lo_[a]) * inv_cell_size_;
+      t = t > 0 ? t : 0;  // NaN too
+      t = t < last_cell_[a] ? t : last_cell_[a];
+      ci[a] = static_cast<int64_t>(t);
+    }
+    return ci[0] + (ci[1] + ci[2] * int64_t{dims_[1]}) * dims_[0];
+  }
   // The cell coordinate along `axis` of a local coordinate, clamped into the grid.
   uint32_t CellCoord(double local, int axis) const {
     const double t = (local - grid_lo_[axis]) * inv_cell_size_;
