@@ -1686,8 +1686,10 @@ TEST_CASE("at the open descriptor limit footfalld says which connections it clos
 TEST_CASE("footfalld listens on IPv6 addresses and logs them in brackets", "[rpc]") {
   SECTION("[::1]:0") {
     ServerProcess server(0, {"--no-rpcbind", "--listen", "[::1]:0"});
-    CHECK_THAT(server.Log(),
-               Catch::Contains("listening on [::1]:" + std::to_string(server.port()) + " "));
+    // footfalld says it listens just after it writes its port file.
+    const std::string listening = "listening on [::1]:" + std::to_string(server.port()) + " ";
+    WaitFor([&] { return server.Log().find(listening) != std::string::npos; });
+    CHECK_THAT(server.Log(), Catch::Contains(listening));
     RpcOptions o;
     o.host = "::1";
     o.port = server.port();
@@ -1977,6 +1979,30 @@ TEST_CASE("clients report a dead server and recover after a restart", "[rpc][rob
   }
 }
 
+TEST_CASE("footfalld exits naming a --port-file it cannot write and never says it listens",
+          "[rpc]") {
+  const TempRoot temp;
+  const std::string log = temp.path + "/log";
+  for (const std::string& port_file :
+       {temp.path + "/no/such/dir/port", temp.path /* a directory */,
+        std::string("/dev/full") /* opens, then fails on the flush */}) {
+    INFO(port_file);
+    // `timeout`: a footfalld that went on serving would be stopped (124), not waited for.
+    const int status = std::system(("timeout 5 " + std::string(ServerProcess::Path()) +
+                                    " --no-rpcbind --listen 127.0.0.1:0 --port-file '" + port_file +
+                                    "' 2>'" + log + "'")
+                                       .c_str());
+    std::ifstream in(log);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    INFO(text);
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 1);
+    CHECK_THAT(text, Catch::Contains("footfalld: --port-file " + port_file +
+                                     ": cannot write the port there: "));
+    CHECK_THAT(text, !Catch::Contains("listening"));
+  }
+}
+
 TEST_CASE("footfalld stops cleanly on SIGTERM, also with clients connected", "[rpc]") {
   ServerProcess server;
   auto rpc = Connect(server.port());
@@ -2000,6 +2026,8 @@ TEST_CASE("footfalld registers with rpcbind and answers rpcinfo", "[rpc][rpcbind
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   ServerProcess server(0, {});
+  // Registered before the port file is written, and said just after.
+  WaitFor([&] { return server.Log().find("registered with rpcbind") != std::string::npos; });
   CHECK(server.Log().find("registered with rpcbind") != std::string::npos);
   // Whether rpcinfo reaches footfall's program through rpcbind.
   auto rpcinfo_answers = [] {
@@ -2018,8 +2046,10 @@ TEST_CASE("footfalld registers with rpcbind and answers rpcinfo", "[rpc][rpcbind
     // A second server leaves the first one's registration alone (taking it over left the first
     // unregistered once the second stopped).
     ServerProcess second(0, {});
-    CHECK_THAT(second.Log(), Catch::Contains("rpcbind already has the footfalld on port " +
-                                             std::to_string(server.port())));
+    const std::string note =
+        "rpcbind already has the footfalld on port " + std::to_string(server.port());
+    WaitFor([&] { return second.Log().find(note) != std::string::npos; });
+    CHECK_THAT(second.Log(), Catch::Contains(note));
   }
   CHECK(rpcinfo_answers());
   // SIGHUP (a closed terminal) stops it cleanly, unregistered (it died registered).
@@ -2028,4 +2058,13 @@ TEST_CASE("footfalld registers with rpcbind and answers rpcinfo", "[rpc][rpcbind
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   CHECK_THAT(server.Log(), Catch::Contains("footfalld: stopped"));
   CHECK_FALSE(rpcinfo_answers());
+  // A footfalld that cannot write its --port-file withdraws its registration as it exits.
+  const TempRoot temp;
+  const int status =
+      std::system(("timeout 5 " + std::string(ServerProcess::Path()) +
+                   " --listen 127.0.0.1:0 --port-file '" + temp.path + "/no/dir/port' 2>/dev/null")
+                      .c_str());
+  CHECK(WEXITSTATUS(status) == 1);
+  CHECK(std::system(("rpcinfo -p 127.0.0.1 | grep -qw " + std::to_string(FOOTFALL_PROG)).c_str()) !=
+        0);
 }

@@ -4,11 +4,12 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
+#include <cstring>
 #include <string>
 #include <thread>
 
@@ -94,6 +95,22 @@ CLI::Validator SampleCount() {
       "SAMPLES");
 }
 
+// Writes `port` and a line end to `path`. On failure false, with a message naming the file.
+bool WritePortFile(const std::string& path, int port, std::string* message) {
+  errno = 0;
+  FILE* out = std::fopen(path.c_str(), "w");
+  bool ok = out != nullptr && std::fprintf(out, "%d\n", port) > 0;
+  int error = errno;
+  if (out && std::fclose(out) != 0 && ok) {  // a full disk fails here, on the flush
+    ok = false;
+    error = errno;
+  }
+  if (ok) return true;
+  *message = "--port-file " + path +
+             ": cannot write the port there: " + std::strerror(error != 0 ? error : EIO);
+  return false;
+}
+
 }  // namespace
 
 // Raises the soft limit on open descriptors to the hard one: at the limit, libtirpc closes the
@@ -149,7 +166,8 @@ int main(int argc, char** argv) {
                  "Seconds a client may leave its replies unread, with no room for another, "
                  "before its connection is closed (default 30)")
       ->check(Seconds(false));
-  app.add_option("--port-file", port_file, "Write the bound port to this file once listening");
+  app.add_option("--port-file", port_file,
+                 "Write the bound port to this file before serving (exit 1 if it cannot)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -184,20 +202,17 @@ int main(int argc, char** argv) {
   RaiseOpenFileLimit();
   bool abandoned_load = false;
   {
+    // The port file is written before footfalld says it listens: a supervisor waiting for the
+    // file would wait forever, and one reading the log would take a server that exits for one
+    // that serves.
+    if (!port_file.empty())
+      options.on_bound = [&port_file](int port, std::string* message) {
+        return WritePortFile(port_file, port, message);
+      };
     footfall::RpcServer server(options);
     if (!server.Start(&error)) {
       std::fprintf(stderr, "footfalld: %s\n", error.c_str());
       return 1;
-    }
-    if (!port_file.empty()) {
-      std::ofstream out(port_file);
-      out << server.port() << "\n";
-      if (!out.flush()) {
-        // A supervisor waiting for the file would wait forever.
-        std::fprintf(stderr, "footfalld: --port-file %s: cannot write the port there\n",
-                     port_file.c_str());
-        return 1;
-      }
     }
     g_server = &server;
     struct sigaction action {};

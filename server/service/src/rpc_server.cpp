@@ -15,6 +15,7 @@
 #include <cstring>
 #include <memory>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "deferred_reply.h"
@@ -146,28 +147,34 @@ bool RpcServer::Start(std::string* error) {
     *error = "cannot register the RPC program";
     return false;
   }
-  const bool v6 = options_.listen_host.find(':') != std::string::npos;
-  std::fprintf(stderr, "footfalld: listening on %s%s%s:%d (program %u version %u)\n", v6 ? "[" : "",
-               options_.listen_host.c_str(), v6 ? "]" : "", port_,
-               static_cast<unsigned>(FOOTFALL_PROG), static_cast<unsigned>(FOOTFALL_V1));
+  // Registered with rpcbind before on_bound (footfalld's --port-file), so that a client
+  // which waits for the port file finds the registration too; said after it. A failing on_bound
+  // leaves the registration to the destructor, which withdraws it.
+  std::string rpcbind_note;
   if (options_.use_rpcbind) {
     const int other = RpcbindRunning() ? LiveRegisteredPort() : 0;
     if (other != 0 && other != port_) {
       // Taking the registration over would leave that server unregistered once this one stops.
-      std::fprintf(stderr,
-                   "footfalld: rpcbind already has the footfalld on port %d; not registering "
-                   "(clients connect to this one by port)\n",
-                   other);
+      rpcbind_note = "rpcbind already has the footfalld on port " + std::to_string(other) +
+                     "; not registering (clients connect to this one by port)";
     } else if (RpcbindRunning()) {
       pmap_unset(FOOTFALL_PROG, FOOTFALL_V1);  // a stale registration of a server gone
       registered_rpcbind_ =
           pmap_set(FOOTFALL_PROG, FOOTFALL_V1, IPPROTO_TCP, static_cast<unsigned short>(port_));
-      std::fprintf(stderr, registered_rpcbind_ ? "footfalld: registered with rpcbind\n"
-                                               : "footfalld: rpcbind refused the registration\n");
+      rpcbind_note =
+          registered_rpcbind_ ? "registered with rpcbind" : "rpcbind refused the registration";
     } else {
-      std::fprintf(stderr, "footfalld: rpcbind is not running; clients connect by port\n");
+      rpcbind_note = "rpcbind is not running; clients connect by port";
     }
   }
+  // Nothing says the server listens until on_bound has succeeded: a server that then exits was
+  // never announced.
+  if (options_.on_bound && !options_.on_bound(port_, error)) return false;
+  const bool v6 = options_.listen_host.find(':') != std::string::npos;
+  std::fprintf(stderr, "footfalld: listening on %s%s%s:%d (program %u version %u)\n", v6 ? "[" : "",
+               options_.listen_host.c_str(), v6 ? "]" : "", port_,
+               static_cast<unsigned>(FOOTFALL_PROG), static_cast<unsigned>(FOOTFALL_V1));
+  if (!rpcbind_note.empty()) std::fprintf(stderr, "footfalld: %s\n", rpcbind_note.c_str());
   if (!options_.data_root.empty())
     std::fprintf(stderr, "footfalld: data root %s\n", options_.data_root.c_str());
   return true;

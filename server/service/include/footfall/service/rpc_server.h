@@ -10,6 +10,7 @@
 
 #include <atomic>
 #include <cstddef>
+#include <functional>
 #include <string>
 
 #include "footfall/service/terrain_registry.h"
@@ -29,6 +30,10 @@ struct RpcServerOptions {
   // that costly queries cannot hold the other clients up for longer.
   double batch_time_limit_s = 1;
   RegistryLimits limits;
+  // [opt] Called by Start with the bound port, once registered (with rpcbind too) and before
+  // the server says it listens (footfalld writes --port-file there): returning false fails
+  // Start with the callback's *error, and nothing has said that the server listens.
+  std::function<bool(int port, std::string* error)> on_bound;
 };
 
 class RpcServer {
@@ -38,7 +43,8 @@ class RpcServer {
   RpcServer(const RpcServer&) = delete;
   RpcServer& operator=(const RpcServer&) = delete;
 
-  // Binds, listens and registers. On failure returns false with a message.
+  // Binds, listens, registers, calls options.on_bound, then says it listens. On failure returns
+  // false with a message (a registration with rpcbind is withdrawn by the destructor).
   bool Start(std::string* error);
   // The bound port (after Start).
   int port() const { return port_; }
