@@ -731,6 +731,25 @@ bool ValidUtf8(const std::string& text) {
   return ok && in_left == 0;
 }
 
+TEST_CASE("An error message footfalld cuts to FF_MAX_MESSAGE bytes ends on a whole character",
+          "[rpc][robustness]") {
+  TempRoot temp;
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", temp.path});
+  auto rpc = Connect(server.port());
+  // The message quotes the path after one quote: "'/a" then two-byte characters from byte 3
+  // on, so byte FF_MAX_MESSAGE falls inside one of them.
+  std::string path = "/a";
+  while (path.size() + 2 <= FF_MAX_PATH) path += "\xC3\xA9";  // é
+  TerrainHandle t = 0;
+  CHECK(rpc->LoadServerFile(path, Separation(0), &t) == Status::kAccessDenied);
+  const std::string& message = rpc->last_error();
+  INFO(message.size());
+  CHECK(message.size() >= FF_MAX_MESSAGE - 1);
+  CHECK(ValidUtf8(message));
+  // The server keeps serving.
+  CHECK(rpc->Ping() == Status::kOk);
+}
+
 TEST_CASE("footfalld escapes bytes that are not UTF-8 from clients in its log",
           "[rpc][robustness]") {
   const TempRoot temp;

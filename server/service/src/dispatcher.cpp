@@ -22,6 +22,7 @@
 #include "footfall.h"
 #include "footfall/rpc/batch_xdr.h"
 #include "footfall/terrain/batch_pool.h"
+#include "footfall/terrain/shown_text.h"
 #include "read_gate.h"
 
 namespace footfall {
@@ -76,37 +77,8 @@ ff_result ToWire(const Foothold& f) {
 }
 
 char* Message(const std::string& text) {
-  g_storage.message = text.substr(0, FF_MAX_MESSAGE);
+  g_storage.message = std::string(Utf8Prefix(text, FF_MAX_MESSAGE));  // whole characters
   return const_cast<char*>(g_storage.message.c_str());
-}
-
-// The length of the well-formed UTF-8 sequence at `text[at]` (RFC 3629: no overlong forms, no
-// surrogates, nothing past U+10FFFF), or 0 when the bytes there are not one.
-size_t Utf8Length(const std::string& text, size_t at) {
-  const auto byte = [&](size_t i) {
-    return at + i < text.size() ? static_cast<unsigned char>(text[at + i]) : 0u;
-  };
-  const unsigned lead = byte(0);
-  size_t length = 0;
-  unsigned low = 0x80, high = 0xBF;  // the second byte's range
-  if (lead < 0x80) return 1;
-  if (lead >= 0xC2 && lead <= 0xDF) {
-    length = 2;
-  } else if (lead >= 0xE0 && lead <= 0xEF) {
-    length = 3;
-    if (lead == 0xE0) low = 0xA0;   // overlong
-    if (lead == 0xED) high = 0x9F;  // surrogates
-  } else if (lead >= 0xF0 && lead <= 0xF4) {
-    length = 4;
-    if (lead == 0xF0) low = 0x90;   // overlong
-    if (lead == 0xF4) high = 0x8F;  // past U+10FFFF
-  } else {
-    return 0;  // a continuation byte, an overlong lead (C0, C1), or F5 to FF
-  }
-  if (byte(1) < low || byte(1) > high) return 0;
-  for (size_t i = 2; i < length; ++i)
-    if (byte(i) < 0x80 || byte(i) > 0xBF) return 0;
-  return length;
 }
 
 // `text` with backslashes, control characters (C0, DEL and C1) and bytes that are not UTF-8
@@ -125,7 +97,7 @@ std::string EscapeControl(const std::string& text) {
   for (size_t at = 0; at < text.size();) {
     const char c = text[at];
     const unsigned char u = static_cast<unsigned char>(c);
-    const size_t length = Utf8Length(text, at);
+    const size_t length = Utf8SequenceLength(text, at);
     if (c == '\\') {
       out += "\\\\";
     } else if (c == '\n') {

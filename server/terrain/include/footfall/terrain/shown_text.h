@@ -3,6 +3,7 @@
 #pragma once
 
 #include <charconv>
+#include <cstddef>
 #include <string>
 #include <string_view>
 
@@ -26,6 +27,49 @@ inline std::string ShownText(std::string_view text) {
   }
   if (text.size() > kMax) out += "... (" + std::to_string(text.size()) + " bytes)";
   return out;
+}
+
+// The length of the well-formed UTF-8 sequence at `text[at]` (RFC 3629: no overlong forms, no
+// surrogates, nothing past U+10FFFF), or 0 when the bytes there are not one (or `at` is past the
+// end).
+inline size_t Utf8SequenceLength(std::string_view text, size_t at) {
+  const auto byte = [&](size_t i) -> unsigned {
+    return at + i < text.size() ? static_cast<unsigned char>(text[at + i]) : 0u;
+  };
+  if (at >= text.size()) return 0;
+  const unsigned lead = byte(0);
+  size_t length = 0;
+  unsigned low = 0x80, high = 0xBF;  // the second byte's range
+  if (lead < 0x80) return 1;
+  if (lead >= 0xC2 && lead <= 0xDF) {
+    length = 2;
+  } else if (lead >= 0xE0 && lead <= 0xEF) {
+    length = 3;
+    if (lead == 0xE0) low = 0xA0;   // overlong
+    if (lead == 0xED) high = 0x9F;  // surrogates
+  } else if (lead >= 0xF0 && lead <= 0xF4) {
+    length = 4;
+    if (lead == 0xF0) low = 0x90;   // overlong
+    if (lead == 0xF4) high = 0x8F;  // past U+10FFFF
+  } else {
+    return 0;  // a continuation byte, an overlong lead (C0, C1), or F5 to FF
+  }
+  if (byte(1) < low || byte(1) > high) return 0;
+  for (size_t i = 2; i < length; ++i)
+    if (byte(i) < 0x80 || byte(i) > 0xBF) return 0;
+  return length;
+}
+
+// `text` cut to at most `bytes` bytes, never inside a UTF-8 sequence: a cut message stays text.
+inline std::string_view Utf8Prefix(std::string_view text, size_t bytes) {
+  if (text.size() <= bytes) return text;
+  size_t cut = bytes;
+  // Back over at most three continuation bytes to the start of the sequence the cut splits.
+  for (int back = 0; back < 3 && cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80;
+       ++back)
+    --cut;
+  if ((static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) cut = bytes;  // not UTF-8 anyway
+  return text.substr(0, cut);
 }
 
 // The shortest text that reads back as `value` ("1.0000001", "2147483648", "0.1"): a message's
