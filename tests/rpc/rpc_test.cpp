@@ -750,6 +750,25 @@ TEST_CASE("An error message footfalld cuts to FF_MAX_MESSAGE bytes ends on a who
   CHECK(rpc->Ping() == Status::kOk);
 }
 
+TEST_CASE("A terrain name cut to FF_MAX_NAME bytes ends on a whole character", "[rpc]") {
+  ServerProcess server(0, {"--no-rpcbind"});
+  auto rpc = Connect(server.port());
+  RawSamples samples;
+  samples.points = {{0, 0, 0}, {1, 0, 0}};
+  samples.normals = {{0, 1, 0}, {0, 1, 0}};
+  std::string name = "a";
+  while (name.size() < 2 * FF_MAX_NAME) name += "\xC3\xA9";  // é: byte FF_MAX_NAME is inside one
+  TerrainHandle t = 0;
+  REQUIRE(rpc->LoadSamples(samples, name, &t) == Status::kOk);
+  TerrainInfo info;
+  REQUIRE(rpc->Info(t, &info) == Status::kOk);
+  INFO(info.name.size());
+  CHECK(info.name.size() >= FF_MAX_NAME - 1);
+  CHECK(info.name.size() <= FF_MAX_NAME);
+  CHECK(ValidUtf8(info.name));
+  CHECK(name.compare(0, info.name.size(), info.name) == 0);
+}
+
 TEST_CASE("footfalld escapes bytes that are not UTF-8 from clients in its log",
           "[rpc][robustness]") {
   const TempRoot temp;

@@ -17,6 +17,7 @@
 #include "footfall.h"
 #include "footfall/client/terrain_session.h"
 #include "footfall/rpc/batch_xdr.h"
+#include "footfall/terrain/shown_text.h"
 #include "rpc_connect.h"
 
 namespace footfall {
@@ -341,7 +342,7 @@ class RpcSession final : public TerrainSession {
     }
     const RawSamples& samples = source->samples;
     ff_upload_begin_args begin;
-    std::string name = source->name.substr(0, FF_MAX_NAME);
+    std::string name(Utf8Prefix(source->name, FF_MAX_NAME));  // whole characters
     begin.name = const_cast<char*>(name.c_str());
     begin.total = samples.size();
     Reply<ff_upload_reply> started(reinterpret_cast<xdrproc_t>(xdr_ff_upload_reply));

@@ -401,7 +401,7 @@ void Info(const ff_terrain_args& a, ff_info_reply* r) {
     return;
   }
   const GridStats& st = t->grid.stats();
-  g_storage.name = t->name.substr(0, FF_MAX_NAME);
+  g_storage.name = std::string(Utf8Prefix(t->name, FF_MAX_NAME));  // whole characters
   r->name = const_cast<char*>(g_storage.name.c_str());
   r->status = FF_OK;
   r->samples = st.samples;
