@@ -378,6 +378,96 @@ static void TestBadArguments(ffc_session* s, uint32_t terrain) {
               "ffc_load_samples of a zero normal");
 }
 
+/* Whether `text` is well-formed UTF-8 (RFC 3629) without control characters (C0, DEL, C1) or
+ * line separators (U+2028, U+2029): one line a plugin can show and decode. */
+static int OneLineOfUtf8(const char* text) {
+  const unsigned char* p = (const unsigned char*)text;
+  while (*p) {
+    int n, i;
+    unsigned code;
+    if (*p < 0x80) {
+      if (*p < 0x20 || *p == 0x7f) return 0;
+      ++p;
+      continue;
+    }
+    n = (*p & 0xe0) == 0xc0 ? 2 : (*p & 0xf0) == 0xe0 ? 3 : (*p & 0xf8) == 0xf0 ? 4 : 0;
+    if (n == 0) return 0;
+    code = *p & (0x7fu >> n);
+    for (i = 1; i < n; ++i) {
+      if ((p[i] & 0xc0) != 0x80) return 0;
+      code = (code << 6) | (p[i] & 0x3fu);
+    }
+    if ((n == 2 && code < 0x80) || (n == 3 && code < 0x800) || (n == 4 && code < 0x10000) ||
+        code > 0x10ffff || (code >= 0xd800 && code <= 0xdfff) || (code >= 0x80 && code <= 0x9f) ||
+        code == 0x2028 || code == 0x2029)
+      return 0;
+    p += n;
+  }
+  return 1;
+}
+
+/* 6b. ffc_last_error is one line of UTF-8 of bounded length, whatever the caller passed: names,
+ * paths and request text with line breaks, bytes that are not UTF-8, and megabytes. */
+static void TestErrorText(ffc_session* s) {
+  double samples[6] = {0, 0, 0, 0, 1, 0};
+  uint32_t handle = 0;
+  enum { kLong = 1 << 20 };
+  char* name = malloc(kLong + 1);
+  char* walk = (char*)&handle; /* not NULL: a failed ffc_generate sets it to NULL */
+  const char* error;
+  if (!Check(name != NULL, "memory for a long name", "")) return;
+  CheckStatus(s, ffc_load_samples(s, samples, 0, "two\nlines\r\x85\xe2\x80\xa8 \xff\xc0\xaf", &handle),
+              FF_C_INVALID_ARGUMENT, "ffc_load_samples of 0 samples under an odd name");
+  error = ffc_last_error(s);
+  Check(OneLineOfUtf8(error), "ffc_last_error shows an odd name as one line of UTF-8",
+        "last error: %s", error);
+  Check(strstr(error, "two?lines") != NULL, "ffc_last_error shows a line break as '?'",
+        "last error: %s", error);
+  CheckStatus(s, ffc_load_file(s, "/nonexistent\n\xff.pts", 0, &handle), FF_C_IO_ERROR,
+              "ffc_load_file of a missing path with a line break");
+  error = ffc_last_error(s);
+  Check(OneLineOfUtf8(error), "ffc_last_error shows an odd path as one line of UTF-8",
+        "last error: %s", error);
+  CheckStatus(s, ffc_generate(s, 1, "{\"character\": \"\xff\"}", &walk), FF_C_PARSE_ERROR,
+              "ffc_generate of a request that is not UTF-8");
+  Check(walk == NULL, "a failed ffc_generate sets walk_json to NULL", "");
+  Check(OneLineOfUtf8(ffc_last_error(s)), "ffc_last_error quotes a bad request as UTF-8",
+        "last error: %s", ffc_last_error(s));
+  walk = (char*)&handle;
+  CheckStatus(s, ffc_generate(s, 1, NULL, &walk), FF_C_INVALID_ARGUMENT,
+              "ffc_generate with a NULL request, again");
+  Check(walk == NULL, "ffc_generate with a NULL request sets walk_json to NULL", "");
+  walk = (char*)&handle;
+  Check(ffc_generate(NULL, 1, "{}", &walk) == FF_C_INVALID_ARGUMENT && walk == NULL,
+        "ffc_generate on a NULL session sets walk_json to NULL", "");
+
+  memset(name, 'a', kLong);
+  name[kLong] = '\0';
+  memcpy(name, "/nonexistent/", 13);
+  CheckStatus(s, ffc_load_samples(s, samples, 0, name, &handle), FF_C_INVALID_ARGUMENT,
+              "ffc_load_samples of 0 samples under a name of 1 MiB");
+  error = ffc_last_error(s);
+  Check(strlen(error) <= 8192 && strstr(error, "bytes)") != NULL,
+        "ffc_last_error cuts a reason of 1 MiB to 8192 bytes, saying how long it was",
+        "%zu bytes: %.60s...%s", strlen(error), error,
+        strlen(error) > 60 ? error + strlen(error) - 40 : "");
+  CheckStatus(s, ffc_load_file(s, name, 0, &handle), FF_C_IO_ERROR,
+              "ffc_load_file of a path of 1 MiB");
+  Check(strlen(ffc_last_error(s)) <= 8192, "ffc_last_error cuts a path of 1 MiB", "%zu bytes",
+        strlen(ffc_last_error(s)));
+  /* A cut never splits a character. */
+  {
+    size_t i;
+    for (i = 0; i + 2 <= kLong; i += 2) memcpy(name + i, "\xc3\xa9", 2);
+    name[kLong - (kLong % 2)] = '\0';
+    CheckStatus(s, ffc_load_samples(s, samples, 0, name, &handle), FF_C_INVALID_ARGUMENT,
+                "ffc_load_samples of 0 samples under a long name of e-acute");
+    Check(OneLineOfUtf8(ffc_last_error(s)), "ffc_last_error cuts on a whole character",
+          "last error ends: %s", ffc_last_error(s) + strlen(ffc_last_error(s)) - 30);
+  }
+  free(name);
+}
+
 static void TestCharacterAndWalk(ffc_session* s, uint32_t terrain, const char* character_path) {
   char* character = ReadFile(character_path);
   char* request;
@@ -527,6 +617,7 @@ int main(int argc, char** argv) {
 
   TestQueries(s, terrain, samples);
   TestBadArguments(s, terrain);
+  TestErrorText(s);
   TestCharacterAndWalk(s, terrain, argv[1]);
 
   /* 10. Unloading: the handle is gone; another terrain is unaffected. */

@@ -1,6 +1,7 @@
 // The C ABI over TerrainSession. Nothing may throw across it: every entry point catches.
 #include "footfall/client/footfall_c.h"
 
+#include <algorithm>
 #include <cmath>
 #include <csignal>
 #include <cstdlib>
@@ -17,6 +18,7 @@
 #include "footfall/steps/generate_request.h"
 #include "footfall/steps/generator.h"
 #include "footfall/steps/walk_json.h"
+#include "footfall/terrain/shown_text.h"
 
 struct ffc_session {
   // Calls on one session from several threads take turns (the sessions below are not
@@ -34,6 +36,38 @@ using footfall::Status;
 constexpr double kMaxTimeout = 1e6;    // seconds, as footfall's --timeout
 constexpr double kMinTimeout = 0.001;  // seconds, as footfall's --timeout: shorter ones (below
                                        // 1 us, none at all) fail every call
+
+// [Units: bytes] the longest reason ffc_last_error gives (a path of PATH_MAX and its message fit).
+constexpr size_t kMaxError = 8192;
+
+// `text` as ffc_last_error promises it: one line of well-formed UTF-8 of at most kMaxError
+// bytes. Reasons quote names, paths and request text as the caller gave them: their line breaks
+// and other control characters (C0, DEL, C1, U+2028, U+2029) and bytes that are not UTF-8 are
+// shown as '?'; a longer reason is cut on a whole character and ends "... (N bytes)".
+std::string OneLine(const std::string& text) {
+  const std::string tail_room = "... (" + std::to_string(text.size()) + " bytes)";
+  const size_t limit = text.size() > kMaxError ? kMaxError - tail_room.size() : kMaxError;
+  std::string out;
+  out.reserve(std::min(text.size(), kMaxError));
+  size_t i = 0;
+  while (i < text.size()) {
+    const size_t n = footfall::Utf8SequenceLength(text, i);
+    const auto byte = [&](size_t k) { return static_cast<unsigned char>(text[i + k]); };
+    const bool control =
+        n == 0 || (n == 1 && (byte(0) < 0x20 || byte(0) == 0x7f)) ||
+        (n == 2 && byte(0) == 0xc2 && byte(1) <= 0x9f) ||
+        (n == 3 && byte(0) == 0xe2 && byte(1) == 0x80 && (byte(2) == 0xa8 || byte(2) == 0xa9));
+    const size_t width = control ? 1 : n;
+    if (out.size() + width > limit) break;
+    if (control)
+      out += '?';
+    else
+      out.append(text, i, n);
+    i += n == 0 ? 1 : n;
+  }
+  if (i < text.size()) out += tail_room;
+  return out;
+}
 
 int32_t Result(ffc_session* s, Status status) {
   if (status != Status::kOk) s->error = s->session->last_error();
@@ -130,8 +164,16 @@ const char* ffc_last_error(const ffc_session* session) {
   if (!session) return "no session";
   // The calling thread's copy: another thread's call may replace the session's meanwhile.
   thread_local std::string copy;
-  std::lock_guard<std::mutex> lock(session->mutex);
-  copy = session->error;
+  try {
+    std::string error;
+    {
+      std::lock_guard<std::mutex> lock(session->mutex);
+      error = session->error;
+    }
+    copy = OneLine(error);
+  } catch (...) {  // no memory for the copy
+    return "out of memory for the error text";
+  }
   return copy.c_str();
 }
 
@@ -229,10 +271,10 @@ int32_t ffc_next(ffc_session* s, uint32_t terrain, const double* steps, size_t c
 }
 
 int32_t ffc_generate(ffc_session* s, uint32_t terrain, const char* request_json, char** walk_json) {
+  if (walk_json) *walk_json = nullptr;  // on every failure but a walk that stopped early
   return Guard(s, [&]() -> int32_t {
     if (!request_json || !walk_json)
       return BadArgument(s, "request_json and walk_json must not be NULL");
-    *walk_json = nullptr;
     footfall::Character character;
     footfall::GenerateOptions options;
     footfall::Walk walk;

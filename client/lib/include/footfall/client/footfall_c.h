@@ -57,7 +57,10 @@ ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s);
  * twice, or while another thread is in a call on it, is undefined). NULL is ignored. */
 void ffc_close(ffc_session* session);
 /* The reason for the session's last failed call (from any thread), as a copy that stays valid
- * until this thread calls ffc_last_error again. Not cleared by calls that succeed. Never NULL. */
+ * until this thread calls ffc_last_error again. Not cleared by calls that succeed. Never NULL.
+ * One line of UTF-8 of at most 8192 bytes: names, paths and request text quoted in it show line
+ * breaks, other control characters and bytes that are not UTF-8 as '?', and a longer reason is
+ * cut on a whole character, ending "... (N bytes)". */
 const char* ffc_last_error(const ffc_session* session);
 /* Whether the session's engine answers: FF_C_OK, or FF_C_UNAVAILABLE (ffc_last_error says why)
  * when no footfalld answers within the call timeout. An RPC session calls the RPC NULL
@@ -101,7 +104,8 @@ int32_t ffc_next(ffc_session* s, uint32_t terrain, const double* steps, size_t c
  * file).
  * On FF_C_OK and on a walk that stopped early, *walk_json receives the walk as footfall's JSON
  * (release it with ffc_free_string); a walk that stopped early returns FF_C_NO_FOOTHOLD,
- * still fills *walk_json with the keys so far, and sets ffc_last_error() to why it stopped. */
+ * still fills *walk_json with the keys so far, and sets ffc_last_error() to why it stopped.
+ * Every other return sets *walk_json to NULL (when walk_json is not NULL). */
 int32_t ffc_generate(ffc_session* s, uint32_t terrain, const char* request_json, char** walk_json);
 void ffc_free_string(char* text);
 
