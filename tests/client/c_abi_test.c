@@ -12,11 +12,13 @@
 #include <arpa/inet.h>
 #include <math.h>
 #include <netinet/in.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "footfall/client/footfall_c.h"
@@ -519,6 +521,77 @@ static void TestCharacterAndWalk(ffc_session* s, uint32_t terrain, const char* c
   free(character);
 }
 
+static double Seconds(void) {
+  struct timespec now;
+  clock_gettime(CLOCK_MONOTONIC, &now);
+  return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
+}
+
+static void Sleep(double seconds) {
+  struct timespec wait;
+  wait.tv_sec = (time_t)seconds;
+  wait.tv_nsec = (long)((seconds - (double)wait.tv_sec) * 1e9);
+  nanosleep(&wait, NULL);
+}
+
+/* A thread's call that waits out its timeout on a server that never answers. */
+struct SlowCall {
+  ffc_session* session;
+  _Atomic int started;
+  int32_t status;
+};
+
+static void* PingSlowly(void* arg) {
+  struct SlowCall* call = arg;
+  call->started = 1;
+  call->status = ffc_ping(call->session);
+  return NULL;
+}
+
+/* 9b. ffc_last_error answers at once while another thread's call on the session waits (for its
+ * server, a load of minutes): it does not take its turn behind that call. The server is a
+ * loopback socket that listens (connections complete in its backlog) but never answers. */
+static void TestLastErrorDuringCall(void) {
+  struct sockaddr_in address;
+  socklen_t length = sizeof address;
+  struct SlowCall call;
+  pthread_t thread;
+  double began, took;
+  int port = 0;
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  if (!Check(fd >= 0, "a socket for a server that never answers", "")) return;
+  memset(&address, 0, sizeof address);
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (bind(fd, (struct sockaddr*)&address, sizeof address) == 0 && listen(fd, 8) == 0 &&
+      getsockname(fd, (struct sockaddr*)&address, &length) == 0)
+    port = ntohs(address.sin_port);
+  if (!Check(port > 0, "a loopback port that never answers", "bind, listen or getsockname failed")) {
+    close(fd);
+    return;
+  }
+  call.session = ffc_open_rpc("127.0.0.1", port, 2);
+  call.started = 0;
+  call.status = FF_C_OK;
+  if (!Check(call.session != NULL, "ffc_open_rpc to a server that never answers", "") ||
+      !Check(pthread_create(&thread, NULL, PingSlowly, &call) == 0, "a thread that pings", "")) {
+    ffc_close(call.session);
+    close(fd);
+    return;
+  }
+  while (!call.started) Sleep(0.001);
+  Sleep(0.3); /* the ping now waits for its answer */
+  began = Seconds();
+  Check(ffc_last_error(call.session) != NULL, "ffc_last_error during another thread's call", "");
+  took = Seconds() - began;
+  Check(took < 0.5, "ffc_last_error answers at once during another thread's call",
+        "it took %.2f s", took);
+  pthread_join(thread, NULL);
+  CheckStatus(call.session, call.status, FF_C_UNAVAILABLE, "ffc_ping to a server that never answers");
+  ffc_close(call.session);
+  close(fd);
+}
+
 static void TestRpc(const char* character_path) {
   const double samples[6] = {0, 0, 0, 0, 1, 0};
   uint32_t terrain = 0;
@@ -633,6 +706,7 @@ int main(int argc, char** argv) {
   ffc_close(s);
 
   TestRpc(argv[1]);
+  TestLastErrorDuringCall();
 
   if (failures) {
     fprintf(stderr, "c_abi_test: %d of %d checks failed\n", failures, checks);

@@ -22,10 +22,13 @@
 
 struct ffc_session {
   // Calls on one session from several threads take turns (the sessions below are not
-  // thread-safe, and neither is `error`).
-  mutable std::mutex mutex;
+  // thread-safe).
+  std::mutex mutex;
   std::unique_ptr<footfall::TerrainSession> session;
-  std::string error;
+  // Guards `error` alone, so ffc_last_error answers at once while another thread's call (a load
+  // of minutes) holds `mutex`.
+  mutable std::mutex error_mutex;
+  std::string error;  // written through SetError
 };
 
 namespace {
@@ -69,13 +72,18 @@ std::string OneLine(const std::string& text) {
   return out;
 }
 
+void SetError(ffc_session* s, std::string text) {
+  std::lock_guard<std::mutex> lock(s->error_mutex);
+  s->error = std::move(text);
+}
+
 int32_t Result(ffc_session* s, Status status) {
-  if (status != Status::kOk) s->error = s->session->last_error();
+  if (status != Status::kOk) SetError(s, s->session->last_error());
   return static_cast<int32_t>(status);
 }
 
 int32_t BadArgument(ffc_session* s, const char* what) {
-  if (s) s->error = what;
+  if (s) SetError(s, what);
   return FF_C_INVALID_ARGUMENT;
 }
 
@@ -93,16 +101,16 @@ int32_t Guard(ffc_session* s, Fn&& fn) {
   try {
     return fn();
   } catch (const std::bad_alloc&) {
-    s->error = "out of memory";
+    SetError(s, "out of memory");
     return FF_C_LIMIT_EXCEEDED;
   } catch (const std::length_error&) {
-    s->error = "too many items for memory";
+    SetError(s, "too many items for memory");
     return FF_C_LIMIT_EXCEEDED;
   } catch (const std::exception& e) {
-    s->error = std::string("internal error: ") + e.what();
+    SetError(s, std::string("internal error: ") + e.what());
     return FF_C_INTERNAL_ERROR;
   } catch (...) {
-    s->error = "internal error";
+    SetError(s, "internal error");
     return FF_C_INTERNAL_ERROR;
   }
 }
@@ -167,7 +175,7 @@ const char* ffc_last_error(const ffc_session* session) {
   try {
     std::string error;
     {
-      std::lock_guard<std::mutex> lock(session->mutex);
+      std::lock_guard<std::mutex> lock(session->error_mutex);
       error = session->error;
     }
     copy = OneLine(error);
@@ -283,19 +291,19 @@ int32_t ffc_generate(ffc_session* s, uint32_t terrain, const char* request_json,
     if (status == Status::kOk)
       status = footfall::GenerateWalk(*s->session, terrain, character, options, &walk, &error);
     if (status != Status::kOk) {
-      s->error = error;
+      SetError(s, error);
       return static_cast<int32_t>(status);
     }
     const std::string text = footfall::WalkToJson(walk);
     char* copy = static_cast<char*>(std::malloc(text.size() + 1));
     if (!copy) {
-      s->error = "out of memory";
+      SetError(s, "out of memory");
       return FF_C_LIMIT_EXCEEDED;
     }
     std::memcpy(copy, text.c_str(), text.size() + 1);
     *walk_json = copy;
     if (!walk.stopped.empty()) {  // the keys so far are in *walk_json
-      s->error = walk.stopped;
+      SetError(s, walk.stopped);
       return FF_C_NO_FOOTHOLD;
     }
     return FF_C_OK;
@@ -310,7 +318,7 @@ int32_t ffc_check_character(ffc_session* s, const char* character_json) {
     footfall::Character character;
     std::string error;
     const Status status = footfall::ParseCharacter(character_json, "character", &character, &error);
-    if (status != Status::kOk) s->error = error;
+    if (status != Status::kOk) SetError(s, error);
     return static_cast<int32_t>(status);
   });
 }

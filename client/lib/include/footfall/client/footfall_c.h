@@ -58,6 +58,8 @@ ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s);
 void ffc_close(ffc_session* session);
 /* The reason for the session's last failed call (from any thread), as a copy that stays valid
  * until this thread calls ffc_last_error again. Not cleared by calls that succeed. Never NULL.
+ * It answers at once, also while another thread's call on the session is under way (it does not
+ * take its turn behind a load of minutes).
  * One line of UTF-8 of at most 8192 bytes: names, paths and request text quoted in it show line
  * breaks, other control characters and bytes that are not UTF-8 as '?', and a longer reason is
  * cut on a whole character, ending "... (N bytes)". */
