@@ -662,6 +662,9 @@ int main(int argc, char** argv) {
   for (i = FF_C_OK; i <= FF_C_INTERNAL_ERROR; ++i)
     Check(ffc_status_name(i) != NULL && ffc_status_name(i)[0] != '\0',
           "ffc_status_name names every status", "status %d", i);
+  Check(ffc_status_name(42) != NULL && strcmp(ffc_status_name(42), "unknown_status") == 0,
+        "ffc_status_name of an unknown status", "%s", ffc_status_name(42));
+  Check(ffc_status_name(-1) != NULL, "ffc_status_name of -1 is not NULL", "");
   ffc_close(NULL); /* ignored */
 
   s = ffc_open_embedded();
@@ -688,6 +691,13 @@ int main(int argc, char** argv) {
             bounds[3 + k], lo[k], hi[k]);
   }
 
+  CheckStatus(s, ffc_info(s, terrain, NULL, NULL), FF_C_OK, "ffc_info with NULL samples and bounds");
+  {
+    uint32_t unnamed = 0;
+    if (CheckStatus(s, ffc_load_samples(s, samples, 1, NULL, &unnamed), FF_C_OK,
+                    "ffc_load_samples with a NULL name"))
+      CheckStatus(s, ffc_unload(s, unnamed), FF_C_OK, "ffc_unload of the unnamed terrain");
+  }
   TestQueries(s, terrain, samples);
   TestBadArguments(s, terrain);
   TestErrorText(s);

@@ -6,6 +6,10 @@
  * (SIGPIPE is ignored once a session is opened). Calls on one session from several threads
  * take turns; open a session per thread to query in parallel. Counts no memory can hold give
  * FF_C_LIMIT_EXCEEDED. Points are world space, 3 doubles each; normals are unit.
+ * A NULL session gives FF_C_INVALID_ARGUMENT (ffc_last_error(NULL) says "no session"); so does a
+ * NULL pointer the call needs (an out pointer, a path, an array of count > 0) unless its
+ * comment says NULL is allowed. Terrain handles belong to their session; one unloaded is
+ * FF_C_UNKNOWN_TERRAIN after, as is one never given.
  */
 #ifndef FOOTFALL_C_H_
 #define FOOTFALL_C_H_
@@ -68,7 +72,7 @@ const char* ffc_last_error(const ffc_session* session);
  * when no footfalld answers within the call timeout. An RPC session calls the RPC NULL
  * procedure, which footfalld answers however busy it is with loads; it loads nothing. */
 int32_t ffc_ping(ffc_session* s);
-/* A stable name for a status, e.g. "no_foothold". */
+/* A stable name for a status, e.g. "no_foothold"; "unknown_status" for other values. Never NULL. */
 const char* ffc_status_name(int32_t status);
 
 /* Loads a terrain file read on this machine (points, meshes, height maps); separation > 0
@@ -77,11 +81,16 @@ int32_t ffc_load_file(ffc_session* s, const char* path, double separation, uint3
 /* Loads a file under the server's data root (RPC), or a local path (embedded). */
 int32_t ffc_load_server_file(ffc_session* s, const char* path, double separation,
                              uint32_t* terrain);
-/* Loads `count` samples given as 6 doubles each: x y z nx ny nz. */
+/* Loads `count` samples given as 6 doubles each: x y z nx ny nz. name labels the terrain in
+ * messages and info (NULL: "samples"; footfalld keeps at most its first 256 bytes, cut on a whole
+ * character). */
 int32_t ffc_load_samples(ffc_session* s, const double* samples, size_t count, const char* name,
                          uint32_t* terrain);
+/* Forgets the terrain; an RPC session asks footfalld to unload it (best effort: FF_C_OK also
+ * when footfalld does not answer). */
 int32_t ffc_unload(ffc_session* s, uint32_t terrain);
-/* Sample count and world bounds (min xyz, max xyz) of a terrain. */
+/* Sample count and world bounds (min xyz, max xyz) of a terrain; samples and bounds may each be
+ * NULL. */
 int32_t ffc_info(ffc_session* s, uint32_t terrain, uint64_t* samples, double bounds[6]);
 
 /* Batch queries: points are 3 doubles each; steps are 6 doubles each (foot xyz, direction xyz).
