@@ -370,6 +370,14 @@ static void TestBadArguments(ffc_session* s, uint32_t terrain) {
           "status %d", (int)out[1].status);
   CheckStatus(s, ffc_next(s, terrain, steps, 1, NAN, out), FF_C_INVALID_ARGUMENT,
               "ffc_next with a NaN tolerance");
+  CheckStatus(s, ffc_load_file(s, "/nonexistent.pts", -INFINITY, &handle), FF_C_INVALID_ARGUMENT,
+              "ffc_load_file with a separation of -infinity");
+  CheckStatus(s, ffc_load_server_file(s, "/nonexistent.pts", -INFINITY, &handle),
+              FF_C_INVALID_ARGUMENT, "ffc_load_server_file with a separation of -infinity");
+  CheckStatus(s, ffc_load_file(s, "/nonexistent.pts", NAN, &handle), FF_C_INVALID_ARGUMENT,
+              "ffc_load_file with a NaN separation");
+  CheckStatus(s, ffc_load_file(s, "/nonexistent.pts", -1, &handle), FF_C_IO_ERROR,
+              "ffc_load_file with a separation of -1 (the default) reads the file");
   samples[7] = NAN;
   CheckStatus(s, ffc_load_samples(s, samples, 2, "nan", &handle), FF_C_INVALID_ARGUMENT,
               "ffc_load_samples of a NaN coordinate");

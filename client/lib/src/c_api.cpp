@@ -193,9 +193,9 @@ int32_t ffc_load_file(ffc_session* s, const char* path, double separation, uint3
   return Guard(s, [&]() -> int32_t {
     if (!path || !terrain) return BadArgument(s, "path and terrain must not be NULL");
     footfall::TerrainLoadOptions options;
-    // (<= 0: the default. A NaN is passed on, to be refused as an infinite one is: it was
-    // taken for the default.)
-    options.separation = separation > 0 || std::isnan(separation) ? separation : 0;
+    // (<= 0: the default. A NaN or -infinity is passed on, to be refused as +infinity is: they
+    // were taken for the default.)
+    options.separation = separation > 0 || !std::isfinite(separation) ? separation : 0;
     return Result(s, s->session->LoadFile(path, options, terrain));
   });
 }
@@ -205,9 +205,9 @@ int32_t ffc_load_server_file(ffc_session* s, const char* path, double separation
   return Guard(s, [&]() -> int32_t {
     if (!path || !terrain) return BadArgument(s, "path and terrain must not be NULL");
     footfall::TerrainLoadOptions options;
-    // (<= 0: the default. A NaN is passed on, to be refused as an infinite one is: it was
-    // taken for the default.)
-    options.separation = separation > 0 || std::isnan(separation) ? separation : 0;
+    // (<= 0: the default. A NaN or -infinity is passed on, to be refused as +infinity is: they
+    // were taken for the default.)
+    options.separation = separation > 0 || !std::isfinite(separation) ? separation : 0;
     return Result(s, s->session->LoadServerFile(path, options, terrain));
   });
 }
