@@ -96,7 +96,9 @@ int32_t ffc_info(ffc_session* s, uint32_t terrain, uint64_t* samples, double bou
 /* Batch queries: points are 3 doubles each; steps are 6 doubles each (foot xyz, direction xyz).
  * out[i] answers item i. tolerance <= 0: the candidate radius is the step length.
  * A call that returns FF_C_OK answers every item: out[i].status is FF_C_OK, FF_C_NO_FOOTHOLD,
- * or FF_C_INVALID_ARGUMENT for a non-finite point, foot or direction or a zero direction
+ * or FF_C_INVALID_ARGUMENT for a non-finite point, foot or direction, a zero direction, a
+ * point, foot or ideal point (foot + direction) with a coordinate farther than 1e15 from the
+ * terrain's centre, or (tolerance <= 0) a direction whose squared length overflows a double
  * (ffc_last_error is not set for an item). A NaN or infinite tolerance fails the whole call
  * with FF_C_INVALID_ARGUMENT. count 0 is allowed, with NULL arrays. */
 int32_t ffc_snap(ffc_session* s, uint32_t terrain, const double* points, size_t count,
