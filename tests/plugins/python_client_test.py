@@ -606,6 +606,23 @@ class ConnectionTest(unittest.TestCase):
                             footfalld=ff.find_footfalld()), c.session)
         self.assertIs(c.local, fourth)
 
+    def test_the_timeout_bounds_the_wait_for_a_local_footfalld(self):
+        # The wait for a local footfalld to listen was always 10 s, whatever the timeout the
+        # plugin's preferences gave: one that started but never listened held the DCC 10 s.
+        with tempfile.TemporaryDirectory() as folder:
+            stand_in = os.path.join(folder, "never_listens.sh")
+            with open(stand_in, "w") as f:
+                f.write("#!/bin/sh\nexec sleep 60\n")
+            os.chmod(stand_in, 0o755)
+            began = time.monotonic()
+            with self.assertRaises(ff.FootfallError) as e:
+                self.c.get("127.0.0.1", self.dead_port, start_local=True, footfalld=stand_in,
+                           timeout=1.0)
+            self.assertLess(time.monotonic() - began, 3.0)
+            self.assertEqual(e.exception.status_name, "unavailable")
+            self.assertIn("%s did not start listening within 1 s" % stand_in, e.exception.message)
+            self.assertIsNone(self.c.local)
+
     def test_a_terrain_is_replaced_once_its_successor_is_loaded(self):
         # Loading a terrain again under the same name unloaded the old one first: a new upload
         # that failed left no terrain at all.

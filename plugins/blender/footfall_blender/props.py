@@ -21,7 +21,8 @@ class FootfallPreferences(bpy.types.AddonPreferences):
                               description="footfalld to start (empty: the bundled one, "
                                           "$FOOTFALLD or PATH)")
     timeout: FloatProperty(name="Timeout (s)", default=10.0, min=0.5, max=600.0,
-                           description="Seconds per server call")
+                           description="Seconds per server call, and the longest wait for "
+                                       "a local footfalld to start listening")
 
     def draw(self, context):
         col = self.layout.column()

@@ -24,6 +24,8 @@ class Connection:
     def get(self, host="127.0.0.1", port=7407, start_local=True, footfalld=None, timeout=10.0):
         """A Session that answers. Tries host:port (or the local server started earlier); when
         nothing answers and start_local is set, starts footfalld on a free loopback port.
+        `timeout` [s] bounds each call and the wait for a local footfalld to listen (a program
+        that starts but never listens holds the caller that long, not longer).
         Raises FootfallError('unavailable') with what to do when no server can be had."""
         target = (host or "127.0.0.1", int(port))
         wanted = (target, footfalld or None)
@@ -45,7 +47,7 @@ class Connection:
                                 "allow starting a local footfalld" % target, "connect")
         self._stop_local()
         try:
-            self.local = LocalServer(executable=footfalld or None).start()
+            self.local = LocalServer(executable=footfalld or None).start(timeout)
             self._local_for = wanted
         except ServerError as e:
             self.local = None
