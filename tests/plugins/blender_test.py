@@ -15,6 +15,7 @@ import json
 import math
 import os
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -264,31 +265,62 @@ class BlenderAddonTest(unittest.TestCase):
 
     def test_1c_a_closed_path_curve_ends_at_its_start(self):
         # A cyclic spline's path lost its closing segment: the walk ended a segment short.
-        data = bpy.data.curves.new("loop_path", "CURVE")
         corners = [(0, 0, 0), (2, 0, 0), (2, 2, 0)]
-        for cyclic in (True, False):
+        moved = [(x + 1, y, z) for x, y, z in corners]
+        for cyclic, want in ((True, moved + moved[:1]), (False, moved)):
+            data = bpy.data.curves.new("loop_path", "CURVE")
             spline = data.splines.new("POLY")
             spline.points.add(len(corners) - 1)
             for p, c in zip(spline.points, corners):
                 p.co = c + (1,)
             spline.use_cyclic_u = cyclic
-        obj = bpy.data.objects.new("loop_path", data)
-        bpy.context.scene.collection.objects.link(obj)
-        obj.location = (1, 0, 0)
-        bpy.context.view_layer.update()
-        try:
-            pts = [tuple(p) for p in self.ops.curve_points(bpy.context, obj)]
-        finally:
-            bpy.data.objects.remove(obj)
-            bpy.data.curves.remove(data)
-        moved = [(x + 1, y, z) for x, y, z in corners]
-        self.assertEqual(pts, moved + moved[:1] + moved)
+            obj = bpy.data.objects.new("loop_path", data)
+            bpy.context.scene.collection.objects.link(obj)
+            obj.location = (1, 0, 0)
+            bpy.context.view_layer.update()
+            try:
+                pts = [tuple(p) for p in self.ops.curve_points(bpy.context, obj)]
+            finally:
+                bpy.data.objects.remove(obj)
+                bpy.data.curves.remove(data)
+            self.assertEqual(pts, want, "cyclic" if cyclic else "open")
 
     def test_2_bad_selection_is_a_report(self):
         self.select([], None)
         with self.assertRaises(RuntimeError) as e:
             bpy.ops.footfall.terrain_setup()
         self.assertIn("select a mesh", str(e.exception))
+
+    def test_2b_a_footfalld_that_never_listens_fails_within_the_timeout(self):
+        # The add-on waited 10 s for a local footfalld to listen, whatever its Timeout
+        # preference: a footfalld that started but never listened froze Blender for 10 s.
+        stand_in = os.path.join(ARGS.work_dir, "never_listens.sh")
+        with open(stand_in, "w") as f:
+            f.write("#!/bin/sh\nexec sleep 60\n")
+        os.chmod(stand_in, 0o755)
+        with socket.socket() as s:  # a port where nothing answers
+            s.bind(("127.0.0.1", 0))
+            dead_port = s.getsockname()[1]
+        prefs = self.prefs
+        saved = (prefs.port, prefs.start_local, prefs.footfalld, prefs.timeout)
+        prefs.port, prefs.start_local, prefs.footfalld, prefs.timeout = \
+            dead_port, True, stand_in, 1.0
+        self.select([], None)
+        try:
+            began = time.monotonic()
+            with self.assertRaises(RuntimeError) as e:
+                bpy.ops.footfall.terrain_setup()
+            took = time.monotonic() - began
+        finally:
+            prefs.port, prefs.start_local, prefs.footfalld, prefs.timeout = saved
+        print("a footfalld that never listens: reported after %.2f s (timeout 1 s)" % took)
+        self.assertLess(took, 3.0)
+        self.assertIn("no footfalld answers at 127.0.0.1:%d and a local one could not be "
+                      "started: %s did not start listening within 1 s" % (dead_port, stand_in),
+                      str(e.exception))
+        self.assertIsNone(self.ops._connection.local)  # the stand-in stopped, not left behind
+        # The configured server again: the next command goes to it.
+        self.assertTrue(self.ops.session(bpy.context).ping())
 
     def test_3_hexapod_setup_creates_empties(self):
         bpy.context.scene.cursor.location = (-3.0, 3.0, 0.0)
@@ -986,6 +1018,41 @@ class BlenderAddonTest(unittest.TestCase):
             self.assertEqual((len(bpy.data.objects), len(bpy.data.curves)), counts)
         finally:
             settings.path = None
+            bpy.data.objects.remove(path)
+            bpy.data.curves.remove(data)
+
+    def test_7h_a_path_of_several_splines_is_refused(self):
+        # A path curve of several splines was walked as one line, jumping from the end of one
+        # spline to the start of the next: a report now, before anything is keyed.
+        settings = bpy.context.scene.footfall
+        rig = bpy.data.objects["biped_rig"]
+        feet = {f.name: f.target for f in rig.footfall_rig.feet}
+        objects = list(feet.values()) + [rig.footfall_rig.body]
+        data = bpy.data.curves.new("forked_path", "CURVE")
+        data.dimensions = "3D"
+        for line in ([(0.0, 3.0, 0.5), (1.0, 1.0, 0.5)], [(3.0, -1.0, 0.5), (2.0, 2.0, 0.5)],
+                     [(-2.0, 0.0, 0.5), (-1.0, 1.0, 0.5)]):
+            spline = data.splines.new("POLY")
+            spline.points.add(len(line) - 1)
+            for p, co in zip(spline.points, line):
+                p.co = co + (1.0,)
+        path = bpy.data.objects.new("forked_path", data)
+        bpy.context.scene.collection.objects.link(path)
+        saved = (settings.rig, settings.path, settings.steps)
+        settings.rig, settings.path, settings.steps = rig, path, 4
+        self.select([rig], rig)
+        before = {o.name: fcurve_keys(o, "location", 3) for o in objects}
+        try:
+            bpy.context.view_layer.update()
+            with self.assertRaises(RuntimeError) as e:
+                bpy.ops.footfall.generate_walk()
+            self.assertIn("path curve forked_path has 3 splines, and one spline is expected",
+                          str(e.exception))
+            self.assertIn("Separate", str(e.exception))
+            self.assertIn("the rig's keys are unchanged", str(e.exception))
+            self.assertEqual({o.name: fcurve_keys(o, "location", 3) for o in objects}, before)
+        finally:
+            settings.rig, settings.path, settings.steps = saved
             bpy.data.objects.remove(path)
             bpy.data.curves.remove(data)
 

@@ -549,9 +549,17 @@ def walk_request(context, rig_obj, steps, start_frame):
 
 
 def curve_points(context, obj):
-    """World points of a path curve's centre line: its splines as Blender evaluates them (at
-    their resolution), without Bevel or Extrude, whose tube or ribbon is not the path, in the
-    order of their edges: a closed (cyclic) spline ends back at its first point."""
+    """World points of a path curve's centre line: its spline as Blender evaluates it (at its
+    resolution), without Bevel or Extrude, whose tube or ribbon is not the path, in the order
+    of its edges: a closed (cyclic) spline ends back at its first point. Raises ValueError when
+    the curve has more than one spline (walked as one line, the path jumped from one to the
+    next)."""
+    count = len(obj.data.splines)
+    if count > 1:
+        raise ValueError("path curve %s has %d splines, and one spline is expected (the walk "
+                         "would jump from one to the next): in Edit Mode select the spline to "
+                         "follow and use Curve > Separate (P), then pick its curve as the path"
+                         % (obj.name, count))
     data = obj.data.copy()
     data.bevel_mode, data.bevel_object = "ROUND", None
     data.bevel_depth, data.extrude = 0.0, 0.0
@@ -573,7 +581,7 @@ def curve_points(context, obj):
 
 
 def _edge_chain(mesh):
-    """The vertex indices of a curve's mesh along its edges, spline after spline: a cyclic
+    """The vertex indices of a curve's mesh along its edges (one spline's): a cyclic
     spline's closing edge brings its first vertex back at its end (the vertices alone lost it,
     and a closed path ended a segment short of its start). Vertices on no edge (a one-point
     spline) come in their place."""
