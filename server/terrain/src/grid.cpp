@@ -408,9 +408,24 @@ struct NearbySearch {
       }
       return false;
     };
+    // Per axis, the padded distances to the own cell's lower and upper faces. Most often the
+    // ball stays within the own cell: then no neighbour (nor any cell two away) can hold a
+    // nearer sample, and the answer is known.
+    double to_lo[3], to_hi[3];
+    bool inside = !own_empty;
     for (int a = 0; a < 3; ++a) {
       const double face = g.grid_lo_[a] + static_cast<double>(ci[a]) * g.cell_size_;
-      const double dlo = c[a] - face - pad, dhi = face + g.cell_size_ - c[a] - pad;
+      to_lo[a] = c[a] - face - pad, to_hi[a] = face + g.cell_size_ - c[a] - pad;
+      inside &= std::min(to_lo[a], to_hi[a]) > 0 &&
+                std::min(to_lo[a] * to_lo[a], to_hi[a] * to_hi[a]) > best;
+    }
+    if (inside) {
+      *cell_out = static_cast<uint32_t>(best_cell);
+      *slot_out = best_slot;
+      return true;
+    }
+    for (int a = 0; a < 3; ++a) {
+      const double dlo = to_lo[a], dhi = to_hi[a];
       far[a][0] = dlo + g.cell_size_, far[a][1] = dhi + g.cell_size_;
       sides[a] = 0;
       const double glo = dlo > 0 ? dlo * dlo : 0, ghi = dhi > 0 ? dhi * dhi : 0;
@@ -421,8 +436,7 @@ struct NearbySearch {
     // The ball of the own cell's nearest bounds the search: when it reaches two cells away, so
     // might the answer.
     if (!own_empty) {
-      // Most often the ball stays within the own cell: no neighbour to visit (nor any two away:
-      // a face the ball does not reach is not crossed by it either).
+      // No neighbour within the ball (at the grid's border): none two away either.
       if (sides[0] + sides[1] + sides[2] == 0) {
         *cell_out = static_cast<uint32_t>(best_cell);
         *slot_out = best_slot;
@@ -485,9 +499,8 @@ bool TerrainGrid::NearestNearby(const double c[3], uint32_t* cell, uint32_t* slo
 
 TerrainGrid::Located TerrainGrid::LocateSnap(const Vec3& q, QueryTrace* trace) const {
   Located found;  // kInvalidArgument
-  if (!IsFinite(q)) return found;
   const double c[3] = {q.x - origin_[0], q.y - origin_[1], q.z - origin_[2]};
-  if (!detail::InQueryRange(c)) return found;
+  if (!detail::InQueryRange(c)) return found;  // NaN and infinities too
   found.status = Status::kNoFoothold;
   if (trace) {
     *trace = QueryTrace{}, trace->ideal = q;
