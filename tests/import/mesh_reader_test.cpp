@@ -691,6 +691,34 @@ TEST_CASE("ReadMesh: binary PLY list counts and vertex indices are whole numbers
   CHECK(Contains(error, "index.ply: face 1: vertex index 1.5 is not an index below 3"));
 }
 
+TEST_CASE("ReadMesh: binary PLY data after the declared elements is refused", "[import][mesh]") {
+  // A header declaring one face of a file holding two loaded the first face only, silently.
+  // A line end after the data (as some writers add) is still read.
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  auto ply = [](int declared, int held, const std::string& tail) {
+    std::string s =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float "
+        "x\nproperty float y\nproperty float z\nelement face " +
+        std::to_string(declared) + "\nproperty list uchar int vertex_indices\nend_header\n";
+    const float v[12] = {0, 0, 0, 1, 0, 0, 1, 0, 1, 0, 0, 1};
+    s.append(reinterpret_cast<const char*>(v), sizeof v);
+    const int32_t faces[2][3] = {{0, 2, 1}, {0, 3, 2}};
+    for (int f = 0; f < held; ++f) {
+      s.push_back(3);
+      s.append(reinterpret_cast<const char*>(faces[f]), sizeof faces[f]);
+    }
+    return s + tail;
+  };
+  REQUIRE(Read(dir.Write("whole.ply", ply(2, 2, "")), &mesh, &error) == Status::kOk);
+  CHECK(mesh.triangles.size() == 2);
+  REQUIRE(Read(dir.Write("newline.ply", ply(2, 2, "\r\n")), &mesh, &error) == Status::kOk);
+  CHECK(mesh.triangles.size() == 2);
+  CHECK(Read(dir.Write("more.ply", ply(1, 2, "")), &mesh, &error) == Status::kParseError);
+  CHECK(Contains(error, "more.ply: 13 bytes after the data the header declares"));
+}
+
 TEST_CASE("ReadMesh: PLY element counts too large to add up are refused as truncated",
           "[import][mesh]") {
   // Two counts near 2^63 added up to a negative number of records: a file of one record read

@@ -76,6 +76,16 @@ class PlyValues {
     return 0;
   }
 
+  // Bytes read through Next so far.
+  long long taken() const { return taken_; }
+  // Whether the `count` bytes after those read are only a line end ("\n" or "\r\n"), as some
+  // writers end a binary PLY.
+  bool RestIsLineEnd(long long count) {
+    unsigned char b[2];
+    if (count > 2 || !Take(b, static_cast<int>(count))) return false;
+    return count == 0 || (b[count - 1] == '\n' && (count == 1 || b[0] == '\r'));
+  }
+
  private:
   template <typename T>
   static T Get(const unsigned char* b) {
@@ -92,10 +102,12 @@ class PlyValues {
       }
       out[i] = *at_++;
     }
+    taken_ += size;
     return true;
   }
   std::istream& in_;
   const bool swap_;
+  long long taken_ = 0;
   unsigned char buffer_[1 << 16];
   unsigned char* at_ = buffer_;
   unsigned char* end_ = buffer_;
@@ -651,6 +663,15 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
       if (e.name == "vertex") out->vertices.push_back(point);
       if (face) out->EndFace(0);
     }
+  }
+  // Data left over: the header declares fewer records than the file holds (the rest was
+  // dropped, silently), or the elements' properties are not those written.
+  const long long left = data_bytes - values.taken();
+  if (left > 0 && !values.RestIsLineEnd(left)) {
+    return Fail(path,
+                std::to_string(left) + " bytes after the data the header declares (expected " +
+                    "the end of the file: check the header's element counts and properties)",
+                error);
   }
   return Status::kOk;
 }
