@@ -111,7 +111,9 @@ file(READ "${WORK}/cube.obj" cube)
 string(REPLACE "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n"
        "f 2 3 4 1\nf 8 7 6 5\nf 5 6 2 1\nf 6 7 3 2\nf 7 8 4 3\nf 8 5 1 4\n" inside_out "${cube}")
 file(WRITE "${WORK}/inside_out.obj" "${inside_out}")
-expect(EXIT_ZERO "faces turned over: 1 of 1 closed shells inside out: 12 faces turned over"
+# The cube's 6 quads are 12 triangles: what was turned over is counted in triangles, not in
+# the file's faces (the count read "12 faces" of a 6-face cube).
+expect(EXIT_ZERO "faces turned over: 1 of 1 closed shells inside out: 12 triangles turned over"
        terrain info "${WORK}/inside_out.obj" --separation 0.1)
 expect(EXIT_ZERO "faces turned over: none" terrain info "${WORK}/cube.obj" --separation 0.1)
 # One face wound against the others is counted in the singular.

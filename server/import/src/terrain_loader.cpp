@@ -234,6 +234,10 @@ Status ResampleTerrainMesh(const std::string& path, const TriangleMesh& mesh,
 std::string DescribeTurnover(const TerrainLoadReport& report) {
   const MeshTurnover& t = report.turnover;
   auto faces = [](size_t n) { return std::to_string(n) + (n == 1 ? " face" : " faces"); };
+  // MeshTurnover counts the triangles the polygons were cut into.
+  auto triangles = [](size_t n) {
+    return std::to_string(n) + (n == 1 ? " triangle" : " triangles");
+  };
   std::vector<std::string> parts;
   if (report.rewound_faces > 0)
     parts.push_back(faces(report.rewound_faces) +
@@ -244,10 +248,10 @@ std::string DescribeTurnover(const TerrainLoadReport& report) {
     parts.push_back(std::to_string(t.inside_out_shells) + " of " + std::to_string(t.closed_shells) +
                     " closed shells inside out");
   if (t.open_faced_down)
-    parts.push_back("the " + faces(t.open_faces) + " of its open parts faced down");
+    parts.push_back("the " + triangles(t.open_faces) + " of its open parts faced down");
   std::string text;
   for (const std::string& part : parts) text += (text.empty() ? "" : "; ") + part;
-  if (t.turned_faces > 0) text += ": " + faces(t.turned_faces) + " turned over";
+  if (t.turned_faces > 0) text += ": " + triangles(t.turned_faces) + " turned over";
   return text;
 }
 

@@ -70,8 +70,9 @@ struct TerrainLoadReport {
 // the process's memory holds at this rate.
 constexpr uint64_t kSamplingBytesPerSample = 1000;
 
-// What a mesh load turned over, in a phrase ("1 of 2 closed shells was inside out: 3030 faces
-// turned over"), or "" when nothing was.
+// What a mesh load turned over, in a phrase ("1 of 2 closed shells inside out: 3030 triangles
+// turned over"; faces wound against their neighbours are counted in the file's faces, the rest
+// in the triangles they were cut into), or "" when nothing was.
 std::string DescribeTurnover(const TerrainLoadReport& report);
 
 // Loads `path` into *out. Errors: kIoError (cannot open), kParseError (malformed content,
