@@ -76,6 +76,24 @@ check "jitter 0 taken as given" grep -q "jitter 0)" <<< "$out"
 check "batches no larger than the queries" grep -q "batches of 64" <<< "$out"
 err=$("$footfall" bench --terrain "$hills" --queries 0 2>&1 >/dev/null)
 check "zero queries refused" [ $? -ne 0 ]
+# Whole-number flags (bench's and terrain make's) name their bounds as --steps does; CLI11 said
+# "Value 1.5 not in range" or "Could not convert", and --query-seed read -1 as 2^64 - 1.
+whole() {  # whole NAME EXPECTED_MESSAGE ARGS...: refused with this message
+  local name=$1 want=$2; shift 2
+  local err
+  err=$("$footfall" "$@" 2>&1 >/dev/null)
+  check "$name: refused" [ $? -ne 0 ]
+  check "$name: message '$want'" grep -qF -- "$want" <<< "$err"
+}
+whole "bench --threads 1.5" "--threads: '1.5' is not a whole number from 1 to 256" bench --terrain "$hills" --threads 1.5
+whole "bench --queries 1.5" "--queries: '1.5' is not a whole number from 1 to 16777216" bench --terrain "$hills" --queries 1.5
+whole "bench --queries 0" "--queries: '0' is not a whole number from 1 to 16777216" bench --terrain "$hills" --queries 0
+whole "bench --batch 2.5" "--batch: '2.5' is not a whole number from 1 to 1048576" bench --terrain "$hills" --batch 2.5
+whole "bench --query-seed -1" "--query-seed: '-1' is not a whole number from 0 to 18446744073709551615" bench --terrain "$hills" --query-seed -1
+whole "make --steps 1.5" "--steps: '1.5' is not a whole number from 1 to 2147483647" terrain make stairs --steps 1.5 -o "$work/x.pts"
+whole "make --size 2.5" "--size: '2.5' is not a whole number from 1 to 2147483647" terrain make blocks --size 2.5 -o "$work/x.pts"
+whole "make --max-height -1" "--max-height: '-1' is not a whole number from 0 to 2147483647" terrain make blocks --max-height -1 -o "$work/x.pts"
+check "bad whole numbers: nothing written" [ ! -e "$work/x.pts" ]
 stop_server
 err=$("$footfall" bench --terrain "$hills" --server "$server" --timeout 2 2>&1 >/dev/null)
 check "no server: exit 1" [ $? -eq 1 ]

@@ -667,7 +667,7 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
   CLI::Option* crowd =
       cmd->add_option("--crowd", flags->crowd,
                       "Generate this many characters at once on a grid around --start")
-          ->check(CLI::Range(1, 1000000));
+          ->check(WholeRange(1, 1000000));
   CLI::Option* crowd_spacing =
       cmd->add_option("--crowd-spacing", flags->crowd_spacing,
                       "Distance between crowd characters (default: twice the character's reach)")
@@ -675,7 +675,7 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
   cmd->add_option("--threads", flags->threads,
                   "Threads for the embedded engine's queries and the generator's own work "
                   "(default: the hardware's; the walk is the same whatever the count)")
-      ->check(CLI::Range(1, 256));
+      ->check(WholeRange(1, 256));
   cmd->add_flag("--progress", flags->progress,
                 "Show a progress bar on stderr (shown anyway for long runs on a terminal)");
   cmd->add_option("--out", flags->out,

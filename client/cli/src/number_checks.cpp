@@ -71,15 +71,20 @@ CLI::Validator Seed() {
       "SEED");
 }
 
-CLI::Validator WholeUpTo(long long hi) {
+CLI::Validator WholeRange(long long lo, long long hi) {
   return CLI::Validator(
-      [hi](std::string& input) -> std::string {
+      [lo, hi](std::string& input) -> std::string {
         if (!input.empty() && input.size() <= 18 &&
-            input.find_first_not_of("0123456789") == std::string::npos && std::stoll(input) <= hi)
-          return std::string();
-        return "'" + input + "' is not a whole number from 0 to " + std::to_string(hi);
+            input.find_first_not_of("0123456789") == std::string::npos) {
+          const long long v = std::stoll(input);
+          if (v >= lo && v <= hi) return std::string();
+        }
+        return "'" + input + "' is not a whole number from " + std::to_string(lo) + " to " +
+               std::to_string(hi);
       },
-      "INT in [0 - " + std::to_string(hi) + "]");
+      "INT in [" + std::to_string(lo) + " - " + std::to_string(hi) + "]");
 }
+
+CLI::Validator WholeUpTo(long long hi) { return WholeRange(0, hi); }
 
 }  // namespace footfall::cli

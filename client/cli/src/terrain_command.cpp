@@ -319,7 +319,7 @@ void AddTerrainCommand(CLI::App& app, int* exit_code) {
       ->capture_default_str();
   m->add_option("--steps", make->steps,
                 "stairs: number of treads, the first on the ground (one riser fewer)")
-      ->check(CLI::PositiveNumber)
+      ->check(WholeRange(1, 2147483647))
       ->capture_default_str();
   m->add_option("--rise", make->rise, "stairs: step height (negative: stairs going down along +z)")
       ->check(Finite())
@@ -331,10 +331,10 @@ void AddTerrainCommand(CLI::App& app, int* exit_code) {
       ->check(FiniteAbove(0))
       ->capture_default_str();
   m->add_option("--size", make->size, "blocks: columns per side; rocks, flat, hills: side length")
-      ->check(CLI::PositiveNumber)
+      ->check(WholeRange(1, 2147483647))
       ->capture_default_str();
   m->add_option("--max-height", make->max_height, "blocks: tallest pile in unit cubes")
-      ->check(CLI::NonNegativeNumber)
+      ->check(WholeRange(0, 2147483647))
       ->capture_default_str();
   m->add_option("--amplitude", make->amplitude,
                 "rocks, hills: height of the relief (hills: the same hills at any --spacing)")

@@ -23,6 +23,10 @@ CLI::Validator Seed();
 // A whole number written in digits alone, from 0 to hi (hi < 10^18): "1.5", "-1" and "1e3" are
 // refused as not whole numbers, where a range check alone said "not in range".
 CLI::Validator WholeUpTo(long long hi);
+// A whole number written in digits alone, from lo to hi (0 <= lo <= hi < 10^18), refused as
+// "'1.5' is not a whole number from LO to HI" (CLI11's range check said "not in range", and its
+// integer conversion "Could not convert").
+CLI::Validator WholeRange(long long lo, long long hi);
 // Text that is not empty or blank ("expected EXPECTED" otherwise): a flag given an unset shell
 // variable.
 CLI::Validator NotBlank(const std::string& expected);
