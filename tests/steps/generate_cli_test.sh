@@ -159,6 +159,15 @@ check "Z-up terrain with the default up: the stop names --up" grep -q 'give the 
 "$footfall" generate --terrain "$work/zup.pts" --character "$chars/biped.json" --start 1.5,1.5,0 \
   --up 0,0,1 --heading 0,1,0 --steps 4 --out "$work/zup.json" 2> "$work/zup.err"
 check "Z-up terrain with --up 0,0,1: walks" [ $? -eq 0 ]
+# In a scene, the up to give is written as the scene's field takes it (the flag form was
+# suggested, which a scene file cannot hold); a character without 'up' takes --up, named so.
+printf '{"format": "footfall-scene", "version": 1, "characters": [{"name": "b1", "character_file": "%s", "start": [1.5, 1.5, 0], "steps": 4, "up": [0, 1, 0]}, {"name": "b2", "character_file": "%s", "start": [1.5, 1.5, 0], "steps": 4}]}\n' \
+  "$chars/biped.json" "$chars/biped.json" > "$work/zup-scene.json"
+"$footfall" generate --terrain "$work/zup.pts" --scene "$work/zup-scene.json" --out "$work/zup-scene.json.out.json" 2> "$work/zup-scene.err"
+check "Z-up scene: exit 2" [ $? -eq 2 ]
+check "Z-up scene: the stop names the character" grep -qF "b1: step 1: foot L cannot stand at" "$work/zup-scene.err"
+check "Z-up scene: the field's up as JSON" grep -qF "give the world up with $work/zup-scene.json: characters[0]: 'up' (Z up: [0, 0, 1])" "$work/zup-scene.err"
+check "Z-up scene: a character without 'up' names --up" grep -qF "give the world up with --up (Z up: --up 0,0,1)" "$work/zup-scene.err"
 # The other way round: a Y-up terrain given --up 0,0,1 is told the up its ground faces, not the
 # Z up it was given.
 "$footfall" generate --terrain "$hills" --character "$chars/biped.json" --up 0,0,1 \
@@ -367,6 +376,9 @@ bad gltf-negative-frame "--out $work/neg.gltf: glTF animation times must be >= 0
 check "gltf-negative-frame: nothing written" [ ! -e "$work/neg.json" ]
 bad far-start "the start is too far from the terrain to snap" --terrain "$hills" --character "$chars/biped.json" --start 1e20,0,0 --out "$work/x.json"
 bad steps-fraction "--steps: '1.5' is not a whole number from 0 to 1000000" --terrain "$hills" --character "$chars/biped.json" --steps 1.5 --out "$work/x.json"
+bad crowd-fraction "--crowd: '1.5' is not a whole number from 1 to 1000000" --terrain "$hills" --character "$chars/biped.json" --crowd 1.5 --out "$work/x.json"
+bad crowd-0 "--crowd: '0' is not a whole number from 1 to 1000000" --terrain "$hills" --character "$chars/biped.json" --crowd 0 --out "$work/x.json"
+bad threads-fraction "--threads: '2.5' is not a whole number from 1 to 256" --terrain "$hills" --character "$chars/biped.json" --threads 2.5 --out "$work/x.json"
 bad heading-up-flag "it gives no clear direction on the ground; give a heading along the ground with --heading" --terrain "$hills" --character "$chars/biped.json" --heading 0,1,0 --out "$work/x.json"
 # A scene's character: its start, heading and up named by the scene file and field (--scene
 # refuses those flags).

@@ -16,19 +16,25 @@ namespace footfall::steps_detail {
 
 namespace {
 
-// The --up flag of the world axis nearest `normal`, said as "Z up: --up 0,0,1": the up to give
-// an upright character whose ground there faces across the world up it was given.
-std::string UpFlagNearest(const Vec3& normal) {
+// The world axis nearest `normal` as the up to give an upright character whose ground there
+// faces across the world up it was given, written for where that up comes from (`up_name`):
+// "Z up: --up 0,0,1" for the flag, "Z up: [0, 0, 1]" for a field of a scene file or of a
+// generate request (JSON), where the flag form cannot be given.
+std::string UpNearest(const Vec3& normal, const std::string& up_name) {
   const double c[3] = {normal.x, normal.y, normal.z};
   int axis = 0;
   for (int i = 1; i < 3; ++i) {
     if (std::abs(c[i]) > std::abs(c[axis])) axis = i;
   }
   const bool down = c[axis] < 0;
-  std::string flag = "0,0,0";
-  flag[2 * axis] = '1';
-  if (down) flag.insert(2 * axis, "-");
-  return std::string(down ? "-" : "") + "XYZ"[axis] + " up: --up " + flag;
+  const bool flag = up_name == GenerateInputNames().up;
+  std::string value = flag ? "" : "[";
+  for (int i = 0; i < 3; ++i) {
+    if (i > 0) value += flag ? "," : ", ";
+    value += i != axis ? "0" : down ? "-1" : "1";
+  }
+  value += flag ? "" : "]";
+  return std::string(down ? "-" : "") + "XYZ"[axis] + " up: " + (flag ? "--up " : "") + value;
 }
 
 }  // namespace
@@ -454,7 +460,7 @@ std::string Generator::Plant(Agent& a, const Foothold* feet) const {
       // axis (a height map read with --up-axis z) with the default world up.
       if (!c_.align_to_normal && slope > 60 && slope < 120)
         m << "; if the terrain's up is not " << Point(world_up_) << ", give the world up with "
-          << o_.names.up << " (" << UpFlagNearest(a.foot_normal[f]) << ")";
+          << o_.names.up << " (" << UpNearest(a.foot_normal[f], o_.names.up) << ")";
       return m.str();
     }
   }
