@@ -691,6 +691,26 @@ TEST_CASE("ReadMesh: binary PLY list counts and vertex indices are whole numbers
   CHECK(Contains(error, "index.ply: face 1: vertex index 1.5 is not an index below 3"));
 }
 
+TEST_CASE("ReadMesh: OBJ face corners are v or v/vt or v//vn or v/vt/vn", "[import][mesh]") {
+  // A corner '1/x' or '1/2/3/4' (a damaged or misexported face) was read as vertex 1, silently.
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  const std::string v = "v 0 0 0\nv 1 0 0\nv 1 0 1\nvt 0 0\nvn 0 1 0\n";
+  for (const char* face : {"f 1 3 2\n", "f 1/1 3/1 2/1\n", "f 1//1 3//1 2//1\n",
+                           "f 1/1/1 3/1/1 2/1/1\n", "f -3/-1/-1 -1/-1/-1 -2/-1/-1\n"}) {
+    INFO(face);
+    REQUIRE(Read(dir.Write("good.obj", v + face), &mesh, &error) == Status::kOk);
+    CHECK(mesh.triangles.size() == 1);
+  }
+  for (const char* face : {"f 1/x 3 2\n", "f 1 3/1/1/1 2\n", "f 1 3 2/1.5\n", "f 1 3 2//n\n"}) {
+    INFO(face);
+    CHECK(Read(dir.Write("bad.obj", v + face), &mesh, &error) == Status::kParseError);
+    CHECK(Contains(error, "bad.obj:6: face vertex '"));
+    CHECK(Contains(error, "' is not v, v/vt, v//vn or v/vt/vn"));
+  }
+}
+
 TEST_CASE("ReadMesh: binary PLY data after the declared elements is refused", "[import][mesh]") {
   // A header declaring one face of a file holding two loaded the first face only, silently.
   // A line end after the data (as some writers add) is still read.

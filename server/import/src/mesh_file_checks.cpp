@@ -229,6 +229,23 @@ Status ParseObjFile(const std::string& path, ParsedMesh* out, std::string* error
       for (size_t i = 1; i < t.size(); ++i) {
         long long index = 0;
         const std::string digits = t[i].substr(0, t[i].find('/'));
+        // The texture and normal indices after it (not used) are whole numbers or absent.
+        size_t slashes = 0;
+        bool other_indices = true;
+        for (size_t at = t[i].find('/'); at != std::string::npos; at = t[i].find('/', at + 1)) {
+          const size_t end = t[i].find('/', at + 1);
+          const std::string part =
+              t[i].substr(at + 1, end == std::string::npos ? end : end - at - 1);
+          long long unused = 0;
+          if (++slashes > 2 || !(part.empty() || (ParseInteger(part, &unused) && unused != 0)))
+            other_indices = false;
+        }
+        if (!other_indices) {
+          return Fail(At(path, number),
+                      "face vertex '" + ShownText(t[i]) +
+                          "' is not v, v/vt, v//vn or v/vt/vn (1-based or negative indices)",
+                      error);
+        }
         if (!ParseInteger(digits, &index) || index == 0) {
           return Fail(
               At(path, number),
