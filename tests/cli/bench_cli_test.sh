@@ -93,6 +93,9 @@ whole "bench --query-seed -1" "--query-seed: '-1' is not a whole number from 0 t
 whole "make --steps 1.5" "--steps: '1.5' is not a whole number from 1 to 2147483647" terrain make stairs --steps 1.5 -o "$work/x.pts"
 whole "make --size 2.5" "--size: '2.5' is not a whole number from 1 to 2147483647" terrain make blocks --size 2.5 -o "$work/x.pts"
 whole "make --max-height -1" "--max-height: '-1' is not a whole number from 0 to 2147483647" terrain make blocks --max-height -1 -o "$work/x.pts"
+# terrain make: a flag of another kind's shape is refused, not ignored.
+whole "make flat --steps" "--steps is for stairs, not flat" terrain make flat --steps 5 -o "$work/x.pts"
+whole "make stairs --seed" "--seed is for blocks rocks hills, not stairs" terrain make stairs --seed 2 -o "$work/x.pts"
 check "bad whole numbers: nothing written" [ ! -e "$work/x.pts" ]
 stop_server
 err=$("$footfall" bench --terrain "$hills" --server "$server" --timeout 2 2>&1 >/dev/null)

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <iomanip>
 #include <iostream>
+#include <iterator>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -349,7 +350,33 @@ void AddTerrainCommand(CLI::App& app, int* exit_code) {
   m->add_option("--radius", make->radius, "sphere: radius (it rests on y = 0)")
       ->check(FiniteAbove(0))
       ->capture_default_str();
-  m->callback([make, exit_code] { *exit_code = RunMake(*make); });
+  // A flag of another kind's shape (--steps for flat) is refused, not ignored.
+  m->callback([m, make, exit_code] {
+    static const std::vector<std::pair<std::string, std::string>> kKinds = {
+        {"--seed", "blocks rocks hills"},
+        {"--steps", "stairs"},
+        {"--rise", "stairs"},
+        {"--run", "stairs"},
+        {"--width", "stairs ramp"},
+        {"--size", "blocks rocks flat hills"},
+        {"--max-height", "blocks"},
+        {"--amplitude", "rocks hills"},
+        {"--slope", "ramp"},
+        {"--length", "ramp"},
+        {"--radius", "sphere"}};
+    for (const auto& [flag, kinds] : kKinds) {
+      if (m->get_option(flag)->count() == 0) continue;
+      if (std::istringstream words(kinds);
+          std::find(std::istream_iterator<std::string>(words), std::istream_iterator<std::string>(),
+                    make->kind) == std::istream_iterator<std::string>()) {
+        std::cerr << "footfall terrain make: " << flag << " is for " << kinds << ", not "
+                  << make->kind << '\n';
+        *exit_code = 1;
+        return;
+      }
+    }
+    *exit_code = RunMake(*make);
+  });
 }
 
 }  // namespace footfall::cli
