@@ -614,6 +614,15 @@ TEST_CASE("a walk drawn on a terrain it was not made on is pointed out", "[viewe
   CHECK_THAT(r.err, Catch::Contains("the walk was made on another terrain?"));
 }
 
+TEST_CASE("a walk without keys is pointed out", "[viewer][walk]") {
+  const std::string dir = test::TempDir();
+  test::WriteFile(dir + "/empty.json",
+                  R"({"format": "footfall-walk", "version": 1, "fps": 24, "tracks": []})");
+  const RunResult r = View({"--walk", dir + "/empty.json", "--screenshot", dir + "/x.png"});
+  CHECK(r.exit_code == 0);  // the overlay is still drawn
+  CHECK_THAT(r.err, Catch::Contains("note: " + dir + "/empty.json has no keys: no walk to draw"));
+}
+
 TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][errors]") {
   const std::string dir = test::TempDir();
   const std::string shot = dir + "/x.png";

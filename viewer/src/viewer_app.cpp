@@ -566,6 +566,14 @@ int RunViewer(const ViewerOptions& options) {
   }
   if (!options.walk.empty() && app.scene.LoadWalk(options.walk, &error) != Status::kOk)
     return Fail(error);
+  if (!options.walk.empty()) {
+    // A walk of no keys (no tracks, or tracks without keys) draws nothing: say so rather than
+    // leave an empty picture unexplained.
+    bool any_key = false;
+    for (const WalkTrack& track : app.scene.walk().tracks) any_key = any_key || !track.keys.empty();
+    if (!any_key)
+      std::cerr << "footfall-view: note: " << options.walk << " has no keys: no walk to draw\n";
+  }
   {
     // A walk drawn on a terrain it was not made on floats or sinks: say so. (A foot key of a
     // walk made on this terrain is a sample; a grid cell is some 3.5 sample spacings.)
