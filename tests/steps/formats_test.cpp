@@ -104,6 +104,9 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
        "'align_to_normal': expected true"},
       {{"[0.1, 0, 0]", "[0.1, 0]"}, "'feet'[0].rest: expected [x, y, z]"},
       {{"{\"name\": \"R\"", "{\"name\": \"\""}, "'feet'[1].name: expected a non-empty name"},
+      // Two feet resting on one spot would have their targets and keys on top of each other.
+      {{"[-0.1, 0, 0]", "[0.1, 0, 0]"},
+       "b.json: 'feet'[1].rest: the same as foot 'L''s: each foot needs its own rest position"},
       {{"\"body_height\": 0.9,", ""}, "missing field 'body_height'"},
       // Fields of the wrong JSON type are named with the type found, never thrown.
       {{"\"footfall-character\"", "5"}, "b.json: 'format' must be a string, found number"},

@@ -1,5 +1,6 @@
 #include "footfall/steps/character.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <set>
@@ -206,6 +207,14 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
         }
         spec.name = f["name"].get<std::string>();
         if (!r.Vector(f["rest"], where + ".rest", &spec.rest)) break;
+        const auto same_rest = std::find_if(c.feet.begin(), c.feet.end(), [&](const FootSpec& o) {
+          return o.rest.x == spec.rest.x && o.rest.y == spec.rest.y && o.rest.z == spec.rest.z;
+        });
+        if (same_rest != c.feet.end()) {
+          r.Fail(Status::kInvalidArgument, where + ".rest: the same as foot '" + same_rest->name +
+                                               "''s: each foot needs its own rest position");
+          break;
+        }
         if (!foot_index.emplace(spec.name, static_cast<int>(i)).second) {
           r.Fail(Status::kInvalidArgument, where + ": foot name '" + spec.name + "' is used twice");
           break;
