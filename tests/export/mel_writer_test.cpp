@@ -445,6 +445,19 @@ TEST_CASE("WriteMel keeps comments to one line and names Maya's second and milli
   }
 }
 
+TEST_CASE("WriteMel's header names no file but its own", "[export][mel]") {
+  // It said source "walk.mel" whatever the file was called.
+  const std::string path = WriteAndKeep(test::BipedWalk(), "stairs.mel");
+  std::ifstream in(path);
+  std::string first, second;
+  std::getline(in, first);
+  std::getline(in, second);
+  CHECK(second ==
+        "// In Maya: source this file (File > Source Script); one keyed locator per foot IK "
+        "target and body.");
+  std::remove(path.c_str());
+}
+
 TEST_CASE("WriteMel names Maya's VR audio and high frame rate units", "[export][mel]") {
   Walk walk = test::BipedWalk();
   for (const auto& [fps, unit] : {std::pair<double, std::string>{90, "90fps"},
