@@ -170,9 +170,9 @@ std::string StripComment(const std::string& line) {
   return s;
 }
 
-// What OpenMesh's text readers misread at the start of a file: a UTF-8 byte order mark (an OBJ
-// lost its first vertex to it), lines ended by CR alone (read as one line) and UTF-16 text (an
-// OBJ read as empty).
+// What text mesh readers misread at the start of a file: lines ended by CR alone (read as one
+// line) and UTF-16 text (an OBJ read as empty). A UTF-8 byte order mark is skipped instead
+// (SkipByteOrderMark).
 Status CheckTextStart(const std::string& path, std::string* error) {
   std::ifstream in(path, std::ios::binary);
   char head[65536];
@@ -180,12 +180,6 @@ Status CheckTextStart(const std::string& path, std::string* error) {
   const std::string_view text(head, static_cast<size_t>(in.gcount()));
   if (text.substr(0, 2) == "\xFF\xFE" || text.substr(0, 2) == "\xFE\xFF") {
     return Fail(path, "UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)", error);
-  }
-  if (text.substr(0, 3) == "\xEF\xBB\xBF") {
-    return Fail(path,
-                "starts with a UTF-8 byte order mark, which OpenMesh cannot read: save it "
-                "without one",
-                error);
   }
   const size_t cr = text.find('\r');
   if (cr != std::string_view::npos && text.find('\n') == std::string_view::npos &&
@@ -197,10 +191,21 @@ Status CheckTextStart(const std::string& path, std::string* error) {
 
 }  // namespace
 
+// Skips a UTF-8 byte order mark at the start of `in` (a file saved by a Windows editor), as
+// point files and height maps do; line numbers are unchanged.
+void SkipByteOrderMark(std::istream& in) {
+  char head[3] = {};
+  in.read(head, sizeof head);
+  if (in.gcount() == 3 && std::string_view(head, 3) == "\xEF\xBB\xBF") return;
+  in.clear();
+  in.seekg(0);
+}
+
 Status ParseObjFile(const std::string& path, ParsedMesh* out, std::string* error) {
   const Status start = CheckTextStart(path, error);
   if (start != Status::kOk) return start;
   std::ifstream in(path);
+  SkipByteOrderMark(in);
   LineReader lines(in);
   std::string line;
   long long vertices = 0;
@@ -403,6 +408,7 @@ Status ParseOffFile(const std::string& path, ParsedMesh* out, std::string* error
   const Status start = CheckTextStart(path, error);
   if (start != Status::kOk) return start;
   std::ifstream in(path);
+  SkipByteOrderMark(in);
   LineReader lines(in);
   const Status status = ParseOffLines(path, lines, out, error);
   return lines.too_long() ? TooLongLine(path, lines, error) : status;
