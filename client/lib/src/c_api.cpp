@@ -57,8 +57,7 @@ std::string OneLine(const std::string& text) {
     const size_t n = footfall::Utf8SequenceLength(text, i);
     const auto byte = [&](size_t k) { return static_cast<unsigned char>(text[i + k]); };
     const bool control =
-        n == 0 || (n == 1 && (byte(0) < 0x20 || byte(0) == 0x7f)) ||
-        (n == 2 && byte(0) == 0xc2 && byte(1) <= 0x9f) ||
+        n == 0 || footfall::IsControlCharacter(text, i, n) ||
         (n == 3 && byte(0) == 0xe2 && byte(1) == 0x80 && (byte(2) == 0xa8 || byte(2) == 0xa9));
     const size_t width = control ? 1 : n;
     if (out.size() + width > limit) break;

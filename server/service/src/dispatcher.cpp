@@ -106,13 +106,10 @@ std::string EscapeControl(const std::string& text) {
       out += "\\r";
     } else if (c == '\t') {
       out += "\\t";
-    } else if (u < 0x20 || u == 0x7F) {
-      escape(u);
     } else if (length == 0) {
       escape(u);  // one byte, then read on from the next: the log stays in step
-    } else if (u == 0xC2 && static_cast<unsigned char>(text[at + 1]) < 0xA0) {
-      escape(u);  // a C1 control (U+0080 to U+009F): CSI is a terminal escape
-      escape(static_cast<unsigned char>(text[at + 1]));
+    } else if (IsControlCharacter(text, at, length)) {
+      for (size_t k = 0; k < length; ++k) escape(static_cast<unsigned char>(text[at + k]));
     } else {
       out.append(text, at, length);
     }

@@ -60,6 +60,14 @@ inline size_t Utf8SequenceLength(std::string_view text, size_t at) {
   return length;
 }
 
+// True when the UTF-8 sequence of `length` bytes (Utf8SequenceLength) at `text[at]` is a
+// control character: C0, DEL, or C1 (U+0080 to U+009F, which some terminals obey as escapes).
+inline bool IsControlCharacter(std::string_view text, size_t at, size_t length) {
+  const unsigned c = static_cast<unsigned char>(text[at]);
+  if (length == 1) return c < 0x20 || c == 0x7f;
+  return length == 2 && c == 0xc2 && static_cast<unsigned char>(text[at + 1]) <= 0x9f;
+}
+
 // `text` cut to at most `bytes` bytes, never inside a UTF-8 sequence: a cut message stays text.
 inline std::string_view Utf8Prefix(std::string_view text, size_t bytes) {
   if (text.size() <= bytes) return text;
