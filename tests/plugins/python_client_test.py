@@ -882,23 +882,24 @@ class MayaKeyWalkTest(unittest.TestCase):
             footfall_maya.key_walk(walk, feet, body)
         return calls
 
-    def test_a_mirrored_mesh_keeps_its_normals_up(self):
-        # A terrain mesh under a negative scale had its triangles wound the other way in world
-        # space, so every sample's normal pointed down (Maya shows it the right way up).
+    def _mesh_samples(self, points, det, separation, to_ui=lambda v: v):
+        """footfall_maya._mesh_samples of one triangle at `points` (world, internal units:
+        centimetres) under a transform of determinant `det`, in a scene whose UI unit is
+        `to_ui` (MDistance.internalToUI)."""
         class Point:
             def __init__(self, x, y, z):
                 self.x, self.y, self.z = x, y, z
 
         class Dag:
             def inclusiveMatrix(self):  # noqa: N802 (Maya's name)
-                return types.SimpleNamespace(det3x3=lambda: -1.0)  # scale (-1, 1, 1)
+                return types.SimpleNamespace(det3x3=lambda: det)
 
         class MFnMesh:
             def __init__(self, dag):
                 pass
 
             def getPoints(self, space):  # noqa: N802
-                return [Point(0, 0, 0), Point(0, 0, 1), Point(-1, 0, 0)]  # world, mirrored
+                return [Point(*p) for p in points]
 
             def getTriangles(self):  # noqa: N802
                 return [1], [0, 1, 2]  # wound up in the mesh's own space
@@ -908,6 +909,7 @@ class MayaKeyWalkTest(unittest.TestCase):
                                                           getDagPath=lambda i: Dag())
         om.MFnMesh = MFnMesh
         om.MSpace = types.SimpleNamespace(kWorld=4)
+        om.MDistance = types.SimpleNamespace(internalToUI=to_ui)
         api = types.ModuleType("maya.api")
         api.OpenMaya = om
         saved = {name: sys.modules.pop(name, None) for name in ("maya.api", "maya.api.OpenMaya")}
@@ -915,15 +917,33 @@ class MayaKeyWalkTest(unittest.TestCase):
         try:
             with self._footfall_maya(types.ModuleType("maya.cmds")) as footfall_maya:
                 sys.modules["maya"].api = api
-                samples = footfall_maya._mesh_samples("ground", 0.25)
+                return footfall_maya._mesh_samples("ground", separation)
         finally:
             for name, module in saved.items():
                 sys.modules.pop(name, None)
                 if module is not None:
                     sys.modules[name] = module
+
+    def test_a_mirrored_mesh_keeps_its_normals_up(self):
+        # A terrain mesh under a negative scale had its triangles wound the other way in world
+        # space, so every sample's normal pointed down (Maya shows it the right way up).
+        samples = self._mesh_samples([(0, 0, 0), (0, 0, 1), (-1, 0, 0)], -1.0, 0.25)  # mirrored
         self.assertGreater(len(samples), 3)
         for sample in samples:
             self.assertAlmostEqual(sample[4], 1.0, places=9)  # the normal's Y: up
+
+    def test_a_mesh_is_sampled_in_the_scenes_linear_unit(self):
+        # MFnMesh gives points in centimetres (Maya's internal unit) whatever the scene's
+        # unit, while xform places the character in the scene's: in a metre scene the terrain
+        # was sent 100 times too large (and sampled at a separation taken as centimetres).
+        cm = self._mesh_samples([(0, 0, 0), (0, 0, 200), (200, 0, 0)], 1.0, 50.0)
+        m = self._mesh_samples([(0, 0, 0), (0, 0, 200), (200, 0, 0)], 1.0, 0.5,
+                               to_ui=lambda v: v / 100.0)
+        self.assertEqual(len(m), len(cm))
+        for a, b in zip(m, cm):
+            for i in range(3):
+                self.assertAlmostEqual(a[i], b[i] / 100.0, places=9)
+        self.assertAlmostEqual(max(p[0] for p in m), 2.0, places=9)
 
     def test_import_of_tracks_without_keys_changes_nothing(self):
         # Tracks of the rig without keys (alone, or beside another's keyed track) cut the rig's

@@ -64,7 +64,11 @@ def _mesh_samples(mesh, separation):
     sel.add(mesh)
     dag = sel.getDagPath(0)
     fn = om.MFnMesh(dag)
-    points = [(p.x, p.y, p.z) for p in fn.getPoints(om.MSpace.kWorld)]
+    # The API gives internal units (centimetres) whatever the scene's linear unit; xform,
+    # pointOnCurve and the separation are in the scene's (UI) unit: in a metre scene the
+    # terrain was 100 times too large for the character placed on it.
+    to_ui = om.MDistance.internalToUI(1.0)
+    points = [(p.x * to_ui, p.y * to_ui, p.z * to_ui) for p in fn.getPoints(om.MSpace.kWorld)]
     counts, verts = fn.getTriangles()
     # A mirroring transform (a negative scale) turns the winding in world space: wound back,
     # the normals face as Maya shows them (they pointed into the ground).
