@@ -982,6 +982,59 @@ class MayaKeyWalkTest(unittest.TestCase):
                 os.unlink(os.path.join(folder, name))
             os.rmdir(folder)
 
+    def test_generate_walk_keeps_the_users_keys_after_both_walks(self):
+        # Generate Walk cut every translate and rotate key from the start frame on (to frame
+        # 1e9), the user's keys long after the walk with the previous walk's.
+        with open(os.path.join(CHARACTERS, "biped.json")) as f:
+            character_text = f.read()
+
+        def walk_of(steps):  # 12 frames a step from frame 1, as the biped's file
+            keys = [{"frame": 1 + 12 * i, "position": [0.0, 0.0, 0.7 * i]}
+                    for i in range(steps + 1)]
+            return json.dumps({"tracks": [{"name": "L", "kind": "foot", "keys": keys}]})
+
+        class FakeSession:
+            def generate_json(self, terrain, request):
+                return 0, walk_of(request["steps"]), None
+
+        def run(attributes, steps):
+            calls = []
+            cmds = types.ModuleType("maya.cmds")
+            for name in ("setKeyframe", "cutKey", "undoInfo", "warning", "confirmDialog"):
+                setattr(cmds, name, lambda *args, _name=name, **kwargs:
+                        calls.append((_name, args, kwargs)))
+
+            def set_attr(plug, *values, **kwargs):
+                attributes[plug.split(".")[1]] = values[0]
+
+            def add_attr(node, longName, **kwargs):  # noqa: N803 (Maya's name)
+                attributes.setdefault(longName, 0.0)
+            cmds.setAttr, cmds.addAttr = set_attr, add_attr
+            cmds.getAttr = lambda plug, **kwargs: attributes[plug.split(".")[1]]
+            cmds.attributeQuery = lambda attr, node, exists: attr in attributes
+            cmds.listConnections = lambda plug, **kwargs: [plug.split(".")[1] + "_handle"]
+            cmds.xform = lambda *args, **kwargs: (
+                [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1] if kwargs.get("m")
+                else [0.0, 0.0, 0.0]) if kwargs.get("q") else None
+            with self._footfall_maya(cmds) as footfall_maya:
+                footfall_maya._session = lambda: FakeSession()
+                footfall_maya._connection = types.SimpleNamespace(terrain=lambda name: 1)
+                self.assertEqual(footfall_maya.generate_walk("biped_rig", steps, 1, chunk_steps=3),
+                                 steps)
+            return [c[2]["time"] for c in calls if c[0] == "cutKey"]
+
+        attributes = {"footfallCharacter": character_text, "footfallFoot0": None,
+                      "footfallWalkEnd": -1e9}  # a rig Character Setup made
+        cuts = run(attributes, 8)  # no walk before: only the walk's own frames
+        self.assertEqual(max(c[1] for c in cuts), 97)
+        self.assertEqual(attributes["footfallWalkEnd"], 97)
+        cuts = run(attributes, 4)  # shorter: the longer walk's keys go, not those after it
+        self.assertEqual(cuts[0], (1, 97))
+        self.assertEqual(max(c[1] for c in cuts), 97)
+        self.assertEqual(attributes["footfallWalkEnd"], 49)
+        del attributes["footfallWalkEnd"]  # a rig of an older version: its end is unknown
+        self.assertEqual(run(attributes, 4)[0], (1, 1e9))
+
     def test_rotations_of_any_length_are_turned_as_unit_quaternions(self):
         # The walk reader keeps rotations as written (non-zero); the viewer and exporters scale
         # them to unit length. Blender keyed [0, 2, 0, 2] as 49 degrees (its matrices take the

@@ -23,6 +23,10 @@ _settings = {"host": "127.0.0.1", "port": 7407, "start_local": True, "footfalld"
              "timeout": 10.0}
 TERRAIN = "scene"
 RIG_ATTR = "footfallCharacter"   # string attribute on the rig group: the character JSON
+# Double attribute on the rig group: the last frame its walk keyed (Generate Walk or Import);
+# NO_WALK before any. A rig without it (an older version's) has an unknown end.
+WALK_END_ATTR = "footfallWalkEnd"
+NO_WALK = -1e9
 WINDOW = "footfallWindow"
 
 
@@ -147,6 +151,7 @@ def character_setup(character_file, name=None, ik_handles=None, body=None):
         rig = mc.group(empty=True, name=name + "_rig")
         mc.addAttr(rig, longName=RIG_ATTR, dataType="string")
         mc.setAttr(rig + "." + RIG_ATTR, json.dumps(data), type="string")
+        _set_walk_end(rig, NO_WALK)
         mc.xform(rig, ws=True, t=ground)
         _orient(rig, (0.0, 1.0, 0.0), forward)  # Generate Walk heads along the rig's Z
         if not body:
@@ -181,6 +186,27 @@ def character_setup(character_file, name=None, ik_handles=None, body=None):
 def _foot_attr(index):
     """The rig's message attribute linking foot `index` (file order) to its IK handle."""
     return "footfallFoot%d" % index
+
+
+def _walk_end(rig):
+    """The last frame the rig's previous walk keyed (NO_WALK: none yet), or None when unknown
+    (a rig set up by an older version)."""
+    if not mc.attributeQuery(WALK_END_ATTR, node=rig, exists=True):
+        return None
+    return float(mc.getAttr(rig + "." + WALK_END_ATTR))
+
+
+def _set_walk_end(rig, frame):
+    if not mc.attributeQuery(WALK_END_ATTR, node=rig, exists=True):
+        mc.addAttr(rig, longName=WALK_END_ATTR, attributeType="double")
+    mc.setAttr(rig + "." + WALK_END_ATTR, float(frame))
+
+
+def _cut(nodes, first, last):
+    """Removes the nodes' translate and rotate keys from frame `first` to `last` (none when
+    `last` is before `first`)."""
+    if nodes and last >= first:
+        mc.cutKey(nodes, time=(first, last), attribute=["translate", "rotate"], clear=True)
 
 
 def _rig_targets(rig):
@@ -268,13 +294,20 @@ def generate_walk(rig, steps=8, start_frame=1, frames_per_step=0, step_length=0.
             status, text, message = s.generate_json(terrain, request)
             walk = json.loads(text) if text is not None else None
             if walk is not None:
+                frames = [k["frame"] for t in walk.get("tracks", []) for k in t.get("keys", [])]
+                walk_last = max(frames) if frames else start_frame
                 if last_frame is None:
-                    # The previous walk goes once this one has keys (a refused request keeps it).
-                    mc.cutKey(nodes, time=(start_frame, 1e9), attribute=["translate", "rotate"],
-                              clear=True)
+                    # The previous walk goes once this one has keys (a refused request keeps
+                    # it), up to its end (on to the last key for a rig of an older version):
+                    # the user's keys after both walks stay (they were all cut).
+                    old_end = _walk_end(rig)
+                    _cut(nodes, start_frame, 1e9 if old_end is None else old_end)
+                # Keys within this walk's frames go as it is keyed there.
+                _cut(nodes, start_frame if last_frame is None else last_frame + 1e-3,
+                     walk_last)
+                _set_walk_end(rig, walk_last)
                 # Each call gives the walk so far: only its new keys are set.
                 key_walk(walk, feet, body, from_frame=last_frame)
-                frames = [k["frame"] for t in walk.get("tracks", []) for k in t.get("keys", [])]
                 last_frame = max(frames) if frames else last_frame
             stopped = walk.get("stopped") if walk is not None else None
             if status != 0 or stopped:
@@ -325,6 +358,8 @@ def import_walk(path, rig=None):
                    for t in walk["tracks"]):
             raise ValueError("%s has no track for this rig's feet or body" % path)
         sets = [(walk, feet, body)]
+        # The rig's walk now ends at the walk's last frame: a later Generate Walk replaces it.
+        _set_walk_end(rig, max(k["frame"] for t in walk["tracks"] for k in t.get("keys", [])))
     else:
         sets = []
         for who in crowd:
