@@ -4,6 +4,7 @@
 
 #include "footfall/client/terrain_session.h"
 #include "footfall/terrain/batch_pool.h"
+#include "handle_counter.h"
 
 namespace footfall {
 namespace {
@@ -11,7 +12,8 @@ namespace {
 class EmbeddedSession final : public TerrainSession {
  public:
   // Batches are shared with the threads - 1 persistent workers of the process's shared pool.
-  explicit EmbeddedSession(int threads) : pool_(SharedBatchPool(threads)) {}
+  EmbeddedSession(int threads, TerrainHandle first_handle)
+      : pool_(SharedBatchPool(threads)), handles_(first_handle) {}
 
   Status LoadServerFile(const std::string& path, const TerrainLoadOptions& options,
                         TerrainHandle* out) override {
@@ -30,7 +32,8 @@ class EmbeddedSession final : public TerrainSession {
     entry.name = name;
     status = TerrainGrid::Build(copy, GridOptions{}, &entry.grid, &error);
     if (status != Status::kOk) return Fail(status, name + ": " + error);
-    const TerrainHandle handle = next_handle_++;
+    const TerrainHandle handle =
+        handles_.Next([this](TerrainHandle h) { return terrains_.count(h) != 0; });
     terrains_.emplace(handle, std::move(entry));
     *out = handle;
     return Status::kOk;
@@ -86,14 +89,14 @@ class EmbeddedSession final : public TerrainSession {
   }
 
   std::shared_ptr<BatchPool> pool_;  // the process's shared pool (null: one thread)
-  TerrainHandle next_handle_ = 1;
+  HandleCounter handles_;
   std::map<TerrainHandle, Entry> terrains_;
 };
 
 }  // namespace
 
-std::unique_ptr<TerrainSession> MakeEmbeddedSession(int threads) {
-  return std::make_unique<EmbeddedSession>(threads);
+std::unique_ptr<TerrainSession> MakeEmbeddedSession(int threads, TerrainHandle first_handle) {
+  return std::make_unique<EmbeddedSession>(threads, first_handle);
 }
 
 }  // namespace footfall

@@ -18,6 +18,7 @@
 #include "footfall/client/terrain_session.h"
 #include "footfall/rpc/batch_xdr.h"
 #include "footfall/terrain/shown_text.h"
+#include "handle_counter.h"
 #include "rpc_connect.h"
 
 namespace footfall {
@@ -315,7 +316,8 @@ class RpcSession final : public TerrainSession {
     if (s != Status::kOk) return s;
     s = Upload(&source);
     if (s != Status::kOk) return s;
-    const TerrainHandle handle = next_handle_++;
+    const TerrainHandle handle =
+        handles_.Next([this](TerrainHandle h) { return terrains_.count(h) != 0; });
     terrains_.emplace(handle, std::move(source));
     *out = handle;
     return Status::kOk;
@@ -468,7 +470,7 @@ class RpcSession final : public TerrainSession {
 
   RpcOptions options_;
   CLIENT* client_ = nullptr;
-  TerrainHandle next_handle_ = 1;
+  HandleCounter handles_;
   std::map<TerrainHandle, TerrainSource> terrains_;
 };
 

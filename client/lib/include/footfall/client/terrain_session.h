@@ -79,8 +79,10 @@ class TerrainSession {
 };
 
 // The in-process engine. With `threads` > 1, batches are shared with threads - 1 persistent
-// workers started here.
-std::unique_ptr<TerrainSession> MakeEmbeddedSession(int threads = 1);
+// workers started here. Handles are never 0 and never one still loaded: they count up from
+// `first_handle` (tests start it near 2^32 - 1) and wrap past the top, skipping those in use.
+std::unique_ptr<TerrainSession> MakeEmbeddedSession(int threads = 1,
+                                                    TerrainHandle first_handle = 1);
 
 struct RpcOptions {
   std::string host = "127.0.0.1";
