@@ -9,13 +9,37 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
 #include <cstring>
+#include <memory>
+#include <mutex>
+#include <thread>
 
 #include "footfall.h"
 
 namespace footfall {
 namespace {
+
+std::atomic<ResolveFunction> g_resolver{nullptr};
+std::atomic<int> g_pending_lookups{0};  // abandoned lookups still running
+
+// One lookup on a helper thread, shared by the thread and the caller waiting for it.
+struct Lookup {
+  std::mutex mutex;
+  std::condition_variable done_cv;
+  bool done = false;
+  bool abandoned = false;
+  int code = EAI_SYSTEM;
+  addrinfo* result = nullptr;
+};
+
+std::string LookupError(int code) {
+  return std::string("cannot resolve host: ") + gai_strerror(code);
+}
 
 int ConnectWithTimeout(const addrinfo* a, double timeout_s, std::string* reason) {
   const int fd = socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
@@ -53,6 +77,63 @@ int ConnectWithTimeout(const addrinfo* a, double timeout_s, std::string* reason)
 
 }  // namespace
 
+bool ResolveBounded(const std::string& host, const std::string& service, const addrinfo& hints,
+                    double timeout_s, ResolveFunction resolve, addrinfo** out,
+                    std::string* reason) {
+  *out = nullptr;
+  addrinfo numeric = hints;
+  numeric.ai_flags |= AI_NUMERICHOST;
+  int code = getaddrinfo(host.c_str(), service.c_str(), &numeric, out);
+  if (code != EAI_NONAME) {  // a literal address (or a bad service): no lookup
+    if (code != 0) *reason = LookupError(code);
+    return code == 0;
+  }
+  if (g_pending_lookups.load() >= kMaxPendingLookups) {
+    *reason = "cannot resolve host: " + std::to_string(kMaxPendingLookups) +
+              " earlier lookups are still unanswered";
+    return false;
+  }
+  auto lookup = std::make_shared<Lookup>();
+  try {
+    std::thread([lookup, host, service, hints, resolve] {
+      addrinfo* result = nullptr;
+      const int code = resolve(host.c_str(), service.c_str(), &hints, &result);
+      std::lock_guard<std::mutex> lock(lookup->mutex);
+      if (lookup->abandoned) {
+        if (code == 0 && result) freeaddrinfo(result);
+        g_pending_lookups.fetch_sub(1);
+        return;
+      }
+      lookup->code = code;
+      lookup->result = code == 0 ? result : nullptr;
+      lookup->done = true;
+      lookup->done_cv.notify_all();
+    }).detach();
+  } catch (const std::exception&) {
+    *reason = "cannot resolve host: cannot start a lookup thread";
+    return false;
+  }
+  std::unique_lock<std::mutex> lock(lookup->mutex);
+  const auto wait = std::chrono::duration<double>(std::max(0.0, timeout_s));
+  if (!lookup->done_cv.wait_for(lock, wait, [&lookup] { return lookup->done; })) {
+    lookup->abandoned = true;
+    g_pending_lookups.fetch_add(1);
+    char seconds[32];
+    std::snprintf(seconds, sizeof seconds, "%g", timeout_s);
+    *reason =
+        std::string("cannot resolve host: no answer from the name lookup within ") + seconds + " s";
+    return false;
+  }
+  if (lookup->code != 0) {
+    *reason = LookupError(lookup->code);
+    return false;
+  }
+  *out = lookup->result;
+  return true;
+}
+
+void SetHostResolver(ResolveFunction resolve) { g_resolver.store(resolve); }
+
 void SetCallTimeout(CLIENT* client, double seconds) {
   timeval timeout;
   timeout.tv_sec = static_cast<time_t>(seconds);
@@ -65,12 +146,10 @@ CLIENT* ConnectFootfalld(const RpcOptions& options, std::string* reason) {
   hints.ai_family = AF_UNSPEC;
   hints.ai_socktype = SOCK_STREAM;
   addrinfo* found = nullptr;
-  const std::string port = std::to_string(options.port);
-  const int gai = getaddrinfo(options.host.c_str(), port.c_str(), &hints, &found);
-  if (gai != 0) {
-    *reason = std::string("cannot resolve host: ") + gai_strerror(gai);
+  const ResolveFunction resolver = g_resolver.load();
+  if (!ResolveBounded(options.host, std::to_string(options.port), hints, options.call_timeout_s,
+                      resolver ? resolver : &getaddrinfo, &found, reason))
     return nullptr;
-  }
   CLIENT* client = nullptr;
   *reason = "no address";
   for (addrinfo* a = found; a && !client; a = a->ai_next) {

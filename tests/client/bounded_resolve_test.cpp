@@ -1,0 +1,148 @@
+// Host name lookups bounded by the session's call timeout: a resolver that does not answer no
+// longer blocks a client call indefinitely; literal addresses need no lookup at all.
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include <catch2/catch.hpp>
+
+#include "footfall/client/terrain_session.h"
+#include "footfall/import/terrain_generators.h"
+#include "rpc_connect.h"
+
+using namespace footfall;
+
+namespace {
+
+std::atomic<int> g_calls{0};
+std::atomic<int> g_finished{0};
+std::mutex g_mutex;
+std::condition_variable g_cv;
+bool g_release = false;
+
+// A resolver that does not answer until the test releases it, then answers 127.0.0.1.
+int StuckResolver(const char*, const char* service, const addrinfo* hints, addrinfo** out) {
+  ++g_calls;
+  {
+    std::unique_lock<std::mutex> lock(g_mutex);
+    g_cv.wait(lock, [] { return g_release; });
+  }
+  const int code = getaddrinfo("127.0.0.1", service, hints, out);
+  ++g_finished;
+  return code;
+}
+
+int CountingResolver(const char*, const char* service, const addrinfo* hints, addrinfo** out) {
+  ++g_calls;
+  return getaddrinfo("127.0.0.1", service, hints, out);
+}
+
+void Reset() {
+  g_calls = 0;
+  g_finished = 0;
+  std::lock_guard<std::mutex> lock(g_mutex);
+  g_release = false;
+}
+
+// Lets every stuck lookup answer and waits until `count` of them have ended.
+void ReleaseAndWait(int count) {
+  {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    g_release = true;
+  }
+  g_cv.notify_all();
+  for (int i = 0; i < 500 && g_finished.load() < count; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  REQUIRE(g_finished.load() == count);
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));  // past their last lines
+}
+
+addrinfo StreamHints() {
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  return hints;
+}
+
+double SecondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+TEST_CASE("literal addresses are resolved without a name lookup", "[client]") {
+  Reset();
+  for (const char* host : {"127.0.0.1", "::1", "10.1.2.3"}) {
+    addrinfo* found = nullptr;
+    std::string reason;
+    REQUIRE(ResolveBounded(host, "7407", StreamHints(), 0.5, &StuckResolver, &found, &reason));
+    REQUIRE(found != nullptr);
+    freeaddrinfo(found);
+  }
+  CHECK(g_calls.load() == 0);
+  addrinfo* found = nullptr;
+  std::string reason;
+  REQUIRE(
+      ResolveBounded("some.name", "7407", StreamHints(), 0.5, &CountingResolver, &found, &reason));
+  CHECK(g_calls.load() == 1);
+  REQUIRE(found != nullptr);
+  freeaddrinfo(found);
+}
+
+TEST_CASE("a name lookup that does not answer is abandoned after the timeout", "[client]") {
+  Reset();
+  addrinfo* found = nullptr;
+  std::string reason;
+  const auto t0 = std::chrono::steady_clock::now();
+  CHECK_FALSE(
+      ResolveBounded("stuck.test", "7407", StreamHints(), 0.2, &StuckResolver, &found, &reason));
+  CHECK(SecondsSince(t0) < 2);
+  CHECK(found == nullptr);
+  CHECK(reason == "cannot resolve host: no answer from the name lookup within 0.2 s");
+  ReleaseAndWait(1);  // its thread frees the late answer
+}
+
+TEST_CASE("at most a few abandoned name lookups run at once", "[client]") {
+  Reset();
+  std::string reason;
+  addrinfo* found = nullptr;
+  for (int i = 0; i < kMaxPendingLookups; ++i)
+    REQUIRE_FALSE(
+        ResolveBounded("stuck.test", "7407", StreamHints(), 0.01, &StuckResolver, &found, &reason));
+  const auto t0 = std::chrono::steady_clock::now();
+  CHECK_FALSE(
+      ResolveBounded("stuck.test", "7407", StreamHints(), 5, &StuckResolver, &found, &reason));
+  CHECK(SecondsSince(t0) < 1);
+  CHECK(reason == "cannot resolve host: 8 earlier lookups are still unanswered");
+  CHECK(g_calls.load() == kMaxPendingLookups);
+  ReleaseAndWait(kMaxPendingLookups);
+  // Once they have ended, names are looked up again.
+  REQUIRE(
+      ResolveBounded("some.name", "7407", StreamHints(), 1, &CountingResolver, &found, &reason));
+  freeaddrinfo(found);
+}
+
+TEST_CASE("an RPC session whose host lookup hangs fails within its call timeout", "[client]") {
+  Reset();
+  SetHostResolver(&StuckResolver);
+  RpcOptions options;
+  options.host = "footfalld.stuck.test";
+  options.port = 7407;
+  options.call_timeout_s = 0.3;
+  auto session = MakeRpcSession(options);
+  TerrainHandle handle = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  const Status status = session->LoadSamples(MakeHeightField(4, 4, 0.5, 0.1, 1), "t", &handle);
+  const double waited = SecondsSince(t0);
+  SetHostResolver(nullptr);
+  CHECK(status == Status::kUnavailable);
+  CHECK(waited < 2);
+  CHECK(session->last_error() ==
+        "footfalld at footfalld.stuck.test:7407: cannot resolve host: no answer from the name "
+        "lookup within 0.3 s");
+  session.reset();
+  ReleaseAndWait(1);
+}
