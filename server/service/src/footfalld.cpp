@@ -78,6 +78,24 @@ CLI::Validator Seconds(bool zero_ok) {
       "SECONDS");
 }
 
+// A count flag's check: a whole number written in digits alone, from lo to hi (hi < 10^18),
+// refused as "'1.5' is not a whole number from LO to HI", as footfall's own flags say it
+// (CLI11's range check said "Value 1.5 not in range [1 - 64]", and its conversion "Could not
+// convert").
+CLI::Validator WholeRange(long long lo, long long hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& input) -> std::string {
+        if (!input.empty() && input.size() <= 18 &&
+            input.find_first_not_of("0123456789") == std::string::npos) {
+          const long long v = std::stoll(input);
+          if (v >= lo && v <= hi) return std::string();
+        }
+        return "'" + input + "' is not a whole number from " + std::to_string(lo) + " to " +
+               std::to_string(hi);
+      },
+      "INT in [" + std::to_string(lo) + " - " + std::to_string(hi) + "]");
+}
+
 // --max-samples: a whole number of samples up to 1e12 (CLI11 took "-5" for a huge budget).
 CLI::Validator SampleCount() {
   return CLI::Validator(
@@ -142,7 +160,7 @@ int main(int argc, char** argv) {
   options.batch_threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   app.add_option("--threads", options.batch_threads,
                  "Threads per batch query (default: the hardware's cores)")
-      ->check(CLI::Range(1, 64));
+      ->check(WholeRange(1, 64));
   app.add_option("--max-samples", options.limits.max_total_samples,
                  "Samples held over all terrains and uploads (default 268435456, 2^28, or what "
                  "memory holds at 100 bytes per sample)")
@@ -161,7 +179,7 @@ int main(int argc, char** argv) {
       ->check(Seconds(false));
   app.add_option("--max-client-terrains", options.limits.max_client_terrains,
                  "Terrains one connection may hold loaded at once (default 64)")
-      ->check(CLI::Range(1, 256));
+      ->check(WholeRange(1, 256));
   app.add_option("--unread-timeout", options.unread_timeout_s,
                  "Seconds a client may leave its replies unread, with no room for another, "
                  "before its connection is closed (default 30)")
