@@ -168,8 +168,9 @@ class BlenderAddonTest(unittest.TestCase):
         with open(out) as f:
             return json.load(f), out
 
-    def assert_keys_equal_walk(self, walk, feet, body):
-        """The objects' keys are exactly the walk's tracks (frames, positions, rotations)."""
+    def assert_keys_equal_walk(self, walk, feet, body, scale=1.0):
+        """The objects' keys are exactly the walk's tracks (frames, positions, rotations), in
+        a scene of Unit Scale `scale` (positions divided by it)."""
         for track in walk["tracks"]:
             is_body = track["kind"] == "body"
             obj = body if is_body else feet[track["name"]]
@@ -178,7 +179,7 @@ class BlenderAddonTest(unittest.TestCase):
             self.assertEqual(sorted(keys), [float(f) for f in frames], track["name"])
             for k in track["keys"]:
                 got = keys[float(k["frame"])]
-                want = from_ff(k["position"])
+                want = [c / scale for c in from_ff(k["position"])]
                 for g, w in zip(got, want):
                     self.assertAlmostEqual(g, w, delta=TOL * max(1.0, abs(w)),
                                            msg="%s frame %s" % (track["name"], k["frame"]))
@@ -1398,6 +1399,84 @@ class BlenderAddonTest(unittest.TestCase):
         full, _ = self.cli_walk(rig, 10, "biped_10")
         self.assert_keys_equal_walk(full, feet, body)
 
+
+    def test_9x_scenes_in_other_unit_scales(self):
+        # footfall's lengths are metres (the character files'), Blender's scene units are the
+        # Unit Scale in metres. The add-on took scene units for metres: in a centimetre scene
+        # (0.01) the biped was 0.95 cm tall and took 0.7 cm steps, a point file loaded 100
+        # times too small, and a walk imported from JSON landed elsewhere than from glTF.
+        character_file = os.path.join(CHARACTERS, "biped.json")
+        original = bpy.data.objects["terrain"]
+        for scale in (0.01, 100.0):
+            other = bpy.data.scenes.new("units %g" % scale)
+            other.unit_settings.system, other.unit_settings.scale_length = "METRIC", scale
+            try:
+                with bpy.context.temp_override(scene=other, view_layer=other.view_layers[0]):
+                    self._walk_in_unit_scale(other, scale, character_file, original)
+            finally:
+                for obj in list(other.collection.all_objects):
+                    bpy.data.objects.remove(obj)
+                bpy.data.scenes.remove(other)
+        self.ops.release_unused_terrains()
+        self.ops.wait_for_unloads()
+
+    def _walk_in_unit_scale(self, scene, scale, character_file, original):
+        settings = scene.footfall
+        # The terrain mesh, its object scaled to scene units: the same samples, in metres.
+        terrain = original.copy()
+        terrain.scale = (1 / scale,) * 3
+        scene.collection.objects.link(terrain)
+        bpy.context.view_layer.update()
+        settings.terrain_source, settings.separation = "MESH", 0.05 / scale
+        self.assertAlmostEqual(settings.separation * scale, 0.05, delta=1e-7)  # (not clamped)
+        pts = os.path.join(ARGS.work_dir, "terrain_scaled.pts")
+        with bpy.context.temp_override(active_object=terrain):
+            self.assertEqual(bpy.ops.footfall.terrain_setup(save_points=pts), {"FINISHED"})
+        tree = self.samples_tree()
+        with open(pts) as f:
+            rows = [tuple(float(v) for v in line.split()[:3]) for line in f
+                    if line.strip() and not line.startswith("#")]
+        self.assertAlmostEqual(len(rows), self._count, delta=0.01 * self._count)
+        for p in rows[::97]:
+            self.assertLess(tree.find(p)[2], 1e-3, "sample %s of the scaled mesh" % (p,))
+        # The metres point file, and a biped on it: its size and its walk are the command
+        # line's, in scene units.
+        settings.terrain_source, settings.terrain_file = "FILE", self.pts
+        self.assertEqual(bpy.ops.footfall.terrain_setup(), {"FINISHED"})
+        self.assertEqual(settings.sample_count, self._count)
+        scene.cursor.location = Vector((0.5, 2.5, 0.0)) / scale
+        with bpy.context.temp_override(active_object=None):
+            self.assertEqual(bpy.ops.footfall.character_setup(
+                character_file=character_file, mode="CREATE", name="biped_units"), {"FINISHED"})
+        rig = settings.rig
+        body = rig.footfall_rig.body
+        feet = {f.name: f.target for f in rig.footfall_rig.feet}
+        for obj in feet.values():  # on the terrain: a sample, in metres
+            _, _, dist = tree.find([c * scale for c in to_ff(obj.matrix_world.translation)])
+            self.assertLess(dist, 1e-5, obj.name)
+        height = (body.matrix_world.translation - rig.matrix_world.translation).length * scale
+        self.assertAlmostEqual(height, 0.95, delta=1e-4)
+        settings.steps, settings.start_frame = 6, 1
+        with bpy.context.temp_override(active_object=rig):
+            self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
+        mw = rig.matrix_world
+        out = os.path.join(ARGS.work_dir, "units_walk.json")
+        run_cli("generate", "--terrain", self.pts, "--character", character_file,
+                "--start", csv([c * scale for c in to_ff(mw.translation)]),
+                "--heading", csv(to_ff(mw.to_3x3() @ Vector((0, -1, 0)))),
+                "--steps", 6, "--start-frame", 1, "--out", out)
+        with open(out) as f:
+            expected = json.load(f)
+        got = json.loads(bpy.data.texts["footfall_walk.json"].as_string())
+        self.assertEqual(got, expected)
+        self.assert_keys_equal_walk(expected, feet, body, scale)
+        # Import onto new empties: the same keys.
+        settings.rig = None
+        with bpy.context.temp_override(active_object=None):
+            self.assertEqual(bpy.ops.footfall.import_walk(filepath=out), {"FINISHED"})
+        feet = {t["name"]: bpy.data.objects["units_walk_" + t["name"]]
+                for t in expected["tracks"] if t["kind"] == "foot"}
+        self.assert_keys_equal_walk(expected, feet, bpy.data.objects["units_walk_body"], scale)
 
     def test_9y_a_deleted_scenes_terrains_are_unloaded(self):
         # Terrains were unloaded only when a file was loaded: a deleted scene's stayed loaded on

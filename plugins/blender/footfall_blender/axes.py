@@ -1,16 +1,33 @@
 """Blender (Z up, characters face -Y) <-> footfall (Y up, characters face +Z), the same
 conversion as Blender's glTF importer: footfall (x, y, z) is Blender (x, -z, y). It is a proper
-rotation (90 degrees about X), so quaternions convert by rotating their vector part."""
+rotation (90 degrees about X), so quaternions convert by rotating their vector part.
+
+Lengths: footfall's are metres (the character files' unit), Blender's are scene units, each
+the scene's Unit Scale (scale_length) in metres, as the glTF importer converts: a point is
+multiplied by the scale on its way to footfall and divided by it on its way back. At Unit
+Scale 1 (the default) the numbers are unchanged, bit for bit."""
 
 
-def to_ff(v):
-    """A Blender world point or direction -> footfall world (tuple)."""
-    return (float(v[0]), float(v[2]), -float(v[1]))
+def unit_scale(scene):
+    """Metres per Blender unit in `scene`: its Unit Scale (1 when it is not a positive finite
+    number)."""
+    try:
+        s = float(scene.unit_settings.scale_length)
+    except (AttributeError, TypeError, ValueError):
+        return 1.0
+    return s if 0.0 < s < float("inf") else 1.0
 
 
-def from_ff(v):
-    """A footfall world point or direction -> Blender world (tuple)."""
-    return (float(v[0]), -float(v[2]), float(v[1]))
+def to_ff(v, scale=1.0):
+    """A Blender world point -> footfall world (tuple), its coordinates times `scale` (metres
+    per Blender unit: unit_scale(); a direction: 1)."""
+    return (float(v[0]) * scale, float(v[2]) * scale, -float(v[1]) * scale)
+
+
+def from_ff(v, scale=1.0):
+    """A footfall world point -> Blender world (tuple), its coordinates divided by `scale`
+    (metres per Blender unit: unit_scale(); a direction: 1)."""
+    return (float(v[0]) / scale, -float(v[2]) / scale, float(v[1]) / scale)
 
 
 def quat_from_ff(q):

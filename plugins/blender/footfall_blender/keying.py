@@ -6,7 +6,7 @@ import math
 import bpy
 from mathutils import Euler, Matrix, Quaternion, Vector
 
-from .axes import from_ff, quat_from_ff
+from .axes import from_ff, quat_from_ff, unit_scale
 
 
 def _path_curve(obj):
@@ -365,12 +365,12 @@ def _key_channel(obj, path, values, frames):
     setattr(obj, path, values[-1])
 
 
-def _worlds(is_body, keys, orientation):
+def _worlds(is_body, keys, orientation, scale):
     """The world matrices of a track's keys: the body's positions and rotations, a foot's
-    positions in `orientation`."""
+    positions in `orientation`; positions (metres) divided by `scale` (metres a unit)."""
     worlds = []
     for key in keys:
-        loc = Vector(from_ff(key["position"]))
+        loc = Vector(from_ff(key["position"], scale))
         if is_body and "rotation" in key:
             rot = Quaternion(quat_from_ff(key["rotation"]))
             world = Matrix.Translation(loc) @ rot.to_matrix().to_4x4()
@@ -387,7 +387,8 @@ def key_walk(walk, feet, body, from_frame=None):
     without an object are skipped; with `from_frame`, so are keys before it (keyed already: a
     longer walk generated again keeps the keys of its first steps). Keys are world positions:
     an object under an animated parent is keyed in its parent's space at each key's frame (the
-    scene's frame is the same afterwards). Returns the number of keys set."""
+    scene's frame is the same afterwards). Positions are metres, keyed in scene units (divided
+    by the scene's Unit Scale). Returns the number of keys set."""
     tracks = []  # (object, is body, frames, keys, orientation) of the whole track, by frame
     for track in walk.get("tracks", []):
         is_body = track.get("kind") == "body"
@@ -415,6 +416,7 @@ def key_walk(walk, feet, body, from_frame=None):
     for track in tracks:
         groups.setdefault(len(above[track[0]]), []).append(track)
     spaces = _ParentSpaces(bpy.context.scene)
+    scale = unit_scale(bpy.context.scene)  # the walk's metres in scene units
     changed = {}  # keyed object with keyed objects under it -> _changed_from of its keys
     count = 0
     try:
@@ -432,7 +434,7 @@ def key_walk(walk, feet, body, from_frame=None):
                              start is not None and start < from_frame))
             spaces.read([(job[0], job[2]) for job in jobs])
             for obj, is_body, frames, keys, orientation, again in jobs:
-                worlds = _worlds(is_body, keys, orientation)
+                worlds = _worlds(is_body, keys, orientation, scale)
                 before = _curves(obj) if obj in below else None
                 if again:  # keys from where the objects above changed
                     clear_keys([obj], frames[0], to_frame=frames[-1])

@@ -14,7 +14,7 @@ from bpy_extras.io_utils import ImportHelper
 from mathutils import Matrix, Quaternion, Vector
 
 from . import keying
-from .axes import from_ff, to_ff
+from .axes import from_ff, to_ff, unit_scale
 from .props import preferences
 
 try:  # inside the add-on zip
@@ -202,10 +202,11 @@ def _status(context, text):
 
 # -- Terrain Setup ------------------------------------------------------------------------------
 
-def _add_triangles(source, matrix, points, tris):
+def _add_triangles(source, matrix, points, tris, scale):
     """Appends the triangles of `source` (an evaluated object; its mesh) in world space by
-    `matrix` to `points` (footfall's frame) and `tris`, wound counter-clockwise when `matrix`
-    mirrors. An object with no mesh (an empty, a light) adds nothing."""
+    `matrix` to `points` (footfall's frame, in metres: `scale` metres a Blender unit) and
+    `tris`, wound counter-clockwise when `matrix` mirrors. An object with no mesh (an empty,
+    a light) adds nothing."""
     try:
         mesh = source.to_mesh()
     except RuntimeError:
@@ -215,7 +216,7 @@ def _add_triangles(source, matrix, points, tris):
     try:
         mesh.calc_loop_triangles()
         base = len(points)
-        points.extend(to_ff(matrix @ v.co) for v in mesh.vertices)
+        points.extend(to_ff(matrix @ v.co, scale) for v in mesh.vertices)
         mirrored = matrix.determinant() < 0
         for t in mesh.loop_triangles:
             a, b, c = (base + i for i in t.vertices)
@@ -227,19 +228,20 @@ def _add_triangles(source, matrix, points, tris):
 def mesh_triangles(context, obj):
     """The points (footfall's frame) and triangles of `obj` as evaluated (modifiers count),
     with the instances it makes (a Geometry Nodes modifier's Instance on Points, its instancing
-    of vertices or faces), each where the viewport shows it."""
+    of vertices or faces), each where the viewport shows it. Points in metres (unit_scale)."""
     depsgraph = context.evaluated_depsgraph_get()
     points, tris = [], []
-    _add_triangles(obj.evaluated_get(depsgraph), obj.matrix_world, points, tris)
+    scale = unit_scale(context.scene)
+    _add_triangles(obj.evaluated_get(depsgraph), obj.matrix_world, points, tris, scale)
     for inst in depsgraph.object_instances:
         if inst.is_instance and inst.parent is not None and inst.parent.original == obj:
-            _add_triangles(inst.object, inst.matrix_world.copy(), points, tris)
+            _add_triangles(inst.object, inst.matrix_world.copy(), points, tris, scale)
     return points, tris
 
 
 def mesh_samples(context, obj, separation):
     """The evaluated mesh of `obj` (and its instances, see mesh_triangles) resampled at
-    `separation`, in footfall's frame."""
+    `separation` [metres], in footfall's frame (metres)."""
     points, tris = mesh_triangles(context, obj)
     if not tris:
         raise ValueError("%s has no faces" % obj.name)
@@ -263,6 +265,8 @@ class FOOTFALL_OT_terrain_setup(bpy.types.Operator):
 
     def execute(self, context):
         settings = context.scene.footfall
+        # The separation is in scene units (shown in the scene's), footfall's in metres.
+        separation = settings.separation * unit_scale(context.scene)
         # A new key each time: a copied scene shares its original's key until either runs
         # Terrain Setup, and must not replace the other's terrain.
         key = "scene-" + uuid.uuid4().hex
@@ -274,13 +278,13 @@ class FOOTFALL_OT_terrain_setup(bpy.types.Operator):
                 path = bpy.path.abspath(settings.terrain_file)
                 if not path:
                     return _fail(self, "footfall: choose a terrain file first")
-                terrain = _connection.load_file(key, path, settings.separation)
+                terrain = _connection.load_file(key, path, separation)
                 name = os.path.basename(path)
             else:
                 obj = context.active_object
                 if obj is None or obj.type != "MESH":
                     return _fail(self, "footfall: select a mesh for the terrain")
-                samples = mesh_samples(context, obj, settings.separation)
+                samples = mesh_samples(context, obj, separation)
                 if self.save_points:
                     sampling.write_point_file(bpy.path.abspath(self.save_points), samples,
                                               "footfall terrain points from Blender " + obj.name)
@@ -322,12 +326,14 @@ def _frame(up, forward):
     return Matrix((x, y, z)).transposed()
 
 
-def _snap(s, terrain, point):
-    hold = s.snap(terrain, [to_ff(point)])[0]
+def _snap(s, terrain, point, scale):
+    """The terrain point nearest `point` (Blender world, `scale` metres a unit) and its
+    normal, in Blender's world."""
+    hold = s.snap(terrain, [to_ff(point, scale)])[0]
     if not hold.ok:
         raise ffc.FootfallError(hold.status, "no terrain near (%.3f, %.3f, %.3f)" % tuple(point),
                                 "ffc_snap")
-    return Vector(from_ff(hold.point)), Vector(from_ff(hold.normal))
+    return Vector(from_ff(hold.point, scale)), Vector(from_ff(hold.normal))
 
 
 class FOOTFALL_OT_character_setup(bpy.types.Operator):
@@ -398,8 +404,10 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
     def _setup(self, context, s, terrain, data, feet):
         rig_name = self.name or character.display_name(
             data, os.path.splitext(os.path.basename(self.character_file))[0])
-        height = character.body_height(data)
-        step = character.number(data, "step_length", 0.5)
+        # The character's lengths are metres: in scene units, divided by the Unit Scale.
+        scale = unit_scale(context.scene)
+        height = character.body_height(data) / scale
+        step = character.number(data, "step_length", 0.5) / scale
         if self.mode == "PICK":
             body, targets = self._pick(context, feet)
             origin = body.matrix_world.translation.copy()
@@ -408,19 +416,19 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
             body, targets = None, {}
             origin = context.scene.cursor.location.copy()
             forward = context.scene.cursor.matrix.to_3x3() @ Vector((0, -1, 0))
-        ground, normal = _snap(s, terrain, origin)
+        ground, normal = _snap(s, terrain, origin, scale)
         multiped = not character.is_biped(data)
         up = normal if multiped else Vector((0, 0, 1))
         rot = _frame(up, forward)
         # Every snap before anything is made: a failure leaves no half-built rig.
         foot_points = {}
         for name, offset in feet:
-            local = Vector(from_ff((offset[0], 0.0, offset[2])))
-            foot_points[name] = _snap(s, terrain, ground + rot @ local)[0]
+            local = Vector(from_ff((offset[0], 0.0, offset[2]), scale))
+            foot_points[name] = _snap(s, terrain, ground + rot @ local, scale)[0]
         centres = []
         for pair_name, members in character.pairs(data):
             centre = sum((foot_points[m] for m in members), Vector()) / len(members)
-            centres.append((pair_name, members) + _snap(s, terrain, centre))
+            centres.append((pair_name, members) + _snap(s, terrain, centre, scale))
 
         # Character Setup again on a rig's body or IK targets replaces that rig (a second rig
         # on the same objects had Generate Walk key the old one). Its walk is the new rig's
@@ -431,7 +439,7 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
             walk_end_known = walk_end_known and known
             walk_end = max(walk_end, end)
 
-        root = _empty(context, rig_name + "_rig", "ARROWS", 0.5)
+        root = _empty(context, rig_name + "_rig", "ARROWS", 0.5 / scale)
         root.matrix_world = Matrix.Translation(ground) @ rot.to_4x4()
         rig = root.footfall_rig
         rig.is_rig = True
@@ -449,7 +457,8 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
         placed = {}
         for name, offset in feet:
             foot_point = foot_points[name]
-            obj = targets.get(name) or _empty(context, "%s_%s" % (rig_name, name), "SPHERE", 0.08)
+            obj = targets.get(name) or _empty(context, "%s_%s" % (rig_name, name), "SPHERE",
+                                             0.08 / scale)
             m = obj.matrix_world.copy()
             m.translation = foot_point
             obj.matrix_world = m
@@ -459,12 +468,12 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
             item.target = obj
         fwd = rot @ Vector((0, -1, 0))
         for pair_name, members, point, normal in centres:
-            central = _empty(context, "%s_%s_center" % (rig_name, pair_name), "CIRCLE", 0.3,
-                             parent=root)
+            central = _empty(context, "%s_%s_center" % (rig_name, pair_name), "CIRCLE",
+                             0.3 / scale, parent=root)
             central.matrix_world = Matrix.Translation(point) @ _frame(normal, fwd).to_4x4()
             central.footfall_rig.is_locator = True
             for m in members:
-                target = _empty(context, "%s_%s_target" % (rig_name, m), "CONE", 0.06,
+                target = _empty(context, "%s_%s_target" % (rig_name, m), "CONE", 0.06 / scale,
                                 parent=central)
                 target.footfall_rig.is_locator = True
                 target.matrix_world = Matrix.Translation(
@@ -531,20 +540,22 @@ def replace_rigs(scene, objects):
 # -- Generate Walk ------------------------------------------------------------------------------
 
 def walk_request(context, rig_obj, steps, start_frame):
-    """The ffc_generate request for the rig and the scene's walk settings, and the character."""
+    """The ffc_generate request for the rig and the scene's walk settings, and the character.
+    Lengths in metres: the scene's (points, the step overrides) times its Unit Scale."""
     settings = context.scene.footfall
+    scale = unit_scale(context.scene)
     rig = rig_obj.footfall_rig
     data = character.parse(rig.character_json, rig.character_path or rig_obj.name)
-    data = character.with_overrides(data, step_length=settings.step_length,
-                                    step_height=settings.step_height,
+    data = character.with_overrides(data, step_length=settings.step_length * scale,
+                                    step_height=settings.step_height * scale,
                                     frames_per_step=settings.frames_per_step)
     mw = rig_obj.matrix_world
     request = {"character": data,
-               "start": list(to_ff(mw.translation)),
+               "start": list(to_ff(mw.translation, scale)),
                "heading": list(to_ff(mw.to_3x3() @ Vector((0, -1, 0)))),
                "steps": int(steps), "start_frame": int(start_frame)}
     if settings.path is not None:
-        request["path"] = [list(to_ff(p)) for p in curve_points(context, settings.path)]
+        request["path"] = [list(to_ff(p, scale)) for p in curve_points(context, settings.path)]
     return request
 
 
@@ -824,13 +835,14 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
         return {"FINISHED"}
 
     def _empties(self, context, walk, name):
-        feet, body = {}, None
+        feet, body, scale = {}, None, unit_scale(context.scene)  # (sizes in metres)
         for track in walk["tracks"]:
             if track.get("kind") == "body":
-                body = _empty(context, "%s_body" % name, "CUBE", 0.3)
+                body = _empty(context, "%s_body" % name, "CUBE", 0.3 / scale)
                 body.rotation_mode = "QUATERNION"
             else:
-                feet[track["name"]] = _empty(context, "%s_%s" % (name, track["name"]), "SPHERE", 0.08)
+                feet[track["name"]] = _empty(context, "%s_%s" % (name, track["name"]), "SPHERE",
+                                             0.08 / scale)
         return feet, body
 
     def _walk_from_gltf(self, context, path):
@@ -859,12 +871,14 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
             raise ValueError("Blender's glTF importer failed")
         made = [o for o in bpy.data.objects if o not in before]
         bpy.context.view_layer.update()  # the parents' world matrices, for _parent_transform
+        # The importer divides the glTF's metres by the Unit Scale: back to metres.
+        scale = unit_scale(bpy.context.scene)
         tracks = []
         for obj in made:
             action = obj.animation_data.action if obj.animation_data else None
             if action is None:
                 continue
-            origin, parent_matrix = _parent_transform(obj)
+            origin, parent_matrix = _parent_transform(obj, scale)
             curves = {(fc.data_path, fc.array_index): fc for fc in action.fcurves}
             frames = sorted({kp.co[0] for fc in action.fcurves for kp in fc.keyframe_points})
             keys = []
@@ -875,7 +889,7 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
                     if parent_matrix is not None:
                         local = parent_matrix @ Vector(local)
                     # Added in double: the origin of a far walk is what keeps it precise.
-                    key["position"] = [o + c for o, c in zip(origin, to_ff(local))]
+                    key["position"] = [o + c for o, c in zip(origin, to_ff(local, scale))]
                 if ("rotation_quaternion", 0) in curves:
                     from .axes import quat_to_ff
                     q = Quaternion([curves[("rotation_quaternion", i)].evaluate(f)
@@ -903,13 +917,14 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
         return {"tracks": tracks}
 
 
-def _parent_transform(obj):
+def _parent_transform(obj, scale):
     """How an imported glTF node's local keys become world ones: (origin, matrix). A footfall
     glTF of a far walk parents the track nodes to one root node, "footfall_origin" (custom
     property kind "origin"), that only translates: the origin is its translation in footfall's
     frame, in double precision (its "origin" property, else its location), added to each key
     in double; matrix is None. Any other parent (a glTF from elsewhere): origin 0 and its world
-    matrix (32-bit, as Blender holds it). No parent: origin 0, matrix None."""
+    matrix (32-bit, as Blender holds it). No parent: origin 0, matrix None. `scale`: metres
+    per Blender unit (the origin is in metres)."""
     zero = (0.0, 0.0, 0.0)
     parent = obj.parent
     if parent is None:
@@ -920,7 +935,7 @@ def _parent_transform(obj):
         except (KeyError, TypeError, ValueError):
             origin = ()
         if len(origin) != 3 or not all(math.isfinite(c) for c in origin):
-            origin = to_ff(parent.location)
+            origin = to_ff(parent.location, scale)
         return origin, None
     return zero, parent.matrix_world @ obj.matrix_parent_inverse
 
