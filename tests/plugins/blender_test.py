@@ -1464,7 +1464,7 @@ class BlenderAddonTest(unittest.TestCase):
         run_cli("generate", "--terrain", self.pts, "--character", character_file,
                 "--start", csv([c * scale for c in to_ff(mw.translation)]),
                 "--heading", csv(to_ff(mw.to_3x3() @ Vector((0, -1, 0)))),
-                "--steps", 6, "--start-frame", 1, "--out", out)
+                "--steps", 6, "--start-frame", 1, "--out", out, "--out", out[:-5] + "_gltf.gltf")
         with open(out) as f:
             expected = json.load(f)
         got = json.loads(bpy.data.texts["footfall_walk.json"].as_string())
@@ -1477,6 +1477,14 @@ class BlenderAddonTest(unittest.TestCase):
         feet = {t["name"]: bpy.data.objects["units_walk_" + t["name"]]
                 for t in expected["tracks"] if t["kind"] == "foot"}
         self.assert_keys_equal_walk(expected, feet, bpy.data.objects["units_walk_body"], scale)
+        # And from glTF (Blender's importer divides its metres by the Unit Scale too).
+        with bpy.context.temp_override(active_object=None):
+            self.assertEqual(bpy.ops.footfall.import_walk(filepath=out[:-5] + "_gltf.gltf"),
+                             {"FINISHED"})
+        feet = {t["name"]: bpy.data.objects["units_walk_gltf_" + t["name"]]
+                for t in expected["tracks"] if t["kind"] == "foot"}
+        self.assert_keys_equal_walk(expected, feet, bpy.data.objects["units_walk_gltf_body"],
+                                    scale)
 
     def test_9y_a_deleted_scenes_terrains_are_unloaded(self):
         # Terrains were unloaded only when a file was loaded: a deleted scene's stayed loaded on

@@ -855,8 +855,12 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
             return self._read_gltf(path)
         finally:
             for obj in selected:
-                obj.select_set(True)
-            layer.objects.active = active
+                # (Only where it can be: a script's context may name objects of another view
+                # layer, and select_set raised there, failing the import after it had read.)
+                if layer.objects.get(obj.name) == obj:
+                    obj.select_set(True)
+            if active is None or layer.objects.get(active.name) == active:
+                layer.objects.active = active
 
     def _read_gltf(self, path):
         before = set(bpy.data.objects)
