@@ -1400,6 +1400,61 @@ class BlenderAddonTest(unittest.TestCase):
         self.assert_keys_equal_walk(full, feet, body)
 
 
+    def test_9w_long_names_of_several_bytes_a_character(self):
+        # Object names hold 63 bytes: Blender cut the end off, so a rig named in a script of
+        # several bytes a character (22 of them in Japanese) had every empty named alike, its
+        # feet and locators told apart only by .001, .002.
+        scene = bpy.context.scene.footfall
+        field = scene.rig
+        with open(os.path.join(CHARACTERS, "biped.json")) as f:
+            data = json.load(f)
+        name = "歩行者" * 8  # 72 bytes
+        feet = {"L": "左足", "R": "右足"}
+        data["name"] = name
+        for foot in data["feet"]:
+            foot["name"] = feet[foot["name"]]
+        data["gait"] = [[feet[n] for n in step] for step in data["gait"]]
+        data["pairs"] = [[feet[n] for n in pair] for pair in data["pairs"]]
+        path = os.path.join(ARGS.work_dir, "キャラクター.json")
+        with open(path, "w", encoding="utf-8") as f:
+            json.dump(data, f, ensure_ascii=False)
+        before = set(bpy.data.objects)
+        try:
+            bpy.context.scene.cursor.location = (2.0, -2.0, 0.0)
+            self.select([], None)
+            for copy in ("", ".001"):  # a second rig of the same name: Blender's suffix too
+                self.assertEqual(bpy.ops.footfall.character_setup(
+                    character_file=path, mode="CREATE"), {"FINISHED"})
+                rig = scene.rig
+                self.assertTrue(rig.name.endswith("_rig" + copy), rig.name)
+                self.assertTrue(rig.name.startswith("歩行者歩行者"), rig.name)
+                self.assertTrue(rig.footfall_rig.body.name.endswith("_body" + copy))
+                for foot in rig.footfall_rig.feet:
+                    self.assertTrue(foot.target.name.endswith("_" + foot.name + copy),
+                                    foot.target.name)
+                locators = sorted(o.name.rsplit("_", 1)[1] for o in rig.children_recursive)
+                self.assertEqual(locators, ["center" + copy] + ["target" + copy] * 2)
+            self.select([rig], rig)
+            scene.steps = 4
+            self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
+            walk = json.loads(bpy.data.texts["footfall_walk.json"].as_string())
+            self.assertEqual(sorted(t["name"] for t in walk["tracks"]), ["body", "右足", "左足"])
+            # Import onto new empties, from a file of a long name: each keeps its track's name.
+            out = os.path.join(ARGS.work_dir, "歩く" * 12 + ".json")
+            with open(out, "w", encoding="utf-8") as f:
+                json.dump(walk, f, ensure_ascii=False)
+            self.select([], None)
+            scene.rig = None
+            made = set(bpy.data.objects)
+            self.assertEqual(bpy.ops.footfall.import_walk(filepath=out), {"FINISHED"})
+            names = sorted(o.name for o in set(bpy.data.objects) - made)
+            self.assertEqual(sorted(n.rsplit("_", 1)[1] for n in names), ["body", "右足", "左足"])
+            self.assertTrue(all(n.startswith("歩く歩く") for n in names), names)
+        finally:
+            for obj in set(bpy.data.objects) - before:
+                bpy.data.objects.remove(obj)
+            scene.rig = field
+
     def test_9x_scenes_in_other_unit_scales(self):
         # footfall's lengths are metres (the character files'), Blender's scene units are the
         # Unit Scale in metres. The add-on took scene units for metres: in a centimetre scene

@@ -305,6 +305,22 @@ class FOOTFALL_OT_terrain_setup(bpy.types.Operator):
 
 # -- Character Setup ----------------------------------------------------------------------------
 
+# Blender's longest object name, in UTF-8 bytes; longer ones are cut at the end.
+MAX_NAME_BYTES = 63
+
+
+def object_name(base, suffix):
+    """`base` + `suffix` as an object name: `base` cut (at a whole character) so that the
+    name, with room for Blender's ".001", fits MAX_NAME_BYTES and keeps its suffix. (Blender
+    cut the end off: a rig of a long name, or of a shorter one in a script of several bytes a
+    character, had every empty named alike, its feet told apart by .001, .002 alone.)"""
+    room = MAX_NAME_BYTES - 4 - len(suffix.encode("utf-8"))
+    encoded = base.encode("utf-8")
+    if len(encoded) > room:
+        base = encoded[:max(room, 0)].decode("utf-8", "ignore")
+    return base + suffix
+
+
 def _empty(context, name, display="PLAIN_AXES", size=0.2, parent=None):
     obj = bpy.data.objects.new(name, None)
     obj.empty_display_type = display
@@ -439,7 +455,7 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
             walk_end_known = walk_end_known and known
             walk_end = max(walk_end, end)
 
-        root = _empty(context, rig_name + "_rig", "ARROWS", 0.5 / scale)
+        root = _empty(context, object_name(rig_name, "_rig"), "ARROWS", 0.5 / scale)
         root.matrix_world = Matrix.Translation(ground) @ rot.to_4x4()
         rig = root.footfall_rig
         rig.is_rig = True
@@ -447,7 +463,7 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
         rig.character_path = self.character_file
         rig.character_json = json.dumps(data)
         if body is None:  # a picked body keeps its rotation mode (the user's keys use it)
-            body = _empty(context, rig_name + "_body", "CUBE", 0.3 * height)
+            body = _empty(context, object_name(rig_name, "_body"), "CUBE", 0.3 * height)
             body.rotation_mode = "QUATERNION"
         body.matrix_world = Matrix.Translation(ground + up.normalized() * height) @ rot.to_4x4()
         rig.body = body
@@ -457,8 +473,8 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
         placed = {}
         for name, offset in feet:
             foot_point = foot_points[name]
-            obj = targets.get(name) or _empty(context, "%s_%s" % (rig_name, name), "SPHERE",
-                                             0.08 / scale)
+            obj = targets.get(name) or _empty(context, object_name(rig_name, "_" + name),
+                                             "SPHERE", 0.08 / scale)
             m = obj.matrix_world.copy()
             m.translation = foot_point
             obj.matrix_world = m
@@ -468,13 +484,13 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
             item.target = obj
         fwd = rot @ Vector((0, -1, 0))
         for pair_name, members, point, normal in centres:
-            central = _empty(context, "%s_%s_center" % (rig_name, pair_name), "CIRCLE",
-                             0.3 / scale, parent=root)
+            central = _empty(context, object_name(rig_name, "_%s_center" % pair_name),
+                             "CIRCLE", 0.3 / scale, parent=root)
             central.matrix_world = Matrix.Translation(point) @ _frame(normal, fwd).to_4x4()
             central.footfall_rig.is_locator = True
             for m in members:
-                target = _empty(context, "%s_%s_target" % (rig_name, m), "CONE", 0.06 / scale,
-                                parent=central)
+                target = _empty(context, object_name(rig_name, "_%s_target" % m), "CONE",
+                                0.06 / scale, parent=central)
                 target.footfall_rig.is_locator = True
                 target.matrix_world = Matrix.Translation(
                     placed[m][1] + _frame(normal, fwd) @ Vector((0, -step / 2, 0)))
@@ -838,11 +854,11 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
         feet, body, scale = {}, None, unit_scale(context.scene)  # (sizes in metres)
         for track in walk["tracks"]:
             if track.get("kind") == "body":
-                body = _empty(context, "%s_body" % name, "CUBE", 0.3 / scale)
+                body = _empty(context, object_name(name, "_body"), "CUBE", 0.3 / scale)
                 body.rotation_mode = "QUATERNION"
             else:
-                feet[track["name"]] = _empty(context, "%s_%s" % (name, track["name"]), "SPHERE",
-                                             0.08 / scale)
+                feet[track["name"]] = _empty(context, object_name(name, "_" + track["name"]),
+                                             "SPHERE", 0.08 / scale)
         return feet, body
 
     def _walk_from_gltf(self, context, path):
