@@ -316,3 +316,39 @@ TEST_CASE("A crowd whose grid runs off a slab's edge stands no two characters on
     for (size_t j = i + 1; j < bodies.size(); ++j) stacked += Distance(bodies[i], bodies[j]) < 0.15;
   CHECK(stacked == 0);
 }
+
+TEST_CASE("PrepareWalkTerrain: a surface too large to resample finely enough is refused at once",
+          "[steps][walk_terrain]") {
+  // A hexapod of 3 cm steps (a separation of 0.0075) along a path across a 100 m height map:
+  // about 190 million samples, past the 2,000,000 cap. The surface was resampled at 0.072, 10
+  // times a quarter step, after a minute of sampling, and the walk then stopped at its first
+  // step for want of footholds, advising a separation it could not have.
+  Character c = LoadShipped("hexapod");
+  c.step_length = 0.03;
+  const BumpyAsc asc(100, 1, "large");
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {10, 0, 10};
+  o.path = {{90, 0, 90}};
+  WalkTerrain prepared;
+  std::string error;
+  CHECK(PrepareWalkTerrain(asc.path, TerrainLoadOptions{}, c, o, &prepared, &error) ==
+        Status::kLimitExceeded);
+  CHECK_THAT(error, Catch::StartsWith(asc.path + ": resampled for hexapod at a quarter of its "
+                                                 "step (0.0075) within the box its walk can "
+                                                 "reach, its "));
+  CHECK_THAT(error, Catch::Contains(" samples, more than the 2000000 a walk's terrain may have; "
+                                    "at the separation that fits, 0.07"));
+  CHECK_THAT(error, Catch::Contains("(more than its step), samples lie farther apart than the "
+                                    "half step (0.015) within which the character looks for a "
+                                    "foothold, and the walk would stop within its first steps; "
+                                    "give --steps, or waypoints nearer the start (the box holds "
+                                    "them and eight steps around them), or --separation S to "
+                                    "resample the whole file at S"));
+  // Its steps given, the box is theirs: as many as cover the map are refused the same way.
+  o.path.clear();
+  o.steps = 1000;
+  CHECK(PrepareWalkTerrain(asc.path, TerrainLoadOptions{}, c, o, &prepared, &error) ==
+        Status::kLimitExceeded);
+  CHECK_THAT(error, Catch::Contains("; give fewer --steps, or --separation S"));
+}

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "frame_math.h"
+#include "step_generator.h"
 
 namespace footfall {
 namespace {
@@ -29,6 +30,32 @@ double SpreadAroundStart(const Character& c, const GenerateOptions& o) {
   for (const FootSpec& f : c.feet) rest = std::max(rest, Length(f.rest));
   return 2 * crowd + 2 * rest + c.reach + c.step_length + kArcStepHeights * c.step_height +
          c.max_rise;
+}
+
+// The error for a surface that the sample budget would resample at `separation`, too coarse
+// for the character: the walk would stop at its first steps, wanting footholds.
+Status TooCoarse(const std::string& path, const Character& c, const WalkTerrain& t,
+                 double separation, double area, std::string* error) {
+  steps_detail::Text m(4);
+  m << path << ": resampled for " << (c.name.empty() ? "the character" : c.name)
+    << " at a quarter of its step (" << t.wanted_separation << ")";
+  if (t.cropped) m << " within the box its walk can reach";
+  m << ", its " << static_cast<long long>(std::min(9e18, std::ceil(area)))
+    << " square units would need about "
+    << static_cast<long long>(
+           std::min(9e18, std::ceil(1.6 * area / (t.wanted_separation * t.wanted_separation))))
+    << " samples, more than the " << kMaxWalkSamples
+    << " a walk's terrain may have; at the separation that fits, " << separation
+    << " (more than its step), samples lie farther apart than the half step ("
+    << 0.5 * c.step_length
+    << ") within which the character looks for a foothold, and the walk would stop within its "
+       "first steps; "
+    << (t.region_is_bound ? "give fewer --steps"
+                          : "give --steps, or waypoints nearer the start (the box holds them "
+                            "and eight steps around them)")
+    << ", or --separation S to resample the whole file at S";
+  *error = m.str();
+  return Status::kLimitExceeded;
 }
 
 }  // namespace
@@ -81,7 +108,19 @@ Status PrepareWalkTerrain(const std::string& path, const TerrainLoadOptions& loa
   out->wanted_separation = kSeparationPerStep * character.step_length;
   sample.finest_default = out->wanted_separation;
   sample.max_samples = std::min(load.max_samples, kMaxWalkSamples);
-  return ResampleTerrainMesh(path, mesh, sample, &out->samples, error, &out->report);
+  // The separation the sample budget allows over the box (ResampleTerrainMesh's estimate, 1.6
+  // samples per separation squared), said before the long resampling when it is too coarse for
+  // the character to walk on, and checked again after it (its memory may allow fewer).
+  const double wanted = std::min(out->wanted_separation, out->report.file_separation);
+  const double area = SurfaceArea(mesh);
+  const double fits =
+      1.001 * std::sqrt(1.6 * area / std::max<double>(1, static_cast<double>(sample.max_samples)));
+  if (std::max(wanted, fits) > kMaxWalkCoarsening * out->wanted_separation)
+    return TooCoarse(path, character, *out, std::max(wanted, fits), area, error);
+  status = ResampleTerrainMesh(path, mesh, sample, &out->samples, error, &out->report);
+  if (status == Status::kOk && out->report.separation > kMaxWalkCoarsening * out->wanted_separation)
+    return TooCoarse(path, character, *out, out->report.separation, area, error);
+  return status;
 }
 
 }  // namespace footfall

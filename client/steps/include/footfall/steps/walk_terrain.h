@@ -21,6 +21,13 @@ namespace footfall {
 // At most this many samples for a character, whatever the load's budget: the sampler needs
 // several hundred bytes per sample while it works.
 constexpr size_t kMaxWalkSamples = 2000000;
+// A surface that those samples would cover only at a separation more than this many times
+// kSeparationPerStep of the step (a whole step: samples at least 2/3 of a step apart, while a
+// character looks for each foothold within half a step; the shipped insects resampled so
+// stopped within their first steps on gentle bumps, and walked at 3 times) is refused before it
+// is resampled (kLimitExceeded, saying what to give instead); a coarser one within it is
+// resampled at what fits (WalkTerrain::report says at what).
+constexpr double kMaxWalkCoarsening = 4;
 
 struct WalkTerrain {
   RawSamples samples;
@@ -41,7 +48,8 @@ struct WalkTerrain {
 
 // Reads the mesh or height map at `path` (load: its frame flags and sample budget; its
 // separation must be 0) and resamples it for `character` walking as `options` say. Errors as
-// LoadTerrain; kInvalidArgument for a point file or a separation set.
+// LoadTerrain; kInvalidArgument for a point file or a separation set; kLimitExceeded for a
+// surface too large to resample finely enough for the character (kMaxWalkCoarsening).
 Status PrepareWalkTerrain(const std::string& path, const TerrainLoadOptions& load,
                           const Character& character, const GenerateOptions& options,
                           WalkTerrain* out, std::string* error);
