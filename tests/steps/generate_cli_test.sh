@@ -197,6 +197,18 @@ check "--steps 0 with a path: no note about the goal" bash -c "! grep -q 'goal i
 check "--steps short of the goal: exit 0" [ $? -eq 0 ]
 check "--steps short of the goal: no stop" grep -q '"stopped":""' "$work/short.json"
 check "--steps short of the goal: the note" grep -qE "^footfall generate: note: the path's goal \(2.5000, 0.0000, 4.0000\) is still [0-9.]+ away after the 2 steps asked for" "$work/short.err"
+# A --start far off the terrain (20 m above the plateau) is said, with where the character
+# starts instead (it was snapped there without a word); the walk is made (exit 0).
+"$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,20,1 \
+  --steps 2 --out "$work/far-start.json" 2> "$work/far-start.err"
+check "--start off the terrain: exit 0" [ $? -eq 0 ]
+check "--start off the terrain: the note" grep -qxF "footfall generate: note: the start (2.5000, 20.0000, 1.0000) (--start) lies 20 from the terrain, more than a step (0.7): the character starts on the terrain's sample nearest it, at (2.5000, 0.0000, 1.0000)" "$work/far-start.err"
+# A character whose step_length its reach cannot follow is said once, not shortened silently.
+sed 's/"step_length": 0.7/"step_length": 5/' "$chars/biped.json" > "$work/long-step.json"
+"$footfall" generate --terrain "$hills" --character "$work/long-step.json" --start 10,0,10 \
+  --steps 4 --crowd 3 --out "$work/long-step.json.out.json" 2> "$work/long-step.err"
+check "step_length beyond reach: exit 0" [ $? -eq 0 ]
+check "step_length beyond reach: said once" [ "$(grep -c '^footfall generate: note: step_length 5 is longer than reach 1.2 lets a foot travel (about 2.89 on level ground)' "$work/long-step.err")" -eq 1 ]
 # A glTF output that cannot hold the walk's times is named; the JSON beside it is written (it
 # keeps every key).
 "$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,1 \

@@ -2,6 +2,7 @@
 // stand, feet that snap onto one sample, a crowd's grid across a box.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -214,4 +215,71 @@ TEST_CASE("A generate request's start heading and up are named by its fields",
   CHECK(o.names.heading == "--heading");
   CHECK(o.names.up == "--up");
   CHECK(o.names.start == "--start");
+}
+
+TEST_CASE("A start given farther than a step from the terrain is said in the walk's notes",
+          "[steps][generator]") {
+  // A start 3 m above a floor, or 5 m past its edge, was snapped to the nearest sample without a
+  // word: the character walked somewhere else than asked.
+  const Character c = LoadShipped("biped");
+  Terrain t = LoadTerrain(MakeFlat(101, 0.05, 0), 0.05);  // 5 x 5 m at y = 0
+  GenerateOptions o = StartOptions({2.5, 3, 2.5}, 2);
+  Walk w = Generate(t, c, o);
+  REQUIRE(w.notes.size() == 1);
+  CHECK(w.notes[0] ==
+        "the start (2.5000, 3.0000, 2.5000) (--start) lies 3 from the terrain, more than a step "
+        "(0.7): the character starts on the terrain's sample nearest it, at (2.5000, 0.0000, "
+        "2.5000)");
+  CheckWalk(t, c, o, w);
+  o.start = {10, 0, 2.5};  // past the edge at x = 5
+  o.crowd = 4;
+  o.names.start = "scene.json: characters[0]: 'start'";
+  w = Generate(t, c, o);
+  REQUIRE_FALSE(w.notes.empty());
+  CHECK_THAT(w.notes[0], Catch::StartsWith("the start (10.0000, 0.0000, 2.5000) (scene.json: "
+                                           "characters[0]: 'start') lies 5 from the terrain"));
+  CHECK(std::count_if(w.notes.begin(), w.notes.end(), [](const std::string& n) {
+          return n.find("from the terrain") != std::string::npos;
+        }) == 1);  // once for the crowd
+  // Within a step of it (a start a little above the ground, as usually given): nothing to say.
+  o = StartOptions({2.5, 0.6, 2.5}, 2);
+  CHECK(Generate(t, c, o).notes.empty());
+  o.start = {5.6, 0, 2.5};
+  CHECK(Generate(t, c, o).notes.empty());
+}
+
+TEST_CASE("A step_length longer than the reach allows is said once in the walk's notes",
+          "[steps][generator]") {
+  // Every step was shortened to keep the feet within reach (7), without a word: a biped of
+  // step_length 5 and reach 1.2 took steps of under 3.
+  Character c = LoadShipped("biped");
+  Terrain t = LoadTerrain(MakeFlat(301, 0.1, 0), 0.1);  // 30 x 30 m
+  GenerateOptions o = StartOptions({15, 0, 5}, 8);
+  o.crowd = 2;
+  CHECK(Generate(t, c, o).notes.empty());  // the shipped biped walks full steps
+  c.step_length = 5;
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CHECK(w.stopped.empty());
+  REQUIRE(w.notes.size() == 1);
+  CHECK(w.notes[0] ==
+        "step_length 5 is longer than reach 1.2 lets a foot travel (about 2.89 on level ground): "
+        "every step is shortened to keep the feet within reach of the body (raise reach or lower "
+        "step_length)");
+  CheckWalk(t, c, o, w);
+  // The steps taken are no longer than that, and far longer than the shipped biped's.
+  const WalkTrack& foot = *TracksOf(w, "c1")[0];
+  std::vector<Vec3> ends;
+  for (const WalkKey& k : foot.keys)
+    if (k.phase == KeyPhase::kEnd) ends.push_back(k.position);
+  REQUIRE(ends.size() >= 4);
+  for (size_t i = 2; i < ends.size(); ++i) {
+    CHECK(Distance(ends[i], ends[i - 1]) <= 2.9);
+    CHECK(Distance(ends[i], ends[i - 1]) > 2);
+  }
+  // Every shipped character walks its full step_length: no note.
+  for (const std::string& name : ShippedCharacters()) {
+    INFO(name);
+    CHECK(CheckedWalkOnFlat(LoadShipped(name), 6).notes.empty());
+  }
 }

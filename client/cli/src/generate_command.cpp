@@ -163,9 +163,13 @@ void ReportResampling(const std::string& path, const Character& character, const
   if (t.cropped) o << " within " << Box(t.region_min, t.region_max);
   o << ": " << r.samples << " samples; --separation S resamples all of it at S\n";
   if (r.separation > 1.0001 * std::min(t.wanted_separation, r.file_separation)) {
-    o << "footfall generate: not finer than " << r.separation
-      << ": the surface would need more samples than the limit; give fewer --steps or set "
-         "--separation\n";
+    o << "footfall generate: not finer than " << r.separation << " ("
+      << r.separation / t.wanted_separation
+      << " times a quarter of the step): the surface would need more samples than the "
+      << kMaxWalkSamples
+      << " a walk's terrain may have, and the character may miss footholds and stop; "
+      << (t.region_is_bound ? "give fewer --steps" : "give --steps, or waypoints nearer the start,")
+      << " or set --separation\n";
   }
   std::cerr << o.str();
 }
@@ -417,7 +421,7 @@ bool ReportWalkEnd(const Walk& walk, const LoadedTerrain& terrain) {
     std::cerr << "footfall generate: note: " << walk.notes[i] << '\n';
   if (walk.notes.size() > kMaxNotes)
     std::cerr << "footfall generate: note: ... and " << walk.notes.size() - kMaxNotes
-              << " more characters short of their goals\n";
+              << " more notes\n";
   if (walk.stopped.empty()) return false;
   std::cerr << "footfall generate: stopped early: " << walk.stopped << '\n';
   constexpr size_t kMaxListed = 20;

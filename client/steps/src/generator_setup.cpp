@@ -57,6 +57,28 @@ Status Generator::Setup(std::string* error) {
   Foothold first;
   s = FindStart(start, !o_.has_start || o_.start_may_move, &first, error);
   if (s != Status::kOk) return s;
+  // A start given off the terrain by more than a step (a typo, coordinates of another scene,
+  // a 2D point under a DEM hundreds of metres up) is not where the character walks: say where
+  // it stands instead. (The default start is the top of the bounds: its snap is no news.)
+  setup_notes_.clear();
+  if (o_.has_start && start_off_ > c_.step_length) {
+    Text m(4);
+    m << "the start " << Point(start) << " (" << o_.names.start << ") lies " << start_off_
+      << " from the terrain, more than a step (" << c_.step_length
+      << "): the character starts on the terrain's sample nearest it, at " << Point(first.point);
+    setup_notes_.push_back(m.str());
+  }
+  // A step_length longer than the reach lets a foot travel is shortened at every step (7):
+  // said once, with the step the character actually takes on level ground.
+  const double longest = LongestStepInReach();
+  if (c_.step_length > kReachNoteMargin * longest) {
+    Text m(3);
+    m << "step_length " << c_.step_length << " is longer than reach " << c_.reach
+      << " lets a foot travel (about " << longest
+      << " on level ground): every step is shortened to keep the feet within reach of the body "
+         "(raise reach or lower step_length)";
+    setup_notes_.push_back(m.str());
+  }
   // 2. The start frame: up (terrain normal for multipeds, world up for bipeds) and the heading
   //    projected onto the plane perpendicular to it. Crowds stand on a grid in that plane, or,
   //    on ground within 45 degrees of world up, across world up: one bump's normal tilted a
@@ -315,6 +337,7 @@ Status Generator::SeparateSharedFeet(const Vec3* places, Foothold* feet, size_t 
 Status Generator::FindStart(const Vec3& start, bool may_move, Foothold* first, std::string* error) {
   Status s = Check(session_.Snap(terrain_, &start, 1, first), "snap start", error);
   if (s != Status::kOk) return s;
+  start_off_ = first->status == Status::kOk ? Distance(first->point, start) : 0;
   if (first->status != Status::kOk) {
     *error = first->status == Status::kInvalidArgument
                  ? (o_.names.start == "--start" ? std::string("the start") : o_.names.start) +
@@ -410,6 +433,24 @@ Status Generator::FindStart(const Vec3& start, bool may_move, Foothold* first, s
     if (s != Status::kOk || found) break;
   }
   return s;  // found nowhere: the start's own sample, where Setup says why it cannot stand
+}
+
+double Generator::LongestStepInReach() const {
+  // Walking straight, each foot lands d = L (G - 1) / (2G) ahead of its rest relative to the
+  // body and lifts d behind it. 7 checks a step toward that landing against where the foot's
+  // own share of it (1/n of it) takes the body: the foot ends r.z - d + L (1 - 1/n) ahead,
+  // r.z + k L, within reach of a body body_height above the feet's ground.
+  const double groups = static_cast<double>(c_.gait.size());
+  const double feet = static_cast<double>(c_.feet.size());
+  const double k = (1 - 1 / feet) - (groups - 1) / (2 * groups);
+  double longest = std::numeric_limits<double>::infinity();
+  if (!(k > 0)) return longest;
+  for (const Vec3& r : rest_) {
+    const double up = c_.body_height - r.y;
+    const double along2 = c_.reach * c_.reach - r.x * r.x - up * up;
+    longest = std::min(longest, along2 > 0 ? (std::sqrt(along2) - r.z) / k : 0.0);
+  }
+  return std::max(longest, 0.0);
 }
 
 void Generator::Orient(Agent& a, const Foothold& ground, const Vec3& up0, const Vec3& fwd0) const {

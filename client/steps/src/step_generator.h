@@ -95,6 +95,9 @@ inline double ArcS(size_t j, size_t checks) {
 // Required clearance at each check point, as a fraction of the arc's nominal clearance there
 // (the step height at the mid key, falling linearly to 0 at the start and end keys).
 inline constexpr double kClearanceFraction = 0.25;
+// A step_length more than this many times the longest step the reach allows on level ground
+// (Generator::LongestStepInReach) is worth a note: its steps are all shortened.
+inline constexpr double kReachNoteMargin = 1.05;
 // Steer: a turn is tried at its whole and then in kTurnShares - 1 smaller shares, and the
 // largest that keeps every pair's feet at least kMinPairGap of their rest gap apart is taken.
 inline constexpr int kTurnShares = 8;
@@ -217,6 +220,10 @@ class Generator {
   // 1. The start's sample: where `start` snaps, or, when it may move and the character cannot
   //    stand there, the nearest candidate around it where it can (GenerateOptions).
   Status FindStart(const Vec3& start, bool may_move, Foothold* first, std::string* error);
+  // The longest step_length with which every foot of a character walking straight on level
+  // ground stays within reach of the body (the step vector's reach limit of 7 leaves full
+  // steps alone); infinite when any length does (a single gait group). [Units: wu]
+  double LongestStepInReach() const;
   // 2. The heading at a start whose up is up0: GenerateOptions::heading projected across it.
   Vec3 StartHeading(const Vec3& up0) const {
     return TangentForward(o_.heading, AnyPerpendicular(world_up_), world_up_, up0);
@@ -385,6 +392,11 @@ class Generator {
   // One pass walks every character: a call failing after the first step stops the walk there,
   // its keys so far kept (with several passes, later ones would have no keys at all).
   bool keep_on_failure_ = false;
+  // What the set-up found worth saying of the whole walk (a start far from the terrain, steps
+  // longer than the reach allows): the first of Walk::notes.
+  std::vector<std::string> setup_notes_;
+  // How far the start lies from its nearest sample (FindStart's first snap). [Units: wu]
+  double start_off_ = 0;
   std::shared_ptr<BatchPool> pool_;
   std::vector<int> pair_of_foot_;
   // Each foot's other foot across the body, whose side it keeps to (PairGap, GapToMate): its

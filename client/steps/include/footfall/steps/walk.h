@@ -83,9 +83,11 @@ struct Walk {
   // Every stopped character's reason, earliest step first (not written to files: the walk JSON
   // carries `stopped` alone).
   std::vector<std::string> stops;
-  // What is worth saying of a walk that did every step asked, one line per character, earliest
-  // first (not written to files either): a path walk given its number of steps that ended short
-  // of its goal says how far the goal still is.
+  // What is worth saying of a walk, one line each (not written to files either): first what
+  // the set-up found (a start given farther than a step from the terrain, and where the
+  // character starts instead; a step_length longer than the reach lets a foot travel, and the
+  // step taken instead), then, one line per character, earliest first, a path walk given its
+  // number of steps that did them all short of its goal: how far the goal still is.
   std::vector<std::string> notes;
 };
 
