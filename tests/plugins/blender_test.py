@@ -1363,6 +1363,31 @@ class BlenderAddonTest(unittest.TestCase):
         settings.rig = bpy.data.objects["biped_rig"]
         bpy.context.scene.frame_set(1)
 
+    def test_8e_a_walk_again_keeps_the_users_curve_modifiers(self):
+        # Generate Walk again removed the previous walk's keys, and a curve left without keys
+        # went with the modifiers the user had put on it (a Noise on the body's height for a
+        # bob): the new walk's keys came on a bare curve.
+        rig = bpy.data.objects["biped_rig"]
+        body = rig.footfall_rig.body
+        scene = bpy.context.scene.footfall
+        scene.rig, scene.steps, scene.start_frame = rig, 6, 1
+        self.select([rig], rig)
+        clear_animation([body])
+        self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
+        curve = body.animation_data.action.fcurves.find("location", index=2)
+        noise = curve.modifiers.new("NOISE")
+        noise.strength = 0.05
+        scene.steps = 4
+        self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
+        curve = body.animation_data.action.fcurves.find("location", index=2)
+        self.assertEqual([m.type for m in curve.modifiers], ["NOISE"])
+        self.assertAlmostEqual(curve.modifiers[0].strength, 0.05, places=6)
+        walk = json.loads(bpy.data.texts["footfall_walk.json"].as_string())
+        frames = sorted({k["frame"] for t in walk["tracks"] if t["kind"] == "body"
+                         for k in t["keys"]})
+        self.assertEqual([kp.co[0] for kp in curve.keyframe_points], [float(f) for f in frames])
+        clear_animation([body])
+
     def test_9_server_killed_mid_walk(self):
         rig = bpy.data.objects["biped_rig"]
         feet = {f.name: f.target for f in rig.footfall_rig.feet}

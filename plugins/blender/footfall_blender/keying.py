@@ -264,7 +264,8 @@ def rotation_path(obj):
 def clear_keys(objects, from_frame, body=None, to_frame=None):
     """Removes location keys at frames from from_frame to to_frame (None: on to the end) from
     `objects`, and the rotation keys of `body` (one of them) in the path of its rotation
-    mode."""
+    mode. A curve left without keys is removed, but for one with modifiers, kept for the keys
+    to come."""
     for obj in objects:
         action = obj.animation_data.action if obj and obj.animation_data else None
         if action is None:
@@ -278,7 +279,9 @@ def clear_keys(objects, from_frame, body=None, to_frame=None):
                 if frame >= from_frame - 1e-6 and (to_frame is None or frame <= to_frame + 1e-6):
                     fc.keyframe_points.remove(fc.keyframe_points[i], fast=True)
             fc.update()
-            if not fc.keyframe_points:
+            # An emptied curve goes, unless the user gave it modifiers (a Noise for a bob, a
+            # Cycles): those went with it, and the walk keyed again made a bare curve.
+            if not fc.keyframe_points and not fc.modifiers:
                 action.fcurves.remove(fc)
 
 
