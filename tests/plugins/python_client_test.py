@@ -1035,6 +1035,46 @@ class MayaKeyWalkTest(unittest.TestCase):
         del attributes["footfallWalkEnd"]  # a rig of an older version: its end is unknown
         self.assertEqual(run(attributes, 4)[0], (1, 1e9))
 
+    def test_import_is_one_undo_chunk(self):
+        # Import set every key as an undo step of its own: one undo took back one key of a
+        # walk of thousands (Generate Walk and Character Setup were one chunk each).
+        calls = []
+        cmds = types.ModuleType("maya.cmds")
+        for name in ("setAttr", "addAttr", "xform", "setKeyframe", "cutKey", "undoInfo",
+                     "warning", "confirmDialog"):
+            setattr(cmds, name, lambda *args, _name=name, **kwargs:
+                    calls.append((_name, args, kwargs)))
+        cmds.spaceLocator = lambda name: calls.append(("spaceLocator", (), {})) or [name]
+        with open(os.path.join(CHARACTERS, "biped.json")) as f:
+            character_text = f.read()
+        cmds.getAttr = lambda *args, **kwargs: character_text
+        cmds.attributeQuery = lambda attr, node, exists: attr != "footfallWalkEnd"
+        cmds.listConnections = lambda plug, **kwargs: [plug.split(".")[1] + "_target"]
+        walk = {"tracks": [{"name": "L", "kind": "foot",
+                            "keys": [{"frame": f, "position": [0, 0, 0.1 * f]}
+                                     for f in (1, 2, 3)]},
+                           {"name": "body", "kind": "body",
+                            "keys": [{"frame": 1, "position": [0, 1, 0],
+                                      "rotation": [0, 0, 0, 1]}]}]}
+        folder = tempfile.mkdtemp()
+        path = os.path.join(folder, "walk.json")
+        try:
+            with open(path, "w") as f:
+                json.dump(walk, f)
+            with self._footfall_maya(cmds) as footfall_maya:
+                for rig in (None, "biped_rig"):
+                    del calls[:]
+                    self.assertEqual(footfall_maya.import_walk(path, rig), 4, rig)
+                    names = [c[0] for c in calls]
+                    self.assertEqual(calls[0], ("undoInfo", (), {
+                        "openChunk": True, "chunkName": "footfall import walk"}), rig)
+                    self.assertEqual(calls[-1], ("undoInfo", (), {"closeChunk": True}), rig)
+                    self.assertEqual(names.count("undoInfo"), 2, rig)
+                    self.assertIn("setKeyframe", names)
+        finally:
+            os.unlink(path)
+            os.rmdir(folder)
+
     def test_rotations_of_any_length_are_turned_as_unit_quaternions(self):
         # The walk reader keeps rotations as written (non-zero); the viewer and exporters scale
         # them to unit length. Blender keyed [0, 2, 0, 2] as 49 degrees (its matrices take the

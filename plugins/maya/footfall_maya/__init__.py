@@ -342,7 +342,8 @@ def _main_progress_bar():
 @_guard
 def import_walk(path, rig=None):
     """Keys a footfall walk JSON file onto `rig` (or new locators, one set per character of a
-    crowd). Nothing is changed unless the walk keys something."""
+    crowd). Nothing is changed unless the walk keys something. One undo chunk (one undo took
+    back one key)."""
     walk = ffc.character.read_json(path, "walk file")
     ffc.character.check_walk(walk, path)  # before any locator is made
     # (Tracks without keys made their locators, or cut the rig's keys from frame 0 on.)
@@ -358,23 +359,31 @@ def import_walk(path, rig=None):
                    for t in walk["tracks"]):
             raise ValueError("%s has no track for this rig's feet or body" % path)
         sets = [(walk, feet, body)]
-        # The rig's walk now ends at the walk's last frame: a later Generate Walk replaces it.
-        _set_walk_end(rig, max(k["frame"] for t in walk["tracks"] for k in t.get("keys", [])))
-    else:
-        sets = []
-        for who in crowd:
-            part = {"tracks": [t for t in walk["tracks"] if t.get("character", "") == who]}
-            prefix = who + "_" if who else ""
-            feet = {t["name"]: mc.spaceLocator(name=prefix + t["name"])[0]
-                    for t in part["tracks"] if t.get("kind") == "foot"}
-            body = mc.spaceLocator(name=prefix + "body")[0]
-            sets.append((part, feet, body))
-    count = 0
-    for part, feet, body in sets:
-        first = min((k["frame"] for t in part["tracks"] for k in t.get("keys", [])), default=0)
-        nodes = [n for n in list(feet.values()) + [body] if n]
-        mc.cutKey(nodes, time=(first, 1e9), attribute=["translate", "rotate"], clear=True)
-        count += key_walk(part, feet, body)
+    mc.undoInfo(openChunk=True, chunkName="footfall import walk")
+    try:
+        if rig:
+            # The rig's walk now ends at the walk's last frame: a later Generate Walk replaces
+            # it.
+            _set_walk_end(rig, max(k["frame"] for t in walk["tracks"]
+                                   for k in t.get("keys", [])))
+        else:
+            sets = []
+            for who in crowd:
+                part = {"tracks": [t for t in walk["tracks"] if t.get("character", "") == who]}
+                prefix = who + "_" if who else ""
+                feet = {t["name"]: mc.spaceLocator(name=prefix + t["name"])[0]
+                        for t in part["tracks"] if t.get("kind") == "foot"}
+                body = mc.spaceLocator(name=prefix + "body")[0]
+                sets.append((part, feet, body))
+        count = 0
+        for part, feet, body in sets:
+            first = min((k["frame"] for t in part["tracks"] for k in t.get("keys", [])),
+                        default=0)
+            nodes = [n for n in list(feet.values()) + [body] if n]
+            mc.cutKey(nodes, time=(first, 1e9), attribute=["translate", "rotate"], clear=True)
+            count += key_walk(part, feet, body)
+    finally:
+        mc.undoInfo(closeChunk=True)
     return count
 
 
