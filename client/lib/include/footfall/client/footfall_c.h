@@ -52,7 +52,9 @@ int ffc_abi_version(void);
 /* Opens the in-process engine. Never NULL. */
 ffc_session* ffc_open_embedded(void);
 /* Opens a footfalld client; it connects lazily (the first call may return FF_C_UNAVAILABLE).
- * host NULL means 127.0.0.1; timeout_s <= 0 means 10 s per call. NULL only on bad arguments:
+ * host NULL means 127.0.0.1; timeout_s <= 0 means 10 s per call. A host name is looked up
+ * within that timeout (a lookup that does not answer fails the call FF_C_UNAVAILABLE); a
+ * literal IPv4 or IPv6 address needs no lookup. NULL only on bad arguments:
  * a port outside 1-65535, a timeout above 1e6 s, infinite or NaN, or one above 0 but below
  * 0.001 s (as footfall's --timeout: no call could be answered in it). */
 ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s);

@@ -86,8 +86,9 @@ std::unique_ptr<TerrainSession> MakeEmbeddedSession(int threads = 1,
 
 struct RpcOptions {
   std::string host = "127.0.0.1";
-  int port = 7407;               // footfalld's default port
-  double call_timeout_s = 10;    // [Units: s] per call
+  int port = 7407;  // footfalld's default port
+  // [Units: s] per call; also bounds the lookup of a host name (a literal address has none)
+  double call_timeout_s = 10;
   double connect_timeout_s = 2;  // [Units: s] per connection attempt
   // [Units: s] per load of a server-side file, when longer than call_timeout_s: resampling a
   // large mesh or height map finely takes longer than any query.
