@@ -25,6 +25,10 @@ check "unknown terrain command: named" grep -qF "footfall terrain: unknown comma
 "$footfall" -v > /dev/null 2> "$work/err.txt"
 check "an option before any command: exit 1" [ $? -eq 1 ]
 check "an option before any command: named" grep -qF "footfall: unknown option '-v' where a command is expected: query, terrain, generate, bench" "$work/err.txt"
+# --version prints the version and exits 0, as a script checking which footfall it runs expects.
+out=$("$footfall" --version 2> "$work/err.txt")
+check "--version: exit 0" [ $? -eq 0 ]
+check "--version: footfall and its version" grep -qxE 'footfall [0-9]+\.[0-9]+\.[0-9]+' <<< "$out"
 
 # 1. Answers, in order, one JSON object per line.
 printf 'snap 1.2 3 2.9\nnormal 4 4 4\nnext 1 0 1 0 0 2\nnext 1 0 4 0 0 2\n' |

@@ -28,7 +28,7 @@ std::string CommandHint(const CLI::App& root, int argc, char** argv) {
     const std::vector<const CLI::App*> commands = at->get_subcommands({});
     if (commands.empty()) return "";  // a command's own flags and arguments: CLI11's
     const std::string word = argv[i];
-    if (word == "-h" || word == "--help") return "";
+    if (word == "-h" || word == "--help" || (at == &root && word == "--version")) return "";
     if (!word.empty() && word[0] == '-')
       return path + ": unknown option '" + word + "' where a command is expected: " + names(at) +
              " (" + path + " --help)";
@@ -52,6 +52,9 @@ int main(int argc, char** argv) {
   footfall::RemoveTemporaryFileOnSignal();  // an interrupted write leaves no temporary file
   CLI::App app{"footfall: places footsteps of bipeds and multipeds on uneven terrain"};
   app.require_subcommand(1);
+  // `footfall --version`: "footfall 0.1.0" on stdout, exit 0 (CMake's project version).
+  app.set_version_flag("--version", std::string("footfall ") + FOOTFALL_VERSION,
+                       "Print footfall's version and exit");
   int exit_code = 0;
   footfall::cli::AddQueryCommand(app, &exit_code);
   footfall::cli::AddTerrainCommand(app, &exit_code);
