@@ -75,6 +75,19 @@ check "long line: four answers" [ "$(wc -l < "$work/long.jsonl")" -eq 4 ]
 check "long line: an error naming the line" grep -qx '{"op":"error","line":2,"message":"line longer than 4096 characters"}' <(sed -n 2p "$work/long.jsonl")
 check "long line: the lines after it are answered" grep -q '"op":"snap","found":true,"index":12' <(sed -n 3p "$work/long.jsonl")
 check "long line: a last line without newline is answered" grep -q '"op":"snap","found":true' <(sed -n 4p "$work/long.jsonl")
+# An empty --terrain, --server-terrain or --server (a script's unset variable) is refused, naming
+# the flag: --server "" ran the embedded engine and --server-terrain "" was ignored, silently.
+for flag in --terrain --server --server-terrain; do
+  given=(--terrain "$work/flat.pts")
+  [ "$flag" = --terrain ] && given=()
+  err=$(echo "snap 1 0 1" | "$footfall" query "${given[@]}" "$flag" "" 2>&1 >/dev/null)
+  check "query $flag '': exit 1" [ $? -eq 1 ]
+  check "query $flag '': the flag named" grep -qF -- "$flag: expected a" <<< "$err"
+done
+# The consumer closing stdout early (head): a clean exit 1 saying so, no signal, no hang.
+{ for i in $(seq 20000); do echo "snap 1 0 1"; done; } | "$footfall" query --terrain "$work/flat.pts" 2> "$work/err.txt" | head -1 > /dev/null
+check "stdout closed early: exit 1, no signal" [ "${PIPESTATUS[1]}" -eq 1 ]
+check "stdout closed early: message" grep -qF "footfall query: cannot write the answers to stdout" "$work/err.txt"
 # stdin that cannot be read (a directory) is an error, not an empty input answered with exit 0.
 err=$("$footfall" query --terrain "$work/flat.pts" 2>&1 >/dev/null < "$work")
 check "unreadable stdin: exit 1" [ $? -eq 1 ]

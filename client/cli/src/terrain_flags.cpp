@@ -5,13 +5,21 @@
 namespace footfall::cli {
 
 void AddTerrainFlags(CLI::App* command, TerrainFlags* flags) {
-  command->add_option("--terrain", flags->terrain,
-                      "Terrain file on this machine: points (.pts .xyz .txt), mesh (.obj .ply .off "
-                      ".stl) or height map (.asc .pgm)");
-  command->add_option("--server-terrain", flags->server_terrain,
-                      "Terrain file under footfalld's --data-root, read by the server");
-  command->add_option("--server", flags->server,
-                      "footfalld HOST:PORT; without it the embedded engine answers");
+  // Given empty (a script's unset variable: --server "$HOST"), each is refused, not taken as
+  // absent: --server "" ran the embedded engine and --server-terrain "" was ignored, silently.
+  command
+      ->add_option("--terrain", flags->terrain,
+                   "Terrain file on this machine: points (.pts .xyz .txt), mesh (.obj .ply .off "
+                   ".stl) or height map (.asc .pgm)")
+      ->check(NotBlank("a terrain file"));
+  command
+      ->add_option("--server-terrain", flags->server_terrain,
+                   "Terrain file under footfalld's --data-root, read by the server")
+      ->check(NotBlank("a terrain file under footfalld's data root"));
+  command
+      ->add_option("--server", flags->server,
+                   "footfalld HOST:PORT; without it the embedded engine answers")
+      ->check(NotBlank("a footfalld HOST:PORT"));
   AddLoadFlags(command, &flags->load);
   command
       ->add_option("--timeout", flags->timeout_s,
