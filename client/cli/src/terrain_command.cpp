@@ -184,6 +184,29 @@ double EstimateMeshCells(const MakeFlags& f) {
   return 0;
 }
 
+// [Units: wu] The largest coordinate, in size, of the mesh that `make` samples (ramp: its
+// profile, as MakeRampsMesh lays it; rocks: their side and relief), checked before the mesh is
+// built: the sampler cannot take coordinates out of the grid's range (a ramp 1e300 long failed
+// allocating, rocks 1e300 high were "a separation of at least -nan"); 0 for the other kinds,
+// whose samples are checked as made.
+double MeshReach(const MakeFlags& f) {
+  if (f.kind == "rocks") return std::max(static_cast<double>(f.size), std::fabs(f.amplitude));
+  if (f.kind != "ramp") return 0;
+  double y = 0, reach = std::max(f.width, f.length * (static_cast<double>(f.slopes.size()) + 2));
+  for (double slope : f.slopes) {
+    y += f.length * std::tan(slope * 3.14159265358979323846 / 180);
+    reach = std::max(reach, std::fabs(y));
+  }
+  return reach;
+}
+
+// The refusal of a terrain whose coordinates (of size `m`) pass the grid's range.
+int OutOfRange(const std::string& kind, double m) {
+  std::cerr << "footfall terrain make: " << kind << ": the parameters give coordinates beyond "
+            << terrain::kMaxCoordinate << " (" << m << "), out of the grid's range\n";
+  return 1;
+}
+
 // `x` with 3 significant digits ("4e+24"), for counts far beyond any limit.
 std::string Format3(double x) {
   std::ostringstream o;
@@ -219,6 +242,8 @@ int RunMake(const MakeFlags& f) {
     std::cerr << m.str() << '\n';
     return 1;
   }
+  if (const double reach = MeshReach(f); !(reach <= terrain::kMaxCoordinate))
+    return OutOfRange(k, reach);
   std::string why;  // the mesh sampler's, for blocks, ramp and rocks
   if (k == "stairs") {
     samples = MakeStairs(f.steps, f.rise, f.run, f.width, f.spacing);
@@ -247,11 +272,7 @@ int RunMake(const MakeFlags& f) {
   }
   for (const Vec3& p : samples.points) {
     const double m = std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
-    if (!(m <= terrain::kMaxCoordinate)) {
-      std::cerr << "footfall terrain make: " << k << ": the parameters give coordinates beyond "
-                << terrain::kMaxCoordinate << " (" << m << "), out of the grid's range\n";
-      return 1;
-    }
+    if (!(m <= terrain::kMaxCoordinate)) return OutOfRange(k, m);
   }
   if (WritePointFile(f.output, samples, &error) != Status::kOk) {
     std::cerr << "footfall terrain make: " << error << '\n';
