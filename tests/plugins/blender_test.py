@@ -1388,6 +1388,40 @@ class BlenderAddonTest(unittest.TestCase):
         self.assertEqual([kp.co[0] for kp in curve.keyframe_points], [float(f) for f in frames])
         clear_animation([body])
 
+    def test_8f_a_picked_body_keeps_its_scale(self):
+        # Character Setup set a picked body's world matrix without its scale: a body control
+        # scaled 2 came back at scale 1 (the IK targets kept theirs).
+        bpy.context.scene.frame_set(1)
+        before = set(bpy.data.objects)
+        settings = bpy.context.scene.footfall
+        field = settings.rig
+        try:
+            body = new_empty("scaled_body", location=(-2.0, -2.0, 1.0))
+            body.scale = (2.0, 2.0, 0.5)
+            targets = [new_empty("scaled_IK_" + n, location=(-2.0 + x, -2.0, 0.0))
+                       for n, x in (("L", 0.12), ("R", -0.12))]
+            targets[0].scale = (3.0, 3.0, 3.0)
+            bpy.context.view_layer.update()
+            self.select([body] + targets, body)
+            self.assertEqual(bpy.ops.footfall.character_setup(
+                character_file=os.path.join(CHARACTERS, "biped.json"), mode="PICK"),
+                {"FINISHED"})
+            for obj, scale in ((body, (2.0, 2.0, 0.5)), (targets[0], (3.0, 3.0, 3.0))):
+                for got, want in zip(obj.matrix_world.to_scale(), scale):
+                    self.assertAlmostEqual(got, want, places=5, msg=obj.name)
+            rig = settings.rig
+            self.select([rig], rig)
+            settings.steps, settings.start_frame = 3, 1
+            self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
+            bpy.context.scene.frame_set(13)
+            for got, want in zip(body.matrix_world.to_scale(), (2.0, 2.0, 0.5)):
+                self.assertAlmostEqual(got, want, places=5)
+        finally:
+            bpy.context.scene.frame_set(1)
+            for obj in set(bpy.data.objects) - before:
+                bpy.data.objects.remove(obj)
+            settings.rig = field
+
     def test_9_server_killed_mid_walk(self):
         rig = bpy.data.objects["biped_rig"]
         feet = {f.name: f.target for f in rig.footfall_rig.feet}

@@ -465,7 +465,9 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
         if body is None:  # a picked body keeps its rotation mode (the user's keys use it)
             body = _empty(context, object_name(rig_name, "_body"), "CUBE", 0.3 * height)
             body.rotation_mode = "QUATERNION"
-        body.matrix_world = Matrix.Translation(ground + up.normalized() * height) @ rot.to_4x4()
+        # A picked body keeps its scale (it was set to 1, the user's scaled control with it).
+        body.matrix_world = (Matrix.Translation(ground + up.normalized() * height) @ rot.to_4x4()
+                             @ Matrix.Diagonal(body.matrix_world.to_scale()).to_4x4())
         rig.body = body
 
         # Feet: on the terrain below their offset from the body (character space: +X left,
