@@ -1459,6 +1459,43 @@ class BlenderAddonTest(unittest.TestCase):
         self.assert_keys_equal_walk(full, feet, body)
 
 
+    def test_9v_the_add_on_disabled_and_enabled_again(self):
+        # Disabling stops the add-on's own footfalld and forgets the loaded terrains: enabled
+        # again, a scene asks for Terrain Setup (nothing keyed), and after it walks as before.
+        rig = bpy.data.objects["biped_rig"]
+        body = rig.footfall_rig.body
+        scene = bpy.context.scene.footfall
+        scene.rig, scene.steps, scene.start_frame = rig, 4, 1
+        keys = fcurve_keys(body, "location", 3)
+        local = self.ops._connection.local
+        addon_utils.disable("footfall_blender", default_set=True)
+        if local is not None:
+            self.assertFalse(local.running())
+        self.assertIsNotNone(addon_utils.enable("footfall_blender", default_set=True,
+                                                handle_error=None))
+        prefs = bpy.context.preferences.addons["footfall_blender"].preferences
+        prefs.host, prefs.port, prefs.start_local = "127.0.0.1", self.server.port, False
+        type(self).prefs = prefs
+        handlers = [h for h in bpy.app.handlers.depsgraph_update_post
+                    if h.__name__ == "_depsgraph_updated"]
+        self.assertEqual(len(handlers), 1)
+        self.select([rig], rig)
+        with self.assertRaises(RuntimeError) as e:
+            bpy.ops.footfall.generate_walk()
+        self.assertIn("not loaded in this Blender session: run Terrain Setup again",
+                      str(e.exception))
+        self.assertEqual(fcurve_keys(body, "location", 3), keys)
+        terrain = bpy.data.objects["terrain"]
+        self.select([terrain], terrain)
+        scene.terrain_source, scene.separation = "MESH", 0.05
+        self.assertEqual(bpy.ops.footfall.terrain_setup(), {"FINISHED"})
+        self.assertEqual(scene.sample_count, self._count)
+        self.select([rig], rig)
+        self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
+        expected, _ = self.cli_walk(rig, 4, "biped_reenabled")
+        feet = {f.name: f.target for f in rig.footfall_rig.feet}
+        self.assert_keys_equal_walk(expected, feet, body)
+
     def test_9w_long_names_of_several_bytes_a_character(self):
         # Object names hold 63 bytes: Blender cut the end off, so a rig named in a script of
         # several bytes a character (22 of them in Japanese) had every empty named alike, its
