@@ -2106,3 +2106,41 @@ TEST_CASE("footfalld registers with rpcbind and answers rpcinfo", "[rpc][rpcbind
   CHECK(std::system(("rpcinfo -p 127.0.0.1 | grep -qw " + std::to_string(FOOTFALL_PROG)).c_str()) !=
         0);
 }
+
+TEST_CASE("a client repeating a failing request cannot flood footfalld's log",
+          "[rpc][robustness]") {
+  // Every refused request wrote a line: thousands a second from one client filled the disk.
+  // Error lines are written at most 100 at once and 10 a second after, then counted.
+  ServerProcess server;
+  CLIENT* c = RawClient(server.port());
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < 3000; ++i) REQUIRE(RawSnap(c, 12346) == FF_UNKNOWN_TERRAIN);
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  CHECK(RawSnap(c, 12346) == FF_UNKNOWN_TERRAIN);  // still answered
+  // Error lines written, and those said not written (in one line a second or so).
+  auto count = [&server](size_t* written, size_t* unwritten) {
+    const std::string log = server.Log();
+    *written = *unwritten = 0;
+    for (size_t at = log.find("error: snap: unknown_terrain"); at != std::string::npos;
+         at = log.find("error: snap: unknown_terrain", at + 1))
+      ++*written;
+    const std::string said = " error lines not written in the last ";
+    for (size_t at = log.find(said); at != std::string::npos; at = log.find(said, at + 1)) {
+      const size_t line = log.rfind('\n', at) + 1;
+      *unwritten += std::stoul(log.substr(line + std::strlen("footfalld: ")));
+      CHECK_THAT(log.substr(at, log.find('\n', at) - at),
+                 Catch::EndsWith(" s (more than 100 at once or 10 a second); every request was "
+                                 "answered"));
+    }
+  };
+  size_t lines = 0, unwritten = 0;
+  CHECK(WaitFor([&] {
+    count(&lines, &unwritten);
+    return lines + unwritten == 3001;
+  }));
+  INFO(lines << " lines written, " << unwritten << " not, in " << elapsed << " s");
+  CHECK(lines >= 100);
+  CHECK(lines <= 100 + 10 * (elapsed + 2));
+  clnt_destroy(c);
+}

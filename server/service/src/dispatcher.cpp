@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <set>
 #include <string>
@@ -118,9 +119,58 @@ std::string EscapeControl(const std::string& text) {
   return out;
 }
 
+// Error lines ("error: ...") are written at most kErrorLineBurst at once and
+// kErrorLinesPerSecond after (a token bucket); those beyond are counted and said in one line by
+// ReportUnwrittenErrors. A client that repeats a refused request thousands of times a second
+// wrote as many lines, and could fill the disk.
+constexpr double kErrorLineBurst = 100;
+constexpr double kErrorLinesPerSecond = 10;
+
+struct ErrorLineBudget {
+  std::mutex mutex;
+  double tokens = kErrorLineBurst;
+  std::chrono::steady_clock::time_point refilled = std::chrono::steady_clock::now();
+  uint64_t unwritten = 0;
+  std::chrono::steady_clock::time_point first_unwritten;
+};
+ErrorLineBudget g_error_lines;
+
+// True when an error line may be written now; false counts it as unwritten.
+bool TakeErrorLine() {
+  std::lock_guard<std::mutex> lock(g_error_lines.mutex);
+  const auto now = std::chrono::steady_clock::now();
+  const double elapsed = std::chrono::duration<double>(now - g_error_lines.refilled).count();
+  g_error_lines.refilled = now;
+  g_error_lines.tokens =
+      std::min(kErrorLineBurst, g_error_lines.tokens + elapsed * kErrorLinesPerSecond);
+  if (g_error_lines.tokens >= 1) {
+    g_error_lines.tokens -= 1;
+    return true;
+  }
+  if (g_error_lines.unwritten++ == 0) g_error_lines.first_unwritten = now;
+  return false;
+}
+
 // One log line; every line may hold text from a client (paths, names, messages quoting them).
 void Log(const std::string& line) {
+  if (line.compare(0, 7, "error: ") == 0 && !TakeErrorLine()) return;
   std::fprintf(stderr, "footfalld: %s\n", EscapeControl(line).c_str());
+}
+
+// Says how many error lines were not written since the first of them, if any. Called about once
+// a second.
+void ReportUnwrittenErrors() {
+  std::lock_guard<std::mutex> lock(g_error_lines.mutex);
+  if (g_error_lines.unwritten == 0) return;
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                                       g_error_lines.first_unwritten)
+                             .count();
+  std::fprintf(stderr,
+               "footfalld: %llu error lines not written in the last %.1f s (more than %g at once "
+               "or %g a second); every request was answered\n",
+               static_cast<unsigned long long>(g_error_lines.unwritten), seconds, kErrorLineBurst,
+               kErrorLinesPerSecond);
+  g_error_lines.unwritten = 0;
 }
 
 void LogError(const char* proc, Status status, const std::string& message) {
@@ -900,6 +950,7 @@ void FinishLoads() {
 }
 
 void ExpireIdle() {
+  ReportUnwrittenErrors();
   if (!g_state) return;
   g_state->registry.ExpireUploads();
   LogExpiredUploads();
