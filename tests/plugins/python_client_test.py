@@ -1013,12 +1013,14 @@ class MayaKeyWalkTest(unittest.TestCase):
             cmds.getAttr = lambda plug, **kwargs: attributes[plug.split(".")[1]]
             cmds.attributeQuery = lambda attr, node, exists: attr in attributes
             cmds.listConnections = lambda plug, **kwargs: [plug.split(".")[1] + "_handle"]
+            cmds.fileInfo = lambda *args, **kwargs: ["scene-1"]
             cmds.xform = lambda *args, **kwargs: (
                 [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1] if kwargs.get("m")
                 else [0.0, 0.0, 0.0]) if kwargs.get("q") else None
             with self._footfall_maya(cmds) as footfall_maya:
                 footfall_maya._session = lambda: FakeSession()
-                footfall_maya._connection = types.SimpleNamespace(terrain=lambda name: 1)
+                footfall_maya._connection = types.SimpleNamespace(
+                    terrain=lambda name: 1, has_terrain=lambda name: name == "scene-1")
                 self.assertEqual(footfall_maya.generate_walk("biped_rig", steps, 1, chunk_steps=3),
                                  steps)
             return [c[2]["time"] for c in calls if c[0] == "cutKey"]
@@ -1034,6 +1036,66 @@ class MayaKeyWalkTest(unittest.TestCase):
         self.assertEqual(attributes["footfallWalkEnd"], 49)
         del attributes["footfallWalkEnd"]  # a rig of an older version: its end is unknown
         self.assertEqual(run(attributes, 4)[0], (1, 1e9))
+
+    def test_each_scene_has_its_own_terrain(self):
+        # One terrain name served every scene: after File > New (or opening another file),
+        # Character Setup and Generate Walk used the previous scene's terrain without a word,
+        # and it stayed loaded.
+        file_info = {}
+        errors = []
+        cmds = types.ModuleType("maya.cmds")
+
+        def info(key, value=None, query=False):
+            if query:
+                return [file_info[key]] if key in file_info else []
+            file_info[key] = value
+        cmds.fileInfo = info
+        cmds.warning = lambda message: errors.append(message)
+        cmds.confirmDialog = lambda **kwargs: None
+        cmds.inViewMessage = lambda **kwargs: None
+        cmds.getAttr = lambda *args, **kwargs: "{}"
+        loaded = {}
+
+        class FakeConnection:
+            def load_file(self, name, path, separation):
+                loaded[name] = len(loaded) + 1
+                return loaded[name]
+
+            def terrain(self, name):
+                return loaded[name]
+
+            def has_terrain(self, name):
+                return name in loaded
+
+            def terrain_names(self):
+                return list(loaded)
+
+            def unload(self, name):
+                loaded.pop(name, None)
+        session = types.SimpleNamespace(info=lambda terrain: (100, None))
+        with self._footfall_maya(cmds) as footfall_maya:
+            footfall_maya._connection = FakeConnection()
+            footfall_maya._session = lambda: session
+            self.assertEqual(footfall_maya.terrain_setup(0.25, "hills.pts"), 100)
+            first = file_info["footfallTerrain"]
+            self.assertEqual(list(loaded), [first])
+            self.assertEqual(footfall_maya.terrain_setup(0.25, "hills.pts"), 100)  # replaced
+            self.assertEqual(list(loaded), [first])
+            file_info.clear()  # File > New
+            for call in (lambda: footfall_maya.generate_walk("biped_rig"),
+                         lambda: footfall_maya.character_setup(
+                             os.path.join(CHARACTERS, "biped.json"))):
+                del errors[:]
+                self.assertIsNone(call())
+                self.assertEqual(errors, ["footfall: no terrain in this scene: run Terrain "
+                                          "Setup first"])
+            self.assertEqual(footfall_maya.terrain_setup(0.25, "hills.pts"), 100)
+            self.assertNotEqual(file_info["footfallTerrain"], first)
+            self.assertEqual(list(loaded), [file_info["footfallTerrain"]])  # the old one gone
+            file_info["footfallTerrain"] = first  # a file of an unloaded terrain opened
+            del errors[:]
+            self.assertIsNone(footfall_maya.generate_walk("biped_rig"))
+            self.assertIn("not loaded in this Maya session: run Terrain Setup again", errors[0])
 
     def test_import_is_one_undo_chunk(self):
         # Import set every key as an undo step of its own: one undo took back one key of a

@@ -8,6 +8,7 @@ plugins/README.md); the logic it shares with Blender is tested through footfall_
 
 import json
 import math
+import uuid
 
 import maya.cmds as mc
 
@@ -21,7 +22,10 @@ character = ffc.character
 _connection = ffc.Connection()
 _settings = {"host": "127.0.0.1", "port": 7407, "start_local": True, "footfalld": "",
              "timeout": 10.0}
-TERRAIN = "scene"
+# The scene's terrain: its name in the connection, kept in the scene's fileInfo under this key
+# (saved with the file, gone with File > New). One name served every scene: a new or another
+# scene walked on the terrain of the one before, without a word.
+TERRAIN_INFO = "footfallTerrain"
 RIG_ATTR = "footfallCharacter"   # string attribute on the rig group: the character JSON
 # Double attribute on the rig group: the last frame its walk keyed (Generate Walk or Import);
 # NO_WALK before any. A rig without it (an older version's) has an unknown end.
@@ -89,16 +93,60 @@ def terrain_setup(separation=0.25, point_file=None):
     """Sends the selected mesh resampled at `separation` [scene units], or loads `point_file`.
     Returns the sample count."""
     s = _session()
+    _release_other_terrains()
     if point_file:
-        terrain = _connection.load_file(TERRAIN, point_file, separation)
+        terrain = _connection.load_file(_new_scene_terrain(), point_file, separation)
     else:
         sel = mc.ls(selection=True, dag=True, type="mesh", noIntermediate=True)
         if not sel:
             raise ValueError("select a mesh for the terrain")
-        terrain = _connection.load_samples(TERRAIN, _mesh_samples(sel[0], separation))
+        samples = _mesh_samples(sel[0], separation)
+        terrain = _connection.load_samples(_new_scene_terrain(), samples)
     count, _ = s.info(terrain)
     mc.inViewMessage(amg="footfall: %d terrain samples" % count, pos="topCenter", fade=True)
     return count
+
+
+def _scene_terrain_name():
+    """The name of the open scene's terrain (its fileInfo), or None when it has none."""
+    values = mc.fileInfo(TERRAIN_INFO, query=True) or []
+    return values[0] if values and values[0] else None
+
+
+def _new_scene_terrain():
+    """The name Terrain Setup loads the open scene's terrain under: its own (replaced once the
+    new one is loaded), or a new one recorded in the scene."""
+    name = _scene_terrain_name()
+    if name is None:
+        name = "scene-" + uuid.uuid4().hex
+        mc.fileInfo(TERRAIN_INFO, name)
+    return name
+
+
+def _release_other_terrains():
+    """Unloads the terrains of scenes no longer open (Maya has one open at a time)."""
+    name = _scene_terrain_name()
+    for other in _connection.terrain_names():
+        if other != name:
+            _connection.unload(other)
+
+
+def _scene_terrain_key():
+    """The name of the open scene's terrain (no server call). Raises ValueError when the scene
+    has none, or none loaded in this Maya session."""
+    name = _scene_terrain_name()
+    if name is None:
+        raise ValueError("no terrain in this scene: run Terrain Setup first")
+    if not _connection.has_terrain(name):
+        raise ValueError("the terrain of this scene is not loaded in this Maya session: run "
+                         "Terrain Setup again")
+    return name
+
+
+def _scene_terrain():
+    """The id of the open scene's terrain on the current session (uploaded again if the session
+    changed)."""
+    return _connection.terrain(_scene_terrain_key())
 
 
 # -- Character Setup ------------------------------------------------------------------------------
@@ -123,11 +171,12 @@ def character_setup(character_file, name=None, ik_handles=None, body=None):
     a step ahead of each foot under a central locator per foot pair, aligned to the terrain
     normal. Checks the file as the generator reads it, and snaps everything, before anything is
     made; one undo chunk."""
+    _scene_terrain_key()  # (no terrain: before anything else)
     data = character.load(character_file)
     s = _session()
     s.check_character(data, character_file)
     feet = character.rest_positions(data, character_file)
-    terrain = _connection.terrain(TERRAIN)
+    terrain = _scene_terrain()
     name = name or character.display_name(data, "character")
     origin = mc.xform(body, q=True, ws=True, t=True) if body else [0.0, 0.0, 0.0]
     forward = (0.0, 0.0, 1.0)
@@ -267,6 +316,7 @@ def generate_walk(rig, steps=8, start_frame=1, frames_per_step=0, step_length=0.
                   step_height=0.0, path=None, chunk_steps=0):
     """Generates `steps` steps for `rig` and keys them; keys made before a failure stay. One
     undo chunk; progress in the main progress bar."""
+    _scene_terrain_key()  # (no terrain: before anything else)
     data, feet, body = _rig_targets(rig)
     data = character.with_overrides(data, step_length=step_length, step_height=step_height,
                                     frames_per_step=frames_per_step)
@@ -278,7 +328,7 @@ def generate_walk(rig, steps=8, start_frame=1, frames_per_step=0, step_length=0.
         request["path"] = _curve_points(path)
     chunk = chunk_steps or max(1, int(math.ceil(steps / 10.0)))
     s = _session()
-    terrain = _connection.terrain(TERRAIN)
+    terrain = _scene_terrain()
     bar = _main_progress_bar()
     if bar:
         mc.progressBar(bar, e=True, beginProgress=True, maxValue=steps,
