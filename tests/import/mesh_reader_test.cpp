@@ -785,3 +785,210 @@ TEST_CASE("ReadMesh: an ASCII STL facet loop left open is refused at its line", 
 }
 
 }  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("ReadMesh: OBJ lines ending in a backslash continue on the next line", "[import][mesh]") {
+  // The OBJ format's line continuation: "face vertex '\' is not v, v/vt, v//vn or v/vt/vn".
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  MeshReadReport report;
+  const std::string obj =
+      "# made in C:\\models\\\nv 0 0 \\\n  0\nv 1 0 0\nv 1 0 1\r\nv 0 0 1\nf 1 \\\r\n4 \\\n3 2\n";
+  REQUIRE(Read(dir.Write("joined.obj", obj), &mesh, &error, &report) == Status::kOk);
+  CHECK(report.vertices == 4);
+  CHECK(report.faces == 1);
+  CHECK(mesh.vertices[0] == Vec3{0, 0, 0});
+  CHECK(SurfaceArea(mesh) == Approx(1));
+  // A continued line's errors are named at its first line.
+  CHECK(Read(dir.Write("bad.obj", "v 0 0 0\nv 1 \\\n0 x\nv 0 1 0\nf 1 2 3\n"), &mesh, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error, "bad.obj:2: vertex coordinate 'x' is not a finite number"));
+  CHECK(Read(dir.Write("last.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 \\\n"), &mesh, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error,
+                 "last.obj:4: the line ends in '\\' (continued on the next line), but the "
+                 "file ends there"));
+}
+
+TEST_CASE("ReadMesh: Microsoft C's NaN and infinity are not finite numbers at their line",
+          "[import][mesh]") {
+  // '#' started a comment: "v 0 0 1.#QNAN" read as "v 0 0 1.", and "v 1.#INF 0 0" as a vertex of
+  // one coordinate.
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  for (const std::string token : {"1.#QNAN", "-1.#IND", "1.#INF", "-1.#INF00", "1.#SNAN0"}) {
+    INFO(token);
+    const std::string why =
+        "'" + token + "' is not a finite number (Microsoft C's NaN or infinity)";
+    CHECK(Read(dir.Write("q.obj", "v 0 0 0\nv 1 0 " + token + "\nv 0 1 0\nf 1 2 3\n"), &mesh,
+               &error) == Status::kParseError);
+    CHECK(Contains(error, "q.obj:2: vertex coordinate " + why));
+    CHECK(Read(dir.Write("q.off", "OFF\n3 1 0\n0 0 0\n" + token + " 0 0\n0 1 0\n3 0 1 2\n"), &mesh,
+               &error) == Status::kParseError);
+    CHECK(Contains(error, "q.off:4: vertex coordinate " + why));
+    CHECK(Read(dir.Write("q.ply",
+                         "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty "
+                         "float y\nproperty float z\nelement face 1\nproperty list uchar int "
+                         "vertex_indices\nend_header\n0 0 0\n1 " +
+                             token + " 0\n0 1 0\n3 0 1 2\n"),
+               &mesh, &error) == Status::kParseError);
+    CHECK(Contains(error, "q.ply:11: vertex coordinate " + why));
+    CHECK(
+        Read(dir.Write("q.stl", "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex " +
+                                    token + " 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid s\n"),
+             &mesh, &error) == Status::kParseError);
+    CHECK(Contains(error, "q.stl:5: vertex coordinate " + why));
+  }
+}
+
+TEST_CASE("ReadMesh: PLY tristrips are read as triangle strips", "[import][mesh]") {
+  // A 'tristrips' element was passed over: "4 vertices but no faces", or with faces beside it,
+  // the strips left out silently.
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  MeshReadReport report;
+  // Two strips over a row of three unit squares in the y = 0 plane (a -1 restarts a strip), the
+  // second one starting with two triangles of a repeated corner (as strips stitched into one are
+  // written), which are left out.
+  const std::string header =
+      "element vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+      "element tristrips 1\nproperty list int int vertex_indices\nend_header\n";
+  const float v[24] = {0, 0, 0, 1, 0, 0, 0, 0, 1, 1, 0, 1, 2, 0, 0, 2, 0, 1, 3, 0, 0, 3, 0, 1};
+  const int32_t strip[] = {0, 2, 1, 3, 4, 5, -1, 4, 4, 4, 5, 6, 7};
+  std::string ascii = "ply\nformat ascii 1.0\n" + header + "0 0 0\n1 0 0\n0 0 1\n1 0 1\n" +
+                      "2 0 0\n2 0 1\n3 0 0\n3 0 1\n13";
+  for (int32_t i : strip) ascii += " " + std::to_string(i);
+  std::string binary = "ply\nformat binary_little_endian 1.0\n" + header;
+  binary.append(reinterpret_cast<const char*>(v), sizeof v);
+  const int32_t n = 13;
+  binary.append(reinterpret_cast<const char*>(&n), 4);
+  binary.append(reinterpret_cast<const char*>(strip), sizeof strip);
+  for (const auto& [name, text] :
+       {std::make_pair("a.ply", ascii + "\n"), std::make_pair("b.ply", binary)}) {
+    INFO(name);
+    REQUIRE(Read(dir.Write(name, text), &mesh, &error, &report) == Status::kOk);
+    CHECK(report.faces == 6);
+    CHECK(report.skipped_faces == 0);
+    CHECK(report.turned_faces == 0);  // every other triangle of a strip wound the other way
+    CHECK(mesh.triangles.size() == 6);
+    CHECK(SurfaceArea(mesh) == Approx(3));
+    for (size_t t = 0; t < mesh.triangles.size(); ++t)  // one winding, turned up or down
+      CHECK(std::fabs(Dot(Normalize(TriangleCross(mesh, t)), Vec3{0, 1, 0})) == Approx(1));
+  }
+  // Indices in a strip are -1 or vertices.
+  std::string bad = ascii;
+  bad.replace(bad.rfind(" 7"), 2, " 8");
+  CHECK(Read(dir.Write("bad.ply", bad + "\n"), &mesh, &error) == Status::kParseError);
+  CHECK(Contains(error, "bad.ply:18: tristrips vertex '8' is not -1 or an index below 8"));
+}
+
+TEST_CASE("ReadMesh: a PLY element line needs a whole count", "[import][mesh]") {
+  // "element vertex" without a count was passed over: its properties went to the element
+  // before it, or were dropped.
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  const std::string rest =
+      "\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  REQUIRE(Read(dir.Write("m.ply", "ply\nformat ascii 1.0\nelement vertex 3" + rest), &mesh,
+               &error) == Status::kOk);
+  for (const std::string count : {"", "-3", "3.0", "three"}) {
+    INFO(count);
+    CHECK(Read(dir.Write("m.ply", "ply\nformat ascii 1.0\nelement vertex " + count + rest), &mesh,
+               &error) == Status::kParseError);
+    CHECK(Contains(error, "m.ply:3: element 'vertex' " +
+                              (count.empty() ? "has no count"
+                                             : "count '" + count + "' is not a whole number >= 0") +
+                              " (expected 'element NAME COUNT')"));
+  }
+}
+
+}  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("ReadMesh: PLY header lines that are not read are refused at their line",
+          "[import][mesh]") {
+  // Each was passed over: a misspelt keyword, a property without its name or before any
+  // element, a property or element given twice (the last x read), a face element without an
+  // index list ("4 vertices but no faces", or the faces left out beside other ones).
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  const std::string vertex =
+      "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+  const std::string face = "element face 1\nproperty list uchar int vertex_indices\n";
+  const std::string data = "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {"elemnt vertex 3\n" + vertex + face,
+       "m.ply:3: 'elemnt' does not start a PLY header line (expected format, element, "
+       "property, comment, obj_info or end_header)"},
+      {"property float w\n" + vertex + face,
+       "m.ply:3: a property before any element (expected 'element NAME COUNT' before it)"},
+      {vertex + "property float\n" + face, "m.ply:7: expected 'property TYPE NAME'"},
+      {vertex + "property list uchar int\n" + face,
+       "m.ply:7: expected 'property list COUNT_TYPE ITEM_TYPE NAME'"},
+      {vertex + "property float x\n" + face,
+       "m.ply:7: vertex property 'x' given again (first on line 4)"},
+      {vertex + face + "element vertex 0\n",
+       "m.ply:9: element 'vertex' given again (first on line 3)"},
+      {vertex + "element face 1\nproperty list uchar int indices\n",
+       "m.ply:7: element 'face' has no list property 'vertex_indices' (or 'vertex_index'): its 1 "
+       "records cannot be read"},
+  };
+  for (const auto& [header, expected] : cases) {
+    INFO(header);
+    CHECK(Read(dir.Write("m.ply", "ply\nformat ascii 1.0\n" + header + data), &mesh, &error) ==
+          Status::kParseError);
+    CHECK(error == dir.File("m.ply") + expected.substr(5));
+  }
+  REQUIRE(Read(dir.Write("m.ply", "ply\nformat ascii 1.0\n" + vertex + face + data), &mesh,
+               &error) == Status::kOk);
+}
+
+TEST_CASE("ReadMesh: ASCII PLY values of properties not read are numbers", "[import][mesh]") {
+  // A damaged normal or colour ("abc") loaded without a word.
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  auto ply = [](const std::string& nx) {
+    return "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+           "property float z\nproperty float nx\nelement face 1\nproperty list uchar int "
+           "vertex_indices\nproperty list uchar float texcoord\nend_header\n0 0 0 0\n1 0 0 " +
+           nx + "\n0 1 0 0\n3 0 1 2 2 0.5 " + nx + "\n";
+  };
+  for (const std::string nx : {"0.5", "nan", "-1.#IND", "1e999"})
+    CHECK(Read(dir.Write("n.ply", ply(nx)), &mesh, &error) == Status::kOk);
+  CHECK(Read(dir.Write("n.ply", ply("abc")), &mesh, &error) == Status::kParseError);
+  CHECK(Contains(error, "n.ply:13: vertex property 'nx': 'abc' is not a number"));
+}
+
+TEST_CASE("ReadMesh: OBJ statements of other kinds are named when no faces are read",
+          "[import][mesh]") {
+  // "V 0 0 0" lines read as "no vertices: the mesh is empty"; "fo", the faces of older files,
+  // as "4 vertices but no faces"; a free-form surface was left out silently.
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  const std::string v = "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\n";
+  REQUIRE(Read(dir.Write("fo.obj", v + "fo 1 4 3 2\n"), &mesh, &error) == Status::kOk);
+  CHECK(SurfaceArea(mesh) == Approx(1));
+  CHECK(Read(dir.Write("up.obj", "V 0 0 0\nV 1 0 0\nV 0 1 0\nF 1 2 3\n"), &mesh, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error,
+                 "up.obj:1: 'V' is not an OBJ statement, and the file has no vertices "
+                 "(expected 'v x y z' and 'f v1 v2 v3 ...', in lower case)"));
+  CHECK(Read(dir.Write("face.obj", v + "# faces\nface 1 2 3\n"), &mesh, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error, "face.obj:6: 'face' is not an OBJ statement, and the file has no faces"));
+  CHECK(Read(dir.Write("surf.obj", v + "f 1 4 3 2\ncstype bezier\ndeg 1 1\nsurf 0 1 0 1 1 2 3 4\n"),
+             &mesh, &error) == Status::kParseError);
+  CHECK(Contains(error, "surf.obj:8: free-form surfaces ('surf') are not read"));
+}
+
+}  // namespace footfall

@@ -1157,7 +1157,7 @@ TEST_CASE("Reader fuzz: OFF and PLY counts beyond 2^63 are refused as written", 
       {"OFF\n3 " + big + " 0\n" + tri + "3 0 1 2\n", "m.off:2: expected counts"},
       {"OFF\n3 1 0\n" + tri + big + " 0 1 2\n", "m.off:6: face must start with its vertex count"},
       {"ply\nformat ascii 1.0\nelement vertex " + big + ply_end,
-       "m.ply:3: element count '" + big + "' is not a count"},
+       "m.ply:3: element 'vertex' count '" + big + "' is not a whole number >= 0"},
   };
   for (const auto& [text, expected] : cases) {
     const std::string name = text[0] == 'O' ? "m.off" : "m.ply";

@@ -20,6 +20,7 @@
 #include "footfall/terrain/input_file.h"
 #include "footfall/terrain/samples.h"
 #include "footfall/terrain/shown_text.h"
+#include "text_numbers.h"
 
 namespace footfall::detail {
 namespace {
@@ -126,7 +127,9 @@ Status CheckCoordinate(const std::string& where, const std::string& token, doubl
                        std::string* error) {
   double value = 0;
   if (!ParseFiniteDecimal(token, &value))
-    return Fail(where, "vertex coordinate '" + ShownText(token) + "' is not a finite number",
+    return Fail(where,
+                "vertex coordinate '" + ShownText(token) + "' is not a finite number" +
+                    NotFiniteNote(token),
                 error);
   *value_out = value;
   if (std::fabs(value) > terrain::kMaxCoordinate) {
@@ -164,8 +167,17 @@ bool ParseCount(const std::string& token, long long* value) {
   return ParseInteger(token, value) && errno != ERANGE;
 }
 
+// The line up to its '#' comment (a '#' in Microsoft C's "1.#QNAN" starts none), without a
+// final CR.
+// Whether an ASCII PLY value is a decimal number (NaN, infinity and numbers beyond a double
+// included, as Microsoft C writes them too).
+bool IsPlyNumber(const std::string& token) {
+  double value = 0;
+  return ReadDecimal(token, &value) != DecimalRead::kNotANumber || IsMicrosoftNonFinite(token);
+}
+
 std::string StripComment(const std::string& line) {
-  std::string s = line.substr(0, line.find('#'));
+  std::string s = line.substr(0, CommentStart(line));
   if (!s.empty() && s.back() == '\r') s.pop_back();
   return s;
 }
@@ -201,16 +213,54 @@ void SkipByteOrderMark(std::istream& in) {
   in.seekg(0);
 }
 
+namespace {
+
+// Whether `word` starts a statement of the OBJ format (those read and those passed over).
+bool IsObjStatement(const std::string& word) {
+  static const char* const kWords[] = {
+      "v",      "vt",    "vn",       "vp",       "f",          "fo",        "l",      "p",
+      "o",      "g",     "s",        "mg",       "usemtl",     "mtllib",    "maplib", "usemap",
+      "lod",    "bevel", "c_interp", "d_interp", "shadow_obj", "trace_obj", "ctech",  "stech",
+      "cstype", "deg",   "bmat",     "step",     "curv",       "curv2",     "surf",   "parm",
+      "trim",   "hole",  "scrv",     "sp",       "end",        "con",       "call",   "csh"};
+  return std::find(std::begin(kWords), std::end(kWords), word) != std::end(kWords);
+}
+
+}  // namespace
+
 Status ParseObjFile(const std::string& path, ParsedMesh* out, std::string* error) {
   const Status start = CheckTextStart(path, error);
   if (start != Status::kOk) return start;
   std::ifstream in(path);
   SkipByteOrderMark(in);
   LineReader lines(in);
-  std::string line;
+  std::string line, statement;
   long long vertices = 0;
-  for (size_t number = 1; lines.Next(&line); ++number) {
-    const std::vector<std::string> t = Tokens(StripComment(line));
+  size_t number = 0, read = 0;  // the statement's first line; the line last read
+  size_t unknown = 0;           // the line of the first statement that is not OBJ's
+  std::string unknown_word;
+  bool continues = false;  // the last line read ends in '\' (a backslash)
+  while (lines.Next(&line)) {
+    // A line whose statement ends in '\' continues on the next (the OBJ format's line
+    // continuation; a '\' in a comment continues nothing): they are read as one statement,
+    // named by its first line.
+    ++read;
+    if (!continues) statement.clear(), number = read;
+    const std::string data = StripComment(line);
+    const size_t end = data.find_last_not_of(" \t\r\f\v");
+    continues = end != std::string::npos && data[end] == '\\';
+    statement.append(data, 0, continues ? end : std::string::npos);
+    if (statement.size() > kMaxLineBytes) {
+      return Fail(At(path, number),
+                  "a statement continued ('\\' at line ends) over more than 1 MiB, up to line " +
+                      std::to_string(read) + " (expected lines that end)",
+                  error);
+    }
+    if (continues) {
+      statement += ' ';
+      continue;
+    }
+    const std::vector<std::string> t = Tokens(statement);
     if (t.empty()) continue;
     if (t[0] == "v") {
       if (t.size() < 4) {
@@ -225,7 +275,7 @@ Status ParseObjFile(const std::string& path, ParsedMesh* out, std::string* error
       }
       out->vertices.push_back({c[0], c[1], c[2]});
       ++vertices;
-    } else if (t[0] == "f") {
+    } else if (t[0] == "f" || t[0] == "fo") {  // "fo": the faces of older files
       if (t.size() < 4) {
         return Fail(At(path, number),
                     "face has " + std::to_string(t.size() - 1) + " vertices, expected 3 or more",
@@ -267,9 +317,31 @@ Status ParseObjFile(const std::string& path, ParsedMesh* out, std::string* error
         out->corners.push_back(static_cast<uint32_t>(index > 0 ? index - 1 : vertices + index));
       }
       out->EndFace(number);
+    } else if (t[0] == "surf") {
+      // A free-form surface: the mesh would load without it.
+      return Fail(At(path, number),
+                  "free-form surfaces ('surf') are not read (expected polygons: export the "
+                  "surface as a polygon mesh)",
+                  error);
+    } else if (unknown == 0 && !IsObjStatement(t[0])) {
+      unknown = number, unknown_word = t[0];
     }
   }
   if (lines.too_long()) return TooLongLine(path, lines, error);
+  if (continues) {
+    return Fail(At(path, read),
+                "the line ends in '\\' (continued on the next line), but the file ends there",
+                error);
+  }
+  // A file of statements this reader does not know ("V", "F") was "no vertices: the mesh is
+  // empty".
+  if (unknown != 0 && (out->vertices.empty() || out->Faces() == 0)) {
+    return Fail(At(path, unknown),
+                "'" + ShownText(unknown_word) + "' is not an OBJ statement, and the file has no " +
+                    (out->vertices.empty() ? "vertices" : "faces") +
+                    " (expected 'v x y z' and 'f v1 v2 v3 ...', in lower case)",
+                error);
+  }
   return Status::kOk;
 }
 
@@ -432,6 +504,8 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
     std::vector<bool> lists;               // whether each is a list
     std::vector<std::string> types;        // each one's type (lists: their items')
     std::vector<std::string> count_types;  // lists: their counts' type ("" for scalars)
+    std::vector<size_t> lines;             // each one's header line
+    size_t line = 0;                       // the element's header line
   };
   std::vector<Element> elements;
   std::string format;
@@ -445,22 +519,72 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
       ended = true;
       break;
     }
-    if (t[0] == "format" && t.size() >= 2) {
-      format = t[1];
-    } else if (t[0] == "element" && t.size() >= 3) {
-      Element e;
-      e.name = t[1];
-      if (!ParseCount(t[2], &e.count) || e.count < 0) {
-        return Fail(At(path, number), "element count '" + ShownText(t[2]) + "' is not a count",
+    // Header lines the reader passed over (a keyword misspelt, a property without its name or
+    // before any element) left a file read with properties of the wrong element, or none.
+    if (t[0] == "format") {
+      if (t.size() < 2) {
+        return Fail(At(path, number),
+                    "expected 'format ascii 1.0' (or binary_little_endian or binary_big_endian)",
                     error);
       }
+      format = t[1];
+    } else if (t[0] == "element") {
+      // A line without its count was passed over: its properties went to the element before.
+      if (t.size() < 2)
+        return Fail(At(path, number), "expected 'element NAME COUNT', found 'element'", error);
+      Element e;
+      e.name = t[1];
+      if (t.size() < 3) {
+        return Fail(
+            At(path, number),
+            "element '" + ShownText(e.name) + "' has no count (expected 'element NAME COUNT')",
+            error);
+      }
+      if (!ParseCount(t[2], &e.count) || e.count < 0) {
+        return Fail(At(path, number),
+                    "element '" + ShownText(e.name) + "' count '" + ShownText(t[2]) +
+                        "' is not a whole number >= 0 (expected 'element NAME COUNT')",
+                    error);
+      }
+      for (const Element& earlier : elements) {
+        if (earlier.name == e.name) {
+          return Fail(At(path, number),
+                      "element '" + ShownText(e.name) + "' given again (first on line " +
+                          std::to_string(earlier.line) + ")",
+                      error);
+        }
+      }
+      e.line = number;
       elements.push_back(e);
-    } else if (t[0] == "property" && !elements.empty()) {
+    } else if (t[0] == "property") {
+      if (elements.empty()) {
+        return Fail(At(path, number),
+                    "a property before any element (expected 'element NAME COUNT' before it)",
+                    error);
+      }
       Element& e = elements.back();
-      if (t.size() >= 5 && t[1] == "list") {
+      const bool list = t.size() >= 2 && t[1] == "list";
+      if (t.size() < (list ? 5u : 3u)) {
+        return Fail(At(path, number),
+                    list ? "expected 'property list COUNT_TYPE ITEM_TYPE NAME'"
+                         : "expected 'property TYPE NAME'",
+                    error);
+      }
+      const std::string& name = t[list ? 4 : 2];
+      for (size_t p = 0; p < e.properties.size(); ++p) {
+        if (e.properties[p] == name) {
+          return Fail(At(path, number),
+                      ShownText(e.name) + " property '" + ShownText(name) +
+                          "' given again (first on line " + std::to_string(e.lines[p]) + ")",
+                      error);
+        }
+      }
+      e.lines.push_back(number);
+      if (list) {
         const int count_size = type_size(t[2]), item_size = type_size(t[3]);
         if (!count_size || !item_size) {
-          return Fail(At(path, number), "unknown PLY property type", error);
+          return Fail(At(path, number),
+                      "unknown PLY type '" + ShownText(count_size ? t[3] : t[2]) + "'", error);
         }
         if (e.name == "vertex") {
           // Kept from when OpenMesh read PLY: it read no vertex with a list (and then no face).
@@ -473,7 +597,7 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
         e.list_min_bytes += count_size + (e.name == "face" ? 3 * item_size : 0);
         e.properties.push_back(t[4]), e.lists.push_back(true);
         e.types.push_back(t[3]), e.count_types.push_back(t[2]);
-      } else if (t.size() >= 3) {
+      } else {
         const int size = type_size(t[1]);
         if (!size)
           return Fail(At(path, number), "unknown PLY type '" + ShownText(t[1]) + "'", error);
@@ -481,6 +605,12 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
         e.properties.push_back(t[2]), e.lists.push_back(false);
         e.types.push_back(t[1]), e.count_types.push_back("");
       }
+    } else {
+      return Fail(At(path, number),
+                  "'" + ShownText(t[0]) +
+                      "' does not start a PLY header line (expected format, element, property, "
+                      "comment, obj_info or end_header)",
+                  error);
     }
   }
   if (lines.too_long()) return TooLongLine(path, lines, error);
@@ -503,14 +633,54 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
     return name[0] == 'x' ? 0 : name[0] == 'y' ? 1 : name[0] == 'z' ? 2 : -1;
   };
   auto is_indices = [](const Element& e, size_t p) {
-    return e.name == "face" && e.lists[p] &&
+    return (e.name == "face" || e.name == "tristrips") && e.lists[p] &&
            (e.properties[p] == "vertex_indices" || e.properties[p] == "vertex_index");
+  };
+  for (const Element& e : elements) {
+    if ((e.name != "face" && e.name != "tristrips") || e.count == 0) continue;
+    bool has_indices = false;
+    for (size_t p = 0; p < e.properties.size(); ++p) has_indices |= is_indices(e, p);
+    if (!has_indices) {
+      return Fail(At(path, e.line),
+                  "element '" + ShownText(e.name) +
+                      "' has no list property 'vertex_indices' (or 'vertex_index'): its " +
+                      std::to_string(e.count) + " records cannot be read",
+                  error);
+    }
+  }
+  // A tristrips element's index list: strips of vertices, each ended by -1 or the list's end.
+  // Triangle k of a strip takes its vertices k, k + 1, k + 2, every other one wound the other
+  // way, so that the strip is wound one way; triangles repeating a vertex (which join strips
+  // written as one) are left out.
+  std::vector<long long> strip;
+  auto add_strip = [&](size_t line) {
+    strip.push_back(-1);
+    size_t begin = 0;
+    for (size_t i = 0; i < strip.size(); ++i) {
+      if (strip[i] != -1) continue;
+      for (size_t k = begin; k + 2 < i; ++k) {
+        const bool odd = (k - begin) % 2 != 0;
+        const long long a = strip[odd ? k + 1 : k], b = strip[odd ? k : k + 1], c = strip[k + 2];
+        if (a == b || b == c || a == c) continue;
+        for (long long v : {a, b, c}) out->corners.push_back(static_cast<uint32_t>(v));
+        out->EndFace(line);
+      }
+      begin = i + 1;
+    }
+    strip.clear();
   };
   if (format == "ascii") {
     long long records = 0;
     for (const Element& e : elements) records = SaturatingAdd(records, e.count);
     // One record per line, checked against its element: vertices' x, y, z finite; faces'
     // index lists of 3 or more indices of declared vertices.
+    // A value of a property that is not read is still a number (NaN and infinity too).
+    auto not_a_number = [&](const Element& e, size_t p, const std::string& token) {
+      return Fail(At(path, number),
+                  ShownText(e.name) + " property '" + ShownText(e.properties[p]) + "': '" +
+                      ShownText(token) + "' is not a number",
+                  error);
+    };
     long long found = 0;
     size_t element = 0;
     long long in_element = 0;
@@ -547,6 +717,8 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
             const Status s = CheckCoordinate(At(path, number), t[at], &value, error);
             if (s != Status::kOk) return s;
             (axis == 0 ? point.x : axis == 1 ? point.y : point.z) = value;
+          } else if (!IsPlyNumber(t[at])) {
+            return not_a_number(e, p, t[at]);
           }
           ++at;
           expected += (expected.empty() ? "" : " ") + ShownText(e.properties[p]);
@@ -560,20 +732,28 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
               error);
         }
         const bool indices = is_indices(e, p) && !face;
-        if (indices && n < 3) {
+        const bool strips = indices && e.name == "tristrips";
+        if (indices && !strips && n < 3) {
           return Fail(At(path, number),
                       "face has " + std::to_string(n) + " vertices, expected 3 or more", error);
         }
         for (long long i = 1; indices && i <= n; ++i) {
           long long index = 0;
-          if (!ParseInteger(t[at + i], &index) || index < 0 || index >= vertices) {
+          if (!ParseInteger(t[at + i], &index) || index < (strips ? -1 : 0) || index >= vertices) {
             return Fail(At(path, number),
-                        "face vertex '" + ShownText(t[at + i]) + "' is not an index below " +
-                            std::to_string(vertices),
+                        ShownText(e.name) + " vertex '" + ShownText(t[at + i]) + "' is not " +
+                            (strips ? "-1 or " : "") + "an index below " + std::to_string(vertices),
                         error);
           }
-          out->corners.push_back(static_cast<uint32_t>(index));
+          if (strips)
+            strip.push_back(index);
+          else
+            out->corners.push_back(static_cast<uint32_t>(index));
         }
+        for (long long i = 1; !indices && i <= n; ++i) {
+          if (!IsPlyNumber(t[at + i])) return not_a_number(e, p, t[at + i]);
+        }
+        if (strips) add_strip(number);
         if (indices) face = true;
         at += 1 + static_cast<size_t>(n);
         expected += (expected.empty() ? "" : " ") + ShownText(e.properties[p]) + " (its count, " +
@@ -587,7 +767,7 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
                     error);
       }
       if (e.name == "vertex") out->vertices.push_back(point);
-      if (face) out->EndFace(number);
+      if (face && e.name == "face") out->EndFace(number);
     }
     if (lines.too_long()) return TooLongLine(path, lines, error);
     if (found < records) {
@@ -660,7 +840,8 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
           return Fail(path, m.str(), error);
         }
         const bool indices = is_indices(e, p) && !face;
-        if (indices && n < 3) {
+        const bool strips = indices && e.name == "tristrips";
+        if (indices && !strips && n < 3) {
           return Fail(path,
                       "face " + std::to_string(r + 1) + " has " +
                           std::to_string(static_cast<long long>(n)) +
@@ -669,22 +850,27 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
         }
         for (double i = 0; i < n; ++i) {
           if (!values.Next(e.types[p], &v)) return truncated(e, r);
-          if (indices && !(v >= 0 && v < static_cast<double>(vertices) && v == std::floor(v))) {
+          if (indices && !(v >= (strips ? -1 : 0) && v < static_cast<double>(vertices) &&
+                           v == std::floor(v))) {
             std::ostringstream m;
-            m << "face " << r + 1 << ": vertex index ";
+            m << ShownText(e.name) << " " << r + 1 << ": vertex index ";
             if (std::fabs(v) < 1e18 && v == std::floor(v))
               m << static_cast<long long>(v);
             else
               m << v;
-            m << " is not an index below " << vertices;
+            m << " is not " << (strips ? "-1 or " : "") << "an index below " << vertices;
             return Fail(path, m.str(), error);
           }
-          if (indices) out->corners.push_back(static_cast<uint32_t>(v));
+          if (strips)
+            strip.push_back(static_cast<long long>(v));
+          else if (indices)
+            out->corners.push_back(static_cast<uint32_t>(v));
         }
+        if (strips) add_strip(0);
         if (indices) face = true;
       }
       if (e.name == "vertex") out->vertices.push_back(point);
-      if (face) out->EndFace(0);
+      if (face && e.name == "face") out->EndFace(0);
     }
   }
   // Data left over: the header declares fewer records than the file holds (the rest was
