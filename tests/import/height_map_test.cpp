@@ -318,3 +318,51 @@ TEST_CASE("LoadTerrain: height maps with NODATA are resampled over the valid cel
 }
 
 }  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("ReadAscGrid: rows of unequal length are refused at their line", "[import][heightmap]") {
+  // A short row and a long one added up to the header's count and the grid loaded shifted,
+  // silently.
+  test::TempDir dir;
+  HeightMap map;
+  std::string error;
+  const std::string header = "ncols 3\nnrows 3\ncellsize 1\n";
+  CHECK(ReadAscGrid(dir.Write("short.asc", header + "1 2 3\n4 5\n6 7 8 9\n"), &map, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error, "short.asc:5: 2 values, expected 3 (ncols 3, one row per line)"));
+  CHECK(ReadAscGrid(dir.Write("long.asc", header + "1 2 3 4\n5 6\n7 8 9\n"), &map, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error, "long.asc:4: 4 values, expected 3 (ncols 3, one row per line)"));
+  CHECK(ReadAscGrid(dir.Write("end.asc", header + "1 2 3\n4 5 6\n7 8 9 10\n"), &map, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error, "end.asc:6: 4 values, expected 3 (ncols 3, one row per line)"));
+  // Rows wrapped over lines, as long as every row is wrapped alike, and blank lines, are read.
+  REQUIRE(ReadAscGrid(dir.Write("wrap.asc", header + "1 2\n3\n\n4 5\n6\n7 8 \r\n9\n"), &map,
+                      &error) == Status::kOk);
+  CHECK(map.heights[8] == 9);
+  CHECK(ReadAscGrid(dir.Write("wrapbad.asc", header + "1 2\n3\n4\n5 6\n7 8\n9\n"), &map, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error,
+                 "wrapbad.asc:6: 1 value, expected 2 (ncols 3, each row on lines of 2 "
+                 "and 1 values as the first row)"));
+}
+
+TEST_CASE("ReadAscGrid: Microsoft C's NaN is read as NaN", "[import][heightmap]") {
+  // As "nan": a NaN NODATA_value leaves such cells out; elsewhere it is not a finite number.
+  test::TempDir dir;
+  HeightMap map;
+  std::string error;
+  REQUIRE(ReadAscGrid(dir.Write("nan.asc",
+                                "ncols 2\nnrows 1\ncellsize 1\n"
+                                "NODATA_value -1.#QNAN\n-1.#IND 2\n"),
+                      &map, &error) == Status::kOk);
+  CHECK(map.ValidCount() == 1);
+  CHECK(ReadAscGrid(dir.Write("inf.asc", "ncols 2\nnrows 1\ncellsize 1\n1 1.#INF\n"), &map,
+                    &error) == Status::kParseError);
+  CHECK(Contains(error,
+                 "inf.asc:4: value '1.#INF' is not a finite number (Microsoft C's NaN or "
+                 "infinity)"));
+}
+
+}  // namespace footfall

@@ -19,6 +19,7 @@
 #include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/samples.h"
 #include "footfall/terrain/shown_text.h"
+#include "text_numbers.h"
 
 namespace footfall {
 namespace {
@@ -44,7 +45,8 @@ std::string Number(double v) {
 class TokenReader {
  public:
   TokenReader(const std::string& text, bool comments) : text_(&text), comments_(comments) {}
-  bool Next(std::string* token) {
+  // Next without the token: false at the end of the text.
+  bool Skip() {
     for (;;) {
       while (pos_ < text_->size() && std::isspace(static_cast<unsigned char>((*text_)[pos_]))) {
         if ((*text_)[pos_] == '\n') ++line_;
@@ -57,10 +59,14 @@ class TokenReader {
       break;
     }
     if (pos_ >= text_->size()) return false;
-    const size_t start = pos_;
+    start_ = pos_;
     while (pos_ < text_->size() && !std::isspace(static_cast<unsigned char>((*text_)[pos_])))
       ++pos_;
-    *token = text_->substr(start, pos_ - start);
+    return true;
+  }
+  bool Next(std::string* token) {
+    if (!Skip()) return false;
+    *token = text_->substr(start_, pos_ - start_);
     return true;
   }
   size_t line() const { return line_; }
@@ -70,13 +76,14 @@ class TokenReader {
   const std::string* text_;
   bool comments_;
   size_t pos_ = 0, line_ = 1;
+  size_t start_ = 0;  // where the token last read starts
 };
 
 // Whether an ASCII grid's token spells NaN ("nan", "NaN", "-nan": a NODATA_value of NaN and its
 // cells).
 bool IsNanText(const std::string& token) {
   const std::string t = Lower(token);
-  return t == "nan" || t == "-nan" || t == "+nan";
+  return t == "nan" || t == "-nan" || t == "+nan" || detail::IsMicrosoftNaN(token);
 }
 
 // Whether an ASCII grid's token is meant as a value, not a header key: it starts like a number
@@ -155,9 +162,8 @@ std::string Count(double n) {
 size_t CountValues(TokenReader reader, double declared, size_t* last_line) {
   const double limit = std::min(declared, static_cast<double>(kMaxHeightMapCells) + 1);
   size_t count = 0;
-  std::string token;
   *last_line = reader.line();
-  while (static_cast<double>(count) < limit && reader.Next(&token)) {
+  while (static_cast<double>(count) < limit && reader.Skip()) {
     ++count, *last_line = reader.line();
   }
   return count;
@@ -191,6 +197,61 @@ Status CheckGridSize(const std::string& path, const std::string& header, double 
       << cells * kBytesPerCell / 1e9 << " GB, more than the " << memory / 1e9
       << " GB of memory this process may use (crop or downsample the grid)";
     return Fail(header, m.str(), error);
+  }
+  return Status::kOk;
+}
+
+// "1 value", "2 values".
+std::string Values(size_t n) { return std::to_string(n) + (n == 1 ? " value" : " values"); }
+
+// Checks that an ASCII grid's rows (`rows` of `cols` values, from `reader` on) lie on whole
+// lines, each as the first row does: one row per line, or wrapped over lines alike. A short row
+// and a long one added up to the header's count, and the grid loaded shifted. Data that ends
+// within a row is left to the truncation check, and values after the last row to the check for
+// values too many.
+Status CheckAscRows(const std::string& path, TokenReader reader, size_t cols, size_t rows,
+                    std::string* error) {
+  std::vector<size_t> pattern;  // the values on each line of the first row
+  size_t first_row = 0;         // the first row's values so far
+  size_t row = 0, line_in_row = 0;
+  auto layout = [&] {
+    std::string text = "ncols " + std::to_string(cols) + ", ";
+    if (pattern.size() == 1) return text + "one row per line";
+    if (pattern.size() > 4)
+      return text + "each row on " + std::to_string(pattern.size()) + " lines as the first row";
+    text += "each row on lines of ";
+    for (size_t i = 0; i < pattern.size(); ++i) {
+      text += (i == 0 ? "" : i + 1 == pattern.size() ? " and " : ", ") + std::to_string(pattern[i]);
+    }
+    return text + " values as the first row";
+  };
+  bool more = reader.Skip();
+  while (more && row < rows) {
+    const size_t line = reader.line();
+    size_t n = 1;  // the values on `line`
+    while ((more = reader.Skip()) && reader.line() == line) ++n;
+    if (row == 0) {
+      pattern.push_back(n);
+      first_row += n;
+      if (first_row < cols) continue;
+      if (first_row > cols) {
+        return Fail(path + ":" + std::to_string(line),
+                    pattern.size() == 1
+                        ? Values(n) + ", expected " + std::to_string(cols) + " (" + layout() + ")"
+                        : Values(n) + ", past the end of the first row (ncols " +
+                              std::to_string(cols) + ": expected each row to end its line)",
+                    error);
+      }
+      row = 1;
+      continue;
+    }
+    const size_t want = pattern[line_in_row];
+    if (n != want) {
+      if (!more && n < want) return Status::kOk;  // cut short: truncated
+      return Fail(path + ":" + std::to_string(line),
+                  Values(n) + ", expected " + std::to_string(want) + " (" + layout() + ")", error);
+    }
+    if (++line_in_row == pattern.size()) ++row, line_in_row = 0;
   }
   return Status::kOk;
 }
@@ -282,6 +343,12 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
                 "cellsize " + NumberText(cellsize) + " (expected a number > 0)", error);
   }
   const double cells = ncols * nrows;
+  if (ncols <= static_cast<double>(kMaxHeightMapCells) &&
+      nrows <= static_cast<double>(kMaxHeightMapCells)) {
+    status =
+        CheckAscRows(path, reader, static_cast<size_t>(ncols), static_cast<size_t>(nrows), error);
+    if (status != Status::kOk) return status;
+  }
   size_t last_line;
   const size_t present = CountValues(reader, cells, &last_line);
   status =
@@ -308,8 +375,10 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
       continue;
     }
     if (!ParseFiniteDecimal(value, &h)) {
-      return Fail(path + ":" + std::to_string(reader.line()),
-                  "value '" + ShownText(value) + "' is not a finite number", error);
+      return Fail(
+          path + ":" + std::to_string(reader.line()),
+          "value '" + ShownText(value) + "' is not a finite number" + detail::NotFiniteNote(value),
+          error);
     }
     out->heights[i] = h;
     out->valid[i] = !(has_nodata && h == nodata);
