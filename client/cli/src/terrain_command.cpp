@@ -20,6 +20,7 @@
 #include "footfall/steps/walk_terrain.h"
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/grid.h"
+#include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/output_file.h"
 #include "footfall/terrain/point_file.h"
 #include "terrain_flags.h"
@@ -148,6 +149,12 @@ int RunInfo(const InfoFlags& flags) {
 
 // The most samples `terrain make` writes (about 1 GB of point file).
 constexpr double kMaxMadeSamples = 20000000;
+// [Units: bytes] Peak memory per sample made: laid out directly (stairs, sphere, flat, hills;
+// measured 49 to 62 resident, and more address space while an array doubles: 19.4 million
+// flat samples fail under a 1.5 GB limit and pass under 2 GB), and sampled from a mesh
+// (blocks, ramp, rocks; measured 400 to 460 resident).
+constexpr double kBytesPerSample = 96;
+constexpr double kMeshBytesPerSample = 500;
 
 // About how many samples `make` would write, in double so that no flag can overflow it (areas
 // in units of spacing^2, measured per side: a 1e300 sphere at --spacing 1e300 was inf * 0,
@@ -184,13 +191,13 @@ double EstimateMeshCells(const MakeFlags& f) {
   return 0;
 }
 
-// [Units: wu] The largest coordinate, in size, of the mesh that `make` samples (ramp: its
-// profile, as MakeRampsMesh lays it; rocks: their side and relief), checked before the mesh is
-// built: the sampler cannot take coordinates out of the grid's range (a ramp 1e300 long failed
-// allocating, rocks 1e300 high were "a separation of at least -nan"); 0 for the other kinds,
-// whose samples are checked as made.
+// [Units: wu] The largest coordinate, in size, of the mesh that `make` samples, checked before
+// the mesh is built where the sampler cannot take it: a ramp's profile, as MakeRampsMesh lays
+// it (a ramp 1e300 long failed allocating), and rocks whose relief is beyond what the sampler
+// can measure (squared lengths overflow: rocks 1e300 high asked for "a separation of at least
+// -nan"; lower ones it refuses itself, or their samples are checked as made); 0 otherwise.
 double MeshReach(const MakeFlags& f) {
-  if (f.kind == "rocks") return std::max(static_cast<double>(f.size), std::fabs(f.amplitude));
+  if (f.kind == "rocks") return std::fabs(f.amplitude) > 1e150 ? std::fabs(f.amplitude) : 0;
   if (f.kind != "ramp") return 0;
   double y = 0, reach = std::max(f.width, f.length * (static_cast<double>(f.slopes.size()) + 2));
   for (double slope : f.slopes) {
@@ -244,6 +251,18 @@ int RunMake(const MakeFlags& f) {
   }
   if (const double reach = MeshReach(f); !(reach <= terrain::kMaxCoordinate))
     return OutOfRange(k, reach);
+  // Sizes this machine cannot hold are refused now, not after minutes of sampling ended in
+  // "out of memory" (rocks of 9 million samples under a 2 GB limit).
+  const bool meshed = k == "blocks" || k == "ramp" || k == "rocks";
+  const double bytes = estimate * (meshed ? kMeshBytesPerSample : kBytesPerSample);
+  if (const double memory = UsableMemoryBytes(); memory > 0 && bytes > memory) {
+    std::cerr << std::setprecision(3) << "footfall terrain make: " << k
+              << ": these sizes at --spacing " << f.spacing << " give about "
+              << std::llround(estimate) << " samples: making them needs about " << bytes / 1e9
+              << " GB, more than the " << memory / 1e9
+              << " GB of memory this process may use (raise --spacing or make it smaller)\n";
+    return 1;
+  }
   std::string why;  // the mesh sampler's, for blocks, ramp and rocks
   if (k == "stairs") {
     samples = MakeStairs(f.steps, f.rise, f.run, f.width, f.spacing);
