@@ -102,4 +102,9 @@ err=$("$footfall" bench --terrain "$hills" --server "$server" --timeout 2 2>&1 >
 check "no server: exit 1" [ $? -eq 1 ]
 check "no server: says so" grep -qi "footfall bench: .*$server" <<< "$err"
 
+# More query points than the memory the process may use holds are refused before the terrain
+# is loaded (--queries 16777216 under a 2 GB limit ran out of memory after 25 s).
+err=$( (ulimit -v 2000000; timeout 20 "$footfall" bench --terrain "$hills" --queries 16777216) 2>&1 >/dev/null)
+check "--queries beyond memory: exit 1" [ $? -eq 1 ]
+check "--queries beyond memory: message" grep -qxF "footfall bench: --queries 16777216 needs about 2.68 GB for its queries, more than the 2.05 GB of memory this process may use (give fewer)" <<< "$err"
 finish
