@@ -366,3 +366,25 @@ TEST_CASE("ReadAscGrid: Microsoft C's NaN is read as NaN", "[import][heightmap]"
 }
 
 }  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("ReadAscGrid: a '#' comment is named as one", "[import][heightmap]") {
+  // It was "header '#' needs a number on its line", or among the values a row too long.
+  test::TempDir dir;
+  HeightMap map;
+  std::string error;
+  for (const std::string& text :
+       {std::string("ncols 2\nnrows 2\ncellsize 1\n# heights in metres\n1 2\n3 4\n"),
+        std::string("ncols 2\nnrows 2\ncellsize 1 # metres\n1 2\n3 4\n"),
+        std::string("ncols 2\nnrows 2\ncellsize 1\n1 2\n3 4\n# end\n")}) {
+    INFO(text);
+    CHECK(ReadAscGrid(dir.Write("c.asc", text), &map, &error) == Status::kParseError);
+    CHECK(Contains(error, "' starts a comment, which ESRI ASCII grids do not have"));
+  }
+  CHECK(ReadAscGrid(dir.Write("c.asc", "ncols 2\nnrows 2\ncellsize 1\n1 2 # row 1\n3 4\n"), &map,
+                    &error) == Status::kParseError);
+  CHECK(Contains(error, "c.asc:4: '#' starts a comment, which ESRI ASCII grids do not have"));
+}
+
+}  // namespace footfall

@@ -992,3 +992,26 @@ TEST_CASE("ReadMesh: OBJ statements of other kinds are named when no faces are r
 }
 
 }  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("ReadMesh: ASCII STL lines of other kinds are refused at their line", "[import][mesh]") {
+  // A damaged line ("foo bar") and a vertex of four coordinates were read past.
+  test::TempDir dir;
+  TriangleMesh mesh;
+  std::string error;
+  auto stl = [](const std::string& vertex, const std::string& extra) {
+    return "solid s\nfacet normal 0 1 0\nouter loop\nvertex 0 0 0\nvertex 0 0 1\n" + vertex +
+           "\nendloop\nendfacet\n" + extra + "endsolid s\n";
+  };
+  REQUIRE(Read(dir.Write("s.stl", stl("vertex 1 0 0", "")), &mesh, &error) == Status::kOk);
+  CHECK(Read(dir.Write("s.stl", stl("vertex 1 0 0", "foo bar\n")), &mesh, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error,
+                 "s.stl:9: 'foo' does not start an ASCII STL line (expected solid, facet "
+                 "normal, outer loop, vertex, endloop, endfacet or endsolid)"));
+  CHECK(Read(dir.Write("s.stl", stl("vertex 1 0 0 0", "")), &mesh, &error) == Status::kParseError);
+  CHECK(Contains(error, "s.stl:6: vertex has 4 coordinates, expected 3"));
+}
+
+}  // namespace footfall

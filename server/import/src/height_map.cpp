@@ -71,6 +71,8 @@ class TokenReader {
   }
   size_t line() const { return line_; }
   size_t pos() const { return pos_; }
+  // The first character of the token last read.
+  char first() const { return (*text_)[start_]; }
 
  private:
   const std::string* text_;
@@ -201,6 +203,14 @@ Status CheckGridSize(const std::string& path, const std::string& header, double 
   return Status::kOk;
 }
 
+// The error for a '#' comment in an ASCII grid (read as a header or a value).
+Status CommentInGrid(const std::string& path, size_t line, std::string* error) {
+  return Fail(path + ":" + std::to_string(line),
+              "'#' starts a comment, which ESRI ASCII grids do not have (expected header keys, "
+              "then the values): remove it",
+              error);
+}
+
 // "1 value", "2 values".
 std::string Values(size_t n) { return std::to_string(n) + (n == 1 ? " value" : " values"); }
 
@@ -228,8 +238,11 @@ Status CheckAscRows(const std::string& path, TokenReader reader, size_t cols, si
   bool more = reader.Skip();
   while (more && row < rows) {
     const size_t line = reader.line();
-    size_t n = 1;  // the values on `line`
-    while ((more = reader.Skip()) && reader.line() == line) ++n;
+    size_t n = 0;  // the values on `line`
+    do {
+      if (reader.first() == '#') return CommentInGrid(path, line, error);
+      ++n;
+    } while ((more = reader.Skip()) && reader.line() == line);
     if (row == 0) {
       pattern.push_back(n);
       first_row += n;
@@ -284,6 +297,7 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
     const TokenReader before = reader;
     if (!reader.Next(&key)) return Fail(path, "truncated: the grid header has no data", error);
     const size_t line = reader.line();
+    if (key[0] == '#') return CommentInGrid(path, line, error);
     double number;
     if (ParseFiniteDecimal(key, &number) || IsValueText(key)) {
       reader = before;  // the first data value
@@ -390,6 +404,7 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
     }
   }
   if (reader.Next(&value)) {
+    if (value[0] == '#') return CommentInGrid(path, reader.line(), error);
     return Fail(path + ":" + std::to_string(reader.line()),
                 "more than the " + std::to_string(total) + " values the header declares", error);
   }

@@ -995,6 +995,15 @@ Status ParseStlFile(const std::string& path, ParsedMesh* out, std::string* error
                       std::to_string(loop_line) + " (expected 'endloop' after its 3 vertices)",
                   error);
     }
+    // A line of another kind (a damaged file) was passed over.
+    if (t[0] != "solid" && t[0] != "facet" && t[0] != "outer" && t[0] != "vertex" &&
+        t[0] != "endloop" && t[0] != "endfacet" && t[0] != "endsolid") {
+      return Fail(At(path, number),
+                  "'" + ShownText(t[0]) +
+                      "' does not start an ASCII STL line (expected solid, facet normal, outer "
+                      "loop, vertex, endloop, endfacet or endsolid)",
+                  error);
+    }
     if (t[0] == "endsolid") closed = true;
     if (t[0] == "outer") in_loop = 0, loop_line = number;
     if (t[0] == "endloop") {
@@ -1014,7 +1023,11 @@ Status ParseStlFile(const std::string& path, ParsedMesh* out, std::string* error
                     "vertex outside a facet loop (expected 'outer loop' before it)", error);
       }
       ++in_loop;
-      if (t.size() < 4) return Fail(At(path, number), "vertex needs 3 coordinates", error);
+      if (t.size() != 4) {
+        return Fail(At(path, number),
+                    "vertex has " + std::to_string(t.size() - 1) + " coordinates, expected 3",
+                    error);
+      }
       double c[3];
       for (int i = 1; i <= 3; ++i) {
         const Status s = CheckCoordinate(At(path, number), t[i], &c[i - 1], error);
