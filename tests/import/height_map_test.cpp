@@ -388,3 +388,28 @@ TEST_CASE("ReadAscGrid: a '#' comment is named as one", "[import][heightmap]") {
 }
 
 }  // namespace footfall
+
+namespace footfall {
+
+TEST_CASE("ReadAscGrid: GDAL's DX and DY give the cell size when equal", "[import][heightmap]") {
+  // They were "unknown header 'DX'", though GDAL writes them for its grids.
+  test::TempDir dir;
+  HeightMap map;
+  std::string error;
+  const std::string data = "1 2\n3 4\n";
+  REQUIRE(ReadAscGrid(dir.Write("d.asc", "ncols 2\nnrows 2\nDX 0.5\nDY 0.5\n" + data), &map,
+                      &error) == Status::kOk);
+  CHECK(map.cell_size == 0.5);
+  const std::pair<std::string, std::string> cases[] = {
+      {"DX 0.5\nDY 0.25\n", "d.asc:4: DX and DY differ (expected cellsize, or DX and DY equal"},
+      {"DX 0.5\n", "d.asc:3: DX and DY come together"},
+      {"cellsize 1\nDY 0.5\n", "d.asc:4: cellsize and DX/DY both given"},
+  };
+  for (const auto& [header, expected] : cases) {
+    CHECK(ReadAscGrid(dir.Write("d.asc", "ncols 2\nnrows 2\n" + header + data), &map, &error) ==
+          Status::kParseError);
+    CHECK(Contains(error, expected));
+  }
+}
+
+}  // namespace footfall

@@ -291,6 +291,9 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
   size_t size_line = 1;                   // the line of ncols or nrows, whichever comes last
   size_t ncols_line = 0, nrows_line = 0;  // 0: not given
   size_t cellsize_line = 0;               // 0: no cellsize
+  // GDAL's DX and DY (its cell width and height, written for cells that are not square).
+  double dx = -1, dy = -1;
+  size_t dx_line = 0, dy_line = 0;                   // 0: not given
   std::vector<std::pair<std::string, size_t>> seen;  // header keys (lower case) and their lines
   // Header: KEY VALUE pairs until the first token that is a number.
   for (;;) {
@@ -331,10 +334,16 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
       cellsize = number, cellsize_line = line;
     } else if (k == "nodata_value") {
       nodata = number, has_nodata = true, nodata_is_nan = nan_nodata;
+    } else if (k == "dx") {
+      dx = number, dx_line = line;
+    } else if (k == "dy") {
+      dy = number, dy_line = line;
     } else if (k != "xllcorner" && k != "yllcorner" && k != "xllcenter" && k != "yllcenter") {
       return Fail(path + ":" + std::to_string(line),
                   "unknown header '" + ShownText(key) +
-                      "' (expected ncols, nrows, xllcorner, yllcorner, cellsize, NODATA_value)",
+                      "' (expected ncols, nrows, xllcorner, yllcorner, cellsize, NODATA_value; or "
+                      "DX and DY for "
+                      "cellsize)",
                   error);
     }
   }
@@ -350,6 +359,22 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
   }
   if (ncols_line == 0 || nrows_line == 0) {
     return Fail(path, "header needs whole ncols and nrows >= 1", error);
+  }
+  if (dx_line != 0 || dy_line != 0) {
+    const size_t at = std::max(dx_line, dy_line);
+    const char* why = cellsize_line != 0             ? "cellsize and DX/DY both given"
+                      : dx_line == 0 || dy_line == 0 ? "DX and DY come together"
+                      : dx != dy                     ? "DX and DY differ"
+                                                     : nullptr;
+    if (why) {
+      return Fail(path + ":" + std::to_string(at),
+                  std::string(why) +
+                      " (expected cellsize, or DX and DY equal: cells that are not square are "
+                      "not read; resample the grid to square cells, for example with gdalwarp "
+                      "-tr)",
+                  error);
+    }
+    cellsize = dx, cellsize_line = dx_line;
   }
   if (cellsize_line == 0) return Fail(path, "header needs cellsize (a number > 0)", error);
   if (!(cellsize > 0)) {
