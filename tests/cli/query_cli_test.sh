@@ -58,6 +58,15 @@ printf '\xEF\xBB\xBFsnap 2 0 2\r\n\xEF\xBB\xBFsnap 2 0 2\r\n' | "$footfall" quer
 check "byte order mark: exit 1 for the second line" [ $? -eq 1 ]
 check "byte order mark: the first line answered" grep -q '"op":"snap","found":true,"index":12' <(sed -n 1p "$work/bom.jsonl")
 check "byte order mark: not on a later line" grep -q '"op":"error","line":2,"message":"unknown command' <(sed -n 2p "$work/bom.jsonl")
+# Lines ended by CR alone (classic Mac OS) are refused saying so (they ran together as one
+# line, "snap: expected 3 numbers, found 7"); CRLF and a lone CR before the newline are read.
+printf 'snap 1 0 1\rsnap 2 0 2\r\nsnap 2 0 2 \r \r\n' | "$footfall" query --terrain "$work/flat.pts" > "$work/cr.jsonl"
+check "CR-only line ends: exit 1" [ $? -eq 1 ]
+check "CR-only line ends: said" grep -qxF '{"op":"error","line":1,"message":"carriage return within the line: lines ended by CR alone (classic Mac OS) are not read (end lines with LF or CRLF)"}' <(sed -n 1p "$work/cr.jsonl")
+check "CR-only line ends: CRLF read" grep -q '"op":"snap","found":true,"index":12' <(sed -n 2p "$work/cr.jsonl")
+printf '# queries\rsnap 1 0 1\r' | "$footfall" query --terrain "$work/flat.pts" > "$work/cr.jsonl"
+check "CR-only line ends after a comment: exit 1" [ $? -eq 1 ]
+check "CR-only line ends after a comment: said" grep -q '"line":1,"message":"carriage return within the line' "$work/cr.jsonl"
 # A byte that is not UTF-8 in a line: that line's error (the byte replaced), and the run goes on
 # (the JSON writer threw, and no later line was answered).
 printf 'snap \xff 0 0\nsnap 2 0 2\n' | "$footfall" query --terrain "$work/flat.pts" > "$work/utf8.jsonl"

@@ -57,7 +57,20 @@ bool ParseCommand(const std::string& text, size_t line, Command* out) {
   // A UTF-8 byte order mark, as every text file footfall reads may start with (one saved by a
   // Windows editor): else the first command was "unknown command 'snap'", the mark unseen.
   const bool bom = line == 1 && text.compare(0, 3, "\xEF\xBB\xBF") == 0;
-  const std::string command = WithoutComment(bom ? text.substr(3) : text);
+  const std::string whole = bom ? text.substr(3) : text;
+  // A carriage return followed by more of the line, comments included: lines ended by CR alone
+  // (classic Mac OS) ran together, "snap: expected 3 numbers, found 7", or all went unanswered
+  // behind a first comment line (point files refuse them alike).
+  if (const size_t cr = whole.find('\r');
+      cr != std::string::npos && whole.find_first_not_of(" \t\r\v\f", cr) != std::string::npos) {
+    *out = Command{};
+    out->line = line;
+    out->error =
+        "carriage return within the line: lines ended by CR alone (classic Mac OS) are not "
+        "read (end lines with LF or CRLF)";
+    return true;
+  }
+  const std::string command = WithoutComment(whole);
   if (command.find_first_not_of(" \t\r\v\f") == std::string::npos) return false;
   *out = Command{};
   out->line = line;
