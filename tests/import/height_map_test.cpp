@@ -346,6 +346,17 @@ TEST_CASE("ReadAscGrid: rows of unequal length are refused at their line", "[imp
   CHECK(Contains(error,
                  "wrapbad.asc:6: 1 value, expected 2 (ncols 3, each row on lines of 2 "
                  "and 1 values as the first row)"));
+  // Values that run on over rows, the same number to a line but the last (all on one line, or
+  // wrapped at a fixed width), can only be counted: they are read.
+  for (const std::string data :
+       {"1 2 3 4 5 6 7 8 9\n", "1 2 3 4\n5 6 7 8\n9\n", "1 2\n3 4\n5 6\n7 8\n9"}) {
+    INFO(data);
+    REQUIRE(ReadAscGrid(dir.Write("run.asc", header + data), &map, &error) == Status::kOk);
+    CHECK(map.heights[8] == 9);
+  }
+  CHECK(ReadAscGrid(dir.Write("run.asc", header + "1 2 3 4\n5 6 7\n8 9\n"), &map, &error) ==
+        Status::kParseError);
+  CHECK(Contains(error, "run.asc:4: 4 values, expected 3 (ncols 3, one row per line)"));
 }
 
 TEST_CASE("ReadAscGrid: Microsoft C's NaN is read as NaN", "[import][heightmap]") {
