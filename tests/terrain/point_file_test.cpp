@@ -262,3 +262,15 @@ TEST_CASE("ReadDecimal reads decimal numbers only, tiny ones as zero", "[terrain
   CHECK(ParseFiniteDecimal("-3.5e2", &v));
   CHECK(v == -350);
 }
+
+TEST_CASE("WholeNumberProblem takes decimal digits within the range only", "[terrain][decimal]") {
+  CHECK(WholeNumberProblem("1", 1, 64).empty());
+  CHECK(WholeNumberProblem("64", 1, 64).empty());
+  CHECK(WholeNumberProblem("007", 0, 10).empty());
+  CHECK(WholeNumberProblem("0", 1, 64) == "'0' is not a whole number from 1 to 64");
+  CHECK(WholeNumberProblem("65", 1, 64) == "'65' is not a whole number from 1 to 64");
+  for (const char* bad : {"", "1.5", "-1", "+5", " 5", "5 ", "1e3", "0x10", "nan",
+                          "9999999999999999999999"})
+    CHECK(WholeNumberProblem(bad, 0, 100) ==
+          "'" + std::string(bad) + "' is not a whole number from 0 to 100");
+}

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "footfall/client/query_text.h"
+#include "footfall/terrain/decimal_number.h"
 
 namespace footfall::cli {
 namespace {
@@ -72,17 +73,8 @@ CLI::Validator Seed() {
 }
 
 CLI::Validator WholeRange(long long lo, long long hi) {
-  return CLI::Validator(
-      [lo, hi](std::string& input) -> std::string {
-        if (!input.empty() && input.size() <= 18 &&
-            input.find_first_not_of("0123456789") == std::string::npos) {
-          const long long v = std::stoll(input);
-          if (v >= lo && v <= hi) return std::string();
-        }
-        return "'" + input + "' is not a whole number from " + std::to_string(lo) + " to " +
-               std::to_string(hi);
-      },
-      "INT in [" + std::to_string(lo) + " - " + std::to_string(hi) + "]");
+  return CLI::Validator([lo, hi](std::string& input) { return WholeNumberProblem(input, lo, hi); },
+                        "INT in [" + std::to_string(lo) + " - " + std::to_string(hi) + "]");
 }
 
 CLI::Validator WholeUpTo(long long hi) { return WholeRange(0, hi); }

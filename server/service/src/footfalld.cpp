@@ -17,6 +17,7 @@
 
 #include "footfall/service/pinned_file.h"
 #include "footfall/service/rpc_server.h"
+#include "footfall/terrain/decimal_number.h"
 #include "footfall/terrain/large_memory.h"
 
 namespace {
@@ -84,15 +85,7 @@ CLI::Validator Seconds(bool zero_ok) {
 // convert").
 CLI::Validator WholeRange(long long lo, long long hi) {
   return CLI::Validator(
-      [lo, hi](std::string& input) -> std::string {
-        if (!input.empty() && input.size() <= 18 &&
-            input.find_first_not_of("0123456789") == std::string::npos) {
-          const long long v = std::stoll(input);
-          if (v >= lo && v <= hi) return std::string();
-        }
-        return "'" + input + "' is not a whole number from " + std::to_string(lo) + " to " +
-               std::to_string(hi);
-      },
+      [lo, hi](std::string& input) { return footfall::WholeNumberProblem(input, lo, hi); },
       "INT in [" + std::to_string(lo) + " - " + std::to_string(hi) + "]");
 }
 

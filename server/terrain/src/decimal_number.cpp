@@ -59,4 +59,15 @@ bool ParseFiniteDecimal(std::string_view token, double* value) {
   return true;
 }
 
+std::string WholeNumberProblem(std::string_view token, long long lo, long long hi) {
+  if (!token.empty() && token.size() <= 18 &&
+      token.find_first_not_of("0123456789") == std::string_view::npos) {
+    long long v = 0;
+    std::from_chars(token.data(), token.data() + token.size(), v);
+    if (v >= lo && v <= hi) return std::string();
+  }
+  return "'" + std::string(token) + "' is not a whole number from " + std::to_string(lo) + " to " +
+         std::to_string(hi);
+}
+
 }  // namespace footfall
