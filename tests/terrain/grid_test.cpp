@@ -256,6 +256,12 @@ TEST_CASE("TerrainGrid answers exactly as brute force", "[terrain][grid]") {
     RawSamples exact;
     for (int i = 0; i < 8; ++i) exact.push_back({i * 0.5, 0, (i % 3) * 0.25}, {0, 1, 0});
     CHECK(Build(exact).stats().max_rounding == 0);
+    // Offsets too small for a float (1e-300 apart) are stored as the centre: said, not hidden.
+    RawSamples tiny;
+    for (int i = 0; i < 4; ++i) tiny.push_back({i * 1e-300, 0, (i % 2) * 1e-300}, {0, 1, 0});
+    const double rounding = Build(tiny).stats().max_rounding;
+    CHECK(rounding >= 1e-300);
+    CHECK(rounding <= 3e-300);
   }
   SECTION("with huge coordinates (near 1e5)") {
     RawSamples s = MakeHeightField(60, 60, 0.5, 2, 12);

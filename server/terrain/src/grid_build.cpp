@@ -106,7 +106,7 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
   }
   // 3. Positions as float offsets from the origin; bounds recomputed from the stored values.
   std::vector<float> local(3 * n);
-  double rounding2 = 0;
+  double rounding2 = 0, tiny_rounding = 0;
   for (size_t i = 0; i < n; ++i) {
     const Vec3& p = samples.points[i];
     const Vec3 offset{p.x - g.origin_[0], p.y - g.origin_[1], p.z - g.origin_[2]};
@@ -114,7 +114,13 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
     local[3 * i + 1] = static_cast<float>(offset.y);
     local[3 * i + 2] = static_cast<float>(offset.z);
     const Vec3 kept{local[3 * i + 0], local[3 * i + 1], local[3 * i + 2]};
-    rounding2 = std::max(rounding2, Distance2(kept, offset));
+    const double d2 = Distance2(kept, offset);
+    rounding2 = std::max(rounding2, d2);
+    // Offsets below about 1e-154 square to nothing: a terrain of such size, whose floats flush
+    // to zero, must not be said to be stored exactly.
+    if (d2 == 0 && !(kept.x == offset.x && kept.y == offset.y && kept.z == offset.z))
+      tiny_rounding = std::max(tiny_rounding,
+                               std::hypot(kept.x - offset.x, kept.y - offset.y, kept.z - offset.z));
   }
   for (int a = 0; a < 3; ++a) g.bounds_lo_[a] = kInf, g.bounds_hi_[a] = -kInf;
   for (size_t i = 0; i < 3 * n; ++i) {
@@ -235,7 +241,7 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
   st.cell_size = h;
   st.occupied_cells = occupied_cells;
   st.bytes = bytes;
-  st.max_rounding = std::sqrt(rounding2);
+  st.max_rounding = std::max(std::sqrt(rounding2), tiny_rounding);
   const double* o = g.origin_;
   st.bounds_min = {o[0] + g.bounds_lo_[0], o[1] + g.bounds_lo_[1], o[2] + g.bounds_lo_[2]};
   st.bounds_max = {o[0] + g.bounds_hi_[0], o[1] + g.bounds_hi_[1], o[2] + g.bounds_hi_[2]};
