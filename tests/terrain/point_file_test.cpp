@@ -97,6 +97,16 @@ TEST_CASE("ReadPointStream rejects bad lines with file and line", "[terrain][poi
     CHECK(error.find("t.pts:1: column 2: 'inf' is NaN or infinite") == 0);
     CHECK(Read("0 1e999 0 0 1 0\n", &s, &error) == Status::kParseError);
     CHECK(error.find("t.pts:1: column 2: '1e999' is out of range") == 0);
+    // Microsoft C's spellings: the '#' starts no comment (the normal 0 0 1 was read).
+    CHECK(Read("0 0 1 0 0 1.#INF\n", &s, &error) == Status::kParseError);
+    CHECK(error ==
+          "t.pts:1: column 6: '1.#INF' is NaN or infinite (Microsoft C's NaN or infinity) "
+          "(expected a finite number)");
+    CHECK(Read("-1.#IND 0 0 0 1 0 # a comment\n", &s, &error) == Status::kParseError);
+    CHECK(error.find("t.pts:1: column 1: '-1.#IND' is NaN or infinite (Microsoft") == 0);
+    CHECK(Read("1 2 3 0 1 0 #1.#QNAN\n", &s, &error) == Status::kOk);
+    CHECK(s.size() == 1);
+    s.clear();
   }
   SECTION("beyond the grid's range") {
     // The grid stores float offsets from its origin and answers within 1e15 of it: coordinates
@@ -269,8 +279,8 @@ TEST_CASE("WholeNumberProblem takes decimal digits within the range only", "[ter
   CHECK(WholeNumberProblem("007", 0, 10).empty());
   CHECK(WholeNumberProblem("0", 1, 64) == "'0' is not a whole number from 1 to 64");
   CHECK(WholeNumberProblem("65", 1, 64) == "'65' is not a whole number from 1 to 64");
-  for (const char* bad : {"", "1.5", "-1", "+5", " 5", "5 ", "1e3", "0x10", "nan",
-                          "9999999999999999999999"})
+  for (const char* bad :
+       {"", "1.5", "-1", "+5", " 5", "5 ", "1e3", "0x10", "nan", "9999999999999999999999"})
     CHECK(WholeNumberProblem(bad, 0, 100) ==
           "'" + std::string(bad) + "' is not a whole number from 0 to 100");
 }

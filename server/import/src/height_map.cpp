@@ -19,7 +19,6 @@
 #include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/samples.h"
 #include "footfall/terrain/shown_text.h"
-#include "text_numbers.h"
 
 namespace footfall {
 namespace {
@@ -85,7 +84,7 @@ class TokenReader {
 // cells).
 bool IsNanText(const std::string& token) {
   const std::string t = Lower(token);
-  return t == "nan" || t == "-nan" || t == "+nan" || detail::IsMicrosoftNaN(token);
+  return t == "nan" || t == "-nan" || t == "+nan" || IsMicrosoftNaN(token);
 }
 
 // Whether an ASCII grid's token is meant as a value, not a header key: it starts like a number
@@ -439,10 +438,9 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
       continue;
     }
     if (!ParseFiniteDecimal(value, &h)) {
-      return Fail(
-          path + ":" + std::to_string(reader.line()),
-          "value '" + ShownText(value) + "' is not a finite number" + detail::NotFiniteNote(value),
-          error);
+      return Fail(path + ":" + std::to_string(reader.line()),
+                  "value '" + ShownText(value) + "' is not a finite number" + NotFiniteNote(value),
+                  error);
     }
     out->heights[i] = h;
     out->valid[i] = !(has_nodata && h == nodata);

@@ -20,7 +20,6 @@
 #include "footfall/terrain/input_file.h"
 #include "footfall/terrain/samples.h"
 #include "footfall/terrain/shown_text.h"
-#include "text_numbers.h"
 
 namespace footfall::detail {
 namespace {

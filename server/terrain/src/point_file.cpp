@@ -54,7 +54,8 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
     }
     // A CR read as a space joined lines, and a comment on the first one hid all the others.
     if (HasLoneCr(line)) return Fail(name, line_no, kLoneCr, out, error);
-    const size_t hash = line.find('#');
+    // A comment starts at '#', but not within Microsoft C's "1.#INF" or "1.#QNAN".
+    const size_t hash = CommentStart(line);
     if (hash != std::string_view::npos) line = line.substr(0, hash);
     double v[6];
     int count = 0;
@@ -72,6 +73,13 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
           return Fail(name, line_no,
                       "column " + std::to_string(count + 1) + ": '" + ShownText(token) +
                           "' is out of range (expected a finite number)",
+                      out, error);
+        }
+        if (read == DecimalRead::kNotANumber && IsMicrosoftNonFinite(token)) {
+          return Fail(name, line_no,
+                      "column " + std::to_string(count + 1) + ": '" + ShownText(token) +
+                          "' is NaN or infinite" + NotFiniteNote(token) +
+                          " (expected a finite number)",
                       out, error);
         }
         if (read == DecimalRead::kNotANumber) {

@@ -2,6 +2,7 @@
 // (std::from_chars; strtod follows LC_NUMERIC, and reads hexadecimal).
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <string_view>
 
@@ -24,5 +25,17 @@ bool ParseFiniteDecimal(std::string_view token, double* value);
 // (0 <= lo <= hi < 10^18): "" when it is, else "'TOKEN' is not a whole number from LO to HI"
 // ("1.5", "-1", "1e3" and "+5" are refused). The wording every count flag uses.
 std::string WholeNumberProblem(std::string_view token, long long lo, long long hi);
+
+// Whether `token` is how Microsoft's C library writes NaN or infinity: "1.#QNAN", "-1.#IND",
+// "1.#INF00", "1.#SNAN0e+000" (letters in either case). In text that takes '#' for a comment,
+// the '#' of such a token starts none.
+bool IsMicrosoftNonFinite(std::string_view token);
+// Whether `token` is one of those that spells NaN ("1.#QNAN", "-1.#IND", "1.#SNAN"), not infinity.
+bool IsMicrosoftNaN(std::string_view token);
+// " (Microsoft C's NaN or infinity)" for such a token, else "": for "is not a finite number".
+std::string NotFiniteNote(std::string_view token);
+// Where the '#' comment of `line` starts (npos for none): at its first '#' but those inside a
+// token IsMicrosoftNonFinite accepts.
+size_t CommentStart(std::string_view line);
 
 }  // namespace footfall
