@@ -1,5 +1,6 @@
 // The walk JSON writer with walks built by hand: whatever the order of a track's keys, the text
 // reads back, holding the keys the glTF and MEL exporters key.
+#include <algorithm>
 #include <string>
 #include <utility>
 
@@ -69,7 +70,8 @@ TEST_CASE("ParseWalkJson refuses zero and non-finite foot normals and body rotat
       CHECK(parse(std::string(R"({"frame": 2, "phase": "start", "position": [0, 0, 0], )") +
                       R"("normal": )" + normal + "}",
                   &error) == Status::kParseError);
-      CHECK(error == "w.json: tracks[1].keys[1].normal: expected a non-zero normal [nx, ny, nz]");
+      CHECK(error ==
+            "w.json: tracks[1].keys[1].normal: expected a non-zero normal [nx, ny, nz] (line 3)");
     }
   }
   SECTION("a foot normal with a number that is not finite") {
@@ -103,12 +105,75 @@ TEST_CASE("ParseWalkJson refuses zero and non-finite foot normals and body rotat
           Status::kParseError);
     CHECK(error ==
           "w.json: tracks[0].keys[0].rotation: expected a non-zero quaternion "
-          "[qx, qy, qz, qw]");
+          "[qx, qy, qz, qw] (line 1)");
     error.clear();
     CHECK(ParseWalkJson(body_head + "[0, 0, 0, -1e999]}]}]}", "w.json", &walk, &error) ==
           Status::kParseError);
     CHECK(error ==
           "w.json:1:165: malformed JSON: number overflow parsing '-1e999' (beyond the range of a "
           "double)");
+  }
+}
+
+TEST_CASE("ParseWalkJson says on which line the value it refuses stands", "[export][walk_json]") {
+  // A walk as `footfall generate` writes it: a line per key. (Errors named the value's path
+  // alone: "tracks[1].keys[3].phase" left a file of thousands of lines to count.)
+  const std::string text = WalkToJson(test::BipedWalk());
+  auto line_of = [&text](const std::string& needle, size_t nth) {
+    size_t at = text.find(needle);
+    for (size_t i = 0; i < nth && at != std::string::npos; ++i) at = text.find(needle, at + 1);
+    REQUIRE(at != std::string::npos);
+    return 1 + static_cast<size_t>(std::count(text.begin(), text.begin() + at, '\n'));
+  };
+  auto refuse = [](const std::string& bad) {
+    Walk walk;
+    std::string error;
+    CHECK(ParseWalkJson(bad, "w.json", &walk, &error) == Status::kParseError);
+    return error;
+  };
+  SECTION("a bad value: its own line") {
+    // R's fourth key (tracks[1].keys[3]): its phase replaced.
+    const size_t first_r_key = line_of("\"name\":\"R\"", 0) + 1;
+    std::string bad = text;
+    const size_t key = bad.find("\"phase\":\"", bad.find("\"name\":\"R\""));
+    size_t at = key;
+    for (int i = 0; i < 3; ++i) at = bad.find("\"phase\":\"", at + 1);
+    bad.replace(bad.find('"', at + 8), 1, "\"jump");
+    CHECK(refuse(bad) ==
+          "w.json: tracks[1].keys[3].phase: expected \"start\", \"mid\" or \"end\" "
+          "(line " +
+              std::to_string(first_r_key + 3) + ")");
+  }
+  SECTION("a missing field: the line of the object without it") {
+    std::string bad = text;
+    const size_t at = bad.find(",\"phase\":\"mid\"");
+    bad.erase(at, bad.find(',', at + 1) - at);
+    CHECK(refuse(bad) ==
+          "w.json: tracks[0].keys[1].phase: expected \"start\", \"mid\" or \"end\" "
+          "(line 4)");
+  }
+  SECTION("nested values written over several lines") {
+    const std::string pretty =
+        "{\n  \"format\": \"footfall-walk\",\n  \"version\": 1,\n"
+        "  \"fps\": 24,\n  \"tracks\": [\n    {\"name\": \"b\", \"kind\": "
+        "\"body\",\n     \"keys\": [\n       {\"frame\": 1,\n"
+        "        \"position\": [0, 0, 0]},\n       {\"frame\": 2,\n"
+        "        \"position\": [0,\n 0,\n \"x\"]}]}]}";
+    CHECK(refuse(pretty) ==
+          "w.json: tracks[0].keys[1].position[2]: expected a finite number "
+          "(line 13)");
+    std::string fps = pretty;
+    fps.replace(fps.find("24"), 2, "\"24\"");
+    CHECK(refuse(fps) == "w.json: fps: expected a finite number (line 4)");
+  }
+  SECTION("field names written with escapes, and brackets in strings, do not mislead it") {
+    const std::string odd =
+        "{\"format\": \"footfall-walk\", \"version\": 1, \"fps\": 24, \"stopped\": \"a [b, {c\",\n"
+        "\"tracks\": [{\"name\": \"x\\\"]\", \"kind\": \"foot\", \"keys\": [\n"
+        "{\"fr\\u0061me\": 1, \"phase\": \"end\", \"position\": [0, 0, 0]},\n"
+        "{\"frame\": 2, \"phase\": \"end\", \"position\": [0, 0, true]}]}]}";
+    CHECK(refuse(odd) ==
+          "w.json: tracks[0].keys[1].position[2]: expected a finite number "
+          "(line 4)");
   }
 }

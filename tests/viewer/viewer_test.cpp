@@ -885,7 +885,8 @@ TEST_CASE("walk files with descending frames are refused", "[viewer][walk]") {
   Walk walk;
   std::string error;
   CHECK(ReadWalkJson(dir + "/w.json", &walk, &error) == Status::kParseError);
-  CHECK(error == dir + "/w.json: tracks[0].keys[1].frame: frames must increase along a track");
+  CHECK(error ==
+        dir + "/w.json: tracks[0].keys[1].frame: frames must increase along a track (line 4)");
 }
 
 }  // namespace

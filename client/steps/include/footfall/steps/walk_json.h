@@ -30,11 +30,12 @@ Status WriteWalkJson(const Walk& walk, const std::string& path, std::string* err
 constexpr double kMaxKeyCoordinate = 1e15;
 
 // Parses walk JSON. `source` names it in errors: "SOURCE:LINE:COLUMN: malformed JSON: ..." for
-// text that is not JSON, "SOURCE: tracks[2].keys[5].position: expected an array of 3 numbers"
-// for a wrong structure. Frames must increase along each track, positions lie within
-// +-kMaxKeyCoordinate, foot normals must be non-zero vectors and body rotations non-zero
-// quaternions (both finite, read as written, not normalised). kParseError for malformed or
-// unsupported input.
+// text that is not JSON, "SOURCE: tracks[2].keys[5].position: expected an array of 3 numbers
+// (line 8)" for a wrong structure: the line (1-based) where that value starts, or, for a missing
+// field, where the object without it starts. Frames must increase along each track, positions
+// lie within +-kMaxKeyCoordinate, foot normals must be non-zero vectors and body rotations
+// non-zero quaternions (both finite, read as written, not normalised). kParseError for
+// malformed or unsupported input.
 Status ParseWalkJson(const std::string& text, const std::string& source, Walk* out,
                      std::string* error);
 
