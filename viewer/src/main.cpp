@@ -65,8 +65,10 @@ int main(int argc, char** argv) {
   app.add_option("--screenshot", o.screenshot, "Render one frame off screen to this PNG and exit")
       ->check(footfall::cli::NotBlank("a PNG file path"));
   app.add_option("--size", size, "Window or image size WxH (default 1280x800)");
-  auto* frame_opt = app.add_option("--frame", frame, "Walk frame to show")
-                        ->check(footfall::cli::FiniteRange(-1e9, 1e9));
+  // Any finite frame: a walk keeps the frames it was given (past 1e9 from --start-frame 1e9);
+  // one outside the walk's shows its nearest end, with a note.
+  auto* frame_opt =
+      app.add_option("--frame", frame, "Walk frame to show")->check(footfall::cli::Finite());
   app.add_option("--dump-state", o.dump_state,
                  "Write what is drawn (pixel positions of chosen samples and feet, live "
                  "queries) as JSON");

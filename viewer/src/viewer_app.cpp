@@ -23,6 +23,7 @@
 #include "footfall/viewer/png_writer.h"
 #include "footfall/viewer/renderer.h"
 #include "footfall/viewer/scene.h"
+#include "footfall/viewer/walk_pose.h"
 
 namespace footfall::viewer {
 namespace {
@@ -284,8 +285,9 @@ struct App {
       const float mx = x0 + (x1 - x0) * std::clamp(t, 0.0f, 1.0f);
       screen->Rect(mx - 3, bar_y - 5, mx + 3, bar_y + 11, Rgba{255, 255, 255, 255});
       std::ostringstream f;
-      f << "frame " << view.frame << " of " << scene.first_frame() << "-" << scene.last_frame()
-        << " at " << scene.walk().fps << " fps" << (playing ? "  (playing)" : "");
+      f << "frame " << FrameText(view.frame) << " of " << FrameText(scene.first_frame()) << "-"
+        << FrameText(scene.last_frame()) << " at " << scene.walk().fps << " fps"
+        << (playing ? "  (playing)" : "");
       // Why the walk stopped, in full: wrapped over as many lines as it takes.
       if (!scene.walk().stopped.empty()) f << "   stopped: " << scene.walk().stopped;
       const std::vector<std::string> frame_lines =
@@ -593,9 +595,10 @@ int RunViewer(const ViewerOptions& options) {
   app.SetFrame(options.has_frame ? options.frame : app.scene.first_frame());
   if (options.has_frame && app.scene.has_walk() &&
       (options.frame < app.scene.first_frame() || options.frame > app.scene.last_frame())) {
-    std::cerr << "footfall-view: note: --frame " << options.frame << " is outside the walk's "
-              << app.scene.first_frame() << "-" << app.scene.last_frame() << "; showing "
-              << app.view.frame << '\n';
+    std::cerr << "footfall-view: note: --frame " << FrameText(options.frame)
+              << " is outside the walk's " << FrameText(app.scene.first_frame()) << "-"
+              << FrameText(app.scene.last_frame()) << "; showing " << FrameText(app.view.frame)
+              << '\n';
   }
 
   // 3. Open a window (hidden for screenshots) with an OpenGL 3.3 core context.

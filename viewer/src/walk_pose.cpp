@@ -1,6 +1,7 @@
 #include "footfall/viewer/walk_pose.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 
 namespace footfall::viewer {
@@ -91,6 +92,21 @@ void FrameRange(const Walk& walk, double* first, double* last) {
     if (!any || t.keys.back().frame > *last) *last = t.keys.back().frame;
     any = true;
   }
+}
+
+std::string FrameText(double frame) {
+  char text[64];
+  if (!(std::fabs(frame) < 1e15)) {
+    const std::to_chars_result r = std::to_chars(text, text + sizeof text, frame);
+    return std::string(text, r.ptr);
+  }
+  // (std::to_chars ignores the C locale: a decimal point whatever LC_NUMERIC says.)
+  const std::to_chars_result r =
+      std::to_chars(text, text + sizeof text, frame, std::chars_format::fixed, 3);
+  std::string s(text, r.ptr);
+  s.erase(s.find_last_not_of('0') + 1);
+  if (s.back() == '.') s.pop_back();
+  return s == "-0" ? "0" : s;
 }
 
 }  // namespace footfall::viewer

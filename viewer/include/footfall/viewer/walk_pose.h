@@ -1,6 +1,8 @@
 // Where a walk's feet and body are at a given frame, for drawing and playback.
 #pragma once
 
+#include <string>
+
 #include "footfall/steps/walk.h"
 
 namespace footfall::viewer {
@@ -24,5 +26,10 @@ Vec3 ArcPoint(const Vec3& start, const Vec3& mid, const Vec3& end, double t);
 
 // The first and last key frames over all tracks; {0, 0} for a walk without keys.
 void FrameRange(const Walk& walk, double* first, double* last);
+
+// A frame as the overlay and messages show it: in plain digits with at most 3 decimals, trailing
+// zeros dropped ("1000000010.5", "0.667"; six significant digits wrote frame 1000010 as
+// "1.00001e+06"); beyond 1e15, the shortest text that reads back ("1e+300").
+std::string FrameText(double frame);
 
 }  // namespace footfall::viewer
