@@ -197,12 +197,12 @@ check "--steps 0 with a path: no note about the goal" bash -c "! grep -q 'goal i
 check "--steps short of the goal: exit 0" [ $? -eq 0 ]
 check "--steps short of the goal: no stop" grep -q '"stopped":""' "$work/short.json"
 check "--steps short of the goal: the note" grep -qE "^footfall generate: note: the path's goal \(2.5000, 0.0000, 4.0000\) is still [0-9.]+ away after the 2 steps asked for" "$work/short.err"
-# A --start far off the terrain (20 m above the plateau) is said, with where the character
-# starts instead (it was snapped there without a word); the walk is made (exit 0).
-"$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,20,1 \
+# A --start past the plateau's side is said, with where the character starts instead (it was
+# snapped there without a word); the walk is made (exit 0).
+"$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 10,0,1 \
   --steps 2 --out "$work/far-start.json" 2> "$work/far-start.err"
 check "--start off the terrain: exit 0" [ $? -eq 0 ]
-check "--start off the terrain: the note" grep -qxF "footfall generate: note: the start (2.5000, 20.0000, 1.0000) (--start) lies 20 from the terrain, more than a step (0.7): the character starts on the terrain's sample nearest it, at (2.5000, 0.0000, 1.0000)" "$work/far-start.err"
+check "--start off the terrain: the note" grep -qxF "footfall generate: note: the start (10.0000, 0.0000, 1.0000) (--start) snaps to the terrain's sample nearest it, (4.9500, 0.0000, 1.0000), 5.05 away across the up (more than a step, 0.7): the character starts there" "$work/far-start.err"
 # A character whose step_length its reach cannot follow is said once, not shortened silently.
 sed 's/"step_length": 0.7/"step_length": 5/' "$chars/biped.json" > "$work/long-step.json"
 "$footfall" generate --terrain "$hills" --character "$work/long-step.json" --start 10,0,10 \

@@ -219,33 +219,47 @@ TEST_CASE("A generate request's start heading and up are named by its fields",
 
 TEST_CASE("A start given farther than a step from the terrain is said in the walk's notes",
           "[steps][generator]") {
-  // A start 3 m above a floor, or 5 m past its edge, was snapped to the nearest sample without a
-  // word: the character walked somewhere else than asked.
+  // A start 5 m past a floor's edge, or high above a slope, was snapped to the nearest sample
+  // without a word: the character walked somewhere else than asked. Straight above or below the
+  // ground (a start at y = 0 over hills) it is the ground there, as expected: nothing said.
   const Character c = LoadShipped("biped");
   Terrain t = LoadTerrain(MakeFlat(101, 0.05, 0), 0.05);  // 5 x 5 m at y = 0
-  GenerateOptions o = StartOptions({2.5, 3, 2.5}, 2);
+  GenerateOptions o = StartOptions({10, 0, 2.5}, 2);      // past the edge at x = 5
   Walk w = Generate(t, c, o);
   REQUIRE(w.notes.size() == 1);
   CHECK(w.notes[0] ==
-        "the start (2.5000, 3.0000, 2.5000) (--start) lies 3 from the terrain, more than a step "
-        "(0.7): the character starts on the terrain's sample nearest it, at (2.5000, 0.0000, "
-        "2.5000)");
+        "the start (10.0000, 0.0000, 2.5000) (--start) snaps to the terrain's sample nearest it, "
+        "(5.0000, 0.0000, 2.5000), 5 away across the up (more than a step, 0.7): the character "
+        "starts there");
   CheckWalk(t, c, o, w);
-  o.start = {10, 0, 2.5};  // past the edge at x = 5
   o.crowd = 4;
+  o.heading = {-1, 0, 0};
   o.names.start = "scene.json: characters[0]: 'start'";
   w = Generate(t, c, o);
   REQUIRE_FALSE(w.notes.empty());
-  CHECK_THAT(w.notes[0], Catch::StartsWith("the start (10.0000, 0.0000, 2.5000) (scene.json: "
-                                           "characters[0]: 'start') lies 5 from the terrain"));
+  CHECK_THAT(w.notes[0],
+             Catch::StartsWith("the start (10.0000, 0.0000, 2.5000) (scene.json: characters[0]: "
+                               "'start') snaps to the terrain's sample nearest it"));
   CHECK(std::count_if(w.notes.begin(), w.notes.end(), [](const std::string& n) {
-          return n.find("from the terrain") != std::string::npos;
+          return n.find("snaps to the terrain") != std::string::npos;
         }) == 1);  // once for the crowd
-  // Within a step of it (a start a little above the ground, as usually given): nothing to say.
-  o = StartOptions({2.5, 0.6, 2.5}, 2);
-  CHECK(Generate(t, c, o).notes.empty());
-  o.start = {5.6, 0, 2.5};
-  CHECK(Generate(t, c, o).notes.empty());
+  // Within a step of it, or straight above it: nothing to say.
+  for (const Vec3& start : {Vec3{5.6, 0, 2.5}, Vec3{2.5, 3, 2.5}, Vec3{2.5, -30, 2.5}}) {
+    INFO(start.x << " " << start.y);
+    CHECK(Generate(t, c, StartOptions(start, 2)).notes.empty());
+  }
+  // An insect beside a wall (a floor stood on its side) stands on it, its up the wall's normal.
+  RawSamples wall;
+  for (int i = 0; i <= 100; ++i)
+    for (int j = 0; j <= 100; ++j) wall.push_back({0, 0.02 * i, 0.02 * j}, {1, 0, 0});
+  Terrain side = LoadTerrain(wall, 0.02);
+  o = StartOptions({3, 1, 1}, 2);
+  o.heading = {0, 1, 0};
+  CHECK(Generate(side, LoadShipped("hexapod"), o).notes.empty());
+  o.start = {3, 1, 5};
+  w = Generate(side, LoadShipped("hexapod"), o);
+  REQUIRE(w.notes.size() == 1);
+  CHECK_THAT(w.notes[0], Catch::Contains("(0.0000, 1.0000, 2.0000), 3 away across the up"));
 }
 
 TEST_CASE("A step_length longer than the reach allows is said once in the walk's notes",

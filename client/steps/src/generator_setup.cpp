@@ -57,16 +57,25 @@ Status Generator::Setup(std::string* error) {
   Foothold first;
   s = FindStart(start, !o_.has_start || o_.start_may_move, &first, error);
   if (s != Status::kOk) return s;
-  // A start given off the terrain by more than a step (a typo, coordinates of another scene,
-  // a 2D point under a DEM hundreds of metres up) is not where the character walks: say where
-  // it stands instead. (The default start is the top of the bounds: its snap is no news.)
+  // A start given off the terrain by more than a step across the up (past its edge, or high
+  // above a slope it slid down) is not where the character walks: say where it stands instead.
+  // Along the up it is the ground below (a start at y = 0 over hills), as expected; the up is
+  // --up for upright characters and, for those whose up follows the terrain, the normal of
+  // the sample it snapped to (a start beside a wall stands on it). (The default start is the
+  // top of the bounds: its snap is no news.)
   setup_notes_.clear();
-  if (o_.has_start && start_off_ > c_.step_length) {
-    Text m(4);
-    m << "the start " << Point(start) << " (" << o_.names.start << ") lies " << start_off_
-      << " from the terrain, more than a step (" << c_.step_length
-      << "): the character starts on the terrain's sample nearest it, at " << Point(first.point);
-    setup_notes_.push_back(m.str());
+  if (o_.has_start) {
+    const Vec3 up = c_.align_to_normal ? start_snap_.normal : world_up_;
+    const double across = Length(ProjectOnPlane(start - start_snap_.point, up));
+    if (across > c_.step_length) {
+      Text m(4);
+      m << "the start " << Point(start) << " (" << o_.names.start
+        << ") snaps to the terrain's sample nearest it, " << Point(start_snap_.point) << ", "
+        << across << " away across the up (more than a step, " << c_.step_length
+        << "): the character starts "
+        << (first.point == start_snap_.point ? std::string("there") : "at " + Point(first.point));
+      setup_notes_.push_back(m.str());
+    }
   }
   // A step_length longer than the reach lets a foot travel is shortened at every step (7):
   // said once, with the step the character actually takes on level ground.
@@ -337,7 +346,7 @@ Status Generator::SeparateSharedFeet(const Vec3* places, Foothold* feet, size_t 
 Status Generator::FindStart(const Vec3& start, bool may_move, Foothold* first, std::string* error) {
   Status s = Check(session_.Snap(terrain_, &start, 1, first), "snap start", error);
   if (s != Status::kOk) return s;
-  start_off_ = first->status == Status::kOk ? Distance(first->point, start) : 0;
+  start_snap_ = *first;
   if (first->status != Status::kOk) {
     *error = first->status == Status::kInvalidArgument
                  ? (o_.names.start == "--start" ? std::string("the start") : o_.names.start) +

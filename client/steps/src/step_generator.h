@@ -395,8 +395,8 @@ class Generator {
   // What the set-up found worth saying of the whole walk (a start far from the terrain, steps
   // longer than the reach allows): the first of Walk::notes.
   std::vector<std::string> setup_notes_;
-  // How far the start lies from its nearest sample (FindStart's first snap). [Units: wu]
-  double start_off_ = 0;
+  // The start's nearest sample (FindStart's first snap, before the start may move).
+  Foothold start_snap_;
   std::shared_ptr<BatchPool> pool_;
   std::vector<int> pair_of_foot_;
   // Each foot's other foot across the body, whose side it keeps to (PairGap, GapToMate): its
