@@ -11,6 +11,7 @@ FOOTFALLD and data/characters/{hexapod,biped}.json.
 """
 
 import argparse
+import ctypes
 import json
 import math
 import os
@@ -18,6 +19,7 @@ import signal
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 import unittest
 
@@ -96,6 +98,31 @@ def new_empty(name, parent=None, location=None):
     if location is not None:
         obj.location = location
     return obj
+
+
+def run_reporting(operator, **kwargs):
+    """(result, error, reports): the operator's result (None when it raised), the RuntimeError
+    it raised (or None), and the reports Blender printed for it ("Warning: ...", one a line),
+    as an animator reads them in the Info editor."""
+    libc = ctypes.CDLL(None)
+    sys.stdout.flush()
+    libc.fflush(None)
+    saved = os.dup(1)
+    result = error = None
+    with tempfile.TemporaryFile() as f:
+        os.dup2(f.fileno(), 1)
+        try:
+            result = operator(**kwargs)
+        except RuntimeError as e:
+            error = e
+        finally:
+            sys.stdout.flush()
+            libc.fflush(None)
+            os.dup2(saved, 1)
+            os.close(saved)
+        f.seek(0)
+        reports = f.read().decode("utf-8", "replace").splitlines()
+    return result, error, reports
 
 
 def clear_animation(objects):
@@ -804,6 +831,62 @@ class BlenderAddonTest(unittest.TestCase):
         self.assertEqual(walk, self.cli_walk(rig, 16, "stepper_cli")[0])
         settings.rig = None
         scene.frame_set(1)
+
+    def test_6g_a_walks_notes_and_its_stop_reach_the_animator(self):
+        # The notes `footfall generate` prints (a step length beyond the reach, a start far
+        # from the terrain) were never shown in Blender: warning reports now. A walk that stops
+        # at the terrain's edge reports why, and its keys so far stay.
+        rig = bpy.data.objects["biped_rig"]
+        feet = {f.name: f.target for f in rig.footfall_rig.feet}
+        body = rig.footfall_rig.body
+        settings = bpy.context.scene.footfall
+        settings.rig, settings.steps, settings.start_frame = rig, 4, 1
+        self.select([rig], rig)
+        home = rig.location.copy()
+        try:
+            result, error, reports = run_reporting(bpy.ops.footfall.generate_walk)
+            self.assertEqual((result, error), ({"FINISHED"}, None))
+            self.assertEqual([r for r in reports if r.startswith("Warning")], [])
+            settings.step_length = 5.0  # the biped's reach 1.2 lets a foot travel about 2.9
+            result, error, reports = run_reporting(bpy.ops.footfall.generate_walk)
+            self.assertEqual((result, error), ({"FINISHED"}, None))
+            notes = [r for r in reports if r.startswith("Warning: footfall: note: ")]
+            self.assertEqual(len(notes), 1, reports)  # no position: no word on the frame
+            self.assertIn("step_length 5 is longer than reach 1.2", notes[0])
+            self.assertEqual(reports[-1], notes[-1])  # last: the status bar shows it
+            settings.step_length = 0.0
+            rig.location.x += 30.0  # 25 m beyond the terrain's edge
+            bpy.context.view_layer.update()
+            result, error, reports = run_reporting(bpy.ops.footfall.generate_walk)
+            self.assertEqual((result, error), ({"FINISHED"}, None))
+            notes = [r for r in reports if r.startswith("Warning: footfall: note: ")]
+            self.assertEqual(len(notes), 2, reports)
+            self.assertIn("snaps to the terrain's sample nearest it", notes[0])
+            # Its positions are footfall's: the last note says how to read them in Blender.
+            self.assertIn("is Blender's (x, -z, y) divided by the scene's Unit Scale", notes[1])
+            start = to_ff(rig.matrix_world.translation)
+            self.assertIn("the start (%.4f, %.4f, %.4f)" % start, notes[0])
+            rig.location = home
+            bpy.context.view_layer.update()
+            # 200 steps walk off the 10 m terrain: the stop is an error report naming why and
+            # the keys kept, and the keys up to the stop are there.
+            clear_animation(list(feet.values()) + [body])
+            settings.steps = 200
+            result, error, reports = run_reporting(bpy.ops.footfall.generate_walk)
+            self.assertIsNotNone(error, reports)
+            walk = json.loads(bpy.data.texts["footfall_walk.json"].as_string())
+            self.assertTrue(walk.get("stopped"), walk.keys())
+            self.assertIn(walk["stopped"], str(error))
+            self.assertIn("(no_foothold)", str(error))
+            kept = sum(len(t["keys"]) for t in walk["tracks"])
+            self.assertIn("; %d keys made before it were kept" % kept, str(error))
+            self.assertTrue(any(r.startswith("Error: footfall: ") for r in reports), reports)
+            self.assert_keys_equal_walk(walk, feet, body)
+        finally:
+            settings.step_length = 0.0
+            rig.location = home
+            bpy.context.view_layer.update()
+        self._generate_and_compare("biped_rig", 8)  # as the tests after this one expect it
 
     def test_7_import_json_walk(self):
         path = os.path.join(ARGS.work_dir, "hexapod_rig_cli.json")

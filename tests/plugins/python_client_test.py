@@ -6,6 +6,7 @@ Run: FOOTFALL_LIB=build/client/lib/libfootfall.so FOOTFALLD=build/server/service
 """
 
 import contextlib
+import ctypes
 import json
 import math
 import os
@@ -171,6 +172,8 @@ class SharedLogicTest(unittest.TestCase):
                              (error.status, error.status_name, error.message, error.call,
                               str(error)))
             self.assertEqual(getattr(copy, "walk", None), getattr(error, "walk", None))
+        stopped = ff.WalkStopped(1, "step 3: a cliff", {"tracks": []}, notes=["far start"])
+        self.assertEqual(pickle.loads(pickle.dumps(stopped)).notes, ["far start"])
 
     def test_square_resampled_in_halves(self):
         pts = [(0, 0, 0), (1, 0, 0), (1, 0, 1), (0, 0, 1)]
@@ -997,6 +1000,9 @@ class MayaKeyWalkTest(unittest.TestCase):
             def generate_json(self, terrain, request):
                 return 0, walk_of(request["steps"]), None
 
+            def generate_json_with_notes(self, terrain, request):
+                return self.generate_json(terrain, request) + ([],)
+
         def run(attributes, steps):
             calls = []
             cmds = types.ModuleType("maya.cmds")
@@ -1228,6 +1234,179 @@ class MayaKeyWalkTest(unittest.TestCase):
             self.assertEqual(call[2].get("outTangentType"), "linear", msg=str(call))
 
 
+class NotesTest(unittest.TestCase):
+    """A walk's notes (what `footfall generate` prints as "note:" lines, which the walk JSON
+    does not carry) through ffc_generate_with_notes, the Session and the Maya plugin: the
+    plugins never showed them."""
+
+    def setUp(self):
+        self.s = ff.Session.embedded()
+        self.t = self.s.load_samples(flat_grid(), "flat")  # 10 x 10 m, y = 0
+        with open(os.path.join(CHARACTERS, "biped.json")) as f:
+            self.biped = json.load(f)  # step_length 0.7, reach 1.2
+
+    def tearDown(self):
+        self.s.close()
+
+    def request(self, **fields):
+        request = {"character": self.biped, "start": [5.0, 0.0, 5.0],
+                   "heading": [0.0, 0.0, 1.0], "steps": 2, "start_frame": 1}
+        request.update(fields)
+        return request
+
+    # A start 20 m off the terrain's edge (it snaps to (5, 0, 0)), and a walk of 200 steps
+    # that stops at the far edge.
+    FAR = [5.0, 0.0, -20.0]
+
+    def _c_generate(self, request, notes=True):
+        """ffc_generate_with_notes itself: (status, walk text or None, notes text or None), the
+        out pointers set to garbage first (the function must overwrite them)."""
+        lib = self.s._lib.lib
+        # Declared (an undeclared call would pass the session pointer as a C int: a crash).
+        self.assertIsNotNone(lib.ffc_generate_with_notes.argtypes)
+        walk, text = ctypes.c_void_p(1), ctypes.c_void_p(1)
+        status = lib.ffc_generate_with_notes(self.s._h, self.t, json.dumps(request).encode(),
+                                             ctypes.byref(walk),
+                                             ctypes.byref(text) if notes else None)
+        out = []
+        for p in (walk, text) if notes else (walk,):
+            out.append(None if not p.value else ctypes.string_at(p.value).decode("utf-8"))
+            if p.value:
+                lib.ffc_free_string(p.value)
+        return (status,) + tuple(out) + ((None,) if not notes else ())
+
+    def test_the_c_abi_gives_the_notes_with_the_walk(self):
+        self.assertTrue(self.s._lib.has("ffc_generate_with_notes"))
+        plain = self._c_generate(self.request())
+        self.assertEqual(plain[0], 0)
+        self.assertEqual(plain[2], "")  # no notes: an empty text, not NULL
+        self.assertEqual(plain[1], self.s.generate_json(self.t, self.request())[1])
+        far = self._c_generate(self.request(start=self.FAR))
+        self.assertEqual(far[0], 0)
+        self.assertEqual(far[1], self.s.generate_json(self.t, self.request(start=self.FAR))[1])
+        self.assertTrue(far[2].endswith("\n") and far[2].count("\n") == 1, far[2])
+        self.assertIn("snaps to the terrain's sample nearest it", far[2])
+        self.assertIn("20 away", far[2])
+        long_step = self._c_generate(self.request(character=dict(self.biped, step_length=5.0)))
+        self.assertEqual(long_step[0], 0)
+        self.assertIn("step_length 5 is longer than reach 1.2", long_step[2])
+        both = self._c_generate(self.request(start=self.FAR,
+                                             character=dict(self.biped, step_length=5.0)))
+        lines = both[2].split("\n")
+        self.assertEqual(len(lines), 3)  # two notes, each ending in a line break
+        self.assertIn("snaps to the terrain", lines[0])  # in the command line's order
+        self.assertIn("step_length", lines[1])
+        # A walk that stops early: its keys, and its notes too.
+        stopped = self._c_generate(self.request(start=self.FAR, steps=200))
+        self.assertEqual(stopped[0], 1)  # no_foothold
+        self.assertIn('"stopped"', stopped[1])
+        self.assertIn("snaps to the terrain", stopped[2])
+        # No notes wanted: a NULL notes pointer.
+        self.assertEqual(self._c_generate(self.request(start=self.FAR), notes=False)[:2], far[:2])
+        # A refused request: both out pointers NULL.
+        self.assertEqual(self._c_generate(self.request(steps=-1))[1:], (None, None))
+        self.assertEqual(self._c_generate({"steps": 2})[1:], (None, None))
+
+    def test_the_session_passes_the_notes_on(self):
+        status, walk, message, notes = self.s.generate_json_with_notes(
+            self.t, self.request(start=self.FAR))
+        self.assertEqual((status, message), (0, ""))
+        self.assertEqual(len(notes), 1)
+        self.assertIn("snaps to the terrain", notes[0])
+        self.assertEqual(self.s.generate_json(self.t, self.request(start=self.FAR)),
+                         (status, walk, message))
+        self.assertEqual(self.s.generate_json_with_notes(self.t, self.request())[3], [])
+        self.assertEqual(self.s.generate_json_with_notes(self.t, self.request(steps=-1))[3], [])
+        self.s.generate(self.t, self.request(start=self.FAR))
+        self.assertEqual(self.s.last_notes, notes)
+        self.s.generate(self.t, self.request(start=self.FAR, steps=6), chunk_steps=2)
+        self.assertEqual(self.s.last_notes, notes)
+        self.s.generate(self.t, self.request())
+        self.assertEqual(self.s.last_notes, [])
+        for chunk in (0, 50):
+            with self.assertRaises(ff.WalkStopped) as e:
+                self.s.generate(self.t, self.request(start=self.FAR, steps=200), chunk_steps=chunk)
+            self.assertEqual(e.exception.notes, notes)
+            self.assertEqual(self.s.last_notes, notes)
+            self.assertTrue(e.exception.walk["stopped"])
+
+    def test_maya_shows_the_notes_and_the_stop_and_keeps_the_keys(self):
+        # The Maya plugin through a stand-in for maya.cmds and API 2.0's MGlobal, over the real
+        # library: the notes are warnings, the stop an error naming the keys kept.
+        calls, warnings, errors = [], [], []
+        attributes = {"footfallCharacter": json.dumps(self.biped), "footfallFoot0": None,
+                      "footfallFoot1": None, "footfallWalkEnd": -1e9}
+        cmds = types.ModuleType("maya.cmds")
+        for name in ("setKeyframe", "cutKey", "undoInfo", "progressBar"):
+            setattr(cmds, name, lambda *args, _name=name, **kwargs:
+                    calls.append((_name, args, kwargs)))
+        cmds.warning = errors.append
+        cmds.confirmDialog = lambda **kwargs: None
+
+        def set_attr(plug, *values, **kwargs):
+            attributes[plug.split(".")[1]] = values[0]
+        cmds.setAttr = set_attr
+        cmds.addAttr = lambda node, longName, **kwargs: attributes.setdefault(longName, 0.0)
+        cmds.getAttr = lambda plug, **kwargs: attributes[plug.split(".")[1]]
+        cmds.attributeQuery = lambda attr, node, exists: attr in attributes
+        cmds.listConnections = lambda plug, **kwargs: {
+            "footfallFoot0": ["ik_L"], "footfallFoot1": ["ik_R"]}.get(plug.split(".")[1], [])
+        cmds.fileInfo = lambda *args, **kwargs: ["scene-1"]
+        place = {"start": self.FAR}
+
+        def xform(*args, **kwargs):
+            if kwargs.get("q"):
+                return ([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1] if kwargs.get("m")
+                        else list(place["start"]))
+        cmds.xform = xform
+        om = types.ModuleType("maya.api.OpenMaya")
+        om.MGlobal = types.SimpleNamespace(displayWarning=warnings.append)
+        api = types.ModuleType("maya.api")
+        api.OpenMaya = om
+        saved = {name: sys.modules.pop(name, None) for name in ("maya.api", "maya.api.OpenMaya")}
+        sys.modules.update({"maya.api": api, "maya.api.OpenMaya": om})
+        try:
+            with self._maya(cmds, api) as footfall_maya:
+                footfall_maya._session = lambda: self.s
+                footfall_maya._connection = types.SimpleNamespace(
+                    terrain=lambda name: self.t, has_terrain=lambda name: name == "scene-1")
+                self.assertEqual(footfall_maya.generate_walk("biped_rig", 4, 1, chunk_steps=2), 4)
+                self.assertEqual(errors, [])
+                self.assertEqual(len(warnings), 1, warnings)
+                self.assertTrue(warnings[0].startswith("footfall: note: the start "), warnings)
+                self.assertIn("snaps to the terrain", warnings[0])
+                # From the middle, 200 steps: it stops at the edge of the terrain.
+                del warnings[:]
+                place["start"] = [5.0, 0.0, 5.0]
+                del calls[:]
+                self.assertIsNone(footfall_maya.generate_walk("biped_rig", 200, 1,
+                                                              chunk_steps=50))
+                self.assertEqual(warnings, [])  # no note for a start on the terrain
+                self.assertEqual(len(errors), 1, errors)
+                with self.assertRaises(ff.WalkStopped) as e:
+                    self.s.generate(self.t, self.request(start=[5.0, 0.0, 5.0], steps=200))
+                kept = sum(len(t["keys"]) for t in e.exception.walk["tracks"]
+                           if t["kind"] == "foot")
+                self.assertIn(e.exception.message, errors[0])
+                self.assertIn("(no_foothold)", errors[0])
+                self.assertIn("; %d keys made before it were kept" % kept, errors[0])
+                keyed = [c for c in calls if c[0] == "setKeyframe"]
+                last = max(c[2]["time"] for c in keyed)
+                self.assertEqual(last, max(k["frame"] for t in e.exception.walk["tracks"]
+                                           for k in t["keys"]))
+        finally:
+            for name, module in saved.items():
+                sys.modules.pop(name, None)
+                if module is not None:
+                    sys.modules[name] = module
+
+    @contextlib.contextmanager
+    def _maya(self, cmds, api):
+        with MayaKeyWalkTest._footfall_maya(cmds) as footfall_maya:
+            sys.modules["maya"].api = api
+            yield footfall_maya
+
+
 class GenerateTest(unittest.TestCase):
     """ffc_generate over RPC gives the same walk JSON as `footfall generate`."""
 
@@ -1311,6 +1490,28 @@ class GenerateTest(unittest.TestCase):
                 self.assertIn("no key of the walk was kept", e.exception.message)
         finally:
             dying.stop()
+
+    def test_notes_are_the_command_lines(self):
+        # A start 10 m beyond the hills' edge: the command line prints a note, and the session
+        # gives the same one.
+        with ff.Session.rpc("127.0.0.1", self.server.port) as s:
+            t = s.load_file(HILLS)
+            count, bounds = s.info(t)
+            start = [bounds[3] + 10.0, 0.0, (bounds[2] + bounds[5]) / 2]
+            status, _, _, notes = s.generate_json_with_notes(
+                t, {"character_file": self.character, "start": start, "steps": 2})
+        self.assertEqual(status, 0)
+        flag = ",".join(repr(v) for v in start)
+        with tempfile.TemporaryDirectory() as tmp:
+            run = subprocess.run([self.cli, "generate", "--terrain", HILLS, "--character",
+                                  self.character, "--start", flag, "--steps", "2", "--out",
+                                  os.path.join(tmp, "walk.json")],
+                                 check=True, stderr=subprocess.PIPE, universal_newlines=True)
+        printed = [line[len("footfall generate: note: "):] for line in run.stderr.splitlines()
+                   if line.startswith("footfall generate: note: ")]
+        self.assertEqual(len(printed), 1, run.stderr)
+        # The same note, but for how the start is named: "--start" there, the request's here.
+        self.assertEqual(notes[0].split(") snaps")[1], printed[0].split(") snaps")[1])
 
     def test_generate_bad_request_raises(self):
         with ff.Session.rpc("127.0.0.1", self.server.port) as s:

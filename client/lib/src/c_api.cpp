@@ -129,6 +129,52 @@ int32_t PointQuery(ffc_session* s, uint32_t terrain, const double* points, size_
   });
 }
 
+// A malloc'd copy of `text` for the caller to release with ffc_free_string; NULL when no memory.
+char* MallocCopy(const std::string& text) {
+  char* copy = static_cast<char*>(std::malloc(text.size() + 1));
+  if (copy) std::memcpy(copy, text.c_str(), text.size() + 1);
+  return copy;
+}
+
+// ffc_generate and ffc_generate_with_notes (notes NULL: not wanted).
+int32_t Generate(ffc_session* s, uint32_t terrain, const char* request_json, char** walk_json,
+                 char** notes) {
+  if (walk_json) *walk_json = nullptr;  // on every failure but a walk that stopped early
+  if (notes) *notes = nullptr;
+  return Guard(s, [&]() -> int32_t {
+    if (!request_json || !walk_json)
+      return BadArgument(s, "request_json and walk_json must not be NULL");
+    footfall::Character character;
+    footfall::GenerateOptions options;
+    footfall::Walk walk;
+    std::string error;
+    Status status = footfall::ParseGenerateRequest(request_json, &character, &options, &error);
+    if (status == Status::kOk)
+      status = footfall::GenerateWalk(*s->session, terrain, character, options, &walk, &error);
+    if (status != Status::kOk) {
+      SetError(s, error);
+      return static_cast<int32_t>(status);
+    }
+    std::string note_text;
+    if (notes)
+      for (const std::string& note : walk.notes) note_text += OneLine(note) + '\n';
+    char* copy = MallocCopy(footfall::WalkToJson(walk));
+    char* note_copy = notes ? MallocCopy(note_text) : nullptr;
+    if (!copy || (notes && !note_copy)) {
+      std::free(copy), std::free(note_copy);
+      SetError(s, "out of memory");
+      return FF_C_LIMIT_EXCEEDED;
+    }
+    *walk_json = copy;
+    if (notes) *notes = note_copy;
+    if (!walk.stopped.empty()) {  // the keys so far are in *walk_json
+      SetError(s, walk.stopped);
+      return FF_C_NO_FOOTHOLD;
+    }
+    return FF_C_OK;
+  });
+}
+
 }  // namespace
 
 extern "C" {
@@ -278,35 +324,12 @@ int32_t ffc_next(ffc_session* s, uint32_t terrain, const double* steps, size_t c
 }
 
 int32_t ffc_generate(ffc_session* s, uint32_t terrain, const char* request_json, char** walk_json) {
-  if (walk_json) *walk_json = nullptr;  // on every failure but a walk that stopped early
-  return Guard(s, [&]() -> int32_t {
-    if (!request_json || !walk_json)
-      return BadArgument(s, "request_json and walk_json must not be NULL");
-    footfall::Character character;
-    footfall::GenerateOptions options;
-    footfall::Walk walk;
-    std::string error;
-    Status status = footfall::ParseGenerateRequest(request_json, &character, &options, &error);
-    if (status == Status::kOk)
-      status = footfall::GenerateWalk(*s->session, terrain, character, options, &walk, &error);
-    if (status != Status::kOk) {
-      SetError(s, error);
-      return static_cast<int32_t>(status);
-    }
-    const std::string text = footfall::WalkToJson(walk);
-    char* copy = static_cast<char*>(std::malloc(text.size() + 1));
-    if (!copy) {
-      SetError(s, "out of memory");
-      return FF_C_LIMIT_EXCEEDED;
-    }
-    std::memcpy(copy, text.c_str(), text.size() + 1);
-    *walk_json = copy;
-    if (!walk.stopped.empty()) {  // the keys so far are in *walk_json
-      SetError(s, walk.stopped);
-      return FF_C_NO_FOOTHOLD;
-    }
-    return FF_C_OK;
-  });
+  return Generate(s, terrain, request_json, walk_json, nullptr);
+}
+
+int32_t ffc_generate_with_notes(ffc_session* s, uint32_t terrain, const char* request_json,
+                                char** walk_json, char** notes) {
+  return Generate(s, terrain, request_json, walk_json, notes);
 }
 
 void ffc_free_string(char* text) { std::free(text); }

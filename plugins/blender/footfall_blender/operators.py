@@ -4,6 +4,7 @@ failure is a Blender report; nothing here may raise into Blender."""
 import json
 import math
 import os
+import re
 import tempfile
 import threading
 import uuid
@@ -190,6 +191,29 @@ def _error_text(e):
     if isinstance(e, ffc.FootfallError):
         return "footfall: %s (%s)" % (e.message, e.status_name)
     return "footfall: %s" % e
+
+
+# The most notes a walk reports one by one (as `footfall generate` prints them); the rest are
+# counted.
+MAX_NOTES = 20
+
+
+# A position as footfall's notes write it: "(x, y, z)".
+_POSITION = re.compile(r"\(-?[0-9][0-9.e+-]*, -?[0-9][0-9.e+-]*, -?[0-9][0-9.e+-]*\)")
+
+
+def report_notes(op, notes):
+    """The walk's notes (a start far from the terrain, a step length beyond the reach, a path's
+    goal not reached), each a warning report, as `footfall generate` prints them. They speak
+    footfall's frame: when one gives a position, a last note says how to read it."""
+    for note in notes[:MAX_NOTES]:
+        op.report({"WARNING"}, "footfall: note: %s" % note)
+    if len(notes) > MAX_NOTES:
+        op.report({"WARNING"}, "footfall: note: ... and %d more notes" % (len(notes) - MAX_NOTES))
+    if any(_POSITION.search(note) for note in notes[:MAX_NOTES]):
+        op.report({"WARNING"}, "footfall: note: the notes' positions and lengths are "
+                  "footfall's: its (x, y, z), Y up in metres, is Blender's (x, -z, y) divided "
+                  "by the scene's Unit Scale; the request's 'start' is the rig root")
 
 
 def _status(context, text):
@@ -711,6 +735,7 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
         wm = context.window_manager
         keyed = 0
         walk_text = None
+        notes = []  # the last walk's
         try:
             # Parents the keys cannot be computed in, before anything is keyed.
             keying.check_parents(list(feet.values()) + [body])
@@ -736,8 +761,10 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
                 done = min(total, done + chunk)
                 _status(context, "footfall: generating step %d of %d" % (done, total))
                 request = walk_request(context, rig_obj, done, settings.start_frame)
-                status, walk_text_new, message = s.generate_json(terrain, request)
+                status, walk_text_new, message, notes_new = s.generate_json_with_notes(
+                    terrain, request)
                 if walk_text_new is not None:
+                    notes = notes_new
                     walk = json.loads(walk_text_new)
                     keying.check_frames(walk)
                     frames = [k["frame"] for t in walk.get("tracks", []) for k in t.get("keys", [])]
@@ -773,6 +800,7 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
         except (ffc.FootfallError, ValueError, OSError) as e:
             if walk_text is None:  # nothing generated: the rig's keys are as they were
                 return _fail(self, "%s; the rig's keys are unchanged" % _error_text(e))
+            report_notes(self, notes)
             self.report({"ERROR"}, "%s; %d keys made before it were kept" % (_error_text(e), keyed))
             return {"FINISHED"} if keyed else {"CANCELLED"}
         finally:
@@ -784,6 +812,7 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
                 pass
             _status(context, None)
         self.report({"INFO"}, "footfall: %d steps, %d keys on %s" % (total, keyed, rig_obj.name))
+        report_notes(self, notes)  # after: the status bar shows the last report
         return {"FINISHED"}
 
 

@@ -44,6 +44,24 @@ def _error(message):
         pass
 
 
+# The most notes a walk shows one by one (as `footfall generate` prints them); the rest are
+# counted.
+MAX_NOTES = 20
+
+
+def _show_notes(notes):
+    """The walk's notes (a start far from the terrain, a step length beyond the reach, a path's
+    goal not reached), each a warning in the script line, as `footfall generate` prints them."""
+    if not notes:
+        return
+    from maya.api import OpenMaya as om  # noqa: N813 (MGlobal.displayWarning)
+    for note in notes[:MAX_NOTES]:
+        om.MGlobal.displayWarning("footfall: note: " + note)
+    if len(notes) > MAX_NOTES:
+        om.MGlobal.displayWarning("footfall: note: ... and %d more notes"
+                                  % (len(notes) - MAX_NOTES))
+
+
 def _session():
     return _connection.get(_settings["host"], _settings["port"], _settings["start_local"],
                            _settings["footfalld"] or None, _settings["timeout"])
@@ -314,8 +332,9 @@ def key_walk(walk, feet, body, from_frame=None):
 @_guard
 def generate_walk(rig, steps=8, start_frame=1, frames_per_step=0, step_length=0.0,
                   step_height=0.0, path=None, chunk_steps=0):
-    """Generates `steps` steps for `rig` and keys them; keys made before a failure stay. One
-    undo chunk; progress in the main progress bar."""
+    """Generates `steps` steps for `rig` and keys them; keys made before a failure stay (the
+    error says how many). One undo chunk; progress in the main progress bar. The walk's notes
+    are shown as warnings."""
     _scene_terrain_key()  # (no terrain: before anything else)
     data, feet, body = _rig_targets(rig)
     data = character.with_overrides(data, step_length=step_length, step_height=step_height,
@@ -334,6 +353,8 @@ def generate_walk(rig, steps=8, start_frame=1, frames_per_step=0, step_length=0.
         mc.progressBar(bar, e=True, beginProgress=True, maxValue=steps,
                        status="footfall: generating")
     mc.undoInfo(openChunk=True, chunkName="footfall generate walk")
+    notes = []  # the last walk's
+    keyed = 0
     try:
         done = 0
         last_frame = None
@@ -341,9 +362,10 @@ def generate_walk(rig, steps=8, start_frame=1, frames_per_step=0, step_length=0.
         while done < steps:
             done = min(steps, done + chunk)
             request["steps"] = done
-            status, text, message = s.generate_json(terrain, request)
+            status, text, message, notes_new = s.generate_json_with_notes(terrain, request)
             walk = json.loads(text) if text is not None else None
             if walk is not None:
+                notes = notes_new
                 frames = [k["frame"] for t in walk.get("tracks", []) for k in t.get("keys", [])]
                 walk_last = max(frames) if frames else start_frame
                 if last_frame is None:
@@ -358,16 +380,22 @@ def generate_walk(rig, steps=8, start_frame=1, frames_per_step=0, step_length=0.
                 _set_walk_end(rig, walk_last)
                 # Each call gives the walk so far: only its new keys are set.
                 key_walk(walk, feet, body, from_frame=last_frame)
+                keyed = sum(len(t.get("keys", [])) for t in walk.get("tracks", [])
+                            if (body if t.get("kind") == "body" else feet.get(t.get("name"))))
                 last_frame = max(frames) if frames else last_frame
             stopped = walk.get("stopped") if walk is not None else None
             if status != 0 or stopped:
-                raise ffc.FootfallError(status or 1, message or stopped or "no walk", "generate")
+                message = message or stopped or "no walk"
+                if keyed:
+                    message += "; %d keys made before it were kept" % keyed
+                raise ffc.FootfallError(status or 1, message, "generate")
             if bar:
                 mc.progressBar(bar, e=True, progress=done)
     finally:
         mc.undoInfo(closeChunk=True)
         if bar:
             mc.progressBar(bar, e=True, endProgress=True)
+        _show_notes(notes)  # (before the error's dialog, when it failed)
     return done
 
 

@@ -75,6 +75,8 @@ def _declare(lib):
         "ffc_next": (c.c_int32, [sess, c.c_uint32, dptr, c.c_size_t, c.c_double, hold]),
         # char** out: declared as a void pointer so ctypes leaves the memory to ffc_free_string.
         "ffc_generate": (c.c_int32, [sess, c.c_uint32, c.c_char_p, c.POINTER(c.c_void_p)]),
+        "ffc_generate_with_notes": (c.c_int32, [sess, c.c_uint32, c.c_char_p,
+                                                c.POINTER(c.c_void_p), c.POINTER(c.c_void_p)]),
         "ffc_free_string": (None, [c.c_void_p]),
         "ffc_check_character": (c.c_int32, [sess, c.c_char_p]),
         "ffc_ping": (c.c_int32, [sess]),

@@ -43,14 +43,16 @@ class FootfallError(Exception):
 
 class WalkStopped(FootfallError):
     """generate() stopped before every step was made (a cliff, the server gone). `walk` holds
-    the keys made up to that point (footfall's walk JSON as a dict), or None."""
+    the keys made up to that point (footfall's walk JSON as a dict), or None; `notes` that
+    walk's notes (see Session.generate_json_with_notes)."""
 
-    def __init__(self, status, message, walk, call="ffc_generate"):
+    def __init__(self, status, message, walk, call="ffc_generate", notes=()):
         super().__init__(status, message, call)
         self.walk = walk
+        self.notes = list(notes)
 
     def __reduce__(self):
-        return (type(self), (self.status, self.message, self.walk, self.call))
+        return (type(self), (self.status, self.message, self.walk, self.call, self.notes))
 
 
 # One answer of snap/normal/next. point and normal are world-space 3-tuples (None unless ok).
@@ -134,6 +136,9 @@ class Session:
         self._h = handle
         self._lib = library
         self.description = description
+        # The notes of the walk the last generate() gave or raised (WalkStopped) in its walk:
+        # a list of one-line texts, [] when it had none or gave no walk.
+        self.last_notes = []
 
     @classmethod
     def rpc(cls, host="127.0.0.1", port=7407, timeout=10.0, library=None):
@@ -342,6 +347,14 @@ class Session:
     def generate_json(self, terrain, request):
         """Runs the step generator (as `footfall generate` does) and returns (status, walk JSON
         text or None, message). request: a dict or JSON text (keys of footfall_c.h)."""
+        return self.generate_json_with_notes(terrain, request)[:3]
+
+    def generate_json_with_notes(self, terrain, request):
+        """generate_json, and the walk's notes: (status, walk JSON text or None, message, notes).
+        notes is a list of one-line texts, what `footfall generate` prints as "note:" lines (a
+        start far from the terrain, a step_length beyond the reach, a path walk's goal not
+        reached), which the walk JSON does not carry; [] when there are none, when no walk was
+        made, and with an older library (without ffc_generate_with_notes)."""
         h = self._handle("ffc_generate")
         if not self._lib.has("ffc_generate"):
             raise FootfallError(INTERNAL_ERROR, "%s has no ffc_generate (an older library)"
@@ -349,15 +362,25 @@ class Session:
         terrain = _terrain(terrain, "ffc_generate")
         text = _json_text(request, "request", "ffc_generate")
         out = ctypes.c_void_p()
-        status = self._lib.lib.ffc_generate(h, terrain, text, ctypes.byref(out))
-        walk = None
-        if out.value:
-            try:
+        notes_out = ctypes.c_void_p()
+        if self._lib.has("ffc_generate_with_notes"):
+            status = self._lib.lib.ffc_generate_with_notes(h, terrain, text, ctypes.byref(out),
+                                                           ctypes.byref(notes_out))
+        else:
+            status = self._lib.lib.ffc_generate(h, terrain, text, ctypes.byref(out))
+        walk, notes = None, []
+        try:
+            if out.value:
                 walk = ctypes.string_at(out.value).decode("utf-8")
-            finally:
+            if notes_out.value:
+                notes = ctypes.string_at(notes_out.value).decode("utf-8", "replace").splitlines()
+        finally:
+            if out.value:
                 self._lib.lib.ffc_free_string(out.value)
+            if notes_out.value:
+                self._lib.lib.ffc_free_string(notes_out.value)
         message = self.last_error() if (status != OK or walk is None) else ""
-        return status, walk, message
+        return status, walk, message, notes
 
     def generate(self, terrain, request, chunk_steps=0, progress=None):
         """The walk as a dict (footfall's walk JSON). Raises WalkStopped (with .walk holding the
@@ -369,7 +392,10 @@ class Session:
         so each call's walk starts with the one before; the calls together cost about
         steps / chunk_steps / 2 walks), and a call that fails after another gave a walk raises
         WalkStopped with that walk, its message naming the steps that failed. Chunks need the request's "steps" (an integer from 1); without it
-        the walk is asked for in one call. progress(done, total) is called after each chunk."""
+        the walk is asked for in one call. progress(done, total) is called after each chunk.
+        The walk's notes (generate_json_with_notes) are in `last_notes` after the call, and in
+        WalkStopped's `notes`: those of the last call that gave a walk."""
+        self.last_notes = []
         if isinstance(chunk_steps, bool) or not isinstance(chunk_steps, int) or chunk_steps < 0:
             raise FootfallError(INVALID_ARGUMENT, "chunk_steps %r: expected a whole number of "
                                 "steps from 0 (one call)" % (chunk_steps,), "ffc_generate")
@@ -404,7 +430,7 @@ class Session:
                     raise
                 raise WalkStopped(e.status, "%s (generating steps %d to %d); walk stopped, keys "
                                   "up to step %d kept" % (e.message, done + 1, ask, done),
-                                  walk) from None
+                                  walk, notes=self.last_notes) from None
             walk, done = part, ask
             if progress is not None:
                 progress(done, total)
@@ -415,7 +441,9 @@ class Session:
         return walk
 
     def _generate_once(self, terrain, request):
-        status, text, message = self.generate_json(terrain, request)
+        status, text, message, notes = self.generate_json_with_notes(terrain, request)
+        if text is not None:
+            self.last_notes = notes
         walk = None
         if text is not None:
             try:
@@ -426,12 +454,12 @@ class Session:
         stopped = walk.get("stopped") if isinstance(walk, dict) else None
         if status != OK:
             if walk is not None:
-                raise WalkStopped(status, message or stopped or "walk stopped", walk)
+                raise WalkStopped(status, message or stopped or "walk stopped", walk, notes=notes)
             raise FootfallError(status, message, "ffc_generate")
         if walk is None:
             raise FootfallError(INTERNAL_ERROR, "ffc_generate gave no walk", "ffc_generate")
         if stopped:
-            raise WalkStopped(NO_FOOTHOLD, message or stopped, walk)
+            raise WalkStopped(NO_FOOTHOLD, message or stopped, walk, notes=notes)
         return walk
 
 

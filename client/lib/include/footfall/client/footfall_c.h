@@ -46,7 +46,8 @@ typedef struct {
   double normal[3];
 } ffc_foothold;
 
-/* FFC_ABI_VERSION of the loaded library. */
+/* FFC_ABI_VERSION of the loaded library. It changes only when an existing function's signature
+ * or promise changes; functions added later keep it (a caller finds them by name). */
 int ffc_abi_version(void);
 
 /* Opens the in-process engine. Never NULL. */
@@ -122,6 +123,19 @@ int32_t ffc_next(ffc_session* s, uint32_t terrain, const double* steps, size_t c
  * still fills *walk_json with the keys so far, and sets ffc_last_error() to why it stopped.
  * Every other return sets *walk_json to NULL (when walk_json is not NULL). */
 int32_t ffc_generate(ffc_session* s, uint32_t terrain, const char* request_json, char** walk_json);
+/* ffc_generate, which it equals in every return and in *walk_json, and the walk's notes: what
+ * `footfall generate` prints as "note:" lines and the walk JSON does not carry (a start farther
+ * than a step from the terrain and where the character starts instead, a step_length beyond
+ * the reach and the step taken instead, a path walk whose steps ended short of its goal).
+ * Whenever *walk_json receives a walk (FF_C_OK, or FF_C_NO_FOOTHOLD for a walk that stopped
+ * early), *notes receives them as UTF-8 text: one line per note, each ending in '\n', in the
+ * order `footfall generate` prints them, each line as ffc_last_error's (line breaks and other
+ * control characters shown as '?', at most 8192 bytes, a longer note cut on a whole
+ * character); "" when there are none. Release it with ffc_free_string. Every other return sets
+ * *notes to NULL. notes may be NULL (no notes wanted). Added in ABI version 1 without changing
+ * it: a caller finds it by name (dlsym, ctypes), and an older library lacks it. */
+int32_t ffc_generate_with_notes(ffc_session* s, uint32_t terrain, const char* request_json,
+                                char** walk_json, char** notes);
 void ffc_free_string(char* text);
 
 /* Checks a character file's JSON object (text) as ffc_generate would read it, without
