@@ -291,6 +291,80 @@ class BlenderAddonTest(unittest.TestCase):
             bpy.data.objects.remove(ground)
             bpy.data.node_groups.remove(tree)
 
+    def test_1d_objects_that_make_faces_are_terrains(self):
+        # Terrain Setup took meshes alone: a collection instance (a linked set), an extruded
+        # curve or text was "select a mesh". Now any object whose faces the viewport shows is
+        # sampled, a collection instance as the meshes it instances, where it puts them; one
+        # without faces (an empty) is a report that changes nothing.
+        scene = bpy.context.scene.footfall
+        made = []
+        setups = bpy.data.collections.new("footfall_test_set")
+        try:
+            bpy.ops.mesh.primitive_grid_add(x_subdivisions=8, y_subdivisions=8, size=3)
+            ground = bpy.context.active_object
+            made.append(ground)
+            for v in ground.data.vertices:
+                v.co.z = 0.2 * math.sin(v.co.x) + 0.1 * v.co.y
+            ground.location = (0.5, -0.25, 0.1)
+            for c in ground.users_collection:
+                c.objects.unlink(ground)
+            setups.objects.link(ground)
+            instance = new_empty("footfall_test_set_instance", location=(30.0, 5.0, 1.0))
+            made.append(instance)
+            instance.instance_type, instance.instance_collection = "COLLECTION", setups
+            instance.rotation_euler = (0.0, 0.0, math.radians(30))
+            instance.scale = (2.0, 2.0, 2.0)
+            # The same mesh placed where the instance shows it, as a mesh of the scene.
+            reference = bpy.data.objects.new("footfall_test_set_reference", ground.data)
+            made.append(reference)
+            bpy.context.scene.collection.objects.link(reference)
+            bpy.context.view_layer.update()
+            reference.matrix_world = instance.matrix_world @ ground.matrix_world
+            bpy.context.view_layer.update()
+            want = sorted(self.ops.mesh_samples(bpy.context, reference, 0.2))
+            self.select([instance], instance)
+            scene.terrain_source, scene.separation = "MESH", 0.2
+            out = os.path.join(ARGS.work_dir, "set_instance.pts")
+            self.assertEqual(bpy.ops.footfall.terrain_setup(save_points=out), {"FINISHED"})
+            self.assertEqual(scene.sample_count, len(want))
+            self.assertEqual(scene.terrain_name, instance.name)
+            got = sorted(self.ops.mesh_samples(bpy.context, instance, 0.2))
+            self.assertEqual(len(got), len(want))
+            for g, w in zip(got, want):
+                for a, b in zip(g, w):
+                    self.assertAlmostEqual(a, b, delta=1e-5)
+            # An extruded curve.
+            bpy.ops.curve.primitive_bezier_curve_add(location=(40.0, 0.0, 0.0))
+            curve = bpy.context.active_object
+            made.append(curve)
+            curve.data.extrude = 0.5
+            self.select([curve], curve)
+            self.assertEqual(bpy.ops.footfall.terrain_setup(), {"FINISHED"})
+            self.assertGreater(scene.sample_count, 0)
+            # No faces: a report, and the scene's terrain as it was.
+            key, count = scene.terrain_key, scene.sample_count
+            empty = new_empty("footfall_test_plain_empty")
+            made.append(empty)
+            self.select([empty], empty)
+            with self.assertRaises(RuntimeError) as e:
+                bpy.ops.footfall.terrain_setup()
+            self.assertIn("footfall_test_plain_empty has no faces to walk on: select a mesh",
+                          str(e.exception))
+            self.assertEqual((scene.terrain_key, scene.sample_count), (key, count))
+        finally:
+            curves = [o.data for o in made if o.type == "CURVE"]
+            for obj in made:
+                bpy.data.objects.remove(obj)
+            for data in curves:
+                bpy.data.curves.remove(data)
+            bpy.data.collections.remove(setups)
+            # The hills again, for the tests after this one.
+            terrain = bpy.data.objects["terrain"]
+            self.select([terrain], terrain)
+            scene.terrain_source, scene.separation = "MESH", 0.05
+            self.assertEqual(bpy.ops.footfall.terrain_setup(), {"FINISHED"})
+            self.assertEqual(scene.sample_count, self._count)
+
     def test_1c_a_closed_path_curve_ends_at_its_start(self):
         # A cyclic spline's path lost its closing segment: the walk ended a segment short.
         corners = [(0, 0, 0), (2, 0, 0), (2, 2, 0)]

@@ -268,7 +268,9 @@ def mesh_samples(context, obj, separation):
     `separation` [metres], in footfall's frame (metres)."""
     points, tris = mesh_triangles(context, obj)
     if not tris:
-        raise ValueError("%s has no faces" % obj.name)
+        raise ValueError("%s has no faces to walk on: select a mesh, or an object that makes "
+                         "faces (a curve with Extrude or Bevel, text, a collection instance)"
+                         % obj.name)
     # Normals from the geometry, as `footfall generate` samples a mesh file (smooth, sharp at
     # edges past the crease angle), whatever the viewport's shading.
     sampling.check_sample_count(points, tris, separation)  # before the slow corner normals
@@ -305,8 +307,12 @@ class FOOTFALL_OT_terrain_setup(bpy.types.Operator):
                 terrain = _connection.load_file(key, path, separation)
                 name = os.path.basename(path)
             else:
+                # Any object whose faces the viewport shows: a mesh, a curve, text or surface
+                # (as evaluated), a collection instance (the faces of what it instances); an
+                # object without faces is refused by mesh_samples. (Only meshes were taken: a
+                # linked set, a collection instance, was "select a mesh".)
                 obj = context.active_object
-                if obj is None or obj.type != "MESH":
+                if obj is None:
                     return _fail(self, "footfall: select a mesh for the terrain")
                 samples = mesh_samples(context, obj, separation)
                 if self.save_points:

@@ -65,7 +65,8 @@ class FootfallRig(bpy.types.PropertyGroup):
 class FootfallScene(bpy.types.PropertyGroup):
     # Terrain Setup
     terrain_source: EnumProperty(name="Source", items=[
-        ("MESH", "Selected mesh", "Resample the selected mesh at the point separation"),
+        ("MESH", "Selected mesh", "Resample the active object's faces at the point separation "
+                                  "(a mesh, or a curve, text or collection instance)"),
         ("FILE", "Point file", "Load a terrain file (.pts)")], default="MESH")
     # In scene units (shown in the scene's): down to a micrometre in a scene of 1 unit = 1 m,
     # 0.1 mm at 100 m a unit (a minimum of 0.001 held it at 10 cm there).
