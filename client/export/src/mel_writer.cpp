@@ -70,6 +70,21 @@ std::string MayaName(const std::string& name) {
   return out;
 }
 
+// True when `name` is a Maya node name as it stands (MayaName leaves it as it is).
+bool LegalAsGiven(const std::string& name) { return !name.empty() && MayaName(name) == name; }
+
+// True when every '/'-separated part of a crowd character's name ("c1", a scene's "dogs/c1")
+// is legal as given: its MEL name joins them with '_', which makes nothing legal that was not.
+bool CharacterLegalAsGiven(const std::string& character) {
+  size_t begin = 0;
+  for (;;) {
+    const size_t end = character.find('/', begin);
+    if (!LegalAsGiven(character.substr(begin, end - begin))) return false;
+    if (end == std::string::npos) return true;
+    begin = end + 1;
+  }
+}
+
 // A double-quoted MEL string literal holding `text`.
 std::string MelString(const std::string& text) {
   std::string out = "\"";
@@ -157,16 +172,21 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
     group_of[t] = found.first->second;
   }
   // Names that are legal as given claim them before names made legal here (a foot `left_foot`
-  // keeps its name beside a foot `left foot`, which becomes left_foot_2).
+  // keeps its name beside a foot `left foot`, which becomes left_foot_2), in a crowd too: a
+  // crowd track's name is its character's and its own joined by '_' (c1_left_foot), as given
+  // when both are. A track without a name (named track<i> here) claims nothing.
   std::vector<std::string> names = {kRootName};
   std::vector<bool> as_given = {true};
-  auto add = [&](const std::string& name) {
-    names.push_back(MayaName(name));
-    as_given.push_back(names.back() == name);
-  };
-  for (const std::string& character : characters) add(character);
-  for (size_t t = 0; t < walk.tracks.size(); ++t)
-    add(walk_export::QualifiedTrackName(walk.tracks[t], t));
+  for (const std::string& character : characters) {
+    names.push_back(MayaName(character));
+    as_given.push_back(CharacterLegalAsGiven(character));
+  }
+  for (size_t t = 0; t < walk.tracks.size(); ++t) {
+    const WalkTrack& track = walk.tracks[t];
+    names.push_back(MayaName(walk_export::QualifiedTrackName(track, t)));
+    as_given.push_back(LegalAsGiven(track.name) &&
+                       (track.character.empty() || CharacterLegalAsGiven(track.character)));
+  }
   names = walk_export::UniqueNames(names, as_given);  // the root, first, keeps its name
   names.erase(names.begin());
 
