@@ -954,7 +954,11 @@ class BlenderAddonTest(unittest.TestCase):
             self.assertIn("(no_foothold)", str(error))
             kept = sum(len(t["keys"]) for t in walk["tracks"])
             self.assertIn("; %d keys made before it were kept" % kept, str(error))
-            self.assertTrue(any(r.startswith("Error: footfall: ") for r in reports), reports)
+            self.assertTrue(reports[-1].startswith("Error: footfall: "), reports)
+            # Its position is footfall's too: a note before it says how to read it.
+            self.assertRegex(walk["stopped"], r"\(-?[0-9.]+, -?[0-9.]+, -?[0-9.]+\)")
+            self.assertIn("is Blender's (x, -z, y) divided by the scene's Unit Scale",
+                          reports[-2])
             self.assert_keys_equal_walk(walk, feet, body)
         finally:
             settings.step_length = 0.0

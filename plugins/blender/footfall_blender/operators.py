@@ -202,18 +202,19 @@ MAX_NOTES = 20
 _POSITION = re.compile(r"\(-?[0-9][0-9.e+-]*, -?[0-9][0-9.e+-]*, -?[0-9][0-9.e+-]*\)")
 
 
-def report_notes(op, notes):
+def report_notes(op, notes, error=""):
     """The walk's notes (a start far from the terrain, a step length beyond the reach, a path's
-    goal not reached), each a warning report, as `footfall generate` prints them. They speak
-    footfall's frame: when one gives a position, a last note says how to read it."""
+    goal not reached), each a warning report, as `footfall generate` prints them. They, and the
+    `error` reported after them (why the walk stopped), speak footfall's frame: when one gives
+    a position, a last note says how to read it."""
     for note in notes[:MAX_NOTES]:
         op.report({"WARNING"}, "footfall: note: %s" % note)
     if len(notes) > MAX_NOTES:
         op.report({"WARNING"}, "footfall: note: ... and %d more notes" % (len(notes) - MAX_NOTES))
-    if any(_POSITION.search(note) for note in notes[:MAX_NOTES]):
-        op.report({"WARNING"}, "footfall: note: the notes' positions and lengths are "
-                  "footfall's: its (x, y, z), Y up in metres, is Blender's (x, -z, y) divided "
-                  "by the scene's Unit Scale; the request's 'start' is the rig root")
+    if any(_POSITION.search(text) for text in notes[:MAX_NOTES] + [error]):
+        op.report({"WARNING"}, "footfall: note: positions and lengths in footfall's messages "
+                  "are footfall's: its (x, y, z), Y up in metres, is Blender's (x, -z, y) "
+                  "divided by the scene's Unit Scale; the request's 'start' is the rig root")
 
 
 def _status(context, text):
@@ -806,7 +807,7 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
         except (ffc.FootfallError, ValueError, OSError) as e:
             if walk_text is None:  # nothing generated: the rig's keys are as they were
                 return _fail(self, "%s; the rig's keys are unchanged" % _error_text(e))
-            report_notes(self, notes)
+            report_notes(self, notes, _error_text(e))  # before: the status bar shows the error
             self.report({"ERROR"}, "%s; %d keys made before it were kept" % (_error_text(e), keyed))
             return {"FINISHED"} if keyed else {"CANCELLED"}
         finally:
