@@ -21,6 +21,7 @@
 #include "deferred_reply.h"
 #include "dispatcher.h"
 #include "footfall.h"
+#include "partial_requests.h"
 #include "read_gate.h"
 
 namespace footfall {
@@ -28,6 +29,19 @@ namespace {
 
 constexpr int kListenBacklog = 1024;  // 64 dropped SYNs in bursts of connects
 std::unique_ptr<ServiceState> g_state;
+
+// [Units: connections] How many may hold part of a request at once (about 270 KB each at most,
+// in libtirpc's record buffers): past it, the one holding its part longest is closed. A request
+// of a client on the same network arrives within milliseconds: only stalled ones count up.
+constexpr size_t kMaxPartialRequests = 64;
+std::unique_ptr<PartialRequests> g_partial;
+DispatchFn g_dispatch = nullptr;
+
+// The dispatcher, noting which connections had a whole request.
+void NotedDispatch(svc_req* request, SVCXPRT* transport) {
+  g_partial->Dispatched(transport->xp_fd);
+  g_dispatch(request, transport);
+}
 
 // True when something accepts TCP connections on 127.0.0.1:111 (rpcbind), checked without
 // waiting on libtirpc's long timeouts.
@@ -141,9 +155,10 @@ bool RpcServer::Start(std::string* error) {
                    {},
                    1,
                    {}});
-  const DispatchFn dispatch = InstallDispatcher(g_state.get());
+  g_dispatch = InstallDispatcher(g_state.get());
+  g_partial = std::make_unique<PartialRequests>(options_.request_timeout_s, kMaxPartialRequests);
   WatchListener(transport);
-  if (!svc_register(transport, FOOTFALL_PROG, FOOTFALL_V1, dispatch, 0)) {
+  if (!svc_register(transport, FOOTFALL_PROG, FOOTFALL_V1, NotedDispatch, 0)) {
     *error = "cannot register the RPC program";
     return false;
   }
@@ -225,12 +240,21 @@ void RpcServer::Run() {
       // svc_getreq_poll serves the first `count` entries with revents set, reading a request
       // from each: hand it only those whose reply fits.
       gate.Collect(fds, &readable);
-      if (!readable.empty()) svc_getreq_poll(readable.data(), static_cast<int>(readable.size()));
+      if (!readable.empty()) {
+        g_partial->Before(readable, listen_fd_);
+        svc_getreq_poll(readable.data(), static_cast<int>(readable.size()));
+        g_partial->After();
+      }
       ReapConnections();
     }
     const auto now = std::chrono::steady_clock::now();
     if (now - last_expiry >= std::chrono::seconds(1)) {
       ExpireIdle();
+      g_partial->Expire([](int fd) {
+        for (int i = 0; i < svc_max_pollfd; ++i)
+          if (svc_pollfd[i].fd == fd) return true;
+        return false;
+      });
       last_expiry = now;
     }
   }

@@ -25,6 +25,10 @@ struct RpcServerOptions {
   int batch_threads = 1;    // threads per batch query
   // [Units: s] A connection whose unread replies leave no room for another this long is closed.
   double unread_timeout_s = 30;
+  // [Units: s] A connection that has sent part of a request and not the rest this long is
+  // closed (libtirpc buffers the part, up to about 270 KB a connection); one idle between
+  // requests is kept.
+  double request_timeout_s = 30;
   // [Units: s] A batch still being answered after this long answers its remaining queries
   // FF_LIMIT_EXCEEDED ("ask again": the client library sends them again in another call), so
   // that costly queries cannot hold the other clients up for longer.

@@ -1,0 +1,81 @@
+// PartialRequests: closes connections stalled in the middle of a request (internal to
+// footfall::service).
+//
+// libtirpc's non-blocking transports keep the part of a request read so far in the
+// connection's record buffer, up to FF_MAX_REQUEST_BYTES (about 270 KB): 400 connections that
+// each send most of a request and stop held 49 MiB. Which connections hold part of a request is
+// told without libtirpc's private state: a connection handed to svc_getreq_poll whose request
+// was not dispatched, and to which nothing was written (libtirpc answers a whole request it
+// refuses itself, another version or program, with a reply), holds a part of one. A connection
+// that holds a part longer than the limit, or the longest-holding one when too many hold parts
+// at once, is shut down. Connections idle between requests hold nothing and are kept.
+#pragma once
+
+#include <poll.h>
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+namespace footfall {
+
+class PartialRequests {
+ public:
+  // `limit_s` [Units: s]: how long a connection may hold part of a request. `max_partial`: how
+  // many connections may hold part of a request at once.
+  PartialRequests(double limit_s, size_t max_partial);
+
+  // Before svc_getreq_poll(readable): notes what was written so far to each connection in
+  // `readable` (the listening socket `listener` excepted).
+  void Before(const std::vector<pollfd>& readable, int listener);
+  // A request of connection `fd` reached the dispatcher (call from the dispatch function).
+  void Dispatched(int fd) { dispatched_.insert(fd); }
+  // After svc_getreq_poll: marks the connections that now hold part of a request, and shuts
+  // down those past the count.
+  void After();
+  // Shuts down the connections that have held part of a request past the limit. `open(fd)`
+  // says whether libtirpc still serves socket `fd`. Call about once a second.
+  template <typename Open>
+  void Expire(Open&& open) {
+    const auto now = std::chrono::steady_clock::now();
+    for (auto it = partial_.begin(); it != partial_.end();) {
+      if (!open(it->first) || PeerOf(it->first) != it->second.peer) {
+        it = partial_.erase(it);  // closed by libtirpc (its number maybe reused)
+        continue;
+      }
+      const double held_s = std::chrono::duration<double>(now - it->second.since).count();
+      if (held_s >= limit_s_) {
+        char why[96];
+        std::snprintf(why, sizeof why, "it sent part of a request and not the rest for %.0f s",
+                      held_s);
+        Close(it->first, why);
+        it = partial_.erase(it);
+      } else {
+        ++it;
+      }
+    }
+  }
+  // Connections holding part of a request now.
+  size_t count() const { return partial_.size(); }
+
+ private:
+  struct Partial {
+    std::chrono::steady_clock::time_point since;  // first seen holding part of this request
+    std::string peer;
+  };
+  static std::string PeerOf(int fd);
+  void Close(int fd, const std::string& why);
+
+  double limit_s_;
+  size_t max_partial_;
+  std::vector<std::pair<int, uint64_t>> handed_;  // connection, bytes written before the round
+  std::unordered_set<int> dispatched_;
+  std::unordered_map<int, Partial> partial_;
+};
+
+}  // namespace footfall
