@@ -2236,3 +2236,23 @@ TEST_CASE("many connections sending part of a request keep footfalld's memory bo
   CHECK(idle - drained < 16 * 1024);
   for (const int fd : fds) close(fd);
 }
+
+TEST_CASE("a C client on rpcgen's stubs alone calls every procedure of footfalld",
+          "[rpc][protocol]") {
+  // Over TCP with AUTH_NONE and AUTH_SYS; version 2 and an unknown procedure refused by
+  // number; UDP refused at once (tests/rpc/plain_c_client.c prints each check).
+  ServerProcess server;
+  const std::string command =
+      std::string(PLAIN_C_CLIENT) + " " + std::to_string(server.port()) + " 2>&1";
+  FILE* p = popen(command.c_str(), "r");
+  REQUIRE(p);
+  std::string out;
+  char buffer[4096];
+  for (size_t n; (n = fread(buffer, 1, sizeof buffer, p)) > 0;) out.append(buffer, n);
+  const int status = pclose(p);
+  INFO(out);
+  CHECK(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 0);
+  CHECK(out.find("FAILED") == std::string::npos);
+  CHECK_THAT(out, Catch::Contains("ok: AUTH_SYS: FF_NEXT_BATCH of FF_MAX_BATCH queries"));
+}
