@@ -2256,3 +2256,33 @@ TEST_CASE("a C client on rpcgen's stubs alone calls every procedure of footfalld
   CHECK(out.find("FAILED") == std::string::npos);
   CHECK_THAT(out, Catch::Contains("ok: AUTH_SYS: FF_NEXT_BATCH of FF_MAX_BATCH queries"));
 }
+
+TEST_CASE("footfalld logs the separation a mesh was resampled at and when its limit coarsened it",
+          "[rpc]") {
+  const TempRoot temp;
+  std::ofstream(temp.path + "/plane.obj")
+      << "v 0 0 0\nv 100 0 0\nv 100 0 100\nv 0 0 100\nf 1 3 2\nf 1 4 3\n";
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", temp.path});
+  auto rpc = Connect(server.port());
+  TerrainHandle t = 0;
+  // As fine as 0.05 (a character's quarter step) within 1000 samples: about 5 apart instead.
+  TerrainLoadOptions o;
+  o.finest_default = 0.05;
+  o.max_samples = 1000;
+  REQUIRE(rpc->LoadServerFile("plane.obj", o, &t) == Status::kOk);
+  REQUIRE(rpc->Unload(t) == Status::kOk);
+  // At a separation given: no note.
+  o = TerrainLoadOptions{};
+  o.separation = 10;
+  REQUIRE(rpc->LoadServerFile("plane.obj", o, &t) == Status::kOk);
+  const std::string log = server.Log();
+  INFO(log);
+  CHECK_THAT(log, Catch::Contains("samples at separation 10, grid"));
+  CHECK_THAT(log, Catch::Contains(
+                      "(coarser than the 0.05 asked: within the limit of 1000 samples, no finer)"));
+  size_t notes = 0;
+  for (size_t at = log.find("coarser than"); at != std::string::npos;
+       at = log.find("coarser than", at + 1))
+    ++notes;
+  CHECK(notes == 1);
+}

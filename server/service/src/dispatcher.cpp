@@ -14,6 +14,7 @@
 #include <mutex>
 #include <new>
 #include <set>
+#include <sstream>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -298,19 +299,40 @@ void LogEvicted() {
         "least recently queried orphan goes)");
 }
 
-// The reply of a load (a file's `path`) or of an upload (`upload`: its name in `path`): its
-// handle, or its error; logged.
+// How a mesh or height map loaded by `load` was resampled, for its log line and reply: " at
+// separation S", and when the sample limit made it coarser than the finest the client asked
+// (TerrainLoadOptions::finest_default, a character's quarter step), that limit; else "".
+std::string ResampledText(const PendingLoad* load) {
+  if (!load || load->upload || !(load->report.separation > 0)) return "";
+  std::ostringstream text;
+  text.precision(4);
+  const TerrainLoadOptions& o = load->options;
+  text << " at separation " << load->report.separation;
+  // The loader aims at the finer of finest_default and the file's own default.
+  const double file = load->report.file_separation;
+  const double wanted = file > 0 ? std::min(o.finest_default, file) : o.finest_default;
+  if (!(o.separation > 0) && wanted > 0 && load->report.separation > 1.001 * wanted)
+    text << " (coarser than the " << wanted << " asked: within the limit of " << o.max_samples
+         << " samples, no finer)";
+  return text.str();
+}
+
+// The reply of a load (a file's `path`; `load` [opt] says how it was read) or of an upload
+// (`upload`: its name in `path`): its handle, or its error; logged.
 void ReplyLoaded(Status s, uint32_t handle, const std::string& path, bool upload,
-                 std::string message, ff_load_reply* r) {
+                 std::string message, ff_load_reply* r, const PendingLoad* load = nullptr) {
   r->status = Wire(s);
   r->terrain = handle;
   if (s == Status::kOk) {
     const GridStats& st = g_state->registry.Find(handle)->grid.stats();
-    message = upload ? "" : "loaded " + path;
+    const std::string resampled = ResampledText(load);
+    message =
+        upload ? "" : "loaded " + path + ": " + std::to_string(st.samples) + " samples" + resampled;
     Log("loaded terrain " + std::to_string(handle) +
         (upload ? " '" + path + "' (uploaded)" : " from '" + path + "'") + ": " +
-        std::to_string(st.samples) + " samples, grid " + std::to_string(st.cells[0]) + "x" +
-        std::to_string(st.cells[1]) + "x" + std::to_string(st.cells[2]));
+        std::to_string(st.samples) + " samples" + resampled + ", grid " +
+        std::to_string(st.cells[0]) + "x" + std::to_string(st.cells[1]) + "x" +
+        std::to_string(st.cells[2]));
   } else {
     LogError(upload ? "upload" : "load", s, message);
   }
@@ -942,7 +964,7 @@ void FinishLoads() {
     uint32_t handle = 0;
     const Status s = g_state->registry.FinishLoad(load.get(), &handle, &message);
     LogEvicted();
-    ReplyLoaded(s, handle, load->relative_path, load->upload, message, &r);
+    ReplyLoaded(s, handle, load->relative_path, load->upload, message, &r, load.get());
     if (!SendHeldReply(ticket, FF_XDR(ff_load_reply), &r))
       Log(std::string("error: ") + (load->upload ? "upload" : "load") +
           ": reply could not be sent");

@@ -292,7 +292,8 @@ void RunLoad(PendingLoad* load) {
     error = "'" + load->relative_path + "': cancelled, its client has gone";
     return false;
   };
-  if (load->pinned && go_on()) load->status = LoadTerrain(pinned, load->options, &samples, &error);
+  if (load->pinned && go_on())
+    load->status = LoadTerrain(pinned, load->options, &samples, &error, &load->report);
   if (go_on()) load->status = ValidateAndNormalize(&samples, &error);
   if (go_on()) load->status = TerrainGrid::Build(samples, GridOptions{}, &load->grid, &error);
   // Report the path as the client gave it, not the server's layout.

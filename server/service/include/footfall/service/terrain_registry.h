@@ -61,6 +61,7 @@ struct PendingLoad {
   Status status = Status::kInternalError;
   std::string message;
   TerrainGrid grid;
+  TerrainLoadReport report;  // a file's: how it was read (a mesh's separation)
 };
 
 // The most samples one server-side load of a mesh or height map may be sampled to: 20,000,000,
