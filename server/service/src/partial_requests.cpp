@@ -4,6 +4,7 @@
 #include <netinet/in.h>
 #include <sys/socket.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdio>
 
@@ -31,8 +32,14 @@ uint64_t BytesWritten(int fd) {
 
 }  // namespace
 
+constexpr double kLogBurst = 20;
+constexpr double kLogPerSecond = 2;
+
 PartialRequests::PartialRequests(double limit_s, size_t max_partial)
-    : limit_s_(limit_s), max_partial_(max_partial) {}
+    : limit_s_(limit_s),
+      max_partial_(max_partial),
+      log_tokens_(kLogBurst),
+      log_refilled_(std::chrono::steady_clock::now()) {}
 
 std::string PartialRequests::PeerOf(int fd) { return footfall::PeerOf(fd); }
 
@@ -70,11 +77,30 @@ void PartialRequests::After() {
 }
 
 void PartialRequests::Close(int fd, const std::string& why) {
-  std::fprintf(stderr, "footfalld: closing the connection from %s: %s\n", PeerOf(fd).c_str(),
-               why.c_str());
+  const auto now = std::chrono::steady_clock::now();
+  log_tokens_ = std::min(
+      kLogBurst,
+      log_tokens_ + kLogPerSecond * std::chrono::duration<double>(now - log_refilled_).count());
+  log_refilled_ = now;
+  if (log_tokens_ >= 1) {
+    log_tokens_ -= 1;
+    std::fprintf(stderr, "footfalld: closing the connection from %s: %s\n", PeerOf(fd).c_str(),
+                 why.c_str());
+  } else {
+    ++unlogged_;
+  }
   const linger reset{1, 0};
   setsockopt(fd, SOL_SOCKET, SO_LINGER, &reset, sizeof reset);
   shutdown(fd, SHUT_RDWR);
+}
+
+void PartialRequests::ReportUnlogged() {
+  if (unlogged_ == 0) return;
+  std::fprintf(stderr,
+               "footfalld: closed %llu more connections that sent part of a request (more than "
+               "%g lines at once or %g a second are not written one by one)\n",
+               static_cast<unsigned long long>(unlogged_), kLogBurst, kLogPerSecond);
+  unlogged_ = 0;
 }
 
 }  // namespace footfall

@@ -43,6 +43,7 @@ class PartialRequests {
   template <typename Open>
   void Expire(Open&& open) {
     const auto now = std::chrono::steady_clock::now();
+    ReportUnlogged();
     for (auto it = partial_.begin(); it != partial_.end();) {
       if (!open(it->first) || PeerOf(it->first) != it->second.peer) {
         it = partial_.erase(it);  // closed by libtirpc (its number maybe reused)
@@ -69,13 +70,20 @@ class PartialRequests {
     std::string peer;
   };
   static std::string PeerOf(int fd);
+  // Shuts `fd` down with a log line: at most kLogBurst lines at once and kLogPerSecond after
+  // (a flood of connections would write as many); the others are counted, and said in one
+  // line by ReportUnlogged.
   void Close(int fd, const std::string& why);
+  void ReportUnlogged();
 
   double limit_s_;
   size_t max_partial_;
   std::vector<std::pair<int, uint64_t>> handed_;  // connection, bytes written before the round
   std::unordered_set<int> dispatched_;
   std::unordered_map<int, Partial> partial_;
+  double log_tokens_;
+  std::chrono::steady_clock::time_point log_refilled_;
+  uint64_t unlogged_ = 0;  // connections closed without a line of their own
 };
 
 }  // namespace footfall
