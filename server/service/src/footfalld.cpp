@@ -1,5 +1,4 @@
 // footfalld: the footfall terrain query server (ONC RPC over TCP).
-#include <malloc.h>
 #include <signal.h>
 #include <sys/resource.h>
 
@@ -201,11 +200,6 @@ int main(int argc, char** argv) {
   options.use_rpcbind = !no_rpcbind;
 
   std::signal(SIGPIPE, SIG_IGN);
-  // Every connection's record buffers (about 520 KB, FF_MAX_REQUEST_BYTES each way) mapped on
-  // their own, as glibc does at first: its threshold otherwise rises to their size once one is
-  // freed, and later connections then took theirs from the heap, kept resident and written
-  // whole (200 idle connections after a burst of half-sent requests held 54 MB; 4 MB before).
-  mallopt(M_MMAP_THRESHOLD, 128 * 1024);
   setvbuf(stderr, nullptr, _IOLBF, 0);
   // The default budget, lowered to what this machine's memory holds: a finished upload peaks
   // near 100 bytes per sample (its samples and its grid at once).
