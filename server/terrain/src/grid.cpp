@@ -390,6 +390,21 @@ struct NearbySearch {
                               &best_slot);
       if (best_slot != before) best_cell = at, __builtin_prefetch(&g.answers_[best_slot]);
     };
+    // The query's cell and its neighbours along x lie in one run of positions: start loading
+    // it whole, and the own cell's normals and indices, before the first scan, so that the
+    // misses of the neighbours the ball reaches and of the answer overlap instead of following
+    // one another (terrain not in cache: single snaps and steps 15-25% faster; queries on cells
+    // already in cache pay ~90 instructions, ~10%).
+    {
+      const int64_t row = cell - ci[0];
+      const uint32_t b = g.cell_start_[std::max<int64_t>(cell - 1, row)];
+      const uint32_t e = g.cell_start_[std::min<int64_t>(cell + 1, row + g.dims_[0] - 1) + 1];
+      for (size_t f = 3 * size_t{b} & ~size_t{15}; f < 3 * size_t{e}; f += 16)
+        __builtin_prefetch(g.positions_ + f);
+      const uint32_t own_e = g.cell_start_[cell + 1];
+      for (size_t s = g.cell_start_[cell] & ~size_t{3}; s < own_e; s += 4)
+        __builtin_prefetch(&g.answers_[s]);
+    }
     scan(cell);
     // An empty own cell: every neighbour is visited, and the ball is checked afterwards.
     const bool own_empty = best_slot == kNoIndex;
