@@ -426,7 +426,8 @@ static void TestErrorText(ffc_session* s) {
   char* walk = (char*)&handle; /* not NULL: a failed ffc_generate sets it to NULL */
   const char* error;
   if (!Check(name != NULL, "memory for a long name", "")) return;
-  CheckStatus(s, ffc_load_samples(s, samples, 0, "two\nlines\r\x85\xe2\x80\xa8 \xff\xc0\xaf", &handle),
+  CheckStatus(s,
+              ffc_load_samples(s, samples, 0, "two\nlines\r\x85\xe2\x80\xa8 \xff\xc0\xaf", &handle),
               FF_C_INVALID_ARGUMENT, "ffc_load_samples of 0 samples under an odd name");
   error = ffc_last_error(s);
   Check(OneLineOfUtf8(error), "ffc_last_error shows an odd name as one line of UTF-8",
@@ -525,6 +526,50 @@ static void TestCharacterAndWalk(ffc_session* s, uint32_t terrain, const char* c
         "ffc_generate of -1 steps is refused", "status %d", (int)status);
   Check(strstr(ffc_last_error(s), "'steps'") != NULL, "ffc_generate names the bad field",
         "last error: %s", ffc_last_error(s));
+  /* 9. ffc_generate_with_notes: the walk ffc_generate gives, and its notes as lines. */
+  snprintf(request, size,
+           "{\"character\": %s, \"start\": [5, 0, 5], \"heading\": [1, 0, 0], \"steps\": 4}",
+           character);
+  {
+    char* plain = NULL;
+    char* notes = NULL;
+    CheckStatus(s, ffc_generate(s, terrain, request, &plain), FF_C_OK, "ffc_generate again");
+    if (CheckStatus(s, ffc_generate_with_notes(s, terrain, request, &json, &notes), FF_C_OK,
+                    "ffc_generate_with_notes") &&
+        Check(json != NULL && notes != NULL, "ffc_generate_with_notes fills both", "")) {
+      Check(plain != NULL && strcmp(json, plain) == 0,
+            "ffc_generate_with_notes gives ffc_generate's walk", "");
+      Check(notes[0] == '\0', "a walk from the middle of the terrain has no notes", "notes: %s",
+            notes);
+    }
+    ffc_free_string(plain);
+    ffc_free_string(json);
+    ffc_free_string(notes);
+    json = NULL, notes = NULL;
+    /* A start 20 m beyond the terrain's edge (the terrain spans 0 to 10 in x and z). */
+    snprintf(request, size,
+             "{\"character\": %s, \"start\": [-20, 0, 5], \"heading\": [1, 0, 0], "
+             "\"steps\": 2}",
+             character);
+    if (CheckStatus(s, ffc_generate_with_notes(s, terrain, request, &json, &notes), FF_C_OK,
+                    "ffc_generate_with_notes from a far start") &&
+        Check(notes != NULL, "ffc_generate_with_notes fills notes", "")) {
+      Check(strstr(notes, "the start (-20.0000, 0.0000, 5.0000)") != NULL &&
+                notes[strlen(notes) - 1] == '\n',
+            "a far start is one note line naming the start", "notes: %s", notes);
+    }
+    ffc_free_string(json);
+    ffc_free_string(notes);
+    json = NULL;
+    notes = (char*)request; /* not NULL: a failed call sets it to NULL */
+    CheckStatus(s, ffc_generate_with_notes(s, terrain + 1000, request, &json, &notes),
+                FF_C_UNKNOWN_TERRAIN, "ffc_generate_with_notes on an unknown terrain");
+    Check(notes == NULL && json == NULL, "a failed ffc_generate_with_notes sets both to NULL", "");
+    CheckStatus(s, ffc_generate_with_notes(s, terrain, request, &json, NULL), FF_C_OK,
+                "ffc_generate_with_notes without notes wanted");
+    ffc_free_string(json);
+    json = NULL;
+  }
   free(request);
   free(character);
 }
@@ -574,7 +619,8 @@ static void TestLastErrorDuringCall(void) {
   if (bind(fd, (struct sockaddr*)&address, sizeof address) == 0 && listen(fd, 8) == 0 &&
       getsockname(fd, (struct sockaddr*)&address, &length) == 0)
     port = ntohs(address.sin_port);
-  if (!Check(port > 0, "a loopback port that never answers", "bind, listen or getsockname failed")) {
+  if (!Check(port > 0, "a loopback port that never answers",
+             "bind, listen or getsockname failed")) {
     close(fd);
     return;
   }
@@ -592,10 +638,11 @@ static void TestLastErrorDuringCall(void) {
   began = Seconds();
   Check(ffc_last_error(call.session) != NULL, "ffc_last_error during another thread's call", "");
   took = Seconds() - began;
-  Check(took < 0.5, "ffc_last_error answers at once during another thread's call",
-        "it took %.2f s", took);
+  Check(took < 0.5, "ffc_last_error answers at once during another thread's call", "it took %.2f s",
+        took);
   pthread_join(thread, NULL);
-  CheckStatus(call.session, call.status, FF_C_UNAVAILABLE, "ffc_ping to a server that never answers");
+  CheckStatus(call.session, call.status, FF_C_UNAVAILABLE,
+              "ffc_ping to a server that never answers");
   ffc_close(call.session);
   close(fd);
 }
@@ -617,8 +664,7 @@ static void TestRpc(const char* character_path) {
   Check(ffc_open_rpc(NULL, 7407, -INFINITY) == NULL, "ffc_open_rpc refuses a -infinite timeout",
         "");
   Check(ffc_open_rpc(NULL, 7407, 2e6) == NULL, "ffc_open_rpc refuses a timeout above 1e6 s", "");
-  Check(ffc_open_rpc(NULL, 7407, 1e-9) == NULL, "ffc_open_rpc refuses a timeout below 0.001 s",
-        "");
+  Check(ffc_open_rpc(NULL, 7407, 1e-9) == NULL, "ffc_open_rpc refuses a timeout below 0.001 s", "");
   Check(ffc_open_rpc(NULL, 7407, 0.0009) == NULL, "ffc_open_rpc refuses a timeout of 0.9 ms", "");
   s = ffc_open_rpc(NULL, 7407, 0.001);
   Check(s != NULL, "ffc_open_rpc takes a timeout of 0.001 s", "");
@@ -699,7 +745,8 @@ int main(int argc, char** argv) {
             bounds[3 + k], lo[k], hi[k]);
   }
 
-  CheckStatus(s, ffc_info(s, terrain, NULL, NULL), FF_C_OK, "ffc_info with NULL samples and bounds");
+  CheckStatus(s, ffc_info(s, terrain, NULL, NULL), FF_C_OK,
+              "ffc_info with NULL samples and bounds");
   {
     uint32_t unnamed = 0;
     if (CheckStatus(s, ffc_load_samples(s, samples, 1, NULL, &unnamed), FF_C_OK,
