@@ -2,12 +2,11 @@
 // nearest-sample ("snap", "normal") and foothold ("next") queries.
 //
 // The grid covers the samples' bounding box in any orientation (walls, ceilings, spheres, not
-// only height fields). Its cell size is chosen for query speed (about two dozen samples per
-// occupied cell, GridOptions::samples_per_cell) under a memory cap of 0.95 cells per sample,
-// whatever the bounds. A few far outliers do not stretch it: the grid then covers the bulk of
-// the samples, and its border cells take the outliers (border cells extend to the true bounds).
-// Queries are exact: they return what a brute-force scan over all samples returns (see
-// brute_force.h), ties going to the lowest index.
+// only height fields). Its cell size is chosen for query speed (a few samples per occupied cell)
+// under a memory cap of 0.95 cells per sample, whatever the bounds. A few far outliers do
+// not stretch it: the grid then covers the bulk of the samples, and its border cells take the
+// outliers (border cells extend to the true bounds). Queries are exact: they return what a
+// brute-force scan over all samples returns (see brute_force.h), ties going to the lowest index.
 //
 // Samples are stored as float offsets from the grid's origin (the centre of the bulk of the
 // samples): a stored sample differs from its input by at most ~6e-8 of its distance to that
@@ -72,11 +71,8 @@ struct GridStats {
 };
 
 struct GridOptions {
-  // Target mean samples per occupied cell. [Limit: > 0] Larger cells cost more distances per
-  // cell but fewer visits to neighbour cells, whose loads from memory dominate queries on a
-  // terrain larger than the cache (1M samples: 24 answers single snaps and steps about 0.8x
-  // the time of 12, and queries on cells already in cache about 1.05x).
-  double samples_per_cell = 24;
+  // Target mean samples per occupied cell. [Limit: > 0]
+  double samples_per_cell = 12;
   // Memory cap: total cells <= max(64, cells_per_sample * samples). [Limit: > 0] The default
   // keeps a grid within 32 bytes per sample: 28 for the sample and its normal, 4 per cell.
   double cells_per_sample = 0.95;
