@@ -30,6 +30,17 @@ out=$("$footfall" --version 2> "$work/err.txt")
 check "--version: exit 0" [ $? -eq 0 ]
 check "--version: footfall and its version" grep -qxE 'footfall [0-9]+\.[0-9]+\.[0-9]+' <<< "$out"
 
+# `footfall help [COMMAND...]` prints that command's help, as `--help` does, and exits 0.
+out=$("$footfall" help 2> "$work/err.txt")
+check "help: exit 0" [ $? -eq 0 ]
+check "help: the commands listed" grep -q '^  generate  ' <<< "$out"
+out=$("$footfall" help terrain make 2> "$work/err.txt")
+check "help terrain make: exit 0" [ $? -eq 0 ]
+check "help terrain make: the make command's help" [ "$out" = "$("$footfall" terrain make --help)" ]
+"$footfall" help walk > /dev/null 2> "$work/err.txt"
+check "help of an unknown command: exit 1" [ $? -eq 1 ]
+check "help of an unknown command: named" grep -qF "footfall: unknown command 'walk'" "$work/err.txt"
+
 # 1. Answers, in order, one JSON object per line.
 printf 'snap 1.2 3 2.9\nnormal 4 4 4\nnext 1 0 1 0 0 2\nnext 1 0 4 0 0 2\n' |
   "$footfall" query --terrain "$work/flat.pts" > "$work/out.jsonl"

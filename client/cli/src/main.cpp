@@ -60,6 +60,15 @@ int main(int argc, char** argv) {
   footfall::cli::AddTerrainCommand(app, &exit_code);
   footfall::cli::AddGenerateCommand(app, &exit_code);
   footfall::cli::AddBenchCommand(app, &exit_code);
+  // `footfall help [COMMAND...]` is `footfall [COMMAND...] --help`, as git and cargo take it.
+  std::vector<char*> args(argv, argv + argc);
+  static char help_flag[] = "--help";
+  if (argc >= 2 && std::string(argv[1]) == "help") {
+    args.erase(args.begin() + 1);
+    args.push_back(help_flag);
+    argc = static_cast<int>(args.size());
+    argv = args.data();
+  }
   // No command, or a word that names none: say which there are (CLI11 only says that one is
   // required).
   const std::string hint = CommandHint(app, argc, argv);
