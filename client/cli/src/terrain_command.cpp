@@ -28,6 +28,9 @@
 namespace footfall::cli {
 namespace {
 
+// "1 sample", "2 samples".
+std::string SampleCount(size_t n) { return std::to_string(n) + (n == 1 ? " sample" : " samples"); }
+
 struct ConvertFlags {
   std::string input, output;
   std::string character;  // resample for this character's steps (walk_terrain.h)
@@ -94,7 +97,7 @@ int RunConvert(const ConvertFlags& flags) {
     std::cerr << "footfall terrain convert: " << error << '\n';
     return 1;
   }
-  std::cout << "wrote " << samples.size() << " samples to " << flags.output;
+  std::cout << "wrote " << SampleCount(samples.size()) << " to " << flags.output;
   if (report.separation > 0) std::cout << " (separation " << report.separation << ")";
   std::cout << '\n';
   return 0;
@@ -297,7 +300,7 @@ int RunMake(const MakeFlags& f) {
     std::cerr << "footfall terrain make: " << error << '\n';
     return 1;
   }
-  std::cout << "wrote " << samples.size() << " samples to " << f.output << '\n';
+  std::cout << "wrote " << SampleCount(samples.size()) << " to " << f.output << '\n';
   return 0;
 }
 
