@@ -157,8 +157,9 @@ class TerrainGrid {
   // The common case of a nearest-sample search, in few instructions: the ball around the query
   // of the nearest sample in its cell (or, when that cell is empty, in its direct neighbours)
   // reaches no cell two away. Then sets *cell and *slot to the nearest sample and returns true;
-  // otherwise returns false, and Search must answer.
-  bool NearestNearby(const double c[3], uint32_t* cell, uint32_t* slot) const;
+  // otherwise returns false, and Search must answer. `prefetched`: a batch has already started
+  // loading the query's cell (Prefetch), so the search does not.
+  bool NearestNearby(const double c[3], bool prefetched, uint32_t* cell, uint32_t* slot) const;
   // Search's visitors for nearest-sample and candidate scans (grid.cpp).
   template <bool kTraced>
   struct SnapScanner;
@@ -172,6 +173,9 @@ class TerrainGrid {
   // Starts loading what a query at q reads first: its cell's offsets, or (once those have
   // arrived) its cell's samples. Any q is safe.
   void Prefetch(const Vec3& q, bool samples) const;
+  // Starts loading the positions of cell `cell` and of its neighbours along x (one run in
+  // memory), and the cell's answers; ci are the cell's coordinates.
+  void PrefetchRow(int64_t cell, const int64_t ci[3]) const;
   // The linear index of the cell holding local point c, clamped into the grid (NaN counts as
   // below); ci receives its coordinates. Same cell as CellCoord per axis.
   // (Inline: it starts every query, also in the AVX2 search.)
@@ -200,8 +204,10 @@ class TerrainGrid {
     uint32_t cell = 0xFFFFFFFFu;
     uint32_t slot = 0xFFFFFFFFu;
   };
-  Located LocateSnap(const Vec3& q, QueryTrace* trace) const;
-  Located LocateNext(const StepQuery& q, double tolerance, QueryTrace* trace) const;
+  // `prefetched` as for NearestNearby.
+  Located LocateSnap(const Vec3& q, bool prefetched, QueryTrace* trace) const;
+  Located LocateNext(const StepQuery& q, double tolerance, bool prefetched,
+                     QueryTrace* trace) const;
   Foothold Answer(const Located& found) const;
   // The batch loop shared by SnapBatch and NextBatch: ideal(i) is where query i searches (for
   // prefetching), locate(i) finds its answer.
