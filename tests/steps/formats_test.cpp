@@ -140,6 +140,10 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
   CHECK(ParseCharacter(std::string("{\"format\":\0 1}", 14), "b.json", &c, &error) ==
         Status::kParseError);
   CHECK_THAT(error, Catch::StartsWith("b.json:1:11: malformed JSON: a NUL byte"));
+  // UTF-16 text (Windows editors' "Unicode") is named, not "a NUL byte" at its second byte.
+  CHECK(ParseCharacter(std::string("\xFF\xFE{\0\"\0f\0\"\0", 10), "b.json", &c, &error) ==
+        Status::kParseError);
+  CHECK(error == "b.json:1: UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)");
   CHECK(ParseCharacter(Biped("\"step_length\": 0.6", "\"step_length\": 0.6, \"step_length\": -5"),
                        "b.json", &c, &error) == Status::kParseError);
   CHECK_THAT(error,

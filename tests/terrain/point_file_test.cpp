@@ -160,10 +160,66 @@ TEST_CASE("ReadPointStream rejects bad lines with file and line", "[terrain][poi
         "0\0 \0"
         "0\0\n",
         10);
-    for (const std::string& text : {little_endian, big_endian}) {
+    // Without a byte order mark: the NUL byte after or before each character.
+    const std::string little_no_mark(
+        "0\0 \0"
+        "0\0\n\0"
+        "1\0 \0"
+        "1\0\n\0",
+        16);
+    const std::string big_no_mark(
+        "\0"
+        "0\0 \0"
+        "0\0\n\0"
+        "1\0 \0"
+        "1\0\n",
+        16);
+    for (const std::string& text : {little_endian, big_endian, little_no_mark, big_no_mark}) {
       CHECK(Read(text, &s, &error) == Status::kParseError);
       CHECK(error == "t.pts:1: UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)");
     }
+  }
+  SECTION("UTF-32 text") {
+    // Was called UTF-16 (its mark starts as UTF-16's), or "'0?' is not a number".
+    const std::string little_endian(
+        "\xff\xfe\0\0"
+        "0\0\0\0"
+        " \0\0\0"
+        "0\0\0\0"
+        "\n\0\0\0",
+        20);
+    const std::string big_endian(
+        "\0\0\xfe\xff"
+        "\0\0\0"
+        "0\0\0\0 "
+        "\0\0\0"
+        "0\0\0\0\n",
+        20);
+    const std::string little_no_mark(
+        "0\0\0\0"
+        " \0\0\0"
+        "0\0\0\0"
+        "\n\0\0\0",
+        16);
+    const std::string big_no_mark(
+        "\0\0\0"
+        "0\0\0\0 "
+        "\0\0\0"
+        "0\0\0\0\n",
+        16);
+    for (const std::string& text : {little_endian, big_endian, little_no_mark, big_no_mark}) {
+      CHECK(Read(text, &s, &error) == Status::kParseError);
+      CHECK(error == "t.pts:1: UTF-32 text (expected ASCII or UTF-8: save the file as UTF-8)");
+    }
+  }
+  SECTION("text that is not UTF-16 or UTF-32 is not called so") {
+    CHECK(WideTextProblem("0 0 0 0 1 0\n").empty());
+    CHECK(WideTextProblem("\xEF\xBB\xBF"
+                          "0 0 0 0 1 0\n")
+              .empty());  // UTF-8 with its mark
+    CHECK(WideTextProblem("\xC3\xA9t\xC3\xA9").empty());
+    CHECK(WideTextProblem(std::string("\x01\0\x02\0", 4)).empty());  // binary
+    CHECK(WideTextProblem(std::string("0\0", 2)).empty());           // too short to tell
   }
   SECTION("a line longer than 1 MiB") {
     // A file of NUL bytes, or without line breaks, was read whole into one line (2 to 5 times

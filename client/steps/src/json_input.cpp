@@ -73,6 +73,11 @@ bool ParseJsonText(const std::string& text, const std::string& source, json* out
                    std::string* error, int max_depth) {
   // nlohmann stops at a NUL byte as at the end of the input ("unexpected end of input" with 40
   // lines still to come): name it.
+  const std::string wide = WideTextProblem(text);
+  if (!wide.empty()) {
+    *error = source + ":1: " + wide;
+    return false;
+  }
   const size_t nul = text.find('\0');
   if (nul != std::string::npos) {
     *error = source + ":" + Where(text, nul) + ": malformed JSON: a NUL byte (JSON text has none)";

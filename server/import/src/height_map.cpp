@@ -126,13 +126,10 @@ Status ReadWhole(const std::string& path, std::string* text, std::string* error,
     if (error) *error = path + ": cannot open: " + std::strerror(errno ? errno : EIO);
     return Status::kIoError;
   }
-  char mark[2] = {};
+  char mark[8] = {};
   in.read(mark, sizeof mark);
-  const std::string_view start(mark, static_cast<size_t>(in.gcount()));
-  if (start == "\xFF\xFE" || start == "\xFE\xFF") {
-    return Fail(path + ":1", "UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)",
-                error);
-  }
+  const std::string wide = WideTextProblem({mark, static_cast<size_t>(in.gcount())});
+  if (!wide.empty()) return Fail(path + ":1", wide, error);
   in.clear();
   in.seekg(0);
   const std::string word = FirstWord(in);

@@ -189,9 +189,8 @@ Status CheckTextStart(const std::string& path, std::string* error) {
   char head[65536];
   in.read(head, sizeof head);
   const std::string_view text(head, static_cast<size_t>(in.gcount()));
-  if (text.substr(0, 2) == "\xFF\xFE" || text.substr(0, 2) == "\xFE\xFF") {
-    return Fail(path, "UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)", error);
-  }
+  const std::string wide = WideTextProblem(text);
+  if (!wide.empty()) return Fail(path, wide, error);
   const size_t cr = text.find('\r');
   if (cr != std::string_view::npos && text.find('\n') == std::string_view::npos &&
       cr + 1 < text.size()) {

@@ -26,6 +26,36 @@ Status CheckInputFile(const std::string& path, const char* what, std::string* er
   return status;
 }
 
+std::string WideTextProblem(std::string_view start) {
+  auto byte = [&](size_t i) {
+    return i < start.size() ? static_cast<unsigned char>(start[i]) : -1;
+  };
+  // A character of a text file: printable ASCII or a tab, line end or space.
+  auto text = [&](size_t i) {
+    const int c = byte(i);
+    return (c >= 0x20 && c < 0x7f) || c == '\t' || c == '\n' || c == '\r';
+  };
+  const char* kind = nullptr;
+  if (start.substr(0, 4) == std::string_view("\xFF\xFE\0\0", 4) ||
+      start.substr(0, 4) == std::string_view("\0\0\xFE\xFF", 4)) {
+    kind = "UTF-32";
+  } else if (start.substr(0, 2) == "\xFF\xFE" || start.substr(0, 2) == "\xFE\xFF") {
+    kind = "UTF-16";
+  } else if (start.size() >= 8 && text(0) && byte(1) == 0 && byte(2) == 0 && byte(3) == 0 &&
+             text(4)) {
+    kind = "UTF-32";  // little-endian, no byte order mark
+  } else if (start.size() >= 8 && byte(0) == 0 && byte(1) == 0 && byte(2) == 0 && text(3) &&
+             byte(4) == 0) {
+    kind = "UTF-32";  // big-endian
+  } else if (start.size() >= 4 && text(0) && byte(1) == 0 && text(2) && byte(3) == 0) {
+    kind = "UTF-16";  // little-endian
+  } else if (start.size() >= 4 && byte(0) == 0 && text(1) && byte(2) == 0 && text(3)) {
+    kind = "UTF-16";  // big-endian
+  }
+  if (!kind) return "";
+  return std::string(kind) + " text (expected ASCII or UTF-8: save the file as UTF-8)";
+}
+
 bool LineReader::Next(std::string* line) {
   line->clear();
   if (too_long_ || !in_.good()) return false;

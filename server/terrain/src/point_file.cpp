@@ -48,9 +48,11 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
     ++line_no;
     std::string_view line(text);
     if (line_no == 1 && line.substr(0, 3) == "\xEF\xBB\xBF") line.remove_prefix(3);  // UTF-8 BOM
-    if (line_no == 1 && (line.substr(0, 2) == "\xFF\xFE" || line.substr(0, 2) == "\xFE\xFF")) {
-      return Fail(name, line_no, "UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)",
-                  out, error);
+    if (line_no == 1) {
+      // The first line holds the file's first bytes, up to its first '\n' byte (in UTF-16 and
+      // UTF-32 text too).
+      const std::string wide = WideTextProblem(line.size() < 8 ? text + '\n' : line);
+      if (!wide.empty()) return Fail(name, line_no, wide, out, error);
     }
     // A CR read as a space joined lines, and a comment on the first one hid all the others.
     if (HasLoneCr(line)) return Fail(name, line_no, kLoneCr, out, error);

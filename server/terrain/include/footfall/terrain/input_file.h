@@ -15,6 +15,12 @@ namespace footfall {
 // wait for a writer; a device may never end).
 Status CheckInputFile(const std::string& path, const char* what, std::string* error);
 
+// When `start`, the first bytes of a file (4 or more when it has them), is UTF-16 or UTF-32
+// text, with a byte order mark or without one (ASCII characters each followed or preceded by
+// NUL bytes): "UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)", or UTF-32. ""
+// otherwise (ASCII, UTF-8, binary).
+std::string WideTextProblem(std::string_view start);
+
 // The longest line a text terrain file may have. [Units: bytes] A file of NUL bytes or one
 // without line breaks is refused at its first line instead of being read whole.
 constexpr size_t kMaxLineBytes = size_t{1} << 20;
