@@ -148,6 +148,13 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
                        "b.json", &c, &error) == Status::kParseError);
   CHECK_THAT(error,
              Catch::Contains("b.json:3:72: malformed JSON: the key 'step_length' appears twice"));
+  // A comment is text, at the top level and in a foot.
+  CHECK(ParseCharacter(Biped("\"step_length\": 0.6", "\"step_length\": 0.6, \"comment\": 3"),
+                       "b.json", &c, &error) == Status::kParseError);
+  CHECK(error == "b.json: 'comment' must be a string, found number");
+  CHECK(ParseCharacter(Biped("[0.1, 0, 0]}", "[0.1, 0, 0], \"comment\": [\"left\"]}"), "b.json", &c,
+                       &error) == Status::kParseError);
+  CHECK(error == "b.json: 'feet'[0].comment: expected a string, found array");
   // Keys may repeat in different objects; a foot may carry a comment as the file may.
   CHECK(ParseCharacter(Biped("[0.1, 0, 0]}", "[0.1, 0, 0], \"comment\": \"left\"}"), "b.json", &c,
                        &error) == Status::kOk);
@@ -211,7 +218,27 @@ TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]")
        "1)"},
       {R"({"format":"footfall-walk","version":1,"fps":24,"fps":30,"tracks":[]})",
        "w.json:1:48: malformed JSON: the key 'fps' appears twice"},
+      // A misspelt field is named, at every level (a foot key's "normals" left its normal at
+      // the default, unseen); a comment is text.
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[],"frame_rate":30})",
+       "w.json: frame_rate: unknown field 'frame_rate' (known fields: comment, format, fps, "
+       "stopped, tracks, version)"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","key":[]}]})",
+       "w.json: tracks[0].key: unknown field 'key'"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","keys":[{"frame":1,"phase":"end","position":[0,0,0],"normals":[0,0,1]}]}]})",
+       "w.json: tracks[0].keys[0].normals: unknown field 'normals' (known fields: comment, "
+       "frame, normal, phase, position)"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"b","kind":"body","keys":[{"frame":1,"position":[0,0,0],"phase":"end"}]}]})",
+       "w.json: tracks[0].keys[0].phase: unknown field 'phase' (known fields: comment, frame, "
+       "position, rotation)"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[],"comment":{"by":"me"}})",
+       "w.json: comment: expected a string, found object"},
   };
+  // Comments are allowed at every level.
+  CHECK(
+      ParseWalkJson(
+          R"({"format":"footfall-walk","version":1,"fps":24,"comment":"a","tracks":[{"name":"L","kind":"foot","comment":"b","keys":[{"frame":1,"phase":"end","position":[0,0,0],"comment":"c"}]}]})",
+          "w.json", &back, &error) == Status::kOk);
   // Rotations of any non-zero length are read (readers normalise them): 1e-10 components
   // were refused as zero.
   for (const char* q : {"[0,1e-10,0,1e-10]", "[0,1e300,0,1e300]"}) {

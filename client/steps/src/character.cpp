@@ -160,6 +160,9 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
                                       " is not supported (this build reads version " +
                                       std::to_string(kCharacterFormatVersion) + ")");
   }
+  // A comment is text (a number or an object there is a misplaced field, not a remark).
+  if (r.status == Status::kOk && j.contains("comment") && !j["comment"].is_string())
+    r.Mistyped("comment", "a string", j["comment"]);
   if (r.status == Status::kOk && j.contains("name")) {
     if (!j["name"].is_string())
       r.Mistyped("name", "a string", j["name"]);
@@ -183,6 +186,11 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
         if (f.is_object() && detail::FindUnknownKey(f, kKnownFoot, &unknown)) {
           r.Fail(Status::kParseError,
                  where + ": " + detail::UnknownFieldMessage(unknown, kKnownFoot));
+          break;
+        }
+        if (f.is_object() && f.contains("comment") && !f["comment"].is_string()) {
+          r.Fail(Status::kParseError, where + ".comment: expected a string, found " +
+                                          std::string(f["comment"].type_name()));
           break;
         }
         if (!f.is_object() || !f.contains("name") || !f["name"].is_string() ||

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <set>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -147,6 +148,19 @@ struct Reader {
     if (error.empty()) error = source + ": " + where_ + ": " + what, where = where_;
     return false;
   }
+  // Fails on the first field of object `j` not in `known` (a misspelt "normal" left a default
+  // normal unseen), and on a "comment" that is not a string. `at`: where `j` stands ("" for the
+  // root).
+  bool Known(const json& j, const std::string& at, const std::set<std::string>& known) {
+    const std::string prefix = at.empty() ? "" : at + ".";
+    std::string key;
+    if (detail::FindUnknownKey(j, known, &key))
+      return Fail(prefix + key, detail::UnknownFieldMessage(key, known));
+    if (j.contains("comment") && !j["comment"].is_string())
+      return Fail(prefix + "comment",
+                  std::string("expected a string, found ") + j["comment"].type_name());
+    return true;
+  }
   bool Finite(const json& j, const std::string& where, double* out) {
     if (!j.is_number() || !std::isfinite(j.get<double>()))
       return Fail(where, "expected a finite number");
@@ -262,6 +276,8 @@ Status ParseWalkJson(const std::string& text, const std::string& source, Walk* o
     r.Fail("stopped", "expected a string");
   } else if (!j.contains("tracks") || !j["tracks"].is_array()) {
     r.Fail("tracks", "expected an array");
+  } else {
+    r.Known(j, "", {"format", "version", "fps", "stopped", "tracks", "comment"});
   }
   if (r.error.empty()) {
     walk.stopped = j.value("stopped", std::string());
@@ -274,6 +290,7 @@ Status ParseWalkJson(const std::string& text, const std::string& source, Walk* o
         r.Fail(tw, "expected {\"name\": STRING, \"kind\": \"foot\"|\"body\", \"keys\": [...]}");
         break;
       }
+      if (!r.Known(t, tw, {"name", "kind", "character", "keys", "comment"})) break;
       track.name = t["name"].get<std::string>();
       if (!detail::ControlCharacterIn(track.name).empty()) {
         r.Fail(tw + ".name", detail::ControlCharacterIn(track.name));
@@ -314,6 +331,10 @@ Status ParseWalkJson(const std::string& text, const std::string& source, Walk* o
           r.Fail(kw, "expected an object with frame and position");
           break;
         }
+        static const std::set<std::string> kFootKey = {"frame", "phase", "position", "normal",
+                                                       "comment"};
+        static const std::set<std::string> kBodyKey = {"frame", "position", "rotation", "comment"};
+        if (!r.Known(k, kw, track.kind == TrackKind::kFoot ? kFootKey : kBodyKey)) break;
         if (!r.Finite(k["frame"], kw + ".frame", &key.frame)) break;
         if (!track.keys.empty() && !(key.frame > track.keys.back().frame)) {
           r.Fail(kw + ".frame", "frames must increase along a track");
