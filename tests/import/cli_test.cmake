@@ -229,6 +229,23 @@ foreach(seed "-1" "18446744073709551616" "1.5")
   expect(EXIT_NONZERO "--seed: '${seed}' is not a whole number from 0 to 18446744073709551615"
          terrain make hills --seed ${seed} -o "${WORK}/x.pts")
 endforeach()
+# convert --character: as fine as a quarter of the step, and said when the sample limit of a
+# walk's terrain makes it coarser (a 1 mm step on a 10 m square).
+file(READ "${SOURCE_DIR}/data/characters/biped.json" biped)
+string(REPLACE "\"step_length\": 0.7" "\"step_length\": 0.004" tiny "${biped}")
+file(WRITE "${WORK}/tiny.json" "${tiny}")
+file(WRITE "${WORK}/square.obj" "v 0 0 0\nv 10 0 0\nv 10 0 10\nv 0 0 10\nf 1 4 3 2\n")
+execute_process(COMMAND "${FOOTFALL}" terrain convert "${WORK}/square.obj" --character "${WORK}/tiny.json"
+                -o "${WORK}/square.pts" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT err MATCHES "footfall terrain convert: not finer than 0\\.0[0-9]+ \\([0-9.]+ times a quarter of the character's step\\)")
+  message(FATAL_ERROR "convert --character past the sample limit: exit ${rc}, '${out}' '${err}'")
+endif()
+execute_process(COMMAND "${FOOTFALL}" terrain convert "${WORK}/square.obj" --character
+                "${SOURCE_DIR}/data/characters/biped.json" -o "${WORK}/square.pts"
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "separation 0\\.17" OR NOT err STREQUAL "")
+  message(FATAL_ERROR "convert --character within the limit: exit ${rc}, '${out}' '${err}'")
+endif()
 # convert never writes over its input; --separation with a point file is refused, not ignored.
 file(WRITE "${WORK}/two.pts" "# surveyed\n0 0 0 0 1 0\n1 0 0 0 1 0\n")
 expect(EXIT_NONZERO "two.pts: the output is the input file"
