@@ -331,8 +331,9 @@ bool LoadWalkTerrain(const GenerateFlags& flags, const Character& character,
               << info.stats.samples << " samples"
               << (terrain_flags.load.separation > 0
                       ? std::string(" at --separation ") + NumberText(terrain_flags.load.separation)
-                      : std::string(" as fine as a quarter of the step within 2,000,000 and what "
-                                    "is left of its --max-samples budget"))
+                      : std::string(" as fine as a quarter of the step (or the file's own "
+                                    "spacing, if finer) within 2,000,000 and what is left of its "
+                                    "--max-samples budget"))
               << "\n";
   }
   return true;
