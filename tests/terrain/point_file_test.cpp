@@ -18,6 +18,19 @@
 using namespace footfall;
 
 namespace {
+// `ascii` as UTF-16 (width 2) or UTF-32 (width 4) text, little- or big-endian, with or without
+// a byte order mark.
+std::string Wide(const std::string& ascii, int width, bool little, bool mark) {
+  std::string out;
+  auto put = [&](uint32_t c) {
+    for (int b = 0; b < width; ++b)
+      out += static_cast<char>((c >> (8 * (little ? b : width - 1 - b))) & 0xff);
+  };
+  if (mark) put(0xFEFF);
+  for (const char c : ascii) put(static_cast<unsigned char>(c));
+  return out;
+}
+
 Status Read(const std::string& text, RawSamples* out, std::string* error) {
   std::istringstream in(text);
   return ReadPointStream(in, "t.pts", out, error);
@@ -148,68 +161,21 @@ TEST_CASE("ReadPointStream rejects bad lines with file and line", "[terrain][poi
     CHECK(s.size() == 3);
     s.clear();
   }
-  SECTION("UTF-16 text") {
-    // Was "column 1: '\xff\xfe0?' is not a number".
-    const std::string little_endian(
-        "\xff\xfe"
-        "0\0 \0"
-        "0\0\n\0",
-        10);
-    const std::string big_endian(
-        "\xfe\xff\0"
-        "0\0 \0"
-        "0\0\n",
-        10);
-    // Without a byte order mark: the NUL byte after or before each character.
-    const std::string little_no_mark(
-        "0\0 \0"
-        "0\0\n\0"
-        "1\0 \0"
-        "1\0\n\0",
-        16);
-    const std::string big_no_mark(
-        "\0"
-        "0\0 \0"
-        "0\0\n\0"
-        "1\0 \0"
-        "1\0\n",
-        16);
-    for (const std::string& text : {little_endian, big_endian, little_no_mark, big_no_mark}) {
-      CHECK(Read(text, &s, &error) == Status::kParseError);
-      CHECK(error == "t.pts:1: UTF-16 text (expected ASCII or UTF-8: save the file as UTF-8)");
-    }
-  }
-  SECTION("UTF-32 text") {
-    // Was called UTF-16 (its mark starts as UTF-16's), or "'0?' is not a number".
-    const std::string little_endian(
-        "\xff\xfe\0\0"
-        "0\0\0\0"
-        " \0\0\0"
-        "0\0\0\0"
-        "\n\0\0\0",
-        20);
-    const std::string big_endian(
-        "\0\0\xfe\xff"
-        "\0\0\0"
-        "0\0\0\0 "
-        "\0\0\0"
-        "0\0\0\0\n",
-        20);
-    const std::string little_no_mark(
-        "0\0\0\0"
-        " \0\0\0"
-        "0\0\0\0"
-        "\n\0\0\0",
-        16);
-    const std::string big_no_mark(
-        "\0\0\0"
-        "0\0\0\0 "
-        "\0\0\0"
-        "0\0\0\0\n",
-        16);
-    for (const std::string& text : {little_endian, big_endian, little_no_mark, big_no_mark}) {
-      CHECK(Read(text, &s, &error) == Status::kParseError);
-      CHECK(error == "t.pts:1: UTF-32 text (expected ASCII or UTF-8: save the file as UTF-8)");
+  SECTION("UTF-16 and UTF-32 text") {
+    // UTF-16 with its mark was "column 1: '\xff\xfe0?' is not a number", UTF-32 was called
+    // UTF-16 (its mark starts as UTF-16's), and either without a mark "'0?' is not a number".
+    // A short first line too (the first line is all the reader looks at).
+    for (const char* ascii : {"0 0 0 0 1 0\n1 0 0 0 1 0\n", "0 0\n1 1\n"}) {
+      for (const int width : {2, 4}) {
+        for (const bool little : {true, false}) {
+          for (const bool mark : {true, false}) {
+            INFO(ascii << " width " << width << (little ? " LE" : " BE") << (mark ? " BOM" : ""));
+            CHECK(Read(Wide(ascii, width, little, mark), &s, &error) == Status::kParseError);
+            CHECK(error == std::string("t.pts:1: UTF-") + (width == 2 ? "16" : "32") +
+                               " text (expected ASCII or UTF-8: save the file as UTF-8)");
+          }
+        }
+      }
     }
   }
   SECTION("text that is not UTF-16 or UTF-32 is not called so") {
