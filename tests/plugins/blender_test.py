@@ -170,6 +170,16 @@ class BlenderAddonTest(unittest.TestCase):
             o.select_set(True)
         bpy.context.view_layer.objects.active = active
 
+    def biped_walk_setup(self, steps):
+        """The biped rig selected and set to walk `steps` steps from frame 1: the rig, its foot
+        targets by name, its body and the scene's footfall settings."""
+        rig = bpy.data.objects["biped_rig"]
+        feet = {f.name: f.target for f in rig.footfall_rig.feet}
+        settings = bpy.context.scene.footfall
+        settings.rig, settings.steps, settings.start_frame = rig, steps, 1
+        self.select([rig], rig)
+        return rig, feet, rig.footfall_rig.body, settings
+
     def samples_tree(self):
         if not hasattr(type(self), "_tree"):
             pts = []
@@ -910,12 +920,7 @@ class BlenderAddonTest(unittest.TestCase):
         # The notes `footfall generate` prints (a step length beyond the reach, a start far
         # from the terrain) were never shown in Blender: warning reports now. A walk that stops
         # at the terrain's edge reports why, and its keys so far stay.
-        rig = bpy.data.objects["biped_rig"]
-        feet = {f.name: f.target for f in rig.footfall_rig.feet}
-        body = rig.footfall_rig.body
-        settings = bpy.context.scene.footfall
-        settings.rig, settings.steps, settings.start_frame = rig, 4, 1
-        self.select([rig], rig)
+        rig, feet, body, settings = self.biped_walk_setup(4)
         home = rig.location.copy()
         try:
             result, error, reports = run_reporting(bpy.ops.footfall.generate_walk)
@@ -1396,12 +1401,7 @@ class BlenderAddonTest(unittest.TestCase):
     def test_8b_a_walk_after_an_import_replaces_it(self):
         # Import left the rig's walk end where it was: a shorter Generate Walk afterwards kept
         # the imported walk's later keys.
-        rig = bpy.data.objects["biped_rig"]
-        feet = {f.name: f.target for f in rig.footfall_rig.feet}
-        body = rig.footfall_rig.body
-        settings = bpy.context.scene.footfall
-        settings.rig, settings.steps, settings.start_frame = rig, 4, 1
-        self.select([rig], rig)
+        rig, feet, body, settings = self.biped_walk_setup(4)
         _, path = self.cli_walk(rig, 12, "biped_12")
         self.assertEqual(bpy.ops.footfall.import_walk(filepath=path), {"FINISHED"})
         self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
@@ -1411,12 +1411,7 @@ class BlenderAddonTest(unittest.TestCase):
         # A path walk that reaches its goal long before Steps end: its end was taken as the
         # start plus Steps, and the user's keys up to there were removed (and that end kept for
         # the next walk).
-        rig = bpy.data.objects["biped_rig"]
-        feet = {f.name: f.target for f in rig.footfall_rig.feet}
-        body = rig.footfall_rig.body
-        settings = bpy.context.scene.footfall
-        settings.rig, settings.steps, settings.start_frame = rig, 40, 1
-        self.select([rig], rig)
+        rig, feet, body, settings = self.biped_walk_setup(40)
         start = body.matrix_world.translation.copy()
         data = bpy.data.curves.new("short_path", "CURVE")
         data.dimensions = "3D"
