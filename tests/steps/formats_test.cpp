@@ -221,16 +221,19 @@ TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]")
       // A misspelt field is named, at every level (a foot key's "normals" left its normal at
       // the default, unseen); a comment is text.
       {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[],"frame_rate":30})",
-       "w.json: frame_rate: unknown field 'frame_rate' (known fields: comment, format, fps, "
+       "w.json: unknown field 'frame_rate' (known fields: comment, format, fps, "
        "stopped, tracks, version)"},
       {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","key":[]}]})",
-       "w.json: tracks[0].key: unknown field 'key'"},
+       "w.json: tracks[0]: unknown field 'key'"},
       {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","keys":[{"frame":1,"phase":"end","position":[0,0,0],"normals":[0,0,1]}]}]})",
-       "w.json: tracks[0].keys[0].normals: unknown field 'normals' (known fields: comment, "
+       "w.json: tracks[0].keys[0]: unknown field 'normals' (known fields: comment, "
        "frame, normal, phase, position)"},
       {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"b","kind":"body","keys":[{"frame":1,"position":[0,0,0],"phase":"end"}]}]})",
-       "w.json: tracks[0].keys[0].phase: unknown field 'phase' (known fields: comment, frame, "
+       "w.json: tracks[0].keys[0]: unknown field 'phase' (known fields: comment, frame, "
        "position, rotation)"},
+      // A key with an escape sequence is shown safely.
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","keys":[],"\u001b[2J":1}]})",
+       "w.json: tracks[0]: unknown field '?[2J'"},
       {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[],"comment":{"by":"me"}})",
        "w.json: comment: expected a string, found object"},
   };

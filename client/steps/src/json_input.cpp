@@ -71,13 +71,14 @@ size_t RepeatedKeyAt(const std::string& text) {
 
 bool ParseJsonText(const std::string& text, const std::string& source, json* out,
                    std::string* error, int max_depth) {
-  // nlohmann stops at a NUL byte as at the end of the input ("unexpected end of input" with 40
-  // lines still to come): name it.
+  // UTF-16 and UTF-32 text are named as such (their NUL bytes are not a stray byte).
   const std::string wide = WideTextProblem(text);
   if (!wide.empty()) {
     *error = source + ":1: " + wide;
     return false;
   }
+  // nlohmann stops at a NUL byte as at the end of the input ("unexpected end of input" with 40
+  // lines still to come): name it.
   const size_t nul = text.find('\0');
   if (nul != std::string::npos) {
     *error = source + ":" + Where(text, nul) + ": malformed JSON: a NUL byte (JSON text has none)";

@@ -149,13 +149,20 @@ struct Reader {
     return false;
   }
   // Fails on the first field of object `j` not in `known` (a misspelt "normal" left a default
-  // normal unseen), and on a "comment" that is not a string. `at`: where `j` stands ("" for the
-  // root).
+  // normal unseen), said of `j`, and on a "comment" that is not a string. `at`: where `j` stands
+  // ("" for the root).
   bool Known(const json& j, const std::string& at, const std::set<std::string>& known) {
     const std::string prefix = at.empty() ? "" : at + ".";
     std::string key;
-    if (detail::FindUnknownKey(j, known, &key))
-      return Fail(prefix + key, detail::UnknownFieldMessage(key, known));
+    if (detail::FindUnknownKey(j, known, &key)) {
+      // Said of the object that holds it (the key, shown safely, may hold any character).
+      if (error.empty()) {
+        error =
+            source + ": " + (at.empty() ? "" : at + ": ") + detail::UnknownFieldMessage(key, known);
+        where = at;
+      }
+      return false;
+    }
     if (j.contains("comment") && !j["comment"].is_string())
       return Fail(prefix + "comment",
                   std::string("expected a string, found ") + j["comment"].type_name());
