@@ -237,7 +237,7 @@ file(WRITE "${WORK}/tiny.json" "${tiny}")
 file(WRITE "${WORK}/square.obj" "v 0 0 0\nv 10 0 0\nv 10 0 10\nv 0 0 10\nf 1 4 3 2\n")
 execute_process(COMMAND "${FOOTFALL}" terrain convert "${WORK}/square.obj" --character "${WORK}/tiny.json"
                 -o "${WORK}/square.pts" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT rc EQUAL 0 OR NOT err MATCHES "footfall terrain convert: not finer than 0\\.0[0-9]+ \\([0-9.]+ times a quarter of the character's step\\)")
+if(NOT rc EQUAL 0 OR NOT err MATCHES "footfall terrain convert: not finer than 0\\.0[0-9]+ \\([0-9.]+ times a quarter of the step\\)")
   message(FATAL_ERROR "convert --character past the sample limit: exit ${rc}, '${out}' '${err}'")
 endif()
 execute_process(COMMAND "${FOOTFALL}" terrain convert "${WORK}/square.obj" --character

@@ -162,12 +162,9 @@ void ReportResampling(const std::string& path, const Character& character, const
     << ", a quarter of the step " << t.wanted_separation << ")";
   if (t.cropped) o << " within " << Box(t.region_min, t.region_max);
   o << ": " << r.samples << " samples; --separation S resamples all of it at S\n";
-  if (r.separation > 1.0001 * std::min(t.wanted_separation, r.file_separation)) {
-    o << "footfall generate: not finer than " << r.separation << " ("
-      << r.separation / t.wanted_separation
-      << " times a quarter of the step): the surface would need more samples than the "
-      << kMaxWalkSamples
-      << " a walk's terrain may have, and the character may miss footholds and stop; "
+  const std::string coarser = CoarserThanStepsNote(r, t.wanted_separation);
+  if (!coarser.empty()) {
+    o << "footfall generate: " << coarser << " and stop; "
       << (t.region_is_bound ? "give fewer --steps" : "give --steps, or waypoints nearer the start,")
       << " or set --separation\n";
   }

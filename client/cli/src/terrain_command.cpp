@@ -101,18 +101,12 @@ int RunConvert(const ConvertFlags& flags) {
   if (report.separation > 0) std::cout << " (separation " << report.separation << ")";
   std::cout << '\n';
   // Coarser than the character's steps want, to stay within a walk's samples: said, as
-  // generate says it (the character may miss footholds on this file).
-  const double wanted = std::min(load.finest_default, report.file_separation);
-  if (!flags.character.empty() && report.format != "points" &&
-      report.separation > 1.0001 * wanted) {
-    std::cerr << "footfall terrain convert: not finer than " << report.separation << " ("
-              << report.separation / load.finest_default
-              << " times a quarter of the character's step): the surface would need more "
-                 "samples than the "
-              << kMaxWalkSamples
-              << " a walk's terrain may have, and the character may miss footholds; set "
-                 "--separation for a finer file\n";
-  }
+  // generate says it.
+  const std::string coarser = flags.character.empty() || report.format == "points"
+                                  ? std::string()
+                                  : CoarserThanStepsNote(report, load.finest_default);
+  if (!coarser.empty())
+    std::cerr << "footfall terrain convert: " << coarser << "; set --separation for a finer file\n";
   return 0;
 }
 

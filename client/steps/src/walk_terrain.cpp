@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "frame_math.h"
 #include "step_generator.h"
@@ -59,6 +60,16 @@ Status TooCoarse(const std::string& path, const Character& c, const WalkTerrain&
 }
 
 }  // namespace
+
+std::string CoarserThanStepsNote(const TerrainLoadReport& report, double wanted) {
+  if (!(report.separation > 1.0001 * std::min(wanted, report.file_separation))) return "";
+  std::ostringstream o;
+  o.precision(4);
+  o << "not finer than " << report.separation << " (" << report.separation / wanted
+    << " times a quarter of the step): the surface would need more samples than the "
+    << kMaxWalkSamples << " a walk's terrain may have, and the character may miss footholds";
+  return o.str();
+}
 
 Status PrepareWalkTerrain(const std::string& path, const TerrainLoadOptions& load,
                           const Character& character, const GenerateOptions& options,

@@ -51,7 +51,7 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
     if (line_no == 1) {
       // The first line holds the file's first bytes, up to its first '\n' byte (in UTF-16 and
       // UTF-32 text too).
-      const std::string wide = WideTextProblem(line.size() < 8 ? text + '\n' : line);
+      const std::string wide = WideTextProblem(text + '\n');
       if (!wide.empty()) return Fail(name, line_no, wide, out, error);
     }
     // A CR read as a space joined lines, and a comment on the first one hid all the others.

@@ -46,6 +46,12 @@ struct WalkTerrain {
   bool region_is_bound = true;
 };
 
+// When `report`'s resampling came out coarser than `wanted` (kSeparationPerStep of the step)
+// and than the file's own spacing, as the kMaxWalkSamples limit makes it: "not finer than S (K
+// times a quarter of the step): the surface would need more samples than the 2000000 a walk's
+// terrain may have, and the character may miss footholds"; else "".
+std::string CoarserThanStepsNote(const TerrainLoadReport& report, double wanted);
+
 // Reads the mesh or height map at `path` (load: its frame flags and sample budget; its
 // separation must be 0) and resamples it for `character` walking as `options` say. Errors as
 // LoadTerrain; kInvalidArgument for a point file or a separation set; kLimitExceeded for a
