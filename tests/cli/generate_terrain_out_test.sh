@@ -71,6 +71,14 @@ check "points: every sample written" [ "$("$footfall" terrain info "$work/hills_
   "$("$footfall" terrain info "$hills" | sed -n 's/^samples: //p')" ]
 check "points: the feet stand on the written samples" keys_on_samples "$work/hills_walk.json" "$work/hills_copy.xyz"
 
+# 2b. terrain info says the spacing a flat terrain was made at, coarse or fine.
+for spacing in 0.25 0.04; do
+  "$footfall" terrain make flat --spacing $spacing --size 20 -o "$work/flat.pts" > /dev/null
+  said=$("$footfall" terrain info "$work/flat.pts" | sed -n 's/^sample spacing: about \([^ ]*\) .*/\1/p')
+  check "terrain info: sample spacing about $spacing (said '$said')" \
+    python3 -c "import sys; s = float(sys.argv[1]); sys.exit(not abs(s - $spacing) < 0.1 * $spacing)" "$said"
+done
+
 # 3. A --server-terrain's samples are not here: refused before anything is read or written.
 "$footfall" generate --server-terrain hills.pts --server 127.0.0.1:1 --character "$quadruped" \
   --out "$work/s.json" --out "$work/s.pts" 2> "$work/server.err"

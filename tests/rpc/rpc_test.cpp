@@ -438,6 +438,8 @@ TEST_CASE("RPC answers equal the embedded engine", "[rpc]") {
     CHECK(ri.stats.bounds_max == li.stats.bounds_max);
     CHECK(ri.stats.cells[0] == li.stats.cells[0]);
     CHECK(ri.stats.bytes == li.stats.bytes);
+    CHECK(ri.stats.spacing == li.stats.spacing);
+    CHECK(li.stats.spacing > 0);
   }
   SECTION("unload and unknown terrains") {
     REQUIRE(rpc->Unload(remote) == Status::kOk);

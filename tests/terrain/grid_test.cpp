@@ -479,6 +479,31 @@ TEST_CASE("TerrainGrid next from flat ground straight up skips blocks level with
   CHECK(trace.examined_samples.size() * 10 < st.samples);
 }
 
+TEST_CASE("TerrainGrid reports its samples' spacing whatever its cells hold", "[terrain][grid]") {
+  struct Case {
+    RawSamples samples;
+    double spacing;  // as generated
+  };
+  const Case cases[] = {{MakeFlat(200, 0.25, 3), 0.25},
+                        {MakeHills(300, 0.02, 0.5, 7), 0.02},
+                        {MakeRamp(150, 120, 0.5, 30), 0.5}};
+  for (const Case& c : cases) {
+    double first = 0;
+    for (const double per_cell : {4.0, 12.0, 24.0, 60.0}) {
+      GridOptions options;
+      options.samples_per_cell = per_cell;
+      const TerrainGrid g = Build(c.samples, options);
+      INFO("generated every " << c.spacing << ", " << per_cell << " samples per cell");
+      // Along the ground: slopes and hills spread it a little.
+      CHECK(g.stats().spacing > 0.95 * c.spacing);
+      CHECK(g.stats().spacing < 1.3 * c.spacing);
+      if (first == 0) first = g.stats().spacing;
+      CHECK(g.stats().spacing == first);
+    }
+  }
+  CHECK(Build(RawSamples{}).stats().spacing == 0);
+}
+
 TEST_CASE("TerrainGrid keeps memory bounded", "[terrain][grid]") {
   SECTION("an empty grid answers no foothold") {
     TerrainGrid g;

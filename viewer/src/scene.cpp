@@ -119,10 +119,7 @@ Status Scene::LoadTerrain(const std::string& path, const TerrainLoadOptions& opt
   grid_ = std::move(grid);
   terrain_path_ = path;
   const GridStats& st = grid_.stats();
-  if (st.samples > 0 && st.occupied_cells > 0) {
-    spacing_ = st.cell_size *
-               std::sqrt(static_cast<double>(st.occupied_cells) / static_cast<double>(st.samples));
-  }
+  if (st.spacing > 0) spacing_ = st.spacing;
   for (const Vec3& p : samples_.points) Grow(p, &lo_, &hi_, &has_bounds_);
   bool any_cell = false;
   for (const uint32_t cell : grid_.OccupiedCells()) {

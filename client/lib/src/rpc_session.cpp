@@ -129,6 +129,7 @@ class RpcSession final : public TerrainSession {
       out->stats.cell_size = r.cell_size;
       out->stats.occupied_cells = r.occupied_cells;
       out->stats.bytes = r.bytes;
+      out->stats.spacing = r.spacing;
       return Status::kOk;
     });
   }

@@ -46,10 +46,7 @@ Status Generator::Setup(std::string* error) {
   if (s != Status::kOk) return s;
   const GridStats& g = info.stats;
   bounds_min_ = g.bounds_min, bounds_max_ = g.bounds_max;
-  gap_ = g.samples > 0
-             ? 2 * g.cell_size *
-                   std::sqrt(static_cast<double>(g.occupied_cells) / static_cast<double>(g.samples))
-             : 0;
+  gap_ = 2 * g.spacing;
   // 1. The start: --start, or the centre of the top of the bounds; either may move to where
   //    the character can stand.
   const Vec3 start =

@@ -383,7 +383,7 @@ class Generator {
   // ground moves step_length over the number of gait groups a step).
   double turn_radius_ = 0;
   // The farthest a point of the surface may be from its nearest sample, estimated from the
-  // grid: twice the mean spacing, cell_size / sqrt(samples per occupied cell). [Units: wu]
+  // grid: twice its sample spacing (GridStats::spacing). [Units: wu]
   double gap_ = 0;
   Vec3 bounds_min_, bounds_max_;  // the terrain's samples' bounds
   // cos(max_slope_deg), sin(slope_threshold_deg): slope tests on dot products of unit vectors.

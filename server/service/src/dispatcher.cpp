@@ -480,6 +480,7 @@ void Info(const ff_terrain_args& a, ff_info_reply* r) {
   r->cell_size = st.cell_size;
   r->occupied_cells = st.occupied_cells;
   r->bytes = st.bytes;
+  r->spacing = st.spacing;
 }
 
 void Unload(const ff_terrain_args& a, uint64_t client, ff_status_reply* r) {

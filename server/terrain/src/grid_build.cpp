@@ -17,6 +17,9 @@ namespace {
 
 using detail::kBlockCells;
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// GridStats::spacing is measured on cells grown to hold about this many samples each, whatever
+// the query cells hold: callers size their checks by it (the step generator's swing arcs).
+constexpr double kSpacingSamplesPerCell = 12;
 
 // Total cells for a cell size h over local extents e, saturating in double.
 double CellCount(const double e[3], double h) {
@@ -53,6 +56,29 @@ void ChooseGridBox(const RawSamples& s, const double lo[3], const double hi[3], 
       ghi[a] = std::min(hi[a], q_hi + margin);
     }
   }
+}
+
+// The cells of size h over the grid box (local corner lo, extents e) that hold a sample of
+// `local` (x, y, z per sample), each sample in the cell TerrainGrid::CellCoord gives it.
+size_t CountOccupiedCells(const std::vector<float>& local, const double lo[3], const double e[3],
+                          double h) {
+  uint32_t dims[3];
+  for (int a = 0; a < 3; ++a) dims[a] = AxisCells(e[a], h);
+  const double inv = 1 / h;
+  auto coord = [&](float v, int a) -> size_t {
+    const double t = (v - lo[a]) * inv;
+    if (!(t > 0)) return 0;
+    if (t >= static_cast<double>(dims[a])) return dims[a] - 1;
+    return static_cast<size_t>(t);
+  };
+  std::vector<bool> occupied(size_t{dims[0]} * dims[1] * dims[2], false);
+  size_t count = 0;
+  for (size_t i = 0; i + 2 < local.size(); i += 3) {
+    const size_t cell =
+        (coord(local[i + 2], 2) * dims[1] + coord(local[i + 1], 1)) * dims[0] + coord(local[i], 0);
+    if (!occupied[cell]) occupied[cell] = true, ++count;
+  }
+  return count;
 }
 
 }  // namespace
@@ -132,31 +158,28 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
     for (int a = 0; a < 3; ++a) g.bounds_lo_[a] = g.bounds_hi_[a] = 0;
   }
   // 4. Cell size: the smallest that fits the memory cap, then grown until occupied cells hold
-  //    about options.samples_per_cell samples (a surface's occupancy falls as 1/h^2).
+  //    about options.samples_per_cell samples (a surface's occupancy falls as 1/h^2). The
+  //    sample spacing is measured on cells grown to kSpacingSamplesPerCell instead, so that it
+  //    does not follow the query cells' size.
   const double budget = std::max(64.0, options.cells_per_sample * static_cast<double>(n));
   const double max_extent = std::max({extent[0], extent[1], extent[2]});
-  double h = 1;
+  double h = 1, spacing_h = 1;
+  size_t spacing_occupied = 0;  // 0: count them in the final grid (spacing_h == h)
   if (max_extent > 0) {
     double h_hi = max_extent, h_lo = max_extent / (budget + 1);
     for (int it = 0; it < 100 && h_hi > h_lo * (1 + 1e-12); ++it) {
       const double mid = std::sqrt(h_lo * h_hi);
       (CellCount(extent, mid) <= budget ? h_hi : h_lo) = mid;
     }
-    h = h_hi;
-    g.cell_size_ = h, g.inv_cell_size_ = 1 / h;
-    for (int a = 0; a < 3; ++a) g.dims_[a] = AxisCells(extent[a], h);
-    const size_t total = size_t{g.dims_[0]} * g.dims_[1] * g.dims_[2];
-    std::vector<bool> occupied(total, false);
-    size_t occupied_count = 0;
-    for (size_t i = 0; i < n; ++i) {
-      const float* p = &local[3 * i];
-      const size_t cell =
-          (size_t{g.CellCoord(p[2], 2)} * g.dims_[1] + g.CellCoord(p[1], 1)) * g.dims_[0] +
-          g.CellCoord(p[0], 0);
-      if (!occupied[cell]) occupied[cell] = true, ++occupied_count;
-    }
-    const double per_cell = static_cast<double>(n) / std::max<size_t>(1, occupied_count);
-    if (per_cell < options.samples_per_cell) h *= std::sqrt(options.samples_per_cell / per_cell);
+    const double per_cell =
+        static_cast<double>(n) /
+        std::max<size_t>(1, CountOccupiedCells(local, g.grid_lo_, extent, h_hi));
+    auto grown = [&](double target) {
+      return per_cell < target ? h_hi * std::sqrt(target / per_cell) : h_hi;
+    };
+    h = grown(options.samples_per_cell);
+    spacing_h = grown(kSpacingSamplesPerCell);
+    if (spacing_h != h) spacing_occupied = CountOccupiedCells(local, g.grid_lo_, extent, spacing_h);
   }
   g.cell_size_ = h, g.inv_cell_size_ = 1 / h;
   for (int a = 0; a < 3; ++a) g.dims_[a] = AxisCells(extent[a], h);
@@ -240,6 +263,10 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
   for (int a = 0; a < 3; ++a) st.cells[a] = g.dims_[a];
   st.cell_size = h;
   st.occupied_cells = occupied_cells;
+  if (spacing_occupied == 0) spacing_occupied = occupied_cells;
+  st.spacing =
+      n > 0 ? spacing_h * std::sqrt(static_cast<double>(spacing_occupied) / static_cast<double>(n))
+            : 0;
   st.bytes = bytes;
   st.max_rounding = std::max(std::sqrt(rounding2), tiny_rounding);
   const double* o = g.origin_;

@@ -61,6 +61,11 @@ struct GridStats {
   uint32_t cells[3] = {0, 0, 0};  // grid dimensions in x, y, z
   double cell_size = 0;           // [Units: wu] edge length of a (cubic) cell
   size_t occupied_cells = 0;
+  // [Units: wu] The typical distance between neighbouring samples, taking them as a surface: the
+  // side of the square each sample covers, from how many cells they occupy in a grid of about
+  // 12 samples per occupied cell (not the query cells: it does not change with
+  // GridOptions::samples_per_cell). 0 for no samples.
+  double spacing = 0;
   size_t bytes = 0;             // the grid's single allocation
   Vec3 bounds_min, bounds_max;  // world-space bounds of all samples
   Vec3 grid_min, grid_max;      // world-space box the cells divide (the bulk of the samples)
