@@ -11,6 +11,8 @@
 #include <tuple>
 #include <vector>
 
+#include "footfall/terrain/large_memory.h"
+
 namespace footfall {
 namespace {
 
@@ -99,14 +101,14 @@ class CellTable {
     size_ = 0;
   }
   void Grow() {
-    std::vector<Entry> old;
+    LargeVector<Entry> old;
     old.swap(entries_);
     Reset(old.size() * 2);
     for (const Entry& e : old) {
       if (e.key != kEmpty) Insert(e.key, e.id);
     }
   }
-  std::vector<Entry> entries_;
+  LargeVector<Entry> entries_;
   size_t mask_ = 0, size_ = 0;
 };
 
@@ -122,15 +124,17 @@ class CellMap {
     if (id == kNone) id = next;
     return id;
   }
-  uint32_t Find(uint64_t x, uint64_t y, uint64_t z) {
-    const uint32_t* block = Block(x, y, z, false);
-    return block ? block[Local(x, y, z)] : kNone;
+  // The ids of tile (tx, ty, tz), cells (4 tx .. 4 tx + 3, ...), at Local(x, y, z) (kNone
+  // where absent), or nullptr when the tile holds no cell.
+  const uint32_t* Tile(uint64_t tx, uint64_t ty, uint64_t tz) const {
+    const uint32_t tile = tiles_.Find(CellKey(tx, ty, tz));
+    return tile == kNone ? nullptr : &blocks_[static_cast<size_t>(tile) * 64];
   }
-
- private:
   static size_t Local(uint64_t x, uint64_t y, uint64_t z) {
     return static_cast<size_t>((x & 3) << 4 | (y & 3) << 2 | (z & 3));
   }
+
+ private:
   uint32_t* Block(uint64_t x, uint64_t y, uint64_t z, bool create) {
     const uint64_t key = CellKey(x >> 2, y >> 2, z >> 2);
     if (key != last_key_) {
@@ -145,7 +149,7 @@ class CellMap {
     return &blocks_[static_cast<size_t>(last_tile_) * 64];
   }
   CellTable tiles_;
-  std::vector<uint32_t> blocks_;
+  LargeVector<uint32_t> blocks_;
   uint64_t last_key_ = ~0ull;
   uint32_t last_tile_ = 0;
 };
@@ -345,33 +349,19 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
     return Status::kLimitExceeded;
   }
 
-  // 1. Candidates by longest-edge bisection, one per piece at its centroid. Counted first:
-  // long thin triangles (a height map whose cells are far smaller than its heights) are cut
-  // into far more pieces than their area predicts, and are refused before any is stored. Pieces
-  // keep their triangle's thinness: well-shaped triangles give about 9 per predicted sample,
-  // slivers 70 times longer than wide about 175; the limit allows 256 (at least 4 million),
-  // within 32 per sample of the budget. (A 2 x 2 16-bit height map 65535 units tall took 80 s and
-  // 4.6 GB for 136,000 samples under the budget's limit alone.)
+  // 1. Candidates by longest-edge bisection, one per piece at its centroid. Long thin
+  // triangles (a height map whose cells are far smaller than its heights) are cut into far more
+  // pieces than their area predicts, and are refused before many are stored. Pieces keep
+  // their triangle's thinness: well-shaped triangles give about 9 per predicted sample, slivers
+  // 70 times longer than wide about 175; the limit allows 256 (at least 4 million), within 32
+  // per sample of the budget. (A 2 x 2 16-bit height map 65535 units tall took 80 s and 4.6 GB
+  // for 136,000 samples under the budget's limit alone.)
   const double pieces_for_area = std::max(256 * predicted, 4e6);
   const size_t candidate_limit =
       static_cast<size_t>(
           std::min(pieces_for_area, 32.0 * static_cast<double>(options.max_samples))) +
       mesh.triangles.size();
-  // Counting takes seconds for the worst slivers (heights of 1e6 on unit cells: 16 s). Pieces
-  // keep their triangle's shape, so a triangle with longest edge L makes about (L / 1.5h)^2
-  // of them; the estimate overshoots slivers by up to ~15 times (the tests' 1e4 x 1e-4 strip),
-  // so only an estimate 64 times over the limit refuses at once, without counting.
-  double estimate = 0;
-  for (const auto& tri : mesh.triangles) {
-    const Vec3 &a = mesh.vertices[tri[0]], &b = mesh.vertices[tri[1]], &c = mesh.vertices[tri[2]];
-    const double longest2 = std::max({Distance2(a, b), Distance2(b, c), Distance2(c, a)});
-    estimate += std::max(1.0, longest2 / (2.25 * h2));
-  }
-  std::vector<Piece> stack;
-  size_t counted = estimate > 64.0 * static_cast<double>(candidate_limit) ? candidate_limit + 1 : 0;
-  for (size_t t = 0; t < mesh.triangles.size() && counted <= candidate_limit; ++t)
-    SplitTriangle(mesh, t, h2, &stack, [&](const Piece&) { return ++counted <= candidate_limit; });
-  if (counted > candidate_limit) {
+  auto refuse_pieces = [&]() {
     if (error) {
       *error = "separation " + Format3(s) + " would cut the mesh into more than " +
                std::to_string(candidate_limit) +
@@ -381,11 +371,35 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
                                 RoundUp3(1.01 * s)));
     }
     return Status::kLimitExceeded;
+  };
+  // Pieces keep their triangle's shape, so a triangle with longest edge L makes about
+  // (L / 1.5h)^2 of them: up to about twice as many when well shaped, and the estimate
+  // overshoots slivers by up to ~15 times (the tests' 1e4 x 1e-4 strip). An estimate 64 times
+  // over the limit refuses at once; one within an eighth of it is cut straight into candidates
+  // (a limit reached all the same stops the cutting there); between the two, the pieces are
+  // counted first (seconds for the worst slivers, heights of 1e6 on unit cells: 16 s), so that
+  // none is stored for a mesh refused.
+  double estimate = 0;
+  for (const auto& tri : mesh.triangles) {
+    const Vec3 &a = mesh.vertices[tri[0]], &b = mesh.vertices[tri[1]], &c = mesh.vertices[tri[2]];
+    const double longest2 = std::max({Distance2(a, b), Distance2(b, c), Distance2(c, a)});
+    estimate += std::max(1.0, longest2 / (2.25 * h2));
   }
-  std::vector<Candidate> candidates;
-  candidates.reserve(counted);
-  std::vector<uint32_t> first_candidate(mesh.triangles.size() + 1);  // per triangle
-  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+  const double limit = static_cast<double>(candidate_limit);
+  if (estimate > 64 * limit) return refuse_pieces();
+  std::vector<Piece> stack;
+  size_t expected = static_cast<size_t>(std::min(limit, 3 * estimate));
+  if (8 * estimate > limit) {
+    size_t counted = 0;
+    for (size_t t = 0; t < mesh.triangles.size() && counted <= candidate_limit; ++t)
+      SplitTriangle(mesh, t, h2, &stack, [&](const Piece&) { return ++counted <= candidate_limit; });
+    if (counted > candidate_limit) return refuse_pieces();
+    expected = counted;
+  }
+  LargeVector<Candidate> candidates;
+  candidates.reserve(expected);
+  LargeVector<uint32_t> first_candidate(mesh.triangles.size() + 1);  // per triangle
+  for (size_t t = 0; t < mesh.triangles.size() && candidates.size() <= candidate_limit; ++t) {
     first_candidate[t] = static_cast<uint32_t>(candidates.size());
     const Vec3 normal = Normalize(TriangleCross(mesh, t));
     int8_t side[4] = {0, 0, 0, 0};
@@ -399,16 +413,17 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
       candidates.push_back(
           {{static_cast<float>(local.x), static_cast<float>(local.y), static_cast<float>(local.z)},
            {side[0], side[1], side[2], 0}});
-      return true;
+      return candidates.size() <= candidate_limit;
     });
   }
+  if (candidates.size() > candidate_limit) return refuse_pieces();
   first_candidate.back() = static_cast<uint32_t>(candidates.size());
 
   // Cells of side r over the bounds; each candidate's cell id.
   const size_t n = candidates.size();
   auto table = std::make_unique<CellMap>(static_cast<size_t>(predicted) + 16);
-  std::vector<uint32_t> cell_of(n);
-  std::vector<uint64_t> cell_keys;
+  LargeVector<uint32_t> cell_of(n);
+  LargeVector<uint64_t> cell_keys;
   uint64_t last_key = ~0ull;
   uint32_t last_id = kNone;
   for (size_t c = 0; c < n; ++c) {
@@ -443,14 +458,14 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
     for (int m = 27; m > 1; --m) std::swap(phase_order[m - 1], phase_order[rng.Below(m)]);
     for (int p = 0; p < 27; ++p) phase_rank[phase_order[p]] = p;
   }
-  std::vector<uint32_t> rank(cells);
+  LargeVector<uint32_t> rank(cells);
   {
-    std::vector<std::tuple<uint64_t, int, uint32_t>> sort_keys(cells);
+    LargeVector<std::tuple<uint64_t, int, uint32_t>> sort_keys(cells);
     for (uint32_t id = 0; id < cells; ++id) {
       sort_keys[id] = {tile_of(cell_keys[id]), phase_rank[phase_of(cell_keys[id])], id};
     }
     std::sort(sort_keys.begin(), sort_keys.end());
-    std::vector<uint64_t> sorted_keys(cells);
+    LargeVector<uint64_t> sorted_keys(cells);
     for (uint32_t r = 0; r < cells; ++r) {
       rank[std::get<2>(sort_keys[r])] = r;
       sorted_keys[r] = cell_keys[std::get<2>(sort_keys[r])];
@@ -458,43 +473,84 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
     cell_keys.swap(sorted_keys);
     for (uint32_t& id : cell_of) id = rank[id];
   }
-  // The occupied neighbours of each occupied cell (itself included), as a CSR list.
-  std::vector<uint32_t> neighbour_start(cells + 1, 0);
-  std::vector<uint32_t> neighbours;
+  // The occupied neighbours of each occupied cell (itself included), as a CSR list. Cells are
+  // taken tile by tile (their order since the renumbering): the ids of a tile's cells and of
+  // the cells around it are first copied into `window`, from the few table tiles it overlaps.
+  LargeVector<uint32_t> neighbour_start(cells + 1, 0);
+  LargeVector<uint32_t> neighbours;
   neighbours.reserve(cells * 9);
-  for (size_t id = 0; id < cells; ++id) {
-    const uint64_t key = cell_keys[id];
-    const uint64_t x = key >> (2 * kCellBits), y = (key >> kCellBits) & field, z = key & field;
-    // Nearest first (itself, then faces, edges, corners): most rejections end early.
-    for (int ring = 0; ring <= 3; ++ring) {
-      for (int dx = -1; dx <= 1; ++dx) {
-        for (int dy = -1; dy <= 1; ++dy) {
-          for (int dz = -1; dz <= 1; ++dz) {
-            if (std::abs(dx) + std::abs(dy) + std::abs(dz) != ring) continue;
-            const uint32_t other = table->Find(x + dx, y + dy, z + dz);
-            if (other != kNone) neighbours.push_back(rank[other]);
-          }
+  constexpr int kWindow = 10;  // a tile's 8 cells and one more each side, per axis
+  std::vector<uint32_t> window(kWindow * kWindow * kWindow);
+  for (size_t tile_begin = 0; tile_begin < cells;) {
+    const uint64_t tile = tile_of(cell_keys[tile_begin]);
+    size_t tile_end = tile_begin + 1;
+    while (tile_end < cells && tile_of(cell_keys[tile_end]) == tile) ++tile_end;
+    // The window's lowest cell, per axis (-1 beside tile 0: cells are numbered from 1).
+    const int64_t base[3] = {static_cast<int64_t>(tile >> (2 * kCellBits)) * 8 - 1,
+                             static_cast<int64_t>((tile >> kCellBits) & field) * 8 - 1,
+                             static_cast<int64_t>(tile & field) * 8 - 1};
+    std::fill(window.begin(), window.end(), kNone);
+    // The table tiles (4 cells wide) the window overlaps, and the cells of each in it.
+    auto tiles = [&](int a) {
+      return std::make_pair(std::max<int64_t>(0, base[a] >> 2), (base[a] + kWindow - 1) >> 2);
+    };
+    const auto [x0, x1] = tiles(0);
+    const auto [y0, y1] = tiles(1);
+    const auto [z0, z1] = tiles(2);
+    for (int64_t tx = x0; tx <= x1; ++tx) {
+      for (int64_t ty = y0; ty <= y1; ++ty) {
+        for (int64_t tz = z0; tz <= z1; ++tz) {
+          const uint32_t* ids = table->Tile(tx, ty, tz);
+          if (!ids) continue;
+          const int64_t t[3] = {tx, ty, tz};
+          int64_t lo[3], hi[3];
+          for (int a = 0; a < 3; ++a)
+            lo[a] = std::max(4 * t[a], base[a]), hi[a] = std::min(4 * t[a] + 3, base[a] + 9);
+          for (int64_t x = lo[0]; x <= hi[0]; ++x)
+            for (int64_t y = lo[1]; y <= hi[1]; ++y)
+              for (int64_t z = lo[2]; z <= hi[2]; ++z)
+                window[((x - base[0]) * kWindow + (y - base[1])) * kWindow + (z - base[2])] =
+                    ids[CellMap::Local(x, y, z)];
         }
       }
     }
-    neighbour_start[id + 1] = static_cast<uint32_t>(neighbours.size());
+    for (size_t id = tile_begin; id < tile_end; ++id) {
+      const uint64_t key = cell_keys[id];
+      const int64_t x = static_cast<int64_t>(key >> (2 * kCellBits)) - base[0];
+      const int64_t y = static_cast<int64_t>((key >> kCellBits) & field) - base[1];
+      const int64_t z = static_cast<int64_t>(key & field) - base[2];
+      // Nearest first (itself, then faces, edges, corners): most rejections end early.
+      for (int ring = 0; ring <= 3; ++ring) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          for (int dy = -1; dy <= 1; ++dy) {
+            for (int dz = -1; dz <= 1; ++dz) {
+              if (std::abs(dx) + std::abs(dy) + std::abs(dz) != ring) continue;
+              const uint32_t other = window[((x + dx) * kWindow + (y + dy)) * kWindow + (z + dz)];
+              if (other != kNone) neighbours.push_back(rank[other]);
+            }
+          }
+        }
+      }
+      neighbour_start[id + 1] = static_cast<uint32_t>(neighbours.size());
+    }
+    tile_begin = tile_end;
   }
   table.reset();  // what steps 2 and 3 no longer need goes before they allocate theirs
-  std::vector<uint32_t>().swap(rank);
+  LargeVector<uint32_t>().swap(rank);
 
   // 2. A seeded random order with locality (after Wei, "Parallel Poisson disk sampling", 2008):
   // each cell's candidates are shuffled; then, tile by tile, pass j tries the j-th candidate of
   // every cell of the tile, cells taken by phase in a seeded phase order. Cells of one phase are
   // at least 2r apart, so the order within a phase does not matter.
-  std::vector<uint32_t> cell_start(cells + 1, 0);
+  LargeVector<uint32_t> cell_start(cells + 1, 0);
   for (size_t c = 0; c < n; ++c) ++cell_start[cell_of[c] + 1];
   for (size_t id = 0; id < cells; ++id) cell_start[id + 1] += cell_start[id];
-  std::vector<uint32_t> by_cell(n);
+  LargeVector<uint32_t> by_cell(n);
   {
-    std::vector<uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
+    LargeVector<uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
     for (size_t c = 0; c < n; ++c) by_cell[fill[cell_of[c]]++] = static_cast<uint32_t>(c);
   }
-  std::vector<uint32_t>().swap(cell_of);
+  LargeVector<uint32_t>().swap(cell_of);
   for (size_t id = 0; id < cells; ++id) {
     uint32_t* first = &by_cell[cell_start[id]];
     for (uint32_t m = cell_start[id + 1] - cell_start[id]; m > 1; --m) {
@@ -517,10 +573,10 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
     Candidate p[kBlock];
     uint32_t next = kNone;
   };
-  std::vector<Slots> slots(cells);
+  LargeVector<Slots> slots(cells);
   for (Slots& slot : slots) slot.count = 0;
-  std::vector<Block> overflow;
-  std::vector<uint32_t> accepted;
+  LargeVector<Block> overflow;
+  LargeVector<uint32_t> accepted;
   accepted.reserve(static_cast<size_t>(predicted * 1.2) + 16);
   const float r2f = static_cast<float>(r2);
   // Too near an accepted piece facing the same way.
@@ -589,7 +645,7 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   out->points.reserve(accepted.size());
   out->normals.reserve(accepted.size());
   const size_t accepted_count = accepted.size();
-  std::vector<Candidate>().swap(candidates);  // no longer needed: step 4 cuts again
+  LargeVector<Candidate>().swap(candidates);  // no longer needed: step 4 cuts again
   // Each triangle holding accepted pieces is cut again (the same pieces in the same order); a
   // piece's barycentric position is the mean of its corners', as step 1 had it.
   std::vector<std::array<float, 2>> piece_uv;
