@@ -154,35 +154,51 @@ class CellMap {
   uint32_t last_tile_ = 0;
 };
 
-// A piece of a triangle in step 1's longest-edge bisection.
+// A piece of a triangle in step 1's longest-edge bisection: its corners and how many cuts
+// made it, and with kBarycentric (for step 4) each corner's barycentric (u, v) in the source
+// triangle.
+template <bool kBarycentric>
 struct Piece {
   Vec3 p[3];
-  double b[3][2];  // barycentric (u, v) of each corner in the source triangle
   int depth;
+};
+template <>
+struct Piece<true> {
+  Vec3 p[3];
+  int depth;
+  double b[3][2];
 };
 
 // Step 1 for triangle t: bisects its longest edge until each piece's centroid lies within
 // sqrt(h2) of the piece's corners (or 60 cuts deep), and calls leaf(piece) for each final
 // piece, in a fixed order, until leaf returns false. `stack` is scratch space.
-template <typename Leaf>
-void SplitTriangle(const TriangleMesh& mesh, size_t t, double h2, std::vector<Piece>* stack,
-                   const Leaf& leaf) {
+template <bool kBarycentric, typename Leaf>
+void SplitTriangle(const TriangleMesh& mesh, size_t t, double h2,
+                   std::vector<Piece<kBarycentric>>* stack, const Leaf& leaf) {
   const auto& tri = mesh.triangles[t];
   stack->clear();
-  stack->push_back({{mesh.vertices[tri[0]], mesh.vertices[tri[1]], mesh.vertices[tri[2]]},
-                    {{0, 0}, {1, 0}, {0, 1}},
-                    0});
+  Piece<kBarycentric> whole;
+  whole.p[0] = mesh.vertices[tri[0]], whole.p[1] = mesh.vertices[tri[1]];
+  whole.p[2] = mesh.vertices[tri[2]];
+  whole.depth = 0;
+  if constexpr (kBarycentric) {
+    const double corners[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+    std::copy(&corners[0][0], &corners[0][0] + 6, &whole.b[0][0]);
+  }
+  stack->push_back(whole);
   while (!stack->empty()) {
-    const Piece piece = stack->back();
-    stack->pop_back();
+    Piece<kBarycentric>& piece = stack->back();
     const Vec3 g = (piece.p[0] + piece.p[1] + piece.p[2]) / 3;
     const double reach =
         std::max({Distance2(g, piece.p[0]), Distance2(g, piece.p[1]), Distance2(g, piece.p[2])});
     if (reach <= h2 || piece.depth >= 60) {
-      if (!leaf(piece)) return;
+      const bool more = leaf(piece);
+      stack->pop_back();
+      if (!more) return;
       continue;
     }
-    // Split the longest edge (i, j) at its midpoint; k is the opposite corner.
+    // Split the longest edge (i, j) at its midpoint; k is the opposite corner. The piece
+    // becomes (m, j, k) where it lies, and (i, m, k) goes above it, to be cut first.
     int i = 0;
     double longest = -1;
     for (int e = 0; e < 3; ++e) {
@@ -190,14 +206,17 @@ void SplitTriangle(const TriangleMesh& mesh, size_t t, double h2, std::vector<Pi
       if (d > longest) longest = d, i = e;
     }
     const int j = (i + 1) % 3;
-    Piece a = piece, b = piece;
+    Piece<kBarycentric> a = piece;
     const Vec3 m = (piece.p[i] + piece.p[j]) / 2;
-    const double mb[2] = {(piece.b[i][0] + piece.b[j][0]) / 2, (piece.b[i][1] + piece.b[j][1]) / 2};
-    a.p[j] = m, a.b[j][0] = mb[0], a.b[j][1] = mb[1];  // (i, m, k)
-    b.p[i] = m, b.b[i][0] = mb[0], b.b[i][1] = mb[1];  // (m, j, k)
-    a.depth = b.depth = piece.depth + 1;
-    stack->push_back(b);
-    stack->push_back(a);
+    a.p[j] = m, piece.p[i] = m;
+    if constexpr (kBarycentric) {
+      const double mb[2] = {(piece.b[i][0] + piece.b[j][0]) / 2,
+                            (piece.b[i][1] + piece.b[j][1]) / 2};
+      a.b[j][0] = mb[0], a.b[j][1] = mb[1];
+      piece.b[i][0] = mb[0], piece.b[i][1] = mb[1];
+    }
+    a.depth = piece.depth = piece.depth + 1;
+    stack->push_back(a);  // (piece is not used again: the push may move it)
   }
 }
 
@@ -387,12 +406,13 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   }
   const double limit = static_cast<double>(candidate_limit);
   if (estimate > 64 * limit) return refuse_pieces();
-  std::vector<Piece> stack;
+  std::vector<Piece<false>> stack;
   size_t expected = static_cast<size_t>(std::min(limit, 3 * estimate));
   if (8 * estimate > limit) {
     size_t counted = 0;
     for (size_t t = 0; t < mesh.triangles.size() && counted <= candidate_limit; ++t)
-      SplitTriangle(mesh, t, h2, &stack, [&](const Piece&) { return ++counted <= candidate_limit; });
+      SplitTriangle(mesh, t, h2, &stack,
+                    [&](const Piece<false>&) { return ++counted <= candidate_limit; });
     if (counted > candidate_limit) return refuse_pieces();
     expected = counted;
   }
@@ -408,7 +428,7 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
       side[1] = static_cast<int8_t>(std::lround(127 * normal.y));
       side[2] = static_cast<int8_t>(std::lround(127 * normal.z));
     }
-    SplitTriangle(mesh, t, h2, &stack, [&](const Piece& piece) {
+    SplitTriangle(mesh, t, h2, &stack, [&](const Piece<false>& piece) {
       const Vec3 local = (piece.p[0] + piece.p[1] + piece.p[2]) / 3 - lo;
       candidates.push_back(
           {{static_cast<float>(local.x), static_cast<float>(local.y), static_cast<float>(local.z)},
@@ -649,12 +669,13 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   // Each triangle holding accepted pieces is cut again (the same pieces in the same order); a
   // piece's barycentric position is the mean of its corners', as step 1 had it.
   std::vector<std::array<float, 2>> piece_uv;
+  std::vector<Piece<true>> uv_stack;
   for (size_t a = 0; a < accepted.size();) {
     const size_t t = static_cast<size_t>(
         std::upper_bound(first_candidate.begin(), first_candidate.end(), accepted[a]) -
         first_candidate.begin() - 1);
     piece_uv.clear();
-    SplitTriangle(mesh, t, h2, &stack, [&](const Piece& piece) {
+    SplitTriangle(mesh, t, h2, &uv_stack, [&](const Piece<true>& piece) {
       piece_uv.push_back({static_cast<float>((piece.b[0][0] + piece.b[1][0] + piece.b[2][0]) / 3),
                           static_cast<float>((piece.b[0][1] + piece.b[1][1] + piece.b[2][1]) / 3)});
       return true;
