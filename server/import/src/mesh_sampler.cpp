@@ -407,7 +407,9 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   const double limit = static_cast<double>(candidate_limit);
   if (estimate > 64 * limit) return refuse_pieces();
   std::vector<Piece<false>> stack;
-  size_t expected = static_cast<size_t>(std::min(limit, 3 * estimate));
+  // (The estimate came within 0.74 to 1.13 of the count on real and generated meshes.)
+  size_t expected = static_cast<size_t>(
+      std::min(limit, 1.5 * estimate + static_cast<double>(mesh.triangles.size())));
   if (8 * estimate > limit) {
     size_t counted = 0;
     for (size_t t = 0; t < mesh.triangles.size() && counted <= candidate_limit; ++t)
@@ -493,67 +495,81 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
     cell_keys.swap(sorted_keys);
     for (uint32_t& id : cell_of) id = rank[id];
   }
-  // The occupied neighbours of each occupied cell (itself included), as a CSR list. Cells are
-  // taken tile by tile (their order since the renumbering): the ids of a tile's cells and of
-  // the cells around it are first copied into `window`, from the few table tiles it overlaps.
-  LargeVector<uint32_t> neighbour_start(cells + 1, 0);
-  LargeVector<uint32_t> neighbours;
-  neighbours.reserve(cells * 9);
+  // The occupied neighbours of each occupied cell (itself included), as a CSR list, counted
+  // first so that the list is allocated once. Cells are taken tile by tile (their order since
+  // the renumbering): the ids of a tile's cells and of the cells around it are first copied
+  // into `window`, from the few table tiles it overlaps.
   constexpr int kWindow = 10;  // a tile's 8 cells and one more each side, per axis
   std::vector<uint32_t> window(kWindow * kWindow * kWindow);
-  for (size_t tile_begin = 0; tile_begin < cells;) {
-    const uint64_t tile = tile_of(cell_keys[tile_begin]);
-    size_t tile_end = tile_begin + 1;
-    while (tile_end < cells && tile_of(cell_keys[tile_end]) == tile) ++tile_end;
-    // The window's lowest cell, per axis (-1 beside tile 0: cells are numbered from 1).
-    const int64_t base[3] = {static_cast<int64_t>(tile >> (2 * kCellBits)) * 8 - 1,
-                             static_cast<int64_t>((tile >> kCellBits) & field) * 8 - 1,
-                             static_cast<int64_t>(tile & field) * 8 - 1};
-    std::fill(window.begin(), window.end(), kNone);
-    // The table tiles (4 cells wide) the window overlaps, and the cells of each in it.
-    auto tiles = [&](int a) {
-      return std::make_pair(std::max<int64_t>(0, base[a] >> 2), (base[a] + kWindow - 1) >> 2);
-    };
-    const auto [x0, x1] = tiles(0);
-    const auto [y0, y1] = tiles(1);
-    const auto [z0, z1] = tiles(2);
-    for (int64_t tx = x0; tx <= x1; ++tx) {
-      for (int64_t ty = y0; ty <= y1; ++ty) {
-        for (int64_t tz = z0; tz <= z1; ++tz) {
-          const uint32_t* ids = table->Tile(tx, ty, tz);
-          if (!ids) continue;
-          const int64_t t[3] = {tx, ty, tz};
-          int64_t lo[3], hi[3];
-          for (int a = 0; a < 3; ++a)
-            lo[a] = std::max(4 * t[a], base[a]), hi[a] = std::min(4 * t[a] + 3, base[a] + 9);
-          for (int64_t x = lo[0]; x <= hi[0]; ++x)
-            for (int64_t y = lo[1]; y <= hi[1]; ++y)
-              for (int64_t z = lo[2]; z <= hi[2]; ++z)
-                window[((x - base[0]) * kWindow + (y - base[1])) * kWindow + (z - base[2])] =
-                    ids[CellMap::Local(x, y, z)];
-        }
-      }
-    }
-    for (size_t id = tile_begin; id < tile_end; ++id) {
-      const uint64_t key = cell_keys[id];
-      const int64_t x = static_cast<int64_t>(key >> (2 * kCellBits)) - base[0];
-      const int64_t y = static_cast<int64_t>((key >> kCellBits) & field) - base[1];
-      const int64_t z = static_cast<int64_t>(key & field) - base[2];
-      // Nearest first (itself, then faces, edges, corners): most rejections end early.
-      for (int ring = 0; ring <= 3; ++ring) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          for (int dy = -1; dy <= 1; ++dy) {
-            for (int dz = -1; dz <= 1; ++dz) {
-              if (std::abs(dx) + std::abs(dy) + std::abs(dz) != ring) continue;
-              const uint32_t other = window[((x + dx) * kWindow + (y + dy)) * kWindow + (z + dz)];
-              if (other != kNone) neighbours.push_back(rank[other]);
-            }
+  // A cell's 27 neighbours as steps in the window, nearest first (itself, then faces, edges,
+  // corners: most rejections end early).
+  int ring_steps[27];
+  {
+    int k = 0;
+    for (int ring = 0; ring <= 3; ++ring)
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dz = -1; dz <= 1; ++dz)
+            if (std::abs(dx) + std::abs(dy) + std::abs(dz) == ring)
+              ring_steps[k++] = (dx * kWindow + dy) * kWindow + dz;
+  }
+  // Calls visit(id, other) for each cell id, in order, and each of its occupied neighbours'
+  // table ids in ring_steps' order.
+  auto each_neighbour = [&](const auto& visit) {
+    for (size_t tile_begin = 0; tile_begin < cells;) {
+      const uint64_t tile = tile_of(cell_keys[tile_begin]);
+      size_t tile_end = tile_begin + 1;
+      while (tile_end < cells && tile_of(cell_keys[tile_end]) == tile) ++tile_end;
+      // The window's lowest cell, per axis (-1 beside tile 0: cells are numbered from 1).
+      const int64_t base[3] = {static_cast<int64_t>(tile >> (2 * kCellBits)) * 8 - 1,
+                               static_cast<int64_t>((tile >> kCellBits) & field) * 8 - 1,
+                               static_cast<int64_t>(tile & field) * 8 - 1};
+      std::fill(window.begin(), window.end(), kNone);
+      // The table tiles (4 cells wide) the window overlaps, and the cells of each in it.
+      auto tiles = [&](int a) {
+        return std::make_pair(std::max<int64_t>(0, base[a] >> 2), (base[a] + kWindow - 1) >> 2);
+      };
+      const auto [x0, x1] = tiles(0);
+      const auto [y0, y1] = tiles(1);
+      const auto [z0, z1] = tiles(2);
+      for (int64_t tx = x0; tx <= x1; ++tx) {
+        for (int64_t ty = y0; ty <= y1; ++ty) {
+          for (int64_t tz = z0; tz <= z1; ++tz) {
+            const uint32_t* ids = table->Tile(tx, ty, tz);
+            if (!ids) continue;
+            const int64_t t[3] = {tx, ty, tz};
+            int64_t lo[3], hi[3];
+            for (int a = 0; a < 3; ++a)
+              lo[a] = std::max(4 * t[a], base[a]), hi[a] = std::min(4 * t[a] + 3, base[a] + 9);
+            for (int64_t x = lo[0]; x <= hi[0]; ++x)
+              for (int64_t y = lo[1]; y <= hi[1]; ++y)
+                for (int64_t z = lo[2]; z <= hi[2]; ++z)
+                  window[((x - base[0]) * kWindow + (y - base[1])) * kWindow + (z - base[2])] =
+                      ids[CellMap::Local(x, y, z)];
           }
         }
       }
-      neighbour_start[id + 1] = static_cast<uint32_t>(neighbours.size());
+      for (size_t id = tile_begin; id < tile_end; ++id) {
+        const uint64_t key = cell_keys[id];
+        const int64_t x = static_cast<int64_t>(key >> (2 * kCellBits)) - base[0];
+        const int64_t y = static_cast<int64_t>((key >> kCellBits) & field) - base[1];
+        const int64_t z = static_cast<int64_t>(key & field) - base[2];
+        const uint32_t* at = &window[(x * kWindow + y) * kWindow + z];
+        for (const int step : ring_steps) {
+          const uint32_t other = at[step];
+          if (other != kNone) visit(id, other);
+        }
+      }
+      tile_begin = tile_end;
     }
-    tile_begin = tile_end;
+  };
+  LargeVector<uint32_t> neighbour_start(cells + 1, 0);
+  each_neighbour([&](size_t id, uint32_t) { ++neighbour_start[id + 1]; });
+  for (size_t id = 0; id < cells; ++id) neighbour_start[id + 1] += neighbour_start[id];
+  LargeVector<uint32_t> neighbours(neighbour_start[cells]);
+  {
+    size_t at = 0;
+    each_neighbour([&](size_t, uint32_t other) { neighbours[at++] = rank[other]; });
   }
   table.reset();  // what steps 2 and 3 no longer need goes before they allocate theirs
   LargeVector<uint32_t>().swap(rank);
@@ -666,27 +682,28 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   out->normals.reserve(accepted.size());
   const size_t accepted_count = accepted.size();
   LargeVector<Candidate>().swap(candidates);  // no longer needed: step 4 cuts again
-  // Each triangle holding accepted pieces is cut again (the same pieces in the same order); a
-  // piece's barycentric position is the mean of its corners', as step 1 had it.
-  std::vector<std::array<float, 2>> piece_uv;
+  // Each triangle holding accepted pieces is cut again (the same pieces in the same order), up
+  // to its last accepted piece; a piece's barycentric position is the mean of its corners', as
+  // step 1 had it.
   std::vector<Piece<true>> uv_stack;
   for (size_t a = 0; a < accepted.size();) {
     const size_t t = static_cast<size_t>(
         std::upper_bound(first_candidate.begin(), first_candidate.end(), accepted[a]) -
         first_candidate.begin() - 1);
-    piece_uv.clear();
-    SplitTriangle(mesh, t, h2, &uv_stack, [&](const Piece<true>& piece) {
-      piece_uv.push_back({static_cast<float>((piece.b[0][0] + piece.b[1][0] + piece.b[2][0]) / 3),
-                          static_cast<float>((piece.b[0][1] + piece.b[1][1] + piece.b[2][1]) / 3)});
-      return true;
-    });
     std::array<Vec3, 3> corners;
     if (corner_normals) corners = corner_normals->Of(t);
-    for (; a < accepted.size() && accepted[a] < first_candidate[t + 1]; ++a) {
-      const auto& uv = piece_uv[accepted[a] - first_candidate[t]];
-      out->push_back(SamplePoint(mesh, t, uv[0], uv[1]),
-                     SampleNormal(mesh, corner_normals ? &corners : nullptr, t, uv[0], uv[1]));
-    }
+    const size_t last = static_cast<size_t>(
+        std::lower_bound(accepted.begin() + a, accepted.end(), first_candidate[t + 1]) -
+        accepted.begin());
+    uint32_t piece = first_candidate[t];
+    SplitTriangle(mesh, t, h2, &uv_stack, [&](const Piece<true>& cut) {
+      if (piece++ != accepted[a]) return true;
+      const float u = static_cast<float>((cut.b[0][0] + cut.b[1][0] + cut.b[2][0]) / 3);
+      const float v = static_cast<float>((cut.b[0][1] + cut.b[1][1] + cut.b[2][1]) / 3);
+      out->push_back(SamplePoint(mesh, t, u, v),
+                     SampleNormal(mesh, corner_normals ? &corners : nullptr, t, u, v));
+      return ++a < last;
+    });
   }
   if (stats) stats->candidates = n, stats->samples = accepted_count;
   return Status::kOk;
