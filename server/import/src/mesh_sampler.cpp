@@ -495,10 +495,9 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
     cell_keys.swap(sorted_keys);
     for (uint32_t& id : cell_of) id = rank[id];
   }
-  // The occupied neighbours of each occupied cell (itself included), as a CSR list, counted
-  // first so that the list is allocated once. Cells are taken tile by tile (their order since
-  // the renumbering): the ids of a tile's cells and of the cells around it are first copied
-  // into `window`, from the few table tiles it overlaps.
+  // A cell's neighbours (itself included) are read from a window around the tile of cells that
+  // step 3 works through (the tiles are in the renumbered order): the renumbered ids of the
+  // tile's cells and of the cells around it, copied from the few table tiles it overlaps.
   constexpr int kWindow = 10;  // a tile's 8 cells and one more each side, per axis
   std::vector<uint32_t> window(kWindow * kWindow * kWindow);
   // A cell's 27 neighbours as steps in the window, nearest first (itself, then faces, edges,
@@ -513,66 +512,44 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
             if (std::abs(dx) + std::abs(dy) + std::abs(dz) == ring)
               ring_steps[k++] = (dx * kWindow + dy) * kWindow + dz;
   }
-  // Calls visit(id, other) for each cell id, in order, and each of its occupied neighbours'
-  // table ids in ring_steps' order.
-  auto each_neighbour = [&](const auto& visit) {
-    for (size_t tile_begin = 0; tile_begin < cells;) {
-      const uint64_t tile = tile_of(cell_keys[tile_begin]);
-      size_t tile_end = tile_begin + 1;
-      while (tile_end < cells && tile_of(cell_keys[tile_end]) == tile) ++tile_end;
-      // The window's lowest cell, per axis (-1 beside tile 0: cells are numbered from 1).
-      const int64_t base[3] = {static_cast<int64_t>(tile >> (2 * kCellBits)) * 8 - 1,
-                               static_cast<int64_t>((tile >> kCellBits) & field) * 8 - 1,
-                               static_cast<int64_t>(tile & field) * 8 - 1};
-      std::fill(window.begin(), window.end(), kNone);
-      // The table tiles (4 cells wide) the window overlaps, and the cells of each in it.
-      auto tiles = [&](int a) {
-        return std::make_pair(std::max<int64_t>(0, base[a] >> 2), (base[a] + kWindow - 1) >> 2);
-      };
-      const auto [x0, x1] = tiles(0);
-      const auto [y0, y1] = tiles(1);
-      const auto [z0, z1] = tiles(2);
-      for (int64_t tx = x0; tx <= x1; ++tx) {
-        for (int64_t ty = y0; ty <= y1; ++ty) {
-          for (int64_t tz = z0; tz <= z1; ++tz) {
-            const uint32_t* ids = table->Tile(tx, ty, tz);
-            if (!ids) continue;
-            const int64_t t[3] = {tx, ty, tz};
-            int64_t lo[3], hi[3];
-            for (int a = 0; a < 3; ++a)
-              lo[a] = std::max(4 * t[a], base[a]), hi[a] = std::min(4 * t[a] + 3, base[a] + 9);
-            for (int64_t x = lo[0]; x <= hi[0]; ++x)
-              for (int64_t y = lo[1]; y <= hi[1]; ++y)
-                for (int64_t z = lo[2]; z <= hi[2]; ++z)
+  int64_t window_base[3] = {0, 0, 0};  // the window's lowest cell, per axis
+  // Fills the window around tile `tile` (a tile_of key).
+  auto fill_window = [&](uint64_t tile) {
+    int64_t* base = window_base;  // -1 beside tile 0: cells are numbered from 1
+    base[0] = static_cast<int64_t>(tile >> (2 * kCellBits)) * 8 - 1;
+    base[1] = static_cast<int64_t>((tile >> kCellBits) & field) * 8 - 1;
+    base[2] = static_cast<int64_t>(tile & field) * 8 - 1;
+    std::fill(window.begin(), window.end(), kNone);
+    // The table tiles (4 cells wide) the window overlaps, and the cells of each in it.
+    auto tiles = [&](int a) {
+      return std::make_pair(std::max<int64_t>(0, base[a] >> 2), (base[a] + kWindow - 1) >> 2);
+    };
+    const auto [x0, x1] = tiles(0);
+    const auto [y0, y1] = tiles(1);
+    const auto [z0, z1] = tiles(2);
+    for (int64_t tx = x0; tx <= x1; ++tx) {
+      for (int64_t ty = y0; ty <= y1; ++ty) {
+        for (int64_t tz = z0; tz <= z1; ++tz) {
+          const uint32_t* ids = table->Tile(tx, ty, tz);
+          if (!ids) continue;
+          const int64_t t[3] = {tx, ty, tz};
+          int64_t lo[3], hi[3];
+          for (int a = 0; a < 3; ++a)
+            lo[a] = std::max(4 * t[a], base[a]), hi[a] = std::min(4 * t[a] + 3, base[a] + 9);
+          for (int64_t x = lo[0]; x <= hi[0]; ++x) {
+            for (int64_t y = lo[1]; y <= hi[1]; ++y) {
+              for (int64_t z = lo[2]; z <= hi[2]; ++z) {
+                const uint32_t id = ids[CellMap::Local(x, y, z)];
+                if (id != kNone)
                   window[((x - base[0]) * kWindow + (y - base[1])) * kWindow + (z - base[2])] =
-                      ids[CellMap::Local(x, y, z)];
+                      rank[id];
+              }
+            }
           }
         }
       }
-      for (size_t id = tile_begin; id < tile_end; ++id) {
-        const uint64_t key = cell_keys[id];
-        const int64_t x = static_cast<int64_t>(key >> (2 * kCellBits)) - base[0];
-        const int64_t y = static_cast<int64_t>((key >> kCellBits) & field) - base[1];
-        const int64_t z = static_cast<int64_t>(key & field) - base[2];
-        const uint32_t* at = &window[(x * kWindow + y) * kWindow + z];
-        for (const int step : ring_steps) {
-          const uint32_t other = at[step];
-          if (other != kNone) visit(id, other);
-        }
-      }
-      tile_begin = tile_end;
     }
   };
-  LargeVector<uint32_t> neighbour_start(cells + 1, 0);
-  each_neighbour([&](size_t id, uint32_t) { ++neighbour_start[id + 1]; });
-  for (size_t id = 0; id < cells; ++id) neighbour_start[id + 1] += neighbour_start[id];
-  LargeVector<uint32_t> neighbours(neighbour_start[cells]);
-  {
-    size_t at = 0;
-    each_neighbour([&](size_t, uint32_t other) { neighbours[at++] = rank[other]; });
-  }
-  table.reset();  // what steps 2 and 3 no longer need goes before they allocate theirs
-  LargeVector<uint32_t>().swap(rank);
 
   // 2. A seeded random order with locality (after Wei, "Parallel Poisson disk sampling", 2008):
   // each cell's candidates are shuffled; then, tile by tile, pass j tries the j-th candidate of
@@ -623,8 +600,15 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   };
   auto try_candidate = [&](uint32_t c, uint32_t cell) {
     const Candidate& cand = candidates[c];
-    for (uint32_t e = neighbour_start[cell]; e < neighbour_start[cell + 1]; ++e) {
-      const Slots& slot = slots[neighbours[e]];
+    const uint64_t key = cell_keys[cell];
+    const uint32_t* around =
+        &window[((static_cast<int64_t>(key >> (2 * kCellBits)) - window_base[0]) * kWindow +
+                 (static_cast<int64_t>((key >> kCellBits) & field) - window_base[1])) *
+                    kWindow +
+                static_cast<int64_t>(key & field) - window_base[2]];
+    for (const int step : ring_steps) {
+      if (around[step] == kNone) continue;
+      const Slots& slot = slots[around[step]];
       for (uint32_t q = 0; q < std::min(slot.count, kInline); ++q)
         if (near(slot.p[q], cand)) return;
       uint32_t block = slot.more;
@@ -659,6 +643,7 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
     size_t tile_end = tile_begin + 1;
     const uint64_t tile = tile_of(cell_keys[tile_begin]);
     while (tile_end < cells && tile_of(cell_keys[tile_end]) == tile) ++tile_end;
+    fill_window(tile);
     active.clear();
     for (size_t id = tile_begin; id < tile_end; ++id) active.push_back(static_cast<uint32_t>(id));
     for (uint32_t pass = 0; !active.empty(); ++pass) {
@@ -673,6 +658,9 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
     }
     tile_begin = tile_end;
   }
+
+  table.reset();
+  LargeVector<uint32_t>().swap(rank);
 
   // 4. Points and normals, in triangle order.
   std::sort(accepted.begin(), accepted.end());
