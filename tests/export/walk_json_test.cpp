@@ -1,6 +1,9 @@
 // The walk JSON writer with walks built by hand: whatever the order of a track's keys, the text
 // reads back, holding the keys the glTF and MEL exporters key.
 #include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <utility>
 
@@ -46,6 +49,38 @@ TEST_CASE("WalkToJson writes keys that read back whatever their order", "[export
     CHECK(WalkToJson(back) == text);
     CHECK(back.tracks[0].keys.size() == walk.tracks[0].keys.size());
   }
+}
+
+TEST_CASE("WriteWalkJson writes a walk of many megabytes as WalkToJson gives it",
+          "[export][walk_json]") {
+  // The file is written as the text is built, a megabyte at a time: 60,000 keys (about 5.6 MB)
+  // cross many of those pieces, each boundary within a key or between tracks.
+  Walk walk = test::CrowdWalk();
+  for (WalkTrack& track : walk.tracks) {
+    const WalkKey last = track.keys.back();
+    const Quat turn = track.Rotation(track.keys.size() - 1);
+    for (int i = 1; i <= 10000; ++i) {
+      WalkKey key = last;
+      key.frame = last.frame + i;
+      key.position.x += 1e-3 * i + 1.0 / 3.0;
+      track.keys.push_back(key);
+      if (track.kind == TrackKind::kBody) track.rotations.push_back(turn);
+    }
+  }
+  const std::string text = WalkToJson(walk);
+  REQUIRE(text.size() > 5u << 20);
+  const std::string path = test::ScratchPath("many_keys.json");
+  std::string error;
+  REQUIRE(WriteWalkJson(walk, path, &error) == Status::kOk);
+  std::ifstream in(path, std::ios::binary);
+  const std::string written((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::remove(path.c_str());
+  CHECK(written.size() == text.size());
+  CHECK(written == text);
+  Walk back;
+  REQUIRE(ParseWalkJson(written, path, &back, &error) == Status::kOk);
+  CHECK(back.tracks.size() == walk.tracks.size());
+  CHECK(back.tracks[0].keys.size() == walk.tracks[0].keys.size());
 }
 
 TEST_CASE("ParseWalkJson refuses zero and non-finite foot normals and body rotations",

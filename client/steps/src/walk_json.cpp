@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <functional>
 #include <set>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -200,11 +203,14 @@ struct Reader {
 
 }  // namespace
 
-std::string WalkToJson(const Walk& walk) {
+namespace {
+
+// Builds the walk's JSON text piece by piece: sink(piece) for each of about kPieceBytes (the
+// text of a crowd's walk runs to gigabytes), in order; false as soon as sink returns false.
+bool EmitWalkJson(const Walk& walk, const std::function<bool(std::string_view)>& sink) {
+  constexpr size_t kPieceBytes = size_t{1} << 20;
   std::string out;
-  size_t keys = 0;
-  for (const WalkTrack& t : walk.tracks) keys += t.keys.size();
-  out.reserve(256 + keys * 140);
+  out.reserve(kPieceBytes + 4096);
   out += "{\"format\":\"footfall-walk\",\"version\":";
   out += std::to_string(kWalkFormatVersion);
   out += ",\"fps\":";
@@ -247,15 +253,41 @@ std::string WalkToJson(const Walk& walk) {
         out += ']';
       }
       out += '}';
+      if (out.size() >= kPieceBytes) {
+        if (!sink(out)) return false;
+        out.clear();
+      }
     }
     out += "]}";
   }
   out += "\n]}\n";
-  return out;
+  return sink(out);
+}
+
+}  // namespace
+
+std::string WalkToJson(const Walk& walk) {
+  std::string text;
+  size_t keys = 0;
+  for (const WalkTrack& t : walk.tracks) keys += t.keys.size();
+  text.reserve(256 + keys * 160);  // about 150 bytes a key
+  EmitWalkJson(walk, [&text](std::string_view piece) {
+    text += piece;
+    return true;
+  });
+  return text;
 }
 
 Status WriteWalkJson(const Walk& walk, const std::string& path, std::string* error) {
-  return ReplaceFile(path, WalkToJson(walk), error);
+  // Written as it is built, never whole in memory.
+  return ReplaceFile(
+      path,
+      [&walk](std::FILE* file) {
+        return EmitWalkJson(walk, [file](std::string_view piece) {
+          return std::fwrite(piece.data(), 1, piece.size(), file) == piece.size();
+        });
+      },
+      error);
 }
 
 Status ParseWalkJson(const std::string& text, const std::string& source, Walk* out,

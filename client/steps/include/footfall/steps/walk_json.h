@@ -22,7 +22,8 @@ constexpr int kWalkFormatVersion = 1;
 // them), so the text always reads back with ParseWalkJson.
 std::string WalkToJson(const Walk& walk);
 
-// Writes WalkToJson(walk) to `path`. kIoError with a message naming the file on failure.
+// Writes WalkToJson(walk) to `path`, as it is built (never whole in memory: a crowd's walk runs
+// to gigabytes). kIoError with a message naming the file on failure.
 Status WriteWalkJson(const Walk& walk, const std::string& path, std::string* error);
 
 // Keys lie within +-this of the origin: terrain samples within +-5e14 (terrain::kMaxCoordinate),
