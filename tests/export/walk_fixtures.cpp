@@ -108,6 +108,22 @@ Walk FarWalk() {
   return walk;
 }
 
+Walk LongCrowdWalk(int extra) {
+  Walk walk = CrowdWalk();
+  for (WalkTrack& track : walk.tracks) {
+    const WalkKey last = track.keys.back();
+    const Quat turn = track.Rotation(track.keys.size() - 1);
+    for (int i = 1; i <= extra; ++i) {
+      WalkKey key = last;
+      key.frame = last.frame + i;
+      key.position.x += 1.0 / 3.0 + 1e-3 * i;
+      track.keys.push_back(key);
+      if (track.kind == TrackKind::kBody) track.rotations.push_back(turn);
+    }
+  }
+  return walk;
+}
+
 std::string ScratchPath(const std::string& name) {
   return (std::filesystem::temp_directory_path() /
           ("footfall_export_" + std::to_string(::getpid()) + "_" + name))

@@ -22,6 +22,10 @@ Walk BipedWalk();
 // offset 2 units apart along X.
 Walk CrowdWalk();
 
+// CrowdWalk with `extra` more keys on every track, one a frame after its last, the i-th moved
+// 1/3 + 0.001 i units along X from it (bodies keep their last rotation).
+Walk LongCrowdWalk(int extra);
+
 // BipedWalk at real-world coordinates, near (5e5, 120, -3e5) as in a UTM terrain: every key
 // moved by (500000.0004, 120.0007, -300000.0009) plus 1.3 mm * its index along (1, 1, -1), so
 // keys differ by millimetres that a float at 5e5 (a step of 1/32) cannot hold.

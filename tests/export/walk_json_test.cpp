@@ -55,18 +55,7 @@ TEST_CASE("WriteWalkJson writes a walk of many megabytes as WalkToJson gives it"
           "[export][walk_json]") {
   // The file is written as the text is built, a megabyte at a time: 60,000 keys (about 5.6 MB)
   // cross many of those pieces, each boundary within a key or between tracks.
-  Walk walk = test::CrowdWalk();
-  for (WalkTrack& track : walk.tracks) {
-    const WalkKey last = track.keys.back();
-    const Quat turn = track.Rotation(track.keys.size() - 1);
-    for (int i = 1; i <= 10000; ++i) {
-      WalkKey key = last;
-      key.frame = last.frame + i;
-      key.position.x += 1e-3 * i + 1.0 / 3.0;
-      track.keys.push_back(key);
-      if (track.kind == TrackKind::kBody) track.rotations.push_back(turn);
-    }
-  }
+  const Walk walk = test::LongCrowdWalk(10000);
   const std::string text = WalkToJson(walk);
   REQUIRE(text.size() > 5u << 20);
   const std::string path = test::ScratchPath("many_keys.json");
