@@ -282,6 +282,19 @@ TEST_CASE("ffc_generate gives the walk GenerateWalk gives", "[steps][c_api]") {
   o.has_start = true, o.start = {5, 0, 5}, o.heading = {1, 0, 0}, o.steps = 6, o.start_frame = 10;
   CHECK(std::string(json) == WalkToJson(Generate(t, LoadShipped("biped"), o)));
   ffc_free_string(json);
+  // A crowd's walk, some megabytes of text built in pieces: the same text.
+  json = nullptr;
+  const std::string crowd = R"({"character_file": ")" + file +
+                            R"(", "start": [5, 0, 5], "heading": [1, 0, 0], "steps": 8,
+                               "crowd": 300, "crowd_spacing": 0.45})";
+  const int32_t crowd_status = ffc_generate(s, terrain, crowd.c_str(), &json);
+  REQUIRE(json);
+  o.steps = 8, o.crowd = 300, o.crowd_spacing = 0.45, o.start_frame = 1;
+  const std::string expected = WalkToJson(Generate(t, LoadShipped("biped"), o));
+  CHECK(expected.size() > 1u << 20);
+  CHECK(std::string(json) == expected);
+  CHECK((crowd_status == FF_C_OK) == (expected.find("\"stopped\":\"\"") != std::string::npos));
+  ffc_free_string(json);
   // Bad requests: a status and a message, no walk.
   json = nullptr;
   CHECK(ffc_generate(s, terrain, R"({"steps": 3})", &json) == FF_C_INVALID_ARGUMENT);

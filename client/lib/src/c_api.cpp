@@ -11,6 +11,7 @@
 #include <new>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "footfall/client/terrain_session.h"
@@ -136,6 +137,31 @@ char* MallocCopy(const std::string& text) {
   return copy;
 }
 
+// The walk's JSON in one malloc'd, NUL-terminated block, or nullptr when memory runs out. The
+// block grows by realloc as the text is built (large blocks move without being copied), so a
+// crowd's gigabytes of text are never held twice.
+char* MallocWalkJson(const footfall::Walk& walk) {
+  char* text = nullptr;
+  size_t size = 0, capacity = 0;
+  const bool built = footfall::EmitWalkJson(walk, [&](std::string_view piece) {
+    if (size + piece.size() + 1 > capacity) {
+      const size_t grown = std::max(2 * capacity, size + piece.size() + 1);
+      char* more = static_cast<char*>(std::realloc(text, grown));
+      if (!more) return false;
+      text = more, capacity = grown;
+    }
+    std::memcpy(text + size, piece.data(), piece.size());
+    size += piece.size();
+    return true;
+  });
+  if (!built || !text) {
+    std::free(text);
+    return nullptr;
+  }
+  text[size] = '\0';
+  return text;
+}
+
 // ffc_generate and ffc_generate_with_notes (notes NULL: not wanted).
 int32_t Generate(ffc_session* s, uint32_t terrain, const char* request_json, char** walk_json,
                  char** notes) {
@@ -158,7 +184,7 @@ int32_t Generate(ffc_session* s, uint32_t terrain, const char* request_json, cha
     std::string note_text;
     if (notes)
       for (const std::string& note : walk.notes) note_text += OneLine(note) + '\n';
-    char* copy = MallocCopy(footfall::WalkToJson(walk));
+    char* copy = MallocWalkJson(walk);
     char* note_copy = notes ? MallocCopy(note_text) : nullptr;
     if (!copy || (notes && !note_copy)) {
       std::free(copy), std::free(note_copy);

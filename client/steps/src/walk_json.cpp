@@ -203,10 +203,6 @@ struct Reader {
 
 }  // namespace
 
-namespace {
-
-// Builds the walk's JSON text piece by piece: sink(piece) for each of about kPieceBytes (the
-// text of a crowd's walk runs to gigabytes), in order; false as soon as sink returns false.
 bool EmitWalkJson(const Walk& walk, const std::function<bool(std::string_view)>& sink) {
   constexpr size_t kPieceBytes = size_t{1} << 20;
   std::string out;
@@ -263,8 +259,6 @@ bool EmitWalkJson(const Walk& walk, const std::function<bool(std::string_view)>&
   out += "\n]}\n";
   return sink(out);
 }
-
-}  // namespace
 
 std::string WalkToJson(const Walk& walk) {
   std::string text;

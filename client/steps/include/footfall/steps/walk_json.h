@@ -8,7 +8,9 @@
 // Crowd tracks add "character": "c1". Numbers are written so they read back exactly.
 #pragma once
 
+#include <functional>
 #include <string>
+#include <string_view>
 
 #include "footfall/steps/walk.h"
 #include "footfall/terrain/status.h"
@@ -21,6 +23,11 @@ constexpr int kWalkFormatVersion = 1;
 // frames; of keys on the same frame only the last is written (as the glTF and MEL exporters key
 // them), so the text always reads back with ParseWalkJson.
 std::string WalkToJson(const Walk& walk);
+
+// WalkToJson(walk) piece by piece: sink(piece) for each of about a megabyte, in order, so that
+// a caller can write or copy the text without holding it twice. Stops, returning false, as soon
+// as sink returns false.
+bool EmitWalkJson(const Walk& walk, const std::function<bool(std::string_view)>& sink);
 
 // Writes WalkToJson(walk) to `path`, as it is built (never whole in memory: a crowd's walk runs
 // to gigabytes). kIoError with a message naming the file on failure.
