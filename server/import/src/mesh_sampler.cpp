@@ -535,7 +535,8 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
           const int64_t t[3] = {tx, ty, tz};
           int64_t lo[3], hi[3];
           for (int a = 0; a < 3; ++a)
-            lo[a] = std::max(4 * t[a], base[a]), hi[a] = std::min(4 * t[a] + 3, base[a] + 9);
+            lo[a] = std::max(4 * t[a], base[a]),
+            hi[a] = std::min(4 * t[a] + 3, base[a] + kWindow - 1);
           for (int64_t x = lo[0]; x <= hi[0]; ++x) {
             for (int64_t y = lo[1]; y <= hi[1]; ++y) {
               for (int64_t z = lo[2]; z <= hi[2]; ++z) {
