@@ -4,10 +4,12 @@
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <random>
 #include <string>
 #include <utility>
 
 #include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
 
 #include "footfall/steps/walk_json.h"
 #include "walk_fixtures.h"
@@ -199,5 +201,177 @@ TEST_CASE("ParseWalkJson says on which line the value it refuses stands", "[expo
     CHECK(refuse(odd) ==
           "w.json: tracks[0].keys[1].position[2]: expected a finite number "
           "(line 4)");
+  }
+}
+
+namespace {
+
+// The first difference between two walks read from JSON ("" when they are the same).
+std::string WalkDifference(const Walk& a, const Walk& b) {
+  if (a.fps != b.fps || a.stopped != b.stopped) return "fps or stopped";
+  if (a.tracks.size() != b.tracks.size()) return "track count";
+  for (size_t t = 0; t < a.tracks.size(); ++t) {
+    const WalkTrack& x = a.tracks[t];
+    const WalkTrack& y = b.tracks[t];
+    const std::string at = "track " + std::to_string(t) + ": ";
+    if (x.name != y.name || x.character != y.character || x.kind != y.kind)
+      return at + "name, character or kind";
+    if (x.keys.size() != y.keys.size() || x.rotations.size() != y.rotations.size())
+      return at + "key count";
+    for (size_t k = 0; k < x.keys.size(); ++k) {
+      const WalkKey& p = x.keys[k];
+      const WalkKey& q = y.keys[k];
+      if (p.frame != q.frame || p.position != q.position || p.normal != q.normal ||
+          p.phase != q.phase)
+        return at + "key " + std::to_string(k);
+    }
+    for (size_t k = 0; k < x.rotations.size(); ++k) {
+      const Quat& p = x.rotations[k];
+      const Quat& q = y.rotations[k];
+      if (p.x != q.x || p.y != q.y || p.z != q.z || p.w != q.w)
+        return at + "rotation " + std::to_string(k);
+    }
+  }
+  return "";
+}
+
+struct Reading {
+  Status status;
+  std::string error;
+  Walk walk;
+};
+
+Reading Streamed(const std::string& text) {
+  Reading r;
+  r.status = ParseWalkJson(text, "w.json", &r.walk, &r.error);
+  return r;
+}
+
+Reading Whole(const std::string& text) {
+  Reading r;
+  r.status = detail::ParseWalkJsonWhole(text, "w.json", &r.walk, &r.error);
+  return r;
+}
+
+// `text` read as its keys are parsed and read as a whole document: the same status, message
+// and walk. Returns the streamed reading.
+Reading ReadBothWays(const std::string& text) {
+  Reading s = Streamed(text);
+  const Reading w = Whole(text);
+  CHECK(s.status == w.status);
+  CHECK(s.error == w.error);
+  if (s.status == Status::kOk && w.status == Status::kOk)
+    CHECK(WalkDifference(s.walk, w.walk) == "");
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("ParseWalkJson reads keys as they are parsed as the whole document reads them",
+          "[export][walk_json]") {
+  // Keys are taken from the parser as each key object ends and left out of the document (a
+  // crowd's walk of millions of keys stood whole in memory at about five times its text); the
+  // result and every message must stay those of reading the whole document.
+  const Walk walk = test::LongCrowdWalk(500);
+  const std::string text = WalkToJson(walk);
+
+  SECTION("as footfall writes it: every track's kind before its keys") {
+    const Reading r = ReadBothWays(text);
+    REQUIRE(r.status == Status::kOk);
+    CHECK(WalkDifference(r.walk, walk) == "");
+  }
+  SECTION("kind after keys (written by another tool, in sorted order): keys kept, then read") {
+    const std::string sorted = nlohmann::json::parse(text).dump(2);
+    REQUIRE(sorted.find("\"keys\"") < sorted.find("\"kind\""));
+    const Reading r = ReadBothWays(sorted);
+    REQUIRE(r.status == Status::kOk);
+    CHECK(WalkDifference(r.walk, walk) == "");
+  }
+  SECTION("tracks of both orders in one file") {
+    nlohmann::json j = nlohmann::json::parse(text);
+    // Track 1 rewritten with its kind last: the others stay as written.
+    const std::string kind = "\"kind\":" + j["tracks"][1]["kind"].dump();
+    std::string mixed = text;
+    const size_t track1 = mixed.find("\"name\":\"R1\"");
+    REQUIRE(track1 != std::string::npos);
+    const size_t at = mixed.find(kind, track1);
+    REQUIRE(at != std::string::npos);
+    mixed.erase(at, kind.size() + 1);  // with its comma
+    const size_t close = mixed.find("}]}", at);  // its last key, keys and track end
+    mixed.insert(close + 2, "," + kind);
+    REQUIRE(mixed.find(kind, track1) > mixed.find("\"keys\"", track1));
+    const Reading r = ReadBothWays(mixed);
+    INFO(r.error);
+    REQUIRE(r.status == Status::kOk);
+    CHECK(WalkDifference(r.walk, walk) == "");
+  }
+  SECTION("a refused key: the first error in reading order, as before") {
+    // A bad key in the last track, and a bad fps written after the tracks: the fps is read
+    // first, as the whole document is.
+    std::string bad = text;
+    const size_t last = bad.rfind("\"phase\":\"");
+    REQUIRE(last != std::string::npos);
+    bad.replace(last + 9, 0, "x");
+    const Reading key_only = ReadBothWays(bad);
+    CHECK(key_only.status == Status::kParseError);
+    CHECK(key_only.error.find(".phase: expected \"start\", \"mid\" or \"end\"") !=
+          std::string::npos);
+    const size_t fps = bad.find("\"fps\":30,");
+    REQUIRE(fps != std::string::npos);
+    bad.erase(fps, 9);
+    bad.insert(bad.rfind('}'), ",\"fps\":-1");
+    const Reading both = ReadBothWays(bad);
+    CHECK(both.status == Status::kParseError);
+    CHECK(both.error.rfind("w.json: fps: expected a positive number (line ", 0) == 0);
+  }
+  SECTION("a key refused in a track whose name is refused: the name, as before") {
+    std::string bad = text;
+    const size_t name = bad.find("\"name\":\"L1\"");
+    REQUIRE(name != std::string::npos);
+    bad.replace(name + 8, 2, "\\u0007");
+    const size_t frame = bad.find("\"frame\":", bad.find("\"keys\"", name));
+    bad.replace(frame + 8, 0, "\"");
+    bad.replace(bad.find(',', frame), 0, "\"");
+    const Reading r = ReadBothWays(bad);
+    CHECK(r.status == Status::kParseError);
+    CHECK(r.error.find("tracks[0].name: expected a name without control characters") !=
+          std::string::npos);
+  }
+  SECTION("damaged at random: the same status, message and walk both ways") {
+    const std::string small = WalkToJson(test::CrowdWalk());
+    std::mt19937 rng(7);
+    const std::string pieces[] = {
+        "{",           "}", "[",     "]",    ",",          ":", "\"kind\":\"body\"",
+        "\"keys\":[]", "1", "\"x\"", "null", "\"frame\":2"};
+    size_t ok = 0;
+    for (int i = 0; i < 3000; ++i) {
+      std::string damaged = small;
+      const int edits = 1 + static_cast<int>(rng() % 3);
+      for (int e = 0; e < edits; ++e) {
+        const size_t at = rng() % damaged.size();
+        switch (rng() % 4) {
+          case 0:
+            damaged.erase(at, 1 + rng() % 12);
+            break;
+          case 1:
+            damaged.insert(at, pieces[rng() % std::size(pieces)]);
+            break;
+          case 2:
+            damaged[at] = "0123456789-.e\"{}[],:"[rng() % 20];
+            break;
+          default: {  // a stretch moved elsewhere
+            const size_t n = std::min<size_t>(1 + rng() % 40, damaged.size() - at);
+            const std::string cut = damaged.substr(at, n);
+            damaged.erase(at, n);
+            damaged.insert(rng() % (damaged.size() + 1), cut);
+          }
+        }
+      }
+      INFO("case " << i << ": " << damaged);
+      ok += ReadBothWays(damaged).status == Status::kOk;
+    }
+    // Some damage leaves valid walks (a digit changed), most does not: both kinds were read.
+    CHECK(ok > 30);
+    CHECK(ok < 2900);
   }
 }

@@ -70,7 +70,7 @@ size_t RepeatedKeyAt(const std::string& text) {
 }  // namespace
 
 bool ParseJsonText(const std::string& text, const std::string& source, json* out,
-                   std::string* error, int max_depth) {
+                   std::string* error, int max_depth, const JsonFilter& filter) {
   // UTF-16 and UTF-32 text are named as such (their NUL bytes are not a stray byte).
   const std::string wide = WideTextProblem(text);
   if (!wide.empty()) {
@@ -97,7 +97,7 @@ bool ParseJsonText(const std::string& text, const std::string& source, json* out
       if (!keys.back().insert(parsed.get<std::string>()).second)
         throw DuplicateKey{parsed.get<std::string>()};
     }
-    return true;
+    return filter ? filter(depth, event, parsed) : true;
   };
   try {
     *out = json::parse(text, check);  // nlohmann skips a leading UTF-8 byte order mark

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <set>
 #include <string>
 
@@ -18,8 +19,14 @@ namespace footfall::detail {
 // column in bytes) locating the last byte the parser read. Also refused, as malformed: a NUL
 // byte, a number beyond the range of a double, a key repeated within one object, and (when
 // max_depth > 0) nesting deeper than max_depth.
+//
+// `filter`, when given, sees every parse event after those checks, as nlohmann's parser callback
+// does (depth, event, the value parsed), and returns false to leave that value out of *out: a
+// reader can take values as they are parsed, rather than hold the whole document.
+using JsonFilter =
+    std::function<bool(int depth, nlohmann::json::parse_event_t event, nlohmann::json& parsed)>;
 bool ParseJsonText(const std::string& text, const std::string& source, nlohmann::json* out,
-                   std::string* error, int max_depth = 0);
+                   std::string* error, int max_depth = 0, const JsonFilter& filter = nullptr);
 
 // Reads the whole of the file at `path` into *text, after CheckInputFile (a regular file);
 // `what` names it in errors ("character file": "PATH: cannot open character file").

@@ -284,10 +284,174 @@ Status WriteWalkJson(const Walk& walk, const std::string& path, std::string* err
       error);
 }
 
-Status ParseWalkJson(const std::string& text, const std::string& source, Walk* out,
-                     std::string* error) {
+namespace {
+
+// Reads key object `k` (at `kw`, for messages) onto the end of `track`, whose kind says which
+// fields it has; false, with r's error, when it is refused.
+bool ReadKey(Reader& r, const json& k, const std::string& kw, WalkTrack* track) {
+  WalkKey key;
+  if (!k.is_object() || !k.contains("frame") || !k.contains("position")) {
+    r.Fail(kw, "expected an object with frame and position");
+    return false;
+  }
+  static const std::set<std::string> kFootKey = {"frame", "phase", "position", "normal", "comment"};
+  static const std::set<std::string> kBodyKey = {"frame", "position", "rotation", "comment"};
+  if (!r.Known(k, kw, track->kind == TrackKind::kFoot ? kFootKey : kBodyKey)) return false;
+  if (!r.Finite(k["frame"], kw + ".frame", &key.frame)) return false;
+  if (!track->keys.empty() && !(key.frame > track->keys.back().frame)) {
+    r.Fail(kw + ".frame", "frames must increase along a track");
+    return false;
+  }
+  if (!r.Position(k["position"], kw + ".position", &key.position)) return false;
+  if (track->kind == TrackKind::kFoot) {
+    const std::string phase =
+        k.contains("phase") && k["phase"].is_string() ? k["phase"].get<std::string>() : "?";
+    if (phase == "start")
+      key.phase = KeyPhase::kStart;
+    else if (phase == "mid")
+      key.phase = KeyPhase::kMid;
+    else if (phase == "end")
+      key.phase = KeyPhase::kEnd;
+    else {
+      r.Fail(kw + ".phase", "expected \"start\", \"mid\" or \"end\"");
+      return false;
+    }
+    if (k.contains("normal")) {
+      if (!r.Vec(k["normal"], kw + ".normal", &key.normal)) return false;
+      // Any non-zero length, as samples' normals and body rotations (zero has no direction).
+      if (std::max({std::fabs(key.normal.x), std::fabs(key.normal.y), std::fabs(key.normal.z)}) ==
+          0) {
+        r.Fail(kw + ".normal", "expected a non-zero normal [nx, ny, nz]");
+        return false;
+      }
+    }
+  } else {
+    double q[4] = {0, 0, 0, 1};
+    if (k.contains("rotation") && !r.Array(k["rotation"], 4, kw + ".rotation", q)) return false;
+    // Any non-zero length (1e-10 or 1e300 components alike): readers normalise it.
+    if (std::max({std::fabs(q[0]), std::fabs(q[1]), std::fabs(q[2]), std::fabs(q[3])}) == 0) {
+      r.Fail(kw + ".rotation", "expected a non-zero quaternion [qx, qy, qz, qw]");
+      return false;
+    }
+    track->rotations.push_back({q[0], q[1], q[2], q[3]});
+  }
+  track->keys.push_back(key);
+  return true;
+}
+
+// The keys of each track, read as the parser finishes each key object and then left out of the
+// document: a crowd's walk of millions of keys never stands whole as a document (about five times
+// its text). A track's keys are taken so only when its "kind" comes before its "keys" (as footfall
+// writes it); otherwise they stay in the document, for the reading below. A refused key stops the
+// parse (Restart): the whole document is then read again, so that the first error in reading
+// order is the one reported, word for word as before.
+class KeyStream {
+ public:
+  struct Restart {};
+
+  explicit KeyStream(const std::string& source) { reader_.source = source; }
+
+  // The parser callback (detail::JsonFilter).
+  bool operator()(int depth, json::parse_event_t event, json& parsed) {
+    using E = json::parse_event_t;
+    const size_t d = static_cast<size_t>(depth);
+    switch (event) {
+      case E::object_start:
+      case E::array_start:
+        if (d == levels_.size()) {  // always so: the depth of the value that starts
+          Count(d);
+          levels_.push_back({event == E::object_start, std::string(), 0});
+        }
+        return true;
+      case E::key:
+        if (d >= 1 && d <= levels_.size() && parsed.is_string())
+          levels_[d - 1].key = parsed.get<std::string>();
+        return true;
+      case E::value:
+        Count(d);
+        if (d == 3 && InTrack() && levels_[2].key == "kind" && parsed.is_string()) {
+          Track& t = Of(levels_[1].count - 1);
+          const std::string kind = parsed.get<std::string>();
+          if (kind == "foot" || kind == "body") {
+            t.known = true;
+            t.keys.kind = kind == "foot" ? TrackKind::kFoot : TrackKind::kBody;
+          }
+        }
+        return true;
+      case E::object_end:
+      case E::array_end: {
+        const bool key = event == E::object_end && d == 4 && levels_.size() == 5 && InKeys();
+        if (d + 1 == levels_.size()) levels_.pop_back();
+        if (!key) return true;
+        Track& t = Of(levels_[1].count - 1);
+        // Kind unknown here (after the keys, or not a kind): keep every key of this track.
+        if (!t.known || t.kept) {
+          t.kept = true;
+          return true;
+        }
+        if (!ReadKey(reader_, parsed, std::string(), &t.keys)) throw Restart{};
+        t.taken = true;
+        return false;
+      }
+    }
+    return true;
+  }
+
+  // Track `ti`'s keys and rotations, when they were taken from the document (moved out).
+  bool Take(size_t ti, WalkTrack* track) {
+    if (ti >= tracks_.size() || !tracks_[ti].taken) return false;
+    track->keys = std::move(tracks_[ti].keys.keys);
+    track->rotations = std::move(tracks_[ti].keys.rotations);
+    return true;
+  }
+
+ private:
+  struct Level {
+    bool object;
+    std::string key;  // objects: the last key read
+    size_t count;     // arrays: the values started in it
+  };
+  struct Track {
+    WalkTrack keys;      // its kind, and the keys taken
+    bool known = false;  // its kind came before its keys
+    bool taken = false;  // keys were taken from the document
+    bool kept = false;   // keys were left in it
+  };
+
+  // A value starts at depth d: one more in the array holding it.
+  void Count(size_t d) {
+    if (d >= 1 && d <= levels_.size() && !levels_[d - 1].object) ++levels_[d - 1].count;
+  }
+  // Inside a track object: {"tracks": [{...}]}.
+  bool InTrack() const {
+    return levels_.size() >= 3 && levels_[0].object && levels_[0].key == "tracks" &&
+           !levels_[1].object && levels_[2].object;
+  }
+  // Inside the keys array of a track: {"tracks": [{"keys": [...]}]}.
+  bool InKeys() const {
+    return levels_.size() >= 4 && InTrack() && levels_[2].key == "keys" && !levels_[3].object;
+  }
+  Track& Of(size_t ti) {
+    if (ti >= tracks_.size()) tracks_.resize(ti + 1);
+    return tracks_[ti];
+  }
+
+  Reader reader_;
+  std::vector<Level> levels_;
+  std::vector<Track> tracks_;
+};
+
+// Parses walk JSON; `stream` takes the keys as they are parsed (KeyStream).
+Status ParseWalk(const std::string& text, const std::string& source, Walk* out, std::string* error,
+                 bool stream) {
   json j;
-  if (!detail::ParseJsonText(text, source, &j, error)) return Status::kParseError;
+  KeyStream keys(source);
+  try {
+    const detail::JsonFilter filter = stream ? detail::JsonFilter(std::ref(keys)) : nullptr;
+    if (!detail::ParseJsonText(text, source, &j, error, 0, filter)) return Status::kParseError;
+  } catch (const KeyStream::Restart&) {
+    return ParseWalk(text, source, out, error, false);
+  }
   Reader r;
   r.source = source;
   Walk walk;
@@ -354,59 +518,12 @@ Status ParseWalkJson(const std::string& text, const std::string& source, Walk* o
         r.Fail(tw + ".keys", "expected an array");
         break;
       }
-      const json& keys = t["keys"];
-      track.keys.reserve(keys.size());
-      for (size_t ki = 0; ki < keys.size(); ++ki) {
-        const json& k = keys[ki];
-        const std::string kw = tw + ".keys[" + std::to_string(ki) + "]";
-        WalkKey key;
-        if (!k.is_object() || !k.contains("frame") || !k.contains("position")) {
-          r.Fail(kw, "expected an object with frame and position");
-          break;
+      if (!keys.Take(ti, &track)) {
+        const json& dom_keys = t["keys"];
+        track.keys.reserve(dom_keys.size());
+        for (size_t ki = 0; ki < dom_keys.size(); ++ki) {
+          if (!ReadKey(r, dom_keys[ki], tw + ".keys[" + std::to_string(ki) + "]", &track)) break;
         }
-        static const std::set<std::string> kFootKey = {"frame", "phase", "position", "normal",
-                                                       "comment"};
-        static const std::set<std::string> kBodyKey = {"frame", "position", "rotation", "comment"};
-        if (!r.Known(k, kw, track.kind == TrackKind::kFoot ? kFootKey : kBodyKey)) break;
-        if (!r.Finite(k["frame"], kw + ".frame", &key.frame)) break;
-        if (!track.keys.empty() && !(key.frame > track.keys.back().frame)) {
-          r.Fail(kw + ".frame", "frames must increase along a track");
-          break;
-        }
-        if (!r.Position(k["position"], kw + ".position", &key.position)) break;
-        if (track.kind == TrackKind::kFoot) {
-          const std::string phase =
-              k.contains("phase") && k["phase"].is_string() ? k["phase"].get<std::string>() : "?";
-          if (phase == "start")
-            key.phase = KeyPhase::kStart;
-          else if (phase == "mid")
-            key.phase = KeyPhase::kMid;
-          else if (phase == "end")
-            key.phase = KeyPhase::kEnd;
-          else {
-            r.Fail(kw + ".phase", "expected \"start\", \"mid\" or \"end\"");
-            break;
-          }
-          if (k.contains("normal")) {
-            if (!r.Vec(k["normal"], kw + ".normal", &key.normal)) break;
-            // Any non-zero length, as samples' normals and body rotations (zero has no direction).
-            if (std::max({std::fabs(key.normal.x), std::fabs(key.normal.y),
-                          std::fabs(key.normal.z)}) == 0) {
-              r.Fail(kw + ".normal", "expected a non-zero normal [nx, ny, nz]");
-              break;
-            }
-          }
-        } else {
-          double q[4] = {0, 0, 0, 1};
-          if (k.contains("rotation") && !r.Array(k["rotation"], 4, kw + ".rotation", q)) break;
-          // Any non-zero length (1e-10 or 1e300 components alike): readers normalise it.
-          if (std::max({std::fabs(q[0]), std::fabs(q[1]), std::fabs(q[2]), std::fabs(q[3])}) == 0) {
-            r.Fail(kw + ".rotation", "expected a non-zero quaternion [qx, qy, qz, qw]");
-            break;
-          }
-          track.rotations.push_back({q[0], q[1], q[2], q[3]});
-        }
-        track.keys.push_back(key);
       }
       walk.tracks.push_back(std::move(track));
     }
@@ -419,6 +536,20 @@ Status ParseWalkJson(const std::string& text, const std::string& source, Walk* o
   *out = std::move(walk);
   return Status::kOk;
 }
+
+}  // namespace
+
+Status ParseWalkJson(const std::string& text, const std::string& source, Walk* out,
+                     std::string* error) {
+  return ParseWalk(text, source, out, error, true);
+}
+
+namespace detail {
+Status ParseWalkJsonWhole(const std::string& text, const std::string& source, Walk* out,
+                          std::string* error) {
+  return ParseWalk(text, source, out, error, false);
+}
+}  // namespace detail
 
 Status ReadWalkJson(const std::string& path, Walk* out, std::string* error) {
   std::string text;

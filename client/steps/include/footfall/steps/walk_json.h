@@ -43,9 +43,18 @@ constexpr double kMaxKeyCoordinate = 1e15;
 // field, where the object without it starts. Frames must increase along each track, positions
 // lie within +-kMaxKeyCoordinate, foot normals must be non-zero vectors and body rotations
 // non-zero quaternions (both finite, read as written, not normalised). kParseError for
-// malformed or unsupported input.
+// malformed or unsupported input. Keys are read as they are parsed: the text and the walk are
+// all it holds.
 Status ParseWalkJson(const std::string& text, const std::string& source, Walk* out,
                      std::string* error);
+
+namespace detail {
+// ParseWalkJson building the whole document before reading it (about five times the text in
+// memory, where ParseWalkJson holds little more than the walk): the same result and the same
+// messages, for comparison.
+Status ParseWalkJsonWhole(const std::string& text, const std::string& source, Walk* out,
+                          std::string* error);
+}  // namespace detail
 
 // Reads and parses a walk file. kIoError when it cannot be read.
 Status ReadWalkJson(const std::string& path, Walk* out, std::string* error);
