@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <fstream>
 #include <set>
-#include <sstream>
 #include <vector>
 
 #include "footfall/terrain/input_file.h"
@@ -196,9 +195,24 @@ Status ReadJsonFile(const std::string& path, const char* what, std::string* text
     *error = path + ": cannot open " + what;
     return Status::kIoError;
   }
-  std::ostringstream whole;
-  whole << in.rdbuf();
-  *text = whole.str();
+  // Read straight into the string (through a stringstream the text stood twice in memory).
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  in.seekg(0, std::ios::beg);
+  text->clear();
+  if (size > 0) {
+    text->resize(static_cast<size_t>(size));
+    in.read(text->data(), size);
+    text->resize(static_cast<size_t>(in.gcount()));
+  }
+  // A file that grew while it was read: the rest too.
+  char buffer[65536];
+  while (in.read(buffer, sizeof buffer) || in.gcount() > 0)
+    text->append(buffer, static_cast<size_t>(in.gcount()));
+  if (in.bad()) {
+    *error = path + ": cannot read " + what;
+    return Status::kIoError;
+  }
   return Status::kOk;
 }
 
