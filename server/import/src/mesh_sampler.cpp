@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 #include <tuple>
 #include <vector>
 
@@ -51,6 +54,12 @@ bool SameSide(const int8_t* a, const int8_t* b) {
   const bool a_zero = (a[0] | a[1] | a[2]) == 0, b_zero = (b[0] | b[1] | b[2]) == 0;
   return dot > 0 || a_zero || b_zero;
 }
+
+// Steps 1 and 4 take another thread only for this many more pieces to cut, or samples to place.
+constexpr double kPiecesPerThread = 200000;
+constexpr double kSamplesPerThread = 50000;
+// Step 1's threads add their pieces to the shared count this often.
+constexpr size_t kCountEvery = 4096;
 
 constexpr int kCellBits = 21;
 constexpr uint64_t kCellLimit = 1ull << kCellBits;
@@ -273,6 +282,35 @@ double RoundUp3(double x) {
   return std::ceil(x / step) * step;
 }
 
+// Runs work(part) for each part in [0, parts): part 0 on the calling thread, the others on
+// threads of their own. The first exception thrown (std::bad_alloc) is rethrown once all end.
+template <typename Work>
+void RunParts(size_t parts, const Work& work) {
+  std::vector<std::exception_ptr> failed(parts);
+  auto run = [&](size_t part) {
+    try {
+      work(part);
+    } catch (...) {
+      failed[part] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> threads;
+  threads.reserve(parts);
+  for (size_t part = 1; part < parts; ++part) threads.emplace_back(run, part);
+  run(0);
+  for (std::thread& t : threads) t.join();
+  for (const std::exception_ptr& e : failed)
+    if (e) std::rethrow_exception(e);
+}
+
+// The threads SampleMesh cuts triangles on: options.threads, or the machine's cores for 0,
+// and no more than one per `per_thread` of `work` (a thread costs tens of microseconds).
+size_t CuttingThreads(int threads, double work, double per_thread) {
+  size_t n = threads > 0 ? static_cast<size_t>(threads) : std::thread::hardware_concurrency();
+  n = std::min<size_t>(std::max<size_t>(n, 1), 64);
+  return std::max<size_t>(1, std::min(n, static_cast<size_t>(work / per_thread)));
+}
+
 // What step 1 of SampleMesh allows at separation s: its estimate of the pieces the mesh is cut
 // into (from each triangle's longest edge, squared in `longest2`) against its limit.
 bool PiecesFit(const std::vector<double>& longest2, double area, size_t max_samples, double s) {
@@ -418,27 +456,72 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
     if (counted > candidate_limit) return refuse_pieces();
     expected = counted;
   }
+  // Cut on several threads, each a run of triangles of about equal estimated pieces, into its
+  // own array; joined in triangle order, the candidates are those one thread would cut. The
+  // limit holds for their sum: each thread adds its count to `cut` every few thousand pieces.
+  const size_t parts = CuttingThreads(options.threads, estimate, kPiecesPerThread);
+  std::vector<size_t> part_first(parts + 1, mesh.triangles.size());  // triangles per part
+  part_first[0] = 0;
+  {
+    double sum = 0;
+    size_t part = 1;
+    for (size_t t = 0; t < mesh.triangles.size() && part < parts; ++t) {
+      const auto& tri = mesh.triangles[t];
+      const Vec3 &a = mesh.vertices[tri[0]], &b = mesh.vertices[tri[1]], &c = mesh.vertices[tri[2]];
+      sum += std::max(1.0,
+                      std::max({Distance2(a, b), Distance2(b, c), Distance2(c, a)}) / (2.25 * h2));
+      while (part < parts && sum >= estimate * static_cast<double>(part) / parts)
+        part_first[part++] = t + 1;
+    }
+  }
   LargeVector<Candidate> candidates;
   candidates.reserve(expected);
+  std::vector<LargeVector<Candidate>> later_parts(parts - 1);
   LargeVector<uint32_t> first_candidate(mesh.triangles.size() + 1);  // per triangle
-  for (size_t t = 0; t < mesh.triangles.size() && candidates.size() <= candidate_limit; ++t) {
-    first_candidate[t] = static_cast<uint32_t>(candidates.size());
-    const Vec3 normal = Normalize(TriangleCross(mesh, t));
-    int8_t side[4] = {0, 0, 0, 0};
-    if (IsFinite(normal)) {
-      side[0] = static_cast<int8_t>(std::lround(127 * normal.x));
-      side[1] = static_cast<int8_t>(std::lround(127 * normal.y));
-      side[2] = static_cast<int8_t>(std::lround(127 * normal.z));
+  std::atomic<size_t> cut{0};
+  std::atomic<bool> over{false};
+  RunParts(parts, [&](size_t part) {
+    LargeVector<Candidate>& into = part == 0 ? candidates : later_parts[part - 1];
+    if (part > 0) {
+      const double share = static_cast<double>(part_first[part + 1] - part_first[part]) /
+                           static_cast<double>(mesh.triangles.size());
+      into.reserve(static_cast<size_t>(static_cast<double>(expected) * std::min(1.0, 2 * share)));
     }
-    SplitTriangle(mesh, t, h2, &stack, [&](const Piece<false>& piece) {
-      const Vec3 local = (piece.p[0] + piece.p[1] + piece.p[2]) / 3 - lo;
-      candidates.push_back(
-          {{static_cast<float>(local.x), static_cast<float>(local.y), static_cast<float>(local.z)},
-           {side[0], side[1], side[2], 0}});
-      return candidates.size() <= candidate_limit;
-    });
+    std::vector<Piece<false>> stack;
+    size_t counted = 0;  // of into's candidates, those added to `cut`
+    auto count = [&]() {
+      const size_t total = cut += into.size() - counted;
+      counted = into.size();
+      if (total > candidate_limit) over = true;
+      return !over;
+    };
+    for (size_t t = part_first[part]; t < part_first[part + 1] && !over; ++t) {
+      first_candidate[t] = static_cast<uint32_t>(into.size());
+      const Vec3 normal = Normalize(TriangleCross(mesh, t));
+      int8_t side[4] = {0, 0, 0, 0};
+      if (IsFinite(normal)) {
+        side[0] = static_cast<int8_t>(std::lround(127 * normal.x));
+        side[1] = static_cast<int8_t>(std::lround(127 * normal.y));
+        side[2] = static_cast<int8_t>(std::lround(127 * normal.z));
+      }
+      SplitTriangle(mesh, t, h2, &stack, [&](const Piece<false>& piece) {
+        const Vec3 local = (piece.p[0] + piece.p[1] + piece.p[2]) / 3 - lo;
+        into.push_back({{static_cast<float>(local.x), static_cast<float>(local.y),
+                         static_cast<float>(local.z)},
+                        {side[0], side[1], side[2], 0}});
+        return into.size() - counted < kCountEvery || count();
+      });
+    }
+    count();
+  });
+  if (over || cut > candidate_limit) return refuse_pieces();
+  for (size_t part = 1; part < parts; ++part) {
+    LargeVector<Candidate>& piece = later_parts[part - 1];
+    const uint32_t base = static_cast<uint32_t>(candidates.size());
+    for (size_t t = part_first[part]; t < part_first[part + 1]; ++t) first_candidate[t] += base;
+    candidates.insert(candidates.end(), piece.begin(), piece.end());
+    LargeVector<Candidate>().swap(piece);
   }
-  if (candidates.size() > candidate_limit) return refuse_pieces();
   first_candidate.back() = static_cast<uint32_t>(candidates.size());
 
   // Cells of side r over the bounds; each candidate's cell id.
@@ -667,33 +750,53 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   std::sort(accepted.begin(), accepted.end());
   std::optional<CornerNormals> corner_normals;
   if (options.smooth_normals) corner_normals.emplace(mesh, options.crease_angle_deg);
-  out->points.reserve(accepted.size());
-  out->normals.reserve(accepted.size());
   const size_t accepted_count = accepted.size();
+  out->points.resize(accepted_count);
+  out->normals.resize(accepted_count);
   LargeVector<Candidate>().swap(candidates);  // no longer needed: step 4 cuts again
-  // Each triangle holding accepted pieces is cut again (the same pieces in the same order), up
-  // to its last accepted piece; a piece's barycentric position is the mean of its corners', as
-  // step 1 had it.
-  std::vector<Piece<true>> uv_stack;
-  for (size_t a = 0; a < accepted.size();) {
-    const size_t t = static_cast<size_t>(
-        std::upper_bound(first_candidate.begin(), first_candidate.end(), accepted[a]) -
-        first_candidate.begin() - 1);
-    std::array<Vec3, 3> corners;
-    if (corner_normals) corners = corner_normals->Of(t);
-    const size_t last = static_cast<size_t>(
-        std::lower_bound(accepted.begin() + a, accepted.end(), first_candidate[t + 1]) -
-        accepted.begin());
-    uint32_t piece = first_candidate[t];
-    SplitTriangle(mesh, t, h2, &uv_stack, [&](const Piece<true>& cut) {
-      if (piece++ != accepted[a]) return true;
-      const float u = static_cast<float>((cut.b[0][0] + cut.b[1][0] + cut.b[2][0]) / 3);
-      const float v = static_cast<float>((cut.b[0][1] + cut.b[1][1] + cut.b[2][1]) / 3);
-      out->push_back(SamplePoint(mesh, t, u, v),
-                     SampleNormal(mesh, corner_normals ? &corners : nullptr, t, u, v));
-      return ++a < last;
-    });
+  // The triangle holding candidate c.
+  auto triangle_of = [&first_candidate](uint32_t c) {
+    return static_cast<size_t>(std::upper_bound(first_candidate.begin(), first_candidate.end(), c) -
+                               first_candidate.begin() - 1);
+  };
+  // On several threads, each a run of whole triangles of about equal accepted pieces, each
+  // sample written at its place in triangle order.
+  const size_t parts4 =
+      CuttingThreads(options.threads, static_cast<double>(accepted_count), kSamplesPerThread);
+  std::vector<size_t> part_accepted(parts4 + 1, accepted_count);
+  part_accepted[0] = 0;
+  for (size_t part = 1; part < parts4; ++part) {
+    const size_t at = accepted_count * part / parts4;
+    // Moved back to its triangle's first accepted piece (a triangle is placed by one thread).
+    part_accepted[part] =
+        std::max(part_accepted[part - 1],
+                 static_cast<size_t>(std::lower_bound(accepted.begin(), accepted.end(),
+                                                      first_candidate[triangle_of(accepted[at])]) -
+                                     accepted.begin()));
   }
+  RunParts(parts4, [&](size_t part) {
+    // Each triangle holding accepted pieces is cut again (the same pieces in the same order),
+    // up to its last accepted piece; a piece's barycentric position is the mean of its
+    // corners', as step 1 had it.
+    std::vector<Piece<true>> uv_stack;
+    for (size_t a = part_accepted[part]; a < part_accepted[part + 1];) {
+      const size_t t = triangle_of(accepted[a]);
+      std::array<Vec3, 3> corners;
+      if (corner_normals) corners = corner_normals->Of(t);
+      const size_t last = static_cast<size_t>(
+          std::lower_bound(accepted.begin() + a, accepted.end(), first_candidate[t + 1]) -
+          accepted.begin());
+      uint32_t piece = first_candidate[t];
+      SplitTriangle(mesh, t, h2, &uv_stack, [&](const Piece<true>& cut) {
+        if (piece++ != accepted[a]) return true;
+        const float u = static_cast<float>((cut.b[0][0] + cut.b[1][0] + cut.b[2][0]) / 3);
+        const float v = static_cast<float>((cut.b[0][1] + cut.b[1][1] + cut.b[2][1]) / 3);
+        out->points[a] = SamplePoint(mesh, t, u, v);
+        out->normals[a] = SampleNormal(mesh, corner_normals ? &corners : nullptr, t, u, v);
+        return ++a < last;
+      });
+    }
+  });
   if (stats) stats->candidates = n, stats->samples = accepted_count;
   return Status::kOk;
 }

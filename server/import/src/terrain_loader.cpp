@@ -186,6 +186,7 @@ Status ResampleTerrainMesh(const std::string& path, const TriangleMesh& mesh,
   sample.smooth_normals = options.smooth_normals;
   sample.crease_angle_deg = options.crease_angle_deg;
   sample.seed = options.seed;
+  sample.threads = options.threads;
   std::string why;
   const Status status = SampleMesh(mesh, sample, out, &why);
   if (status == Status::kLimitExceeded && fits_memory < options.max_samples)

@@ -262,6 +262,8 @@ Status TerrainRegistry::PrepareLoad(const std::string& relative_path, TerrainLoa
   load->per_load_binds = per_load < options.max_samples && per_load < left;
   options.max_samples =
       static_cast<size_t>(std::min<uint64_t>({options.max_samples, left, per_load}));
+  // Two meshes are resampled at once, one thread each: the query threads keep their share.
+  options.threads = 1;
   load->relative_path = relative_path;
   load->options = std::move(options);
   load->owner = owner;

@@ -48,6 +48,9 @@ struct MeshSampleOptions {
   uint64_t seed = 1;
   // Refuse (kLimitExceeded) when area / s^2 predicts more samples than this.
   size_t max_samples = 20000000;
+  // Threads cutting triangles (steps 1 and 4); the samples are the same whatever their number.
+  // 0: one per core.
+  int threads = 0;
 };
 
 struct MeshSampleStats {

@@ -43,6 +43,9 @@ struct TerrainLoadOptions {
   double height_scale = 1;
   // Meshes and height maps: refuse (kLimitExceeded) a separation predicting more samples.
   size_t max_samples = 20000000;
+  // Meshes and height maps: threads cutting triangles (MeshSampleOptions::threads); the samples
+  // are the same whatever their number. 0: one per core.
+  int threads = 0;
 };
 
 // What a load found, for `footfall terrain info` and server logs.
