@@ -250,6 +250,41 @@ TEST_CASE("WritePointFile writes every sample exactly", "[terrain][point_file]")
   rmdir(dir);
 }
 
+TEST_CASE("ReadPointFile reads every sample whatever its header's count says",
+          "[terrain][point_file]") {
+  // The header footfall writes gives the count, taken to reserve room; a header counting too
+  // few, far too many or in another form, or none, reads the same samples.
+  std::string body;
+  for (int i = 0; i < 1000; ++i)
+    body += std::to_string(i) + " " + std::to_string(i % 7) + " 0.5 0 1 0\n";
+  char dir[] = "/tmp/footfall-points-XXXXXX";
+  REQUIRE(mkdtemp(dir));
+  const std::string path = std::string(dir) + "/in.pts";
+  const std::string headers[] = {
+      "# footfall terrain points: x y z nx ny nz (1000 samples)\n",
+      "# footfall terrain points: x y z nx ny nz (5 samples)\n",
+      "# footfall terrain points: x y z nx ny nz (1000000000000 samples)\n",
+      "# footfall terrain points: x y z nx ny nz (18446744073709551616 samples)\n",
+      "# footfall terrain points: (-3 samples)\n",
+      "# (1000 samples)\n",
+      ""};
+  for (const std::string& header : headers) {
+    INFO(header);
+    FILE* f = std::fopen(path.c_str(), "wb");
+    REQUIRE(f);
+    std::fputs((header + body).c_str(), f);
+    std::fclose(f);
+    RawSamples s;
+    std::string error;
+    REQUIRE(ReadPointFile(path, &s, &error) == Status::kOk);
+    REQUIRE(s.size() == 1000);
+    CHECK(s.points[999] == Vec3{999, 999 % 7, 0.5});
+    CHECK(s.points.capacity() < 100000);  // not the header's 1e12
+  }
+  std::remove(path.c_str());
+  rmdir(dir);
+}
+
 TEST_CASE("ReadDecimal reads decimal numbers only, tiny ones as zero", "[terrain][decimal]") {
   double v = -1;
   CHECK(ReadDecimal("0.25", &v) == DecimalRead::kNumber);
