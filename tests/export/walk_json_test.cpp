@@ -296,7 +296,7 @@ TEST_CASE("ParseWalkJson reads keys as they are parsed as the whole document rea
     REQUIRE(track1 != std::string::npos);
     const size_t at = mixed.find(kind, track1);
     REQUIRE(at != std::string::npos);
-    mixed.erase(at, kind.size() + 1);  // with its comma
+    mixed.erase(at, kind.size() + 1);            // with its comma
     const size_t close = mixed.find("}]}", at);  // its last key, keys and track end
     mixed.insert(close + 2, "," + kind);
     REQUIRE(mixed.find(kind, track1) > mixed.find("\"keys\"", track1));
