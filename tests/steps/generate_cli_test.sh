@@ -283,6 +283,15 @@ ln -sf /dev/full "$work/full.json"
 check "stopped walk, unwritten output: exit 1" [ $? -eq 1 ]
 check "stopped walk, unwritten output: named" grep -qF "cannot write '$work/full.json': No space left on device" "$work/stopped-bad.err"
 check "stopped walk, unwritten output: the other written" [ -s "$work/stopped-ok.json" ]
+# glTF is serialised straight into its file: a write that fails is named as JSON's is.
+for ext in glb gltf; do
+  ln -sf /dev/full "$work/full.$ext"
+  "$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
+    --steps 100 --out "$work/full.$ext" --out "$work/full-ok.$ext.json" 2> "$work/full-$ext.err"
+  check "unwritten .$ext: exit 1" [ $? -eq 1 ]
+  check "unwritten .$ext: named" grep -qF "cannot write '$work/full.$ext': No space left on device" "$work/full-$ext.err"
+  check "unwritten .$ext: the other written" [ -s "$work/full-ok.$ext.json" ]
+done
 # An output that cannot be written at all is refused before the walk is generated.
 "$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
   --steps 100 --out "$work/no/such/dir/walk.json" --out "$work/early-ok.json" 2> "$work/early-bad.err"

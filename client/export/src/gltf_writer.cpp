@@ -5,14 +5,18 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <exception>
+#include <ostream>
 #include <sstream>
+#include <streambuf>
 #include <vector>
 
 #include "file_output.h"
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/large_memory.h"
+#include "footfall/terrain/output_file.h"
 #include "walk_prep.h"
 
 namespace footfall {
@@ -103,6 +107,26 @@ int AddAccessor(std::vector<PendingAccessor>* pending, Streams* streams, StreamI
   return static_cast<int>(pending->size() - 1);
 }
 
+// An output stream's buffer writing straight to a C file (which buffers): tinygltf writes to a
+// std::ostream, ReplaceFile hands out a FILE*. A short write sets the stream's badbit.
+class FileStreamBuf : public std::streambuf {
+ public:
+  explicit FileStreamBuf(std::FILE* file) : file_(file) {}
+
+ protected:
+  std::streamsize xsputn(const char* s, std::streamsize n) override {
+    return static_cast<std::streamsize>(std::fwrite(s, 1, static_cast<size_t>(n), file_));
+  }
+  int_type overflow(int_type c) override {
+    if (traits_type::eq_int_type(c, traits_type::eof())) return traits_type::not_eof(c);
+    const char byte = traits_type::to_char_type(c);
+    return std::fwrite(&byte, 1, 1, file_) == 1 ? c : traits_type::eof();
+  }
+
+ private:
+  std::FILE* file_;
+};
+
 bool EndsWithGlb(const std::string& path) { return FileExtension(path) == "glb"; }
 
 // The name and extras kind of the root node that holds a far walk's origin.
@@ -123,12 +147,13 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
   // tinygltf serialises in functions that may not throw: running out of memory there aborts the
   // process (and loses the outputs not yet written). A walk this process cannot hold as glTF is
   // refused first. Measured peaks: about 9 KB a track (its accessors, views and their JSON),
-  // and the buffer three times over for .glb, five times as base64 text for .gltf.
+  // and the buffer twice over for .glb (its streams, then the buffer), five times as base64 text
+  // for .gltf.
   double buffer_bytes = 0;
   for (const WalkTrack& track : walk.tracks)
     buffer_bytes += static_cast<double>(track.keys.size()) *
                     (track.kind == TrackKind::kBody ? 4 + 12 + 16 : 4 + 12);
-  const double needed = buffer_bytes * (options.binary ? 3 : 5) +
+  const double needed = buffer_bytes * (options.binary ? 2 : 5) +
                         9e3 * static_cast<double>(walk.tracks.size()) + 64e6;
   const double available = AvailableMemoryBytes();
   if (available > 0 && needed > available) {
@@ -157,6 +182,17 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
   names = walk_export::UniqueNames(names);
 
   Streams streams;
+  {
+    // Sized for every key (keys sharing a frame are dropped): grown a track at a time, the
+    // streams were copied over and over.
+    size_t keys = 0, body_keys = 0;
+    for (const WalkTrack& track : walk.tracks)
+      keys += track.keys.size(),
+          body_keys += track.kind == TrackKind::kBody ? track.keys.size() : 0;
+    streams.times.reserve(keys);
+    streams.vec3.reserve(3 * keys);
+    streams.vec4.reserve(4 * body_keys);
+  }
   std::vector<PendingAccessor> pending;
   tinygltf::Animation animation;
   animation.name = "walk";
@@ -247,20 +283,21 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
   }
 
   // One buffer holding the three streams back to back, one buffer view per non-empty stream.
-  const std::vector<float>* stream_data[kStreamCount] = {&streams.times, &streams.vec3,
-                                                         &streams.vec4};
+  std::vector<float>* stream_data[kStreamCount] = {&streams.times, &streams.vec3, &streams.vec4};
   int view_of[kStreamCount] = {-1, -1, -1};
   tinygltf::Buffer buffer;
+  buffer.data.reserve((streams.times.size() + streams.vec3.size() + streams.vec4.size()) *
+                      sizeof(float));
   for (int s = 0; s < kStreamCount; ++s) {
-    const std::vector<float>& data = *stream_data[s];
+    std::vector<float>& data = *stream_data[s];
     if (data.empty()) continue;
     tinygltf::BufferView view;
     view.buffer = 0;
     view.byteOffset = buffer.data.size();
     view.byteLength = data.size() * sizeof(float);
-    const size_t at = buffer.data.size();
-    buffer.data.resize(at + view.byteLength);
-    std::memcpy(buffer.data.data() + at, data.data(), view.byteLength);
+    const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
+    buffer.data.insert(buffer.data.end(), bytes, bytes + view.byteLength);
+    std::vector<float>().swap(data);  // copied: freed before the next is
     view_of[s] = static_cast<int>(model.bufferViews.size());
     model.bufferViews.push_back(view);
   }
@@ -281,29 +318,36 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
   model.scenes.push_back(std::move(scene));
   model.defaultScene = 0;
 
-  std::ostringstream out;
+  // Serialised straight into the file (ReplaceFile: a failed write leaves the old file whole),
+  // never whole in memory.
   tinygltf::TinyGLTF gltf;
-  bool serialised = false;
-  try {
-    // Its JSON library throws on what it cannot write; no exception leaves this function.
-    serialised = gltf.WriteGltfSceneToStream(&model, out, /*prettyPrint=*/true, options.binary);
-  } catch (const std::exception& e) {
-    SetError(error, "tinygltf could not serialise the walk for '" + path + "': " + e.what());
+  std::string failed;  // what went wrong inside tinygltf, if it did
+  std::string message;
+  status = ReplaceFile(
+      path,
+      [&](std::FILE* file) {
+        FileStreamBuf file_buffer(file);
+        std::ostream out(&file_buffer);
+        try {
+          // Its JSON library throws on what it cannot write; no exception leaves this function.
+          if (!gltf.WriteGltfSceneToStream(&model, out, /*prettyPrint=*/true, options.binary)) {
+            failed = "tinygltf could not serialise the walk for '" + path + "'";
+            return false;
+          }
+        } catch (const std::exception& e) {
+          failed = "tinygltf could not serialise the walk for '" + path + "': " + e.what();
+          return false;
+        }
+        out.flush();
+        return static_cast<bool>(out);
+      },
+      &message);
+  if (!failed.empty()) {
+    SetError(error, failed);
     return Status::kInternalError;
   }
-  if (!serialised) {
-    SetError(error, "tinygltf could not serialise the walk for '" + path + "'");
-    return Status::kInternalError;
-  }
-  // A string stream that cannot grow (memory short) sets its failbit and drops the rest:
-  // tinygltf does not look, and a cut file would replace a good one.
-  if (!out) {
-    SetError(error,
-             "out of memory serialising the walk as glTF (write .json or .mel, or fewer "
-             "characters or steps)");
-    return Status::kLimitExceeded;
-  }
-  return walk_export::WriteFileBytes(path, out.str(), error);
+  if (status != Status::kOk) SetError(error, message);
+  return status;
 }
 
 Status WriteGltf(const Walk& walk, const std::string& path, std::string* error) {
