@@ -74,6 +74,49 @@ TEST_CASE("WriteWalkJson writes a walk of many megabytes as WalkToJson gives it"
   CHECK(back.tracks[0].keys.size() == walk.tracks[0].keys.size());
 }
 
+TEST_CASE("EmitWalkJson gives the same text on any number of threads", "[export][walk_json]") {
+  // Runs of a few thousand keys are formatted on several threads and handed over in order:
+  // tracks cut into several runs, a track whose keys are written reordered, an empty track.
+  Walk walk = test::LongCrowdWalk(10000);
+  std::swap(walk.tracks[1].keys[5], walk.tracks[1].keys[9000]);
+  walk.tracks.push_back(WalkTrack{});
+  walk.tracks.back().name = "empty";
+  auto emit = [&walk](int threads, size_t* pieces) {
+    std::string text;
+    *pieces = 0;
+    CHECK(EmitWalkJson(
+        walk,
+        [&](std::string_view piece) {
+          text += piece;
+          ++*pieces;
+          return true;
+        },
+        threads));
+    return text;
+  };
+  size_t pieces = 0;
+  const std::string one = emit(1, &pieces);
+  CHECK(pieces > 8);
+  Walk back;
+  std::string error;
+  REQUIRE(ParseWalkJson(one, "w.json", &back, &error) == Status::kOk);
+  CHECK(back.tracks.size() == walk.tracks.size());
+  CHECK(back.tracks[1].keys[5].frame < back.tracks[1].keys[6].frame);
+  for (const int threads : {2, 3, 0}) {
+    INFO(threads << " threads");
+    size_t more = 0;
+    CHECK(emit(threads, &more) == one);
+    CHECK(more == pieces);
+  }
+  // A sink that refuses stops the text at once, whatever the threads.
+  for (const int threads : {1, 3}) {
+    size_t calls = 0;
+    CHECK_FALSE(EmitWalkJson(
+        walk, [&calls](std::string_view) { return ++calls < 3; }, threads));
+    CHECK(calls == 3);
+  }
+}
+
 TEST_CASE("ParseWalkJson refuses zero and non-finite foot normals and body rotations",
           "[export][walk_json]") {
   const std::string head =

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <functional>
 #include <string_view>
+#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -72,10 +73,92 @@ void KeyOrder(const WalkTrack& track, std::vector<size_t>* order) {
 
 }  // namespace
 
-bool EmitWalkJson(const Walk& walk, const std::function<bool(std::string_view)>& sink) {
-  constexpr size_t kPieceBytes = size_t{1} << 20;
-  std::string out;
-  out.reserve(kPieceBytes + 4096);
+namespace {
+
+// A stretch of one track's keys, written on its own: [first, end) of the keys in written order,
+// its track's opening with the first key and its closing with the last.
+struct KeyRun {
+  size_t track, first, end;
+};
+
+// Keys in a run: about a megabyte of text (about 150 bytes a key).
+constexpr size_t kRunKeys = 7000;
+
+// Appends run `run` of `walk` (its track's keys in `order`, or in place when empty) to `out`,
+// exactly as the whole text holds it.
+void AppendRun(const Walk& walk, const KeyRun& run, const std::vector<size_t>& order,
+               std::string& out) {
+  const WalkTrack& t = walk.tracks[run.track];
+  const size_t count = order.empty() ? t.keys.size() : order.size();
+  if (run.first == 0) {
+    out += run.track ? ",\n" : "\n";
+    out += "{\"name\":";
+    String(out, t.name);
+    if (!t.character.empty()) out += ",\"character\":", String(out, t.character);
+    out += ",\"kind\":\"";
+    out += KindName(t.kind);
+    out += "\",\"keys\":[";
+  }
+  for (size_t i = run.first; i < run.end; ++i) {
+    const size_t ki = order.empty() ? i : order[i];
+    const WalkKey& k = t.keys[ki];
+    out += i ? ",\n " : "\n ";
+    out += "{\"frame\":";
+    Number(out, k.frame);
+    if (t.kind == TrackKind::kFoot) {
+      out += ",\"phase\":\"";
+      out += PhaseName(k.phase);
+      out += "\",\"position\":";
+      Vector(out, k.position);
+      out += ",\"normal\":";
+      Vector(out, k.normal);
+    } else {
+      out += ",\"position\":";
+      Vector(out, k.position);
+      out += ",\"rotation\":[";
+      const Quat q = t.Rotation(ki);
+      Number(out, q.x), out += ',', Number(out, q.y), out += ',';
+      Number(out, q.z), out += ',', Number(out, q.w);
+      out += ']';
+    }
+    out += '}';
+  }
+  if (run.end == count) out += "]}";
+}
+
+}  // namespace
+
+bool EmitWalkJson(const Walk& walk, const std::function<bool(std::string_view)>& sink,
+                  int threads) {
+  // Each track's keys in written order, and the runs they are written in.
+  std::vector<std::vector<size_t>> orders(walk.tracks.size());
+  std::vector<KeyRun> runs;
+  size_t keys = 0;
+  for (size_t ti = 0; ti < walk.tracks.size(); ++ti) {
+    KeyOrder(walk.tracks[ti], &orders[ti]);
+    const size_t count = orders[ti].empty() ? walk.tracks[ti].keys.size() : orders[ti].size();
+    keys += count;
+    size_t first = 0;
+    do {
+      const size_t end = std::min(count, first + kRunKeys);
+      runs.push_back({ti, first, end});
+      first = end;
+    } while (first < count);
+  }
+  // Runs are formatted on several threads at a time (numbers to text is most of the work), and
+  // given to the sink in order: the same text on any number of threads.
+  size_t parallel =
+      threads > 0 ? static_cast<size_t>(threads) : std::thread::hardware_concurrency();
+  parallel = std::clamp<size_t>(parallel, 1, 16);
+  if (keys < 4 * kRunKeys) parallel = 1;
+  // Each thread's text on cache lines of its own: a string's size changes with every append
+  // (side by side, two threads' strings made two threads 1.5x slower than one).
+  struct alignas(64) Text {
+    std::string text;
+  };
+  std::vector<Text> texts(parallel);
+  for (Text& t : texts) t.text.reserve(kRunKeys * 180);
+  std::string& out = texts[0].text;
   out += "{\"format\":\"footfall-walk\",\"version\":";
   out += std::to_string(kWalkFormatVersion);
   out += ",\"fps\":";
@@ -83,47 +166,19 @@ bool EmitWalkJson(const Walk& walk, const std::function<bool(std::string_view)>&
   out += ",\"stopped\":";
   String(out, walk.stopped);
   out += ",\"tracks\":[";
-  std::vector<size_t> order;
-  for (size_t ti = 0; ti < walk.tracks.size(); ++ti) {
-    const WalkTrack& t = walk.tracks[ti];
-    KeyOrder(t, &order);
-    const size_t count = order.empty() ? t.keys.size() : order.size();
-    out += ti ? ",\n" : "\n";
-    out += "{\"name\":";
-    String(out, t.name);
-    if (!t.character.empty()) out += ",\"character\":", String(out, t.character);
-    out += ",\"kind\":\"";
-    out += KindName(t.kind);
-    out += "\",\"keys\":[";
-    for (size_t i = 0; i < count; ++i) {
-      const size_t ki = order.empty() ? i : order[i];
-      const WalkKey& k = t.keys[ki];
-      out += i ? ",\n " : "\n ";
-      out += "{\"frame\":";
-      Number(out, k.frame);
-      if (t.kind == TrackKind::kFoot) {
-        out += ",\"phase\":\"";
-        out += PhaseName(k.phase);
-        out += "\",\"position\":";
-        Vector(out, k.position);
-        out += ",\"normal\":";
-        Vector(out, k.normal);
-      } else {
-        out += ",\"position\":";
-        Vector(out, k.position);
-        out += ",\"rotation\":[";
-        const Quat q = t.Rotation(ki);
-        Number(out, q.x), out += ',', Number(out, q.y), out += ',';
-        Number(out, q.z), out += ',', Number(out, q.w);
-        out += ']';
-      }
-      out += '}';
-      if (out.size() >= kPieceBytes) {
-        if (!sink(out)) return false;
-        out.clear();
-      }
+  for (size_t r = 0; r < runs.size(); r += parallel) {
+    const size_t group = std::min(parallel, runs.size() - r);
+    auto format = [&](size_t k) {
+      AppendRun(walk, runs[r + k], orders[runs[r + k].track], texts[k].text);
+    };
+    std::vector<std::thread> helpers;
+    for (size_t k = 1; k < group; ++k) helpers.emplace_back(format, k);
+    format(0);
+    for (std::thread& h : helpers) h.join();
+    for (size_t k = 0; k < group; ++k) {
+      if (!sink(texts[k].text)) return false;
+      texts[k].text.clear();
     }
-    out += "]}";
   }
   out += "\n]}\n";
   return sink(out);

@@ -26,8 +26,11 @@ std::string WalkToJson(const Walk& walk);
 
 // WalkToJson(walk) piece by piece: sink(piece) for each of about a megabyte, in order, so that
 // a caller can write or copy the text without holding it twice. Stops, returning false, as soon
-// as sink returns false.
-bool EmitWalkJson(const Walk& walk, const std::function<bool(std::string_view)>& sink);
+// as sink returns false. The pieces are formatted on `threads` threads (0: one per core; a
+// walk of fewer than about 30,000 keys on one), the same text on any number; sink is called
+// from the calling thread.
+bool EmitWalkJson(const Walk& walk, const std::function<bool(std::string_view)>& sink,
+                  int threads = 0);
 
 // Writes WalkToJson(walk) to `path`, as it is built (never whole in memory: a crowd's walk runs
 // to gigabytes). kIoError with a message naming the file on failure.
