@@ -476,12 +476,16 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   }
   LargeVector<Candidate> candidates;
   candidates.reserve(expected);
-  std::vector<LargeVector<Candidate>> later_parts(parts - 1);
+  // Each on cache lines of its own: a vector's end moves with every push.
+  struct alignas(64) Part {
+    LargeVector<Candidate> candidates;
+  };
+  std::vector<Part> later_parts(parts - 1);
   LargeVector<uint32_t> first_candidate(mesh.triangles.size() + 1);  // per triangle
   std::atomic<size_t> cut{0};
   std::atomic<bool> over{false};
   RunParts(parts, [&](size_t part) {
-    LargeVector<Candidate>& into = part == 0 ? candidates : later_parts[part - 1];
+    LargeVector<Candidate>& into = part == 0 ? candidates : later_parts[part - 1].candidates;
     if (part > 0) {
       const double share = static_cast<double>(part_first[part + 1] - part_first[part]) /
                            static_cast<double>(mesh.triangles.size());
@@ -516,7 +520,7 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
   });
   if (over || cut > candidate_limit) return refuse_pieces();
   for (size_t part = 1; part < parts; ++part) {
-    LargeVector<Candidate>& piece = later_parts[part - 1];
+    LargeVector<Candidate>& piece = later_parts[part - 1].candidates;
     const uint32_t base = static_cast<uint32_t>(candidates.size());
     for (size_t t = part_first[part]; t < part_first[part + 1]; ++t) first_candidate[t] += base;
     candidates.insert(candidates.end(), piece.begin(), piece.end());
