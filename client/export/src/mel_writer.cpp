@@ -17,12 +17,12 @@
 namespace footfall {
 namespace {
 
-// A decimal MEL literal without exponent that reads back as `value` exactly: the fewest
+// Appends a decimal MEL literal without exponent that reads back as `value` exactly: the fewest
 // significant digits that round-trip, written in fixed notation, trailing zeros trimmed, "-0"
 // as "0". A whole number beyond MEL's 32-bit int keeps a ".0": MEL reads a literal without a
 // point as an int. `value` must be finite. std::to_chars, unlike printf, ignores the C locale:
 // a host that sets a decimal-comma LC_NUMERIC (Maya, Blender) still gets points.
-std::string Number(double value) {
+void AppendNumber(std::string& out, double value) {
   // The shortest scientific form that reads back to the same double: what the shortest
   // "%.{p}e" in the "C" locale gives (the correctly rounded digits, ties to even).
   char text[64];
@@ -30,34 +30,49 @@ std::string Number(double value) {
       std::to_chars(text, text + sizeof text, value, std::chars_format::scientific);
   // text is "[-]d[.ddd]e<sign><exp>": split into sign, digits and the power of ten of the first
   // digit.
-  const std::string scientific(text, written.ptr);
-  const size_t e = scientific.find('e');
-  const bool negative = scientific[0] == '-';
-  std::string digits;
-  for (size_t i = negative ? 1 : 0; i < e; ++i) {
-    if (scientific[i] != '.') digits += scientific[i];
-  }
+  const bool negative = text[0] == '-';
+  const char* e = std::find(text, written.ptr, 'e');
+  char digits[32];
+  int count = 0;
+  for (const char* c = text + (negative ? 1 : 0); c < e; ++c)
+    if (*c != '.') digits[count++] = *c;
   int exponent = 0;
-  const char* exponent_text = scientific.c_str() + e + 1;
+  const char* exponent_text = e + 1;
   if (*exponent_text == '+') ++exponent_text;  // from_chars takes '-' but not '+'
-  std::from_chars(exponent_text, scientific.c_str() + scientific.size(), exponent);
-  const int count = static_cast<int>(digits.size());
-  std::string s;
+  std::from_chars(exponent_text, written.ptr, exponent);
+  // Fixed notation: at most "0." and 323 zeros before 17 digits, or 309 digits.
+  char s[400];
+  int n = 0;
   if (exponent < 0) {
-    s = "0." + std::string(static_cast<size_t>(-exponent - 1), '0') + digits;
+    s[n++] = '0', s[n++] = '.';
+    for (int z = 0; z < -exponent - 1; ++z) s[n++] = '0';
+    for (int d = 0; d < count; ++d) s[n++] = digits[d];
   } else if (exponent + 1 >= count) {
-    s = digits + std::string(static_cast<size_t>(exponent + 1 - count), '0');
+    for (int d = 0; d < count; ++d) s[n++] = digits[d];
+    for (int z = 0; z < exponent + 1 - count; ++z) s[n++] = '0';
   } else {
-    s = digits.substr(0, static_cast<size_t>(exponent + 1)) + "." +
-        digits.substr(static_cast<size_t>(exponent + 1));
+    for (int d = 0; d <= exponent; ++d) s[n++] = digits[d];
+    s[n++] = '.';
+    for (int d = exponent + 1; d < count; ++d) s[n++] = digits[d];
   }
-  if (s.find('.') != std::string::npos) {
-    s.erase(s.find_last_not_of('0') + 1);
-    if (s.back() == '.') s.pop_back();
+  const bool point = std::find(s, s + n, '.') != s + n;
+  if (point) {
+    while (s[n - 1] == '0') --n;
+    if (s[n - 1] == '.') --n;
   }
-  if (s == "0") return s;
-  if (s.find('.') == std::string::npos && std::fabs(value) > 2147483647.0) s += ".0";
-  return negative ? "-" + s : s;
+  if (n == 1 && s[0] == '0') {
+    out += '0';
+    return;
+  }
+  if (negative) out += '-';
+  out.append(s, static_cast<size_t>(n));
+  if (!std::count(s, s + n, '.') && std::fabs(value) > 2147483647.0) out += ".0";
+}
+
+std::string Number(double value) {
+  std::string s;
+  AppendNumber(s, value);
+  return s;
 }
 
 // A valid Maya node name: [A-Za-z_][A-Za-z0-9_]*.
@@ -275,23 +290,31 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
 
           Vec3 previous_euler;
           bool first = true;
+          std::string time;
           for (size_t index : walk_export::KeyOrder(track)) {
             const WalkKey& key = track.keys[index];
-            const std::string time = "setKeyframe -t " + Number(key.frame) + " -at ";
+            time.assign("setKeyframe -t ");
+            AppendNumber(time, key.frame);
+            time += " -at ";
+            // One attribute's key, appended piece by piece (no string made per number).
+            auto key_line = [&](const char* attribute, const char* axis, double v) {
+              mel += time;
+              mel += attribute;
+              mel += axis;
+              mel += " -v ";
+              AppendNumber(mel, v);
+              mel += kLinear;
+              mel += " $footfall_node[0];\n";
+            };
             const double translate[] = {key.position.x, key.position.y, key.position.z};
-            for (int axis = 0; axis < 3; ++axis) {
-              mel += time + "translate" + kAxes[axis] + " -v " + Number(translate[axis]) + kLinear +
-                     " $footfall_node[0];\n";
-            }
+            for (int axis = 0; axis < 3; ++axis)
+              key_line("translate", kAxes[axis], translate[axis]);
             if (body) {
               Vec3 euler = QuatToEulerZxyDegrees(track.Rotation(index));
               if (!first) euler = ClosestEulerZxyDegrees(euler, previous_euler);
               previous_euler = euler;
               const double rotate[] = {euler.x, euler.y, euler.z};
-              for (int axis = 0; axis < 3; ++axis) {
-                mel += time + "rotate" + kAxes[axis] + " -v " + Number(rotate[axis]) + kLinear +
-                       " $footfall_node[0];\n";
-              }
+              for (int axis = 0; axis < 3; ++axis) key_line("rotate", kAxes[axis], rotate[axis]);
             }
             first = false;
             if (mel.size() >= kPieceBytes && !flush()) return false;
