@@ -250,6 +250,26 @@ TEST_CASE("WritePointFile writes every sample exactly", "[terrain][point_file]")
   rmdir(dir);
 }
 
+TEST_CASE("WritePointFile writes a file of many runs in order", "[terrain][point_file]") {
+  // Runs of 20,000 samples are formatted on several threads: 70,001 samples cross four runs,
+  // the last one short.
+  RawSamples s;
+  for (int i = 0; i < 70001; ++i)
+    s.push_back({i * 0.25, std::sin(i * 0.01), -i / 3.0}, Normalize(Vec3{0.1, 1, 0.001 * i}));
+  char dir[] = "/tmp/footfall-points-XXXXXX";
+  REQUIRE(mkdtemp(dir));
+  const std::string path = std::string(dir) + "/many.pts";
+  std::string error;
+  REQUIRE(WritePointFile(path, s, &error) == Status::kOk);
+  RawSamples back;
+  REQUIRE(ReadPointFile(path, &back, &error) == Status::kOk);
+  std::remove(path.c_str());
+  rmdir(dir);
+  REQUIRE(back.size() == s.size());
+  CHECK(back.points == s.points);
+  CHECK(back.normals == s.normals);
+}
+
 TEST_CASE("ReadPointFile reads every sample whatever its header's count says",
           "[terrain][point_file]") {
   // The header footfall writes gives the count, taken to reserve room; a header counting too

@@ -8,11 +8,11 @@
 #include <cstdio>
 #include <functional>
 #include <string_view>
-#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "footfall/terrain/ordered_text.h"
 #include "footfall/terrain/output_file.h"
 
 namespace footfall {
@@ -145,20 +145,7 @@ bool EmitWalkJson(const Walk& walk, const std::function<bool(std::string_view)>&
       first = end;
     } while (first < count);
   }
-  // Runs are formatted on several threads at a time (numbers to text is most of the work), and
-  // given to the sink in order: the same text on any number of threads.
-  size_t parallel =
-      threads > 0 ? static_cast<size_t>(threads) : std::thread::hardware_concurrency();
-  parallel = std::clamp<size_t>(parallel, 1, 16);
-  if (keys < 4 * kRunKeys) parallel = 1;
-  // Each thread's text on cache lines of its own: a string's size changes with every append
-  // (side by side, two threads' strings made two threads 1.5x slower than one).
-  struct alignas(64) Text {
-    std::string text;
-  };
-  std::vector<Text> texts(parallel);
-  for (Text& t : texts) t.text.reserve(kRunKeys * 180);
-  std::string& out = texts[0].text;
+  std::string out;
   out += "{\"format\":\"footfall-walk\",\"version\":";
   out += std::to_string(kWalkFormatVersion);
   out += ",\"fps\":";
@@ -166,22 +153,20 @@ bool EmitWalkJson(const Walk& walk, const std::function<bool(std::string_view)>&
   out += ",\"stopped\":";
   String(out, walk.stopped);
   out += ",\"tracks\":[";
-  for (size_t r = 0; r < runs.size(); r += parallel) {
-    const size_t group = std::min(parallel, runs.size() - r);
-    auto format = [&](size_t k) {
-      AppendRun(walk, runs[r + k], orders[runs[r + k].track], texts[k].text);
-    };
-    std::vector<std::thread> helpers;
-    for (size_t k = 1; k < group; ++k) helpers.emplace_back(format, k);
-    format(0);
-    for (std::thread& h : helpers) h.join();
-    for (size_t k = 0; k < group; ++k) {
-      if (!sink(texts[k].text)) return false;
-      texts[k].text.clear();
-    }
-  }
-  out += "\n]}\n";
-  return sink(out);
+  // Runs are formatted on several threads at a time (numbers to text is most of the work), and
+  // given to the sink in order: the same text on any number of threads. The head goes with the
+  // first run, the tail with the last.
+  const bool formatted = FormatInOrder(
+      runs.size(), keys < 4 * kRunKeys ? 1 : threads,
+      [&](size_t r, std::string* text) {
+        if (r == 0) *text += out;
+        text->reserve(text->size() + kRunKeys * 180);
+        AppendRun(walk, runs[r], orders[runs[r].track], *text);
+        if (r + 1 == runs.size()) *text += "\n]}\n";
+      },
+      sink);
+  if (!formatted) return false;
+  return !runs.empty() || sink(out + "\n]}\n");
 }
 
 std::string WalkToJson(const Walk& walk) {
