@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fstream>
 #include <istream>
+#include <new>
 #include <sstream>
 #include <string_view>
 
@@ -178,8 +179,12 @@ Status ReadPointFile(const std::string& path, RawSamples* out, std::string* erro
   in.seekg(0);
   if (bytes > 0 && in) {
     const size_t expected = ExpectedSamples(in, static_cast<uint64_t>(bytes));
-    out->points.reserve(expected);
-    out->normals.reserve(expected);
+    try {
+      out->points.reserve(expected);
+      out->normals.reserve(expected);
+    } catch (const std::bad_alloc&) {
+      *out = RawSamples{};  // no room to reserve (a memory limit): grown as it is read
+    }
   }
   in.clear();
   in.seekg(0);
