@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <new>
 #include <random>
 #include <vector>
 
@@ -356,6 +357,15 @@ Status TerrainRegistry::BeginUpload(const std::string& name, uint64_t total, uin
   u.name = name;
   u.owner = owner;
   u.total = total;
+  // Room for the announced samples, which the budget has admitted: grown chunk by chunk, the
+  // arrays were copied over and over (pages are only taken as samples arrive). Without the
+  // room (a memory limit), they grow as before.
+  try {
+    u.samples.points.reserve(total);
+    u.samples.normals.reserve(total);
+  } catch (const std::bad_alloc&) {
+    u.samples = RawSamples{};
+  }
   u.touched = std::chrono::steady_clock::now();
   *upload = id;
   return Status::kOk;
