@@ -451,4 +451,19 @@ check "server-terrain mesh: the walk on the file resampled at a quarter step" cm
   --character "$chars/biped.json" --start 2,0.1,0.5 --steps 6 --out "$work/server-ramp4.json" 2> /dev/null
 check "server-terrain mesh: the seed reaches the server" bash -c "! cmp -s '$work/server-ramp.json' '$work/server-ramp4.json'"
 stop_server
+# 7. A scene of 400 one-step bipeds takes memory in proportion to its keys (each character's
+#    keys once took a huge page of their own, backed whole: 2 MiB each, about 850 MB here).
+python3 - "$work/many.scene.json" "$chars/biped.json" <<'PY'
+import json, sys
+chars = [{"character_file": sys.argv[2], "name": "w%d" % i, "steps": 1,
+          "start": [2 + 1.8 * (i % 20), 0, 2 + 1.8 * (i // 20)]} for i in range(400)]
+json.dump({"format": "footfall-scene", "version": 1, "characters": chars}, open(sys.argv[1], "w"))
+PY
+peak_kib=$(python3 -c 'import resource, subprocess, sys
+r = subprocess.run(sys.argv[1:], stderr=subprocess.DEVNULL)
+print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss if r.returncode == 0 else -1)' \
+  "$footfall" generate --terrain "$hills" --scene "$work/many.scene.json" --out "$work/many.json")
+check "400-character scene: exit 0" [ "$peak_kib" -ge 0 ]
+check "400-character scene: peak memory under 200 MB ($peak_kib KiB)" [ "$peak_kib" -lt 204800 ]
+check "400-character scene: every character walked" [ "$(grep -o '"name":"body"' "$work/many.json" | wc -l)" -eq 400 ]
 finish

@@ -14,9 +14,10 @@ namespace footfall {
 // so little is).
 class KeyArena : public std::pmr::memory_resource {
  public:
-  // Blocks are in huge pages when the reservations are exact and hold at most this many bytes;
-  // else in ordinary pages: a huge page is backed whole once touched, and reservations that are
-  // only a bound (a path walk's, for its longest) may far exceed the keys written.
+  // Blocks are in huge pages when the reservations are exact and hold from one huge page (2 MiB)
+  // to this many bytes; else in ordinary pages: a huge page is backed whole once touched, and
+  // reservations that are only a bound (a path walk's, for its longest) may far exceed the keys
+  // written, while a small walk would leave most of its page untouched.
   static constexpr size_t kHugePagesUpTo = size_t{1} << 30;
   // Blocks hold at most this many bytes (more only for a single larger request): no single
   // mapping asks for all of a large reservation at once.
