@@ -195,12 +195,14 @@ err=$( (ulimit -v 2000000; "$footfall" terrain info "$work/huge.pgm") 2>&1)
 check "height map beyond memory: exit 1" [ $? -eq 1 ]
 check "height map beyond memory: message" grep -qF "huge.pgm:2: the header declares 5000 x 5000 pixels: reading it needs about 3.25 GB, more than the 2.05 GB of memory this process may use" <<< "$err"
 
-# terrain make: ramps and rocks whose coordinates would pass 5e14 are refused before their mesh
-# is built (a ramp 1e300 long ended in "cannot create std::vector larger than max_size()",
-# rocks 1e300 high asked for "a separation of at least -nan").
+# terrain make: ramps and rocks whose coordinates would pass 5e14 are refused before they are
+# sampled (a ramp 1e300 long ended in "cannot create std::vector larger than max_size()",
+# rocks 1e300 high asked for "a separation of at least -nan", rocks 1e40 high at a spacing of
+# 1e38 were sampled for minutes before their samples were refused).
 for args in "ramp --length 1e300 --spacing 1e299" "ramp --length 1e14 --slope 80 --spacing 1e13" \
-    "rocks --amplitude 1e300" "rocks --amplitude -6e14 --spacing 1e13"; do
-  err=$("$footfall" terrain make $args -o "$work/made.pts" 2>&1 >/dev/null)
+    "rocks --amplitude 1e300" "rocks --amplitude -6e14 --spacing 1e13" \
+    "rocks --amplitude 1e40 --spacing 1e38" "rocks --amplitude 1e150 --spacing 1e148"; do
+  err=$(timeout 20 "$footfall" terrain make $args -o "$work/made.pts" 2>&1 >/dev/null)
   check "make $args: exit 1" [ $? -eq 1 ]
   check "make $args: out of range" grep -qE "^footfall terrain make: (ramp|rocks): the parameters give coordinates beyond 5e\+14 \([0-9.e+]+\), out of the grid's range$" <<< "$err"
 done

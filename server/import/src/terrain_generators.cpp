@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "footfall/import/mesh_generators.h"
 #include "footfall/import/mesh_sampler.h"
+#include "footfall/terrain/samples.h"
 
 namespace footfall {
 namespace {
@@ -174,7 +176,20 @@ RawSamples MakeRamps(const std::vector<double>& slopes_deg, double length, doubl
 RawSamples MakeRocks(double size, double amplitude, double spacing, uint64_t seed,
                      std::string* error) {
   const int n = std::max(1, static_cast<int>(std::ceil(size / std::min(spacing, 0.25))));
-  return Sample(MakeRocksMesh(n, size / n, amplitude, seed), spacing, true, seed, error);
+  const TriangleMesh mesh = MakeRocksMesh(n, size / n, amplitude, seed);
+  // Rocks reaching beyond the grid's range are refused before they are sampled: sampling
+  // slivers 1e40 high took minutes, only for the samples to be refused.
+  double reach = 0;
+  for (const Vec3& v : mesh.vertices)
+    reach = std::max({reach, std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)});
+  if (!(reach <= terrain::kMaxCoordinate)) {
+    std::ostringstream m;
+    m << "the parameters give coordinates beyond " << terrain::kMaxCoordinate << " (" << reach
+      << "), out of the grid's range";
+    if (error) *error = m.str();
+    return {};
+  }
+  return Sample(mesh, spacing, true, seed, error);
 }
 
 }  // namespace footfall

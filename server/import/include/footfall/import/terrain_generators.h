@@ -43,7 +43,8 @@ RawSamples MakeRamp(int nx, int nz, double spacing, double slope_deg);
 // The meshes of mesh_generators.h resampled at separation `spacing` (mesh_sampler.h) with the
 // given seed: blocks of unit cubes (flat normals), ramps of the given slopes joined by flat
 // landings (flat normals), rocky noise over a square `size` wu wide (smooth normals). Empty when
-// the sampler refuses (too many samples for its area, non-finite vertices): *error, when given,
+// the sampler refuses (too many samples for its area, non-finite vertices), or rocks that reach
+// beyond kMaxCoordinate (refused before sampling): *error, when given,
 // then says why.
 RawSamples MakeBlocks(int nx, int nz, int max_height, double spacing, uint64_t seed,
                       std::string* error = nullptr);
