@@ -107,8 +107,9 @@ JSON
 both scene-cliff 2 --terrain "$work/cliff.pts" --scene "$work/scene/cliff.json"
 check "scene cliff: the faller's stop named" grep -qE '"stopped":"faller: step [0-9]+: foot' "$work/scene-cliff-embedded.json"
 check "scene cliff: the other character's keys kept" grep -q '"character":"safe"' "$work/scene-cliff-embedded.json"
-# A scene character whose walk memory cannot hold: said, exit 1, not an abort.
-printf '{"format": "footfall-scene", "version": 1, "characters": [{"character_file": "biped.json", "steps": 5}, {"character_file": "hexapod.json", "crowd": 300000, "steps": 100, "crowd_spacing": 0.01}]}' > "$work/scene/huge.json"
+# A scene character whose walk memory cannot hold: said, exit 1, not an abort. (Its steps are
+# a path's, only a bound: given steps would be refused up front, in 8. below.)
+printf '{"format": "footfall-scene", "version": 1, "characters": [{"character_file": "biped.json", "steps": 5}, {"character_file": "hexapod.json", "crowd": 300000, "path": [[30, 0, 30]], "crowd_spacing": 0.01}]}' > "$work/scene/huge.json"
 (ulimit -v 1500000; "$footfall" generate --terrain "$hills" --scene "$work/scene/huge.json" --out "$work/huge.json" 2> "$work/huge.err")
 check "scene beyond memory: exit 1" [ $? -eq 1 ]
 check "scene beyond memory: said" grep -q 'hexapod2: out of memory generating its walk' "$work/huge.err"
@@ -271,11 +272,16 @@ else:
     fi
   done
 done
-# A crowd beyond memory says how large it is (it said "out of memory" alone).
+# A crowd beyond memory says how large it is (it said "out of memory" alone): refused up front
+# when its steps are given, else when memory runs out (a path's steps are only a bound).
 (ulimit -v 500000; "$footfall" generate --terrain "$hills" --character "$chars/biped.json" \
   --crowd 100000 --crowd-spacing 0.1 --steps 100 --out "$work/oom-crowd.json" 2> "$work/oom-crowd.err")
 check "crowd beyond memory: exit 1" [ $? -eq 1 ]
-check "crowd beyond memory: said how large" grep -qF "out of memory generating 100000 characters x 100 steps: about 4e+07 keys" "$work/oom-crowd.err"
+check "crowd beyond memory: said how large" grep -qF "100000 characters x 100 steps make about 4e+07 keys, 2.72 GB, more than the 0.512 GB of memory this process may use" "$work/oom-crowd.err"
+(ulimit -v 500000; "$footfall" generate --terrain "$hills" --character "$chars/biped.json" \
+  --crowd 100000 --crowd-spacing 0.1 --path 30,0,30 --out "$work/oom-crowd.json" 2> "$work/oom-crowd.err")
+check "path crowd beyond memory: exit 1" [ $? -eq 1 ]
+check "path crowd beyond memory: said how large" grep -qF "out of memory generating 100000 characters x up to 1e+04 steps: up to about 4e+09 keys, 272 GB" "$work/oom-crowd.err"
 # A stopped walk with an output that could not be written is an error (1), not a stop (2), and
 # the other outputs are written; glTF, serialised straight into its file, fails as JSON does.
 for ext in json glb gltf; do
@@ -466,4 +472,20 @@ print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss if r.returncode == 
 check "400-character scene: exit 0" [ "$peak_kib" -ge 0 ]
 check "400-character scene: peak memory under 200 MB ($peak_kib KiB)" [ "$peak_kib" -lt 204800 ]
 check "400-character scene: every character walked" [ "$(grep -o '"name":"body"' "$work/many.json" | wc -l)" -eq 400 ]
+# 8. A walk whose keys alone need more memory than the process may use is refused before the
+#    terrain loads (a million characters x a million steps grew until the system stopped it).
+err=$(timeout 20 "$footfall" generate --terrain "$hills" --character "$chars/hexapod.json" \
+  --steps 1000000 --crowd 1000000 --out "$work/huge.json" 2>&1)
+check "keys beyond memory: exit 1" [ $? -eq 1 ]
+check "keys beyond memory: message" grep -qE "^footfall generate: 1000000 characters x 1000000 steps make about 1e\+13 keys, 6.8e\+05 GB, more than the [0-9.e+]+ GB of memory this process may use; nothing was generated" <<< "$err"
+err=$( (ulimit -v 2000000; timeout 20 "$footfall" generate --terrain "$hills" --character "$chars/hexapod.json" \
+  --steps 100000 --crowd 1000 --out "$work/huge.json") 2>&1)
+check "keys beyond a 2 GB limit: exit 1" [ $? -eq 1 ]
+check "keys beyond a 2 GB limit: message" grep -qF "1000 characters x 100000 steps make about 1e+09 keys, 68 GB, more than the 2.05 GB of memory this process may use" <<< "$err"
+printf '{"format":"footfall-scene","version":1,"characters":[{"character_file":"%s","steps":1000000,"crowd":1000000},{"character_file":"%s","steps":5}]}' \
+  "$chars/hexapod.json" "$chars/biped.json" > "$work/huge.scene.json"
+err=$(timeout 20 "$footfall" generate --terrain "$hills" --scene "$work/huge.scene.json" --out "$work/huge.json" 2>&1)
+check "scene keys beyond memory: exit 1" [ $? -eq 1 ]
+check "scene keys beyond memory: message" grep -qE "^footfall generate: the scene's characters make about 1e\+13 keys" <<< "$err"
+check "keys beyond memory: nothing written" [ ! -e "$work/huge.json" ]
 finish

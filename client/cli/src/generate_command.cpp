@@ -26,6 +26,7 @@
 #include "footfall/steps/walk_json.h"
 #include "footfall/steps/walk_terrain.h"
 #include "footfall/terrain/file_extension.h"
+#include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/output_file.h"
 #include "footfall/terrain/point_file.h"
 #include "footfall/terrain/shown_text.h"
@@ -336,22 +337,47 @@ bool LoadWalkTerrain(const GenerateFlags& flags, const Character& character,
   return true;
 }
 
+// [Units: bytes] About what one key of a walk takes: its frame, phase, position and normal, and a
+// body key's rotation shared out over the keys.
+constexpr double kBytesPerKey = 68;
+
+// About how many keys `crowd` characters walking `steps` steps make: per character and step,
+// the start, mid and end keys of a gait group's feet, and a body key.
+double EstimateKeys(double crowd, double steps, const Character& character) {
+  return crowd * steps *
+         (3.0 * static_cast<double>(character.feet.size()) /
+              static_cast<double>(character.gait.size()) +
+          1);
+}
+
+// Refuses, before the terrain is loaded, a walk whose keys alone need more memory than this
+// process may use (`what` names it): without an address-space limit, a crowd of a million
+// characters x a million steps grew for minutes until the system stopped it.
+bool CheckKeyMemory(double keys, const std::string& what, std::string* error) {
+  const double memory = UsableMemoryBytes();
+  if (!(memory > 0) || keys * kBytesPerKey <= memory) return true;
+  std::ostringstream m;
+  m.precision(3);
+  m << what << " make about " << keys << " keys, " << keys * kBytesPerKey / 1e9
+    << " GB, more than the " << memory / 1e9
+    << " GB of memory this process may use; nothing was generated (give fewer "
+    << "characters, crowds or steps)";
+  *error = m.str();
+  return false;
+}
+
 // What running out of memory while generating says: about how many keys the walk needed.
 std::string OutOfMemoryMessage(const GenerateFlags& flags, const GenerateOptions& options,
                                const Character& character) {
-  // Per character and step: start, mid and end keys of a group's feet, and a body key.
   const double steps = flags.steps < 0 ? kMaxPathSteps : flags.steps;
-  const double keys = static_cast<double>(flags.crowd) * steps *
-                      (3.0 * static_cast<double>(character.feet.size()) /
-                           static_cast<double>(character.gait.size()) +
-                       1);
+  const double keys = EstimateKeys(flags.crowd, steps, character);
   std::ostringstream m;
   m.precision(3);
   const bool capped = flags.steps < 0 && !options.path.empty();
   m << "out of memory generating " << flags.crowd
     << (flags.crowd == 1 ? " character" : " characters") << " x " << (capped ? "up to " : "")
     << steps << " steps: " << (capped ? "up to " : "") << "about " << keys << " keys, "
-    << keys * 68 / 1e9 << " GB; nothing was written (give fewer --crowd or --steps)";
+    << keys * kBytesPerKey / 1e9 << " GB; nothing was written (give fewer --crowd or --steps)";
   return m.str();
 }
 
@@ -466,7 +492,11 @@ int RunScene(const GenerateFlags& flags) {
                 " starts at frame " + NumberText(c.options.start_frame) + "; write .json or .mel";
     }
   }
-  if (!error.empty() || !CheckOutputs(flags, inputs, &error)) {
+  double keys = 0;  // of the characters whose steps are given (the others' are only a bound)
+  for (const SceneCharacter& c : scene)
+    if (c.options.steps >= 0) keys += EstimateKeys(c.options.crowd, c.options.steps, c.character);
+  if (!error.empty() || !CheckOutputs(flags, inputs, &error) ||
+      !CheckKeyMemory(keys, "the scene's characters", &error)) {
     std::cerr << "footfall generate: " << error << '\n';
     return 1;
   }
@@ -591,6 +621,12 @@ int RunGenerate(const GenerateFlags& flags) {
   if (!ReadOptions(flags, &options, &error) ||
       !CheckOutputs(flags, {flags.terrain.terrain, flags.character}, &error) ||
       LoadCharacter(flags.character, &character, &error) != Status::kOk ||
+      (flags.steps >= 0 &&
+       !CheckKeyMemory(EstimateKeys(flags.crowd, flags.steps, character),
+                       std::to_string(flags.crowd) +
+                           (flags.crowd == 1 ? " character x " : " characters x ") +
+                           std::to_string(flags.steps) + " steps",
+                       &error)) ||
       !LoadWalkTerrain(flags, character, &options, &terrain, &error)) {
     std::cerr << "footfall generate: " << error << '\n';
     return 1;
