@@ -977,8 +977,7 @@ std::vector<std::string> FuzzServerArgs(const DataRoot& root) {
   std::vector<std::string> args = {"--no-rpcbind", "--data-root", root.path};
   args.insert(args.end(), {"--max-samples", "20000", "--orphan-timeout", "1"});
   args.insert(args.end(), {"--upload-timeout", "1", "--threads", "2"});
-  // Batches of connections that sent FF_ASK_AGAIN are answered in parts, some of their results
-  // FF_LIMIT_EXCEEDED.
+  // Batches are answered in parts, some of their results FF_LIMIT_EXCEEDED.
   args.insert(args.end(), {"--batch-time-limit", "0.0005"});
   return args;
 }
@@ -1499,17 +1498,23 @@ TEST_CASE("RPC fuzz: a non-finite double in any query or load field answers FF_I
     nb.queries.queries_len = 3;
     nb.queries.queries_val = steps.data();
     const Bytes nb_args = Encode(FF_XDR(ff_next_batch_args), &nb);
+    // The statuses of a batch; asked again while a query is past the (very short) batch time
+    // limit, as clients do.
     auto batch = [&](uint32_t proc, const Bytes& args) {
-      Answer answer{};
-      Bytes body;
-      REQUIRE(raw.Call(proc, args, &answer, &body));
-      REQUIRE(answer == Answer::kSuccess);
-      ff_batch_reply reply;
-      REQUIRE(DecodeWhole(FF_XDR(ff_batch_reply), body, &reply) == "");
-      std::vector<int> statuses = {reply.status};
-      for (u_int i = 0; i < reply.results.results_len; ++i)
-        statuses.push_back(reply.results.results_val[i].status);
-      Free(FF_XDR(ff_batch_reply), &reply);
+      std::vector<int> statuses;
+      for (int call = 0; call < 100; ++call) {
+        Answer answer{};
+        Bytes body;
+        REQUIRE(raw.Call(proc, args, &answer, &body));
+        REQUIRE(answer == Answer::kSuccess);
+        ff_batch_reply reply;
+        REQUIRE(DecodeWhole(FF_XDR(ff_batch_reply), body, &reply) == "");
+        statuses = {reply.status};
+        for (u_int i = 0; i < reply.results.results_len; ++i)
+          statuses.push_back(reply.results.results_val[i].status);
+        Free(FF_XDR(ff_batch_reply), &reply);
+        if (std::find(statuses.begin(), statuses.end(), FF_LIMIT_EXCEEDED) == statuses.end()) break;
+      }
       return statuses;
     };
     const std::vector<int> middle_invalid = {FF_OK, FF_OK, FF_INVALID_ARGUMENT, FF_OK};

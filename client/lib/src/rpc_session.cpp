@@ -460,9 +460,9 @@ class RpcSession final : public TerrainSession {
     std::string reason;
     client_ = ConnectFootfalld(options_, &reason);
     if (!client_) return Fail(Status::kUnavailable, "footfalld at " + Address() + ": " + reason);
-    // This client asks again for batch results left for later (AskAgain), so footfalld may
-    // answer its costly batches in parts and serve other clients between them. A footfalld
-    // without the procedure answers whole batches: nothing to ask again.
+    // This client asks again for batch results left for later (AskAgain). footfalld answers
+    // every connection's costly batches in parts now, but earlier ones did so only for
+    // connections that said so; one without the procedure answers whole batches.
     Reply<ff_status_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_status_reply));
     const clnt_stat asked = ff_ask_again_1(nullptr, &reply.value, client_);
     if (asked != RPC_SUCCESS && asked != RPC_PROCUNAVAIL) return Call(asked, "connect");

@@ -195,10 +195,25 @@ void DropClient(const Connection& connection,
         SecondsText(g_state->registry.limits().orphan_idle_s) + " without queries");
 }
 
-// True when the connection of `transport` asked for batches in parts (FF_ASK_AGAIN).
-bool AsksAgain(SVCXPRT* transport) {
+// [Units: s] How long a batch of the connection of `transport` may take before its remaining
+// queries are answered kLimitExceeded (to be asked again): --batch-time-limit, shared out
+// among the connections whose batches were cut within the last two limits. So others wait
+// about one limit however many connections send costly batches (each had a whole limit: 12
+// such connections held a ping for 12 s).
+double BatchSliceSeconds(SVCXPRT* transport) {
+  const auto now = std::chrono::steady_clock::now();
+  const auto recent = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(2 * g_state->batch_time_limit_s));
+  int costly = 1;  // this connection
+  for (const auto& [fd, connection] : g_state->connections)
+    if (fd != transport->xp_fd && now - connection.last_cut < recent) ++costly;
+  return g_state->batch_time_limit_s / costly;
+}
+
+// Notes that a batch of the connection of `transport` was cut at its time limit.
+void NoteBatchCut(SVCXPRT* transport) {
   const auto it = g_state->connections.find(transport->xp_fd);
-  return it != g_state->connections.end() && it->second.asks_again;
+  if (it != g_state->connections.end()) it->second.last_cut = std::chrono::steady_clock::now();
 }
 
 // The connection a request came on, registered on its first request.
@@ -562,30 +577,19 @@ struct BatchInProgress {
 constexpr double kLimitCheckS = 0.002;
 
 // Answers queries [0, n) of a batch into g_storage.answers on the batch threads; `answer(b, e)`
-// fills answers [b, e). For a connection that asks again (`in_parts`), queries taken after the
-// batch's time limit are answered kLimitExceeded (the first always is answered: every call makes
-// progress).
+// fills answers [b, e). Queries taken after `limit_s` seconds are answered kLimitExceeded, to be
+// asked again (the first always is answered: every call makes progress). True if any was.
 template <typename Fn>
-void RunBatch(size_t n, BatchReplyView<Foothold>* r, bool in_parts, Fn&& answer) {
+bool RunBatch(size_t n, BatchReplyView<Foothold>* r, double limit_s, Fn&& answer) {
   Foothold* answers = g_storage.answers.data();
   using Clock = std::chrono::steady_clock;
-  const auto deadline =
-      in_parts ? Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                    std::chrono::duration<double>(g_state->batch_time_limit_s))
-               : Clock::time_point::max();
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(limit_s));
   const auto check_every = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(std::min(kLimitCheckS, g_state->batch_time_limit_s / 8)));
+      std::chrono::duration<double>(std::min(kLimitCheckS, limit_s / 8)));
   std::atomic<size_t> late{0};
   const BatchInProgress counted;
   g_pool->Run(n, BatchPool::kQueryChunk, [&](size_t begin, size_t end) {
-    if (!in_parts) {
-      for (size_t b = begin; b < end; b += BatchPool::kQueryChunk) {
-        const size_t e = std::min(end, b + BatchPool::kQueryChunk);
-        answer(b, e, answers);
-        for (size_t i = b; i < e; ++i) ClearFailed(&answers[i]);
-      }
-      return;
-    }
     // One call may cover the whole batch (one thread). Queries are answered in runs sized to
     // the time they take: a run starts at one query and doubles while it takes under half of
     // check_every, so costly queries (a `next` of huge tolerance on a large terrain) see the
@@ -612,49 +616,57 @@ void RunBatch(size_t n, BatchReplyView<Foothold>* r, bool in_parts, Fn&& answer)
     }
   });
   if (late > 0)
-    Log("batch of " + std::to_string(n) + " queries past its time limit (" +
-        SecondsText(g_state->batch_time_limit_s) + "): " + std::to_string(late.load()) +
-        " answered limit_exceeded, to be asked again");
+    Log("batch of " + std::to_string(n) + " queries past its time limit (" + SecondsText(limit_s) +
+        (limit_s < g_state->batch_time_limit_s ? ", --batch-time-limit shared with other "
+                                                 "connections sending costly batches"
+                                               : "") +
+        "): " + std::to_string(late.load()) + " answered limit_exceeded, to be asked again");
   r->status = FF_OK;
   r->count = r->capacity = static_cast<u_int>(n);
   r->results = answers;
+  return late > 0;
 }
 
-void PointBatch(const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r, int op, bool in_parts) {
+// A snap or normal batch, answered within `limit_s` seconds (RunBatch). True if cut.
+bool PointBatch(const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r, int op,
+                double limit_s) {
   const LoadedTerrain* t = g_state->registry.Use(a.terrain);
   if (!t) {
     LogUnknownTerrain(op == FF_OP_SNAP ? "snap batch" : "normal batch", a.terrain);
     r->status = FF_UNKNOWN_TERRAIN;
-    return;
+    return false;
   }
   const size_t n = a.count;
   const Vec3* points = a.points;
-  RunBatch(n, r, in_parts, [&](size_t b, size_t e, Foothold* out) {
+  const bool cut = RunBatch(n, r, limit_s, [&](size_t b, size_t e, Foothold* out) {
     t->grid.SnapBatch(points + b, e - b, out + b);
   });
   for (size_t i = 0; i < n && i < kRecordPerBatch; ++i)
     Record(a.terrain, op, points[i], Vec3{}, 0, r->results[i]);
+  return cut;
 }
 
-void NextBatch(const NextBatchView<StepQuery>& a, BatchReplyView<Foothold>* r, bool in_parts) {
+// A next batch, answered within `limit_s` seconds (RunBatch). True if cut.
+bool NextBatch(const NextBatchView<StepQuery>& a, BatchReplyView<Foothold>* r, double limit_s) {
   const LoadedTerrain* t = g_state->registry.Use(a.terrain);
   if (!t) {
     LogUnknownTerrain("next batch", a.terrain);
     r->status = FF_UNKNOWN_TERRAIN;
-    return;
+    return false;
   }
   if (!std::isfinite(a.tolerance)) {
     r->status = FF_INVALID_ARGUMENT;
-    return;
+    return false;
   }
   const size_t n = a.count;
   const StepQuery* steps = a.queries;
   const double tolerance = a.tolerance;
-  RunBatch(n, r, in_parts, [&](size_t b, size_t e, Foothold* out) {
+  const bool cut = RunBatch(n, r, limit_s, [&](size_t b, size_t e, Foothold* out) {
     t->grid.NextBatch(steps + b, e - b, tolerance, out + b);
   });
   for (size_t i = 0; i < n && i < kRecordPerBatch; ++i)
     Record(a.terrain, FF_OP_NEXT, steps[i].foot, steps[i].direction, tolerance, r->results[i]);
+  return cut;
 }
 
 void Recent(const ff_recent_args& a, ff_recent_reply* r) {
@@ -823,7 +835,7 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
           AsXdrProc(XdrBatchReplyView<Foothold>),
           request->rq_proc == FF_SNAP_BATCH ? "snap batch" : "normal batch",
           [op, transport](const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r) {
-            PointBatch(a, r, op, AsksAgain(transport));
+            if (PointBatch(a, r, op, BatchSliceSeconds(transport))) NoteBatchCut(transport);
           });
     }
     case FF_NEXT_BATCH: {
@@ -834,7 +846,7 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
           transport, AsXdrProc(XdrNextBatchView<StepQuery>), args,
           AsXdrProc(XdrBatchReplyView<Foothold>), "next batch",
           [transport](const NextBatchView<StepQuery>& a, BatchReplyView<Foothold>* r) {
-            NextBatch(a, r, AsksAgain(transport));
+            if (NextBatch(a, r, BatchSliceSeconds(transport))) NoteBatchCut(transport);
           });
     }
     case FF_ASK_AGAIN: {
@@ -843,8 +855,8 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
       };
       return Serve<Empty, ff_status_reply>(
           transport, FF_XDR_VOID, FF_XDR(ff_status_reply), "ask again",
-          [transport](const Empty&, ff_status_reply* r) {
-            g_state->connections[transport->xp_fd].asks_again = true;  // registered above
+          // Every connection's batches are answered in parts now: kept for clients that ask.
+          [](const Empty&, ff_status_reply* r) {
             r->status = FF_OK;
             r->message = Message("");
           });

@@ -3,6 +3,7 @@
 
 #include <rpc/rpc.h>
 
+#include <chrono>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -18,7 +19,8 @@ namespace footfall {
 struct Connection {
   uint64_t id = 0;
   std::string peer;
-  bool asks_again = false;  // FF_ASK_AGAIN: its batches may be answered in parts
+  // [Units: steady_clock] When a batch of its was last cut at its time limit (BatchSliceSeconds).
+  std::chrono::steady_clock::time_point last_cut{};
 };
 
 struct ServiceState {

@@ -216,7 +216,7 @@ void RpcServer::Stop() {
   while (n > 0) text[at++] = digits[--n];
   const char* rest = batches == 1 ? " batch in progress" : " batches in progress";
   for (; *rest && at + 1 < sizeof text; ++rest) text[at++] = *rest;
-  rest = " (to its end; to --batch-time-limit for a client that asks again)\n";
+  rest = " (up to --batch-time-limit)\n";
   for (; *rest && at + 1 < sizeof text; ++rest) text[at++] = *rest;
   if (write(STDERR_FILENO, text, at) < 0) {
     // Nothing to do: stderr is gone.
