@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <sstream>
 
 #include "footfall/import/terrain_loader.h"
 #include "footfall/terrain/input_file.h"
@@ -175,6 +176,32 @@ TEST_CASE("ReadMesh: bad meshes give clear errors", "[import][mesh]") {
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n";
     CHECK(Read(dir.Write("fin.obj", obj), &mesh, &error) == Status::kParseError);
     CHECK(Contains(error, "fin.obj: the mesh is not manifold"));
+    CHECK(!Contains(error, "one-sided"));
+  }
+  SECTION("a Moebius strip is said to be one-sided") {
+    // Every edge joins two faces at most, but no winding of them all agrees (it was said to
+    // share edges with two other faces).
+    std::ostringstream obj;
+    constexpr int kSegments = 60;
+    for (int i = 0; i < kSegments; ++i) {
+      const double t = 2 * 3.14159265358979 * i / kSegments;
+      for (const double w : {-0.3, 0.3}) {
+        const double r = 1 + w * std::cos(t / 2);
+        obj << "v " << r * std::cos(t) << ' ' << w * std::sin(t / 2) << ' ' << r * std::sin(t)
+            << '\n';
+      }
+    }
+    for (int i = 0; i < kSegments; ++i) {
+      const int a = 2 * i + 1, b = a + 1;
+      // The last quad joins the first edge turned over.
+      const int c = i + 1 < kSegments ? a + 2 : 2, d = i + 1 < kSegments ? b + 2 : 1;
+      obj << "f " << a << ' ' << b << ' ' << d << ' ' << c << '\n';
+    }
+    CHECK(Read(dir.Write("moebius.obj", obj.str()), &mesh, &error) == Status::kParseError);
+    CHECK(Contains(error, "moebius.obj: the mesh is not manifold"));
+    CHECK(Contains(error,
+                   "or close a one-sided surface (a sheet whose faces cannot all be wound "
+                   "one way, as on a Moebius strip)"));
   }
   SECTION("records beyond the declared counts") {
     // Declaring 2 faces and holding 4 loaded half the area without a word.

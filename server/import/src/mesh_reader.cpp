@@ -171,6 +171,7 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
   // its faces is kept (a sheet that cannot be wound consistently is left as it is). Faces meet
   // where their corners are at the same position, as in a soup's or a split mesh's faces.
   size_t turned = 0;
+  bool one_sided = false;  // a sheet that cannot be wound consistently (a Moebius strip)
   {
     struct Side {
       uint64_t edge;  // the lower vertex << 32 | the higher
@@ -232,6 +233,7 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
       }
       size_t flipped = 0;
       for (uint32_t f : sheet) flipped += flip[f];
+      one_sided |= !consistent;
       if (!consistent || flipped == 0) continue;
       const uint8_t turn = 2 * flipped > sheet.size() ? 0 : 1;  // the minority is turned
       for (uint32_t f : sheet) {
@@ -265,7 +267,10 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
       if (error) {
         *error = path + ": the mesh is not manifold: " + std::to_string(non_manifold) +
                  " faces (the first is " + FaceName(parsed, first_bad) +
-                 ") share an edge with two other faces or meet another sheet at a single vertex";
+                 ") share an edge with two other faces or meet another sheet at a single vertex" +
+                 (one_sided ? ", or close a one-sided surface (a sheet whose faces cannot all be "
+                              "wound one way, as on a Moebius strip)"
+                            : "");
       }
       return Status::kParseError;
     }
