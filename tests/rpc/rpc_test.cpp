@@ -390,6 +390,15 @@ TEST_CASE("Server addresses are read as footfalld's --listen writes them", "[rpc
   CHECK(ParseHostPort("host:x", &o, &error) == Status::kInvalidArgument);
   for (const char* bad : {"host: 7407", "host:+7407", "host:-0", " 7407", "host:7407 ", "host:"})
     CHECK(ParseHostPort(bad, &o, &error) == Status::kInvalidArgument);
+  // Brackets unclosed or misplaced, colons in a name ("[::1" was host "[:" at port 1).
+  for (const char* bad : {"[::1", "::1]:7407", "[[::1]]:7407", "a:b:7407", "[:]:7407"}) {
+    INFO(bad);
+    CHECK(ParseHostPort(bad, &o, &error) == Status::kInvalidArgument);
+    CHECK(error == "'" + std::string(bad) +
+                       "': expected HOST:PORT, an IPv6 address in brackets ([::1]:7407) or alone "
+                       "(::1)");
+  }
+  CHECK(ParseHostPort("[::1]", &o, &error) == Status::kInvalidArgument);  // no port after it
 }
 
 TEST_CASE("RPC answers equal the embedded engine", "[rpc]") {

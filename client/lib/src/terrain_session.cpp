@@ -61,6 +61,15 @@ Status ParseHostPort(const std::string& text, RpcOptions* options, std::string* 
   }
   if (host.size() >= 2 && host.front() == '[' && host.back() == ']')
     host = host.substr(1, host.size() - 2);
+  // Brackets left over, or colons in what is not an IPv6 address ("[::1" was host "[:" at port
+  // 1, named "[[:]:1" when it could not be resolved).
+  if (host.find_first_of("[]") != std::string::npos ||
+      (host.find(':') != std::string::npos && !IsIpv6Address(host))) {
+    if (error)
+      *error = "'" + text +
+               "': expected HOST:PORT, an IPv6 address in brackets ([::1]:7407) or alone (::1)";
+    return Status::kInvalidArgument;
+  }
   options->host = host.empty() ? "127.0.0.1" : host;
   options->port = static_cast<int>(port);
   return Status::kOk;
