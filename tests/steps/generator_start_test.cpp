@@ -291,6 +291,17 @@ TEST_CASE("A step_length longer than the reach allows is said once in the walk's
     CHECK(Distance(ends[i], ends[i - 1]) <= 2.9);
     CHECK(Distance(ends[i], ends[i - 1]) > 2);
   }
+  // Far longer steps are shortened as well, however long (past about 60, eight shortenings by
+  // a quarter fell short of the reach, and the walk stopped at step 1).
+  for (const double step : {100.0, 1e6}) {
+    INFO("step_length " << step);
+    c.step_length = step;
+    const Walk far = Generate(t, c, o);
+    INFO(far.stopped);
+    CHECK(far.stopped.empty());
+    CHECK(far.notes.size() == 1);
+    CheckWalk(t, c, o, far);
+  }
   // Every shipped character walks its full step_length: no note.
   for (const std::string& name : ShippedCharacters()) {
     INFO(name);

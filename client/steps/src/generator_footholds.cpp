@@ -228,8 +228,9 @@ Status Generator::QueryFootholds(std::string* error) {
           continue;
         }
         // No target beyond reach of the body where the step will put it (the feet's centroid
-        // moves by this foot's displacement over the number of feet).
-        for (int shrink = 0; shrink < 8; ++shrink) {
+        // moves by this foot's displacement over the number of feet). Up to 64 shortenings by a
+        // quarter (1e-8 of the step): eight left steps over about 60 times the reach beyond it.
+        for (int shrink = 0; shrink < 64; ++shrink) {
           const Vec3 ground = a.ground + v / static_cast<double>(feet);
           const Vec3 body = ground + a.body_up * c_.body_height;
           if (Distance(a.foot[mv.foot] + v, body) <= c_.reach) break;
