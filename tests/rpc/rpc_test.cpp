@@ -1483,7 +1483,15 @@ TEST_CASE("footfalld refuses uploaded samples out of range, per chunk", "[rpc]")
     REQUIRE(BeginUpload(c, 2, &upload, &message) == FF_OK);
     CHECK(SendChunk(c, upload, {ff_sample{{0, 0, 0}, {0, 1, 0}}, bad}, &message) ==
           FF_INVALID_ARGUMENT);
-    return message;
+    // The upload is gone, and the message says so.
+    const std::string dropped =
+        "; upload " + std::to_string(upload) + " is dropped: begin it again";
+    CHECK(message.size() > dropped.size());
+    CHECK(message.compare(message.size() - dropped.size(), dropped.size(), dropped) == 0);
+    const std::string why = message.substr(0, message.size() - dropped.size());
+    CHECK(SendChunk(c, upload, {ff_sample{{0, 0, 0}, {0, 1, 0}}}, &message) == FF_INVALID_ARGUMENT);
+    CHECK(message == "no upload " + std::to_string(upload) + " in progress on this connection");
+    return why;
   };
   CHECK(refused({{1e308, 0, 0}, {0, 1, 0}}) ==
         "sample 1: point (1e+308, 0, 0) is out of range (expected coordinates within +-5e+14)");

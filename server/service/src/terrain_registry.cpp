@@ -371,6 +371,16 @@ Status TerrainRegistry::BeginUpload(const std::string& name, uint64_t total, uin
   return Status::kOk;
 }
 
+namespace {
+
+// What a refused chunk's message ends with: the upload is gone (its later chunks were answered
+// "no upload N in progress", with no word of why).
+std::string Dropped(uint32_t upload) {
+  return "; upload " + std::to_string(upload) + " is dropped: begin it again";
+}
+
+}  // namespace
+
 Status TerrainRegistry::AppendUpload(uint32_t upload, uint64_t owner, const RawSamples& chunk,
                                      std::string* message) {
   auto it = uploads_.find(upload);
@@ -380,14 +390,15 @@ Status TerrainRegistry::AppendUpload(uint32_t upload, uint64_t owner, const RawS
   }
   Upload& u = it->second;
   if (u.samples.size() + chunk.size() > u.total) {
-    *message = "upload sent more samples than the " + std::to_string(u.total) + " announced";
+    *message = "upload sent more samples than the " + std::to_string(u.total) + " announced" +
+               Dropped(upload);
     uploads_.erase(it);
     return Status::kInvalidArgument;
   }
   for (size_t i = 0; i < chunk.size(); ++i) {
     std::string what;
     if (CheckSample(chunk.points[i], chunk.normals[i], &what) != Status::kOk) {
-      *message = "sample " + std::to_string(u.samples.size() + i) + ": " + what;
+      *message = "sample " + std::to_string(u.samples.size() + i) + ": " + what + Dropped(upload);
       uploads_.erase(it);
       return Status::kInvalidArgument;
     }
