@@ -577,6 +577,14 @@ TEST_CASE("A batch past --batch-time-limit lets other clients in and is complete
   clnt_destroy(raw);
 }
 
+// A full batch of points 1e10 above flat ground at the origin: rounding ties most samples, so
+// each snap compares every sample (the costliest valid queries).
+std::vector<ff_vec3> FarSnaps() {
+  std::vector<ff_vec3> far(FF_MAX_BATCH);
+  for (size_t i = 0; i < far.size(); ++i) far[i] = {0.007 * i, 1e10, 0.003 * i};
+  return far;
+}
+
 TEST_CASE("Connections sending costly batches share --batch-time-limit so others wait one limit",
           "[rpc][robustness]") {
   // Eight raw connections send batches of snaps from 1e10 above flat ground (each query compares
@@ -587,8 +595,7 @@ TEST_CASE("Connections sending costly batches share --batch-time-limit so others
   auto quick = Connect(server.port(), 60);
   TerrainHandle t = 0;
   REQUIRE(quick->LoadSamples(MakeFlat(300, 0.1, 0), "flat", &t) == Status::kOk);
-  std::vector<ff_vec3> far(FF_MAX_BATCH);
-  for (size_t i = 0; i < far.size(); ++i) far[i] = {0.007 * i, 1e10, 0.003 * i};
+  std::vector<ff_vec3> far = FarSnaps();
   const uint32_t handle = OnlyServerTerrain(server.port());
   std::atomic<bool> stop{false};
   std::atomic<int> cut_batches{0};
@@ -643,8 +650,7 @@ TEST_CASE("A batch of costly queries keeps to --batch-time-limit within a few mi
   auto session = Connect(server.port(), 60);
   TerrainHandle t = 0;
   REQUIRE(session->LoadSamples(MakeFlat(800, 0.1, 0), "flat", &t) == Status::kOk);
-  std::vector<ff_vec3> far(FF_MAX_BATCH);
-  for (size_t i = 0; i < far.size(); ++i) far[i] = {0.007 * i, 1e10, 0.003 * i};
+  std::vector<ff_vec3> far = FarSnaps();
   CLIENT* raw = RawClient(server.port(), FF_MAX_REQUEST_BYTES + 8192);
   ff_status_reply asked{};
   REQUIRE(ff_ask_again_1(nullptr, &asked, raw) == RPC_SUCCESS);
