@@ -1852,6 +1852,20 @@ TEST_CASE("footfalld listens on IPv6 addresses and logs them in brackets", "[rpc
                         Catch::Contains("cannot listen on [::1]:7407: "));
     CHECK_THAT(log, !Catch::Contains("cannot resolve"));
   }
+  SECTION("a wildcard address is said to listen on every interface") {
+    // ("0:0" listened on 0.0.0.0 with the log saying "listening on 0:PORT" alone.)
+    for (const char* wildcard : {"0:0", "0.0.0.0:0", "[::]:0"}) {
+      const auto [status, log] = run(wildcard);
+      INFO(wildcard << ": " << log);
+      CHECK(status != 2);
+      CHECK_THAT(log, Catch::Contains("footfalld: warning: listening on every interface: any host "
+                                      "that reaches this machine may load and query terrains"));
+    }
+    const auto [status, log] = run("127.0.0.1:0");
+    INFO(log);
+    CHECK_THAT(log, Catch::Contains("listening on 127.0.0.1:"));
+    CHECK_THAT(log, !Catch::Contains("every interface"));
+  }
   SECTION("malformed addresses and ports are refused") {
     for (const char* bad : {"[::1", "[]:7", "[::1]x", "[::1]:", "[::1]:70000", "127.0.0.1: 0",
                             "127.0.0.1:+0", " 0", "[::1]: 0"}) {

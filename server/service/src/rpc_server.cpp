@@ -129,6 +129,11 @@ bool RpcServer::Start(std::string* error) {
   getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&bound), &len);
   port_ = ntohs(bound.ss_family == AF_INET6 ? reinterpret_cast<sockaddr_in6*>(&bound)->sin6_port
                                             : reinterpret_cast<sockaddr_in*>(&bound)->sin_port);
+  // A wildcard address ("0", "0.0.0.0", "::") listens on every interface: said when listening.
+  every_interface_ =
+      bound.ss_family == AF_INET6
+          ? IN6_IS_ADDR_UNSPECIFIED(&reinterpret_cast<sockaddr_in6*>(&bound)->sin6_addr)
+          : reinterpret_cast<sockaddr_in*>(&bound)->sin_addr.s_addr == htonl(INADDR_ANY);
   int send_buffer = 0;
   len = sizeof send_buffer;
   getsockopt(listen_fd_, SOL_SOCKET, SO_SNDBUF, &send_buffer, &len);
@@ -197,6 +202,13 @@ bool RpcServer::Start(std::string* error) {
   std::fprintf(stderr, "footfalld: listening on %s%s%s:%d (program %u version %u)\n", v6 ? "[" : "",
                options_.listen_host.c_str(), v6 ? "]" : "", port_,
                static_cast<unsigned>(FOOTFALL_PROG), static_cast<unsigned>(FOOTFALL_V1));
+  if (every_interface_) {
+    std::fprintf(stderr,
+                 "footfalld: warning: listening on every interface: any host that reaches this "
+                 "machine may load and query terrains (--listen 127.0.0.1:%d serves this machine "
+                 "only)\n",
+                 port_);
+  }
   if (!rpcbind_note.empty()) std::fprintf(stderr, "footfalld: %s\n", rpcbind_note.c_str());
   if (!options_.data_root.empty())
     std::fprintf(stderr, "footfalld: data root %s\n", options_.data_root.c_str());

@@ -65,7 +65,8 @@ class RpcServer {
   RpcServerOptions options_;
   int listen_fd_ = -1;
   int port_ = 0;
-  size_t send_buffer_ = 0;  // [Units: bytes] of every connection, as the kernel reports it
+  bool every_interface_ = false;  // bound to a wildcard address
+  size_t send_buffer_ = 0;        // [Units: bytes] of every connection, as the kernel reports it
   bool registered_rpcbind_ = false;
   bool abandoned_load_ = false;
   std::atomic<bool> stop_{false};
