@@ -511,6 +511,65 @@ class BlenderAddonTest(unittest.TestCase):
         self.assertIn("has no keys", str(e.exception))
         self.assertEqual(set(bpy.data.objects), before)
 
+    def test_3c_the_panels_buttons_read_its_character_file(self):
+        # The panel's buttons set only the mode: with no file field anywhere on the panel, a
+        # click always read the character file '' and failed.
+        import footfall_blender.ui as ui
+
+        class Layout:
+            def __init__(self):
+                self.props, self.buttons = [], []
+
+            def column(self):
+                return self
+
+            def prop(self, data, name, **_):
+                self.props.append(name)
+
+            def label(self, **_):
+                pass
+
+            def operator(self, idname, **_):
+                button = type("Button", (), {})()
+                self.buttons.append((idname, button))
+                return button
+
+        layout = Layout()
+        panel = type("Panel", (), {"layout": layout})()
+        ui.FOOTFALL_PT_character.draw(panel, bpy.context)
+        self.assertEqual(layout.props[0], "character_file")
+        setups = [b for idname, b in layout.buttons if idname == "footfall.character_setup"]
+        self.assertEqual([b.mode for b in setups], ["CREATE", "PICK"])
+        self.assertFalse(any(hasattr(b, "character_file") for b in setups))
+
+        scene = bpy.context.scene
+        before, rig_before = set(bpy.data.objects), scene.footfall.rig
+        path = os.path.join(CHARACTERS, "hexapod.json")
+        try:
+            scene.footfall.character_file = ""
+            with self.assertRaises(RuntimeError) as e:
+                bpy.ops.footfall.character_setup(mode="CREATE", name="panel")
+            self.assertIn("choose a character file (Character Setup > Character file)",
+                          str(e.exception))
+            self.assertEqual(set(bpy.data.objects), before)
+            scene.footfall.character_file = path
+            self.assertEqual(bpy.ops.footfall.character_setup(mode="CREATE", name="panel"),
+                             {"FINISHED"})
+            rig = bpy.data.objects["panel_rig"]
+            self.assertEqual(rig.footfall_rig.character_path, path)
+            self.assertEqual(len(rig.footfall_rig.feet), 6)
+            # The operator's own file (a script's) goes before the panel's.
+            with self.assertRaises(RuntimeError) as e:
+                bpy.ops.footfall.character_setup(
+                    character_file=os.path.join(ARGS.work_dir, "missing.json"), mode="CREATE",
+                    name="panel2")
+            self.assertIn("missing.json", str(e.exception))
+        finally:
+            scene.footfall.character_file = ""
+            for obj in set(bpy.data.objects) - before:
+                bpy.data.objects.remove(obj)
+            scene.footfall.rig = rig_before
+
     def test_4_biped_setup_picks_ik_targets(self):
         with open(os.path.join(CHARACTERS, "biped.json")) as f:
             names = [foot["name"] for foot in json.load(f)["feet"]]

@@ -391,6 +391,7 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
     bl_label = "Character Setup"
     bl_options = {"REGISTER", "UNDO"}
 
+    # Empty: the panel's (the scene's Character file field).
     character_file: StringProperty(name="Character file", subtype="FILE_PATH")
     mode: EnumProperty(name="Rig", items=[
         ("CREATE", "Create empties", "Create a body and foot IK target empties at the 3D cursor"),
@@ -401,14 +402,18 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
     def execute(self, context):
         try:
             key = scene_terrain_key(context.scene)  # before connecting, or anything made
-            data = character.load(bpy.path.abspath(self.character_file))
+            # The panel's buttons give no file: they take the panel's field.
+            path = self.character_file or context.scene.footfall.character_file
+            if not path:
+                raise ValueError("choose a character file (Character Setup > Character file)")
+            data = character.load(bpy.path.abspath(path))
             s = session(context)
             # As the generator reads it, before anything is made (a file it refuses made a
             # whole rig, and the error came only at Generate Walk).
-            s.check_character(data, self.character_file)
-            feet = character.rest_positions(data, self.character_file)
+            s.check_character(data, path)
+            feet = character.rest_positions(data, path)
             terrain = _connection.terrain(key)  # uploaded again if the session changed
-            return self._setup(context, s, terrain, data, feet)
+            return self._setup(context, s, terrain, data, feet, path)
         except (ffc.FootfallError, ValueError, OSError, TypeError, KeyError) as e:
             return _fail(self, _error_text(e))
 
@@ -448,9 +453,9 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
             raise ValueError("no selected object named after foot %s" % ", ".join(missing))
         return body, chosen
 
-    def _setup(self, context, s, terrain, data, feet):
+    def _setup(self, context, s, terrain, data, feet, path):
         rig_name = self.name or character.display_name(
-            data, os.path.splitext(os.path.basename(self.character_file))[0])
+            data, os.path.splitext(os.path.basename(path))[0])
         # The character's lengths are metres: in scene units, divided by the Unit Scale.
         scale = unit_scale(context.scene)
         height = character.body_height(data) / scale
@@ -491,7 +496,7 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
         rig = root.footfall_rig
         rig.is_rig = True
         rig.walk_end_known, rig.walk_end = walk_end_known, walk_end
-        rig.character_path = self.character_file
+        rig.character_path = path
         rig.character_json = json.dumps(data)
         if body is None:  # a picked body keeps its rotation mode (the user's keys use it)
             body = _empty(context, object_name(rig_name, "_body"), "CUBE", 0.3 * height)

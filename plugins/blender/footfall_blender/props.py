@@ -79,6 +79,9 @@ class FootfallScene(bpy.types.PropertyGroup):
     terrain_key: StringProperty(name="Terrain key", default="", options={"HIDDEN"})
     sample_count: IntProperty(name="Samples", default=0)
     # Character Setup / Generate Walk
+    character_file: StringProperty(name="Character file", subtype="FILE_PATH",
+                                   description="The character file (JSON) Character Setup "
+                                               "reads")
     rig: PointerProperty(type=bpy.types.Object, name="Rig",
                          poll=lambda self, obj: obj.footfall_rig.is_rig)
     steps: IntProperty(name="Steps", default=8, min=1, max=100000)
