@@ -948,6 +948,62 @@ class MayaKeyWalkTest(unittest.TestCase):
                 self.assertAlmostEqual(a[i], b[i] / 100.0, places=9)
         self.assertAlmostEqual(max(p[0] for p in m), 2.0, places=9)
 
+    def test_the_windows_file_buttons_pick_files(self):
+        # The "..." buttons of the Point file and Character file fields had no command: a
+        # click opened no file dialog, and paths had to be typed.
+        calls, fields, dialogs = [], {}, []
+        cmds = types.ModuleType("maya.cmds")
+
+        def record(name):
+            def call(*args, **kwargs):
+                calls.append((name, args, kwargs))
+                return "%s%d" % (name, len(calls))
+            return call
+        for name in ("window", "deleteUI", "columnLayout", "frameLayout", "textFieldGrp",
+                     "intFieldGrp", "floatFieldGrp", "checkBoxGrp", "button", "text",
+                     "setParent", "showWindow"):
+            setattr(cmds, name, record(name))
+
+        def text_field_button_grp(*args, **kwargs):
+            if kwargs.get("e"):
+                fields[args[0]].update(kwargs)
+                return None
+            name = "field%d" % len(fields)
+            fields[name] = dict(kwargs)
+            return name
+        cmds.textFieldButtonGrp = text_field_button_grp
+        cmds.fileDialog2 = lambda **kwargs: dialogs.append(kwargs) or list(self._chosen)
+        with self._footfall_maya(cmds) as footfall_maya:
+            footfall_maya.show()
+            by_label = {f["label"]: f for f in fields.values()}
+            self.assertEqual(sorted(by_label), ["Character file", "Point file"])
+            for label, chosen in (("Point file", "/data/hills.obj"),
+                                  ("Character file", "/data/biped.json")):
+                field = by_label[label]
+                self._chosen = [chosen]
+                field["buttonCommand"]()
+                self.assertEqual(field["text"], chosen)
+                self.assertEqual(dialogs[-1]["fileMode"], 1)  # one existing file
+                self._chosen = []  # cancelled: the field keeps its path
+                field["buttonCommand"](False)
+                self.assertEqual(field["text"], chosen)
+            self.assertIn("*.obj", dialogs[0]["fileFilter"])
+            self.assertIn("*.json", dialogs[2]["fileFilter"])
+            # Generate Walk with a component selected: attributeQuery raised into Maya.
+            cmds.ls = lambda **kwargs: ["pCube1.vtx[0]"]
+
+            def attribute_query(*args, **kwargs):
+                raise RuntimeError("Object pCube1.vtx[0] is invalid")
+            cmds.attributeQuery = attribute_query
+            warnings = []
+            cmds.warning = warnings.append
+            cmds.confirmDialog = lambda **kwargs: None
+            generate = [kw["command"] for name, _, kw in calls
+                        if name == "button" and kw.get("label") == "Generate Walk"]
+            self.assertEqual(len(generate), 1)
+            generate[0]()
+            self.assertEqual(warnings, ["footfall: Object pCube1.vtx[0] is invalid"])
+
     def test_import_of_tracks_without_keys_changes_nothing(self):
         # Tracks of the rig without keys (alone, or beside another's keyed track) cut the rig's
         # keys from the walk's first frame (frame 0 when no track had a key), and with no rig

@@ -467,6 +467,21 @@ def import_walk(path, rig=None):
 
 # -- The window -----------------------------------------------------------------------------------
 
+# The file dialogs' filters (Maya's fileDialog2 form).
+TERRAIN_FILTER = ("Terrains (*.pts *.xyz *.txt *.obj *.ply *.off *.stl *.asc *.pgm);;"
+                  "All files (*.*)")
+CHARACTER_FILTER = "Characters (*.json);;All files (*.*)"
+
+
+def _browse_button(field, caption, file_filter):
+    """Makes the "..." button of the textFieldButtonGrp `field` pick a file into it."""
+    def browse(*_):
+        chosen = mc.fileDialog2(fileMode=1, caption=caption, fileFilter=file_filter)
+        if chosen:
+            mc.textFieldButtonGrp(field, e=True, text=chosen[0])
+    mc.textFieldButtonGrp(field, e=True, buttonCommand=browse)
+
+
 def show():
     """Opens the footfall window: Server, Terrain Setup, Character Setup, Generate Walk."""
     if mc.window(WINDOW, exists=True):
@@ -488,6 +503,7 @@ def show():
     mc.frameLayout(label="Terrain Setup", collapsable=True)
     sep = mc.floatFieldGrp(label="Point separation", value1=0.25)
     pfile = mc.textFieldButtonGrp(label="Point file", buttonLabel="...")
+    _browse_button(pfile, "footfall terrain file", TERRAIN_FILTER)
     count = mc.text(label="Samples: -")
 
     def send(*_):
@@ -501,6 +517,7 @@ def show():
 
     mc.frameLayout(label="Character Setup", collapsable=True)
     cfile = mc.textFieldButtonGrp(label="Character file", buttonLabel="...")
+    _browse_button(cfile, "footfall character file", CHARACTER_FILTER)
 
     @_guard
     def setup(*_):
@@ -521,6 +538,7 @@ def show():
     height = mc.floatFieldGrp(label="Step height (0: file)", value1=0)
     curve = mc.textFieldGrp(label="Path curve")
 
+    @_guard  # (attributeQuery raises on a selected component)
     def generate(*_):
         sel = [n for n in (mc.ls(selection=True) or []) if mc.attributeQuery(RIG_ATTR, node=n,
                                                                                exists=True)]
