@@ -234,12 +234,15 @@ class SharedLogicTest(unittest.TestCase):
         for pts, separation, message in (
                 ([(inf, 0, 0), (1, 0, 0), (0, 0, 1)], 0.1, "triangle 0"),
                 ([(nan, 0, 0), (1, 0, 0), (0, 0, 1)], 0.1, "triangle 0"),
+                # (A NaN in a later corner: max() kept the first edge's finite length.)
+                ([(0, 0, 0), (1, 0, 0), (0, nan, 1)], 0.1, "triangle 0"),
+                ([(0, 0, 0), (1, 0, 0), (0, 0, 1), (nan, 0, 0)], 0.1, "triangle 1"),
                 ([(1e308, 0, 0), (-1e308, 0, 0), (0, 0, 1)], 0.1, "triangle 0"),
                 ([(1e300, 0, 0), (-1e300, 0, 0), (0, 0, 1e300)], 0.1, "triangle 0"),
                 ([(1e100, 0, 0), (-1e100, 0, 0), (0, 0, 1e100)], 0.1, "would make more than"),
                 ([(0, 0, 0), (1, 0, 0), (0, 0, 1)], 1e-300, "would make more than")):
             with self.assertRaises(ValueError, msg=str(pts)) as e:
-                ff.sampling.sample_triangles(pts, [(0, 1, 2)], separation)
+                ff.sampling.sample_triangles(pts, [(0, 1, 2), (0, 1, len(pts) - 1)], separation)
             self.assertIn(message, str(e.exception))
 
     def test_sampling_refuses_more_samples_than_a_dcc_can_hold_before_sampling(self):

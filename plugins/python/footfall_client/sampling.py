@@ -66,9 +66,10 @@ def check_sample_count(points, triangles, separation, max_samples=MAX_SAMPLES):
         a, b, c = (points[i] for i in tri)
         longest = max(_length(_sub(b, a)), _length(_sub(c, b)), _length(_sub(a, c)))
         # (A vertex at infinity or NaN, as a huge object scale makes in Blender's floats,
-        # raised OverflowError, or ValueError "cannot convert float NaN to integer".)
+        # raised OverflowError, or ValueError "cannot convert float NaN to integer"; max()
+        # drops a NaN length after the first, so the corners are checked themselves.)
         ratio = longest / separation
-        if not math.isfinite(ratio):
+        if not (math.isfinite(ratio) and all(math.isfinite(v) for p in (a, b, c) for v in p)):
             raise ValueError("triangle %d (vertices %s): its corners are not finite numbers, or "
                              "too far apart to measure"
                              % (t, ", ".join("(%g, %g, %g)" % tuple(p) for p in (a, b, c))))
