@@ -375,6 +375,9 @@ TEST_CASE("ReadMesh: bad meshes give clear errors", "[import][mesh]") {
     CHECK(LoadTerrain(dir.Write("terrain.xyzw", "1 2 3"), TerrainLoadOptions{}, &samples, &error) ==
           Status::kInvalidArgument);
     CHECK(Contains(error, "unknown terrain file extension 'xyzw'"));
+    // An empty path was named by nothing: ": cannot open terrain file: No such file ...".
+    CHECK(LoadTerrain("", TerrainLoadOptions{}, &samples, &error) == Status::kInvalidArgument);
+    CHECK(error == "cannot open terrain file: expected a path, got an empty one");
   }
 }
 

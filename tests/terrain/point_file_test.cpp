@@ -207,6 +207,9 @@ TEST_CASE("ReadPointFile reports a missing file", "[terrain][point_file]") {
   std::string error;
   CHECK(ReadPointFile("/nonexistent/terrain.pts", &s, &error) == Status::kIoError);
   CHECK(error == "/nonexistent/terrain.pts: cannot open file: No such file or directory");
+  // An empty path was named by nothing: ": cannot open file: No such file or directory".
+  CHECK(ReadPointFile("", &s, &error) == Status::kInvalidArgument);
+  CHECK(error == "cannot open file: expected a path, got an empty one");
 }
 
 TEST_CASE("ReadPointFile refuses a FIFO or a device at once", "[terrain][point_file]") {

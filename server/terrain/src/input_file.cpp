@@ -12,6 +12,11 @@ Status CheckInputFile(const std::string& path, const char* what, std::string* er
   struct stat st;
   std::string why;
   Status status = Status::kOk;
+  if (path.empty()) {
+    // (stat's "No such file or directory" after a name of nothing: ": cannot open ...".)
+    if (error) *error = std::string("cannot open ") + what + ": expected a path, got an empty one";
+    return Status::kInvalidArgument;
+  }
   if (::stat(path.c_str(), &st) != 0) {
     why = std::strerror(errno), status = Status::kIoError;
   } else if (S_ISDIR(st.st_mode)) {
