@@ -672,6 +672,11 @@ static void TestRpc(const char* character_path) {
   s = ffc_open_rpc(NULL, 7407, 0);
   Check(s != NULL, "ffc_open_rpc takes a NULL host and a timeout of 0", "");
   ffc_close(s);
+  /* A port in the host, or stray brackets: "127.0.0.1:7407" was looked up as a host name. */
+  Check(ffc_open_rpc("127.0.0.1:7407", 7407, 1) == NULL, "ffc_open_rpc refuses a host with a port",
+        "");
+  Check(ffc_open_rpc("[::1", 7407, 1) == NULL, "ffc_open_rpc refuses an unclosed bracket", "");
+  Check(ffc_open_rpc("a:b", 7407, 1) == NULL, "ffc_open_rpc refuses colons in a name", "");
 
   if (!Check(port > 0, "a closed loopback port", "socket, bind or getsockname failed")) return;
   snprintf(port_text, sizeof port_text, "%d", port);
@@ -684,6 +689,18 @@ static void TestRpc(const char* character_path) {
         "last error: %s", ffc_last_error(s));
   CheckStatus(s, ffc_load_samples(s, samples, 1, "one", &terrain), FF_C_UNAVAILABLE,
               "ffc_load_samples to a closed port");
+  {
+    /* An IPv6 address in brackets, as footfalld's --listen takes it: "[[::1]]:PORT" before. */
+    char expected[64];
+    ffc_session* v6 = ffc_open_rpc("[::1]", port, 2);
+    snprintf(expected, sizeof expected, "[::1]:%d", port);
+    if (Check(v6 != NULL, "ffc_open_rpc takes a bracketed IPv6 address", "")) {
+      CheckStatus(v6, ffc_ping(v6), FF_C_UNAVAILABLE, "ffc_ping to [::1] at a closed port");
+      Check(strstr(ffc_last_error(v6), expected) != NULL && !strstr(ffc_last_error(v6), "[["),
+            "the reason names [::1]:PORT", "last error: %s", ffc_last_error(v6));
+    }
+    ffc_close(v6);
+  }
   CheckStatus(s, ffc_load_server_file(s, "terrain/hills.pts", 0, &terrain), FF_C_UNAVAILABLE,
               "ffc_load_server_file to a closed port");
   CheckStatus(s, ffc_ping(s), FF_C_UNAVAILABLE, "ffc_ping to a closed port, again");

@@ -529,6 +529,10 @@ class RpcTest(unittest.TestCase):
             self.assertFalse(s.ping())  # an unknown host, not an encoding error
         with ff.Session.rpc(None, self.server.port) as s:
             self.assertTrue(s.ping())  # None is 127.0.0.1
+        # A port in the host was looked up as a host named "127.0.0.1:PORT".
+        with self.assertRaises(ff.FootfallError) as e:
+            ff.Session.rpc("127.0.0.1:%d" % self.server.port, self.server.port)
+        self.assertIn("without a port (the port is given apart)", e.exception.message)
 
 
 class LocalServerTest(unittest.TestCase):

@@ -226,7 +226,7 @@ ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s) {
   if (timeout_s > 0 && timeout_s < kMinTimeout) return nullptr;
   try {
     footfall::RpcOptions options;
-    if (host && *host) options.host = host;
+    if (host && *host && !footfall::ParseHost(host, &options.host)) return nullptr;
     options.port = port;
     if (timeout_s > 0) options.call_timeout_s = timeout_s;
     auto* s = new ffc_session;

@@ -39,6 +39,19 @@ bool IsIpv6Address(const std::string& text) {
 
 }  // namespace
 
+bool ParseHost(const std::string& text, std::string* host) {
+  std::string bare = text;
+  if (bare.size() >= 2 && bare.front() == '[' && bare.back() == ']')
+    bare = bare.substr(1, bare.size() - 2);
+  // Brackets left over, or colons in what is not an IPv6 address ("[::1" was host "[:" at port
+  // 1, named "[[:]:1" when it could not be resolved; "127.0.0.1:7407" a host of that name).
+  if (bare.find_first_of("[]") != std::string::npos ||
+      (bare.find(':') != std::string::npos && !IsIpv6Address(bare)))
+    return false;
+  *host = bare;
+  return true;
+}
+
 Status ParseHostPort(const std::string& text, RpcOptions* options, std::string* error) {
   const size_t colon = text.rfind(':');
   // A bare IPv6 address (`::1`, `fe80::1`), as footfalld's --listen takes it: its default port.
@@ -59,12 +72,7 @@ Status ParseHostPort(const std::string& text, RpcOptions* options, std::string* 
     if (error) *error = "'" + text + "': expected HOST:PORT with a port from 1 to 65535";
     return Status::kInvalidArgument;
   }
-  if (host.size() >= 2 && host.front() == '[' && host.back() == ']')
-    host = host.substr(1, host.size() - 2);
-  // Brackets left over, or colons in what is not an IPv6 address ("[::1" was host "[:" at port
-  // 1, named "[[:]:1" when it could not be resolved).
-  if (host.find_first_of("[]") != std::string::npos ||
-      (host.find(':') != std::string::npos && !IsIpv6Address(host))) {
+  if (!ParseHost(host, &host)) {
     if (error)
       *error = "'" + text +
                "': expected HOST:PORT, an IPv6 address in brackets ([::1]:7407) or alone (::1)";

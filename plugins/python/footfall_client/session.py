@@ -161,9 +161,10 @@ class Session:
             raise FootfallError(INVALID_ARGUMENT, "timeout %r: expected 0.001 to 1e6 seconds (0 "
                                 "or less: the default)" % (timeout,), "ffc_open_rpc")
         handle = lib.lib.ffc_open_rpc((host or "").encode("utf-8", "replace"), port, timeout)
-        if not handle:
-            raise FootfallError(INVALID_ARGUMENT, "cannot open a client for %s:%d" % (host, port),
-                                "ffc_open_rpc")
+        if not handle:  # (the other arguments are checked above)
+            raise FootfallError(INVALID_ARGUMENT, "host %r: expected a host name or an IPv4 or "
+                                "IPv6 address ([::1] or ::1), without a port (the port is "
+                                "given apart)" % (host,), "ffc_open_rpc")
         return cls(handle, lib, "rpc %s:%d" % (host or "127.0.0.1", port))
 
     @classmethod

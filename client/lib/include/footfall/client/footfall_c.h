@@ -55,8 +55,9 @@ ffc_session* ffc_open_embedded(void);
 /* Opens a footfalld client; it connects lazily (the first call may return FF_C_UNAVAILABLE).
  * host NULL means 127.0.0.1; timeout_s <= 0 means 10 s per call. A host name is looked up
  * within that timeout (a lookup that does not answer fails the call FF_C_UNAVAILABLE); a
- * literal IPv4 or IPv6 address needs no lookup. NULL only on bad arguments:
- * a port outside 1-65535, a timeout above 1e6 s, infinite or NaN, or one above 0 but below
+ * literal IPv4 or IPv6 address needs no lookup; an IPv6 address may be in brackets ("[::1]").
+ * NULL only on bad arguments: a host holding a port ("127.0.0.1:7407") or stray brackets, a
+ * port outside 1-65535, a timeout above 1e6 s, infinite or NaN, or one above 0 but below
  * 0.001 s (as footfall's --timeout: no call could be answered in it). */
 ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s);
 /* Frees the session and its terrains (an RPC session unloads them from footfalld while it is

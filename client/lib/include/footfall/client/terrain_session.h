@@ -110,6 +110,10 @@ struct RpcOptions {
 // kept), so handles stay valid across a server restart.
 std::unique_ptr<TerrainSession> MakeRpcSession(const RpcOptions& options);
 
+// Parses a host without its port: a name, an IPv4 address, or an IPv6 address bare or in
+// brackets ("[::1]" gives "::1"). False for stray brackets or a port ("127.0.0.1:7407").
+bool ParseHost(const std::string& text, std::string* host);
+
 // Parses "HOST:PORT" (or ":PORT", "PORT", "[IPV6]:PORT", or a bare IPv6 address at the default
 // port, as footfalld's --listen takes it) into options->host and options->port.
 Status ParseHostPort(const std::string& text, RpcOptions* options, std::string* error);
