@@ -99,6 +99,13 @@ TEST_CASE("Scene file errors name the file the character and the field", "[steps
              Catch::Contains("characters[0]: unknown field 'fps'"));
   CHECK_THAT(SceneError(Scene(R"({"character_file": "biped.json", "crowd": 0})")),
              Catch::Contains("characters[0]: 'crowd': out of range"));
+  // An empty path was taken for none (the command line refuses --path "").
+  for (const char* path : {"[]", "{}", "[0, 0, 1]"})
+    CHECK_THAT(
+        SceneError(Scene(R"({"character_file": "biped.json", "path": )" + std::string(path) + "}")),
+        Catch::Contains("characters[0]: 'path': expected"));
+  CHECK_THAT(SceneError(Scene(R"({"character_file": "biped.json", "path": []})")),
+             Catch::Contains("'path': expected an array of at least one waypoint [x, y, z]"));
   CHECK_THAT(
       SceneError(Scene(R"({"character_file": "biped.json"}, {"character_file": "nothere.json"})")),
       Catch::StartsWith("s.json: characters[1]: " + kCharacters + "/nothere.json: cannot open"));

@@ -161,8 +161,9 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
     }
   }
   if (ok && j.contains("path")) {
-    if (!j["path"].is_array()) {
-      *error = source + ": 'path': expected an array of [x, y, z]";
+    // (An empty one was taken for no path, where --path "" is refused.)
+    if (!j["path"].is_array() || j["path"].empty()) {
+      *error = source + ": 'path': expected an array of at least one waypoint [x, y, z]";
       ok = false;
     }
     for (size_t i = 0; ok && i < j["path"].size(); ++i) {
