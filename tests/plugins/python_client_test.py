@@ -11,6 +11,7 @@ import json
 import math
 import os
 import pickle
+import signal
 import subprocess
 import sys
 import tempfile
@@ -615,6 +616,27 @@ class ConnectionTest(unittest.TestCase):
         self.assertIs(c.get("127.0.0.1", self.dead_port, start_local=True,
                             footfalld=ff.find_footfalld()), c.session)
         self.assertIs(c.local, fourth)
+
+    def test_a_hung_server_is_reported_as_such_after_one_timeout(self):
+        # A stopped footfalld was pinged twice (twice the timeout) and reported as missing: "no
+        # footfalld answers ...: start one there".
+        os.kill(self.server.process.pid, signal.SIGSTOP)
+        pings = []
+        real_ping = ff.Session.ping
+        ff.Session.ping = lambda session: pings.append(1) or real_ping(session)
+        try:
+            with self.assertRaises(ff.FootfallError) as e:
+                self.c.get("127.0.0.1", self.server.port, start_local=False, timeout=0.5)
+        finally:
+            ff.Session.ping = real_ping
+            os.kill(self.server.process.pid, signal.SIGCONT)
+        self.assertEqual(len(pings), 1)
+        self.assertIn("footfalld at 127.0.0.1:%d does not answer within 0.5 s: it is there, but "
+                      "busy or hung" % self.server.port, e.exception.message)
+        self.assertEqual(e.exception.status_name, "unavailable")
+        # Awake again, it answers the next command.
+        self.assertTrue(self.c.get("127.0.0.1", self.server.port, start_local=False,
+                                   timeout=0.5).ping())
 
     def test_the_timeout_bounds_the_wait_for_a_local_footfalld(self):
         # The wait for a local footfalld to listen was always 10 s, whatever the timeout the

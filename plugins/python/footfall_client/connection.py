@@ -38,10 +38,21 @@ class Connection:
                 self._stop_local()
         if self.session is None or self._target != target or self._timeout != timeout:
             self._open(target, timeout)  # (a changed timeout was ignored until host or port changed)
-        # A server restarted on the same port since the last call: the first call finds the
-        # old connection broken and the session reconnects on the next, so ask twice.
-        if self.session.ping() or self.session.ping():
+        if self.session.ping():
             return self.session
+        reason = self.session.last_error()
+        # The library's words for a call that waited its whole timeout: a server is there, but
+        # busy or hung (stopped in a debugger, SIGSTOP).
+        hung = "no answer within the call timeout" in reason
+        # A server restarted on the same port since the last call: the first call finds the
+        # old connection broken and the session reconnects on the next, so ask twice; not
+        # after a whole timeout (that doubled the wait, and said to start a server there).
+        if not hung and self.session.ping():
+            return self.session
+        if hung and not start_local:
+            raise FootfallError(UNAVAILABLE, "footfalld at %s:%d does not answer within %g s: it "
+                                "is there, but busy or hung (%s)" % (target + (timeout, reason)),
+                                "connect")
         if not start_local:
             raise FootfallError(UNAVAILABLE, "no footfalld answers at %s:%d: start one there or "
                                 "allow starting a local footfalld" % target, "connect")
