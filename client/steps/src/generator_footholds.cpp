@@ -228,9 +228,11 @@ Status Generator::QueryFootholds(std::string* error) {
           continue;
         }
         // No target beyond reach of the body where the step will put it (the feet's centroid
-        // moves by this foot's displacement over the number of feet). Up to 64 shortenings by a
-        // quarter (1e-8 of the step): eight left steps over about 60 times the reach beyond it.
-        for (int shrink = 0; shrink < 64; ++shrink) {
+        // moves by this foot's displacement over the number of feet). Up to 256 shortenings by
+        // a quarter (1e-32 of the step): the longest step_length a character file may give,
+        // 1e9, against any reach down to 1e-23 (eight left steps over about 60 times the reach
+        // beyond it, 64 those of a step_length of 1e9).
+        for (int shrink = 0; shrink < 256; ++shrink) {
           const Vec3 ground = a.ground + v / static_cast<double>(feet);
           const Vec3 body = ground + a.body_up * c_.body_height;
           if (Distance(a.foot[mv.foot] + v, body) <= c_.reach) break;
