@@ -696,6 +696,17 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     RunResult r = View({"--terrain", kTerrain, "--query", "snap 1e300 0 0", "--screenshot", shot});
     CHECK(r.exit_code == 2);
     CHECK_THAT(r.err, Catch::Contains("expected a point within +-1e15"));
+    // A step the engine refuses (answered invalid_argument): its ideal point 1e200 away put the
+    // camera at NaN, a blank image with exit 0.
+    for (const char* step : {"next 0 0 0 1e200 0 0", "next 1 1 1 2e15 0 0"}) {
+      INFO(step);
+      r = View(
+          {"--terrain", kTerrain, "--query", "snap 0 0 1", "--query", step, "--screenshot", shot});
+      CHECK(r.exit_code == 2);
+      CHECK_THAT(r.err, Catch::Contains("--query \"" + std::string(step) +
+                                        "\": next: invalid query (a direction too small or too "
+                                        "large, or points farther than 1e15 from the terrain)"));
+    }
     test::WriteFile(dir + "/far.json",
                     "{\"format\": \"footfall-walk\", \"version\": 1, \"fps\": 24, \"tracks\": "
                     "[{\"name\": \"L\", \"kind\": \"foot\", \"keys\": [{\"frame\": 1, "

@@ -563,8 +563,14 @@ int RunViewer(const ViewerOptions& options) {
   if (!options.terrain.empty() &&
       app.scene.LoadTerrain(options.terrain, options.load, &error) != Status::kOk)
     return Fail(error);
-  for (const QuerySpec& spec : specs) {
-    if (app.scene.AddQuery(spec, &error) != Status::kOk) return Fail(error);
+  for (size_t i = 0; i < specs.size(); ++i) {
+    if (app.scene.AddQuery(specs[i], &error) != Status::kOk) return Fail(error);
+    // A query the engine refuses (a step of 1e200) has nothing to draw: its ideal point put
+    // the camera at NaN and gave a blank image.
+    if (app.scene.queries().back().result.status == Status::kInvalidArgument)
+      return Fail("--query \"" + options.queries[i] + "\": " + QueryOpName(specs[i].op) + ": " +
+                      InvalidQueryReason(specs[i].op),
+                  2);
   }
   if (!options.walk.empty() && app.scene.LoadWalk(options.walk, &error) != Status::kOk)
     return Fail(error);

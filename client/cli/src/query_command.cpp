@@ -143,12 +143,9 @@ bool RunBlock(TerrainSession& session, TerrainHandle terrain, double tolerance,
       } else if (f.status == Status::kNoFoothold) {
         j = {{"op", QueryOpName(c.query.op)}, {"found", false}};
       } else {
-        const bool next = c.query.op == QueryOp::kNext;
-        const std::string why =
-            f.status != Status::kInvalidArgument ? StatusName(f.status)
-            : next ? "invalid query (a direction too small or too large, or points farther "
-                     "than 1e15 from the terrain)"
-                   : "invalid query (a point farther than 1e15 from the terrain)";
+        const std::string why = f.status != Status::kInvalidArgument
+                                    ? StatusName(f.status)
+                                    : InvalidQueryReason(c.query.op);
         j = {{"op", "error"},
              {"line", c.line},
              {"message", std::string(QueryOpName(c.query.op)) + ": " + why}};

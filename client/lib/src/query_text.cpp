@@ -18,6 +18,12 @@ bool ParseFiniteNumber(const std::string& token, double* value) {
   return ParseFiniteDecimal(token, value);
 }
 
+std::string InvalidQueryReason(QueryOp op) {
+  return op == QueryOp::kNext ? "invalid query (a direction too small or too large, or points "
+                                "farther than 1e15 from the terrain)"
+                              : "invalid query (a point farther than 1e15 from the terrain)";
+}
+
 const char* QueryOpName(QueryOp op) {
   switch (op) {
     case QueryOp::kSnap:

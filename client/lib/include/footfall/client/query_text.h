@@ -37,6 +37,11 @@ std::string WithoutComment(const std::string& line);
 // command 'jump' (expected snap X Y Z, normal X Y Z or next X Y Z DX DY DZ)".
 bool ParseQueryText(const std::string& text, QueryText* out, std::string* error);
 
+// Why the engine answers a query of `op` kInvalidArgument, as `footfall query` and
+// `footfall-view --query` report it: "invalid query (a point farther than 1e15 from the
+// terrain)", or for next the direction's length too.
+std::string InvalidQueryReason(QueryOp op);
+
 // "next 1 0 2 0.5 0 0": the query in the syntax ParseQueryText reads (numbers to 6 significant
 // digits).
 std::string FormatQueryText(const QueryText& query);
