@@ -210,6 +210,16 @@ TEST_CASE("a camera's clip planes follow the terrain beside the eye, not its tar
     CHECK(state["camera"]["eye"] == json::array({0.0, 0.5, 0.0}));
   }
   CHECK(state["camera"]["target"][0].get<double>() == 1e15);
+  // A query far from the terrain: its box put the near plane past the terrain (and the scene's
+  // origin beside it, the terrain's float vertices 64 units apart): a blank image, exit 0.
+  for (const std::string far : {"snap 1e9 0 0", "snap -1e6 0 0"}) {
+    const std::string shot = dir + "/far_query.png";
+    const RunResult r = View({"--terrain", dir + "/flat.pts", "--camera", "0 0.5 0 10 0 10",
+                              "--query", far, "--size", "320x200", "--screenshot", shot});
+    INFO(far << ": " << r.err);
+    REQUIRE(r.exit_code == 0);
+    CHECK(CountColor(ReadPng(shot), {128, 255, 128}) > near_target * 8 / 10);
+  }
   // An eye 1e15 away still looks at its target: the query there is drawn at the centre (eye +
   // the view direction rounded by 0.125, turning the view up to 5 degrees: 18 px off).
   const RunResult aimed = View({"--terrain", dir + "/flat.pts", "--camera", "1e15 7e14 3e14 2 0 2",

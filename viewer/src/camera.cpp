@@ -117,23 +117,30 @@ glm::dmat4 OrbitCamera::View() const {
   return m;
 }
 
-glm::dmat4 OrbitCamera::Projection(double aspect, const glm::dvec3& lo,
-                                   const glm::dvec3& hi) const {
-  // The depths of the box's corners along the view direction.
+glm::dmat4 OrbitCamera::Projection(double aspect, const std::vector<RenderBox>& boxes) const {
   const glm::dvec3 forward = Forward();
-  double nearest = HUGE_VAL, farthest = -HUGE_VAL;
-  for (int i = 0; i < 8; ++i) {
-    const glm::dvec3 corner(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
-    const double depth = glm::dot(corner - eye_, forward);
-    nearest = std::min(nearest, depth);
-    farthest = std::max(farthest, depth);
+  double near_plane = HUGE_VAL, far_plane = -HUGE_VAL;
+  for (const RenderBox& box : boxes) {
+    // The depths of the box's corners along the view direction.
+    double nearest = HUGE_VAL, farthest = -HUGE_VAL;
+    for (int i = 0; i < 8; ++i) {
+      const glm::dvec3 corner(i & 1 ? box.hi.x : box.lo.x, i & 2 ? box.hi.y : box.lo.y,
+                              i & 4 ? box.hi.z : box.lo.z);
+      const double depth = glm::dot(corner - eye_, forward);
+      nearest = std::min(nearest, depth);
+      farthest = std::max(farthest, depth);
+    }
+    if (!(farthest > 0)) continue;  // behind the eye: nothing of it is drawn
+    far_plane = std::max(far_plane, farthest * 1.001);
+    // Wholly in front: from its nearest corner; around the eye: as near as depth allows.
+    near_plane =
+        std::min(near_plane, nearest > 0 ? nearest * 0.999 : farthest * 1.001 * kNearRatio);
   }
   const double fov = glm::radians(kFovYDegrees);
-  // All of the box behind the eye: nothing to draw, any planes will do.
-  if (!(farthest > 0)) return glm::perspective(fov, aspect, 1.0, 2.0);
-  const double far_plane = farthest * 1.001;
-  const double near_plane =
-      std::max(std::min(nearest * 0.999, far_plane * (1 - kMinDepthSpan)), far_plane * kNearRatio);
+  // Everything behind the eye: nothing to draw, any planes will do.
+  if (!(far_plane > 0)) return glm::perspective(fov, aspect, 1.0, 2.0);
+  far_plane = std::min(far_plane, near_plane / kNearRatio);
+  near_plane = std::min(near_plane, far_plane * (1 - kMinDepthSpan));
   return glm::perspective(fov, aspect, near_plane, far_plane);
 }
 

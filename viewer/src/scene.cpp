@@ -70,27 +70,35 @@ double RingRadius(const QueryView& q) {
 
 }  // namespace
 
-void Scene::GrowDrawn(const QueryView& q) {
-  Grow(q.spec.point, &drawn_lo_, &drawn_hi_, &has_drawn_);
+void Scene::QueryBounds(const QueryView& q, Vec3* lo, Vec3* hi) const {
+  bool any = false;
+  Grow(q.spec.point, lo, hi, &any);
   if (q.spec.op == QueryOp::kNext) {
     const Vec3 ideal = q.spec.point + q.spec.direction;
     const double r = RingRadius(q);
     // The ring, and the arrow's head (as long as DrawQuery draws it, spread to half that).
     const double head = std::max(Length(q.spec.direction) * 0.15, spacing_);
     for (const double d : {r, head}) {
-      Grow(ideal - Vec3{d, d, d}, &drawn_lo_, &drawn_hi_, &has_drawn_);
-      Grow(ideal + Vec3{d, d, d}, &drawn_lo_, &drawn_hi_, &has_drawn_);
+      Grow(ideal - Vec3{d, d, d}, lo, hi, &any);
+      Grow(ideal + Vec3{d, d, d}, lo, hi, &any);
     }
   }
   if (q.traced) {
     for (const uint32_t cell : q.trace.cells) {
-      Vec3 lo, hi;
-      grid_.CellBox(cell, &lo, &hi);
-      Grow(lo, &drawn_lo_, &drawn_hi_, &has_drawn_);
-      Grow(hi, &drawn_lo_, &drawn_hi_, &has_drawn_);
+      Vec3 cell_lo, cell_hi;
+      grid_.CellBox(cell, &cell_lo, &cell_hi);
+      Grow(cell_lo, lo, hi, &any);
+      Grow(cell_hi, lo, hi, &any);
     }
   }
-  if (q.result.status == Status::kOk) Grow(q.result.point, &drawn_lo_, &drawn_hi_, &has_drawn_);
+  if (q.result.status == Status::kOk) Grow(q.result.point, lo, hi, &any);
+}
+
+void Scene::GrowDrawn(const QueryView& q) {
+  Vec3 lo, hi;
+  QueryBounds(q, &lo, &hi);
+  Grow(lo, &drawn_lo_, &drawn_hi_, &has_drawn_);
+  Grow(hi, &drawn_lo_, &drawn_hi_, &has_drawn_);
 }
 
 Rgba FootColor(size_t track_index) {
@@ -120,7 +128,11 @@ Status Scene::LoadTerrain(const std::string& path, const TerrainLoadOptions& opt
   terrain_path_ = path;
   const GridStats& st = grid_.stats();
   if (st.spacing > 0) spacing_ = st.spacing;
-  for (const Vec3& p : samples_.points) Grow(p, &lo_, &hi_, &has_bounds_);
+  bool any_sample = false;
+  for (const Vec3& p : samples_.points) {
+    Grow(p, &lo_, &hi_, &has_bounds_);
+    Grow(p, &terrain_lo_, &terrain_hi_, &any_sample);
+  }
   bool any_cell = false;
   for (const uint32_t cell : grid_.OccupiedCells()) {
     Vec3 lo, hi;
@@ -156,7 +168,10 @@ Status Scene::LoadWalk(const std::string& path, std::string* error) {
   walk_path_ = path;
   FrameRange(walk_, &first_frame_, &last_frame_);
   for (const WalkTrack& t : walk_.tracks) {
-    for (const WalkKey& k : t.keys) Grow(k.position, &lo_, &hi_, &has_bounds_);
+    for (const WalkKey& k : t.keys) {
+      Grow(k.position, &lo_, &hi_, &has_bounds_);
+      Grow(k.position, &walk_lo_, &walk_hi_, &has_walk_keys_);
+    }
   }
   return Status::kOk;
 }
@@ -188,7 +203,12 @@ void Scene::AddLive(const std::vector<RecentQuery>& queries) {
 }
 
 void Scene::Finalize() {
-  origin_ = has_bounds_ ? 0.5 * (lo_ + hi_) : Vec3{};
+  // Centred on the terrain, else the walk: vertices are floats about the origin, and a query
+  // 1e9 away moved it there, leaving the terrain's samples 64 units apart.
+  origin_ = has_terrain()    ? 0.5 * (terrain_lo_ + terrain_hi_)
+            : has_walk_keys_ ? 0.5 * (walk_lo_ + walk_hi_)
+            : has_bounds_    ? 0.5 * (lo_ + hi_)
+                             : Vec3{};
   if (has_bounds_) {
     Grow(lo_, &drawn_lo_, &drawn_hi_, &has_drawn_);
     Grow(hi_, &drawn_lo_, &drawn_hi_, &has_drawn_);
@@ -250,23 +270,38 @@ void Scene::FrameBounds(const ViewState& view, glm::dvec3* lo, glm::dvec3* hi) c
   *lo -= glm::dvec3(margin), *hi += glm::dvec3(margin);
 }
 
-void Scene::DrawnBounds(glm::dvec3* lo, glm::dvec3* hi) const {
-  if (!has_drawn_) {
-    RenderBounds(lo, hi);
-    return;
-  }
-  *lo = ToRenderDouble(drawn_lo_), *hi = ToRenderDouble(drawn_hi_);
+std::vector<RenderBox> Scene::DrawnBoxes() const {
+  std::vector<RenderBox> boxes;
   // Room for markers drawn around points (normals and body axes up to 8 sample spacings long,
   // crosses, arrow heads) and for the grid cells around the samples.
-  double margin = 0.05 * glm::length(*hi - *lo) + 16 * MarkerUnit();
-  if (has_terrain()) margin += grid_.stats().cell_size;
-  *lo -= glm::dvec3(margin), *hi += glm::dvec3(margin);
+  const double markers = 16 * MarkerUnit() + (has_terrain() ? grid_.stats().cell_size : 0);
+  auto add = [&](const Vec3& lo, const Vec3& hi) {
+    RenderBox box{ToRenderDouble(lo), ToRenderDouble(hi)};
+    const double margin = 0.05 * glm::length(box.hi - box.lo) + markers;
+    box.lo -= glm::dvec3(margin), box.hi += glm::dvec3(margin);
+    boxes.push_back(box);
+  };
+  if (has_terrain()) add(cells_lo_, cells_hi_);
+  if (has_walk_keys_) add(walk_lo_, walk_hi_);
+  for (const std::vector<QueryView>* list : {&queries_, &live_}) {
+    for (const QueryView& q : *list) {
+      Vec3 lo, hi;
+      QueryBounds(q, &lo, &hi);
+      add(lo, hi);
+    }
+  }
+  if (boxes.empty()) {
+    RenderBox all;
+    RenderBounds(&all.lo, &all.hi);
+    boxes.push_back(all);
+  }
+  return boxes;
 }
 
 std::vector<DrawVertex> Scene::TerrainPoints(ColorMode mode) const {
   std::vector<DrawVertex> out;
   out.reserve(samples_.size());
-  const double h0 = lo_.y, h1 = hi_.y;
+  const double h0 = terrain_lo_.y, h1 = terrain_hi_.y;     // (not a far query's height)
   const float size = -static_cast<float>(spacing_ * 1.6);  // world-sized splats
   for (size_t i = 0; i < samples_.size(); ++i) {
     const Vec3& p = samples_.points[i];

@@ -235,9 +235,7 @@ struct App {
     }
     // The camera in double (its target may lie 1e15 away), the product in float for GL.
     const double aspect = static_cast<double>(width) / static_cast<double>(std::max(height, 1));
-    glm::dvec3 lo, hi;
-    scene.DrawnBounds(&lo, &hi);
-    const glm::dmat4 projection = camera.Projection(aspect, lo, hi);
+    const glm::dmat4 projection = camera.Projection(aspect, scene.DrawnBoxes());
     const glm::mat4 view_projection(projection * camera.View());
     const float point_scale = static_cast<float>(height * projection[1][1] * 0.5);
     renderer->Begin(width, height, colors::kBackground);

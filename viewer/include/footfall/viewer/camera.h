@@ -4,9 +4,16 @@
 // up to 1e15 away (--camera) and still be placed to the unit.
 #pragma once
 
+#include <vector>
+
 #include <glm/glm.hpp>
 
 namespace footfall::viewer {
+
+// An axis-aligned box in render space: one drawn thing (the terrain, a walk, a query).
+struct RenderBox {
+  glm::dvec3 lo, hi;
+};
 
 class OrbitCamera {
  public:
@@ -41,11 +48,13 @@ class OrbitCamera {
   glm::dvec3 Forward() const;
   glm::dmat4 View() const;
   // Perspective projection for a viewport of this aspect ratio (width / height), its near and
-  // far planes chosen from the depths of the box [lo, hi] (render space: everything drawn)
-  // seen from the eye, whatever the target's distance: nothing in the box is clipped between
-  // far * 1e-5 and far. (Depth is 24-bit: a box reaching from the eye to far keeps about 1/170
-  // of far as its depth resolution at far.)
-  glm::dmat4 Projection(double aspect, const glm::dvec3& lo, const glm::dvec3& hi) const;
+  // far planes chosen from the depths of `boxes` (render space: each drawn thing) seen from the
+  // eye, whatever the target's distance. The near plane is the nearest box's (a box around the
+  // eye: far * 1e-5 of its own far), the far plane the farthest box's, but at most 1e5 times
+  // the near plane: what lies farther is clipped, never what is near (a query 1e9 away left
+  // the terrain under the eye beyond the near plane). (Depth is 24-bit: a box reaching from the
+  // eye to far keeps about 1/170 of far as its depth resolution at far.)
+  glm::dmat4 Projection(double aspect, const std::vector<RenderBox>& boxes) const;
 
   // Projects a render-space point to pixels of a width x height image (x right, y down, origin
   // at the top-left pixel corner). Returns false for points behind the eye.

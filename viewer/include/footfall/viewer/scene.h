@@ -91,10 +91,10 @@ class Scene {
   // queries received, the candidate rings, arrows, cells and markers around them: what the
   // camera frames.
   void FrameBounds(const ViewState& view, glm::dvec3* lo, glm::dvec3* hi) const;
-  // The render-space bounds of everything drawn: what is loaded, the live queries received,
-  // and room for the markers around them (rings, normals, cells). The camera keeps all of it
-  // between its clip planes.
-  void DrawnBounds(glm::dvec3* lo, glm::dvec3* hi) const;
+  // The render-space boxes of what is drawn, one for the terrain (its cells), one for the walk
+  // and one per query and live query, each with room for the markers around it (rings,
+  // normals, cells): the camera keeps them between its clip planes.
+  std::vector<RenderBox> DrawnBoxes() const;
 
   // The terrain samples as world-sized points in render space, coloured by `mode`.
   std::vector<DrawVertex> TerrainPoints(ColorMode mode) const;
@@ -116,7 +116,9 @@ class Scene {
  private:
   void DrawQuery(const QueryView& q, bool latest, DrawList* depth_tested, DrawList* on_top) const;
   void DrawWalk(const ViewState& view, DrawList* on_top) const;
-  // Grows the drawn bounds by a query's points, its arrow, cells and candidate ring.
+  // The world-space box of a query's points, its arrow, cells and candidate ring.
+  void QueryBounds(const QueryView& q, Vec3* lo, Vec3* hi) const;
+  // Grows the drawn bounds by QueryBounds(q).
   void GrowDrawn(const QueryView& q);
 
   std::string terrain_path_, walk_path_;
@@ -132,7 +134,10 @@ class Scene {
   bool has_bounds_ = false;
   Vec3 drawn_lo_, drawn_hi_;  // lo_, hi_ and what only adds to the picture (world space)
   bool has_drawn_ = false;
-  Vec3 cells_lo_, cells_hi_;  // the occupied grid cells' bounds (world space)
+  Vec3 cells_lo_, cells_hi_;      // the occupied grid cells' bounds (world space)
+  Vec3 terrain_lo_, terrain_hi_;  // the terrain samples' bounds (world space)
+  Vec3 walk_lo_, walk_hi_;        // the walk's keys' bounds (world space)
+  bool has_walk_keys_ = false;
 };
 
 }  // namespace footfall::viewer
