@@ -746,6 +746,18 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     r = View({"--terrain", kTerrain, "--screenshot", "/dev/full"});
     CHECK(r.exit_code == 1);
     CHECK_THAT(r.err, Catch::Contains("/dev/full: cannot write PNG: No space left on device"));
+    // A --dump-state that cannot be written failed after the screenshot had replaced the file
+    // at its path: both are checked first, and the old screenshot stays.
+    test::WriteFile(dir + "/old.png", "an earlier screenshot");
+    r = View({"--terrain", kTerrain, "--screenshot", dir + "/old.png", "--dump-state",
+              dir + "/missing/state.json"});
+    CHECK(r.exit_code == 1);
+    CHECK_THAT(r.err, Catch::Contains("--dump-state: cannot open '" + dir +
+                                      "/missing/state.json' for writing"));
+    CHECK(test::ReadFile(dir + "/old.png") == "an earlier screenshot");
+    r = View({"--terrain", kTerrain, "--screenshot", dir + "/missing/shot.png"});
+    CHECK(r.exit_code == 1);
+    CHECK_THAT(r.err, Catch::Contains("--screenshot: cannot open '" + dir + "/missing/shot.png'"));
   }
   SECTION("unreachable server") {
     const RunResult r = View({"--server", "127.0.0.1:1", "--live", "--screenshot", shot});

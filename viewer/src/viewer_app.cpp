@@ -555,6 +555,14 @@ int RunViewer(const ViewerOptions& options) {
     rpc.call_timeout_s = std::min(5.0, options.timeout_s);
   }
 
+  // Both outputs writable before anything is drawn or written: a --dump-state in a missing
+  // directory failed after the screenshot had replaced the file at its path.
+  for (const auto& [flag, path] : outputs) {
+    std::string error;
+    if (!path->empty() && CheckWritable(*path, &error) != Status::kOk)
+      return Fail(std::string(flag) + ": " + error);
+  }
+
   // 2. Load the terrain, answer the queries, read the walk.
   App app(options);
   std::string error;
