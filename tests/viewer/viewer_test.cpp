@@ -952,6 +952,10 @@ TEST_CASE("a walk far from frame 0 is shown at its own frames with whole numbers
   CHECK(viewer::FrameText(2.0 / 3) == "0.667");
   CHECK(viewer::FrameText(-0.0001) == "0");
   CHECK(viewer::FrameText(1e300) == "1e+300");
+  // From 1e15 on, always with an exponent (1e15 + 1 was written in digits beside "1e+15").
+  CHECK(viewer::FrameText(1e15) == "1e+15");
+  CHECK(viewer::FrameText(1e15 + 1) == "1.000000000000001e+15");
+  CHECK(viewer::FrameText(-999999999999999.5) == "-999999999999999.5");
 }
 
 TEST_CASE("walk files with descending frames are refused", "[viewer][walk]") {

@@ -97,7 +97,9 @@ void FrameRange(const Walk& walk, double* first, double* last) {
 std::string FrameText(double frame) {
   char text[64];
   if (!(std::fabs(frame) < 1e15)) {
-    const std::to_chars_result r = std::to_chars(text, text + sizeof text, frame);
+    // Always with an exponent: the shortest form wrote 1e15 so and 1e15 + 1 in digits.
+    const std::to_chars_result r =
+        std::to_chars(text, text + sizeof text, frame, std::chars_format::scientific);
     return std::string(text, r.ptr);
   }
   // (std::to_chars ignores the C locale: a decimal point whatever LC_NUMERIC says.)

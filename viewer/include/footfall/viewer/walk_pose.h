@@ -29,7 +29,7 @@ void FrameRange(const Walk& walk, double* first, double* last);
 
 // A frame as the overlay and messages show it: in plain digits with at most 3 decimals, trailing
 // zeros dropped ("1000000010.5", "0.667"; six significant digits wrote frame 1000010 as
-// "1.00001e+06"); beyond 1e15, the shortest text that reads back ("1e+300").
+// "1.00001e+06"); from 1e15 on, with an exponent ("1e+300", "1.000000000000001e+15").
 std::string FrameText(double frame);
 
 }  // namespace footfall::viewer
