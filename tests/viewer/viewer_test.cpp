@@ -236,6 +236,12 @@ TEST_CASE("a camera's clip planes follow the terrain beside the eye, not its tar
                             "--screenshot", dir + "/refused.png"});
   CHECK(r.exit_code == 2);
   CHECK_THAT(r.err, Catch::Contains("--camera: expected the eye and the target within +-1e15"));
+  // An eye and a target apart in world space but one point about the scene's centre (the
+  // hills': 20 away): a blank image and exit 0.
+  const RunResult same = View({"--terrain", kTerrain, "--camera", "0 5 0 1e-15 5 1e-15",
+                               "--screenshot", dir + "/refused.png"});
+  CHECK(same.exit_code == 2);
+  CHECK_THAT(same.err, Catch::Contains("--camera: the eye and the target are too near each other"));
   std::ifstream none(dir + "/refused.png");
   CHECK_FALSE(none.good());
 }

@@ -602,6 +602,14 @@ int RunViewer(const ViewerOptions& options) {
     }
   }
   app.scene.Finalize();
+  // Told apart in world space but not in render space (about the scene's centre): a target
+  // 1e-15 from an eye 5 away lay on it, and the picture was blank.
+  if (options.has_camera &&
+      app.scene.ToRenderDouble(options.eye) == app.scene.ToRenderDouble(options.target))
+    return Fail(
+        "--camera: the eye and the target are too near each other to be told apart this far "
+        "from the scene's centre; move the target farther from the eye",
+        2);
   app.view.color = options.height_colors ? ColorMode::kHeight : ColorMode::kNormal;
   app.view.show_cells = options.show_cells;
   app.SetFrame(options.has_frame ? options.frame : app.scene.first_frame());
