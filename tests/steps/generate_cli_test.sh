@@ -107,6 +107,24 @@ JSON
 both scene-cliff 2 --terrain "$work/cliff.pts" --scene "$work/scene/cliff.json"
 check "scene cliff: the faller's stop named" grep -qE '"stopped":"faller: step [0-9]+: foot' "$work/scene-cliff-embedded.json"
 check "scene cliff: the other character's keys kept" grep -q '"character":"safe"' "$work/scene-cliff-embedded.json"
+# A scene character that cannot walk at all (its heading along the up): exit 1, the others
+# (before and after it) walked and written, embedded as over RPC, and the walk file says who
+# did not walk. (In process, the characters after it were left unwalked; the file's "stopped"
+# was empty.)
+cat > "$work/scene/upward.json" <<JSON
+{"format": "footfall-scene", "version": 1,
+ "characters": [{"name": "first", "character_file": "biped.json", "start": [10, 0, 10], "steps": 2},
+                {"name": "upward", "character_file": "biped.json", "heading": [0, 1, 0], "steps": 2},
+                {"name": "last", "character_file": "biped.json", "start": [14, 0, 14], "steps": 2}]}
+JSON
+both scene-failed 1 --terrain "$hills" --scene "$work/scene/upward.json"
+check "scene failure: the others written" python3 -c "
+import json, sys
+walk = json.load(open(sys.argv[1]))
+assert sorted({t['character'] for t in walk['tracks']}) == ['first', 'last'], walk['tracks']
+assert walk['stopped'].startswith('upward did not walk: the heading'), walk['stopped']
+" "$work/scene-failed-embedded.json"
+check "scene failure: said" grep -q '^footfall generate: upward: the heading' "$work/scene-failed-embedded.err"
 # A scene character whose walk memory cannot hold: said, exit 1, not an abort. (Its steps are
 # a path's, only a bound: given steps would be refused up front, in 8. below.)
 printf '{"format": "footfall-scene", "version": 1, "characters": [{"character_file": "biped.json", "steps": 5}, {"character_file": "hexapod.json", "crowd": 300000, "path": [[30, 0, 30]], "crowd_spacing": 0.01}]}' > "$work/scene/huge.json"

@@ -535,26 +535,24 @@ int RunScene(const GenerateFlags& flags) {
   }
   // The characters walk on the shared terrain together (over footfalld, their queries joined
   // into one call per round), or one after the other, each on the terrain resampled for it.
+  // A character that fails leaves the others walking: their walks are written.
   std::vector<SceneWalk> walks;
-  std::string failed;  // the first failure, named by its character
   try {
     if (!per_character) {
       GenerateSceneWalks(*shared.session, shared.handle, characters, options, &walks);
     } else {
       walks.resize(scene.size());
-      for (size_t i = 0; i < scene.size() && failed.empty(); ++i) {
+      for (size_t i = 0; i < scene.size(); ++i) {
         LoadedTerrain own;
         if (!LoadWalkTerrain(flags, scene[i].character, &options[i], &own, &error)) {
-          failed = scene[i].name + ": " + error;
-          break;
+          walks[i].walked = true, walks[i].status = Status::kInvalidArgument;
+          walks[i].error = error;
+          continue;
         }
         std::vector<SceneWalk> one;
         GenerateSceneWalks(*own.session, own.handle, {characters[i]}, {options[i]}, &one);
         walks[i] = std::move(one.front());
-        if (walks[i].status != Status::kOk) {
-          if (!walks[i].out_of_memory) failed = scene[i].name + ": " + walks[i].error;
-          break;
-        }
+        if (walks[i].out_of_memory) break;
       }
     }
   } catch (const std::bad_alloc&) {
@@ -564,6 +562,7 @@ int RunScene(const GenerateFlags& flags) {
   Walk walk;
   walk.fps = flags.fps;
   size_t walked = 0;
+  std::vector<std::pair<std::string, std::string>> failures;  // (character, reason)
   for (size_t i = 0; i < walks.size(); ++i) {
     SceneWalk& w = walks[i];
     if (w.out_of_memory) {
@@ -573,7 +572,7 @@ int RunScene(const GenerateFlags& flags) {
     }
     if (!w.walked) continue;
     if (w.status != Status::kOk) {
-      if (failed.empty()) failed = scene[i].name + ": " + w.error;
+      failures.emplace_back(scene[i].name, w.error);
       continue;
     }
     try {
@@ -585,18 +584,21 @@ int RunScene(const GenerateFlags& flags) {
     }
     ++walked;
   }
-  if (walks.empty() && failed.empty()) {
+  if (walks.empty() && failures.empty()) {
     std::cerr << "footfall generate: out of memory setting out the scene's walks; nothing was "
                  "written (give fewer characters, crowds or steps)\n";
     return 1;
   }
-  if (!failed.empty()) {
-    // The characters that walked are kept: written, then the failure said.
-    std::cerr << "footfall generate: " << failed << '\n';
+  if (!failures.empty()) {
+    // The characters that walked are kept: written, with who did not walk among the stops,
+    // then the failures said.
+    for (const auto& [name, error] : failures)
+      std::cerr << "footfall generate: " << name << ": " << error << '\n';
     if (!walk.tracks.empty()) {
       std::cerr << "footfall generate: the walks of the " << walked
                 << (walked == 1 ? " character that walked are" : " characters that walked are")
                 << " written\n";
+      AddFailuresToSceneWalk(failures, &walk);
       WriteOutputs(flags, shared, walk);
     }
     return 1;

@@ -93,6 +93,18 @@ Status LoadScene(const std::string& path, std::vector<SceneCharacter>* out, std:
   return ParseScene(text, path, folder, out, error);
 }
 
+namespace {
+
+// The scene's `stopped`: its first stop, with a count of the others.
+void SetSceneStopped(Walk* scene) {
+  if (scene->stops.empty()) return;
+  scene->stopped = scene->stops.front();
+  if (scene->stops.size() > 1)
+    scene->stopped += " (and " + std::to_string(scene->stops.size() - 1) + " more stopped)";
+}
+
+}  // namespace
+
 void AddToSceneWalk(const std::string& name, Walk&& walk, Walk* scene) {
   for (WalkTrack& track : walk.tracks) {
     track.character = track.character.empty() ? name : name + "/" + track.character;
@@ -102,11 +114,15 @@ void AddToSceneWalk(const std::string& name, Walk&& walk, Walk* scene) {
   if (walk.stops.empty() && !walk.stopped.empty())
     scene->stops.push_back(name + ": " + walk.stopped);
   for (const std::string& note : walk.notes) scene->notes.push_back(name + ": " + note);
-  if (!scene->stops.empty()) {
-    scene->stopped = scene->stops.front();
-    if (scene->stops.size() > 1)
-      scene->stopped += " (and " + std::to_string(scene->stops.size() - 1) + " more stopped)";
-  }
+  SetSceneStopped(scene);
+}
+
+void AddFailuresToSceneWalk(const std::vector<std::pair<std::string, std::string>>& failures,
+                            Walk* scene) {
+  std::vector<std::string> stops;
+  for (const auto& [name, error] : failures) stops.push_back(name + " did not walk: " + error);
+  scene->stops.insert(scene->stops.begin(), stops.begin(), stops.end());
+  SetSceneStopped(scene);
 }
 
 }  // namespace footfall

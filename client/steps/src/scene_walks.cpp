@@ -74,7 +74,7 @@ void GenerateSceneWalks(TerrainSession& session, TerrainHandle terrain,
   if (session.InProcess() || characters.size() < 2) {
     for (size_t i = 0; i < characters.size(); ++i) {
       WalkOne(session, terrain, *characters[i], options[i], &(*out)[i]);
-      if ((*out)[i].status != Status::kOk) break;
+      if ((*out)[i].out_of_memory) break;  // (nothing is written then)
     }
     return;
   }

@@ -46,12 +46,18 @@ Status ParseScene(const std::string& text, const std::string& source, const std:
 // name. The scene's `stopped` is the first character's to stop, with a count of the others.
 void AddToSceneWalk(const std::string& name, Walk&& walk, Walk* scene);
 
+// Records in the scene's walk the characters that could not walk at all, as (name, reason):
+// first among its stops ("NAME did not walk: REASON"), so that the files written with the
+// others' walks say who is missing.
+void AddFailuresToSceneWalk(const std::vector<std::pair<std::string, std::string>>& failures,
+                            Walk* scene);
+
 // Scene characters walked at once over a session that is not in process (GenerateSceneWalks).
 constexpr size_t kJoinedSceneCharacters = 64;
 
 // One scene character's walk, as GenerateSceneWalks made it.
 struct SceneWalk {
-  bool walked = false;          // GenerateWalk ran for it (false: an earlier character failed)
+  bool walked = false;          // GenerateWalk ran for it (false: an earlier one ran out of memory)
   Status status = Status::kOk;  // GenerateWalk's
   std::string error;
   bool out_of_memory = false;  // generating it ran out of memory (status kLimitExceeded)
@@ -60,10 +66,11 @@ struct SceneWalk {
 
 // Generates the walk of every scene character on one loaded terrain: (*out)[i] for
 // characters[i] with options[i], as GenerateWalk takes them. Over a session that answers in
-// process, they walk one after the other, and a character that fails leaves the rest unwalked.
-// Over any other (RPC), up to kJoinedSceneCharacters walk at once, each on a thread of its own,
-// their rounds of queries joined into one session call per round (JoinedCalls): one round trip
-// for the whole scene, not one per character; a character that fails leaves the others walking.
+// process, they walk one after the other. Over any other (RPC), up to kJoinedSceneCharacters
+// walk at once, each on a thread of its own, their rounds of queries joined into one session
+// call per round (JoinedCalls): one round trip for the whole scene, not one per character.
+// Either way a character that fails leaves the others walking (in process, one that runs out of
+// memory leaves the rest unwalked).
 // The walks are the same either way. options[i].progress may be called from several threads
 // at once.
 void GenerateSceneWalks(TerrainSession& session, TerrainHandle terrain,
