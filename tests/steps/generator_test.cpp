@@ -539,6 +539,37 @@ TEST_CASE("An upright body walks on under a roof above it, neither stopped nor r
   for (const WalkKey& k : Body(w).keys) CHECK(k.position.y == Approx(c.body_height).margin(1e-6));
 }
 
+TEST_CASE("A biped steps over a kerb lower than its step height", "[steps][generator]") {
+  // A floor sampled every centimetre, a kerb 2 cm thick across the way: with the feet either
+  // side of it, its top crossed the spine, and kerbs 3 to 6 cm tall stopped the walk with "no
+  // room for the body ... (an overhang or a ceiling lower than body_height)".
+  const Character c = LoadShipped("biped");
+  const double s = 0.01;
+  for (const double height : {0.03, 0.05, 0.06, 0.1}) {
+    INFO("kerb " << height);
+    // The floor (x from 0 to 2, z from 0 to 3) but under the kerb; the kerb's faces sampled
+    // from the floor up, its top across.
+    RawSamples kerb;
+    for (int i = 0; i <= 200; ++i) {
+      const double x = i * s;
+      for (int k = 0; k <= 300; ++k)
+        if (k < 150 || k > 152) kerb.push_back({x, 0, k * s}, {0, 1, 0});
+      for (int j = 0; j * s <= height + 1e-9; ++j) {
+        kerb.push_back({x, j * s, 1.5}, {0, 0, -1});
+        kerb.push_back({x, j * s, 1.52}, {0, 0, 1});
+      }
+      for (int k = 150; k <= 152; ++k) kerb.push_back({x, height, k * s}, {0, 1, 0});
+    }
+    Terrain t = LoadTerrain(kerb, s);
+    const GenerateOptions o = StartOptions({1, 0, 0.8}, 6);
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    CheckWalk(t, c, o, w);
+    CHECK(w.stopped.empty());
+    CHECK(Body(w).keys.back().position.z > 2);
+  }
+}
+
 TEST_CASE("A biped walks straight beside a wall, and stops before a block for its height",
           "[steps][generator]") {
   // A floor and a block 2 m tall across z from 2 to 3 m. Walking along +x with its body 0.24 m

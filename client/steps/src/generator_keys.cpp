@@ -387,12 +387,16 @@ Status Generator::KeyBodies(std::string* error) {
     const double top = c_.body_height + body_raise_[i];
     const Vec3 spine_low = a.ground + a.body_up * gap_;
     const Vec3 spine_top = a.ground + a.body_up * top;
+    // Terrain no higher than step_height above a foot is stepped over, not walked under: a
+    // kerb 5 cm tall between the feet, its top crossing the spine, stopped the walk as an
+    // overhang (a swing arc clears step_height; a slab over the feet is higher).
+    const double low_enough = std::max(gap_, c_.step_height);
     auto across = [&](const Foothold& h) {
       if (h.status != Status::kOk) return false;
       const Vec3 d = h.point - a.ground;
       if (Dot(d, a.body_up) >= top || Length(ProjectOnPlane(d, a.body_up)) > gap_) return false;
       for (const Vec3& foot : a.foot)
-        if (Dot(h.point - foot, a.body_up) <= gap_) return false;
+        if (Dot(h.point - foot, a.body_up) <= low_enough) return false;
       const double below = Dot(spine_low - h.point, h.normal);
       const double above = Dot(spine_top - h.point, h.normal);
       if ((below > 0) == (above > 0) || below == above) return false;
