@@ -227,7 +227,12 @@ sed 's/"step_length": 0.7/"step_length": 5/' "$chars/biped.json" > "$work/long-s
 "$footfall" generate --terrain "$hills" --character "$work/long-step.json" --start 10,0,10 \
   --steps 4 --crowd 3 --out "$work/long-step.json.out.json" 2> "$work/long-step.err"
 check "step_length beyond reach: exit 0" [ $? -eq 0 ]
-check "step_length beyond reach: said once" [ "$(grep -c '^footfall generate: note: step_length 5 is longer than reach 1.2 lets a foot travel (about 2.89 on level ground)' "$work/long-step.err")" -eq 1 ]
+check "step_length beyond reach: said once" [ "$(grep -c '^footfall generate: note: step_length 5 is longer than reach 1.2 lets a foot travel (about 2.89 on level ground, for the foot with the least room)' "$work/long-step.err")" -eq 1 ]
+# Feet snapped at the start onto samples too far apart for the character (the octopod on the
+# 25 cm hills) stood beyond reach with nothing said.
+"$footfall" generate --terrain "$hills" --character "$chars/octopod.json" --steps 4 \
+  --out "$work/coarse-start.json" 2> "$work/coarse-start.err"
+check "start beyond reach: said" grep -q '^footfall generate: note: at the start, foot [A-Z0-9]* stands 0.3[0-9]* from the body, beyond reach 0.32: the terrain.s samples (about 0.26 apart) are too far apart' "$work/coarse-start.err"
 # A glTF output that cannot hold the walk's times is named; the JSON beside it is written (it
 # keeps every key).
 "$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,1 \

@@ -276,10 +276,12 @@ TEST_CASE("A step_length longer than the reach allows is said once in the walk's
   INFO(w.stopped);
   CHECK(w.stopped.empty());
   REQUIRE(w.notes.size() == 1);
-  CHECK(w.notes[0] ==
-        "step_length 5 is longer than reach 1.2 lets a foot travel (about 2.89 on level ground): "
-        "every step is shortened to keep the feet within reach of the body (raise reach or lower "
-        "step_length)");
+  CHECK(
+      w.notes[0] ==
+      "step_length 5 is longer than reach 1.2 lets a foot travel (about 2.89 on level ground, for "
+      "the foot with the least room): "
+      "every step is shortened to keep the feet within reach of the body (raise reach or lower "
+      "step_length)");
   CheckWalk(t, c, o, w);
   // The steps taken are no longer than that, and far longer than the shipped biped's.
   const WalkTrack& foot = *TracksOf(w, "c1")[0];

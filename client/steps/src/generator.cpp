@@ -175,6 +175,7 @@ Status Generator::Run(std::string* error) {
   // A path walk given its number of steps that took them all short of its goal did as asked
   // (no stop), but says how far the goal still is.
   walk_.notes = setup_notes_;
+  if (!start_beyond_reach_.empty()) walk_.notes.push_back(start_beyond_reach_);
   if (o_.steps >= 0 && !o_.path.empty()) {
     for (Agent& a : agents_) {
       if (!a.walking || !a.stopped.empty() || a.path.empty()) continue;

@@ -275,8 +275,23 @@ void Generator::KeyFoot(const Agent& a, int foot, double frame, KeyPhase phase, 
 
 void Generator::KeyStart(const Agent& a) {
   // 4 (end). Every foot and the body keyed planted at the start frame.
-  for (size_t f = 0; f < c_.feet.size(); ++f)
+  const Vec3 body = a.ground + a.body_up * c_.body_height;
+  for (size_t f = 0; f < c_.feet.size(); ++f) {
     KeyFoot(a, static_cast<int>(f), o_.start_frame, KeyPhase::kEnd, a.foot[f], a.foot_normal[f]);
+    // Feet snap to the nearest samples: samples far apart for the character may leave one
+    // beyond reach, which the steps never do. Said once (the walk likely stops soon).
+    const double dist = Distance(a.foot[f], body);
+    if (start_beyond_reach_.empty() && dist > c_.reach * (1 + 1e-9)) {
+      Text note(3);
+      if (!a.id.empty()) note << a.id << ": ";
+      note << "at the start, foot " << c_.feet[f].name << " stands " << dist
+           << " from the body, beyond reach " << c_.reach << ": the terrain's samples (about "
+           << 0.5 * gap_
+           << " apart) are too far apart for this character; resample the terrain finer "
+              "(footfall terrain convert --character) or raise reach";
+      start_beyond_reach_ = note.str();
+    }
+  }
   body_due_.emplace_back(static_cast<size_t>(&a - agents_.data()), o_.start_frame);
 }
 

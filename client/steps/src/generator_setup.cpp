@@ -61,6 +61,7 @@ Status Generator::Setup(std::string* error) {
   // the sample it snapped to (a start beside a wall stands on it). (The default start is the
   // top of the bounds: its snap is no news.)
   setup_notes_.clear();
+  start_beyond_reach_.clear();
   if (o_.has_start) {
     const Vec3 up = c_.align_to_normal ? start_snap_.normal : world_up_;
     const double across = Length(ProjectOnPlane(start - start_snap_.point, up));
@@ -81,8 +82,8 @@ Status Generator::Setup(std::string* error) {
     Text m(3);
     m << "step_length " << c_.step_length << " is longer than reach " << c_.reach
       << " lets a foot travel (about " << longest
-      << " on level ground): every step is shortened to keep the feet within reach of the body "
-         "(raise reach or lower step_length)";
+      << " on level ground, for the foot with the least room): every step is shortened to keep "
+         "the feet within reach of the body (raise reach or lower step_length)";
     setup_notes_.push_back(m.str());
   }
   // 2. The start frame: up (terrain normal for multipeds, world up for bipeds) and the heading

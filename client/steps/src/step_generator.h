@@ -395,6 +395,9 @@ class Generator {
   // What the set-up found worth saying of the whole walk (a start far from the terrain, steps
   // longer than the reach allows): the first of Walk::notes.
   std::vector<std::string> setup_notes_;
+  // The first foot keyed at the start beyond reach of its body (snapped to samples too far
+  // apart for the character), said as a note: "" when none was.
+  std::string start_beyond_reach_;
   // The start's nearest sample (FindStart's first snap, before the start may move).
   Foothold start_snap_;
   std::shared_ptr<BatchPool> pool_;
