@@ -674,6 +674,16 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     CHECK(r.exit_code == 2);
     r = View({"--terrain", kTerrain, "--up-axis", "w", "--screenshot", shot});
     CHECK(r.exit_code == 2);
+    // Flags a point file has no use for exit 2 alike (a height map's frame exited 1).
+    for (const std::vector<std::string>& flag : {std::vector<std::string>{"--separation", "0.1"},
+                                                 {"--up-axis", "z"},
+                                                 {"--cell-size", "2"},
+                                                 {"--height-scale", "2"}}) {
+      INFO(flag[0]);
+      r = View({"--terrain", kTerrain, flag[0], flag[1], "--screenshot", shot});
+      CHECK(r.exit_code == 2);
+      CHECK_THAT(r.err, Catch::Contains(kTerrain + ": "));
+    }
     // A point file is never resampled: resampling flags are refused for it, as by footfall.
     r = View({"--terrain", kTerrain, "--seed", "3", "--screenshot", shot});
     CHECK(r.exit_code == 2);

@@ -11,6 +11,8 @@
 
 #include "footfall/cli/load_flags.h"
 #include "footfall/cli/number_checks.h"
+#include "footfall/import/terrain_loader.h"
+#include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/output_file.h"
 #include "footfall/viewer/viewer_app.h"
 
@@ -114,7 +116,12 @@ int main(int argc, char** argv) {
   }
   if (frame_opt->count() > 0) o.has_frame = true, o.frame = frame;
   std::string error;
-  if (!o.terrain.empty() && !footfall::cli::ResamplingFlagsApply(o.terrain, o.load, &error)) {
+  // (The height-map frame's flags, refused by the loader later, exited 1 where the others
+  // exit 2.)
+  if (!o.terrain.empty() &&
+      (!footfall::cli::ResamplingFlagsApply(o.terrain, o.load, &error) ||
+       footfall::CheckHeightMapOnly(o.terrain, footfall::FileExtension(o.terrain), o.load,
+                                    &error) != footfall::Status::kOk)) {
     std::cerr << "footfall-view: " << error << '\n';  // (they were ignored)
     return 2;
   }

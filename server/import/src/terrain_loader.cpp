@@ -41,19 +41,6 @@ Status CheckOptions(const TerrainLoadOptions& o, std::string* error) {
   return Status::kInvalidArgument;
 }
 
-// A height map's frame (cell size, height scale) given for another kind of file: it would be
-// ignored, and the terrain not the one the caller asked for.
-Status CheckHeightMapOnly(const std::string& path, const std::string& ext,
-                          const TerrainLoadOptions& o, std::string* error) {
-  if (ext == "asc" || ext == "pgm" || (o.cell_size == 0 && o.height_scale == 1)) return Status::kOk;
-  if (error)
-    *error = path +
-             ": a cell size or height scale (--cell-size, --height-scale) applies to "
-             "height maps (.asc .pgm) only, not to " +
-             (IsPointFileExtension(ext) ? "a point file" : "a mesh");
-  return Status::kInvalidArgument;
-}
-
 void Bounds(const RawSamples& samples, Vec3* lo, Vec3* hi) {
   *lo = *hi = samples.size() ? samples.points[0] : Vec3{};
   for (const Vec3& p : samples.points) {
@@ -82,6 +69,17 @@ Status LoadAny(const std::string& path, const std::string& ext, const TerrainLoa
 }
 
 }  // namespace
+
+Status CheckHeightMapOnly(const std::string& path, const std::string& ext,
+                          const TerrainLoadOptions& o, std::string* error) {
+  if (ext == "asc" || ext == "pgm" || (o.cell_size == 0 && o.height_scale == 1)) return Status::kOk;
+  if (error)
+    *error = path +
+             ": a cell size or height scale (--cell-size, --height-scale) applies to "
+             "height maps (.asc .pgm) only, not to " +
+             (IsPointFileExtension(ext) ? "a point file" : "a mesh");
+  return Status::kInvalidArgument;
+}
 
 Status ReadTerrainMesh(const std::string& path, const TerrainLoadOptions& options,
                        TriangleMesh* mesh, std::string* error, TerrainLoadReport* report) {

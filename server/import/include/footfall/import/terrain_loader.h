@@ -78,6 +78,13 @@ constexpr uint64_t kSamplingBytesPerSample = 1000;
 // in the triangles they were cut into), or "" when nothing was.
 std::string DescribeTurnover(const TerrainLoadReport& report);
 
+// kInvalidArgument, with "PATH: a cell size or height scale ... applies to height maps (.asc
+// .pgm) only, not to a point file" (or a mesh), when `options` give a height map's frame for a
+// file of extension `ext` (FileExtension) that is not one: LoadTerrain's own check, for
+// callers that refuse flags before loading.
+Status CheckHeightMapOnly(const std::string& path, const std::string& ext,
+                          const TerrainLoadOptions& options, std::string* error);
+
 // Loads `path` into *out. Errors: kIoError (cannot open), kParseError (malformed content,
 // message "FILE:LINE: what was expected" or "FILE: what is wrong"), kInvalidArgument (unknown
 // extension or bad option), kLimitExceeded (the separation would give too many samples).
