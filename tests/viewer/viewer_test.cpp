@@ -670,6 +670,11 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     r = View({"--terrain", kTerrain, "--query", "# only a comment", "--screenshot", shot});
     CHECK(r.exit_code == 2);
     CHECK_THAT(r.err, Catch::Contains("--query \"# only a comment\": expected snap X Y Z"));
+    for (const char* two : {"snap 1 1 1\nsnap 2 2 2", "snap 1 1\r1"}) {
+      r = View({"--terrain", kTerrain, "--query", two, "--screenshot", shot});
+      CHECK(r.exit_code == 2);
+      CHECK_THAT(r.err, Catch::Contains("--query: expected one query a --query, on one line"));
+    }
     r = View({"--terrain", kTerrain, "--separation", "nan", "--screenshot", shot});
     CHECK(r.exit_code == 2);
     r = View({"--terrain", kTerrain, "--up-axis", "w", "--screenshot", shot});

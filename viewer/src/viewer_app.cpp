@@ -530,7 +530,13 @@ int RunViewer(const ViewerOptions& options) {
   for (const std::string& text : options.queries) {
     QuerySpec spec;
     std::string error;
-    // The syntax of `footfall query`, '#' comments included.
+    // The syntax of `footfall query`, '#' comments included: one line (a line break was taken
+    // for a space, and "snap 1 1 1\nsnap 2 2 2" was "expected 3 numbers, found 7").
+    if (text.find_first_of("\r\n") != std::string::npos)
+      return Fail(
+          "--query: expected one query a --query, on one line (this one holds a line "
+          "break)",
+          2);
     const std::string query = WithoutComment(text);
     if (query.find_first_not_of(" \t\r\v\f") == std::string::npos)
       return Fail(
