@@ -679,6 +679,15 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     CHECK(r.exit_code == 2);
     r = View({"--terrain", kTerrain, "--up-axis", "w", "--screenshot", shot});
     CHECK(r.exit_code == 2);
+    // Loading flags without a terrain were ignored.
+    for (const char* flag : {"--flat-normals", "--smooth-normals"}) {
+      r = View({"--walk", dir + "/none.json", flag, "--screenshot", shot});
+      CHECK(r.exit_code == 2);
+      CHECK_THAT(r.err, Catch::Contains("is a loading flag of --terrain FILE, and no terrain"));
+    }
+    r = View({"--walk", dir + "/none.json", "--separation", "0.1", "--screenshot", shot});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("--separation is a loading flag of --terrain FILE"));
     // Flags a point file has no use for exit 2 alike (a height map's frame exited 1).
     for (const std::vector<std::string>& flag : {std::vector<std::string>{"--separation", "0.1"},
                                                  {"--up-axis", "z"},

@@ -115,6 +115,17 @@ int main(int argc, char** argv) {
     o.eye = {v[0], v[1], v[2]}, o.target = {v[3], v[4], v[5]};
   }
   if (frame_opt->count() > 0) o.has_frame = true, o.frame = frame;
+  // Loading flags without a terrain to load were ignored.
+  if (o.terrain.empty()) {
+    for (const char* flag : {"--separation", "--smooth-normals", "--crease-angle", "--seed",
+                             "--up-axis", "--cell-size", "--height-scale"}) {
+      if (app.count(flag) > 0) {
+        std::cerr << "footfall-view: " << flag
+                  << " is a loading flag of --terrain FILE, and no terrain is given\n";
+        return 2;
+      }
+    }
+  }
   std::string error;
   // (The height-map frame's flags, refused by the loader later, exited 1 where the others
   // exit 2.)
