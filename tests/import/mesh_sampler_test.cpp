@@ -253,6 +253,10 @@ TEST_CASE("SampleMesh: bad options are refused", "[import][sampler]") {
         std::string::npos);
   o.separation = 0.283;
   CHECK(SampleMesh(mesh, o, &out, &error) == Status::kOk);
+  // No room at all (footfalld's --max-samples 0): no separation is offered.
+  o.max_samples = 0;
+  CHECK(SampleMesh(mesh, o, &out, &error) == Status::kLimitExceeded);
+  CHECK(error == "separation 0.283 would give about 1998 samples (limit 0): no separation fits");
   o.max_samples = 20000000;
   TriangleMesh bad = mesh;
   bad.vertices[1].y = NAN;

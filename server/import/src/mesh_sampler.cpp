@@ -383,9 +383,12 @@ Status SampleMesh(const TriangleMesh& mesh, const MeshSampleOptions& options, Ra
                (predicted < 9e18           ? "about " + std::to_string(std::llround(predicted))
                 : std::isfinite(predicted) ? "about " + Format3(predicted)
                                            : std::string("more than 1e+308")) +
-               " samples (limit " + std::to_string(options.max_samples) +
-               "); choose a separation of at least " +
-               Format3(SeparationThatFits(mesh, area, options.max_samples));
+               " samples (limit " + std::to_string(options.max_samples) + ")" +
+               // (With no room at all, a separation "that fits" was offered all the same.)
+               (options.max_samples == 0
+                    ? std::string(": no separation fits")
+                    : "; choose a separation of at least " +
+                          Format3(SeparationThatFits(mesh, area, options.max_samples)));
     }
     return Status::kLimitExceeded;
   }
