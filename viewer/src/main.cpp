@@ -6,6 +6,7 @@
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -47,7 +48,7 @@ int main(int argc, char** argv) {
   std::string size, camera;
   double frame = 0;
   app.add_option("--terrain", o.terrain, "Terrain file (.pts/.xyz/.txt or any loader format)");
-  footfall::cli::AddLoadFlags(&app, &o.load);
+  const std::vector<CLI::Option*> load_flags = footfall::cli::AddLoadFlags(&app, &o.load);
   app.add_option("--query", o.queries,
                  "A query to draw, repeatable: \"next X Y Z DX DY DZ\", \"snap X Y Z\", "
                  "\"normal X Y Z\"");
@@ -117,10 +118,9 @@ int main(int argc, char** argv) {
   if (frame_opt->count() > 0) o.has_frame = true, o.frame = frame;
   // Loading flags without a terrain to load were ignored.
   if (o.terrain.empty()) {
-    for (const char* flag : {"--separation", "--smooth-normals", "--crease-angle", "--seed",
-                             "--up-axis", "--cell-size", "--height-scale"}) {
-      if (app.count(flag) > 0) {
-        std::cerr << "footfall-view: " << flag
+    for (const CLI::Option* flag : load_flags) {
+      if (flag->count() > 0) {
+        std::cerr << "footfall-view: " << flag->get_name()
                   << " is a loading flag of --terrain FILE, and no terrain is given\n";
         return 2;
       }
