@@ -19,6 +19,7 @@
 #include "footfall/steps/walk_json.h"
 #include "footfall/terrain/brute_force.h"
 #include "footfall/terrain/grid.h"
+#include "footfall/viewer/draw_list.h"
 #include "footfall/viewer/query_view.h"
 #include "footfall/viewer/walk_pose.h"
 #include "process.h"
@@ -521,6 +522,20 @@ TEST_CASE("why a walk stopped is shown in full, wrapped to the window", "[viewer
       View({"--walk", dir + "/walk.json", "--size", "8x8", "--screenshot", dir + "/tiny.png"});
   INFO(tiny.err);
   CHECK(tiny.exit_code == 0);
+}
+
+TEST_CASE("overlay text draws a NUL or a character beyond ASCII as a question mark",
+          "[viewer][text]") {
+  // (The font stopped at a NUL, and looked bytes beyond ASCII up outside its table.)
+  using viewer::DrawList;
+  const std::string odd("ab\0c\xc3\xa9\x7f\xff", 8);  // NUL, e-acute in UTF-8, DEL, a stray byte
+  DrawList drawn, expected, cut;
+  drawn.Text(0, 0, odd, 1, {});
+  expected.Text(0, 0, "ab?c???", 1, {});
+  cut.Text(0, 0, "ab", 1, {});
+  CHECK(drawn.triangles().size() == expected.triangles().size());
+  CHECK(drawn.triangles().size() > cut.triangles().size());
+  CHECK(DrawList::TextWidth(odd, 1) == DrawList::TextWidth("ab?c???", 1));
 }
 
 TEST_CASE("live: the viewer shows a query another client sends to footfalld", "[viewer][live]") {

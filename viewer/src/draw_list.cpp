@@ -43,14 +43,37 @@ void DrawList::Rect(float x0, float y0, float x1, float y1, Rgba color) {
   Triangle({x0, y0, 0}, {x1, y1, 0}, {x0, y1, 0}, color);
 }
 
+namespace {
+
+// `text` as stb_easy_font can draw it: printable ASCII as it is, any other character (a
+// control, a NUL, or a code point beyond ASCII in UTF-8) as one '?'. The font looks bytes up in
+// a table of printable ASCII (other bytes read outside it) and stops at a NUL.
+std::string EasyFontText(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (size_t i = 0; i < text.size(); ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    const bool continues =
+        (c & 0xC0) == 0x80 && i > 0 && static_cast<unsigned char>(text[i - 1]) >= 0x80;
+    if (c >= 32 && c < 127) {
+      out += static_cast<char>(c);
+    } else if (!continues) {
+      out += '?';
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 void DrawList::Text(float x, float y, const std::string& text, float scale, Rgba color) {
   // stb_easy_font emits quads of 4 vertices, 16 bytes each (x, y, z floats and a colour).
   struct QuadVertex {
     float x, y, z;
     unsigned char c[4];
   };
-  std::vector<QuadVertex> buffer(text.size() * 70 + 64);
-  std::string copy = text;
+  std::string copy = EasyFontText(text);
+  std::vector<QuadVertex> buffer(copy.size() * 70 + 64);
   unsigned char rgba[4] = {color.r, color.g, color.b, color.a};
   const int quads = stb_easy_font_print(0, 0, copy.data(), rgba, buffer.data(),
                                         static_cast<int>(buffer.size() * sizeof(QuadVertex)));
@@ -64,7 +87,7 @@ void DrawList::Text(float x, float y, const std::string& text, float scale, Rgba
 }
 
 float DrawList::TextWidth(const std::string& text, float scale) {
-  std::string copy = text;
+  std::string copy = EasyFontText(text);
   return static_cast<float>(stb_easy_font_width(copy.data())) * scale;
 }
 

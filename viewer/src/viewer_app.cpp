@@ -75,6 +75,8 @@ std::vector<std::string> WrapText(std::string text, const std::string& separator
     while (!item.empty() && !fits(item)) {
       size_t n = 1;
       while (n < item.size() && fits(item.substr(0, n + 1))) ++n;
+      // (Not inside a UTF-8 sequence: its bytes are one character.)
+      while (n < item.size() && (static_cast<unsigned char>(item[n]) & 0xC0) == 0x80) ++n;
       lines.push_back(item.substr(0, n));
       item.erase(0, n);
     }

@@ -44,7 +44,8 @@ class DrawList {
   // Screen lists: an axis-aligned rectangle from (x0, y0) to (x1, y1) [Units: px].
   void Rect(float x0, float y0, float x1, float y1, Rgba color);
   // Screen lists: text with its top-left corner at (x, y), `scale` pixels per font unit. The
-  // built-in font (stb_easy_font) is ASCII, about 6 x 12 font units a character.
+  // built-in font (stb_easy_font) is ASCII, about 6 x 12 font units a character; any other
+  // character (a control, a NUL, a line break, a UTF-8 code point beyond ASCII) is drawn as '?'.
   void Text(float x, float y, const std::string& text, float scale, Rgba color);
   // The width of `text` in pixels at `scale`.
   static float TextWidth(const std::string& text, float scale);
