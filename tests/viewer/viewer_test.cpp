@@ -992,6 +992,17 @@ TEST_CASE("a walk far from frame 0 is shown at its own frames with whole numbers
   CHECK(outside.exit_code == 0);
   CHECK_THAT(outside.err, Catch::Contains("--frame -3000000000 is outside the walk's "
                                           "1000000001-1000000025; showing 1000000001"));
+  // A fractional frame just outside is quoted as given, not rounded into the range.
+  const RunResult just_outside = View({"--walk", dir + "/walk.json", "--frame", "1000000000.9999",
+                                       "--size", "64x64", "--screenshot", dir + "/shot.png"});
+  CHECK(just_outside.exit_code == 0);
+  CHECK_THAT(just_outside.err, Catch::Contains("--frame 1000000000.9999 is outside the walk's "
+                                               "1000000001-1000000025; showing 1000000001"));
+  CHECK(viewer::ExactFrameText(0.0001) == "0.0001");
+  CHECK(viewer::ExactFrameText(12.25) == "12.25");
+  CHECK(viewer::ExactFrameText(-3e9) == "-3000000000");
+  CHECK(viewer::ExactFrameText(1e-300) == "1e-300");
+  CHECK(viewer::ExactFrameText(1e300) == "1e+300");
   CHECK(viewer::FrameText(12.25) == "12.25");
   CHECK(viewer::FrameText(1e6) == "1000000");
   CHECK(viewer::FrameText(2.0 / 3) == "0.667");

@@ -623,10 +623,10 @@ int RunViewer(const ViewerOptions& options) {
   app.SetFrame(options.has_frame ? options.frame : app.scene.first_frame());
   if (options.has_frame && app.scene.has_walk() &&
       (options.frame < app.scene.first_frame() || options.frame > app.scene.last_frame())) {
-    std::cerr << "footfall-view: note: --frame " << FrameText(options.frame)
-              << " is outside the walk's " << FrameText(app.scene.first_frame()) << "-"
-              << FrameText(app.scene.last_frame()) << "; showing " << FrameText(app.view.frame)
-              << '\n';
+    std::cerr << "footfall-view: note: --frame " << ExactFrameText(options.frame)
+              << " is outside the walk's " << ExactFrameText(app.scene.first_frame()) << "-"
+              << ExactFrameText(app.scene.last_frame()) << "; showing "
+              << ExactFrameText(app.view.frame) << '\n';
   }
 
   // 3. Open a window (hidden for screenshots) with an OpenGL 3.3 core context.

@@ -111,4 +111,24 @@ std::string FrameText(double frame) {
   return s == "-0" ? "0" : s;
 }
 
+std::string ExactFrameText(double frame) {
+  char text[64];
+  if (std::fabs(frame) < 1e15) {
+    for (int decimals = 3; decimals <= 20; ++decimals) {
+      const std::to_chars_result r =
+          std::to_chars(text, text + sizeof text, frame, std::chars_format::fixed, decimals);
+      double back = 0;
+      std::from_chars(text, r.ptr, back);
+      if (back != frame) continue;
+      std::string s(text, r.ptr);
+      s.erase(s.find_last_not_of('0') + 1);
+      if (s.back() == '.') s.pop_back();
+      return s == "-0" ? "0" : s;
+    }
+  }
+  const std::to_chars_result r =
+      std::to_chars(text, text + sizeof text, frame, std::chars_format::scientific);
+  return std::string(text, r.ptr);
+}
+
 }  // namespace footfall::viewer

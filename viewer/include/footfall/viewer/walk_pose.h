@@ -31,5 +31,9 @@ void FrameRange(const Walk& walk, double* first, double* last);
 // zeros dropped ("1000000010.5", "0.667"; six significant digits wrote frame 1000010 as
 // "1.00001e+06"); from 1e15 on, with an exponent ("1e+300", "1.000000000000001e+15").
 std::string FrameText(double frame);
+// A frame as FrameText writes it, with more decimals where it takes them to read back as
+// `frame` (messages quoting a frame against a range: "--frame 0.9999 is outside 1-49", never
+// "--frame 1 is outside 1-49"); in the shortest form with an exponent where no decimals do.
+std::string ExactFrameText(double frame);
 
 }  // namespace footfall::viewer
