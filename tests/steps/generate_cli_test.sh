@@ -472,7 +472,7 @@ start_server "$footfalld" --data-root "$work/root"
 "$footfall" generate --server-terrain ramp.obj --server "$server" --crease-angle 30 --seed 3 \
   --character "$chars/biped.json" --start 2,0.1,0.5 --steps 6 --out "$work/server-ramp.json" 2> "$work/server-ramp.err"
 check "server-terrain mesh: exit 0" [ $? -eq 0 ]
-check "server-terrain mesh: the server's resampling said" grep -qE "footfalld resampled ramp.obj: [0-9]+ samples as fine as a quarter of the step \(or the file's own spacing, if finer\)" "$work/server-ramp.err"
+check "server-terrain mesh: the server's resampling said" grep -qE "footfalld loaded ramp.obj: [0-9]+ samples at separation 0.175$" "$work/server-ramp.err"
 "$footfall" generate --terrain "$work/root/ramp.obj" --separation 0.175 --crease-angle 30 --seed 3 \
   --character "$chars/biped.json" --start 2,0.1,0.5 --steps 6 --out "$work/local-ramp.json" 2> /dev/null
 check "server-terrain mesh: the walk on the file resampled at a quarter step" cmp -s "$work/server-ramp.json" "$work/local-ramp.json"

@@ -319,21 +319,12 @@ bool LoadWalkTerrain(const GenerateFlags& flags, const Character& character,
     terrain_flags.load.max_samples = std::min(terrain_flags.load.max_samples, kMaxWalkSamples);
   }
   if (OpenTerrain(terrain_flags, &t->session, &t->handle, error) != Status::kOk) return false;
-  // footfalld resampled a mesh or height map itself: say with how many samples, as a local
-  // file's resampling is reported.
-  TerrainInfo info;
+  // footfalld resampled a mesh or height map itself: say how, as a local file's resampling is
+  // reported.
   if (!terrain_flags.server_terrain.empty() &&
       !IsPointFileExtension(FileExtension(terrain_flags.server_terrain)) &&
-      t->session->Info(t->handle, &info) == Status::kOk) {
-    std::cerr << "footfall generate: footfalld resampled " << terrain_flags.server_terrain << ": "
-              << info.stats.samples << " samples"
-              << (terrain_flags.load.separation > 0
-                      ? std::string(" at --separation ") + NumberText(terrain_flags.load.separation)
-                      : std::string(" as fine as a quarter of the step (or the file's own "
-                                    "spacing, if finer) within 2,000,000 and what is left of its "
-                                    "--max-samples budget"))
-              << "\n";
-  }
+      !t->session->last_load_report().empty())
+    std::cerr << "footfall generate: footfalld " << t->session->last_load_report() << "\n";
   return true;
 }
 

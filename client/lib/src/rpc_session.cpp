@@ -412,6 +412,7 @@ class RpcSession final : public TerrainSession {
                     message.empty() ? std::string(what) + " failed" : message);
       source->server_handle = reply.value.terrain;
       source->loaded = true;
+      last_load_report_ = message;
       return Status::kOk;
     }
   }

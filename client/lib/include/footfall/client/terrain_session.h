@@ -68,6 +68,10 @@ class TerrainSession {
   virtual bool InProcess() const = 0;
   // The reason for the last failed call, one line.
   const std::string& last_error() const { return last_error_; }
+  // What footfalld said of the last file it loaded for this session ("loaded PATH: N samples",
+  // and for a mesh or height map " at separation S", with why when it is coarser than asked);
+  // empty in process, where the loader's own report says it.
+  const std::string& last_load_report() const { return last_load_report_; }
 
  protected:
   TerrainSession() = default;
@@ -76,6 +80,7 @@ class TerrainSession {
     return status;
   }
   std::string last_error_;
+  std::string last_load_report_;
 };
 
 // The in-process engine. With `threads` > 1, batches are shared with threads - 1 persistent
