@@ -44,7 +44,8 @@ int main(int argc, char** argv) {
   CLI::App app{
       "footfall-view: draws terrain samples, queries (foot, direction, cells, candidates, chosen "
       "sample), walks and the queries of a live footfalld. Keys: drag orbit, right-drag pan, "
-      "wheel zoom, F frame all, C colour, G grid cells, space play, left/right frame, Esc quit."};
+      "wheel zoom, F frame all, C colour, G grid cells, space play, left/right frame, Home/End "
+      "first/last frame, Esc or Q quit."};
   std::string size, camera;
   double frame = 0;
   app.add_option("--terrain", o.terrain, "Terrain file (.pts/.xyz/.txt or any loader format)");

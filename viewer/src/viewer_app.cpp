@@ -211,7 +211,7 @@ struct App {
     s << "drag: orbit   right-drag: pan   wheel: zoom   F: frame all   C: colour ("
       << (view.color == ColorMode::kNormal ? "normal" : "height") << ")   G: cells ("
       << (view.show_cells ? "on" : "off") << ")";
-    if (scene.has_walk()) s << "   space: play   left/right: frame";
+    if (scene.has_walk()) s << "   space: play   left/right: frame   Home/End: first/last";
     s << "   Esc: quit";
     return s.str();
   }
