@@ -1899,6 +1899,26 @@ TEST_CASE("footfalld logs unknown terrains and uploads dropped for idleness", "[
   clnt_destroy(c);
 }
 
+TEST_CASE("footfalld logs an upload whose client went away and an unknown procedure", "[rpc]") {
+  // (Neither had a log line: an upload left by a killed client vanished without a word.)
+  ServerProcess server(0, {"--no-rpcbind"});
+  CLIENT* c = RawClient(server.port());
+  timeval timeout{5, 0};
+  // (xdr_void takes no arguments in libtirpc's declaration: cast through void*.)
+  const auto void_xdr = reinterpret_cast<xdrproc_t>(reinterpret_cast<void*>(xdr_void));
+  const clnt_stat unknown = clnt_call(c, 99, void_xdr, nullptr, void_xdr, nullptr, timeout);
+  CHECK(unknown == RPC_PROCUNAVAIL);
+  uint32_t upload = 0;
+  std::string message;
+  REQUIRE(BeginUpload(c, 10, &upload, &message) == FF_OK);
+  clnt_destroy(c);
+  const std::string dropped = "upload " + std::to_string(upload) +
+                              " 'raw' (0 of 10 samples received) dropped: the connection that "
+                              "began it closed before it finished";
+  CHECK(WaitFor([&] { return server.Log().find(dropped) != std::string::npos; }));
+  CHECK_THAT(server.Log(), Catch::Contains("error: unknown procedure 99 of version 1 from "));
+}
+
 TEST_CASE("SIGTERM during a raw client's batch says that stopping waits for it", "[rpc]") {
   ServerProcess server(0, {"--no-rpcbind", "--threads", "1"});
   // Snaps from 1e10 above 1M flat samples: each compares every sample (seconds for a batch).

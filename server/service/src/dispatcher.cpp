@@ -190,9 +190,14 @@ std::string SecondsText(double seconds) {
 // connection ended, for the log.
 void DropClient(const Connection& connection,
                 const char* how = "the connection that loaded it closed") {
-  for (const uint32_t handle : g_state->registry.DropClient(connection.id))
+  std::vector<std::string> uploads;
+  for (const uint32_t handle : g_state->registry.DropClient(connection.id, &uploads))
     Log("terrain " + std::to_string(handle) + " orphaned: " + how + "; it is freed after " +
         SecondsText(g_state->registry.limits().orphan_idle_s) + " without queries");
+  for (const std::string& upload : uploads)
+    Log(upload +
+        " dropped: the connection that began it closed before it finished; its "
+        "samples are freed");
 }
 
 // [Units: s] How long a batch of the connection of `transport` may take before its remaining
@@ -866,6 +871,9 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
                                                     FF_XDR(ff_recent_reply), "recent", Recent);
     default:
       svcerr_noproc(transport);
+      Log("error: unknown procedure " + std::to_string(request->rq_proc) + " of version " +
+          std::to_string(FOOTFALL_V1) + " from " + PeerOf(transport->xp_fd) +
+          " rejected (PROC_UNAVAIL: a client built from another rpc/footfall.x?)");
       return;
   }
 }

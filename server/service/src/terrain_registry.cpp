@@ -18,6 +18,12 @@ namespace footfall {
 
 namespace {
 
+// An upload as the log names one: "upload N 'NAME' (R of T samples received)".
+std::string UploadText(uint32_t upload, const std::string& name, size_t received, uint64_t total) {
+  return "upload " + std::to_string(upload) + " '" + name + "' (" + std::to_string(received) +
+         " of " + std::to_string(total) + " samples received)";
+}
+
 // True when canonical `path` is an ancestor of `root` (a walk from "/" passes it on the way in).
 bool AboveRoot(const std::string& root, const std::string& path) {
   return path == "/" || root.compare(0, path.size() + 1, path + "/") == 0;
@@ -482,9 +488,18 @@ std::vector<uint32_t> TerrainRegistry::Handles() const {
   return handles;
 }
 
-std::vector<uint32_t> TerrainRegistry::DropClient(uint64_t owner) {
-  for (auto it = uploads_.begin(); it != uploads_.end();)
-    it = it->second.owner == owner ? uploads_.erase(it) : std::next(it);
+std::vector<uint32_t> TerrainRegistry::DropClient(uint64_t owner,
+                                                  std::vector<std::string>* dropped_uploads) {
+  for (auto it = uploads_.begin(); it != uploads_.end();) {
+    if (it->second.owner != owner) {
+      ++it;
+      continue;
+    }
+    if (dropped_uploads)
+      dropped_uploads->push_back(
+          UploadText(it->first, it->second.name, it->second.samples.size(), it->second.total));
+    it = uploads_.erase(it);
+  }
   std::vector<uint32_t> orphaned;
   const auto now = std::chrono::steady_clock::now();
   for (auto& t : terrains_) {
@@ -550,9 +565,8 @@ void TerrainRegistry::ExpireUploads() {
       ++it;
       continue;
     }
-    expired_uploads_.push_back("upload " + std::to_string(it->first) + " '" + it->second.name +
-                               "' (" + std::to_string(it->second.samples.size()) + " of " +
-                               std::to_string(it->second.total) + " samples received)");
+    expired_uploads_.push_back(
+        UploadText(it->first, it->second.name, it->second.samples.size(), it->second.total));
     it = uploads_.erase(it);
   }
 }

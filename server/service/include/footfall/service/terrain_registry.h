@@ -125,8 +125,10 @@ class TerrainRegistry {
   void TouchUpload(uint32_t upload, uint64_t owner);
   // Ends the uploads of a client that went away, releasing their reservations, and orphans its
   // terrains (they stay queryable until RegistryLimits::orphan_idle_s pass without a query).
-  // Returns the handles orphaned.
-  std::vector<uint32_t> DropClient(uint64_t owner);
+  // Returns the handles orphaned; `dropped_uploads` [opt] gets each upload ended, described as
+  // "upload N 'NAME' (R of T samples received)".
+  std::vector<uint32_t> DropClient(uint64_t owner,
+                                   std::vector<std::string>* dropped_uploads = nullptr);
   // Unloads a terrain of client `requester`, or an orphan: kAccessDenied for another client's
   // terrain, kUnknownTerrain for no terrain.
   Status Unload(uint32_t handle, uint64_t requester, std::string* message);
