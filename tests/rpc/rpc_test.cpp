@@ -1896,6 +1896,12 @@ TEST_CASE("footfalld logs unknown terrains and uploads dropped for idleness", "[
   CHECK_THAT(log, Catch::Contains("upload " + std::to_string(upload) +
                                   " 'raw' (0 of 10 samples received) dropped: no samples for "
                                   "0.2 s (--upload-timeout)"));
+  // The client is told why at its next chunk (it was told only "no upload N in progress").
+  CHECK(SendChunk(c, upload, {}, &message) == FF_INVALID_ARGUMENT);
+  CHECK(message == "upload " + std::to_string(upload) +
+                       " was dropped: no samples for 0.2 s (--upload-timeout); begin it again");
+  CHECK(SendChunk(c, upload + 1, {}, &message) == FF_INVALID_ARGUMENT);
+  CHECK(message == "no upload " + std::to_string(upload + 1) + " in progress on this connection");
   clnt_destroy(c);
 }
 

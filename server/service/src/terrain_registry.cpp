@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <new>
 #include <random>
+#include <sstream>
 #include <vector>
 
 namespace footfall {
@@ -387,11 +388,23 @@ std::string Dropped(uint32_t upload) {
 
 }  // namespace
 
+std::string TerrainRegistry::NoUpload(uint32_t upload, uint64_t owner) const {
+  for (const auto& [id, by] : expired_ids_) {
+    if (id == upload && by == owner) {
+      std::ostringstream text;
+      text << "upload " << upload << " was dropped: no samples for " << limits_.upload_idle_s
+           << " s (--upload-timeout); begin it again";
+      return text.str();
+    }
+  }
+  return "no upload " + std::to_string(upload) + " in progress on this connection";
+}
+
 Status TerrainRegistry::AppendUpload(uint32_t upload, uint64_t owner, const RawSamples& chunk,
                                      std::string* message) {
   auto it = uploads_.find(upload);
   if (it == uploads_.end() || it->second.owner != owner) {
-    *message = "no upload " + std::to_string(upload) + " in progress on this connection";
+    *message = NoUpload(upload, owner);
     return Status::kInvalidArgument;
   }
   Upload& u = it->second;
@@ -428,7 +441,7 @@ Status TerrainRegistry::PrepareFinishUpload(uint32_t upload, uint64_t owner, Pen
                                             std::string* message) {
   auto it = uploads_.find(upload);
   if (it == uploads_.end() || it->second.owner != owner) {
-    *message = "no upload " + std::to_string(upload) + " in progress on this connection";
+    *message = NoUpload(upload, owner);
     return Status::kInvalidArgument;
   }
   Upload u = std::move(it->second);
@@ -567,6 +580,8 @@ void TerrainRegistry::ExpireUploads() {
     }
     expired_uploads_.push_back(
         UploadText(it->first, it->second.name, it->second.samples.size(), it->second.total));
+    if (expired_ids_.size() >= kRememberedExpiries) expired_ids_.pop_front();
+    expired_ids_.emplace_back(it->first, it->second.owner);
     it = uploads_.erase(it);
   }
 }

@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "footfall/import/terrain_loader.h"
@@ -171,6 +172,8 @@ class TerrainRegistry {
   Status CheckQuota(uint64_t owner, std::string* message) const;
   // Samples held by loaded terrains plus those reserved by uploads in progress or being built.
   uint64_t TotalSamples() const;
+  // Why `owner` has no upload `upload`: dropped by --upload-timeout, or never begun here.
+  std::string NoUpload(uint32_t upload, uint64_t owner) const;
   // "the sample budget (--max-samples N, M in use)", for messages.
   std::string Budget() const;
 
@@ -188,6 +191,9 @@ class TerrainRegistry {
   std::map<uint32_t, std::unique_ptr<LoadedTerrain>> terrains_;
   std::vector<uint32_t> evicted_;             // orphans freed to make room, until TakeEvicted
   std::vector<std::string> expired_uploads_;  // until TakeExpiredUploads
+  // Uploads dropped by ExpireUploads, and their owners: a later chunk is told why.
+  static constexpr size_t kRememberedExpiries = 1024;
+  std::deque<std::pair<uint32_t, uint64_t>> expired_ids_;
   std::map<uint32_t, Upload> uploads_;
   uint64_t building_ = 0;  // samples of finished uploads whose grids are being built
   std::deque<RecentQuery> recent_;
