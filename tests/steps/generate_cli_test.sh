@@ -511,4 +511,28 @@ err=$(timeout 20 "$footfall" generate --terrain "$hills" --scene "$work/huge.sce
 check "scene keys beyond memory: exit 1" [ $? -eq 1 ]
 check "scene keys beyond memory: message" grep -qE "^footfall generate: the scene's characters make about 1e\+13 keys" <<< "$err"
 check "keys beyond memory: nothing written" [ ! -e "$work/huge.json" ]
+# 9. A walk whose footfalld dies mid-walk exits 1, not 2 (a stop at the terrain), says so, and
+#    writes its keys so far with the failed call as its stop (a crowd's stop named only a
+#    character that had stopped earlier at the terrain's edge).
+awk 'BEGIN { for (k = 0; k <= 400; k++) for (i = 0; i <= 400; i++) printf "%.1f 0 %.1f 0 1 0\n", i * 0.1, k * 0.1 }' > "$work/flat40.pts"
+loop=""
+for _ in $(seq 12); do loop="$loop 35,0,5 35,0,35 5,0,35 5,0,5"; done
+start_server "$footfalld"
+"$footfall" generate --server "$server" --terrain "$work/flat40.pts" --character "$chars/biped.json" \
+  --start 5,0,5 --path "${loop# }" --crowd 16 --steps 4000 --progress --out "$work/died.json" 2> "$work/died.err" &
+walk_pid=$!
+# Killed once the walk is under way: its progress bar past 0%.
+for _ in $(seq 600); do
+  tr '\r' '\n' < "$work/died.err" | grep -qE '\] +[1-9][0-9]?%' && break
+  sleep 0.05
+done
+kill -9 "$server_pid"; wait "$server_pid" 2>/dev/null; server_pid=""
+wait "$walk_pid"
+check "server dies mid-walk: exit 1" [ $? -eq 1 ]
+check "server dies mid-walk: said" grep -qF "footfall generate: footfalld failed mid-walk (not the terrain): the keys up to its failure are written; exit status 1" "$work/died.err"
+check "server dies mid-walk: the keys so far written, the failed call their stop" python3 -c '
+import json, sys
+w = json.load(open(sys.argv[1]))
+sys.exit(not ("footfalld at 127.0.0.1:" in w["stopped"] and len(w["tracks"]) == 48
+              and all(len(t["keys"]) > 3 for t in w["tracks"])))' "$work/died.json"
 finish

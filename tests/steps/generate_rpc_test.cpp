@@ -89,6 +89,7 @@ TEST_CASE("A walk over RPC whose server dies keeps its steps up to the one it di
     CHECK_THAT(w.stopped, Catch::Contains("footfalld at 127.0.0.1:"));
     CHECK_THAT(w.stopped,
                Catch::EndsWith("keys up to step " + std::to_string(kill_after) + " kept"));
+    CHECK(w.session_failed);
     Terrain t = LoadTerrain(samples, spacing);
     GenerateOptions shorter = o;
     shorter.progress = nullptr;
@@ -97,6 +98,63 @@ TEST_CASE("A walk over RPC whose server dies keeps its steps up to the one it di
     CHECK(want.stopped.empty());
     CHECK(SameKeys(w, want));
   }
+}
+
+TEST_CASE("A crowd over RPC whose server dies says so before the terrain's earlier stops",
+          "[steps][rpc]") {
+  // (The crowd's message named a terrain stop of one character at step 4, and "and 3 more
+  // stopped", hiding that the server's death stopped the others at step 8.)
+  const Character c = LoadShipped("biped");
+  const double spacing = c.step_length / 10;
+  const double side = 60 * c.step_length;
+  const RawSamples flat = MakeFlat(static_cast<int>(side / spacing), spacing, 0);
+  const Vec3 start{side / 2, 0, 4 * c.reach};
+  // The ground ends 3 steps ahead on the low-x half: its characters stop there, at a cliff.
+  RawSamples samples;
+  for (size_t i = 0; i < flat.size(); ++i) {
+    const Vec3& p = flat.points[i];
+    if (p.x < start.x && p.z > start.z + 3 * c.step_length) continue;
+    samples.points.push_back(p), samples.normals.push_back(flat.normals[i]);
+  }
+  ServedTerrain served(samples);
+  constexpr int kill_after = 7;
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = start;
+  o.steps = 40;
+  o.crowd = 4;
+  o.crowd_spacing = 4 * c.reach;
+  o.progress = [&](int done, int) {
+    if (done == kill_after) served.server.Kill();
+  };
+  Walk w;
+  std::string error;
+  REQUIRE(GenerateWalk(*served.rpc, served.handle, c, o, &w, &error) == Status::kOk);
+  INFO(w.stopped);
+  CHECK(w.session_failed);
+  REQUIRE(w.stops.size() == 4);
+  // The failures first, then the cliff's stops (one at least), earlier.
+  size_t failures = 0;
+  while (failures < 4 && w.stops[failures].find("footfalld at 127.0.0.1:") != std::string::npos)
+    ++failures;
+  for (const std::string& stop : w.stops) UNSCOPED_INFO(stop);
+  CHECK(failures >= 2);
+  CHECK(failures < 4);
+  for (size_t i = failures; i < 4; ++i) {
+    CHECK_THAT(w.stops[i], Catch::Contains("no foothold"));
+    CHECK(std::stoi(w.stops[i].substr(5)) <= kill_after);
+  }
+  CHECK_THAT(w.stopped, Catch::StartsWith("step " + std::to_string(kill_after + 1) + " of c"));
+  CHECK_THAT(w.stopped, Catch::Contains("footfalld at 127.0.0.1:"));
+  CHECK_THAT(w.stopped, Catch::EndsWith("(and 3 more characters stopped)"));
+  // A walk that stops at the terrain alone is no failure.
+  ServedTerrain again(samples);
+  o.progress = nullptr;
+  Walk cliff;
+  REQUIRE(GenerateWalk(*again.rpc, again.handle, c, o, &cliff, &error) == Status::kOk);
+  CHECK_FALSE(cliff.session_failed);
+  CHECK(cliff.stops.size() == 2);
+  CHECK_THAT(cliff.stopped, Catch::Contains("no foothold"));
 }
 
 TEST_CASE("A walk over RPC whose server is gone before its first step fails with the reason",

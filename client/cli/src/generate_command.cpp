@@ -439,6 +439,9 @@ bool ReportWalkEnd(const Walk& walk, const LoadedTerrain& terrain) {
               << " more notes\n";
   if (walk.stopped.empty()) return false;
   std::cerr << "footfall generate: stopped early: " << walk.stopped << '\n';
+  if (walk.session_failed)
+    std::cerr << "footfall generate: footfalld failed mid-walk (not the terrain): the keys up to "
+                 "its failure are written; exit status 1\n";
   constexpr size_t kMaxListed = 20;
   if (walk.stops.size() > 1) {
     for (size_t i = 0; i < walk.stops.size() && i < kMaxListed; ++i)
@@ -596,7 +599,7 @@ int RunScene(const GenerateFlags& flags) {
   }
   const int written = WriteOutputs(flags, shared, walk);
   const bool stopped = ReportWalkEnd(walk, LoadedTerrain{});
-  return written != 0 ? written : stopped ? 2 : 0;
+  return written != 0 ? written : walk.session_failed ? 1 : stopped ? 2 : 0;
 }
 
 int RunGenerate(const GenerateFlags& flags) {
@@ -649,8 +652,8 @@ int RunGenerate(const GenerateFlags& flags) {
   }
   const int code = WriteOutputs(flags, terrain, walk);
   const bool stopped = ReportWalkEnd(walk, terrain);
-  // An output not written is an error before a stop.
-  return code != 0 ? code : stopped ? 2 : 0;
+  // An output not written, or footfalld failing mid-walk, is an error before a stop.
+  return code != 0 ? code : walk.session_failed ? 1 : stopped ? 2 : 0;
 }
 
 }  // namespace
@@ -717,7 +720,8 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
   for (CLI::Option* o : {start, heading, path_opt, steps, crowd, crowd_spacing}) scene->excludes(o);
   cmd->footer(
       "Exit status: 0 when every step was generated, 2 when the walk stopped early (at a cliff, "
-      "a gap, a wall too steep; the outputs then hold every key up to that step), 1 on errors.");
+      "a gap, a wall too steep; the outputs then hold every key up to that step), 1 on errors "
+      "(footfalld failing mid-walk among them: the keys up to its failure are written).");
   cmd->callback([flags, exit_code] { *exit_code = RunGenerate(*flags); });
 }
 

@@ -191,14 +191,17 @@ Status Generator::Run(std::string* error) {
       walk_.notes.push_back(note.str());
     }
   }
-  // The walk's stop message: the earliest stop (the first character's among those of that
-  // step), and how many others stopped; Walk::stops has every one.
+  // The walk's stop message: the engine's failure if it failed (it is no stop of the terrain's,
+  // and may have stopped most of a crowd behind a few earlier stops), else the earliest stop
+  // (the first character's among those of that step), and how many others stopped;
+  // Walk::stops has every one, failures first.
   std::vector<const Agent*> stopped;
   for (const Agent& a : agents_)
     if (!a.stopped.empty()) stopped.push_back(&a);
   std::stable_sort(stopped.begin(), stopped.end(), [](const Agent* x, const Agent* y) {
-    return x->stopped_step < y->stopped_step;
+    return x->failed != y->failed ? x->failed : x->stopped_step < y->stopped_step;
   });
+  walk_.session_failed = !stopped.empty() && stopped[0]->failed;
   walk_.stops.clear();
   for (const Agent* a : stopped) walk_.stops.push_back(a->stopped);
   if (!stopped.empty()) walk_.stopped = stopped[0]->stopped;
@@ -357,6 +360,7 @@ void Generator::StopPassAt(int k, const std::string& why) {
     while (!body.keys.empty() && body.keys.back().frame > f0) body.keys.pop_back();
     if (body.rotations.size() > body.keys.size()) body.rotations.resize(body.keys.size());
     Stop(a, k + 1, why);
+    a.failed = true;
   }
 }
 

@@ -110,9 +110,17 @@ void AddToSceneWalk(const std::string& name, Walk&& walk, Walk* scene) {
     track.character = track.character.empty() ? name : name + "/" + track.character;
     scene->tracks.push_back(std::move(track));
   }
-  for (const std::string& stop : walk.stops) scene->stops.push_back(name + ": " + stop);
-  if (walk.stops.empty() && !walk.stopped.empty())
-    scene->stops.push_back(name + ": " + walk.stopped);
+  std::vector<std::string> stops;
+  for (const std::string& stop : walk.stops) stops.push_back(name + ": " + stop);
+  if (walk.stops.empty() && !walk.stopped.empty()) stops.push_back(name + ": " + walk.stopped);
+  // A failure of the engine goes before the terrain's stops (the first of a walk's stops is its
+  // failure when it has one).
+  if (walk.session_failed && !stops.empty()) {
+    scene->stops.insert(scene->stops.begin(), stops.front());
+    stops.erase(stops.begin());
+  }
+  scene->stops.insert(scene->stops.end(), stops.begin(), stops.end());
+  scene->session_failed |= walk.session_failed;
   for (const std::string& note : walk.notes) scene->notes.push_back(name + ": " + note);
   SetSceneStopped(scene);
 }

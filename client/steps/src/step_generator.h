@@ -156,6 +156,7 @@ struct Agent {
   bool window_left = false;
   std::string stopped;   // why it stopped early ("" when it did not)
   int stopped_step = 0;  // the step it stopped at
+  bool failed = false;   // stopped by the serving engine's failure, not by the terrain
   size_t first_track = 0;
 };
 

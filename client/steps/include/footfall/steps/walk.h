@@ -89,6 +89,10 @@ struct Walk {
   // step taken instead), then, one line per character, earliest first, a path walk given its
   // number of steps that did them all short of its goal: how far the goal still is.
   std::vector<std::string> notes;
+  // True when the walk stopped because the serving engine failed (footfalld died or stopped
+  // answering after the first step), not at the terrain: stopped and stops then begin with
+  // that failure (not written to files).
+  bool session_failed = false;
 };
 
 const char* PhaseName(KeyPhase phase);  // "start", "mid", "end" or ""
