@@ -368,7 +368,7 @@ if [ -f "$dem" ]; then
   # A --start is snapped as given, as on point files: one beyond the queries' reach is refused.
   err=$("$footfall" generate --terrain "$dem" --character "$chars/biped.json" --start 1e20,0,0 --out "$work/x.json" 2>&1)
   check "dem far start: exit 1" [ $? -eq 1 ]
-  check "dem far start: message" grep -qF "the start is too far from the terrain to snap" <<< "$err"
+  check "dem far start: message" grep -qF "the start (--start) is too far from the terrain to snap" <<< "$err"
   # The same resampling as a point file, for footfalld's --data-root or a plugin's point file:
   # terrain convert --character (the whole file), then walked as points.
   "$footfall" terrain convert "$dem" --character "$chars/quadruped.json" -o "$work/dem-q.pts" > "$work/dem-q.out"
@@ -409,7 +409,9 @@ sed 's/"footfall-character"/5/' "$chars/biped.json" > "$work/format5.json"
 bad character-type "$work/format5.json: 'format' must be a string, found number" --terrain "$hills" --character "$work/format5.json" --out "$work/x.json"
 sed 's/"version": 1/"version": 4294967297/' "$chars/biped.json" > "$work/version.json"
 bad character-version "$work/version.json: 'version' 4294967297 is not supported" --terrain "$hills" --character "$work/version.json" --out "$work/x.json"
-bad zero-heading "heading must be a non-zero finite vector" --terrain "$hills" --character "$chars/biped.json" --heading 0,0,0 --out "$work/x.json"
+bad zero-heading "--heading '0,0,0': expected a direction DX,DY,DZ of non-zero length" --terrain "$hills" --character "$chars/biped.json" --heading 0,0,0 --out "$work/x.json"
+# Refused before the terrain is read (a missing file would be named first otherwise).
+bad zero-up "--up '0,0,-0': expected a direction DX,DY,DZ of non-zero length" --terrain "$work/none.pts" --character "$chars/biped.json" --up 0,0,-0 --out "$work/x.json"
 # A waypoint past the terrain queries' reach: its squared distance overflowed and the walk
 # turned away from it.
 bad far-waypoint "path waypoint 2 (20, 0, 1e+155) is not a finite point with each coordinate within +-1e+15" --terrain "$hills" --character "$chars/biped.json" --path "20,0,30 20,0,1e155" --out "$work/x.json"
@@ -418,7 +420,7 @@ bad empty-heading "--heading: expected DX,DY,DZ" --terrain "$hills" --character 
 bad heading-up "the heading (0.0000, 1.0000, 0.0000) is along the up (0.0000, 1.0000, 0.0000) where the character starts" --terrain "$hills" --character "$chars/biped.json" --heading 0,1,0 --out "$work/x.json"
 bad gltf-negative-frame "--out $work/neg.gltf: glTF animation times must be >= 0, and --start-frame is -100" --terrain "$hills" --character "$chars/biped.json" --start-frame -100 --out "$work/neg.json" --out "$work/neg.gltf"
 check "gltf-negative-frame: nothing written" [ ! -e "$work/neg.json" ]
-bad far-start "the start is too far from the terrain to snap" --terrain "$hills" --character "$chars/biped.json" --start 1e20,0,0 --out "$work/x.json"
+bad far-start "the start (--start) is too far from the terrain to snap" --terrain "$hills" --character "$chars/biped.json" --start 1e20,0,0 --out "$work/x.json"
 bad steps-fraction "--steps: '1.5' is not a whole number from 0 to 1000000" --terrain "$hills" --character "$chars/biped.json" --steps 1.5 --out "$work/x.json"
 bad crowd-fraction "--crowd: '1.5' is not a whole number from 1 to 1000000" --terrain "$hills" --character "$chars/biped.json" --crowd 1.5 --out "$work/x.json"
 bad crowd-0 "--crowd: '0' is not a whole number from 1 to 1000000" --terrain "$hills" --character "$chars/biped.json" --crowd 0 --out "$work/x.json"

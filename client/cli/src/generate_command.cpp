@@ -72,6 +72,18 @@ bool ParseVec(const std::string& text, const std::string& flag, Vec3* out, std::
   return true;
 }
 
+// "DX,DY,DZ" of non-zero length into *out; false with a message naming the flag (before any
+// terrain is read).
+bool ParseDirection(const std::string& text, const std::string& flag, Vec3* out,
+                    std::string* error) {
+  if (!ParseVec(text, flag, out, error)) return false;
+  if (SafeNormalize(*out) == Vec3{}) {
+    *error = flag + " '" + text + "': expected a direction DX,DY,DZ of non-zero length";
+    return false;
+  }
+  return true;
+}
+
 // Writes one output, chosen by its extension.
 Status WriteOutput(const Walk& walk, const std::string& path, std::string* error) {
   const std::string ext = FileExtension(path);
@@ -190,9 +202,10 @@ bool ReadOptions(const GenerateFlags& flags, GenerateOptions* options, std::stri
     if (!ParseVec(flags.start, "--start", &options->start, error)) return false;
     options->has_start = true;
   }
-  if (!flags.heading.empty() && !ParseVec(flags.heading, "--heading", &options->heading, error))
+  if (!flags.heading.empty() &&
+      !ParseDirection(flags.heading, "--heading", &options->heading, error))
     return false;
-  if (!flags.up.empty() && !ParseVec(flags.up, "--up", &options->up, error)) return false;
+  if (!flags.up.empty() && !ParseDirection(flags.up, "--up", &options->up, error)) return false;
   std::istringstream in(flags.path);
   for (std::string point; in >> point;) {
     Vec3 p;

@@ -346,10 +346,11 @@ Status Generator::FindStart(const Vec3& start, bool may_move, Foothold* first, s
   if (s != Status::kOk) return s;
   start_snap_ = *first;
   if (first->status != Status::kOk) {
-    *error = first->status == Status::kInvalidArgument
-                 ? (o_.names.start == "--start" ? std::string("the start") : o_.names.start) +
-                       " is too far from the terrain to snap (queries reach 1e15 from it)"
-                 : "the terrain is empty: no sample to start on";
+    *error =
+        first->status == Status::kInvalidArgument
+            ? (o_.names.start == "--start" ? std::string("the start (--start)") : o_.names.start) +
+                  " is too far from the terrain to snap (queries reach 1e15 from it)"
+            : "the terrain is empty: no sample to start on";
     return Status::kInvalidArgument;
   }
   if (!may_move) {
