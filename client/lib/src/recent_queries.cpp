@@ -65,7 +65,7 @@ Status RecentQueryFeed::Fetch(std::vector<RecentQuery>* out, uint64_t* latest) {
   std::memset(&reply, 0, sizeof reply);
   const clnt_stat cs = ff_recent_1(&args, &reply, connection_->client);
   if (cs != RPC_SUCCESS) {
-    const std::string reason = clnt_sperrno(cs);
+    const std::string reason = CallFailureText(cs);
     Disconnect();
     return Fail(Status::kUnavailable, "recent: footfalld at " + Address() + ": " + reason);
   }

@@ -173,4 +173,13 @@ CLIENT* ConnectFootfalld(const RpcOptions& options, std::string* reason) {
   return client;
 }
 
+std::string CallFailureText(clnt_stat status) {
+  std::string text = clnt_sperrno(status);
+  if (status == RPC_CANTRECV || status == RPC_CANTSEND)
+    text +=
+        " (the connection closed under the call: footfalld stopped, was killed, or closed "
+        "it)";
+  return text;
+}
+
 }  // namespace footfall

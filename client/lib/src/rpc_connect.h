@@ -37,6 +37,11 @@ bool ResolveBounded(const std::string& host, const std::string& service, const a
 // restores getaddrinfo).
 void SetHostResolver(ResolveFunction resolve);
 
+// Why a call failed, one line: libtirpc's text ("RPC: Unable to receive"), and for a
+// connection that failed under the call, what that most likely means (footfalld stopped, was
+// killed or closed the connection).
+std::string CallFailureText(clnt_stat status);
+
 // Sets how long the client's calls wait for their answer. [Units: s]
 void SetCallTimeout(CLIENT* client, double seconds);
 

@@ -430,7 +430,7 @@ class RpcSession final : public TerrainSession {
   // the call's timeout, for the message (call_timeout_s when negative).
   Status Call(clnt_stat status, const char* what, double waited_s = -1) {
     if (status == RPC_SUCCESS) return Status::kOk;
-    std::string reason = clnt_sperrno(status);
+    std::string reason = CallFailureText(status);
     if (status == RPC_TIMEDOUT) {
       // Loading a large terrain (a mesh resampled finely) can take longer than a query.
       std::ostringstream hint;
