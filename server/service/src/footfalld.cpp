@@ -1,6 +1,7 @@
 // footfalld: the footfall terrain query server (ONC RPC over TCP).
 #include <signal.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
@@ -198,6 +199,14 @@ int main(int argc, char** argv) {
     return 2;
   }
   options.use_rpcbind = !no_rpcbind;
+  // A root this user may not search would refuse every load: said now, not at the first one.
+  if (!options.data_root.empty() && access(options.data_root.c_str(), X_OK) != 0) {
+    std::fprintf(stderr,
+                 "footfalld: --data-root %s: this user (uid %u) may not search it (%s), so no "
+                 "load could succeed: give a folder it may read\n",
+                 options.data_root.c_str(), static_cast<unsigned>(geteuid()), std::strerror(errno));
+    return 2;
+  }
 
   std::signal(SIGPIPE, SIG_IGN);
   setvbuf(stderr, nullptr, _IOLBF, 0);

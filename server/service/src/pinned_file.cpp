@@ -6,7 +6,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <map>
 #include <mutex>
 
@@ -43,8 +45,9 @@ Status PinnedFile::Open(const std::string& root, const std::string& path, const 
                         std::string* message) {
   fd_ = open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC | O_NOFOLLOW);
   if (fd_ < 0) {
-    *message = "'" + shown + "': cannot open";
-    return Status::kIoError;
+    const int error = errno;
+    *message = "'" + shown + "': cannot open: " + std::strerror(error);
+    return error == EACCES ? Status::kAccessDenied : Status::kIoError;
   }
   // Where the opened file lies now, whatever the path's components were swapped for.
   const std::string self = "/proc/self/fd/" + std::to_string(fd_);

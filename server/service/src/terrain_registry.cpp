@@ -10,6 +10,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <new>
 #include <random>
 #include <sstream>
@@ -122,8 +124,15 @@ Status ResolveUnderRoot(const std::string& root, const std::string& relative, st
   const std::string joined = root + "/" + relative;
   char buffer[PATH_MAX];
   if (!realpath(joined.c_str(), buffer)) {
+    const int error = errno;
     if (LeadsOutside(root, joined, 0)) {
       *message = outside;
+      return Status::kAccessDenied;
+    }
+    if (error == EACCES) {
+      *message = "'" + relative +
+                 "': permission denied: footfalld's user may not search a folder on its way "
+                 "under the data root";
       return Status::kAccessDenied;
     }
     *message = "'" + relative + "': no such file under the data root";
@@ -152,8 +161,9 @@ Status CheckRegularFile(const std::string& path, const std::string& shown, std::
   // Opened without blocking, in case it was replaced since, and checked again through the fd.
   const int fd = open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
   if (fd < 0) {
-    *message = "'" + shown + "': cannot open";
-    return Status::kIoError;
+    const int error = errno;
+    *message = "'" + shown + "': cannot open: " + std::strerror(error);
+    return error == EACCES ? Status::kAccessDenied : Status::kIoError;
   }
   struct stat opened {};
   const bool same =
