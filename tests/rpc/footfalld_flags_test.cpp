@@ -58,3 +58,17 @@ TEST_CASE("footfalld refuses a bad --threads or --max-client-terrains as footfal
     CHECK(err.find(expected) != std::string::npos);
   }
 }
+
+TEST_CASE("footfalld refuses an empty --data-root or --port-file naming what it expected",
+          "[rpc]") {
+  // (An empty --data-root said "Directory does not exist: ", an empty --port-file was ignored.)
+  int code = 0;
+  std::string err = RunFootfalld("--data-root ''", &code);
+  INFO(err);
+  CHECK(code == 2);
+  CHECK(err.find("--data-root: expected a folder, got an empty name") != std::string::npos);
+  err = RunFootfalld("--port-file ''", &code);
+  INFO(err);
+  CHECK(code == 2);
+  CHECK(err.find("--port-file: expected a file, got an empty name") != std::string::npos);
+}

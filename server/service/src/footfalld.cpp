@@ -90,6 +90,16 @@ CLI::Validator WholeRange(long long lo, long long hi) {
       "INT in [" + std::to_string(lo) + " - " + std::to_string(hi) + "]");
 }
 
+// A path flag's check: not empty (CLI11 said "Directory does not exist: " for an empty
+// --data-root, and an empty --port-file was ignored).
+CLI::Validator NonEmptyPath(const char* what) {
+  return CLI::Validator(
+      [what](std::string& input) -> std::string {
+        return input.empty() ? std::string("expected ") + what + ", got an empty name" : "";
+      },
+      "");
+}
+
 // --max-samples: a whole number of samples up to 1e12 (CLI11 took "-5" for a huge budget).
 CLI::Validator SampleCount() {
   return CLI::Validator(
@@ -149,6 +159,7 @@ int main(int argc, char** argv) {
   app.add_option("--listen", listen, "ADDR:PORT to listen on (port 0 picks a free one)");
   app.add_option("--data-root", options.data_root,
                  "Directory that confines server-side terrain loads (none: refused)")
+      ->check(NonEmptyPath("a folder"))
       ->check(CLI::ExistingDirectory);
   app.add_flag("--no-rpcbind", no_rpcbind, "Do not register with rpcbind");
   options.batch_threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -183,7 +194,8 @@ int main(int argc, char** argv) {
                  "closed (default 30; connections idle between requests are kept)")
       ->check(Seconds(false));
   app.add_option("--port-file", port_file,
-                 "Write the bound port to this file before serving (exit 1 if it cannot)");
+                 "Write the bound port to this file before serving (exit 1 if it cannot)")
+      ->check(NonEmptyPath("a file"));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
