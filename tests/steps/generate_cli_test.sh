@@ -352,7 +352,7 @@ if [ -f "$dem" ]; then
     check "dem-$c: resampled for the character" grep -q "resampled for $c at a separation of" "$work/dem-$c-embedded.err"
     check "dem-$c: ten steps" [ "$(grep -o '"phase":"end"' "$work/dem-$c-embedded.json" | wc -l)" -ge 10 ]
   done
-  check "dem-hexapod: cropped around the walk" grep -q "within (" "$work/dem-hexapod-embedded.err"
+  check "dem-hexapod: cropped around the walk" grep -q "within (.*samples; --separation S resamples all of it at S" "$work/dem-hexapod-embedded.err"
   # --separation is taken as given: at the file's own metre an insect finds no foothold, and
   # the message says at what separation to resample.
   "$footfall" generate --terrain "$dem" --separation 1 --character "$chars/hexapod.json" \
@@ -478,6 +478,9 @@ check "server-terrain mesh: the server's resampling said" grep -qE "footfalld lo
 "$footfall" generate --terrain "$work/root/ramp.obj" --separation 0.175 --crease-angle 30 --seed 3 \
   --character "$chars/biped.json" --start 2,0.1,0.5 --steps 6 --out "$work/local-ramp.json" 2> /dev/null
 check "server-terrain mesh: the walk on the file resampled at a quarter step" cmp -s "$work/server-ramp.json" "$work/local-ramp.json"
+"$footfall" generate --terrain "$work/root/ramp.obj" --character "$chars/biped.json" --start 2,0.1,0.5 \
+  --steps 2 --out "$work/local-ramp2.json" 2> "$work/local-ramp2.err"
+check "local mesh sampled whole: no word of 'all of it'" grep -qE "resampled for biped at a separation of 0.175 \(its own spacing [0-9.]+, a quarter of the step 0.175\): [0-9]+ samples; --separation S resamples it at S$" "$work/local-ramp2.err"
 "$footfall" generate --server-terrain ramp.obj --server "$server" --seed 4 \
   --character "$chars/biped.json" --start 2,0.1,0.5 --steps 6 --out "$work/server-ramp4.json" 2> /dev/null
 check "server-terrain mesh: the seed reaches the server" bash -c "! cmp -s '$work/server-ramp.json' '$work/server-ramp4.json'"

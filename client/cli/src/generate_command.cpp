@@ -174,7 +174,8 @@ void ReportResampling(const std::string& path, const Character& character, const
     << " at a separation of " << r.separation << " (its own spacing " << r.file_separation
     << ", a quarter of the step " << t.wanted_separation << ")";
   if (t.cropped) o << " within " << Box(t.region_min, t.region_max);
-  o << ": " << r.samples << " samples; --separation S resamples all of it at S\n";
+  o << ": " << r.samples << " samples; --separation S resamples "
+    << (t.cropped ? "all of it" : "it") << " at S\n";
   const std::string coarser = CoarserThanStepsNote(r, t.wanted_separation);
   if (!coarser.empty()) {
     o << "footfall generate: " << coarser << " and stop; "
