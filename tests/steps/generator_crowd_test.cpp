@@ -110,6 +110,8 @@ TEST_CASE("Crowd places that snap onto another character's start are left out",
   for (const std::string& stop : w.stops) {
     CHECK_THAT(stop, Catch::Contains("its place on the crowd's grid"));
     CHECK_THAT(stop, Catch::Contains("(the grid runs off the terrain there): left out"));
+    // The distance to the other start, said as a distance ("within 0.25 of" read as a bound).
+    CHECK_THAT(stop, Catch::Matches(".*, only [0-9.e+-]+ from c[0-9]+'s start .*"));
   }
 }
 
