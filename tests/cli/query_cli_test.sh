@@ -214,7 +214,7 @@ check "make: a ramp within range written" [ -s "$work/made.pts" ]
 # 9 million samples under a 2 GB limit sampled for a minute, then ran out of memory).
 err=$( (ulimit -v 2000000; timeout 20 "$footfall" terrain make rocks --size 300 --spacing 0.1 -o "$work/made.pts") 2>&1)
 check "make beyond memory: exit 1" [ $? -eq 1 ]
-check "make beyond memory: message" grep -qxF "footfall terrain make: rocks: these sizes at --spacing 0.1 give about 9006001 samples: making them needs about 4.5 GB, more than the 2.05 GB of memory this process may use (raise --spacing or make it smaller)" <<< "$err"
+check "make beyond memory: message" grep -qxF "footfall terrain make: rocks: these sizes at --spacing 0.1 give about 9006001 samples: making them needs about 4.5 GB, more than the 2.05 GB of memory this process may use (raise --spacing or give smaller sizes)" <<< "$err"
 
 # A low soft limit on descriptors is raised to the hard one (at the limit libtirpc closes the
 # least recently active connections, an idle client's among them).

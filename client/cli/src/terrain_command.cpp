@@ -244,7 +244,7 @@ int RunMake(const MakeFlags& f) {
           : std::isfinite(estimate) ? "about " + Format3(estimate)
                                     : std::string("too many"))
       << " samples, more than the " << std::setprecision(10) << kMaxMadeSamples
-      << " allowed (raise --spacing or make it smaller)";
+      << " allowed (raise --spacing or give smaller sizes)";
     std::cerr << m.str() << '\n';
     return 1;
   }
@@ -257,7 +257,7 @@ int RunMake(const MakeFlags& f) {
       << (k == "rocks" ? "rocks are modelled 0.25 apart, whatever --spacing"
                        : "a face per side of a unit cube")
       << "), more than the " << std::setprecision(10) << kMaxMadeSamples
-      << " allowed (make it smaller)";
+      << " allowed (give smaller sizes)";
     std::cerr << m.str() << '\n';
     return 1;
   }
@@ -272,7 +272,7 @@ int RunMake(const MakeFlags& f) {
               << ": these sizes at --spacing " << f.spacing << " give about "
               << std::llround(estimate) << " samples: making them needs about " << bytes / 1e9
               << " GB, more than the " << memory / 1e9
-              << " GB of memory this process may use (raise --spacing or make it smaller)\n";
+              << " GB of memory this process may use (raise --spacing or give smaller sizes)\n";
     return 1;
   }
   std::string why;  // the mesh sampler's, for blocks, ramp and rocks
