@@ -1400,7 +1400,8 @@ TEST_CASE("one connection holds at most 4 uploads, and an upload without samples
     REQUIRE(SendChunk(b, other, {ff_sample{{0, 0, 1.0 * i}, {0, 1, 0}}}, &message) == FF_OK);
   }
   CHECK(dropped);
-  CHECK_THAT(why, Catch::Contains("no upload " + std::to_string(held[0])));
+  CHECK_THAT(why, Catch::Contains("upload " + std::to_string(held[0]) +
+                                  " was dropped: no samples for 1 s (--upload-timeout)"));
   clnt_destroy(a);
   clnt_destroy(b);
   RequireServed(server.port());

@@ -200,9 +200,9 @@ Status Generator::Setup(std::string* error) {
       const Agent& other = agents_[crowded[i]];
       Text m(3);
       m << "step 1 of " << a.id << ": its place on the crowd's grid, "
-        << Point(first.point + offsets[i]) << ", snaps to " << Point(snapped_start[i])
-        << ", only " << Distance(snapped_start[i], snapped_start[crowded[i]]) << " from "
-        << other.id << "'s start (" << crowded_why.str() << "): left out of the walk";
+        << Point(first.point + offsets[i]) << ", snaps to " << Point(snapped_start[i]) << ", only "
+        << Distance(snapped_start[i], snapped_start[crowded[i]]) << " from " << other.id
+        << "'s start (" << crowded_why.str() << "): left out of the walk";
       a.walking = false, a.left_out = true;
       a.stopped = m.str(), a.stopped_step = 1;
     }
