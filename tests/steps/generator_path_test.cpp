@@ -293,8 +293,9 @@ TEST_CASE("A path walk that runs out of steps before its goal says so as a stop"
   const Walk w = Generate(t, c, o);
   CHECK_THAT(w.stopped, Catch::StartsWith("step 10001: the path's goal (5.0000, 0.0000, 2.0000) "
                                           "is still ") &&
-                            Catch::Contains("after 10000 steps, the most a path walk takes "
-                                            "without --steps"));
+                            Catch::EndsWith("after 10000 steps, the most a path walk takes "
+                                            "without a step count (--steps; give one to walk "
+                                            "farther); walk stopped, keys up to step 10000 kept"));
   CHECK(StepsDone(w) == 10000);
   // With --steps the walk is as asked: no stop, but a note of how far the goal still is (it
   // ended short of it saying nothing).
@@ -304,8 +305,8 @@ TEST_CASE("A path walk that runs out of steps before its goal says so as a stop"
   REQUIRE(asked.notes.size() == 1);
   CHECK_THAT(asked.notes[0],
              Catch::StartsWith("the path's goal (5.0000, 0.0000, 2.0000) is still ") &&
-                 Catch::EndsWith(" away after the 50 steps asked for (without "
-                                 "--steps a path walk goes on to its goal, up to "
+                 Catch::EndsWith(" away after the 50 steps asked for (without a step "
+                                 "count, --steps, a path walk goes on to its goal, up to "
                                  "10000 steps)"));
   // Steps enough to arrive: nothing to say.
   o.path = {{5, 0, 4}};

@@ -185,7 +185,7 @@ TEST_CASE("A start where the character cannot stand moves to the nearest place w
   CHECK(tested >= 1);
 }
 
-TEST_CASE("A generate request's start heading and up are named by its fields",
+TEST_CASE("A generate request's start heading up and steps are named by its fields",
           "[steps][generator]") {
   // The C ABI's request: its set-up errors named the command line's flags, which a plugin has
   // not got.
@@ -210,11 +210,26 @@ TEST_CASE("A generate request's start heading and up are named by its fields",
   CHECK(error_of("\"up\": [0, 0, 0]") == "request: 'up' must be a non-zero finite vector");
   CHECK(error_of("\"start\": [1e300, 0, 0]") ==
         "request: 'start' is too far from the terrain to snap (queries reach 1e15 from it)");
+  // A path walk short of its goal after the steps asked names the request's 'steps' (it said
+  // "--steps").
+  Character c;
+  GenerateOptions request;
+  std::string error;
+  REQUIRE(ParseGenerateRequest("{\"character\": " + biped +
+                                   ", \"start\": [20, 0, 10], \"path\": [[20, 0, 30]], "
+                                   "\"steps\": 3}",
+                               &c, &request, &error) == Status::kOk);
+  Walk w;
+  REQUIRE(GenerateWalk(*t.session, t.handle, c, request, &w, &error) == Status::kOk);
+  REQUIRE(w.notes.size() == 1);
+  CHECK_THAT(w.notes[0], Catch::EndsWith("(without a step count, request: 'steps', a path walk "
+                                         "goes on to its goal, up to 10000 steps)"));
   // The command line's options name its flags.
   GenerateOptions o;
   CHECK(o.names.heading == "--heading");
   CHECK(o.names.up == "--up");
   CHECK(o.names.start == "--start");
+  CHECK(o.names.steps == "--steps");
 }
 
 TEST_CASE("A start given farther than a step from the terrain is said in the walk's notes",

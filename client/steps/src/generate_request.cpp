@@ -76,10 +76,11 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
     }
   }
   GenerateOptions o;
-  // Messages about the start, heading and up name this request's fields.
+  // Messages about the start, heading, up and steps name this request's fields.
   o.names.start = source + ": 'start'";
   o.names.heading = source + ": 'heading'";
   o.names.up = source + ": 'up'";
+  o.names.steps = source + ": 'steps'";
   Status s;
   if (j.contains("character") == j.contains("character_file")) {
     *error = source + ": give exactly one of 'character' (an object) or 'character_file' (a path)";

@@ -159,7 +159,7 @@ Status Generator::Run(std::string* error) {
       s = WalkPass(pass * per_pass, std::min(n, (pass + 1) * per_pass), &progress, error);
   }
   if (s != Status::kOk) return s;
-  // A path walk without --steps that used every step it may take without reaching its goal
+  // A path walk without a step count that used every step it may take without reaching its goal
   // stopped short of what was asked: said as a stop (exit status 2), its keys kept.
   if (o_.steps < 0 && !o_.path.empty()) {
     for (Agent& a : agents_) {
@@ -167,8 +167,8 @@ Status Generator::Run(std::string* error) {
       const double left = Remaining(a, a.path.size() - 1);
       Text why(4);
       why << "the path's goal " << Point(a.path.back()) << " is still " << left << " away after "
-          << steps_
-          << " steps, the most a path walk takes without --steps (give --steps to walk farther)";
+          << steps_ << " steps, the most a path walk takes without a step count (" << o_.names.steps
+          << "; give one to walk farther)";
       Stop(a, steps_ + 1, why.str());
     }
   }
@@ -186,8 +186,8 @@ Status Generator::Run(std::string* error) {
       if (!a.id.empty()) note << a.id << ": ";
       note << "the path's goal " << Point(a.path.back()) << " is still "
            << Remaining(a, a.path.size() - 1) << " away after the " << steps_
-           << " steps asked for (without --steps a path walk goes on to its goal, up to "
-           << kMaxPathSteps << " steps)";
+           << " steps asked for (without a step count, " << o_.names.steps
+           << ", a path walk goes on to its goal, up to " << kMaxPathSteps << " steps)";
       walk_.notes.push_back(note.str());
     }
   }

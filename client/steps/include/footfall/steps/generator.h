@@ -41,13 +41,14 @@ constexpr int kStartSearchSteps = 12;
 constexpr double kMaxStartFrame = 1e9;
 constexpr double kMaxFps = 1e6;
 
-// How the generator's messages refer to the inputs that gave the start, heading and up: the
+// How the generator's messages refer to the inputs that gave the start, heading, up and steps: the
 // command line's flags by default; a scene names its file and field ("s.json: characters[0]:
 // 'heading'"), the C ABI the request's field ("the request's 'heading'").
 struct GenerateInputNames {
   std::string start = "--start";
   std::string heading = "--heading";
   std::string up = "--up";
+  std::string steps = "--steps";
 };
 
 struct GenerateOptions {
