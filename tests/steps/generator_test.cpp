@@ -644,6 +644,35 @@ TEST_CASE("A stop on ground facing down names the likely causes", "[steps][gener
                             Catch::Contains("separation below its thickness"));
 }
 
+TEST_CASE("An insect on a beam narrower than it is told it may be too wide for it",
+          "[steps][generator]") {
+  // A 4 cm beam, its top and two 10 cm sides sampled every centimetre: a hexapod's foot reaches
+  // round a side and finds it facing away from its up. The hint named only thin surfaces and
+  // inward faces, neither of which applies.
+  const Character c = LoadShipped("hexapod");
+  const double spacing = 0.01;
+  RawSamples beam;
+  for (int k = 0; k <= 300; ++k) {
+    const double z = k * spacing;
+    for (int i = -2; i <= 2; ++i) beam.points.push_back({i * spacing, 0, z});
+    beam.normals.resize(beam.points.size(), {0, 1, 0});
+    for (int j = 1; j <= 10; ++j) {
+      beam.points.push_back({-0.02, -j * spacing, z}), beam.normals.push_back({-1, 0, 0});
+      beam.points.push_back({0.02, -j * spacing, z}), beam.normals.push_back({1, 0, 0});
+    }
+  }
+  Terrain t = LoadTerrain(beam, spacing);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {0, 0, 0.5};
+  o.heading = {0, 0, 1};
+  o.steps = 30;
+  const Walk w = Generate(t, c, o);
+  CHECK_THAT(w.stopped, Catch::Contains("it faces away from the character's up") &&
+                            Catch::Contains("wider than the beam or ledge it walks along"));
+  CHECK_THAT(w.stopped, !Catch::Contains("it faces down"));
+}
+
 TEST_CASE("Multipeds climb a wall, others stop at it", "[steps][generator]") {
   for (const std::string& name : ShippedCharacters()) {
     const Character c = LoadShipped(name);

@@ -29,12 +29,24 @@ std::string Beyond(double value, double limit) {
 }
 
 // For ground facing away from the character's up (more than 120 degrees): what would make it
-// so where the ground should face up (an underside is often just that: a log's, a beam's).
-std::string FacingDownHint(double slope_deg) {
+// so where the ground should face up (an underside is often just that: a log's, a beam's). A
+// character that takes the terrain's normal as its up may also be wider than the beam or ledge
+// it walks along, a foot reaching round its side.
+std::string FacingDownHint(double slope_deg, bool aligned_to_normal) {
   if (!(slope_deg > 120)) return "";
-  return "; it faces down: if the ground there should face up, the surface may be thinner than "
-         "the terrain's sample spacing (resample at a separation below its thickness) or a "
-         "mesh's faces may face inward";
+  std::string hint = aligned_to_normal
+                         ? "; it faces away from the character's up: if the ground there should "
+                           "face it, the surface may be thinner"
+                         : "; it faces down: if the ground there should face up, the surface may "
+                           "be thinner";
+  hint +=
+      " than the terrain's sample spacing (resample at a separation below its thickness) or "
+      "a mesh's faces may face inward";
+  if (aligned_to_normal)
+    hint +=
+        "; or the character is wider than the beam or ledge it walks along, a foot reaching "
+        "round its side";
+  return hint;
 }
 
 Vec3 Generator::AveragedUp(const Vec3& previous, const std::vector<Vec3>& normals) const {

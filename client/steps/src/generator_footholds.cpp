@@ -338,7 +338,7 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
     const double slope = Degrees(AngleBetween(h.normal, a.up));
     why << "the foothold at " << Point(h.point) << " leans " << Beyond(slope, c_.max_slope_deg)
         << " deg, more than max_slope_deg " << NumberText(c_.max_slope_deg) << " (too steep)"
-        << FacingDownHint(slope);
+        << FacingDownHint(slope, c_.align_to_normal);
   }
   mv.reason = why.str(), mv.reason_is_gap = !found;
 }

@@ -504,7 +504,7 @@ std::string Generator::Plant(Agent& a, const Foothold* feet) const {
       Text m(3);
       m << "foot " << c_.feet[f].name << " cannot stand at " << Point(a.foot[f])
         << ": ground leans " << Beyond(slope, c_.max_slope_deg) << " deg, more than max_slope_deg "
-        << NumberText(c_.max_slope_deg) << FacingDownHint(slope);
+        << NumberText(c_.max_slope_deg) << FacingDownHint(slope, c_.align_to_normal);
       // An upright character starting on ground across its up: a terrain whose up is another
       // axis (a height map read with --up-axis z) with the default world up.
       if (!c_.align_to_normal && slope > 60 && slope < 120)

@@ -119,8 +119,9 @@ std::string Point(const Vec3& p);
 // it breaks: "leans 100.0001 deg, more than max_slope_deg 100", never "leans 100 ... 100".
 std::string Beyond(double value, double limit);
 // For ground facing away from the character's up (more than 120 degrees): what would make it
-// so where the ground should face up (an underside is often just that: a log's, a beam's).
-std::string FacingDownHint(double slope_deg);
+// so where the ground should face up (an underside is often just that: a log's, a beam's), and
+// for a character `aligned_to_normal`, a beam or ledge narrower than it; "" below 120 degrees.
+std::string FacingDownHint(double slope_deg, bool aligned_to_normal);
 
 // One walking character.
 struct Agent {
