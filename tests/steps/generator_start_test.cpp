@@ -232,6 +232,43 @@ TEST_CASE("A generate request's start heading up and steps are named by its fiel
   CHECK(o.names.steps == "--steps");
 }
 
+TEST_CASE("A step_height that lifts mid keys out of reach is said in the walk's notes",
+          "[steps][generator]") {
+  // A hexapod given step_height 0.4 with its reach of 0.3 keyed every mid key about 0.4 from
+  // its body without a word.
+  Character c = LoadShipped("hexapod");
+  Terrain t = LoadTerrain(MakeFlat(101, 0.01, 0), 0.01);
+  GenerateOptions o = StartOptions({0.5, 0, 0.3}, 4);
+  const Walk usual = Generate(t, c, o);
+  CHECK(usual.notes.empty());
+  c.step_height = 0.4;
+  const Walk high = Generate(t, c, o);
+  REQUIRE(high.notes.size() == 1);
+  CHECK_THAT(high.notes[0], Catch::StartsWith("step_height 0.4 lifts the feet's mid keys about "
+                                              "0.39") &&
+                                Catch::EndsWith(" from the body on level ground, beyond reach 0.3 "
+                                                "(they are keyed there all the same: lower "
+                                                "step_height or raise reach)"));
+  // And so they are: a mid key farther than reach from the body's keys either side of it.
+  double farthest = 0;
+  const WalkTrack* body = nullptr;
+  for (const WalkTrack& track : high.tracks)
+    if (track.kind == TrackKind::kBody) body = &track;
+  REQUIRE(body != nullptr);
+  for (const WalkTrack& track : high.tracks) {
+    if (track.kind != TrackKind::kFoot) continue;
+    for (const WalkKey& key : track.keys) {
+      if (key.phase != KeyPhase::kMid) continue;
+      double nearest = 1e300;
+      for (const WalkKey& b : body->keys)
+        if (std::fabs(b.frame - key.frame) <= c.frames_per_step)
+          nearest = std::min(nearest, Distance(b.position, key.position));
+      farthest = std::max(farthest, nearest);
+    }
+  }
+  CHECK(farthest > c.reach);
+}
+
 TEST_CASE("A start given farther than a step from the terrain is said in the walk's notes",
           "[steps][generator]") {
   // A start 5 m past a floor's edge, or high above a slope, was snapped to the nearest sample

@@ -86,6 +86,17 @@ Status Generator::Setup(std::string* error) {
          "the feet within reach of the body (raise reach or lower step_length)";
     setup_notes_.push_back(m.str());
   }
+  // A step_height that lifts a foot's mid key out of reach of the body (on level ground, the
+  // foot halfway through its swing about its rest, step_height above the ground) is said too:
+  // the mid keys are keyed there all the same.
+  const double mid = MidKeyDistance();
+  if (mid > c_.reach * (1 + 1e-9)) {
+    Text m(3);
+    m << "step_height " << c_.step_height << " lifts the feet's mid keys about " << mid
+      << " from the body on level ground, beyond reach " << c_.reach
+      << " (they are keyed there all the same: lower step_height or raise reach)";
+    setup_notes_.push_back(m.str());
+  }
   // 2. The start frame: up (terrain normal for multipeds, world up for bipeds) and the heading
   //    projected onto the plane perpendicular to it. Crowds stand on a grid in that plane, or,
   //    on ground within 45 degrees of world up, across world up: one bump's normal tilted a
@@ -459,6 +470,18 @@ double Generator::LongestStepInReach() const {
     longest = std::min(longest, along2 > 0 ? (std::sqrt(along2) - r.z) / k : 0.0);
   }
   return std::max(longest, 0.0);
+}
+
+double Generator::MidKeyDistance() const {
+  // Halfway through its swing a foot is about at its rest relative to the body (it lifts as
+  // far behind as it lands ahead), raised step_height off the ground the body stands
+  // body_height above.
+  double farthest = 0;
+  for (const Vec3& r : rest_) {
+    const double up = c_.body_height - r.y - c_.step_height;
+    farthest = std::max(farthest, std::sqrt(r.x * r.x + up * up + r.z * r.z));
+  }
+  return farthest;
 }
 
 void Generator::Orient(Agent& a, const Foothold& ground, const Vec3& up0, const Vec3& fwd0) const {

@@ -226,6 +226,8 @@ class Generator {
   // ground stays within reach of the body (the step vector's reach limit of 7 leaves full
   // steps alone); infinite when any length does (a single gait group). [Units: wu]
   double LongestStepInReach() const;
+  // How far from the body the farthest foot's mid key lies on level ground.
+  double MidKeyDistance() const;
   // 2. The heading at a start whose up is up0: GenerateOptions::heading projected across it.
   Vec3 StartHeading(const Vec3& up0) const {
     return TangentForward(o_.heading, AnyPerpendicular(world_up_), world_up_, up0);
