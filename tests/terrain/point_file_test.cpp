@@ -120,6 +120,21 @@ TEST_CASE("ReadPointStream rejects bad lines with file and line", "[terrain][poi
     CHECK(Read("1 2 3 0 1 0 #1.#QNAN\n", &s, &error) == Status::kOk);
     CHECK(s.size() == 1);
     s.clear();
+    // Printed at a low precision the words are rounded: "1.#J" was read as "1." and a comment.
+    for (const std::string token : {"1.#J", "-1.#J", "1.#R", "1.#IO", "1.#QO", "1.#I", "1.#"}) {
+      INFO(token);
+      CHECK(Read("0 0 0 0 0 " + token + "\n", &s, &error) == Status::kParseError);
+      CHECK(error == "t.pts:1: column 6: '" + token +
+                         "' is NaN or infinite (Microsoft C's NaN or infinity) (expected a finite "
+                         "number)");
+    }
+    CHECK(IsMicrosoftNaN("-1.#IND00"));
+    CHECK(IsMicrosoftNaN("1.#QNAN"));
+    CHECK_FALSE(IsMicrosoftNaN("1.#INF"));
+    CHECK_FALSE(IsMicrosoftNaN("1.#J"));
+    // A comment right after a whole number is still one.
+    CHECK(Read("1 2 3 0 1 0#1.#QNAN\n", &s, &error) == Status::kOk);
+    s.clear();
   }
   SECTION("beyond the grid's range") {
     // The grid stores float offsets from its origin and answers within 1e15 of it: coordinates

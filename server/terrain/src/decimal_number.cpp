@@ -81,8 +81,15 @@ bool IsMicrosoftNonFinite(std::string_view token) {
   };
   if (i < token.size() && (token[i] == '+' || token[i] == '-')) ++i;
   if (!digits()) return false;
-  if (i < token.size() && token[i] == '.') ++i, digits();
+  const bool point = i < token.size() && token[i] == '.';
+  if (point) ++i, digits();
   if (i >= token.size() || token[i++] != '#') return false;
+  // Printed with few digits the word itself is rounded ("1.#J", "1.#IO", "1.#R", "1.#QO",
+  // "1.#"): after "DIGITS.#", up to four letters and digits are taken for one.
+  if (point && token.size() - i <= 4 && std::all_of(token.begin() + i, token.end(), [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c));
+      }))
+    return true;
   size_t word = 0;
   for (const char* name : {"QNAN", "SNAN", "IND", "INF"}) {
     const size_t n = std::strlen(name);
@@ -121,9 +128,11 @@ size_t CommentStart(std::string_view line) {
 
 bool IsMicrosoftNaN(std::string_view token) {
   if (!IsMicrosoftNonFinite(token)) return false;
-  const size_t hash = token.find('#');  // then QNAN, SNAN, IND or INF
-  return std::toupper(static_cast<unsigned char>(token[hash + 1])) != 'I' ||
-         std::toupper(static_cast<unsigned char>(token[hash + 3])) == 'D';
+  // Spelled out after the '#': QNAN, SNAN or IND (a rounded word tells nothing).
+  std::string word;
+  for (size_t i = token.find('#') + 1; i < token.size() && word.size() < 4; ++i)
+    word += static_cast<char>(std::toupper(static_cast<unsigned char>(token[i])));
+  return word == "QNAN" || word == "SNAN" || word.compare(0, 3, "IND") == 0;
 }
 
 }  // namespace footfall

@@ -27,8 +27,9 @@ bool ParseFiniteDecimal(std::string_view token, double* value);
 std::string WholeNumberProblem(std::string_view token, long long lo, long long hi);
 
 // Whether `token` is how Microsoft's C library writes NaN or infinity: "1.#QNAN", "-1.#IND",
-// "1.#INF00", "1.#SNAN0e+000" (letters in either case). In text that takes '#' for a comment,
-// the '#' of such a token starts none.
+// "1.#INF00", "1.#SNAN0e+000" (letters in either case), or those words rounded at a low
+// precision ("1.#J", "-1.#IO", "1.#R", "1.#QO", "1.#": "DIGITS.#" and up to four letters or
+// digits). In text that takes '#' for a comment, the '#' of such a token starts none.
 bool IsMicrosoftNonFinite(std::string_view token);
 // Whether `token` is one of those that spells NaN ("1.#QNAN", "-1.#IND", "1.#SNAN"), not infinity.
 bool IsMicrosoftNaN(std::string_view token);
