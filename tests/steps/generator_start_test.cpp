@@ -269,6 +269,28 @@ TEST_CASE("A step_height that lifts mid keys out of reach is said in the walk's 
   CHECK(farthest > c.reach);
 }
 
+TEST_CASE("Feet resting nearer each other than the samples are said in the walk's notes",
+          "[steps][generator]") {
+  // Rests 2 mm apart (or 1e-12: only equal ones are refused) planted both feet on one sample
+  // and walked them in single file without a word.
+  Character c = LoadShipped("biped");
+  Terrain t = LoadTerrain(MakeFlat(101, 0.05, 0), 0.05);
+  const GenerateOptions o = StartOptions({2.5, 0, 1}, 4);
+  for (const double apart : {0.002, 1e-12}) {
+    INFO(apart);
+    c.feet[1].rest = c.feet[0].rest + Vec3{apart, 0, 0};
+    const Walk w = Generate(t, c, o);
+    REQUIRE_FALSE(w.notes.empty());
+    CHECK_THAT(w.notes[0],
+               Catch::StartsWith("feet L and R rest only ") &&
+                   Catch::EndsWith(" apart, under a tenth of reach 1.2: they may plant on the "
+                                   "same samples and walk in single file (spread their rest "
+                                   "positions)"));
+  }
+  c.feet[1].rest = c.feet[0].rest + Vec3{0.13, 0, 0};
+  CHECK(Generate(t, c, o).notes.empty());
+}
+
 TEST_CASE("A start given farther than a step from the terrain is said in the walk's notes",
           "[steps][generator]") {
   // A start 5 m past a floor's edge, or high above a slope, was snapped to the nearest sample

@@ -97,6 +97,22 @@ Status Generator::Setup(std::string* error) {
       << " (they are keyed there all the same: lower step_height or raise reach)";
     setup_notes_.push_back(m.str());
   }
+  // Feet resting nearly where another does, under a tenth of the reach (rests equal are refused
+  // with the character file), take the same footholds: said once, for the nearest two.
+  double nearest = std::numeric_limits<double>::infinity();
+  size_t near_a = 0, near_b = 0;
+  for (size_t a = 0; a < c_.feet.size(); ++a)
+    for (size_t b = a + 1; b < c_.feet.size(); ++b)
+      if (const double d = Distance(c_.feet[a].rest, c_.feet[b].rest); d < nearest)
+        nearest = d, near_a = a, near_b = b;
+  if (nearest < kNearRestsShare * c_.reach) {
+    Text m(3);
+    m << "feet " << c_.feet[near_a].name << " and " << c_.feet[near_b].name << " rest only "
+      << nearest << " apart, under a tenth of reach " << c_.reach
+      << ": they may plant on the same samples and walk in single file (spread their rest "
+         "positions)";
+    setup_notes_.push_back(m.str());
+  }
   // 2. The start frame: up (terrain normal for multipeds, world up for bipeds) and the heading
   //    projected onto the plane perpendicular to it. Crowds stand on a grid in that plane, or,
   //    on ground within 45 degrees of world up, across world up: one bump's normal tilted a

@@ -98,6 +98,9 @@ inline constexpr double kClearanceFraction = 0.25;
 // A step_length more than this many times the longest step the reach allows on level ground
 // (Generator::LongestStepInReach) is worth a note: its steps are all shortened.
 inline constexpr double kReachNoteMargin = 1.05;
+// Two feet resting closer than this share of the reach are worth a note (they plant on the
+// same samples).
+inline constexpr double kNearRestsShare = 0.1;
 // Steer: a turn is tried at its whole and then in kTurnShares - 1 smaller shares, and the
 // largest that keeps every pair's feet at least kMinPairGap of their rest gap apart is taken.
 inline constexpr int kTurnShares = 8;
