@@ -291,6 +291,21 @@ TEST_CASE("Feet resting nearer each other than the samples are said in the walk'
   CHECK(Generate(t, c, o).notes.empty());
 }
 
+TEST_CASE("Rests written Z-up are said in the walk's notes", "[steps][generator]") {
+  // A quadruped's rests written [x, forward, 0]: its front and hind feet started 0.1 apart
+  // instead of 0.7, without a word.
+  Character c = LoadShipped("quadruped");
+  for (FootSpec& f : c.feet) f.rest = {f.rest.x, f.rest.z, 0};
+  c.reach = 1;
+  Terrain t = LoadTerrain(MakeFlat(101, 0.05, 0), 0.05);
+  const Walk w = Generate(t, c, StartOptions({2.5, 0, 1}, 4));
+  REQUIRE_FALSE(w.notes.empty());
+  CHECK_THAT(w.notes[0], Catch::Contains(" along the up (rest y), against at most ") &&
+                             Catch::EndsWith("rests are [side, up, forward], y along the up (as "
+                                             "in Maya); a rig written Z-up as [x, forward, 0] "
+                                             "puts its forward offsets along the up"));
+}
+
 TEST_CASE("A start given farther than a step from the terrain is said in the walk's notes",
           "[steps][generator]") {
   // A start 5 m past a floor's edge, or high above a slope, was snapped to the nearest sample

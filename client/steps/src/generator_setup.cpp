@@ -97,6 +97,24 @@ Status Generator::Setup(std::string* error) {
       << " (they are keyed there all the same: lower step_height or raise reach)";
     setup_notes_.push_back(m.str());
   }
+  // Rests far off the ground plane (y, along the up, large beside x and z): most likely written
+  // the Z-up way, [x, forward, 0], which puts the forward offsets along the up and collapses the
+  // stance. Said once, for the foot farthest off.
+  double off = 0, across = 0;
+  size_t off_foot = 0;
+  for (size_t f = 0; f < c_.feet.size(); ++f) {
+    const Vec3& r = c_.feet[f].rest;
+    across = std::max(across, std::hypot(r.x, r.z));
+    if (std::fabs(r.y) > off) off = std::fabs(r.y), off_foot = f;
+  }
+  if (off > kOffGroundRestShare * across) {
+    Text m(3);
+    m << "foot " << c_.feet[off_foot].name << " rests " << c_.feet[off_foot].rest.y
+      << " along the up (rest y), against at most " << across
+      << " across it: rests are [side, up, forward], y along the up (as in Maya); a rig written "
+         "Z-up as [x, forward, 0] puts its forward offsets along the up";
+    setup_notes_.push_back(m.str());
+  }
   // Feet resting nearly where another does, under a tenth of the reach (rests equal are refused
   // with the character file), take the same footholds: said once, for the nearest two.
   double nearest = std::numeric_limits<double>::infinity();

@@ -98,6 +98,9 @@ inline constexpr double kClearanceFraction = 0.25;
 // A step_length more than this many times the longest step the reach allows on level ground
 // (Generator::LongestStepInReach) is worth a note: its steps are all shortened.
 inline constexpr double kReachNoteMargin = 1.05;
+// A rest whose y (along the up) exceeds this share of the largest rest across the up is worth
+// a note (most likely written Z-up).
+inline constexpr double kOffGroundRestShare = 0.5;
 // Two feet resting closer than this share of the reach are worth a note (they plant on the
 // same samples).
 inline constexpr double kNearRestsShare = 0.1;
