@@ -58,6 +58,19 @@ struct ServedTerrain {
   TerrainHandle handle = 0;
 };
 
+// The walk `o` asks of `c` on `served`, its server killed once the walk has done `kill_after`
+// steps.
+Walk WalkKillingServer(ServedTerrain& served, const Character& c, GenerateOptions o,
+                       int kill_after) {
+  o.progress = [&](int done, int) {
+    if (done == kill_after) served.server.Kill();
+  };
+  Walk w;
+  std::string error;
+  REQUIRE(GenerateWalk(*served.rpc, served.handle, c, o, &w, &error) == Status::kOk);
+  return w;
+}
+
 }  // namespace
 
 TEST_CASE("A walk over RPC whose server dies keeps its steps up to the one it died in",
@@ -76,12 +89,7 @@ TEST_CASE("A walk over RPC whose server dies keeps its steps up to the one it di
     o.has_start = true;
     o.start = {4 * c.reach, 0, 4 * c.reach};
     o.steps = 40;
-    o.progress = [&](int done, int) {
-      if (done == kill_after) served.server.Kill();
-    };
-    Walk w;
-    std::string error;
-    REQUIRE(GenerateWalk(*served.rpc, served.handle, c, o, &w, &error) == Status::kOk);
+    const Walk w = WalkKillingServer(served, c, o, kill_after);
     INFO(w.stopped);
     // Stopped at the next step, with the failed call named, its keys those of a walk of
     // kill_after steps.
@@ -94,7 +102,6 @@ TEST_CASE("A walk over RPC whose server dies keeps its steps up to the one it di
                                           "stopped, was killed, or closed it)"));
     Terrain t = LoadTerrain(samples, spacing);
     GenerateOptions shorter = o;
-    shorter.progress = nullptr;
     shorter.steps = kill_after;
     const Walk want = Generate(t, c, shorter);
     CHECK(want.stopped.empty());
@@ -126,12 +133,7 @@ TEST_CASE("A crowd over RPC whose server dies says so before the terrain's earli
   o.steps = 40;
   o.crowd = 4;
   o.crowd_spacing = 4 * c.reach;
-  o.progress = [&](int done, int) {
-    if (done == kill_after) served.server.Kill();
-  };
-  Walk w;
-  std::string error;
-  REQUIRE(GenerateWalk(*served.rpc, served.handle, c, o, &w, &error) == Status::kOk);
+  const Walk w = WalkKillingServer(served, c, o, kill_after);
   INFO(w.stopped);
   CHECK(w.session_failed);
   REQUIRE(w.stops.size() == 4);
@@ -151,8 +153,8 @@ TEST_CASE("A crowd over RPC whose server dies says so before the terrain's earli
   CHECK_THAT(w.stopped, Catch::EndsWith("(and 3 more characters stopped)"));
   // A walk that stops at the terrain alone is no failure.
   ServedTerrain again(samples);
-  o.progress = nullptr;
   Walk cliff;
+  std::string error;
   REQUIRE(GenerateWalk(*again.rpc, again.handle, c, o, &cliff, &error) == Status::kOk);
   CHECK_FALSE(cliff.session_failed);
   CHECK(cliff.stops.size() == 2);

@@ -662,11 +662,8 @@ TEST_CASE("An insect on a beam narrower than it is told it may be too wide for i
     }
   }
   Terrain t = LoadTerrain(beam, spacing);
-  GenerateOptions o;
-  o.has_start = true;
-  o.start = {0, 0, 0.5};
+  GenerateOptions o = StartOptions({0, 0, 0.5}, 30);
   o.heading = {0, 0, 1};
-  o.steps = 30;
   const Walk w = Generate(t, c, o);
   CHECK_THAT(w.stopped, Catch::Contains("it faces away from the character's up") &&
                             Catch::Contains("wider than the beam or ledge it walks along"));
