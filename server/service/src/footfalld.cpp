@@ -1,4 +1,5 @@
 // footfalld: the footfall terrain query server (ONC RPC over TCP).
+#include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <unistd.h>
@@ -212,7 +213,8 @@ int main(int argc, char** argv) {
   }
   options.use_rpcbind = !no_rpcbind;
   // A root this user may not search would refuse every load: said now, not at the first one.
-  if (!options.data_root.empty() && access(options.data_root.c_str(), X_OK) != 0) {
+  if (!options.data_root.empty() &&
+      faccessat(AT_FDCWD, options.data_root.c_str(), X_OK, AT_EACCESS) != 0) {
     std::fprintf(stderr,
                  "footfalld: --data-root %s: this user (uid %u) may not search it (%s), so no "
                  "load could succeed: give a folder it may read\n",
