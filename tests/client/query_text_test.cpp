@@ -52,9 +52,21 @@ TEST_CASE("query lines parse into an op, a point and a direction", "[client][que
 
 TEST_CASE("malformed query lines say what was expected", "[client][query_text]") {
   const std::string kZero = "next: direction DX DY DZ must be non-zero";
+  const std::string kNoneBefore =
+      "a comma with no number before it (expected numbers separated by spaces or single commas)";
   const std::pair<std::string, std::string> bad[] = {
       {"", "empty query (expected snap X Y Z, normal X Y Z or next X Y Z DX DY DZ)"},
-      {" , ", "empty query (expected snap X Y Z, normal X Y Z or next X Y Z DX DY DZ)"},
+      {" , ", kNoneBefore},
+      // A comma with no number on one side dropped a number ("0,,0" read as "0 0").
+      {"snap 0,,0 0", kNoneBefore},
+      {"snap 0, ,0 0", kNoneBefore},
+      {",snap 0 0 0", kNoneBefore},
+      {"snap 0 0 0,",
+       "a comma with no number after it (expected numbers separated by spaces or "
+       "single commas)"},
+      // Microsoft C's infinity is a number that is not finite, not "1." and a comment.
+      {WithoutComment("snap 1.#INF 0 0"),
+       "snap: argument 1 '1.#INF' is not a finite number (Microsoft C's NaN or infinity)"},
       {"jump 1 2 3",
        "unknown command 'jump' (expected snap X Y Z, normal X Y Z or next X Y Z DX DY DZ)"},
       {"SNAP 1 2 3",

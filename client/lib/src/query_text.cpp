@@ -1,5 +1,6 @@
 #include "footfall/client/query_text.h"
 
+#include <cctype>
 #include <sstream>
 #include <vector>
 
@@ -36,16 +37,39 @@ const char* QueryOpName(QueryOp op) {
   return "unknown";
 }
 
-std::string WithoutComment(const std::string& line) { return line.substr(0, line.find('#')); }
+std::string WithoutComment(const std::string& line) { return line.substr(0, CommentStart(line)); }
 
 bool ParseQueryText(const std::string& text, QueryText* out, std::string* error) {
-  std::string spaced = text;
-  for (char& c : spaced) {
-    if (c == ',') c = ' ';
-  }
-  std::istringstream in(spaced);
+  // Words are separated by white space, numbers also by commas ("next 1,0,2 0, 0, 1"); a comma
+  // with no number on one side (",,", a comma first or last) is refused: ",," read as one comma
+  // dropped a number.
   std::vector<std::string> tokens;
-  for (std::string t; in >> t;) tokens.push_back(t);
+  bool comma_pending = false;
+  for (size_t i = 0; i < text.size();) {
+    const char c = text[i];
+    if (c == ',') {
+      if (tokens.empty() || comma_pending) {
+        *error =
+            "a comma with no number before it (expected numbers separated by spaces or "
+            "single commas)";
+        return false;
+      }
+      comma_pending = true, ++i;
+    } else if (std::isspace(static_cast<unsigned char>(c))) {
+      ++i;
+    } else {
+      const size_t end = text.find_first_of(", \t\r\n\f\v", i);
+      tokens.push_back(text.substr(i, end == std::string::npos ? end : end - i));
+      comma_pending = false;
+      i = end == std::string::npos ? text.size() : end;
+    }
+  }
+  if (comma_pending) {
+    *error =
+        "a comma with no number after it (expected numbers separated by spaces or single "
+        "commas)";
+    return false;
+  }
   if (tokens.empty()) {
     *error = std::string("empty query (expected ") + kForms + ")";
     return false;
@@ -72,7 +96,7 @@ bool ParseQueryText(const std::string& text, QueryText* out, std::string* error)
   for (size_t i = 0; i < want; ++i) {
     if (!ParseFiniteNumber(tokens[i + 1], &v[i])) {
       *error = op + ": argument " + std::to_string(i + 1) + " '" + ShownText(tokens[i + 1]) +
-               "' is not a finite number";
+               "' is not a finite number" + NotFiniteNote(tokens[i + 1]);
       return false;
     }
   }

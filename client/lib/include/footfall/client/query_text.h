@@ -27,7 +27,8 @@ struct QueryText {
 // files.
 bool ParseFiniteNumber(const std::string& token, double* value);
 
-// `line` without its comment: the text before the first '#'.
+// `line` without its comment: the text before its first '#' (but the one of Microsoft C's
+// "1.#INF", which is a number that is not finite, not a comment).
 std::string WithoutComment(const std::string& line);
 
 // Parses one query line (no comments: callers strip them, WithoutComment). Numbers are finite
