@@ -257,6 +257,8 @@ endif()
 expect(EXIT_ZERO "wrote 2 samples to" terrain convert "${WORK}/two.pts" -o "${WORK}/two-out.pts")
 file(WRITE "${WORK}/one.pts" "0 0 0 0 1 0\n")
 expect(EXIT_ZERO "wrote 1 sample to" terrain convert "${WORK}/one.pts" -o "${WORK}/one-out.pts")
+expect(EXIT_NONZERO "two.pts: --character applies to meshes and height maps, which are resampled for it; a point file is used as it is (leave --character out)"
+       terrain convert "${WORK}/two.pts" --character "${SOURCE_DIR}/data/characters/biped.json" -o "${WORK}/two-c.pts")
 foreach(command "terrain;info" "query;--terrain")
   expect(EXIT_NONZERO "two.pts: --separation applies to meshes and height maps, which are resampled; a point file is used as it is (leave --separation out)"
          ${command} "${WORK}/two.pts" --separation 0.1)

@@ -77,6 +77,11 @@ int RunConvert(const ConvertFlags& flags) {
     Character character;
     if (load.separation > 0) {
       error = "give --separation or --character, not both";
+    } else if (IsPointFileExtension(FileExtension(flags.input))) {
+      // (It was accepted and changed nothing.)
+      error = flags.input +
+              ": --character applies to meshes and height maps, which are resampled for it; a "
+              "point file is used as it is (leave --character out)";
     } else if (LoadCharacter(flags.character, &character, &error) == Status::kOk) {
       load.finest_default = kSeparationPerStep * character.step_length;
       load.max_samples = std::min(load.max_samples, kMaxWalkSamples);
