@@ -7,9 +7,12 @@
 
 #include <catch2/catch.hpp>
 
+#include "footfall/import/terrain_generators.h"
 #include "footfall/steps/scene.h"
+#include "generator_fixtures.h"
 
 using namespace footfall;
+using namespace footfall::test;
 
 namespace {
 
@@ -182,4 +185,22 @@ TEST_CASE("A scene's walk holds every character's tracks under its name", "[step
   AddToSceneWalk("third", std::move(stopped), &scene);
   CHECK(scene.stops.size() == 2);
   CHECK(scene.stopped == "bugs: step 3 of c2: no foothold (and 1 more stopped)");
+}
+
+TEST_CASE("Scene characters started on top of each other are said in notes", "[steps][scene]") {
+  // Two characters given one start walked as one without a word (a crowd keeps its own apart).
+  const Character biped = LoadShipped("biped");
+  const Character quadruped = LoadShipped("quadruped");
+  Terrain t = LoadTerrain(MakeFlat(201, 0.05, 0), 0.05);
+  const Walk a = Generate(t, quadruped, StartOptions({5, 0, 3}, 2));
+  const Walk b = Generate(t, biped, StartOptions({5.1, 0, 3}, 2));
+  const Walk far = Generate(t, biped, StartOptions({8, 0, 3}, 2));
+  const std::vector<std::string> notes =
+      OverlappingStartNotes({"a", "b", "gone", "far"}, {&a, &b, nullptr, &far},
+                            {quadruped.reach, biped.reach, biped.reach, biped.reach});
+  REQUIRE(notes.size() == 1);
+  CHECK_THAT(notes[0], Catch::StartsWith("a and b start 0.1") &&
+                           Catch::EndsWith(" apart, under a quarter of their reach: they walk "
+                                           "through each other (give them starts farther "
+                                           "apart)"));
 }

@@ -567,6 +567,17 @@ int RunScene(const GenerateFlags& flags) {
     walks.clear();
   }
   progress.Finish();
+  // Characters started on top of each other, said (read before the walks move into the scene's).
+  std::vector<std::string> names;
+  std::vector<const Walk*> walked_walks;
+  std::vector<double> reaches;
+  for (size_t i = 0; i < walks.size(); ++i) {
+    names.push_back(scene[i].name);
+    const bool ok = walks[i].walked && walks[i].status == Status::kOk;
+    walked_walks.push_back(ok ? &walks[i].walk : nullptr);
+    reaches.push_back(scene[i].character.reach);
+  }
+  const std::vector<std::string> overlapping = OverlappingStartNotes(names, walked_walks, reaches);
   Walk walk;
   walk.fps = flags.fps;
   size_t walked = 0;
@@ -592,6 +603,7 @@ int RunScene(const GenerateFlags& flags) {
     }
     ++walked;
   }
+  walk.notes.insert(walk.notes.end(), overlapping.begin(), overlapping.end());
   if (walks.empty() && failures.empty()) {
     std::cerr << "footfall generate: out of memory setting out the scene's walks; nothing was "
                  "written (give fewer characters, crowds or steps)\n";

@@ -1,6 +1,8 @@
 #include "footfall/steps/scene.h"
 
+#include <algorithm>
 #include <set>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -123,6 +125,39 @@ void AddToSceneWalk(const std::string& name, Walk&& walk, Walk* scene) {
   scene->session_failed |= walk.session_failed;
   for (const std::string& note : walk.notes) scene->notes.push_back(name + ": " + note);
   SetSceneStopped(scene);
+}
+
+std::vector<std::string> OverlappingStartNotes(const std::vector<std::string>& names,
+                                               const std::vector<const Walk*>& walks,
+                                               const std::vector<double>& reaches) {
+  // (character, where it stands at the start: its first feet's centroid, the tracks before its
+  // first body track)
+  std::vector<std::pair<size_t, Vec3>> starts;
+  for (size_t i = 0; i < walks.size(); ++i) {
+    if (!walks[i]) continue;
+    Vec3 sum;
+    int feet = 0;
+    for (const WalkTrack& track : walks[i]->tracks) {
+      if (track.kind == TrackKind::kBody) break;
+      if (!track.keys.empty()) sum += track.keys.front().position, ++feet;
+    }
+    if (feet > 0) starts.emplace_back(i, sum / static_cast<double>(feet));
+  }
+  std::vector<std::string> notes;
+  for (size_t a = 0; a < starts.size(); ++a) {
+    for (size_t b = a + 1; b < starts.size(); ++b) {
+      const size_t i = starts[a].first, j = starts[b].first;
+      const double apart = Distance(starts[a].second, starts[b].second);
+      if (!(apart < 0.25 * std::min(reaches[i], reaches[j]))) continue;
+      std::ostringstream note;
+      note.precision(3);
+      note << names[i] << " and " << names[j] << " start " << apart
+           << " apart, under a quarter of their reach: they walk through each other (give them "
+              "starts farther apart)";
+      notes.push_back(note.str());
+    }
+  }
+  return notes;
 }
 
 void AddFailuresToSceneWalk(const std::vector<std::pair<std::string, std::string>>& failures,

@@ -52,6 +52,15 @@ void AddToSceneWalk(const std::string& name, Walk&& walk, Walk* scene);
 void AddFailuresToSceneWalk(const std::vector<std::pair<std::string, std::string>>& failures,
                             Walk* scene);
 
+// Notes for scene characters that start on top of each other: for each pair of `names` whose
+// walks' first feet (a crowd's first character's) centre under a quarter of the smaller `reaches`
+// apart, "A and B start D apart: they walk through each other" (a crowd keeps its own
+// characters apart; two scene characters given one start were walked as one, silently).
+// walks[i] may be null (a character that did not walk).
+std::vector<std::string> OverlappingStartNotes(const std::vector<std::string>& names,
+                                               const std::vector<const Walk*>& walks,
+                                               const std::vector<double>& reaches);
+
 // Scene characters walked at once over a session that is not in process (GenerateSceneWalks).
 constexpr size_t kJoinedSceneCharacters = 64;
 
