@@ -340,6 +340,7 @@ cp "$work/near.gltf" "$work/stale.gltf"
   --start 1.2,0,1.2 --start-frame 1e9 --out "$work/stale.json" --out "$work/stale.gltf" 2> "$work/stale.err"
 check "glTF refused late: exit 1" [ $? -eq 1 ]
 check "glTF refused late: the other output written" [ -s "$work/stale.json" ]
+check "glTF refused late: no warning about a glTF not written" bash -c "! grep -qF 'warning: $work/stale.gltf' '$work/stale.err'"
 check "glTF refused late: the old file kept and said so" bash -c "cmp -s '$work/near.gltf' '$work/stale.gltf' && grep -qF '$work/stale.gltf is left as it was, from before this walk' '$work/stale.err'"
 
 # 4. A real DEM (Kootenai river banks, ../shared/data): its 1 m cells are coarser than every

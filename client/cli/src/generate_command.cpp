@@ -393,9 +393,22 @@ int WriteOutputs(const GenerateFlags& flags, const LoadedTerrain& terrain, const
   std::string error;
   for (const std::string& out : flags.out) {
     const std::string ext = FileExtension(out);
-    if (ext == "gltf" || ext == "glb") {
-      // Keys are stored relative to the walk's origin (GltfOrigin): only a walk spanning
-      // kilometres moves visibly.
+    Status written;
+    try {
+      written = IsPointFileExtension(ext)
+                    ? WriteWalkTerrain(terrain.flags,
+                                       terrain.resampled ? &terrain.prepared.samples : nullptr, out,
+                                       &error)
+                    : WriteOutput(walk, out, &error);
+    } catch (const std::bad_alloc&) {
+      error =
+          "out of memory writing it (the outputs before it are written; the walk JSON "
+          "takes least)";
+      written = Status::kLimitExceeded;
+    }
+    if (written == Status::kOk && (ext == "gltf" || ext == "glb")) {
+      // Said of a glTF written (one refused says why it is). Keys are stored relative to the
+      // walk's origin (GltfOrigin): only a walk spanning kilometres moves visibly.
       const double rounding = MaxFloatRounding(walk);
       if (rounding > 1e-4) {
         std::cerr << "footfall generate: warning: " << out
@@ -410,19 +423,6 @@ int WriteOutputs(const GenerateFlags& flags, const LoadedTerrain& terrain, const
                      "to "
                   << late << " frames (JSON and MEL keep the frames exact)\n";
       }
-    }
-    Status written;
-    try {
-      written = IsPointFileExtension(ext)
-                    ? WriteWalkTerrain(terrain.flags,
-                                       terrain.resampled ? &terrain.prepared.samples : nullptr, out,
-                                       &error)
-                    : WriteOutput(walk, out, &error);
-    } catch (const std::bad_alloc&) {
-      error =
-          "out of memory writing it (the outputs before it are written; the walk JSON "
-          "takes least)";
-      written = Status::kLimitExceeded;
     }
     if (written != Status::kOk) {
       // Named by its output (the other outputs are still written).
