@@ -94,41 +94,51 @@ void FrameRange(const Walk& walk, double* first, double* last) {
   }
 }
 
-std::string FrameText(double frame) {
+namespace {
+
+// `frame` in plain digits with `decimals` decimals, trailing zeros dropped ("-0" as "0"); false
+// when that text does not read back as `frame` and `exact` asks it to.
+bool FixedText(double frame, int decimals, bool exact, std::string* out) {
   char text[64];
-  if (!(std::fabs(frame) < 1e15)) {
-    // Always with an exponent: the shortest form wrote 1e15 so and 1e15 + 1 in digits.
-    const std::to_chars_result r =
-        std::to_chars(text, text + sizeof text, frame, std::chars_format::scientific);
-    return std::string(text, r.ptr);
-  }
   // (std::to_chars ignores the C locale: a decimal point whatever LC_NUMERIC says.)
   const std::to_chars_result r =
-      std::to_chars(text, text + sizeof text, frame, std::chars_format::fixed, 3);
+      std::to_chars(text, text + sizeof text, frame, std::chars_format::fixed, decimals);
+  if (exact) {
+    double back = 0;
+    std::from_chars(text, r.ptr, back);
+    if (back != frame) return false;
+  }
   std::string s(text, r.ptr);
   s.erase(s.find_last_not_of('0') + 1);
   if (s.back() == '.') s.pop_back();
-  return s == "-0" ? "0" : s;
+  *out = s == "-0" ? "0" : s;
+  return true;
 }
 
-std::string ExactFrameText(double frame) {
+// `frame` with an exponent, in the shortest form that reads back as it.
+std::string ScientificText(double frame) {
   char text[64];
-  if (std::fabs(frame) < 1e15) {
-    for (int decimals = 3; decimals <= 20; ++decimals) {
-      const std::to_chars_result r =
-          std::to_chars(text, text + sizeof text, frame, std::chars_format::fixed, decimals);
-      double back = 0;
-      std::from_chars(text, r.ptr, back);
-      if (back != frame) continue;
-      std::string s(text, r.ptr);
-      s.erase(s.find_last_not_of('0') + 1);
-      if (s.back() == '.') s.pop_back();
-      return s == "-0" ? "0" : s;
-    }
-  }
   const std::to_chars_result r =
       std::to_chars(text, text + sizeof text, frame, std::chars_format::scientific);
   return std::string(text, r.ptr);
+}
+
+}  // namespace
+
+std::string FrameText(double frame) {
+  // From 1e15 on always with an exponent: the shortest form wrote 1e15 so and 1e15 + 1 in digits.
+  if (!(std::fabs(frame) < 1e15)) return ScientificText(frame);
+  std::string s;
+  FixedText(frame, 3, false, &s);
+  return s;
+}
+
+std::string ExactFrameText(double frame) {
+  std::string s;
+  if (std::fabs(frame) < 1e15)
+    for (int decimals = 3; decimals <= 20; ++decimals)
+      if (FixedText(frame, decimals, true, &s)) return s;
+  return ScientificText(frame);
 }
 
 }  // namespace footfall::viewer

@@ -86,51 +86,7 @@ Status Generator::Setup(std::string* error) {
          "the feet within reach of the body (raise reach or lower step_length)";
     setup_notes_.push_back(m.str());
   }
-  // A step_height that lifts a foot's mid key out of reach of the body (on level ground, the
-  // foot halfway through its swing about its rest, step_height above the ground) is said too:
-  // the mid keys are keyed there all the same.
-  const double mid = MidKeyDistance();
-  if (mid > c_.reach * (1 + 1e-9)) {
-    Text m(3);
-    m << "step_height " << c_.step_height << " lifts the feet's mid keys about " << mid
-      << " from the body on level ground, beyond reach " << c_.reach
-      << " (they are keyed there all the same: lower step_height or raise reach)";
-    setup_notes_.push_back(m.str());
-  }
-  // Rests far off the ground plane (y, along the up, large beside x and z): most likely written
-  // the Z-up way, [x, forward, 0], which puts the forward offsets along the up and collapses the
-  // stance. Said once, for the foot farthest off.
-  double off = 0, across = 0;
-  size_t off_foot = 0;
-  for (size_t f = 0; f < c_.feet.size(); ++f) {
-    const Vec3& r = c_.feet[f].rest;
-    across = std::max(across, std::hypot(r.x, r.z));
-    if (std::fabs(r.y) > off) off = std::fabs(r.y), off_foot = f;
-  }
-  if (off > kOffGroundRestShare * across) {
-    Text m(3);
-    m << "foot " << c_.feet[off_foot].name << " rests " << c_.feet[off_foot].rest.y
-      << " along the up (rest y), against at most " << across
-      << " across it: rests are [side, up, forward], y along the up (as in Maya); a rig written "
-         "Z-up as [x, forward, 0] puts its forward offsets along the up";
-    setup_notes_.push_back(m.str());
-  }
-  // Feet resting nearly where another does, under a tenth of the reach (rests equal are refused
-  // with the character file), take the same footholds: said once, for the nearest two.
-  double nearest = std::numeric_limits<double>::infinity();
-  size_t near_a = 0, near_b = 0;
-  for (size_t a = 0; a < c_.feet.size(); ++a)
-    for (size_t b = a + 1; b < c_.feet.size(); ++b)
-      if (const double d = Distance(c_.feet[a].rest, c_.feet[b].rest); d < nearest)
-        nearest = d, near_a = a, near_b = b;
-  if (nearest < kNearRestsShare * c_.reach) {
-    Text m(3);
-    m << "feet " << c_.feet[near_a].name << " and " << c_.feet[near_b].name << " rest only "
-      << nearest << " apart, under a tenth of reach " << c_.reach
-      << ": they may plant on the same samples and walk in single file (spread their rest "
-         "positions)";
-    setup_notes_.push_back(m.str());
-  }
+  AddCharacterShapeNotes();
   // 2. The start frame: up (terrain normal for multipeds, world up for bipeds) and the heading
   //    projected onto the plane perpendicular to it. Crowds stand on a grid in that plane, or,
   //    on ground within 45 degrees of world up, across world up: one bump's normal tilted a
@@ -504,6 +460,54 @@ double Generator::LongestStepInReach() const {
     longest = std::min(longest, along2 > 0 ? (std::sqrt(along2) - r.z) / k : 0.0);
   }
   return std::max(longest, 0.0);
+}
+
+void Generator::AddCharacterShapeNotes() {
+  // A step_height that lifts a foot's mid key out of reach of the body (on level ground, the
+  // foot halfway through its swing about its rest, step_height above the ground) is said too:
+  // the mid keys are keyed there all the same.
+  const double mid = MidKeyDistance();
+  if (mid > c_.reach * (1 + 1e-9)) {
+    Text m(3);
+    m << "step_height " << c_.step_height << " lifts the feet's mid keys about " << mid
+      << " from the body on level ground, beyond reach " << c_.reach
+      << " (they are keyed there all the same: lower step_height or raise reach)";
+    setup_notes_.push_back(m.str());
+  }
+  // Rests far off the ground plane (y, along the up, large beside x and z): most likely written
+  // the Z-up way, [x, forward, 0], which puts the forward offsets along the up and collapses the
+  // stance. Said once, for the foot farthest off.
+  double off = 0, across = 0;
+  size_t off_foot = 0;
+  for (size_t f = 0; f < c_.feet.size(); ++f) {
+    const Vec3& r = c_.feet[f].rest;
+    across = std::max(across, std::hypot(r.x, r.z));
+    if (std::fabs(r.y) > off) off = std::fabs(r.y), off_foot = f;
+  }
+  if (off > kOffGroundRestShare * across) {
+    Text m(3);
+    m << "foot " << c_.feet[off_foot].name << " rests " << c_.feet[off_foot].rest.y
+      << " along the up (rest y), against at most " << across
+      << " across it: rests are [side, up, forward], y along the up (as in Maya); a rig written "
+         "Z-up as [x, forward, 0] puts its forward offsets along the up";
+    setup_notes_.push_back(m.str());
+  }
+  // Feet resting nearly where another does, under a tenth of the reach (rests equal are refused
+  // with the character file), take the same footholds: said once, for the nearest two.
+  double nearest = std::numeric_limits<double>::infinity();
+  size_t near_a = 0, near_b = 0;
+  for (size_t a = 0; a < c_.feet.size(); ++a)
+    for (size_t b = a + 1; b < c_.feet.size(); ++b)
+      if (const double d = Distance(c_.feet[a].rest, c_.feet[b].rest); d < nearest)
+        nearest = d, near_a = a, near_b = b;
+  if (nearest < kNearRestsShare * c_.reach) {
+    Text m(3);
+    m << "feet " << c_.feet[near_a].name << " and " << c_.feet[near_b].name << " rest only "
+      << nearest << " apart, under a tenth of reach " << c_.reach
+      << ": they may plant on the same samples and walk in single file (spread their rest "
+         "positions)";
+    setup_notes_.push_back(m.str());
+  }
 }
 
 double Generator::MidKeyDistance() const {

@@ -234,6 +234,9 @@ class Generator {
   double LongestStepInReach() const;
   // How far from the body the farthest foot's mid key lies on level ground.
   double MidKeyDistance() const;
+  // Setup's notes on a character file that walks badly without a word: mid keys out of reach,
+  // rests off the ground plane (a Z-up rig), feet resting nearly together.
+  void AddCharacterShapeNotes();
   // 2. The heading at a start whose up is up0: GenerateOptions::heading projected across it.
   Vec3 StartHeading(const Vec3& up0) const {
     return TangentForward(o_.heading, AnyPerpendicular(world_up_), world_up_, up0);
