@@ -1410,15 +1410,15 @@ TEST_CASE("one connection holds at most 4 uploads, and an upload without samples
 TEST_CASE("an upload whose finish is refused as busy is kept while its client asks again",
           "[rpc]") {
   // Sixteen loads of a large point file fill the lane that builds point files and upload grids
-  // past --upload-timeout: each finish refused as busy keeps the upload, which the client library
+  // past --upload-timeout (0.1 s; each load takes longer): each finish refused as busy keeps the upload, which the client library
   // finishes again until footfalld has room.
   const TempRoot temp;
   {
     std::ofstream big(temp.path + "/big.pts");
-    for (int i = 0; i < 600000; ++i)
+    for (int i = 0; i < 900000; ++i)
       big << i % 600 << " " << (i * 7) % 13 << " " << i / 600 << " 0 1 0\n";
   }
-  ServerProcess server(0, {"--no-rpcbind", "--data-root", temp.path, "--upload-timeout", "0.25"});
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", temp.path, "--upload-timeout", "0.1"});
   CLIENT* c = RawClient(server.port());
   std::string message;
   uint32_t upload = 0;
@@ -1457,10 +1457,15 @@ TEST_CASE("an upload whose finish is refused as busy is kept while its client as
     xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&loaded));
     return status;
   };
-  for (int i = 0; i < 3; ++i) {
-    if (i > 0) std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  // Refused for longer than --upload-timeout (polled, as the lane's first load may end soon
+  // after: each finish until then must be refused).
+  const auto first_refusal = std::chrono::steady_clock::now();
+  for (int i = 0; std::chrono::steady_clock::now() - first_refusal <
+                  std::chrono::milliseconds(150);
+       ++i) {
+    if (i > 0) std::this_thread::sleep_for(std::chrono::milliseconds(30));
     INFO("finish " << i);
-    CHECK(finish() == FF_UNAVAILABLE);
+    REQUIRE(finish() == FF_UNAVAILABLE);
   }
   CLIENT* other = RawClient(server.port());
   uint32_t unused = 0;
