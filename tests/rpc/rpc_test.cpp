@@ -1410,8 +1410,8 @@ TEST_CASE("one connection holds at most 4 uploads, and an upload without samples
 TEST_CASE("an upload whose finish is refused as busy is kept while its client asks again",
           "[rpc]") {
   // Sixteen loads of a large point file fill the lane that builds point files and upload grids
-  // past --upload-timeout (0.1 s; each load takes longer): each finish refused as busy keeps the upload, which the client library
-  // finishes again until footfalld has room.
+  // past --upload-timeout (0.1 s; each load takes longer): each finish refused as busy keeps the
+  // upload, which the client library finishes again until footfalld has room.
   const TempRoot temp;
   {
     std::ofstream big(temp.path + "/big.pts");
@@ -1460,8 +1460,7 @@ TEST_CASE("an upload whose finish is refused as busy is kept while its client as
   // Refused for longer than --upload-timeout (polled, as the lane's first load may end soon
   // after: each finish until then must be refused).
   const auto first_refusal = std::chrono::steady_clock::now();
-  for (int i = 0; std::chrono::steady_clock::now() - first_refusal <
-                  std::chrono::milliseconds(150);
+  for (int i = 0; std::chrono::steady_clock::now() - first_refusal < std::chrono::milliseconds(150);
        ++i) {
     if (i > 0) std::this_thread::sleep_for(std::chrono::milliseconds(30));
     INFO("finish " << i);
