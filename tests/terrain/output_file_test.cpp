@@ -344,3 +344,87 @@ TEST_CASE("A program's signals and file size limit leave no temporary file behin
   CHECK(Read(file) == "old");
   CHECK(dir.Entries() == std::vector<std::string>{"walk.json"});
 }
+
+TEST_CASE("An output file set replaces its files together at Commit, or none of them",
+          "[terrain][output_file]") {
+  Dir dir;
+  const std::string a = dir.path + "/walk.json", b = dir.path + "/walk.mel";
+  std::string error;
+  REQUIRE(ReplaceFile(a, "old a", &error) == Status::kOk);
+  REQUIRE(ReplaceFile(b, "old b", &error) == Status::kOk);
+  {
+    OutputFileSet set;
+    REQUIRE(ReplaceFile(a, "new a", &error) == Status::kOk);
+    REQUIRE(ReplaceFile(b, "new b", &error) == Status::kOk);
+    REQUIRE(ReplaceFile(dir.path + "/walk.gltf", "new c", &error) == Status::kOk);
+    // Written, waiting: the targets are as they were until Commit.
+    CHECK(Read(a) == "old a");
+    CHECK(Read(b) == "old b");
+    CHECK(dir.Entries().size() == 5);
+    CHECK(set.Commit().empty());
+    CHECK(Read(a) == "new a");
+    CHECK(Read(b) == "new b");
+    CHECK(Read(dir.path + "/walk.gltf") == "new c");
+    CHECK(dir.Entries().size() == 3);
+    // Closed by Commit: a later write replaces at once.
+    REQUIRE(ReplaceFile(a, "newer a", &error) == Status::kOk);
+    CHECK(Read(a) == "newer a");
+  }
+  {
+    // Closed without Commit (an exception, say): the old files stay, no temporary file.
+    OutputFileSet set;
+    REQUIRE(ReplaceFile(a, "lost a", &error) == Status::kOk);
+    REQUIRE(ReplaceFile(b, "lost b", &error) == Status::kOk);
+  }
+  CHECK(Read(a) == "newer a");
+  CHECK(Read(b) == "new b");
+  CHECK(dir.Entries().size() == 3);
+  {
+    // A file whose directory went away before Commit is said; the others are replaced.
+    const std::string sub = dir.path + "/sub";
+    REQUIRE(::mkdir(sub.c_str(), 0755) == 0);
+    OutputFileSet set;
+    REQUIRE(ReplaceFile(sub + "/walk.json", "gone", &error) == Status::kOk);
+    REQUIRE(ReplaceFile(a, "kept a", &error) == Status::kOk);
+    REQUIRE(std::system(("rm -rf '" + sub + "'").c_str()) == 0);
+    const std::vector<std::string> failures = set.Commit();
+    REQUIRE(failures.size() == 1);
+    CHECK_THAT(failures[0], Catch::Contains("cannot write '" + sub + "/walk.json'"));
+    CHECK(Read(a) == "kept a");
+  }
+}
+
+TEST_CASE("A signal while an output file set waits leaves every old file and no temporary one",
+          "[terrain][output_file]") {
+  Dir dir;
+  const std::string a = dir.path + "/walk.json", b = dir.path + "/walk.glb";
+  std::string error;
+  REQUIRE(ReplaceFile(a, "old a", &error) == Status::kOk);
+  REQUIRE(ReplaceFile(b, "old b", &error) == Status::kOk);
+  // SIGINT (Ctrl-C) while the second file is written, the first waiting.
+  const pid_t child = ::fork();
+  if (child == 0) {
+    RemoveTemporaryFileOnSignal();
+    OutputFileSet set;
+    std::string e;
+    ReplaceFile(a, "new a", &e);
+    ReplaceFile(
+        b,
+        [](std::FILE* f) {
+          std::fputs("half", f);
+          std::fflush(f);
+          std::raise(SIGINT);
+          return true;
+        },
+        &e);
+    set.Commit();
+    ::_exit(0);
+  }
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  CHECK(WIFSIGNALED(status));
+  CHECK(WTERMSIG(status) == SIGINT);
+  CHECK(Read(a) == "old a");
+  CHECK(Read(b) == "old b");
+  CHECK(dir.Entries().size() == 2);
+}

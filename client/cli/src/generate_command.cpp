@@ -387,10 +387,13 @@ std::string OutOfMemoryMessage(const GenerateFlags& flags, const GenerateOptions
 }
 
 // Writes every --out, each on its own: one that fails is said (and an older file of its name
-// said to be left as it was) and the others are still written. Returns 1 if any failed, else 0.
+// said to be left as it was) and the others are still written. They replace older files of
+// their names together, once all are written (OutputFileSet): Ctrl-C while they are written
+// leaves the older files, never a mix. Returns 1 if any failed, else 0.
 int WriteOutputs(const GenerateFlags& flags, const LoadedTerrain& terrain, const Walk& walk) {
   int code = 0;
   std::string error;
+  OutputFileSet outputs;
   for (const std::string& out : flags.out) {
     const std::string ext = FileExtension(out);
     Status written;
@@ -438,6 +441,10 @@ int WriteOutputs(const GenerateFlags& flags, const LoadedTerrain& terrain, const
       }
       code = 1;
     }
+  }
+  for (const std::string& failure : outputs.Commit()) {
+    std::cerr << "footfall generate: " << failure << " (the other outputs are written)\n";
+    code = 1;
   }
   return code;
 }

@@ -1,9 +1,11 @@
 #include "footfall/terrain/output_file.h"
 
 #include <fcntl.h>
+#include <pthread.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <climits>
@@ -79,14 +81,45 @@ std::string FollowLinks(const std::string& path, bool* loop = nullptr) {
   return p;
 }
 
-// The temporary file being written, for RemoveTemporaryFileOnSignal's handler.
-std::atomic<const char*> g_temporary{nullptr};
+// The temporary files being written or waiting in a set, for RemoveTemporaryFileOnSignal's
+// handler: a slot each, claimed and freed without locks (the handler may run at any time).
+constexpr size_t kTemporarySlots = 256;
+std::atomic<const char*> g_temporaries[kTemporarySlots];
 
-void RemoveTemporaryAndReraise(int signal_number) {
-  const char* temporary = g_temporary.load();
-  if (temporary != nullptr) ::unlink(temporary);
+// Claims a slot for `name` (which must outlive the claim); the slot's index, or -1 when all are
+// taken.
+int ClaimTemporarySlot(const char* name) {
+  for (size_t i = 0; i < kTemporarySlots; ++i) {
+    const char* expected = nullptr;
+    if (g_temporaries[i].compare_exchange_strong(expected, name)) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+void FreeTemporarySlot(int slot) {
+  if (slot >= 0) g_temporaries[slot].store(nullptr);
+}
+
+void RemoveTemporariesAndReraise(int signal_number) {
+  for (auto& temporary : g_temporaries) {
+    const char* name = temporary.load();
+    if (name != nullptr) ::unlink(name);
+  }
   std::signal(signal_number, SIG_DFL);
   std::raise(signal_number);
+}
+
+// The signals RemoveTemporaryFileOnSignal handles, held back while a set is replaced.
+constexpr int kCleanedUpSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
+
+// Makes the rename of a file in `dir` ("" for the working directory) reach the disk with its
+// directory (best effort: the file is written).
+void SyncDirectory(const std::string& dir) {
+  const int dir_fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir_fd >= 0) {
+    ::fsync(dir_fd);
+    ::close(dir_fd);
+  }
 }
 
 // How a file is written: where (links followed), and whether in place or by rename.
@@ -145,9 +178,68 @@ Status PlanWrite(const std::string& path, WritePlan* plan, std::string* error) {
 
 }  // namespace
 
+// A file written to its temporary file, waiting for its set's Commit.
+struct WaitingFile {
+  std::string path;       // as given, for messages
+  std::string target;     // links followed
+  std::string dir;        // the target's directory, "" for the working directory
+  std::string temporary;  // its name is in g_temporaries[slot] until renamed or removed
+  int slot = -1;
+};
+
+struct OutputFileSet::State {
+  std::vector<std::unique_ptr<WaitingFile>> waiting;
+};
+
+namespace {
+
+// The set open on this thread, or null.
+thread_local OutputFileSet::State* t_open_set = nullptr;
+
+}  // namespace
+
+OutputFileSet::OutputFileSet() : state_(std::make_unique<State>()) {
+  if (t_open_set == nullptr) t_open_set = state_.get();
+}
+
+OutputFileSet::~OutputFileSet() {
+  if (t_open_set == state_.get()) t_open_set = nullptr;
+  for (const auto& file : state_->waiting) {
+    ::unlink(file->temporary.c_str());
+    FreeTemporarySlot(file->slot);
+  }
+}
+
+std::vector<std::string> OutputFileSet::Commit() {
+  if (t_open_set == state_.get()) t_open_set = nullptr;
+  std::vector<std::string> failures;
+  sigset_t held, before;
+  sigemptyset(&held);
+  for (int signal_number : kCleanedUpSignals) sigaddset(&held, signal_number);
+  pthread_sigmask(SIG_BLOCK, &held, &before);
+  for (const auto& file : state_->waiting) {
+    if (::rename(file->temporary.c_str(), file->target.c_str()) != 0) {
+      std::string message;
+      Fail("cannot write", file->path, errno, &message);
+      failures.push_back(message);
+      ::unlink(file->temporary.c_str());
+    }
+    FreeTemporarySlot(file->slot);
+  }
+  pthread_sigmask(SIG_SETMASK, &before, nullptr);
+  std::vector<std::string> synced;
+  for (const auto& file : state_->waiting) {
+    if (std::find(synced.begin(), synced.end(), file->dir) != synced.end()) continue;
+    SyncDirectory(file->dir);
+    synced.push_back(file->dir);
+  }
+  state_->waiting.clear();
+  return failures;
+}
+
 void RemoveTemporaryFileOnSignal() {
-  for (int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGQUIT})
-    std::signal(signal_number, RemoveTemporaryAndReraise);
+  for (int signal_number : kCleanedUpSignals)
+    std::signal(signal_number, RemoveTemporariesAndReraise);
   // Past the file size limit a write fails (EFBIG) and is reported, instead of killing the
   // process with the temporary file left behind.
   std::signal(SIGXFSZ, SIG_IGN);
@@ -198,10 +290,12 @@ Status ReplaceFile(const std::string& path, const std::function<bool(std::FILE*)
   const std::string dir = slash == std::string::npos ? "" : target.substr(0, slash + 1);
   const std::string name = slash == std::string::npos ? target : target.substr(slash + 1);
   // ".NAME.XXXXXX" beside it; a name too long for that takes a short temporary name.
-  std::string temp = dir + (name.size() <= 200 ? "." + name : std::string(".footfall")) + ".XXXXXX";
+  auto waiting = std::make_unique<WaitingFile>();
+  std::string& temp = waiting->temporary;
+  temp = dir + (name.size() <= 200 ? "." + name : std::string(".footfall")) + ".XXXXXX";
   const int fd = ::mkstemp(&temp[0]);
   if (fd < 0) return Fail("cannot open", path, errno, error);
-  g_temporary.store(temp.c_str());
+  const int slot = ClaimTemporarySlot(temp.c_str());
   if (exists) {
     ::fchmod(fd, st.st_mode & 07777);
     if (::fchown(fd, st.st_uid, st.st_gid) != 0) {
@@ -213,7 +307,7 @@ Status ReplaceFile(const std::string& path, const std::function<bool(std::FILE*)
   // Every failure from here removes the temporary file, and leaves the target as it was.
   auto abandon = [&](int why) {
     ::unlink(temp.c_str());
-    g_temporary.store(nullptr);
+    FreeTemporarySlot(slot);
     return Fail("cannot write", path, why, error);
   };
   std::FILE* file = ::fdopen(fd, "wb");
@@ -224,14 +318,18 @@ Status ReplaceFile(const std::string& path, const std::function<bool(std::FILE*)
   }
   const int failure = WriteAndClose(file, write);
   if (failure != 0) return abandon(failure);
-  if (::rename(temp.c_str(), target.c_str()) != 0) return abandon(errno);
-  g_temporary.store(nullptr);
-  // The rename itself reaches the disk with its directory (best effort: the file is written).
-  const int dir_fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dir_fd >= 0) {
-    ::fsync(dir_fd);
-    ::close(dir_fd);
+  // In an open set (with a slot for the signal handler), replaced at its Commit.
+  if (t_open_set != nullptr && slot >= 0) {
+    waiting->path = path;
+    waiting->target = target;
+    waiting->dir = dir;
+    waiting->slot = slot;
+    t_open_set->waiting.push_back(std::move(waiting));
+    return Status::kOk;
   }
+  if (::rename(temp.c_str(), target.c_str()) != 0) return abandon(errno);
+  FreeTemporarySlot(slot);
+  SyncDirectory(dir);
   return Status::kOk;
 }
 

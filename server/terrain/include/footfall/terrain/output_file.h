@@ -15,8 +15,10 @@
 
 #include <cstdio>
 #include <functional>
+#include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "footfall/terrain/status.h"
 
@@ -41,6 +43,31 @@ Status CheckWritable(const std::string& path, std::string* error);
 // the same path however spelt, links followed (also ones naming a file not there yet), or hard
 // links to one file.
 bool SameFile(const std::string& a, const std::string& b);
+
+// Files replaced together, such as one walk's outputs: while a set is open on a thread, each
+// ReplaceFile there writes its new content to its temporary file and leaves the target as it
+// was; Commit then replaces all of them, one rename after another with SIGINT, SIGTERM, SIGHUP
+// and SIGQUIT held back until the last, so that such a signal (Ctrl-C) leaves either every old
+// file or every new one, never a mix. Files written in place (devices, FIFOs, see above) are
+// written at once, and so is any file past the 256th waiting at a time. A set closed without
+// Commit removes its temporary files: the targets stay as they were. Sets do not nest.
+class OutputFileSet {
+ public:
+  OutputFileSet();
+  ~OutputFileSet();
+  OutputFileSet(const OutputFileSet&) = delete;
+  OutputFileSet& operator=(const OutputFileSet&) = delete;
+
+  // Replaces every file written in the set so far and closes it. Returns a message ("cannot
+  // write 'PATH': REASON") for each that could not be replaced (that target stays as it was);
+  // the others are replaced.
+  std::vector<std::string> Commit();
+
+  struct State;
+
+ private:
+  std::unique_ptr<State> state_;
+};
 
 // For programs (not libraries: it sets process-wide signal handlers): SIGINT, SIGTERM, SIGHUP and
 // SIGQUIT remove the temporary file being written before the process ends as they would end
