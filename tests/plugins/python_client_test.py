@@ -401,6 +401,15 @@ class SharedLogicTest(unittest.TestCase):
             for _ in range(depth - 2):
                 nested = [nested]
             self.assertEqual(ff.character.parse_json(json.dumps(nested)), nested)
+            # Deep brackets before a string of escaped quotes never closed: refused as JSON in
+            # one pass (removing its strings took minutes for 200 KB; this is 2 MB).
+            for end in ("", "\\"):
+                text = "[" * 70 + '"' + '\\"' * 1000000 + end + "]" * 70
+                with self.assertRaises(ff.FootfallError) as e:
+                    ff.character.parse_json(text, "quotes.json")
+                self.assertEqual(e.exception.status_name, "parse_error")
+                self.assertRegex(e.exception.message,
+                                 r"^quotes\.json: (Unterminated string|Invalid \\escape)")
             # Brackets inside strings are text, not nesting.
             self.assertEqual(ff.character.parse_json('{"name": "%s"}' % ("[" * 1000)),
                              {"name": "[" * 1000})
