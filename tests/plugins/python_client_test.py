@@ -482,6 +482,47 @@ class RpcTest(unittest.TestCase):
             steps = [(p[0], 0.5, p[2], 1.0, 0.0, 0.0) for p in points]
             self.assertEqual(self.s.next(t, steps, 0.3), local.next(lt, steps, 0.3))
 
+    def test_threads_sharing_a_session_take_turns_and_close_waits(self):
+        # Closing a session while another thread was in a call on it freed it under that call
+        # (a segfault of the interpreter); failures' messages crossed between the threads.
+        import threading
+        for _ in range(10):
+            s = ff.Session.rpc("127.0.0.1", self.server.port, timeout=5.0)
+            t = s.load_file(HILLS)
+            errors = []
+
+            def query():
+                try:
+                    for _ in range(2000):
+                        s.snap(t, [(10, 5, 10)] * 64)
+                except ff.FootfallError as e:
+                    errors.append(e.message)
+            worker = threading.Thread(target=query)
+            worker.start()
+            time.sleep(0.02)
+            s.close()
+            worker.join()
+            self.assertEqual(errors, ["the session is closed"])
+        t = self.s.load_file(HILLS)
+        crossed = []
+
+        def fail(call, expected):
+            for _ in range(300):
+                try:
+                    call()
+                except ff.FootfallError as e:
+                    if expected not in e.message:
+                        crossed.append(e.message)
+        threads = [threading.Thread(target=fail, args=(lambda: self.s.info(t + 1000),
+                                                       "no terrain with handle")),
+                   threading.Thread(target=fail, args=(
+                       lambda: self.s.load_file("/no/such/terrain.pts"), "terrain.pts"))]
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+        self.assertEqual(crossed, [])
+
     def test_server_killed_then_restarted(self):
         t = self.s.load_samples(flat_grid(), "flat")
         self.assertTrue(self.s.ping())

@@ -1,8 +1,10 @@
 """Session: one embedded engine or footfalld connection, with Pythonic errors."""
 
 import ctypes
+import functools
 import json
 import os
+import threading
 from array import array
 from collections import namedtuple
 
@@ -128,11 +130,24 @@ def _pointer(flat):
     return (ctypes.c_double * len(flat)).from_buffer(flat)
 
 
+def _one_call_at_a_time(method):
+    """Runs a Session method holding the session's lock: calls from several threads take turns
+    (as the C ABI's do), each failure's message is its own call's, and close() waits for a call
+    under way (closing a session another thread was calling freed it under that call: a crash)."""
+    @functools.wraps(method)
+    def locked(self, *args, **kwargs):
+        with self._lock:
+            return method(self, *args, **kwargs)
+    return locked
+
+
 class Session:
     """A footfall session. Open with Session.rpc(...) or Session.embedded(); close() or use
-    `with`. Not thread-safe: one session per thread. Methods raise FootfallError on failure."""
+    `with`. Calls from several threads take turns (close() waits for a call under way); open a
+    session per thread to query in parallel. Methods raise FootfallError on failure."""
 
     def __init__(self, handle, library, description):
+        self._lock = threading.RLock()
         self._h = handle
         self._lib = library
         self.description = description
@@ -176,6 +191,7 @@ class Session:
             raise FootfallError(INTERNAL_ERROR, "cannot open the embedded engine", "ffc_open_embedded")
         return cls(handle, lib, "embedded")
 
+    @_one_call_at_a_time
     def close(self):
         if self._h:
             self._lib.lib.ffc_close(self._h)
@@ -203,6 +219,7 @@ class Session:
             raise FootfallError(INVALID_ARGUMENT, "the session is closed", call)
         return self._h
 
+    @_one_call_at_a_time
     def last_error(self):
         if not self._h:
             return "the session is closed"
@@ -225,6 +242,7 @@ class Session:
 
     # -- terrains -----------------------------------------------------------------------------
 
+    @_one_call_at_a_time
     def load_file(self, path, separation=0.0):
         """Reads a terrain file on this machine and loads it; returns the terrain id.
         separation [world units] resamples meshes (0: the library's default)."""
@@ -236,6 +254,7 @@ class Session:
                     "ffc_load_file")
         return out.value
 
+    @_one_call_at_a_time
     def load_server_file(self, path, separation=0.0):
         """Loads a file under footfalld's data root (RPC) or a local path (embedded)."""
         h = self._handle("ffc_load_server_file")
@@ -247,6 +266,7 @@ class Session:
                     "ffc_load_server_file")
         return out.value
 
+    @_one_call_at_a_time
     def load_samples(self, samples, name="samples"):
         """Loads samples (x, y, z, nx, ny, nz) given as 6-tuples or one flat sequence; returns
         the terrain id."""
@@ -259,10 +279,12 @@ class Session:
                     "ffc_load_samples")
         return out.value
 
+    @_one_call_at_a_time
     def unload(self, terrain):
         self._check(self._lib.lib.ffc_unload(self._handle("ffc_unload"),
                                              _terrain(terrain, "ffc_unload")), "ffc_unload")
 
+    @_one_call_at_a_time
     def info(self, terrain):
         """(sample count, (min x, min y, min z, max x, max y, max z)) of a terrain."""
         h = self._handle("ffc_info")
@@ -272,6 +294,7 @@ class Session:
                                            bounds), "ffc_info")
         return count.value, tuple(bounds)
 
+    @_one_call_at_a_time
     def ping(self):
         """True when the server answers, False when it is unavailable; never raises for a
         missing server. Calls the RPC NULL procedure (ffc_ping), which footfalld answers however
@@ -294,6 +317,7 @@ class Session:
 
     # -- queries ------------------------------------------------------------------------------
 
+    @_one_call_at_a_time
     def _points(self, fn_name, terrain, points):
         h = self._handle(fn_name)
         terrain = _terrain(terrain, fn_name)
@@ -311,6 +335,7 @@ class Session:
         """The terrain normal at each point: a list of Foothold."""
         return self._points("ffc_normal", terrain, points)
 
+    @_one_call_at_a_time
     def next(self, terrain, steps, tolerance=0.0):
         """The next foothold for each step (foot x, y, z, direction x, y, z): a list of
         Foothold. tolerance <= 0: the candidate radius is the step length."""
@@ -326,6 +351,7 @@ class Session:
 
     # -- walks --------------------------------------------------------------------------------
 
+    @_one_call_at_a_time
     def check_character(self, data, name="character"):
         """Raises FootfallError naming the first problem of a character (a dict, or a character
         file's text) as the generator reads it; nothing is generated. A library without
@@ -350,6 +376,7 @@ class Session:
         text or None, message). request: a dict or JSON text (keys of footfall_c.h)."""
         return self.generate_json_with_notes(terrain, request)[:3]
 
+    @_one_call_at_a_time
     def generate_json_with_notes(self, terrain, request):
         """generate_json, and the walk's notes: (status, walk JSON text or None, message, notes).
         notes is a list of one-line texts, what `footfall generate` prints as "note:" lines (a
@@ -383,6 +410,7 @@ class Session:
         message = self.last_error() if (status != OK or walk is None) else ""
         return status, walk, message, notes
 
+    @_one_call_at_a_time
     def generate(self, terrain, request, chunk_steps=0, progress=None):
         """The walk as a dict (footfall's walk JSON). Raises WalkStopped (with .walk holding the
         keys made so far) when the walk stopped early, FootfallError when nothing was made.
