@@ -13,6 +13,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <mutex>
+#include <thread>
 
 namespace footfall {
 namespace {
@@ -240,6 +242,15 @@ std::vector<std::string> OutputFileSet::Commit() {
 void RemoveTemporaryFileOnSignal() {
   for (int signal_number : kCleanedUpSignals)
     std::signal(signal_number, RemoveTemporariesAndReraise);
+  // A thread that only waits, with no signal blocked, to take them while the others block
+  // every signal: libtirpc does for the length of each call, and Ctrl-C waited minutes for a
+  // --server-terrain load to finish.
+  static std::once_flag waiter;
+  std::call_once(waiter, [] {
+    std::thread([] {
+      for (;;) ::pause();
+    }).detach();
+  });
   // Past the file size limit a write fails (EFBIG) and is reported, instead of killing the
   // process with the temporary file left behind.
   std::signal(SIGXFSZ, SIG_IGN);
