@@ -327,6 +327,32 @@ TEST_CASE("TriangulatePolygon: ear clipping in the polygon's plane, a fan when c
     TriangulatePolygon(skewed, {0, 1, 2, 3}, &u);
     CHECK(u.size() == 2);
   }
+  SECTION("a non-convex polygon of thousands of corners is cut along its inside") {
+    // Zigzags of 600 to 8,000 corners, fanned when over 256: the fan covered the notches
+    // outside and held triangles facing the other way (a floor sampled half facing down).
+    for (const size_t teeth : {300u, 1000u, 4000u}) {
+      std::vector<Vec3> v;
+      std::vector<uint32_t> corners;
+      for (size_t i = 0; i < teeth; ++i) v.push_back({double(i), 0, i % 2 ? 1.0 : 0.5});
+      for (size_t i = teeth; i-- > 0;) v.push_back({double(i), 0, -1});
+      for (uint32_t i = 0; i < v.size(); ++i) corners.push_back(i);
+      Triangles t;
+      INFO(teeth << " teeth");
+      CHECK(TriangulatePolygon(v, corners, &t));
+      CHECK(t.size() == v.size() - 2);
+      double shoelace = 0;  // the polygon's area, facing -y as its corners run
+      for (size_t i = 0; i < v.size(); ++i) {
+        const Vec3 &p = v[i], &q = v[(i + 1) % v.size()];
+        shoelace += 0.5 * (p.z * q.x - p.x * q.z);
+      }
+      const Vec3 facing{0, shoelace > 0 ? 1.0 : -1.0, 0};
+      size_t against = 0;
+      for (const auto& tri : t)
+        against += !(Dot(Cross(v[tri[1]] - v[tri[0]], v[tri[2]] - v[tri[0]]), facing) > 0);
+      CHECK(against == 0);
+      CHECK(area(v, t, facing) == Approx(std::fabs(shoelace)));
+    }
+  }
   SECTION("large polygons: convex ones in linear time, non-convex ones past the limit fanned") {
     // A 200,000-corner circle (ear clipping took seconds at 16,000), and a zigzag of
     // 2 * kMaxClippedCorners corners (minutes at a few thousand).

@@ -201,6 +201,94 @@ void MeshBounds(const TriangleMesh& mesh, Vec3* lo, Vec3* hi) {
   }
 }
 
+namespace {
+
+// Ear clipping of a large non-convex polygon in the plane of `normal` (its Newell normal): the
+// corners in a ring of links, each ear tested against the reflex corners alone (a triangle
+// holding another corner of a simple polygon holds a reflex one), and after each ear only its
+// two neighbours change. Returns false when no ear is left (self-intersecting: the rest is
+// fanned from its first remaining corner).
+bool ClipLargePolygon(const std::vector<Vec3>& vertices, const std::vector<uint32_t>& corners,
+                      const Vec3& normal, std::vector<std::array<uint32_t, 3>>* triangles) {
+  const size_t n = corners.size();
+  const Vec3 origin = vertices[corners[0]];
+  std::vector<Vec3> at(n);
+  for (size_t i = 0; i < n; ++i) at[i] = vertices[corners[i]] - origin;
+  std::vector<size_t> prev(n), next(n);
+  for (size_t i = 0; i < n; ++i) prev[i] = (i + n - 1) % n, next[i] = (i + 1) % n;
+  std::vector<char> removed(n, 0), reflex(n, 0);
+  auto turn = [&](size_t i) {
+    const Vec3 &a = at[prev[i]], &b = at[i], &c = at[next[i]];
+    return Dot(Cross(b - a, c - b), normal);
+  };
+  std::vector<size_t> reflexes;  // corners once reflex (a clipped ear's neighbour may turn convex)
+  for (size_t i = 0; i < n; ++i)
+    if (!(turn(i) > 0)) reflex[i] = 1, reflexes.push_back(i);
+  auto is_ear = [&](size_t i) {
+    if (reflex[i]) return false;
+    const Vec3 &a = at[prev[i]], &b = at[i], &c = at[next[i]];
+    for (const size_t j : reflexes) {
+      if (removed[j] || !reflex[j] || j == prev[i] || j == next[i]) continue;
+      const Vec3& p = at[j];
+      if (p == a || p == b || p == c) continue;
+      if (Dot(Cross(b - a, p - a), normal) >= 0 && Dot(Cross(c - b, p - b), normal) >= 0 &&
+          Dot(Cross(a - c, p - c), normal) >= 0)
+        return false;
+    }
+    return true;
+  };
+  auto unlink = [&](size_t i) {
+    removed[i] = 1;
+    next[prev[i]] = next[i], prev[next[i]] = prev[i];
+    for (const size_t neighbour : {prev[i], next[i]}) {
+      const bool now_reflex = !(turn(neighbour) > 0);
+      if (now_reflex && !reflex[neighbour]) reflexes.push_back(neighbour);  // (crossing itself)
+      reflex[neighbour] = now_reflex;
+    }
+  };
+  size_t left = n, cursor = 1 % n, tried = 0;
+  const double flattest = 1e-9;
+  while (left > 3) {
+    if (is_ear(cursor)) {
+      triangles->push_back({corners[prev[cursor]], corners[cursor], corners[next[cursor]]});
+      const size_t after = next[cursor];
+      unlink(cursor);
+      --left, cursor = after, tried = 0;
+      // Drop the corners no longer reflex from the list now and then (it only shrinks).
+      if (reflexes.size() > 64 && left * 2 < reflexes.size()) {
+        reflexes.erase(std::remove_if(reflexes.begin(), reflexes.end(),
+                                      [&](size_t j) { return removed[j] || !reflex[j]; }),
+                       reflexes.end());
+      }
+      continue;
+    }
+    cursor = next[cursor];
+    if (++tried <= left) continue;
+    // A whole round without an ear: a straight corner (collinear with its neighbours, as
+    // rounding leaves it) goes without a triangle, else the polygon crosses itself.
+    size_t flat = n;
+    for (size_t i = cursor, k = 0; k < left && flat == n; ++k, i = next[i]) {
+      const double scale =
+          Length(at[i] - at[prev[i]]) * Length(at[next[i]] - at[i]) * Length(normal);
+      if (!(scale > 0) || std::fabs(turn(i)) <= flattest * scale) flat = i;
+    }
+    if (flat == n) {
+      std::vector<uint32_t> rest;
+      for (size_t i = cursor, k = 0; k < left; ++k, i = next[i]) rest.push_back(corners[i]);
+      for (size_t i = 2; i < rest.size(); ++i)
+        triangles->push_back({rest[0], rest[i - 1], rest[i]});
+      return false;
+    }
+    cursor = next[flat];
+    unlink(flat);
+    --left, tried = 0;
+  }
+  triangles->push_back({corners[prev[cursor]], corners[cursor], corners[next[cursor]]});
+  return true;
+}
+
+}  // namespace
+
 bool TriangulatePolygon(const std::vector<Vec3>& vertices, const std::vector<uint32_t>& corners,
                         std::vector<std::array<uint32_t, 3>>* triangles) {
   const size_t n = corners.size();
@@ -232,11 +320,11 @@ bool TriangulatePolygon(const std::vector<Vec3>& vertices, const std::vector<uin
     fan(corners);
     return true;
   }
-  // Ear clipping takes up to n^3 steps: polygons of more corners are fanned.
   if (n > kMaxClippedCorners) {
     fan(corners);
     return false;
   }
+  if (n > kMaxSearchedCorners) return ClipLargePolygon(vertices, corners, normal, triangles);
   std::vector<uint32_t> rest(corners);
   bool clipped_all = true;
   while (rest.size() > 3) {

@@ -79,8 +79,12 @@ MeshTurnover TurnOutward(TriangleMesh* mesh, const Vec3& up);
 // sampler's cells until a fine separation was refused); both (0, 0, 0) without triangles.
 void MeshBounds(const TriangleMesh& mesh, Vec3* lo, Vec3* hi);
 
-// Non-convex polygons of more corners than this are fanned (ear clipping takes up to n^3 steps).
-constexpr size_t kMaxClippedCorners = 256;
+// Non-convex polygons of up to this many corners are clipped by a search of every corner for
+// each ear (up to n^3 steps, its triangles as before); larger ones keep a list of their reflex
+// corners and look at the neighbours of each ear clipped (about n * reflex corners steps).
+constexpr size_t kMaxSearchedCorners = 256;
+// Non-convex polygons of more corners than this are fanned (clipping would take seconds each).
+constexpr size_t kMaxClippedCorners = 16384;
 
 // Triangulates the polygon `corners` (indices into `vertices`, in order around it) by ear
 // clipping in the plane of its Newell normal, appending triangles wound as the polygon is to
