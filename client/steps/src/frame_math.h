@@ -22,10 +22,13 @@ inline Vec3 NormalizeOr(const Vec3& v, const Vec3& fallback) {
   return len > 1e-12 ? v / len : fallback;
 }
 
-// The unit normal of the plane fitted to points[0..n) (least squares), on the side of the unit
-// vector `side`; `side` itself when the points lie (nearly) on a line or the plane leans more
-// than 60 degrees from it. (The normal is the covariance's direction of least spread, found
-// from the largest of its three 2 x 2 minors.)
+// The unit normal of the plane fitted to points[0..n), on the side of the unit vector `side`;
+// `side` itself when the points lie (nearly) on a line or the plane leans more than 60 degrees
+// from it. (The least-squares fit of the points' offsets along the axis the plane faces most,
+// from the largest of the covariance's three 2 x 2 minors: the points' plane when they lie in
+// one, else leaning toward that axis, so not quite the same for points turned about another.
+// The orthogonal fit, the covariance's direction of least spread, changed walks on stairs: an
+// octopod's hind foot then stopped at a riser's foot.)
 inline Vec3 FittedPlaneNormal(const Vec3* points, size_t n, const Vec3& side) {
   if (n < 3) return side;
   Vec3 c;
