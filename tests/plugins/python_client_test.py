@@ -1083,6 +1083,53 @@ class MayaKeyWalkTest(unittest.TestCase):
             generate[0]()
             self.assertEqual(warnings, ["footfall: Object pCube1.vtx[0] is invalid"])
 
+    def test_character_setup_takes_the_body_apart_from_the_handles(self):
+        # With only the IK handles selected, the first became the body and foot L both (the
+        # walk's keys overwrote each other on it); a body selected alone was ignored.
+        calls, fields = [], {}
+        cmds = types.ModuleType("maya.cmds")
+
+        def record(name):
+            def call(*args, **kwargs):
+                calls.append((name, args, kwargs))
+                return "%s%d" % (name, len(calls))
+            return call
+        for name in ("window", "deleteUI", "columnLayout", "frameLayout", "textFieldGrp",
+                     "intFieldGrp", "floatFieldGrp", "checkBoxGrp", "button", "text",
+                     "setParent", "showWindow", "warning", "confirmDialog"):
+            setattr(cmds, name, record(name))
+
+        def text_field_button_grp(*args, **kwargs):
+            if kwargs.get("q"):
+                return fields[args[0]].get("text", "")
+            if kwargs.get("e"):
+                fields[args[0]].update(kwargs)
+                return None
+            name = "field%d" % len(fields)
+            fields[name] = dict(kwargs)
+            return name
+        cmds.textFieldButtonGrp = text_field_button_grp
+        with self._footfall_maya(cmds) as footfall_maya:
+            footfall_maya.show()
+            by_label = {f["label"]: f for f in fields.values()}
+            by_label["Character file"]["text"] = os.path.join(CHARACTERS, "biped.json")
+            made = []
+            footfall_maya.character_setup = (
+                lambda path, ik_handles=None, body=None: made.append((ik_handles, body)))
+            setup = [kw["command"] for name, _, kw in calls
+                     if name == "button" and kw.get("label", "").startswith("Set Up")]
+            self.assertEqual(len(setup), 1)
+            handles = {"L": "ik_L", "R": "ik_R"}
+            for selected, expected in ((["ik_L", "ik_R"], (handles, None)),
+                                       (["hips"], (None, "hips")),
+                                       (["hips", "ik_L", "ik_R"], (handles, "hips")),
+                                       (["ik_R", "hips", "ik_L"], (handles, "hips")),
+                                       ([], (None, None))):
+                cmds.ls = lambda **kwargs: list(selected)
+                setup[0]()
+                self.assertEqual(made[-1], expected, selected)
+            self.assertEqual([c for c in calls if c[0] == "warning"], [])
+
     def test_import_of_tracks_without_keys_changes_nothing(self):
         # Tracks of the rig without keys (alone, or beside another's keyed track) cut the rig's
         # keys from the walk's first frame (frame 0 when no track had a key), and with no rig

@@ -525,9 +525,12 @@ def show():
         data = character.load(mc.textFieldButtonGrp(cfile, q=True, text=True))
         names = [f for f, _ in character.feet(data)]
         handles = {f: s for f in names for s in sel if s == f or s.endswith("_" + f)}
+        # The body: the first selected that is no foot's handle (the first handle selected
+        # alone became the body and foot both; a body selected alone was ignored).
+        bodies = [s for s in sel if s not in handles.values()]
         character_setup(mc.textFieldButtonGrp(cfile, q=True, text=True),
-                        ik_handles=handles or None, body=sel[0] if handles else None)
-    mc.button(label="Set Up (select body then IK handles, or nothing)", command=setup)
+                        ik_handles=handles or None, body=bodies[0] if bodies else None)
+    mc.button(label="Set Up (select body and/or IK handles, or nothing)", command=setup)
     mc.setParent("..")
 
     mc.frameLayout(label="Generate Walk", collapsable=True)
