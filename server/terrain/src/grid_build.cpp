@@ -19,7 +19,7 @@ using detail::kBlockCells;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // GridStats::spacing is measured on cells grown to hold about this many samples each, whatever
 // the query cells hold: callers size their checks by it (the step generator's swing arcs).
-constexpr double kSpacingSamplesPerCell = 12;
+constexpr double kSpacingSamplesPerCell = 20;
 
 // Total cells for a cell size h over local extents e, saturating in double.
 double CellCount(const double e[3], double h) {
@@ -79,6 +79,64 @@ size_t CountOccupiedCells(const std::vector<float>& local, const double lo[3], c
     if (!occupied[cell]) occupied[cell] = true, ++count;
   }
   return count;
+}
+
+// Cells of side h over local extents e that hold samples, and in *crossing how many more cells
+// the surface crosses than its area in cell faces, averaged over the samples: a plane of area A
+// with unit normal n crosses about A (|nx| + |ny| + |nz|) / h^2 cubes of side h (1 for a
+// surface facing along an axis, up to sqrt(3) across the diagonal). Taken from each cell's mean
+// normal where its samples' normals agree (the surface's direction at the cell's scale, not the
+// roughness within it), else from each sample's own (an edge or a corner, as of a stair).
+size_t OccupiedCellsAndCrossing(const std::vector<float>& local, const std::vector<Vec3>& normals,
+                                const double lo[3], const double e[3], double h, double* crossing) {
+  uint32_t dims[3];
+  for (int a = 0; a < 3; ++a) dims[a] = AxisCells(e[a], h);
+  const double inv = 1 / h;
+  auto coord = [&](float v, int a) -> size_t {
+    const double t = (v - lo[a]) * inv;
+    if (!(t > 0)) return 0;
+    if (t >= static_cast<double>(dims[a])) return dims[a] - 1;
+    return static_cast<size_t>(t);
+  };
+  auto unit = [](const Vec3& v) {
+    const double len = Length(v);
+    return len > 0 ? v / len : Vec3{};
+  };
+  auto across = [](const Vec3& v) {
+    const double len = Length(v);
+    return len > 0 ? (std::fabs(v.x) + std::fabs(v.y) + std::fabs(v.z)) / len : 1.0;
+  };
+  constexpr uint32_t kEmpty = std::numeric_limits<uint32_t>::max();
+  std::vector<uint32_t> slot_of(size_t{dims[0]} * dims[1] * dims[2], kEmpty);
+  std::vector<uint32_t> slot_cell;  // per sample, its cell's slot
+  slot_cell.reserve(normals.size());
+  std::vector<Vec3> sum;
+  std::vector<uint32_t> count;
+  for (size_t i = 0; 3 * i + 2 < local.size(); ++i) {
+    const float* p = &local[3 * i];
+    const size_t cell = (coord(p[2], 2) * dims[1] + coord(p[1], 1)) * dims[0] + coord(p[0], 0);
+    if (slot_of[cell] == kEmpty) {
+      slot_of[cell] = static_cast<uint32_t>(sum.size());
+      sum.emplace_back();
+      count.push_back(0);
+    }
+    const uint32_t slot = slot_of[cell];
+    sum[slot] += unit(normals[i]);
+    ++count[slot];
+    slot_cell.push_back(slot);
+  }
+  constexpr double kAgree = 0.9;  // the mean of the cell's unit normals at least this long
+  double total = 0;
+  for (size_t i = 0; i < slot_cell.size(); ++i) {
+    const uint32_t slot = slot_cell[i];
+    const double c = count[slot];
+    total += Dot(sum[slot], sum[slot]) >= kAgree * kAgree * c * c ? across(sum[slot])
+                                                                  : across(normals[i]);
+  }
+  *crossing = slot_cell.empty()
+                  ? 1.0
+                  : std::clamp(total / static_cast<double>(slot_cell.size()), 1.0, std::sqrt(3.0));
+  return sum.size();
 }
 
 }  // namespace
@@ -160,11 +218,12 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
   // 4. Cell size: the smallest that fits the memory cap, then grown until occupied cells hold
   //    about options.samples_per_cell samples (a surface's occupancy falls as 1/h^2). The
   //    sample spacing is measured on cells grown to kSpacingSamplesPerCell instead, so that it
-  //    does not follow the query cells' size.
+  //    does not follow the query cells' size, less the extra cells a surface leaning across
+  //    the axes crosses, so that it does not follow the terrain's orientation.
   const double budget = std::max(64.0, options.cells_per_sample * static_cast<double>(n));
   const double max_extent = std::max({extent[0], extent[1], extent[2]});
-  double h = 1, spacing_h = 1;
-  size_t spacing_occupied = 0;  // 0: count them in the final grid (spacing_h == h)
+  double h = 1, spacing_h = 1, crossing = 1;
+  size_t spacing_occupied = 0;  // 0: count them in the final grid (no extent)
   if (max_extent > 0) {
     double h_hi = max_extent, h_lo = max_extent / (budget + 1);
     for (int it = 0; it < 100 && h_hi > h_lo * (1 + 1e-12); ++it) {
@@ -179,7 +238,8 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
     };
     h = grown(options.samples_per_cell);
     spacing_h = grown(kSpacingSamplesPerCell);
-    if (spacing_h != h) spacing_occupied = CountOccupiedCells(local, g.grid_lo_, extent, spacing_h);
+    spacing_occupied =
+        OccupiedCellsAndCrossing(local, samples.normals, g.grid_lo_, extent, spacing_h, &crossing);
   }
   g.cell_size_ = h, g.inv_cell_size_ = 1 / h;
   for (int a = 0; a < 3; ++a) g.dims_[a] = AxisCells(extent[a], h);
@@ -264,9 +324,9 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
   st.cell_size = h;
   st.occupied_cells = occupied_cells;
   if (spacing_occupied == 0) spacing_occupied = occupied_cells;
-  st.spacing =
-      n > 0 ? spacing_h * std::sqrt(static_cast<double>(spacing_occupied) / static_cast<double>(n))
-            : 0;
+  st.spacing = n > 0 ? spacing_h * std::sqrt(static_cast<double>(spacing_occupied) /
+                                             (static_cast<double>(n) * crossing))
+                     : 0;
   st.bytes = bytes;
   st.max_rounding = std::max(std::sqrt(rounding2), tiny_rounding);
   const double* o = g.origin_;

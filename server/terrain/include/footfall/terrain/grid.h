@@ -63,8 +63,10 @@ struct GridStats {
   size_t occupied_cells = 0;
   // [Units: wu] The typical distance between neighbouring samples, taking them as a surface: the
   // side of the square each sample covers, from how many cells they occupy in a grid of about
-  // 12 samples per occupied cell (not the query cells: it does not change with
-  // GridOptions::samples_per_cell). 0 for no samples.
+  // 20 samples per occupied cell (not the query cells: it does not change with
+  // GridOptions::samples_per_cell), less the extra cells a surface crosses where it leans
+  // across the axes, so that it stays within a per cent or two however the terrain is turned
+  // (it read up to 15% wider on ground turned 37 degrees). 0 for no samples.
   double spacing = 0;
   size_t bytes = 0;             // the grid's single allocation
   Vec3 bounds_min, bounds_max;  // world-space bounds of all samples
