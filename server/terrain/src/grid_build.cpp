@@ -98,45 +98,45 @@ size_t OccupiedCellsAndCrossing(const std::vector<float>& local, const std::vect
     if (t >= static_cast<double>(dims[a])) return dims[a] - 1;
     return static_cast<size_t>(t);
   };
-  auto unit = [](const Vec3& v) {
-    const double len = Length(v);
-    return len > 0 ? v / len : Vec3{};
-  };
-  auto across = [](const Vec3& v) {
-    const double len = Length(v);
-    return len > 0 ? (std::fabs(v.x) + std::fabs(v.y) + std::fabs(v.z)) / len : 1.0;
+  // Per occupied cell: the sum of its samples' unit normals, of their |nx| + |ny| + |nz|, and
+  // their count.
+  struct CellNormals {
+    Vec3 sum;
+    double across = 0;
+    uint32_t count = 0;
   };
   constexpr uint32_t kEmpty = std::numeric_limits<uint32_t>::max();
   std::vector<uint32_t> slot_of(size_t{dims[0]} * dims[1] * dims[2], kEmpty);
-  std::vector<uint32_t> slot_cell;  // per sample, its cell's slot
-  slot_cell.reserve(normals.size());
-  std::vector<Vec3> sum;
-  std::vector<uint32_t> count;
+  std::vector<CellNormals> cells;
   for (size_t i = 0; 3 * i + 2 < local.size(); ++i) {
     const float* p = &local[3 * i];
     const size_t cell = (coord(p[2], 2) * dims[1] + coord(p[1], 1)) * dims[0] + coord(p[0], 0);
     if (slot_of[cell] == kEmpty) {
-      slot_of[cell] = static_cast<uint32_t>(sum.size());
-      sum.emplace_back();
-      count.push_back(0);
+      slot_of[cell] = static_cast<uint32_t>(cells.size());
+      cells.emplace_back();
     }
-    const uint32_t slot = slot_of[cell];
-    sum[slot] += unit(normals[i]);
-    ++count[slot];
-    slot_cell.push_back(slot);
+    CellNormals& c = cells[slot_of[cell]];
+    const Vec3& v = normals[i];
+    const double len2 = Dot(v, v);
+    // Normals are unit once validated: the square root only for those that are not.
+    const Vec3 u = std::fabs(len2 - 1) < 1e-12 ? v : len2 > 0 ? v / std::sqrt(len2) : Vec3{};
+    c.sum += u;
+    c.across += len2 > 0 ? std::fabs(u.x) + std::fabs(u.y) + std::fabs(u.z) : 1.0;
+    ++c.count;
   }
   constexpr double kAgree = 0.9;  // the mean of the cell's unit normals at least this long
-  double total = 0;
-  for (size_t i = 0; i < slot_cell.size(); ++i) {
-    const uint32_t slot = slot_cell[i];
-    const double c = count[slot];
-    total += Dot(sum[slot], sum[slot]) >= kAgree * kAgree * c * c ? across(sum[slot])
-                                                                  : across(normals[i]);
+  double total = 0, samples = 0;
+  for (const CellNormals& c : cells) {
+    const double count = c.count, len2 = Dot(c.sum, c.sum);
+    samples += count;
+    if (len2 >= kAgree * kAgree * count * count)
+      total +=
+          count * (std::fabs(c.sum.x) + std::fabs(c.sum.y) + std::fabs(c.sum.z)) / std::sqrt(len2);
+    else
+      total += c.across;
   }
-  *crossing = slot_cell.empty()
-                  ? 1.0
-                  : std::clamp(total / static_cast<double>(slot_cell.size()), 1.0, std::sqrt(3.0));
-  return sum.size();
+  *crossing = samples > 0 ? std::clamp(total / samples, 1.0, std::sqrt(3.0)) : 1.0;
+  return cells.size();
 }
 
 }  // namespace
