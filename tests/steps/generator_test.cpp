@@ -314,6 +314,51 @@ TEST_CASE("Multipeds walk around a sphere, bipeds stop where it gets too steep",
   }
 }
 
+TEST_CASE("An insect inside a thin-walled pipe stands on the inner face and not the outer one",
+          "[steps][generator]") {
+  // A pipe of radius 0.5 m along z with a 2 cm wall, both faces sampled every ~7 mm. The rests
+  // laid on the tangent plane at the start fall about 2 cm outside the curved inner face,
+  // nearer the outer one: the hexapod stood on the outside, hanging upside down below the pipe,
+  // its legs crossing under it.
+  const Character c = LoadShipped("hexapod");
+  const double inner = 0.5, wall = 0.02, spacing = 0.007, length = 1.6;
+  RawSamples pipe;
+  for (const double r : {inner, inner + wall}) {
+    const int around = static_cast<int>(2 * kPi * r / spacing);
+    const int along = static_cast<int>(length / spacing);
+    for (int k = 0; k <= along; ++k)
+      for (int i = 0; i < around; ++i) {
+        const double a = 2 * kPi * i / around, x = std::cos(a), y = std::sin(a);
+        const double facing = r == inner ? -1 : 1;  // the inner face looks at the axis
+        pipe.push_back({r * x, r * y, k * spacing}, {facing * x, facing * y, 0});
+      }
+  }
+  Terrain t = LoadTerrain(pipe, spacing);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {0, -0.45, 0.4};  // 5 cm above the inner floor
+  o.heading = {0, 0, 1};
+  o.steps = 20;
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CHECK(w.stopped.empty());
+  size_t on_inner = 0, keys = 0;
+  for (const WalkTrack& track : w.tracks) {
+    if (track.kind != TrackKind::kFoot) continue;
+    for (const WalkKey& k : track.keys) {
+      if (k.phase == KeyPhase::kMid) continue;
+      ++keys;
+      on_inner += std::fabs(std::hypot(k.position.x, k.position.y) - inner) < 1e-3;
+    }
+  }
+  CHECK(keys > 0);
+  CHECK(on_inner == keys);
+  // The body inside the pipe, above its floor, its up toward the axis.
+  CHECK(Body(w).keys[0].position.y > -inner);
+  CHECK(BodyUp(Body(w).rotations[0]).y > 0.8);
+  CheckWalk(t, c, o, w);
+}
+
 TEST_CASE("A goal off the terrain is reached across the ground whatever its height",
           "[steps][generator]") {
   // Multipeds' up leans with the ground: their goals were judged along it, so on a 15-degree

@@ -188,6 +188,9 @@ Status Generator::Setup(std::string* error) {
   s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()), "snap feet",
             error);
   if (s == Status::kOk)
+    s = SnapFeetFacingUp(points_.data(), answers_.data(), points_.size(), feet, agents_.data(),
+                         error);
+  if (s == Status::kOk)
     s = SeparateSharedFeet(points_.data(), answers_.data(), points_.size(), feet, error);
   if (s != Status::kOk) return s;
   // 4. The body at the feet's centroid, raised by body_height along its up (multipeds: BodyUp;
@@ -297,6 +300,45 @@ std::vector<int> Generator::CrowdedStarts(const Vec3* places, const Foothold* st
     if (crowded[i] < 0) cells[c].push_back(i);  // only characters that walk keep others off
   }
   return crowded;
+}
+
+Status Generator::SnapFeetFacingUp(const Vec3* places, Foothold* feet, size_t total, size_t count,
+                                   const Agent* agents, std::string* error) {
+  if (count == 0) return Status::kOk;
+  auto faces_away = [&](size_t f) {
+    return feet[f].status == Status::kOk && Dot(feet[f].normal, agents[f / count].up) < 0;
+  };
+  std::vector<size_t> turned;
+  std::vector<double> lift;
+  for (size_t f = 0; f < total; ++f) {
+    if (!faces_away(f)) continue;
+    turned.push_back(f);
+    lift.push_back(std::max(2 * Distance(places[f], feet[f].point), gap_ / 2));
+  }
+  std::vector<Vec3> lifted;
+  std::vector<Foothold> again;
+  while (!turned.empty()) {
+    lifted.clear();
+    for (size_t i = 0; i < turned.size(); ++i)
+      lifted.push_back(places[turned[i]] + agents[turned[i] / count].up * lift[i]);
+    again.assign(lifted.size(), Foothold{});
+    const Status s = Check(session_.Snap(terrain_, lifted.data(), lifted.size(), again.data()),
+                           "snap feet", error);
+    if (s != Status::kOk) return s;
+    size_t kept = 0;
+    for (size_t i = 0; i < turned.size(); ++i) {
+      const size_t f = turned[i];
+      if (again[i].status == Status::kOk && Dot(again[i].normal, agents[f / count].up) > 0 &&
+          Distance(places[f], again[i].point) <= c_.reach) {
+        feet[f] = again[i];
+        continue;
+      }
+      if (2 * lift[i] > c_.reach) continue;  // none within reach: as it snapped
+      turned[kept] = f, lift[kept] = 2 * lift[i], ++kept;
+    }
+    turned.resize(kept), lift.resize(kept);
+  }
+  return Status::kOk;
 }
 
 Status Generator::SeparateSharedFeet(const Vec3* places, Foothold* feet, size_t total, size_t count,

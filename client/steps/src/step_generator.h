@@ -255,6 +255,14 @@ class Generator {
   //    feet, `count` a character, `feet` their snaps, updated.
   Status SeparateSharedFeet(const Vec3* places, Foothold* feet, size_t total, size_t count,
                             std::string* error);
+  // 3. Feet whose nearest sample faces away from their character's up: on the inside of a
+  //    pipe (a concave surface) the rests laid on the start's tangent plane fall outside the
+  //    inner face, nearer a thin wall's outer face, where the character then hung upside down.
+  //    Each snaps again from its rest lifted along the up, twice as far each time up to `reach`,
+  //    and takes the first sample facing the up. `places`, `total`, `count` and `feet` as for
+  //    SeparateSharedFeet; `agents` the characters in order.
+  Status SnapFeetFacingUp(const Vec3* places, Foothold* feet, size_t total, size_t count,
+                          const Agent* agents, std::string* error);
   // For each of the n crowd starts (places on the grid, and their snaps), another start nearer
   // than `apart` that keeps it out, or -1. Starts that snapped nearer their places keep out
   // those that moved farther (then those earlier in the grid the later); a start kept out keeps
