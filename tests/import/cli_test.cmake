@@ -89,6 +89,17 @@ file(WRITE "${WORK}/upper.stl" "SOLID x\nfacet normal 0 1 0\nouter loop\nvertex 
      "vertex 1 0 0\nvertex 0 0 1\nendloop\nendfacet\nENDSOLID x\n")
 expect(EXIT_NONZERO "upper.stl: an ASCII STL must begin with 'solid' in lower case"
        terrain info "${WORK}/upper.stl")
+# A byte order mark before an ASCII STL's 'solid' or a PLY's 'ply' is named (the STL was called
+# a truncated binary STL of billions of triangles, the PLY's first line not 'ply').
+file(WRITE "${WORK}/bom.stl" "${bom}solid x\nfacet normal 0 1 0\nouter loop\nvertex 0 0 0\n"
+     "vertex 1 0 0\nvertex 0 0 1\nendloop\nendfacet\nendsolid x\n")
+expect(EXIT_NONZERO "bom.stl: starts with a UTF-8 byte order mark before 'solid'"
+       terrain info "${WORK}/bom.stl")
+file(WRITE "${WORK}/bom.ply" "${bom}ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+     "property float y\nproperty float z\nelement face 1\n"
+     "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 0 1\n3 0 2 1\n")
+expect(EXIT_NONZERO "bom.ply:1: starts with a UTF-8 byte order mark before 'ply'"
+       terrain info "${WORK}/bom.ply")
 # OFF counts on the header line and '#' comments (OpenMesh read no vertices, or bad faces), a
 # PLY vertex list property (it read no faces), a binary STL longer than its triangles.
 file(WRITE "${WORK}/oneline.off" "OFF 3 1 0\n0 0 0\n1 0 0\n0 0 1\n3 0 2 1\n")

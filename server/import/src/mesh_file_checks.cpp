@@ -490,6 +490,12 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
   std::string line;
   size_t number = 0;
   if (!lines.Next(&line) || StripComment(line) != "ply") {
+    // A byte order mark before 'ply' (a Windows editor's): the line reads 'ply' on screen.
+    if (line.compare(0, 6, "\xEF\xBB\xBFply") == 0)
+      return Fail(At(path, 1),
+                  "starts with a UTF-8 byte order mark before 'ply', which PLY readers do not "
+                  "take: save it without the mark",
+                  error);
     return Fail(At(path, 1), "expected the header line 'ply'", error);
   }
   number = 1;
@@ -945,6 +951,16 @@ Status ParseStlFile(const std::string& path, ParsedMesh* out, std::string* error
       }
       return Status::kOk;
     }
+  }
+  // A byte order mark before 'solid' (a Windows editor's): read as a binary STL's header, it
+  // declared some billions of triangles.
+  if (head.size() >= 8 && head.compare(0, 3, "\xEF\xBB\xBF") == 0 &&
+      std::equal(head.begin() + 3, head.begin() + 8, "solid",
+                 [](char a, char b) { return std::tolower(static_cast<unsigned char>(a)) == b; })) {
+    return Fail(path,
+                "starts with a UTF-8 byte order mark before 'solid', which makes OpenMesh read "
+                "it as a binary STL: save it without the mark",
+                error);
   }
   if (head.size() >= 5 && head.compare(0, 5, "solid") != 0 &&
       std::equal(head.begin(), head.begin() + 5, "solid",
