@@ -523,6 +523,16 @@ class RpcTest(unittest.TestCase):
             thread.join()
         self.assertEqual(crossed, [])
 
+    def test_a_local_server_on_ipv6_loopback(self):
+        # LocalServer(host="::1") passed --listen ::1:0, which footfalld refuses: it never
+        # started.
+        for host in ("::1", "[::1]"):
+            with ff.LocalServer(host=host).start() as server:
+                with ff.Session.rpc("::1", server.port, timeout=5.0) as s:
+                    self.assertIs(s.ping(), True)
+                    t = s.load_file(HILLS)
+                    self.assertTrue(s.snap(t, [(10, 5, 10)])[0].ok)
+
     def test_server_killed_then_restarted(self):
         t = self.s.load_samples(flat_grid(), "flat")
         self.assertTrue(self.s.ping())

@@ -68,7 +68,10 @@ class LocalServer:
     def _start(self, exe, timeout):
         self._dir = tempfile.mkdtemp(prefix="footfalld-")
         port_file = os.path.join(self._dir, "port")
-        args = [exe, "--listen", "%s:%d" % (self.host, self.requested_port),
+        # An IPv6 address in brackets, as footfalld's --listen takes it (::1:0 was refused).
+        host = "[%s]" % self.host if ":" in self.host and not self.host.startswith("[") \
+            else self.host
+        args = [exe, "--listen", "%s:%d" % (host, self.requested_port),
                 "--port-file", port_file, "--no-rpcbind"]
         if self.data_root:
             args += ["--data-root", self.data_root]
