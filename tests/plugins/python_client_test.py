@@ -841,9 +841,13 @@ class RotationTest(unittest.TestCase):
         def mul(p, q):
             return [[sum(p[i][k] * q[k][j] for k in range(3)) for j in range(3)]
                     for i in range(3)]
-        if order == "zxy":
-            return mul(ry, mul(rx, rz))  # Maya's ZXY rotate order: Z first, then X, then Y
-        return mul(rz, mul(ry, rx))  # Maya's XYZ rotate order
+        # Maya's rotate order names the axes in the order they turn: ZXY is Z first, then X,
+        # then Y (R = Ry * Rx * Rz).
+        by_axis = {"x": rx, "y": ry, "z": rz}
+        m = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+        for axis in order:
+            m = mul(by_axis[axis], m)
+        return m
 
     @staticmethod
     def _matrix_of_quat(q):
@@ -950,6 +954,8 @@ class MayaKeyWalkTest(unittest.TestCase):
         and sys.path are as before afterwards."""
         maya = types.ModuleType("maya")
         maya.cmds = cmds
+        if not hasattr(cmds, "keyframe"):
+            cmds.keyframe = lambda *args, **kwargs: 0  # no node has keys yet
         saved = {name: sys.modules.pop(name, None) for name in ("maya", "maya.cmds",
                                                                 "footfall_maya")}
         sys.modules.update({"maya": maya, "maya.cmds": cmds})
@@ -964,12 +970,17 @@ class MayaKeyWalkTest(unittest.TestCase):
                 if module is not None:
                     sys.modules[name] = module
 
-    def _key_walk(self, walk, feet, body):
+    def _key_walk(self, walk, feet, body, keyed_order=None):
+        """The calls key_walk makes; with `keyed_order`, every node has rotation keys and that
+        rotateOrder."""
         calls = []
         cmds = types.ModuleType("maya.cmds")
         for name in ("setAttr", "xform", "setKeyframe"):
             setattr(cmds, name, lambda *args, _name=name, **kwargs:
                     calls.append((_name, args, kwargs)))
+        if keyed_order is not None:
+            cmds.keyframe = lambda *args, **kwargs: 3
+            cmds.getAttr = lambda plug, **kwargs: keyed_order
         with self._footfall_maya(cmds) as footfall_maya:
             footfall_maya.key_walk(walk, feet, body)
         return calls
@@ -1408,6 +1419,31 @@ class MayaKeyWalkTest(unittest.TestCase):
                 for a, b in zip(euler, previous):
                     self.assertLess(abs(a - b), 3.0, msg="%s after %s" % (euler, previous))
             previous = euler
+
+    def test_a_body_with_rotation_keys_keeps_its_rotate_order(self):
+        # Generate Walk set a picked body's rotateOrder to ZXY without converting its keys: a
+        # pose the user keyed before the walk turned (Maya does not convert keys).
+        keys = [{"frame": 1 + i, "position": [0.0, 1.0, 0.1 * i],
+                 "rotation": ff.rotation.quat_from_frame(
+                     (0.2, 1.0, 0.1 * i), (math.cos(0.3 * i), 0.0, math.sin(0.3 * i)))}
+                for i in range(25)]
+        walk = {"tracks": [{"name": "body", "kind": "body", "keys": keys}]}
+        for order, name in enumerate(ff.rotation.ROTATE_ORDERS):
+            calls = self._key_walk(walk, {}, "hips", keyed_order=order)
+            self.assertEqual([c for c in calls if c[0] == "setAttr"], [], name)
+            rotations = [c[2]["ro"] for c in calls if c[0] == "xform" and "ro" in c[2]]
+            self.assertEqual(len(rotations), len(keys))
+            previous = None
+            for key, euler in zip(keys, rotations):
+                got = RotationTest._matrix_of_euler(euler, name)
+                want = RotationTest._matrix_of_quat(key["rotation"])
+                for i in range(3):
+                    for j in range(3):
+                        self.assertAlmostEqual(got[i][j], want[i][j], places=9, msg=name)
+                if previous is not None:  # unwrapped: no angle jumps by 180 or more
+                    self.assertLess(max(abs(a - b) for a, b in zip(euler, previous)), 180.0,
+                                    msg="%s: %s after %s" % (name, euler, previous))
+                previous = euler
 
     def test_keys_have_linear_tangents(self):
         # As the MEL export: Maya's default tangent (auto or spline) overshoots between a foot's

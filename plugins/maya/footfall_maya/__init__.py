@@ -299,20 +299,26 @@ def key_walk(walk, feet, body, from_frame=None):
         node = body if is_body else feet.get(track.get("name"))
         if not node:
             continue
+        order = 2
         if is_body:
-            # Rotate order ZXY, as the MEL export: heading is rotateY alone, so a body heading
-            # +-X is not at gimbal lock (in Maya's default XYZ it is).
-            mc.setAttr(node + ".rotateOrder", 2)
+            # A body with rotation keys of its own keeps its rotate order, the walk keyed in it
+            # (setting another reinterpreted those keys: a pose keyed before the walk turned).
+            # Any other turns in ZXY, as the MEL export: heading is rotateY alone, so a body
+            # heading +-X is not at gimbal lock (in Maya's default XYZ it is).
+            if mc.keyframe(node, attribute="rotate", query=True, keyframeCount=True):
+                order = int(mc.getAttr(node + ".rotateOrder"))
+            else:
+                mc.setAttr(node + ".rotateOrder", 2)
         previous = None
         for key in track.get("keys", []):
             frame = key["frame"]
             euler = None
             if is_body and "rotation" in key:
-                # ZXY Euler degrees (R = Ry * Rx * Rz), unwrapped from the previous key (as the
-                # MEL export keys them), keyed or not.
-                euler = ffc.rotation.quat_to_euler_zxy(key["rotation"])
+                # Euler degrees in the body's rotate order (ZXY: R = Ry * Rx * Rz, as the MEL
+                # export keys them), unwrapped from the previous key, keyed or not.
+                euler = ffc.rotation.quat_to_euler(key["rotation"], order)
                 if previous is not None:
-                    euler = ffc.rotation.closest_euler_zxy(euler, previous)
+                    euler = ffc.rotation.closest_euler_in_order(euler, previous, order)
                 previous = euler
             if from_frame is not None and frame < from_frame:
                 continue

@@ -95,6 +95,53 @@ def closest_euler_zxy(euler, previous):
     return alternative if l1(alternative) < l1(direct) else direct
 
 
+# Maya's rotateOrder values: the axes in the order they turn (xyz: X first, R = Rz * Ry * Rx).
+ROTATE_ORDERS = ("xyz", "yzx", "zxy", "xzy", "yxz", "zyx")
+
+
+def quat_to_euler(q, order):
+    """(x, y, z, w) -> (rx, ry, rz) degrees in Maya's rotate order `order` (a ROTATE_ORDERS
+    name or its rotateOrder number): R = R_last * R_middle * R_first. The middle angle is in
+    [-90, 90]; at gimbal lock (+-90) the last is 0."""
+    if not isinstance(order, str):
+        order = ROTATE_ORDERS[int(order)]
+    i, j, k = ("xyz".index(a) for a in order)
+    # +1 when the axes turn in cyclic order (xyz, yzx, zxy), -1 otherwise.
+    sign = 1.0 if (j - i) % 3 == 1 else -1.0
+    x, y, z, w = unit_quat(q)
+    m = ((1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)),
+         (2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)),
+         (2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)))
+    sin_b = max(-1.0, min(1.0, -sign * m[k][i]))
+    b = math.asin(sin_b)
+    if abs(sin_b) > 1 - 1e-12:  # gimbal lock: the first and last turn about one axis; all in the first
+        a, c = math.atan2(-sign * m[j][k], m[j][j]), 0.0
+    else:
+        a, c = math.atan2(sign * m[k][j], m[k][k]), math.atan2(sign * m[j][i], m[i][i])
+    angles = [0.0, 0.0, 0.0]
+    angles[i], angles[j], angles[k] = math.degrees(a), math.degrees(b), math.degrees(c)
+    return tuple(angles)
+
+
+def closest_euler_in_order(euler, previous, order):
+    """As closest_euler, for angles in rotate order `order` (quat_to_euler): the other solution
+    is (first + 180, 180 - middle, last + 180)."""
+    if not isinstance(order, str):
+        order = ROTATE_ORDERS[int(order)]
+    i, j, k = ("xyz".index(a) for a in order)
+
+    def unwrap_all(e):
+        return tuple(_unwrap(e[n], previous[n]) for n in range(3))
+
+    def l1(e):
+        return sum(abs(e[n] - previous[n]) for n in range(3))
+
+    other = list(euler)
+    other[i], other[j], other[k] = euler[i] + 180.0, 180.0 - euler[j], euler[k] + 180.0
+    direct, alternative = unwrap_all(euler), unwrap_all(other)
+    return alternative if l1(alternative) < l1(direct) else direct
+
+
 def quat_from_frame(up, forward):
     """(x, y, z, w): the rotation taking the character axes (Y up, Z forward) to `up` and to
     `forward` projected across it (any direction across `up` when forward lies along it), as the
