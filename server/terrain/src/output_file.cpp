@@ -102,7 +102,13 @@ void FreeTemporarySlot(int slot) {
   if (slot >= 0) g_temporaries[slot].store(nullptr);
 }
 
+// Set while a set's files are renamed: a signal taken on another thread then waits for the
+// renames to end (they take microseconds), so that it never leaves some renamed and some not.
+std::atomic<bool> g_committing{false};
+
 void RemoveTemporariesAndReraise(int signal_number) {
+  while (g_committing.load()) {
+  }
   for (auto& temporary : g_temporaries) {
     const char* name = temporary.load();
     if (name != nullptr) ::unlink(name);
@@ -218,7 +224,8 @@ std::vector<std::string> OutputFileSet::Commit() {
   sigset_t held, before;
   sigemptyset(&held);
   for (int signal_number : kCleanedUpSignals) sigaddset(&held, signal_number);
-  pthread_sigmask(SIG_BLOCK, &held, &before);
+  pthread_sigmask(SIG_BLOCK, &held, &before);  // (signals taken on other threads wait too)
+  g_committing.store(true);
   for (const auto& file : state_->waiting) {
     if (::rename(file->temporary.c_str(), file->target.c_str()) != 0) {
       std::string message;
@@ -228,6 +235,7 @@ std::vector<std::string> OutputFileSet::Commit() {
     }
     FreeTemporarySlot(file->slot);
   }
+  g_committing.store(false);
   pthread_sigmask(SIG_SETMASK, &before, nullptr);
   std::vector<std::string> synced;
   for (const auto& file : state_->waiting) {
