@@ -58,24 +58,37 @@ void ChooseGridBox(const RawSamples& s, const double lo[3], const double hi[3], 
   }
 }
 
-// The cells of size h over the grid box (local corner lo, extents e) that hold a sample of
-// `local` (x, y, z per sample), each sample in the cell TerrainGrid::CellCoord gives it.
-size_t CountOccupiedCells(const std::vector<float>& local, const double lo[3], const double e[3],
-                          double h) {
+// The cells of size h over the grid box (local corner lo, extents e), each sample in the cell
+// TerrainGrid::CellCoord gives it.
+struct CellIndexer {
   uint32_t dims[3];
-  for (int a = 0; a < 3; ++a) dims[a] = AxisCells(e[a], h);
-  const double inv = 1 / h;
-  auto coord = [&](float v, int a) -> size_t {
+  double lo[3];
+  double inv;
+  CellIndexer(const double grid_lo[3], const double e[3], double h) : inv(1 / h) {
+    for (int a = 0; a < 3; ++a) dims[a] = AxisCells(e[a], h), lo[a] = grid_lo[a];
+  }
+  size_t Cells() const { return size_t{dims[0]} * dims[1] * dims[2]; }
+  size_t Coord(float v, int a) const {
     const double t = (v - lo[a]) * inv;
     if (!(t > 0)) return 0;
     if (t >= static_cast<double>(dims[a])) return dims[a] - 1;
     return static_cast<size_t>(t);
-  };
-  std::vector<bool> occupied(size_t{dims[0]} * dims[1] * dims[2], false);
+  }
+  // The cell of the sample at p (x, y, z).
+  size_t Cell(const float* p) const {
+    return (Coord(p[2], 2) * dims[1] + Coord(p[1], 1)) * dims[0] + Coord(p[0], 0);
+  }
+};
+
+// The cells of size h over the grid box (local corner lo, extents e) that hold a sample of
+// `local` (x, y, z per sample).
+size_t CountOccupiedCells(const std::vector<float>& local, const double lo[3], const double e[3],
+                          double h) {
+  const CellIndexer cells(lo, e, h);
+  std::vector<bool> occupied(cells.Cells(), false);
   size_t count = 0;
   for (size_t i = 0; i + 2 < local.size(); i += 3) {
-    const size_t cell =
-        (coord(local[i + 2], 2) * dims[1] + coord(local[i + 1], 1)) * dims[0] + coord(local[i], 0);
+    const size_t cell = cells.Cell(&local[i]);
     if (!occupied[cell]) occupied[cell] = true, ++count;
   }
   return count;
@@ -89,15 +102,7 @@ size_t CountOccupiedCells(const std::vector<float>& local, const double lo[3], c
 // roughness within it), else from each sample's own (an edge or a corner, as of a stair).
 size_t OccupiedCellsAndCrossing(const std::vector<float>& local, const std::vector<Vec3>& normals,
                                 const double lo[3], const double e[3], double h, double* crossing) {
-  uint32_t dims[3];
-  for (int a = 0; a < 3; ++a) dims[a] = AxisCells(e[a], h);
-  const double inv = 1 / h;
-  auto coord = [&](float v, int a) -> size_t {
-    const double t = (v - lo[a]) * inv;
-    if (!(t > 0)) return 0;
-    if (t >= static_cast<double>(dims[a])) return dims[a] - 1;
-    return static_cast<size_t>(t);
-  };
+  const CellIndexer indexer(lo, e, h);
   // Per occupied cell: the sum of its samples' unit normals, of their |nx| + |ny| + |nz|, and
   // their count.
   struct CellNormals {
@@ -106,11 +111,10 @@ size_t OccupiedCellsAndCrossing(const std::vector<float>& local, const std::vect
     uint32_t count = 0;
   };
   constexpr uint32_t kEmpty = std::numeric_limits<uint32_t>::max();
-  std::vector<uint32_t> slot_of(size_t{dims[0]} * dims[1] * dims[2], kEmpty);
+  std::vector<uint32_t> slot_of(indexer.Cells(), kEmpty);
   std::vector<CellNormals> cells;
   for (size_t i = 0; 3 * i + 2 < local.size(); ++i) {
-    const float* p = &local[3 * i];
-    const size_t cell = (coord(p[2], 2) * dims[1] + coord(p[1], 1)) * dims[0] + coord(p[0], 0);
+    const size_t cell = indexer.Cell(&local[3 * i]);
     if (slot_of[cell] == kEmpty) {
       slot_of[cell] = static_cast<uint32_t>(cells.size());
       cells.emplace_back();
