@@ -1048,10 +1048,11 @@ class MayaKeyWalkTest(unittest.TestCase):
                 self.assertAlmostEqual(a[i], b[i] / 100.0, places=9)
         self.assertAlmostEqual(max(p[0] for p in m), 2.0, places=9)
 
-    def test_the_windows_file_buttons_pick_files(self):
-        # The "..." buttons of the Point file and Character file fields had no command: a
-        # click opened no file dialog, and paths had to be typed.
-        calls, fields, dialogs = [], {}, []
+    @staticmethod
+    def _window_cmds(calls, fields):
+        """A stand-in for maya.cmds enough for show(): the window's commands append (name,
+        args, kwargs) to `calls`; its text fields with buttons go to `fields` by name (their
+        keyword arguments, edited as Maya edits them, and their text queried)."""
         cmds = types.ModuleType("maya.cmds")
 
         def record(name):
@@ -1061,10 +1062,12 @@ class MayaKeyWalkTest(unittest.TestCase):
             return call
         for name in ("window", "deleteUI", "columnLayout", "frameLayout", "textFieldGrp",
                      "intFieldGrp", "floatFieldGrp", "checkBoxGrp", "button", "text",
-                     "setParent", "showWindow"):
+                     "setParent", "showWindow", "warning", "confirmDialog"):
             setattr(cmds, name, record(name))
 
         def text_field_button_grp(*args, **kwargs):
+            if kwargs.get("q"):
+                return fields[args[0]].get("text", "")
             if kwargs.get("e"):
                 fields[args[0]].update(kwargs)
                 return None
@@ -1072,6 +1075,13 @@ class MayaKeyWalkTest(unittest.TestCase):
             fields[name] = dict(kwargs)
             return name
         cmds.textFieldButtonGrp = text_field_button_grp
+        return cmds
+
+    def test_the_windows_file_buttons_pick_files(self):
+        # The "..." buttons of the Point file and Character file fields had no command: a
+        # click opened no file dialog, and paths had to be typed.
+        calls, fields, dialogs = [], {}, []
+        cmds = self._window_cmds(calls, fields)
         cmds.fileDialog2 = lambda **kwargs: dialogs.append(kwargs) or list(self._chosen)
         with self._footfall_maya(cmds) as footfall_maya:
             footfall_maya.show()
@@ -1108,28 +1118,7 @@ class MayaKeyWalkTest(unittest.TestCase):
         # With only the IK handles selected, the first became the body and foot L both (the
         # walk's keys overwrote each other on it); a body selected alone was ignored.
         calls, fields = [], {}
-        cmds = types.ModuleType("maya.cmds")
-
-        def record(name):
-            def call(*args, **kwargs):
-                calls.append((name, args, kwargs))
-                return "%s%d" % (name, len(calls))
-            return call
-        for name in ("window", "deleteUI", "columnLayout", "frameLayout", "textFieldGrp",
-                     "intFieldGrp", "floatFieldGrp", "checkBoxGrp", "button", "text",
-                     "setParent", "showWindow", "warning", "confirmDialog"):
-            setattr(cmds, name, record(name))
-
-        def text_field_button_grp(*args, **kwargs):
-            if kwargs.get("q"):
-                return fields[args[0]].get("text", "")
-            if kwargs.get("e"):
-                fields[args[0]].update(kwargs)
-                return None
-            name = "field%d" % len(fields)
-            fields[name] = dict(kwargs)
-            return name
-        cmds.textFieldButtonGrp = text_field_button_grp
+        cmds = self._window_cmds(calls, fields)
         with self._footfall_maya(cmds) as footfall_maya:
             footfall_maya.show()
             by_label = {f["label"]: f for f in fields.values()}
