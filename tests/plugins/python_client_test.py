@@ -677,6 +677,26 @@ class ConnectionTest(unittest.TestCase):
                             footfalld=ff.find_footfalld()), c.session)
         self.assertIs(c.local, fourth)
 
+    def test_a_hung_local_server_is_stopped_within_the_calls_timeout(self):
+        # The connection's own footfalld, hung (SIGSTOP): get() gave it a fixed 5 s to end on
+        # SIGTERM before killing it, whatever the timeout asked (8 s for timeout=1).
+        c = self.c
+        c.get("127.0.0.1", self.dead_port, start_local=True, timeout=1.0)
+        hung = c.local
+        os.kill(hung.process.pid, signal.SIGSTOP)
+        waits = []
+        real_stop = ff.LocalServer.stop
+        ff.LocalServer.stop = lambda server, timeout=5.0: (waits.append(timeout),
+                                                           real_stop(server, timeout))[1]
+        try:
+            self.assertTrue(c.get("127.0.0.1", self.dead_port, start_local=True,
+                                  timeout=1.0).ping())
+        finally:
+            ff.LocalServer.stop = real_stop
+        self.assertEqual(waits, [1.0])
+        self.assertFalse(hung.running())  # killed, not left stopped
+        self.assertIsNot(c.local, hung)
+
     def test_a_hung_server_is_reported_as_such_after_one_timeout(self):
         # A stopped footfalld was pinged twice (twice the timeout) and reported as missing: "no
         # footfalld answers ...: start one there".

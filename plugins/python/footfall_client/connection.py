@@ -35,7 +35,7 @@ class Connection:
             else:
                 # Stopped, or started for other preferences (another server, another footfalld,
                 # or local servers no longer allowed): the configured server is asked again.
-                self._stop_local()
+                self._stop_local(timeout)
         if self.session is None or self._target != target or self._timeout != timeout:
             self._open(target, timeout)  # (a changed timeout was ignored until host or port changed)
         if self.session.ping():
@@ -56,7 +56,7 @@ class Connection:
         if not start_local:
             raise FootfallError(UNAVAILABLE, "no footfalld answers at %s:%d: start one there or "
                                 "allow starting a local footfalld" % target, "connect")
-        self._stop_local()
+        self._stop_local(timeout)  # (a hung one held get 5 s more whatever its timeout)
         try:
             self.local = LocalServer(executable=footfalld or None).start(timeout)
             self._local_for = wanted
@@ -70,15 +70,16 @@ class Connection:
                                 % self.local.port, "connect")
         return self.session
 
-    def _stop_local(self):
-        """Stops the server this connection started, closing the session to it first."""
+    def _stop_local(self, timeout=5.0):
+        """Stops the server this connection started, closing the session to it first; one that
+        has not ended `timeout` s after SIGTERM (a hung one never does) is killed."""
         if self.local is None:
             return
         if self.session is not None and self._target == ("127.0.0.1", self.local.port):
             self.session.close()
             self.session = None
             self._target = None
-        self.local.stop()
+        self.local.stop(min(timeout, 5.0))
         self.local = None
         self._local_for = None
 
