@@ -1728,6 +1728,40 @@ class GenerateTest(unittest.TestCase):
         finally:
             dying.stop()
 
+    def test_a_server_that_dies_mid_walk_is_told_from_a_cliff(self):
+        # A footfalld killed during a one-call walk gave WalkStopped 'no_foothold', as a stop at
+        # the terrain would: now 'unavailable' (ffc_walk_stop), with the keys so far.
+        import threading
+        flat = [(x * 0.1, 0.0, z * 0.1, 0.0, 1.0, 0.0) for z in range(401) for x in range(401)]
+        loop = [[35.0, 0.0, 5.0], [35.0, 0.0, 35.0], [5.0, 0.0, 35.0], [5.0, 0.0, 5.0]] * 40
+        request = {"character_file": self.character, "start": [5.0, 0.0, 5.0], "path": loop,
+                   "steps": 20000, "crowd": 16}
+        dying = ff.LocalServer().start()
+        try:
+            with ff.Session.rpc("127.0.0.1", dying.port, timeout=5.0) as s:
+                t = s.load_samples(flat, "flat")
+                killer = threading.Timer(0.5, dying.kill)  # the walk takes some seconds
+                killer.start()
+                try:
+                    with self.assertRaises(ff.WalkStopped) as e:
+                        s.generate(t, request)
+                finally:
+                    killer.join()
+                self.assertEqual(e.exception.status_name, "unavailable")
+                self.assertIn("footfalld at 127.0.0.1:%d" % dying.port, e.exception.message)
+                bodies = [tr for tr in e.exception.walk["tracks"] if tr["kind"] == "body"]
+                self.assertEqual(len(bodies), 16)
+                self.assertTrue(all(len(b["keys"]) > 1 for b in bodies))
+        finally:
+            dying.stop()
+        # A walk stopped by the terrain is still 'no_foothold'.
+        with ff.Session.rpc("127.0.0.1", self.server.port) as s:
+            t = s.load_file(HILLS)
+            with self.assertRaises(ff.WalkStopped) as e:
+                s.generate(t, {"character_file": self.character, "start": [20.0, 0.0, 12.0],
+                               "heading": [1.0, 0.0, 0.0], "steps": 400})
+            self.assertEqual(e.exception.status_name, "no_foothold")
+
     def test_notes_are_the_command_lines(self):
         # A start 10 m beyond the hills' edge: the command line prints a note, and the session
         # gives the same one.

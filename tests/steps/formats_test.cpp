@@ -309,7 +309,16 @@ TEST_CASE("ffc_generate gives the walk GenerateWalk gives", "[steps][c_api]") {
   REQUIRE(json);
   CHECK_THAT(std::string(json), Catch::Contains("\"phase\":\"end\""));
   CHECK_THAT(ffc_last_error(s), Catch::StartsWith("step "));
+  // Stopped at the terrain, not by a failed server (ffc_walk_stop tells them apart).
+  CHECK(ffc_walk_stop(s) == FF_C_NO_FOOTHOLD);
   ffc_free_string(json);
+  // A walk that did not stop, and a request refused: nothing stopped.
+  const std::string short_walk = R"({"character_file": ")" + file +
+                                 R"(", "start": [5, 0, 5], "heading": [1, 0, 0], "steps": 2})";
+  REQUIRE(ffc_generate(s, terrain, short_walk.c_str(), &json) == FF_C_OK);
+  CHECK(ffc_walk_stop(s) == FF_C_OK);
+  ffc_free_string(json);
+  CHECK(ffc_walk_stop(nullptr) == FF_C_INVALID_ARGUMENT);
   ffc_close(s);
 }
 

@@ -29,7 +29,8 @@ struct ffc_session {
   // Guards `error` alone, so ffc_last_error answers at once while another thread's call (a load
   // of minutes) holds `mutex`.
   mutable std::mutex error_mutex;
-  std::string error;  // written through SetError
+  std::string error;            // written through SetError
+  int32_t walk_stop = FF_C_OK;  // why the last walk stopped early (ffc_walk_stop)
 };
 
 namespace {
@@ -168,6 +169,7 @@ int32_t Generate(ffc_session* s, uint32_t terrain, const char* request_json, cha
   if (walk_json) *walk_json = nullptr;  // on every failure but a walk that stopped early
   if (notes) *notes = nullptr;
   return Guard(s, [&]() -> int32_t {
+    s->walk_stop = FF_C_OK;
     if (!request_json || !walk_json)
       return BadArgument(s, "request_json and walk_json must not be NULL");
     footfall::Character character;
@@ -195,6 +197,7 @@ int32_t Generate(ffc_session* s, uint32_t terrain, const char* request_json, cha
     if (notes) *notes = note_copy;
     if (!walk.stopped.empty()) {  // the keys so far are in *walk_json
       SetError(s, walk.stopped);
+      s->walk_stop = walk.session_failed ? FF_C_UNAVAILABLE : FF_C_NO_FOOTHOLD;
       return FF_C_NO_FOOTHOLD;
     }
     return FF_C_OK;
@@ -359,6 +362,10 @@ int32_t ffc_generate_with_notes(ffc_session* s, uint32_t terrain, const char* re
 }
 
 void ffc_free_string(char* text) { std::free(text); }
+
+int32_t ffc_walk_stop(ffc_session* s) {
+  return Guard(s, [&]() -> int32_t { return s->walk_stop; });
+}
 
 int32_t ffc_check_character(ffc_session* s, const char* character_json) {
   return Guard(s, [&]() -> int32_t {

@@ -80,6 +80,7 @@ def _declare(lib):
         "ffc_free_string": (None, [c.c_void_p]),
         "ffc_check_character": (c.c_int32, [sess, c.c_char_p]),
         "ffc_ping": (c.c_int32, [sess]),
+        "ffc_walk_stop": (c.c_int32, [sess]),
     }
     missing = []
     for name, (restype, argtypes) in sigs.items():

@@ -481,6 +481,9 @@ class Session:
                 raise FootfallError(INTERNAL_ERROR, "walk JSON from the library: %s" % e,
                                     "ffc_generate") from None
         stopped = walk.get("stopped") if isinstance(walk, dict) else None
+        if status == NO_FOOTHOLD and walk is not None and self._lib.has("ffc_walk_stop"):
+            # 'unavailable' when footfalld failed mid-walk, not the terrain (the same return).
+            status = self._lib.lib.ffc_walk_stop(self._handle("ffc_walk_stop")) or status
         if status != OK:
             if walk is not None:
                 raise WalkStopped(status, message or stopped or "walk stopped", walk, notes=notes)

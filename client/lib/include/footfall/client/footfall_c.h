@@ -139,6 +139,13 @@ int32_t ffc_generate_with_notes(ffc_session* s, uint32_t terrain, const char* re
                                 char** walk_json, char** notes);
 void ffc_free_string(char* text);
 
+/* Why the session's last walk (ffc_generate or ffc_generate_with_notes) stopped early: FF_C_OK
+ * when it did not stop (or none was generated yet), FF_C_NO_FOOTHOLD when it stopped at the
+ * terrain, FF_C_UNAVAILABLE when footfalld failed mid-walk (both return FF_C_NO_FOOTHOLD with
+ * the keys so far: this tells a dead server from a cliff). Added in ABI version 1 without
+ * changing it: a caller finds it by name, and an older library lacks it. */
+int32_t ffc_walk_stop(ffc_session* s);
+
 /* Checks a character file's JSON object (text) as ffc_generate would read it, without
  * generating anything: FF_C_OK, or the status and ffc_last_error naming the first problem
  * (a plugin checks a file before it builds a rig from it). No server call. */
