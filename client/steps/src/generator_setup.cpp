@@ -333,7 +333,8 @@ Status Generator::SnapFeetFacingUp(const Vec3* places, Foothold* feet, size_t to
         feet[f] = again[i];
         continue;
       }
-      if (2 * lift[i] > c_.reach) continue;  // none within reach: as it snapped
+      // None within reach (or no lift to double): as it snapped.
+      if (!(lift[i] > 0) || 2 * lift[i] > c_.reach) continue;
       turned[kept] = f, lift[kept] = 2 * lift[i], ++kept;
     }
     turned.resize(kept), lift.resize(kept);
