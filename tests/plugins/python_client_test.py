@@ -976,6 +976,8 @@ class MayaKeyWalkTest(unittest.TestCase):
         maya.cmds = cmds
         if not hasattr(cmds, "keyframe"):
             cmds.keyframe = lambda *args, **kwargs: 0  # no node has keys yet
+        if not hasattr(cmds, "upAxis"):
+            cmds.upAxis = lambda *args, **kwargs: "y"  # Maya's default
         saved = {name: sys.modules.pop(name, None) for name in ("maya", "maya.cmds",
                                                                 "footfall_maya")}
         sys.modules.update({"maya": maya, "maya.cmds": cmds})
@@ -1159,6 +1161,26 @@ class MayaKeyWalkTest(unittest.TestCase):
                 setup[0]()
                 self.assertEqual(made[-1], expected, selected)
             self.assertEqual([c for c in calls if c[0] == "warning"], [])
+
+    def test_a_z_up_scene_is_refused_with_what_to_set(self):
+        # In a Z-up scene the body was placed sideways (Y up) and Generate Walk stopped at once
+        # with "ground leans 84.3 deg".
+        calls = []
+        cmds = types.ModuleType("maya.cmds")
+        for name in ("warning", "confirmDialog", "xform", "spaceLocator", "group", "setAttr"):
+            setattr(cmds, name, lambda *args, _name=name, **kwargs:
+                    calls.append((_name, args, kwargs)))
+        cmds.upAxis = lambda *args, **kwargs: "z"
+        with self._footfall_maya(cmds) as footfall_maya:
+            for run in (lambda: footfall_maya.terrain_setup(0.1),
+                        lambda: footfall_maya.character_setup(
+                            os.path.join(CHARACTERS, "biped.json")),
+                        lambda: footfall_maya.generate_walk("rig1")):
+                del calls[:]
+                self.assertIsNone(run())
+                self.assertEqual([c[0] for c in calls], ["warning", "confirmDialog"])
+                self.assertIn("this scene is Z-up", calls[0][1][0])
+                self.assertIn("Up axis to Y", calls[0][1][0])
 
     def test_import_of_tracks_without_keys_changes_nothing(self):
         # Tracks of the rig without keys (alone, or beside another's keyed track) cut the rig's

@@ -106,10 +106,20 @@ def _mesh_samples(mesh, separation):
     return ffc.sampling.sample_triangles(points, tris, separation, corner_normals=normals)
 
 
+def _require_y_up():
+    """Raises ValueError in a Z-up scene: the plugin places characters and asks for walks with
+    Y up, as footfall's files are (in a Z-up scene the body stood sideways and Generate Walk
+    stopped at once: "ground leans 84 deg")."""
+    if str(mc.upAxis(q=True, axis=True)).lower() != "y":
+        raise ValueError("this scene is Z-up, and footfall's Maya plugin works in Y-up scenes: "
+                         "set Preferences > Settings > World Coordinate System > Up axis to Y")
+
+
 @_guard
 def terrain_setup(separation=0.25, point_file=None):
     """Sends the selected mesh resampled at `separation` [scene units], or loads `point_file`.
     Returns the sample count."""
+    _require_y_up()
     s = _session()
     _release_other_terrains()
     if point_file:
@@ -189,6 +199,7 @@ def character_setup(character_file, name=None, ik_handles=None, body=None):
     a step ahead of each foot under a central locator per foot pair, aligned to the terrain
     normal. Checks the file as the generator reads it, and snaps everything, before anything is
     made; one undo chunk."""
+    _require_y_up()
     _scene_terrain_key()  # (no terrain: before anything else)
     data = character.load(character_file)
     s = _session()
@@ -341,6 +352,7 @@ def generate_walk(rig, steps=8, start_frame=1, frames_per_step=0, step_length=0.
     """Generates `steps` steps for `rig` and keys them; keys made before a failure stay (the
     error says how many). One undo chunk; progress in the main progress bar. The walk's notes
     are shown as warnings."""
+    _require_y_up()
     _scene_terrain_key()  # (no terrain: before anything else)
     data, feet, body = _rig_targets(rig)
     data = character.with_overrides(data, step_length=step_length, step_height=step_height,
