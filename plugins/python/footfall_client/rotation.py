@@ -27,21 +27,7 @@ def unit_quat(q):
 
 def quat_to_euler_xyz(q):
     """(x, y, z, w) -> (rx, ry, rz) degrees with R = Rz(rz) * Ry(ry) * Rx(rx)."""
-    x, y, z, w = unit_quat(q)
-    m00 = 1 - 2 * (y * y + z * z)
-    m01 = 2 * (x * y - z * w)
-    m10 = 2 * (x * y + z * w)
-    m11 = 1 - 2 * (x * x + z * z)
-    m20 = 2 * (x * z - y * w)
-    m21 = 2 * (y * z + x * w)
-    m22 = 1 - 2 * (x * x + y * y)
-    sin_b = max(-1.0, min(1.0, -m20))
-    b = math.asin(sin_b)
-    if abs(sin_b) > 1 - 1e-12:  # gimbal lock: X and Z turn about the same axis; all in Z
-        a, c = 0.0, math.atan2(-m01, m11)
-    else:
-        a, c = math.atan2(m21, m22), math.atan2(m10, m00)
-    return (math.degrees(a), math.degrees(b), math.degrees(c))
+    return quat_to_euler(q, "xyz")
 
 
 def _unwrap(angle, target):
@@ -51,48 +37,19 @@ def _unwrap(angle, target):
 def closest_euler(euler, previous):
     """The XYZ angles equal to `euler` as a rotation that lie closest to `previous` (degrees), so
     that interpolating between keys turns the short way instead of spinning through 360."""
-    def unwrap_all(e):
-        return tuple(_unwrap(e[i], previous[i]) for i in range(3))
-
-    def l1(e):
-        return sum(abs(e[i] - previous[i]) for i in range(3))
-
-    direct = unwrap_all(euler)
-    alternative = unwrap_all((euler[0] + 180.0, 180.0 - euler[1], euler[2] + 180.0))
-    return alternative if l1(alternative) < l1(direct) else direct
+    return closest_euler_in_order(euler, previous, "xyz")
 
 
 def quat_to_euler_zxy(q):
     """(x, y, z, w) -> (rx, ry, rz) degrees with R = Ry(ry) * Rx(rx) * Rz(rz): Maya's rotate
     order ZXY (rotateOrder 2). rx is in [-90, 90]; at gimbal lock (rx = +-90) rz is 0."""
-    x, y, z, w = unit_quat(q)
-    m00 = 1 - 2 * (y * y + z * z)
-    m02 = 2 * (x * z + y * w)
-    m10 = 2 * (x * y + z * w)
-    m11 = 1 - 2 * (x * x + z * z)
-    m12 = 2 * (y * z - x * w)
-    m20 = 2 * (x * z - y * w)
-    m22 = 1 - 2 * (x * x + y * y)
-    sin_a = max(-1.0, min(1.0, -m12))
-    if abs(sin_a) > 1 - 1e-12:  # gimbal lock: Z and Y turn about the same axis; all in Y
-        a, b, c = math.copysign(math.pi / 2, sin_a), math.atan2(-m20, m00), 0.0
-    else:
-        a, b, c = math.asin(sin_a), math.atan2(m02, m22), math.atan2(m10, m11)
-    return (math.degrees(a), math.degrees(b), math.degrees(c))
+    return quat_to_euler(q, "zxy")
 
 
 def closest_euler_zxy(euler, previous):
     """As closest_euler, for ZXY angles (quat_to_euler_zxy): the alternative solution is
     (180 - rx, ry + 180, rz + 180)."""
-    def unwrap_all(e):
-        return tuple(_unwrap(e[i], previous[i]) for i in range(3))
-
-    def l1(e):
-        return sum(abs(e[i] - previous[i]) for i in range(3))
-
-    direct = unwrap_all(euler)
-    alternative = unwrap_all((180.0 - euler[0], euler[1] + 180.0, euler[2] + 180.0))
-    return alternative if l1(alternative) < l1(direct) else direct
+    return closest_euler_in_order(euler, previous, "zxy")
 
 
 # Maya's rotateOrder values: the axes in the order they turn (xyz: X first, R = Rz * Ry * Rx).
@@ -102,7 +59,7 @@ ROTATE_ORDERS = ("xyz", "yzx", "zxy", "xzy", "yxz", "zyx")
 def quat_to_euler(q, order):
     """(x, y, z, w) -> (rx, ry, rz) degrees in Maya's rotate order `order` (a ROTATE_ORDERS
     name or its rotateOrder number): R = R_last * R_middle * R_first. The middle angle is in
-    [-90, 90]; at gimbal lock (+-90) the last is 0."""
+    [-90, 90]; at gimbal lock (+-90) the first is 0, the turn all in the last."""
     if not isinstance(order, str):
         order = ROTATE_ORDERS[int(order)]
     i, j, k = ("xyz".index(a) for a in order)
@@ -113,11 +70,11 @@ def quat_to_euler(q, order):
          (2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)),
          (2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)))
     sin_b = max(-1.0, min(1.0, -sign * m[k][i]))
-    b = math.asin(sin_b)
-    if abs(sin_b) > 1 - 1e-12:  # gimbal lock: the first and last turn about one axis; all in the first
-        a, c = math.atan2(-sign * m[j][k], m[j][j]), 0.0
+    if abs(sin_b) > 1 - 1e-12:  # gimbal lock: the first and last turn about one axis; all in the last
+        a, b, c = 0.0, math.copysign(math.pi / 2, sin_b), math.atan2(-sign * m[i][j], m[j][j])
     else:
-        a, c = math.atan2(sign * m[k][j], m[k][k]), math.atan2(sign * m[j][i], m[i][i])
+        a, b = math.atan2(sign * m[k][j], m[k][k]), math.asin(sin_b)
+        c = math.atan2(sign * m[j][i], m[i][i])
     angles = [0.0, 0.0, 0.0]
     angles[i], angles[j], angles[k] = math.degrees(a), math.degrees(b), math.degrees(c)
     return tuple(angles)
