@@ -110,21 +110,26 @@ check "scene cliff: the other character's keys kept" grep -q '"character":"safe"
 # A scene character that cannot walk at all (its heading along the up): exit 1, the others
 # (before and after it) walked and written, embedded as over RPC, and the walk file says who
 # did not walk. (In process, the characters after it were left unwalked; the file's "stopped"
-# was empty.)
+# was empty.) The others' stops are said too (a faller's at the hills' east edge was said
+# nowhere: neither on stderr nor in the file).
 cat > "$work/scene/upward.json" <<JSON
 {"format": "footfall-scene", "version": 1,
  "characters": [{"name": "first", "character_file": "biped.json", "start": [10, 0, 10], "steps": 2},
                 {"name": "upward", "character_file": "biped.json", "heading": [0, 1, 0], "steps": 2},
-                {"name": "last", "character_file": "biped.json", "start": [14, 0, 14], "steps": 2}]}
+                {"name": "last", "character_file": "biped.json", "start": [14, 0, 14], "steps": 2},
+                {"name": "faller", "character_file": "biped.json", "start": [39, 0, 20],
+                 "heading": [1, 0, 0], "steps": 6}]}
 JSON
 both scene-failed 1 --terrain "$hills" --scene "$work/scene/upward.json"
 check "scene failure: the others written" python3 -c "
 import json, sys
 walk = json.load(open(sys.argv[1]))
-assert sorted({t['character'] for t in walk['tracks']}) == ['first', 'last'], walk['tracks']
+assert sorted({t['character'] for t in walk['tracks']}) == ['faller', 'first', 'last'], walk['tracks']
 assert walk['stopped'].startswith('upward did not walk: the heading'), walk['stopped']
+assert walk['stopped'].endswith('(and 1 more stopped)'), walk['stopped']
 " "$work/scene-failed-embedded.json"
 check "scene failure: said" grep -q '^footfall generate: upward: the heading' "$work/scene-failed-embedded.err"
+check "scene failure: the others' stops said" grep -q '^footfall generate: stopped early: faller: step [0-9]*: foot' "$work/scene-failed-embedded.err"
 # A scene character whose walk memory cannot hold: said, exit 1, not an abort. (Its steps are
 # a path's, only a bound: given steps would be refused up front, in 8. below.)
 printf '{"format": "footfall-scene", "version": 1, "characters": [{"character_file": "biped.json", "steps": 5}, {"character_file": "hexapod.json", "crowd": 300000, "path": [[30, 0, 30]], "crowd_spacing": 0.01}]}' > "$work/scene/huge.json"
@@ -148,12 +153,24 @@ printf '{"format": "footfall-scene", "version": 1, "characters": [{"character_fi
 "$footfall" generate --terrain "$work/floor.pts" --scene "$work/scene/bad.json" --out "$work/bad.json" 2> "$work/bad.err"
 check "bad scene file: exit 1" [ $? -eq 1 -a ! -e "$work/bad.json" ]
 check "bad scene file: the character and field named" grep -qF "$work/scene/bad.json: characters[0]: unknown field 'fps'" "$work/bad.err"
+check "bad scene file: the known fields listed, name among them, fps not" grep -qE "unknown field 'fps' \(known fields: .*crowd_spacing, .*name, path, .*up\)" "$work/bad.err"
+check "bad scene file: fps not listed" sh -c "! grep -q 'known fields: .*fps' '$work/bad.err'"
 
 # The default start moves to where the character can stand: the top centre of the bundled
 # blocks is on a pile's edge (a foot on a vertical face, which stopped them at step 1); the
 # biped and the quadruped start on a flat top nearby and walk on (until a 1 m block's face).
 both biped-blocks 0 --terrain "$src/data/terrain/blocks.pts" --character "$chars/biped.json" --steps 2
 both quadruped-blocks 0 --terrain "$src/data/terrain/blocks.pts" --character "$chars/quadruped.json" --steps 8
+# A crowd member whose place snaps onto a block's side, where the heading runs along its up:
+# the heading is judged at the crowd's start, and that member walks as far as it can (the
+# whole crowd was refused, nothing written, with advice to change a heading that was fine).
+both hexapod-blocks-crowd 2 --terrain "$src/data/terrain/blocks.pts" --character "$chars/hexapod.json" \
+  --steps 3 --crowd 3
+check "crowd with a member on a block's side: every member keyed" python3 -c "
+import json, sys
+walk = json.load(open(sys.argv[1]))
+assert sorted({t['character'] for t in walk['tracks']}) == ['c1', 'c2', 'c3'], walk['stopped']
+" "$work/hexapod-blocks-crowd-embedded.json"
 first_keys=$(grep -c '{"frame":1,"phase"' "$work/biped-blocks-embedded.json")
 level_keys=$(grep -c '{"frame":1,"phase".*"normal":\[0,1,0\]' "$work/biped-blocks-embedded.json")
 check "blocks: both feet start on level ground" [ "$first_keys" -eq 2 -a "$level_keys" -eq 2 ]

@@ -204,3 +204,20 @@ TEST_CASE("Scene characters started on top of each other are said in notes", "[s
                                            "through each other (give them starts farther "
                                            "apart)"));
 }
+
+TEST_CASE("Overlapping start notes name a few pairs and count the others", "[steps][scene]") {
+  // 4000 characters at one start made every pair a note: 8 million, 2.8 GB.
+  const Character biped = LoadShipped("biped");
+  Terrain t = LoadTerrain(MakeFlat(101, 0.05, 0), 0.05);
+  const Walk one = Generate(t, biped, StartOptions({2.5, 0, 2.5}, 1));
+  constexpr size_t kCharacters = 300;  // 44,850 pairs
+  const std::vector<std::string> names(kCharacters, "x");
+  const std::vector<const Walk*> walks(kCharacters, &one);
+  const std::vector<double> reaches(kCharacters, biped.reach);
+  const std::vector<std::string> notes = OverlappingStartNotes(names, walks, reaches);
+  REQUIRE(notes.size() == kMaxOverlappingStartNotes + 1);
+  CHECK_THAT(notes[0], Catch::StartsWith("x and x start 0 apart"));
+  const size_t pairs = kCharacters * (kCharacters - 1) / 2;
+  CHECK(notes.back() == "... and " + std::to_string(pairs - kMaxOverlappingStartNotes) +
+                            " more pairs of characters start under a quarter of their reach apart");
+}

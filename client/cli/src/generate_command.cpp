@@ -622,6 +622,7 @@ int RunScene(const GenerateFlags& flags) {
     for (const auto& [name, error] : failures)
       std::cerr << "footfall generate: " << name << ": " << error << '\n';
     if (!walk.tracks.empty()) {
+      ReportWalkEnd(walk, LoadedTerrain{});  // the others' notes and stops
       std::cerr << "footfall generate: the walks of the " << walked
                 << (walked == 1 ? " character that walked are" : " characters that walked are")
                 << " written\n";

@@ -52,13 +52,14 @@ Status ParseGenerateRequest(const std::string& text, Character* character, Gener
   constexpr int kMaxDepth = 32;
   json j;
   if (!detail::ParseJsonText(text, "request", &j, error, kMaxDepth)) return Status::kParseError;
-  return detail::ReadGenerateRequest(j, "request", "", {}, character, options, nullptr, error);
+  return detail::ReadGenerateRequest(j, "request", "", {}, {}, character, options, nullptr, error);
 }
 
 namespace detail {
 
 Status ReadGenerateRequest(const json& j, const std::string& source, const std::string& folder,
-                           const std::set<std::string>& refused, Character* character,
+                           const std::set<std::string>& refused,
+                           const std::set<std::string>& read_by_caller, Character* character,
                            GenerateOptions* options, std::string* character_file,
                            std::string* error) {
   if (!j.is_object()) {
@@ -70,8 +71,12 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
       "path",      "steps",          "start_frame",  "up",
       "fps",       "crowd",          "crowd_spacing"};
   for (auto it = j.begin(); it != j.end(); ++it) {
+    if (read_by_caller.count(it.key())) continue;
     if (!kKnown.count(it.key()) || refused.count(it.key())) {
-      *error = source + ": unknown field '" + ShownText(it.key()) + "'";
+      std::set<std::string> known = read_by_caller;
+      for (const std::string& k : kKnown)
+        if (!refused.count(k)) known.insert(k);
+      *error = source + ": " + detail::UnknownFieldMessage(it.key(), known);
       return Status::kParseError;
     }
   }

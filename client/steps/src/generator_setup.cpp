@@ -144,11 +144,14 @@ Status Generator::Setup(std::string* error) {
   // A heading along the up where the character starts gives no direction on the ground (it
   // used to fall back to another direction silently). Within a few degrees of the up, what is
   // left on the ground is the terrain's tilt, not a direction the user chose: the default +Z
-  // heading on a Z-up terrain would walk a multiped downhill.
+  // heading on a Z-up terrain would walk a multiped downhill. Judged at the start given (a
+  // crowd's), not at any one member's place: a member whose up differs there (on a block's
+  // side) takes the heading turned onto its ground (Orient), and stops on its own if it
+  // cannot walk.
   if (o_.path.empty() && n > 0) {
     constexpr double kMinDegreesFromUp = 10;
     const double min_sin = std::sin(Radians(kMinDegreesFromUp));
-    const Vec3 up = c_.align_to_normal ? answers_[0].normal : world_up_;
+    const Vec3& up = up0;
     if (Length2(ProjectOnPlane(o_.heading, up)) <= min_sin * min_sin * Length2(o_.heading)) {
       Text m;
       m << "the heading " << Point(o_.heading) << " is along the up " << Point(up)

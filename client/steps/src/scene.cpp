@@ -42,7 +42,7 @@ Status ParseScene(const std::string& text, const std::string& source, const std:
   std::set<std::string> names;
   for (size_t i = 0; i < j["characters"].size(); ++i) {
     const std::string where = source + ": characters[" + std::to_string(i) + "]";
-    nlohmann::json entry = j["characters"][i];
+    const nlohmann::json& entry = j["characters"][i];
     if (!entry.is_object()) {
       *error = where + ": expected an object";
       return Status::kParseError;
@@ -62,11 +62,11 @@ Status ParseScene(const std::string& text, const std::string& source, const std:
             (control.empty() ? "a name without '/' (it separates a crowd's characters)" : control);
         return Status::kInvalidArgument;
       }
-      entry.erase("name");
     }
     // "fps" is the whole walk's (--fps).
-    const Status read = detail::ReadGenerateRequest(entry, where, folder, {"fps"}, &c.character,
-                                                    &c.options, &c.character_file, error);
+    const Status read =
+        detail::ReadGenerateRequest(entry, where, folder, {"fps"}, {"name"}, &c.character,
+                                    &c.options, &c.character_file, error);
     if (read != Status::kOk) return read;
     c.has_start_frame = entry.contains("start_frame");
     c.has_up = entry.contains("up");
@@ -144,11 +144,16 @@ std::vector<std::string> OverlappingStartNotes(const std::vector<std::string>& n
     if (feet > 0) starts.emplace_back(i, sum / static_cast<double>(feet));
   }
   std::vector<std::string> notes;
+  size_t more = 0;  // pairs beyond kMaxOverlappingStartNotes, counted
   for (size_t a = 0; a < starts.size(); ++a) {
     for (size_t b = a + 1; b < starts.size(); ++b) {
       const size_t i = starts[a].first, j = starts[b].first;
       const double apart = Distance(starts[a].second, starts[b].second);
       if (!(apart < 0.25 * std::min(reaches[i], reaches[j]))) continue;
+      if (notes.size() == kMaxOverlappingStartNotes) {
+        ++more;
+        continue;
+      }
       std::ostringstream note;
       note.precision(3);
       note << names[i] << " and " << names[j] << " start " << apart
@@ -156,6 +161,10 @@ std::vector<std::string> OverlappingStartNotes(const std::vector<std::string>& n
               "starts farther apart)";
       notes.push_back(note.str());
     }
+  }
+  if (more > 0) {
+    notes.push_back("... and " + std::to_string(more) + (more == 1 ? " more pair" : " more pairs") +
+                    " of characters start under a quarter of their reach apart");
   }
   return notes;
 }

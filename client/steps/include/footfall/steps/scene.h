@@ -56,10 +56,15 @@ void AddFailuresToSceneWalk(const std::vector<std::pair<std::string, std::string
 // walks' first feet (a crowd's first character's) centre under a quarter of the smaller `reaches`
 // apart, "A and B start D apart: they walk through each other" (a crowd keeps its own
 // characters apart; two scene characters given one start were walked as one, silently).
-// walks[i] may be null (a character that did not walk).
+// walks[i] may be null (a character that did not walk). Up to kMaxOverlappingStartNotes pairs
+// are named, the others counted in one more note (a scene of thousands at one start has
+// millions of pairs).
 std::vector<std::string> OverlappingStartNotes(const std::vector<std::string>& names,
                                                const std::vector<const Walk*>& walks,
                                                const std::vector<double>& reaches);
+
+// The most pairs OverlappingStartNotes names.
+constexpr size_t kMaxOverlappingStartNotes = 10;
 
 // Scene characters walked at once over a session that is not in process (GenerateSceneWalks).
 constexpr size_t kJoinedSceneCharacters = 64;
