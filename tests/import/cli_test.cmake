@@ -266,6 +266,23 @@ if(NOT kept MATCHES "# surveyed")
   message(FATAL_ERROR "terrain convert wrote over its input")
 endif()
 expect(EXIT_ZERO "wrote 2 samples to" terrain convert "${WORK}/two.pts" -o "${WORK}/two-out.pts")
+# Nor over its --character file, by name or through a link (the character was replaced by
+# points, exit 0).
+file(COPY "${SOURCE_DIR}/data/characters/biped.json" DESTINATION "${WORK}/own")
+file(CREATE_LINK "${WORK}/own/biped.json" "${WORK}/own/link.pts" SYMBOLIC)
+file(COPY_FILE "${SOURCE_DIR}/data/characters/biped.json" "${WORK}/own/char.pts")
+foreach(pair "biped.json;link.pts" "char.pts;char.pts")
+  list(GET pair 0 character)
+  list(GET pair 1 output)
+  expect(EXIT_NONZERO "${output}: the output is the character file --character reads"
+         terrain convert "${WORK}/square.obj" --character "${WORK}/own/${character}"
+         -o "${WORK}/own/${output}")
+endforeach()
+file(READ "${WORK}/own/biped.json" kept)
+file(READ "${WORK}/own/char.pts" kept_pts)
+if(NOT kept MATCHES "\"step_length\"" OR NOT kept_pts MATCHES "\"step_length\"")
+  message(FATAL_ERROR "terrain convert wrote over its character file")
+endif()
 file(WRITE "${WORK}/one.pts" "0 0 0 0 1 0\n")
 expect(EXIT_ZERO "wrote 1 sample to" terrain convert "${WORK}/one.pts" -o "${WORK}/one-out.pts")
 expect(EXIT_NONZERO "two.pts: --character applies to meshes and height maps, which are resampled for it; a point file is used as it is (leave --character out)"

@@ -93,6 +93,11 @@ int RunConvert(const ConvertFlags& flags) {
   }
   if (error.empty() && SameFile(flags.input, flags.output))
     error = flags.output + ": the output is the input file (write the points to another file)";
+  if (error.empty() && !flags.character.empty() && SameFile(flags.character, flags.output)) {
+    error = flags.output +
+            ": the output is the character file --character reads (write the points to another "
+            "file)";
+  }
   if (error.empty()) ResamplingFlagsApply(flags.input, load, &error);
   if (!error.empty() || LoadTerrain(flags.input, load, &samples, &error, &report) != Status::kOk) {
     std::cerr << "footfall terrain convert: " << error << '\n';
