@@ -309,7 +309,18 @@ file(WRITE "${WORK}/bare.asc" "ncols 2\nnrows 2\ncellsize 1\nNODATA_value\n1 2\n
 expect(EXIT_NONZERO "bare.asc:4: header 'NODATA_value' needs a number on its line"
        terrain info "${WORK}/bare.asc")
 file(WRITE "${WORK}/neg.asc" "ncols 2\nnrows 2\ncellsize -1\n1 2\n3 4\n")
-expect(EXIT_NONZERO "neg.asc:3: cellsize -1 (expected a number > 0)" terrain info "${WORK}/neg.asc")
+expect(EXIT_NONZERO "neg.asc:3: cellsize -1 (expected a number > 0; or give a cell size of your own, --cell-size)" terrain info "${WORK}/neg.asc")
+# --cell-size overrides a bad, missing or not square cell size (all were refused with it).
+file(WRITE "${WORK}/nocell.asc" "ncols 2\nnrows 2\n1 2\n3 4\n")
+file(WRITE "${WORK}/dxdy.asc" "ncols 2\nnrows 2\nDX 1\nDY 2\n1 2\n3 4\n")
+foreach(grid neg nocell dxdy)
+  expect(EXIT_ZERO "wrote 4 samples to" terrain convert "${WORK}/${grid}.asc" --cell-size 2
+         -o "${WORK}/${grid}.pts")
+endforeach()
+file(STRINGS "${WORK}/nocell.pts" nocell_lines REGEX "^1\\.[5-9]")
+if(NOT nocell_lines)
+  message(FATAL_ERROR "--cell-size 2 over a grid without cellsize: no sample past x = 1.5")
+endif()
 string(ASCII 27 escape)
 file(WRITE "${WORK}/esc.asc" "ncols 2\nnrows 2\ncellsize 1\n1 2\n3 ${escape}]0x\n")
 expect(EXIT_NONZERO "esc.asc:5: value '?]0x' is not a finite number" terrain info "${WORK}/esc.asc")

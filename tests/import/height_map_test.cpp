@@ -1,5 +1,9 @@
 #include "footfall/import/height_map.h"
 
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <filesystem>
 
 #include "footfall/import/terrain_loader.h"
@@ -421,6 +425,128 @@ TEST_CASE("ReadAscGrid: GDAL's DX and DY give the cell size when equal", "[impor
           Status::kParseError);
     CHECK(Contains(error, expected));
   }
+}
+
+}  // namespace footfall
+
+namespace footfall {
+namespace {
+
+// The peak resident memory of this process so far, in bytes.
+long PeakResidentBytes() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss * 1024L;
+}
+
+}  // namespace
+
+TEST_CASE("Height maps: a grid too large is refused from its header, before the file is read",
+          "[import][heightmap]") {
+  // A 3 GB image declaring 60000 x 50000 pixels took 29 s and 6 GB of memory to be refused:
+  // the file was read whole before its header was looked at. Sparse files: no disk space.
+  test::TempDir dir;
+  HeightMap map;
+  std::string error;
+  constexpr size_t kBytes = size_t{3} << 30;
+  const long peak_before = PeakResidentBytes();
+  {
+    const std::string header = "P5\n60000 50000\n255\n";
+    const std::string path = dir.Write("wide.pgm", header);
+    std::filesystem::resize_file(path, header.size() + kBytes);
+    CHECK(ReadPgm(path, &map, &error) == Status::kParseError);
+    CHECK(Contains(error,
+                   "wide.pgm:2: the header declares 60000 x 50000 pixels, more than the "
+                   "100000000 cells a height map may have"));
+  }
+  {
+    const std::string header = "ncols 20000\nnrows 20000\ncellsize 1\n";
+    std::string row;
+    for (int i = 0; i < 20000; ++i) row += "0 ";
+    const std::string path = dir.Write("wide.asc", header + row + "\n");
+    std::filesystem::resize_file(path, header.size() + kBytes);
+    CHECK(ReadAscGrid(path, &map, &error) == Status::kParseError);
+    CHECK(Contains(error,
+                   "wide.asc:2: the header declares 400000000 values (20000 rows of "
+                   "20000), more than the 100000000 cells a height map may have"));
+  }
+  CHECK(PeakResidentBytes() - peak_before < (long{256} << 20));
+}
+
+TEST_CASE("Height maps: a file too large for memory is named, not a bare out of memory",
+          "[import][heightmap]") {
+  // A small header over 3 GB of data, read in a child process limited to 1 GB of address space.
+  test::TempDir dir;
+  const std::string header = "ncols 2\nnrows 2\ncellsize 1\n";
+  const std::string path = dir.Write("long.asc", header + "1 2\n3 4\n");
+  std::filesystem::resize_file(path, size_t{3} << 30);
+  int fds[2];
+  REQUIRE(pipe(fds) == 0);
+  const pid_t child = fork();
+  REQUIRE(child >= 0);
+  if (child == 0) {
+    close(fds[0]);
+    rlimit limit{size_t{1} << 30, size_t{1} << 30};
+    setrlimit(RLIMIT_AS, &limit);
+    HeightMap map;
+    std::string error;
+    const Status status = ReadAscGrid(path, &map, &error);
+    error = std::to_string(static_cast<int>(status)) + " " + error;
+    if (write(fds[1], error.data(), error.size()) < 0) _exit(2);
+    _exit(0);
+  }
+  close(fds[1]);
+  std::string said;
+  char buffer[4096];
+  for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;) said.append(buffer, n);
+  close(fds[0]);
+  int wstatus = 0;
+  waitpid(child, &wstatus, 0);
+  CHECK(WIFEXITED(wstatus));
+  CHECK(WEXITSTATUS(wstatus) == 0);
+  INFO(said);
+  CHECK(Contains(said, std::to_string(static_cast<int>(Status::kLimitExceeded)) + " "));
+  CHECK(Contains(said, "long.asc: out of memory reading the file whole (3221225472 bytes"));
+}
+
+TEST_CASE("ReadAscGrid: a header line holds one key and one value", "[import][heightmap]") {
+  // "cellsize 1 7 8" loaded with 7 8 as the grid's first row; "xllcorner 0 0" was "header
+  // needs cellsize", "ncols 2 4" "header needs whole ncols and nrows".
+  test::TempDir dir;
+  HeightMap map;
+  std::string error;
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1 7 8\n1 2\n",
+       "a.asc:5: header "
+       "'cellsize' has more "
+       "than one value"},
+      {"ncols 2\nnrows 2\nxllcorner 0 0\nyllcorner 0\ncellsize 1\n1 2\n3 4\n",
+       "a.asc:3: header 'xllcorner' has more than one value on its line"},
+      {"ncols 2 4\nnrows 2\ncellsize 1\n1 2\n3 4\n", "a.asc:1: header 'ncols' has more"},
+      {"ncols 3\nnrows 2\ncellsize 1\nNODATA_value -9999 7 8 9\n1 2 3\n4 5 6\n",
+       "a.asc:4: header 'NODATA_value' has more"},
+  };
+  for (const auto& [text, expected] : cases) {
+    INFO(text);
+    CHECK(ReadAscGrid(dir.Write("a.asc", text), &map, &error) == Status::kParseError);
+    CHECK(Contains(error, expected));
+  }
+}
+
+TEST_CASE("ReadAscGrid: lines ended by CR alone are counted as lines", "[import][heightmap]") {
+  // Every error of a classic Mac OS file was named at line 1.
+  test::TempDir dir;
+  HeightMap map;
+  std::string error;
+  CHECK(ReadAscGrid(dir.Write("cr.asc", "ncols 2\rnrows 2\rcellsize 1\r1 2\r3 x\r"), &map,
+                    &error) == Status::kParseError);
+  CHECK(Contains(error, "cr.asc:5: value 'x' is not a finite number"));
+  CHECK(ReadAscGrid(dir.Write("cr.asc", "ncols 2\rnrows 2\rcellsize 1\r1 2 5\r3 4\r"), &map,
+                    &error) == Status::kParseError);
+  CHECK(Contains(error, "cr.asc:4: 3 values, expected 2"));
+  REQUIRE(ReadAscGrid(dir.Write("cr.asc", "ncols 2\rnrows 2\rcellsize 1\r1 2\r3 4\r"), &map,
+                      &error) == Status::kOk);
+  CHECK(map.heights == std::vector<double>{1, 2, 3, 4});
 }
 
 }  // namespace footfall

@@ -40,7 +40,8 @@ std::string Number(double v) {
   return out.str();
 }
 
-// Whitespace-separated tokens with their line numbers; '#' comments optional.
+// Whitespace-separated tokens with their line numbers (lines end at LF, CR LF or CR); '#'
+// comments optional.
 class TokenReader {
  public:
   TokenReader(const std::string& text, bool comments) : text_(&text), comments_(comments) {}
@@ -48,7 +49,10 @@ class TokenReader {
   bool Skip() {
     for (;;) {
       while (pos_ < text_->size() && std::isspace(static_cast<unsigned char>((*text_)[pos_]))) {
-        if ((*text_)[pos_] == '\n') ++line_;
+        // LF, CR LF, and a CR alone (old Mac files: their errors were all named at line 1).
+        const char c = (*text_)[pos_];
+        if (c == '\n' || (c == '\r' && (pos_ + 1 == text_->size() || (*text_)[pos_ + 1] != '\n')))
+          ++line_;
         ++pos_;
       }
       if (comments_ && pos_ < text_->size() && (*text_)[pos_] == '#') {
@@ -112,11 +116,18 @@ std::string FirstWord(std::istream& in) {
   return head.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
 }
 
+// The first bytes of a file a header must lie within: a head check reads no further.
+constexpr size_t kHeadBytes = 65536;
+
 // Reads the file whole, once its first word is one `starts_ok` accepts (a file of NUL bytes or
-// without line breaks is refused before it is read; `expected` says what should start it).
-template <typename StartsOk>
+// without line breaks is refused before it is read; `expected` says what should start it) and,
+// for a file longer than kHeadBytes, once `head_ok` accepts its head (up to its last white space
+// within kHeadBytes, byte order mark removed): a header declaring a grid too large is refused
+// before the file is read (a 3 GB image took 29 s and 6 GB to be refused). Out of memory is
+// kLimitExceeded naming the file.
+template <typename StartsOk, typename HeadOk>
 Status ReadWhole(const std::string& path, std::string* text, std::string* error,
-                 const StartsOk& starts_ok, const char* expected) {
+                 const StartsOk& starts_ok, const char* expected, const HeadOk& head_ok) {
   // A directory opened as a file threw out of the read below (EISDIR); a FIFO waited.
   const Status input = CheckInputFile(path, "height map", error);
   if (input != Status::kOk) return input;
@@ -139,8 +150,38 @@ Status ReadWhole(const std::string& path, std::string* text, std::string* error,
     return Fail(path + ":1", std::string("expected ") + expected + ", found " + found, error);
   }
   in.clear();
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
   in.seekg(0);
-  text->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  if (size > static_cast<std::streamoff>(kHeadBytes)) {
+    std::string head(kHeadBytes, '\0');
+    in.read(&head[0], static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<size_t>(in.gcount()));
+    const size_t last_space = head.find_last_of(" \t\r\n");  // no word cut in two
+    if (last_space != std::string::npos) head.resize(last_space + 1);
+    if (head.compare(0, 3, "\xEF\xBB\xBF") == 0) head.erase(0, 3);
+    const Status status = head_ok(head);
+    if (status != Status::kOk) return status;
+    in.clear();
+    in.seekg(0);
+  }
+  try {
+    text->clear();
+    if (size > 0) {
+      text->resize(static_cast<size_t>(size));
+      in.read(&(*text)[0], static_cast<std::streamsize>(size));
+      text->resize(static_cast<size_t>(in.gcount()));
+    }
+    // A file that grew since its size was taken (or one without a size): the rest too.
+    text->append(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  } catch (const std::bad_alloc&) {
+    std::string().swap(*text);
+    if (error) {
+      *error = path + ": out of memory reading the file whole (" + std::to_string(size) +
+               " bytes; crop or downsample the grid)";
+    }
+    return Status::kLimitExceeded;
+  }
   if (text->compare(0, 3, "\xEF\xBB\xBF") == 0) text->erase(0, 3);  // UTF-8 byte order mark
   if (text->empty()) return Fail(path, "the file is empty, expected a height map", error);
   return Status::kOk;
@@ -290,52 +331,60 @@ Status CheckAscRows(const std::string& path, TokenReader reader, size_t cols, si
   return Status::kOk;
 }
 
-}  // namespace
-
-size_t HeightMap::ValidCount() const {
-  return static_cast<size_t>(std::count(valid.begin(), valid.end(), uint8_t{1}));
-}
-
-Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) {
-  *out = HeightMap{};
-  std::string text;
-  auto header_word = [](const std::string& word) {
-    return !word.empty() && std::isalpha(static_cast<unsigned char>(word[0])) != 0;
-  };
-  Status status =
-      ReadWhole(path, &text, error, header_word, "the grid header's first key ('ncols N')");
-  if (status != Status::kOk) return status;
-  TokenReader reader(text, false);
-  std::string key, value;
+// An ESRI ASCII grid's header, as ParseAscHeader reads it.
+struct AscHeader {
   double ncols = -1, nrows = -1, cellsize = -1, nodata = NAN;
   bool has_nodata = false, nodata_is_nan = false;
-  size_t size_line = 1;                   // the line of ncols or nrows, whichever comes last
+  size_t size_line = 1;  // the line of ncols or nrows, whichever comes last
+};
+
+// Reads an ASCII grid's header from `reader` (KEY VALUE lines until the first token that is a
+// number), leaving `reader` before the first value. *ended (if not null) is set when the text
+// ends within the header.
+Status ParseAscHeader(const std::string& path, TokenReader* reader, bool cell_size_given,
+                      AscHeader* h, std::string* error, bool* ended = nullptr) {
+  std::string key, value;
+  double& ncols = h->ncols;
+  double& nrows = h->nrows;
+  double& cellsize = h->cellsize;
   size_t ncols_line = 0, nrows_line = 0;  // 0: not given
   size_t cellsize_line = 0;               // 0: no cellsize
   // GDAL's DX and DY (its cell width and height, written for cells that are not square).
   double dx = -1, dy = -1;
   size_t dx_line = 0, dy_line = 0;                   // 0: not given
   std::vector<std::pair<std::string, size_t>> seen;  // header keys (lower case) and their lines
-  // Header: KEY VALUE pairs until the first token that is a number.
   for (;;) {
-    const TokenReader before = reader;
-    if (!reader.Next(&key)) return Fail(path, "truncated: the grid header has no data", error);
-    const size_t line = reader.line();
+    const TokenReader before = *reader;
+    if (!reader->Next(&key)) {
+      if (ended) *ended = true;
+      return Fail(path, "truncated: the grid header has no data", error);
+    }
+    const size_t line = reader->line();
     if (key[0] == '#') return CommentInGrid(path, line, error);
     double number;
     if (ParseFiniteDecimal(key, &number) || IsValueText(key)) {
-      reader = before;  // the first data value
+      *reader = before;  // the first data value
       break;
     }
     // The value on the key's own line: a key alone is not given the first data value. Only
     // NODATA_value may be NaN (GDAL and R's terra write NaN for float grids).
-    const bool value_on_line = reader.Next(&value) && reader.line() == line;
+    const bool value_on_line = reader->Next(&value) && reader->line() == line;
     const bool nan_nodata = value_on_line && Lower(key) == "nodata_value" && IsNanText(value);
     if (nan_nodata) {
       number = NAN;
     } else if (!value_on_line || !ParseFiniteDecimal(value, &number)) {
       return Fail(path + ":" + std::to_string(line),
                   "header '" + ShownText(key) + "' needs a number on its line", error);
+    }
+    // One value a line: more after it ("cellsize 1 7 8") were read as the grid's first row.
+    TokenReader after = *reader;
+    if (after.Skip() && after.line() == line) {
+      if (after.first() == '#') return CommentInGrid(path, line, error);
+      return Fail(path + ":" + std::to_string(line),
+                  "header '" + ShownText(key) +
+                      "' has more than one value on its line (expected one KEY VALUE pair a "
+                      "line, the grid's values after the header)",
+                  error);
     }
     const std::string k = Lower(key);
     for (const auto& [earlier, at] : seen) {
@@ -348,13 +397,13 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
     }
     seen.emplace_back(k, line);
     if (k == "ncols") {
-      ncols = number, size_line = ncols_line = line;
+      ncols = number, h->size_line = ncols_line = line;
     } else if (k == "nrows") {
-      nrows = number, size_line = nrows_line = line;
+      nrows = number, h->size_line = nrows_line = line;
     } else if (k == "cellsize") {
       cellsize = number, cellsize_line = line;
     } else if (k == "nodata_value") {
-      nodata = number, has_nodata = true, nodata_is_nan = nan_nodata;
+      h->nodata = number, h->has_nodata = true, h->nodata_is_nan = nan_nodata;
     } else if (k == "dx") {
       dx = number, dx_line = line;
     } else if (k == "dy") {
@@ -370,16 +419,23 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
   }
   // A count given but not a whole number >= 1 is named at its line; a missing one in the file.
   auto bad_count = [](double n) { return !(n >= 1 && n == std::floor(n)); };
-  for (const auto& [value, at, name] :
+  for (const auto& [count, at, name] :
        {std::make_tuple(ncols, ncols_line, "ncols"), std::make_tuple(nrows, nrows_line, "nrows")}) {
-    if (at != 0 && bad_count(value)) {
+    if (at != 0 && bad_count(count)) {
       return Fail(path + ":" + std::to_string(at),
-                  std::string(name) + " " + NumberText(value) + " (expected a whole number >= 1)",
+                  std::string(name) + " " + NumberText(count) + " (expected a whole number >= 1)",
                   error);
     }
   }
   if (ncols_line == 0 || nrows_line == 0) {
-    return Fail(path, "header needs whole ncols and nrows >= 1", error);
+    return Fail(path,
+                std::string("header needs ") + (ncols_line == 0 ? "ncols" : "nrows") +
+                    " (a whole number >= 1)",
+                error);
+  }
+  if (cell_size_given) {  // the caller's own: cellsize, DX and DY as they are
+    cellsize = 0;
+    return Status::kOk;
   }
   if (dx_line != 0 || dy_line != 0) {
     const size_t at = std::max(dx_line, dy_line);
@@ -392,16 +448,62 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
                   std::string(why) +
                       " (expected cellsize, or DX and DY equal: cells that are not square are "
                       "not read; resample the grid to square cells, for example with gdalwarp "
-                      "-tr)",
+                      "-tr; or give a cell size of your own, --cell-size)",
                   error);
     }
     cellsize = dx, cellsize_line = dx_line;
   }
-  if (cellsize_line == 0) return Fail(path, "header needs cellsize (a number > 0)", error);
+  if (cellsize_line == 0) {
+    return Fail(path, "header needs cellsize (a number > 0; or give one, --cell-size)", error);
+  }
   if (!(cellsize > 0)) {
     return Fail(path + ":" + std::to_string(cellsize_line),
-                "cellsize " + NumberText(cellsize) + " (expected a number > 0)", error);
+                "cellsize " + NumberText(cellsize) +
+                    " (expected a number > 0; or give a cell size of your own, --cell-size)",
+                error);
   }
+  return Status::kOk;
+}
+
+// "R values (N rows of C)" for a header's grid.
+std::string AscDeclared(const AscHeader& h) {
+  return Count(h.ncols * h.nrows) + " values (" + Count(h.nrows) + " rows of " + Count(h.ncols) +
+         ")";
+}
+
+}  // namespace
+
+size_t HeightMap::ValidCount() const {
+  return static_cast<size_t>(std::count(valid.begin(), valid.end(), uint8_t{1}));
+}
+
+Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error,
+                   bool cell_size_given) {
+  *out = HeightMap{};
+  std::string text;
+  auto header_word = [](const std::string& word) {
+    return !word.empty() && std::isalpha(static_cast<unsigned char>(word[0])) != 0;
+  };
+  // The header alone first: a grid too large is refused before the file is read whole.
+  auto header_ok = [&](const std::string& head) {
+    TokenReader reader(head, false);
+    AscHeader h;
+    bool ended = false;
+    const Status status = ParseAscHeader(path, &reader, cell_size_given, &h, error, &ended);
+    if (ended) return Status::kOk;  // a header longer than the head: judged whole
+    if (status != Status::kOk) return status;
+    return CheckGridSize(path, path + ":" + std::to_string(h.size_line), h.ncols * h.nrows,
+                         AscDeclared(h), kMaxHeightMapCells + 1, 0, error);
+  };
+  Status status = ReadWhole(path, &text, error, header_word,
+                            "the grid header's first key ('ncols N')", header_ok);
+  if (status != Status::kOk) return status;
+  TokenReader reader(text, false);
+  AscHeader h;
+  status = ParseAscHeader(path, &reader, cell_size_given, &h, error);
+  if (status != Status::kOk) return status;
+  const double ncols = h.ncols, nrows = h.nrows;
+  std::string value;
   const double cells = ncols * nrows;
   if (ncols <= static_cast<double>(kMaxHeightMapCells) &&
       nrows <= static_cast<double>(kMaxHeightMapCells)) {
@@ -411,13 +513,11 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
   }
   size_t last_line;
   const size_t present = CountValues(reader, cells, &last_line);
-  status =
-      CheckGridSize(path, path + ":" + std::to_string(size_line), cells,
-                    Count(cells) + " values (" + Count(nrows) + " rows of " + Count(ncols) + ")",
-                    present, last_line, error);
+  status = CheckGridSize(path, path + ":" + std::to_string(h.size_line), cells, AscDeclared(h),
+                         present, last_line, error);
   if (status != Status::kOk) return status;
   out->cols = static_cast<int>(ncols), out->rows = static_cast<int>(nrows);
-  out->cell_size = cellsize;
+  out->cell_size = h.cellsize;
   const size_t total = static_cast<size_t>(out->cols) * out->rows;
   out->heights.resize(total);
   out->valid.resize(total);
@@ -429,19 +529,19 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
                       "), found " + std::to_string(i),
                   error);
     }
-    double h;
-    if (nodata_is_nan && IsNanText(value)) {
+    double height;
+    if (h.nodata_is_nan && IsNanText(value)) {
       out->heights[i] = 0, out->valid[i] = 0;
       continue;
     }
-    if (!ParseFiniteDecimal(value, &h)) {
+    if (!ParseFiniteDecimal(value, &height)) {
       return Fail(path + ":" + std::to_string(reader.line()),
                   "value '" + ShownText(value) + "' is not a finite number" + NotFiniteNote(value),
                   error);
     }
-    out->heights[i] = h;
-    out->valid[i] = !(has_nodata && h == nodata);
-    if (out->valid[i] && std::fabs(h) > terrain::kMaxCoordinate) {
+    out->heights[i] = height;
+    out->valid[i] = !(h.has_nodata && height == h.nodata);
+    if (out->valid[i] && std::fabs(height) > terrain::kMaxCoordinate) {
       return Fail(path + ":" + std::to_string(reader.line()),
                   "value " + ShownText(value) + " is out of range (expected |height| <= " +
                       Number(terrain::kMaxCoordinate) + ")",
@@ -456,42 +556,74 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error) 
   return Status::kOk;
 }
 
+namespace {
+
+// Reads a PGM header from `reader`: the magic ("P5" or "P2"), then width, height and maxval
+// (fields[0..2]); *size_line is the height's line.
+Status ParsePgmHeader(const std::string& path, TokenReader* reader, std::string* magic,
+                      double fields[3], size_t* size_line, std::string* error) {
+  std::string token;
+  reader->Next(magic);
+  if (*magic != "P5" && *magic != "P2") {
+    return Fail(path + ":1", "expected the PGM magic 'P5' (binary) or 'P2' (ASCII)", error);
+  }
+  const char* names[3] = {"width", "height", "maxval"};
+  for (int i = 0; i < 3; ++i) {
+    if (!reader->Next(&token) || !ParseFiniteDecimal(token, &fields[i]) || fields[i] < 1 ||
+        fields[i] != std::floor(fields[i])) {
+      return Fail(path + ":" + std::to_string(reader->line()),
+                  std::string("expected the PGM ") + names[i] + " as a whole number >= 1", error);
+    }
+    if (i == 1) *size_line = reader->line();
+  }
+  if (fields[2] > 65535) {
+    return Fail(path + ":" + std::to_string(reader->line()), "PGM maxval above 65535", error);
+  }
+  return Status::kOk;
+}
+
+// "W x H pixels" (P5), "N grey levels (W x H pixels)" (P2).
+std::string PgmDeclared(const std::string& magic, const double fields[3]) {
+  const std::string pixels = Count(fields[0]) + " x " + Count(fields[1]) + " pixels";
+  return magic == "P5" ? pixels : Count(fields[0] * fields[1]) + " grey levels (" + pixels + ")";
+}
+
+}  // namespace
+
 Status ReadPgm(const std::string& path, HeightMap* out, std::string* error) {
   *out = HeightMap{};
   std::string text;
   auto magic_word = [](const std::string& word) {
     return word.compare(0, 2, "P5") == 0 || word.compare(0, 2, "P2") == 0;
   };
-  Status status =
-      ReadWhole(path, &text, error, magic_word, "the PGM magic 'P5' (binary) or 'P2' (ASCII)");
+  // The header alone first: an image too large is refused before the file is read whole (a
+  // header the head does not hold whole is judged once it is).
+  auto header_ok = [&](const std::string& head) {
+    TokenReader reader(head, true);
+    std::string magic;
+    double fields[3];
+    size_t size_line = 1;
+    if (ParsePgmHeader(path, &reader, &magic, fields, &size_line, nullptr) != Status::kOk)
+      return Status::kOk;
+    return CheckGridSize(path, path + ":" + std::to_string(size_line), fields[0] * fields[1],
+                         PgmDeclared(magic, fields), kMaxHeightMapCells + 1, 0, error);
+  };
+  Status status = ReadWhole(path, &text, error, magic_word,
+                            "the PGM magic 'P5' (binary) or 'P2' (ASCII)", header_ok);
   if (status != Status::kOk) return status;
   TokenReader reader(text, true);
   std::string magic, token;
-  reader.Next(&magic);
-  if (magic != "P5" && magic != "P2") {
-    return Fail(path + ":1", "expected the PGM magic 'P5' (binary) or 'P2' (ASCII)", error);
-  }
   double fields[3];
   size_t size_line = 1;
-  const char* names[3] = {"width", "height", "maxval"};
-  for (int i = 0; i < 3; ++i) {
-    if (!reader.Next(&token) || !ParseFiniteDecimal(token, &fields[i]) || fields[i] < 1 ||
-        fields[i] != std::floor(fields[i])) {
-      return Fail(path + ":" + std::to_string(reader.line()),
-                  std::string("expected the PGM ") + names[i] + " as a whole number >= 1", error);
-    }
-    if (i == 1) size_line = reader.line();
-  }
-  if (fields[2] > 65535) {
-    return Fail(path + ":" + std::to_string(reader.line()), "PGM maxval above 65535", error);
-  }
+  status = ParsePgmHeader(path, &reader, &magic, fields, &size_line, error);
+  if (status != Status::kOk) return status;
   const double cells = fields[0] * fields[1];
   const std::string header = path + ":" + std::to_string(size_line);
   const size_t bytes = fields[2] < 256 ? 1 : 2;  // per P5 pixel
   const size_t start = reader.pos() + 1;         // P5: exactly one whitespace byte after maxval
   if (magic == "P5") {
     const size_t available = text.size() > start ? text.size() - start : 0;
-    const std::string declared = Count(fields[0]) + " x " + Count(fields[1]) + " pixels";
+    const std::string declared = PgmDeclared(magic, fields);
     if (static_cast<double>(available) < cells * bytes) {
       return Fail(path,
                   "truncated: " + declared + " of " + std::to_string(bytes) + " bytes need " +
@@ -524,10 +656,8 @@ Status ReadPgm(const std::string& path, HeightMap* out, std::string* error) {
   } else {
     size_t last_line;
     const size_t present = CountValues(reader, cells, &last_line);
-    status = CheckGridSize(
-        path, header, cells,
-        Count(cells) + " grey levels (" + Count(fields[0]) + " x " + Count(fields[1]) + " pixels)",
-        present, last_line, error);
+    status =
+        CheckGridSize(path, header, cells, PgmDeclared(magic, fields), present, last_line, error);
   }
   if (status != Status::kOk) return status;
   out->cols = static_cast<int>(fields[0]), out->rows = static_cast<int>(fields[1]);

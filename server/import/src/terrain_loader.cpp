@@ -115,7 +115,8 @@ Status ReadTerrainMesh(const std::string& path, const TerrainLoadOptions& option
   if (ext == "asc" || ext == "pgm") {
     report->format = "heightmap";
     HeightMap map;
-    status = ext == "asc" ? ReadAscGrid(path, &map, error) : ReadPgm(path, &map, error);
+    status = ext == "asc" ? ReadAscGrid(path, &map, error, options.cell_size > 0)
+                          : ReadPgm(path, &map, error);
     if (status != Status::kOk) return status;
     HeightMapFrame frame;
     frame.cell_size = options.cell_size > 0 ? options.cell_size : map.cell_size;

@@ -34,8 +34,11 @@ struct HeightMap {
 // NODATA_value are marked invalid. A leading UTF-8 byte order mark is skipped. Errors: kIoError
 // (cannot open), kInvalidArgument (a directory, FIFO or device: CheckInputFile), kParseError with
 // "FILE:LINE: what was expected" (bad header, more cells than kMaxHeightMapCells or than the file
-// has data for, a value that is not a finite decimal number, truncated data).
-Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error);
+// has data for, a value that is not a finite decimal number, truncated data). With
+// `cell_size_given` (the caller has a cell size of its own), the header's cellsize, DX and DY are
+// neither required nor checked, and out->cell_size is 0.
+Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error,
+                   bool cell_size_given = false);
 
 // Reads a PGM image, binary (P5, 8 or 16 bit big-endian by maxval) or ASCII (P2). Heights are
 // the grey levels, each at most maxval; every cell is valid. Errors as ReadAscGrid.
