@@ -218,6 +218,10 @@ execute_process(COMMAND "${FOOTFALL}" query --terrain "${WORK}/down.pts" INPUT_F
 if(NOT rc EQUAL 0 OR NOT riser MATCHES "\"normal\":\\[0\\.0,0\\.0,1\\.0\\]")
   message(FATAL_ERROR "the riser of stairs going down does not face +z: ${riser}")
 endif()
+file(STRINGS "${WORK}/down.pts" negative_zero REGEX "(^| )-0( |$)")
+if(negative_zero)
+  message(FATAL_ERROR "stairs going down written with -0: ${negative_zero}")
+endif()
 # terrain make hills makes the same hills at any spacing: the sample at (2, 2) of a 0.05 m and a
 # 0.2 m lattice has the same height and normal (the relief was laid in sample units: 0.14 m at
 # one spacing, -0.12, -0.95 and 0.49 at others).

@@ -89,7 +89,7 @@ RawSamples MakeStairs(int steps, double rise, double run, double width, double s
   // Risers face the way down: -z on stairs rising along +z, +z on stairs falling along it.
   const Vec3 riser_normal{0, 0, rise > 0 ? -1.0 : 1.0};
   for (int step = 0; step < steps; ++step) {
-    const double y = step * rise, z0 = step * run;
+    const double y = step * rise + 0.0, z0 = step * run;  // (+ 0.0: no -0 for a negative rise)
     for (int a = 0; a <= across; ++a) {
       const double x = a * width / across;
       for (int b = 0; b < along; ++b) s.push_back({x, y, z0 + b * run / along}, {0, 1, 0});
