@@ -372,6 +372,32 @@ TEST_CASE("framing leaves the overlay's bands clear", "[viewer][camera]") {
   }
 }
 
+TEST_CASE("a window too small for the overlay still shows the terrain", "[viewer][camera]") {
+  // At 300 x 80 and 100 x 100 the overlay's bands met and no terrain was drawn (exit 0), and
+  // a line of text was placed above the window.
+  const std::string dir = test::TempDir();
+  for (const std::string size : {"300x80", "100x100", "160x120"}) {
+    const RunResult r = View({"--terrain", kTerrain, "--size", size, "--screenshot",
+                              dir + "/small.png", "--dump-state", dir + "/state.json"});
+    INFO(size << ": " << r.err);
+    REQUIRE(r.exit_code == 0);
+    const json state = json::parse(test::ReadFile(dir + "/state.json"));
+    const int height = state["image"]["height"];
+    for (const json& line : state["hud"]) {
+      CHECK(line["y"].get<double>() >= 0);
+      CHECK(line["y"].get<double>() + 12 <= height);
+    }
+    // The terrain fills much of the middle rows: not the background colour.
+    const Image image = ReadPng(dir + "/small.png");
+    int terrain = 0, pixels = 0;
+    for (int y = image.height * 3 / 8; y < image.height * 5 / 8; ++y) {
+      for (int x = 0; x < image.width; ++x, ++pixels)
+        terrain += !Near(image.At(x, y), {28, 30, 36}, 3);
+    }
+    CHECK(terrain > pixels / 10);
+  }
+}
+
 TEST_CASE("scenes a few centimetres across are framed to their size", "[viewer][camera]") {
   // (Framing took a radius of at least 0.5 m: a terrain or a walk of 4 cm was a dot.)
   const std::string dir = test::TempDir();

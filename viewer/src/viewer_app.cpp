@@ -264,18 +264,30 @@ struct App {
         hud_lines.push_back({lines[i], x, y, DrawList::TextWidth(lines[i], scale)});
       }
     };
-    const std::vector<std::string> info = WrapText(InfoText(), "   ", scale, max_width);
-    hud_top = static_cast<float>(info.size()) * line + 6;
-    screen->Rect(0, 0, static_cast<float>(width), hud_top, Rgba{0, 0, 0, 140});
-    draw_lines(6, 4, info);
+    std::vector<std::string> info = WrapText(InfoText(), "   ", scale, max_width);
     // The help line, wrapped at its item separators.
-    const std::vector<std::string> lines = WrapText(HelpText(), "   ", scale, max_width);
-    const float top = static_cast<float>(height) - static_cast<float>(lines.size()) * line - 6;
-    screen->Rect(0, top - 4, static_cast<float>(width), static_cast<float>(height),
-                 Rgba{0, 0, 0, 140});
-    draw_lines(6, top, lines);
-    hud_bottom = static_cast<float>(height) - (top - 4);
-    if (scene.has_walk()) {
+    std::vector<std::string> lines = WrapText(HelpText(), "   ", scale, max_width);
+    // A window too small for every line keeps the scene in view: the help is left out, and
+    // each band keeps what fits in a quarter of the height (at 300 x 80 the bands met, and no
+    // terrain was drawn).
+    const size_t quarter = static_cast<size_t>(std::max(0.0f, 0.25f * height - 10) / line);
+    const bool tight = static_cast<float>(info.size() + lines.size()) * line + 20 > 0.5f * height;
+    if (tight) {
+      lines.clear();
+      info.resize(std::min(info.size(), quarter));
+    }
+    hud_top = info.empty() ? 0 : static_cast<float>(info.size()) * line + 6;
+    if (hud_top > 0) screen->Rect(0, 0, static_cast<float>(width), hud_top, Rgba{0, 0, 0, 140});
+    draw_lines(6, 4, info);
+    float top = static_cast<float>(height);
+    if (!lines.empty()) {
+      top -= static_cast<float>(lines.size()) * line + 6;
+      screen->Rect(0, top - 4, static_cast<float>(width), static_cast<float>(height),
+                   Rgba{0, 0, 0, 140});
+      draw_lines(6, top, lines);
+    }
+    hud_bottom = lines.empty() ? 0 : static_cast<float>(height) - (top - 4);
+    if (scene.has_walk() && (!tight || quarter > 0)) {
       // The timeline: a bar over the walk's frames with a marker at the current frame.
       const float bar_y = top - 14;
       const float x0 = 10, x1 = static_cast<float>(width) - 10;
@@ -290,8 +302,9 @@ struct App {
         << (playing ? "  (playing)" : "");
       // Why the walk stopped, in full: wrapped over as many lines as it takes.
       if (!scene.walk().stopped.empty()) f << "   stopped: " << scene.walk().stopped;
-      const std::vector<std::string> frame_lines =
+      std::vector<std::string> frame_lines =
           WrapText(f.str(), "   ", scale, static_cast<float>(width) - 2 * x0);
+      if (tight) frame_lines.resize(std::min(frame_lines.size(), quarter));
       const float frame_top = bar_y - static_cast<float>(frame_lines.size()) * line - 6;
       draw_lines(x0, frame_top, frame_lines);
       hud_bottom = static_cast<float>(height) - frame_top;
