@@ -1801,6 +1801,11 @@ TEST_CASE("at the open descriptor limit footfalld says which connections it clos
   CHECK(late->LoadSamples(MakeFlat(10, 1, 0), "late", &late_own) == Status::kOk);
   CHECK(late->Snap(late_own, Vec3{3.2, 1, 4.7}).point == Vec3{3, 0, 5});
   for (const int fd : idle) close(fd);
+  // The owner's connection, closed while idle, is replaced before its next call, which
+  // succeeds (it failed once with "the connection closed under the call", footfalld serving).
+  const Foothold again = owner->Snap(owned, Vec3{3.2, 1, 4.7});
+  CHECK(again.status == Status::kOk);
+  CHECK(again.point == Vec3{3, 0, 5});
   const std::string log = server.Log();
   CHECK_THAT(log, Catch::Contains("at the open descriptor limit (64): closed the least recently "
                                   "active connection, from 127.0.0.1:"));

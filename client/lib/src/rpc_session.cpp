@@ -2,8 +2,11 @@
 //
 // Connections are made by ConnectFootfalld (rpc_connect.h): a bounded connect, and every
 // request in one record fragment. A transport failure destroys the client; the next call
-// reconnects, and reloads a terrain the server no longer knows (it restarted).
+// reconnects, and reloads a terrain the server no longer knows (it restarted). A connection the
+// server closed while idle is replaced before the next call.
+#include <poll.h>
 #include <rpc/rpc.h>
+#include <sys/socket.h>
 
 #include <algorithm>
 #include <chrono>
@@ -447,6 +450,18 @@ class RpcSession final : public TerrainSession {
 
   std::string Address() const { return FormatHostPort(options_.host, options_.port); }
 
+  // Whether the server has closed this idle connection: its socket reads an end of file or
+  // an error (bytes waiting are no such sign: left to the call).
+  bool ClosedByServer() const {
+    int fd = -1;
+    if (!clnt_control(client_, CLGET_FD, reinterpret_cast<char*>(&fd)) || fd < 0) return false;
+    pollfd p{fd, POLLIN | POLLRDHUP, 0};
+    if (poll(&p, 1, 0) <= 0) return false;
+    if (p.revents & (POLLRDHUP | POLLHUP | POLLERR | POLLNVAL)) return true;
+    char byte;
+    return (p.revents & POLLIN) && recv(fd, &byte, 1, MSG_PEEK | MSG_DONTWAIT) == 0;
+  }
+
   void Disconnect() {
     if (client_) {
       clnt_destroy(client_);  // closes the socket (CLSET_FD_CLOSE)
@@ -457,6 +472,10 @@ class RpcSession final : public TerrainSession {
   }
 
   Status EnsureConnected() {
+    // A connection footfalld closed while it was idle (at its descriptor limit, or at its
+    // --unread-timeout) is replaced before the call, which would fail at once with "the
+    // connection closed under the call" although footfalld is serving.
+    if (client_ && ClosedByServer()) Disconnect();
     if (client_) return Status::kOk;
     std::string reason;
     client_ = ConnectFootfalld(options_, &reason);
