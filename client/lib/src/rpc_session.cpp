@@ -472,8 +472,8 @@ class RpcSession final : public TerrainSession {
   }
 
   Status EnsureConnected() {
-    // A connection footfalld closed while it was idle (at its descriptor limit, or at its
-    // --unread-timeout) is replaced before the call, which would fail at once with "the
+    // A connection footfalld closed while it was idle (at its descriptor limit) is replaced
+    // before the call, which would fail at once with "the
     // connection closed under the call" although footfalld is serving.
     if (client_ && ClosedByServer()) Disconnect();
     if (client_) return Status::kOk;
