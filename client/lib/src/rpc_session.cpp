@@ -473,8 +473,8 @@ class RpcSession final : public TerrainSession {
 
   Status EnsureConnected() {
     // A connection footfalld closed while it was idle (at its descriptor limit) is replaced
-    // before the call, which would fail at once with "the
-    // connection closed under the call" although footfalld is serving.
+    // before the call, which would fail at once with "the connection closed under the call"
+    // although footfalld is serving.
     if (client_ && ClosedByServer()) Disconnect();
     if (client_) return Status::kOk;
     std::string reason;
