@@ -890,6 +890,65 @@ class BlenderAddonTest(unittest.TestCase):
             bpy.data.objects.remove(obj)
         scene.footfall.rig = None
 
+    def test_6e2_delta_transforms_and_own_constraints(self):
+        # A Delta Location on a target floated every foot key by it, and a Delta Rotation on the
+        # body turned it by it; a constraint on a target itself (Child Of, Copy Location) put its
+        # keys metres off the walk, reported as done.
+        scene = bpy.context.scene
+        scene.frame_set(1)
+        rig = bpy.data.objects["biped_rig"]
+        feet = {f.name: f.target for f in rig.footfall_rig.feet}
+        body = rig.footfall_rig.body
+        target = feet["L"]
+        scene.footfall.rig, scene.footfall.steps, scene.footfall.start_frame = rig, 6, 1
+        self.select([rig], rig)  # the rig of the active object is keyed
+        target.delta_location = (0.0, 0.0, 0.5)
+        body.delta_rotation_euler = (0.0, 0.0, math.radians(30))
+        scene.render.fps, scene.render.fps_base = 30, 1.001  # recorded in the walk (it said 24)
+        try:
+            self.assertEqual(bpy.ops.footfall.generate_walk(chunk_steps=2), {"FINISHED"})
+            walk = json.loads(bpy.data.texts["footfall_walk.json"].as_string())
+            self.assert_world_at_key_frames(walk, feet, body, tol=1e-5)
+            self.assertAlmostEqual(walk["fps"], 30 / 1.001, delta=1e-5)  # fps_base: a float32
+        finally:
+            target.delta_location = (0.0, 0.0, 0.0)
+            body.delta_rotation_euler = (0.0, 0.0, 0.0)
+            scene.render.fps, scene.render.fps_base = 24, 1.0
+        control = new_empty("constraint_control", location=(0.3, 0.2, 0.0))
+        objects = list(feet.values()) + [body]
+        for kind, shown in (("CHILD_OF", "Child Of"), ("COPY_LOCATION", "Copy Location")):
+            c = target.constraints.new(kind)
+            c.target = control
+            bpy.context.view_layer.update()
+            before = {o.name: fcurve_keys(o, "location", 3) for o in objects}
+            with self.assertRaises(RuntimeError) as e:
+                bpy.ops.footfall.generate_walk(chunk_steps=2)
+            self.assertIn("has a %s constraint" % shown, str(e.exception))
+            self.assertEqual({o.name: fcurve_keys(o, "location", 3) for o in objects}, before)
+            c.mute = True  # a muted constraint moves nothing
+            self.assertEqual(bpy.ops.footfall.generate_walk(chunk_steps=2), {"FINISHED"})
+            target.constraints.remove(c)
+        bpy.data.objects.remove(control)
+        scene.footfall.rig = None
+
+    def test_6e3_picked_objects_with_blenders_number_suffix(self):
+        # Use Selected refused the body and IK targets of any second rig (biped_L.001) and
+        # Shift+D duplicates: "no selected object named after foot L, R".
+        with open(os.path.join(CHARACTERS, "biped.json")) as f:
+            names = [foot["name"] for foot in json.load(f)["feet"]]
+        body = new_empty("suffix_body", location=(1.0, 2.5, 1.0))
+        new_empty("suffix_IK_" + names[0], location=(1.2, 2.5, 0.0))  # taken: the next are .001
+        targets = [new_empty("suffix_IK_" + n, location=(1.0 + (0.2 if i == 0 else -0.2), 2.5, 0.0))
+                   for i, n in enumerate(names)]
+        self.assertTrue(targets[0].name.endswith(".001"))
+        self.select(targets + [body], body)
+        self.assertEqual(bpy.ops.footfall.character_setup(
+            character_file=os.path.join(CHARACTERS, "biped.json"), mode="PICK",
+            name="suffix"), {"FINISHED"})
+        rig = bpy.context.scene.footfall.rig
+        self.assertEqual({f.name: f.target for f in rig.footfall_rig.feet},
+                         dict(zip(names, targets)))
+
     def test_6f_feet_under_the_body_keyed_again_only_where_it_changed(self):
         # Feet under the body were keyed again over the whole walk at each chunk, the scene
         # stepped through all their frames so far at each chunk (4830 frames for a walk of 400
@@ -1246,6 +1305,34 @@ class BlenderAddonTest(unittest.TestCase):
             settings.path = None
             bpy.data.objects.remove(path)
             bpy.data.curves.remove(data)
+
+    def test_7f2_a_filled_2d_path_is_its_outline_and_a_deleted_one_is_a_report(self):
+        # A closed 2D curve with a fill was walked along its fill's inner edges (186 waypoints,
+        # jumps of 6 m); a path deleted from the scene was still followed.
+        settings = bpy.context.scene.footfall
+        rig = bpy.data.objects["biped_rig"]
+        bpy.ops.curve.primitive_bezier_circle_add(radius=3.0, location=(0.0, 0.0, 0.5))
+        path = bpy.context.active_object
+        path.data.dimensions = "2D"
+        settings.path = path
+        try:
+            path.data.fill_mode = "NONE"
+            bpy.context.view_layer.update()
+            outline = self.ops.walk_request(bpy.context, rig, 4, 1)["path"]
+            for mode in ("BOTH", "FRONT", "BACK"):
+                path.data.fill_mode = mode
+                bpy.context.view_layer.update()
+                self.assertEqual(self.ops.walk_request(bpy.context, rig, 4, 1)["path"], outline,
+                                 mode)
+            bpy.ops.object.select_all(action="DESELECT")
+            path.select_set(True)
+            bpy.context.view_layer.objects.active = path
+            bpy.ops.object.delete()
+            with self.assertRaises(ValueError) as e:
+                self.ops.walk_request(bpy.context, rig, 4, 1)
+            self.assertIn("is no longer in the scene", str(e.exception))
+        finally:
+            settings.path = None
 
     def test_7h_a_path_of_several_splines_is_refused(self):
         # A path curve of several splines was walked as one line, jumping from the end of one

@@ -33,13 +33,37 @@ def unsupported_parent(obj):
     return None
 
 
+def own_constraint(obj):
+    """Why obj's own constraints keep its keys from being world positions (None when it has
+    none that act): a constraint moves the object after its keys (a Child Of or a Copy
+    Location put its keys metres off the walk), which the add-on cannot undo."""
+    for c in obj.constraints:
+        if not c.mute and c.influence > 0:
+            return ("%s has a %s constraint (%s), which moves it after its keys: the walk's world "
+                    "positions cannot be keyed through it; mute or remove it, or parent the "
+                    "object instead" % (obj.name, c.type.replace("_", " ").title(), c.name))
+    return None
+
+
 def check_parents(objects):
     """Raises ValueError naming the first of `objects` (None ones skipped) whose parent relation
-    cannot be keyed exactly (see unsupported_parent)."""
+    cannot be keyed exactly (see unsupported_parent), or whose own constraints move it
+    (own_constraint)."""
     for obj in objects:
-        why = unsupported_parent(obj) if obj is not None else None
+        why = (unsupported_parent(obj) or own_constraint(obj)) if obj is not None else None
         if why:
             raise ValueError(why)
+
+
+def _delta_rotation(obj):
+    """obj's delta rotation as a quaternion, in its rotation mode (Blender applies it before
+    the rotation: basis rotation = delta @ rotation). Axis-angle objects have none the Python
+    API shows (Blender's is then the identity)."""
+    if obj.rotation_mode == "QUATERNION":
+        return obj.delta_rotation_quaternion.normalized()
+    if obj.rotation_mode == "AXIS_ANGLE":
+        return Quaternion()
+    return Euler(obj.delta_rotation_euler, obj.rotation_mode).to_quaternion()
 
 
 def _bone(obj):
@@ -390,7 +414,7 @@ def key_walk(walk, feet, body, from_frame=None):
     without an object are skipped; with `from_frame`, so are keys before it (keyed already: a
     longer walk generated again keeps the keys of its first steps). Keys are world positions:
     an object under an animated parent is keyed in its parent's space at each key's frame (the
-    scene's frame is the same afterwards). Positions are metres, keyed in scene units (divided
+    scene's frame is the same afterwards), less its delta transform. Positions are metres, keyed in scene units (divided
     by the scene's Unit Scale). Returns the number of keys set."""
     tracks = []  # (object, is body, frames, keys, orientation) of the whole track, by frame
     for track in walk.get("tracks", []):
@@ -441,11 +465,15 @@ def key_walk(walk, feet, body, from_frame=None):
                 before = _curves(obj) if obj in below else None
                 if again:  # keys from where the objects above changed
                     clear_keys([obj], frames[0], to_frame=frames[-1])
+                # Less its delta transform, which Blender adds to the keyed location and
+                # turns the keyed rotation by (a 0.5 m Delta Location floated every foot key).
+                delta_location = obj.delta_location.copy()
+                undelta = _delta_rotation(obj).inverted()
                 locations, rotations = [], []
                 for inverse, world in zip(spaces.inverse(obj, frames), worlds):
                     l, r, _ = (inverse @ world).decompose()
-                    locations.append(tuple(l))
-                    rotations.append(r)
+                    locations.append(tuple(l - delta_location))
+                    rotations.append(undelta @ r)
                 if is_body:
                     path, values = _rotation_values(obj, rotations, frames[0])
                 _key_channel(obj, "location", locations, frames)

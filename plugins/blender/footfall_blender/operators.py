@@ -441,7 +441,7 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
         candidates = [o for o in context.selected_objects if o is not body and o not in parts]
         for name, _ in feet:
             for o in candidates:
-                n = o.name
+                n = _without_number(o.name)  # biped_L.001 (a second rig, a duplicate) is L's
                 if n == name or n.endswith(("_" + name, "." + name, "-" + name, ":" + name)):
                     chosen[name] = o
                     break
@@ -538,6 +538,12 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
         return {"FINISHED"}
 
 
+def _without_number(name):
+    """`name` without the number Blender appends to a name already taken ("IK_L.001")."""
+    head, dot, tail = name.rpartition(".")
+    return head if dot and tail.isdigit() else name
+
+
 def _is_locator(obj):
     """True for a central or target locator Character Setup made (older versions did not mark
     them: an empty named ..._center or ..._target, with Blender's .001 suffix or not)."""
@@ -545,8 +551,7 @@ def _is_locator(obj):
         return True
     if obj.type != "EMPTY" or obj.footfall_rig.is_rig:
         return False
-    head, dot, tail = obj.name.rpartition(".")
-    return (head if dot and tail.isdigit() else obj.name).endswith(("_center", "_target"))
+    return _without_number(obj.name).endswith(("_center", "_target"))
 
 
 def rig_parts(rig_obj):
@@ -607,15 +612,19 @@ def walk_request(context, rig_obj, steps, start_frame):
     request = {"character": data,
                "start": list(to_ff(mw.translation, scale)),
                "heading": list(to_ff(mw.to_3x3() @ Vector((0, -1, 0)))),
-               "steps": int(steps), "start_frame": int(start_frame)}
+               "steps": int(steps), "start_frame": int(start_frame),
+               "fps": context.scene.render.fps / context.scene.render.fps_base}
     if settings.path is not None:
+        if not in_scene(context.scene, settings.path):
+            raise ValueError("the path curve %s is no longer in the scene: pick another path, or "
+                             "clear the Path field" % settings.path.name)
         request["path"] = [list(to_ff(p, scale)) for p in curve_points(context, settings.path)]
     return request
 
 
 def curve_points(context, obj):
     """World points of a path curve's centre line: its spline as Blender evaluates it (at its
-    resolution), without Bevel or Extrude, whose tube or ribbon is not the path, in the order
+    resolution), without Bevel, Extrude or a 2D curve's fill, which are not the path, in the order
     of its edges: a closed (cyclic) spline ends back at its first point. Raises ValueError when
     the curve has more than one spline (walked as one line, the path jumped from one to the
     next)."""
@@ -628,6 +637,8 @@ def curve_points(context, obj):
     data = obj.data.copy()
     data.bevel_mode, data.bevel_object = "ROUND", None
     data.bevel_depth, data.extrude = 0.0, 0.0
+    if data.dimensions == "2D":
+        data.fill_mode = "NONE"  # a closed 2D curve's fill: its inner edges joined the path
     line = obj.copy()  # (modifiers and all; never linked to a scene)
     line.data = data
     try:
