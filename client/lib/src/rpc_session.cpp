@@ -475,11 +475,20 @@ class RpcSession final : public TerrainSession {
     // A connection footfalld closed while it was idle (at its descriptor limit) is replaced
     // before the call, which would fail at once with "the connection closed under the call"
     // although footfalld is serving.
-    if (client_ && ClosedByServer()) Disconnect();
+    const bool closed = client_ && ClosedByServer();
+    if (closed) Disconnect();
     if (client_) return Status::kOk;
     std::string reason;
     client_ = ConnectFootfalld(options_, &reason);
-    if (!client_) return Fail(Status::kUnavailable, "footfalld at " + Address() + ": " + reason);
+    if (!client_) {
+      if (closed) {
+        reason =
+            "the connection closed (footfalld stopped, was killed, or closed it), and "
+            "connecting again failed: " +
+            reason;
+      }
+      return Fail(Status::kUnavailable, "footfalld at " + Address() + ": " + reason);
+    }
     // This client asks again for batch results left for later (AskAgain). footfalld answers
     // every connection's costly batches in parts now, but earlier ones did so only for
     // connections that said so; one without the procedure answers whole batches.
