@@ -136,6 +136,27 @@ TEST_CASE("Scene file errors name the file the character and the field", "[steps
              Catch::Contains("control characters"));
 }
 
+TEST_CASE("A scene character named after a character with a slash is no crowd's member",
+          "[steps][scene]") {
+  // A character file named "x/c" gave "x/c1", the name of crowd "x"'s first character: two
+  // characters' tracks shared it, exit 0.
+  std::vector<SceneCharacter> scene;
+  std::string error;
+  const std::string text = Scene(
+      R"({"character": {"format": "footfall-character", "version": 1, "name": "x/c",
+                         "feet": [{"name": "L", "rest": [0.1, 0, 0]},
+                                  {"name": "R", "rest": [-0.1, 0, 0]}],
+                         "gait": [["L"], ["R"]], "step_length": 0.7, "step_height": 0.15,
+                         "body_height": 0.95, "frames_per_step": 12, "reach": 1.2,
+                         "align_to_normal": false}},
+          {"name": "x", "character_file": "biped.json", "crowd": 2})");
+  const Status status = ParseScene(text, "s.json", kCharacters, &scene, &error);
+  INFO(error);
+  REQUIRE(status == Status::kOk);
+  CHECK(scene[0].name == "x_c1");
+  CHECK(scene[1].name == "x");
+}
+
 TEST_CASE("LoadScene reads character files beside the scene file", "[steps][scene]") {
   std::vector<SceneCharacter> scene;
   std::string error;
@@ -210,14 +231,14 @@ TEST_CASE("Overlapping start notes name a few pairs and count the others", "[ste
   const Character biped = LoadShipped("biped");
   Terrain t = LoadTerrain(MakeFlat(101, 0.05, 0), 0.05);
   const Walk one = Generate(t, biped, StartOptions({2.5, 0, 2.5}, 1));
-  constexpr size_t kCharacters = 300;  // 44,850 pairs
-  const std::vector<std::string> names(kCharacters, "x");
-  const std::vector<const Walk*> walks(kCharacters, &one);
-  const std::vector<double> reaches(kCharacters, biped.reach);
+  constexpr size_t kStarts = 300;  // 44,850 pairs
+  const std::vector<std::string> names(kStarts, "x");
+  const std::vector<const Walk*> walks(kStarts, &one);
+  const std::vector<double> reaches(kStarts, biped.reach);
   const std::vector<std::string> notes = OverlappingStartNotes(names, walks, reaches);
   REQUIRE(notes.size() == kMaxOverlappingStartNotes + 1);
   CHECK_THAT(notes[0], Catch::StartsWith("x and x start 0 apart"));
-  const size_t pairs = kCharacters * (kCharacters - 1) / 2;
+  const size_t pairs = kStarts * (kStarts - 1) / 2;
   CHECK(notes.back() == "... and " + std::to_string(pairs - kMaxOverlappingStartNotes) +
                             " more pairs of characters start under a quarter of their reach apart");
 }

@@ -70,7 +70,13 @@ Status ParseScene(const std::string& text, const std::string& source, const std:
     if (read != Status::kOk) return read;
     c.has_start_frame = entry.contains("start_frame");
     c.has_up = entry.contains("up");
-    c.name = name.empty() ? c.character.name + std::to_string(i + 1) : name;
+    c.name = name;
+    if (name.empty()) {
+      // Named after its character, with '/' (which names a crowd's characters) as '_': a
+      // character named "x/c" was "x/c1", crowd "x"'s first character.
+      c.name = c.character.name + std::to_string(i + 1);
+      std::replace(c.name.begin(), c.name.end(), '/', '_');
+    }
     if (!names.insert(c.name).second) {
       *error = where + ": the name '" + ShownText(c.name) + "' is another character's " +
                (name.empty() ? "(it has no 'name', and is named after its character file's name "
