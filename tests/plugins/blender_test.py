@@ -1275,6 +1275,24 @@ class BlenderAddonTest(unittest.TestCase):
         for obj in list(feet.values()) + [body]:
             self.assertEqual(fcurve_keys(obj, "location", 3), {}, obj.name)
         settings.rig = None
+        # A body removed from the file (the rig's pointer then None): the feet alone were keyed,
+        # reported as done.
+        bpy.context.scene.cursor.location = (3.0, 1.0, 0.0)
+        self.assertEqual(bpy.ops.footfall.character_setup(
+            character_file=os.path.join(CHARACTERS, "biped.json"), mode="CREATE",
+            name="bodiless"), {"FINISHED"})
+        rig = bpy.data.objects["bodiless_rig"]
+        feet = {f.name: f.target for f in rig.footfall_rig.feet}
+        bpy.data.objects.remove(rig.footfall_rig.body)
+        self.assertIsNone(rig.footfall_rig.body)
+        self.select([rig], rig)
+        with self.assertRaises(RuntimeError) as e:
+            bpy.ops.footfall.generate_walk()
+        self.assertIn("the body of bodiless_rig is no longer in the file: run Character Setup",
+                      str(e.exception))
+        for obj in feet.values():
+            self.assertEqual(fcurve_keys(obj, "location", 3), {}, obj.name)
+        settings.rig = None
 
     def test_7f_a_beveled_path_is_its_centre_line(self):
         # A path curve with Bevel Depth or Extrude was sent as its tube's (or ribbon's) vertices.

@@ -680,13 +680,18 @@ def in_scene(scene, obj):
 
 
 def rig_targets(scene, rig_obj):
-    """The rig's {foot name: IK target} and body (None: none). Raises ValueError when one of
-    them is no longer in `scene`."""
+    """The rig's {foot name: IK target} and body. Raises ValueError when one of them is no
+    longer in `scene`, or in the file."""
     rig = rig_obj.footfall_rig
-    feet = {f.name: f.target for f in rig.feet if f.target is not None}
+    feet = {f.name: f.target for f in rig.feet}
     for what, obj in [("the body", rig.body)] + [("foot %s's IK target" % n, o)
                                                  for n, o in feet.items()]:
-        if obj is not None and not in_scene(scene, obj):
+        # Character Setup sets every one: none is one removed from the file (Outliner > Delete
+        # of the data, a script), whose keys were dropped without a word.
+        if obj is None:
+            raise ValueError("%s of %s is no longer in the file: run Character Setup again"
+                             % (what, rig_obj.name))
+        if not in_scene(scene, obj):
             raise ValueError("%s of %s (%s) is no longer in the scene: run Character Setup "
                              "again" % (what, rig_obj.name, obj.name))
     return feet, rig.body
