@@ -100,6 +100,12 @@ def new_empty(name, parent=None, location=None):
     return obj
 
 
+def rig_feet_body(name):
+    """The rig root `name`, its {foot name: IK target} and its body."""
+    rig = bpy.data.objects[name]
+    return rig, {f.name: f.target for f in rig.footfall_rig.feet}, rig.footfall_rig.body
+
+
 def run_reporting(operator, **kwargs):
     """(result, error, reports): the operator's result (None when it raised), the RuntimeError
     it raised (or None), and the reports Blender printed for it ("Warning: ...", one a line),
@@ -846,9 +852,7 @@ class BlenderAddonTest(unittest.TestCase):
         # the path, was keyed as if parented to the object: a report now, nothing changed.
         scene = bpy.context.scene
         scene.frame_set(1)
-        rig = bpy.data.objects["boner_rig"]
-        feet = {f.name: f.target for f in rig.footfall_rig.feet}
-        body = rig.footfall_rig.body
+        rig, feet, body = rig_feet_body("boner_rig")
         target = feet["R"]
         saved = (target.parent, target.parent_type, target.parent_bone,
                  target.matrix_world.copy())
@@ -896,9 +900,7 @@ class BlenderAddonTest(unittest.TestCase):
         # keys metres off the walk, reported as done.
         scene = bpy.context.scene
         scene.frame_set(1)
-        rig = bpy.data.objects["biped_rig"]
-        feet = {f.name: f.target for f in rig.footfall_rig.feet}
-        body = rig.footfall_rig.body
+        rig, feet, body = rig_feet_body("biped_rig")
         target = feet["L"]
         scene.footfall.rig, scene.footfall.steps, scene.footfall.start_frame = rig, 6, 1
         self.select([rig], rig)  # the rig of the active object is keyed
