@@ -1685,6 +1685,55 @@ class BlenderAddonTest(unittest.TestCase):
         settings.rig = bpy.data.objects["biped_rig"]
         bpy.context.scene.frame_set(1)
 
+    def test_8d2_objects_under_a_replaced_rig_keep_their_keyed_places(self):
+        # Targets and body parented under the rig root (a master control), then Character Setup
+        # again with the root active: they kept their place at the current frame only, and the
+        # walk keyed under the old root played 1.8 to 3.5 m away.
+        scene = bpy.context.scene
+        settings = scene.footfall
+        scene.frame_set(1)
+        scene.cursor.location = (1.5, 1.0, 0.0)
+        scene.cursor.rotation_euler = (0.0, 0.0, math.radians(60))
+        self.select([], None)
+        self.assertEqual(bpy.ops.footfall.character_setup(
+            character_file=os.path.join(CHARACTERS, "biped.json"), mode="CREATE",
+            name="master"), {"FINISHED"})
+        rig, feet, body = rig_feet_body("master_rig")
+        for obj in list(feet.values()) + [body]:
+            world = obj.matrix_world.copy()
+            obj.parent = rig
+            obj.matrix_world = world
+        bpy.context.view_layer.update()
+        settings.rig, settings.steps, settings.start_frame = rig, 6, 1
+        self.select([rig], rig)
+        self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
+        objects = list(feet.values()) + [body]
+        frames = (13, 25, 49, 73)
+
+        def worlds():
+            out = {}
+            for frame in frames:
+                scene.frame_set(frame)
+                out.update({(o.name, frame): o.matrix_world.translation.copy() for o in objects})
+            scene.frame_set(1)
+            return out
+
+        before = worlds()
+        self.select([rig], rig)
+        self.assertEqual(bpy.ops.footfall.character_setup(
+            character_file=os.path.join(CHARACTERS, "biped.json"), mode="PICK",
+            name="master"), {"FINISHED"})
+        new_rig = settings.rig
+        self.assertEqual(new_rig.name, "master_rig")
+        self.assertEqual({o.parent for o in objects}, {new_rig})  # still under the rig
+        after = worlds()
+        for key, where in before.items():
+            self.assertLess((after[key] - where).length, 1e-5, key)
+        for obj in objects + self.ops.rig_parts(new_rig):
+            bpy.data.objects.remove(obj)
+        settings.rig = None
+        scene.cursor.rotation_euler = (0.0, 0.0, 0.0)
+
     def test_8e_a_walk_again_keeps_the_users_curve_modifiers(self):
         # Generate Walk again removed the previous walk's keys, and a curve left without keys
         # went with the modifiers the user had put on it (a Noise on the body's height for a

@@ -486,13 +486,15 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
         # on the same objects had Generate Walk key the old one). Its walk is the new rig's
         # previous walk, whose keys the next Generate Walk replaces.
         walk_end_known, walk_end = True, -keying.MAX_FRAME - 1  # no walk yet
-        replaced = replace_rigs(context.scene, [body] + list(targets.values()))
+        replaced, adopted = replace_rigs(context.scene, [body] + list(targets.values()))
         for known, end in replaced:
             walk_end_known = walk_end_known and known
             walk_end = max(walk_end, end)
 
         root = _empty(context, object_name(rig_name, "_rig"), "ARROWS", 0.5 / scale)
-        root.matrix_world = Matrix.Translation(ground) @ rot.to_4x4()
+        root_world = Matrix.Translation(ground) @ rot.to_4x4()
+        root.matrix_world = root_world
+        adopt(root, root_world, adopted)
         rig = root.footfall_rig
         rig.is_rig = True
         rig.walk_end_known, rig.walk_end = walk_end_known, walk_end
@@ -570,30 +572,39 @@ def rig_parts(rig_obj):
 
 def replace_rigs(scene, objects):
     """Removes the rigs of `scene` whose body or IK targets are among `objects` (a rig about to
-    be made for them): their roots and locators. The bodies, the IK targets and anything else
-    under the removed objects stay, where they are in the world. Returns (walk_end_known,
-    walk_end) of each removed rig."""
+    be made for them): their roots and locators. Returns (walk_end_known, walk_end) of each
+    removed rig, and the objects that were under the removed objects (the bodies, the IK
+    targets, anything else of the user's) as (object, the parent space it had): adopt() puts
+    them under the new rig's root where they were at every frame."""
     objects = {o for o in objects if o is not None}
     rigs = [o for o in scene.objects if o.footfall_rig.is_rig and
             ({o.footfall_rig.body} | {f.target for f in o.footfall_rig.feet}) & objects]
     if not rigs:
-        return []
+        return [], []
     removed = set()
     for rig_obj in rigs:
         removed.update(rig_parts(rig_obj))
     removed -= objects
+    adopted = []
     for obj in bpy.data.objects:
         if obj not in removed and obj.parent in removed:
-            world = obj.matrix_world.copy()
-            parent = obj.parent
-            while parent in removed:
-                parent = parent.parent
-            obj.parent = parent
-            obj.matrix_world = world
+            adopted.append((obj, obj.parent.matrix_world @ obj.matrix_parent_inverse))
+            obj.parent = None  # (its basis kept: adopt() gives it the same space again)
     ends = [(r.footfall_rig.walk_end_known, r.footfall_rig.walk_end) for r in rigs]
     for obj in removed:
         bpy.data.objects.remove(obj)
-    return ends
+    return ends, adopted
+
+
+def adopt(root, root_world, adopted):
+    """Parents the objects replace_rigs took from under a removed rig to `root` (whose world
+    matrix is `root_world`), with the parent inverse that keeps the space they had: their
+    location and keys, in it, keep them where they were at every frame. (Their world matrix set
+    at the current frame kept them there, and played a walk keyed under the old root metres
+    away.)"""
+    for obj, space in adopted:
+        obj.parent = root
+        obj.matrix_parent_inverse = root_world.inverted_safe() @ space
 
 
 # -- Generate Walk ------------------------------------------------------------------------------
