@@ -414,8 +414,8 @@ def key_walk(walk, feet, body, from_frame=None):
     without an object are skipped; with `from_frame`, so are keys before it (keyed already: a
     longer walk generated again keeps the keys of its first steps). Keys are world positions:
     an object under an animated parent is keyed in its parent's space at each key's frame (the
-    scene's frame is the same afterwards), less its delta transform. Positions are metres, keyed in scene units (divided
-    by the scene's Unit Scale). Returns the number of keys set."""
+    scene's frame is the same afterwards), less its delta transform. Positions are metres,
+    keyed in scene units (divided by the scene's Unit Scale). Returns the number of keys set."""
     tracks = []  # (object, is body, frames, keys, orientation) of the whole track, by frame
     for track in walk.get("tracks", []):
         is_body = track.get("kind") == "body"
