@@ -131,6 +131,11 @@ file(WRITE "${WORK}/inside_out.obj" "${inside_out}")
 expect(EXIT_ZERO "faces turned over: 1 of 1 closed shells inside out: 12 triangles turned over"
        terrain info "${WORK}/inside_out.obj" --separation 0.1)
 expect(EXIT_ZERO "faces turned over: none" terrain info "${WORK}/cube.obj" --separation 0.1)
+# generate says so too at a --separation (it did only when it resampled the mesh itself).
+file(WRITE "${WORK}/down.obj" "v 0 0 0\nv 10 0 0\nv 10 0 10\nv 0 0 10\nf 1 2 3 4\n")
+expect(EXIT_ZERO "down.obj: the 2 triangles of its open parts faced down: 2 triangles turned over"
+       generate --terrain "${WORK}/down.obj" --separation 0.5 --character
+       "${SOURCE_DIR}/data/characters/biped.json" --steps 2 --out "${WORK}/down.json")
 # One face wound against the others is counted in the singular.
 string(REPLACE "f 1 4 3 2\n" "f 2 3 4 1\n" one_turned "${cube}")
 file(WRITE "${WORK}/one_turned.obj" "${one_turned}")

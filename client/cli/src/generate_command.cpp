@@ -333,6 +333,13 @@ bool LoadWalkTerrain(const GenerateFlags& flags, const Character& character,
     terrain_flags.load.max_samples = std::min(terrain_flags.load.max_samples, kMaxWalkSamples);
   }
   if (OpenTerrain(terrain_flags, &t->session, &t->handle, error) != Status::kOk) return false;
+  // A mesh read here at --separation: faces turned over are said, as when it is resampled for
+  // the character.
+  if (!terrain_flags.terrain.empty()) {
+    const std::string turned = DescribeTurnover(t->session->last_file_report());
+    if (!turned.empty())
+      std::cerr << "footfall generate: " << terrain_flags.terrain << ": " << turned << '\n';
+  }
   // footfalld resampled a mesh or height map itself: say how, as a local file's resampling is
   // reported.
   if (!terrain_flags.server_terrain.empty() &&

@@ -312,7 +312,9 @@ class RpcSession final : public TerrainSession {
     if (source.kind == TerrainSource::kLocalFile) {
       // Parse on this machine first, so file errors name this machine's file and line.
       std::string error;
-      const Status s = LoadTerrain(source.path, source.options, &source.samples, &error);
+      last_file_report_ = TerrainLoadReport{};
+      const Status s =
+          LoadTerrain(source.path, source.options, &source.samples, &error, &last_file_report_);
       if (s != Status::kOk) return Fail(s, error);
       source.kind = TerrainSource::kSamples;
     }

@@ -11,7 +11,8 @@ Status TerrainSession::LoadFile(const std::string& path, const TerrainLoadOption
                                 TerrainHandle* out) {
   RawSamples samples;
   std::string error;
-  const Status status = LoadTerrain(path, options, &samples, &error);
+  last_file_report_ = TerrainLoadReport{};
+  const Status status = LoadTerrain(path, options, &samples, &error, &last_file_report_);
   if (status != Status::kOk) return Fail(status, error);
   return LoadSamples(samples, path, out);
 }

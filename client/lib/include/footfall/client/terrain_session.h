@@ -72,6 +72,9 @@ class TerrainSession {
   // and for a mesh or height map " at separation S", with why when it is coarser than asked);
   // empty in process, where the loader's own report says it.
   const std::string& last_load_report() const { return last_load_report_; }
+  // How the last LoadFile read its file on this machine (a mesh's faces turned over, its
+  // resampling): empty before one.
+  const TerrainLoadReport& last_file_report() const { return last_file_report_; }
 
  protected:
   TerrainSession() = default;
@@ -81,6 +84,7 @@ class TerrainSession {
   }
   std::string last_error_;
   std::string last_load_report_;
+  TerrainLoadReport last_file_report_;
 };
 
 // The in-process engine. With `threads` > 1, batches are shared with threads - 1 persistent
