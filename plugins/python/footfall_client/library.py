@@ -4,6 +4,8 @@ import ctypes
 import ctypes.util
 import os
 
+from .installed import installed_path
+
 ABI_VERSION = 1  # FFC_ABI_VERSION this package was written against
 
 _LIB_NAME = "libfootfall.so"
@@ -26,13 +28,17 @@ class FfcFoothold(ctypes.Structure):
 
 
 def _candidates():
-    """Where the library may be, in order: $FOOTFALL_LIB, next to this package, a build tree."""
+    """Where the library may be, in order: $FOOTFALL_LIB, next to this package, the install
+    this package belongs to (cmake --install), a build tree, the system's library path."""
     env = os.environ.get("FOOTFALL_LIB")
     if env:
         yield env
     here = os.path.dirname(os.path.abspath(__file__))
     yield os.path.join(here, _LIB_NAME)
     yield os.path.join(os.path.dirname(here), _LIB_NAME)
+    installed = installed_path("lib")
+    if installed:
+        yield installed
     # The source tree: plugins/python/footfall_client -> <repo>/build/client/lib.
     repo = os.path.dirname(os.path.dirname(os.path.dirname(here)))
     yield os.path.join(repo, "build", "client", "lib", _LIB_NAME)

@@ -6,18 +6,21 @@ import subprocess
 import tempfile
 import time
 
+from .installed import installed_path
+
 
 class ServerError(RuntimeError):
     """footfalld could not be found, did not start, or exited early; the message says why."""
 
 
 def find_footfalld():
-    """The footfalld to run: $FOOTFALLD, next to this package, a build tree, then PATH."""
+    """The footfalld to run: $FOOTFALLD, next to this package, the install this package belongs
+    to (cmake --install), a build tree, then PATH."""
     tried = []
     env = os.environ.get("FOOTFALLD")
     here = os.path.dirname(os.path.abspath(__file__))
     repo = os.path.dirname(os.path.dirname(os.path.dirname(here)))
-    for path in filter(None, [env, os.path.join(here, "footfalld"),
+    for path in filter(None, [env, os.path.join(here, "footfalld"), installed_path("footfalld"),
                               os.path.join(repo, "build", "server", "service", "footfalld")]):
         tried.append(path)
         if os.path.isfile(path):
