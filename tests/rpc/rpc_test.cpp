@@ -2258,7 +2258,8 @@ TEST_CASE("a client repeating a failing request cannot flood footfalld's log",
     for (size_t at = log.find("error: snap: unknown_terrain"); at != std::string::npos;
          at = log.find("error: snap: unknown_terrain", at + 1))
       ++*written;
-    const std::string said = " error lines not written in the last ";
+    const std::string said =
+        " lines (errors, batches past their time limit) not written in the last ";
     for (size_t at = log.find(said); at != std::string::npos; at = log.find(said, at + 1)) {
       const size_t line = log.rfind('\n', at) + 1;
       *unwritten += std::stoul(log.substr(line + std::strlen("footfalld: ")));
@@ -2276,6 +2277,36 @@ TEST_CASE("a client repeating a failing request cannot flood footfalld's log",
   CHECK(lines >= 100);
   CHECK(lines <= 100 + 10 * (elapsed + 2));
   clnt_destroy(c);
+}
+
+TEST_CASE("a client sending costly batches cannot flood footfalld's log", "[rpc][robustness]") {
+  // Every batch cut at --batch-time-limit wrote a line: far snaps, sent again and again, wrote
+  // about 100 lines a second. They share the error lines' budget: 100 at once, 10 a second.
+  ServerProcess server(0, {"--no-rpcbind", "--threads", "1", "--batch-time-limit", "0.001"});
+  auto rpc = Connect(server.port(), 60);
+  TerrainHandle t = 0;
+  REQUIRE(rpc->LoadSamples(MakeFlat(300, 0.1, 0), "flat", &t) == Status::kOk);
+  std::vector<Vec3> far(600);
+  for (size_t i = 0; i < far.size(); ++i) far[i] = {0.007 * i, 1e10, 0.003 * i};
+  std::vector<Foothold> got(far.size());
+  const auto t0 = std::chrono::steady_clock::now();
+  REQUIRE(rpc->Snap(t, far.data(), far.size(), got.data()) == Status::kOk);
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  for (const Foothold& f : got) REQUIRE(f.status == Status::kOk);  // every query answered
+  auto count = [&server](const std::string& what) {
+    const std::string log = server.Log();
+    size_t n = 0;
+    for (size_t at = log.find(what); at != std::string::npos; at = log.find(what, at + 1)) ++n;
+    return n;
+  };
+  // The batch was cut hundreds of times (each far snap compares all 90,000 samples), and the lines
+  // beyond the budget were counted in a line of their own.
+  CHECK(WaitFor([&] { return count(" not written in the last ") > 0; }));
+  const size_t lines = count("past its time limit (0.001 s)");
+  INFO(lines << " lines written in " << elapsed << " s");
+  CHECK(lines >= 100);
+  CHECK(lines <= 100 + 10 * (elapsed + 2));
 }
 
 // True when the server has closed `fd` (an end of file or a reset), waiting up to `wait_ms`.

@@ -120,10 +120,11 @@ std::string EscapeControl(const std::string& text) {
   return out;
 }
 
-// Error lines ("error: ...") are written at most kErrorLineBurst at once and
-// kErrorLinesPerSecond after (a token bucket); those beyond are counted and said in one line by
-// ReportUnwrittenErrors. A client that repeats a refused request thousands of times a second
-// wrote as many lines, and could fill the disk.
+// Lines a client can cause at will (errors, "error: ...", and batches cut at their time limit)
+// are written at most kErrorLineBurst at once and kErrorLinesPerSecond after (a token bucket);
+// those beyond are counted and said in one line by ReportUnwrittenErrors. A client that repeats
+// a refused request, or a costly batch, thousands of times a second wrote as many lines, and
+// could fill the disk.
 constexpr double kErrorLineBurst = 100;
 constexpr double kErrorLinesPerSecond = 10;
 
@@ -153,13 +154,20 @@ bool TakeErrorLine() {
 }
 
 // One log line; every line may hold text from a client (paths, names, messages quoting them).
+// Error lines are rate-limited (LogLimited).
+void LogLimited(const std::string& line);
 void Log(const std::string& line) {
-  if (line.compare(0, 7, "error: ") == 0 && !TakeErrorLine()) return;
+  if (line.compare(0, 7, "error: ") == 0) return LogLimited(line);
   std::fprintf(stderr, "footfalld: %s\n", EscapeControl(line).c_str());
 }
 
-// Says how many error lines were not written since the first of them, if any. Called about once
-// a second.
+// A log line a client can cause as often as it likes, within the budget above.
+void LogLimited(const std::string& line) {
+  if (TakeErrorLine()) std::fprintf(stderr, "footfalld: %s\n", EscapeControl(line).c_str());
+}
+
+// Says how many rate-limited lines were not written since the first of them, if any. Called about
+// once a second.
 void ReportUnwrittenErrors() {
   std::lock_guard<std::mutex> lock(g_error_lines.mutex);
   if (g_error_lines.unwritten == 0) return;
@@ -167,8 +175,8 @@ void ReportUnwrittenErrors() {
                                                        g_error_lines.first_unwritten)
                              .count();
   std::fprintf(stderr,
-               "footfalld: %llu error lines not written in the last %.1f s (more than %g at once "
-               "or %g a second); every request was answered\n",
+               "footfalld: %llu lines (errors, batches past their time limit) not written in the "
+               "last %.1f s (more than %g at once or %g a second); every request was answered\n",
                static_cast<unsigned long long>(g_error_lines.unwritten), seconds, kErrorLineBurst,
                kErrorLinesPerSecond);
   g_error_lines.unwritten = 0;
@@ -621,11 +629,12 @@ bool RunBatch(size_t n, BatchReplyView<Foothold>* r, double limit_s, Fn&& answer
     }
   });
   if (late > 0)
-    Log("batch of " + std::to_string(n) + " queries past its time limit (" + SecondsText(limit_s) +
-        (limit_s < g_state->batch_time_limit_s ? ", --batch-time-limit shared with other "
-                                                 "connections sending costly batches"
-                                               : "") +
-        "): " + std::to_string(late.load()) + " answered limit_exceeded, to be asked again");
+    LogLimited("batch of " + std::to_string(n) + " queries past its time limit (" +
+               SecondsText(limit_s) +
+               (limit_s < g_state->batch_time_limit_s ? ", --batch-time-limit shared with other "
+                                                        "connections sending costly batches"
+                                                      : "") +
+               "): " + std::to_string(late.load()) + " answered limit_exceeded, to be asked again");
   r->status = FF_OK;
   r->count = r->capacity = static_cast<u_int>(n);
   r->results = answers;
