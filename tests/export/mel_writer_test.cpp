@@ -38,6 +38,8 @@ struct MelScript {
   std::map<std::string, std::map<std::string, std::vector<MelKey>>> keys;  // loc -> attr
   std::vector<std::string> warnings;
   int braces = 0;
+  std::string angle_unit;       // set by the script, before any rotation key
+  bool angle_restored = false;  // the user's angle unit put back, after every key
 };
 
 // Every setKeyframe line must match `key`: keys carry linear tangents, as glTF's LINEAR samplers,
@@ -60,13 +62,24 @@ MelScript ParseMel(const std::string& path) {
       R"re(^setAttr \(\$footfall_node\[0\] \+ "\.rotateOrder"\) (\d);$)re");
   static const std::regex key(
       R"re(^setKeyframe -t (-?[0-9.]+) -at (translate[XYZ]|rotate[XYZ]) -v (-?[0-9.]+) -itt linear -ott linear \$footfall_node\[0\];$)re");
+  static const std::regex angle_query(
+      R"re(^string \$footfall_angle_unit = `currentUnit -query -angle`;$)re");
   MelScript script;
+  bool angle_queried = false;
   std::string line, current;
   std::smatch m;
   while (std::getline(in, line)) {
     if (line == "{") ++script.braces;
     if (line == "}") --script.braces;
-    if (std::regex_match(line, m, unit)) {
+    if (std::regex_match(line, m, angle_query)) {
+      angle_queried = true;
+    } else if (line == "currentUnit -angle \"deg\";") {
+      REQUIRE(angle_queried);
+      script.angle_unit = "deg";
+    } else if (line == "currentUnit -angle $footfall_angle_unit;") {
+      REQUIRE(script.angle_unit == "deg");
+      script.angle_restored = true;
+    } else if (std::regex_match(line, m, unit)) {
       script.time_unit = m[1];
     } else if (std::regex_match(line, m, playback)) {
       script.min_time = std::stod(m[1]);
@@ -90,6 +103,8 @@ MelScript ParseMel(const std::string& path) {
       script.rotate_order[current] = std::stoi(m[1]);
     } else if (std::regex_match(line, m, key)) {
       REQUIRE(!current.empty());
+      REQUIRE(!script.angle_restored);
+      if (m[2].str().rfind("rotate", 0) == 0) REQUIRE(script.angle_unit == "deg");
       script.keys[current][m[2]].push_back({std::stod(m[1]), std::stod(m[3])});
     } else if (line.rfind("warning ", 0) == 0) {
       script.warnings.push_back(line);
@@ -162,6 +177,9 @@ TEST_CASE("WriteMel keys a locator per track", "[export][mel]") {
   const MelScript script = ParseMel(path);
   CHECK(script.braces == 0);
   CHECK(script.time_unit == "film");
+  // Rotations keyed in degrees whatever the scene's angle unit, which is put back after.
+  CHECK(script.angle_unit == "deg");
+  CHECK(script.angle_restored);
   CHECK(script.root == "footfall_walk");
   CHECK(script.min_time == 1);
   CHECK(script.max_time == 37);

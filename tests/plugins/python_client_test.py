@@ -992,11 +992,12 @@ class MayaKeyWalkTest(unittest.TestCase):
                 if module is not None:
                     sys.modules[name] = module
 
-    def _key_walk(self, walk, feet, body, keyed_order=None):
+    def _key_walk(self, walk, feet, body, keyed_order=None, angle_unit="deg"):
         """The calls key_walk makes; with `keyed_order`, every node has rotation keys and that
-        rotateOrder."""
+        rotateOrder; `angle_unit`: the scene's ("deg" or "rad")."""
         calls = []
         cmds = types.ModuleType("maya.cmds")
+        cmds.currentUnit = lambda *args, **kwargs: angle_unit
         for name in ("setAttr", "xform", "setKeyframe"):
             setattr(cmds, name, lambda *args, _name=name, **kwargs:
                     calls.append((_name, args, kwargs)))
@@ -1240,6 +1241,7 @@ class MayaKeyWalkTest(unittest.TestCase):
         def run(attributes, steps):
             calls = []
             cmds = types.ModuleType("maya.cmds")
+            cmds.currentUnit = lambda *args, **kwargs: "deg"
             for name in ("setKeyframe", "cutKey", "undoInfo", "warning", "confirmDialog"):
                 setattr(cmds, name, lambda *args, _name=name, **kwargs:
                         calls.append((_name, args, kwargs)))
@@ -1342,6 +1344,7 @@ class MayaKeyWalkTest(unittest.TestCase):
         # walk of thousands (Generate Walk and Character Setup were one chunk each).
         calls = []
         cmds = types.ModuleType("maya.cmds")
+        cmds.currentUnit = lambda *args, **kwargs: "deg"
         for name in ("setAttr", "addAttr", "xform", "setKeyframe", "cutKey", "undoInfo",
                      "warning", "confirmDialog"):
             setattr(cmds, name, lambda *args, _name=name, **kwargs:
@@ -1450,6 +1453,24 @@ class MayaKeyWalkTest(unittest.TestCase):
                 for a, b in zip(euler, previous):
                     self.assertLess(abs(a - b), 3.0, msg="%s after %s" % (euler, previous))
             previous = euler
+
+    def test_rotations_are_keyed_in_the_scenes_angle_unit(self):
+        # xform takes the scene's angle unit: in a scene set to radians, degrees turned the
+        # body 57.3 times too far.
+        keys = [{"frame": 1 + i, "position": [0.0, 1.0, 0.1 * i],
+                 "rotation": (0.0, math.sin(0.1 * i), 0.0, math.cos(0.1 * i))}
+                for i in range(1, 5)]
+        walk = {"tracks": [{"name": "body", "kind": "body", "keys": keys}]}
+
+        def rotations(unit):
+            calls = self._key_walk(walk, {}, "hips", angle_unit=unit)
+            return [c[2]["ro"] for c in calls if c[0] == "xform" and "ro" in c[2]]
+        degrees, radians = rotations("deg"), rotations("rad")
+        self.assertEqual(len(degrees), len(keys))
+        for i, (d, r) in enumerate(zip(degrees, radians)):
+            self.assertAlmostEqual(d[1], 0.2 * (i + 1) * 180 / math.pi, places=9)  # yaw, degrees
+            for a, b in zip(d, r):
+                self.assertAlmostEqual(math.radians(a), b, places=12)
 
     def test_a_body_with_rotation_keys_keeps_its_rotate_order(self):
         # Generate Walk set a picked body's rotateOrder to ZXY without converting its keys: a
@@ -1596,6 +1617,7 @@ class NotesTest(unittest.TestCase):
         attributes = {"footfallCharacter": json.dumps(self.biped), "footfallFoot0": None,
                       "footfallFoot1": None, "footfallWalkEnd": -1e9}
         cmds = types.ModuleType("maya.cmds")
+        cmds.currentUnit = lambda *args, **kwargs: "deg"
         for name in ("setKeyframe", "cutKey", "undoInfo", "progressBar"):
             setattr(cmds, name, lambda *args, _name=name, **kwargs:
                     calls.append((_name, args, kwargs)))

@@ -216,6 +216,9 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
     }
   }
 
+  // The script's end: the user's angle unit back, the walk's root selected.
+  static const char* kTail =
+      "currentUnit -angle $footfall_angle_unit;\nselect -replace $footfall_root;\n}\n";
   // The script's head: time unit, playback range, the root and the characters' groups.
   std::string head;
   {
@@ -238,6 +241,12 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
                        " fps; keys are at the walk's frames in the scene's current unit") +
              ";\n";
     }
+    // setKeyframe values are in the scene's units: rotations are keyed in degrees whatever the
+    // user's angle unit (a scene in radians turned bodies 57.3 times too far), which is put back
+    // at the end. Lengths stay in the scene's linear unit, one footfall unit to one scene unit,
+    // as the Maya plugin sends the scene's terrain.
+    mel += "string $footfall_angle_unit = `currentUnit -query -angle`;\n";
+    mel += "currentUnit -angle \"deg\";\n";
     if (first_frame <= last_frame) {
       mel += "playbackOptions -minTime " + Number(first_frame) + " -maxTime " + Number(last_frame) +
              " -animationStartTime " + Number(first_frame) + " -animationEndTime " +
@@ -341,17 +350,14 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
         for (int axis = 0; axis < 3; ++axis) key_line("rotate", kAxes[axis], rotate[axis]);
       }
     }
-    if (r + 1 == runs.size()) {
-      mel += "select -replace $footfall_root;\n";
-      mel += "}\n";
-    }
+    if (r + 1 == runs.size()) mel += kTail;
   };
   std::string message;
   const Status written = ReplaceFile(
       path,
       [&](std::FILE* file) {
         if (runs.empty()) {  // no tracks: the head and the end
-          const std::string all = head + "select -replace $footfall_root;\n}\n";
+          const std::string all = head + kTail;
           return std::fwrite(all.data(), 1, all.size(), file) == all.size();
         }
         return FormatInOrder(runs.size(), 0, format, [file](std::string_view text) {

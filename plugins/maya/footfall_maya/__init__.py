@@ -305,6 +305,9 @@ def key_walk(walk, feet, body, from_frame=None):
     """Keys the walk (footfall JSON dict) on the IK handles and body, as the seed's tool did;
     with `from_frame`, only its keys from that frame on (those before are keyed already)."""
     count = 0
+    # xform takes rotations in the scene's angle unit: in a scene set to radians, degrees
+    # turned the body 57.3 times too far.
+    to_ui_angle = math.radians if mc.currentUnit(query=True, angle=True) == "rad" else float
     for track in walk.get("tracks", []):
         is_body = track.get("kind") == "body"
         node = body if is_body else feet.get(track.get("name"))
@@ -339,7 +342,7 @@ def key_walk(walk, feet, body, from_frame=None):
             mc.setKeyframe(node, attribute="translate", time=frame,
                            inTangentType="linear", outTangentType="linear")
             if euler is not None:
-                mc.xform(node, ws=True, ro=euler)
+                mc.xform(node, ws=True, ro=[to_ui_angle(a) for a in euler])
                 mc.setKeyframe(node, attribute="rotate", time=frame,
                                inTangentType="linear", outTangentType="linear")
             count += 1
