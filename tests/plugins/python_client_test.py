@@ -629,6 +629,41 @@ class LocalServerTest(unittest.TestCase):
                 tempfile.tempdir = saved
 
 
+class LibraryLoadTest(unittest.TestCase):
+    """Loading a libfootfall.so that cannot load: the message says why, in one line."""
+
+    def test_a_missing_dependency_is_named(self):
+        # A zip or install copied to a machine without footfall's runtime libraries said only
+        # "cannot load .../libfootfall.so: libOpenMeshCore.so.9.0: cannot open shared object
+        # file", as if the library itself were missing.
+        with tempfile.TemporaryDirectory() as folder:
+            for name, text in (("dep.c", "int footfall_dep(void) { return 1; }\n"),
+                               ("lib.c", "int footfall_dep(void);\n"
+                                         "int ffc_abi_version(void) { return footfall_dep(); }\n")):
+                with open(os.path.join(folder, name), "w") as f:
+                    f.write(text)
+            cc = os.environ.get("CC", "cc")
+            subprocess.run([cc, "-shared", "-fPIC", "-o", os.path.join(folder, "libffdep.so"),
+                            os.path.join(folder, "dep.c")], check=True)
+            lib = os.path.join(folder, "libfootfall.so")
+            subprocess.run([cc, "-shared", "-fPIC", "-o", lib, os.path.join(folder, "lib.c"),
+                            "-L" + folder, "-lffdep"], check=True)
+            os.unlink(os.path.join(folder, "libffdep.so"))
+            with self.assertRaises(ff.library.LibraryNotFound) as e:
+                ff.library.Library(lib)
+            message = str(e.exception)
+            self.assertIn("it needs libffdep.so, which this machine does not have", message)
+            self.assertIn("apt-get install libopenmesh1 libtirpc3", message)
+            self.assertNotIn("\n", message)
+            # A file that is no library at all is said as such, with no dependency named.
+            with open(lib, "w") as f:
+                f.write("not a library\n")
+            with self.assertRaises(ff.library.LibraryNotFound) as e:
+                ff.library.Library(lib)
+            self.assertIn("cannot load " + lib, str(e.exception))
+            self.assertNotIn("it needs", str(e.exception))
+
+
 class ConnectionTest(unittest.TestCase):
     """Connection, as the plugins keep it between commands, against real footfalld servers."""
 

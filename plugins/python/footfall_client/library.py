@@ -100,6 +100,18 @@ def _declare(lib):
     return missing
 
 
+def _load_failure(path, reason):
+    """Why `path` could not be loaded, saying which library it needs when one is missing (a zip
+    or install copied from the machine that built footfall, to one without its libraries)."""
+    marker = ": cannot open shared object file"
+    needed = reason.split(marker)[0] if marker in reason else ""
+    if needed and os.path.basename(needed) != os.path.basename(path):
+        return ("cannot load %s: it needs %s, which this machine does not have (footfall's "
+                "runtime libraries: on Debian and Ubuntu, apt-get install libopenmesh1 "
+                "libtirpc3; or build footfall on this machine): %s" % (path, needed, reason))
+    return "cannot load %s: %s" % (path, reason)
+
+
 class Library:
     """A loaded libfootfall.so: `lib` is the ctypes handle, `missing` the entry points it lacks
     (an older library), `path` where it was loaded from."""
@@ -108,7 +120,7 @@ class Library:
         try:
             self.lib = ctypes.CDLL(path)
         except OSError as e:
-            raise LibraryNotFound("cannot load %s: %s" % (path, e)) from None
+            raise LibraryNotFound(_load_failure(path, str(e))) from None
         self.path = path
         self.missing = _declare(self.lib)
         if "ffc_abi_version" in self.missing or "ffc_open_rpc" in self.missing:
