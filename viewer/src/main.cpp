@@ -15,6 +15,7 @@
 #include "footfall/import/terrain_loader.h"
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/output_file.h"
+#include "footfall/terrain/standard_streams.h"
 #include "footfall/viewer/viewer_app.h"
 
 namespace {
@@ -38,6 +39,7 @@ bool ParseNumbers(const std::string& text, size_t count, std::vector<double>* ou
 }  // namespace
 
 int main(int argc, char** argv) {
+  footfall::OpenClosedStandardStreams();  // no file the viewer writes may take descriptor 1 or 2
   std::signal(SIGPIPE, SIG_IGN);
   footfall::RemoveTemporaryFileOnSignal();  // an interrupted write leaves no temporary file
   footfall::viewer::ViewerOptions o;

@@ -4,12 +4,14 @@
 #include <iostream>
 #include <new>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
 #include "footfall/terrain/output_file.h"
+#include "footfall/terrain/standard_streams.h"
 
 namespace {
 
@@ -48,6 +50,7 @@ std::string CommandHint(const CLI::App& root, int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  footfall::OpenClosedStandardStreams();    // no output file may take descriptor 1 or 2
   std::signal(SIGPIPE, SIG_IGN);            // a vanished server must give an error, not kill us
   footfall::RemoveTemporaryFileOnSignal();  // an interrupted write leaves no temporary file
   CLI::App app{"footfall: places footsteps of bipeds and multipeds on uneven terrain"};
@@ -83,6 +86,14 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 1;
   } catch (const std::bad_alloc&) {
     std::cerr << "footfall: out of memory\n";
+    return 1;
+  } catch (const std::system_error& e) {
+    // std::thread's failure to start one (ulimit -u, or memory for its stack).
+    std::cerr << "footfall: " << e.what()
+              << (e.code() == std::errc::resource_unavailable_try_again
+                      ? " (a thread could not start: the limit on processes, ulimit -u, or memory)"
+                      : "")
+              << '\n';
     return 1;
   } catch (const std::exception& e) {
     // A last resort: every reader reports bad input as a message of its own; whatever escapes

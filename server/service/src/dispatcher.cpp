@@ -25,6 +25,7 @@
 #include "footfall/rpc/batch_xdr.h"
 #include "footfall/terrain/batch_pool.h"
 #include "footfall/terrain/shown_text.h"
+#include "log_text.h"
 #include "read_gate.h"
 
 namespace footfall {
@@ -81,43 +82,6 @@ ff_result ToWire(const Foothold& f) {
 char* Message(const std::string& text) {
   g_storage.message = std::string(Utf8Prefix(text, FF_MAX_MESSAGE));  // whole characters
   return const_cast<char*>(g_storage.message.c_str());
-}
-
-// `text` with backslashes, control characters (C0, DEL and C1) and bytes that are not UTF-8
-// escaped (\\, \n, \r, \t, \xHH for each byte), so text from a client cannot start a log line of
-// its own nor send terminal escapes, and the log stays UTF-8; other characters are kept as they
-// are.
-std::string EscapeControl(const std::string& text) {
-  static const char kHex[] = "0123456789abcdef";
-  std::string out;
-  out.reserve(text.size());
-  const auto escape = [&](unsigned char u) {
-    out += "\\x";
-    out += kHex[u >> 4];
-    out += kHex[u & 15];
-  };
-  for (size_t at = 0; at < text.size();) {
-    const char c = text[at];
-    const unsigned char u = static_cast<unsigned char>(c);
-    const size_t length = Utf8SequenceLength(text, at);
-    if (c == '\\') {
-      out += "\\\\";
-    } else if (c == '\n') {
-      out += "\\n";
-    } else if (c == '\r') {
-      out += "\\r";
-    } else if (c == '\t') {
-      out += "\\t";
-    } else if (length == 0) {
-      escape(u);  // one byte, then read on from the next: the log stays in step
-    } else if (IsControlCharacter(text, at, length)) {
-      for (size_t k = 0; k < length; ++k) escape(static_cast<unsigned char>(text[at + k]));
-    } else {
-      out.append(text, at, length);
-    }
-    at += std::max<size_t>(length, 1);
-  }
-  return out;
 }
 
 // Lines a client can cause at will (errors, "error: ...", and batches cut at their time limit)

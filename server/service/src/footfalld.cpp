@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <system_error>
 #include <thread>
 
 #include <CLI/CLI.hpp>
@@ -21,6 +22,7 @@
 #include "footfall/service/rpc_server.h"
 #include "footfall/terrain/decimal_number.h"
 #include "footfall/terrain/large_memory.h"
+#include "footfall/terrain/standard_streams.h"
 
 namespace {
 
@@ -152,6 +154,9 @@ static void RaiseOpenFileLimit() {
 }
 
 int main(int argc, char** argv) {
+  // Sockets and files opened later never take descriptor 0, 1 or 2 (with all three closed,
+  // the log went into the first client's connection, which then hung).
+  footfall::OpenClosedStandardStreams();
   CLI::App app{"footfalld: serves footfall terrain queries over ONC RPC (TCP)"};
   std::string listen = "127.0.0.1:7407";
   footfall::RpcServerOptions options;
@@ -224,6 +229,9 @@ int main(int argc, char** argv) {
 
   std::signal(SIGPIPE, SIG_IGN);
   setvbuf(stderr, nullptr, _IOLBF, 0);
+  // Server-side loads read through a private directory: one that cannot be made is said now.
+  if (!options.data_root.empty() && !footfall::CanMakePrivateDirectory(&error))
+    std::fprintf(stderr, "footfalld: warning: server-side loads will fail: %s\n", error.c_str());
   // The default budget, lowered to what this machine's memory holds: a finished upload peaks
   // near 100 bytes per sample (its samples and its grid at once).
   if (app.count("--max-samples") == 0) {
@@ -239,7 +247,7 @@ int main(int argc, char** argv) {
   }
   RaiseOpenFileLimit();
   bool abandoned_load = false;
-  {
+  try {
     // The port file is written before footfalld says it listens: a supervisor waiting for the
     // file would wait forever, and one reading the log would take a server that exits for one
     // that serves.
@@ -256,12 +264,26 @@ int main(int argc, char** argv) {
     struct sigaction action {};
     action.sa_handler = OnStopSignal;  // no SA_RESTART: poll returns EINTR at once
     sigaction(SIGTERM, &action, nullptr);
-    sigaction(SIGINT, &action, nullptr);
-    sigaction(SIGHUP, &action, nullptr);  // a closed terminal: stop cleanly, unregistered
+    // SIGINT and SIGHUP (a closed terminal) stop it cleanly, unregistered, unless ignored when
+    // it started (`nohup footfalld`, a background job of a script): those keep serving.
+    for (const int signal_number : {SIGINT, SIGHUP}) {
+      struct sigaction current {};
+      if (sigaction(signal_number, nullptr, &current) == 0 && current.sa_handler == SIG_IGN)
+        continue;
+      sigaction(signal_number, &action, nullptr);
+    }
     server.Run();
     g_server = nullptr;
     abandoned_load = server.abandoned_load();
-  }  // unregistered from rpcbind
+  } catch (const std::system_error& e) {  // the server, destroyed, is unregistered
+    // std::thread's failure to start one (ulimit -u, or memory for its stack).
+    g_server = nullptr;
+    std::fprintf(stderr, "footfalld: %s%s\n", e.what(),
+                 e.code() == std::errc::resource_unavailable_try_again
+                     ? " (a thread could not start: the limit on processes, ulimit -u, or memory)"
+                     : "");
+    return 1;
+  }
   if (abandoned_load) {
     // The load's thread still reads the file: end without running static destructors (its
     // private name for the file is removed first).

@@ -12,6 +12,8 @@
 #include <map>
 #include <mutex>
 
+#include "log_text.h"
+
 namespace footfall {
 namespace {
 
@@ -41,6 +43,34 @@ PinnedFile::~PinnedFile() {
   if (fd_ >= 0) close(fd_);
 }
 
+namespace {
+
+// Makes a new private directory in $TMPDIR (else /tmp) into *dir; false with *message saying
+// where and why not.
+bool MakePrivateDirectory(std::string* dir, std::string* message) {
+  const char* tmp = getenv("TMPDIR");
+  const std::string base = tmp && *tmp ? tmp : "/tmp";
+  std::string made = base + "/footfalld-XXXXXX";
+  if (!mkdtemp(made.data())) {
+    const int error = errno;
+    *message = "cannot make a private directory to read it from in " + EscapeControl(base) + ": " +
+               std::strerror(error) +
+               " (footfalld's TMPDIR, else /tmp, must be a folder it may write)";
+    return false;
+  }
+  *dir = made;
+  return true;
+}
+
+}  // namespace
+
+bool CanMakePrivateDirectory(std::string* message) {
+  std::string dir;
+  if (!MakePrivateDirectory(&dir, message)) return false;
+  rmdir(dir.c_str());
+  return true;
+}
+
 Status PinnedFile::Open(const std::string& root, const std::string& path, const std::string& shown,
                         std::string* message) {
   fd_ = open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC | O_NOFOLLOW);
@@ -68,13 +98,11 @@ Status PinnedFile::Open(const std::string& root, const std::string& path, const 
     return Status::kInvalidArgument;
   }
   // A private name for it: <tmp>/footfalld-XXXXXX/terrain.<ext> -> /proc/self/fd/N.
-  const char* tmp = getenv("TMPDIR");
-  std::string dir = std::string(tmp && *tmp ? tmp : "/tmp") + "/footfalld-XXXXXX";
-  if (!mkdtemp(dir.data())) {
-    *message = "'" + shown + "': cannot make a private directory to read it from";
+  std::string why;
+  if (!MakePrivateDirectory(&dir_, &why)) {
+    *message = "'" + shown + "': " + why;
     return Status::kIoError;
   }
-  dir_ = dir;
   // The format is the one the client's name says, as for a local file of that name: not the
   // resolved target's (a link into an extensionless blob store).
   const size_t slash = shown.rfind('/'), dot = shown.rfind('.');

@@ -22,6 +22,7 @@
 #include "deferred_reply.h"
 #include "dispatcher.h"
 #include "footfall.h"
+#include "log_text.h"
 #include "partial_requests.h"
 #include "read_gate.h"
 
@@ -211,7 +212,7 @@ bool RpcServer::Start(std::string* error) {
   }
   if (!rpcbind_note.empty()) std::fprintf(stderr, "footfalld: %s\n", rpcbind_note.c_str());
   if (!options_.data_root.empty())
-    std::fprintf(stderr, "footfalld: data root %s\n", options_.data_root.c_str());
+    std::fprintf(stderr, "footfalld: data root %s\n", EscapeControl(options_.data_root).c_str());
   return true;
 }
 

@@ -248,16 +248,26 @@ std::vector<std::string> OutputFileSet::Commit() {
 }
 
 void RemoveTemporaryFileOnSignal() {
-  for (int signal_number : kCleanedUpSignals)
+  // A signal ignored when the program started stays ignored (`nohup footfall generate` died at
+  // the hangup, writing nothing).
+  for (int signal_number : kCleanedUpSignals) {
+    struct sigaction current {};
+    if (::sigaction(signal_number, nullptr, &current) == 0 && current.sa_handler == SIG_IGN)
+      continue;
     std::signal(signal_number, RemoveTemporariesAndReraise);
+  }
   // A thread that only waits, with no signal blocked, to take them while the others block
   // every signal: libtirpc does for the length of each call, and Ctrl-C waited minutes for a
-  // --server-terrain load to finish.
+  // --server-terrain load to finish. Without one (no thread may start: ulimit -u), signals
+  // wait for those calls.
   static std::once_flag waiter;
   std::call_once(waiter, [] {
-    std::thread([] {
-      for (;;) ::pause();
-    }).detach();
+    try {
+      std::thread([] {
+        for (;;) ::pause();
+      }).detach();
+    } catch (const std::system_error&) {
+    }
   });
   // Past the file size limit a write fails (EFBIG) and is reported, instead of killing the
   // process with the temporary file left behind.

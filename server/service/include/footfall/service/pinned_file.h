@@ -18,6 +18,10 @@ namespace footfall {
 // True when the canonical `path` is the canonical directory `root` or lies below it.
 bool PathInside(const std::string& root, const std::string& path);
 
+// Whether PinnedFile::Open can make its private directories (in $TMPDIR, else /tmp): false with
+// *message saying where and why not, for footfalld to warn at start.
+bool CanMakePrivateDirectory(std::string* message);
+
 // Removes the private names of every PinnedFile still open, for a process that ends without
 // destroying them (footfalld abandoning a load at SIGTERM). Thread-safe.
 void RemovePinnedNames();

@@ -72,8 +72,9 @@ class OutputFileSet {
 
 // For programs (not libraries: it sets process-wide signal handlers): SIGINT, SIGTERM, SIGHUP and
 // SIGQUIT remove the temporary file being written before the process ends as they would end
-// it, and SIGXFSZ is ignored, so that a write past the file size limit fails with a message.
-// A thread of its own takes those signals while the others block them (libtirpc blocks every
+// it (those ignored when the program started, as under nohup, stay ignored), and SIGXFSZ is
+// ignored, so that a write past the file size limit fails with a message. A thread of its own,
+// when one can start, takes those signals while the others block them (libtirpc blocks every
 // signal during an RPC call), so that they end the process at once.
 void RemoveTemporaryFileOnSignal();
 
