@@ -44,12 +44,22 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-# The export tests write files with the C and C++ locales set to a decimal-comma locale, which
-# must be installed: de_DE.UTF-8, generated when the test packages are wanted.
-if [[ " ${wanted[*]} " == *" locales "* ]] && ! locale -a 2>/dev/null | grep -qix 'de_DE\.utf-\?8'; then
-  echo "install-deps: generating the de_DE.UTF-8 locale"
-  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
-  grep -qx 'de_DE.UTF-8 UTF-8' /etc/locale.gen 2>/dev/null ||
-    echo 'de_DE.UTF-8 UTF-8' | $SUDO tee -a /etc/locale.gen >/dev/null
-  $SUDO locale-gen >/dev/null
+# The tests write and read files with the C and C++ locales set as a host program's may be: a
+# decimal comma (German), a two-byte decimal point (Pashto), Turkish letter case. Those locales
+# must be installed: generated when the test packages are wanted.
+test_locales=(de_DE ps_AF tr_TR)
+if [[ " ${wanted[*]} " == *" locales "* ]]; then
+  generate=()
+  for name in "${test_locales[@]}"; do
+    locale -a 2>/dev/null | grep -qix "${name}\.utf-\?8" || generate+=("$name")
+  done
+  if [ ${#generate[@]} -gt 0 ]; then
+    echo "install-deps: generating the ${generate[*]} UTF-8 locales"
+    SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+    for name in "${generate[@]}"; do
+      grep -qx "$name.UTF-8 UTF-8" /etc/locale.gen 2>/dev/null ||
+        echo "$name.UTF-8 UTF-8" | $SUDO tee -a /etc/locale.gen >/dev/null
+    done
+    $SUDO locale-gen >/dev/null
+  fi
 fi

@@ -19,6 +19,7 @@
 
 #include "footfall/client/recent_queries.h"
 #include "footfall/steps/walk_json.h"
+#include "footfall/terrain/ascii.h"
 #include "footfall/terrain/output_file.h"
 #include "footfall/viewer/png_writer.h"
 #include "footfall/viewer/renderer.h"
@@ -523,7 +524,7 @@ int RunViewer(const ViewerOptions& options) {
   const size_t dot = shot_name.rfind('.');
   if (dot != std::string::npos && dot > 0) {
     std::string extension = shot_name.substr(dot);
-    for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    for (char& c : extension) c = AsciiLower(c);
     if (extension != ".png")
       return Fail("--screenshot " + options.screenshot +
                       ": expected a .png file name (the screenshot is written as PNG)",

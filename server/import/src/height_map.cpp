@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "footfall/terrain/ascii.h"
 #include "footfall/terrain/decimal_number.h"
 #include "footfall/terrain/input_file.h"
 #include "footfall/terrain/large_memory.h"
@@ -29,7 +30,7 @@ Status Fail(const std::string& where, const std::string& what, std::string* erro
 }
 
 std::string Lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  for (char& c : s) c = AsciiLower(c);
   return s;
 }
 

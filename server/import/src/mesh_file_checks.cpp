@@ -16,6 +16,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "footfall/terrain/ascii.h"
 #include "footfall/terrain/decimal_number.h"
 #include "footfall/terrain/input_file.h"
 #include "footfall/terrain/samples.h"
@@ -956,7 +957,7 @@ Status ParseStlFile(const std::string& path, ParsedMesh* out, std::string* error
   // declared some billions of triangles.
   if (head.size() >= 8 && head.compare(0, 3, "\xEF\xBB\xBF") == 0 &&
       std::equal(head.begin() + 3, head.begin() + 8, "solid",
-                 [](char a, char b) { return std::tolower(static_cast<unsigned char>(a)) == b; })) {
+                 [](char a, char b) { return AsciiLower(a) == b; })) {
     return Fail(path,
                 "starts with a UTF-8 byte order mark before 'solid', which makes OpenMesh read "
                 "it as a binary STL: save it without the mark",
@@ -964,7 +965,7 @@ Status ParseStlFile(const std::string& path, ParsedMesh* out, std::string* error
   }
   if (head.size() >= 5 && head.compare(0, 5, "solid") != 0 &&
       std::equal(head.begin(), head.begin() + 5, "solid",
-                 [](char a, char b) { return std::tolower(static_cast<unsigned char>(a)) == b; })) {
+                 [](char a, char b) { return AsciiLower(a) == b; })) {
     return Fail(path,
                 "an ASCII STL must begin with 'solid' in lower case (OpenMesh reads it as "
                 "binary otherwise)",

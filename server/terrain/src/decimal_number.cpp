@@ -1,5 +1,7 @@
 #include "footfall/terrain/decimal_number.h"
 
+#include "footfall/terrain/ascii.h"
+
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -93,9 +95,8 @@ bool IsMicrosoftNonFinite(std::string_view token) {
   size_t word = 0;
   for (const char* name : {"QNAN", "SNAN", "IND", "INF"}) {
     const size_t n = std::strlen(name);
-    if (token.size() - i >= n && std::equal(name, name + n, token.begin() + i, [](char a, char b) {
-          return a == std::toupper(static_cast<unsigned char>(b));
-        })) {
+    if (token.size() - i >= n && std::equal(name, name + n, token.begin() + i,
+                                            [](char a, char b) { return a == AsciiUpper(b); })) {
       word = n;
       break;
     }
@@ -131,7 +132,7 @@ bool IsMicrosoftNaN(std::string_view token) {
   // Spelled out after the '#': QNAN, SNAN or IND (a rounded word tells nothing).
   std::string word;
   for (size_t i = token.find('#') + 1; i < token.size() && word.size() < 4; ++i)
-    word += static_cast<char>(std::toupper(static_cast<unsigned char>(token[i])));
+    word += AsciiUpper(token[i]);
   return word == "QNAN" || word == "SNAN" || word.compare(0, 3, "IND") == 0;
 }
 

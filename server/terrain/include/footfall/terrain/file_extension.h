@@ -1,8 +1,9 @@
 // The extension of a file name, lower-cased, which every reader and writer dispatches on.
 #pragma once
 
-#include <cctype>
 #include <string>
+
+#include "footfall/terrain/ascii.h"
 
 namespace footfall {
 
@@ -12,7 +13,7 @@ inline std::string FileExtension(const std::string& path) {
   const size_t dot = path.find_last_of('.');
   if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
   std::string ext = path.substr(dot + 1);
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  for (char& c : ext) c = AsciiLower(c);
   return ext;
 }
 
