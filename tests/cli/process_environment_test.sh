@@ -104,4 +104,12 @@ wait_for_port "$work/port6" > /dev/null
 check "data root logged escaped" grep -qF 'data root '"$work"'/root\xff' "$work/server6.log"
 check "the log is UTF-8" iconv -f UTF-8 -t UTF-8 "$work/server6.log" -o /dev/null
 kill "$server_pid"; wait "$server_pid" 2>/dev/null; server_pid=""
+
+# 7. Output that cannot be written fails the command (it exited 0 with nothing written).
+for command in "--version" "terrain info $hills" \
+    "bench --terrain $hills --queries 1000 --min-time 0.01 --json"; do
+  $footfall $command > /dev/full 2> "$work/err.txt"
+  check "footfall $command > /dev/full: exit 1" [ $? -eq 1 ]
+  check "footfall $command > /dev/full: said" grep -Eq "cannot write (standard output|to stdout)" "$work/err.txt"
+done
 finish

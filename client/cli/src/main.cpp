@@ -1,5 +1,8 @@
 // footfall: footstep placement on uneven terrain, from the command line.
+#include <cerrno>
 #include <csignal>
+#include <cstdio>
+#include <cstring>
 #include <exception>
 #include <iostream>
 #include <new>
@@ -47,9 +50,8 @@ std::string CommandHint(const CLI::App& root, int argc, char** argv) {
   return path + ": a command is required: " + names(at) + " (" + path + " --help)";
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+// The command line's work; its exit status.
+int Run(int argc, char** argv) {
   footfall::OpenClosedStandardStreams();    // no output file may take descriptor 1 or 2
   std::signal(SIGPIPE, SIG_IGN);            // a vanished server must give an error, not kill us
   footfall::RemoveTemporaryFileOnSignal();  // an interrupted write leaves no temporary file
@@ -102,4 +104,22 @@ int main(int argc, char** argv) {
     return 1;
   }
   return exit_code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int status = Run(argc, argv);
+  // Output that could not be written (a full disk, a closed pipe) fails the command: `bench
+  // --json > file` on a full disk left an empty file and exit 0. (`query` says so itself.)
+  errno = 0;
+  std::cout.flush();
+  const bool failed = !std::cout || std::fflush(stdout) != 0 || std::ferror(stdout);
+  if (failed && status == 0) {
+    // The reason is known when the last flush failed; an earlier write's is gone.
+    std::cerr << "footfall: cannot write standard output"
+              << (errno ? std::string(": ") + std::strerror(errno) : std::string()) << '\n';
+    return 1;
+  }
+  return status;
 }
