@@ -629,8 +629,48 @@ class LocalServerTest(unittest.TestCase):
                 tempfile.tempdir = saved
 
 
+@contextlib.contextmanager
+def environment(**values):
+    """os.environ with `values` set for the block, as it was after."""
+    saved = {name: os.environ.get(name) for name in values}
+    os.environ.update(values)
+    try:
+        yield
+    finally:
+        for name, value in saved.items():
+            if value is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = value
+
+
 class LibraryLoadTest(unittest.TestCase):
     """Loading a libfootfall.so that cannot load: the message says why, in one line."""
+
+    def test_wrong_environment_paths_are_errors(self):
+        # FOOTFALL_LIB naming a missing file or a folder, or FOOTFALLD naming a file that is
+        # not executable, passed over to a library or server found elsewhere, saying nothing
+        # (and FOOTFALLD's file was made executable).
+        with tempfile.TemporaryDirectory() as folder:
+            for wrong, said in ((os.path.join(folder, "missing.so"), "not a file"),
+                                (folder, "a directory")):
+                with environment(FOOTFALL_LIB=wrong):
+                    with self.assertRaises(ff.library.LibraryNotFound) as e:
+                        ff.library.find_library()
+                    self.assertIn("FOOTFALL_LIB names %s, which is %s" % (wrong, said),
+                                  str(e.exception))
+            plain = os.path.join(folder, "footfalld")
+            with open(plain, "w") as f:
+                f.write("#!/bin/sh\n")
+            os.chmod(plain, 0o644)
+            for wrong, said in ((plain, "not an executable file"), (folder, "a directory"),
+                                (os.path.join(folder, "missing"), "not a file")):
+                with environment(FOOTFALLD=wrong):
+                    with self.assertRaises(ff.ServerError) as e:
+                        ff.server.find_footfalld()
+                    self.assertIn("FOOTFALLD names %s, which is %s" % (wrong, said),
+                                  str(e.exception))
+            self.assertEqual(os.stat(plain).st_mode & 0o777, 0o644)  # left as it was
 
     def test_a_missing_dependency_is_named(self):
         # A zip or install copied to a machine without footfall's runtime libraries said only

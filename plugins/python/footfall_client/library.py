@@ -48,7 +48,14 @@ def _candidates():
 
 
 def find_library():
-    """The path of the first libfootfall.so candidate that exists; LibraryNotFound otherwise."""
+    """The path of the first libfootfall.so candidate that exists; LibraryNotFound otherwise.
+    $FOOTFALL_LIB, when set, must name the library: a wrong one is an error, not passed over
+    for a library found elsewhere."""
+    env = os.environ.get("FOOTFALL_LIB")
+    if env and not os.path.isfile(env):
+        raise LibraryNotFound("FOOTFALL_LIB names %s, which is %s: set it to libfootfall.so's "
+                              "path, or unset it to use the one found beside this package"
+                              % (env, "a directory" if os.path.isdir(env) else "not a file"))
     tried = []
     for path in _candidates():
         tried.append(path)

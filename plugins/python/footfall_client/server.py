@@ -15,16 +15,27 @@ class ServerError(RuntimeError):
 
 def find_footfalld():
     """The footfalld to run: $FOOTFALLD, next to this package, the install this package belongs
-    to (cmake --install), a build tree, then PATH."""
-    tried = []
+    to (cmake --install), a build tree, then PATH. $FOOTFALLD, when set, must name an
+    executable file: a wrong one is an error, and its mode is left as it is."""
     env = os.environ.get("FOOTFALLD")
+    if env:
+        if not os.path.isfile(env) or not os.access(env, os.X_OK):
+            raise ServerError("FOOTFALLD names %s, which is %s: set it to footfalld's path, or "
+                              "unset it to use the one found beside this package"
+                              % (env, "not an executable file" if os.path.isfile(env)
+                                 else "a directory" if os.path.isdir(env) else "not a file"))
+        return env
+    tried = []
     here = os.path.dirname(os.path.abspath(__file__))
     repo = os.path.dirname(os.path.dirname(os.path.dirname(here)))
-    for path in filter(None, [env, os.path.join(here, "footfalld"), installed_path("footfalld"),
+    bundled = os.path.join(here, "footfalld")
+    for path in filter(None, [bundled, installed_path("footfalld"),
                               os.path.join(repo, "build", "server", "service", "footfalld")]):
         tried.append(path)
         if os.path.isfile(path):
             if not os.access(path, os.X_OK):
+                if path != bundled:
+                    continue
                 try:  # unpacked from a zip (Blender's add-on installer drops the mode bits)
                     os.chmod(path, 0o755)
                 except OSError:
