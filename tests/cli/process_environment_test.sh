@@ -112,4 +112,19 @@ for command in "--version" "terrain info $hills" \
   check "footfall $command > /dev/full: exit 1" [ $? -eq 1 ]
   check "footfall $command > /dev/full: said" grep -Eq "cannot write (standard output|to stdout)" "$work/err.txt"
 done
+
+# 8. An output past the file size limit (ulimit -f) is refused and the file from before is kept,
+#    said so; "it does not match the other outputs" only when there are others.
+echo old > "$work/kept.json"
+(ulimit -f 1; "$footfall" generate --terrain "$hills" --character "$biped" --steps 4 \
+  --out "$work/kept.json") 2> "$work/err.txt"
+check "ulimit -f: exit 1" [ $? -eq 1 ]
+check "ulimit -f: the old file kept" grep -qx old "$work/kept.json"
+check "ulimit -f, one output: said kept" \
+  grep -qx "footfall generate: $work/kept.json is left as it was, from before this walk" "$work/err.txt"
+(ulimit -f 1; "$footfall" generate --terrain "$hills" --character "$biped" --steps 4 \
+  --out "$work/kept.json" --out "$work/small.mel") 2> "$work/err.txt"
+check "ulimit -f, two outputs: said it does not match the others" grep -qF \
+  "$work/kept.json is left as it was, from before this walk (it does not match the other outputs)" \
+  "$work/err.txt"
 finish

@@ -439,12 +439,11 @@ int WriteOutputs(const GenerateFlags& flags, const LoadedTerrain& terrain, const
       const bool named = error.compare(0, out.size(), out) == 0;
       std::cerr << "footfall generate: " << (named ? "" : "--out " + out + ": ") << error << '\n';
       // A file of that name from before stays as it was: say so, as it no longer matches the
-      // other outputs.
+      // other outputs, if there are any.
       struct stat st;
       if (::stat(out.c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
-        std::cerr << "footfall generate: " << out
-                  << " is left as it was, from before this walk (it does not match the other "
-                     "outputs)\n";
+        std::cerr << "footfall generate: " << out << " is left as it was, from before this walk"
+                  << (flags.out.size() > 1 ? " (it does not match the other outputs)" : "") << '\n';
       }
       code = 1;
     }
