@@ -127,4 +127,13 @@ check "ulimit -f, one output: said kept" \
 check "ulimit -f, two outputs: said it does not match the others" grep -qF \
   "$work/kept.json is left as it was, from before this walk (it does not match the other outputs)" \
   "$work/err.txt"
+
+# 9. A --port-file that cannot be written (past the file size limit, as on a full disk): exit 1,
+#    and no empty file left for a supervisor to read.
+err=$( (ulimit -f 0; "$footfalld" --listen 127.0.0.1:0 --no-rpcbind --port-file "$work/port9") 2>&1)
+check "port file past the size limit: exit 1" [ $? -eq 1 ]
+check "port file past the size limit: said" grep -qF -- "--port-file $work/port9: cannot write the port there" <<< "$err"
+check "port file past the size limit: no file left" [ ! -e "$work/port9" ]
+check "port file past the size limit: no temporary file left" \
+  bash -c '[ -z "$(ls -A "$1" | grep port9)" ]' _ "$work"
 finish

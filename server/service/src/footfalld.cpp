@@ -22,6 +22,7 @@
 #include "footfall/service/rpc_server.h"
 #include "footfall/terrain/decimal_number.h"
 #include "footfall/terrain/large_memory.h"
+#include "footfall/terrain/output_file.h"
 #include "footfall/terrain/standard_streams.h"
 
 namespace {
@@ -122,17 +123,12 @@ CLI::Validator SampleCount() {
 
 // Writes `port` and a line end to `path`. On failure false, with a message naming the file.
 bool WritePortFile(const std::string& path, int port, std::string* message) {
-  errno = 0;
-  FILE* out = std::fopen(path.c_str(), "w");
-  bool ok = out != nullptr && std::fprintf(out, "%d\n", port) > 0;
-  int error = errno;
-  if (out && std::fclose(out) != 0 && ok) {  // a full disk fails here, on the flush
-    ok = false;
-    error = errno;
-  }
-  if (ok) return true;
-  *message = "--port-file " + path +
-             ": cannot write the port there: " + std::strerror(error != 0 ? error : EIO);
+  // Written whole beside it and renamed over it: a supervisor waiting for the file never reads
+  // it empty, and a failed write (a full disk) leaves no empty file behind.
+  std::string error;
+  if (footfall::ReplaceFile(path, std::to_string(port) + "\n", &error) == footfall::Status::kOk)
+    return true;
+  *message = "--port-file " + path + ": cannot write the port there: " + error;
   return false;
 }
 
@@ -228,6 +224,9 @@ int main(int argc, char** argv) {
   }
 
   std::signal(SIGPIPE, SIG_IGN);
+  // Past the file size limit (ulimit -f) a write fails with EFBIG and is reported, instead of
+  // the signal killing footfalld with its port file half made.
+  std::signal(SIGXFSZ, SIG_IGN);
   setvbuf(stderr, nullptr, _IOLBF, 0);
   // Server-side loads read through a private directory: one that cannot be made is said now.
   if (!options.data_root.empty() && !footfall::CanMakePrivateDirectory(&error))
