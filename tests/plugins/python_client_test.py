@@ -1790,6 +1790,19 @@ class GenerateTest(unittest.TestCase):
             with open(out) as f:
                 return walk, json.load(f)
 
+    def test_a_character_file_name_that_is_not_utf8_is_said(self):
+        # JSON cannot carry it: the library answered "malformed JSON: ... surrogate U+DC00".
+        with tempfile.TemporaryDirectory() as folder, ff.Session.embedded() as s:
+            path = os.path.join(os.fsencode(folder), b"biped\xff.json")
+            with open(self.character, "rb") as f, open(path, "wb") as out:
+                out.write(f.read())
+            t = s.load_file(HILLS)
+            with self.assertRaises(ff.FootfallError) as e:
+                s.generate(t, {"character_file": os.fsdecode(path), "steps": 2})
+            self.assertEqual(e.exception.status_name, "invalid_argument")
+            self.assertIn("the name is not UTF-8, which a JSON request cannot carry",
+                          str(e.exception))
+
     def test_generate_matches_cli(self):
         self.assertTrue(os.path.isfile(self.character), self.character)
         walk, expected = self._generate_both(

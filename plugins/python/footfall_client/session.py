@@ -118,6 +118,15 @@ def _json_text(value, what, function):
     if not isinstance(value, dict):
         raise FootfallError(INVALID_ARGUMENT, "%s: expected a dict or JSON text, got %s"
                             % (what, type(value).__name__), function)
+    path = value.get("character_file")
+    if isinstance(path, str):
+        try:
+            path.encode("utf-8")
+        except UnicodeEncodeError:  # a file name that is not UTF-8 (os.fsdecode's surrogates)
+            raise FootfallError(
+                INVALID_ARGUMENT, "%s: character_file %r: the name is not UTF-8, which a JSON "
+                "request cannot carry: rename the file, or give the character's data as "
+                "\"character\"" % (what, path), function) from None
     try:
         return json.dumps(value, allow_nan=False).encode("utf-8", "replace")
     except (TypeError, ValueError, RecursionError) as e:
