@@ -14,9 +14,11 @@ cp "$work/walk.json" "$work/old.json"
 cp "$work/walk.mel" "$work/old.mel"
 
 # A FIFO among the outputs is written in place once a process reads it (waited for up to 5 s):
-# the JSON before it is written and waits; Ctrl-C then.
+# the JSON before it is written and waits; Ctrl-C then. (A script's background job starts with
+# SIGINT ignored, which footfall keeps, as under nohup: a terminal's Ctrl-C finds it at its
+# default, as env --default-signal sets it here.)
 mkfifo "$work/pipe.json"
-"$footfall" generate "${walk[@]}" --steps 8 --out "$work/walk.json" --out "$work/pipe.json" \
+env --default-signal=INT "$footfall" generate "${walk[@]}" --steps 8 --out "$work/walk.json" --out "$work/pipe.json" \
   --out "$work/walk.mel" 2> "$work/interrupted.err" &
 pid=$!
 for _ in $(seq 100); do

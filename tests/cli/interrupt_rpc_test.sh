@@ -30,7 +30,9 @@ port=$(cat "$work/silent_port")
 
 for signal in INT TERM; do
   rm -f "$work/connected"
-  "$footfall" query --server "127.0.0.1:$port" --timeout 300 \
+  # (SIGINT at its default, as for a terminal's foreground job: a script's background job
+  # starts with it ignored, which footfall keeps.)
+  env --default-signal=INT "$footfall" query --server "127.0.0.1:$port" --timeout 300 \
     --terrain "$src/data/terrain/hills.pts" < /dev/null > /dev/null 2> "$work/err" &
   pid=$!
   for _ in $(seq 200); do [ -e "$work/connected" ] && break; sleep 0.05; done
