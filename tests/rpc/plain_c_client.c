@@ -186,6 +186,7 @@ int main(int argc, char** argv) {
   enum clnt_stat s = clnt_call(c, 17, XDR_VOID, NULL, XDR_VOID, NULL, timeout);
   check(s == RPC_PROCUNAVAIL, "procedure 17 is PROC_UNAVAIL");
   check(ff_null_1(NULL, NULL, c) == RPC_SUCCESS, "FF_NULL after an unknown procedure");
+  auth_destroy(c->cl_auth); /* clnt_destroy leaves the AUTH_SYS handle */
   clnt_destroy(c);
 
   /* Version 2: PROG_MISMATCH, naming version 1 as the only one served. */

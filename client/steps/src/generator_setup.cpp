@@ -269,7 +269,9 @@ std::vector<int> Generator::CrowdedStarts(const Vec3* places, const Foothold* st
   if (n < 2 || !(apart > 0)) return crowded;
   struct CellHash {
     size_t operator()(const std::array<int64_t, 3>& c) const {
-      return static_cast<size_t>(c[0] * 73856093 ^ c[1] * 19349663 ^ c[2] * 83492791);
+      // In unsigned arithmetic: cells far from the origin overflowed the signed products.
+      const auto u = [](int64_t v) { return static_cast<uint64_t>(v); };
+      return static_cast<size_t>(u(c[0]) * 73856093u ^ u(c[1]) * 19349663u ^ u(c[2]) * 83492791u);
     }
   };
   std::unordered_map<std::array<int64_t, 3>, std::vector<int>, CellHash> cells;
