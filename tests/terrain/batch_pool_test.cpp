@@ -2,8 +2,13 @@
 // exactly once whatever the threads and chunk sizes, exceptions carried back to the caller, the
 // pool still serving after one, a pool shared by callers on several threads, and batches run
 // from inside a batch.
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
+#include <fstream>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -113,4 +118,37 @@ TEST_CASE("a batch run from inside a batch runs on the thread that asks", "[pool
     REQUIRE(inner_calls.load() == kOuter);
     REQUIRE(off_thread.load() == 0);
   }
+}
+
+TEST_CASE("a pool whose threads cannot all start serves on those that did", "[pool]") {
+  // Under a memory limit (ulimit -v) the workers' stacks ran out, and the half-made pool ended
+  // the process (std::terminate), whatever the caller caught. Tried in a child process with
+  // little address space left: 64 workers of 8 MiB stacks cannot all start.
+  const pid_t child = fork();
+  REQUIRE(child >= 0);
+  if (child == 0) {
+    rlimit limit{};
+    getrlimit(RLIMIT_AS, &limit);
+    std::ifstream status("/proc/self/statm");
+    size_t pages = 0;
+    status >> pages;
+    limit.rlim_cur = pages * static_cast<size_t>(sysconf(_SC_PAGESIZE)) + (64u << 20);
+    if (setrlimit(RLIMIT_AS, &limit) != 0) _exit(3);
+    int code = 0;
+    {
+      BatchPool pool(64);
+      std::vector<int> seen(10000, 0);
+      pool.Run(seen.size(), 16, [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i) ++seen[i];
+      });
+      for (const int n : seen)
+        if (n != 1) code = 2;
+    }
+    _exit(code);
+  }
+  int status = 0;
+  REQUIRE(waitpid(child, &status, 0) == child);
+  INFO("child status " << status);
+  REQUIRE(WIFEXITED(status));  // not ended by a signal (SIGABRT)
+  CHECK(WEXITSTATUS(status) == 0);
 }

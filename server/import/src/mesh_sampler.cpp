@@ -8,8 +8,10 @@
 #include <cstdlib>
 #include <exception>
 #include <memory>
+#include <new>
 #include <optional>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <tuple>
 #include <vector>
@@ -283,7 +285,9 @@ double RoundUp3(double x) {
 }
 
 // Runs work(part) for each part in [0, parts): part 0 on the calling thread, the others on
-// threads of their own. The first exception thrown (std::bad_alloc) is rethrown once all end.
+// threads of their own, or after part 0 on the calling thread when no thread could be started
+// for them (the parts must not wait on each other). The first exception thrown (std::bad_alloc)
+// is rethrown once all end.
 template <typename Work>
 void RunParts(size_t parts, const Work& work) {
   std::vector<std::exception_ptr> failed(parts);
@@ -294,10 +298,17 @@ void RunParts(size_t parts, const Work& work) {
       failed[part] = std::current_exception();
     }
   };
+  // Parts no thread could be started for (a memory or process limit) run on this one.
   std::vector<std::thread> threads;
-  threads.reserve(parts);
-  for (size_t part = 1; part < parts; ++part) threads.emplace_back(run, part);
+  size_t started = 1;
+  try {
+    threads.reserve(parts);
+    for (; started < parts; ++started) threads.emplace_back(run, started);
+  } catch (const std::system_error&) {
+  } catch (const std::bad_alloc&) {
+  }
   run(0);
+  for (size_t part = started; part < parts; ++part) run(part);
   for (std::thread& t : threads) t.join();
   for (const std::exception_ptr& e : failed)
     if (e) std::rethrow_exception(e);

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <map>
+#include <new>
+#include <system_error>
 
 namespace footfall {
 namespace {
@@ -21,7 +23,15 @@ inline void CpuRelax() {
 
 BatchPool::BatchPool(int threads, int caller_spin_us, int worker_spin_us)
     : caller_spin_us_(caller_spin_us), worker_spin_us_(worker_spin_us) {
-  for (int i = 1; i < threads; ++i) workers_.emplace_back([this] { Work(); });
+  // As many workers as can start (a memory or process limit may allow fewer, or none): a
+  // thread that cannot start ended the process, as a half-made vector of threads may not be
+  // destroyed.
+  try {
+    workers_.reserve(static_cast<size_t>(std::max(threads - 1, 0)));
+    for (int i = 1; i < threads; ++i) workers_.emplace_back([this] { Work(); });
+  } catch (const std::system_error&) {
+  } catch (const std::bad_alloc&) {
+  }
 }
 
 BatchPool::~BatchPool() {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <exception>
+#include <new>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -33,8 +35,15 @@ bool FormatInOrder(size_t count, int threads,
       }
     };
     helpers.clear();
-    for (size_t k = 1; k < group; ++k) helpers.emplace_back(run, k);
+    // Parts no thread could be started for (a memory or process limit) run on this one.
+    size_t started = 1;
+    try {
+      for (; started < group; ++started) helpers.emplace_back(run, started);
+    } catch (const std::system_error&) {
+    } catch (const std::bad_alloc&) {
+    }
     run(0);
+    for (size_t k = started; k < group; ++k) run(k);
     for (std::thread& h : helpers) h.join();
     // An exception (std::bad_alloc) reaches the caller once every thread has ended.
     for (std::exception_ptr& e : failed)
