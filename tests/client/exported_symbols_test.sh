@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# libfootfall.so exports exactly the functions footfall_c.h declares: it exported 800 more
+# (footfall's C++, nlohmann JSON, std instantiations), and a host program defining one of those
+# names (footfall::ReadPointFile) had its own function run inside ffc_load_file.
+# Usage: exported_symbols_test.sh LIBFOOTFALL HEADER
+set -u
+lib=$1
+header=$2
+source "$(dirname "$0")/../support/cli_checks.sh"
+
+nm -D --defined-only "$lib" | awk '{print $NF}' | sort -u > "$work/exported.txt"
+grep -o '\bffc_[a-z_]*(' "$header" | tr -d '(' | sort -u > "$work/declared.txt"
+check "the header declares the C ABI" [ "$(wc -l < "$work/declared.txt")" -ge 15 ]
+check "exported: the header's functions, nothing else" \
+  diff "$work/declared.txt" "$work/exported.txt"
+finish
