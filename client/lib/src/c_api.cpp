@@ -1,8 +1,6 @@
 // The C ABI over TerrainSession. Nothing may throw across it: every entry point catches.
 #include "footfall/client/footfall_c.h"
 
-#include <locale.h>
-
 #include <algorithm>
 #include <cmath>
 #include <csignal>
@@ -21,6 +19,7 @@
 #include "footfall/steps/generate_request.h"
 #include "footfall/steps/generator.h"
 #include "footfall/steps/walk_json.h"
+#include "footfall/terrain/c_locale.h"
 #include "footfall/terrain/shown_text.h"
 
 struct ffc_session {
@@ -97,29 +96,11 @@ void Copy(const Foothold& f, ffc_foothold* out) {
   out->normal[0] = f.normal.x, out->normal[1] = f.normal.y, out->normal[2] = f.normal.z;
 }
 
-// The "C" locale on the calling thread for the length of a call, whatever the host program set
-// (Maya follows its UI language): the JSON reader takes LC_NUMERIC's decimal point, one byte of
-// it, and in a Pashto locale, whose decimal point is two bytes, read [10.75, 0, 10.75] as
-// [10, 0, 10]. The host's locale is back when the call returns.
-class CLocaleScope {
- public:
-  CLocaleScope() : previous_(c_locale_ ? uselocale(c_locale_) : nullptr) {}
-  ~CLocaleScope() {
-    if (c_locale_) uselocale(previous_);
-  }
-  CLocaleScope(const CLocaleScope&) = delete;
-  CLocaleScope& operator=(const CLocaleScope&) = delete;
-
- private:
-  static inline const locale_t c_locale_ = newlocale(LC_ALL_MASK, "C", nullptr);
-  const locale_t previous_;
-};
-
 template <typename Fn>
 int32_t Guard(ffc_session* s, Fn&& fn) {
   if (!s) return FF_C_INVALID_ARGUMENT;
   std::lock_guard<std::mutex> lock(s->mutex);
-  const CLocaleScope c_locale;
+  const footfall::CLocaleScope c_locale;  // the host's locale back on return
   try {
     return fn();
   } catch (const std::bad_alloc&) {

@@ -6,6 +6,7 @@
 #include <set>
 #include <vector>
 
+#include "footfall/terrain/c_locale.h"
 #include "footfall/terrain/input_file.h"
 #include "footfall/terrain/shown_text.h"
 
@@ -98,6 +99,8 @@ bool ParseJsonText(const std::string& text, const std::string& source, json* out
     }
     return filter ? filter(depth, event, parsed) : true;
   };
+  // Numbers read as written whatever the host program's locale (a Pashto decimal point).
+  const CLocaleScope c_locale;
   try {
     *out = json::parse(text, check);  // nlohmann skips a leading UTF-8 byte order mark
   } catch (const json::parse_error& e) {

@@ -1,6 +1,6 @@
-// The C ABI in a host program that set its locale from the user's (Maya follows its UI
-// language): requests, character files and terrain files read as in the "C" locale, and the
-// host's locale is as it was after each call.
+// The C ABI and the C++ readers in a host program that set its locale from the user's (Maya
+// follows its UI language): requests, character, walk and terrain files read as in the "C"
+// locale, and the host's locale is as it was after each call.
 #include <clocale>
 #include <cstdio>
 #include <cstdlib>
@@ -10,6 +10,8 @@
 #include <catch2/catch.hpp>
 
 #include "footfall/client/footfall_c.h"
+#include "footfall/steps/character.h"
+#include "footfall/steps/walk_json.h"
 
 namespace {
 
@@ -106,4 +108,32 @@ TEST_CASE("ffc_load_file reads a height map's headers whatever the host's letter
     CHECK(SampleCount(path) == in_c);
   }
   std::remove(path.c_str());
+}
+
+TEST_CASE("the C++ readers read character and walk files whatever the host's decimal point",
+          "[client][locale]") {
+  // LoadCharacter refused biped.json (its rests collided as whole numbers), and ReadWalkJson
+  // refused a walk the command line wrote.
+  const std::string biped = FOOTFALL_SOURCE_DIR "/data/characters/biped.json";
+  footfall::Character in_c;
+  std::string error;
+  REQUIRE(footfall::LoadCharacter(biped, &in_c, &error) == footfall::Status::kOk);
+  const std::string walk_text = Generate("{\"character_file\": \"" + biped + "\", \"steps\": 3}");
+  footfall::Walk walk_in_c;
+  REQUIRE(footfall::ParseWalkJson(walk_text, "walk.json", &walk_in_c, &error) ==
+          footfall::Status::kOk);
+  const HostLocale host({"ps_AF.UTF-8", "ps_AF.utf8"});
+  footfall::Character character;
+  INFO(error);
+  REQUIRE(footfall::LoadCharacter(biped, &character, &error) == footfall::Status::kOk);
+  CHECK(character.step_length == in_c.step_length);
+  REQUIRE(character.feet.size() == in_c.feet.size());
+  for (size_t i = 0; i < character.feet.size(); ++i) {
+    CHECK(character.feet[i].rest.x == in_c.feet[i].rest.x);
+    CHECK(character.feet[i].rest.z == in_c.feet[i].rest.z);
+  }
+  footfall::Walk walk;
+  REQUIRE(footfall::ParseWalkJson(walk_text, "walk.json", &walk, &error) == footfall::Status::kOk);
+  CHECK(footfall::WalkToJson(walk) == footfall::WalkToJson(walk_in_c));
+  CHECK(std::string(std::localeconv()->decimal_point) != ".");  // the host's, after
 }
