@@ -399,3 +399,13 @@ TEST_CASE("A step_length longer than the reach allows is said once in the walk's
     CHECK(CheckedWalkOnFlat(LoadShipped(name), 6).notes.empty());
   }
 }
+
+TEST_CASE("GenerateWalk takes a null error string", "[steps][generator]") {
+  // Bad options with no error string to fill dereferenced it (a crash).
+  Terrain t = LoadTerrain(MakeFlat(41, 0.25, 0), 0.25);
+  GenerateOptions o;
+  o.up = {0, 0, 0};
+  Walk w;
+  CHECK(GenerateWalk(*t.session, t.handle, LoadShipped("biped"), o, &w, nullptr) ==
+        Status::kInvalidArgument);
+}

@@ -415,6 +415,8 @@ std::string Subject(const std::string& name, const char* flag, const char* field
 
 Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Character& character,
                     const GenerateOptions& given, Walk* out, std::string* error) {
+  std::string unwanted;  // a caller that passes no error string gets the status alone
+  if (!error) error = &unwanted;
   // Directions are normalised here, exactly even for components near 1e300 (their squares
   // would overflow).
   GenerateOptions options = given;

@@ -44,7 +44,9 @@ class TerrainSession {
   virtual Status Info(TerrainHandle terrain, TerrainInfo* out) = 0;
   virtual Status Unload(TerrainHandle terrain) = 0;
 
-  // out[i] answers points[i] / queries[i]; see TerrainGrid for the exact semantics.
+  // out[i] answers points[i] / queries[i]; see TerrainGrid for the exact semantics. The
+  // arrays must hold `count` items (they may be null when count is 0), as every out pointer of
+  // this interface must point at its result: they are not checked (the C ABI checks them).
   virtual Status Snap(TerrainHandle terrain, const Vec3* points, size_t count, Foothold* out) = 0;
   virtual Status Normal(TerrainHandle terrain, const Vec3* points, size_t count, Foothold* out) = 0;
   virtual Status Next(TerrainHandle terrain, const StepQuery* queries, size_t count,

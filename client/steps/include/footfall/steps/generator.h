@@ -113,7 +113,8 @@ double MaxStepTravel(const Character& character);
 // Generates the walk into *out (replacing it). Returns kOk when the walk was generated, even if
 // it stopped early: then out->stopped says at which step and position, and every key up to that
 // step is kept. Other statuses: kInvalidArgument (bad options, message in *error), or the
-// session's failure (kUnavailable, kUnknownTerrain ...; *error from last_error()).
+// session's failure (kUnavailable, kUnknownTerrain ...; *error from last_error()). `error` may
+// be null.
 Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Character& character,
                     const GenerateOptions& options, Walk* out, std::string* error);
 
