@@ -38,6 +38,22 @@ cmake --build "$work/consumer" -j2 >> "$work/consumer.log" 2>&1
 check "it builds against the installed libraries" [ $? -eq 0 ]
 [ "$failures" -eq 0 ] || cat "$work/consumer.log" >&2
 
+# Optional use: components by target name, an unknown one not found; libtirpc missing (no
+# pkg-config file for it) is footfall not found, and the project configures on.
+optional() {  # optional BUILD_NAME COMPONENTS [ENV...]: prints "footfall found: ..."
+  local name=$1 components=$2; shift 2
+  env "$@" cmake -S "$source_dir/tests/install/optional" -B "$work/$name" \
+    -DCMAKE_PREFIX_PATH="$prefix" "-DFOOTFALL_COMPONENTS=$components" 2>&1 |
+    sed -n 's/^-- footfall found: //p'
+}
+check "find_package(footfall COMPONENTS c steps export): found" \
+  [ "$(optional opt1 "c;steps;export")" = "1" ]
+check "find_package(footfall COMPONENTS nosuch): not found, configured" \
+  [ "$(optional opt2 "nosuch")" = "0" ]
+mkdir -p "$work/no_pc"
+check "without libtirpc's pkg-config file: not found, configured" \
+  [ "$(optional opt3 "" PKG_CONFIG_LIBDIR="$work/no_pc")" = "0" ]
+
 printf '{"character_file": "%s", "steps": 6}\n' "$data/characters/biped.json" > "$work/request.json"
 "$work/consumer/walk_consumer" "$data/terrain/hills.pts" "$work/request.json" > "$work/lib.json"
 check "the C++ program generates a walk" [ $? -eq 0 ]

@@ -68,7 +68,10 @@ class TerrainSession {
   // Snap, Normal and Next from several threads at once on a loaded terrain (last_error() is
   // then undefined after a failure). Other sessions serve one call at a time.
   virtual bool InProcess() const = 0;
-  // The reason for the last failed call, one line.
+  // The reason for the last failure, one line: also one a call recovered from (after a
+  // footfalld restart, a query that reloaded its terrain succeeds and leaves "server answered
+  // unknown_terrain" here), so read it after a call that failed. Destroying a session while
+  // another thread calls it is undefined.
   const std::string& last_error() const { return last_error_; }
   // What footfalld said of the last file it loaded for this session ("loaded PATH: N samples",
   // and for a mesh or height map " at separation S", with why when it is coarser than asked);

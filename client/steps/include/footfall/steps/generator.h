@@ -95,7 +95,8 @@ struct GenerateOptions {
   // same whatever the value.
   int characters_per_pass = 0;
   // Called as the walk advances with (work done, total work), in steps times passes; may be
-  // empty.
+  // empty. Called from the generating thread and, for crowds walked in passes, from the batch
+  // threads too, one call at a time: it must not assume the caller's thread.
   std::function<void(int, int)> progress;
 };
 
