@@ -13,4 +13,8 @@ grep -o '\bffc_[a-z_]*(' "$header" | tr -d '(' | sort -u > "$work/declared.txt"
 check "the header declares the C ABI" [ "$(wc -l < "$work/declared.txt")" -ge 15 ]
 check "exported: the header's functions, nothing else" \
   diff "$work/declared.txt" "$work/exported.txt"
+# The SONAME's major version is the header's FFC_ABI_VERSION.
+abi=$(sed -n 's/^#define FFC_ABI_VERSION \([0-9]*\).*/\1/p' "$header")
+soname=$(objdump -p "$lib" | awk '$1 == "SONAME" {print $2}')
+check "SONAME libfootfall.so.$abi, the header's ABI version ($soname)" [ "$soname" = "libfootfall.so.$abi" ]
 finish

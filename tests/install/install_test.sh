@@ -16,7 +16,8 @@ check "cmake --install succeeds" [ $? -eq 0 ]
 for program in footfall footfalld; do
   check "$program installed and executable" [ -x "$prefix/bin/$program" ]
 done
-check "libfootfall.so installed" [ -f "$prefix/lib/libfootfall.so" ]
+check "libfootfall.so installed, with its SONAME's name" \
+  [ -f "$prefix/lib/libfootfall.so" ] && [ -f "$prefix/lib/libfootfall.so.1" ]
 check "the C ABI header installed" [ -f "$prefix/include/footfall/client/footfall_c.h" ]
 check "the C++ headers installed" [ -f "$prefix/include/footfall/steps/generator.h" ]
 check "no header of the protocol's stubs installed" [ ! -e "$prefix/include/footfall.h" ]
@@ -78,7 +79,7 @@ from footfall_client import library, server, Session
 from footfall_client.server import LocalServer
 prefix = os.path.realpath(sys.argv[1])
 lib = os.path.realpath(library.find_library())
-assert lib == os.path.join(prefix, "lib", "libfootfall.so"), lib
+assert lib == os.path.realpath(os.path.join(prefix, "lib", "libfootfall.so")), lib
 footfalld = os.path.realpath(server.find_footfalld())
 assert footfalld == os.path.join(prefix, "bin", "footfalld"), footfalld
 local = LocalServer().start()
