@@ -11,11 +11,6 @@ source "$(dirname "$0")/../support/cli_checks.sh"
 hills=$source_dir/data/terrain/hills.pts
 biped=$source_dir/data/characters/biped.json
 
-wait_for_port() {
-  for _ in $(seq 100); do [ -s "$1" ] && break; sleep 0.05; done
-  cat "$1"
-}
-
 # 1. footfalld started with stdin, stdout and stderr closed serves its clients: its log lines
 #    went into the first client's connection, which hung for 300 s.
 "$footfalld" --listen 127.0.0.1:0 --port-file "$work/port1" --no-rpcbind 0<&- 1>&- 2>&- &

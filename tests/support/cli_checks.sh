@@ -3,6 +3,7 @@
 #   check NAME COMMAND...      passes when COMMAND succeeds; prints FAILED: NAME otherwise
 #   start_server FOOTFALLD [FLAGS...]   sets server_pid, port and server (127.0.0.1:PORT)
 #   stop_server                 stops it (SIGTERM) and waits for it
+#   wait_for_port FILE          waits up to 5 s for a port file, then prints the port
 #   finish                      prints the counts; its status is the test's
 work=$(mktemp -d)
 server_pid=""
@@ -18,9 +19,12 @@ start_server() {
   rm -f "$work/port"
   "$footfalld" --listen 127.0.0.1:0 --port-file "$work/port" --no-rpcbind "$@" 2> "$work/server.log" &
   server_pid=$!
-  for _ in $(seq 100); do [ -s "$work/port" ] && break; sleep 0.05; done
-  port=$(cat "$work/port")
+  port=$(wait_for_port "$work/port")
   server=127.0.0.1:$port
+}
+wait_for_port() {
+  for _ in $(seq 100); do [ -s "$1" ] && break; sleep 0.05; done
+  cat "$1"
 }
 stop_server() {
   kill "$server_pid"; wait "$server_pid" 2>/dev/null; server_pid=""

@@ -15,7 +15,7 @@
 #include "footfall/import/terrain_loader.h"
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/output_file.h"
-#include "footfall/terrain/standard_streams.h"
+#include "footfall/terrain/process_start.h"
 #include "footfall/viewer/viewer_app.h"
 
 namespace {

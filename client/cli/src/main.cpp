@@ -14,7 +14,7 @@
 
 #include "commands.h"
 #include "footfall/terrain/output_file.h"
-#include "footfall/terrain/standard_streams.h"
+#include "footfall/terrain/process_start.h"
 
 namespace {
 
@@ -91,11 +91,7 @@ int Run(int argc, char** argv) {
     return 1;
   } catch (const std::system_error& e) {
     // std::thread's failure to start one (ulimit -u, or memory for its stack).
-    std::cerr << "footfall: " << e.what()
-              << (e.code() == std::errc::resource_unavailable_try_again
-                      ? " (a thread could not start: the limit on processes, ulimit -u, or memory)"
-                      : "")
-              << '\n';
+    std::cerr << "footfall: " << footfall::SystemErrorText(e) << '\n';
     return 1;
   } catch (const std::exception& e) {
     // A last resort: every reader reports bad input as a message of its own; whatever escapes

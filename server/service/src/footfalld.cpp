@@ -23,7 +23,7 @@
 #include "footfall/terrain/decimal_number.h"
 #include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/output_file.h"
-#include "footfall/terrain/standard_streams.h"
+#include "footfall/terrain/process_start.h"
 
 namespace {
 
@@ -265,22 +265,15 @@ int main(int argc, char** argv) {
     sigaction(SIGTERM, &action, nullptr);
     // SIGINT and SIGHUP (a closed terminal) stop it cleanly, unregistered, unless ignored when
     // it started (`nohup footfalld`, a background job of a script): those keep serving.
-    for (const int signal_number : {SIGINT, SIGHUP}) {
-      struct sigaction current {};
-      if (sigaction(signal_number, nullptr, &current) == 0 && current.sa_handler == SIG_IGN)
-        continue;
-      sigaction(signal_number, &action, nullptr);
-    }
+    for (const int signal_number : {SIGINT, SIGHUP})
+      if (!footfall::SignalIgnored(signal_number)) sigaction(signal_number, &action, nullptr);
     server.Run();
     g_server = nullptr;
     abandoned_load = server.abandoned_load();
   } catch (const std::system_error& e) {  // the server, destroyed, is unregistered
     // std::thread's failure to start one (ulimit -u, or memory for its stack).
     g_server = nullptr;
-    std::fprintf(stderr, "footfalld: %s%s\n", e.what(),
-                 e.code() == std::errc::resource_unavailable_try_again
-                     ? " (a thread could not start: the limit on processes, ulimit -u, or memory)"
-                     : "");
+    std::fprintf(stderr, "footfalld: %s\n", footfall::SystemErrorText(e).c_str());
     return 1;
   }
   if (abandoned_load) {

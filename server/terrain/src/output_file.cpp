@@ -16,6 +16,8 @@
 #include <mutex>
 #include <thread>
 
+#include "footfall/terrain/process_start.h"
+
 namespace footfall {
 namespace {
 
@@ -250,12 +252,8 @@ std::vector<std::string> OutputFileSet::Commit() {
 void RemoveTemporaryFileOnSignal() {
   // A signal ignored when the program started stays ignored (`nohup footfall generate` died at
   // the hangup, writing nothing).
-  for (int signal_number : kCleanedUpSignals) {
-    struct sigaction current {};
-    if (::sigaction(signal_number, nullptr, &current) == 0 && current.sa_handler == SIG_IGN)
-      continue;
-    std::signal(signal_number, RemoveTemporariesAndReraise);
-  }
+  for (int signal_number : kCleanedUpSignals)
+    if (!SignalIgnored(signal_number)) std::signal(signal_number, RemoveTemporariesAndReraise);
   // A thread that only waits, with no signal blocked, to take them while the others block
   // every signal: libtirpc does for the length of each call, and Ctrl-C waited minutes for a
   // --server-terrain load to finish. Without one (no thread may start: ulimit -u), signals
