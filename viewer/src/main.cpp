@@ -16,6 +16,7 @@
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/output_file.h"
 #include "footfall/terrain/process_start.h"
+#include "footfall/version.h"
 #include "footfall/viewer/viewer_app.h"
 
 namespace {
@@ -48,6 +49,8 @@ int main(int argc, char** argv) {
       "sample), walks and the queries of a live footfalld. Keys: drag orbit, right-drag pan, "
       "wheel zoom, F frame all, C colour, G grid cells, space play, left/right frame, Home/End "
       "first/last frame, Esc or Q quit."};
+  app.set_version_flag("--version", "footfall-view " FOOTFALL_VERSION,
+                       "Print footfall-view's version and exit");
   std::string size, camera;
   double frame = 0;
   app.add_option("--terrain", o.terrain, "Terrain file (.pts/.xyz/.txt or any loader format)");

@@ -15,6 +15,7 @@
 #include "commands.h"
 #include "footfall/terrain/output_file.h"
 #include "footfall/terrain/process_start.h"
+#include "footfall/version.h"
 
 namespace {
 
@@ -57,8 +58,8 @@ int Run(int argc, char** argv) {
   footfall::RemoveTemporaryFileOnSignal();  // an interrupted write leaves no temporary file
   CLI::App app{"footfall: places footsteps of bipeds and multipeds on uneven terrain"};
   app.require_subcommand(1);
-  // `footfall --version`: "footfall 0.1.0" on stdout, exit 0 (CMake's project version).
-  app.set_version_flag("--version", std::string("footfall ") + FOOTFALL_VERSION,
+  // `footfall --version`: "footfall 0.1.0" on stdout, exit 0 (footfall/version.h).
+  app.set_version_flag("--version", "footfall " FOOTFALL_VERSION,
                        "Print footfall's version and exit");
   int exit_code = 0;
   footfall::cli::AddQueryCommand(app, &exit_code);

@@ -17,6 +17,7 @@
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/output_file.h"
+#include "footfall/version.h"
 #include "walk_prep.h"
 
 namespace footfall {

@@ -13,6 +13,7 @@
 #include "footfall/export/euler.h"
 #include "footfall/terrain/ordered_text.h"
 #include "footfall/terrain/output_file.h"
+#include "footfall/version.h"
 #include "walk_prep.h"
 
 namespace footfall {

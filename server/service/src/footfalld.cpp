@@ -24,6 +24,7 @@
 #include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/output_file.h"
 #include "footfall/terrain/process_start.h"
+#include "footfall/version.h"
 
 namespace {
 
@@ -154,6 +155,8 @@ int main(int argc, char** argv) {
   // the log went into the first client's connection, which then hung).
   footfall::OpenClosedStandardStreams();
   CLI::App app{"footfalld: serves footfall terrain queries over ONC RPC (TCP)"};
+  app.set_version_flag("--version", "footfalld " FOOTFALL_VERSION,
+                       "Print footfalld's version and exit");
   std::string listen = "127.0.0.1:7407";
   footfall::RpcServerOptions options;
   std::string port_file;

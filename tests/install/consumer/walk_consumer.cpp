@@ -5,11 +5,20 @@
 #include <footfall/steps/generate_request.h>
 #include <footfall/steps/generator.h>
 #include <footfall/steps/walk_json.h>
+#include <footfall/version.h>
 
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#if FOOTFALL_VERSION_NUMBER != PACKAGE_VERSION_NUMBER
+#error "footfall/version.h and the CMake package disagree on the version"
+#endif
+static_assert(sizeof(FOOTFALL_VERSION) == sizeof(PACKAGE_VERSION) &&
+                  std::char_traits<char>::compare(FOOTFALL_VERSION, PACKAGE_VERSION,
+                                                  sizeof(PACKAGE_VERSION)) == 0,
+              "FOOTFALL_VERSION is the package's version string");
 
 int main(int argc, char** argv) {
   if (argc != 3) {
