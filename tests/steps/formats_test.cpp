@@ -1,11 +1,16 @@
 // The character file and walk JSON readers (round trips, each kind of bad input named), and the
 // C ABI's ffc_generate against GenerateWalk.
+#include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <thread>
 #include <vector>
@@ -162,6 +167,30 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
   CHECK(ParseCharacter("\xEF\xBB\xBF" + Biped(), "b.json", &c, &error) == Status::kOk);
   CHECK(LoadCharacter("/nonexistent/c.json", &c, &error) == Status::kIoError);
   CHECK_THAT(error, Catch::Contains("/nonexistent/c.json: cannot open"));
+}
+
+TEST_CASE("A character file that exists but cannot be opened is named with the reason",
+          "[steps][character]") {
+  // A host at its descriptor limit (a DCC with many files open): the message said only
+  // "cannot open character file".
+  const std::string path = std::string(FOOTFALL_SOURCE_DIR) + "/data/characters/biped.json";
+  struct rlimit old_limit;
+  REQUIRE(getrlimit(RLIMIT_NOFILE, &old_limit) == 0);
+  struct rlimit low_limit = old_limit;
+  low_limit.rlim_cur = std::min<rlim_t>(old_limit.rlim_cur, 256);
+  REQUIRE(setrlimit(RLIMIT_NOFILE, &low_limit) == 0);
+  std::vector<int> taken;  // every descriptor left below the limit
+  for (int fd; (fd = open("/dev/null", O_RDONLY)) >= 0;) taken.push_back(fd);
+  const int full_errno = errno;
+  Character c;
+  std::string error;
+  const Status status = LoadCharacter(path, &c, &error);
+  for (int fd : taken) close(fd);
+  REQUIRE(setrlimit(RLIMIT_NOFILE, &old_limit) == 0);
+  REQUIRE(full_errno == EMFILE);
+  CHECK(status == Status::kIoError);
+  CHECK(error == path + ": cannot open character file: " + std::strerror(EMFILE));
+  CHECK(LoadCharacter(path, &c, &error) == Status::kOk);  // and once descriptors are free
 }
 
 TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]") {

@@ -1,9 +1,12 @@
 #include "json_input.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "footfall/terrain/c_locale.h"
@@ -193,9 +196,13 @@ Status ReadJsonFile(const std::string& path, const char* what, std::string* text
                     std::string* error) {
   const Status status = CheckInputFile(path, what, error);
   if (status != Status::kOk) return status;
+  errno = 0;
   std::ifstream in(path, std::ios::binary);
   if (!in) {
-    *error = path + ": cannot open " + what;
+    // The file exists (CheckInputFile): the reason is the open's (permissions, descriptors).
+    const int open_error = errno;
+    *error = path + ": cannot open " + what +
+             (open_error ? ": " + std::string(std::strerror(open_error)) : "");
     return Status::kIoError;
   }
   // Read straight into the string (through a stringstream the text stood twice in memory).
