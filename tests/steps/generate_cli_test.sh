@@ -558,4 +558,21 @@ import json, sys
 w = json.load(open(sys.argv[1]))
 sys.exit(not ("footfalld at 127.0.0.1:" in w["stopped"] and len(w["tracks"]) == 48
               and all(len(t["keys"]) > 3 for t in w["tracks"])))' "$work/died.json"
+# 10. `--out -` writes the walk JSON to standard output, the bytes a .json file gets, beside
+#     file outputs and after them; messages stay on stderr. Twice is refused; standard output
+#     that cannot be written fails the command.
+walk=(--terrain "$hills" --character "$chars/quadruped.json" --steps 4)
+"$footfall" generate "${walk[@]}" --out "$work/file.json" 2> /dev/null
+"$footfall" generate "${walk[@]}" --out - --out "$work/beside.gltf" > "$work/stdout.json" 2> "$work/stdout.err"
+check "--out -: exit 0" [ $? -eq 0 ]
+check "--out -: the .json file's bytes" cmp -s "$work/stdout.json" "$work/file.json"
+check "--out -: the other output written too" [ -s "$work/beside.gltf" ]
+check "--out -: no file named -" [ ! -e ./- ]
+"$footfall" generate "${walk[@]}" --out - --out - > "$work/twice.json" 2> "$work/twice.err"
+check "--out - twice: exit 1" [ $? -eq 1 ]
+check "--out - twice: said" grep -qF "footfall generate: --out - is given twice" "$work/twice.err"
+check "--out - twice: nothing generated" [ ! -s "$work/twice.json" ]
+"$footfall" generate "${walk[@]}" --out - > /dev/full 2> "$work/full.err"
+check "--out - on a full disk: exit 1" [ $? -eq 1 ]
+check "--out - on a full disk: said" grep -qF "footfall generate: --out -: cannot write the walk JSON to standard output: No space left on device" "$work/full.err"
 finish

@@ -5,9 +5,11 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <mutex>
 #include <sstream>
@@ -82,6 +84,24 @@ bool ParseDirection(const std::string& text, const std::string& flag, Vec3* out,
     return false;
   }
   return true;
+}
+
+// `--out -`: the walk JSON on standard output.
+const std::string kStandardOutput = "-";
+
+// Writes the walk JSON to standard output, as it is built. False with a message on failure
+// (a closed pipe, a full disk).
+bool WriteWalkJsonToStandardOutput(const Walk& walk, std::string* error) {
+  errno = 0;
+  const bool written = EmitWalkJson(walk, [](std::string_view piece) {
+    std::cout.write(piece.data(), static_cast<std::streamsize>(piece.size()));
+    return static_cast<bool>(std::cout);
+  });
+  std::cout.flush();
+  if (written && std::cout && std::fflush(stdout) == 0) return true;
+  *error = std::string("--out -: cannot write the walk JSON to standard output") +
+           (errno ? std::string(": ") + std::strerror(errno) : std::string());
+  return false;
 }
 
 // Writes one output, chosen by its extension.
@@ -232,7 +252,12 @@ bool ReadOptions(const GenerateFlags& flags, GenerateOptions* options, std::stri
 // that it is neither another output nor an input. False with a message naming the output.
 bool CheckOutputs(const GenerateFlags& flags, const std::vector<std::string>& inputs,
                   std::string* error) {
+  if (std::count(flags.out.begin(), flags.out.end(), kStandardOutput) > 1) {
+    *error = "--out - is given twice; standard output takes the walk JSON once";
+    return false;
+  }
   for (const std::string& out : flags.out) {
+    if (out == kStandardOutput) continue;
     const std::string ext = FileExtension(out);
     if (ext != "json" && ext != "gltf" && ext != "glb" && ext != "mel" &&
         !IsPointFileExtension(ext)) {
@@ -261,7 +286,7 @@ bool CheckOutputs(const GenerateFlags& flags, const std::vector<std::string>& in
     // other: the last written would win, silently.
     for (const std::string& other : flags.out) {
       if (&other == &out) break;
-      if (SameFile(out, other)) {
+      if (other != kStandardOutput && SameFile(out, other)) {
         *error = "--out " + other + " and --out " + out +
                  " are the same file; give each output its own file";
         return false;
@@ -402,6 +427,7 @@ int WriteOutputs(const GenerateFlags& flags, const LoadedTerrain& terrain, const
   std::string error;
   OutputFileSet outputs;
   for (const std::string& out : flags.out) {
+    if (out == kStandardOutput) continue;  // after the files (below)
     const std::string ext = FileExtension(out);
     Status written;
     try {
@@ -450,6 +476,12 @@ int WriteOutputs(const GenerateFlags& flags, const LoadedTerrain& terrain, const
   }
   for (const std::string& failure : outputs.Commit()) {
     std::cerr << "footfall generate: " << failure << " (the other outputs are written)\n";
+    code = 1;
+  }
+  // Standard output last: a reader that stops early (`| head`) costs no file.
+  if (std::count(flags.out.begin(), flags.out.end(), kStandardOutput) > 0 &&
+      !WriteWalkJsonToStandardOutput(walk, &error)) {
+    std::cerr << "footfall generate: " << error << '\n';
     code = 1;
   }
   return code;
@@ -755,7 +787,7 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
   cmd->add_option("--out", flags->out,
                   "Output file: .json, .gltf, .glb or .mel (repeatable); .pts: the terrain's "
                   "samples the walk was placed on (as resampled for the character), for "
-                  "footfall-view or a plugin")
+                  "footfall-view or a plugin; -: the walk JSON on standard output")
       ->required();
   for (CLI::Option* o : {start, heading, path_opt, steps, crowd, crowd_spacing}) scene->excludes(o);
   cmd->footer(
