@@ -223,6 +223,30 @@ ff_status SendChunk(CLIENT* c, uint32_t upload, std::vector<ff_sample> samples,
   return status;
 }
 
+// FF_UPLOAD_FINISH from a raw client; returns the status, the terrain in *terrain.
+ff_status FinishUpload(CLIENT* c, uint32_t upload, uint32_t* terrain, std::string* message) {
+  ff_upload_args args{upload};
+  ff_load_reply reply{};
+  REQUIRE(ff_upload_finish_1(&args, &reply, c) == RPC_SUCCESS);
+  *terrain = reply.terrain;
+  *message = reply.message ? reply.message : "";
+  const ff_status status = reply.status;
+  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&reply));
+  return status;
+}
+
+// A complete upload of three samples, not yet finished; returns its id.
+uint32_t UploadThreeSamples(CLIENT* c) {
+  std::string message;
+  uint32_t upload = 0;
+  REQUIRE(BeginUpload(c, 3, &upload, &message) == FF_OK);
+  REQUIRE(SendChunk(c, upload,
+                    {ff_sample{{0, 0, 0}, {0, 1, 0}}, ff_sample{{1, 0, 0}, {0, 1, 0}},
+                     ff_sample{{0, 0, 1}, {0, 1, 0}}},
+                    &message) == FF_OK);
+  return upload;
+}
+
 // FF_LOAD_OPTIONS arguments with the loader's defaults (TerrainLoadOptions) for `path`.
 ff_load_options_args DefaultLoadOptionsArgs(const char* path) {
   const TerrainLoadOptions o;
@@ -2069,7 +2093,12 @@ TEST_CASE("at the terrain limit, a new terrain frees the least recently queried 
   auto late = Connect(server.port());
   TerrainHandle t = 0;
   CHECK(late->LoadSamples(MakeFlat(2, 1, 0), "late", &t) == Status::kLimitExceeded);
-  CHECK_THAT(late->last_error(), Catch::Contains("too many terrains loaded (limit 256)"));
+  CHECK(late->last_error() == "too many terrains loaded or being loaded (limit 256)");
+  // The upload footfalld kept for finishing again is dropped by the session, which has
+  // returned: its samples do not wait out --upload-timeout in the budget.
+  CHECK(WaitFor([&] {
+    return server.Log().find("upload sent more samples than the 4 announced") != std::string::npos;
+  }));
   // The first connection closes: its 64 terrains are orphans; one of them is queried again.
   clients[0].reset();
   CHECK(WaitFor([&] {
@@ -2103,6 +2132,75 @@ TEST_CASE("footfalld holds each connection to --max-client-terrains", "[rpc]") {
   CHECK(second->LoadSamples(MakeFlat(10, 1, 0), "d", &c) == Status::kOk);
   REQUIRE(first->Unload(a) == Status::kOk);
   CHECK(first->LoadSamples(MakeFlat(10, 1, 0), "c", &c) == Status::kOk);
+}
+
+TEST_CASE("an upload finished without a terrain slot left is kept, to be finished again", "[rpc]") {
+  // The samples were dropped with the refusal, though it said "unload one first".
+  ServerProcess server(0, {"--no-rpcbind", "--max-client-terrains", "2"});
+  CLIENT* c = RawClient(server.port());
+  std::string message;
+  uint32_t first = 0, second = 0, third = 0;
+  REQUIRE(FinishUpload(c, UploadThreeSamples(c), &first, &message) == FF_OK);
+  const uint32_t upload_b = UploadThreeSamples(c), upload_c = UploadThreeSamples(c);
+  REQUIRE(FinishUpload(c, upload_b, &second, &message) == FF_OK);
+  CHECK(FinishUpload(c, upload_c, &third, &message) == FF_LIMIT_EXCEEDED);
+  CHECK(message ==
+        "this connection holds 2 terrains, the most one connection may hold "
+        "(--max-client-terrains 2): unload one first; upload " +
+            std::to_string(upload_c) + " is kept: unload a terrain and finish it again");
+  REQUIRE(RawUnload(c, first, &message) == FF_OK);
+  CHECK(FinishUpload(c, upload_c, &third, &message) == FF_OK);
+  CHECK(RawInfo(c, third) == FF_OK);
+  clnt_destroy(c);
+}
+
+TEST_CASE("a load holds its terrain slot while it is built: others fill only the rest", "[rpc]") {
+  // A height map resampled on the server (half a million samples: a few seconds) while other
+  // connections fill every terrain slot: the limit refused the load once built, its work
+  // lost; now it holds its slot from its request on, and the last of the others is refused.
+  const TempRoot temp;
+  {
+    std::ofstream asc(temp.path + "/dem.asc");
+    constexpr int kSide = 200;
+    asc << "ncols " << kSide << "\nnrows " << kSide << "\nxllcorner 0\nyllcorner 0\ncellsize 1\n";
+    for (int r = 0; r < kSide; ++r) {
+      for (int col = 0; col < kSide; ++col) asc << (r * 7 + col * 3) % 11 << ' ';
+      asc << '\n';
+    }
+  }
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", temp.path});
+  ff_status loaded = FF_INTERNAL_ERROR;
+  std::string load_message;
+  std::thread loader([&] {
+    CLIENT* c = RawClient(server.port());
+    timeval wait{120, 0};
+    clnt_control(c, CLSET_TIMEOUT, reinterpret_cast<char*>(&wait));
+    ff_load_args args{const_cast<char*>("dem.asc"), 0};
+    ff_load_reply reply{};
+    if (ff_load_1(&args, &reply, c) == RPC_SUCCESS) {
+      loaded = reply.status;
+      load_message = reply.message ? reply.message : "";
+    }
+    xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&reply));
+    clnt_destroy(c);
+  });
+  // 256 terrains at most, 64 per connection: four connections ask for all 256.
+  std::vector<std::unique_ptr<TerrainSession>> fillers;
+  int filled = 0;
+  std::string refusal;
+  for (int i = 0; i < 256; ++i) {
+    if (i % 64 == 0) fillers.push_back(Connect(server.port(), 30));
+    TerrainHandle h = 0;
+    if (fillers.back()->LoadSamples(MakeFlat(4, 1, 0), "fill", &h) == Status::kOk)
+      ++filled;
+    else
+      refusal = fillers.back()->last_error();
+  }
+  loader.join();
+  INFO(load_message);
+  CHECK(loaded == FF_OK);
+  CHECK(filled == 255);
+  CHECK(refusal.find("too many terrains loaded or being loaded (limit 256)") != std::string::npos);
 }
 
 TEST_CASE("clients report a dead server and recover after a restart", "[rpc][robustness]") {

@@ -377,9 +377,34 @@ class RpcSession final : public TerrainSession {
                     reply.value.message ? reply.value.message : "upload failed");
     }
     ff_upload_args finish{upload};
-    return BuildCall("upload", source, [&](ff_load_reply* reply) {
+    s = BuildCall("upload", source, [&](ff_load_reply* reply) {
       return ff_upload_finish_1(&finish, reply, client_);
     });
+    if (s == Status::kLimitExceeded) DropKeptUpload(upload, samples);
+    return s;
+  }
+
+  // footfalld keeps an upload whose finish it refused for want of a terrain slot, for a raw
+  // client to finish again; this session's caller loads anew instead (Load* has returned), so
+  // the upload goes at once rather than holding its samples' budget until --upload-timeout: a
+  // chunk past its announced total ends it. The server's advice to finish it again is cut from
+  // last_error().
+  void DropKeptUpload(uint32_t upload, const RawSamples& samples) {
+    const std::string kept = "; upload " + std::to_string(upload) + " is kept";
+    const size_t at = last_error_.find(kept);
+    if (at == std::string::npos) return;  // not kept (an older server drops it itself)
+    last_error_.erase(at);
+    ff_sample extra{ToWire(samples.points[0]), ToWire(samples.normals[0])};
+    ff_upload_chunk_args args;
+    args.upload = upload;
+    args.samples.samples_len = 1;
+    args.samples.samples_val = &extra;
+    Reply<ff_status_reply> reply(reinterpret_cast<xdrproc_t>(xdr_ff_status_reply));
+    // Its answer (the upload dropped) changes nothing here; a call that failed reconnects at
+    // the next, and the refusal stays what last_error() says.
+    const std::string refusal = last_error_;
+    Call(ff_upload_chunk_1(&args, &reply.value, client_), "upload");
+    last_error_ = refusal;
   }
 
   // A call whose terrain footfalld builds before it answers (FF_LOAD_OPTIONS, FF_UPLOAD_FINISH):

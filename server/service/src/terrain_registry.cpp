@@ -199,11 +199,30 @@ std::string TerrainRegistry::Budget() const {
 Status TerrainRegistry::CheckQuota(uint64_t owner, std::string* message) const {
   size_t held = 0;
   for (const auto& t : terrains_) held += t.second->owner == owner;
-  if (held < limits_.max_client_terrains) return Status::kOk;
-  *message = "this connection holds " + std::to_string(held) +
-             " terrains, the most one connection may hold (--max-client-terrains " +
+  const auto loading = held_slots_.find(owner);
+  const size_t being_loaded = loading == held_slots_.end() ? 0 : loading->second;
+  if (held + being_loaded < limits_.max_client_terrains) return Status::kOk;
+  *message = "this connection holds " + std::to_string(held) + " terrains" +
+             (being_loaded ? " and loads " + std::to_string(being_loaded) + " more" : "") +
+             ", the most one connection may hold (--max-client-terrains " +
              std::to_string(limits_.max_client_terrains) + "): unload one first";
   return Status::kLimitExceeded;
+}
+
+Status TerrainRegistry::HoldSlot(uint64_t owner, PendingLoad* load, std::string* message) {
+  const Status status = CheckQuota(owner, message);
+  if (status != Status::kOk) return status;
+  size_t orphans = 0;
+  for (const auto& t : terrains_) orphans += t.second->owner == 0;
+  if (terrains_.size() - orphans + held_slots_total_ >= limits_.max_terrains) {
+    *message = "too many terrains loaded or being loaded (limit " +
+               std::to_string(limits_.max_terrains) + ")";
+    return Status::kLimitExceeded;
+  }
+  ++held_slots_[owner];
+  ++held_slots_total_;
+  load->holds_slot = true;
+  return Status::kOk;
 }
 
 Status TerrainRegistry::Add(const std::string& name, RawSamples samples, uint64_t owner,
@@ -260,10 +279,20 @@ Status TerrainRegistry::LoadFile(const std::string& relative_path, TerrainLoadOp
 
 Status TerrainRegistry::PrepareLoad(const std::string& relative_path, TerrainLoadOptions options,
                                     uint64_t owner, PendingLoad* load, std::string* message) {
-  Status status = CheckQuota(owner, message);  // before reading or sampling anything
+  // A slot before reading or sampling anything; given back on every refusal below.
+  load->owner = owner;
+  Status status = HoldSlot(owner, load, message);
   if (status != Status::kOk) return status;
+  status = PrepareLoadFile(relative_path, std::move(options), load, message);
+  if (status != Status::kOk) DropLoad(load);
+  return status;
+}
+
+Status TerrainRegistry::PrepareLoadFile(const std::string& relative_path,
+                                        TerrainLoadOptions options, PendingLoad* load,
+                                        std::string* message) {
   std::string path;
-  status = ResolveUnderRoot(data_root_, relative_path, &path, message);
+  Status status = ResolveUnderRoot(data_root_, relative_path, &path, message);
   if (status != Status::kOk) return status;
   status = CheckRegularFile(path, relative_path, message);
   if (status != Status::kOk) return status;
@@ -284,7 +313,6 @@ Status TerrainRegistry::PrepareLoad(const std::string& relative_path, TerrainLoa
   options.threads = 1;
   load->relative_path = relative_path;
   load->options = std::move(options);
-  load->owner = owner;
   load->pinned = std::move(pinned);
   return Status::kOk;
 }
@@ -326,6 +354,11 @@ void RunLoad(PendingLoad* load) {
 void TerrainRegistry::DropLoad(PendingLoad* load) {
   building_ -= std::min(building_, load->reserved);
   load->reserved = 0;
+  if (load->holds_slot) {
+    load->holds_slot = false;
+    --held_slots_total_;
+    if (--held_slots_[load->owner] == 0) held_slots_.erase(load->owner);
+  }
 }
 
 Status TerrainRegistry::FinishLoad(PendingLoad* load, uint32_t* handle, std::string* message) {
@@ -454,6 +487,17 @@ Status TerrainRegistry::PrepareFinishUpload(uint32_t upload, uint64_t owner, Pen
     *message = NoUpload(upload, owner);
     return Status::kInvalidArgument;
   }
+  if (it->second.samples.size() == it->second.total) {
+    // No slot for it: the upload is kept, to be finished once the client has unloaded one.
+    load->owner = owner;
+    const Status slot = HoldSlot(owner, load, message);
+    if (slot != Status::kOk) {
+      it->second.touched = std::chrono::steady_clock::now();  // asked for: not idle
+      *message +=
+          "; upload " + std::to_string(upload) + " is kept: unload a terrain and finish it again";
+      return slot;
+    }
+  }
   Upload u = std::move(it->second);
   uploads_.erase(it);
   if (u.samples.size() != u.total) {
@@ -462,7 +506,6 @@ Status TerrainRegistry::PrepareFinishUpload(uint32_t upload, uint64_t owner, Pen
     return Status::kInvalidArgument;
   }
   load->relative_path = u.name;
-  load->owner = owner;
   load->samples = std::move(u.samples);
   load->reserved = u.total;
   load->upload = true;

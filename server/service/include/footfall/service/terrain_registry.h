@@ -54,6 +54,10 @@ struct PendingLoad {
   std::unique_ptr<PinnedFile> pinned;  // a file to read; or, when null, `samples`
   RawSamples samples;                  // an upload's samples (kept in the budget: `reserved`)
   uint64_t reserved = 0;
+  // A terrain slot is held for it (against RegistryLimits::max_client_terrains and
+  // max_terrains) from its Prepare stage until FinishLoad or DropLoad, so that a load or upload
+  // whose grid is built always has its place.
+  bool holds_slot = false;
   bool upload = false;  // an upload's samples (FF_UPLOAD_FINISH), not a file
   // Set (from any thread) when the client that asked has gone: RunLoad stops at its next stage
   // with kUnavailable, and nothing more is built for nobody.
@@ -116,7 +120,9 @@ class TerrainRegistry {
   // Makes the upload a terrain belonging to `owner`.
   Status FinishUpload(uint32_t upload, uint64_t owner, uint32_t* handle, std::string* message);
   // FinishUpload's first stage, for RunLoad and FinishLoad: the complete upload's samples move
-  // to *load, still counted in the budget until FinishLoad or DropLoad.
+  // to *load, still counted in the budget until FinishLoad or DropLoad. When `owner` or the
+  // server has no terrain slot left, kLimitExceeded and the upload is kept: the client may
+  // unload a terrain and finish it again.
   Status PrepareFinishUpload(uint32_t upload, uint64_t owner, PendingLoad* load,
                              std::string* message);
   // Forgets a prepared load that will not be finished (its client went away).
@@ -168,8 +174,15 @@ class TerrainRegistry {
   // Adds a built grid; kLimitExceeded when the quota, the terrain limit or the budget refuse it.
   Status AddGrid(const std::string& name, TerrainGrid grid, uint64_t owner, uint32_t* handle,
                  std::string* message);
-  // kLimitExceeded, with a message, when `owner` holds its quota of terrains.
+  // kLimitExceeded, with a message, when `owner` holds its quota of terrains (loaded, or being
+  // loaded: slots held by prepared loads count).
   Status CheckQuota(uint64_t owner, std::string* message) const;
+  // PrepareLoad's checks of the file, once `load` holds its slot.
+  Status PrepareLoadFile(const std::string& relative_path, TerrainLoadOptions options,
+                         PendingLoad* load, std::string* message);
+  // CheckQuota, then the server's terrain limit (orphans count as room: AddGrid frees them);
+  // on kOk, `load` holds a slot until FinishLoad or DropLoad.
+  Status HoldSlot(uint64_t owner, PendingLoad* load, std::string* message);
   // Samples held by loaded terrains plus those reserved by uploads in progress or being built.
   uint64_t TotalSamples() const;
   // Why `owner` has no upload `upload`: dropped by --upload-timeout, or never begun here.
@@ -196,6 +209,8 @@ class TerrainRegistry {
   std::deque<std::pair<uint32_t, uint64_t>> expired_ids_;
   std::map<uint32_t, Upload> uploads_;
   uint64_t building_ = 0;  // samples of finished uploads whose grids are being built
+  std::map<uint64_t, size_t> held_slots_;  // terrain slots held by prepared loads, per owner
+  size_t held_slots_total_ = 0;
   std::deque<RecentQuery> recent_;
   uint64_t sequence_ = 0;
 };
