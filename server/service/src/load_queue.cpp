@@ -21,12 +21,21 @@ LoadQueue::LoadQueue(size_t capacity, const int (&workers)[kLanes])
     : capacity_(capacity), state_(std::make_shared<State>()) {
   state_->wake_fd = eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
   if (state_->wake_fd < 0) throw std::runtime_error("cannot create the load queue's eventfd");
-  for (int lane = 0; lane < kLanes; ++lane)
-    for (int i = 0; i < workers[lane]; ++i)
-      workers_.emplace_back([state = state_, lane] { Work(state, static_cast<Lane>(lane)); });
+  try {
+    for (int lane = 0; lane < kLanes; ++lane)
+      for (int i = 0; i < workers[lane]; ++i)
+        workers_.emplace_back([state = state_, lane] { Work(state, static_cast<Lane>(lane)); });
+  } catch (...) {
+    // A thread that could not start (a memory or process limit): the ones started are stopped
+    // and joined before the error goes on (left joinable, they ended the process).
+    StopWorkers();
+    throw;
+  }
 }
 
-LoadQueue::~LoadQueue() {
+LoadQueue::~LoadQueue() { StopWorkers(); }
+
+void LoadQueue::StopWorkers() {
   {
     std::lock_guard<std::mutex> lock(state_->mutex);
     state_->stop = true;

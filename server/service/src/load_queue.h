@@ -60,6 +60,8 @@ class LoadQueue {
   bool Abandon();
 
  private:
+  // Stops the workers and joins those not abandoned.
+  void StopWorkers();
   // Shared with the worker, which may outlive the queue once abandoned.
   struct State {
     ~State();
