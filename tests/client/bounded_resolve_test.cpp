@@ -1,11 +1,19 @@
 // Host name lookups bounded by the session's call timeout: a resolver that does not answer no
 // longer blocks a client call indefinitely; literal addresses need no lookup at all.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/time.h>
+#include <unistd.h>
+
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <catch2/catch.hpp>
 
@@ -145,4 +153,50 @@ TEST_CASE("an RPC session whose host lookup hangs fails within its call timeout"
         "lookup within 0.3 s");
   session.reset();
   ReleaseAndWait(1);
+}
+
+TEST_CASE("a connect interrupted by a signal still ends within the connect timeout", "[client]") {
+  // A host that drops connection attempts (a listener whose accept queue is full), and a
+  // caller whose signal handler runs during the connect, as Python's, Go's and DCCs' do: the
+  // interrupted wait was read as connected, and libtirpc then waited about 130 s for the
+  // connect with every signal blocked.
+  const int listener = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  REQUIRE(bind(listener, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0);
+  REQUIRE(listen(listener, 0) == 0);
+  socklen_t length = sizeof address;
+  REQUIRE(getsockname(listener, reinterpret_cast<sockaddr*>(&address), &length) == 0);
+  std::vector<int> queued;  // fill the accept queue: later handshakes get no answer
+  for (int i = 0; i < 2; ++i) {
+    queued.push_back(socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK, 0));
+    connect(queued.back(), reinterpret_cast<sockaddr*>(&address), sizeof address);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  struct sigaction handler {
+  }, old_handler{};
+  handler.sa_handler = [](int) {};
+  handler.sa_flags = SA_RESTART;
+  REQUIRE(sigaction(SIGALRM, &handler, &old_handler) == 0);
+  itimerval once{{0, 0}, {0, 200000}};  // one signal, 0.2 s into the connect
+  setitimer(ITIMER_REAL, &once, nullptr);
+
+  RpcOptions options;
+  options.host = "127.0.0.1";
+  options.port = ntohs(address.sin_port);
+  options.connect_timeout_s = 1;
+  options.call_timeout_s = 1;
+  auto session = MakeRpcSession(options);
+  TerrainHandle handle = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  const Status status = session->LoadSamples(MakeHeightField(4, 4, 0.5, 0.1, 1), "t", &handle);
+  const double waited = SecondsSince(t0);
+  sigaction(SIGALRM, &old_handler, nullptr);
+  for (const int fd : queued) close(fd);
+  close(listener);
+  CHECK(status == Status::kUnavailable);
+  INFO(session->last_error());
+  CHECK(session->last_error().find("connection timed out") != std::string::npos);
+  CHECK(waited < 20);  // about the 1 s timeout; never the kernel's 130 s
 }

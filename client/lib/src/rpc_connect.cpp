@@ -51,8 +51,24 @@ int ConnectWithTimeout(const addrinfo* a, double timeout_s, std::string* reason)
   fcntl(fd, F_SETFL, flags | O_NONBLOCK);
   int rc = connect(fd, a->ai_addr, a->ai_addrlen);
   if (rc != 0 && errno == EINPROGRESS) {
+    // Waited for until the deadline, across signals the caller's handlers take: an interrupted
+    // wait read as connected handed libtirpc a connect still in progress, which it waited for
+    // with every signal blocked until the kernel gave up (about 130 s).
+    const auto deadline = std::chrono::steady_clock::now() +
+                          std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                              std::chrono::duration<double>(timeout_s));
     pollfd p{fd, POLLOUT, 0};
-    rc = poll(&p, 1, std::max(1, static_cast<int>(timeout_s * 1000)));
+    for (;;) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+          deadline - std::chrono::steady_clock::now());
+      rc = poll(&p, 1, static_cast<int>(std::max<int64_t>(0, left.count())));
+      if (rc >= 0 || errno != EINTR) break;
+    }
+    if (rc < 0) {
+      *reason = std::strerror(errno);
+      close(fd);
+      return -1;
+    }
     if (rc == 0) {
       *reason = "connection timed out";
       close(fd);
