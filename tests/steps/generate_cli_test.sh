@@ -558,6 +558,41 @@ import json, sys
 w = json.load(open(sys.argv[1]))
 sys.exit(not ("footfalld at 127.0.0.1:" in w["stopped"] and len(w["tracks"]) == 48
               and all(len(t["keys"]) > 3 for t in w["tracks"])))' "$work/died.json"
+# 11. A dead end: a body that settles within half a step of a spot stops a window (100 steps)
+#     after it settled. An 8-legged spider that cannot climb a bare wall mills at its foot from
+#     about step 20; fixed windows stopped it at step 201, and a 150-step walk ended "complete".
+#     (It climbs the wall, or stops beyond reach, from other starts or spacings: the test needs
+#     the milling, which this floor spacing of 0.5/62 gives.)
+awk 'BEGIN { for (i = 0; i <= 100; i++) { x = i * 0.008
+  for (k = 0; k < 62; k++) printf "%.9g 0 %.9g 0 1 0\n", x, -0.5 + 0.5 * k / 62
+  for (k = 1; k <= 100; k++) printf "%.9g %.9g 0 0 0 -1\n", x, k * 0.008 } }' > "$work/bare_wall.pts"
+cat > "$work/spider.json" <<'JSON'
+{"format": "footfall-character", "version": 1, "name": "spider",
+ "feet": [{"name": "L1", "rest": [0.1, 0, 0.2]}, {"name": "L2", "rest": [0.22, 0, 0.07]},
+          {"name": "L3", "rest": [0.16, 0, -0.06]}, {"name": "L4", "rest": [0.09, 0, -0.18]},
+          {"name": "R1", "rest": [-0.1, 0, 0.2]}, {"name": "R2", "rest": [-0.22, 0, 0.07]},
+          {"name": "R3", "rest": [-0.16, 0, -0.06]}, {"name": "R4", "rest": [-0.09, 0, -0.18]}],
+ "gait": [["L1", "R2", "L3", "R4"], ["R1", "L2", "R3", "L4"]],
+ "pairs": [["L1", "R1"], ["L2", "R2"], ["L3", "R3"], ["L4", "R4"]],
+ "step_length": 0.1, "step_height": 0.04, "body_height": 0.04, "frames_per_step": 7,
+ "align_to_normal": true, "reach": 0.36, "max_slope_deg": 100, "max_rise": 0.07,
+ "slope_threshold_deg": 25, "slope_step_scale": 0.7}
+JSON
+"$footfall" generate --terrain "$work/bare_wall.pts" --character "$work/spider.json" \
+  --start 0.4,0,-0.35 --steps 150 --out "$work/dead_end.json" 2> "$work/dead_end.err"
+check "dead end: exit 2" [ $? -eq 2 ]
+check "dead end: said" grep -qF "steps (a dead end)" "$work/dead_end.err"
+check "dead end: stopped a window after the body settled" python3 -c '
+import json, math, sys
+w = json.load(open(sys.argv[1]))
+body = next(t for t in w["tracks"] if t["kind"] == "body")["keys"]  # one key a step
+# Settled: from the first step whose body stays within a step (the half-step ball across,
+# 0.1) of where it stopped.
+near = [math.dist(k["position"], body[-1]["position"]) < 0.1 for k in body]
+settled = len(near) - next(i for i, n in enumerate(reversed(near)) if not n)
+stayed = len(body) - settled
+print("settled at step", settled, "stayed", stayed, "steps", file=sys.stderr)
+sys.exit(not (settled < 60 and 95 <= stayed <= 105))' "$work/dead_end.json"
 # 10. `--out -` writes the walk JSON to standard output, the bytes a .json file gets, beside
 #     file outputs and after them; messages stay on stderr. Twice is refused; standard output
 #     that cannot be written fails the command.

@@ -155,12 +155,11 @@ struct Agent {
   bool walking = true;  // false once stopped or arrived
   int waits = 0;        // steps in a row its group stepped in place, waiting for a planted foot
   int still = 0;        // steps in a row no foot of it moved (waits, turns on the spot included)
-  // Where the body was at step `window_step`: a body that stays within half a step of it for
-  // Generator::window_steps_ steps is milling about at a dead end (`window_left`: it has been
-  // farther since, as a walk along a loop that comes back there is).
+  // Where the body was at step `window_step`, the first step since it was last half a step or
+  // more from the previous such place: a body that stays within half a step of it for
+  // Generator::window_steps_ steps is milling about at a dead end.
   Vec3 window_from;
   int window_step = -1;
-  bool window_left = false;
   std::string stopped;   // why it stopped early ("" when it did not)
   int stopped_step = 0;  // the step it stopped at
   bool failed = false;   // stopped by the serving engine's failure, not by the terrain
