@@ -395,6 +395,22 @@ if [ -f "$dem" ]; then
   "$footfall" generate --terrain "$work/dem-q.pts" --character "$chars/quadruped.json" --steps 10 \
     --out "$work/dem-q.json" 2> /dev/null
   check "convert --character: the quadruped walks the point file" [ $? -eq 0 ]
+  # A --start straight below the ground (y = 0 under banks at 537 m) starts on the ground above
+  # it, biped or multiped, on the height map or its points, embedded or over RPC: the nearest
+  # sample was the lowest bank nearby, 17 m aside, and a multiped's note said 10 m.
+  for c in biped quadruped; do
+    for t in "$dem" "$work/dem-q.pts"; do
+      name=below-$c-$(basename "$t" | tr . _)
+      both "$name" 0 --terrain "$t" --character "$chars/$c.json" --start 8,0,8 --steps 3
+      check "$name: no note of a start off the terrain" bash -c "! grep -q 'snaps to the terrain' '$work/$name-embedded.err'"
+      check "$name: the body starts above (8, 8)" python3 -c '
+import json, math, sys
+w = json.load(open(sys.argv[1]))
+step = json.load(open(sys.argv[2]))["step_length"]
+x, y, z = next(t for t in w["tracks"] if t["kind"] == "body")["keys"][0]["position"]
+sys.exit(not (math.hypot(x - 8, z - 8) < step and y > 537))' "$work/$name-embedded.json" "$chars/$c.json"
+    done
+  done
   err=$("$footfall" terrain convert "$dem" --character "$chars/quadruped.json" --separation 1 -o "$work/x.pts" 2>&1)
   check "convert --character --separation: exit 1" [ $? -eq 1 ]
   check "convert --character --separation: message" grep -qF "give --separation or --character, not both" <<< "$err"

@@ -16,6 +16,30 @@ inline double Degrees(double rad) { return rad * 180 / kPi; }
 // v without its component along the unit normal n.
 inline Vec3 ProjectOnPlane(const Vec3& v, const Vec3& n) { return v - n * Dot(v, n); }
 
+// The ground straight above or below `start` along the unit `up`, from *found, the surface's
+// point nearest `start`: `snap(q, &next)` finds the point nearest q (false: it failed), and
+// is asked again at the line's point at the height of the last one found until that stays
+// (a height field settles in two or three). True, with *found that ground, when it lies
+// within `within` of the line; *found unchanged otherwise, and when it lies that near already.
+// `point_of(found)` is its position.
+template <typename Found, typename Snap, typename PointOf>
+bool SettleAlongUp(const Vec3& start, const Vec3& up, double within, Found* found, Snap&& snap,
+                   PointOf&& point_of) {
+  auto across = [&](const Vec3& p) { return Length((p - start) - up * Dot(p - start, up)); };
+  if (across(point_of(*found)) <= within) return false;
+  Found ground = *found;
+  constexpr int kMostSnaps = 8;
+  for (int i = 0; i < kMostSnaps; ++i) {
+    const Vec3 at = point_of(ground);
+    Found next;
+    if (!snap(start + up * Dot(at - start, up), &next) || point_of(next) == at) break;
+    ground = next;
+  }
+  if (across(point_of(ground)) > within) return false;
+  *found = ground;
+  return true;
+}
+
 // v / |v|, or `fallback` when v is (nearly) zero.
 inline Vec3 NormalizeOr(const Vec3& v, const Vec3& fallback) {
   const double len = Length(v);

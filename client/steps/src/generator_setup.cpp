@@ -63,7 +63,7 @@ Status Generator::Setup(std::string* error) {
   setup_notes_.clear();
   start_beyond_reach_.clear();
   if (o_.has_start) {
-    const Vec3 up = c_.align_to_normal ? start_snap_.normal : world_up_;
+    const Vec3 up = c_.align_to_normal && !start_along_up_ ? start_snap_.normal : world_up_;
     const double across = Length(ProjectOnPlane(start - start_snap_.point, up));
     if (across > c_.step_length) {
       Text m(4);
@@ -390,8 +390,22 @@ Status Generator::SeparateSharedFeet(const Vec3* places, Foothold* feet, size_t 
   return Status::kOk;
 }
 
+bool Generator::GroundAlongUp(const Vec3& start, Foothold* first, std::string* error,
+                              Status* status) {
+  return SettleAlongUp(
+      start, world_up_, c_.step_length, first,
+      [&](const Vec3& q, Foothold* next) {
+        *status = Check(session_.Snap(terrain_, &q, 1, next), "snap start", error);
+        return *status == Status::kOk && next->status == Status::kOk;
+      },
+      [](const Foothold& f) { return f.point; });
+}
+
 Status Generator::FindStart(const Vec3& start, bool may_move, Foothold* first, std::string* error) {
   Status s = Check(session_.Snap(terrain_, &start, 1, first), "snap start", error);
+  if (s != Status::kOk) return s;
+  start_along_up_ =
+      o_.has_start && first->status == Status::kOk && GroundAlongUp(start, first, error, &s);
   if (s != Status::kOk) return s;
   start_snap_ = *first;
   if (first->status != Status::kOk) {

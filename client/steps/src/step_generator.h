@@ -227,6 +227,12 @@ class Generator {
   // 1. The start's sample: where `start` snaps, or, when it may move and the character cannot
   //    stand there, the nearest candidate around it where it can (GenerateOptions).
   Status FindStart(const Vec3& start, bool may_move, Foothold* first, std::string* error);
+  // A given start whose nearest sample `*first` lies more than a step across world up from
+  // it: the ground on the line through it along world up, found by snapping the line's point
+  // at the sample's height until the sample stays (a start at y = 0 under a DEM's hills snapped
+  // to the lowest bank nearby, 17 m aside). *first becomes that ground when it lies within a
+  // step of the line; true then.
+  bool GroundAlongUp(const Vec3& start, Foothold* first, std::string* error, Status* status);
   // The longest step_length with which every foot of a character walking straight on level
   // ground stays within reach of the body (the step vector's reach limit of 7 leaves full
   // steps alone); infinite when any length does (a single gait group). [Units: wu]
@@ -418,8 +424,10 @@ class Generator {
   // The first foot keyed at the start beyond reach of its body (snapped to samples too far
   // apart for the character), said as a note: "" when none was.
   std::string start_beyond_reach_;
-  // The start's nearest sample (FindStart's first snap, before the start may move).
+  // The start's nearest sample (FindStart's first snap, before the start may move), or the
+  // ground straight above or below a given start (GroundAlongUp).
   Foothold start_snap_;
+  bool start_along_up_ = false;  // start_snap_ is GroundAlongUp's
   std::shared_ptr<BatchPool> pool_;
   std::vector<int> pair_of_foot_;
   // Each foot's other foot across the body, whose side it keeps to (PairGap, GapToMate): its

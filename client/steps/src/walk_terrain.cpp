@@ -87,6 +87,16 @@ Status PrepareWalkTerrain(const std::string& path, const TerrainLoadOptions& loa
   MeshBounds(mesh, &mesh_lo, &mesh_hi);
   out->start = NearestSurfacePoint(
       mesh, options.has_start ? options.start : TopCentre(mesh_lo, mesh_hi, up));
+  // A start given straight above or below the ground (y = 0 under a DEM's hills) is that
+  // ground, as the generator takes it (GroundAlongUp): the box goes around it.
+  if (options.has_start)
+    steps_detail::SettleAlongUp(
+        options.start, up, character.step_length, &out->start,
+        [&](const Vec3& q, Vec3* next) {
+          *next = NearestSurfacePoint(mesh, q);
+          return true;
+        },
+        [](const Vec3& p) { return p; });
 
   // The box the walk cannot leave: its steps from the start, or, along a path walked to its
   // end, the path's box widened by a few steps.
