@@ -604,6 +604,41 @@ TEST_CASE("live: the viewer shows a query another client sends to footfalld", "[
   CHECK(CountColorNear(image, pixel, 4, kChosen) >= 40);
 }
 
+TEST_CASE("live: a query on another terrain of footfalld is drawn untraced, with a note",
+          "[viewer][live]") {
+  // (Traced on the viewer's terrain, it showed that terrain's cells and candidates beside the
+  // other terrain's answer, without a word.)
+  const std::string dir = test::TempDir();
+  const LocalServer server(dir);
+  INFO("footfalld stderr: " << server.child.Err());
+  REQUIRE_FALSE(server.port.empty());
+  const std::string& address = server.address;
+  test::Child viewer({kView, "--terrain", kTerrain, "--server", address, "--live", "--live-wait",
+                      "2", "--timeout", "30", "--size", "320x200", "--screenshot",
+                      dir + "/live.png", "--dump-state", dir + "/state.json"},
+                     {test::XDisplay()});
+  INFO("viewer stderr: " << viewer.Err());
+  REQUIRE(viewer.WaitForOutput("live: following footfalld at " + address, kTimeout));
+  const std::string stairs = std::string(FOOTFALL_DATA_DIR) + "/terrain/stairs.pts";
+  for (const std::string& terrain : {stairs, kTerrain}) {
+    const RunResult client = Run({FOOTFALL_CLI, "query", "--terrain", terrain, "--server", address},
+                                 {}, kTimeout, "snap 1 0.5 1\n");
+    INFO("footfall query: " << client.out << client.err);
+    REQUIRE(client.exit_code == 0);
+  }
+  int code = -1;
+  REQUIRE(viewer.Wait(kTimeout, &code));
+  REQUIRE(code == 0);
+  const json state = json::parse(test::ReadFile(dir + "/state.json"));
+  const json& queries = state["live"]["queries"];
+  REQUIRE(queries.size() == 2);
+  CHECK(queries[0]["other_terrain"] == true);  // the stairs'
+  CHECK(queries[0]["traced"] == false);
+  CHECK(queries[1]["other_terrain"] == false);  // the viewer's own terrain's
+  CHECK(queries[1]["traced"] == true);
+  CHECK_THAT(viewer.Err(), Catch::Contains("were asked on another terrain of the server"));
+}
+
 TEST_CASE("live: without a terrain, the picture is framed on the queries received",
           "[viewer][live]") {
   // (The camera framed the unit box at the origin before any query came: a blank picture.)

@@ -21,7 +21,15 @@ QueryView FromRecent(const RecentQuery& query, const TerrainGrid* grid) {
   spec.direction = query.direction;
   spec.tolerance = query.tolerance;
   QueryView view;
-  if (grid && !grid->empty()) view = RunQuery(*grid, spec);
+  if (grid && !grid->empty()) {
+    view = RunQuery(*grid, spec);
+    const Foothold& local = view.result;
+    const Foothold& served = query.result;
+    view.other_terrain = local.status != served.status ||
+                         (served.status == Status::kOk &&
+                          (local.point != served.point || local.index != served.index));
+    if (view.other_terrain) view.traced = false, view.trace = QueryTrace{};
+  }
   view.spec = spec;
   view.result = query.result;
   view.live = true;

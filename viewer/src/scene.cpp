@@ -197,6 +197,7 @@ void Scene::AddLive(const std::vector<RecentQuery>& queries) {
     live_.push_back(FromRecent(q, has_terrain() ? &grid_ : nullptr));
     GrowDrawn(live_.back());
     ++live_received_;
+    live_other_terrain_ += live_.back().other_terrain;
   }
   if (live_.size() > kMaxLive)
     live_.erase(live_.begin(), live_.begin() + static_cast<long>(live_.size() - kMaxLive));
@@ -447,6 +448,7 @@ ordered_json Scene::Describe(const ViewState& view, const OrbitCamera& camera, i
       j["point"] = Json(q.result.point);
       pixel(q.result.point, &j);
     }
+    if (q.live) j["other_terrain"] = q.other_terrain;
     j["traced"] = q.traced;
     if (q.traced) {
       j["cells"] = q.trace.cells.size();

@@ -317,7 +317,12 @@ struct App {
     std::vector<RecentQuery> got;
     live->Take(&got);
     if (got.empty()) return;
+    const size_t other_before = scene.live_other_terrain();
     scene.AddLive(got);
+    if (other_before == 0 && scene.live_other_terrain() > 0)
+      std::cerr << "footfall-view: note: live queries answered otherwise than " << options.terrain
+                << " answers them were asked on another terrain of the server: drawn with the "
+                   "server's answer alone, without cells and candidates\n";
     // (The camera framed the unit box before any query came: a blank picture.)
     if (follow_live) FrameAll(frame_width, frame_height);
   }

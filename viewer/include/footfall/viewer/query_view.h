@@ -26,13 +26,17 @@ struct QueryView {
   bool traced = false;
   bool live = false;      // received from footfalld rather than given on the command line
   uint64_t sequence = 0;  // live: the server's query sequence
+  // live: the local terrain answers it otherwise than footfalld did (the query was on another
+  // terrain): drawn with the server's answer alone, untraced.
+  bool other_terrain = false;
 };
 
 // Answers `spec` with `grid`, recording its trace.
 QueryView RunQuery(const TerrainGrid& grid, const QuerySpec& spec);
 
 // A query footfalld answered. Its result is the server's; when `grid` is given (the same
-// terrain loaded locally) the query is traced again on it to show cells and candidates.
+// terrain loaded locally) the query is traced again on it to show cells and candidates,
+// unless the grid's answer differs from the server's (`other_terrain`).
 QueryView FromRecent(const RecentQuery& query, const TerrainGrid* grid);
 
 }  // namespace footfall::viewer

@@ -76,6 +76,8 @@ class Scene {
   double first_frame() const { return first_frame_; }
   double last_frame() const { return last_frame_; }
   size_t live_received() const { return live_received_; }
+  // Live queries the local terrain answered otherwise (asked on another terrain of footfalld).
+  size_t live_other_terrain() const { return live_other_terrain_; }
   const std::vector<QueryView>& queries() const { return queries_; }
   const std::vector<QueryView>& live() const { return live_; }
 
@@ -127,6 +129,7 @@ class Scene {
   double spacing_ = 0.1;
   std::vector<QueryView> queries_, live_;
   size_t live_received_ = 0;
+  size_t live_other_terrain_ = 0;
   Walk walk_;
   double first_frame_ = 0, last_frame_ = 0;
   Vec3 origin_;
