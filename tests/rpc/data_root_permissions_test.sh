@@ -40,6 +40,17 @@ check "unreadable file: said" grep -qF "'secret.pts': cannot open: Permission de
 out=$(query open.pts)
 check "readable file: answered" grep -qF '"found":true' <<< "$out"
 check "errors logged" grep -qF "error: load: access_denied: 'secret.pts': cannot open: Permission denied" "$work/run/log"
+# The root renamed or removed while footfalld runs: said so (every path was "leads outside the
+# data root", as a link escaping it is), and loads work again once it is back.
+mv "$work/root" "$work/root.moved"
+for f in open.pts nosuch.pts; do
+  out=$(query "$f")
+  check "root moved away, $f: exit 1" [ $? -eq 1 ]
+  check "root moved away, $f: said" grep -qF "footfalld's data root is gone (No such file or directory): it loads no file until the folder is back where it was" <<< "$out"
+done
+mv "$work/root.moved" "$work/root"
+out=$(query open.pts)
+check "root back: answered" grep -qF '"found":true' <<< "$out"
 kill "$server_pid"; wait "$server_pid" 2>/dev/null; server_pid=""
 # A root its user may not search: refused at start, exit 2.
 chmod 700 "$work/root"

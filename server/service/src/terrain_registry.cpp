@@ -102,6 +102,21 @@ Status ResolveUnderRoot(const std::string& root, const std::string& relative, st
     *message = "'" + relative + "': expected a path relative to the data root";
     return Status::kAccessDenied;
   }
+  // A root removed or renamed while footfalld runs: every path read as leading outside it.
+  char root_now[PATH_MAX];
+  struct stat root_stat {};
+  const char* gone = nullptr;
+  if (!realpath(root.c_str(), root_now))
+    gone = std::strerror(errno);
+  else if (root_now != root)
+    gone = "its name now leads elsewhere";
+  else if (stat(root_now, &root_stat) != 0 || !S_ISDIR(root_stat.st_mode))
+    gone = "it is no longer a folder";
+  if (gone) {
+    *message = std::string("footfalld's data root is gone (") + gone +
+               "): it loads no file until the folder is back where it was";
+    return Status::kIoError;
+  }
   // Every path that leaves the root gets this one answer, whether or not its target exists.
   const std::string outside = "'" + relative + "' leads outside the data root";
   // '..' is refused whatever it leads to; read without the file system (no answer tells what
