@@ -426,6 +426,29 @@ TEST_CASE("WriteGltf rejects walks glTF cannot hold", "[export][gltf]") {
   CHECK_FALSE(written.good());  // nothing written
 }
 
+TEST_CASE("WriteGltf refuses a .glb larger than its 32-bit lengths hold", "[export][gltf]") {
+  // (Past 4 GiB tinygltf wrote the lengths wrapped round: a corrupt file, reported written.)
+  // The limit lowered to a few kilobytes stands for 4 GiB here.
+  const Walk walk = test::CrowdWalk();
+  const std::string path = test::ScratchPath("large.glb");
+  std::string error;
+  GltfOptions options;
+  options.binary = true;
+  REQUIRE(WriteGltf(walk, path, options, &error) == Status::kOk);
+  const double written = static_cast<double>(ReadBytes(path).size());
+  std::remove(path.c_str());
+  // Refused at one byte below its size: the estimate never falls short of the file.
+  options.max_glb_bytes = written - 1;
+  CHECK(WriteGltf(walk, path, options, &error) == Status::kLimitExceeded);
+  CHECK_THAT(error, Catch::Contains("as .glb, whose lengths are 32-bit"));
+  CHECK_THAT(error, Catch::Contains("write .gltf, .json or .mel"));
+  CHECK_FALSE(std::ifstream(path).good());  // nothing written
+  options.max_glb_bytes = 100 * written;    // within it: written
+  CHECK(WriteGltf(walk, path, options, &error) == Status::kOk);
+  options.binary = false;  // .gltf has no such limit
+  CHECK(WriteGltf(walk, test::ScratchPath("large.gltf"), options, &error) == Status::kOk);
+}
+
 TEST_CASE("MaxFloatRounding: how far glTF's float positions move a walk's keys", "[export][gltf]") {
   Walk walk = test::BipedWalk();
   CHECK(MaxFloatRounding(walk) < 1e-7);

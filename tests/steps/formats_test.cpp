@@ -81,6 +81,9 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
        "'step_length' = 1000000000.001 is out of range (0, 1e+09]"},
       {{"\"frames_per_step\": 10", "\"frames_per_step\": 2147483648"},
        "'frames_per_step' = 2147483648 is out of range [2, 1e+06]"},
+      // (Converted to int before the check: undefined, said by UBSan.)
+      {{"\"frames_per_step\": 10", "\"frames_per_step\": -1e300"},
+       "'frames_per_step' = -1e+300 is out of range [2, 1e+06]"},
       // Control characters in names: a NUL cut glTF node names short, others broke MEL lines.
       {{"{\"name\": \"L\"", "{\"name\": \"L\\u0000a\""},
        "b.json: 'feet'[0].name: expected a name without control characters (byte 0x00 at offset "

@@ -154,6 +154,18 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
   for (const WalkTrack& track : walk.tracks)
     buffer_bytes += static_cast<double>(track.keys.size()) *
                     (track.kind == TrackKind::kBody ? 4 + 12 + 16 : 4 + 12);
+  constexpr double kGlbBytesPerTrack = 2048, kGlbHeaderBytes = 28;
+  const double glb_bytes =
+      buffer_bytes + kGlbBytesPerTrack * static_cast<double>(walk.tracks.size()) + kGlbHeaderBytes;
+  if (options.binary && glb_bytes > options.max_glb_bytes) {
+    std::ostringstream m;
+    m.precision(3);
+    m << "the walk takes about " << glb_bytes / 1e9 << " GB as .glb, whose lengths are 32-bit: it "
+      << "holds at most " << options.max_glb_bytes / 1e9
+      << " GB (write .gltf, .json or .mel, or fewer characters or steps)";
+    SetError(error, m.str());
+    return Status::kLimitExceeded;
+  }
   const double needed = buffer_bytes * (options.binary ? 2 : 5) +
                         9e3 * static_cast<double>(walk.tracks.size()) + 64e6;
   const double available = AvailableMemoryBytes();

@@ -215,9 +215,9 @@ int ffc_abi_version(void) { return FFC_ABI_VERSION; }
 ffc_session* ffc_open_embedded(void) {
   std::signal(SIGPIPE, SIG_IGN);
   try {
-    auto* s = new ffc_session;
+    auto s = std::make_unique<ffc_session>();  // freed if the session cannot be made
     s->session = footfall::MakeEmbeddedSession();
-    return s;
+    return s.release();
   } catch (...) {
     return nullptr;
   }
@@ -234,9 +234,9 @@ ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s) {
     if (host && *host && !footfall::ParseHost(host, &options.host)) return nullptr;
     options.port = port;
     if (timeout_s > 0) options.call_timeout_s = timeout_s;
-    auto* s = new ffc_session;
+    auto s = std::make_unique<ffc_session>();
     s->session = footfall::MakeRpcSession(options);
-    return s;
+    return s.release();
   } catch (...) {
     return nullptr;
   }

@@ -265,7 +265,8 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
   if (r.status == Status::kOk) {
     if (fps != std::floor(fps))
       r.Fail(Status::kParseError, "'frames_per_step': expected an integer");
-    c.frames_per_step = static_cast<int>(std::min(fps, 1e6));
+    // Clamped before the conversion (out of int's range it is undefined); refused below.
+    c.frames_per_step = static_cast<int>(std::clamp(fps, 0.0, 1e6));
   }
   if (r.status == Status::kOk) {
     r.Range(c.step_length, 0, kMaxLength, true, false, "step_length") &&

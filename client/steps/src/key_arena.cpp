@@ -42,7 +42,8 @@ void* KeyArena::do_allocate(size_t bytes, size_t alignment) {
     return next_ + ((alignment - at % alignment) % alignment);
   };
   unsigned char* p = next_ ? aligned() : nullptr;
-  if (!p || static_cast<size_t>(end_ - p) < bytes) {
+  // (Padding past the block's end leaves no room: end_ - p would be negative.)
+  if (!p || p > end_ || static_cast<size_t>(end_ - p) < bytes) {
     if (bytes > SIZE_MAX - alignment) throw std::bad_alloc();
     AddBlock(bytes + alignment);
     p = aligned();

@@ -24,6 +24,11 @@ struct GltfOptions {
   // false: .gltf JSON with the buffer embedded as a base64 data URI, so the file is
   // self-contained (no side .bin to lose when the file is moved).
   bool binary = false;
+  // [Units: bytes] The largest .glb written: its header and chunk lengths are 32-bit, so one
+  // larger would be written with lengths wrapped round, corrupt. A walk whose .glb would be
+  // larger (its buffer and about 2 KB of JSON a track) is refused, naming .gltf, which has no
+  // such limit.
+  double max_glb_bytes = 4294967295.0;
 };
 
 // [Units: wu] [Limit: > 0] Beyond this |coordinate| a walk's glTF gets a root origin node: below
