@@ -452,6 +452,30 @@ TEST_CASE("scenes a few centimetres across are framed to their size", "[viewer][
   }
 }
 
+TEST_CASE("the state dump names each track's character in a crowd", "[viewer][walk]") {
+  // (Two characters' tracks were dumped as L1, body, L1, body: pixels could not be told apart.)
+  const std::string dir = test::TempDir();
+  test::WriteFile(dir + "/crowd.json", R"({"format": "footfall-walk", "version": 1, "fps": 24,
+    "tracks": [
+    {"name": "L1", "kind": "foot", "character": "c1", "keys": [
+      {"frame": 1, "phase": "start", "position": [0, 0, 0], "normal": [0, 1, 0]}]},
+    {"name": "body", "kind": "body", "character": "c1", "keys": [
+      {"frame": 1, "position": [0, 1, 0], "rotation": [0, 0, 0, 1]}]},
+    {"name": "L1", "kind": "foot", "character": "c2", "keys": [
+      {"frame": 1, "phase": "start", "position": [2, 0, 0], "normal": [0, 1, 0]}]},
+    {"name": "body", "kind": "body", "character": "c2", "keys": [
+      {"frame": 1, "position": [2, 1, 0], "rotation": [0, 0, 0, 1]}]}]})");
+  const RunResult r = View({"--walk", dir + "/crowd.json", "--size", "160x100", "--screenshot",
+                            dir + "/crowd.png", "--dump-state", dir + "/state.json"});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const json state = json::parse(test::ReadFile(dir + "/state.json"));
+  std::vector<std::string> named;
+  for (const json& t : state["walk"]["tracks"])
+    named.push_back(t.value("character", std::string("?")) + "/" + t["name"].get<std::string>());
+  CHECK(named == std::vector<std::string>{"c1/L1", "c1/body", "c2/L1", "c2/body"});
+}
+
 TEST_CASE("screenshot of a walk shows the feet where the JSON puts them at that frame",
           "[viewer][walk]") {
   const std::string dir = test::TempDir();
@@ -749,10 +773,16 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     for (const char* two : {"snap 1 1 1\nsnap 2 2 2", "snap 1 1\r1"}) {
       r = View({"--terrain", kTerrain, "--query", two, "--screenshot", shot});
       CHECK(r.exit_code == 2);
-      CHECK_THAT(r.err, Catch::Contains("--query: expected one query a --query, on one line"));
+      CHECK_THAT(r.err, Catch::Contains("--query: expected one query per --query, on one line"));
     }
     r = View({"--terrain", kTerrain, "--separation", "nan", "--screenshot", shot});
     CHECK(r.exit_code == 2);
+    // --live-wait said "not in range 0.000000 to 1797..." (309 digits) or "Could not convert".
+    for (const char* count : {"-1", "abc", "1.5", "2147483648"}) {
+      r = View({"--terrain", kTerrain, "--live-wait", count, "--screenshot", shot});
+      CHECK(r.exit_code == 2);
+      CHECK_THAT(r.err, Catch::Contains("is not a whole number from 0 to 1000000"));
+    }
     r = View({"--terrain", kTerrain, "--up-axis", "w", "--screenshot", shot});
     CHECK(r.exit_code == 2);
     // Loading flags without a terrain were ignored.

@@ -492,6 +492,7 @@ ordered_json Scene::Describe(const ViewState& view, const OrbitCamera& camera, i
       const TrackPose pose = PoseAt(t, view.frame);
       ordered_json j;
       j["name"] = t.name;
+      if (!t.character.empty()) j["character"] = t.character;  // a crowd's or a scene's
       j["kind"] = t.kind == TrackKind::kFoot ? "foot" : "body";
       j["position"] = Json(pose.position);
       pixel(pose.position, &j);

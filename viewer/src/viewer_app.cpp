@@ -555,7 +555,7 @@ int RunViewer(const ViewerOptions& options) {
     // for a space, and "snap 1 1 1\nsnap 2 2 2" was "expected 3 numbers, found 7").
     if (text.find_first_of("\r\n") != std::string::npos)
       return Fail(
-          "--query: expected one query a --query, on one line (this one holds a line "
+          "--query: expected one query per --query, on one line (this one holds a line "
           "break)",
           2);
     const std::string query = WithoutComment(text);
