@@ -891,6 +891,12 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     CHECK_THAT(r.err, Catch::Contains("--dump-state: cannot open '" + dir +
                                       "/missing/state.json' for writing"));
     CHECK(test::ReadFile(dir + "/old.png") == "an earlier screenshot");
+    // ... and one that fails as it is written (a full disk): the screenshot had been replaced.
+    r = View(
+        {"--terrain", kTerrain, "--screenshot", dir + "/old.png", "--dump-state", "/dev/full"});
+    CHECK(r.exit_code == 1);
+    CHECK_THAT(r.err, Catch::Contains("/dev/full: cannot write the state dump"));
+    CHECK(test::ReadFile(dir + "/old.png") == "an earlier screenshot");
     r = View({"--terrain", kTerrain, "--screenshot", dir + "/missing/shot.png"});
     CHECK(r.exit_code == 1);
     CHECK_THAT(r.err, Catch::Contains("--screenshot: cannot open '" + dir + "/missing/shot.png'"));

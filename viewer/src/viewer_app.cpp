@@ -476,6 +476,9 @@ struct App {
     }
     PullLive();
     Render(options.width, options.height);
+    // The screenshot and the state dump replace their files together, once both are written:
+    // a dump that failed left a new picture beside the old dump.
+    OutputFileSet outputs;
     try {
       std::vector<uint8_t> rgba;
       target.Read(&rgba);
@@ -488,7 +491,10 @@ struct App {
                   "image (about " + std::to_string(static_cast<long long>(mib)) +
                   " MiB); try a smaller --size");
     }
-    return WriteDump(options.width, options.height) ? 0 : 1;
+    if (!WriteDump(options.width, options.height)) return 1;
+    int code = 0;
+    for (const std::string& failure : outputs.Commit()) code = Fail(failure);
+    return code;
   }
 };
 
