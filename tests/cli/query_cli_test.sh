@@ -155,6 +155,10 @@ err=$(echo "snap 0 0 0" | "$footfall" query --server-terrain sub/../flat.pts --s
 check "'..' within the root refused: exit 1" [ $? -eq 1 ]
 check "'..' within the root refused: message" grep -qF "'sub/../flat.pts': '..' is not allowed in a path under the data root" <<< "$err"
 check "server logs loads" grep -q "loaded terrain" "$work/server.log"
+# Each load and error line names its client, so an operator can tell who caused it.
+check "load lines name the client" grep -qE "loaded terrain [0-9]+ from 'flat.pts': .* \(client 127\.0\.0\.1:[0-9]+\)$" "$work/server.log"
+check "upload lines name the client" grep -qE "loaded terrain [0-9]+ '.*' \(uploaded\): .* \(client 127\.0\.0\.1:[0-9]+\)$" "$work/server.log"
+check "error lines name the client" grep -qE "error: load: access_denied: '\.\./\.\./etc/passwd' leads outside the data root \(client 127\.0\.0\.1:[0-9]+\)$" "$work/server.log"
 stop_server
 err=$(echo "snap 0 0 0" | "$footfall" query --terrain "$work/flat.pts" --server "127.0.0.1:$port" 2>&1 >/dev/null)
 check "server gone: exit 1" [ $? -eq 1 ]

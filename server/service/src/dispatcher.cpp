@@ -146,9 +146,29 @@ void ReportUnwrittenErrors() {
   g_error_lines.unwritten = 0;
 }
 
+// The client whose request (or load) is being handled, for the log lines it causes; null
+// between requests.
+const std::string* g_log_client = nullptr;
+
+// Names `client` in the log lines written while it lives.
+struct LogClientScope {
+  explicit LogClientScope(const std::string* client) : saved(g_log_client) {
+    g_log_client = client;
+  }
+  ~LogClientScope() { g_log_client = saved; }
+  LogClientScope(const LogClientScope&) = delete;
+  LogClientScope& operator=(const LogClientScope&) = delete;
+  const std::string* saved;
+};
+
+// " (client ADDR:PORT)" while a client's request is handled, else "".
+std::string ClientSuffix() {
+  return g_log_client && !g_log_client->empty() ? " (client " + *g_log_client + ")" : "";
+}
+
 void LogError(const char* proc, Status status, const std::string& message) {
   Log(std::string("error: ") + proc + ": " + StatusName(status) +
-      (message.empty() ? "" : ": " + message));
+      (message.empty() ? "" : ": " + message) + ClientSuffix());
 }
 
 // "N s", with decimals only when needed.
@@ -204,10 +224,13 @@ uint64_t ConnectionOf(SVCXPRT* transport) {
     g_state->connections.erase(it);
     it = g_state->connections.end();
   }
-  if (it == g_state->connections.end())
-    it =
-        g_state->connections.emplace(transport->xp_fd, Connection{g_state->next_connection++, peer})
-            .first;
+  if (it == g_state->connections.end()) {
+    Connection connection;
+    connection.id = g_state->next_connection++;
+    connection.peer = peer;
+    connection.shown = PeerOf(transport->xp_fd);
+    it = g_state->connections.emplace(transport->xp_fd, std::move(connection)).first;
+  }
   return it->second.id;
 }
 
@@ -324,7 +347,7 @@ void ReplyLoaded(Status s, uint32_t handle, const std::string& path, bool upload
         (upload ? " '" + path + "' (uploaded)" : " from '" + path + "'") + ": " +
         std::to_string(st.samples) + " samples" + resampled + ", grid " +
         std::to_string(st.cells[0]) + "x" + std::to_string(st.cells[1]) + "x" +
-        std::to_string(st.cells[2]));
+        std::to_string(st.cells[2]) + ClientSuffix());
   } else {
     LogError(upload ? "upload" : "load", s, message);
   }
@@ -743,6 +766,7 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
     return;
   }
   const uint64_t client = ConnectionOf(transport);
+  const LogClientScope named(&g_state->connections.find(transport->xp_fd)->second.shown);
   switch (request->rq_proc) {
     case FF_NULL:
       svc_sendreply(transport, FF_XDR_VOID, nullptr);
@@ -956,6 +980,10 @@ void FinishLoads() {
     ff_load_reply r{};
     std::string message;
     uint32_t handle = 0;
+    const std::string* owner = nullptr;
+    for (const auto& connection : g_state->connections)
+      if (connection.second.id == load->owner) owner = &connection.second.shown;
+    const LogClientScope named(owner);
     const Status s = g_state->registry.FinishLoad(load.get(), &handle, &message);
     LogEvicted();
     ReplyLoaded(s, handle, load->relative_path, load->upload, message, &r, load.get());

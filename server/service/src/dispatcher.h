@@ -19,6 +19,7 @@ namespace footfall {
 struct Connection {
   uint64_t id = 0;
   std::string peer;
+  std::string shown;  // the peer as text ("127.0.0.1:40312"), for the log
   // [Units: steady_clock] When a batch of its was last cut at its time limit (BatchSliceSeconds).
   std::chrono::steady_clock::time_point last_cut{};
 };
