@@ -538,6 +538,37 @@ TEST_CASE("a walk's rotations with huge components are drawn as unit quaternions
   }
 }
 
+TEST_CASE("a stopped walk's lines leave its feet and body clear in small windows",
+          "[viewer][walk]") {
+  // (The frame and "stopped" lines were not counted in the small-window rule: at 320 x 200 and
+  // 400 x 180 they covered the feet and the body, where 320 x 180 showed them.)
+  const std::string dir = test::TempDir();
+  std::string walk = WalkJson();
+  walk.replace(walk.find(R"("tracks")"), 0,
+               R"("stopped": ")" + std::string(12, 'x') +
+                   " step 3 of the walk: no way forward from the ledge's edge, every target "
+                   "beyond the terrain's end, the feet kept where they stood and the body "
+                   "over them, which the overlay must not cover\", ");
+  test::WriteFile(dir + "/walk.json", walk);
+  for (const std::string size : {"320x180", "320x200", "400x180", "320x240", "480x200"}) {
+    const RunResult r =
+        View({"--walk", dir + "/walk.json", "--frame", "13", "--size", size, "--screenshot",
+              dir + "/shot.png", "--dump-state", dir + "/state.json"});
+    INFO(size << ": " << r.err);
+    REQUIRE(r.exit_code == 0);
+    const json state = json::parse(test::ReadFile(dir + "/state.json"));
+    for (const json& track : state["walk"]["tracks"]) {
+      const double px = track["pixel"][0], py = track["pixel"][1];
+      for (const json& line : state["hud"]) {
+        const double x = line["x"], y = line["y"], w = line["width"];
+        INFO(track["name"] << " at " << px << ", " << py << "; line '" << line["text"] << "' at "
+                           << x << ", " << y);
+        CHECK_FALSE((px >= x && px <= x + w && py >= y - 2 && py <= y + 14));
+      }
+    }
+  }
+}
+
 TEST_CASE("why a walk stopped is shown in full, wrapped to the window", "[viewer][walk]") {
   // (The reason ran off the right edge of the window in one line.)
   const std::string dir = test::TempDir();

@@ -272,7 +272,22 @@ struct App {
     // each band keeps what fits in a quarter of the height (at 300 x 80 the bands met, and no
     // terrain was drawn).
     const size_t quarter = static_cast<size_t>(std::max(0.0f, 0.25f * height - 10) / line);
-    const bool tight = static_cast<float>(info.size() + lines.size()) * line + 20 > 0.5f * height;
+    // The walk's frame line, and why it stopped, in full: wrapped over as many lines as it
+    // takes, counted with the others (a stopped walk's lines covered the scene in windows just
+    // too large for the bands' limit, counted without them).
+    constexpr float kTimelineX = 10, kTimelineHeight = 20;
+    std::vector<std::string> frame_lines;
+    if (scene.has_walk()) {
+      std::ostringstream f;
+      f << "frame " << FrameText(view.frame) << " of " << FrameText(scene.first_frame()) << "-"
+        << FrameText(scene.last_frame()) << " at " << scene.walk().fps << " fps"
+        << (playing ? "  (playing)" : "");
+      if (!scene.walk().stopped.empty()) f << "   stopped: " << scene.walk().stopped;
+      frame_lines = WrapText(f.str(), "   ", scale, static_cast<float>(width) - 2 * kTimelineX);
+    }
+    const bool tight = static_cast<float>(info.size() + lines.size() + frame_lines.size()) * line +
+                           20 + (scene.has_walk() ? kTimelineHeight : 0) >
+                       0.5f * height;
     if (tight) {
       lines.clear();
       info.resize(std::min(info.size(), quarter));
@@ -291,20 +306,12 @@ struct App {
     if (scene.has_walk() && (!tight || quarter > 0)) {
       // The timeline: a bar over the walk's frames with a marker at the current frame.
       const float bar_y = top - 14;
-      const float x0 = 10, x1 = static_cast<float>(width) - 10;
+      const float x0 = kTimelineX, x1 = static_cast<float>(width) - kTimelineX;
       screen->Rect(x0, bar_y, x1, bar_y + 6, Rgba{90, 90, 100, 220});
       const double span = std::max(scene.last_frame() - scene.first_frame(), 1e-9);
       const float t = static_cast<float>((view.frame - scene.first_frame()) / span);
       const float mx = x0 + (x1 - x0) * std::clamp(t, 0.0f, 1.0f);
       screen->Rect(mx - 3, bar_y - 5, mx + 3, bar_y + 11, Rgba{255, 255, 255, 255});
-      std::ostringstream f;
-      f << "frame " << FrameText(view.frame) << " of " << FrameText(scene.first_frame()) << "-"
-        << FrameText(scene.last_frame()) << " at " << scene.walk().fps << " fps"
-        << (playing ? "  (playing)" : "");
-      // Why the walk stopped, in full: wrapped over as many lines as it takes.
-      if (!scene.walk().stopped.empty()) f << "   stopped: " << scene.walk().stopped;
-      std::vector<std::string> frame_lines =
-          WrapText(f.str(), "   ", scale, static_cast<float>(width) - 2 * x0);
       if (tight) frame_lines.resize(std::min(frame_lines.size(), quarter));
       const float frame_top = bar_y - static_cast<float>(frame_lines.size()) * line - 6;
       draw_lines(x0, frame_top, frame_lines);
