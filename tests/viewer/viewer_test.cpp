@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <sstream>
 #include <thread>
 
 #include <glm/glm.hpp>
@@ -370,6 +371,35 @@ TEST_CASE("framing leaves the overlay's bands clear", "[viewer][camera]") {
       CHECK(px.x < width);
     }
   }
+}
+
+TEST_CASE("a terrain a billionth the size is drawn as the same picture", "[viewer][camera]") {
+  // (Point sizes stopped growing at a camera distance of 1e-6: at 1e-9 scale a solid grid of
+  // samples was drawn as scattered one-pixel dots.)
+  const std::string dir = test::TempDir();
+  std::vector<int> lit;
+  for (const double scale : {1.0, 1e-9}) {
+    std::ostringstream grid;
+    grid.precision(17);
+    for (int k = 0; k < 20; ++k) {
+      for (int i = 0; i < 20; ++i)
+        grid << i * 0.1 * scale << " 0 " << k * 0.1 * scale << " 0 1 0\n";
+    }
+    test::WriteFile(dir + "/grid.pts", grid.str());
+    const RunResult r = View(
+        {"--terrain", dir + "/grid.pts", "--size", "320x240", "--screenshot", dir + "/grid.png"});
+    INFO(scale << ": " << r.err);
+    REQUIRE(r.exit_code == 0);
+    const Image image = ReadPng(dir + "/grid.png");
+    int count = 0;
+    for (int y = image.height / 4; y < image.height * 3 / 4; ++y) {
+      for (int x = 0; x < image.width; ++x) count += !Near(image.At(x, y), {28, 30, 36}, 3);
+    }
+    lit.push_back(count);
+  }
+  INFO("lit pixels at scale 1: " << lit[0] << ", at 1e-9: " << lit[1]);
+  CHECK(lit[0] > 2000);
+  CHECK(std::abs(lit[1] - lit[0]) < lit[0] / 20);
 }
 
 TEST_CASE("a window too small for the overlay still shows the terrain", "[viewer][camera]") {

@@ -23,7 +23,7 @@ void main() {
   gl_Position = u_mvp * vec4(a_position, 1.0);
   v_color = a_color;
   gl_PointSize = a_size > 0.0 ? a_size
-                              : clamp(-a_size * u_point_scale / max(gl_Position.w, 1e-6), 1.0, 64.0);
+                              : clamp(-a_size * u_point_scale / max(gl_Position.w, 1e-30), 1.0, 64.0);
 }
 )";
 
