@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <thread>
 
@@ -649,6 +650,26 @@ TEST_CASE("overlay text draws a NUL or a character beyond ASCII as a question ma
   CHECK(DrawList::TextWidth(odd, 1) == DrawList::TextWidth("ab?c???", 1));
 }
 
+namespace {
+
+// A viewer with `--terrain` hills (unless `terrain` is false) following footfalld at `address`
+// until two queries arrive, then writing DIR/live.png and DIR/state.json; started, and seen
+// following, when returned.
+std::unique_ptr<test::Child> FollowLive(const std::string& address, const std::string& dir,
+                                        const std::string& size, bool terrain = true) {
+  std::vector<std::string> argv = {kView};
+  if (terrain) argv.insert(argv.end(), {"--terrain", kTerrain});
+  argv.insert(argv.end(),
+              {"--server", address, "--live", "--live-wait", "2", "--timeout", "30", "--size", size,
+               "--screenshot", dir + "/live.png", "--dump-state", dir + "/state.json"});
+  auto viewer = std::make_unique<test::Child>(argv, std::vector<std::string>{test::XDisplay()});
+  INFO("viewer stderr: " << viewer->Err());
+  REQUIRE(viewer->WaitForOutput("live: following footfalld at " + address, kTimeout));
+  return viewer;
+}
+
+}  // namespace
+
 TEST_CASE("live: the viewer shows a query another client sends to footfalld", "[viewer][live]") {
   const std::string dir = test::TempDir();
   const LocalServer server(dir);
@@ -656,12 +677,8 @@ TEST_CASE("live: the viewer shows a query another client sends to footfalld", "[
   REQUIRE_FALSE(server.port.empty());
   const std::string& address = server.address;
 
-  test::Child viewer({kView, "--terrain", kTerrain, "--server", address, "--live", "--live-wait",
-                      "2", "--timeout", "30", "--size", "640x400", "--screenshot",
-                      dir + "/live.png", "--dump-state", dir + "/state.json"},
-                     {test::XDisplay()});
-  INFO("viewer stderr: " << viewer.Err());
-  REQUIRE(viewer.WaitForOutput("live: following footfalld at " + address, kTimeout));
+  const std::unique_ptr<test::Child> viewer = FollowLive(address, dir, "640x400");
+  INFO("viewer stderr: " << viewer->Err());
 
   // A next and a normal (footfall query sent normals as snaps: the viewer showed them so).
   const RunResult client = Run({FOOTFALL_CLI, "query", "--terrain", kTerrain, "--server", address},
@@ -672,7 +689,7 @@ TEST_CASE("live: the viewer shows a query another client sends to footfalld", "[
   REQUIRE(answer["found"] == true);
 
   int code = -1;
-  REQUIRE(viewer.Wait(kTimeout, &code));
+  REQUIRE(viewer->Wait(kTimeout, &code));
   REQUIRE(code == 0);
   const json state = json::parse(test::ReadFile(dir + "/state.json"));
   REQUIRE(state["live"]["received"].get<int>() >= 2);
@@ -698,12 +715,8 @@ TEST_CASE("live: a query on another terrain of footfalld is drawn untraced, with
   INFO("footfalld stderr: " << server.child.Err());
   REQUIRE_FALSE(server.port.empty());
   const std::string& address = server.address;
-  test::Child viewer({kView, "--terrain", kTerrain, "--server", address, "--live", "--live-wait",
-                      "2", "--timeout", "30", "--size", "320x200", "--screenshot",
-                      dir + "/live.png", "--dump-state", dir + "/state.json"},
-                     {test::XDisplay()});
-  INFO("viewer stderr: " << viewer.Err());
-  REQUIRE(viewer.WaitForOutput("live: following footfalld at " + address, kTimeout));
+  const std::unique_ptr<test::Child> viewer = FollowLive(address, dir, "320x200");
+  INFO("viewer stderr: " << viewer->Err());
   const std::string stairs = std::string(FOOTFALL_DATA_DIR) + "/terrain/stairs.pts";
   for (const std::string& terrain : {stairs, kTerrain}) {
     const RunResult client = Run({FOOTFALL_CLI, "query", "--terrain", terrain, "--server", address},
@@ -712,7 +725,7 @@ TEST_CASE("live: a query on another terrain of footfalld is drawn untraced, with
     REQUIRE(client.exit_code == 0);
   }
   int code = -1;
-  REQUIRE(viewer.Wait(kTimeout, &code));
+  REQUIRE(viewer->Wait(kTimeout, &code));
   REQUIRE(code == 0);
   const json state = json::parse(test::ReadFile(dir + "/state.json"));
   const json& queries = state["live"]["queries"];
@@ -721,7 +734,7 @@ TEST_CASE("live: a query on another terrain of footfalld is drawn untraced, with
   CHECK(queries[0]["traced"] == false);
   CHECK(queries[1]["other_terrain"] == false);  // the viewer's own terrain's
   CHECK(queries[1]["traced"] == true);
-  CHECK_THAT(viewer.Err(), Catch::Contains("were asked on another terrain of the server"));
+  CHECK_THAT(viewer->Err(), Catch::Contains("were asked on another terrain of the server"));
 }
 
 TEST_CASE("live: without a terrain, the picture is framed on the queries received",
@@ -732,18 +745,14 @@ TEST_CASE("live: without a terrain, the picture is framed on the queries receive
   INFO("footfalld stderr: " << server.child.Err());
   REQUIRE_FALSE(server.port.empty());
   const std::string& address = server.address;
-  test::Child viewer(
-      {kView, "--server", address, "--live", "--live-wait", "2", "--timeout", "30", "--size",
-       "640x400", "--screenshot", dir + "/live.png", "--dump-state", dir + "/state.json"},
-      {test::XDisplay()});
-  INFO("viewer stderr: " << viewer.Err());
-  REQUIRE(viewer.WaitForOutput("live: following footfalld at " + address, kTimeout));
+  const std::unique_ptr<test::Child> viewer = FollowLive(address, dir, "640x400", false);
+  INFO("viewer stderr: " << viewer->Err());
   const RunResult client = Run({FOOTFALL_CLI, "query", "--terrain", kTerrain, "--server", address},
                                {}, kTimeout, "next 10 1 10 1.2 0 0.3\nsnap 16 1 11\n");
   INFO("footfall query: " << client.out << client.err);
   REQUIRE(client.exit_code == 0);
   int code = -1;
-  REQUIRE(viewer.Wait(kTimeout, &code));
+  REQUIRE(viewer->Wait(kTimeout, &code));
   REQUIRE(code == 0);
   const json state = json::parse(test::ReadFile(dir + "/state.json"));
   REQUIRE(state["live"]["queries"].size() == 2);
