@@ -151,3 +151,32 @@ TEST_CASE("Joined threads that stop early or fail leave the others served", "[jo
   CHECK(f.counting->query_calls >= 5);
   CHECK(f.counting->query_calls <= 6);
 }
+
+TEST_CASE("A joined call whose session throws fails for every member in it, none left waiting",
+          "[joined]") {
+  // (The exception left RunCall through one member's thread; the others waited for ever.)
+  Fixture f;
+  f.counting->throw_on_snap = true;
+  JoinedCalls joined(*f.counting);
+  constexpr int kThreads = 3;
+  std::vector<Status> status(kThreads, Status::kOk);
+  std::vector<std::string> errors(kThreads);
+  RunMembers(joined, kThreads, [&](int t, TerrainSession& s) {
+    const std::vector<Vec3> p = PointsOf(t, 0);
+    std::vector<Foothold> got(p.size());
+    status[t] = s.Snap(f.terrain, p.data(), p.size(), got.data());
+    errors[t] = s.last_error();
+  });
+  for (int t = 0; t < kThreads; ++t) {
+    CHECK(status[t] == Status::kInternalError);
+    CHECK(errors[t] == "the joined call failed: snap failed inside the session");
+  }
+  // The session works again for the members of a later round.
+  f.counting->throw_on_snap = false;
+  RunMembers(joined, kThreads, [&](int t, TerrainSession& s) {
+    const std::vector<Vec3> p = PointsOf(t, 1);
+    std::vector<Foothold> got(p.size());
+    status[t] = s.Snap(f.terrain, p.data(), p.size(), got.data());
+  });
+  for (int t = 0; t < kThreads; ++t) CHECK(status[t] == Status::kOk);
+}

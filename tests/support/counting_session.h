@@ -3,6 +3,7 @@
 #pragma once
 
 #include <atomic>
+#include <stdexcept>
 #include <string>
 
 #include "footfall/client/terrain_session.h"
@@ -28,6 +29,7 @@ class CountingSession final : public TerrainSession {
   Status Unload(TerrainHandle terrain) override { return Pass(inner_.Unload(terrain)); }
   Status Snap(TerrainHandle terrain, const Vec3* points, size_t count, Foothold* out) override {
     ++query_calls;
+    if (throw_on_snap) throw std::runtime_error("snap failed inside the session");
     return Pass(inner_.Snap(terrain, points, count, out));
   }
   Status Normal(TerrainHandle terrain, const Vec3* points, size_t count, Foothold* out) override {
@@ -44,6 +46,7 @@ class CountingSession final : public TerrainSession {
 
   std::atomic<int> query_calls{0};  // Snap, Normal and Next
   std::atomic<int> info_calls{0};
+  std::atomic<bool> throw_on_snap{false};  // Snap throws, as a failing session might
 
  private:
   Status Pass(Status s) { return s == Status::kOk ? s : Fail(s, inner_.last_error()); }

@@ -129,6 +129,20 @@ bool JoinedCalls::SameCall(const Request* a, const Request* b) {
           std::memcmp(&a->tolerance, &b->tolerance, sizeof(double)) == 0);
 }
 
+namespace {
+
+// *text = head + what, or false when memory for it ran out.
+bool SetText(std::string* text, const char* head, const char* what) noexcept {
+  try {
+    *text = std::string(head) + what;
+    return true;
+  } catch (...) {
+    return false;
+  }
+}
+
+}  // namespace
+
 void JoinedCalls::RunCall() {
   std::lock_guard<std::mutex> direct(direct_);
   // The call of the oldest waiting request, with every waiting request that can share it. The
@@ -163,6 +177,14 @@ void JoinedCalls::RunCall() {
   } catch (const std::bad_alloc&) {
     status = Status::kLimitExceeded;
     out_of_memory = true;
+  } catch (const std::exception& e) {
+    // Any other failure of the shared session ends this call for every member in it, said as
+    // such: escaping, it left the other members waiting for ever.
+    status = Status::kInternalError;
+    out_of_memory = !SetText(&error, "the joined call failed: ", e.what());
+  } catch (...) {
+    status = Status::kInternalError;
+    out_of_memory = !SetText(&error, "the joined call failed: ", "an unknown exception");
   }
   size_t at = 0;
   for (Request* r : call) {
