@@ -1,5 +1,10 @@
-// Terrain handles: never 0, never one still loaded, also once the counter wraps past 2^32 - 1.
+// Terrain handles: never 0, never one still loaded, also once the counter wraps past 2^32 - 1;
+// the embedded session's failures from several threads at once.
+#include <cmath>
 #include <set>
+#include <string>
+#include <thread>
+#include <vector>
 
 #include <catch2/catch.hpp>
 
@@ -42,4 +47,32 @@ TEST_CASE("embedded handles near the wrap stay distinct from live ones", "[clien
   TerrainInfo info;
   REQUIRE(session->Info(kept, &info) == Status::kOk);
   CHECK(info.name == "kept");
+}
+
+TEST_CASE("embedded queries failing on several threads at once keep last_error whole", "[client]") {
+  // Queries may come from several threads at once in process (InProcess); their failures
+  // wrote last_error_ at once, which could corrupt the string (and the heap with it).
+  auto session = MakeEmbeddedSession();
+  TerrainHandle terrain = 0;
+  REQUIRE(session->LoadSamples(MakeFlat(4, 1, 0), "flat", &terrain) == Status::kOk);
+  std::vector<int> wrong(4, 0);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t) {
+    threads.emplace_back([&, t] {
+      const Vec3 point{1, 0, 1};
+      Foothold out;
+      for (int i = 0; i < 20000; ++i) {
+        // An unknown handle, one per thread (messages of different lengths), and a bad tolerance.
+        const TerrainHandle unknown = terrain + 1 + static_cast<TerrainHandle>(t) * 1000003u;
+        wrong[t] += session->Snap(unknown, &point, 1, &out) != Status::kUnknownTerrain;
+        const StepQuery step{point, {0.5, 0, 0}};
+        wrong[t] +=
+            session->Next(terrain, &step, 1, std::nan(""), &out) != Status::kInvalidArgument;
+      }
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  for (int t = 0; t < 4; ++t) CHECK(wrong[t] == 0);
+  const std::string& last = session->last_error();
+  CHECK((last == "tolerance is not finite" || last.rfind("no terrain with handle ", 0) == 0));
 }

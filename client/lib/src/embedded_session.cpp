@@ -1,6 +1,9 @@
 // The embedded backend: the terrain engine in this process.
+#include <cmath>
 #include <map>
 #include <memory>
+#include <mutex>
+#include <string>
 
 #include "footfall/client/terrain_session.h"
 #include "footfall/terrain/batch_pool.h"
@@ -67,7 +70,8 @@ class EmbeddedSession final : public TerrainSession {
               Foothold* out) override {
     const Entry* e = Find(terrain);
     if (!e) return Unknown(terrain);
-    if (!std::isfinite(tolerance)) return Fail(Status::kInvalidArgument, "tolerance is not finite");
+    if (!std::isfinite(tolerance))
+      return FailFromAnyThread(Status::kInvalidArgument, "tolerance is not finite");
     e->grid.NextBatch(queries, count, tolerance, out, pool_.get());
     return Status::kOk;
   }
@@ -85,12 +89,20 @@ class EmbeddedSession final : public TerrainSession {
     return it == terrains_.end() ? nullptr : &it->second;
   }
   Status Unknown(TerrainHandle terrain) {
-    return Fail(Status::kUnknownTerrain, "no terrain with handle " + std::to_string(terrain));
+    return FailFromAnyThread(Status::kUnknownTerrain,
+                             "no terrain with handle " + std::to_string(terrain));
+  }
+  // Fail for the queries, which several threads may make at once (InProcess): their failures
+  // write last_error_ one at a time (two at once corrupted the string).
+  Status FailFromAnyThread(Status status, std::string message) {
+    std::lock_guard<std::mutex> lock(fail_mutex_);
+    return Fail(status, std::move(message));
   }
 
   std::shared_ptr<BatchPool> pool_;  // the process's shared pool (null: one thread)
   HandleCounter handles_;
   std::map<TerrainHandle, Entry> terrains_;
+  std::mutex fail_mutex_;
 };
 
 }  // namespace
