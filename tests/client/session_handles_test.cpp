@@ -61,7 +61,7 @@ TEST_CASE("embedded queries failing on several threads at once keep last_error w
     threads.emplace_back([&, t] {
       const Vec3 point{1, 0, 1};
       Foothold out;
-      for (int i = 0; i < 20000; ++i) {
+      for (int i = 0; i < 100000; ++i) {
         // An unknown handle, one per thread (messages of different lengths), and a bad tolerance.
         const TerrainHandle unknown = terrain + 1 + static_cast<TerrainHandle>(t) * 1000003u;
         wrong[t] += session->Snap(unknown, &point, 1, &out) != Status::kUnknownTerrain;
