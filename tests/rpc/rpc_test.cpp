@@ -1509,6 +1509,56 @@ TEST_CASE("an upload whose finish is refused as busy is kept while its client as
   clnt_destroy(c);
 }
 
+TEST_CASE("a load refused as busy gives its terrain slot back", "[rpc]") {
+  // (The slot it held from its request on stayed held: with --max-client-terrains 1 the second
+  // try was refused as "holds 0 terrains and loads 1 more", and 256 such refusals over the
+  // server's life refused every load.)
+  const TempRoot temp;
+  {
+    std::ofstream big(temp.path + "/big.pts");
+    for (int i = 0; i < 300000; ++i)
+      big << i % 600 << " " << (i * 7) % 13 << " " << i / 600 << " 0 1 0\n";
+    std::ofstream small(temp.path + "/small.pts");
+    small << "0 0 0 0 1 0\n1 0 0 0 1 0\n0 0 1 0 1 0\n";
+  }
+  ServerProcess server(0, {"--no-rpcbind", "--data-root", temp.path, "--max-client-terrains", "1"});
+  // Sixteen loads of the large file fill the lane of point files, replies not read.
+  std::vector<unsigned char> args;
+  Put32(&args, 7);
+  for (const char ch : std::string("big.pts\0", 8)) args.push_back(static_cast<unsigned char>(ch));
+  PutDouble(&args, 0);
+  const std::vector<unsigned char> record = CallRecord(1, FF_LOAD, args);
+  std::vector<int> loaders;
+  for (int i = 0; i < 16; ++i) {
+    loaders.push_back(RawConnect(server.port()));
+    REQUIRE(SendSome(loaders.back(), record) == record.size());
+  }
+  CLIENT* c = RawClient(server.port());
+  auto load_small = [&](std::string* message) {
+    ff_load_args load{const_cast<char*>("small.pts"), 0};
+    ff_load_reply reply{};
+    REQUIRE(ff_load_1(&load, &reply, c) == RPC_SUCCESS);
+    *message = reply.message ? reply.message : "";
+    const ff_status status = reply.status;
+    xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&reply));
+    return status;
+  };
+  std::string message;
+  CHECK(load_small(&message) == FF_UNAVAILABLE);  // busy
+  // Asked again until footfalld has room: busy, then loaded, never over the quota.
+  ff_status status = FF_UNAVAILABLE;
+  const auto begin = std::chrono::steady_clock::now();
+  while (status == FF_UNAVAILABLE &&
+         std::chrono::steady_clock::now() - begin < std::chrono::seconds(60)) {
+    status = load_small(&message);
+    if (status == FF_UNAVAILABLE) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  INFO(message);
+  CHECK(status == FF_OK);
+  for (const int l : loaders) close(l);
+  clnt_destroy(c);
+}
+
 TEST_CASE("footfalld refuses uploaded samples out of range, per chunk", "[rpc]") {
   ServerProcess server;
   CLIENT* c = RawClient(server.port());
@@ -2184,6 +2234,8 @@ TEST_CASE("a load holds its terrain slot while it is built: others fill only the
     xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), reinterpret_cast<char*>(&reply));
     clnt_destroy(c);
   });
+  // Its request reaches footfalld first (the resampling takes seconds after it).
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
   // 256 terrains at most, 64 per connection: four connections ask for all 256.
   std::vector<std::unique_ptr<TerrainSession>> fillers;
   int filled = 0;

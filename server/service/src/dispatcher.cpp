@@ -408,6 +408,7 @@ bool StartLoad(SVCXPRT* transport, const std::string& path, const TerrainLoadOpt
   Status s = g_state->registry.PrepareLoad(path, options, client, load.get(), &message);
   if (s == Status::kOk) {
     if (QueueLoad(transport, &load)) return true;
+    g_state->registry.DropLoad(load.get());  // its terrain slot goes back: refused as busy
     s = Status::kUnavailable;
     message = QueueFullMessage(LoadQueue::LaneOf(*load));
   }
