@@ -223,6 +223,23 @@ ff_status SendChunk(CLIENT* c, uint32_t upload, std::vector<ff_sample> samples,
   return status;
 }
 
+// Sixteen FF_LOADs of "big.pts" (under the server's data root: make it large enough to take a
+// while) sent at once on raw connections, replies left unread: footfalld's lane of point files
+// and upload grids is full until they are built. Returns the connections (close them).
+std::vector<int> FillPointFileLane(int port) {
+  std::vector<unsigned char> args;
+  Put32(&args, 7);
+  for (const char ch : std::string("big.pts\0", 8)) args.push_back(static_cast<unsigned char>(ch));
+  PutDouble(&args, 0);
+  const std::vector<unsigned char> record = CallRecord(1, FF_LOAD, args);
+  std::vector<int> loaders;
+  for (int i = 0; i < 16; ++i) {
+    loaders.push_back(RawConnect(port));
+    REQUIRE(SendSome(loaders.back(), record) == record.size());
+  }
+  return loaders;
+}
+
 // FF_UPLOAD_FINISH from a raw client; returns the status, the terrain in *terrain.
 ff_status FinishUpload(CLIENT* c, uint32_t upload, uint32_t* terrain, std::string* message) {
   ff_upload_args args{upload};
@@ -1452,16 +1469,7 @@ TEST_CASE("an upload whose finish is refused as busy is kept while its client as
                      ff_sample{{0, 0, 1}, {0, 1, 0}}},
                     &message) == FF_OK);
   // Sent at once on raw sockets, replies not read: the lane is full before the first is built.
-  std::vector<unsigned char> args;
-  Put32(&args, 7);
-  for (const char ch : std::string("big.pts\0", 8)) args.push_back(static_cast<unsigned char>(ch));
-  PutDouble(&args, 0);
-  const std::vector<unsigned char> record = CallRecord(1, FF_LOAD, args);
-  std::vector<int> loaders;
-  for (int i = 0; i < 16; ++i) {
-    loaders.push_back(RawConnect(server.port()));
-    REQUIRE(SendSome(loaders.back(), record) == record.size());
-  }
+  const std::vector<int> loaders = FillPointFileLane(server.port());
   // A seventeenth is refused: the lane is full.
   CLIENT* probe = RawClient(server.port());
   ff_load_args load{const_cast<char*>("big.pts"), 0};
@@ -1522,17 +1530,7 @@ TEST_CASE("a load refused as busy gives its terrain slot back", "[rpc]") {
     small << "0 0 0 0 1 0\n1 0 0 0 1 0\n0 0 1 0 1 0\n";
   }
   ServerProcess server(0, {"--no-rpcbind", "--data-root", temp.path, "--max-client-terrains", "1"});
-  // Sixteen loads of the large file fill the lane of point files, replies not read.
-  std::vector<unsigned char> args;
-  Put32(&args, 7);
-  for (const char ch : std::string("big.pts\0", 8)) args.push_back(static_cast<unsigned char>(ch));
-  PutDouble(&args, 0);
-  const std::vector<unsigned char> record = CallRecord(1, FF_LOAD, args);
-  std::vector<int> loaders;
-  for (int i = 0; i < 16; ++i) {
-    loaders.push_back(RawConnect(server.port()));
-    REQUIRE(SendSome(loaders.back(), record) == record.size());
-  }
+  const std::vector<int> loaders = FillPointFileLane(server.port());
   CLIENT* c = RawClient(server.port());
   auto load_small = [&](std::string* message) {
     ff_load_args load{const_cast<char*>("small.pts"), 0};
