@@ -10,6 +10,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <limits>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -199,4 +200,50 @@ TEST_CASE("a connect interrupted by a signal still ends within the connect timeo
   INFO(session->last_error());
   CHECK(session->last_error().find("connection timed out") != std::string::npos);
   CHECK(waited < 20);  // about the 1 s timeout; never the kernel's 130 s
+}
+
+TEST_CASE("infinite and huge timeouts are bounded instead of overflowing", "[client]") {
+  // A connect timeout past 2^31 ms reached poll() wrapped round: 2^32 ms + 0.2 s (49.7 days)
+  // gave up after 0.2 s, "connection timed out"; infinity overflowed the deadline's clock
+  // arithmetic. Here the host drops connection attempts until its listener closes 0.6 s in;
+  // the retried handshake is then refused.
+  const double connect_timeout =
+      GENERATE(4294967.296 + 0.2, std::numeric_limits<double>::infinity());
+  const int listener = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  REQUIRE(bind(listener, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0);
+  REQUIRE(listen(listener, 0) == 0);
+  socklen_t length = sizeof address;
+  REQUIRE(getsockname(listener, reinterpret_cast<sockaddr*>(&address), &length) == 0);
+  std::vector<int> queued;  // fill the accept queue: later handshakes get no answer
+  for (int i = 0; i < 2; ++i) {
+    queued.push_back(socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK, 0));
+    connect(queued.back(), reinterpret_cast<sockaddr*>(&address), sizeof address);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  std::thread closer([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(600));
+    for (const int fd : queued) close(fd);
+    close(listener);
+  });
+
+  RpcOptions options;
+  options.host = "127.0.0.1";
+  options.port = ntohs(address.sin_port);
+  options.connect_timeout_s = connect_timeout;
+  options.call_timeout_s = 1e300;
+  options.busy_timeout_s = std::numeric_limits<double>::quiet_NaN();
+  auto session = MakeRpcSession(options);
+  TerrainHandle handle = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  const Status status = session->LoadSamples(MakeHeightField(4, 4, 0.5, 0.1, 1), "t", &handle);
+  const double waited = SecondsSince(t0);
+  closer.join();
+  CHECK(status == Status::kUnavailable);
+  INFO(session->last_error());
+  CHECK(session->last_error().find("timed out") == std::string::npos);
+  CHECK(waited > 0.5);  // it waited for the host, until the host refused
+  CHECK(waited < 20);
 }

@@ -15,6 +15,7 @@
 #include <condition_variable>
 #include <cstdio>
 #include <cstring>
+#include <initializer_list>
 #include <memory>
 #include <mutex>
 #include <thread>
@@ -155,6 +156,18 @@ void SetCallTimeout(CLIENT* client, double seconds) {
   timeout.tv_sec = static_cast<time_t>(seconds);
   timeout.tv_usec = static_cast<suseconds_t>((seconds - static_cast<double>(timeout.tv_sec)) * 1e6);
   clnt_control(client, CLSET_TIMEOUT, reinterpret_cast<char*>(&timeout));
+}
+
+double BoundedSeconds(double seconds) {
+  if (!(seconds > 0)) return 0;  // NaN too
+  return std::min(seconds, kMaxTimeoutSeconds);
+}
+
+RpcOptions BoundedTimeouts(RpcOptions options) {
+  for (double* s : {&options.call_timeout_s, &options.connect_timeout_s, &options.load_timeout_s,
+                    &options.busy_timeout_s})
+    *s = BoundedSeconds(*s);
+  return options;
 }
 
 CLIENT* ConnectFootfalld(const RpcOptions& options, std::string* reason) {

@@ -45,4 +45,13 @@ std::string CallFailureText(clnt_stat status);
 // Sets how long the client's calls wait for their answer. [Units: s]
 void SetCallTimeout(CLIENT* client, double seconds);
 
+// A timeout as the session uses it: NaN and negative values are 0, values above
+// kMaxTimeoutSeconds (infinity too) are kMaxTimeoutSeconds, so that no wait overflows a clock.
+// [Units: s]
+constexpr double kMaxTimeoutSeconds = 1e6;  // about 11.6 days: "for ever", for a call
+double BoundedSeconds(double seconds);
+
+// `options` with every timeout bounded by BoundedSeconds.
+RpcOptions BoundedTimeouts(RpcOptions options);
+
 }  // namespace footfall

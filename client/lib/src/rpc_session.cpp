@@ -68,7 +68,7 @@ struct TerrainSource {
 
 class RpcSession final : public TerrainSession {
  public:
-  explicit RpcSession(const RpcOptions& options) : options_(options) {
+  explicit RpcSession(const RpcOptions& options) : options_(BoundedTimeouts(options)) {
     std::signal(SIGPIPE, SIG_IGN);
   }
   ~RpcSession() override {

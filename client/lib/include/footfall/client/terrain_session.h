@@ -98,6 +98,8 @@ class TerrainSession {
 std::unique_ptr<TerrainSession> MakeEmbeddedSession(int threads = 1,
                                                     TerrainHandle first_handle = 1);
 
+// Timeouts are taken between 0 and 1e6 s: NaN and negative ones as 0, longer ones (infinity
+// too) as 1e6 s.
 struct RpcOptions {
   std::string host = "127.0.0.1";
   int port = 7407;  // footfalld's default port
