@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <iomanip>
 #include <iostream>
 #include <mutex>
 #include <sstream>
@@ -32,6 +33,7 @@
 #include "footfall/terrain/output_file.h"
 #include "footfall/terrain/point_file.h"
 #include "footfall/terrain/shown_text.h"
+#include "standard_streams.h"
 #include "terrain_flags.h"
 
 namespace footfall::cli {
@@ -92,15 +94,15 @@ const std::string kStandardOutput = "-";
 // Writes the walk JSON to standard output, as it is built. False with a message on failure
 // (a closed pipe, a full disk).
 bool WriteWalkJsonToStandardOutput(const Walk& walk, std::string* error) {
-  errno = 0;
   const bool written = EmitWalkJson(walk, [](std::string_view piece) {
     std::cout.write(piece.data(), static_cast<std::streamsize>(piece.size()));
     return static_cast<bool>(std::cout);
   });
   std::cout.flush();
-  if (written && std::cout && std::fflush(stdout) == 0) return true;
+  if (written && std::cout) return true;
+  const int why = StandardOutputError();
   *error = std::string("--out -: cannot write the walk JSON to standard output") +
-           (errno ? std::string(": ") + std::strerror(errno) : std::string());
+           (why ? std::string(": ") + std::strerror(why) : std::string());
   return false;
 }
 
@@ -123,14 +125,13 @@ class ProgressBar {
     const int width = 40;
     const int filled =
         total > 0 ? static_cast<int>(static_cast<double>(done) * width / total) : width;
-    std::fprintf(stderr, "\r[%s%s] %3d%%", std::string(filled, '#').c_str(),
-                 std::string(width - filled, '.').c_str(),
-                 total > 0 ? static_cast<int>(100.0 * done / total) : 100);
-    std::fflush(stderr);
+    const int percent = total > 0 ? static_cast<int>(100.0 * done / total) : 100;
+    std::cerr << "\r[" << std::string(filled, '#') << std::string(width - filled, '.') << "] "
+              << std::setw(3) << percent << '%' << std::flush;
     shown_ = true;
   }
   void Finish() {
-    if (shown_) std::fputc('\n', stderr);
+    if (shown_) std::cerr << '\n';
   }
 
  private:

@@ -16,6 +16,7 @@
 #include "footfall/terrain/output_file.h"
 #include "footfall/terrain/process_start.h"
 #include "footfall/version.h"
+#include "standard_streams.h"
 
 namespace {
 
@@ -53,9 +54,10 @@ std::string CommandHint(const CLI::App& root, int argc, char** argv) {
 
 // The command line's work; its exit status.
 int Run(int argc, char** argv) {
-  footfall::OpenClosedStandardStreams();    // no output file may take descriptor 1 or 2
-  std::signal(SIGPIPE, SIG_IGN);            // a vanished server must give an error, not kill us
-  footfall::RemoveTemporaryFileOnSignal();  // an interrupted write leaves no temporary file
+  footfall::OpenClosedStandardStreams();       // no output file may take descriptor 1 or 2
+  footfall::cli::UseWaitingStandardStreams();  // non-blocking ones waited for, not failed
+  std::signal(SIGPIPE, SIG_IGN);               // a vanished server must give an error, not kill us
+  footfall::RemoveTemporaryFileOnSignal();     // an interrupted write leaves no temporary file
   CLI::App app{"footfall: places footsteps of bipeds and multipeds on uneven terrain"};
   app.require_subcommand(1);
   // `footfall --version`: "footfall 0.1.0" on stdout, exit 0 (footfall/version.h).
@@ -109,13 +111,11 @@ int main(int argc, char** argv) {
   const int status = Run(argc, argv);
   // Output that could not be written (a full disk, a closed pipe) fails the command: `bench
   // --json > file` on a full disk left an empty file and exit 0. (`query` says so itself.)
-  errno = 0;
   std::cout.flush();
-  const bool failed = !std::cout || std::fflush(stdout) != 0 || std::ferror(stdout);
-  if (failed && status == 0) {
-    // The reason is known when the last flush failed; an earlier write's is gone.
+  if (!std::cout && status == 0) {
+    const int why = footfall::cli::StandardOutputError();
     std::cerr << "footfall: cannot write standard output"
-              << (errno ? std::string(": ") + std::strerror(errno) : std::string()) << '\n';
+              << (why ? std::string(": ") + std::strerror(why) : std::string()) << '\n';
     return 1;
   }
   return status;

@@ -15,6 +15,7 @@
 #include "commands.h"
 #include "footfall/cli/number_checks.h"
 #include "footfall/client/query_text.h"
+#include "standard_streams.h"
 #include "terrain_flags.h"
 
 namespace footfall::cli {
@@ -79,11 +80,6 @@ bool ParseCommand(const std::string& text, size_t line, Command* out) {
 }
 
 nlohmann::ordered_json Vec(const Vec3& v) { return nlohmann::ordered_json::array({v.x, v.y, v.z}); }
-
-bool InputReady() {
-  pollfd p{STDIN_FILENO, POLLIN, 0};
-  return poll(&p, 1, 0) > 0;
-}
 
 // Runs a block of commands (batching each kind) and prints one line per command, in order.
 bool RunBlock(TerrainSession& session, TerrainHandle terrain, double tolerance,
@@ -189,7 +185,7 @@ int RunQuery(const QueryFlags& flags) {
       block.push_back(std::move(c));
     }
     // Answer at once when no more input is waiting, so interactive callers are never stalled.
-    if (block.size() >= kBlock || (!block.empty() && !InputReady())) {
+    if (block.size() >= kBlock || (!block.empty() && !StandardInputReady())) {
       ok = RunBlock(*session, terrain, flags.tolerance, block) && ok;
       block.clear();
       if (!std::cout) break;  // answers that cannot be written: stop reading
@@ -197,11 +193,11 @@ int RunQuery(const QueryFlags& flags) {
   }
   // A read error ends the input as the end of the file does: say so (stdin a directory, or a
   // terminal gone, answered nothing and exited 0).
-  const int read_error = !std::ferror(stdin) ? 0 : errno ? errno : EIO;
+  const int read_error = StandardInputError();
   if (!block.empty() && std::cout) ok = RunBlock(*session, terrain, flags.tolerance, block) && ok;
   // (SIGPIPE is ignored: a reader gone, or a full disk, left every answer lost and exit 0.)
   if (!std::cout) {
-    const int why = errno ? errno : EIO;
+    const int why = StandardOutputError() ? StandardOutputError() : EIO;
     std::cerr << "footfall query: cannot write the answers to stdout (line " << line
               << " read): " << std::strerror(why) << '\n';
     return 1;

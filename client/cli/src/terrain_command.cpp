@@ -23,6 +23,7 @@
 #include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/output_file.h"
 #include "footfall/terrain/point_file.h"
+#include "standard_streams.h"
 #include "terrain_flags.h"
 
 namespace footfall::cli {
@@ -162,8 +163,9 @@ int RunInfo(const InfoFlags& flags) {
             << " of the given coordinates (float offsets from the centre of the bulk)\n";
   // (A full disk lost the description with exit 0.)
   if (!std::cout.flush()) {
-    std::cerr << "footfall terrain info: cannot write to stdout: "
-              << std::strerror(errno ? errno : EIO) << '\n';
+    const int why = StandardOutputError();
+    std::cerr << "footfall terrain info: cannot write to stdout: " << std::strerror(why ? why : EIO)
+              << '\n';
     return 1;
   }
   return 0;

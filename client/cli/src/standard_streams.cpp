@@ -1,0 +1,117 @@
+// Standard streams over descriptors 0, 1 and 2 that wait when a descriptor is non-blocking.
+#include "standard_streams.h"
+
+#include <poll.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <iostream>
+#include <streambuf>
+
+namespace footfall::cli {
+namespace {
+
+// Waits until `fd` is ready for `events` (or reports an error or hang-up, which the next read
+// or write then meets). False only when poll itself fails.
+bool WaitFor(int fd, short events) {
+  pollfd p{fd, events, 0};
+  for (;;) {
+    if (poll(&p, 1, -1) >= 0) return true;
+    if (errno != EINTR) return false;
+  }
+}
+
+// A buffered stream over one descriptor, read or written whole: interrupted calls are made
+// again, and a descriptor that is not ready is waited for.
+class DescriptorBuf final : public std::streambuf {
+ public:
+  explicit DescriptorBuf(int fd) : fd_(fd) {}
+  DescriptorBuf(const DescriptorBuf&) = delete;
+  DescriptorBuf& operator=(const DescriptorBuf&) = delete;
+
+  int error() const { return error_; }
+  bool HasBuffered() const { return gptr() < egptr(); }
+
+ protected:
+  int_type underflow() override {
+    if (gptr() < egptr()) return traits_type::to_int_type(*gptr());
+    for (;;) {
+      const ssize_t n = read(fd_, in_, sizeof in_);
+      if (n > 0) {
+        setg(in_, in_, in_ + n);
+        return traits_type::to_int_type(*gptr());
+      }
+      if (n == 0) return traits_type::eof();
+      if (errno == EINTR) continue;
+      if ((errno == EAGAIN || errno == EWOULDBLOCK) && WaitFor(fd_, POLLIN)) continue;
+      error_ = errno;
+      return traits_type::eof();
+    }
+  }
+
+  int_type overflow(int_type c) override {
+    if (!Drain()) return traits_type::eof();
+    if (traits_type::eq_int_type(c, traits_type::eof())) return traits_type::not_eof(c);
+    *pptr() = traits_type::to_char_type(c);
+    pbump(1);
+    return c;
+  }
+
+  int sync() override { return Drain() ? 0 : -1; }
+
+ private:
+  // Writes what is buffered; false (the error kept) when the descriptor refuses it.
+  bool Drain() {
+    if (!pbase()) setp(out_, out_ + sizeof out_);
+    const char* at = pbase();
+    while (at < pptr()) {
+      const ssize_t n = write(fd_, at, static_cast<size_t>(pptr() - at));
+      if (n > 0) {
+        at += n;
+        continue;
+      }
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK) && WaitFor(fd_, POLLOUT)) continue;
+      if (error_ == 0) error_ = n < 0 ? errno : EIO;
+      return false;
+    }
+    setp(out_, out_ + sizeof out_);
+    return true;
+  }
+
+  int fd_;
+  int error_ = 0;
+  char in_[1 << 16];
+  char out_[1 << 16];
+};
+
+DescriptorBuf* g_in = nullptr;
+DescriptorBuf* g_out = nullptr;
+
+}  // namespace
+
+void UseWaitingStandardStreams() {
+  // Never freed: the streams are flushed at exit, after static objects are gone.
+  auto* in = new DescriptorBuf(STDIN_FILENO);
+  auto* out = new DescriptorBuf(STDOUT_FILENO);
+  auto* err = new DescriptorBuf(STDERR_FILENO);
+  std::cout.flush();
+  std::cin.rdbuf(in);
+  std::cout.rdbuf(out);
+  std::cerr.rdbuf(err);
+  std::clog.rdbuf(err);
+  g_in = in;
+  g_out = out;
+}
+
+int StandardInputError() { return g_in ? g_in->error() : 0; }
+
+int StandardOutputError() { return g_out ? g_out->error() : 0; }
+
+bool StandardInputReady() {
+  if (g_in && g_in->HasBuffered()) return true;
+  pollfd p{STDIN_FILENO, POLLIN, 0};
+  return poll(&p, 1, 0) > 0;
+}
+
+}  // namespace footfall::cli
