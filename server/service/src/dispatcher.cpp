@@ -25,8 +25,8 @@
 #include "footfall/rpc/batch_xdr.h"
 #include "footfall/terrain/batch_pool.h"
 #include "footfall/terrain/shown_text.h"
-#include "log_text.h"
 #include "read_gate.h"
+#include "service_log.h"
 
 namespace footfall {
 namespace {
@@ -82,100 +82,6 @@ ff_result ToWire(const Foothold& f) {
 char* Message(const std::string& text) {
   g_storage.message = std::string(Utf8Prefix(text, FF_MAX_MESSAGE));  // whole characters
   return const_cast<char*>(g_storage.message.c_str());
-}
-
-// Lines a client can cause at will (errors, "error: ...", and batches cut at their time limit)
-// are written at most kErrorLineBurst at once and kErrorLinesPerSecond after (a token bucket);
-// those beyond are counted and said in one line by ReportUnwrittenErrors. A client that repeats
-// a refused request, or a costly batch, thousands of times a second wrote as many lines, and
-// could fill the disk.
-constexpr double kErrorLineBurst = 100;
-constexpr double kErrorLinesPerSecond = 10;
-
-struct ErrorLineBudget {
-  std::mutex mutex;
-  double tokens = kErrorLineBurst;
-  std::chrono::steady_clock::time_point refilled = std::chrono::steady_clock::now();
-  uint64_t unwritten = 0;
-  std::chrono::steady_clock::time_point first_unwritten;
-};
-ErrorLineBudget g_error_lines;
-
-// True when an error line may be written now; false counts it as unwritten.
-bool TakeErrorLine() {
-  std::lock_guard<std::mutex> lock(g_error_lines.mutex);
-  const auto now = std::chrono::steady_clock::now();
-  const double elapsed = std::chrono::duration<double>(now - g_error_lines.refilled).count();
-  g_error_lines.refilled = now;
-  g_error_lines.tokens =
-      std::min(kErrorLineBurst, g_error_lines.tokens + elapsed * kErrorLinesPerSecond);
-  if (g_error_lines.tokens >= 1) {
-    g_error_lines.tokens -= 1;
-    return true;
-  }
-  if (g_error_lines.unwritten++ == 0) g_error_lines.first_unwritten = now;
-  return false;
-}
-
-// One log line; every line may hold text from a client (paths, names, messages quoting them).
-// Error lines are rate-limited (LogLimited).
-void LogLimited(const std::string& line);
-void Log(const std::string& line) {
-  if (line.compare(0, 7, "error: ") == 0) return LogLimited(line);
-  std::fprintf(stderr, "footfalld: %s\n", EscapeControl(line).c_str());
-}
-
-// A log line a client can cause as often as it likes, within the budget above.
-void LogLimited(const std::string& line) {
-  if (TakeErrorLine()) std::fprintf(stderr, "footfalld: %s\n", EscapeControl(line).c_str());
-}
-
-// Says how many rate-limited lines were not written since the first of them, if any. Called about
-// once a second.
-void ReportUnwrittenErrors() {
-  std::lock_guard<std::mutex> lock(g_error_lines.mutex);
-  if (g_error_lines.unwritten == 0) return;
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                                       g_error_lines.first_unwritten)
-                             .count();
-  std::fprintf(stderr,
-               "footfalld: %llu lines (errors, batches past their time limit) not written in the "
-               "last %.1f s (more than %g at once or %g a second); every request was answered\n",
-               static_cast<unsigned long long>(g_error_lines.unwritten), seconds, kErrorLineBurst,
-               kErrorLinesPerSecond);
-  g_error_lines.unwritten = 0;
-}
-
-// The client whose request (or load) is being handled, for the log lines it causes; null
-// between requests.
-const std::string* g_log_client = nullptr;
-
-// Names `client` in the log lines written while it lives.
-struct LogClientScope {
-  explicit LogClientScope(const std::string* client) : saved(g_log_client) {
-    g_log_client = client;
-  }
-  ~LogClientScope() { g_log_client = saved; }
-  LogClientScope(const LogClientScope&) = delete;
-  LogClientScope& operator=(const LogClientScope&) = delete;
-  const std::string* saved;
-};
-
-// " (client ADDR:PORT)" while a client's request is handled, else "".
-std::string ClientSuffix() {
-  return g_log_client && !g_log_client->empty() ? " (client " + *g_log_client + ")" : "";
-}
-
-void LogError(const char* proc, Status status, const std::string& message) {
-  Log(std::string("error: ") + proc + ": " + StatusName(status) +
-      (message.empty() ? "" : ": " + message) + ClientSuffix());
-}
-
-// "N s", with decimals only when needed.
-std::string SecondsText(double seconds) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g s", seconds);
-  return text;
 }
 
 // Forgets a client that went away: ends its uploads and orphans its terrains. `how` says how the

@@ -12,7 +12,7 @@
 #include <map>
 #include <mutex>
 
-#include "log_text.h"
+#include "service_log.h"
 
 namespace footfall {
 namespace {

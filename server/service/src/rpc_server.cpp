@@ -22,9 +22,9 @@
 #include "deferred_reply.h"
 #include "dispatcher.h"
 #include "footfall.h"
-#include "log_text.h"
 #include "partial_requests.h"
 #include "read_gate.h"
+#include "service_log.h"
 
 namespace footfall {
 namespace {
