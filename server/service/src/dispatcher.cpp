@@ -120,7 +120,7 @@ void NoteBatchCut(SVCXPRT* transport) {
 }
 
 // The connection a request came on, registered on its first request.
-uint64_t ConnectionOf(SVCXPRT* transport) {
+const Connection& ConnectionOf(SVCXPRT* transport) {
   const netbuf& address = transport->xp_rtaddr;
   const std::string peer =
       address.buf ? std::string(static_cast<const char*>(address.buf), address.len) : std::string();
@@ -137,7 +137,7 @@ uint64_t ConnectionOf(SVCXPRT* transport) {
     connection.shown = PeerOf(transport->xp_fd);
     it = g_state->connections.emplace(transport->xp_fd, std::move(connection)).first;
   }
-  return it->second.id;
+  return it->second;
 }
 
 // --- procedures -------------------------------------------------------------------------
@@ -672,8 +672,9 @@ void Dispatch(svc_req* request, SVCXPRT* transport) {
     Log("error: a request sent while the connection's load was in progress: refused");
     return;
   }
-  const uint64_t client = ConnectionOf(transport);
-  const LogClientScope named(&g_state->connections.find(transport->xp_fd)->second.shown);
+  const Connection& connection = ConnectionOf(transport);
+  const uint64_t client = connection.id;
+  const LogClientScope named(&connection.shown);
   switch (request->rq_proc) {
     case FF_NULL:
       svc_sendreply(transport, FF_XDR_VOID, nullptr);
