@@ -54,11 +54,33 @@ uint64_t HoldReply(SVCXPRT* transport) {
   h->watched = *transport->xp_ops;
   h->watched.xp_destroy = Destroyed;
   h->watched.xp_recv = Received;
-  transport->xp_ops = &h->watched;
-  g_tickets[transport] = ticket;
-  g_sockets.insert(h->socket);
-  g_held.emplace(ticket, std::move(h));
+  // Every entry made before the transport is watched, and all undone if memory runs out, so
+  // that the three never disagree (a transport watched without its entry was read through a
+  // missing one, and ended the server).
+  const auto held = g_held.emplace(ticket, nullptr).first;
+  try {
+    g_tickets[transport] = ticket;
+    g_sockets.insert(h->socket);
+  } catch (...) {
+    g_tickets.erase(transport);
+    g_held.erase(held);
+    throw;
+  }
+  held->second = std::move(h);
+  transport->xp_ops = &held->second->watched;
   return ticket;
+}
+
+void ReleaseHeldReply(uint64_t ticket) noexcept {
+  const auto it = g_held.find(ticket);
+  if (it == g_held.end()) return;
+  Held& h = *it->second;
+  if (h.transport) {
+    h.transport->xp_ops = h.original;
+    g_tickets.erase(h.transport);
+    g_sockets.erase(h.socket);
+  }
+  g_held.erase(it);
 }
 
 bool SendHeldReply(uint64_t ticket, xdrproc_t encode, void* reply) {

@@ -16,8 +16,11 @@
 namespace footfall {
 
 // Holds the request just dispatched on `transport` for a later SendHeldReply. Returns its
-// ticket (never 0).
+// ticket (never 0). Throws std::bad_alloc, holding nothing, when memory runs out.
 uint64_t HoldReply(SVCXPRT* transport);
+
+// Releases ticket `ticket` without a reply: its connection is read again as any other.
+void ReleaseHeldReply(uint64_t ticket) noexcept;
 
 // Sends the reply of ticket `ticket`, encoded with `encode`, if its connection is still open, and
 // releases the ticket. False when the connection had closed (nothing is sent) or the send failed.

@@ -282,19 +282,46 @@ void CancelAbandonedLoads() {
     // Releases the ticket; nothing is sent, the connection being closed.
     SendHeldReply(ticket, reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), nullptr);
     g_state->registry.DropLoad(withdrawn.get());
+    it = g_load_tickets.erase(it);  // before the log line, which may run out of memory
     Log(std::string(withdrawn->upload ? "upload" : "load of") + " '" + withdrawn->relative_path +
         "' cancelled: its connection closed while it waited its turn");
-    it = g_load_tickets.erase(it);
   }
 }
 
 // Queues a prepared load and holds the request's reply for it; false (the load untouched) when
 // the queue is full.
 bool QueueLoad(SVCXPRT* transport, std::unique_ptr<PendingLoad>* load) {
-  PendingLoad* key = load->get();
-  if (!g_state->loads->Submit(load)) return false;
-  g_load_tickets[key] = HoldReply(transport);
+  // Whatever needs memory comes before the load is queued, and is undone if it runs out: a
+  // load queued without its ticket finished with nobody to answer.
+  const auto entry = g_load_tickets.emplace(load->get(), 0).first;
+  uint64_t ticket = 0;
+  bool queued = false;
+  try {
+    ticket = HoldReply(transport);
+    queued = g_state->loads->Submit(load);
+  } catch (...) {
+    if (ticket) ReleaseHeldReply(ticket);
+    g_load_tickets.erase(entry);
+    throw;
+  }
+  if (!queued) {
+    ReleaseHeldReply(ticket);
+    g_load_tickets.erase(entry);
+    return false;
+  }
+  entry->second = ticket;
   return true;
+}
+
+// QueueLoad for a prepared load: one that memory ran out for gives back what it reserved (its
+// samples' budget, its terrain slot) before the error goes on.
+bool QueueLoadOrDrop(SVCXPRT* transport, std::unique_ptr<PendingLoad>* load) {
+  try {
+    return QueueLoad(transport, load);
+  } catch (...) {
+    g_state->registry.DropLoad(load->get());
+    throw;
+  }
 }
 
 std::string QueueFullMessage(LoadQueue::Lane lane) {
@@ -313,7 +340,7 @@ bool StartLoad(SVCXPRT* transport, const std::string& path, const TerrainLoadOpt
   std::string message;
   Status s = g_state->registry.PrepareLoad(path, options, client, load.get(), &message);
   if (s == Status::kOk) {
-    if (QueueLoad(transport, &load)) return true;
+    if (QueueLoadOrDrop(transport, &load)) return true;
     g_state->registry.DropLoad(load.get());  // its terrain slot goes back: refused as busy
     s = Status::kUnavailable;
     message = QueueFullMessage(LoadQueue::LaneOf(*load));
@@ -365,7 +392,7 @@ bool StartUploadFinish(SVCXPRT* transport, const ff_upload_args& a, uint64_t cli
     s = g_state->registry.PrepareFinishUpload(a.upload, client, load.get(), &message);
   }
   if (s == Status::kOk) {
-    if (QueueLoad(transport, &load)) return true;
+    if (QueueLoadOrDrop(transport, &load)) return true;
     g_state->registry.DropLoad(load.get());  // not reached: the lane was not full
     s = Status::kUnavailable;
     message = QueueFullMessage(LoadQueue::kBuilding);
@@ -871,6 +898,33 @@ void ReapConnections() {
   }
 }
 
+namespace {
+
+// Answers the finished load `load` on its held reply `ticket`: adds its terrain (*handle, once
+// added) and replies, or drops it when its connection has closed.
+void AnswerLoad(PendingLoad* load, uint64_t ticket, uint32_t* handle) {
+  if (!HeldReplyOpen(ticket)) {
+    SendHeldReply(ticket, FF_XDR(ff_load_reply), nullptr);  // releases the ticket
+    g_state->registry.DropLoad(load);
+    Log(std::string(load->upload ? "upload" : "load of") + " '" + load->relative_path +
+        "' dropped: its connection closed before it finished");
+    return;
+  }
+  ff_load_reply r{};
+  std::string message;
+  const std::string* owner = nullptr;
+  for (const auto& connection : g_state->connections)
+    if (connection.second.id == load->owner) owner = &connection.second.shown;
+  const LogClientScope named(owner);
+  const Status s = g_state->registry.FinishLoad(load, handle, &message);
+  LogEvicted();
+  ReplyLoaded(s, *handle, load->relative_path, load->upload, message, &r, load);
+  if (!SendHeldReply(ticket, FF_XDR(ff_load_reply), &r))
+    Log(std::string("error: ") + (load->upload ? "upload" : "load") + ": reply could not be sent");
+}
+
+}  // namespace
+
 void FinishLoads() {
   if (!g_state) return;
   for (const std::unique_ptr<PendingLoad>& load : g_state->loads->TakeFinished()) {
@@ -878,26 +932,22 @@ void FinishLoads() {
     if (it == g_load_tickets.end()) continue;
     const uint64_t ticket = it->second;
     g_load_tickets.erase(it);
-    if (!HeldReplyOpen(ticket)) {
-      SendHeldReply(ticket, FF_XDR(ff_load_reply), nullptr);  // releases the ticket
-      g_state->registry.DropLoad(load.get());
-      Log(std::string(load->upload ? "upload" : "load of") + " '" + load->relative_path +
-          "' dropped: its connection closed before it finished");
-      continue;
-    }
-    ff_load_reply r{};
-    std::string message;
     uint32_t handle = 0;
-    const std::string* owner = nullptr;
-    for (const auto& connection : g_state->connections)
-      if (connection.second.id == load->owner) owner = &connection.second.shown;
-    const LogClientScope named(owner);
-    const Status s = g_state->registry.FinishLoad(load.get(), &handle, &message);
-    LogEvicted();
-    ReplyLoaded(s, handle, load->relative_path, load->upload, message, &r, load.get());
-    if (!SendHeldReply(ticket, FF_XDR(ff_load_reply), &r))
-      Log(std::string("error: ") + (load->upload ? "upload" : "load") +
-          ": reply could not be sent");
+    try {
+      AnswerLoad(load.get(), ticket, &handle);
+    } catch (const std::bad_alloc&) {
+      // Memory ran out on the way: the client is answered all the same (no reply at all held
+      // it until its timeout), with its terrain if it was added. (A reply already sent is not
+      // sent again: its ticket is gone.)
+      static char no_message[] = "";
+      static char out_of_memory[] = "footfalld ran out of memory finishing the load: try again";
+      ff_load_reply r{};
+      r.terrain = handle;
+      r.status = handle ? FF_OK : FF_LIMIT_EXCEEDED;
+      r.message = handle ? no_message : out_of_memory;
+      if (!handle) g_state->registry.DropLoad(load.get());
+      SendHeldReply(ticket, FF_XDR(ff_load_reply), &r);
+    }
   }
 }
 

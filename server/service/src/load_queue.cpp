@@ -4,9 +4,12 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <new>
 #include <stdexcept>
+#include <string>
+#include <thread>
 
 #include "footfall/import/terrain_loader.h"
 #include "footfall/terrain/file_extension.h"
@@ -91,11 +94,13 @@ std::unique_ptr<PendingLoad> LoadQueue::Cancel(PendingLoad* load) {
 
 std::vector<std::unique_ptr<PendingLoad>> LoadQueue::TakeFinished() {
   State& s = *state_;
+  std::lock_guard<std::mutex> lock(s.mutex);
+  std::vector<std::unique_ptr<PendingLoad>> done;
+  // Room first: memory that runs out here leaves every load waiting, and wake_fd() up.
+  done.reserve(s.finished.size());
   uint64_t count = 0;
   while (read(s.wake_fd, &count, sizeof count) > 0) {
   }
-  std::lock_guard<std::mutex> lock(s.mutex);
-  std::vector<std::unique_ptr<PendingLoad>> done;
   for (auto& load : s.finished) {
     --s.in_lane[load.second];
     done.push_back(std::move(load.first));
@@ -116,6 +121,21 @@ bool LoadQueue::Abandon() {
   return running;
 }
 
+namespace {
+
+// Ends `load` with `status` and the message `text` + `name` (+ "'" when a name is given), or
+// with no message when memory for one runs out too.
+void Fail(PendingLoad* load, Status status, const char* text, const std::string& name) noexcept {
+  load->status = status;
+  try {
+    load->message = text + name + (name.empty() ? "" : "'");
+  } catch (const std::bad_alloc&) {
+    load->message.clear();
+  }
+}
+
+}  // namespace
+
 void LoadQueue::Work(const std::shared_ptr<State>& state, Lane lane) {
   State& s = *state;
   std::unique_lock<std::mutex> lock(s.mutex);
@@ -129,16 +149,25 @@ void LoadQueue::Work(const std::shared_ptr<State>& state, Lane lane) {
     try {
       RunLoad(load.get());
     } catch (const std::bad_alloc&) {
-      load->status = Status::kLimitExceeded;
-      load->message = "out of memory loading '" + load->relative_path + "'";
+      Fail(load.get(), Status::kLimitExceeded, "out of memory loading '", load->relative_path);
     } catch (const std::exception& e) {
-      load->status = Status::kInternalError;
-      load->message = e.what();
+      Fail(load.get(), Status::kInternalError, e.what(), "");
     }
     lock.lock();
     --s.running;
-    if (s.stop) return;  // abandoned, or the queue is going: nobody takes it back
-    s.finished.emplace_back(std::move(load), lane);
+    // Handed back whatever memory is left: a load lost here left its client waiting for a
+    // reply that never came.
+    for (;;) {
+      if (s.stop) return;  // abandoned, or the queue is going: nobody takes it back
+      try {
+        s.finished.emplace_back(std::move(load), lane);
+        break;
+      } catch (const std::bad_alloc&) {
+        lock.unlock();
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        lock.lock();
+      }
+    }
     const uint64_t one = 1;
     if (write(s.wake_fd, &one, sizeof one) < 0) {
       // Only on counter overflow, after 2^64 - 2 loads untaken: the flag is already up.

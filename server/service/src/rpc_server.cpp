@@ -12,11 +12,14 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <new>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "deferred_reply.h"
@@ -240,14 +243,16 @@ void RpcServer::Run() {
   ReadGate gate(send_buffer_, options_.unread_timeout_s);
   std::vector<pollfd> fds, readable;
   auto last_expiry = std::chrono::steady_clock::now();
-  while (!stop_.load()) {
+  // One turn of the loop: waits for sockets and finished loads, serves what is ready, and about
+  // once a second expires what has idled. False when the loop must end (poll failed).
+  auto turn = [&]() -> bool {
     const int timeout_ms = gate.Prepare(&fds, 250, HeldSockets());
     fds.push_back({g_state->loads->wake_fd(), POLLIN, 0});  // finished loads
     const int ready = poll(fds.data(), fds.size(), timeout_ms);
     if (ready < 0) {
-      if (errno == EINTR) continue;
+      if (errno == EINTR) return true;
       std::fprintf(stderr, "footfalld: error: poll: %s\n", std::strerror(errno));
-      break;
+      return false;
     }
     const bool loads_done = fds.back().revents != 0;
     fds.pop_back();
@@ -277,6 +282,18 @@ void RpcServer::Run() {
         return false;
       });
       last_expiry = now;
+    }
+    return true;
+  };
+  while (!stop_.load()) {
+    try {
+      if (!turn()) break;
+    } catch (const std::bad_alloc&) {
+      // Memory ran out in the loop's own work (its lists of sockets, its log lines): the turn
+      // is given up, and the next starts again from the sockets' state. (A request's own
+      // failure is its alone: the dispatcher answers it.) Aborting lost every client's terrains.
+      LogLimited("error: out of memory in the main loop: the turn is given up, serving on");
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
   }
   if (g_state->loads->Abandon()) {

@@ -1,0 +1,65 @@
+// Preloaded (LD_PRELOAD) into a process under test: while the file named by
+// FOOTFALL_FAIL_NEW_WHILE exists, every FOOTFALL_FAIL_NEW_EVERY-th C++ allocation (operator new,
+// in any thread) fails as it does when memory runs out: std::bad_alloc, or nullptr from the
+// nothrow forms. Checks that a process keeps its promises when memory runs short, anywhere.
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+namespace {
+
+// Whether this allocation fails. Reads the environment once; makes no C++ allocation.
+bool FailNow() {
+  static const char* const flag = std::getenv("FOOTFALL_FAIL_NEW_WHILE");
+  static const long every = [] {
+    const char* text = std::getenv("FOOTFALL_FAIL_NEW_EVERY");
+    const long n = text ? std::atol(text) : 0;
+    return n > 0 ? n : 1;
+  }();
+  static std::atomic<unsigned long> count{0};
+  if (!flag || access(flag, F_OK) != 0) return false;
+  return count.fetch_add(1, std::memory_order_relaxed) % static_cast<unsigned long>(every) == 0;
+}
+
+void* Allocate(std::size_t size) {
+  if (FailNow()) return nullptr;
+  return std::malloc(size == 0 ? 1 : size);
+}
+
+void* AllocateAligned(std::size_t size, std::align_val_t align) {
+  if (FailNow()) return nullptr;
+  const std::size_t a = static_cast<std::size_t>(align);
+  const std::size_t rounded = (size + a - 1) / a * a;
+  return std::aligned_alloc(a, rounded == 0 ? a : rounded);
+}
+
+}  // namespace
+
+void* operator new(std::size_t size) {
+  if (void* p = Allocate(size)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) {
+  if (void* p = Allocate(size)) return p;
+  throw std::bad_alloc();
+}
+void* operator new(std::size_t size, const std::nothrow_t&) noexcept { return Allocate(size); }
+void* operator new[](std::size_t size, const std::nothrow_t&) noexcept { return Allocate(size); }
+void* operator new(std::size_t size, std::align_val_t align) {
+  if (void* p = AllocateAligned(size, align)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size, std::align_val_t align) {
+  if (void* p = AllocateAligned(size, align)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
