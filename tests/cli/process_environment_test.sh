@@ -120,6 +120,17 @@ for command in "--version" "terrain info $hills" \
   check "footfall $command > /dev/full: said" grep -Eq "cannot write (standard output|to stdout)" "$work/err.txt"
 done
 
+# 7b. ... and so does a standard output closed at start (it went to /dev/null, exit 0).
+echo "snap 10 0 10" | "$footfall" query --terrain "$hills" >&- 2> "$work/err.txt"
+check "footfall query >&-: exit 1" [ $? -eq 1 ]
+check "footfall query >&-: said" grep -qF "cannot write the answers to stdout (line 1 read): Bad file descriptor" "$work/err.txt"
+"$footfall" generate --terrain "$hills" --character "$biped" --steps 4 --out - >&- 2> "$work/err.txt"
+check "footfall generate --out - >&-: exit 1" [ $? -eq 1 ]
+check "footfall generate --out - >&-: said" grep -qF "cannot write the walk JSON to standard output: Bad file descriptor" "$work/err.txt"
+"$footfall" generate --terrain "$hills" --character "$biped" --steps 4 --out "$work/closed.json" >&- 2> "$work/err.txt"
+check "footfall generate --out FILE >&-: exit 0 (nothing for stdout)" [ $? -eq 0 ]
+check "footfall generate --out FILE >&-: the walk written" grep -q '"tracks"' "$work/closed.json"
+
 # 8. An output past the file size limit (ulimit -f) is refused and the file from before is kept,
 #    said so; "it does not match the other outputs" only when there are others.
 echo old > "$work/kept.json"

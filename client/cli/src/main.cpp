@@ -54,10 +54,10 @@ std::string CommandHint(const CLI::App& root, int argc, char** argv) {
 
 // The command line's work; its exit status.
 int Run(int argc, char** argv) {
-  footfall::OpenClosedStandardStreams();       // no output file may take descriptor 1 or 2
-  footfall::cli::UseWaitingStandardStreams();  // non-blocking ones waited for, not failed
-  std::signal(SIGPIPE, SIG_IGN);               // a vanished server must give an error, not kill us
-  footfall::RemoveTemporaryFileOnSignal();     // an interrupted write leaves no temporary file
+  // No output file may take descriptor 1 or 2; non-blocking streams are waited for, not failed.
+  footfall::cli::UseWaitingStandardStreams(footfall::OpenClosedStandardStreams());
+  std::signal(SIGPIPE, SIG_IGN);            // a vanished server must give an error, not kill us
+  footfall::RemoveTemporaryFileOnSignal();  // an interrupted write leaves no temporary file
   CLI::App app{"footfall: places footsteps of bipeds and multipeds on uneven terrain"};
   app.require_subcommand(1);
   // `footfall --version`: "footfall 0.1.0" on stdout, exit 0 (footfall/version.h).

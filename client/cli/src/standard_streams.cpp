@@ -25,7 +25,9 @@ bool WaitFor(int fd, short events) {
 // again, and a descriptor that is not ready is waited for.
 class DescriptorBuf final : public std::streambuf {
  public:
-  explicit DescriptorBuf(int fd) : fd_(fd) {}
+  // `closed`: the descriptor was closed when the process started (it is /dev/null now): what
+  // is written fails, EBADF.
+  DescriptorBuf(int fd, bool closed) : fd_(fd), closed_(closed) {}
   DescriptorBuf(const DescriptorBuf&) = delete;
   DescriptorBuf& operator=(const DescriptorBuf&) = delete;
 
@@ -63,6 +65,10 @@ class DescriptorBuf final : public std::streambuf {
   // Writes what is buffered; false (the error kept) when the descriptor refuses it.
   bool Drain() {
     if (!pbase()) setp(out_, out_ + sizeof out_);
+    if (closed_ && pptr() > pbase()) {
+      if (error_ == 0) error_ = EBADF;
+      return false;
+    }
     const char* at = pbase();
     while (at < pptr()) {
       const ssize_t n = write(fd_, at, static_cast<size_t>(pptr() - at));
@@ -80,6 +86,7 @@ class DescriptorBuf final : public std::streambuf {
   }
 
   int fd_;
+  bool closed_;
   int error_ = 0;
   char in_[1 << 16];
   char out_[1 << 16];
@@ -90,11 +97,12 @@ DescriptorBuf* g_out = nullptr;
 
 }  // namespace
 
-void UseWaitingStandardStreams() {
+void UseWaitingStandardStreams(int closed_at_start) {
   // Never freed: the streams are flushed at exit, after static objects are gone.
-  auto* in = new DescriptorBuf(STDIN_FILENO);
-  auto* out = new DescriptorBuf(STDOUT_FILENO);
-  auto* err = new DescriptorBuf(STDERR_FILENO);
+  auto closed = [closed_at_start](int fd) { return (closed_at_start & (1 << fd)) != 0; };
+  auto* in = new DescriptorBuf(STDIN_FILENO, false);  // reads /dev/null: the input is empty
+  auto* out = new DescriptorBuf(STDOUT_FILENO, closed(STDOUT_FILENO));
+  auto* err = new DescriptorBuf(STDERR_FILENO, false);  // nowhere else to say it
   std::cout.flush();
   std::cin.rdbuf(in);
   std::cout.rdbuf(out);

@@ -8,8 +8,10 @@ namespace footfall::cli {
 
 // Makes std::cin, std::cout and std::cerr read and write descriptors 0, 1 and 2 directly,
 // waiting (poll) whenever a descriptor is not ready. Call once, before any use of the streams;
-// stdio's stdin, stdout and stderr must not be used afterwards.
-void UseWaitingStandardStreams();
+// stdio's stdin, stdout and stderr must not be used afterwards. `closed_at_start`: the
+// descriptors OpenClosedStandardStreams found closed (bits 1 << fd); output to a standard
+// output closed at start fails (EBADF), as it would have, rather than vanish into /dev/null.
+void UseWaitingStandardStreams(int closed_at_start);
 
 // The errno of the read that ended std::cin early (0 when it reached the end of its input).
 int StandardInputError();

@@ -8,13 +8,16 @@
 
 namespace footfall {
 
-void OpenClosedStandardStreams() {
+int OpenClosedStandardStreams() {
+  int closed = 0;
   for (int fd = 0; fd <= 2; ++fd) {
     if (::fcntl(fd, F_GETFD) != -1 || errno != EBADF) continue;
+    closed |= 1 << fd;
     // open returns the lowest free descriptor: this one, as those below it are open.
     const int opened = ::open("/dev/null", fd == 0 ? O_RDONLY : O_WRONLY);
     if (opened >= 0 && opened != fd) ::close(opened);
   }
+  return closed;
 }
 
 bool SignalIgnored(int signal_number) {

@@ -9,8 +9,9 @@ namespace footfall {
 
 // Opens /dev/null on each of descriptors 0, 1 and 2 that is closed, so that files and sockets
 // opened later never take their numbers (with stderr closed, footfalld's log lines went into its
-// first client's connection). Call first thing in main.
-void OpenClosedStandardStreams();
+// first client's connection). Call first thing in main. Returns those that were closed, as bits
+// (1 << descriptor).
+int OpenClosedStandardStreams();
 
 // Whether `signal_number` is ignored (SIG_IGN) now: a program that installs a handler leaves one
 // ignored when it started so (under nohup, or as a script's background job).
