@@ -10,6 +10,9 @@
  * NULL pointer the call needs (an out pointer, a path, an array of count > 0) unless its
  * comment says NULL is allowed. Terrain handles belong to their session; one unloaded is
  * FF_C_UNKNOWN_TERRAIN after, as is one never given.
+ * While a call on an RPC session waits for footfalld, the calling thread has every signal
+ * blocked (libtirpc's clnt_vc_call does so for the whole call, up to its timeout): a host that
+ * must take signals at once makes its footfalld calls from a thread of their own.
  */
 #ifndef FOOTFALL_C_H_
 #define FOOTFALL_C_H_

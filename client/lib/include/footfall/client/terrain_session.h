@@ -123,7 +123,9 @@ struct RpcOptions {
 // A client of footfalld. It connects lazily, reports kUnavailable when the server is gone or
 // does not answer within the timeouts, and reconnects on the next call once the server is back;
 // it then loads its terrains again on the new server (from the same file or the samples it
-// kept), so handles stay valid across a server restart.
+// kept), so handles stay valid across a server restart. While a call waits for footfalld, the
+// calling thread has every signal blocked (libtirpc's clnt_vc_call blocks them for the whole
+// call, up to its timeout).
 std::unique_ptr<TerrainSession> MakeRpcSession(const RpcOptions& options);
 
 // Parses a host without its port: a name, an IPv4 address, or an IPv6 address bare or in
