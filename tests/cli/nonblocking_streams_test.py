@@ -3,9 +3,13 @@ terminals it hands on): input that arrives in bursts and a reader that lags must
 answers as plain pipes. Through stdio, `footfall query` failed "Resource temporarily
 unavailable" after 4096 lines and lost the rest.
 
-Usage: nonblocking_streams_test.py FOOTFALL SOURCE_DIR
+footfalld with such a stderr, read late: log lines that do not fit are counted and said
+("N log lines were lost"), never lost without a word, and clients are not held up meanwhile.
+
+Usage: nonblocking_streams_test.py FOOTFALL FOOTFALLD SOURCE_DIR
 """
 import fcntl
+import re
 import os
 import subprocess
 import sys
@@ -13,7 +17,7 @@ import tempfile
 import threading
 import time
 
-footfall, source_dir = sys.argv[1], sys.argv[2]
+footfall, footfalld, source_dir = sys.argv[1], sys.argv[2], sys.argv[3]
 hills = os.path.join(source_dir, "data", "terrain", "hills.pts")
 biped = os.path.join(source_dir, "data", "characters", "biped.json")
 failures = []
@@ -115,6 +119,53 @@ with tempfile.TemporaryDirectory() as work:
             written = f.read()
     check("generate --out -, non-blocking stdout: the walk JSON of the file (%d of %d bytes)"
           % (len(out), len(written)), out == written and len(written) > 65536)
+
+# 3. footfalld logging to a full non-blocking 4 KiB pipe: 40 error lines while nobody reads.
+with tempfile.TemporaryDirectory() as work:
+    r, w = nonblocking_pipe()
+    fcntl.fcntl(w, 1031, 4096)  # F_SETPIPE_SZ
+    port_file = os.path.join(work, "port")
+    server = subprocess.Popen([footfalld, "--listen", "127.0.0.1:0", "--no-rpcbind", "--port-file",
+                               port_file, "--data-root", os.path.join(source_dir, "data")],
+                              stdout=w, stderr=w)
+    os.close(w)
+    for _ in range(200):
+        if os.path.exists(port_file) and os.path.getsize(port_file) > 0:
+            break
+        time.sleep(0.05)
+    with open(port_file) as f:
+        address = "127.0.0.1:" + f.read().strip()
+    slowest = 0.0
+    refused = 0
+    for i in range(40):
+        t = time.monotonic()
+        p = subprocess.run([footfall, "query", "--server", address, "--server-terrain",
+                            "nonexistent_%d_%s.pts" % (i, "x" * 100), "--timeout", "5"],
+                           input=b"snap 1 0 1\n", capture_output=True, timeout=60)
+        slowest = max(slowest, time.monotonic() - t)
+        refused += p.returncode == 1 and b"nonexistent_" in p.stderr
+    check("footfalld, full log: every bad load refused (%d of 40)" % refused, refused == 40)
+    check("footfalld, full log: no client held up (slowest %.2f s)" % slowest, slowest < 2)
+    log = {}
+    reader = threading.Thread(target=lambda: log.update(text=read_all(r, 0)))
+    reader.start()
+    time.sleep(0.5)
+    p = subprocess.run([footfall, "query", "--server", address, "--server-terrain",
+                        "terrain/hills.pts"], input=b"snap 1 0 1\n", capture_output=True,
+                       timeout=60)
+    check("footfalld, full log: a good load served", p.returncode == 0)
+    time.sleep(0.3)
+    server.terminate()
+    server.wait(timeout=30)
+    reader.join()
+    text = log["text"].decode("utf-8", "replace")
+    written = text.count("nonexistent_")
+    said = re.search(r"footfalld: (\d+) log lines were lost: stderr was full", text)
+    lost = int(said.group(1)) if said else 0
+    check("footfalld, full log: lines lost are said (%d written, %d said lost)" % (written, lost),
+          said is not None and 40 <= written + lost <= 43)
+    check("footfalld, full log: the lines after it are written",
+          "loaded terrain" in text and "footfalld: stopped" in text)
 
 if failures:
     print("%d check(s) failed" % len(failures))

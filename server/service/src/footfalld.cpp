@@ -25,6 +25,7 @@
 #include "footfall/terrain/output_file.h"
 #include "footfall/terrain/process_start.h"
 #include "footfall/version.h"
+#include "service_log.h"
 
 namespace {
 
@@ -154,6 +155,7 @@ int main(int argc, char** argv) {
   // Sockets and files opened later never take descriptor 0, 1 or 2 (with all three closed,
   // the log went into the first client's connection, which then hung).
   footfall::OpenClosedStandardStreams();
+  footfall::WaitForSlowLogReaders();  // a non-blocking stderr lost log lines without a word
   CLI::App app{"footfalld: serves footfall terrain queries over ONC RPC (TCP)"};
   app.set_version_flag("--version", "footfalld " FOOTFALL_VERSION,
                        "Print footfalld's version and exit");

@@ -1,8 +1,14 @@
 #include "service_log.h"
 
+#include <fcntl.h>
+#include <poll.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <mutex>
 
 #include "footfall/terrain/shown_text.h"
@@ -74,7 +80,81 @@ bool TakeErrorLine() {
 // between requests.
 const std::string* g_log_client = nullptr;
 
+// The stderr of WaitForSlowLogReaders: writes to descriptor 2, waiting when it is full.
+struct PatientStderr {
+  std::mutex mutex;
+  uint64_t lost = 0;  // lines not written since the last one that was
+};
+PatientStderr g_stderr;
+
+// Waits until descriptor 2 takes more, at most `ms` milliseconds; true when it does.
+bool WaitWritable(int ms) {
+  pollfd p{STDERR_FILENO, POLLOUT, 0};
+  const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+                          end - std::chrono::steady_clock::now())
+                          .count();
+    const int r = poll(&p, 1, static_cast<int>(std::max<int64_t>(0, left)));
+    if (r > 0) return true;
+    if (r == 0 || errno != EINTR) return false;
+  }
+}
+
+// Writes `size` bytes whole, waiting up to `wait_ms` for room before the first byte; a line
+// begun is finished (within 5 s more). False when nothing was written.
+bool WritePatiently(const char* data, size_t size, int wait_ms) {
+  size_t done = 0;
+  while (done < size) {
+    const ssize_t n = write(STDERR_FILENO, data + done, size - done);
+    if (n > 0) {
+      done += static_cast<size_t>(n);
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK) &&
+        WaitWritable(done == 0 ? wait_ms : 5000))
+      continue;
+    break;  // a full stderr whose reader is gone, or an error
+  }
+  return done > 0;
+}
+
+// fopencookie's write: one call per line (the stream is line-buffered).
+ssize_t WriteLogBytes(void*, const char* data, size_t size) {
+  std::lock_guard<std::mutex> lock(g_stderr.mutex);
+  size_t lines = 0;
+  for (size_t i = 0; i < size; ++i) lines += data[i] == '\n';
+  if (lines == 0) lines = 1;
+  const int wait_ms = g_stderr.lost ? 0 : static_cast<int>(kLogWaitSeconds * 1000);
+  if (g_stderr.lost) {
+    pollfd p{STDERR_FILENO, POLLOUT, 0};
+    if (poll(&p, 1, 0) > 0) {
+      char note[160];
+      const int n = std::snprintf(note, sizeof note,
+                                  "footfalld: %llu log lines were lost: stderr was full (its "
+                                  "reader fell behind)\n",
+                                  static_cast<unsigned long long>(g_stderr.lost));
+      if (n > 0 && WritePatiently(note, static_cast<size_t>(n), 0)) g_stderr.lost = 0;
+    }
+  }
+  if (g_stderr.lost || !WritePatiently(data, size, wait_ms)) g_stderr.lost += lines;
+  return static_cast<ssize_t>(size);  // stdio keeps no error: the next line is tried afresh
+}
+
 }  // namespace
+
+void WaitForSlowLogReaders() {
+  const int flags = fcntl(STDERR_FILENO, F_GETFL);
+  if (flags < 0 || !(flags & O_NONBLOCK)) return;
+  cookie_io_functions_t io{};
+  io.write = WriteLogBytes;
+  FILE* patient = fopencookie(nullptr, "w", io);
+  if (!patient) return;
+  setvbuf(patient, nullptr, _IOLBF, 4096);
+  std::fflush(stderr);
+  stderr = patient;  // glibc's stderr is a variable a program may set
+}
 
 void Log(const std::string& line) {
   // Every line may hold text from a client (paths, names, messages quoting them): escaped.

@@ -14,6 +14,16 @@ namespace footfall {
 // as they are.
 std::string EscapeControl(const std::string& text);
 
+// Makes every write to stderr (stdio's stderr: every log line) wait for a non-blocking stderr
+// that is full, up to kLogWaitSeconds a line, when stderr is non-blocking at start (a parent
+// process made it so, as Node.js does with the pipes and terminals it hands on): such lines
+// were lost without a word. A line that still does not fit is counted, and the next line
+// written says how many were lost; while lines are being lost, none waits (a stalled reader
+// costs the server one wait, not one per line). A blocking stderr is left as it is. Call first
+// thing in main, after OpenClosedStandardStreams.
+constexpr double kLogWaitSeconds = 0.2;
+void WaitForSlowLogReaders();
+
 // Writes one log line (escaped). Lines starting "error: " are rate-limited as LogLimited's.
 void Log(const std::string& line);
 
