@@ -663,7 +663,11 @@ void ServeWith(SVCXPRT* transport, xdrproc_t decode, Args& args, xdrproc_t encod
     return;
   }
   if (failure) {
-    Log(std::string("error: ") + proc + ": " + failure);
+    try {
+      Log(std::string("error: ") + proc + ": " + failure);
+    } catch (const std::bad_alloc&) {
+      // The reply matters more than its log line: a throw here left the client unanswered.
+    }
     res = Res{};
     *reinterpret_cast<ff_status*>(&res) = FF_INTERNAL_ERROR;
   }
@@ -675,8 +679,12 @@ void ServeWith(SVCXPRT* transport, xdrproc_t decode, Args& args, xdrproc_t encod
   if constexpr (std::is_same_v<Res, ff_info_reply>) {
     if (!res.name) res.name = const_cast<char*>("");
   }
-  if (!svc_sendreply(transport, encode, reinterpret_cast<char*>(&res)))
-    Log(std::string("error: ") + proc + ": reply could not be sent");
+  if (!svc_sendreply(transport, encode, reinterpret_cast<char*>(&res))) {
+    try {
+      Log(std::string("error: ") + proc + ": reply could not be sent");
+    } catch (const std::bad_alloc&) {
+    }
+  }
   svc_freeargs(transport, decode, reinterpret_cast<char*>(&args));
 }
 
@@ -691,7 +699,7 @@ void Serve(SVCXPRT* transport, xdrproc_t decode, xdrproc_t encode, const char* p
 // xdr_void takes no arguments in libtirpc's declaration; go through void* to cast it.
 #define FF_XDR_VOID reinterpret_cast<xdrproc_t>(reinterpret_cast<void*>(xdr_void))
 
-void Dispatch(svc_req* request, SVCXPRT* transport) {
+void DispatchRequest(svc_req* request, SVCXPRT* transport) {
   if (ReplyHeld(transport)) {
     // Only a client that sent another request before its load's reply, then closed, gets here
     // (a held connection is read only once in error).
@@ -822,8 +830,12 @@ uint64_t g_closed_at_limit = 0;      // connections libtirpc closed at the descr
 // descriptor, libtirpc closes the least recently active connection (its idle sweep), inside this
 // call and without a word: the sockets open before and gone after are those, and are logged
 // (with the terrains they orphan) rather than taken for clients that went away.
+std::vector<char> g_open_before, g_open_after;  // by socket number, before and after an accept
+
+template <typename Mark>
+void NoteAcceptedAndClosed(const Mark& mark);
+
 bool_t ListenerReceived(SVCXPRT* listener, rpc_msg* message) {
-  static std::vector<char> before, after;  // by socket number: open before, after the call
   auto mark = [](std::vector<char>* open) {
     open->assign(open->size(), 0);
     for (int i = 0; i < svc_max_pollfd; ++i) {
@@ -833,14 +845,31 @@ bool_t ListenerReceived(SVCXPRT* listener, rpc_msg* message) {
       (*open)[static_cast<size_t>(fd)] = 1;
     }
   };
-  mark(&before);
+  // No exception crosses into libtirpc: when memory runs out for the watch, the accept goes on
+  // unwatched (a connection closed at the limit meanwhile is then forgotten by ReapConnections).
+  try {
+    mark(&g_open_before);
+  } catch (const std::bad_alloc&) {
+    return g_listener_original->xp_recv(listener, message);
+  }
   const bool_t result = g_listener_original->xp_recv(listener, message);
-  mark(&after);
-  after.resize(std::max(after.size(), before.size()), 0);
-  for (size_t fd = 0; fd < after.size(); ++fd) {
-    const bool was = fd < before.size() && before[fd];
-    if (!was && after[fd]) g_peers[static_cast<int>(fd)] = PeerOf(static_cast<int>(fd));
-    if (!was || after[fd]) continue;
+  try {
+    NoteAcceptedAndClosed(mark);
+  } catch (const std::bad_alloc&) {
+  }
+  return result;
+}
+
+// The sockets libtirpc opened (accepted) and closed (its idle sweep) within an accept, from
+// ListenerReceived's marks before it and after it.
+template <typename Mark>
+void NoteAcceptedAndClosed(const Mark& mark) {
+  mark(&g_open_after);
+  g_open_after.resize(std::max(g_open_after.size(), g_open_before.size()), 0);
+  for (size_t fd = 0; fd < g_open_after.size(); ++fd) {
+    const bool was = fd < g_open_before.size() && g_open_before[fd];
+    if (!was && g_open_after[fd]) g_peers[static_cast<int>(fd)] = PeerOf(static_cast<int>(fd));
+    if (!was || g_open_after[fd]) continue;
     // Closed inside accept: the idle sweep.
     ++g_closed_at_limit;
     const auto peer = g_peers.find(static_cast<int>(fd));
@@ -860,7 +889,6 @@ bool_t ListenerReceived(SVCXPRT* listener, rpc_msg* message) {
       g_state->connections.erase(it);
     }
   }
-  return result;
 }
 
 }  // namespace
@@ -960,6 +988,21 @@ void ExpireIdle() {
     Log("freed orphaned terrain " + std::to_string(handle) + " after " +
         SecondsText(g_state->registry.limits().orphan_idle_s) + " without queries");
 }
+
+namespace {
+
+// libtirpc's entry point: no exception crosses into its C code. What throws before a reply is
+// sent (memory running out as the connection is registered) is answered SYSTEM_ERR: the client
+// is told at once, not left waiting for its timeout.
+void Dispatch(svc_req* request, SVCXPRT* transport) {
+  try {
+    DispatchRequest(request, transport);
+  } catch (...) {
+    svcerr_systemerr(transport);
+  }
+}
+
+}  // namespace
 
 DispatchFn InstallDispatcher(ServiceState* state) {
   g_state = state;
