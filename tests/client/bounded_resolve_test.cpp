@@ -80,6 +80,44 @@ double SecondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// A loopback listener whose accept queue is full: connection attempts get no answer (their
+// connect waits) until Close, after which retried handshakes are refused.
+class DroppingListener {
+ public:
+  DroppingListener() {
+    listener_ = socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    REQUIRE(bind(listener_, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0);
+    REQUIRE(listen(listener_, 0) == 0);
+    socklen_t length = sizeof address;
+    REQUIRE(getsockname(listener_, reinterpret_cast<sockaddr*>(&address), &length) == 0);
+    port_ = ntohs(address.sin_port);
+    for (int i = 0; i < 2; ++i) {  // fill the accept queue
+      queued_.push_back(socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK, 0));
+      connect(queued_.back(), reinterpret_cast<sockaddr*>(&address), sizeof address);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  ~DroppingListener() { Close(); }
+  DroppingListener(const DroppingListener&) = delete;
+  DroppingListener& operator=(const DroppingListener&) = delete;
+
+  int port() const { return port_; }
+  void Close() {
+    for (const int fd : queued_) close(fd);
+    queued_.clear();
+    if (listener_ >= 0) close(listener_);
+    listener_ = -1;
+  }
+
+ private:
+  int listener_ = -1;
+  int port_ = 0;
+  std::vector<int> queued_;
+};
+
 }  // namespace
 
 TEST_CASE("literal addresses are resolved without a name lookup", "[client]") {
@@ -161,20 +199,7 @@ TEST_CASE("a connect interrupted by a signal still ends within the connect timeo
   // caller whose signal handler runs during the connect, as Python's, Go's and DCCs' do: the
   // interrupted wait was read as connected, and libtirpc then waited about 130 s for the
   // connect with every signal blocked.
-  const int listener = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  REQUIRE(bind(listener, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0);
-  REQUIRE(listen(listener, 0) == 0);
-  socklen_t length = sizeof address;
-  REQUIRE(getsockname(listener, reinterpret_cast<sockaddr*>(&address), &length) == 0);
-  std::vector<int> queued;  // fill the accept queue: later handshakes get no answer
-  for (int i = 0; i < 2; ++i) {
-    queued.push_back(socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK, 0));
-    connect(queued.back(), reinterpret_cast<sockaddr*>(&address), sizeof address);
-  }
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  DroppingListener host;
   struct sigaction handler {
   }, old_handler{};
   handler.sa_handler = [](int) {};
@@ -185,7 +210,7 @@ TEST_CASE("a connect interrupted by a signal still ends within the connect timeo
 
   RpcOptions options;
   options.host = "127.0.0.1";
-  options.port = ntohs(address.sin_port);
+  options.port = host.port();
   options.connect_timeout_s = 1;
   options.call_timeout_s = 1;
   auto session = MakeRpcSession(options);
@@ -194,8 +219,7 @@ TEST_CASE("a connect interrupted by a signal still ends within the connect timeo
   const Status status = session->LoadSamples(MakeHeightField(4, 4, 0.5, 0.1, 1), "t", &handle);
   const double waited = SecondsSince(t0);
   sigaction(SIGALRM, &old_handler, nullptr);
-  for (const int fd : queued) close(fd);
-  close(listener);
+  host.Close();
   CHECK(status == Status::kUnavailable);
   INFO(session->last_error());
   CHECK(session->last_error().find("connection timed out") != std::string::npos);
@@ -209,29 +233,15 @@ TEST_CASE("infinite and huge timeouts are bounded instead of overflowing", "[cli
   // the retried handshake is then refused.
   const double connect_timeout =
       GENERATE(4294967.296 + 0.2, std::numeric_limits<double>::infinity());
-  const int listener = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  REQUIRE(bind(listener, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0);
-  REQUIRE(listen(listener, 0) == 0);
-  socklen_t length = sizeof address;
-  REQUIRE(getsockname(listener, reinterpret_cast<sockaddr*>(&address), &length) == 0);
-  std::vector<int> queued;  // fill the accept queue: later handshakes get no answer
-  for (int i = 0; i < 2; ++i) {
-    queued.push_back(socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK, 0));
-    connect(queued.back(), reinterpret_cast<sockaddr*>(&address), sizeof address);
-  }
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));
-  std::thread closer([&] {
+  DroppingListener host;
+  std::thread closer([&host] {
     std::this_thread::sleep_for(std::chrono::milliseconds(600));
-    for (const int fd : queued) close(fd);
-    close(listener);
+    host.Close();
   });
 
   RpcOptions options;
   options.host = "127.0.0.1";
-  options.port = ntohs(address.sin_port);
+  options.port = host.port();
   options.connect_timeout_s = connect_timeout;
   options.call_timeout_s = 1e300;
   options.busy_timeout_s = std::numeric_limits<double>::quiet_NaN();
