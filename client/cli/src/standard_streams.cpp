@@ -8,6 +8,8 @@
 #include <iostream>
 #include <streambuf>
 
+#include "footfall/terrain/process_start.h"
+
 namespace footfall::cli {
 namespace {
 
@@ -69,16 +71,10 @@ class DescriptorBuf final : public std::streambuf {
       if (error_ == 0) error_ = EBADF;
       return false;
     }
-    const char* at = pbase();
-    while (at < pptr()) {
-      const ssize_t n = write(fd_, at, static_cast<size_t>(pptr() - at));
-      if (n > 0) {
-        at += n;
-        continue;
-      }
-      if (n < 0 && errno == EINTR) continue;
-      if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK) && WaitFor(fd_, POLLOUT)) continue;
-      if (error_ == 0) error_ = n < 0 ? errno : EIO;
+    const size_t pending = static_cast<size_t>(pptr() - pbase());
+    int error = 0;
+    if (WriteWaiting(fd_, pbase(), pending, -1, -1, &error) < pending) {
+      if (error_ == 0) error_ = error;
       return false;
     }
     setp(out_, out_ + sizeof out_);

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <mutex>
 
+#include "footfall/terrain/process_start.h"
 #include "footfall/terrain/shown_text.h"
 
 namespace footfall {
@@ -87,37 +88,11 @@ struct PatientStderr {
 };
 PatientStderr g_stderr;
 
-// Waits until descriptor 2 takes more, at most `ms` milliseconds; true when it does.
-bool WaitWritable(int ms) {
-  pollfd p{STDERR_FILENO, POLLOUT, 0};
-  const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
-  for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-                          end - std::chrono::steady_clock::now())
-                          .count();
-    const int r = poll(&p, 1, static_cast<int>(std::max<int64_t>(0, left)));
-    if (r > 0) return true;
-    if (r == 0 || errno != EINTR) return false;
-  }
-}
-
 // Writes `size` bytes whole, waiting up to `wait_ms` for room before the first byte; a line
 // begun is finished (within 5 s more). False when nothing was written.
 bool WritePatiently(const char* data, size_t size, int wait_ms) {
-  size_t done = 0;
-  while (done < size) {
-    const ssize_t n = write(STDERR_FILENO, data + done, size - done);
-    if (n > 0) {
-      done += static_cast<size_t>(n);
-      continue;
-    }
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK) &&
-        WaitWritable(done == 0 ? wait_ms : 5000))
-      continue;
-    break;  // a full stderr whose reader is gone, or an error
-  }
-  return done > 0;
+  int error = 0;
+  return WriteWaiting(STDERR_FILENO, data, size, wait_ms, 5000, &error) > 0;
 }
 
 // fopencookie's write: one call per line (the stream is line-buffered).

@@ -1,10 +1,14 @@
 #include "footfall/terrain/process_start.h"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <chrono>
+#include <cstdint>
 
 namespace footfall {
 
@@ -18,6 +22,49 @@ int OpenClosedStandardStreams() {
     if (opened >= 0 && opened != fd) ::close(opened);
   }
   return closed;
+}
+
+namespace {
+
+// Waits until `fd` takes more, at most `ms` milliseconds (-1: for ever); true when it does (or
+// reports an error, which the next write meets).
+bool WaitWritable(int fd, int ms) {
+  pollfd p{fd, POLLOUT, 0};
+  const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(std::max(ms, 0));
+  for (;;) {
+    int left = -1;
+    if (ms >= 0) {
+      left = static_cast<int>(std::max<int64_t>(
+          0, std::chrono::duration_cast<std::chrono::milliseconds>(end -
+                                                                   std::chrono::steady_clock::now())
+                 .count()));
+    }
+    const int r = ::poll(&p, 1, left);
+    if (r > 0) return true;
+    if (r == 0 || errno != EINTR) return false;
+  }
+}
+
+}  // namespace
+
+size_t WriteWaiting(int fd, const char* data, size_t size, int first_wait_ms, int rest_wait_ms,
+                    int* error) {
+  size_t done = 0;
+  while (done < size) {
+    const ssize_t n = ::write(fd, data + done, size - done);
+    if (n > 0) {
+      done += static_cast<size_t>(n);
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    const int why = n < 0 ? errno : EIO;
+    if ((why == EAGAIN || why == EWOULDBLOCK) &&
+        WaitWritable(fd, done == 0 ? first_wait_ms : rest_wait_ms))
+      continue;
+    *error = why;
+    break;
+  }
+  return done;
 }
 
 bool SignalIgnored(int signal_number) {

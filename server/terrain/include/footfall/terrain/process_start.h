@@ -2,6 +2,7 @@
 // may have closed, signals it may have ignored, and limits that keep threads from starting.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <system_error>
 
@@ -12,6 +13,14 @@ namespace footfall {
 // first client's connection). Call first thing in main. Returns those that were closed, as bits
 // (1 << descriptor).
 int OpenClosedStandardStreams();
+
+// Writes `size` bytes of `data` to descriptor `fd` whole, as a parent may have made it
+// non-blocking (Node.js does): interrupted writes are made again, and a full descriptor is waited
+// for (poll), up to `first_wait_ms` before the first byte and `rest_wait_ms` for the rest once one
+// is written (-1: for ever). Returns the bytes written; when fewer than `size`, *error is errno
+// (EAGAIN: a wait ran out).
+size_t WriteWaiting(int fd, const char* data, size_t size, int first_wait_ms, int rest_wait_ms,
+                    int* error);
 
 // Whether `signal_number` is ignored (SIG_IGN) now: a program that installs a handler leaves one
 // ignored when it started so (under nohup, or as a script's background job).
