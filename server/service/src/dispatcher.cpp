@@ -26,6 +26,7 @@
 #include "footfall/terrain/batch_pool.h"
 #include "footfall/terrain/shown_text.h"
 #include "read_gate.h"
+#include "reserve_ahead.h"
 #include "service_log.h"
 
 namespace footfall {
@@ -626,6 +627,16 @@ void Recent(const ff_recent_args& a, ff_recent_reply* r) {
   r->queries.queries_val = g_storage.recent.data();
 }
 
+// Logs the line `make()` builds, once the request has been answered: when memory runs out the
+// line is lost, rather than the exception reaching Dispatch, which would answer again.
+template <typename Make>
+void LogAnswered(Make&& make) noexcept {
+  try {
+    Log(make());
+  } catch (...) {
+  }
+}
+
 // Decodes the arguments into `args` (set up by the caller: empty, or pointing at storage),
 // runs the handler, replies and frees the arguments, whatever happens. Every reply type starts
 // with its ff_status, which an exception turns into an error. A handler that returns true has
@@ -636,11 +647,14 @@ void ServeWith(SVCXPRT* transport, xdrproc_t decode, Args& args, xdrproc_t encod
   if (!svc_getargs(transport, decode, reinterpret_cast<char*>(&args))) {
     svc_freeargs(transport, decode, reinterpret_cast<char*>(&args));
     svcerr_decode(transport);
-    Log(std::string("error: ") + proc + ": malformed request from " + PeerOf(transport->xp_fd) +
-        " rejected (its arguments do not decode: more items than the protocol allows or than "
-        "were sent, a string too long, a value out of its type, or a request sent in more than "
-        "one record fragment: a client must send each in one, with a send size of at least "
-        "FF_MAX_REQUEST_BYTES)");
+    LogAnswered([&] {
+      return std::string("error: ") + proc + ": malformed request from " +
+             PeerOf(transport->xp_fd) +
+             " rejected (its arguments do not decode: more items than the protocol allows or "
+             "than were sent, a string too long, a value out of its type, or a request sent in "
+             "more than one record fragment: a client must send each in one, with a send size "
+             "of at least FF_MAX_REQUEST_BYTES)";
+    });
     return;
   }
   Res res{};
@@ -679,12 +693,8 @@ void ServeWith(SVCXPRT* transport, xdrproc_t decode, Args& args, xdrproc_t encod
   if constexpr (std::is_same_v<Res, ff_info_reply>) {
     if (!res.name) res.name = const_cast<char*>("");
   }
-  if (!svc_sendreply(transport, encode, reinterpret_cast<char*>(&res))) {
-    try {
-      Log(std::string("error: ") + proc + ": reply could not be sent");
-    } catch (const std::bad_alloc&) {
-    }
-  }
+  if (!svc_sendreply(transport, encode, reinterpret_cast<char*>(&res)))
+    LogAnswered([&] { return std::string("error: ") + proc + ": reply could not be sent"; });
   svc_freeargs(transport, decode, reinterpret_cast<char*>(&args));
 }
 
@@ -704,7 +714,11 @@ void DispatchRequest(svc_req* request, SVCXPRT* transport) {
     // Only a client that sent another request before its load's reply, then closed, gets here
     // (a held connection is read only once in error).
     svcerr_systemerr(transport);
-    Log("error: a request sent while the connection's load was in progress: refused");
+    LogAnswered([] {
+      return std::string(
+          "error: a request sent while the connection's load was in progress: "
+          "refused");
+    });
     return;
   }
   const Connection& connection = ConnectionOf(transport);
@@ -811,9 +825,11 @@ void DispatchRequest(svc_req* request, SVCXPRT* transport) {
                                                     FF_XDR(ff_recent_reply), "recent", Recent);
     default:
       svcerr_noproc(transport);
-      Log("error: unknown procedure " + std::to_string(request->rq_proc) + " of version " +
-          std::to_string(FOOTFALL_V1) + " from " + PeerOf(transport->xp_fd) +
-          " rejected (PROC_UNAVAIL: a client built from another rpc/footfall.x?)");
+      LogAnswered([&] {
+        return "error: unknown procedure " + std::to_string(request->rq_proc) + " of version " +
+               std::to_string(FOOTFALL_V1) + " from " + PeerOf(transport->xp_fd) +
+               " rejected (PROC_UNAVAIL: a client built from another rpc/footfall.x?)";
+      });
       return;
   }
 }
@@ -913,7 +929,7 @@ void ReapConnections() {
   for (int i = 0; i < svc_max_pollfd; ++i) {
     const int fd = svc_pollfd[i].fd;
     if (fd < 0) continue;
-    if (static_cast<size_t>(fd) >= open.size()) open.resize(static_cast<size_t>(fd) + 1, 0);
+    GrowForSocket(&open, fd);
     open[static_cast<size_t>(fd)] = 1;
   }
   for (auto it = g_state->connections.begin(); it != g_state->connections.end();) {

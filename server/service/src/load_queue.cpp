@@ -95,17 +95,13 @@ std::unique_ptr<PendingLoad> LoadQueue::Cancel(PendingLoad* load) {
 std::vector<std::unique_ptr<PendingLoad>> LoadQueue::TakeFinished() {
   State& s = *state_;
   std::lock_guard<std::mutex> lock(s.mutex);
-  std::vector<std::unique_ptr<PendingLoad>> done;
-  // Room first: memory that runs out here leaves every load waiting, and wake_fd() up.
-  done.reserve(s.finished.size());
   uint64_t count = 0;
   while (read(s.wake_fd, &count, sizeof count) > 0) {
   }
-  for (auto& load : s.finished) {
-    --s.in_lane[load.second];
-    done.push_back(std::move(load.first));
-  }
-  s.finished.clear();
+  for (const Lane lane : s.finished_lanes) --s.in_lane[lane];
+  s.finished_lanes.clear();
+  std::vector<std::unique_ptr<PendingLoad>> done;
+  done.swap(s.finished);
   return done;
 }
 
@@ -160,7 +156,9 @@ void LoadQueue::Work(const std::shared_ptr<State>& state, Lane lane) {
     for (;;) {
       if (s.stop) return;  // abandoned, or the queue is going: nobody takes it back
       try {
-        s.finished.emplace_back(std::move(load), lane);
+        s.finished_lanes.reserve(s.finished_lanes.size() + 1);
+        s.finished.push_back(std::move(load));  // the load is kept when this throws
+        s.finished_lanes.push_back(lane);       // room reserved above
         break;
       } catch (const std::bad_alloc&) {
         lock.unlock();

@@ -51,6 +51,7 @@ class LoadQueue {
   // does one already finished (nullptr for both).
   std::unique_ptr<PendingLoad> Cancel(PendingLoad* load);
   // The loads finished since the last call, in the order they finished; clears wake_fd().
+  // Allocates nothing, so that finished loads are answered even while memory runs out.
   std::vector<std::unique_ptr<PendingLoad>> TakeFinished();
   // Readable (POLLIN) while finished loads wait to be taken.
   int wake_fd() const;
@@ -69,7 +70,10 @@ class LoadQueue {
     mutable std::mutex mutex;
     std::condition_variable wake_worker[kLanes];
     std::deque<std::unique_ptr<PendingLoad>> waiting[kLanes];
-    std::deque<std::pair<std::unique_ptr<PendingLoad>, Lane>> finished;
+    // The finished loads untaken, and the lane of each (apart, so that TakeFinished hands the
+    // loads over by a swap, allocating nothing).
+    std::vector<std::unique_ptr<PendingLoad>> finished;
+    std::vector<Lane> finished_lanes;
     size_t in_lane[kLanes] = {0, 0};  // waiting, running or finished untaken
     int running = 0;                  // loads the workers hold, over both lanes
     bool stop = false;

@@ -9,6 +9,7 @@
 #include <cstdio>
 
 #include "read_gate.h"
+#include "reserve_ahead.h"
 
 namespace footfall {
 namespace {
@@ -39,21 +40,28 @@ PartialRequests::PartialRequests(double limit_s, size_t max_partial)
     : limit_s_(limit_s),
       max_partial_(max_partial),
       log_tokens_(kLogBurst),
-      log_refilled_(std::chrono::steady_clock::now()) {}
+      log_refilled_(std::chrono::steady_clock::now()) {
+  ReserveAhead(&handed_, kLeastReserved);
+  GrowForSocket(&dispatched_, static_cast<int>(kLeastReserved) - 1);
+}
 
 std::string PartialRequests::PeerOf(int fd) { return footfall::PeerOf(fd); }
 
 void PartialRequests::Before(const std::vector<pollfd>& readable, int listener) {
   handed_.clear();
-  dispatched_.clear();
-  for (const pollfd& p : readable)
-    if (p.fd >= 0 && p.fd != listener) handed_.emplace_back(p.fd, BytesWritten(p.fd));
+  ReserveAhead(&handed_, readable.size());
+  dispatched_.assign(dispatched_.size(), 0);
+  for (const pollfd& p : readable) {
+    if (p.fd < 0 || p.fd == listener) continue;
+    GrowForSocket(&dispatched_, p.fd);
+    handed_.emplace_back(p.fd, BytesWritten(p.fd));
+  }
 }
 
 void PartialRequests::After() {
   const auto now = std::chrono::steady_clock::now();
   for (const auto& [fd, before] : handed_) {
-    if (dispatched_.count(fd)) {
+    if (dispatched_[static_cast<size_t>(fd)]) {
       partial_.erase(fd);  // a whole request: nothing of the next one is read yet
       continue;
     }

@@ -19,7 +19,6 @@
 #include <cstdio>
 #include <string>
 #include <unordered_map>
-#include <unordered_set>
 #include <vector>
 
 namespace footfall {
@@ -31,10 +30,16 @@ class PartialRequests {
   PartialRequests(double limit_s, size_t max_partial);
 
   // Before svc_getreq_poll(readable): notes what was written so far to each connection in
-  // `readable` (the listening socket `listener` excepted).
+  // `readable` (the listening socket `listener` excepted). Throws std::bad_alloc when memory
+  // runs out, before anything is read.
   void Before(const std::vector<pollfd>& readable, int listener);
-  // A request of connection `fd` reached the dispatcher (call from the dispatch function).
-  void Dispatched(int fd) { dispatched_.insert(fd); }
+  // A request of connection `fd`, one of those handed to Before, reached the dispatcher (call
+  // from the dispatch function). Allocates nothing: an exception thrown here would cross
+  // libtirpc after it had read the request, which then went unanswered.
+  void Dispatched(int fd) noexcept {
+    if (fd >= 0 && static_cast<size_t>(fd) < dispatched_.size())
+      dispatched_[static_cast<size_t>(fd)] = 1;
+  }
   // After svc_getreq_poll: marks the connections that now hold part of a request, and shuts
   // down those past the count.
   void After();
@@ -79,7 +84,7 @@ class PartialRequests {
   double limit_s_;
   size_t max_partial_;
   std::vector<std::pair<int, uint64_t>> handed_;  // connection, bytes written before the round
-  std::unordered_set<int> dispatched_;
+  std::vector<char> dispatched_;  // by socket number: 1 once a request of it was dispatched
   std::unordered_map<int, Partial> partial_;
   double log_tokens_;
   std::chrono::steady_clock::time_point log_refilled_;

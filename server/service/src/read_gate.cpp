@@ -40,9 +40,12 @@ std::string PeerOf(int fd) {
 
 ReadGate::ReadGate(size_t send_buffer, double stuck_limit_s)
     : max_queued_(send_buffer > kReplyRoomBytes ? send_buffer - kReplyRoomBytes : 0),
-      stuck_limit_s_(stuck_limit_s) {}
+      stuck_limit_s_(stuck_limit_s) {
+  GrowForSocket(&served_, static_cast<int>(kLeastReserved) - 1);
+}
 
 int ReadGate::Prepare(std::vector<pollfd>* fds, int idle_ms, const std::set<int>& held) {
+  ReserveAhead(fds, static_cast<size_t>(svc_max_pollfd) + 1);  // and the caller's one more
   fds->assign(svc_pollfd, svc_pollfd + svc_max_pollfd);
   const auto now = std::chrono::steady_clock::now();
   bool any_waiting = false;
@@ -53,7 +56,7 @@ int ReadGate::Prepare(std::vector<pollfd>* fds, int idle_ms, const std::set<int>
       p.events = POLLRDHUP;  // the client closing, which Collect hands to libtirpc
       continue;
     }
-    if (!served_.count(p.fd) && !waiting_.count(p.fd)) continue;  // had room, nothing written
+    if (!WasServed(p.fd) && !waiting_.count(p.fd)) continue;  // had room, nothing written
     // The listening socket answers EINVAL, and is always read (accept).
     int queued = 0;
     if (ioctl(p.fd, SIOCOUTQ, &queued) != 0 || static_cast<size_t>(queued) <= max_queued_) {
@@ -71,17 +74,18 @@ int ReadGate::Prepare(std::vector<pollfd>* fds, int idle_ms, const std::set<int>
     p.events = w.writable ? 0 : POLLOUT;
     any_waiting = true;
   }
-  served_.clear();
+  served_.assign(served_.size(), 0);
   return any_waiting ? kRecheckMs : idle_ms;
 }
 
 void ReadGate::Collect(const std::vector<pollfd>& fds, std::vector<pollfd>* readable) {
   readable->clear();
+  ReserveAhead(readable, fds.size());
   for (const pollfd& p : fds) {
     if (p.revents == 0) continue;
     if ((p.events & kReadEvents) || (p.revents & (POLLERR | POLLHUP | POLLNVAL | POLLRDHUP))) {
       readable->push_back(p);
-      served_.insert(p.fd);
+      Served(p.fd);
     } else if (p.revents & POLLOUT) {
       // The kernel calls a socket writable at a third free, which may be less than a reply:
       // stop polling it for POLLOUT (it would spin) and only recheck it in Prepare.

@@ -15,10 +15,10 @@
 #include <set>
 #include <string>
 #include <unordered_map>
-#include <unordered_set>
 #include <vector>
 
 #include "footfall.h"
+#include "reserve_ahead.h"
 
 namespace footfall {
 
@@ -58,7 +58,7 @@ class ReadGate {
 
   // A reply was written to `fd` outside svc_getreq_poll (a held reply): Prepare checks its room
   // again.
-  void Wrote(int fd) { served_.insert(fd); }
+  void Wrote(int fd) { Served(fd); }
 
  private:
   struct Waiting {
@@ -66,6 +66,15 @@ class ReadGate {
     bool writable = false;  // the kernel reported POLLOUT, yet there was no room: recheck only
     bool closing = false;   // shut down after the limit: read until libtirpc closes it
   };
+  // Marks `fd` served. Allocates only for a socket number above every one reserved for.
+  void Served(int fd) {
+    if (fd < 0) return;
+    GrowForSocket(&served_, fd);
+    served_[static_cast<size_t>(fd)] = 1;
+  }
+  bool WasServed(int fd) const {
+    return fd >= 0 && static_cast<size_t>(fd) < served_.size() && served_[static_cast<size_t>(fd)];
+  }
   // Shuts `fd` down, so that libtirpc closes it at its next read (a reply written to it fails at
   // once), with a reset rather than a lingering close, and logs it.
   void Close(int fd, double waited_s);
@@ -73,8 +82,10 @@ class ReadGate {
   // Sockets handed to libtirpc (or written to) since the last Prepare: only they, and those
   // waiting, can have less room than before (the unsent bytes of the others only drain), so
   // only they are asked (SIOCOUTQ, a system call each: asking every socket at every turn took
-  // the whole core with 2000 idle connections).
-  std::unordered_set<int> served_;
+  // the whole core with 2000 idle connections). By socket number, so that a turn of the loop
+  // allocates nothing once the numbers in use have been seen: while memory runs out, requests
+  // are still read and answered.
+  std::vector<char> served_;
   size_t max_queued_;  // [Units: bytes] unsent bytes that still leave kReplyRoomBytes
   double stuck_limit_s_;
   std::unordered_map<int, Waiting> waiting_;  // by socket; a new connection starts with room

@@ -27,6 +27,7 @@
 #include "footfall.h"
 #include "partial_requests.h"
 #include "read_gate.h"
+#include "reserve_ahead.h"
 #include "service_log.h"
 
 namespace footfall {
@@ -242,6 +243,10 @@ void RpcServer::Stop() {
 void RpcServer::Run() {
   ReadGate gate(send_buffer_, options_.unread_timeout_s);
   std::vector<pollfd> fds, readable;
+  std::vector<int> held;       // reused: a turn allocates nothing once its lists have grown
+  ReserveAhead(&fds, 1);       // the least room, from the start: memory may run out before the
+  ReserveAhead(&readable, 1);  // first client comes
+  ReserveAhead(&held, 1);
   auto last_expiry = std::chrono::steady_clock::now();
   // One turn of the loop: waits for sockets and finished loads, serves what is ready, and about
   // once a second expires what has idled. False when the loop must end (poll failed).
@@ -257,7 +262,8 @@ void RpcServer::Run() {
     const bool loads_done = fds.back().revents != 0;
     fds.pop_back();
     if (loads_done) {
-      const std::set<int> held = HeldSockets();
+      ReserveAhead(&held, HeldSockets().size());
+      held.assign(HeldSockets().begin(), HeldSockets().end());
       FinishLoads();
       for (const int fd : held)
         if (!HeldSockets().count(fd)) gate.Wrote(fd);
@@ -292,7 +298,11 @@ void RpcServer::Run() {
       // Memory ran out in the loop's own work (its lists of sockets, its log lines): the turn
       // is given up, and the next starts again from the sockets' state. (A request's own
       // failure is its alone: the dispatcher answers it.) Aborting lost every client's terrains.
-      LogLimited("error: out of memory in the main loop: the turn is given up, serving on");
+      try {
+        LogLimited("error: out of memory in the main loop: the turn is given up, serving on");
+      } catch (const std::bad_alloc&) {
+        // The line needs memory too.
+      }
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
   }
