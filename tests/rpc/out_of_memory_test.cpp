@@ -44,9 +44,11 @@ bool Unanswered(Status s, const TerrainSession& session) {
 }
 
 // A few seconds of every kind of request, from several connections at once; their answers
-// (errors while memory is short) are not checked here, but every request must be answered:
-// those that were not are counted in `unanswered` and their errors kept in `errors`.
-void Churn(int port, int seed, std::atomic<int>* unanswered, std::vector<std::string>* errors) {
+// (errors while memory is short) are not checked here, but every request must be answered and
+// every failure said: those that were not are counted in `unanswered`, and failures with an
+// empty last_error() in `unexplained`; the errors of both are kept in `errors`.
+void Churn(int port, int seed, std::atomic<int>* unanswered, std::atomic<int>* unexplained,
+           std::vector<std::string>* errors) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(2000);
   std::vector<Vec3> points;
   std::vector<StepQuery> steps;
@@ -59,6 +61,10 @@ void Churn(int port, int seed, std::atomic<int>* unanswered, std::vector<std::st
   for (int round = 0; std::chrono::steady_clock::now() < end; ++round) {
     auto session = Connect(port);
     auto note = [&](Status s) {
+      if (s != Status::kOk && session->last_error().empty()) {
+        ++*unexplained;  // a failure without a word of why
+        errors->push_back("(no error text) status " + std::string(StatusName(s)));
+      }
       if (!Unanswered(s, *session)) return s;
       ++*unanswered;
       errors->push_back(session->last_error());
@@ -132,10 +138,10 @@ TEST_CASE("footfalld survives C++ allocations failing anywhere, and loses no ter
 
   failing.Fail();
   std::vector<std::thread> clients;
-  std::atomic<int> unanswered{0};
+  std::atomic<int> unanswered{0}, unexplained{0};
   std::vector<std::vector<std::string>> errors(3);
   for (int c = 0; c < 3; ++c)
-    clients.emplace_back(Churn, server.port(), 100 * c, &unanswered, &errors[c]);
+    clients.emplace_back(Churn, server.port(), 100 * c, &unanswered, &unexplained, &errors[c]);
   int keeper_unanswered = 0;
   for (int i = 0; i < 10; ++i) {  // the keeper queries too
     const Vec3 at{5, 1, 5};
@@ -155,6 +161,7 @@ TEST_CASE("footfalld survives C++ allocations failing anywhere, and loses no ter
   for (const auto& list : errors)
     for (const std::string& e : list) UNSCOPED_INFO(e);
   CHECK(unanswered.load() == 0);
+  CHECK(unexplained.load() == 0);
   CHECK(keeper_unanswered == 0);
   // The terrain loaded before is answered as before (over its connection, or reloaded by the
   // client library on a new one), and new clients are served.
@@ -184,6 +191,7 @@ TEST_CASE("footfalld answers its first client while every allocation fails", "[r
   INFO(session->last_error());
   CHECK(refused != Status::kOk);
   CHECK_FALSE(Unanswered(refused, *session));
+  CHECK_THAT(session->last_error(), Catch::Contains("ran out of memory"));
   failing.Recover();
   const Status loaded = session->LoadSamples(samples, "first", &handle);
   INFO(session->last_error());

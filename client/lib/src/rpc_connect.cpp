@@ -208,6 +208,10 @@ std::string CallFailureText(clnt_stat status) {
     text +=
         " (the connection closed under the call: footfalld stopped, was killed, or closed "
         "it)";
+  else if (status == RPC_SYSTEMERROR)
+    text +=
+        " (footfalld could not serve the call: it ran out of memory, or the request came on a "
+        "connection whose load was still in progress; its log says which)";
   return text;
 }
 

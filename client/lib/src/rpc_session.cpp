@@ -357,8 +357,7 @@ class RpcSession final : public TerrainSession {
     Status s = Call(ff_upload_begin_1(&begin, &started.value, client_), "upload");
     if (s != Status::kOk) return s;
     if (started.value.status != FF_OK)
-      return Fail(FromWire(started.value.status),
-                  started.value.message ? started.value.message : "upload refused");
+      return Refused(started.value.status, started.value.message, "upload");
     const uint32_t upload = started.value.upload;
     std::vector<ff_sample> chunk(std::min<size_t>(samples.size(), FF_MAX_CHUNK));
     for (size_t b = 0; b < samples.size(); b += FF_MAX_CHUNK) {
@@ -373,8 +372,7 @@ class RpcSession final : public TerrainSession {
       s = Call(ff_upload_chunk_1(&args, &reply.value, client_), "upload");
       if (s != Status::kOk) return s;
       if (reply.value.status != FF_OK)
-        return Fail(FromWire(reply.value.status),
-                    reply.value.message ? reply.value.message : "upload failed");
+        return Refused(reply.value.status, reply.value.message, "upload");
     }
     ff_upload_args finish{upload};
     s = BuildCall("upload", source, [&](ff_load_reply* reply) {
@@ -437,14 +435,19 @@ class RpcSession final : public TerrainSession {
         pause_s = std::min(1.0, pause_s * 2);
         continue;
       }
-      if (reply.value.status != FF_OK)
-        return Fail(FromWire(reply.value.status),
-                    message.empty() ? std::string(what) + " failed" : message);
+      if (reply.value.status != FF_OK) return Refused(reply.value.status, message.c_str(), what);
       source->server_handle = reply.value.terrain;
       source->loaded = true;
       last_load_report_ = message;
       return Status::kOk;
     }
+  }
+
+  // A request footfalld refused with `status`: its `message`, or when it sent none (or an
+  // empty one), "WHAT: server answered STATUS".
+  Status Refused(ff_status status, const char* message, const char* what) {
+    if (!message || !*message) return ServerFail(status, what);
+    return Fail(FromWire(status), message);
   }
 
   Status ServerFail(ff_status status, const char* what) {

@@ -658,7 +658,10 @@ void ServeWith(SVCXPRT* transport, xdrproc_t decode, Args& args, xdrproc_t encod
     return;
   }
   Res res{};
-  const char* failure = nullptr;
+  // What went wrong, copied without allocating (an exception's own text dies with its handler),
+  // and the reply's message saying it.
+  char failure[128] = "";
+  char failure_message[192] = "";
   bool held = false;
   try {
     if constexpr (std::is_same_v<std::invoke_result_t<Fn&, Args&, Res*>, bool>)
@@ -666,17 +669,17 @@ void ServeWith(SVCXPRT* transport, xdrproc_t decode, Args& args, xdrproc_t encod
     else
       fn(args, &res);
   } catch (const std::bad_alloc&) {
-    failure = "out of memory";
+    std::snprintf(failure, sizeof failure, "%s", "out of memory");
   } catch (const std::exception& e) {
-    failure = e.what();
+    std::snprintf(failure, sizeof failure, "%s", e.what());
   } catch (...) {
-    failure = "unknown exception";
+    std::snprintf(failure, sizeof failure, "%s", "unknown exception");
   }
   if (held) {
     svc_freeargs(transport, decode, reinterpret_cast<char*>(&args));
     return;
   }
-  if (failure) {
+  if (failure[0]) {
     try {
       Log(std::string("error: ") + proc + ": " + failure);
     } catch (const std::bad_alloc&) {
@@ -684,6 +687,11 @@ void ServeWith(SVCXPRT* transport, xdrproc_t decode, Args& args, xdrproc_t encod
     }
     res = Res{};
     *reinterpret_cast<ff_status*>(&res) = FF_INTERNAL_ERROR;
+    std::snprintf(failure_message, sizeof failure_message, "footfalld failed serving %s: %s", proc,
+                  failure);
+    if constexpr (std::is_same_v<Res, ff_status_reply> || std::is_same_v<Res, ff_load_reply> ||
+                  std::is_same_v<Res, ff_upload_reply>)
+      res.message = failure_message;
   }
   // Strings may not be NULL on the wire: give unset ones an empty value.
   if constexpr (std::is_same_v<Res, ff_status_reply> || std::is_same_v<Res, ff_load_reply> ||
@@ -1008,14 +1016,22 @@ void ExpireIdle() {
 namespace {
 
 // libtirpc's entry point: no exception crosses into its C code. What throws before a reply is
-// sent (memory running out as the connection is registered) is answered SYSTEM_ERR: the client
-// is told at once, not left waiting for its timeout.
+// sent (memory running out as the connection is registered) is answered SYSTEM_ERR, and logged
+// when memory allows: the client is told at once, not left waiting for its timeout.
 void Dispatch(svc_req* request, SVCXPRT* transport) {
+  const char* why = "an unknown exception";
   try {
     DispatchRequest(request, transport);
+    return;
+  } catch (const std::bad_alloc&) {
+    why = "out of memory";
   } catch (...) {
-    svcerr_systemerr(transport);
   }
+  svcerr_systemerr(transport);
+  LogAnswered([why, transport] {
+    return std::string("error: a request from ") + PeerOf(transport->xp_fd) +
+           " could not be served (" + why + "): answered SYSTEM_ERR";
+  });
 }
 
 }  // namespace
