@@ -20,6 +20,7 @@
 
 #include "footfall/client/terrain_session.h"
 #include "footfall/import/terrain_generators.h"
+#include "raw_rpc.h"
 #include "server_process.h"
 
 using namespace footfall;
@@ -198,4 +199,36 @@ TEST_CASE("footfalld answers its first client while every allocation fails", "[r
   REQUIRE(loaded == Status::kOk);
   CHECK(session->Snap(handle, {1, 1, 1}).status == Status::kOk);
   CHECK(failing.server().Terminate() == 0);
+}
+
+TEST_CASE("footfalld serves others while a client never reads and every allocation fails",
+          "[rpc][memory]") {
+  // A connection without room for its replies is polled for room at every turn; noting it must
+  // not need memory, or no turn got as far as reading anybody's request.
+  FailingServer failing(1);
+  const int port = failing.server().port();
+  auto keeper = Connect(port);
+  TerrainHandle kept = 0;
+  REQUIRE(keeper->LoadSamples(MakeHeightField(30, 30, 0.25, 1.0, 5), "kept", &kept) == Status::kOk);
+  REQUIRE(keeper->Snap(kept, {3, 1, 3}).status == Status::kOk);
+  std::vector<uint32_t> handles;
+  REQUIRE(footfall::test::ListServerTerrains(port, &handles));
+  REQUIRE(handles.size() == 1);
+  footfall::test::Flooder flooder(port, footfall::test::FullBatchCall(handles[0]));
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (flooder.blocked() == 0 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  REQUIRE(flooder.blocked() > 0);  // its socket is full: footfalld holds it back
+
+  failing.Fail();
+  for (int i = 0; i < 5; ++i) {
+    const Vec3 at{3, 1, 3};
+    Foothold answer;
+    const Status s = keeper->Snap(kept, &at, 1, &answer);
+    INFO(keeper->last_error());
+    CHECK_FALSE(Unanswered(s, *keeper));
+  }
+  failing.Recover();
+  CHECK(keeper->Snap(kept, {3, 1, 3}).status == Status::kOk);
+  CHECK(flooder.drops() == 0);
 }

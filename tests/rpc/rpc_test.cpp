@@ -34,10 +34,12 @@
 #include "footfall/client/recent_queries.h"
 #include "footfall/client/terrain_session.h"
 #include "footfall/import/terrain_generators.h"
+#include "raw_rpc.h"
 #include "server_process.h"
 
 using namespace footfall;
 using footfall::test::ServerProcess;
+using namespace footfall::test;
 
 namespace {
 
@@ -116,36 +118,6 @@ void MakeQueries(size_t n, std::vector<Vec3>* points, std::vector<StepQuery>* st
 }
 
 // --- raw ONC RPC messages, for misbehaving clients ------------------------------------------
-
-void Put32(std::vector<unsigned char>* b, uint32_t v) {
-  for (int s = 24; s >= 0; s -= 8) b->push_back(static_cast<unsigned char>(v >> s));
-}
-
-void PutDouble(std::vector<unsigned char>* b, double v) {
-  uint64_t bits;
-  std::memcpy(&bits, &v, 8);
-  Put32(b, static_cast<uint32_t>(bits >> 32));
-  Put32(b, static_cast<uint32_t>(bits));
-}
-
-// A complete one-fragment call record for `proc` with already encoded arguments.
-std::vector<unsigned char> CallRecord(uint32_t xid, uint32_t proc,
-                                      const std::vector<unsigned char>& args) {
-  std::vector<unsigned char> body;
-  Put32(&body, xid);
-  Put32(&body, 0);  // CALL
-  Put32(&body, 2);  // RPC version
-  Put32(&body, FOOTFALL_PROG);
-  Put32(&body, FOOTFALL_V1);
-  Put32(&body, proc);
-  Put32(&body, 0), Put32(&body, 0);  // AUTH_NONE credentials
-  Put32(&body, 0), Put32(&body, 0);  // AUTH_NONE verifier
-  body.insert(body.end(), args.begin(), args.end());
-  std::vector<unsigned char> record;
-  Put32(&record, 0x80000000u | static_cast<uint32_t>(body.size()));
-  record.insert(record.end(), body.begin(), body.end());
-  return record;
-}
 
 int RawConnect(int port) {
   const int fd = socket(AF_INET, SOCK_STREAM, 0);
@@ -289,13 +261,8 @@ clnt_stat CallLoad(CLIENT* c, ff_load_options_args* args, ff_load_reply* reply, 
 
 // The handles of the terrains footfalld holds, in its order (FF_LIST).
 std::vector<uint32_t> ServerTerrains(int port) {
-  CLIENT* c = RawClient(port);
-  ff_list_reply reply{};
-  REQUIRE(ff_list_1(nullptr, &reply, c) == RPC_SUCCESS);
-  const std::vector<uint32_t> handles(reply.terrains.terrains_val,
-                                      reply.terrains.terrains_val + reply.terrains.terrains_len);
-  xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_list_reply), reinterpret_cast<char*>(&reply));
-  clnt_destroy(c);
+  std::vector<uint32_t> handles;
+  REQUIRE(ListServerTerrains(port, &handles));
   return handles;
 }
 
@@ -335,69 +302,6 @@ ff_status RawSnap(CLIENT* c, uint32_t terrain) {
   REQUIRE(ff_snap_1(&args, &reply, c) == RPC_SUCCESS);
   return reply.status;
 }
-
-// Full snap batch calls on `terrain` (FF_MAX_BATCH points), whose replies are the largest.
-std::vector<unsigned char> FullBatchCall(uint32_t terrain) {
-  std::vector<unsigned char> batch;
-  Put32(&batch, terrain);
-  Put32(&batch, FF_MAX_BATCH);
-  for (int i = 0; i < FF_MAX_BATCH; ++i)
-    PutDouble(&batch, i % 30), PutDouble(&batch, 0), PutDouble(&batch, 0);
-  return CallRecord(1, FF_SNAP_BATCH, batch);
-}
-
-// A client on its own thread that sends `record` again and again and never reads a reply, until
-// destroyed; when the server drops it, it counts the drop and connects again. No Catch2
-// assertions on this thread: the test reads the counters.
-class Flooder {
- public:
-  Flooder(int port, std::vector<unsigned char> record)
-      : port_(port), record_(std::move(record)), thread_([this] { Run(); }) {}
-  ~Flooder() {
-    stop_ = true;
-    thread_.join();
-  }
-  int drops() const { return drops_; }
-  int blocked() const { return blocked_; }  // sends that waited 100 ms on a full socket
-
- private:
-  void Run() {
-    int fd = -1;
-    size_t at = 0;
-    while (!stop_) {
-      if (fd < 0) {
-        fd = socket(AF_INET, SOCK_STREAM, 0);
-        sockaddr_in a{};
-        a.sin_family = AF_INET;
-        a.sin_port = htons(static_cast<uint16_t>(port_));
-        a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-        const timeval wait{0, 100000};
-        setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &wait, sizeof wait);
-        if (connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
-          close(fd), fd = -1;
-          std::this_thread::sleep_for(std::chrono::milliseconds(10));
-          continue;
-        }
-        at = 0;
-      }
-      const ssize_t n = send(fd, record_.data() + at, record_.size() - at, MSG_NOSIGNAL);
-      if (n > 0) {
-        at = (at + static_cast<size_t>(n)) % record_.size();
-      } else if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)) {
-        ++blocked_;
-      } else {
-        close(fd), fd = -1;
-        ++drops_;
-      }
-    }
-    if (fd >= 0) close(fd);
-  }
-  const int port_;
-  const std::vector<unsigned char> record_;
-  std::atomic<bool> stop_{false};
-  std::atomic<int> drops_{0}, blocked_{0};
-  std::thread thread_;
-};
 
 // Waits up to 10 s for `done`.
 bool WaitFor(const std::function<bool()>& done) {

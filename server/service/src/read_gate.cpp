@@ -63,7 +63,9 @@ int ReadGate::Prepare(std::vector<pollfd>* fds, int idle_ms, const std::set<int>
       waiting_.erase(p.fd);
       continue;
     }
-    Waiting& w = waiting_.emplace(p.fd, Waiting{now}).first->second;
+    // try_emplace: nothing is allocated for a connection already waiting (emplace made a node
+    // first), so that while memory runs out the turn goes on to read the others.
+    Waiting& w = waiting_.try_emplace(p.fd, Waiting{now}).first->second;
     if (w.closing) continue;  // shut down: its replies fail at once, so it may be read
     const double waited_s = std::chrono::duration<double>(now - w.since).count();
     if (waited_s >= stuck_limit_s_) {
