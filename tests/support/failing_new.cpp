@@ -1,10 +1,15 @@
 // Preloaded (LD_PRELOAD) into a process under test: while the file named by
 // FOOTFALL_FAIL_NEW_WHILE exists, every FOOTFALL_FAIL_NEW_EVERY-th C++ allocation (operator new,
 // in any thread) fails as it does when memory runs out: std::bad_alloc, or nullptr from the
-// nothrow forms. Checks that a process keeps its promises when memory runs short, anywhere.
+// nothrow forms. The file may hold a number K: the first K allocations after it appears succeed
+// (a test moves the first failure through a call). With FOOTFALL_FAIL_NEW_AFTER=N instead of a
+// file, failures start after the process's first N allocations (the same point at every run of a
+// single-threaded program: a sweep over N fails each allocation in turn). Checks that a process
+// keeps its promises when memory runs short, anywhere.
 #include <unistd.h>
 
 #include <atomic>
+#include <cstdio>
 #include <cstdlib>
 #include <new>
 
@@ -18,9 +23,34 @@ bool FailNow() {
     const long n = text ? std::atol(text) : 0;
     return n > 0 ? n : 1;
   }();
-  static std::atomic<unsigned long> count{0};
-  if (!flag || access(flag, F_OK) != 0) return false;
-  return count.fetch_add(1, std::memory_order_relaxed) % static_cast<unsigned long>(every) == 0;
+  static const long after = [] {
+    const char* text = std::getenv("FOOTFALL_FAIL_NEW_AFTER");
+    return text ? std::atol(text) : -1;
+  }();
+  static std::atomic<unsigned long> count{0}, made{0};
+  if (after >= 0) {
+    const unsigned long n = made.fetch_add(1, std::memory_order_relaxed);
+    if (n < static_cast<unsigned long>(after)) return false;
+    return (n - static_cast<unsigned long>(after)) % static_cast<unsigned long>(every) == 0;
+  }
+  static std::atomic<long> skip{0};
+  if (!flag || access(flag, F_OK) != 0) {
+    count.store(0, std::memory_order_relaxed);  // from the start again when the file comes back
+    return false;
+  }
+  const unsigned long n = count.fetch_add(1, std::memory_order_relaxed);
+  if (n == 0) {
+    // The file may hold a number: that many allocations succeed first.
+    long first = 0;
+    if (FILE* f = std::fopen(flag, "r")) {
+      if (std::fscanf(f, "%ld", &first) != 1) first = 0;
+      std::fclose(f);
+    }
+    skip.store(first, std::memory_order_relaxed);
+  }
+  const long first = skip.load(std::memory_order_relaxed);
+  if (static_cast<long>(n) < first) return false;
+  return (n - static_cast<unsigned long>(first)) % static_cast<unsigned long>(every) == 0;
 }
 
 void* Allocate(std::size_t size) {

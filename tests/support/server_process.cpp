@@ -37,6 +37,10 @@ ServerProcess::ServerProcess(int port, std::vector<std::string> extra_args, long
   if (pid_ == 0) {
     FILE* log = std::fopen(log_file.c_str(), "w");
     if (log) dup2(fileno(log), STDERR_FILENO);
+    // Only the standard streams go on: descriptors the test process holds (other tests'
+    // sockets, when a test binary runs many) would count against a server started under a
+    // descriptor limit.
+    close_range(3, ~0U, 0);
     if (max_open_files > 0) {
       const rlimit files{static_cast<rlim_t>(max_open_files), static_cast<rlim_t>(max_open_files)};
       if (setrlimit(RLIMIT_NOFILE, &files) != 0) _exit(126);

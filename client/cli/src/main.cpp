@@ -108,7 +108,14 @@ int Run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int status = Run(argc, argv);
+  int status = 1;
+  try {
+    status = Run(argc, argv);
+  } catch (const std::bad_alloc&) {
+    // Memory ran out setting the command line up (Run's own try covers the command's work).
+    std::fputs("footfall: out of memory\n", stderr);
+    return 1;
+  }
   // Output that could not be written (a full disk, a closed pipe) fails the command: `bench
   // --json > file` on a full disk left an empty file and exit 0. (`query` says so itself.)
   std::cout.flush();

@@ -79,7 +79,22 @@ bool ParseCommand(const std::string& text, size_t line, Command* out) {
   return true;
 }
 
-nlohmann::ordered_json Vec(const Vec3& v) { return nlohmann::ordered_json::array({v.x, v.y, v.z}); }
+// One JSON scalar (a number, a string, a boolean) as nlohmann writes it, bytes that are not
+// UTF-8 replaced. Answer lines are built from scalars: a JSON value with children allocates as
+// it is destroyed (nlohmann), so memory running out there ended the run with an abort, its
+// answers lost; a failure building a line is now an error like any other.
+template <typename T>
+std::string Scalar(const T& value) {
+  return nlohmann::json(value).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+std::string VecText(const Vec3& v) {
+  return "[" + Scalar(v.x) + "," + Scalar(v.y) + "," + Scalar(v.z) + "]";
+}
+
+std::string ErrorLine(size_t line, const std::string& message) {
+  return "{\"op\":\"error\",\"line\":" + Scalar(line) + ",\"message\":" + Scalar(message) + "}";
+}
 
 // Runs a block of commands (batching each kind) and prints one line per command, in order.
 bool RunBlock(TerrainSession& session, TerrainHandle terrain, double tolerance,
@@ -112,9 +127,9 @@ bool RunBlock(TerrainSession& session, TerrainHandle terrain, double tolerance,
   bool ok = true;
   size_t snap_at = 0, normal_at = 0, step_at = 0;
   for (const Command& c : block) {
-    nlohmann::ordered_json j;
+    std::string j;
     if (!c.error.empty()) {
-      j = {{"op", "error"}, {"line", c.line}, {"message", c.error}};
+      j = ErrorLine(c.line, c.error);
       ok = false;
     } else {
       const QueryOp op = c.query.op;
@@ -124,32 +139,27 @@ bool RunBlock(TerrainSession& session, TerrainHandle terrain, double tolerance,
       const Foothold& f = op == QueryOp::kNext     ? step_answers[step_at++]
                           : op == QueryOp::kNormal ? normal_answers[normal_at++]
                                                    : snap_answers[snap_at++];
+      const std::string op_text = "{\"op\":" + Scalar(QueryOpName(op));
       if (call != Status::kOk) {
         const std::string& why = op == QueryOp::kNext     ? step_error
                                  : op == QueryOp::kNormal ? normal_error
                                                           : snap_error;
-        j = {{"op", "error"}, {"line", c.line}, {"message", why}};
+        j = ErrorLine(c.line, why);
         ok = false;
       } else if (f.status == Status::kOk) {
-        j = {{"op", QueryOpName(c.query.op)},
-             {"found", true},
-             {"index", f.index},
-             {"point", Vec(f.point)},
-             {"normal", Vec(f.normal)}};
+        j = op_text + ",\"found\":true,\"index\":" + Scalar(f.index) +
+            ",\"point\":" + VecText(f.point) + ",\"normal\":" + VecText(f.normal) + "}";
       } else if (f.status == Status::kNoFoothold) {
-        j = {{"op", QueryOpName(c.query.op)}, {"found", false}};
+        j = op_text + ",\"found\":false}";
       } else {
         const std::string why = f.status != Status::kInvalidArgument
                                     ? StatusName(f.status)
                                     : InvalidQueryReason(c.query.op);
-        j = {{"op", "error"},
-             {"line", c.line},
-             {"message", std::string(QueryOpName(c.query.op)) + ": " + why}};
+        j = ErrorLine(c.line, std::string(QueryOpName(op)) + ": " + why);
         ok = false;
       }
     }
-    // (Replacing bytes that are not UTF-8: a line holding one threw, and ended the run.)
-    std::cout << j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
+    std::cout << j << '\n';
   }
   std::cout.flush();
   return ok;

@@ -10,6 +10,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "commands.h"
@@ -414,22 +415,28 @@ void AddTerrainCommand(CLI::App& app, int* exit_code) {
   m->add_option("--radius", make->radius, "sphere: radius (it rests on y = 0)")
       ->check(FiniteAbove(0))
       ->capture_default_str();
-  // A flag of another kind's shape (--steps for flat) is refused, not ignored.
-  m->callback([m, make, exit_code] {
-    static const std::vector<std::pair<std::string, std::string>> kKinds = {
-        {"--seed", "blocks rocks hills"},
-        {"--steps", "stairs"},
-        {"--rise", "stairs"},
-        {"--run", "stairs"},
-        {"--width", "stairs ramp"},
-        {"--size", "blocks rocks flat hills"},
-        {"--max-height", "blocks"},
-        {"--amplitude", "rocks hills"},
-        {"--slope", "ramp"},
-        {"--length", "ramp"},
-        {"--radius", "sphere"}};
-    for (const auto& [flag, kinds] : kKinds) {
-      if (m->get_option(flag)->count() == 0) continue;
+  // A flag of another kind's shape (--steps for flat) is refused, not ignored. The options are
+  // found here by their long names, not with CLI11's get_option, which may not throw: memory
+  // running out within it ended the process.
+  const std::pair<const char*, const char*> kinds_of[] = {{"--seed", "blocks rocks hills"},
+                                                          {"--steps", "stairs"},
+                                                          {"--rise", "stairs"},
+                                                          {"--run", "stairs"},
+                                                          {"--width", "stairs ramp"},
+                                                          {"--size", "blocks rocks flat hills"},
+                                                          {"--max-height", "blocks"},
+                                                          {"--amplitude", "rocks hills"},
+                                                          {"--slope", "ramp"},
+                                                          {"--length", "ramp"},
+                                                          {"--radius", "sphere"}};
+  std::vector<std::tuple<const CLI::Option*, std::string, std::string>> shaped;
+  for (const CLI::Option* option : m->get_options())
+    for (const auto& [flag, kinds] : kinds_of)
+      for (const std::string& name : option->get_lnames())
+        if (name == flag + 2) shaped.emplace_back(option, flag, kinds);
+  m->callback([shaped, make, exit_code] {
+    for (const auto& [option, flag, kinds] : shaped) {
+      if (option->count() == 0) continue;
       if (std::istringstream words(kinds);
           std::find(std::istream_iterator<std::string>(words), std::istream_iterator<std::string>(),
                     make->kind) == std::istream_iterator<std::string>()) {

@@ -212,13 +212,18 @@ extern "C" {
 
 int ffc_abi_version(void) { return FFC_ABI_VERSION; }
 
+// Whether the last ffc_open_* on this thread ran out of memory (said by ffc_last_error(NULL)).
+static thread_local bool t_open_ran_out = false;
+
 ffc_session* ffc_open_embedded(void) {
   std::signal(SIGPIPE, SIG_IGN);
+  t_open_ran_out = false;
   try {
     auto s = std::make_unique<ffc_session>();  // freed if the session cannot be made
     s->session = footfall::MakeEmbeddedSession();
     return s.release();
   } catch (...) {
+    t_open_ran_out = true;
     return nullptr;
   }
 }
@@ -229,6 +234,7 @@ ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s) {
   // NaN, infinite either way, beyond any bound, or too short for any call to be answered.
   if (!std::isfinite(timeout_s) || timeout_s > kMaxTimeout) return nullptr;
   if (timeout_s > 0 && timeout_s < kMinTimeout) return nullptr;
+  t_open_ran_out = false;
   try {
     footfall::RpcOptions options;
     if (host && *host && !footfall::ParseHost(host, &options.host)) return nullptr;
@@ -238,6 +244,7 @@ ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s) {
     s->session = footfall::MakeRpcSession(options);
     return s.release();
   } catch (...) {
+    t_open_ran_out = true;
     return nullptr;
   }
 }
@@ -245,7 +252,9 @@ ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s) {
 void ffc_close(ffc_session* session) { delete session; }
 
 const char* ffc_last_error(const ffc_session* session) {
-  if (!session) return "no session";
+  if (!session)
+    return t_open_ran_out ? "no session (the last ffc_open_* on this thread ran out of memory)"
+                          : "no session";
   // The calling thread's copy: another thread's call may replace the session's meanwhile.
   thread_local std::string copy;
   try {

@@ -111,8 +111,9 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
                       std::string* error) {
   Reader r;
   r.source = source;
-  json j;
-  if (!detail::ParseJsonText(text, source, &j, error)) return Status::kParseError;
+  detail::JsonDocument document;
+  json& j = document.value;
+  if (!detail::ParseJsonText(text, source, &document, error)) return Status::kParseError;
   if (!j.is_object()) {
     *error = source + ": not a JSON object (expected a footfall character file)";
     return Status::kParseError;

@@ -50,8 +50,10 @@ Status ParseGenerateRequest(const std::string& text, Character* character, Gener
   // Nesting deeper than any request needs is refused: serialising the character object again
   // (below) recurses once per level, and a plugin thread's stack is small.
   constexpr int kMaxDepth = 32;
-  json j;
-  if (!detail::ParseJsonText(text, "request", &j, error, kMaxDepth)) return Status::kParseError;
+  detail::JsonDocument document;
+  json& j = document.value;
+  if (!detail::ParseJsonText(text, "request", &document, error, kMaxDepth))
+    return Status::kParseError;
   return detail::ReadGenerateRequest(j, "request", "", {}, {}, character, options, nullptr, error);
 }
 

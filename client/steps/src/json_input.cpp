@@ -72,7 +72,53 @@ size_t RepeatedKeyAt(const std::string& text) {
 
 }  // namespace
 
-bool ParseJsonText(const std::string& text, const std::string& source, json* out,
+namespace {
+
+bool HasChildren(const json& j) { return (j.is_array() || j.is_object()) && !j.empty(); }
+
+json& LastChild(json& j) { return j.is_array() ? j.back() : std::prev(j.end()).value(); }
+
+// Removes the last child of `j` (one without children: destroyed without allocating).
+void DropLastChild(json* j) {
+  if (j->is_array())
+    j->get_ref<json::array_t&>().pop_back();
+  else
+    j->get_ref<json::object_t&>().erase(std::prev(j->get_ref<json::object_t&>().end()));
+}
+
+}  // namespace
+
+void JsonDocument::ReserveDepth(size_t depth) {
+  if (path_.capacity() < depth + 2) path_.reserve(2 * (depth + 2));
+}
+
+void JsonDocument::Release() noexcept {
+  path_.clear();
+  if (HasChildren(value)) path_.push_back(&value);  // room reserved at construction
+  while (!path_.empty()) {
+    json* node = path_.back();
+    if (!HasChildren(*node)) {
+      path_.pop_back();  // emptied: its parent drops it next
+      continue;
+    }
+    json* last = &LastChild(*node);
+    if (!HasChildren(*last)) {
+      DropLastChild(node);
+      continue;
+    }
+    if (path_.size() < path_.capacity()) {
+      path_.push_back(last);
+      continue;
+    }
+    // Deeper than reserved: down the last children from here to one whose last child has none,
+    // which goes.
+    while (HasChildren(LastChild(*last))) last = &LastChild(*last);
+    DropLastChild(last);
+  }
+  value = nullptr;
+}
+
+bool ParseJsonText(const std::string& text, const std::string& source, JsonDocument* document,
                    std::string* error, int max_depth, const JsonFilter& filter) {
   // UTF-16 and UTF-32 text are named as such (their NUL bytes are not a stray byte).
   const std::string wide = WideTextProblem(text);
@@ -92,6 +138,8 @@ bool ParseJsonText(const std::string& text, const std::string& source, json* out
   std::vector<std::set<std::string>> keys;
   auto check = [&](int depth, json::parse_event_t event, json& parsed) {
     too_deep |= max_depth > 0 && depth > max_depth;
+    if (event == json::parse_event_t::object_start || event == json::parse_event_t::array_start)
+      document->ReserveDepth(static_cast<size_t>(depth) + 1);
     if (event == json::parse_event_t::object_start) {
       keys.emplace_back();
     } else if (event == json::parse_event_t::object_end) {
@@ -105,7 +153,14 @@ bool ParseJsonText(const std::string& text, const std::string& source, json* out
   // Numbers read as written whatever the host program's locale (a Pashto decimal point).
   const CLocaleScope c_locale;
   try {
-    *out = json::parse(text, check);  // nlohmann skips a leading UTF-8 byte order mark
+    // Parsed straight into the document (nlohmann's parse builds it in a value of its own,
+    // destroyed by its destructor when parsing throws). nlohmann skips a leading UTF-8 byte
+    // order mark.
+    document->Release();
+    json* out = &document->value;
+    nlohmann::detail::json_sax_dom_callback_parser<json> builder(*out, check, true);
+    json::sax_parse(text, &builder);
+    if (out->is_discarded()) *out = nullptr;  // the whole document left out by the filter
   } catch (const json::parse_error& e) {
     // e.what() is "[json.exception.parse_error.101] parse error at line L, column C: WHAT".
     std::string what = e.what();

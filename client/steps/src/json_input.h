@@ -7,6 +7,7 @@
 #include <functional>
 #include <set>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -14,10 +15,35 @@
 
 namespace footfall::detail {
 
-// Parses `text` (a leading UTF-8 byte order mark is skipped) into *out. On malformed JSON returns
-// false with "SOURCE:LINE:COLUMN: malformed JSON: WHAT" in *error, LINE and COLUMN (1-based,
-// column in bytes) locating the last byte the parser read. Also refused, as malformed: a NUL
-// byte, a number beyond the range of a double, a key repeated within one object, and (when
+// A parsed JSON document, released from its deepest values up when it goes, allocating nothing:
+// nlohmann's destructor of a value with children allocates (a list of them), and an exception
+// from a destructor ends the process, so a document destroyed while memory ran out aborted the
+// program, or the host of the C ABI. Parse into one with ParseJsonText, so that memory running
+// out while it is parsed or read is an error, not an abort.
+class JsonDocument {
+ public:
+  nlohmann::json value;
+
+  JsonDocument() { path_.reserve(16); }
+  ~JsonDocument() { Release(); }
+  JsonDocument(const JsonDocument&) = delete;
+  JsonDocument& operator=(const JsonDocument&) = delete;
+
+  // Makes room to release `value` nested `depth` levels deep in time linear in its size (a
+  // deeper one is released all the same, the levels beyond in time proportional to their
+  // depth). Throws std::bad_alloc, unchanged, when memory runs out.
+  void ReserveDepth(size_t depth);
+  // Empties `value` (null), allocating nothing, recursing not at all.
+  void Release() noexcept;
+
+ private:
+  std::vector<nlohmann::json*> path_;  // the values from `value` down to the one being emptied
+};
+
+// Parses `text` (a leading UTF-8 byte order mark is skipped) into out->value. On malformed
+// JSON returns false with "SOURCE:LINE:COLUMN: malformed JSON: WHAT" in *error, LINE and COLUMN
+// (1-based, column in bytes) locating the last byte the parser read. Also refused, as malformed: a
+// NUL byte, a number beyond the range of a double, a key repeated within one object, and (when
 // max_depth > 0) nesting deeper than max_depth.
 //
 // `filter`, when given, sees every parse event after those checks, as nlohmann's parser callback
@@ -25,7 +51,7 @@ namespace footfall::detail {
 // reader can take values as they are parsed, rather than hold the whole document.
 using JsonFilter =
     std::function<bool(int depth, nlohmann::json::parse_event_t event, nlohmann::json& parsed)>;
-bool ParseJsonText(const std::string& text, const std::string& source, nlohmann::json* out,
+bool ParseJsonText(const std::string& text, const std::string& source, JsonDocument* out,
                    std::string* error, int max_depth = 0, const JsonFilter& filter = nullptr);
 
 // Reads the whole of the file at `path` into *text, after CheckInputFile (a regular file);

@@ -16,8 +16,9 @@ Status ParseScene(const std::string& text, const std::string& source, const std:
                   std::vector<SceneCharacter>* out, std::string* error) {
   // Nesting as deep as a request's (a character object inside a scene's list).
   constexpr int kMaxDepth = 34;
-  nlohmann::json j;
-  if (!detail::ParseJsonText(text, source, &j, error, kMaxDepth)) return Status::kParseError;
+  detail::JsonDocument document;
+  nlohmann::json& j = document.value;
+  if (!detail::ParseJsonText(text, source, &document, error, kMaxDepth)) return Status::kParseError;
   auto fail = [&](Status status, const std::string& what) {
     *error = source + ": " + what;
     return status;

@@ -306,11 +306,13 @@ class KeyStream {
 // Parses walk JSON; `stream` takes the keys as they are parsed (KeyStream).
 Status ParseWalk(const std::string& text, const std::string& source, Walk* out, std::string* error,
                  bool stream) {
-  json j;
+  detail::JsonDocument document;
+  json& j = document.value;
   KeyStream keys(source);
   try {
     const detail::JsonFilter filter = stream ? detail::JsonFilter(std::ref(keys)) : nullptr;
-    if (!detail::ParseJsonText(text, source, &j, error, 0, filter)) return Status::kParseError;
+    if (!detail::ParseJsonText(text, source, &document, error, 0, filter))
+      return Status::kParseError;
   } catch (const KeyStream::Restart&) {
     return ParseWalk(text, source, out, error, false);
   }

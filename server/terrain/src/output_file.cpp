@@ -14,6 +14,7 @@
 #include <cstring>
 #include <filesystem>
 #include <mutex>
+#include <new>
 #include <thread>
 
 #include "footfall/terrain/process_start.h"
@@ -119,8 +120,10 @@ void RemoveTemporariesAndReraise(int signal_number) {
   std::raise(signal_number);
 }
 
-// The signals RemoveTemporaryFileOnSignal handles, held back while a set is replaced.
-constexpr int kCleanedUpSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
+// The signals RemoveTemporaryFileOnSignal handles, held back while a set is replaced. SIGABRT
+// too: a library that aborts (tinygltf's assertions when memory runs out as it serialises)
+// left the temporary files of every output written so far.
+constexpr int kCleanedUpSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGABRT};
 
 // Makes the rename of a file in `dir` ("" for the working directory) reach the disk with its
 // directory (best effort: the file is written).
@@ -228,14 +231,25 @@ std::vector<std::string> OutputFileSet::Commit() {
   for (int signal_number : kCleanedUpSignals) sigaddset(&held, signal_number);
   pthread_sigmask(SIG_BLOCK, &held, &before);  // (signals taken on other threads wait too)
   g_committing.store(true);
-  for (const auto& file : state_->waiting) {
-    if (::rename(file->temporary.c_str(), file->target.c_str()) != 0) {
-      std::string message;
-      Fail("cannot write", file->path, errno, &message);
-      failures.push_back(message);
-      ::unlink(file->temporary.c_str());
+  try {
+    for (const auto& file : state_->waiting) {
+      if (::rename(file->temporary.c_str(), file->target.c_str()) != 0) {
+        const int why = errno;
+        ::unlink(file->temporary.c_str());
+        FreeTemporarySlot(file->slot);
+        file->slot = -1;
+        std::string message;
+        Fail("cannot write", file->path, why, &message);
+        failures.push_back(message);
+      }
+      FreeTemporarySlot(file->slot);
+      file->slot = -1;
     }
-    FreeTemporarySlot(file->slot);
+  } catch (...) {
+    // Memory ran out describing a failure: the signal handler may not wait for ever.
+    g_committing.store(false);
+    pthread_sigmask(SIG_SETMASK, &before, nullptr);
+    throw;
   }
   g_committing.store(false);
   pthread_sigmask(SIG_SETMASK, &before, nullptr);
@@ -343,15 +357,26 @@ Status ReplaceFile(const std::string& path, const std::function<bool(std::FILE*)
     ::close(fd);
     return abandon(why);
   }
+  // In an open set (with a slot for the signal handler), replaced at its Commit. Its place in
+  // the set is made before the file is written: memory running out once it was written left the
+  // temporary file behind.
+  const bool in_set = t_open_set != nullptr && slot >= 0;
+  if (in_set) {
+    try {
+      waiting->path = path;
+      waiting->target = target;
+      waiting->dir = dir;
+      waiting->slot = slot;
+      t_open_set->waiting.reserve(t_open_set->waiting.size() + 1);
+    } catch (const std::bad_alloc&) {
+      std::fclose(file);
+      return abandon(ENOMEM);
+    }
+  }
   const int failure = WriteAndClose(file, write);
   if (failure != 0) return abandon(failure);
-  // In an open set (with a slot for the signal handler), replaced at its Commit.
-  if (t_open_set != nullptr && slot >= 0) {
-    waiting->path = path;
-    waiting->target = target;
-    waiting->dir = dir;
-    waiting->slot = slot;
-    t_open_set->waiting.push_back(std::move(waiting));
+  if (in_set) {
+    t_open_set->waiting.push_back(std::move(waiting));  // room made above
     return Status::kOk;
   }
   if (::rename(temp.c_str(), target.c_str()) != 0) return abandon(errno);

@@ -53,7 +53,8 @@ typedef struct {
  * or promise changes; functions added later keep it (a caller finds them by name). */
 int ffc_abi_version(void);
 
-/* Opens the in-process engine. Never NULL. */
+/* Opens the in-process engine. NULL only when memory runs out (ffc_last_error(NULL) then says
+ * so, on this thread). */
 ffc_session* ffc_open_embedded(void);
 /* Opens a footfalld client; it connects lazily (the first call may return FF_C_UNAVAILABLE).
  * host NULL means 127.0.0.1; timeout_s <= 0 means 10 s per call. A host name is looked up
@@ -61,7 +62,8 @@ ffc_session* ffc_open_embedded(void);
  * literal IPv4 or IPv6 address needs no lookup; an IPv6 address may be in brackets ("[::1]").
  * NULL only on bad arguments: a host holding a port ("127.0.0.1:7407") or stray brackets, a
  * port outside 1-65535, a timeout above 1e6 s, infinite or NaN, or one above 0 but below
- * 0.001 s (as footfall's --timeout: no call could be answered in it). */
+ * 0.001 s (as footfall's --timeout: no call could be answered in it); or when memory runs out
+ * (ffc_last_error(NULL) then says so, on this thread). */
 ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s);
 /* Frees the session and its terrains (an RPC session unloads them from footfalld while it is
  * connected, waiting at most 2 s per terrain): the pointer is invalid afterwards (closing it

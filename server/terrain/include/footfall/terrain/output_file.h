@@ -70,9 +70,10 @@ class OutputFileSet {
   std::unique_ptr<State> state_;
 };
 
-// For programs (not libraries: it sets process-wide signal handlers): SIGINT, SIGTERM, SIGHUP and
-// SIGQUIT remove the temporary file being written before the process ends as they would end
-// it (those ignored when the program started, as under nohup, stay ignored), and SIGXFSZ is
+// For programs (not libraries: it sets process-wide signal handlers): SIGINT, SIGTERM, SIGHUP,
+// SIGQUIT and SIGABRT (an abort, as a library's failed assertion) remove the temporary files
+// being written or waiting in a set before the process ends as they would end it (those ignored
+// when the program started, as under nohup, stay ignored), and SIGXFSZ is
 // ignored, so that a write past the file size limit fails with a message. A thread of its own,
 // when one can start, takes those signals while the others block them (libtirpc blocks every
 // signal during an RPC call), so that they end the process at once.
