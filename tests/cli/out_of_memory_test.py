@@ -83,6 +83,9 @@ def sweep(name, args, start, stdin=b"", outputs=(), may_abort=False):
                         os.remove(os.path.join(cwd, f))
                 if p.returncode != baseline.returncode and not aborted(p) and not p.stderr.strip():
                     failures.append("%s: exit %d without a message" % (what, p.returncode))
+                for line in p.stderr.decode(errors="replace").splitlines():
+                    if ": footfall: " in line:  # a message cut by another failure
+                        failures.append("%s: a line begun twice: %s" % (what, line))
                 # Each output is its previous file or the whole new one (an output that fails
                 # leaves its file; the others are written).
                 for out in outputs:

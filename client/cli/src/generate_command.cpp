@@ -13,6 +13,7 @@
 #include <iomanip>
 #include <iostream>
 #include <mutex>
+#include <new>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -708,7 +709,13 @@ int RunGenerate(const GenerateFlags& flags) {
     status = GenerateWalk(*terrain.session, terrain.handle, character, options, &walk, &error);
   } catch (const std::bad_alloc&) {
     bar.Finish();
-    std::cerr << "footfall generate: " << OutOfMemoryMessage(flags, options, character) << '\n';
+    // The message is made before anything is written: memory may run out making it too.
+    std::string message = "out of memory generating the walk; nothing was written";
+    try {
+      message = OutOfMemoryMessage(flags, options, character);
+    } catch (const std::bad_alloc&) {
+    }
+    std::cerr << "footfall generate: " << message << '\n';
     return 1;
   }
   bar.Finish();
