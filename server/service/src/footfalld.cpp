@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <new>
 #include <string>
 #include <system_error>
 #include <thread>
@@ -151,7 +152,10 @@ static void RaiseOpenFileLimit() {
                  static_cast<unsigned long long>(limit.rlim_cur));
 }
 
-int main(int argc, char** argv) {
+namespace {
+
+// footfalld's work, from its command line to its stop; its exit status.
+int Serve(int argc, char** argv) {
   // Sockets and files opened later never take descriptor 0, 1 or 2 (with all three closed,
   // the log went into the first client's connection, which then hung).
   footfall::OpenClosedStandardStreams();
@@ -289,4 +293,17 @@ int main(int argc, char** argv) {
     std::_Exit(0);
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return Serve(argc, argv);
+  } catch (const std::bad_alloc&) {
+    // Memory ran out starting (its command line, its lists, its threads' records): said, not
+    // an abort. Once serving, the loop and the dispatcher answer memory running out themselves.
+    std::fputs("footfalld: error: out of memory; stopped\n", stderr);
+    return 1;
+  }
 }
