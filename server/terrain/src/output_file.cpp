@@ -236,11 +236,12 @@ std::vector<std::string> OutputFileSet::Commit() {
       if (::rename(file->temporary.c_str(), file->target.c_str()) != 0) {
         const int why = errno;
         ::unlink(file->temporary.c_str());
-        FreeTemporarySlot(file->slot);
+        FreeTemporarySlot(file->slot);  // before the message, which may run out of memory
         file->slot = -1;
         std::string message;
         Fail("cannot write", file->path, why, &message);
         failures.push_back(message);
+        continue;
       }
       FreeTemporarySlot(file->slot);
       file->slot = -1;

@@ -46,8 +46,8 @@ bool SameFile(const std::string& a, const std::string& b);
 
 // Files replaced together, such as one walk's outputs: while a set is open on a thread, each
 // ReplaceFile there writes its new content to its temporary file and leaves the target as it
-// was; Commit then replaces all of them, one rename after another with SIGINT, SIGTERM, SIGHUP
-// and SIGQUIT held back until the last (on this thread, and RemoveTemporaryFileOnSignal's
+// was; Commit then replaces all of them, one rename after another with SIGINT, SIGTERM, SIGHUP,
+// SIGQUIT and SIGABRT held back until the last (on this thread, and RemoveTemporaryFileOnSignal's
 // handler waits for the renames on any other), so that such a signal (Ctrl-C) leaves either
 // every old file or every new one, never a mix. Files written in place (devices, FIFOs, see above)
 // are written at once, and so is any file past the 256th waiting at a time. A set closed without
