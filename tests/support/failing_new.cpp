@@ -4,8 +4,12 @@
 // nothrow forms. The file may hold a number K: the first K allocations after it appears succeed
 // (a test moves the first failure through a call). With FOOTFALL_FAIL_NEW_AFTER=N instead of a
 // file, failures start after the process's first N allocations (the same point at every run of a
-// single-threaded program: a sweep over N fails each allocation in turn). Checks that a process
-// keeps its promises when memory runs short, anywhere.
+// single-threaded program: a sweep over N fails each allocation in turn). With
+// FOOTFALL_FAIL_NEW_IN_MAIN=1 too, N counts from the moment main is called: the static
+// constructors before it (libraries', where a failure ends any program) neither fail nor count, so
+// the same N names the same allocation of the program's own startup whatever they make. Checks
+// that a process keeps its promises when memory runs short, anywhere.
+#include <dlfcn.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -14,6 +18,17 @@
 #include <new>
 
 namespace {
+
+using MainFunction = int (*)(int, char**, char**);
+MainFunction g_main = nullptr;
+std::atomic<bool> g_in_main{false};
+std::atomic<unsigned long> g_made{0};  // allocations counted (FOOTFALL_FAIL_NEW_AFTER)
+
+// The program's main, after marking that it runs (FOOTFALL_FAIL_NEW_IN_MAIN counts from here).
+int CountedMain(int argc, char** argv, char** envp) {
+  g_in_main.store(true);
+  return g_main(argc, argv, envp);
+}
 
 // Whether this allocation fails. Reads the environment once; makes no C++ allocation.
 bool FailNow() {
@@ -27,9 +42,14 @@ bool FailNow() {
     const char* text = std::getenv("FOOTFALL_FAIL_NEW_AFTER");
     return text ? std::atol(text) : -1;
   }();
-  static std::atomic<unsigned long> count{0}, made{0};
+  static const bool in_main_only = [] {
+    const char* text = std::getenv("FOOTFALL_FAIL_NEW_IN_MAIN");
+    return text && text[0] == '1';
+  }();
+  static std::atomic<unsigned long> count{0};
   if (after >= 0) {
-    const unsigned long n = made.fetch_add(1, std::memory_order_relaxed);
+    if (in_main_only && !g_in_main.load()) return false;
+    const unsigned long n = g_made.fetch_add(1, std::memory_order_relaxed);
     if (n < static_cast<unsigned long>(after)) return false;
     return (n - static_cast<unsigned long>(after)) % static_cast<unsigned long>(every) == 0;
   }
@@ -66,6 +86,20 @@ void* AllocateAligned(std::size_t size, std::align_val_t align) {
 }
 
 }  // namespace
+
+// Interposed on the C library's (which every dynamically linked program's entry calls with its
+// main): hands it CountedMain instead.
+extern "C" int __libc_start_main(MainFunction main, int argc, char** argv, void (*init)(),
+                                 void (*fini)(), void (*rtld_fini)(), void* stack_end) {
+  using Start = int (*)(MainFunction, int, char**, void (*)(), void (*)(), void (*)(), void*);
+  const auto start = reinterpret_cast<Start>(dlsym(RTLD_NEXT, "__libc_start_main"));
+  if (!start) {
+    std::fputs("failing_new: no __libc_start_main to call\n", stderr);
+    std::_Exit(127);
+  }
+  g_main = main;
+  return start(CountedMain, argc, argv, init, fini, rtld_fini, stack_end);
+}
 
 void* operator new(std::size_t size) {
   if (void* p = Allocate(size)) return p;

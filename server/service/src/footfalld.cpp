@@ -2,6 +2,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -107,6 +108,19 @@ CLI::Validator NonEmptyPath(const char* what) {
       "");
 }
 
+// --data-root's check: a folder that exists. (CLI11's ExistingDirectory looks the path up in a
+// function that may not throw: memory running out there was an abort.)
+CLI::Validator ExistingFolder() {
+  return CLI::Validator(
+      [](std::string& input) -> std::string {
+        struct stat st;
+        if (stat(input.c_str(), &st) != 0)
+          return "'" + input + "': no such folder (" + std::strerror(errno) + ")";
+        return S_ISDIR(st.st_mode) ? std::string() : "'" + input + "' is not a folder";
+      },
+      "DIR");
+}
+
 // --max-samples: a whole number of samples up to 1e12 (CLI11 took "-5" for a huge budget).
 CLI::Validator SampleCount() {
   return CLI::Validator(
@@ -171,16 +185,19 @@ int Serve(int argc, char** argv) {
   app.add_option("--data-root", options.data_root,
                  "Directory that confines server-side terrain loads (none: refused)")
       ->check(NonEmptyPath("a folder"))
-      ->check(CLI::ExistingDirectory);
+      ->check(ExistingFolder());
   app.add_flag("--no-rpcbind", no_rpcbind, "Do not register with rpcbind");
   options.batch_threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   app.add_option("--threads", options.batch_threads,
                  "Threads per batch query (default: the hardware's cores)")
       ->check(WholeRange(1, 64));
-  app.add_option("--max-samples", options.limits.max_total_samples,
-                 "Samples held over all terrains and uploads (default 268435456, 2^28, or what "
-                 "memory holds at 100 bytes per sample)")
-      ->transform(SampleCount());
+  // (Its count is asked of the option itself: App::count looks the name up in a function that
+  // may not throw, so memory running out there was an abort.)
+  const CLI::Option* max_samples =
+      app.add_option("--max-samples", options.limits.max_total_samples,
+                     "Samples held over all terrains and uploads (default 268435456, 2^28, or what "
+                     "memory holds at 100 bytes per sample)")
+          ->transform(SampleCount());
   app.add_option("--orphan-timeout", options.limits.orphan_idle_s,
                  "Seconds without queries after which a terrain whose connection has closed is "
                  "freed (default 600)")
@@ -242,7 +259,7 @@ int Serve(int argc, char** argv) {
     std::fprintf(stderr, "footfalld: warning: server-side loads will fail: %s\n", error.c_str());
   // The default budget, lowered to what this machine's memory holds: a finished upload peaks
   // near 100 bytes per sample (its samples and its grid at once).
-  if (app.count("--max-samples") == 0) {
+  if (max_samples->count() == 0) {
     constexpr double kPeakBytesPerSample = 100;
     const double fits = footfall::UsableMemoryBytes() / kPeakBytesPerSample;
     if (fits > 0 && fits < static_cast<double>(options.limits.max_total_samples)) {
@@ -264,11 +281,13 @@ int Serve(int argc, char** argv) {
         return WritePortFile(port_file, port, message);
       };
     footfall::RpcServer server(options);
-    if (!server.Start(&error)) {
-      std::fprintf(stderr, "footfalld: %s\n", error.c_str());
-      return 1;
-    }
+    // The stop signals are handled before Start registers with rpcbind and says it listens: a
+    // supervisor that stops footfalld as soon as it reads that line killed it, still registered.
+    // (Stopped while starting, it starts, then stops at once.)
     g_server = &server;
+    struct Unset {  // before the server is destroyed, whichever way this block is left
+      ~Unset() { g_server = nullptr; }
+    } unset;
     struct sigaction action {};
     action.sa_handler = OnStopSignal;  // no SA_RESTART: poll returns EINTR at once
     sigaction(SIGTERM, &action, nullptr);
@@ -276,12 +295,14 @@ int Serve(int argc, char** argv) {
     // it started (`nohup footfalld`, a background job of a script): those keep serving.
     for (const int signal_number : {SIGINT, SIGHUP})
       if (!footfall::SignalIgnored(signal_number)) sigaction(signal_number, &action, nullptr);
+    if (!server.Start(&error)) {
+      std::fprintf(stderr, "footfalld: %s\n", error.c_str());
+      return 1;
+    }
     server.Run();
-    g_server = nullptr;
     abandoned_load = server.abandoned_load();
   } catch (const std::system_error& e) {  // the server, destroyed, is unregistered
     // std::thread's failure to start one (ulimit -u, or memory for its stack).
-    g_server = nullptr;
     std::fprintf(stderr, "footfalld: %s\n", footfall::SystemErrorText(e).c_str());
     return 1;
   }

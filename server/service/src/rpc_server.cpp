@@ -43,6 +43,20 @@ constexpr size_t kMaxPartialRequests = 64;
 std::unique_ptr<PartialRequests> g_partial;
 DispatchFn g_dispatch = nullptr;
 
+// The serving loop's own lists, made by Start before it says it listens: a server that has
+// said so does not then stop for want of memory to begin serving.
+struct LoopState {
+  LoopState(size_t send_buffer, double unread_timeout_s) : gate(send_buffer, unread_timeout_s) {
+    ReserveAhead(&fds, 1);       // the least room, from the start: memory may run out before the
+    ReserveAhead(&readable, 1);  // first client comes
+    ReserveAhead(&held, 1);
+  }
+  ReadGate gate;
+  std::vector<pollfd> fds, readable;
+  std::vector<int> held;  // reused: a turn allocates nothing once its lists have grown
+};
+std::unique_ptr<LoopState> g_loop;
+
 // The dispatcher, noting which connections had a whole request.
 void NotedDispatch(svc_req* request, SVCXPRT* transport) {
   g_partial->Dispatched(transport->xp_fd);
@@ -200,6 +214,11 @@ bool RpcServer::Start(std::string* error) {
       rpcbind_note = "rpcbind is not running; clients connect by port";
     }
   }
+  // Everything that needs memory is made before on_bound: once the port file is written and the
+  // server has said it listens, starting cannot fail.
+  g_loop = std::make_unique<LoopState>(send_buffer_, options_.unread_timeout_s);
+  const std::string data_root_note =
+      options_.data_root.empty() ? "" : "footfalld: data root " + EscapeControl(options_.data_root);
   // Nothing says the server listens until on_bound has succeeded: a server that then exits was
   // never announced.
   if (options_.on_bound && !options_.on_bound(port_, error)) return false;
@@ -215,8 +234,7 @@ bool RpcServer::Start(std::string* error) {
                  port_);
   }
   if (!rpcbind_note.empty()) std::fprintf(stderr, "footfalld: %s\n", rpcbind_note.c_str());
-  if (!options_.data_root.empty())
-    std::fprintf(stderr, "footfalld: data root %s\n", EscapeControl(options_.data_root).c_str());
+  if (!data_root_note.empty()) std::fprintf(stderr, "%s\n", data_root_note.c_str());
   return true;
 }
 
@@ -241,12 +259,10 @@ void RpcServer::Stop() {
 }
 
 void RpcServer::Run() {
-  ReadGate gate(send_buffer_, options_.unread_timeout_s);
-  std::vector<pollfd> fds, readable;
-  std::vector<int> held;       // reused: a turn allocates nothing once its lists have grown
-  ReserveAhead(&fds, 1);       // the least room, from the start: memory may run out before the
-  ReserveAhead(&readable, 1);  // first client comes
-  ReserveAhead(&held, 1);
+  ReadGate& gate = g_loop->gate;
+  std::vector<pollfd>& fds = g_loop->fds;
+  std::vector<pollfd>& readable = g_loop->readable;
+  std::vector<int>& held = g_loop->held;
   auto last_expiry = std::chrono::steady_clock::now();
   // One turn of the loop: waits for sockets and finished loads, serves what is ready, and about
   // once a second expires what has idled. False when the loop must end (poll failed).

@@ -52,7 +52,8 @@ class RpcServer {
   bool Start(std::string* error);
   // The bound port (after Start).
   int port() const { return port_; }
-  // Serves until Stop() is called (from a signal handler or another thread).
+  // After Start succeeded: serves until Stop() is called (from a signal handler or another
+  // thread; also before Run, which then returns at once).
   void Run();
   // Async-signal-safe. When a batch is being answered, says (on stderr) that stopping waits for
   // it: a client that did not ask for batches in parts (FF_ASK_AGAIN) gets its whole batch.
