@@ -2,8 +2,11 @@
 #include <charconv>
 #include <cmath>
 #include <csignal>
+#include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <iostream>
+#include <new>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -37,9 +40,8 @@ bool ParseNumbers(const std::string& text, size_t count, std::vector<double>* ou
   return out->size() == count;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+// footfall-view's work, from its command line to its exit status.
+int View(int argc, char** argv) {
   footfall::OpenClosedStandardStreams();  // no file the viewer writes may take descriptor 1 or 2
   std::signal(SIGPIPE, SIG_IGN);
   footfall::RemoveTemporaryFileOnSignal();  // an interrupted write leaves no temporary file
@@ -144,10 +146,28 @@ int main(int argc, char** argv) {
   }
   try {
     return footfall::viewer::RunViewer(o);
+  } catch (const std::bad_alloc&) {
+    throw;  // said by main
   } catch (const std::exception& e) {
     // A last resort, as in `footfall`: every reader reports bad input itself; whatever escapes
     // still ends in a message and exit status 1, never an abort.
     std::cerr << "footfall-view: " << e.what() << '\n';
     return 1;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return View(argc, argv);
+  } catch (const std::bad_alloc&) {
+    // Memory ran out (its command line, a file, what it draws): said, not an abort. Ended
+    // without the libraries' exit handlers: memory running out within the OpenGL driver may
+    // leave it holding a lock that its own handler then waits on for ever. (Within the driver,
+    // llvmpipe's compiler may also end the process itself.)
+    std::fputs("footfall-view: error: out of memory; stopped\n", stderr);
+    std::fflush(nullptr);
+    std::_Exit(1);
   }
 }

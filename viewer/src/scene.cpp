@@ -9,8 +9,6 @@
 namespace footfall::viewer {
 namespace {
 
-using nlohmann::ordered_json;
-
 uint8_t Byte(double v) { return static_cast<uint8_t>(std::clamp(v, 0.0, 1.0) * 255.0 + 0.5); }
 
 Rgba NormalColor(const Vec3& n) {
@@ -35,11 +33,6 @@ Rgba HeightColor(double t) {
 // A world-space direction as a render-space vector (directions need no origin shift).
 glm::vec3 Direction(const Vec3& v) {
   return glm::vec3(static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z));
-}
-
-ordered_json Json(const Vec3& v) { return ordered_json::array({v.x, v.y, v.z}); }
-ordered_json Json(const glm::dvec2& v) {
-  return ordered_json::array({static_cast<float>(v.x), static_cast<float>(v.y)});
 }
 
 void Grow(const Vec3& p, Vec3* lo, Vec3* hi, bool* any) {
@@ -427,90 +420,119 @@ void Scene::Draw(const ViewState& view, DrawList* depth_tested, DrawList* on_top
   if (has_walk()) DrawWalk(view, on_top);
 }
 
-ordered_json Scene::Describe(const ViewState& view, const OrbitCamera& camera, int width,
-                             int height) const {
-  auto pixel = [&](const Vec3& world, ordered_json* j) {
+void Scene::Describe(const ViewState& view, const OrbitCamera& camera, int width, int height,
+                     const LiveSource* source, JsonText* out) const {
+  JsonText& j = *out;
+  auto vec3 = [&](const Vec3& v) {
+    j.BeginArray();
+    j.Value(v.x), j.Value(v.y), j.Value(v.z);
+    j.End();
+  };
+  auto pixel = [&](const Vec3& world) {
     glm::dvec2 px(0, 0);
     const bool front = camera.Project(ToRenderDouble(world), width, height, &px);
-    (*j)["pixel"] = Json(px);
-    (*j)["visible"] = front && px.x >= 0 && px.y >= 0 && px.x < width && px.y < height;
+    j.Key("pixel").BeginArray();
+    j.Value(static_cast<float>(px.x)), j.Value(static_cast<float>(px.y));
+    j.End();
+    j.Key("visible").Value(front && px.x >= 0 && px.y >= 0 && px.x < width && px.y < height);
   };
-  auto query_json = [&](const QueryView& q) {
-    ordered_json j;
-    j["query"] = FormatQueryText(q.spec);
-    j["op"] = QueryOpName(q.spec.op);
-    if (q.live) j["sequence"] = q.sequence;
-    if (q.spec.op == QueryOp::kNext) j["radius"] = RingRadius(q);
-    j["status"] = StatusName(q.result.status);
-    j["found"] = q.result.status == Status::kOk;
+  auto query = [&](const QueryView& q) {
+    j.BeginObject();
+    j.Key("query").Value(FormatQueryText(q.spec));
+    j.Key("op").Value(QueryOpName(q.spec.op));
+    if (q.live) j.Key("sequence").Value(static_cast<uint64_t>(q.sequence));
+    if (q.spec.op == QueryOp::kNext) j.Key("radius").Value(RingRadius(q));
+    j.Key("status").Value(StatusName(q.result.status));
+    j.Key("found").Value(q.result.status == Status::kOk);
     if (q.result.status == Status::kOk) {
-      j["index"] = q.result.index;
-      j["point"] = Json(q.result.point);
-      pixel(q.result.point, &j);
+      j.Key("index").Value(static_cast<uint64_t>(q.result.index));
+      j.Key("point"), vec3(q.result.point);
+      pixel(q.result.point);
     }
-    if (q.live) j["other_terrain"] = q.other_terrain;
-    j["traced"] = q.traced;
+    if (q.live) j.Key("other_terrain").Value(q.other_terrain);
+    j.Key("traced").Value(q.traced);
     if (q.traced) {
-      j["cells"] = q.trace.cells.size();
-      j["examined"] = q.trace.examined_samples.size();
-      j["candidates"] = q.trace.candidates.size();
+      j.Key("cells").Value(static_cast<uint64_t>(q.trace.cells.size()));
+      j.Key("examined").Value(static_cast<uint64_t>(q.trace.examined_samples.size()));
+      j.Key("candidates").Value(static_cast<uint64_t>(q.trace.candidates.size()));
     }
-    return j;
+    j.End();
   };
-  ordered_json root;
-  root["image"] = {{"width", width}, {"height", height}};
-  root["camera"] = {{"eye", Json(ToWorld(camera.eye()))},
-                    {"target", Json(ToWorld(camera.target()))},
-                    {"fov_y_degrees", OrbitCamera::kFovYDegrees}};
-  root["color_mode"] = view.color == ColorMode::kNormal ? "normal" : "height";
-  root["show_cells"] = view.show_cells;
+  j.Key("image").BeginObject();
+  j.Key("width").Value(width);
+  j.Key("height").Value(height);
+  j.End();
+  j.Key("camera").BeginObject();
+  j.Key("eye"), vec3(ToWorld(camera.eye()));
+  j.Key("target"), vec3(ToWorld(camera.target()));
+  j.Key("fov_y_degrees").Value(OrbitCamera::kFovYDegrees);
+  j.End();
+  j.Key("color_mode").Value(view.color == ColorMode::kNormal ? "normal" : "height");
+  j.Key("show_cells").Value(view.show_cells);
+  j.Key("terrain");
   if (has_terrain()) {
     const GridStats& st = grid_.stats();
-    root["terrain"] = {{"path", terrain_path_},
-                       {"samples", st.samples},
-                       {"bounds_min", Json(st.bounds_min)},
-                       {"bounds_max", Json(st.bounds_max)},
-                       {"occupied_cells", st.occupied_cells}};
+    j.BeginObject();
+    j.Key("path").Value(terrain_path_);
+    j.Key("samples").Value(static_cast<uint64_t>(st.samples));
+    j.Key("bounds_min"), vec3(st.bounds_min);
+    j.Key("bounds_max"), vec3(st.bounds_max);
+    j.Key("occupied_cells").Value(static_cast<uint64_t>(st.occupied_cells));
+    j.End();
   } else {
-    root["terrain"] = nullptr;
+    j.Null();
   }
-  root["queries"] = ordered_json::array();
-  for (const QueryView& q : queries_) root["queries"].push_back(query_json(q));
-  root["live"] = {{"received", live_received_}, {"queries", ordered_json::array()}};
-  for (const QueryView& q : live_) root["live"]["queries"].push_back(query_json(q));
-  if (has_walk()) {
-    ordered_json w;
-    w["path"] = walk_path_;
-    w["fps"] = walk_.fps;
-    w["frame"] = view.frame;
-    w["first_frame"] = first_frame_;
-    w["last_frame"] = last_frame_;
-    w["tracks"] = ordered_json::array();
-    size_t foot_index = 0;
-    for (const WalkTrack& t : walk_.tracks) {
-      if (t.keys.empty()) continue;
-      const TrackPose pose = PoseAt(t, view.frame);
-      ordered_json j;
-      j["name"] = t.name;
-      if (!t.character.empty()) j["character"] = t.character;  // a crowd's or a scene's
-      j["kind"] = t.kind == TrackKind::kFoot ? "foot" : "body";
-      j["position"] = Json(pose.position);
-      pixel(pose.position, &j);
-      if (t.kind == TrackKind::kFoot) {
-        const Rgba c = FootColor(foot_index++);
-        j["color"] = ordered_json::array({c.r, c.g, c.b});
-        j["swinging"] = pose.swinging;
-      } else {
-        const Quat& q = pose.rotation;
-        j["rotation"] = ordered_json::array({q.x, q.y, q.z, q.w});
-      }
-      w["tracks"].push_back(j);
+  j.Key("queries").BeginArray();
+  for (const QueryView& q : queries_) query(q);
+  j.End();
+  j.Key("live").BeginObject();
+  j.Key("received").Value(static_cast<uint64_t>(live_received_));
+  j.Key("queries").BeginArray();
+  for (const QueryView& q : live_) query(q);
+  j.End();
+  if (source) {
+    j.Key("server").Value(source->address);
+    j.Key("after").Value(source->after);
+  }
+  j.End();
+  j.Key("walk");
+  if (!has_walk()) {
+    j.Null();
+    return;
+  }
+  j.BeginObject();
+  j.Key("path").Value(walk_path_);
+  j.Key("fps").Value(walk_.fps);
+  j.Key("frame").Value(view.frame);
+  j.Key("first_frame").Value(first_frame_);
+  j.Key("last_frame").Value(last_frame_);
+  j.Key("tracks").BeginArray();
+  size_t foot_index = 0;
+  for (const WalkTrack& t : walk_.tracks) {
+    if (t.keys.empty()) continue;
+    const TrackPose pose = PoseAt(t, view.frame);
+    j.BeginObject();
+    j.Key("name").Value(t.name);
+    if (!t.character.empty()) j.Key("character").Value(t.character);  // a crowd's or a scene's
+    j.Key("kind").Value(t.kind == TrackKind::kFoot ? "foot" : "body");
+    j.Key("position"), vec3(pose.position);
+    pixel(pose.position);
+    if (t.kind == TrackKind::kFoot) {
+      const Rgba c = FootColor(foot_index++);
+      j.Key("color").BeginArray();
+      j.Value(c.r), j.Value(c.g), j.Value(c.b);
+      j.End();
+      j.Key("swinging").Value(pose.swinging);
+    } else {
+      const Quat& q = pose.rotation;
+      j.Key("rotation").BeginArray();
+      j.Value(q.x), j.Value(q.y), j.Value(q.z), j.Value(q.w);
+      j.End();
     }
-    root["walk"] = w;
-  } else {
-    root["walk"] = nullptr;
+    j.End();
   }
-  return root;
+  j.End();
+  j.End();
 }
 
 }  // namespace footfall::viewer

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <exception>
 #include <fstream>
 #include <iostream>
 #include <mutex>
@@ -336,18 +337,24 @@ struct App {
 
   bool WriteDump(int width, int height) {
     if (options.dump_state.empty()) return true;
-    nlohmann::ordered_json j = scene.Describe(view, camera, width, height);
-    j["hud"] = nlohmann::ordered_json::array();
-    for (const HudLine& l : hud_lines)
-      j["hud"].push_back({{"text", l.text}, {"x", l.x}, {"y", l.y}, {"width", l.width}});
-    if (live) {
-      j["live"]["server"] = live->Address();
-      j["live"]["after"] = live->start_after();
+    Scene::LiveSource source;
+    if (live) source.address = live->Address(), source.after = live->start_after();
+    JsonText j;
+    j.BeginObject();
+    scene.Describe(view, camera, width, height, live ? &source : nullptr, &j);
+    j.Key("hud").BeginArray();
+    for (const HudLine& l : hud_lines) {
+      j.BeginObject();
+      j.Key("text").Value(l.text);
+      j.Key("x").Value(l.x);
+      j.Key("y").Value(l.y);
+      j.Key("width").Value(l.width);
+      j.End();
     }
+    j.End();
+    j.End();
     std::string message;
-    if (ReplaceFile(options.dump_state,
-                    j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + '\n',
-                    &message) != Status::kOk) {
+    if (ReplaceFile(options.dump_state, j.text() + '\n', &message) != Status::kOk) {
       Fail(options.dump_state + ": cannot write the state dump: " + message);
       return false;
     }
@@ -667,10 +674,14 @@ int RunViewer(const ViewerOptions& options) {
     return Fail("cannot open a display: " + g_glfw_error +
                 " (for headless use: xvfb-run -a footfall-view ... --screenshot out.png)");
   }
-  // GL objects go before the context, the context before GLFW.
+  // GL objects go before the context, the context before GLFW; not when an exception is on its
+  // way out (memory ran out, maybe within the OpenGL driver, which may then hold its locks for
+  // ever: glfwTerminate waited on one): the process ends, and with it the context.
   struct GlfwGuard {
     App* app;
+    int unwinding = std::uncaught_exceptions();
     ~GlfwGuard() {
+      if (std::uncaught_exceptions() > unwinding) return;
       app->renderer.reset();
       glfwTerminate();
     }

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "footfall/terrain/c_locale.h"
@@ -136,10 +137,15 @@ bool ParseJsonText(const std::string& text, const std::string& source, JsonDocum
   bool too_deep = false;
   // Keys seen in each object being parsed, innermost last.
   std::vector<std::set<std::string>> keys;
+  // Where an object or array the filter leaves out is released (the parser would destroy it
+  // with nlohmann's destructor, which allocates).
+  JsonDocument left_out;
   auto check = [&](int depth, json::parse_event_t event, json& parsed) {
     too_deep |= max_depth > 0 && depth > max_depth;
-    if (event == json::parse_event_t::object_start || event == json::parse_event_t::array_start)
+    if (event == json::parse_event_t::object_start || event == json::parse_event_t::array_start) {
       document->ReserveDepth(static_cast<size_t>(depth) + 1);
+      if (filter) left_out.ReserveDepth(static_cast<size_t>(depth) + 1);
+    }
     if (event == json::parse_event_t::object_start) {
       keys.emplace_back();
     } else if (event == json::parse_event_t::object_end) {
@@ -148,7 +154,13 @@ bool ParseJsonText(const std::string& text, const std::string& source, JsonDocum
       if (!keys.back().insert(parsed.get<std::string>()).second)
         throw DuplicateKey{parsed.get<std::string>()};
     }
-    return filter ? filter(depth, event, parsed) : true;
+    if (!filter || filter(depth, event, parsed)) return true;
+    if (event == json::parse_event_t::object_end || event == json::parse_event_t::array_end) {
+      using std::swap;
+      swap(parsed, left_out.value);  // (noexcept) the parser then discards a null
+      left_out.Release();
+    }
+    return false;
   };
   // Numbers read as written whatever the host program's locale (a Pashto decimal point).
   const CLocaleScope c_locale;

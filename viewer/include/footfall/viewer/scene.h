@@ -3,10 +3,9 @@
 // describes what it drew as JSON (the state dump used by tests).
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "footfall/client/recent_queries.h"
 #include "footfall/import/terrain_loader.h"
@@ -14,6 +13,7 @@
 #include "footfall/terrain/grid.h"
 #include "footfall/viewer/camera.h"
 #include "footfall/viewer/draw_list.h"
+#include "footfall/viewer/json_text.h"
 #include "footfall/viewer/query_view.h"
 
 namespace footfall::viewer {
@@ -111,9 +111,15 @@ class Scene {
   // Fills `depth_tested` (grid cells) and `on_top` (queries, walk) for one frame.
   void Draw(const ViewState& view, DrawList* depth_tested, DrawList* on_top) const;
 
-  // What a frame shows, with pixel positions for a width x height image seen by `camera`.
-  nlohmann::ordered_json Describe(const ViewState& view, const OrbitCamera& camera, int width,
-                                  int height) const;
+  // The live server a frame's live queries come from, for Describe.
+  struct LiveSource {
+    std::string address;
+    uint64_t after = 0;  // the first sequence number followed
+  };
+  // Writes what a frame shows as the members of the object open in *out (left open for the
+  // caller's own members), with pixel positions for a width x height image seen by `camera`.
+  void Describe(const ViewState& view, const OrbitCamera& camera, int width, int height,
+                const LiveSource* source, JsonText* out) const;
 
  private:
   void DrawQuery(const QueryView& q, bool latest, DrawList* depth_tested, DrawList* on_top) const;
