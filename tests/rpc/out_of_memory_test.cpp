@@ -85,7 +85,8 @@ void Churn(int port, int seed, std::atomic<int>* unanswered, std::atomic<int>* u
 // A footfalld whose C++ allocations fail, every `every`-th, while Fail() is in force.
 class FailingServer {
  public:
-  explicit FailingServer(int every) {
+  // `args`: footfalld's flags beside --no-rpcbind and --threads 2.
+  explicit FailingServer(int every, const std::vector<std::string>& args = {}) {
     char flag[] = "/tmp/footfall-fail-new-XXXXXX";
     const int fd = mkstemp(flag);
     if (fd < 0) throw std::runtime_error("mkstemp failed");
@@ -95,8 +96,9 @@ class FailingServer {
     setenv("LD_PRELOAD", FAILING_NEW_PATH, 1);
     setenv("FOOTFALL_FAIL_NEW_WHILE", flag_.c_str(), 1);
     setenv("FOOTFALL_FAIL_NEW_EVERY", std::to_string(every).c_str(), 1);
-    server_ = std::make_unique<ServerProcess>(
-        0, std::vector<std::string>{"--no-rpcbind", "--threads", "2"});
+    std::vector<std::string> flags{"--no-rpcbind", "--threads", "2"};
+    flags.insert(flags.end(), args.begin(), args.end());
+    server_ = std::make_unique<ServerProcess>(0, flags);
     unsetenv("LD_PRELOAD");
     unsetenv("FOOTFALL_FAIL_NEW_WHILE");
     unsetenv("FOOTFALL_FAIL_NEW_EVERY");
@@ -106,10 +108,11 @@ class FailingServer {
   FailingServer& operator=(const FailingServer&) = delete;
 
   ServerProcess& server() { return *server_; }
-  // Allocations fail from now on.
-  void Fail() {
+  // Allocations fail from now on (after the first `spared`, which succeed).
+  void Fail(long spared = 0) {
     FILE* f = std::fopen(flag_.c_str(), "w");
     if (!f) throw std::runtime_error("cannot create " + flag_);
+    std::fprintf(f, "%ld\n", spared);
     std::fclose(f);
   }
   // Memory is back.
@@ -231,4 +234,80 @@ TEST_CASE("footfalld serves others while a client never reads and every allocati
   failing.Recover();
   CHECK(keeper->Snap(kept, {3, 1, 3}).status == Status::kOk);
   CHECK(flooder.drops() == 0);
+}
+
+TEST_CASE("footfalld answers server-side loads while memory runs out and stays out",
+          "[rpc][memory]") {
+  // A load thread handed its finished load back into a list that grew: with memory gone it
+  // waited for memory to come back, and the client waited out its load timeout (300 s by
+  // default). The list now has room for every load the queue may hold.
+  char root[] = "/tmp/footfall-memory-root-XXXXXX";
+  REQUIRE(mkdtemp(root));
+  const std::string dir = root;
+  struct Cleanup {
+    std::string dir;
+    ~Cleanup() { std::system(("rm -rf '" + dir + "'").c_str()); }
+  } cleanup{dir};
+  auto write = [&](const std::string& name, const std::string& text) {
+    FILE* f = std::fopen((dir + "/" + name).c_str(), "w");
+    REQUIRE(f);
+    std::fputs(text.c_str(), f);
+    std::fclose(f);
+  };
+  std::string pts, obj, asc = "ncols 12\nnrows 12\nxllcorner 0\nyllcorner 0\ncellsize 0.5\n";
+  for (int i = 0; i < 12; ++i) {
+    for (int k = 0; k < 12; ++k) {
+      const double y = 0.05 * ((i * 7 + k * 3) % 5);
+      pts += std::to_string(0.5 * i) + " " + std::to_string(y) + " " + std::to_string(0.5 * k) +
+             " 0 1 0\n";
+      obj += "v " + std::to_string(0.5 * i) + " " + std::to_string(y) + " " +
+             std::to_string(0.5 * k) + "\n";
+      asc += std::to_string(y) + (k == 11 ? "\n" : " ");
+    }
+  }
+  for (int i = 0; i < 11; ++i) {
+    for (int k = 0; k < 11; ++k) {
+      const int a = i * 12 + k + 1, b = a + 1, c = a + 12, d = c + 1;  // OBJ counts from 1
+      obj += "f " + std::to_string(a) + " " + std::to_string(b) + " " + std::to_string(d) + "\n";
+      obj += "f " + std::to_string(a) + " " + std::to_string(d) + " " + std::to_string(c) + "\n";
+    }
+  }
+  write("ground.pts", pts);
+  write("ground.obj", obj);
+  write("ground.asc", asc);
+
+  FailingServer failing(1, {"--data-root", dir});
+  const int port = failing.server().port();
+  TerrainLoadOptions options;
+  options.separation = 0.25;
+  int refused = 0;
+  for (const char* name : {"ground.pts", "ground.asc", "ground.obj"}) {
+    // The first failure moved through the load: the request, the file's reading and
+    // resampling, the grid, the reply.
+    for (long spared = 0; spared <= 3000; spared = spared < 10 ? spared + 1 : spared * 3 / 2) {
+      INFO(name << ", allocations failing after the first " << spared);
+      auto session = Connect(port);
+      failing.Fail(spared);
+      TerrainHandle handle = 0;
+      const Status s = session->LoadServerFile(name, options, &handle);
+      failing.Recover();
+      INFO(session->last_error());
+      CHECK_FALSE(Unanswered(s, *session));
+      if (s != Status::kOk) {
+        ++refused;
+        CHECK_FALSE(session->last_error().empty());
+      }
+      int status = 0;
+      REQUIRE(waitpid(failing.server().pid(), &status, WNOHANG) == 0);  // still serving
+    }
+    // Memory back: the same load succeeds.
+    auto session = Connect(port);
+    TerrainHandle handle = 0;
+    const Status s = session->LoadServerFile(name, options, &handle);
+    INFO(name << ": " << session->last_error());
+    REQUIRE(s == Status::kOk);
+    CHECK(session->Snap(handle, {1, 1, 1}).status == Status::kOk);
+  }
+  CHECK(refused > 0);  // memory did run out in those loads
+  CHECK(failing.server().Terminate() == 0);
 }

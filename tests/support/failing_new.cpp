@@ -10,6 +10,7 @@
 // the same N names the same allocation of the program's own startup whatever they make. Checks
 // that a process keeps its promises when memory runs short, anywhere.
 #include <dlfcn.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -54,10 +55,17 @@ bool FailNow() {
     return (n - static_cast<unsigned long>(after)) % static_cast<unsigned long>(every) == 0;
   }
   static std::atomic<long> skip{0};
-  if (!flag || access(flag, F_OK) != 0) {
+  static std::atomic<long long> seen{-1};  // the flag file last seen (its inode and mtime)
+  struct stat st;
+  if (!flag || stat(flag, &st) != 0) {
     count.store(0, std::memory_order_relaxed);  // from the start again when the file comes back
     return false;
   }
+  // A file made again since the last allocation (none happened while it was gone, an idle
+  // server's case) counts from the start too.
+  const long long stamp = static_cast<long long>(st.st_ino) * 1000003 +
+                          st.st_mtim.tv_sec * 1000000000LL + st.st_mtim.tv_nsec;
+  if (seen.exchange(stamp) != stamp) count.store(0, std::memory_order_relaxed);
   const unsigned long n = count.fetch_add(1, std::memory_order_relaxed);
   if (n == 0) {
     // The file may hold a number: that many allocations succeed first.

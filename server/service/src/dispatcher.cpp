@@ -263,6 +263,8 @@ void ReplyLoaded(Status s, uint32_t handle, const std::string& path, bool upload
 
 // The reply ticket of each load in the LoadQueue.
 std::map<PendingLoad*, uint64_t> g_load_tickets;
+// The finished loads FinishLoads answers, with room for every load the queue may hold.
+std::vector<std::unique_ptr<PendingLoad>> g_finished_loads;
 
 // Withdraws the loads whose connection has closed: those still waiting leave the queue at once
 // (their reservations released), those running stop at their next stage. Either way nothing is
@@ -979,7 +981,8 @@ void AnswerLoad(PendingLoad* load, uint64_t ticket, uint32_t* handle) {
 
 void FinishLoads() {
   if (!g_state) return;
-  for (const std::unique_ptr<PendingLoad>& load : g_state->loads->TakeFinished()) {
+  g_state->loads->TakeFinished(&g_finished_loads);
+  for (const std::unique_ptr<PendingLoad>& load : g_finished_loads) {
     const auto it = g_load_tickets.find(load.get());
     if (it == g_load_tickets.end()) continue;
     const uint64_t ticket = it->second;
@@ -1001,6 +1004,7 @@ void FinishLoads() {
       SendHeldReply(ticket, FF_XDR(ff_load_reply), &r);
     }
   }
+  g_finished_loads.clear();  // (keeps its room for the next turn)
 }
 
 void ExpireIdle() {
@@ -1040,6 +1044,7 @@ DispatchFn InstallDispatcher(ServiceState* state) {
   g_state = state;
   g_pool = std::make_unique<BatchPool>(state->batch_threads);
   state->loads = std::make_unique<LoadQueue>(kMaxQueuedLoads, kLoadWorkers);
+  g_finished_loads.reserve(state->loads->MostFinished());
   g_storage.points.resize(FF_MAX_BATCH);
   g_storage.steps.resize(FF_MAX_BATCH);
   g_storage.answers.resize(FF_MAX_BATCH);

@@ -4,7 +4,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdint>
 #include <new>
 #include <stdexcept>
@@ -24,6 +23,10 @@ LoadQueue::LoadQueue(size_t capacity, const int (&workers)[kLanes])
     : capacity_(capacity), state_(std::make_shared<State>()) {
   state_->wake_fd = eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
   if (state_->wake_fd < 0) throw std::runtime_error("cannot create the load queue's eventfd");
+  // Room for every load the lanes may hold finished: a worker hands one over allocating
+  // nothing (it waited, retrying, for memory that might never come back).
+  state_->finished.reserve(MostFinished());
+  state_->finished_lanes.reserve(MostFinished());
   try {
     for (int lane = 0; lane < kLanes; ++lane)
       for (int i = 0; i < workers[lane]; ++i)
@@ -92,7 +95,7 @@ std::unique_ptr<PendingLoad> LoadQueue::Cancel(PendingLoad* load) {
   return nullptr;
 }
 
-std::vector<std::unique_ptr<PendingLoad>> LoadQueue::TakeFinished() {
+void LoadQueue::TakeFinished(std::vector<std::unique_ptr<PendingLoad>>* done) {
   State& s = *state_;
   std::lock_guard<std::mutex> lock(s.mutex);
   uint64_t count = 0;
@@ -100,9 +103,8 @@ std::vector<std::unique_ptr<PendingLoad>> LoadQueue::TakeFinished() {
   }
   for (const Lane lane : s.finished_lanes) --s.in_lane[lane];
   s.finished_lanes.clear();
-  std::vector<std::unique_ptr<PendingLoad>> done;
-  done.swap(s.finished);
-  return done;
+  done->clear();
+  done->swap(s.finished);  // the queue keeps the caller's room
 }
 
 bool LoadQueue::Abandon() {
@@ -151,21 +153,11 @@ void LoadQueue::Work(const std::shared_ptr<State>& state, Lane lane) {
     }
     lock.lock();
     --s.running;
-    // Handed back whatever memory is left: a load lost here left its client waiting for a
-    // reply that never came.
-    for (;;) {
-      if (s.stop) return;  // abandoned, or the queue is going: nobody takes it back
-      try {
-        s.finished_lanes.reserve(s.finished_lanes.size() + 1);
-        s.finished.push_back(std::move(load));  // the load is kept when this throws
-        s.finished_lanes.push_back(lane);       // room reserved above
-        break;
-      } catch (const std::bad_alloc&) {
-        lock.unlock();
-        std::this_thread::sleep_for(std::chrono::milliseconds(10));
-        lock.lock();
-      }
-    }
+    if (s.stop) return;  // abandoned, or the queue is going: nobody takes it back
+    // Handed back into room reserved for it (it counts in its lane until taken): a load lost
+    // here left its client waiting for a reply that never came.
+    s.finished.push_back(std::move(load));
+    s.finished_lanes.push_back(lane);
     const uint64_t one = 1;
     if (write(s.wake_fd, &one, sizeof one) < 0) {
       // Only on counter overflow, after 2^64 - 2 loads untaken: the flag is already up.

@@ -50,9 +50,13 @@ class LoadQueue {
   // (PendingLoad::cancelled), ends at its next stage and comes back through TakeFinished, as
   // does one already finished (nullptr for both).
   std::unique_ptr<PendingLoad> Cancel(PendingLoad* load);
-  // The loads finished since the last call, in the order they finished; clears wake_fd().
-  // Allocates nothing, so that finished loads are answered even while memory runs out.
-  std::vector<std::unique_ptr<PendingLoad>> TakeFinished();
+  // Room for every load the lanes may hold, for the caller's vector that TakeFinished swaps.
+  size_t MostFinished() const { return kLanes * capacity_; }
+  // Puts the loads finished since the last call into *done (empty, with room for
+  // MostFinished(), which it then keeps), in the order they finished; clears wake_fd().
+  // Allocates nothing, as a worker handing a load over does not: finished loads are answered
+  // even while memory runs out, and stays out.
+  void TakeFinished(std::vector<std::unique_ptr<PendingLoad>>* done);
   // Readable (POLLIN) while finished loads wait to be taken.
   int wake_fd() const;
   // Drops the waiting loads and leaves those running to finish on their own (they hold what
