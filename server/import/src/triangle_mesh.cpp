@@ -30,15 +30,16 @@ std::vector<Vec3> VertexNormals(const TriangleMesh& mesh) {
 
 CornerNormals::CornerNormals(const TriangleMesh& mesh, double crease_deg)
     : mesh_(mesh),
-      cos_crease_(crease_deg >= 180 ? -2.0 : std::cos(std::max(crease_deg, 0.0) * kPi / 180)) {
+      cos_crease_(crease_deg >= 180 ? -2.0 : std::cos(std::max(crease_deg, 0.0) * kPi / 180)),
+      position_(CoincidentVertexIds(mesh.vertices)) {
   first_.assign(mesh.vertices.size() + 1, 0);
   for (const auto& tri : mesh.triangles)
-    for (uint32_t v : tri) ++first_[v + 1];
+    for (uint32_t v : tri) ++first_[position_[v] + 1];
   for (size_t v = 0; v < mesh.vertices.size(); ++v) first_[v + 1] += first_[v];
   around_.resize(first_.back());
   std::vector<uint32_t> next(first_.begin(), first_.end() - 1);
   for (size_t t = 0; t < mesh.triangles.size(); ++t)
-    for (uint32_t v : mesh.triangles[t]) around_[next[v]++] = static_cast<uint32_t>(t);
+    for (uint32_t v : mesh.triangles[t]) around_[next[position_[v]]++] = static_cast<uint32_t>(t);
 }
 
 std::array<Vec3, 3> CornerNormals::Of(size_t t) const {
@@ -48,7 +49,7 @@ std::array<Vec3, 3> CornerNormals::Of(size_t t) const {
   if (!(length > 0)) return out;
   const Vec3 face = cross / length;
   for (int k = 0; k < 3; ++k) {
-    const uint32_t v = mesh_.triangles[t][k];
+    const uint32_t v = position_[mesh_.triangles[t][k]];
     Vec3 sum;
     for (uint32_t i = first_[v]; i < first_[v + 1]; ++i) {
       const Vec3 n = TriangleCross(mesh_, around_[i]);  // length = 2 * area: area weighting
@@ -79,33 +80,87 @@ std::vector<uint32_t> CoincidentVertexIds(const std::vector<Vec3>& vertices) {
   return id;
 }
 
+namespace {
+
+// Union-find over vertices: the root of each vertex's set.
+class VertexSets {
+ public:
+  explicit VertexSets(size_t vertices) : parent_(vertices) {
+    for (uint32_t v = 0; v < parent_.size(); ++v) parent_[v] = v;
+  }
+  uint32_t Root(uint32_t v) {
+    while (parent_[v] != v) v = parent_[v] = parent_[parent_[v]];
+    return v;
+  }
+  void Join(uint32_t a, uint32_t b) {
+    a = Root(a), b = Root(b);
+    if (a != b) parent_[b] = a;
+  }
+
+ private:
+  std::vector<uint32_t> parent_;
+};
+
+constexpr uint32_t kNoShell = std::numeric_limits<uint32_t>::max();
+
+// Per triangle, the shell closed by the mesh's own vertex indices it belongs to (the root vertex
+// of a part connected through shared vertices whose every directed edge (a, b) has its twin
+// (b, a)), or kNoShell.
+std::vector<uint32_t> ShellsByIndex(const TriangleMesh& mesh) {
+  VertexSets sets(mesh.vertices.size());
+  for (const auto& tri : mesh.triangles) sets.Join(tri[0], tri[1]), sets.Join(tri[0], tri[2]);
+  std::vector<uint64_t> edges;
+  edges.reserve(3 * mesh.triangles.size());
+  for (const auto& tri : mesh.triangles)
+    for (int k = 0; k < 3; ++k) edges.push_back(uint64_t{tri[k]} << 32 | tri[(k + 1) % 3]);
+  std::sort(edges.begin(), edges.end());
+  std::vector<uint8_t> open(mesh.vertices.size(), 0);  // per part (its root vertex)
+  for (const uint64_t e : edges)
+    if (!std::binary_search(edges.begin(), edges.end(), e << 32 | e >> 32))
+      open[sets.Root(static_cast<uint32_t>(e >> 32))] = 1;
+  std::vector<uint32_t> shell(mesh.triangles.size());
+  for (size_t t = 0; t < shell.size(); ++t) {
+    const uint32_t r = sets.Root(mesh.triangles[t][0]);
+    shell[t] = open[r] ? kNoShell : r;
+  }
+  return shell;
+}
+
+}  // namespace
+
 MeshTurnover TurnOutward(TriangleMesh* mesh, const Vec3& up) {
   MeshTurnover out;
   const size_t n = mesh->triangles.size();
   if (n == 0) return out;
-  // The topology by position: a soup's faces meet where their corners coincide.
+  // Shells closed by their own vertices are judged each on its own, whatever they touch: two
+  // crates stacked, or one on the ground, meet at positions but are not one shell.
+  const std::vector<uint32_t> own_shell = ShellsByIndex(*mesh);
+  // The other faces' topology by position: a soup's faces meet where their corners coincide.
   const std::vector<uint32_t> id = CoincidentVertexIds(mesh->vertices);
   auto corner = [&](const std::array<uint32_t, 3>& tri, int k) { return id[tri[k]]; };
-  // Connected parts: triangles sharing a vertex (union-find over vertices).
-  std::vector<uint32_t> parent(mesh->vertices.size());
-  for (uint32_t v = 0; v < parent.size(); ++v) parent[v] = v;
-  auto root = [&](uint32_t v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  for (const auto& tri : mesh->triangles) {
-    const uint32_t a = root(corner(tri, 0));
-    for (int k = 1; k < 3; ++k) {
-      const uint32_t b = root(corner(tri, k));
-      if (a != b) parent[b] = a;
-    }
+  // Their connected parts: triangles sharing a vertex (union-find over vertices).
+  VertexSets sets(mesh->vertices.size());
+  auto root = [&](uint32_t v) { return sets.Root(v); };
+  for (size_t t = 0; t < n; ++t) {
+    if (own_shell[t] != kNoShell) continue;
+    const auto& tri = mesh->triangles[t];
+    sets.Join(corner(tri, 0), corner(tri, 1)), sets.Join(corner(tri, 0), corner(tri, 2));
   }
+  // Each triangle's part: its own shell's root vertex, or past the vertices its part's root.
+  const size_t vertices = mesh->vertices.size();
+  auto part = [&](size_t t) -> size_t {
+    if (own_shell[t] != kNoShell) return own_shell[t];
+    return vertices + root(corner(mesh->triangles[t], 0));
+  };
   // A part is closed when each of its directed edges (a, b) has its twin (b, a).
   std::vector<uint64_t> edges;
   edges.reserve(3 * n);
-  for (const auto& tri : mesh->triangles)
+  for (size_t t = 0; t < n; ++t) {
+    if (own_shell[t] != kNoShell) continue;
+    const auto& tri = mesh->triangles[t];
     for (int k = 0; k < 3; ++k)
       edges.push_back(uint64_t{corner(tri, k)} << 32 | corner(tri, (k + 1) % 3));
+  }
   std::sort(edges.begin(), edges.end());
   std::vector<uint64_t> lone;  // edges without their twin
   for (const uint64_t e : edges) {
@@ -153,33 +208,34 @@ MeshTurnover TurnOutward(TriangleMesh* mesh, const Vec3& up) {
       for (const size_t c : chain) matched[c] = 1;
     }
   }
-  std::vector<uint8_t> open(parent.size(), 0);  // per part (its root vertex)
+  std::vector<uint8_t> open(2 * vertices, 0);  // per part
   for (size_t i = 0; i < lone.size(); ++i)
-    if (!matched[i]) open[root(static_cast<uint32_t>(lone[i] >> 32))] = 1;
+    if (!matched[i]) open[vertices + root(static_cast<uint32_t>(lone[i] >> 32))] = 1;
   // Six times each closed part's volume, about its root vertex (less cancellation); the open
   // parts' area-weighted normal and area.
-  std::vector<double> volume(parent.size(), 0);
-  std::vector<uint8_t> counted(parent.size(), 0);
+  std::vector<double> volume(2 * vertices, 0);
+  std::vector<uint8_t> counted(2 * vertices, 0);
   Vec3 open_sum;
   double open_area = 0;
   for (size_t t = 0; t < n; ++t) {
     const auto& tri = mesh->triangles[t];
-    const uint32_t r = root(corner(tri, 0));
+    const size_t r = part(t);
     if (open[r]) {
       const Vec3 c = TriangleCross(*mesh, t);
       open_sum += c, open_area += Length(c), ++out.open_faces;
       continue;
     }
     if (!counted[r]) counted[r] = 1, ++out.closed_shells;
-    const Vec3& o = mesh->vertices[r];
+    const Vec3& o = mesh->vertices[r < vertices ? r : r - vertices];
     volume[r] += Dot(mesh->vertices[tri[0]] - o,
                      Cross(mesh->vertices[tri[1]] - o, mesh->vertices[tri[2]] - o));
   }
-  for (uint32_t v = 0; v < parent.size(); ++v)
-    if (counted[v] && volume[v] < 0) ++out.inside_out_shells;
+  for (size_t r = 0; r < 2 * vertices; ++r)
+    if (counted[r] && volume[r] < 0) ++out.inside_out_shells;
   out.open_faced_down = open_area > 0 && Dot(open_sum, up) < -0.25 * open_area * Length(up);
-  for (auto& tri : mesh->triangles) {
-    const uint32_t r = root(corner(tri, 0));
+  for (size_t t = 0; t < n; ++t) {
+    auto& tri = mesh->triangles[t];
+    const size_t r = part(t);
     if (open[r] ? out.open_faced_down : volume[r] < 0)
       std::swap(tri[1], tri[2]), ++out.turned_faces;
   }

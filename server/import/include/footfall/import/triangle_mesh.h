@@ -30,11 +30,13 @@ double SurfaceArea(const TriangleMesh& mesh);
 std::vector<Vec3> VertexNormals(const TriangleMesh& mesh);
 
 // Smooth-shading normals that keep sharp edges, per triangle corner: corner k of triangle t
-// gets the area-weighted mean normal of the triangles around its vertex whose normals lie
-// within `crease_deg` of t's (t's own included). Faces meeting at a sharper edge (a stair's
-// nose, a block's rim, a wall's foot) keep their own normals right up to it, as a modelling
-// package shades them with auto smooth; gentler edges (a terrain's facets) are smoothed over.
-// crease_deg >= 180 gives the plain vertex normals of VertexNormals, 0 the face normals.
+// gets the area-weighted mean normal of the triangles with a corner at its position (its
+// vertex, or another at the same place: a soup or a mesh split at seams is smoothed as the
+// surface it models) whose normals lie within `crease_deg` of t's (t's own included). Faces
+// meeting at a sharper edge (a stair's nose, a block's rim, a wall's foot) keep their own
+// normals right up to it, as a modelling package shades them with auto smooth; gentler edges (a
+// terrain's facets) are smoothed over. crease_deg >= 180 gives, on a mesh whose vertices are
+// all at distinct positions, the plain vertex normals of VertexNormals; 0 the face normals.
 class CornerNormals {
  public:
   // Keeps a reference to `mesh`, which must outlive this and not change.
@@ -46,8 +48,9 @@ class CornerNormals {
  private:
   const TriangleMesh& mesh_;
   double cos_crease_;
-  std::vector<uint32_t> first_;   // per vertex + 1: offsets into around_
-  std::vector<uint32_t> around_;  // the triangles using each vertex
+  std::vector<uint32_t> position_;  // per vertex: CoincidentVertexIds
+  std::vector<uint32_t> first_;     // per position's id + 1: offsets into around_
+  std::vector<uint32_t> around_;    // the triangles with a corner at each position
 };
 
 // For each vertex, the lowest index of a vertex at exactly the same position: the mesh's
@@ -65,7 +68,8 @@ struct MeshTurnover {
 };
 
 // Turns the faces of a mesh wound the wrong way over (reverses their winding), so that normals
-// face out of each closed shell (a connected part, vertices at the same position joined as in
+// face out of each closed shell (a part connected through its own vertex indices and closed by
+// them, whatever it touches; else a connected part, vertices at the same position joined as in
 // CoincidentVertexIds, whose every edge is used once in each
 // direction, or matched the other way by a chain of edges through corners on it within 1e-5 of
 // its length, a T-junction: turned when the volume it encloses is negative) and up out of the open
