@@ -1696,7 +1696,12 @@ TEST_CASE("clients that never read their replies are held back while others are 
   TerrainHandle t = 0;
   REQUIRE(loader->LoadSamples(MakeFlat(30, 1, 0), "flat", &t) == Status::kOk);
   const std::vector<unsigned char> call = FullBatchCall(OnlyServerTerrain(server.port()));
-  Flooder first(server.port(), call), second(server.port(), call);
+  // Their receive buffers as the system makes them, or small: the server's replies then queue
+  // in small buffers, each with its overhead, and fewer bytes fit its socket (replies it took
+  // room for did not fit, and its thread spun up to 2 s on each before dropping the client).
+  const int receive_buffer = GENERATE(0, 1, 4096);
+  INFO("the flooders' SO_RCVBUF: " << receive_buffer);
+  Flooder first(server.port(), call, receive_buffer), second(server.port(), call, receive_buffer);
   // Both fill their sockets: the server no longer takes their requests.
   REQUIRE(WaitFor([&] { return first.blocked() > 0 && second.blocked() > 0; }));
 

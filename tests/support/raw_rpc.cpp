@@ -71,8 +71,11 @@ bool ListServerTerrains(int port, std::vector<uint32_t>* handles) {
   return ok;
 }
 
-Flooder::Flooder(int port, std::vector<unsigned char> record)
-    : port_(port), record_(std::move(record)), thread_([this] { Run(); }) {}
+Flooder::Flooder(int port, std::vector<unsigned char> record, int receive_buffer)
+    : port_(port),
+      record_(std::move(record)),
+      receive_buffer_(receive_buffer),
+      thread_([this] { Run(); }) {}
 
 Flooder::~Flooder() {
   stop_ = true;
@@ -91,6 +94,8 @@ void Flooder::Run() {
       a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
       const timeval wait{0, 100000};
       setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &wait, sizeof wait);
+      if (receive_buffer_ > 0)
+        setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &receive_buffer_, sizeof receive_buffer_);
       if (connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
         close(fd), fd = -1;
         std::this_thread::sleep_for(std::chrono::milliseconds(10));

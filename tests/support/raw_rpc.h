@@ -29,10 +29,11 @@ bool ListServerTerrains(int port, std::vector<uint32_t>* handles);
 
 // A client on its own thread that sends `record` again and again and never reads a reply, until
 // destroyed; when the server drops it, it counts the drop and connects again. Tests read the
-// counters (no assertions on its thread).
+// counters (no assertions on its thread). `receive_buffer` [Units: bytes], when not 0, is its
+// socket's SO_RCVBUF: a small one makes the server's replies queue in small buffers.
 class Flooder {
  public:
-  Flooder(int port, std::vector<unsigned char> record);
+  Flooder(int port, std::vector<unsigned char> record, int receive_buffer = 0);
   ~Flooder();
   Flooder(const Flooder&) = delete;
   Flooder& operator=(const Flooder&) = delete;
@@ -45,6 +46,7 @@ class Flooder {
 
   const int port_;
   const std::vector<unsigned char> record_;
+  const int receive_buffer_;
   std::atomic<bool> stop_{false};
   std::atomic<int> drops_{0}, blocked_{0};
   std::thread thread_;

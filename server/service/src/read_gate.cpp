@@ -1,12 +1,14 @@
 #include "read_gate.h"
 
 #include <arpa/inet.h>
+#include <linux/sock_diag.h>
 #include <linux/sockios.h>
 #include <netinet/in.h>
 #include <rpc/rpc.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 
@@ -17,6 +19,26 @@ namespace {
 constexpr int kRecheckMs = 10;
 
 constexpr short kReadEvents = POLLIN | POLLPRI | POLLRDNORM | POLLRDBAND;
+
+// Whether the socket `fd` has room for a largest reply beside the bytes still unsent on it, or
+// is not a connection (the listening socket, always read). Measured in the kernel's own
+// accounting of the queued buffers (SO_MEMINFO), which is what the send buffer limits: a
+// client that makes its receive window small has its bytes queued in small buffers, each with
+// its overhead (a 1-byte SO_RCVBUF makes it 2.4 bytes a byte), and the next reply is cut the
+// same way. `max_queued` [Units: bytes] is the bound on unsent bytes used where SO_MEMINFO is
+// not answered.
+bool HasRoom(int fd, size_t max_queued) {
+  int queued = 0;
+  if (ioctl(fd, SIOCOUTQ, &queued) != 0 || queued <= 0) return true;
+  uint32_t memory[SK_MEMINFO_VARS] = {};
+  socklen_t length = sizeof memory;
+  if (getsockopt(fd, SOL_SOCKET, SO_MEMINFO, memory, &length) != 0 ||
+      length <= SK_MEMINFO_WMEM_QUEUED * sizeof(uint32_t))
+    return static_cast<size_t>(queued) <= max_queued;
+  const double held = memory[SK_MEMINFO_WMEM_QUEUED], limit = memory[SK_MEMINFO_SNDBUF];
+  const double per_byte = std::max(1.0, held / queued);
+  return limit - held >= static_cast<double>(kReplyRoomBytes) * per_byte;
+}
 
 }  // namespace
 
@@ -57,9 +79,7 @@ int ReadGate::Prepare(std::vector<pollfd>* fds, int idle_ms, const std::set<int>
       continue;
     }
     if (!WasServed(p.fd) && !waiting_.count(p.fd)) continue;  // had room, nothing written
-    // The listening socket answers EINVAL, and is always read (accept).
-    int queued = 0;
-    if (ioctl(p.fd, SIOCOUTQ, &queued) != 0 || static_cast<size_t>(queued) <= max_queued_) {
+    if (HasRoom(p.fd, max_queued_)) {
       waiting_.erase(p.fd);
       continue;
     }

@@ -3,9 +3,11 @@
 // libtirpc's non-blocking transports read a request whenever a socket is readable and then write
 // the whole reply, looping on a full socket for up to 2 s: one client that sends requests but
 // never reads its replies would hold up everybody else. The gate lets libtirpc read from a
-// connection only while the bytes still unsent on its socket (SIOCOUTQ) leave room for a largest
-// reply (kMaxReplyBytes), so every reply is written at once; a connection without room is polled
-// for POLLOUT only until it drains, and closed when it stays without room too long.
+// connection only while the buffers still unsent on its socket (the kernel's own accounting,
+// SO_MEMINFO: a client with a small receive window has them cut small, each with its overhead)
+// leave room for a largest reply (kMaxReplyBytes) cut the same way, so every reply is written at
+// once; a connection without room is polled for POLLOUT only until it drains, and closed when it
+// stays without room too long.
 #pragma once
 
 #include <poll.h>
@@ -86,7 +88,8 @@ class ReadGate {
   // allocates nothing once the numbers in use have been seen: while memory runs out, requests
   // are still read and answered.
   std::vector<char> served_;
-  size_t max_queued_;  // [Units: bytes] unsent bytes that still leave kReplyRoomBytes
+  size_t max_queued_;  // [Units: bytes] unsent bytes that still leave kReplyRoomBytes, where
+                       // the kernel does not answer SO_MEMINFO
   double stuck_limit_s_;
   std::unordered_map<int, Waiting> waiting_;  // by socket; a new connection starts with room
 };
