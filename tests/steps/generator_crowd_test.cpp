@@ -277,6 +277,31 @@ TEST_CASE("Generation is deterministic", "[steps][generator]") {
   }
 }
 
+TEST_CASE("A crowd walked in passes on two threads says what one thread says",
+          "[steps][generator][crowd]") {
+  // 260 octopods on the shipped hills, whose samples are too far apart for a foot of some to
+  // stand within reach at the start: the note of the first such character was made on the
+  // copy that walked its pass, and lost, on two threads.
+  const Character c = LoadShipped("octopod");
+  const std::string hills = std::string(FOOTFALL_SOURCE_DIR) + "/data/terrain/hills.pts";
+  auto run = [&](int threads) {
+    auto session = MakeEmbeddedSession(threads);
+    TerrainHandle h;
+    REQUIRE(session->LoadFile(hills, TerrainLoadOptions{}, &h) == Status::kOk);
+    GenerateOptions o;
+    o.steps = 1, o.crowd = 260, o.crowd_spacing = 1, o.threads = threads;
+    Walk w;
+    std::string error;
+    INFO(error);
+    REQUIRE(GenerateWalk(*session, h, c, o, &w, &error) == Status::kOk);
+    return w;
+  };
+  const Walk one = run(1), two = run(2);
+  REQUIRE_FALSE(one.notes.empty());
+  CHECK_THAT(one.notes.back(), Catch::Contains("at the start, foot "));
+  CHECK(two.notes == one.notes);
+}
+
 TEST_CASE("A large crowd's walk is the same on one thread and on two",
           "[steps][generator][crowd]") {
   // 2,100 hexapods: enough for the generator and the engine to split their work.

@@ -466,3 +466,34 @@ TEST_CASE("A path walk on rocky ground turned about a slanting axis is the same 
   CHECK(keys > 100);
   CHECK(worst < 1e-5);
 }
+
+TEST_CASE("A path walk without a step count that arrives on its last step has arrived",
+          "[steps][generator][path]") {
+  // A strip 3.6 km long; the biped walks kMaxPathSteps steps along it toward goals about as far
+  // as that takes it. Without a step count it walks those steps at most, so it arrives exactly
+  // when the same walk given kMaxPathSteps does (an arrival on the last step was said as a
+  // stop: "still 0.15 away", within the arrival radius).
+  RawSamples s;
+  for (int j = 0; j <= 36000; ++j)
+    for (int i = 0; i < 13; ++i) s.push_back({i * 0.1, 0, j * 0.1}, {0, 1, 0});
+  Terrain t = LoadTerrain(s, 0.1);
+  const Character c = LoadShipped("biped");
+  int arrived_last = 0;
+  for (const double goal : {3500.6, 3501.0, 3501.2, 3501.5}) {
+    INFO("goal at z = " << goal);
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {0.6, 0, 1};
+    o.path = {{0.6, 0, goal}};
+    const Walk open = Generate(t, c, o);
+    o.steps = kMaxPathSteps;
+    const Walk counted = Generate(t, c, o);
+    bool short_of_goal = false;
+    for (const std::string& note : counted.notes)
+      short_of_goal |= note.find("is still") != std::string::npos;
+    CHECK(open.stopped.empty() == !short_of_goal);
+    arrived_last += !short_of_goal && StepsDone(counted) == static_cast<size_t>(kMaxPathSteps);
+    CHECK(StepsDone(open) == StepsDone(counted));
+  }
+  CHECK(arrived_last >= 1);  // one goal is reached by the last step exactly
+}

@@ -808,6 +808,62 @@ TEST_CASE("A gait of one group keys every touch-down, its feet lifting from ther
   }
 }
 
+TEST_CASE("Keys at a fractional start frame fall on the frames of an integer one, shifted",
+          "[steps][generator]") {
+  // start_frame + k * frames_per_step computed once for each frame: summed step by step, a
+  // touch-down and the next lift-off differed by a rounding, so a gait of one group got a second
+  // lift-off key beside its touch-down (and glTF refused two keys that close), and a stopped
+  // walk took back its last kept step's touch-down with the stopped step's keys.
+  Character hop = LoadShipped("quadruped");
+  hop.gait = {{0, 1, 2, 3}};
+  const Character biped = LoadShipped("biped");
+  Terrain flat = LoadTerrain(MakeFlat(200, 0.05, 0), 0.05);
+  // Flat ground with a slab over it, lower than the biped's body (it stops under its edge).
+  RawSamples slab = MakeFlat(200, 0.05, 0);
+  for (int k = 0; k < 200; ++k)
+    for (int i = 0; i < 200; ++i)
+      if (k * 0.05 > 6) slab.push_back({i * 0.05, 0.6, k * 0.05}, {0, -1, 0});
+  Terrain under_slab = LoadTerrain(slab, 0.05);
+  int stops = 0;
+  for (const int frames : {8, 19}) {
+    for (const double start : {1.0, 0.13, 0.23, 8.355, 0.05525882872479637}) {
+      INFO(frames << " frames a step from frame " << start);
+      for (Character c : {hop, biped}) {
+        c.frames_per_step = frames;
+        GenerateOptions o;
+        o.has_start = true;
+        o.start = {5, 0, 2};
+        o.steps = 16;
+        o.start_frame = start;
+        GenerateOptions at_zero = o;
+        at_zero.start_frame = 0;
+        for (Terrain* t : {&flat, &under_slab}) {
+          const Walk w = Generate(*t, c, o), from_zero = Generate(*t, c, at_zero);
+          CHECK(w.stopped.empty() == from_zero.stopped.empty());
+          stops += !w.stopped.empty();
+          CheckWalk(*t, c, o, w);
+          REQUIRE(w.tracks.size() == from_zero.tracks.size());
+          for (size_t i = 0; i < w.tracks.size(); ++i) {
+            const auto &keys = w.tracks[i].keys, &zero_keys = from_zero.tracks[i].keys;
+            INFO(w.tracks[i].name);
+            REQUIRE(keys.size() == zero_keys.size());
+            for (size_t j = 0; j < keys.size(); ++j) {
+              // Every key on start + (a half-step count) * frames_per_step / 2, exactly.
+              const double half_steps = 2 * zero_keys[j].frame / frames;
+              CHECK(half_steps == std::round(half_steps));
+              CHECK(keys[j].frame == start + 0.5 * half_steps * frames);
+              CHECK(keys[j].phase == zero_keys[j].phase);
+              CHECK(keys[j].position == zero_keys[j].position);
+              if (j > 0) CHECK(keys[j].frame > keys[j - 1].frame);
+            }
+          }
+        }
+      }
+    }
+  }
+  CHECK(stops >= 10);  // the biped under the slab, at every start frame
+}
+
 TEST_CASE("Feet whose rests are off the body's origin walk straight", "[steps][generator]") {
   // One foot 0.1 to the left of and 0.2 ahead of the body, and a biped shifted 0.3 sideways:
   // their walks follow the heading (each drifted by its rests' offset every step).

@@ -214,7 +214,8 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
     const bool bound = farthest >= c.reach - 1e-6 || raised >= 3 * c.body_height - 1e-6;
     CHECK((!behind || across || bound));
   }
-  // Gait order: step k moves exactly group k % G, at frames start_frame + k * frames_per_step.
+  // Gait order: step k moves exactly group k % G, at frames start_frame + k * frames_per_step
+  // (each computed so: a step's touch-down and the next one's lift-off are the same double).
   const size_t steps = body.keys.size() - 1;
   const int groups = static_cast<int>(c.gait.size());
   int waits = 0;
@@ -227,6 +228,7 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
   };
   for (size_t k = 0; k < steps; ++k) {
     const double f0 = o.start_frame + static_cast<double>(k) * c.frames_per_step;
+    const double f1 = o.start_frame + static_cast<double>(k + 1) * c.frames_per_step;
     const auto& group = c.gait[k % groups];
     // A wait (its group held back by a foot left behind): no foot lifts and the body holds.
     bool any_lifts = false;
@@ -236,7 +238,7 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
     if (!any_lifts) {
       INFO("step " << k + 1 << ": no foot lifts");
       CHECK(body.keys[k + 1].position == body.keys[k].position);
-      CHECK(body.keys[k + 1].frame == f0 + c.frames_per_step);
+      CHECK(body.keys[k + 1].frame == f1);
       if (waits++ == 0) waits_from = k;
       if (waits >= groups) CHECK(!o.path.empty());  // a whole cycle of waits: a turn on the spot
       continue;
@@ -255,7 +257,7 @@ void CheckCharacter(Terrain& t, const Character& c, const GenerateOptions& o, co
       INFO("step " << k + 1 << " foot " << c.feet[f].name);
       CHECK(lifts == in_group);
     }
-    CHECK(body.keys[k + 1].frame == f0 + c.frames_per_step);
+    CHECK(body.keys[k + 1].frame == f1);
   }
 }
 

@@ -175,7 +175,7 @@ Status Generator::Run(std::string* error) {
   // stopped short of what was asked: said as a stop (exit status 2), its keys kept.
   if (o_.steps < 0 && !o_.path.empty()) {
     for (Agent& a : agents_) {
-      if (!a.walking || !a.stopped.empty() || a.path.empty()) continue;
+      if (!a.walking || !a.stopped.empty() || a.path.empty() || Arrived(a)) continue;
       const double left = Remaining(a, a.path.size() - 1);
       Text why(4);
       why << "the path's goal " << Point(a.path.back()) << " is still " << left << " away after "
@@ -190,10 +190,7 @@ Status Generator::Run(std::string* error) {
   if (!start_beyond_reach_.empty()) walk_.notes.push_back(start_beyond_reach_);
   if (o_.steps >= 0 && !o_.path.empty()) {
     for (Agent& a : agents_) {
-      if (!a.walking || !a.stopped.empty() || a.path.empty()) continue;
-      size_t next = a.waypoint;  // arrived with the last step?
-      while (next < a.path.size() && Reached(a, next)) ++next;
-      if (next == a.path.size()) continue;
+      if (!a.walking || !a.stopped.empty() || a.path.empty() || Arrived(a)) continue;
       Text note(4);
       if (!a.id.empty()) note << a.id << ": ";
       note << "the path's goal " << Point(a.path.back()) << " is still "
@@ -286,6 +283,12 @@ Status Generator::WalkPassesInParallel(size_t passes, size_t per_pass, Progress*
       }
     }
   });
+  // What the copies found worth saying: the first character's note, as one pass would say it.
+  for (Generator& g : copies) {
+    if (g.start_beyond_reach_agent_ >= start_beyond_reach_agent_) continue;
+    start_beyond_reach_agent_ = g.start_beyond_reach_agent_;
+    start_beyond_reach_ = std::move(g.start_beyond_reach_);
+  }
   return failure;
 }
 
@@ -363,7 +366,7 @@ void Generator::Stop(Agent& a, int step, const std::string& why) {
 }
 
 void Generator::StopPassAt(int k, const std::string& why) {
-  const double f0 = o_.start_frame + static_cast<double>(k) * c_.frames_per_step;
+  const double f0 = StepFrame(k);
   for (size_t i = pass_begin_; i < pass_end_; ++i) {
     Agent& a = agents_[i];
     if (!a.walking) continue;

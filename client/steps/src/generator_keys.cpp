@@ -180,9 +180,7 @@ Status Generator::ClearArcs(int k, std::string* error) {
 //     and key it at touch-down. A character with a refused foot stops before this step's keys.
 void Generator::Finish(size_t w, int k) {
   const size_t per_agent = moves_.size() / walking_.size();
-  const double f0 = o_.start_frame + static_cast<double>(k) * c_.frames_per_step;
-  const double f_mid = f0 + 0.5 * c_.frames_per_step;
-  const double f1 = f0 + c_.frames_per_step;
+  const double f0 = StepFrame(k), f_mid = StepFrame(k + 0.5), f1 = StepFrame(k + 1);
   const size_t m = w * per_agent, e = m + per_agent;
   Agent& a = agents_[walking_[w]];
   // The window slides: it starts again wherever the body gets half a step from its start, so a
@@ -275,12 +273,15 @@ void Generator::KeyFoot(const Agent& a, int foot, double frame, KeyPhase phase, 
 void Generator::KeyStart(const Agent& a) {
   // 4 (end). Every foot and the body keyed planted at the start frame.
   const Vec3 body = a.ground + a.body_up * c_.body_height;
+  const size_t index = static_cast<size_t>(&a - agents_.data());
   for (size_t f = 0; f < c_.feet.size(); ++f) {
     KeyFoot(a, static_cast<int>(f), o_.start_frame, KeyPhase::kEnd, a.foot[f], a.foot_normal[f]);
     // Feet snap to the nearest samples: samples far apart for the character may leave one
-    // beyond reach, which the steps never do. Said once (the walk likely stops soon).
+    // beyond reach, which the steps never do. Said once, for the first such character (the walk
+    // likely stops soon).
     const double dist = Distance(a.foot[f], body);
-    if (start_beyond_reach_.empty() && dist > c_.reach * (1 + 1e-9)) {
+    if (index < start_beyond_reach_agent_ && dist > c_.reach * (1 + 1e-9)) {
+      start_beyond_reach_agent_ = index;
       Text note(3);
       if (!a.id.empty()) note << a.id << ": ";
       note << "at the start, foot " << c_.feet[f].name << " stands " << dist
@@ -291,7 +292,7 @@ void Generator::KeyStart(const Agent& a) {
       start_beyond_reach_ = note.str();
     }
   }
-  body_due_.emplace_back(static_cast<size_t>(&a - agents_.data()), o_.start_frame);
+  body_due_.emplace_back(index, o_.start_frame);
 }
 
 void Generator::KeyBody(const Agent& a, double frame, double raise) {
@@ -428,9 +429,10 @@ Status Generator::KeyBodies(std::string* error) {
     why << "no room for the body at " << Point(body_points_[spine_first_[i + 1] - 1])
         << ": the terrain at " << Point(crossing->point)
         << " lies between it and its feet (an overhang or a ceiling lower than body_height)";
-    UnkeyStep(a, frame - c_.frames_per_step);
-    Stop(a, static_cast<int>(std::lround((frame - o_.start_frame) / c_.frames_per_step)),
-         why.str());
+    // The body is keyed where its step ends: step `step` (from 1) ends at StepFrame(step).
+    const int step = static_cast<int>(std::lround((frame - o_.start_frame) / c_.frames_per_step));
+    UnkeyStep(a, StepFrame(step - 1));
+    Stop(a, step, why.str());
   }
   body_due_.clear();
   return Status::kOk;

@@ -62,6 +62,7 @@ Status Generator::Setup(std::string* error) {
   // top of the bounds: its snap is no news.)
   setup_notes_.clear();
   start_beyond_reach_.clear();
+  start_beyond_reach_agent_ = std::numeric_limits<size_t>::max();
   if (o_.has_start) {
     const Vec3 up = c_.align_to_normal && !start_along_up_ ? start_snap_.normal : world_up_;
     const double across = Length(ProjectOnPlane(start - start_snap_.point, up));

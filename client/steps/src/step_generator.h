@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <locale>
 #include <memory>
 #include <sstream>
@@ -303,6 +304,10 @@ class Generator {
   Status ClearArcs(int k, std::string* error);
   // Keys (or stops) the w-th walking character at step k once its moves are final.
   void Finish(size_t w, int k);
+  // The frame at which step k (from 0) starts, and step k - 1 ends: the same double wherever
+  // it is asked for, so that a touch-down and the next lift-off, or a body key and its step's
+  // foot keys, never differ by a rounding (a fractional start frame drifted them apart).
+  double StepFrame(double k) const { return o_.start_frame + k * c_.frames_per_step; }
   int window_steps_ = 100;  // steps a body must get half a step in (Agent::window_from)
   // fn(begin, end) over [0, count), split across the pool's threads for large counts. Each
   // item's result must not depend on the split.
@@ -337,6 +342,13 @@ class Generator {
   // the waypoint lies on the terrain farther than the radius along a's up: the far side of a
   // sphere, a floor under a table top, a ceiling.
   bool Reached(const Agent& a, size_t i) const;
+  // Whether a's body has reached its path's goal, every waypoint from its current one on
+  // reached in turn (the last step's arrival, which no later step has looked at yet).
+  bool Arrived(const Agent& a) const {
+    size_t next = a.waypoint;
+    while (next < a.path.size() && Reached(a, next)) ++next;
+    return next == a.path.size();
+  }
   // How far a's waypoint i still is, as Reached measures it: in 3D when it lies on the terrain,
   // else along the ground.
   double Remaining(const Agent& a, size_t i) const;
@@ -422,8 +434,10 @@ class Generator {
   // longer than the reach allows): the first of Walk::notes.
   std::vector<std::string> setup_notes_;
   // The first foot keyed at the start beyond reach of its body (snapped to samples too far
-  // apart for the character), said as a note: "" when none was.
+  // apart for the character), said as a note: "" when none was. It is the first character's
+  // with such a foot (start_beyond_reach_agent_, in agents_), whichever pass walked it.
   std::string start_beyond_reach_;
+  size_t start_beyond_reach_agent_ = std::numeric_limits<size_t>::max();
   // The start's nearest sample (FindStart's first snap, before the start may move), or the
   // ground straight above or below a given start (GroundAlongUp).
   Foothold start_snap_;
