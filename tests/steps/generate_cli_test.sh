@@ -454,6 +454,20 @@ bad empty-heading "--heading: expected DX,DY,DZ" --terrain "$hills" --character 
 bad heading-up "the heading (0.0000, 1.0000, 0.0000) is along the up (0.0000, 1.0000, 0.0000) where the character starts" --terrain "$hills" --character "$chars/biped.json" --heading 0,1,0 --out "$work/x.json"
 bad gltf-negative-frame "--out $work/neg.gltf: glTF animation times must be >= 0, and --start-frame is -100" --terrain "$hills" --character "$chars/biped.json" --start-frame -100 --out "$work/neg.json" --out "$work/neg.gltf"
 check "gltf-negative-frame: nothing written" [ ! -e "$work/neg.json" ]
+# In a scene, --start-frame is the default of the characters that give none: a negative one
+# refuses glTF only when a character takes it.
+cat > "$work/scene/framed.json" <<JSON
+{"format": "footfall-scene", "version": 1,
+ "characters": [
+  {"name": "a", "character_file": "biped.json", "start": [0.6, 0, 0.4], "steps": 2, "start_frame": 5},
+  {"name": "b", "character_file": "biped.json", "start": [1.8, 0, 0.4], "steps": 2, "start_frame": 0}
+ ]}
+JSON
+"$footfall" generate --terrain "$work/floor.pts" --scene "$work/scene/framed.json" --start-frame -3 \
+  --out "$work/framed.gltf" 2> /dev/null
+check "scene gltf: a negative --start-frame no character takes is no matter" [ -s "$work/framed.gltf" ]
+sed 's/, "start_frame": 0//' "$work/scene/framed.json" > "$work/scene/unframed.json"
+bad scene-gltf-negative-frame "--out $work/unframed.gltf: glTF animation times must be >= 0, and b starts at frame -3 (--start-frame)" --terrain "$work/floor.pts" --scene "$work/scene/unframed.json" --start-frame -3 --out "$work/unframed.gltf"
 bad far-start "the start (--start) is too far from the terrain to snap" --terrain "$hills" --character "$chars/biped.json" --start 1e20,0,0 --out "$work/x.json"
 bad steps-fraction "--steps: '1.5' is not a whole number from 0 to 1000000" --terrain "$hills" --character "$chars/biped.json" --steps 1.5 --out "$work/x.json"
 bad crowd-fraction "--crowd: '1.5' is not a whole number from 1 to 1000000" --terrain "$hills" --character "$chars/biped.json" --crowd 1.5 --out "$work/x.json"

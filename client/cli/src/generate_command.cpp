@@ -276,8 +276,10 @@ bool CheckOutputs(const GenerateFlags& flags, const std::vector<std::string>& in
                "terrain convert";
       return false;
     }
-    // Refused before anything is generated or written (glTF times are >= 0).
-    if ((ext == "gltf" || ext == "glb") && flags.start_frame < 0) {
+    // Refused before anything is generated or written (glTF times are >= 0). A scene's
+    // characters are checked each (RunScene): --start-frame is only the default of those that
+    // give none.
+    if ((ext == "gltf" || ext == "glb") && flags.start_frame < 0 && flags.scene.empty()) {
       std::ostringstream m;
       m << "--out " << out << ": glTF animation times must be >= 0, and --start-frame is "
         << flags.start_frame << "; start at frame 0 or later, or write .json or .mel only";
@@ -542,9 +544,11 @@ int RunScene(const GenerateFlags& flags) {
       break;
     }
     for (const SceneCharacter& c : scene) {
-      if ((ext == "gltf" || ext == "glb") && c.has_start_frame && c.options.start_frame < 0)
+      const double start = c.has_start_frame ? c.options.start_frame : flags.start_frame;
+      if ((ext == "gltf" || ext == "glb") && start < 0 && error.empty())
         error = "--out " + out + ": glTF animation times must be >= 0, and " + c.name +
-                " starts at frame " + NumberText(c.options.start_frame) + "; write .json or .mel";
+                " starts at frame " + NumberText(start) +
+                (c.has_start_frame ? "" : " (--start-frame)") + "; write .json or .mel";
     }
   }
   double keys = 0;  // of the characters whose steps are given (the others' are only a bound)
