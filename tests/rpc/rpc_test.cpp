@@ -640,6 +640,15 @@ TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
     REQUIRE(symlink((outside + "/there.pts").c_str(), (root + "/link.pts").c_str()) == 0);
     REQUIRE(symlink((outside + "/gone.pts").c_str(), (root + "/dangling.pts").c_str()) == 0);
     REQUIRE(symlink(outside.c_str(), (root + "/out").c_str()) == 0);
+    // Links that stay within the root: a loop, and a chain of 20 to a missing file.
+    REQUIRE(symlink("loop-b.pts", (root + "/loop-a.pts").c_str()) == 0);
+    REQUIRE(symlink("loop-a.pts", (root + "/loop-b.pts").c_str()) == 0);
+    std::string previous = "missing.pts";
+    for (int i = 1; i <= 20; ++i) {
+      const std::string name = "chain" + std::to_string(i) + ".pts";
+      REQUIRE(symlink(previous.c_str(), (root + "/" + name).c_str()) == 0);
+      previous = name;
+    }
   }
   ServerProcess server(0, {"--no-rpcbind", "--data-root", root});
   auto rpc = Connect(server.port());
@@ -668,6 +677,14 @@ TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
       CHECK(rpc->LoadServerFile(path, Separation(0), &t) == Status::kAccessDenied);
       CHECK(rpc->last_error() == "'" + path + "' leads outside the data root");
     }
+  }
+  SECTION("links that stay within the root are told as such, not as leaving it") {
+    CHECK(rpc->LoadServerFile("loop-a.pts", Separation(0), &t) == Status::kIoError);
+    CHECK(rpc->last_error() ==
+          "'loop-a.pts': more than 40 symbolic links on its way under the data root (a loop of "
+          "links?)");
+    CHECK(rpc->LoadServerFile("chain20.pts", Separation(0), &t) == Status::kIoError);
+    CHECK(rpc->last_error() == "'chain20.pts': no such file under the data root");
   }
   SECTION("a path with a NUL byte is refused, not cut short") {
     CLIENT* c = RawClient(server.port());

@@ -43,12 +43,22 @@ std::vector<std::string> Components(const std::string& path) {
   return parts;
 }
 
-// For an absolute path that realpath cannot resolve: true when resolving it leaves `root` before
-// it fails (a prefix resolves outside, or the part that fails is a link whose target leads out).
-// Decided without looking at anything outside the root that the path names, so the answer does
-// not reveal whether such things exist.
-bool LeadsOutside(const std::string& root, const std::string& path, int depth) {
-  if (depth > 16) return true;  // a loop of links
+// Where resolving a path that realpath cannot resolve goes.
+enum class Lead {
+  kInside,        // it fails inside the root (a name missing there)
+  kOutside,       // it leaves the root before it fails
+  kTooManyLinks,  // it follows more links than the system would (a loop), all within the root
+};
+
+// [Units: links] As many as the system follows before it gives up (Linux's MAXSYMLINKS).
+constexpr int kMaxLinks = 40;
+
+// For an absolute path that realpath cannot resolve: whether resolving it leaves `root` before
+// it fails (a prefix resolves outside, or the part that fails is a link whose target leads
+// out). Decided without looking at anything outside the root that the path names, so the answer
+// does not reveal whether such things exist.
+Lead Resolving(const std::string& root, const std::string& path, int links) {
+  if (links > kMaxLinks) return Lead::kTooManyLinks;
   const std::vector<std::string> parts = Components(path);
   std::string at = "/";  // canonical, inside the root or above it
   for (size_t i = 0; i < parts.size(); ++i) {
@@ -56,18 +66,18 @@ bool LeadsOutside(const std::string& root, const std::string& path, int depth) {
     char buffer[PATH_MAX];
     if (realpath(next.c_str(), buffer)) {
       at = buffer;
-      if (!PathInside(root, at) && !AboveRoot(root, at)) return true;
+      if (!PathInside(root, at) && !AboveRoot(root, at)) return Lead::kOutside;
       continue;
     }
-    if (!PathInside(root, at)) return true;
+    if (!PathInside(root, at)) return Lead::kOutside;
     const ssize_t n = readlink(next.c_str(), buffer, sizeof buffer - 1);
-    if (n < 0) return false;  // missing below a directory of the root
+    if (n < 0) return Lead::kInside;  // missing below a directory of the root
     buffer[n] = '\0';
     std::string rest = buffer[0] == '/' ? std::string(buffer) : at + "/" + buffer;
     for (size_t j = i + 1; j < parts.size(); ++j) rest += "/" + parts[j];
-    return LeadsOutside(root, rest, depth + 1);
+    return Resolving(root, rest, links + 1);
   }
-  return !PathInside(root, at);
+  return PathInside(root, at) ? Lead::kInside : Lead::kOutside;
 }
 
 // What a file type is, for messages about files that are not regular.
@@ -140,9 +150,15 @@ Status ResolveUnderRoot(const std::string& root, const std::string& relative, st
   char buffer[PATH_MAX];
   if (!realpath(joined.c_str(), buffer)) {
     const int error = errno;
-    if (LeadsOutside(root, joined, 0)) {
+    const Lead lead = Resolving(root, joined, 0);
+    if (lead == Lead::kOutside) {
       *message = outside;
       return Status::kAccessDenied;
+    }
+    if (lead == Lead::kTooManyLinks) {
+      *message = "'" + relative + "': more than " + std::to_string(kMaxLinks) +
+                 " symbolic links on its way under the data root (a loop of links?)";
+      return Status::kIoError;
     }
     if (error == EACCES) {
       *message = "'" + relative +
