@@ -20,6 +20,11 @@ constexpr int kRecheckMs = 10;
 
 constexpr short kReadEvents = POLLIN | POLLPRI | POLLRDNORM | POLLRDBAND;
 
+// [Units: bytes] Unsent bytes from which their buffers' overhead per byte is taken as the next
+// reply's: below, a few small buffers (a short reply not yet acknowledged) weigh little beside
+// the send buffer, whose half holds a largest reply cut however small.
+constexpr int kMeasuredFrom = 4096;
+
 // Whether the socket `fd` has room for a largest reply beside the bytes still unsent on it, or
 // is not a connection (the listening socket, always read). Measured in the kernel's own
 // accounting of the queued buffers (SO_MEMINFO), which is what the send buffer limits: a
@@ -36,7 +41,7 @@ bool HasRoom(int fd, size_t max_queued) {
       length <= SK_MEMINFO_WMEM_QUEUED * sizeof(uint32_t))
     return static_cast<size_t>(queued) <= max_queued;
   const double held = memory[SK_MEMINFO_WMEM_QUEUED], limit = memory[SK_MEMINFO_SNDBUF];
-  const double per_byte = std::max(1.0, held / queued);
+  const double per_byte = queued < kMeasuredFrom ? 1.0 : std::max(1.0, held / queued);
   return limit - held >= static_cast<double>(kReplyRoomBytes) * per_byte;
 }
 
