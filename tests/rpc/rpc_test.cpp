@@ -2333,7 +2333,8 @@ TEST_CASE("a client repeating a failing request cannot flood footfalld's log",
          at = log.find("error: snap: unknown_terrain", at + 1))
       ++*written;
     const std::string said =
-        " lines (errors, batches past their time limit) not written in the last ";
+        " lines (errors, loads, unloads, batches past their time limit) not written in the "
+        "last ";
     for (size_t at = log.find(said); at != std::string::npos; at = log.find(said, at + 1)) {
       const size_t line = log.rfind('\n', at) + 1;
       *unwritten += std::stoul(log.substr(line + std::strlen("footfalld: ")));
@@ -2351,6 +2352,34 @@ TEST_CASE("a client repeating a failing request cannot flood footfalld's log",
   CHECK(lines >= 100);
   CHECK(lines <= 100 + 10 * (elapsed + 2));
   clnt_destroy(c);
+}
+
+TEST_CASE("a client loading and unloading in a loop cannot flood footfalld's log",
+          "[rpc][robustness]") {
+  // Each load and unload wrote a line: a tiny terrain loaded and unloaded in a loop wrote
+  // thousands a second. They share the error lines' budget: 100 at once, 10 a second.
+  ServerProcess server;
+  auto rpc = Connect(server.port());
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < 400; ++i) {
+    TerrainHandle t = 0;
+    REQUIRE(rpc->LoadSamples(MakeFlat(2, 1, 0), "tiny", &t) == Status::kOk);
+    REQUIRE(rpc->Unload(t) == Status::kOk);
+  }
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  TerrainHandle kept = 0;  // still served
+  REQUIRE(rpc->LoadSamples(MakeFlat(10, 1, 0), "kept", &kept) == Status::kOk);
+  CHECK(rpc->Snap(kept, Vec3{3.2, 1, 4.7}).point == Vec3{3, 0, 5});
+  CHECK(
+      WaitFor([&] { return server.Log().find(" not written in the last ") != std::string::npos; }));
+  const std::string log = server.Log();
+  size_t lines = 0;
+  for (const char* what : {"footfalld: loaded terrain ", "footfalld: unloaded terrain "})
+    for (size_t at = log.find(what); at != std::string::npos; at = log.find(what, at + 1)) ++lines;
+  INFO(lines << " load and unload lines in " << elapsed << " s");
+  CHECK(lines >= 100);
+  CHECK(lines <= 100 + 10 * (elapsed + 2));
 }
 
 TEST_CASE("a client sending costly batches cannot flood footfalld's log", "[rpc][robustness]") {

@@ -148,7 +148,8 @@ void ReportUnwrittenErrors() {
                                                        g_error_lines.first_unwritten)
                              .count();
   std::fprintf(stderr,
-               "footfalld: %llu lines (errors, batches past their time limit) not written in the "
+               "footfalld: %llu lines (errors, loads, unloads, batches past their time limit) not "
+               "written in the "
                "last %.1f s (more than %g at once or %g a second); every request was answered\n",
                static_cast<unsigned long long>(g_error_lines.unwritten), seconds, kErrorLineBurst,
                kErrorLinesPerSecond);

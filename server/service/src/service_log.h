@@ -27,10 +27,10 @@ void WaitForSlowLogReaders();
 // Writes one log line (escaped). Lines starting "error: " are rate-limited as LogLimited's.
 void Log(const std::string& line);
 
-// Writes a line a client can cause as often as it likes (errors, batches cut at their time
-// limit): at most kErrorLineBurst at once and kErrorLinesPerSecond after (a token bucket); the
-// lines beyond are counted for ReportUnwrittenErrors. A client repeating a refused request
-// thousands of times a second wrote as many lines, and could fill the disk.
+// Writes a line a client can cause as often as it likes (errors, loads and unloads, batches cut
+// at their time limit): at most kErrorLineBurst at once and kErrorLinesPerSecond after (a token
+// bucket); the lines beyond are counted for ReportUnwrittenErrors. A client repeating a refused
+// request thousands of times a second wrote as many lines, and could fill the disk.
 constexpr double kErrorLineBurst = 100;
 constexpr double kErrorLinesPerSecond = 10;
 void LogLimited(const std::string& line);
