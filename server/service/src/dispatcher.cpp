@@ -250,13 +250,11 @@ void ReplyLoaded(Status s, uint32_t handle, const std::string& path, bool upload
     const std::string resampled = ResampledText(load);
     message =
         upload ? "" : "loaded " + path + ": " + std::to_string(st.samples) + " samples" + resampled;
-    // Rate-limited with the error lines: a client loading and unloading a small terrain in a
-    // loop wrote thousands of lines a second.
-    LogLimited("loaded terrain " + std::to_string(handle) +
-               (upload ? " '" + path + "' (uploaded)" : " from '" + path + "'") + ": " +
-               std::to_string(st.samples) + " samples" + resampled + ", grid " +
-               std::to_string(st.cells[0]) + "x" + std::to_string(st.cells[1]) + "x" +
-               std::to_string(st.cells[2]) + ClientSuffix());
+    LogLoadLimited("loaded terrain " + std::to_string(handle) +
+                   (upload ? " '" + path + "' (uploaded)" : " from '" + path + "'") + ": " +
+                   std::to_string(st.samples) + " samples" + resampled + ", grid " +
+                   std::to_string(st.cells[0]) + "x" + std::to_string(st.cells[1]) + "x" +
+                   std::to_string(st.cells[2]) + ClientSuffix());
   } else {
     LogError(upload ? "upload" : "load", s, message);
   }
@@ -440,7 +438,7 @@ void Info(const ff_terrain_args& a, ff_info_reply* r) {
 void Unload(const ff_terrain_args& a, uint64_t client, ff_status_reply* r) {
   std::string message;
   const Status s = g_state->registry.Unload(a.terrain, client, &message);
-  if (s == Status::kOk) LogLimited("unloaded terrain " + std::to_string(a.terrain));
+  if (s == Status::kOk) LogLoadLimited("unloaded terrain " + std::to_string(a.terrain));
   if (s != Status::kOk) LogError("unload", s, message);
   r->status = Wire(s);
   r->message = Message(s == Status::kOk ? "" : message);

@@ -51,29 +51,32 @@ std::string EscapeControl(const std::string& text) {
 
 namespace {
 
-// The token bucket of LogLimited.
-struct ErrorLineBudget {
+// A token bucket of rate-limited lines: LogLimited's, and LogLoadLimited's apart (so that a
+// client's many loads leave room for the lines that say what failed).
+struct LineBudget {
+  explicit LineBudget(const char* lines) : what(lines) {}
+  const char* what;  // the lines, for ReportUnwrittenErrors
   std::mutex mutex;
   double tokens = kErrorLineBurst;
   std::chrono::steady_clock::time_point refilled = std::chrono::steady_clock::now();
   uint64_t unwritten = 0;
   std::chrono::steady_clock::time_point first_unwritten;
 };
-ErrorLineBudget g_error_lines;
+LineBudget g_error_lines{"errors, batches past their time limit"};
+LineBudget g_load_lines{"loads and unloads"};
 
-// True when an error line may be written now; false counts it as unwritten.
-bool TakeErrorLine() {
-  std::lock_guard<std::mutex> lock(g_error_lines.mutex);
+// True when a line of `budget` may be written now; false counts it as unwritten.
+bool TakeLine(LineBudget& budget) {
+  std::lock_guard<std::mutex> lock(budget.mutex);
   const auto now = std::chrono::steady_clock::now();
-  const double elapsed = std::chrono::duration<double>(now - g_error_lines.refilled).count();
-  g_error_lines.refilled = now;
-  g_error_lines.tokens =
-      std::min(kErrorLineBurst, g_error_lines.tokens + elapsed * kErrorLinesPerSecond);
-  if (g_error_lines.tokens >= 1) {
-    g_error_lines.tokens -= 1;
+  const double elapsed = std::chrono::duration<double>(now - budget.refilled).count();
+  budget.refilled = now;
+  budget.tokens = std::min(kErrorLineBurst, budget.tokens + elapsed * kErrorLinesPerSecond);
+  if (budget.tokens >= 1) {
+    budget.tokens -= 1;
     return true;
   }
-  if (g_error_lines.unwritten++ == 0) g_error_lines.first_unwritten = now;
+  if (budget.unwritten++ == 0) budget.first_unwritten = now;
   return false;
 }
 
@@ -138,22 +141,27 @@ void Log(const std::string& line) {
 }
 
 void LogLimited(const std::string& line) {
-  if (TakeErrorLine()) std::fprintf(stderr, "footfalld: %s\n", EscapeControl(line).c_str());
+  if (TakeLine(g_error_lines)) std::fprintf(stderr, "footfalld: %s\n", EscapeControl(line).c_str());
+}
+
+void LogLoadLimited(const std::string& line) {
+  if (TakeLine(g_load_lines)) std::fprintf(stderr, "footfalld: %s\n", EscapeControl(line).c_str());
 }
 
 void ReportUnwrittenErrors() {
-  std::lock_guard<std::mutex> lock(g_error_lines.mutex);
-  if (g_error_lines.unwritten == 0) return;
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                                       g_error_lines.first_unwritten)
-                             .count();
-  std::fprintf(stderr,
-               "footfalld: %llu lines (errors, loads, unloads, batches past their time limit) not "
-               "written in the "
-               "last %.1f s (more than %g at once or %g a second); every request was answered\n",
-               static_cast<unsigned long long>(g_error_lines.unwritten), seconds, kErrorLineBurst,
-               kErrorLinesPerSecond);
-  g_error_lines.unwritten = 0;
+  for (LineBudget* budget : {&g_error_lines, &g_load_lines}) {
+    std::lock_guard<std::mutex> lock(budget->mutex);
+    if (budget->unwritten == 0) continue;
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - budget->first_unwritten)
+            .count();
+    std::fprintf(stderr,
+                 "footfalld: %llu lines (%s) not written in the last %.1f s (more than %g at "
+                 "once or %g a second); every request was answered\n",
+                 static_cast<unsigned long long>(budget->unwritten), budget->what, seconds,
+                 kErrorLineBurst, kErrorLinesPerSecond);
+    budget->unwritten = 0;
+  }
 }
 
 LogClientScope::LogClientScope(const std::string* client) : saved_(g_log_client) {

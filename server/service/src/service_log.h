@@ -27,13 +27,18 @@ void WaitForSlowLogReaders();
 // Writes one log line (escaped). Lines starting "error: " are rate-limited as LogLimited's.
 void Log(const std::string& line);
 
-// Writes a line a client can cause as often as it likes (errors, loads and unloads, batches cut
-// at their time limit): at most kErrorLineBurst at once and kErrorLinesPerSecond after (a token
+// Writes a line a client can cause as often as it likes (errors, batches cut at their time
+// limit): at most kErrorLineBurst at once and kErrorLinesPerSecond after (a token
 // bucket); the lines beyond are counted for ReportUnwrittenErrors. A client repeating a refused
 // request thousands of times a second wrote as many lines, and could fill the disk.
 constexpr double kErrorLineBurst = 100;
 constexpr double kErrorLinesPerSecond = 10;
 void LogLimited(const std::string& line);
+
+// Writes a "loaded terrain" or "unloaded terrain" line within a budget of its own, as
+// LogLimited's (a client loading and unloading a small terrain in a loop wrote thousands a
+// second; many loads in a row must not use up the error lines' budget).
+void LogLoadLimited(const std::string& line);
 
 // Says in one line how many rate-limited lines were not written since the first of them, if
 // any. Call about once a second.
