@@ -1141,6 +1141,21 @@ class BlenderAddonTest(unittest.TestCase):
         self.assertIn("no track for this rig", str(e.exception))
         after = {o.name: fcurve_keys(o, "location", 3) for o in list(feet.values()) + [body]}
         self.assertEqual(after, before)
+        # Another character's walk, whose body track alone matched: the rig's feet were cleared
+        # and the import said it had keyed 3 keys.
+        quadruped = os.path.join(ARGS.work_dir, "quadruped_walk.json")
+        with open(quadruped, "w") as f:
+            json.dump({"tracks": [
+                {"name": n, "kind": "foot", "keys": [{"frame": 1, "position": [0, 0, 0]}]}
+                for n in ("LF", "RF", "LH", "RH")] + [
+                {"name": "body", "kind": "body", "keys": [
+                    {"frame": 1, "position": [0, 1, 0], "rotation": [0, 0, 0, 1]}]}]}, f)
+        with self.assertRaises(RuntimeError) as e:
+            bpy.ops.footfall.import_walk(filepath=quadruped)
+        self.assertIn("keys feet this rig does not have (LF, RF, LH, RH", str(e.exception))
+        self.assertIn("the rig's keys are unchanged", str(e.exception))
+        after = {o.name: fcurve_keys(o, "location", 3) for o in list(feet.values()) + [body]}
+        self.assertEqual(after, before)
         # Tracks of this rig without keys (beside another's keyed track, or alone): its keys
         # were cleared from the walk's first frame (frame 0 when no track had a key) before the
         # import found nothing to key.
@@ -1324,6 +1339,42 @@ class BlenderAddonTest(unittest.TestCase):
         finally:
             settings.path = None
             bpy.data.objects.remove(path)
+            bpy.data.curves.remove(data)
+
+    def test_7f1_a_path_is_walked_as_its_modifiers_leave_it(self):
+        # A Hook on a path's end point drags it where the viewport draws it; the path was read
+        # without its modifiers, and the walk went to the end the Hook had moved away.
+        data = bpy.data.curves.new("hooked_path", "CURVE")
+        data.dimensions = "3D"
+        spline = data.splines.new("POLY")
+        spline.points.add(1)
+        for p, co in zip(spline.points, [(-1.0, 0.0, 0.0), (1.0, 0.0, 0.0)]):
+            p.co = co + (1.0,)
+        path = bpy.data.objects.new("hooked_path", data)
+        hook = bpy.data.objects.new("hook_target", None)
+        for o in (path, hook):
+            bpy.context.scene.collection.objects.link(o)
+        modifier = path.modifiers.new("Hook", "HOOK")
+        modifier.object = hook
+        modifier.vertex_indices_set([1])
+        hook.location = (0.0, -3.0, 0.0)
+        try:
+            bpy.context.view_layer.update()
+            dg = bpy.context.evaluated_depsgraph_get()
+            shown = path.evaluated_get(dg).to_mesh()
+            end = path.matrix_world @ shown.vertices[1].co
+            path.evaluated_get(dg).to_mesh_clear()
+            self.assertLess((end - Vector((1.0, -3.0, 0.0))).length, 1e-5)
+            counts = (len(bpy.data.objects), len(bpy.data.curves), len(bpy.data.meshes))
+            pts = self.ops.curve_points(bpy.context, path)
+            self.assertEqual(len(pts), 2)
+            self.assertLess((pts[0] - Vector((-1.0, 0.0, 0.0))).length, 1e-5)
+            self.assertLess((pts[-1] - end).length, 1e-5)
+            self.assertEqual((len(bpy.data.objects), len(bpy.data.curves), len(bpy.data.meshes)),
+                             counts)
+        finally:
+            bpy.data.objects.remove(path)
+            bpy.data.objects.remove(hook)
             bpy.data.curves.remove(data)
 
     def test_7f2_a_filled_2d_path_is_its_outline_and_a_deleted_one_is_a_report(self):

@@ -1280,7 +1280,15 @@ class MayaKeyWalkTest(unittest.TestCase):
                                [{"name": "L", "kind": "foot", "keys": []},
                                 {"name": "body", "kind": "body", "keys": []},
                                 {"name": "X1", "kind": "foot",
-                                 "keys": [{"frame": 1, "position": [0, 0, 0]}]}]):
+                                 "keys": [{"frame": 1, "position": [0, 0, 0]}]}],
+                               # another character's walk: its body track alone matched, and
+                               # the rig's feet were cut
+                               [{"name": n, "kind": "foot",
+                                 "keys": [{"frame": 1, "position": [0, 0, 0]}]}
+                                for n in ("LF", "RF", "LH", "RH")] +
+                               [{"name": "body", "kind": "body",
+                                 "keys": [{"frame": 1, "position": [0, 1, 0],
+                                           "rotation": [0, 0, 0, 1]}]}]):
                     path = os.path.join(folder, "walk.json")
                     with open(path, "w") as f:
                         json.dump({"tracks": tracks}, f)
@@ -1546,6 +1554,23 @@ class MayaKeyWalkTest(unittest.TestCase):
             self.assertAlmostEqual(d[1], 0.2 * (i + 1) * 180 / math.pi, places=9)  # yaw, degrees
             for a, b in zip(d, r):
                 self.assertAlmostEqual(math.radians(a), b, places=12)
+
+    def test_set_up_nodes_are_turned_in_the_scenes_angle_unit(self):
+        # Character Setup turned the rig and the central locators in degrees whatever the
+        # scene's unit: in a scene set to radians, 57.3 times too far, and the walk's heading,
+        # read back from the rig, went off by anything up to 180 degrees.
+        def turned(unit):
+            calls = []
+            cmds = types.ModuleType("maya.cmds")
+            cmds.currentUnit = lambda *args, **kwargs: unit
+            cmds.xform = lambda *args, **kwargs: calls.append(kwargs["ro"])
+            with self._footfall_maya(cmds) as footfall_maya:
+                footfall_maya._orient("rig", (0.0, 1.0, 0.0), (1.0, 0.0, 0.0))  # facing +X
+            return calls[0]
+        degrees, radians = turned("deg"), turned("rad")
+        self.assertAlmostEqual(degrees[1], 90.0, places=9)
+        for d, r in zip(degrees, radians):
+            self.assertAlmostEqual(math.radians(d), r, places=12)
 
     def test_a_body_with_rotation_keys_keeps_its_rotate_order(self):
         # Generate Walk set a picked body's rotateOrder to ZXY without converting its keys: a

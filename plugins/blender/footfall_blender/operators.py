@@ -650,15 +650,22 @@ def curve_points(context, obj):
     data.bevel_depth, data.extrude = 0.0, 0.0
     if data.dimensions == "2D":
         data.fill_mode = "NONE"  # a closed 2D curve's fill: its inner edges joined the path
-    line = obj.copy()  # (modifiers and all; never linked to a scene)
+    # The copy keeps the curve's modifiers (a Hook dragging its points, a Lattice bending it),
+    # which only a depsgraph applies: it is linked to the scene for as long as it is read (an
+    # object in no scene is evaluated without them, and the walk followed a path the viewport
+    # did not show).
+    line = obj.copy()
     line.data = data
+    line.hide_viewport = False
     try:
-        mesh = line.to_mesh()
+        context.scene.collection.objects.link(line)
+        evaluated = line.evaluated_get(context.evaluated_depsgraph_get())
+        mesh = evaluated.to_mesh()
         try:
             pts = [obj.matrix_world @ mesh.vertices[i].co for i in _edge_chain(mesh)] \
                 if mesh else []
         finally:
-            line.to_mesh_clear()
+            evaluated.to_mesh_clear()
     finally:
         bpy.data.objects.remove(line)
         bpy.data.curves.remove(data)
@@ -887,12 +894,14 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
                                      % len(crowd))
                 feet, body = rig_targets(context.scene, rig_obj)
                 keying.check_parents(list(feet.values()) + [body])
-                # Nothing is cleared unless the walk keys something of this rig.
-                if not any(t.get("keys") and ((t.get("kind") == "body" and body) or
-                                              t["name"] in feet)
-                           for t in walk["tracks"]):
-                    return _fail(self, "footfall: %s has no track for this rig's feet or body; the "
-                                 "rig's keys are unchanged" % path)
+                # Nothing is cleared unless the walk keys something of this rig, and only what
+                # it keys: another character's walk is refused.
+                try:
+                    keyed, keys_body = character.rig_tracks(walk, feet, body is not None, path)
+                except ValueError as e:
+                    return _fail(self, "footfall: %s; the rig's keys are unchanged" % e)
+                feet = {n: feet[n] for n in keyed}
+                body = body if keys_body else None
                 sets = [(walk, feet, body, rig_obj)]
             else:
                 base = os.path.splitext(os.path.basename(path))[0]

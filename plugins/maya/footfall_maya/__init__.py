@@ -186,10 +186,17 @@ def _snap(s, terrain, point):
     return hold.point, hold.normal
 
 
+def _ui_angles():
+    """The function from degrees to the scene's angle unit, which xform takes rotations in: in
+    a scene set to radians, degrees turned a node 57.3 times too far."""
+    return math.radians if mc.currentUnit(query=True, angle=True) == "rad" else float
+
+
 def _orient(node, up, forward):
     """Turns `node` (world space) so that its Y is `up` and its Z `forward` across it."""
     euler = ffc.rotation.quat_to_euler_xyz(ffc.rotation.quat_from_frame(up, forward))
-    mc.xform(node, ws=True, ro=euler)
+    to_ui_angle = _ui_angles()
+    mc.xform(node, ws=True, ro=[to_ui_angle(a) for a in euler])
 
 
 @_guard
@@ -305,9 +312,7 @@ def key_walk(walk, feet, body, from_frame=None):
     """Keys the walk (footfall JSON dict) on the IK handles and body, as the seed's tool did;
     with `from_frame`, only its keys from that frame on (those before are keyed already)."""
     count = 0
-    # xform takes rotations in the scene's angle unit: in a scene set to radians, degrees
-    # turned the body 57.3 times too far.
-    to_ui_angle = math.radians if mc.currentUnit(query=True, angle=True) == "rad" else float
+    to_ui_angle = _ui_angles()
     for track in walk.get("tracks", []):
         is_body = track.get("kind") == "body"
         node = body if is_body else feet.get(track.get("name"))
@@ -454,9 +459,10 @@ def import_walk(path, rig=None):
             raise ValueError("a crowd walk (%d characters) goes onto new locators: import it "
                              "without a rig" % len(crowd))
         _, feet, body = _rig_targets(rig)
-        if not any(t.get("keys") and ((t.get("kind") == "body" and body) or t["name"] in feet)
-                   for t in walk["tracks"]):
-            raise ValueError("%s has no track for this rig's feet or body" % path)
+        # Only what the walk keys is cut and keyed; another character's walk is refused.
+        keyed, keys_body = ffc.character.rig_tracks(walk, feet, bool(body), path)
+        feet = {n: feet[n] for n in keyed}
+        body = body if keys_body else None
         sets = [(walk, feet, body)]
     mc.undoInfo(openChunk=True, chunkName="footfall import walk")
     try:

@@ -264,3 +264,22 @@ def check_walk(walk, name="walk"):
                                       not any(key["rotation"])):
                 raise ValueError("%s: expected \"rotation\": [x, y, z, w] (finite numbers, not "
                                  "all zero)" % at)
+
+
+def rig_tracks(walk, feet, has_body, name="walk"):
+    """The names of the foot tracks with keys of a checked walk dict that go onto a rig whose
+    feet are `feet` (names), and whether its body track with keys goes onto the rig's body
+    (`has_body`). Raises ValueError when the walk keys a foot the rig does not have (another
+    character's walk: its body track alone would have gone on, and the rig's feet been cleared),
+    or nothing of the rig."""
+    walk_feet = [t["name"] for t in walk["tracks"]
+                 if t.get("kind", "foot") == "foot" and t.get("keys")]
+    body = has_body and any(t.get("kind") == "body" and t.get("keys") for t in walk["tracks"])
+    if not body and not any(n in feet for n in walk_feet):
+        raise ValueError("%s has no track for this rig's feet or body" % name)
+    foreign = [n for n in walk_feet if n not in feet]
+    if foreign:
+        raise ValueError("%s keys feet this rig does not have (%s; the rig's: %s): it is "
+                         "another character's walk; import it with no rig active, onto new "
+                         "objects" % (name, ", ".join(foreign), ", ".join(feet) or "none"))
+    return walk_feet, body
