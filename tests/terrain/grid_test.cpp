@@ -263,6 +263,37 @@ TEST_CASE("TerrainGrid answers exactly as brute force", "[terrain][grid]") {
     CHECK(rounding >= 1e-300);
     CHECK(rounding <= 3e-300);
   }
+  SECTION("with a few far outliers where a fixed-stride subsample would pick them all") {
+    // A 1e-4 lattice near 1e5 with strays at the origin: kept in the grid's box, they moved
+    // its centre 5e4 away, whose float offsets (spacing 0.004) merged the lattice. Strays one
+    // every n / 4096 samples (0.15%) were all in the subsample the box was chosen from, and a
+    // terrain of up to 100 samples kept any outlier.
+    for (const int side : {200, 10, 8, 4}) {
+      INFO(side * side << " lattice samples");
+      RawSamples s;
+      for (int k = 0; k < side; ++k)
+        for (int i = 0; i < side; ++i)
+          s.push_back({1e5 + i * 1e-4, 1e5, 1e5 + k * 1e-4}, {0, 1, 0});
+      std::vector<bool> stray(s.size(), false);
+      if (side == 200) {
+        for (size_t i = 0; i < 60; ++i) stray[i * s.size() / 4096] = true;
+      } else {
+        stray[s.size() / 2] = true;
+      }
+      for (size_t i = 0; i < s.size(); ++i)
+        if (stray[i]) s.points[i] = {0, 0, 0};
+      const TerrainGrid g = Build(s);
+      CHECK(g.stats().cell_size < 1e-2);
+      size_t own = 0, kept = 0;
+      for (size_t i = 0; i < s.size(); ++i) {
+        if (stray[i]) continue;
+        ++kept;
+        own += g.Snap(s.points[i]).index == i;  // each lattice sample stays apart
+      }
+      CHECK(own == kept);
+      CheckAgainstBruteForce(g, 500, 18);
+    }
+  }
   SECTION("with huge coordinates (near 1e5)") {
     RawSamples s = MakeHeightField(60, 60, 0.5, 2, 12);
     for (auto& p : s.points) p = p + Vec3{1e5, 1e5, -1e5};

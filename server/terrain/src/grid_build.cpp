@@ -32,23 +32,43 @@ uint32_t AxisCells(double extent, double h) {
   return static_cast<uint32_t>(std::max(1.0, std::ceil(extent / h)));
 }
 
+// A well-mixed 64-bit hash of i (SplitMix64's finaliser): where a subsample looks in each run of
+// the samples.
+uint64_t Scramble(uint64_t i) {
+  i += 0x9E3779B97F4A7C15ull;
+  i = (i ^ (i >> 30)) * 0xBF58476D1CE4E5B9ull;
+  i = (i ^ (i >> 27)) * 0x94D049BB133111EBull;
+  return i ^ (i >> 31);
+}
+
 // Picks the grid box per axis: the true bounds, unless a few far outliers stretch an axis to
-// more than 4 times its bulk (1st to 99th percentile of a subsample), then the bulk plus margin.
+// more than 4 times its bulk, then the bulk plus margin. The bulk runs from the (k+1)-th lowest
+// to the (k+1)-th highest value of a subsample of m (every sample up to 4096; else one from each
+// of 4096 equal runs of the samples, at a place in the run that varies from run to run: at a
+// fixed stride, outliers one every so many samples were all picked and taken for bulk), k = 1%
+// of m and at least 1 (a terrain of 100 samples and one outlier kept the outlier in its box,
+// and its origin far from the rest, whose float offsets then lost their spacing).
 void ChooseGridBox(const RawSamples& s, const double lo[3], const double hi[3], double glo[3],
                    double ghi[3]) {
   const size_t n = s.size();
   for (int a = 0; a < 3; ++a) glo[a] = lo[a], ghi[a] = hi[a];
-  if (n < 64) return;
+  if (n < 8) return;
   const size_t m = std::min<size_t>(n, 4096);
+  const size_t k = std::max<size_t>(1, (m - 1) / 100);
+  std::vector<size_t> picked(m);
+  for (size_t i = 0; i < m; ++i) {
+    const size_t begin = i * n / m, end = (i + 1) * n / m;
+    picked[i] = begin + static_cast<size_t>(Scramble(i) % (end - begin));
+  }
   std::vector<double> v(m);
   for (int a = 0; a < 3; ++a) {
     for (size_t i = 0; i < m; ++i) {
-      const Vec3& p = s.points[i * n / m];
+      const Vec3& p = s.points[picked[i]];
       v[i] = a == 0 ? p.x : a == 1 ? p.y : p.z;
     }
     std::sort(v.begin(), v.end());
-    const double q_lo = v[(m - 1) / 100];
-    const double q_hi = v[(m - 1) - (m - 1) / 100];
+    const double q_lo = v[k];
+    const double q_hi = v[(m - 1) - k];
     const double bulk = q_hi - q_lo;
     if (hi[a] - lo[a] > 4 * bulk) {
       const double margin = 0.25 * bulk;
