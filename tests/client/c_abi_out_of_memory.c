@@ -61,6 +61,10 @@ int main(int argc, char** argv) {
   Check(strstr(ffc_last_error(NULL), "ran out of memory") != NULL,
         "ffc_last_error(NULL) says the open ran out of memory");
   ffc_close(none);
+  /* A later open refused for its arguments is no want of memory (the reason stayed). */
+  Check(ffc_open_rpc("127.0.0.1", 0, 1.0) == NULL, "ffc_open_rpc refuses port 0");
+  Check(strcmp(ffc_last_error(NULL), "no session") == 0,
+        "ffc_last_error(NULL) after a refused open is no longer out of memory");
 
   int answered = 0, refused = 0;
   for (int round = 0; round < 120; ++round) {

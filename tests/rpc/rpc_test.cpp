@@ -31,6 +31,7 @@
 #include <catch2/catch.hpp>
 
 #include "footfall.h"
+#include "footfall/client/joined_calls.h"
 #include "footfall/client/recent_queries.h"
 #include "footfall/client/terrain_session.h"
 #include "footfall/import/terrain_generators.h"
@@ -1790,8 +1791,11 @@ TEST_CASE("at the open descriptor limit footfalld says which connections it clos
   // first) to take new ones.
   ServerProcess server(0, {"--no-rpcbind"}, 64);
   auto owner = ConnectLeavingOrphans(server.port());
-  TerrainHandle owned = 0;
+  TerrainHandle owned = 0, dropped = 0;
   REQUIRE(owner->LoadSamples(MakeFlat(10, 1, 0), "owned", &owned) == Status::kOk);
+  REQUIRE(owner->LoadSamples(MakeFlat(10, 1, 0), "dropped", &dropped) == Status::kOk);
+  const std::vector<uint32_t> held = ServerTerrains(server.port());
+  REQUIRE(held.size() == 2);
   std::vector<int> idle;
   for (int i = 0; i < 100; ++i) idle.push_back(RawConnect(server.port()));
   auto late = Connect(server.port(), 30);
@@ -1799,6 +1803,11 @@ TEST_CASE("at the open descriptor limit footfalld says which connections it clos
   CHECK(late->LoadSamples(MakeFlat(10, 1, 0), "late", &late_own) == Status::kOk);
   CHECK(late->Snap(late_own, Vec3{3.2, 1, 4.7}).point == Vec3{3, 0, 5});
   for (const int fd : idle) close(fd);
+  // An unload first: through a new connection (it was lost, "best effort" on the closed one,
+  // and the terrain stayed an orphan for --orphan-timeout).
+  CHECK(owner->Unload(dropped) == Status::kOk);
+  CHECK(WaitFor([&] { return ServerTerrains(server.port()).size() == 2; }));  // owned, late
+  CHECK(server.Log().find("unloaded terrain " + std::to_string(held[1])) != std::string::npos);
   // The owner's connection, closed while idle, is replaced before its next call, which
   // succeeds (it failed once with "the connection closed under the call", footfalld serving).
   const Foothold again = owner->Snap(owned, Vec3{3.2, 1, 4.7});
@@ -2205,6 +2214,17 @@ TEST_CASE("clients report a dead server and recover after a restart", "[rpc][rob
   SECTION("a server that stops answering times out") {
     kill(server->pid(), SIGSTOP);
     const Foothold stuck = rpc->Snap(t, Vec3{5, 1, 5});
+    // The recent-queries feed bounds its timeouts as sessions do: a negative or NaN one is 0
+    // (it waited libtirpc's default, 25 s).
+    for (const double timeout : {-1.0, std::nan("")}) {
+      RpcOptions o;
+      o.port = port, o.connect_timeout_s = timeout, o.call_timeout_s = timeout;
+      RecentQueryFeed feed(o);
+      std::vector<RecentQuery> recent;
+      const auto start = std::chrono::steady_clock::now();
+      CHECK(feed.Poll(&recent) == Status::kUnavailable);
+      CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(10));
+    }
     kill(server->pid(), SIGCONT);
     CHECK(stuck.status == Status::kUnavailable);
     INFO(rpc->last_error());
@@ -2351,6 +2371,36 @@ TEST_CASE("a client repeating a failing request cannot flood footfalld's log",
   CHECK(lines >= 100);
   CHECK(lines <= 100 + 10 * (elapsed + 2));
   clnt_destroy(c);
+}
+
+TEST_CASE("an unknown terrain is said alike by every session, whatever the count or tolerance",
+          "[rpc]") {
+  // Over RPC, batches of no queries on an unknown or unloaded terrain answered OK (the embedded
+  // session says unknown_terrain), and a NaN tolerance was judged before the terrain.
+  ServerProcess server;
+  auto rpc = Connect(server.port());
+  auto embedded = MakeEmbeddedSession(1);
+  JoinedCalls rpc_joined(*rpc), embedded_joined(*embedded);
+  auto rpc_member = rpc_joined.Join(), embedded_member = embedded_joined.Join();
+  for (TerrainSession* s : {rpc.get(), embedded.get(), rpc_member.get(), embedded_member.get()}) {
+    INFO(s->Describe() << (s == rpc_member.get() || s == embedded_member.get() ? ", joined" : ""));
+    TerrainHandle loaded = 0, unloaded = 0;
+    REQUIRE(s->LoadSamples(MakeFlat(4, 1, 0), "kept", &loaded) == Status::kOk);
+    REQUIRE(s->LoadSamples(MakeFlat(4, 1, 0), "gone", &unloaded) == Status::kOk);
+    REQUIRE(s->Unload(unloaded) == Status::kOk);
+    Foothold out;
+    const Vec3 point{1, 0, 1};
+    const StepQuery step{point, {0.5, 0, 0}};
+    for (const TerrainHandle t : {unloaded, TerrainHandle{987654}}) {
+      CHECK(s->Snap(t, &point, 0, &out) == Status::kUnknownTerrain);
+      CHECK(s->Normal(t, &point, 0, &out) == Status::kUnknownTerrain);
+      CHECK(s->Next(t, &step, 0, 0, &out) == Status::kUnknownTerrain);
+      CHECK(s->Next(t, &step, 1, std::nan(""), &out) == Status::kUnknownTerrain);
+    }
+    CHECK(s->Snap(loaded, &point, 0, &out) == Status::kOk);
+    CHECK(s->Next(loaded, &step, 0, 0, &out) == Status::kOk);
+    CHECK(s->Next(loaded, &step, 1, std::nan(""), &out) == Status::kInvalidArgument);
+  }
 }
 
 TEST_CASE("a client loading and unloading in a loop cannot flood footfalld's log",

@@ -230,11 +230,11 @@ ffc_session* ffc_open_embedded(void) {
 
 ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s) {
   std::signal(SIGPIPE, SIG_IGN);
+  t_open_ran_out = false;  // (a refusal below is no want of memory)
   if (port < 1 || port > 65535) return nullptr;
   // NaN, infinite either way, beyond any bound, or too short for any call to be answered.
   if (!std::isfinite(timeout_s) || timeout_s > kMaxTimeout) return nullptr;
   if (timeout_s > 0 && timeout_s < kMinTimeout) return nullptr;
-  t_open_ran_out = false;
   try {
     footfall::RpcOptions options;
     if (host && *host && !footfall::ParseHost(host, &options.host)) return nullptr;

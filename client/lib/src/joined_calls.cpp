@@ -75,7 +75,13 @@ class JoinedCalls::Member final : public TerrainSession {
     return s;
   }
   Status Joined(Request r) {
-    if (r.count == 0) return Status::kOk;  // nothing to ask: as every session answers it
+    if (r.count == 0) {  // nothing to join: the session answers it alone (a terrain it lacks)
+      return Direct([&r](TerrainSession& s) {
+        return r.kind == JoinedKind::kNext     ? s.Next(r.terrain, r.queries, 0, r.tolerance, r.out)
+               : r.kind == JoinedKind::kNormal ? s.Normal(r.terrain, r.points, 0, r.out)
+                                               : s.Snap(r.terrain, r.points, 0, r.out);
+      });
+    }
     joined_.Ask(&r);
     if (r.status == Status::kOk) return r.status;
     return Fail(r.status, r.out_of_memory ? "out of memory joining the queries of several "

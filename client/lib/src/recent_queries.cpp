@@ -26,7 +26,7 @@ struct RecentQueryFeed::Connection {
 };
 
 RecentQueryFeed::RecentQueryFeed(const RpcOptions& options)
-    : options_(options), connection_(std::make_unique<Connection>()) {
+    : options_(BoundedTimeouts(options)), connection_(std::make_unique<Connection>()) {
   std::signal(SIGPIPE, SIG_IGN);
 }
 

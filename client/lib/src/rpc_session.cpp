@@ -72,7 +72,7 @@ class RpcSession final : public TerrainSession {
     std::signal(SIGPIPE, SIG_IGN);
   }
   ~RpcSession() override {
-    if (options_.unload_on_close && client_) {
+    if (options_.unload_on_close && client_ && ReconnectIfClosed()) {
       SetCallTimeout(client_, std::min(options_.call_timeout_s, kCloseTimeout));
       for (const auto& entry : terrains_)
         if (entry.second.loaded && UnloadOnServer(entry.second) != RPC_SUCCESS) break;  // orphans
@@ -140,7 +140,10 @@ class RpcSession final : public TerrainSession {
   Status Unload(TerrainHandle terrain) override {
     auto it = terrains_.find(terrain);
     if (it == terrains_.end()) return Unknown(terrain);
-    if (it->second.loaded && client_) Call(UnloadOnServer(it->second), "unload");  // best effort
+    // Best effort; through a new connection when footfalld closed the idle one (its terrains
+    // are orphans then, which any connection may unload).
+    if (it->second.loaded && client_ && ReconnectIfClosed())
+      Call(UnloadOnServer(it->second), "unload");
     terrains_.erase(it);
     return Status::kOk;
   }
@@ -155,6 +158,8 @@ class RpcSession final : public TerrainSession {
 
   Status Next(TerrainHandle terrain, const StepQuery* queries, size_t count, double tolerance,
               Foothold* out) override {
+    // The terrain first, as the embedded session judges it.
+    if (!terrains_.count(terrain)) return Unknown(terrain);
     if (!std::isfinite(tolerance)) return Fail(Status::kInvalidArgument, "tolerance is not finite");
     return BatchCalls(
         terrain, queries, count, out, "next",
@@ -211,6 +216,9 @@ class RpcSession final : public TerrainSession {
         return TakeBatch(reply, n, answers, what);
       });
     };
+    // No queries: nothing to send, but an unknown terrain is said, as the embedded session says
+    // it.
+    if (count == 0 && !terrains_.count(terrain)) return Unknown(terrain);
     for (size_t begin = 0; begin < count; begin += FF_MAX_BATCH) {
       const size_t n = std::min<size_t>(FF_MAX_BATCH, count - begin);
       Status s = call(queries + begin, n, out + begin);
@@ -499,6 +507,16 @@ class RpcSession final : public TerrainSession {
       // Terrains stay marked loaded: a server that restarted answers FF_UNKNOWN_TERRAIN for
       // them (its handles start at a random base), and WithTerrain then loads them again.
     }
+  }
+
+  // Replaces a connection footfalld closed while it was idle, quietly (last_error() is kept).
+  // False when there is no connection to call on.
+  bool ReconnectIfClosed() {
+    if (!client_ || !ClosedByServer()) return client_ != nullptr;
+    const std::string kept = last_error_;
+    const bool connected = EnsureConnected() == Status::kOk;
+    last_error_ = kept;
+    return connected;
   }
 
   Status EnsureConnected() {
