@@ -1509,7 +1509,14 @@ class BlenderAddonTest(unittest.TestCase):
         clear_animation(list(feet.values()) + [body])
         bpy.context.scene.footfall.rig = rig
         self.select([rig], rig)  # the rig of the active object is keyed
-        self.assertEqual(bpy.ops.footfall.import_walk(filepath=out), {"FINISHED"})
+        # Blender's importer switched a Workbench scene to EEVEE; the user's engine stays.
+        render = bpy.context.scene.render
+        engine, render.engine = render.engine, "BLENDER_WORKBENCH"
+        try:
+            self.assertEqual(bpy.ops.footfall.import_walk(filepath=out), {"FINISHED"})
+            self.assertEqual(render.engine, "BLENDER_WORKBENCH")
+        finally:
+            render.engine = engine
         # glTF holds 32-bit floats and times in seconds: the same keys as the JSON walk.
         self.assert_keys_equal_walk(walk, feet, body)
 

@@ -960,12 +960,19 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
     def _read_gltf(self, path):
         before = set(bpy.data.objects)
         actions_before = set(bpy.data.actions)
+        # Blender's importer switches a Workbench scene to EEVEE (for the materials it makes):
+        # the walk read, the scene's render engine is the user's again.
+        render = bpy.context.scene.render
+        engine = render.engine
         try:
             result = bpy.ops.import_scene.gltf(filepath=path)
         except RuntimeError as e:  # the importer's own error on a damaged file
             for obj in set(bpy.data.objects) - before:
                 bpy.data.objects.remove(obj)
             raise ValueError("Blender's glTF importer: %s" % str(e).strip()) from None
+        finally:
+            if render.engine != engine:
+                render.engine = engine
         if "FINISHED" not in result:
             raise ValueError("Blender's glTF importer failed")
         made = [o for o in bpy.data.objects if o not in before]
