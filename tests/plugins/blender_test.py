@@ -888,6 +888,20 @@ class BlenderAddonTest(unittest.TestCase):
         self.assertEqual(bpy.ops.footfall.generate_walk(chunk_steps=2), {"FINISHED"})
         walk = json.loads(bpy.data.texts["footfall_walk.json"].as_string())
         self.assert_world_at_key_frames(walk, feet, body, tol=1e-5)
+        # Targets sharing one action (Duplicate Linked): each played both feet's keys, one
+        # mixed track, and the walk said it had succeeded.
+        own = feet["L"].animation_data.action
+        feet["L"].animation_data.action = feet["R"].animation_data.action
+        try:
+            before = {o.name: fcurve_keys(o, "location", 3) for o in objects}
+            for run in (lambda: bpy.ops.footfall.generate_walk(chunk_steps=2),
+                        lambda: bpy.ops.footfall.import_walk(filepath=path)):
+                with self.assertRaises(RuntimeError) as e:
+                    run()
+                self.assertIn("share the action", str(e.exception))
+                self.assertEqual({o.name: fcurve_keys(o, "location", 3) for o in objects}, before)
+        finally:
+            feet["L"].animation_data.action = own
         target.parent, target.parent_type, target.parent_bone = saved[:3]
         target.matrix_world = saved[3]
         for obj in (cube, curve):

@@ -48,11 +48,22 @@ def own_constraint(obj):
 def check_parents(objects):
     """Raises ValueError naming the first of `objects` (None ones skipped) whose parent relation
     cannot be keyed exactly (see unsupported_parent), or whose own constraints move it
-    (own_constraint)."""
+    (own_constraint), or two of them that share one action (Duplicate Linked, Alt+D, shares
+    it: both would play every key of both, one mixed track)."""
     for obj in objects:
         why = (unsupported_parent(obj) or own_constraint(obj)) if obj is not None else None
         if why:
             raise ValueError(why)
+    owner = {}
+    for obj in objects:
+        action = obj.animation_data.action if obj is not None and obj.animation_data else None
+        if action is None:
+            continue
+        if action in owner and owner[action] is not obj:
+            raise ValueError("%s and %s share the action %s, so each would play the other's keys "
+                             "too: give each its own (Object > Relations > Make Single User > "
+                             "Object Animation)" % (owner[action].name, obj.name, action.name))
+        owner[action] = obj
 
 
 def _delta_rotation(obj):
