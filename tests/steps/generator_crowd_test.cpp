@@ -277,6 +277,22 @@ TEST_CASE("Generation is deterministic", "[steps][generator]") {
   }
 }
 
+// The walk of `c` with options `o` in an embedded session of `threads` threads, on the terrain
+// load(session, &handle) loads.
+template <typename Load>
+Walk WalkOnThreads(int threads, const Character& c, GenerateOptions o, Load&& load) {
+  auto session = MakeEmbeddedSession(threads);
+  TerrainHandle h = 0;
+  REQUIRE(load(*session, &h) == Status::kOk);
+  o.threads = threads;
+  Walk w;
+  std::string error;
+  const Status s = GenerateWalk(*session, h, c, o, &w, &error);
+  INFO(error);
+  REQUIRE(s == Status::kOk);
+  return w;
+}
+
 TEST_CASE("A crowd walked in passes on two threads says what one thread says",
           "[steps][generator][crowd]") {
   // 260 octopods on the shipped hills, whose samples are too far apart for a foot of some to
@@ -284,19 +300,12 @@ TEST_CASE("A crowd walked in passes on two threads says what one thread says",
   // copy that walked its pass, and lost, on two threads.
   const Character c = LoadShipped("octopod");
   const std::string hills = std::string(FOOTFALL_SOURCE_DIR) + "/data/terrain/hills.pts";
-  auto run = [&](int threads) {
-    auto session = MakeEmbeddedSession(threads);
-    TerrainHandle h;
-    REQUIRE(session->LoadFile(hills, TerrainLoadOptions{}, &h) == Status::kOk);
-    GenerateOptions o;
-    o.steps = 1, o.crowd = 260, o.crowd_spacing = 1, o.threads = threads;
-    Walk w;
-    std::string error;
-    INFO(error);
-    REQUIRE(GenerateWalk(*session, h, c, o, &w, &error) == Status::kOk);
-    return w;
+  GenerateOptions o;
+  o.steps = 1, o.crowd = 260, o.crowd_spacing = 1;
+  auto load = [&](TerrainSession& s, TerrainHandle* h) {
+    return s.LoadFile(hills, TerrainLoadOptions{}, h);
   };
-  const Walk one = run(1), two = run(2);
+  const Walk one = WalkOnThreads(1, c, o, load), two = WalkOnThreads(2, c, o, load);
   REQUIRE_FALSE(one.notes.empty());
   CHECK_THAT(one.notes.back(), Catch::Contains("at the start, foot "));
   CHECK(two.notes == one.notes);
@@ -307,19 +316,11 @@ TEST_CASE("A large crowd's walk is the same on one thread and on two",
   // 2,100 hexapods: enough for the generator and the engine to split their work.
   const Character c = LoadShipped("hexapod");
   const RawSamples ground = MakeHeightField(500, 500, 0.03, 0.01, 3);
-  auto run = [&](int threads) {
-    auto session = MakeEmbeddedSession(threads);
-    TerrainHandle h;
-    REQUIRE(session->LoadSamples(ground, "bumps", &h) == Status::kOk);
-    GenerateOptions o = CrowdOptions({7.5, 0, 7}, 4, 2100, 0.3);
-    o.threads = threads;
-    Walk w;
-    std::string error;
-    INFO(error);
-    REQUIRE(GenerateWalk(*session, h, c, o, &w, &error) == Status::kOk);
-    return w;
+  const GenerateOptions o = CrowdOptions({7.5, 0, 7}, 4, 2100, 0.3);
+  auto load = [&](TerrainSession& s, TerrainHandle* h) {
+    return s.LoadSamples(ground, "bumps", h);
   };
-  const Walk one = run(1), two = run(2);
+  const Walk one = WalkOnThreads(1, c, o, load), two = WalkOnThreads(2, c, o, load);
   CHECK(one.stopped == two.stopped);
   REQUIRE(one.tracks.size() == two.tracks.size());
   size_t left_out = 0;  // crowd places at the terrain's edge snapped onto others' starts
