@@ -454,6 +454,16 @@ bad empty-heading "--heading: expected DX,DY,DZ" --terrain "$hills" --character 
 bad heading-up "the heading (0.0000, 1.0000, 0.0000) is along the up (0.0000, 1.0000, 0.0000) where the character starts" --terrain "$hills" --character "$chars/biped.json" --heading 0,1,0 --out "$work/x.json"
 bad gltf-negative-frame "--out $work/neg.gltf: glTF animation times must be >= 0, and --start-frame is -100" --terrain "$hills" --character "$chars/biped.json" --start-frame -100 --out "$work/neg.json" --out "$work/neg.gltf"
 check "gltf-negative-frame: nothing written" [ ! -e "$work/neg.json" ]
+# Whole numbers with leading zeros are decimal (CLI11 read "010" as octal 8 and refused "08").
+for pair in "010 10" "08 8"; do
+  read -r zeros plain <<< "$pair"
+  "$footfall" generate --terrain "$hills" --character "$chars/biped.json" --steps "$zeros" --out "$work/steps-$zeros.json" 2> /dev/null
+  "$footfall" generate --terrain "$hills" --character "$chars/biped.json" --steps "$plain" --out "$work/steps-$plain.json" 2> /dev/null
+  check "--steps $zeros is --steps $plain" cmp -s "$work/steps-$zeros.json" "$work/steps-$plain.json"
+  "$footfall" terrain make rocks --size "$zeros" --seed "$zeros" -o "$work/rocks-$zeros.pts" > /dev/null 2>&1
+  "$footfall" terrain make rocks --size "$plain" --seed "$plain" -o "$work/rocks-$plain.pts" > /dev/null 2>&1
+  check "terrain make --size $zeros --seed $zeros is --size $plain --seed $plain" cmp -s "$work/rocks-$zeros.pts" "$work/rocks-$plain.pts"
+done
 # In a scene, --start-frame is the default of the characters that give none: a negative one
 # refuses glTF only when a character takes it.
 cat > "$work/scene/framed.json" <<JSON

@@ -70,7 +70,7 @@ int View(int argc, char** argv) {
       app.add_option("--live-wait", o.live_wait,
                      "With --live and --screenshot: wait for this many live queries before "
                      "rendering")
-          ->check(footfall::cli::WholeUpTo(1000000));
+          ->transform(footfall::cli::WholeUpTo(1000000));
   app.add_option("--timeout", o.timeout_s, "Bound on waits for the server (s)")
       ->check(footfall::cli::FiniteRange(0.001, 1e6));
   app.add_option("--screenshot", o.screenshot, "Render one frame off screen to this PNG and exit")

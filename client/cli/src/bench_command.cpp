@@ -368,12 +368,12 @@ void AddBenchCommand(CLI::App& app, int* exit_code) {
       "with --server), beside brute force and, over RPC, the embedded engine");
   AddTerrainFlags(cmd, &flags->terrain);
   cmd->add_option("--threads", flags->terrain.threads, "threads of the embedded engine's batches")
-      ->check(WholeRange(1, 256));
+      ->transform(WholeRange(1, 256));
   cmd->add_option("--queries", flags->queries, "query points per pass")
-      ->check(WholeRange(1, 1 << 24));
+      ->transform(WholeRange(1, 1 << 24));
   cmd->add_option("--batch", flags->batch,
                   "queries per batch call (over RPC, a batch above 4096 goes as several calls)")
-      ->check(WholeRange(1, 1 << 20));
+      ->transform(WholeRange(1, 1 << 20));
   cmd->add_option("--jitter", flags->jitter,
                   "how far query points lie off the terrain, per axis (default: a quarter cell)")
       ->check(FiniteRange(0, 1e12));
@@ -381,7 +381,7 @@ void AddBenchCommand(CLI::App& app, int* exit_code) {
       ->check(FiniteAboveUpTo(0, 1e12));
   cmd->add_option("--min-time", flags->min_time, "seconds each figure is measured for at least")
       ->check(FiniteRange(0.001, 3600));
-  cmd->add_option("--query-seed", flags->seed, "seed of the query points")->check(Seed());
+  cmd->add_option("--query-seed", flags->seed, "seed of the query points")->transform(Seed());
   cmd->add_flag("--json", flags->json, "write the figures as one JSON object");
   cmd->callback([flags, exit_code] { *exit_code = RunBench(*flags); });
 }

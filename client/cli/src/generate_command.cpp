@@ -775,7 +775,7 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
       cmd->add_option("--steps", flags->steps,
                       "Steps per character, one gait group each (default 8; with --path, until "
                       "the goal)")
-          ->check(WholeUpTo(1000000));
+          ->transform(WholeUpTo(1000000));
   cmd->add_option("--start-frame", flags->start_frame, "Frame of the first keys (default 1)")
       ->check(FiniteRange(-kMaxStartFrame, kMaxStartFrame));
   cmd->add_option("--fps", flags->fps, "Frames per second of the walk (default 24)")
@@ -785,7 +785,7 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
   CLI::Option* crowd =
       cmd->add_option("--crowd", flags->crowd,
                       "Generate this many characters at once on a grid around --start")
-          ->check(WholeRange(1, 1000000));
+          ->transform(WholeRange(1, 1000000));
   CLI::Option* crowd_spacing =
       cmd->add_option("--crowd-spacing", flags->crowd_spacing,
                       "Distance between crowd characters (default: twice the character's reach)")
@@ -793,7 +793,7 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
   cmd->add_option("--threads", flags->threads,
                   "Threads for the embedded engine's queries and the generator's own work "
                   "(default: the hardware's; the walk is the same whatever the count)")
-      ->check(WholeRange(1, 256));
+      ->transform(WholeRange(1, 256));
   cmd->add_flag("--progress", flags->progress,
                 "Show a progress bar on stderr (shown anyway for long runs on a terminal)");
   cmd->add_option("--out", flags->out,

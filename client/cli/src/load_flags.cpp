@@ -29,7 +29,7 @@ std::vector<CLI::Option*> AddLoadFlags(CLI::App* command, TerrainLoadOptions* lo
       command
           ->add_option("--seed", load->seed,
                        "Seed of the mesh sampler, a whole number from 0 to 2^64 - 1 (default 1)")
-          ->check(Seed()),
+          ->transform(Seed()),
       command->add_option("--up-axis", load->up_axis, "Height maps: up axis x, y or z")
           ->check(CLI::IsMember({'x', 'y', 'z'})),
       command

@@ -27,6 +27,13 @@ CLI::Validator Make(const std::string& expected, Ok ok) {
       expected);
 }
 
+// `digits` (decimal digits alone) without its leading zeros ("0" for zero): CLI11 converts
+// integers with strtoll in base 0, which read "010" as octal 8 and refused "08".
+void DropLeadingZeros(std::string& digits) {
+  const size_t first = digits.find_first_not_of('0');
+  digits.erase(0, first == std::string::npos ? digits.size() - 1 : first);
+}
+
 }  // namespace
 
 CLI::Validator Finite() {
@@ -63,18 +70,28 @@ CLI::Validator FiniteAboveUpTo(double lo, double hi) {
 CLI::Validator Seed() {
   return CLI::Validator(
       [](std::string& input) -> std::string {
-        if (!input.empty() && input.size() <= 20 &&
-            input.find_first_not_of("0123456789") == std::string::npos &&
-            (input.size() < 20 || input <= "18446744073709551615"))
+        std::string digits = input;
+        if (!digits.empty() && digits.find_first_not_of("0123456789") == std::string::npos)
+          DropLeadingZeros(digits);
+        if (!digits.empty() && digits.size() <= 20 &&
+            digits.find_first_not_of("0123456789") == std::string::npos &&
+            (digits.size() < 20 || digits <= "18446744073709551615")) {
+          input = digits;
           return std::string();
+        }
         return "'" + input + "' is not a whole number from 0 to 18446744073709551615";
       },
       "SEED");
 }
 
 CLI::Validator WholeRange(long long lo, long long hi) {
-  return CLI::Validator([lo, hi](std::string& input) { return WholeNumberProblem(input, lo, hi); },
-                        "INT in [" + std::to_string(lo) + " - " + std::to_string(hi) + "]");
+  return CLI::Validator(
+      [lo, hi](std::string& input) {
+        std::string problem = WholeNumberProblem(input, lo, hi);
+        if (problem.empty()) DropLeadingZeros(input);
+        return problem;
+      },
+      "INT in [" + std::to_string(lo) + " - " + std::to_string(hi) + "]");
 }
 
 CLI::Validator WholeUpTo(long long hi) { return WholeRange(0, hi); }

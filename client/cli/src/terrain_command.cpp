@@ -381,11 +381,11 @@ void AddTerrainCommand(CLI::App& app, int* exit_code) {
       ->capture_default_str();
   m->add_option("--seed", make->seed,
                 "Seed (blocks, rocks, hills), a whole number from 0 to 2^64 - 1")
-      ->check(Seed())
+      ->transform(Seed())
       ->capture_default_str();
   m->add_option("--steps", make->steps,
                 "stairs: number of treads, the first on the ground (one riser fewer)")
-      ->check(WholeRange(1, 2147483647))
+      ->transform(WholeRange(1, 2147483647))
       ->capture_default_str();
   m->add_option("--rise", make->rise, "stairs: step height (negative: stairs going down along +z)")
       ->check(Finite())
@@ -397,10 +397,10 @@ void AddTerrainCommand(CLI::App& app, int* exit_code) {
       ->check(FiniteAbove(0))
       ->capture_default_str();
   m->add_option("--size", make->size, "blocks: columns per side; rocks, flat, hills: side length")
-      ->check(WholeRange(1, 2147483647))
+      ->transform(WholeRange(1, 2147483647))
       ->capture_default_str();
   m->add_option("--max-height", make->max_height, "blocks: tallest pile in unit cubes")
-      ->check(WholeRange(0, 2147483647))
+      ->transform(WholeRange(0, 2147483647))
       ->capture_default_str();
   m->add_option("--amplitude", make->amplitude,
                 "rocks, hills: height of the relief (hills: the same hills at any --spacing)")

@@ -94,7 +94,13 @@ CLI::Validator Seconds(bool zero_ok) {
 // convert").
 CLI::Validator WholeRange(long long lo, long long hi) {
   return CLI::Validator(
-      [lo, hi](std::string& input) { return footfall::WholeNumberProblem(input, lo, hi); },
+      [lo, hi](std::string& input) {
+        std::string problem = footfall::WholeNumberProblem(input, lo, hi);
+        // Without its leading zeros: CLI11 converts in base 0, which read "010" as octal 8.
+        if (problem.empty())
+          input.erase(0, std::min(input.find_first_not_of('0'), input.size() - 1));
+        return problem;
+      },
       "INT in [" + std::to_string(lo) + " - " + std::to_string(hi) + "]");
 }
 
@@ -190,7 +196,7 @@ int Serve(int argc, char** argv) {
   options.batch_threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   app.add_option("--threads", options.batch_threads,
                  "Threads per batch query (default: the hardware's cores)")
-      ->check(WholeRange(1, 64));
+      ->transform(WholeRange(1, 64));
   // (Its count is asked of the option itself: App::count looks the name up in a function that
   // may not throw, so memory running out there was an abort.)
   const CLI::Option* max_samples =
@@ -212,7 +218,7 @@ int Serve(int argc, char** argv) {
       ->check(Seconds(false));
   app.add_option("--max-client-terrains", options.limits.max_client_terrains,
                  "Terrains one connection may hold loaded at once (default 64)")
-      ->check(WholeRange(1, 256));
+      ->transform(WholeRange(1, 256));
   app.add_option("--unread-timeout", options.unread_timeout_s,
                  "Seconds a client may leave its replies unread, with no room for another, "
                  "before its connection is closed (default 30)")

@@ -17,6 +17,8 @@ CLI::Validator FiniteAbove(double lo);
 CLI::Validator FiniteRange(double lo, double hi);
 // A finite number in (lo, hi].
 CLI::Validator FiniteAboveUpTo(double lo, double hi);
+// The whole-number checks are transforms (Option::transform, not check): they drop the leading
+// zeros of a number they accept, which CLI11 would read as octal ("010" as 8, "08" refused).
 // A whole number from 0 to 2^64 - 1, written in decimal digits only (CLI11 alone read "-1" as
 // 2^64 - 1 and clamped larger numbers to it).
 CLI::Validator Seed();
