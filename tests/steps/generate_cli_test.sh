@@ -454,6 +454,11 @@ bad empty-heading "--heading: expected DX,DY,DZ" --terrain "$hills" --character 
 bad heading-up "the heading (0.0000, 1.0000, 0.0000) is along the up (0.0000, 1.0000, 0.0000) where the character starts" --terrain "$hills" --character "$chars/biped.json" --heading 0,1,0 --out "$work/x.json"
 bad gltf-negative-frame "--out $work/neg.gltf: glTF animation times must be >= 0, and --start-frame is -100" --terrain "$hills" --character "$chars/biped.json" --start-frame -100 --out "$work/neg.json" --out "$work/neg.gltf"
 check "gltf-negative-frame: nothing written" [ ! -e "$work/neg.json" ]
+# A mesh resampled for the character is checked against the other terrain flags first (a
+# --server-terrain beside it was ignored, and a bad --server said only after the resampling).
+printf 'v -3 0 -3\nv 3 0 -3\nv 3 0 3\nv -3 0 3\nf 1 4 3 2\n' > "$work/flat-mesh.obj"
+bad mesh-and-server-terrain "give exactly one of --terrain FILE or --server-terrain PATH" --terrain "$work/flat-mesh.obj" --server-terrain elsewhere.obj --character "$chars/biped.json" --out "$work/x.json"
+bad mesh-bad-server "'nocolon': expected HOST:PORT" --terrain "$work/flat-mesh.obj" --server nocolon --character "$chars/biped.json" --out "$work/x.json"
 # Whole numbers with leading zeros are decimal (CLI11 read "010" as octal 8 and refused "08").
 for pair in "010 10" "08 8"; do
   read -r zeros plain <<< "$pair"

@@ -335,6 +335,9 @@ bool LoadWalkTerrain(const GenerateFlags& flags, const Character& character,
   t->flags = flags.terrain;
   t->flags.threads = flags.threads;
   TerrainFlags& terrain_flags = t->flags;
+  // Before a mesh is resampled for the character (--server-terrain beside a mesh --terrain was
+  // ignored, and a bad --server said only after the resampling).
+  if (CheckTerrainFlags(terrain_flags, error) != Status::kOk) return false;
   t->resampled = ResamplesForCharacter(terrain_flags);
   if (t->resampled) {
     if (PrepareWalkTerrain(terrain_flags.terrain, terrain_flags.load, character, *options,

@@ -41,8 +41,7 @@ Status OpenSession(const TerrainFlags& flags, std::unique_ptr<TerrainSession>* s
   return Status::kOk;
 }
 
-Status OpenTerrain(const TerrainFlags& flags, std::unique_ptr<TerrainSession>* session,
-                   TerrainHandle* terrain, std::string* error) {
+Status CheckTerrainFlags(const TerrainFlags& flags, std::string* error) {
   if (flags.terrain.empty() == flags.server_terrain.empty()) {
     *error = "give exactly one of --terrain FILE or --server-terrain PATH";
     return Status::kInvalidArgument;
@@ -55,7 +54,15 @@ Status OpenTerrain(const TerrainFlags& flags, std::unique_ptr<TerrainSession>* s
     *error = "--server-terrain needs --server HOST:PORT";
     return Status::kInvalidArgument;
   }
-  Status status = OpenSession(flags, session, error);
+  RpcOptions options;
+  return flags.server.empty() ? Status::kOk : ParseHostPort(flags.server, &options, error);
+}
+
+Status OpenTerrain(const TerrainFlags& flags, std::unique_ptr<TerrainSession>* session,
+                   TerrainHandle* terrain, std::string* error) {
+  Status status = CheckTerrainFlags(flags, error);
+  if (status != Status::kOk) return status;
+  status = OpenSession(flags, session, error);
   if (status != Status::kOk) return status;
   status = flags.terrain.empty()
                ? (*session)->LoadServerFile(flags.server_terrain, flags.load, terrain)

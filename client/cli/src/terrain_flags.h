@@ -30,8 +30,13 @@ void AddTerrainFlags(CLI::App* command, TerrainFlags* flags);
 Status OpenSession(const TerrainFlags& flags, std::unique_ptr<TerrainSession>* session,
                    std::string* error);
 
-// Opens the session the flags ask for and loads the terrain. On failure returns the status and
-// a one-line message naming what failed.
+// Checks the flags before anything is read or loaded: exactly one of --terrain and
+// --server-terrain, the resampling flags only for what they apply to, --server-terrain with
+// --server, and --server a HOST:PORT. On failure returns the status and a one-line message.
+Status CheckTerrainFlags(const TerrainFlags& flags, std::string* error);
+
+// Opens the session the flags ask for and loads the terrain (checked by CheckTerrainFlags
+// first). On failure returns the status and a one-line message naming what failed.
 Status OpenTerrain(const TerrainFlags& flags, std::unique_ptr<TerrainSession>* session,
                    TerrainHandle* terrain, std::string* error);
 
