@@ -95,6 +95,14 @@ check "long line: four answers" [ "$(wc -l < "$work/long.jsonl")" -eq 4 ]
 check "long line: an error naming the line" grep -qx '{"op":"error","line":2,"message":"line longer than 4096 characters"}' <(sed -n 2p "$work/long.jsonl")
 check "long line: the lines after it are answered" grep -q '"op":"snap","found":true,"index":12' <(sed -n 3p "$work/long.jsonl")
 check "long line: a last line without newline is answered" grep -q '"op":"snap","found":true' <(sed -n 4p "$work/long.jsonl")
+# Lines of exactly 4096 characters are read whether LF or CRLF ends them (the CR was counted,
+# and the CRLF one refused as too long); 4097 are too long either way.
+line4096=$(printf 'snap 1 0 1%*s' 4086 '')
+line4097="$line4096 "
+printf '%s\n%s\r\n%s\n%s\r\n' "$line4096" "$line4096" "$line4097" "$line4097" |
+  "$footfall" query --terrain "$work/flat.pts" > "$work/edge.jsonl"
+check "4096-character lines, LF and CRLF: answered" [ "$(grep -c '"op":"snap","found":true' "$work/edge.jsonl")" -eq 2 ]
+check "4097-character lines, LF and CRLF: too long" [ "$(grep -c 'line longer than 4096 characters' "$work/edge.jsonl")" -eq 2 ]
 # An empty --terrain, --server-terrain or --server (a script's unset variable) is refused, naming
 # the flag: --server "" ran the embedded engine and --server-terrain "" was ignored, silently.
 for flag in --terrain --server --server-terrain; do

@@ -37,8 +37,10 @@ constexpr std::streamsize kMaxLine = 4096;
 // (the rest is skipped). False at the end of the input.
 bool ReadLine(std::istream& in, std::string* text, bool* too_long) {
   *too_long = false;
-  text->resize(static_cast<size_t>(kMaxLine) + 1);
-  in.getline(&(*text)[0], kMaxLine + 1);
+  // Room for kMaxLine characters, a CRLF line's CR (not counted: a line of kMaxLine characters
+  // ended by CRLF was refused as too long) and the terminating NUL.
+  text->resize(static_cast<size_t>(kMaxLine) + 2);
+  in.getline(&(*text)[0], kMaxLine + 2);
   const std::streamsize got = in.gcount();
   if (got == 0 && in.eof()) return false;
   if (in.fail() && !in.eof()) {  // the buffer filled before the line ended
@@ -49,8 +51,13 @@ bool ReadLine(std::istream& in, std::string* text, bool* too_long) {
     return true;
   }
   const bool delimited = !in.eof();
-  text->resize(static_cast<size_t>(got - (delimited ? 1 : 0)));
+  const size_t length = static_cast<size_t>(got - (delimited ? 1 : 0));
+  text->resize(length);
   in.clear(in.rdstate() & std::ios::eofbit);
+  if (length > static_cast<size_t>(kMaxLine) && (*text)[kMaxLine] != '\r') {
+    *too_long = true;
+    text->clear();
+  }
   return true;
 }
 
