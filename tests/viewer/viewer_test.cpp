@@ -766,6 +766,34 @@ TEST_CASE("live: without a terrain, the picture is framed on the queries receive
   }
 }
 
+TEST_CASE("live: a query footfalld refuses is not drawn, and the rest are framed",
+          "[viewer][live]") {
+  // (A refused query's point, 1e300 away, grew the drawn bounds: the camera went to NaN, and
+  // the picture stayed blank for the session.)
+  const std::string dir = test::TempDir();
+  const LocalServer server(dir);
+  INFO("footfalld stderr: " << server.child.Err());
+  REQUIRE_FALSE(server.port.empty());
+  const std::string& address = server.address;
+  const std::unique_ptr<test::Child> viewer = FollowLive(address, dir, "640x400", false);
+  INFO("viewer stderr: " << viewer->Err());
+  const RunResult client = Run({FOOTFALL_CLI, "query", "--terrain", kTerrain, "--server", address},
+                               {}, kTimeout, "snap 1e300 0 0\nsnap 10 1 10\n");
+  INFO("footfall query: " << client.out << client.err);
+  int code = -1;
+  REQUIRE(viewer->Wait(kTimeout, &code));
+  REQUIRE(code == 0);
+  const json state = json::parse(test::ReadFile(dir + "/state.json"));
+  CHECK(state["live"]["received"].get<int>() == 2);
+  for (const json& v : state["camera"]["eye"]) CHECK(v.is_number());
+  const json& queries = state["live"]["queries"];
+  REQUIRE(queries.size() == 1);
+  REQUIRE(queries[0]["visible"] == true);
+  const Image image = ReadPng(dir + "/live.png");
+  const glm::vec2 pixel(queries[0]["pixel"][0].get<float>(), queries[0]["pixel"][1].get<float>());
+  CHECK(CountColorNear(image, pixel, 4, kChosen) >= 40);
+}
+
 TEST_CASE("live: a server that never sees a query ends the wait with a message", "[viewer][live]") {
   const std::string dir = test::TempDir();
   const LocalServer server(dir);

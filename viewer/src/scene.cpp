@@ -185,8 +185,26 @@ size_t Scene::PlantedKeysOffTerrain(double limit, size_t* planted) const {
   return off;
 }
 
+namespace {
+
+// Whether p is finite and within +-kMaxKeyCoordinate, as anything drawn must be.
+bool WithinDrawingRange(const Vec3& p) {
+  return std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) <= kMaxKeyCoordinate;
+}
+
+}  // namespace
+
 void Scene::AddLive(const std::vector<RecentQuery>& queries) {
   for (const RecentQuery& q : queries) {
+    // A query footfalld refused (a point beyond its reach, a step of 1e200) has nothing to draw,
+    // as --query refuses it: its ideal point put the camera at NaN, and the view stayed blank.
+    const bool drawable = q.result.status != Status::kInvalidArgument &&
+                          WithinDrawingRange(q.point) &&
+                          (q.op != QueryOp::kNext || WithinDrawingRange(q.point + q.direction));
+    if (!drawable) {
+      ++live_received_;
+      continue;
+    }
     live_.push_back(FromRecent(q, has_terrain() ? &grid_ : nullptr));
     GrowDrawn(live_.back());
     ++live_received_;
