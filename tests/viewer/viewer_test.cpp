@@ -794,6 +794,50 @@ TEST_CASE("live: a query footfalld refuses is not drawn, and the rest are framed
   CHECK(CountColorNear(image, pixel, 4, kChosen) >= 40);
 }
 
+TEST_CASE("live: without a terrain, queries at map coordinates are drawn where they are said to be",
+          "[viewer][live]") {
+  // (Render space stayed about the world's origin: a query near (5e5, 1, 5e6) was drawn from
+  // floats half a unit apart, 55 pixels from the pixel --dump-state gave for it.)
+  const std::string dir = test::TempDir();
+  const std::string far = dir + "/far.pts";
+  {
+    std::ifstream in(kTerrain);
+    std::ofstream out(far);
+    out.precision(17);
+    for (std::string line; std::getline(in, line);) {
+      std::istringstream fields(line);
+      double v[6];
+      if (line.empty() || line[0] == '#' ||
+          !(fields >> v[0] >> v[1] >> v[2] >> v[3] >> v[4] >> v[5]))
+        continue;
+      out << v[0] + 5e5 << ' ' << v[1] << ' ' << v[2] + 5e6 << ' ' << v[3] << ' ' << v[4] << ' '
+          << v[5] << '\n';
+    }
+  }
+  const LocalServer server(dir);
+  INFO("footfalld stderr: " << server.child.Err());
+  REQUIRE_FALSE(server.port.empty());
+  const std::unique_ptr<test::Child> viewer = FollowLive(server.address, dir, "640x400", false);
+  INFO("viewer stderr: " << viewer->Err());
+  const RunResult client =
+      Run({FOOTFALL_CLI, "query", "--terrain", far, "--server", server.address}, {}, kTimeout,
+          "snap 500010.3 1 5000010.2\nsnap 500016.1 1 5000011.4\n");
+  INFO("footfall query: " << client.out << client.err);
+  REQUIRE(client.exit_code == 0);
+  int code = -1;
+  REQUIRE(viewer->Wait(kTimeout, &code));
+  REQUIRE(code == 0);
+  const json state = json::parse(test::ReadFile(dir + "/state.json"));
+  REQUIRE(state["live"]["queries"].size() == 2);
+  const Image image = ReadPng(dir + "/live.png");
+  for (const json& q : state["live"]["queries"]) {
+    INFO(q.dump());
+    REQUIRE(q["visible"] == true);
+    const glm::vec2 pixel(q["pixel"][0].get<float>(), q["pixel"][1].get<float>());
+    CHECK(CountColorNear(image, pixel, 4, kChosen) >= 40);
+  }
+}
+
 TEST_CASE("live: a server that never sees a query ends the wait with a message", "[viewer][live]") {
   const std::string dir = test::TempDir();
   const LocalServer server(dir);

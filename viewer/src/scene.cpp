@@ -205,6 +205,10 @@ void Scene::AddLive(const std::vector<RecentQuery>& queries) {
       ++live_received_;
       continue;
     }
+    // With nothing loaded, the first query drawn is the origin of render space: at the world's
+    // origin, queries at map coordinates (5e6) were drawn from floats half a unit apart, away
+    // from where the camera and the dump put them.
+    if (!has_bounds_ && !live_centred_) origin_ = q.point, live_centred_ = true;
     live_.push_back(FromRecent(q, has_terrain() ? &grid_ : nullptr));
     GrowDrawn(live_.back());
     ++live_received_;

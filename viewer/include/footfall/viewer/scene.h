@@ -139,6 +139,7 @@ class Scene {
   Walk walk_;
   double first_frame_ = 0, last_frame_ = 0;
   Vec3 origin_;
+  bool live_centred_ = false;  // origin_ moved to the first live query (nothing loaded)
   Vec3 lo_, hi_;
   bool has_bounds_ = false;
   Vec3 drawn_lo_, drawn_hi_;  // lo_, hi_ and what only adds to the picture (world space)
