@@ -21,6 +21,7 @@
 #include "footfall/steps/walk_json.h"
 #include "footfall/terrain/brute_force.h"
 #include "footfall/terrain/grid.h"
+#include "footfall/viewer/camera.h"
 #include "footfall/viewer/draw_list.h"
 #include "footfall/viewer/query_view.h"
 #include "footfall/viewer/walk_pose.h"
@@ -177,6 +178,25 @@ TEST_CASE("screenshot of a next query shows the chosen sample where it projects"
   INFO("terrain share " << share);
   CHECK(share > 0.25);
   CHECK(share < 0.98);
+}
+
+TEST_CASE("a camera over the terrain keeps in view what lies beyond the terrain's far side",
+          "[viewer][camera]") {
+  // (A box around the eye set the near plane from its own far side, which capped the far plane
+  // there: a walk 20 m past a 40 m terrain was clipped, though --dump-state said it was
+  // visible.)
+  viewer::OrbitCamera camera;
+  camera.LookAt({0, 8, 0}, {50, 1, 0});
+  const std::vector<viewer::RenderBox> boxes = {{{-20, 0, -20}, {20, 1, 20}},  // under the eye
+                                                {{48, 0, -2}, {70, 2, 2}}};    // beyond it
+  const glm::dmat4 clip_from_render = camera.Projection(1.5, boxes) * camera.View();
+  for (const glm::dvec3& p : {glm::dvec3(69, 1, 0), glm::dvec3(50, 1, 0), glm::dvec3(10, 0.5, 0)}) {
+    const glm::dvec4 clip = clip_from_render * glm::dvec4(p, 1);
+    INFO(p.x << ", " << p.y << ", " << p.z << ": depth " << clip.z / clip.w);
+    REQUIRE(clip.w > 0);
+    CHECK(clip.z / clip.w >= -1);
+    CHECK(clip.z / clip.w <= 1);
+  }
 }
 
 TEST_CASE("a camera's clip planes follow the terrain beside the eye, not its target",

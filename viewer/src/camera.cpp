@@ -11,8 +11,10 @@ namespace {
 constexpr double kMaxPitch = 1.55;      // just under 89 degrees
 constexpr double kNearRatio = 1e-5;     // the nearest the near plane comes: far * this
 constexpr double kMinDepthSpan = 0.01;  // far - near >= far * this (float depth stays exact)
-constexpr double kMinZoom = 1e-4;       // Zoom brings the eye no nearer the target
-constexpr double kMaxZoom = 1e15;       // nor farther ([Units: render units])
+// Boxes around the eye keep in view what lies up to this many times their own far side.
+constexpr double kAroundReach = 100;
+constexpr double kMinZoom = 1e-4;  // Zoom brings the eye no nearer the target
+constexpr double kMaxZoom = 1e15;  // nor farther ([Units: render units])
 
 // The unit vector along d and its length, without the underflow of squaring tiny components.
 glm::dvec3 UnitAndLength(const glm::dvec3& d, double* length) {
@@ -120,6 +122,7 @@ glm::dmat4 OrbitCamera::View() const {
 glm::dmat4 OrbitCamera::Projection(double aspect, const std::vector<RenderBox>& boxes) const {
   const glm::dvec3 forward = Forward();
   double near_plane = HUGE_VAL, far_plane = -HUGE_VAL;
+  double around_far = HUGE_VAL;  // the nearest far side of the boxes around the eye
   for (const RenderBox& box : boxes) {
     // The depths of the box's corners along the view direction.
     double nearest = HUGE_VAL, farthest = -HUGE_VAL;
@@ -132,13 +135,21 @@ glm::dmat4 OrbitCamera::Projection(double aspect, const std::vector<RenderBox>& 
     }
     if (!(farthest > 0)) continue;  // behind the eye: nothing of it is drawn
     far_plane = std::max(far_plane, farthest * 1.001);
-    // Wholly in front: from its nearest corner; around the eye: as near as depth allows.
-    near_plane =
-        std::min(near_plane, nearest > 0 ? nearest * 0.999 : farthest * 1.001 * kNearRatio);
+    // Wholly in front: from its nearest corner. Around the eye: set below.
+    if (nearest > 0)
+      near_plane = std::min(near_plane, nearest * 0.999);
+    else
+      around_far = std::min(around_far, farthest * 1.001);
   }
   const double fov = glm::radians(kFovYDegrees);
   // Everything behind the eye: nothing to draw, any planes will do.
   if (!(far_plane > 0)) return glm::perspective(fov, aspect, 1.0, 2.0);
+  // Around the eye: as near as depth allows of what is drawn up to kAroundReach times the
+  // nearest far side of the boxes around the eye (from that far side itself, a walk just past
+  // the terrain under the eye was clipped; from everything's, a query 1e9 away, whose box
+  // reaches round the eye too, clipped that terrain).
+  if (around_far < HUGE_VAL)
+    near_plane = std::min(near_plane, std::min(far_plane, kAroundReach * around_far) * kNearRatio);
   far_plane = std::min(far_plane, near_plane / kNearRatio);
   near_plane = std::min(near_plane, far_plane * (1 - kMinDepthSpan));
   return glm::perspective(fov, aspect, near_plane, far_plane);

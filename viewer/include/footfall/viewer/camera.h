@@ -49,11 +49,13 @@ class OrbitCamera {
   glm::dmat4 View() const;
   // Perspective projection for a viewport of this aspect ratio (width / height), its near and
   // far planes chosen from the depths of `boxes` (render space: each drawn thing) seen from the
-  // eye, whatever the target's distance. The near plane is the nearest box's (a box around the
-  // eye: far * 1e-5 of its own far), the far plane the farthest box's, but at most 1e5 times
-  // the near plane: what lies farther is clipped, never what is near (a query 1e9 away left
-  // the terrain under the eye beyond the near plane). (Depth is 24-bit: a box reaching from the
-  // eye to far keeps about 1/170 of far as its depth resolution at far.)
+  // eye, whatever the target's distance. The near plane is the nearest box's (boxes around the
+  // eye: 1e-5 of the farthest box's far side, or of 100 times the nearest far side of the boxes
+  // around the eye if less), the
+  // far plane the farthest box's, but at most 1e5 times the near plane: what lies farther is
+  // clipped, never what is near (a query 1e9 away left the terrain under the eye beyond the
+  // near plane), nor what lies just past the terrain under the eye. (Depth is 24-bit: a box
+  // reaching from the eye to far keeps about 1/170 of far as its depth resolution at far.)
   glm::dmat4 Projection(double aspect, const std::vector<RenderBox>& boxes) const;
 
   // Projects a render-space point to pixels of a width x height image (x right, y down, origin
