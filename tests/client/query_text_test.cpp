@@ -47,6 +47,13 @@ TEST_CASE("query lines parse into an op, a point and a direction", "[client][que
     CHECK(back.direction == q.direction);
     q.op = QueryOp::kNormal;
     CHECK(FormatQueryText(q) == "normal 1 2 3");
+    // Every digit that tells two queries apart (6 significant digits wrote both "snap 10 1 10").
+    for (const char* text :
+         {"snap 10.00001 1 10", "snap 10.00004 1 10", "snap 123456.7 -0.1 1e-300",
+          "next 500010.3 1 5000010.2 0.1 0 -2.5e-07"}) {
+      REQUIRE(ParseQueryText(text, &q, &error));
+      CHECK(FormatQueryText(q) == text);
+    }
   }
 }
 

@@ -1192,6 +1192,18 @@ TEST_CASE("walk poses follow keys and swing arcs", "[viewer][walk]") {
   SECTION("the body interpolates linearly") {
     CHECK(viewer::PoseAt(walk.tracks[2], 13).position.x == Approx(3));
   }
+  SECTION("foot normals are drawn at unit length at their keys too") {
+    // (A file's [0, 40, 0] was used as written at a key and outside the keys: a normal drawn
+    // 40 times as long, off the picture.)
+    WalkTrack long_normals = l1;
+    for (WalkKey& k : long_normals.keys) k.normal = k.normal * 40.0;
+    for (const double frame : {0.0, 1.0, 4.0, 7.0, 13.0, 99.0}) {
+      INFO("frame " << frame);
+      const Vec3 n = viewer::PoseAt(long_normals, frame).normal;
+      CHECK(Length(n) == Approx(1));
+      CHECK(Distance(n, viewer::PoseAt(l1, frame).normal) < 1e-12);
+    }
+  }
   SECTION("a foot lifting on the frame it lands swings from its end key") {
     // A gait of one group: end, mid, end, mid, end.
     WalkTrack hop;

@@ -25,7 +25,9 @@ Quat Slerp(Quat a, const Quat& b, double t) {
 TrackPose FromKey(const WalkTrack& track, size_t i) {
   TrackPose p;
   p.position = track.keys[i].position;
-  p.normal = track.keys[i].normal;
+  // At unit length, as between keys (a file's [0, 40, 0] was drawn 40 times as long).
+  const Vec3& n = track.keys[i].normal;
+  p.normal = Length2(n) > 0 ? Normalize(n) : n;
   p.rotation = track.Rotation(i);
   return p;
 }

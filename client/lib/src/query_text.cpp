@@ -1,6 +1,7 @@
 #include "footfall/client/query_text.h"
 
 #include <cctype>
+#include <charconv>
 #include <sstream>
 #include <vector>
 
@@ -112,12 +113,17 @@ bool ParseQueryText(const std::string& text, QueryText* out, std::string* error)
 }
 
 std::string FormatQueryText(const QueryText& query) {
-  std::ostringstream out;
-  out << QueryOpName(query.op) << ' ' << query.point.x << ' ' << query.point.y << ' '
-      << query.point.z;
+  std::string out = QueryOpName(query.op);
+  auto put = [&out](double v) {
+    char digits[32];
+    const auto written = std::to_chars(digits, digits + sizeof digits, v);
+    out += ' ';
+    out.append(digits, written.ptr);
+  };
+  put(query.point.x), put(query.point.y), put(query.point.z);
   if (query.op == QueryOp::kNext)
-    out << ' ' << query.direction.x << ' ' << query.direction.y << ' ' << query.direction.z;
-  return out.str();
+    put(query.direction.x), put(query.direction.y), put(query.direction.z);
+  return out;
 }
 
 }  // namespace footfall

@@ -43,8 +43,9 @@ bool ParseQueryText(const std::string& text, QueryText* out, std::string* error)
 // terrain)", or for next the direction's length too.
 std::string InvalidQueryReason(QueryOp op);
 
-// "next 1 0 2 0.5 0 0": the query in the syntax ParseQueryText reads (numbers to 6 significant
-// digits).
+// "next 1 0 2 0.5 0 0": the query in the syntax ParseQueryText reads, each number in the
+// shortest form that reads back as the same double (to 6 significant digits, 10.00001 and
+// 10.00004 were both written "10").
 std::string FormatQueryText(const QueryText& query);
 
 }  // namespace footfall
