@@ -16,6 +16,7 @@
 #include "footfall/cli/load_flags.h"
 #include "footfall/cli/number_checks.h"
 #include "footfall/import/terrain_loader.h"
+#include "footfall/terrain/decimal_number.h"
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/output_file.h"
 #include "footfall/terrain/process_start.h"
@@ -100,18 +101,18 @@ int View(int argc, char** argv) {
     return 2;
   }
   if (!size.empty()) {
+    // Each side digits alone ("64,48x", "x64 40" and "3 2x" were read as sizes).
     const size_t x = size.find_first_of("xX");
-    std::vector<double> wh;
-    if (x == std::string::npos ||
-        !ParseNumbers(size.substr(0, x) + " " + size.substr(x + 1), 2, &wh) ||
-        wh[0] != std::floor(wh[0]) || wh[1] != std::floor(wh[1]) || wh[0] < 1 || wh[1] < 1 ||
-        wh[0] > 65536 || wh[1] > 65536) {
+    const std::string width = size.substr(0, x),
+                      height = x == std::string::npos ? "" : size.substr(x + 1);
+    if (x == std::string::npos || !footfall::WholeNumberProblem(width, 1, 65536).empty() ||
+        !footfall::WholeNumberProblem(height, 1, 65536).empty()) {
       std::cerr << "footfall-view: --size \"" << size
                 << "\": expected WIDTHxHEIGHT in whole pixels from 1 to 65536 (and within what "
                    "the OpenGL draws), e.g. 1280x800\n";
       return 2;
     }
-    o.width = static_cast<int>(wh[0]), o.height = static_cast<int>(wh[1]);
+    o.width = std::stoi(width), o.height = std::stoi(height);
   }
   if (!camera.empty()) {
     std::vector<double> v;
