@@ -856,6 +856,24 @@ TEST_CASE("live: without a terrain, queries at map coordinates are drawn where t
     const glm::vec2 pixel(q["pixel"][0].get<float>(), q["pixel"][1].get<float>());
     CHECK(CountColorNear(image, pixel, 4, kChosen) >= 40);
   }
+  // A --camera stays where it was put in the world when render space moves to the first query
+  // (it moved with it, by the query's coordinates, and the query was out of the picture).
+  test::Child aimed({kView, "--server", server.address, "--live", "--live-wait", "1", "--timeout",
+                     "30", "--size", "320x200", "--camera", "500016 6 5000020 500010.3 1 5000010.2",
+                     "--screenshot", dir + "/aimed.png", "--dump-state", dir + "/aimed.json"},
+                    std::vector<std::string>{test::XDisplay()});
+  INFO("viewer stderr: " << aimed.Err());
+  REQUIRE(aimed.WaitForOutput("live: following footfalld at " + server.address, kTimeout));
+  const RunResult again = Run({FOOTFALL_CLI, "query", "--terrain", far, "--server", server.address},
+                              {}, kTimeout, "snap 500010.3 1 5000010.2\n");
+  REQUIRE(again.exit_code == 0);
+  REQUIRE(aimed.Wait(kTimeout, &code));
+  REQUIRE(code == 0);
+  const json aimed_state = json::parse(test::ReadFile(dir + "/aimed.json"));
+  CHECK(aimed_state["camera"]["eye"] == json::array({500016.0, 6.0, 5000020.0}));
+  CHECK(aimed_state["camera"]["target"] == json::array({500010.3, 1.0, 5000010.2}));
+  REQUIRE(aimed_state["live"]["queries"].size() == 1);
+  CHECK(aimed_state["live"]["queries"][0]["visible"] == true);
 }
 
 TEST_CASE("live: a server that never sees a query ends the wait with a message", "[viewer][live]") {

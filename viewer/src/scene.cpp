@@ -189,7 +189,8 @@ namespace {
 
 // Whether p is finite and within +-kMaxKeyCoordinate, as anything drawn must be.
 bool WithinDrawingRange(const Vec3& p) {
-  return std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) <= kMaxKeyCoordinate;
+  return std::fabs(p.x) <= kMaxKeyCoordinate && std::fabs(p.y) <= kMaxKeyCoordinate &&
+         std::fabs(p.z) <= kMaxKeyCoordinate;
 }
 
 }  // namespace

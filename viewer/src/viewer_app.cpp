@@ -326,7 +326,13 @@ struct App {
     live->Take(&got);
     if (got.empty()) return;
     const size_t other_before = scene.live_other_terrain();
+    // The camera stays where it is in the world if the first live query moves render space's
+    // origin (nothing loaded): a --camera given moved with it, by the query's coordinates.
+    const Vec3 origin = scene.ToWorld(glm::dvec3(0));
+    const Vec3 eye = scene.ToWorld(camera.eye()), target = scene.ToWorld(camera.target());
     scene.AddLive(got);
+    if (scene.ToWorld(glm::dvec3(0)) != origin)
+      camera.LookAt(scene.ToRenderDouble(eye), scene.ToRenderDouble(target));
     if (other_before == 0 && scene.live_other_terrain() > 0)
       std::cerr << "footfall-view: note: live queries answered otherwise than " << options.terrain
                 << " answers them were asked on another terrain of the server: drawn with the "
