@@ -268,12 +268,13 @@ TEST_CASE("TerrainGrid answers exactly as brute force", "[terrain][grid]") {
     // its centre 5e4 away, whose float offsets (spacing 0.004) merged the lattice. Strays one
     // every n / 4096 samples (0.15%) were all in the subsample the box was chosen from, and a
     // terrain of up to 100 samples kept any outlier.
-    for (const int side : {200, 10, 8, 4}) {
+    for (const int side : {200, 10, 8, 4, 3, 2}) {
       INFO(side * side << " lattice samples");
       RawSamples s;
       for (int k = 0; k < side; ++k)
         for (int i = 0; i < side; ++i)
           s.push_back({1e5 + i * 1e-4, 1e5, 1e5 + k * 1e-4}, {0, 1, 0});
+      if (side == 2) s.push_back({1e5 + 2e-4, 1e5, 1e5}, {0, 1, 0});  // 5 samples, 4 kept
       std::vector<bool> stray(s.size(), false);
       if (side == 200) {
         for (size_t i = 0; i < 60; ++i) stray[i * s.size() / 4096] = true;

@@ -52,7 +52,7 @@ void ChooseGridBox(const RawSamples& s, const double lo[3], const double hi[3], 
                    double ghi[3]) {
   const size_t n = s.size();
   for (int a = 0; a < 3; ++a) glo[a] = lo[a], ghi[a] = hi[a];
-  if (n < 8) return;
+  if (n < 3) return;  // (two samples have no bulk between them)
   const size_t m = std::min<size_t>(n, 4096);
   const size_t k = std::max<size_t>(1, (m - 1) / 100);
   std::vector<size_t> picked(m);
