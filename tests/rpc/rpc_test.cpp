@@ -650,6 +650,21 @@ TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
       REQUIRE(symlink(previous.c_str(), (root + "/" + name).c_str()) == 0);
       previous = name;
     }
+    // 25 folder links, then 20 file links to a file that is there: 45 links on the way.
+    REQUIRE(mkdir((root + "/real").c_str(), 0700) == 0);
+    std::ofstream(root + "/real/t.pts") << "0 0 0 0 1 0\n";
+    previous = "t.pts";
+    for (int i = 1; i <= 20; ++i) {
+      const std::string name = "file" + std::to_string(i) + ".pts";
+      REQUIRE(symlink(previous.c_str(), (root + "/real/" + name).c_str()) == 0);
+      previous = name;
+    }
+    previous = "real";
+    for (int i = 1; i <= 25; ++i) {
+      const std::string name = "folder" + std::to_string(i);
+      REQUIRE(symlink(previous.c_str(), (root + "/" + name).c_str()) == 0);
+      previous = name;
+    }
   }
   ServerProcess server(0, {"--no-rpcbind", "--data-root", root});
   auto rpc = Connect(server.port());
@@ -686,6 +701,9 @@ TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
           "links?)");
     CHECK(rpc->LoadServerFile("chain20.pts", Separation(0), &t) == Status::kIoError);
     CHECK(rpc->last_error() == "'chain20.pts': no such file under the data root");
+    CHECK(rpc->LoadServerFile("folder25/file20.pts", Separation(0), &t) == Status::kIoError);
+    CHECK_THAT(rpc->last_error(), Catch::Contains("more than 40 symbolic links"));
+    CHECK(rpc->LoadServerFile("folder20/file20.pts", Separation(0), &t) == Status::kOk);
   }
   SECTION("a path with a NUL byte is refused, not cut short") {
     CLIENT* c = RawClient(server.port());

@@ -155,7 +155,8 @@ Status ResolveUnderRoot(const std::string& root, const std::string& relative, st
       *message = outside;
       return Status::kAccessDenied;
     }
-    if (lead == Lead::kTooManyLinks) {
+    // (Links followed in the folders on the way count too: the system's ELOOP says so.)
+    if (lead == Lead::kTooManyLinks || (lead == Lead::kInside && error == ELOOP)) {
       *message = "'" + relative + "': more than " + std::to_string(kMaxLinks) +
                  " symbolic links on its way under the data root (a loop of links?)";
       return Status::kIoError;
