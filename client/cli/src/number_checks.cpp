@@ -87,9 +87,12 @@ CLI::Validator Seed() {
 CLI::Validator WholeRange(long long lo, long long hi) {
   return CLI::Validator(
       [lo, hi](std::string& input) {
-        std::string problem = WholeNumberProblem(input, lo, hi);
-        if (problem.empty()) DropLeadingZeros(input);
-        return problem;
+        std::string digits = input;
+        if (!digits.empty() && digits.find_first_not_of("0123456789") == std::string::npos)
+          DropLeadingZeros(digits);
+        if (!WholeNumberProblem(digits, lo, hi).empty()) return WholeNumberProblem(input, lo, hi);
+        input = digits;
+        return std::string();
       },
       "INT in [" + std::to_string(lo) + " - " + std::to_string(hi) + "]");
 }

@@ -95,11 +95,14 @@ CLI::Validator Seconds(bool zero_ok) {
 CLI::Validator WholeRange(long long lo, long long hi) {
   return CLI::Validator(
       [lo, hi](std::string& input) {
-        std::string problem = footfall::WholeNumberProblem(input, lo, hi);
         // Without its leading zeros: CLI11 converts in base 0, which read "010" as octal 8.
-        if (problem.empty())
-          input.erase(0, std::min(input.find_first_not_of('0'), input.size() - 1));
-        return problem;
+        std::string digits = input;
+        if (!digits.empty() && digits.find_first_not_of("0123456789") == std::string::npos)
+          digits.erase(0, std::min(digits.find_first_not_of('0'), digits.size() - 1));
+        if (!footfall::WholeNumberProblem(digits, lo, hi).empty())
+          return footfall::WholeNumberProblem(input, lo, hi);
+        input = digits;
+        return std::string();
       },
       "INT in [" + std::to_string(lo) + " - " + std::to_string(hi) + "]");
 }
