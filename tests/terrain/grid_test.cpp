@@ -295,6 +295,24 @@ TEST_CASE("TerrainGrid answers exactly as brute force", "[terrain][grid]") {
       CheckAgainstBruteForce(g, 500, 18);
     }
   }
+  SECTION("with a few samples far apart, none of them an outlier") {
+    // Three in a line or a cross of five: trimmed as if all but the middle one were outliers,
+    // they had a box of no size, cells of 1 and a spacing made up, whatever their scale.
+    for (const double scale : {0.001, 100.0, 1000.0}) {
+      INFO("samples " << scale << " apart");
+      RawSamples line, cross;
+      for (int i = 0; i < 3; ++i) line.push_back({i * scale, 0, 0}, {0, 1, 0});
+      for (const auto& [x, z] : {std::pair{0, 0}, {1, 0}, {-1, 0}, {0, 1}, {0, -1}})
+        cross.push_back({x * scale, 0, z * scale}, {0, 1, 0});
+      for (const RawSamples* s : {&line, &cross}) {
+        const TerrainGrid g = Build(*s);
+        CHECK(g.stats().cell_size > 0.05 * scale);
+        CHECK(g.stats().cell_size < 2 * scale);
+        CHECK(g.stats().grid_max.x - g.stats().grid_min.x >= 1.999 * scale);  // all of them
+        CheckAgainstBruteForce(g, 200, 19);
+      }
+    }
+  }
   SECTION("with huge coordinates (near 1e5)") {
     RawSamples s = MakeHeightField(60, 60, 0.5, 2, 12);
     for (auto& p : s.points) p = p + Vec3{1e5, 1e5, -1e5};

@@ -76,6 +76,37 @@ void ChooseGridBox(const RawSamples& s, const double lo[3], const double hi[3], 
       ghi[a] = std::min(hi[a], q_hi + margin);
     }
   }
+  // Samples of the subsample near the box (within 4 times its diagonal: the few a small
+  // terrain's trimming left just outside) are taken in; the outliers left must be a few, one or
+  // up to 2% of the subsample, or the true bounds stay (three samples far apart, or a cross of
+  // five, were trimmed to their middle sample: a box of no size, a cell size of 1 and a spacing
+  // made up whatever their scale).
+  const double diagonal =
+      std::sqrt((ghi[0] - glo[0]) * (ghi[0] - glo[0]) + (ghi[1] - glo[1]) * (ghi[1] - glo[1]) +
+                (ghi[2] - glo[2]) * (ghi[2] - glo[2]));
+  double grown_lo[3] = {glo[0], glo[1], glo[2]}, grown_hi[3] = {ghi[0], ghi[1], ghi[2]};
+  size_t outside = 0;
+  for (const size_t i : picked) {
+    const Vec3& p = s.points[i];
+    const double c[3] = {p.x, p.y, p.z};
+    double gap2 = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double gap = std::max({0.0, glo[a] - c[a], c[a] - ghi[a]});
+      gap2 += gap * gap;
+    }
+    if (!(gap2 > 0)) continue;
+    if (std::sqrt(gap2) > 4 * diagonal) {
+      ++outside;
+      continue;
+    }
+    for (int a = 0; a < 3; ++a)
+      grown_lo[a] = std::min(grown_lo[a], c[a]), grown_hi[a] = std::max(grown_hi[a], c[a]);
+  }
+  const bool few = outside <= std::max<size_t>(1, m / 50);
+  for (int a = 0; a < 3; ++a) {
+    glo[a] = few ? grown_lo[a] : lo[a];
+    ghi[a] = few ? grown_hi[a] : hi[a];
+  }
 }
 
 // The cells of size h over the grid box (local corner lo, extents e), each sample in the cell
