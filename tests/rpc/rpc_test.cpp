@@ -665,6 +665,15 @@ TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
       REQUIRE(symlink(previous.c_str(), (root + "/" + name).c_str()) == 0);
       previous = name;
     }
+    // 45 links within the root, then one out of it, to a file there and to one that is not.
+    for (const std::string target : {"there", "gone"}) {
+      previous = outside + "/" + target + ".pts";
+      for (int i = 1; i <= 45; ++i) {
+        const std::string name = "long-" + target + std::to_string(i) + ".pts";
+        REQUIRE(symlink(previous.c_str(), (root + "/" + name).c_str()) == 0);
+        previous = name;
+      }
+    }
   }
   ServerProcess server(0, {"--no-rpcbind", "--data-root", root});
   auto rpc = Connect(server.port());
@@ -685,10 +694,10 @@ TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
 
   SECTION("paths leaving the root get one answer, whether their targets exist or not") {
     const std::string base = root.substr(root.rfind('/') + 1) + "-outside/";
-    for (const std::string& path :
-         std::vector<std::string>{"../" + base + "there.pts", "../" + base + "gone.pts",
-                                  "sub/../../" + base + "there.pts", "link.pts", "dangling.pts",
-                                  "out/there.pts", "out/gone.pts", "out/no/such/dir.pts"}) {
+    for (const std::string& path : std::vector<std::string>{
+             "../" + base + "there.pts", "../" + base + "gone.pts",
+             "sub/../../" + base + "there.pts", "link.pts", "dangling.pts", "long-there45.pts",
+             "long-gone45.pts", "out/there.pts", "out/gone.pts", "out/no/such/dir.pts"}) {
       INFO(path);
       CHECK(rpc->LoadServerFile(path, Separation(0), &t) == Status::kAccessDenied);
       CHECK(rpc->last_error() == "'" + path + "' leads outside the data root");

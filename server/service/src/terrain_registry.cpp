@@ -52,13 +52,18 @@ enum class Lead {
 
 // [Units: links] As many as the system follows before it gives up (Linux's MAXSYMLINKS).
 constexpr int kMaxLinks = 40;
+// [Units: links] How far a chain is followed to tell whether it leads outside the root (beyond
+// kMaxLinks it is refused either way, but every path that leads outside gets one answer,
+// whether or not its target exists); a loop within the root ends here.
+constexpr int kMaxLinksFollowed = 1000;
 
 // For an absolute path that realpath cannot resolve: whether resolving it leaves `root` before
 // it fails (a prefix resolves outside, or the part that fails is a link whose target leads
 // out). Decided without looking at anything outside the root that the path names, so the answer
 // does not reveal whether such things exist.
 Lead Resolving(const std::string& root, const std::string& path, int links) {
-  if (links > kMaxLinks) return Lead::kTooManyLinks;
+  if (links > kMaxLinksFollowed) return Lead::kTooManyLinks;
+  const Lead inside = links > kMaxLinks ? Lead::kTooManyLinks : Lead::kInside;
   const std::vector<std::string> parts = Components(path);
   std::string at = "/";  // canonical, inside the root or above it
   for (size_t i = 0; i < parts.size(); ++i) {
@@ -71,13 +76,13 @@ Lead Resolving(const std::string& root, const std::string& path, int links) {
     }
     if (!PathInside(root, at)) return Lead::kOutside;
     const ssize_t n = readlink(next.c_str(), buffer, sizeof buffer - 1);
-    if (n < 0) return Lead::kInside;  // missing below a directory of the root
+    if (n < 0) return inside;  // missing below a directory of the root
     buffer[n] = '\0';
     std::string rest = buffer[0] == '/' ? std::string(buffer) : at + "/" + buffer;
     for (size_t j = i + 1; j < parts.size(); ++j) rest += "/" + parts[j];
     return Resolving(root, rest, links + 1);
   }
-  return PathInside(root, at) ? Lead::kInside : Lead::kOutside;
+  return PathInside(root, at) ? inside : Lead::kOutside;
 }
 
 // What a file type is, for messages about files that are not regular.
