@@ -1121,7 +1121,7 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     CHECK(r.exit_code == 2);
     CHECK_THAT(r.err, Catch::Contains("in whole pixels from 1 to 65536"));
     // Each side digits alone: these were read as 64x48, 64x40 and 3x2.
-    for (const char* size : {"64,48x", "x64 40", "3 2x", "64 x48", "1e2x50"}) {
+    for (const char* size : {"64,48x", "x64 40", "3 2x", "64 x48", "1e2x50", "0x48"}) {
       r = View({"--terrain", kTerrain, "--size", size, "--screenshot", shot});
       CHECK(r.exit_code == 2);
       CHECK_THAT(r.err, Catch::Contains("--size \"" + std::string(size) + "\": expected"));

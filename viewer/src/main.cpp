@@ -1,4 +1,5 @@
 // footfall-view: the debug viewer of terrains, queries, walks and live servers.
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <csignal>
@@ -103,8 +104,14 @@ int View(int argc, char** argv) {
   if (!size.empty()) {
     // Each side digits alone ("64,48x", "x64 40" and "3 2x" were read as sizes).
     const size_t x = size.find_first_of("xX");
-    const std::string width = size.substr(0, x),
-                      height = x == std::string::npos ? "" : size.substr(x + 1);
+    // (Leading zeros dropped first, as the whole-number flags drop them: "0064" is 64.)
+    auto digits = [](std::string side) {
+      while (side.size() > 1 && side[0] == '0' && std::isdigit(static_cast<unsigned char>(side[1])))
+        side.erase(0, 1);
+      return side;
+    };
+    const std::string width = digits(size.substr(0, x)),
+                      height = x == std::string::npos ? "" : digits(size.substr(x + 1));
     if (x == std::string::npos || !footfall::WholeNumberProblem(width, 1, 65536).empty() ||
         !footfall::WholeNumberProblem(height, 1, 65536).empty()) {
       std::cerr << "footfall-view: --size \"" << size
