@@ -757,6 +757,38 @@ TEST_CASE("live: a query on another terrain of footfalld is drawn untraced, with
   CHECK_THAT(viewer->Err(), Catch::Contains("were asked on another terrain of the server"));
 }
 
+namespace {
+
+// What a viewer with nothing loaded drew once `footfall query --terrain terrain` had sent
+// `queries` to footfalld at `server`: its --dump-state and its screenshot.
+struct LiveShot {
+  json state;
+  Image image;
+};
+LiveShot ShootLiveOnly(const LocalServer& server, const std::string& dir,
+                       const std::string& terrain, const std::string& queries) {
+  const std::unique_ptr<test::Child> viewer = FollowLive(server.address, dir, "640x400", false);
+  INFO("viewer stderr: " << viewer->Err());
+  const RunResult client =
+      Run({FOOTFALL_CLI, "query", "--terrain", terrain, "--server", server.address}, {}, kTimeout,
+          queries);
+  INFO("footfall query: " << client.out << client.err);
+  int code = -1;
+  REQUIRE(viewer->Wait(kTimeout, &code));
+  REQUIRE(code == 0);
+  return {json::parse(test::ReadFile(dir + "/state.json")), ReadPng(dir + "/live.png")};
+}
+
+// Checks that live query q (from a --dump-state) is drawn, its chosen sample at its pixel.
+void CheckChosenDrawn(const json& q, const Image& image) {
+  INFO(q.dump());
+  REQUIRE(q["visible"] == true);
+  const glm::vec2 pixel(q["pixel"][0].get<float>(), q["pixel"][1].get<float>());
+  CHECK(CountColorNear(image, pixel, 4, kChosen) >= 40);
+}
+
+}  // namespace
+
 TEST_CASE("live: without a terrain, the picture is framed on the queries received",
           "[viewer][live]") {
   // (The camera framed the unit box at the origin before any query came: a blank picture.)
@@ -764,25 +796,12 @@ TEST_CASE("live: without a terrain, the picture is framed on the queries receive
   const LocalServer server(dir);
   INFO("footfalld stderr: " << server.child.Err());
   REQUIRE_FALSE(server.port.empty());
-  const std::string& address = server.address;
-  const std::unique_ptr<test::Child> viewer = FollowLive(address, dir, "640x400", false);
-  INFO("viewer stderr: " << viewer->Err());
-  const RunResult client = Run({FOOTFALL_CLI, "query", "--terrain", kTerrain, "--server", address},
-                               {}, kTimeout, "next 10 1 10 1.2 0 0.3\nsnap 16 1 11\n");
-  INFO("footfall query: " << client.out << client.err);
-  REQUIRE(client.exit_code == 0);
-  int code = -1;
-  REQUIRE(viewer->Wait(kTimeout, &code));
-  REQUIRE(code == 0);
-  const json state = json::parse(test::ReadFile(dir + "/state.json"));
-  REQUIRE(state["live"]["queries"].size() == 2);
-  const Image image = ReadPng(dir + "/live.png");
-  for (const json& q : state["live"]["queries"]) {
-    INFO(q.dump());
-    REQUIRE(q["found"] == true);
-    CHECK(q["visible"] == true);
-    const glm::vec2 pixel(q["pixel"][0].get<float>(), q["pixel"][1].get<float>());
-    CHECK(CountColorNear(image, pixel, 4, kChosen) >= 40);
+  const LiveShot shot =
+      ShootLiveOnly(server, dir, kTerrain, "next 10 1 10 1.2 0 0.3\nsnap 16 1 11\n");
+  REQUIRE(shot.state["live"]["queries"].size() == 2);
+  for (const json& q : shot.state["live"]["queries"]) {
+    CHECK(q["found"] == true);
+    CheckChosenDrawn(q, shot.image);
   }
 }
 
@@ -794,24 +813,11 @@ TEST_CASE("live: a query footfalld refuses is not drawn, and the rest are framed
   const LocalServer server(dir);
   INFO("footfalld stderr: " << server.child.Err());
   REQUIRE_FALSE(server.port.empty());
-  const std::string& address = server.address;
-  const std::unique_ptr<test::Child> viewer = FollowLive(address, dir, "640x400", false);
-  INFO("viewer stderr: " << viewer->Err());
-  const RunResult client = Run({FOOTFALL_CLI, "query", "--terrain", kTerrain, "--server", address},
-                               {}, kTimeout, "snap 1e300 0 0\nsnap 10 1 10\n");
-  INFO("footfall query: " << client.out << client.err);
-  int code = -1;
-  REQUIRE(viewer->Wait(kTimeout, &code));
-  REQUIRE(code == 0);
-  const json state = json::parse(test::ReadFile(dir + "/state.json"));
-  CHECK(state["live"]["received"].get<int>() == 2);
-  for (const json& v : state["camera"]["eye"]) CHECK(v.is_number());
-  const json& queries = state["live"]["queries"];
-  REQUIRE(queries.size() == 1);
-  REQUIRE(queries[0]["visible"] == true);
-  const Image image = ReadPng(dir + "/live.png");
-  const glm::vec2 pixel(queries[0]["pixel"][0].get<float>(), queries[0]["pixel"][1].get<float>());
-  CHECK(CountColorNear(image, pixel, 4, kChosen) >= 40);
+  const LiveShot shot = ShootLiveOnly(server, dir, kTerrain, "snap 1e300 0 0\nsnap 10 1 10\n");
+  CHECK(shot.state["live"]["received"].get<int>() == 2);
+  for (const json& v : shot.state["camera"]["eye"]) CHECK(v.is_number());
+  REQUIRE(shot.state["live"]["queries"].size() == 1);
+  CheckChosenDrawn(shot.state["live"]["queries"][0], shot.image);
 }
 
 TEST_CASE("live: without a terrain, queries at map coordinates are drawn where they are said to be",
@@ -837,25 +843,10 @@ TEST_CASE("live: without a terrain, queries at map coordinates are drawn where t
   const LocalServer server(dir);
   INFO("footfalld stderr: " << server.child.Err());
   REQUIRE_FALSE(server.port.empty());
-  const std::unique_ptr<test::Child> viewer = FollowLive(server.address, dir, "640x400", false);
-  INFO("viewer stderr: " << viewer->Err());
-  const RunResult client =
-      Run({FOOTFALL_CLI, "query", "--terrain", far, "--server", server.address}, {}, kTimeout,
-          "snap 500010.3 1 5000010.2\nsnap 500016.1 1 5000011.4\n");
-  INFO("footfall query: " << client.out << client.err);
-  REQUIRE(client.exit_code == 0);
-  int code = -1;
-  REQUIRE(viewer->Wait(kTimeout, &code));
-  REQUIRE(code == 0);
-  const json state = json::parse(test::ReadFile(dir + "/state.json"));
-  REQUIRE(state["live"]["queries"].size() == 2);
-  const Image image = ReadPng(dir + "/live.png");
-  for (const json& q : state["live"]["queries"]) {
-    INFO(q.dump());
-    REQUIRE(q["visible"] == true);
-    const glm::vec2 pixel(q["pixel"][0].get<float>(), q["pixel"][1].get<float>());
-    CHECK(CountColorNear(image, pixel, 4, kChosen) >= 40);
-  }
+  const LiveShot shot =
+      ShootLiveOnly(server, dir, far, "snap 500010.3 1 5000010.2\nsnap 500016.1 1 5000011.4\n");
+  REQUIRE(shot.state["live"]["queries"].size() == 2);
+  for (const json& q : shot.state["live"]["queries"]) CheckChosenDrawn(q, shot.image);
   // A --camera stays where it was put in the world when render space moves to the first query
   // (it moved with it, by the query's coordinates, and the query was out of the picture).
   test::Child aimed({kView, "--server", server.address, "--live", "--live-wait", "1", "--timeout",
@@ -867,6 +858,7 @@ TEST_CASE("live: without a terrain, queries at map coordinates are drawn where t
   const RunResult again = Run({FOOTFALL_CLI, "query", "--terrain", far, "--server", server.address},
                               {}, kTimeout, "snap 500010.3 1 5000010.2\n");
   REQUIRE(again.exit_code == 0);
+  int code = -1;
   REQUIRE(aimed.Wait(kTimeout, &code));
   REQUIRE(code == 0);
   const json aimed_state = json::parse(test::ReadFile(dir + "/aimed.json"));
