@@ -307,6 +307,30 @@ class BlenderAddonTest(unittest.TestCase):
             bpy.data.objects.remove(ground)
             bpy.data.node_groups.remove(tree)
 
+    def test_1b2_an_instancer_the_viewport_hides_is_no_terrain(self):
+        # A plane instancing a box on its face, with Show Instancer off in the viewport: its own
+        # face was sampled too, and feet snapped onto a plane nobody sees.
+        bpy.ops.mesh.primitive_plane_add(size=4, location=(30.0, 0.0, 0.0))
+        plane = bpy.context.active_object
+        bpy.ops.mesh.primitive_cube_add(size=1, location=(30.0, 0.0, 0.5))
+        box = bpy.context.active_object
+        box.parent = plane
+        box.matrix_parent_inverse = plane.matrix_world.inverted()
+        plane.instance_type = "FACES"
+        try:
+            bpy.context.view_layer.update()
+            shown = self.ops.mesh_samples(bpy.context, plane, 0.1)
+            plane.show_instancer_for_viewport = False
+            bpy.context.view_layer.update()
+            hidden = self.ops.mesh_samples(bpy.context, plane, 0.1)
+            self.assertGreater(len(hidden), 0)  # the box
+            self.assertLess(len(hidden), 0.6 * len(shown))
+            # Nothing on the plane outside the box's footprint (footfall x = Blender x).
+            self.assertFalse([s for s in hidden if abs(s[0] - 30.0) > 0.6], hidden[:3])
+        finally:
+            bpy.data.objects.remove(box)
+            bpy.data.objects.remove(plane)
+
     def test_1d_objects_that_make_faces_are_terrains(self):
         # Terrain Setup took meshes alone: a collection instance (a linked set), an extruded
         # curve or text was "select a mesh". Now any object whose faces the viewport shows is

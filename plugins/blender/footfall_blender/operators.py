@@ -257,7 +257,10 @@ def mesh_triangles(context, obj):
     depsgraph = context.evaluated_depsgraph_get()
     points, tris = [], []
     scale = unit_scale(context.scene)
-    _add_triangles(obj.evaluated_get(depsgraph), obj.matrix_world, points, tris, scale)
+    # An instancer the viewport hides ("Show Instancer" off for its vertex or face instancing)
+    # is no terrain: its own faces were sampled, and feet stood on a plane nobody sees.
+    if obj.instance_type not in ("VERTS", "FACES") or obj.show_instancer_for_viewport:
+        _add_triangles(obj.evaluated_get(depsgraph), obj.matrix_world, points, tris, scale)
     for inst in depsgraph.object_instances:
         if inst.is_instance and inst.parent is not None and inst.parent.original == obj:
             _add_triangles(inst.object, inst.matrix_world.copy(), points, tris, scale)
