@@ -1,5 +1,4 @@
 // footfall-view: the debug viewer of terrains, queries, walks and live servers.
-#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <csignal>
@@ -105,13 +104,10 @@ int View(int argc, char** argv) {
     // Each side digits alone ("64,48x", "x64 40" and "3 2x" were read as sizes).
     const size_t x = size.find_first_of("xX");
     // (Leading zeros dropped first, as the whole-number flags drop them: "0064" is 64.)
-    auto digits = [](std::string side) {
-      while (side.size() > 1 && side[0] == '0' && std::isdigit(static_cast<unsigned char>(side[1])))
-        side.erase(0, 1);
-      return side;
-    };
-    const std::string width = digits(size.substr(0, x)),
-                      height = x == std::string::npos ? "" : digits(size.substr(x + 1));
+    const std::string width = footfall::WithoutLeadingZeros(size.substr(0, x)),
+                      height = x == std::string::npos
+                                   ? ""
+                                   : footfall::WithoutLeadingZeros(size.substr(x + 1));
     if (x == std::string::npos || !footfall::WholeNumberProblem(width, 1, 65536).empty() ||
         !footfall::WholeNumberProblem(height, 1, 65536).empty()) {
       std::cerr << "footfall-view: --size \"" << size

@@ -27,13 +27,6 @@ CLI::Validator Make(const std::string& expected, Ok ok) {
       expected);
 }
 
-// `digits` (decimal digits alone) without its leading zeros ("0" for zero): CLI11 converts
-// integers with strtoll in base 0, which read "010" as octal 8 and refused "08".
-void DropLeadingZeros(std::string& digits) {
-  const size_t first = digits.find_first_not_of('0');
-  digits.erase(0, first == std::string::npos ? digits.size() - 1 : first);
-}
-
 }  // namespace
 
 CLI::Validator Finite() {
@@ -70,9 +63,7 @@ CLI::Validator FiniteAboveUpTo(double lo, double hi) {
 CLI::Validator Seed() {
   return CLI::Validator(
       [](std::string& input) -> std::string {
-        std::string digits = input;
-        if (!digits.empty() && digits.find_first_not_of("0123456789") == std::string::npos)
-          DropLeadingZeros(digits);
+        const std::string digits = WithoutLeadingZeros(input);
         if (!digits.empty() && digits.size() <= 20 &&
             digits.find_first_not_of("0123456789") == std::string::npos &&
             (digits.size() < 20 || digits <= "18446744073709551615")) {
@@ -87,9 +78,7 @@ CLI::Validator Seed() {
 CLI::Validator WholeRange(long long lo, long long hi) {
   return CLI::Validator(
       [lo, hi](std::string& input) {
-        std::string digits = input;
-        if (!digits.empty() && digits.find_first_not_of("0123456789") == std::string::npos)
-          DropLeadingZeros(digits);
+        const std::string digits = WithoutLeadingZeros(input);
         if (!WholeNumberProblem(digits, lo, hi).empty()) return WholeNumberProblem(input, lo, hi);
         input = digits;
         return std::string();

@@ -96,9 +96,7 @@ CLI::Validator WholeRange(long long lo, long long hi) {
   return CLI::Validator(
       [lo, hi](std::string& input) {
         // Without its leading zeros: CLI11 converts in base 0, which read "010" as octal 8.
-        std::string digits = input;
-        if (!digits.empty() && digits.find_first_not_of("0123456789") == std::string::npos)
-          digits.erase(0, std::min(digits.find_first_not_of('0'), digits.size() - 1));
+        const std::string digits = footfall::WithoutLeadingZeros(input);
         if (!footfall::WholeNumberProblem(digits, lo, hi).empty())
           return footfall::WholeNumberProblem(input, lo, hi);
         input = digits;

@@ -74,6 +74,13 @@ std::string WholeNumberProblem(std::string_view token, long long lo, long long h
          std::to_string(hi);
 }
 
+std::string WithoutLeadingZeros(std::string_view token) {
+  if (token.empty() || token.find_first_not_of("0123456789") != std::string_view::npos)
+    return std::string(token);
+  const size_t first = token.find_first_not_of('0');
+  return std::string(token.substr(first == std::string_view::npos ? token.size() - 1 : first));
+}
+
 bool IsMicrosoftNonFinite(std::string_view token) {
   size_t i = 0;
   auto digits = [&] {

@@ -26,6 +26,11 @@ bool ParseFiniteDecimal(std::string_view token, double* value);
 // ("1.5", "-1", "1e3" and "+5" are refused). The wording every count flag uses.
 std::string WholeNumberProblem(std::string_view token, long long lo, long long hi);
 
+// `token` without the leading zeros of a number written in decimal digits alone ("0" for zero);
+// any other text as it is. For flags: CLI11 converts integers with strtoll in base 0, which read
+// "010" as octal 8 and refused "08".
+std::string WithoutLeadingZeros(std::string_view token);
+
 // Whether `token` is how Microsoft's C library writes NaN or infinity: "1.#QNAN", "-1.#IND",
 // "1.#INF00", "1.#SNAN0e+000" (letters in either case), or those words rounded at a low
 // precision ("1.#J", "-1.#IO", "1.#R", "1.#QO", "1.#": "DIGITS.#" and up to four letters or
