@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -287,6 +288,110 @@ TEST_CASE("height colouring and grid cells change the picture", "[viewer][screen
   }
   CHECK(normal_green < 50);
   CHECK(other > 320 * 140 / 8);  // the terrain, framed clear of the overlay's bands
+}
+
+// hills.pts turned so that its up is +z: (x, y, z) -> (x, -z, y), normals alike.
+std::string ZUpHills() {
+  std::ifstream in(kTerrain);
+  std::ostringstream out;
+  out.precision(17);
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    double v[6];
+    for (double& x : v) fields >> x;
+    out << v[0] << ' ' << -v[2] << ' ' << v[1] << ' ' << v[3] << ' ' << -v[5] << ' ' << v[4]
+        << '\n';
+  }
+  return out.str();
+}
+
+TEST_CASE("a Z-up terrain seen with --up z is the picture of its Y-up twin", "[viewer][up]") {
+  // (The view stood on +y whatever the data: a Z-up terrain was drawn on its side, its height
+  // colours running across it.)
+  const std::string dir = test::TempDir();
+  for (const char* sub : {"/y", "/z"}) std::filesystem::create_directory(dir + sub);
+  test::WriteFile(dir + "/y/hills.pts", test::ReadFile(kTerrain));
+  test::WriteFile(dir + "/z/hills.pts", ZUpHills());
+  const std::vector<std::string> common = {"--height-colors", "--size", "320x200"};
+  auto shoot = [&](const std::string& terrain, std::vector<std::string> flags,
+                   const std::string& name) {
+    flags.insert(flags.end(), {"--terrain", terrain, "--screenshot", dir + "/" + name + ".png",
+                               "--dump-state", dir + "/" + name + ".json"});
+    flags.insert(flags.end(), common.begin(), common.end());
+    REQUIRE(View(flags).exit_code == 0);
+    return ReadPng(dir + "/" + name + ".png");
+  };
+  const Image y = shoot(dir + "/y/hills.pts", {}, "y");
+  // Below the overlay's first line (the file's name): every pixel the same.
+  auto differing = [&](const Image& other) {
+    int count = 0;
+    for (int row = 16; row < y.height; ++row) {
+      for (int x = 0; x < y.width; ++x) count += y.At(x, row) != other.At(x, row);
+    }
+    return count;
+  };
+  for (const char* up : {"z", "0,0,1", "Z", "0,0,2.5"}) {
+    INFO("--up " << up);
+    CHECK(differing(shoot(dir + "/z/hills.pts", {"--up", up}, "z")) == 0);
+    const json state = json::parse(test::ReadFile(dir + "/z.json"));
+    CHECK(state["camera"]["up"] == json::array({0.0, 0.0, 1.0}));
+  }
+  // Seen Y-up, the same samples differ (the check above could fail).
+  CHECK(differing(shoot(dir + "/z/hills.pts", {}, "side")) > 1000);
+}
+
+TEST_CASE("queries and the camera follow --up", "[viewer][up]") {
+  const std::string dir = test::TempDir();
+  test::WriteFile(dir + "/z.pts", ZUpHills());
+  // hills.pts' "next 10 1 10 1.2 0 0.3", turned; the dumped camera projects the chosen sample
+  // where it is drawn, with the dumped up.
+  const RunResult r =
+      View({"--terrain", dir + "/z.pts", "--up", "z", "--query", "next 10 -10 1 1.2 -0.3 0",
+            "--size", "320x200", "--screenshot", dir + "/q.png", "--dump-state", dir + "/q.json"});
+  REQUIRE(r.exit_code == 0);
+  const json state = json::parse(test::ReadFile(dir + "/q.json"));
+  const json& q = state["queries"][0];
+  REQUIRE(q["found"] == true);
+  const json& c = state["camera"];
+  auto vec = [](const json& v) {
+    return glm::dvec3(v[0].get<double>(), v[1].get<double>(), v[2].get<double>());
+  };
+  const glm::dmat4 view = glm::lookAt(vec(c["eye"]), vec(c["target"]), vec(c["up"]));
+  const glm::dmat4 proj = glm::perspective(glm::radians(45.0), 320.0 / 200, 0.1, 1000.0);
+  const glm::dvec4 clip = proj * view * glm::dvec4(vec(q["point"]), 1);
+  const glm::vec2 px(static_cast<float>((clip.x / clip.w * 0.5 + 0.5) * 320),
+                     static_cast<float>((0.5 - clip.y / clip.w * 0.5) * 200));
+  CHECK(std::abs(px.x - q["pixel"][0].get<float>()) < 1);
+  CHECK(std::abs(px.y - q["pixel"][1].get<float>()) < 1);
+  CHECK(CountColorNear(ReadPng(dir + "/q.png"), px, 6, kChosen) > 10);
+  // Above the terrain along +z: the eye's z beyond the target's.
+  CHECK(c["eye"][2].get<double>() > c["target"][2].get<double>());
+}
+
+TEST_CASE("a height map stood up along --up-axis is seen standing on it", "[viewer][up]") {
+  const std::string dir = test::TempDir();
+  test::WriteFile(dir + "/g.asc",
+                  "ncols 4\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\n"
+                  "0 1 2 3\n1 2 3 4\n2 3 4 5\n");
+  for (const char* axis : {"x", "y", "z"}) {
+    const RunResult r = View({"--terrain", dir + "/g.asc", "--up-axis", axis, "--size", "160x100",
+                              "--screenshot", dir + "/g.png", "--dump-state", dir + "/g.json"});
+    INFO(axis);
+    REQUIRE(r.exit_code == 0);
+    const json up = json::parse(test::ReadFile(dir + "/g.json"))["camera"]["up"];
+    const int i = axis[0] - 'x';
+    CHECK(up[static_cast<size_t>(i)] == 1.0);
+    CHECK(up[static_cast<size_t>((i + 1) % 3)] == 0.0);
+    CHECK(up[static_cast<size_t>((i + 2) % 3)] == 0.0);
+  }
+  // --up wins over --up-axis.
+  const RunResult r =
+      View({"--terrain", dir + "/g.asc", "--up-axis", "z", "--up", "-y", "--size", "160x100",
+            "--screenshot", dir + "/g.png", "--dump-state", dir + "/g.json"});
+  REQUIRE(r.exit_code == 0);
+  CHECK(json::parse(test::ReadFile(dir + "/g.json"))["camera"]["up"] ==
+        json::array({0.0, -1.0, 0.0}));
 }
 
 std::string WalkJson() {
@@ -957,6 +1062,14 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     }
     r = View({"--terrain", kTerrain, "--up-axis", "w", "--screenshot", shot});
     CHECK(r.exit_code == 2);
+    for (const char* up : {"w", "1,1,0", "0,0,0", "0,0,1,", "0,nan,1", "", "-"}) {
+      r = View({"--terrain", kTerrain, "--up", up, "--screenshot", shot});
+      INFO("--up " << up);
+      CHECK(r.exit_code == 2);
+      CHECK_THAT(r.err, Catch::Contains("--up \"" + std::string(up) +
+                                        "\": expected an axis: x, y, "
+                                        "z, -x, -y or -z, or a vector along one"));
+    }
     // Loading flags without a terrain were ignored.
     for (const char* flag : {"--flat-normals", "--smooth-normals"}) {
       r = View({"--walk", dir + "/none.json", flag, "--screenshot", shot});

@@ -54,7 +54,7 @@ int View(int argc, char** argv) {
       "first/last frame, Esc or Q quit."};
   app.set_version_flag("--version", "footfall-view " FOOTFALL_VERSION,
                        "Print footfall-view's version and exit");
-  std::string size, camera;
+  std::string size, camera, up;
   double frame = 0;
   app.add_option("--terrain", o.terrain, "Terrain file (.pts/.xyz/.txt or any loader format)");
   const std::vector<CLI::Option*> load_flags = footfall::cli::AddLoadFlags(&app, &o.load);
@@ -86,9 +86,13 @@ int View(int argc, char** argv) {
                  "queries) as JSON");
   app.add_flag("--height-colors", o.height_colors, "Colour samples by height, not by normal");
   app.add_flag("--cells", o.show_cells, "Draw the occupied grid cells");
+  auto* up_opt =
+      app.add_option("--up", up,
+                     "The world axis shown up: x, y, z, -x, -y, -z or a vector along one (0,0,1); "
+                     "default --up-axis when given, else y");
   app.add_option("--camera", camera,
-                 "Camera \"EX EY EZ TX TY TZ\": eye and target in world space, within +-1e15 (y "
-                 "up, 45 degree vertical field of view); default frames everything");
+                 "Camera \"EX EY EZ TX TY TZ\": eye and target in world space, within +-1e15 "
+                 "(--up up, 45 degree vertical field of view); default frames everything");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -126,6 +130,16 @@ int View(int argc, char** argv) {
     }
     o.has_camera = true;
     o.eye = {v[0], v[1], v[2]}, o.target = {v[3], v[4], v[5]};
+  }
+  // A height map stood up along --up-axis is seen standing on it too.
+  if (up_opt->count() > 0) {
+    std::string problem;
+    if (!footfall::viewer::ParseViewUp(up, &o.up, &problem)) {
+      std::cerr << "footfall-view: " << problem << '\n';
+      return 2;
+    }
+  } else if (o.load.up_axis == 'x' || o.load.up_axis == 'z') {
+    o.up = {o.load.up_axis - 'x', 1};
   }
   if (frame_opt->count() > 0) o.has_frame = true, o.frame = frame;
   // Loading flags without a terrain to load were ignored.

@@ -30,11 +30,6 @@ Rgba HeightColor(double t) {
           Byte(kStops[i][2] + (kStops[i + 1][2] - kStops[i][2]) * f), 255};
 }
 
-// A world-space direction as a render-space vector (directions need no origin shift).
-glm::vec3 Direction(const Vec3& v) {
-  return glm::vec3(static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z));
-}
-
 void Grow(const Vec3& p, Vec3* lo, Vec3* hi, bool* any) {
   if (!*any) {
     *lo = *hi = p;
@@ -243,18 +238,27 @@ double Scene::MarkerUnit() const {
   return std::max(spacing_, std::min(0.02, diagonal / 300));
 }
 
-glm::vec3 Scene::ToRender(const Vec3& world) const {
-  const Vec3 r = world - origin_;
-  return glm::vec3(static_cast<float>(r.x), static_cast<float>(r.y), static_cast<float>(r.z));
-}
+void Scene::SetUp(const ViewUp& up) { up_ = up, to_render_ = RenderRotation(up); }
+
+glm::vec3 Scene::ToRender(const Vec3& world) const { return glm::vec3(ToRenderDouble(world)); }
 
 glm::dvec3 Scene::ToRenderDouble(const Vec3& world) const {
   const Vec3 r = world - origin_;
-  return glm::dvec3(r.x, r.y, r.z);
+  return to_render_ * glm::dvec3(r.x, r.y, r.z);
 }
 
 Vec3 Scene::ToWorld(const glm::dvec3& render) const {
-  return origin_ + Vec3{render.x, render.y, render.z};
+  const glm::dvec3 r = glm::transpose(to_render_) * render;
+  return origin_ + Vec3{r.x, r.y, r.z};
+}
+
+glm::vec3 Scene::ToRenderDirection(const Vec3& world) const {
+  return glm::vec3(to_render_ * glm::dvec3(world.x, world.y, world.z));
+}
+
+RenderBox Scene::ToRenderBox(const Vec3& lo, const Vec3& hi) const {
+  const glm::dvec3 a = ToRenderDouble(lo), b = ToRenderDouble(hi);
+  return {glm::min(a, b), glm::max(a, b)};
 }
 
 void Scene::RenderBounds(glm::dvec3* lo, glm::dvec3* hi) const {
@@ -262,7 +266,8 @@ void Scene::RenderBounds(glm::dvec3* lo, glm::dvec3* hi) const {
     *lo = glm::dvec3(-0.5), *hi = glm::dvec3(0.5);
     return;
   }
-  *lo = ToRenderDouble(lo_), *hi = ToRenderDouble(hi_);
+  const RenderBox box = ToRenderBox(lo_, hi_);
+  *lo = box.lo, *hi = box.hi;
 }
 
 void Scene::FrameBounds(const ViewState& view, glm::dvec3* lo, glm::dvec3* hi) const {
@@ -278,7 +283,8 @@ void Scene::FrameBounds(const ViewState& view, glm::dvec3* lo, glm::dvec3* hi) c
     Grow(cells_lo_, &world_lo, &world_hi, &any);
     Grow(cells_hi_, &world_lo, &world_hi, &any);
   }
-  *lo = ToRenderDouble(world_lo), *hi = ToRenderDouble(world_hi);
+  const RenderBox box = ToRenderBox(world_lo, world_hi);
+  *lo = box.lo, *hi = box.hi;
   // Markers drawn from points: a query's cross and normal (4 spacings), a walk's body axes and
   // foot normals (8 marker units).
   double margin = 0;
@@ -293,7 +299,7 @@ std::vector<RenderBox> Scene::DrawnBoxes() const {
   // crosses, arrow heads) and for the grid cells around the samples.
   const double markers = 16 * MarkerUnit() + (has_terrain() ? grid_.stats().cell_size : 0);
   auto add = [&](const Vec3& lo, const Vec3& hi) {
-    RenderBox box{ToRenderDouble(lo), ToRenderDouble(hi)};
+    RenderBox box = ToRenderBox(lo, hi);
     const double margin = 0.05 * glm::length(box.hi - box.lo) + markers;
     box.lo -= glm::dvec3(margin), box.hi += glm::dvec3(margin);
     boxes.push_back(box);
@@ -318,12 +324,15 @@ std::vector<RenderBox> Scene::DrawnBoxes() const {
 std::vector<DrawVertex> Scene::TerrainPoints(ColorMode mode) const {
   std::vector<DrawVertex> out;
   out.reserve(samples_.size());
-  const double h0 = terrain_lo_.y, h1 = terrain_hi_.y;     // (not a far query's height)
+  // Heights along the up: render space's y. (The terrain's, not a far query's.)
+  const RenderBox range = ToRenderBox(terrain_lo_, terrain_hi_);
+  const double h0 = range.lo.y, h1 = range.hi.y;
   const float size = -static_cast<float>(spacing_ * 1.6);  // world-sized splats
   for (size_t i = 0; i < samples_.size(); ++i) {
     const Vec3& p = samples_.points[i];
-    const Rgba c = mode == ColorMode::kNormal ? NormalColor(samples_.normals[i])
-                                              : HeightColor(h1 > h0 ? (p.y - h0) / (h1 - h0) : 0.5);
+    const Rgba c = mode == ColorMode::kNormal
+                       ? NormalColor(samples_.normals[i])
+                       : HeightColor(h1 > h0 ? (ToRenderDouble(p).y - h0) / (h1 - h0) : 0.5);
     out.push_back({ToRender(p), c, size});
   }
   return out;
@@ -370,7 +379,7 @@ void Scene::DrawQuery(const QueryView& q, bool latest, DrawList* depth_tested,
     const glm::vec3 from =
         q.spec.op == QueryOp::kNext ? ToRender(q.spec.point + q.spec.direction) : foot;
     on_top->Line(from, chosen, colors::kChosen);
-    on_top->Line(chosen, chosen + (unit * 4) * Direction(q.result.normal), colors::kChosen);
+    on_top->Line(chosen, chosen + (unit * 4) * ToRenderDirection(q.result.normal), colors::kChosen);
     on_top->Point(chosen, colors::kChosen, 15 * marker);
   }
 }
@@ -398,7 +407,10 @@ void Scene::DrawWalk(const ViewState& view, DrawList* on_top) const {
                                  {2 * (q.x * q.z + q.w * q.y), 2 * (q.y * q.z - q.w * q.x),
                                   1 - 2 * (q.x * q.x + q.y * q.y)}};
       const Rgba axis_colors[3] = {{255, 60, 60, 255}, {60, 255, 60, 255}, {60, 60, 255, 255}};
-      for (int a = 0; a < 3; ++a) on_top->Line(p, p + axes[a] * (unit * 8), axis_colors[a]);
+      for (int a = 0; a < 3; ++a) {
+        const Vec3 axis{axes[a].x, axes[a].y, axes[a].z};
+        on_top->Line(p, p + ToRenderDirection(axis) * (unit * 8), axis_colors[a]);
+      }
       continue;
     }
     const Rgba color = FootColor(foot_index++);
@@ -424,7 +436,7 @@ void Scene::DrawWalk(const ViewState& view, DrawList* on_top) const {
     }
     const TrackPose pose = PoseAt(track, view.frame);
     const glm::vec3 p = ToRender(pose.position);
-    on_top->Line(p, p + Direction(pose.normal) * (unit * 6), color);
+    on_top->Line(p, p + ToRenderDirection(pose.normal) * (unit * 6), color);
     on_top->Point(p, color, 16);
   }
 }
@@ -488,6 +500,7 @@ void Scene::Describe(const ViewState& view, const OrbitCamera& camera, int width
   j.Key("camera").BeginObject();
   j.Key("eye"), vec3(ToWorld(camera.eye()));
   j.Key("target"), vec3(ToWorld(camera.target()));
+  j.Key("up"), vec3(UpVector(up_));
   j.Key("fov_y_degrees").Value(OrbitCamera::kFovYDegrees);
   j.End();
   j.Key("color_mode").Value(view.color == ColorMode::kNormal ? "normal" : "height");

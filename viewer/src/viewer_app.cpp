@@ -654,6 +654,7 @@ int RunViewer(const ViewerOptions& options) {
                 << options.terrain << ": the walk was made on another terrain?\n";
     }
   }
+  app.scene.SetUp(options.up);
   app.scene.Finalize();
   // Told apart in world space but not in render space (about the scene's centre): a target
   // 1e-15 from an eye 5 away lay on it, and the picture was blank.

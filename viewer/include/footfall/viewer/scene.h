@@ -15,6 +15,7 @@
 #include "footfall/viewer/draw_list.h"
 #include "footfall/viewer/json_text.h"
 #include "footfall/viewer/query_view.h"
+#include "footfall/viewer/view_up.h"
 
 namespace footfall::viewer {
 
@@ -64,6 +65,9 @@ class Scene {
   void AddLive(const std::vector<RecentQuery>& queries);
   static constexpr size_t kMaxLive = 256;
 
+  // Sets the world axis the view stands on (default +y): render space turns it onto +y.
+  void SetUp(const ViewUp& up);
+  const ViewUp& up() const { return up_; }
   // Fixes the render-space origin at the centre of what is loaded. Call once after loading.
   void Finalize();
 
@@ -81,11 +85,15 @@ class Scene {
   const std::vector<QueryView>& queries() const { return queries_; }
   const std::vector<QueryView>& live() const { return live_; }
 
-  // World space to render space (world minus the origin): in float for vertices, in double
-  // for the camera; and back.
+  // World space to render space (world minus the origin, turned so that the up is +y): in
+  // float for vertices, in double for the camera; and back. ToRenderDirection turns a
+  // direction alone.
   glm::vec3 ToRender(const Vec3& world) const;
   glm::dvec3 ToRenderDouble(const Vec3& world) const;
   Vec3 ToWorld(const glm::dvec3& render) const;
+  glm::vec3 ToRenderDirection(const Vec3& world) const;
+  // The render-space box of the world-space box [lo, hi].
+  RenderBox ToRenderBox(const Vec3& lo, const Vec3& hi) const;
   // The render-space bounds of everything loaded (a unit box when nothing is): what the
   // camera frames.
   void RenderBounds(glm::dvec3* lo, glm::dvec3* hi) const;
@@ -139,6 +147,8 @@ class Scene {
   Walk walk_;
   double first_frame_ = 0, last_frame_ = 0;
   Vec3 origin_;
+  ViewUp up_;
+  glm::dmat3 to_render_{1.0};  // RenderRotation(up_)
   bool live_centred_ = false;  // origin_ moved to the first live query (nothing loaded)
   Vec3 lo_, hi_;
   bool has_bounds_ = false;

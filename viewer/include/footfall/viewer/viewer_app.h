@@ -7,6 +7,7 @@
 
 #include "footfall/import/terrain_loader.h"
 #include "footfall/terrain/vec3.h"
+#include "footfall/viewer/view_up.h"
 
 namespace footfall::viewer {
 
@@ -29,6 +30,7 @@ struct ViewerOptions {
   bool show_cells = false;
   bool has_camera = false;
   Vec3 eye, target;  // world space, with has_camera
+  ViewUp up;         // the world axis shown up (the camera's up)
 };
 
 // Runs the viewer. Prints errors as "footfall-view: ..." on stderr and returns the exit code:
