@@ -1855,6 +1855,48 @@ class BlenderAddonTest(unittest.TestCase):
         self.assertEqual([kp.co[0] for kp in curve.keyframe_points], [float(f) for f in frames])
         clear_animation([body])
 
+    def test_8e1_a_walk_keyed_in_nla_tweak_mode_plays_at_its_frames(self):
+        # The body's action is a strip starting at frame 101, tweaked. Keys appended straight
+        # into the action went at the scene's frames in the strip's own time (100 frames late),
+        # while those keyframe_insert set went where they play.
+        rig = bpy.data.objects["biped_rig"]
+        body = rig.footfall_rig.body
+        scene = bpy.context.scene.footfall
+        clear_animation([body])
+        ad = body.animation_data_create()
+        ad.action = bpy.data.actions.new("body_nla")
+        body.keyframe_insert("location", frame=1)
+        action = ad.action
+        ad.action = None
+        track = ad.nla_tracks.new()
+        strip = track.strips.new("body_nla", 101, action)
+        strip.select = True
+        ad.use_tweak_mode = True
+        self.assertTrue(ad.use_tweak_mode)
+        try:
+            scene.rig, scene.steps, scene.start_frame = rig, 4, 101
+            self.select([rig], rig)
+            self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
+            walk = json.loads(bpy.data.texts["footfall_walk.json"].as_string())
+            body_keys = [k for t in walk["tracks"] if t["kind"] == "body" for k in t["keys"]]
+            frames = sorted({float(k["frame"]) for k in body_keys})
+            self.assertEqual(frames[0], 101.0)
+            curve = action.fcurves.find("location", index=0)
+            # (The key at the strip's frame 1 was the walk's to replace: it starts there.)
+            self.assertEqual([kp.co[0] for kp in curve.keyframe_points],
+                             [f - 100 for f in frames])
+            scale = bpy.context.scene.unit_settings.scale_length
+            for k in body_keys[1:]:
+                bpy.context.scene.frame_set(int(k["frame"]))
+                got = body.matrix_world.translation
+                for g, w in zip(got, from_ff(k["position"])):
+                    self.assertAlmostEqual(g, w / scale, delta=TOL * max(1.0, abs(w)),
+                                           msg="body at frame %s" % k["frame"])
+        finally:
+            ad.use_tweak_mode = False
+            clear_animation([body])
+            scene.start_frame = 1
+
     def test_8f_a_picked_body_keeps_its_scale(self):
         # Character Setup set a picked body's world matrix without its scale: a body control
         # scaled 2 came back at scale 1 (the IK targets kept theirs).

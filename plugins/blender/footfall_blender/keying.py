@@ -296,6 +296,17 @@ def rotation_path(obj):
     return _ROTATION_PATHS.get(obj.rotation_mode, "rotation_euler")
 
 
+def action_frame(obj, frame):
+    """The frame of obj's action that plays at scene frame `frame`: in NLA tweak mode, the
+    tweaked strip's own time (its start, scale and repeats), as keyframe_insert maps it; else
+    `frame` itself. (Keys written straight into an action in tweak mode landed at the scene's
+    frames in the strip's time: a strip starting at 101 played them 100 frames late.)"""
+    ad = obj.animation_data
+    if ad is not None and ad.use_tweak_mode and ad.action is not None:
+        return ad.nla_tweak_strip_time_to_scene(frame, invert=True)
+    return frame
+
+
 def clear_keys(objects, from_frame, body=None, to_frame=None):
     """Removes location keys at frames from from_frame to to_frame (None: on to the end) from
     `objects`, and the rotation keys of `body` (one of them) in the path of its rotation
@@ -306,12 +317,14 @@ def clear_keys(objects, from_frame, body=None, to_frame=None):
         if action is None:
             continue
         paths = ("location", rotation_path(obj)) if obj == body else ("location",)
+        first = action_frame(obj, from_frame)
+        last = None if to_frame is None else action_frame(obj, to_frame)
         for fc in list(action.fcurves):
             if fc.data_path not in paths:
                 continue
             for i in reversed(range(len(fc.keyframe_points))):
                 frame = fc.keyframe_points[i].co[0]
-                if frame >= from_frame - 1e-6 and (to_frame is None or frame <= to_frame + 1e-6):
+                if frame >= first - 1e-6 and (last is None or frame <= last + 1e-6):
                     fc.keyframe_points.remove(fc.keyframe_points[i], fast=True)
             fc.update()
             # An emptied curve goes, unless the user gave it modifiers (a Noise for a bob, a
@@ -330,7 +343,8 @@ def _rotation_values(obj, rotations, first_frame):
     action = obj.animation_data.action if obj.animation_data else None
     curves = [action.fcurves.find(path, index=i) if action else None for i in range(width)]
     current = getattr(obj, path)
-    before = [fc.evaluate(first_frame) if fc is not None and len(fc.keyframe_points) else v
+    at = action_frame(obj, first_frame)
+    before = [fc.evaluate(at) if fc is not None and len(fc.keyframe_points) else v
               for fc, v in zip(curves, current)]
     values = []
     if path == "rotation_euler":
@@ -373,13 +387,15 @@ def _fcurve(obj, path, index):
 def _key_channel(obj, path, values, frames):
     """Keys obj's `path` (one value tuple per frame, ascending frames). Keys after the
     F-curves' last one are appended in one go (keyframe_insert reallocates a curve's keys at
-    every insert: a long walk took minutes); earlier frames go through keyframe_insert."""
+    every insert: a long walk took minutes); earlier frames go through keyframe_insert.
+    `frames` are the scene's: appended keys go at the action's frames (action_frame)."""
     width = len(values[0]) if values else 0
     curves = [_fcurve(obj, path, i) for i in range(width)]
     last = max((fc.keyframe_points[-1].co[0] for fc in curves if len(fc.keyframe_points)),
                default=None)
+    local = [action_frame(obj, f) for f in frames]
     tail = 0
-    while tail < len(frames) and last is not None and frames[tail] <= last:
+    while tail < len(frames) and last is not None and local[tail] <= last:
         setattr(obj, path, values[tail])
         obj.keyframe_insert(path, frame=frames[tail], group=obj.name)
         tail += 1
@@ -393,7 +409,7 @@ def _key_channel(obj, path, values, frames):
         co = [0.0] * (2 * (before + count))
         points.foreach_get("co", co)
         for k in range(count):
-            co[2 * (before + k)] = frames[tail + k]
+            co[2 * (before + k)] = local[tail + k]
             co[2 * (before + k) + 1] = values[tail + k][i]
         points.foreach_set("co", co)
         for point in points[before:]:
