@@ -2,6 +2,7 @@
 // become one walk.
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -224,6 +225,38 @@ TEST_CASE("Scene characters started on top of each other are said in notes", "[s
                            Catch::EndsWith(" apart, under a quarter of their reach: they walk "
                                            "through each other (give them starts farther "
                                            "apart)"));
+}
+
+TEST_CASE("A character on a crowd's later member is said, the crowd's own members not",
+          "[steps][scene]") {
+  // (Only a crowd's first member was compared: a character started on its third went
+  // unsaid.)
+  const Character biped = LoadShipped("biped");
+  Terrain t = LoadTerrain(MakeFlat(201, 0.05, 0), 0.05);
+  GenerateOptions o = StartOptions({3, 0, 3}, 2);
+  o.crowd = 4;
+  o.crowd_spacing = 1.5;
+  const Walk crowd = Generate(t, biped, o);
+  REQUIRE(crowd.stopped.empty());
+  // Where each member stands: its first feet's centroid.
+  std::map<std::string, std::pair<Vec3, int>> at;
+  for (const WalkTrack& track : crowd.tracks) {
+    if (track.kind != TrackKind::kFoot) continue;
+    at[track.character].first += track.keys.front().position;
+    ++at[track.character].second;
+  }
+  REQUIRE(at.size() == 4);
+  const Vec3 third = at["c3"].first / static_cast<double>(at["c3"].second);
+  const Walk lone = Generate(t, biped, StartOptions(third + Vec3{0.05, 0, 0}, 2));
+  REQUIRE(lone.stopped.empty());
+  const std::vector<std::string> notes =
+      OverlappingStartNotes({"bugs", "lone"}, {&crowd, &lone}, {biped.reach, biped.reach});
+  REQUIRE(notes.size() == 1);
+  CHECK_THAT(notes[0], Catch::StartsWith("bugs/c3 and lone start 0.0") &&
+                           Catch::Contains("they walk through each other"));
+  // The crowd alone: its members stand apart (1.5 > a quarter of the reach) and are not
+  // compared with each other anyway.
+  CHECK(OverlappingStartNotes({"bugs"}, {&crowd}, {biped.reach}).empty());
 }
 
 TEST_CASE("Overlapping start notes name a few pairs and count the others", "[steps][scene]") {

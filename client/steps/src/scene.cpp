@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <set>
 #include <sstream>
+#include <unordered_map>
 
 #include <nlohmann/json.hpp>
 
@@ -137,38 +138,74 @@ void AddToSceneWalk(const std::string& name, Walk&& walk, Walk* scene) {
 std::vector<std::string> OverlappingStartNotes(const std::vector<std::string>& names,
                                                const std::vector<const Walk*>& walks,
                                                const std::vector<double>& reaches) {
-  // (character, where it stands at the start: its first feet's centroid, the tracks before its
-  // first body track)
-  std::vector<std::pair<size_t, Vec3>> starts;
+  // Where each character stands at the start: its first feet's centroid, each crowd member's
+  // apart (tracks by their `character`; a crowd keeps its own members apart, so only members of
+  // different walks are compared). (Only a crowd's first member was compared: another
+  // character on its fifth went unsaid.)
+  struct Start {
+    size_t walk;
+    std::string member;  // "" or a crowd's "cK"
+    Vec3 at;
+  };
+  std::vector<Start> starts;
+  double widest = 0;  // the largest reach: pairs farther apart than a quarter of it are not near
   for (size_t i = 0; i < walks.size(); ++i) {
     if (!walks[i]) continue;
-    Vec3 sum;
-    int feet = 0;
+    const size_t first = starts.size();
+    std::unordered_map<std::string, size_t> member_start;  // member -> its index in starts
+    std::vector<int> feet;                                 // by start, from `first`
     for (const WalkTrack& track : walks[i]->tracks) {
-      if (track.kind == TrackKind::kBody) break;
-      if (!track.keys.empty()) sum += track.keys.front().position, ++feet;
+      if (track.kind != TrackKind::kFoot || track.keys.empty()) continue;
+      const auto [m, added] = member_start.emplace(track.character, starts.size());
+      if (added) starts.push_back({i, track.character, Vec3{}}), feet.push_back(0);
+      starts[m->second].at += track.keys.front().position, ++feet[m->second - first];
     }
-    if (feet > 0) starts.emplace_back(i, sum / static_cast<double>(feet));
+    for (size_t k = first; k < starts.size(); ++k)
+      starts[k].at = starts[k].at / static_cast<double>(feet[k - first]);
+    if (starts.size() > first) widest = std::max(widest, reaches[i]);
   }
-  std::vector<std::string> notes;
-  size_t more = 0;  // pairs beyond kMaxOverlappingStartNotes, counted
-  for (size_t a = 0; a < starts.size(); ++a) {
-    for (size_t b = a + 1; b < starts.size(); ++b) {
-      const size_t i = starts[a].first, j = starts[b].first;
-      const double apart = Distance(starts[a].second, starts[b].second);
-      if (!(apart < 0.25 * std::min(reaches[i], reaches[j]))) continue;
-      if (notes.size() == kMaxOverlappingStartNotes) {
-        ++more;
+  // Pairs found by sweeping along x; the first kMaxOverlappingStartNotes in the starts' order
+  // are named (a scene of thousands at one start has millions of pairs).
+  std::vector<size_t> by_x(starts.size());
+  for (size_t k = 0; k < by_x.size(); ++k) by_x[k] = k;
+  std::sort(by_x.begin(), by_x.end(),
+            [&](size_t a, size_t b) { return starts[a].at.x < starts[b].at.x; });
+  std::vector<std::pair<size_t, size_t>> named;  // a max-heap of the first pairs
+  size_t pairs = 0;
+  for (size_t u = 0; u < by_x.size(); ++u) {
+    for (size_t v = u + 1; v < by_x.size(); ++v) {
+      if (!(starts[by_x[v]].at.x - starts[by_x[u]].at.x <= 0.25 * widest)) break;
+      const size_t a = std::min(by_x[u], by_x[v]), b = std::max(by_x[u], by_x[v]);
+      const size_t i = starts[a].walk, j = starts[b].walk;
+      if (i == j) continue;
+      if (!(Distance(starts[a].at, starts[b].at) < 0.25 * std::min(reaches[i], reaches[j])))
         continue;
+      ++pairs;
+      if (named.size() < kMaxOverlappingStartNotes || std::make_pair(a, b) < named.front()) {
+        named.emplace_back(a, b);
+        std::push_heap(named.begin(), named.end());
+        if (named.size() > kMaxOverlappingStartNotes) {
+          std::pop_heap(named.begin(), named.end());
+          named.pop_back();
+        }
       }
-      std::ostringstream note;
-      note.precision(3);
-      note << names[i] << " and " << names[j] << " start " << apart
-           << " apart, under a quarter of their reach: they walk through each other (give them "
-              "starts farther apart)";
-      notes.push_back(note.str());
     }
   }
+  std::sort(named.begin(), named.end());
+  auto name = [&](const Start& s) {
+    return s.member.empty() ? names[s.walk] : names[s.walk] + "/" + s.member;
+  };
+  std::vector<std::string> notes;
+  for (const auto& [a, b] : named) {
+    std::ostringstream note;
+    note.precision(3);
+    note << name(starts[a]) << " and " << name(starts[b]) << " start "
+         << Distance(starts[a].at, starts[b].at)
+         << " apart, under a quarter of their reach: they walk through each other (give them "
+            "starts farther apart)";
+    notes.push_back(note.str());
+  }
+  const size_t more = pairs - named.size();
   if (more > 0) {
     notes.push_back("... and " + std::to_string(more) + (more == 1 ? " more pair" : " more pairs") +
                     " of characters start under a quarter of their reach apart");

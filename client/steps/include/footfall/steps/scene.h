@@ -53,9 +53,10 @@ void AddFailuresToSceneWalk(const std::vector<std::pair<std::string, std::string
                             Walk* scene);
 
 // Notes for scene characters that start on top of each other: for each pair of `names` whose
-// walks' first feet (a crowd's first character's) centre under a quarter of the smaller `reaches`
-// apart, "A and B start D apart: they walk through each other" (a crowd keeps its own
-// characters apart; two scene characters given one start were walked as one, silently).
+// walks' first feet centre under a quarter of the smaller `reaches` apart, "A and B start D
+// apart: they walk through each other" (two scene characters given one start were walked as
+// one, silently). Each member of a crowd is compared with the other walks' characters (named
+// "NAME/cK"), not with its own crowd, which keeps its members apart.
 // walks[i] may be null (a character that did not walk). Up to kMaxOverlappingStartNotes pairs
 // are named, the others counted in one more note (a scene of thousands at one start has
 // millions of pairs).
