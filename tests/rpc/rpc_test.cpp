@@ -1326,6 +1326,14 @@ TEST_CASE("footfalld holds --max-samples over parallel uploads and mesh loads", 
     CHECK(SendChunk(b, upload_b, {ff_sample{{0, 0, 0}, {0, 0, 0}}}, &message) ==
           FF_INVALID_ARGUMENT);
     CHECK(BeginUpload(b, 2000, &upload_b, &message) == FF_OK);
+    // So does a finish that comes short, and it says so, as a refused chunk does (the missing
+    // chunk sent after it was answered "no upload N in progress", with no word of why).
+    uint32_t terrain = 0;
+    REQUIRE(SendChunk(b, upload_b, {ff_sample{{0, 0, 0}, {0, 1, 0}}}, &message) == FF_OK);
+    CHECK(FinishUpload(b, upload_b, &terrain, &message) == FF_INVALID_ARGUMENT);
+    CHECK(message == "upload ended after 1 of 2000 samples; upload " + std::to_string(upload_b) +
+                         " is dropped: begin it again");
+    CHECK(BeginUpload(b, 2000, &upload_b, &message) == FF_OK);
     clnt_destroy(b);
   }
   SECTION("meshes are refused on the sampler's estimate, naming a separation that fits") {
@@ -1361,6 +1369,39 @@ TEST_CASE("footfalld holds --max-samples over parallel uploads and mesh loads", 
     CHECK(server.Log().find("freed orphaned terrain " + std::to_string(held[1]) + " early") !=
           std::string::npos);
     clnt_destroy(other);
+  }
+  SECTION("a request refused anyway frees no orphan") {
+    // (Orphans were freed to make room first, and the request refused after: another client's
+    // terrain was gone for nothing.)
+    {
+      std::ofstream points(root + "/wide.pts");  // 1500 samples
+      for (int i = 0; i < 1500; ++i) points << i % 50 << " 0 " << i / 50 << " 0 1 0\n";
+    }
+    auto first = ConnectLeavingOrphans(server.port());
+    TerrainHandle t = 0;
+    REQUIRE(first->LoadSamples(MakeFlat(30, 1, 0), "first", &t) == Status::kOk);  // 900
+    const std::vector<uint32_t> held = ServerTerrains(server.port());
+    REQUIRE(held.size() == 1);
+    first.reset();
+    CHECK(WaitFor([&] {
+      return server.Log().find("terrain " + std::to_string(held[0]) + " orphaned") !=
+             std::string::npos;
+    }));
+    CLIENT* b = RawClient(server.port());
+    uint32_t upload = 0, more = 0;
+    REQUIRE(BeginUpload(b, 1000, &upload, &message) == FF_OK);  // 1900 of 2000 in use
+    // 1000 + 1200 do not fit however many orphans go; nor do 1000 + 1500 loaded from a file.
+    CHECK(BeginUpload(b, 1200, &more, &message) == FF_LIMIT_EXCEEDED);
+    auto other = Connect(server.port());
+    CHECK(other->LoadServerFile("wide.pts", Separation(0.1), &t) == Status::kLimitExceeded);
+    CHECK_THAT(other->last_error(), Catch::StartsWith("'wide.pts': 1500 samples do not fit in "
+                                                      "the sample budget"));
+    CHECK(ServerTerrains(server.port()) == held);  // the orphan stays
+    CHECK(server.Log().find("freed orphaned terrain") == std::string::npos);
+    // What fits once it goes frees it.
+    CHECK(BeginUpload(b, 1000, &more, &message) == FF_OK);
+    CHECK(ServerTerrains(server.port()).empty());
+    clnt_destroy(b);
   }
 }
 

@@ -266,9 +266,9 @@ Status TerrainRegistry::Add(const std::string& name, RawSamples samples, uint64_
                             uint32_t* handle, std::string* message) {
   Status status = CheckQuota(owner, message);
   if (status != Status::kOk) return status;
-  MakeRoomForSamples(samples.size());
-  if (TotalSamples() + samples.size() > limits_.max_total_samples) {
-    *message = std::to_string(samples.size()) + " samples do not fit in " + Budget();
+  if (!MakeRoomForSamples(samples.size())) {
+    *message =
+        "'" + name + "': " + std::to_string(samples.size()) + " samples do not fit in " + Budget();
     return Status::kLimitExceeded;
   }
   status = ValidateAndNormalize(&samples, message);
@@ -283,14 +283,19 @@ Status TerrainRegistry::AddGrid(const std::string& name, TerrainGrid grid, uint6
                                 uint32_t* handle, std::string* message) {
   Status status = CheckQuota(owner, message);
   if (status != Status::kOk) return status;
+  // Refused before any orphan is freed for it (the budget counts orphans as room).
+  const size_t samples = grid.stats().samples;
+  const uint64_t kept = TotalSamples() - OrphanSamples();
+  if (samples > limits_.max_total_samples || kept > limits_.max_total_samples - samples) {
+    *message = "'" + name + "': " + std::to_string(samples) + " samples do not fit in " + Budget();
+    return Status::kLimitExceeded;
+  }
   if (terrains_.size() >= limits_.max_terrains && !EvictOldestOrphan()) {
     *message = "too many terrains loaded (limit " + std::to_string(limits_.max_terrains) + ")";
     return Status::kLimitExceeded;
   }
-  const size_t samples = grid.stats().samples;
-  MakeRoomForSamples(samples);
-  if (TotalSamples() + samples > limits_.max_total_samples) {
-    *message = std::to_string(samples) + " samples do not fit in " + Budget();
+  if (!MakeRoomForSamples(samples)) {
+    *message = "'" + name + "': " + std::to_string(samples) + " samples do not fit in " + Budget();
     return Status::kLimitExceeded;
   }
   auto terrain = std::make_unique<LoadedTerrain>();
@@ -433,8 +438,7 @@ Status TerrainRegistry::BeginUpload(const std::string& name, uint64_t total, uin
     *message = "too many uploads in progress (limit " + std::to_string(limits_.max_uploads) + ")";
     return Status::kLimitExceeded;
   }
-  if (total <= limits_.max_total_samples) MakeRoomForSamples(total);
-  if (total > limits_.max_total_samples || TotalSamples() + total > limits_.max_total_samples) {
+  if (!MakeRoomForSamples(total)) {
     *message = "an upload of " + std::to_string(total) + " samples does not fit in " + Budget();
     return Status::kLimitExceeded;
   }
@@ -539,7 +543,7 @@ Status TerrainRegistry::PrepareFinishUpload(uint32_t upload, uint64_t owner, Pen
   uploads_.erase(it);
   if (u.samples.size() != u.total) {
     *message = "upload ended after " + std::to_string(u.samples.size()) + " of " +
-               std::to_string(u.total) + " samples";
+               std::to_string(u.total) + " samples" + Dropped(upload);
     return Status::kInvalidArgument;
   }
   load->relative_path = u.name;
@@ -633,9 +637,12 @@ uint64_t TerrainRegistry::OrphanSamples() const {
   return total;
 }
 
-void TerrainRegistry::MakeRoomForSamples(uint64_t samples) {
-  while (TotalSamples() + samples > limits_.max_total_samples && EvictOldestOrphan()) {
+bool TerrainRegistry::MakeRoomForSamples(uint64_t samples) {
+  const uint64_t most = limits_.max_total_samples, kept = TotalSamples() - OrphanSamples();
+  if (samples > most || kept > most - samples) return false;
+  while (TotalSamples() > most - samples && EvictOldestOrphan()) {
   }
+  return TotalSamples() <= most - samples;
 }
 
 std::vector<uint32_t> TerrainRegistry::TakeEvicted() {

@@ -165,9 +165,10 @@ class TerrainRegistry {
  private:
   // Frees the least recently queried orphan; false when there is none.
   bool EvictOldestOrphan();
-  // Frees orphans, least recently queried first, until `samples` more fit in the budget or none
-  // is left.
-  void MakeRoomForSamples(uint64_t samples);
+  // Whether `samples` more fit in the budget, orphans freed as needed, least recently queried
+  // first. Frees none when they would not fit with every orphan gone: a request refused
+  // anyway cost other clients their orphans.
+  bool MakeRoomForSamples(uint64_t samples);
   uint64_t OrphanSamples() const;  // samples of orphaned terrains
   Status Add(const std::string& name, RawSamples samples, uint64_t owner, uint32_t* handle,
              std::string* message);
