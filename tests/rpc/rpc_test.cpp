@@ -714,6 +714,29 @@ TEST_CASE("footfalld confines server-side loads to its data root", "[rpc]") {
     CHECK_THAT(rpc->last_error(), Catch::Contains("more than 40 symbolic links"));
     CHECK(rpc->LoadServerFile("folder20/file20.pts", Separation(0), &t) == Status::kOk);
   }
+  SECTION("a path through a file, a name too long, and a long path keep their reasons") {
+    // (Each was "no such file under the data root"; a path near FF_MAX_PATH lost its reason
+    // at the message's end.)
+    CHECK(rpc->LoadServerFile("ok.pts/", Separation(0), &t) == Status::kIoError);
+    CHECK(rpc->last_error() ==
+          "'ok.pts/': not a directory: a file on its way under the data "
+          "root is followed by more of the path");
+    CHECK(rpc->LoadServerFile("ok.pts/x.pts", Separation(0), &t) == Status::kIoError);
+    CHECK_THAT(rpc->last_error(), Catch::Contains("not a directory"));
+    const std::string long_name(300, 'n');
+    CHECK(rpc->LoadServerFile(long_name + ".pts", Separation(0), &t) == Status::kIoError);
+    CHECK_THAT(rpc->last_error(), Catch::EndsWith("file name too long (a name on its way is over "
+                                                  "255 bytes, or the whole path over 4096)"));
+    std::string deep;
+    while (deep.size() < 1000) deep += "folder/";
+    deep += "x.pts";
+    CHECK(rpc->LoadServerFile(deep, Separation(0), &t) == Status::kIoError);
+    CHECK(rpc->last_error().size() <= FF_MAX_MESSAGE);
+    CHECK_THAT(rpc->last_error(), Catch::StartsWith("'folder/folder/") &&
+                                      Catch::Contains(" ... ") &&
+                                      Catch::EndsWith("folder/x.pts': no such file under the "
+                                                      "data root"));
+  }
   SECTION("a path with a NUL byte is refused, not cut short") {
     CLIENT* c = RawClient(server.port());
     RawLoadArgs args;

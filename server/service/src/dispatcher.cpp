@@ -81,7 +81,7 @@ ff_result ToWire(const Foothold& f) {
 }
 
 char* Message(const std::string& text) {
-  g_storage.message = std::string(Utf8Prefix(text, FF_MAX_MESSAGE));  // whole characters
+  g_storage.message = Utf8Shortened(text, FF_MAX_MESSAGE);  // whole characters, reason kept
   return const_cast<char*>(g_storage.message.c_str());
 }
 

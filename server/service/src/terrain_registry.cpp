@@ -172,7 +172,20 @@ Status ResolveUnderRoot(const std::string& root, const std::string& relative, st
                  "under the data root";
       return Status::kAccessDenied;
     }
-    *message = "'" + relative + "': no such file under the data root";
+    // (Within the root, the system's reason is told: every failure was "no such file".)
+    if (error == ENOTDIR) {
+      *message = "'" + relative +
+                 "': not a directory: a file on its way under the data root is "
+                 "followed by more of the path";
+    } else if (error == ENAMETOOLONG) {
+      *message = "'" + relative + "': file name too long (a name on its way is over " +
+                 std::to_string(NAME_MAX) + " bytes, or the whole path over " +
+                 std::to_string(PATH_MAX) + ")";
+    } else if (error == ENOENT) {
+      *message = "'" + relative + "': no such file under the data root";
+    } else {
+      *message = "'" + relative + "': cannot resolve under the data root: " + std::strerror(error);
+    }
     return Status::kIoError;
   }
   const std::string canonical = buffer;

@@ -80,6 +80,26 @@ inline std::string_view Utf8Prefix(std::string_view text, size_t bytes) {
   return text.substr(0, cut);
 }
 
+// `text` within `bytes` bytes (at least 64), cut in its middle where it is longer ("head ...
+// tail", never inside a UTF-8 sequence): a message quoting a long path keeps its reason, which
+// comes last (cut at its end, it lost it).
+inline std::string Utf8Shortened(std::string_view text, size_t bytes) {
+  if (text.size() <= bytes) return std::string(text);
+  constexpr std::string_view kGap = " ... ";
+  const size_t tail_bytes = bytes / 3;
+  size_t from = text.size() - tail_bytes;
+  // Forward over continuation bytes to the start of a sequence.
+  for (int on = 0;
+       on < 3 && from < text.size() && (static_cast<unsigned char>(text[from]) & 0xC0) == 0x80;
+       ++on)
+    ++from;
+  const std::string_view tail = text.substr(from);
+  std::string out(Utf8Prefix(text, bytes - kGap.size() - tail.size()));
+  out += kGap;
+  out += tail;
+  return out;
+}
+
 // The shortest text that reads back as `value` ("1.0000001", "2147483648", "0.1"): a message's
 // number never rounds onto the limit it breaks.
 inline std::string NumberText(double value) {
