@@ -1595,6 +1595,10 @@ TEST_CASE("footfalld refuses uploaded samples out of range, per chunk", "[rpc]")
         "sample 1: point (0, -4e+38, 0) is out of range (expected coordinates within +-5e+14)");
   CHECK(refused({{0, 0, 5.0001e14}, {0, 1, 0}}) ==
         "sample 1: point (0, 0, 5.0001e+14) is out of range (expected coordinates within +-5e+14)");
+  // Just past the range: its every digit (it was shown rounded onto the limit, "5e+14").
+  CHECK(refused({{0, -500000000000000.06, 0}, {0, 1, 0}}) ==
+        "sample 1: point (0, -500000000000000.06, 0) is out of range (expected coordinates "
+        "within +-5e+14)");
   CHECK(refused({{0, 0, 0}, {0, 0, 0}}) ==
         "sample 1: normal (0, 0, 0) has zero length (expected a non-zero nx ny nz)");
 

@@ -4,14 +4,14 @@
 #include <cmath>
 #include <cstdio>
 
+#include "footfall/terrain/shown_text.h"
+
 namespace footfall {
 namespace {
 
-std::string Format(double x) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", x);
-  return text;
-}
+// Every digit it takes to read back: a point just past the range was shown rounded onto it
+// ("(5e+14, 0, 0) is out of range ... within +-5e+14").
+std::string Format(double x) { return NumberText(x); }
 
 std::string Format(const Vec3& v) {
   return "(" + Format(v.x) + ", " + Format(v.y) + ", " + Format(v.z) + ")";
