@@ -434,6 +434,20 @@ TEST_CASE("RPC answers equal the embedded engine", "[rpc]") {
     CHECK(rr.status == FF_OK);
     CHECK(rr.queries.queries_len > 0);
     CHECK(rr.latest >= 600);
+    const uint64_t latest = rr.latest;
+    xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_recent_reply), reinterpret_cast<char*>(&rr));
+    // Every single query, a refused one too: a next with a NaN tolerance was left out.
+    ff_next_args na{server_handle, std::nan(""), {{0, 0, 0}, {1, 0, 0}}};
+    ff_result r{};
+    REQUIRE(ff_next_1(&na, &r, c) == RPC_SUCCESS);
+    CHECK(r.status == FF_INVALID_ARGUMENT);
+    ra.after = latest;
+    rr = ff_recent_reply{};
+    REQUIRE(ff_recent_1(&ra, &rr, c) == RPC_SUCCESS);
+    REQUIRE(rr.queries.queries_len == 1);
+    CHECK(rr.queries.queries_val[0].op == FF_OP_NEXT);
+    CHECK(std::isnan(rr.queries.queries_val[0].tolerance));
+    CHECK(rr.queries.queries_val[0].result.status == FF_INVALID_ARGUMENT);
     xdr_free(reinterpret_cast<xdrproc_t>(xdr_ff_recent_reply), reinterpret_cast<char*>(&rr));
     clnt_destroy(c);
   }

@@ -480,12 +480,13 @@ void NextOne(const ff_next_args& a, ff_result* r) {
     r->status = FF_UNKNOWN_TERRAIN;
     return;
   }
-  if (!std::isfinite(a.tolerance)) {
-    r->status = FF_INVALID_ARGUMENT;
-    return;
-  }
   const StepQuery q{FromWire(a.query.foot), FromWire(a.query.direction)};
-  const Foothold f = t->grid.Next(q, a.tolerance);
+  Foothold f;
+  if (std::isfinite(a.tolerance)) {
+    f = t->grid.Next(q, a.tolerance);
+  } else {
+    f.status = Status::kInvalidArgument;  // recorded too, as every refused single query is
+  }
   *r = ToWire(f);
   Record(a.terrain, FF_OP_NEXT, q.foot, q.direction, a.tolerance, f);
 }
