@@ -126,6 +126,32 @@ TEST_CASE("A character that turns slowly reaches a goal behind it by most of a c
   }
 }
 
+TEST_CASE("A character that turns very slowly reaches a goal it starts facing",
+          "[steps][generator]") {
+  // With max_turn_deg 0.1 its full-stride circle is ~200 m wide: the goal, a few centimetres
+  // aside once the feet had snapped to the samples, lay inside it, and the strides shrank to
+  // nothing; the biped shuffled sideways for 1000 steps. Within half a step of that circle, the
+  // goal is reached at full stride.
+  Character c = LoadShipped("biped");
+  c.max_turn_deg = 0.1;
+  RawSamples hills;
+  std::string error;
+  REQUIRE(footfall::LoadTerrain(std::string(FOOTFALL_SOURCE_DIR) + "/data/terrain/hills.pts",
+                                TerrainLoadOptions{}, &hills, &error) == Status::kOk);
+  Terrain t = LoadTerrain(hills, 0.25);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {20, 0, 20};
+  const Vec3 goal{25, 0, 25};
+  o.path = {goal};
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  REQUIRE(w.stopped.empty());
+  const Vec3 end = Body(w).keys.back().position;
+  CHECK(std::hypot(end.x - goal.x, end.z - goal.z) <= 0.5 * c.step_length);
+  CHECK(StepsDone(w) <= 2 * std::hypot(5.0, 5.0) / c.step_length + 4);
+}
+
 TEST_CASE("A waypoint inside the turning circle is reached with shorter steps, not circled",
           "[steps][generator]") {
   // The shipped biped with --path "0,0,3 0.5,0,2.5" turned 30 degrees a step at full stride
@@ -291,8 +317,10 @@ TEST_CASE("A path walk that runs out of steps before its goal says so as a stop"
   o.start = {5, 0, 2};
   for (int i = 0; i < 2000; ++i) o.path.push_back({5, 0, i % 2 ? 2.0 : 8.0});
   const Walk w = Generate(t, c, o);
+  // How far along the path, not only in a straight line (1000 legs of 6 m are left).
   CHECK_THAT(w.stopped, Catch::StartsWith("step 10001: the path's goal (5.0000, 0.0000, 2.0000) "
                                           "is still ") &&
+                            Catch::Contains(" away along the path (") &&
                             Catch::EndsWith("after 10000 steps, the most a path walk takes "
                                             "without a step count (--steps; give one to walk "
                                             "farther); walk stopped, keys up to step 10000 kept"));
@@ -305,9 +333,12 @@ TEST_CASE("A path walk that runs out of steps before its goal says so as a stop"
   REQUIRE(asked.notes.size() == 1);
   CHECK_THAT(asked.notes[0],
              Catch::StartsWith("the path's goal (5.0000, 0.0000, 2.0000) is still ") &&
-                 Catch::EndsWith(" away after the 50 steps asked for (without a step "
-                                 "count, --steps, a path walk goes on to its goal, up to "
+                 Catch::Contains(" away along the path (") &&
+                 Catch::EndsWith(" in a straight line) after the 50 steps asked for (without a "
+                                 "step count, --steps, a path walk goes on to its goal, up to "
                                  "10000 steps)"));
+  // 1999 legs of 6 m after the one under way: every digit, no exponent.
+  CHECK_THAT(asked.notes[0], Catch::Matches(".* is still 1[12][0-9]{3} away along the path .*"));
   // Steps enough to arrive: nothing to say.
   o.path = {{5, 0, 4}};
   CHECK(Generate(t, c, o).notes.empty());

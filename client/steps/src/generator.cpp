@@ -176,9 +176,8 @@ Status Generator::Run(std::string* error) {
   if (o_.steps < 0 && !o_.path.empty()) {
     for (Agent& a : agents_) {
       if (!a.walking || !a.stopped.empty() || a.path.empty() || Arrived(a)) continue;
-      const double left = Remaining(a, a.path.size() - 1);
       Text why(4);
-      why << "the path's goal " << Point(a.path.back()) << " is still " << left << " away after "
+      why << "the path's goal " << Point(a.path.back()) << " is still " << HowFar(a) << " after "
           << steps_ << " steps, the most a path walk takes without a step count (" << o_.names.steps
           << "; give one to walk farther)";
       Stop(a, steps_ + 1, why.str());
@@ -193,10 +192,10 @@ Status Generator::Run(std::string* error) {
       if (!a.walking || !a.stopped.empty() || a.path.empty() || Arrived(a)) continue;
       Text note(4);
       if (!a.id.empty()) note << a.id << ": ";
-      note << "the path's goal " << Point(a.path.back()) << " is still "
-           << Remaining(a, a.path.size() - 1) << " away after the " << steps_
-           << " steps asked for (without a step count, " << o_.names.steps
-           << ", a path walk goes on to its goal, up to " << kMaxPathSteps << " steps)";
+      note << "the path's goal " << Point(a.path.back()) << " is still " << HowFar(a)
+           << " after the " << steps_ << " steps asked for (without a step count, "
+           << o_.names.steps << ", a path walk goes on to its goal, up to " << kMaxPathSteps
+           << " steps)";
       walk_.notes.push_back(note.str());
     }
   }

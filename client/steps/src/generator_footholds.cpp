@@ -63,16 +63,40 @@ bool Generator::Reached(const Agent& a, size_t i) const {
   return !OnTerrain(a, i) || (along >= -radius && along <= radius + c_.body_height);
 }
 
-double Generator::StrideToward(const Vec3& to, const Vec3& forward) const {
+double Generator::StrideToward(const Vec3& to, const Vec3& forward, double radius) const {
   // A waypoint inside the circle the body turns on at full stride (beside or behind it, nearer
   // than the turn allows) would be circled for ever: the steps shorten so that the circle the
   // body turns on, tangent to the heading, runs through the waypoint, and with the waypoint
-  // behind that heading the character turns on the spot.
+  // behind that heading the character turns on the spot. One the heading already passes
+  // within `radius` of (where it is reached) is walked to at full stride: a character turning
+  // 0.1 degrees a step, whose circle is some 200 m wide, took a goal straight ahead but a few
+  // centimetres aside, where its feet had snapped, for one inside that circle; its strides
+  // shrank to nothing and it shuffled sideways for 1000 steps.
   const double ahead = Dot(to, forward);
   const double aside = Length(to - forward * ahead);
+  if (ahead > 0 && aside <= radius) return 1;
   const double through = Length2(to) / (2 * aside);  // that circle's radius (inf: no circle)
   if (through >= turn_radius_) return 1;
   return ahead > 0 ? through / turn_radius_ : 0;
+}
+
+std::string Generator::HowFar(const Agent& a) const {
+  // Four significant digits, and every digit before the point (not 1.198e+04).
+  auto text = [](double d) {
+    Text t(std::max(4, d >= 1 ? static_cast<int>(std::floor(std::log10(d))) + 1 : 0));
+    t << d;
+    return t.str();
+  };
+  const std::string straight = text(Remaining(a, a.path.size() - 1));
+  if (a.waypoint + 1 >= a.path.size()) return straight + " away";
+  return text(PathLeft(a)) + " away along the path (" + straight + " in a straight line)";
+}
+
+double Generator::PathLeft(const Agent& a) const {
+  double left = Remaining(a, a.waypoint);
+  for (size_t i = a.waypoint; i + 1 < a.path.size(); ++i)
+    left += Distance(a.path[i], a.path[i + 1]);
+  return left;
 }
 
 double Generator::PairGap(const Agent& a, const Vec3& forward, double stride, int group) const {
@@ -121,7 +145,7 @@ void Generator::Steer(Agent& a, int group) const {
   // turn is taken, so that the targets it gives may find footholds.
   if (a.still >= static_cast<int>(c_.gait.size())) {
     a.forward = Normalize(RotateAround(a.forward, a.up, turn));
-    a.stride = StrideToward(to, a.forward);
+    a.stride = StrideToward(to, a.forward, Radius(a, a.waypoint));
     return;
   }
   double best_gap = -std::numeric_limits<double>::infinity();
@@ -129,7 +153,7 @@ void Generator::Steer(Agent& a, int group) const {
   double best_stride = 1;
   for (int eighths = kTurnShares; eighths >= 0; --eighths) {
     const Vec3 forward = Normalize(RotateAround(a.forward, a.up, turn * eighths / kTurnShares));
-    const double stride = StrideToward(to, forward);
+    const double stride = StrideToward(to, forward, Radius(a, a.waypoint));
     const double gap = PairGap(a, forward, stride, group);
     if (gap > best_gap) best_gap = gap, best_forward = forward, best_stride = stride;
     if (gap >= kMinPairGap) {

@@ -325,8 +325,9 @@ class Generator {
   // a's stride; marks a arrived at the last waypoint.
   void Steer(Agent& a, int group) const;
   // The share of a full stride a body heading `forward` takes toward a waypoint `to` away along
-  // the ground: below 1 for a waypoint inside the circle it turns on at full stride.
-  double StrideToward(const Vec3& to, const Vec3& forward) const;
+  // the ground, reached within `radius`: below 1 for a waypoint inside the circle it turns on at
+  // full stride, unless the heading passes within `radius` of it.
+  double StrideToward(const Vec3& to, const Vec3& forward, double radius) const;
   // The least gap across the heading between a foot and its mate (mate_), as a share of their
   // gap at rest, once a heading `forward` at `stride` has been taken and gait group `group` has
   // stepped (each of its feet at most step_length toward its target on ground as level as a's):
@@ -352,6 +353,12 @@ class Generator {
   // How far a's waypoint i still is, as Reached measures it: in 3D when it lies on the terrain,
   // else along the ground.
   double Remaining(const Agent& a, size_t i) const;
+  // How far a's path goes on from where it stands: to its waypoint, then leg after leg to the
+  // goal. [Units: wu]
+  double PathLeft(const Agent& a) const;
+  // "D away" for a path walk short of its goal: along the path when legs are left ("D away
+  // along the path (S in a straight line)": the straight line alone misled by kilometres).
+  std::string HowFar(const Agent& a) const;
   // The offset from a's ground to a point `p` of its path, as the walk aims at it: with p's
   // height along the world up taken off while a stands on ground facing up (within
   // kFloorUpDeg of the world up), unless p lies on the terrain (`on_terrain`): a path given at
