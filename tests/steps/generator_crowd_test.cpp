@@ -87,6 +87,26 @@ TEST_CASE("A crowd batches every character's queries into one call per round",
   CHECK(w9.tracks.back().character == "c9");
 }
 
+TEST_CASE("A crowd member left out inside the terrain is told why", "[steps][generator][crowd]") {
+  // Bipeds 0.35 apart on samples 0.25 apart, turned across the grid: some members' feet snap
+  // onto their neighbours' samples, well inside the terrain. Said as "the grid runs off the
+  // terrain there", which it did not.
+  const Character c = LoadShipped("biped");
+  Terrain t = LoadTerrain(MakeFlat(81, 0.25, 0), 0.25);
+  GenerateOptions o = CrowdOptions({10, 0, 10}, 1, 100, 0.35);
+  o.heading = {1, 0, 1};
+  const Walk w = Generate(t, c, o);
+  REQUIRE_FALSE(w.stops.empty());
+  for (const std::string& stop : w.stops) {
+    INFO(stop);
+    CHECK_THAT(stop, Catch::Contains("left out of the walk"));
+    CHECK_THAT(stop, Catch::Contains("the terrain's samples, about ") &&
+                         Catch::Contains(" apart, are coarse for the crowd's spacing, 0.35: give "
+                                         "a wider --crowd-spacing)"));
+    CHECK_THAT(stop, !Catch::Contains("runs off the terrain"));
+  }
+}
+
 TEST_CASE("Crowd places that snap onto another character's start are left out",
           "[steps][generator][crowd]") {
   // A 3 x 3 grid 1 m apart around (0.3, 0, 0.3) on a 10 m square: the places at -0.7 snap onto
@@ -109,7 +129,9 @@ TEST_CASE("Crowd places that snap onto another character's start are left out",
   REQUIRE(w.stops.size() == 5);
   for (const std::string& stop : w.stops) {
     CHECK_THAT(stop, Catch::Contains("its place on the crowd's grid"));
-    CHECK_THAT(stop, Catch::Contains("(the grid runs off the terrain there): left out"));
+    CHECK_THAT(stop, Catch::Contains("(its place lies ") &&
+                         Catch::Contains(" from the ground it snaps to: the grid runs off the "
+                                         "terrain, or over a drop, there): left out"));
     // The distance to the other start, said as a distance ("within 0.25 of" read as a bound).
     CHECK_THAT(stop, Catch::Matches(".*, only [0-9.e+-]+ from c[0-9]+'s start .*"));
   }

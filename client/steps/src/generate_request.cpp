@@ -88,6 +88,7 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
   o.names.heading = source + ": 'heading'";
   o.names.up = source + ": 'up'";
   o.names.steps = source + ": 'steps'";
+  o.names.crowd_spacing = source + ": 'crowd_spacing'";
   Status s;
   if (j.contains("character") == j.contains("character_file")) {
     *error = source + ": give exactly one of 'character' (an object) or 'character_file' (a path)";
@@ -174,9 +175,18 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
       *error = source + ": 'path': expected an array of at least one waypoint [x, y, z]";
       ok = false;
     }
+    // Each waypoint named by its place ("'path[0]'"), and a path of one point written flat
+    // ([x, y, z]) told as such: "'path': expected [x, y, z]" was what the user wrote.
+    if (ok && j["path"].size() == 3 && j["path"][0].is_number()) {
+      *error = source +
+               ": 'path': expected an array of waypoints, [[x, y, z], ...] (one "
+               "waypoint is [[x, y, z]])";
+      ok = false;
+    }
     for (size_t i = 0; ok && i < j["path"].size(); ++i) {
       Vec3 p;
-      ok = ReadVec(j["path"][i], source, "path", &p, error);
+      const std::string key = "path[" + std::to_string(i) + "]";
+      ok = ReadVec(j["path"][i], source, key.c_str(), &p, error);
       o.path.push_back(p);
     }
   }

@@ -119,14 +119,24 @@ Status Generator::Setup(std::string* error) {
   std::vector<Vec3> snapped_start(n);
   for (int i = 0; i < n; ++i) snapped_start[i] = answers_[i].point;
   // Why places snap together: a grid finer than the terrain's samples (its neighbours snap onto
-  // one sample anywhere), or one running off the terrain.
-  Text crowded_why(3);
-  if (spacing < 0.5 * gap_) {
-    crowded_why << "the crowd's spacing, " << spacing << ", is finer than the terrain's samples, "
-                << "about " << 0.5 * gap_ << " apart";
-  } else {
-    crowded_why << "the grid runs off the terrain there";
-  }
+  // one sample anywhere), samples coarse for the spacing, or a place off the terrain or over a
+  // drop (it snaps onto the edge another snaps onto). (Every case but the first was said as
+  // "the grid runs off the terrain there", for places well inside it too.)
+  const double sample_gap = 0.5 * gap_;
+  auto crowded_why = [&](double place_to_ground) {
+    Text why(3);
+    if (spacing < sample_gap) {
+      why << "the crowd's spacing, " << spacing << ", is finer than the terrain's samples, "
+          << "about " << sample_gap << " apart";
+    } else if (place_to_ground > 0.25 * spacing) {
+      why << "its place lies " << place_to_ground << " from the ground it snaps to: the grid "
+          << "runs off the terrain, or over a drop, there";
+    } else {
+      why << "the terrain's samples, about " << sample_gap << " apart, are coarse for the "
+          << "crowd's spacing, " << spacing << ": give a wider " << o_.names.crowd_spacing;
+    }
+    return why.str();
+  };
   agents_.resize(n);
   walk_.tracks.clear();
   walk_.tracks.reserve(n * (feet + 1));
@@ -210,7 +220,8 @@ Status Generator::Setup(std::string* error) {
       m << "step 1 of " << a.id << ": its place on the crowd's grid, "
         << Point(first.point + offsets[i]) << ", snaps to " << Point(snapped_start[i]) << ", only "
         << Distance(snapped_start[i], snapped_start[crowded[i]]) << " from " << other.id
-        << "'s start (" << crowded_why.str() << "): left out of the walk";
+        << "'s start (" << crowded_why(Distance(first.point + offsets[i], snapped_start[i]))
+        << "): left out of the walk";
       a.walking = false, a.left_out = true;
       a.stopped = m.str(), a.stopped_step = 1;
     }
@@ -231,7 +242,8 @@ Status Generator::Setup(std::string* error) {
     if (stacked[i] < 0 || a.left_out) continue;
     Text m;
     m << "step 1 of " << a.id << ": its feet, around " << Point(a.ground) << ", stand where "
-      << agents_[stacked[i]].id << "'s do (" << crowded_why.str() << "): left out of the walk";
+      << agents_[stacked[i]].id << "'s do (" << crowded_why(Distance(places[i], snapped_start[i]))
+      << "): left out of the walk";
     a.walking = false, a.left_out = true;
     a.stopped = m.str(), a.stopped_step = 1;
   }

@@ -49,6 +49,7 @@ struct GenerateInputNames {
   std::string heading = "--heading";
   std::string up = "--up";
   std::string steps = "--steps";
+  std::string crowd_spacing = "--crowd-spacing";
 };
 
 struct GenerateOptions {
