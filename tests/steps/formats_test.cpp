@@ -159,10 +159,10 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
   // A comment is text, at the top level and in a foot.
   CHECK(ParseCharacter(Biped("\"step_length\": 0.6", "\"step_length\": 0.6, \"comment\": 3"),
                        "b.json", &c, &error) == Status::kParseError);
-  CHECK(error == "b.json: 'comment' must be a string, found number");
+  CHECK(error == "b.json: 'comment' must be a string, found number (line 3)");
   CHECK(ParseCharacter(Biped("[0.1, 0, 0]}", "[0.1, 0, 0], \"comment\": [\"left\"]}"), "b.json", &c,
                        &error) == Status::kParseError);
-  CHECK(error == "b.json: 'feet'[0].comment: expected a string, found array");
+  CHECK(error == "b.json: 'feet'[0].comment: expected a string, found array (line 2)");
   // Keys may repeat in different objects; a foot may carry a comment as the file may.
   CHECK(ParseCharacter(Biped("[0.1, 0, 0]}", "[0.1, 0, 0], \"comment\": \"left\"}"), "b.json", &c,
                        &error) == Status::kOk);

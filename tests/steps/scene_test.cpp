@@ -1,12 +1,16 @@
 // Scene files (scene.h): what they read, the errors they name, and how their characters' walks
 // become one walk.
+#include <unistd.h>
+
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <string>
 #include <vector>
 
 #include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
 
 #include "footfall/import/terrain_generators.h"
 #include "footfall/steps/scene.h"
@@ -66,6 +70,64 @@ TEST_CASE("A scene file reads each character with its own options", "[steps][sce
   CHECK(scene[2].options.heading.x == 1);
 }
 
+TEST_CASE("Scene and character field errors name the field's line", "[steps][scene]") {
+  // (Only syntax errors and walk files named a line.)
+  const std::string scene = R"({"format": "footfall-scene", "version": 1, "characters": [
+    {"character_file": "biped.json"},
+    {"character_file": "biped.json",
+     "strat": [1, 0, 1]},
+    {"character_file": "biped.json",
+     "path": [[1, 0, 1],
+              [2, 0]]}]})";
+  CHECK_THAT(SceneError(scene), Catch::StartsWith("s.json: characters[1]: unknown field 'strat'") &&
+                                    Catch::EndsWith(" (line 4)"));
+  std::string fixed = scene;
+  fixed.replace(fixed.find("strat"), 5, "start");
+  CHECK(SceneError(fixed) == "s.json: characters[2]: 'path[1]': expected [x, y, z] (line 7)");
+  CHECK(SceneError(R"({"format": "footfall-scene", "version": 1, "characters": [
+    {"character_file": "biped.json"},
+    3]})") == "s.json: characters[1]: expected an object (line 3)");
+  // A character file's own line, whichever reads it.
+  Character c;
+  std::string error;
+  CHECK(ParseCharacter(R"({"format": "footfall-character", "version": 1,
+    "feet": [{"name": "L", "rest": [0.1, 0, 0]}, {"name": "R", "rest": [-0.1, 0, 0]}],
+    "gait": [["L"], ["R"]],
+    "step_length": 0.5, "step_height": 0.1, "body_height": 1,
+    "frames_per_step": 2.5,
+    "align_to_normal": false, "reach": 1.2})",
+                       "c.json", &c, &error) != Status::kOk);
+  CHECK_THAT(error, Catch::StartsWith("c.json: 'frames_per_step'") && Catch::EndsWith(" (line 5)"));
+  CHECK(ParseCharacter(R"({"format": "footfall-character", "version": 1,
+    "feet": [{"name": "L", "rest": [0.1, 0, 0]},
+             {"name": "R", "rest": [-0.1, 0, 0], "size": 2}],
+    "gait": [["L"], ["R"]]})",
+                       "c.json", &c, &error) != Status::kOk);
+  CHECK_THAT(error, Catch::EndsWith(" (line 3)"));
+}
+
+TEST_CASE("A character file without a name is named after the file", "[steps][scene]") {
+  // (Messages said "resampled for  at ...", and scene characters were named "1", "2".)
+  const std::string dir =
+      std::filesystem::temp_directory_path() / ("footfall-noname-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ifstream biped(kCharacters + "/biped.json");
+  nlohmann::json j = nlohmann::json::parse(biped);
+  j.erase("name");
+  std::ofstream(dir + "/noname.json") << j.dump();
+  Character c;
+  std::string error;
+  REQUIRE(LoadCharacter(dir + "/noname.json", &c, &error) == Status::kOk);
+  CHECK(c.name == "noname");
+  std::vector<SceneCharacter> scene;
+  const std::string text =
+      Scene(R"({"character_file": "noname.json"}, {"character_file": "noname.json"})");
+  REQUIRE(ParseScene(text, "s.json", dir, &scene, &error) == Status::kOk);
+  CHECK(scene[0].name == "noname1");
+  CHECK(scene[1].name == "noname2");
+  std::filesystem::remove_all(dir);
+}
+
 TEST_CASE("Scene steps and crowd written as whole decimals read as integers", "[steps][scene]") {
   // Python's json writes a float 20.0 as "20.0", as character files' frames_per_step may be.
   std::vector<SceneCharacter> scene;
@@ -84,7 +146,18 @@ TEST_CASE("Scene steps and crowd written as whole decimals read as integers", "[
 TEST_CASE("Scene file errors name the file the character and the field", "[steps][scene]") {
   CHECK_THAT(SceneError("[]"), Catch::StartsWith("s.json: not a JSON object"));
   CHECK_THAT(SceneError(R"({"format": "footfall-walk", "version": 1, "characters": []})"),
-             Catch::Contains("'format' must be \"footfall-scene\""));
+             Catch::EndsWith("'format': expected \"footfall-scene\", found \"footfall-walk\": "
+                             "a walk file, which footfall generate writes (line 1)"));
+  // A character or walk file given as a scene is told by its format, before its fields (it was
+  // refused for one of its own, "unknown field 'align_to_normal'").
+  std::ifstream biped(kCharacters + "/biped.json");
+  const std::string biped_text((std::istreambuf_iterator<char>(biped)),
+                               std::istreambuf_iterator<char>());
+  CHECK(SceneError(biped_text) ==
+        "s.json: 'format': expected \"footfall-scene\", found \"footfall-character\": a "
+        "character file (give it with --character) (line 2)");
+  CHECK(SceneError(R"({"fps": 24, "tracks": []})") ==
+        "s.json: 'format': expected \"footfall-scene\", found no 'format' (line 1)");
   CHECK_THAT(SceneError(R"({"format": "footfall-scene", "version": 2, "characters": []})"),
              Catch::Contains("'version' must be 1"));
   CHECK_THAT(SceneError(R"({"format": "footfall-scene", "version": 1, "characters": []})"),
@@ -110,6 +183,13 @@ TEST_CASE("Scene file errors name the file the character and the field", "[steps
         Catch::Contains("characters[0]: 'path': expected"));
   CHECK_THAT(SceneError(Scene(R"({"character_file": "biped.json", "path": []})")),
              Catch::Contains("'path': expected an array of at least one waypoint [x, y, z]"));
+  // One waypoint written flat is told so, and a bad waypoint by its place (both said
+  // "'path': expected [x, y, z]", what a flat one is).
+  CHECK_THAT(SceneError(Scene(R"({"character_file": "biped.json", "path": [20, 0, 25]})")),
+             Catch::EndsWith("characters[0]: 'path': expected an array of waypoints, [[x, y, "
+                             "z], ...] (one waypoint is [[x, y, z]]) (line 1)"));
+  CHECK_THAT(SceneError(Scene(R"({"character_file": "biped.json", "path": [[1, 0, 1], [2, 0]]})")),
+             Catch::EndsWith("characters[0]: 'path[1]': expected [x, y, z] (line 1)"));
   CHECK_THAT(
       SceneError(Scene(R"({"character_file": "biped.json"}, {"character_file": "nothere.json"})")),
       Catch::StartsWith("s.json: characters[1]: " + kCharacters + "/nothere.json: cannot open"));

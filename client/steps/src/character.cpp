@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/shown_text.h"
 #include "json_input.h"
 
@@ -295,7 +296,7 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
     }
   }
   if (r.status != Status::kOk) {
-    *error = r.error;
+    *error = detail::WithLine(text, source, r.error);  // the field's line
     return r.status;
   }
   *out = std::move(c);
@@ -312,7 +313,11 @@ Status LoadCharacter(const std::string& path, Character* out, std::string* error
   std::string text;
   const Status status = detail::ReadJsonFile(path, "character file", &text, error);
   if (status != Status::kOk) return status;
-  return ParseCharacter(text, path, out, error);
+  const Status parsed = ParseCharacter(text, path, out, error);
+  // Without a name, the file's: messages said "resampled for  at ...", and scene characters
+  // were named "1", "2".
+  if (parsed == Status::kOk && out->name.empty()) out->name = FileStem(path);
+  return parsed;
 }
 
 }  // namespace footfall

@@ -1,6 +1,7 @@
 #include "json_input.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -291,6 +292,121 @@ Status ReadJsonFile(const std::string& path, const char* what, std::string* text
     return Status::kIoError;
   }
   return Status::kOk;
+}
+
+// The 1-based line of `text` (valid JSON) where the value at `where` starts ("tracks[2].keys[5]
+// .position": field names and array indices from the root object), or, when there is no such
+// value (a missing field), where the nearest enclosing value that exists starts.
+size_t LineOf(const std::string& text, const std::string& where) {
+  // `where` as steps: a field name, or an array index written "[i]".
+  std::vector<std::string> steps;
+  for (size_t i = 0; i < where.size();) {
+    if (where[i] == '.') {
+      ++i;
+    } else if (where[i] == '[') {
+      const size_t end = where.find(']', i);
+      steps.push_back(where.substr(i, end - i + 1));
+      i = end == std::string::npos ? where.size() : end + 1;
+    } else {
+      const size_t end = where.find_first_of(".[", i);
+      steps.push_back(where.substr(i, end - i));
+      i = end == std::string::npos ? where.size() : end;
+    }
+  }
+  // The containers open around the scan: each one's step to the value being read.
+  struct Level {
+    bool object;
+    bool expect_key;
+    std::string step;  // the field name, or "[i]"
+    size_t index;
+  };
+  std::vector<Level> levels;
+  size_t line = 1, best_line = 1, best_depth = 0;
+  // A value starts at the current path: the deepest one along `where` is remembered.
+  auto value_starts = [&]() {
+    size_t depth = 0;
+    while (depth < levels.size() && depth < steps.size() && levels[depth].step == steps[depth])
+      ++depth;
+    if (depth == levels.size() && depth >= best_depth) {
+      best_depth = depth, best_line = line;
+      return depth == steps.size();
+    }
+    return false;
+  };
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\n') {
+      ++line;
+    } else if (c == '"') {
+      const size_t begin = i + 1;
+      for (++i; i < text.size() && text[i] != '"'; ++i)
+        if (text[i] == '\\') ++i;
+      if (!levels.empty() && levels.back().object && levels.back().expect_key) {
+        levels.back().step = text.substr(begin, i - begin);  // (as written: escapes kept)
+        levels.back().expect_key = false;
+      } else if (value_starts()) {
+        return best_line;
+      }
+    } else if (c == ',') {
+      if (!levels.empty() && levels.back().object)
+        levels.back().expect_key = true;
+      else if (!levels.empty())
+        levels.back().step = "[" + std::to_string(++levels.back().index) + "]";
+    } else if (c == '{' || c == '[') {
+      if (value_starts()) return best_line;
+      levels.push_back({c == '{', c == '{', c == '{' ? "" : "[0]", 0});
+    } else if (c == '}' || c == ']') {
+      if (!levels.empty()) levels.pop_back();
+    } else if (c == '-' || (c >= '0' && c <= '9') || c == 't' || c == 'f' || c == 'n') {
+      if (value_starts()) return best_line;
+      // The rest of the number or literal (the text holds no NUL: ParseJsonText refuses it).
+      while (i + 1 < text.size() && std::strchr(",]} \t\r\n", text[i + 1]) == nullptr) ++i;
+    }
+  }
+  return best_line;
+}
+
+std::string WithLine(const std::string& text, const std::string& source, std::string message,
+                     const std::string& within) {
+  // The field a message names first, right after the source and any "characters[i]: "
+  // ("'feet'[2]: ...", "characters[1]: 'start': ..."), with its index when it has one.
+  size_t at = message.compare(0, source.size() + 2, source + ": ") == 0 ? source.size() + 2 : 0;
+  std::string where = within;
+  if (!within.empty() && message.compare(at, within.size() + 2, within + ": ") == 0)
+    at += within.size() + 2;
+  for (const char* lead : {"unknown field ", "missing field "}) {
+    if (message.compare(at, std::strlen(lead), lead) == 0) at += std::strlen(lead);
+  }
+  if (at < message.size() && message[at] == '\'') {
+    const size_t close = message.find('\'', at + 1);
+    if (close != std::string::npos) {
+      std::string key = message.substr(at + 1, close - at - 1);
+      // "path[1]" written inside the quotes, or "'feet'[2]" after them: an index.
+      std::string index;
+      const size_t bracket = key.find('[');
+      if (bracket != std::string::npos) {
+        index = key.substr(bracket), key.erase(bracket);
+      } else if (close + 1 < message.size() && message[close + 1] == '[') {
+        const size_t end = message.find(']', close + 1);
+        if (end != std::string::npos) {
+          index = message.substr(close + 1, end - close);
+          // "'feet'[0].comment": the field within.
+          size_t name_end = end + 1;
+          if (name_end < message.size() && message[name_end] == '.') {
+            ++name_end;
+            while (name_end < message.size() &&
+                   (std::isalnum(static_cast<unsigned char>(message[name_end])) ||
+                    message[name_end] == '_'))
+              ++name_end;
+            index += message.substr(end + 1, name_end - end - 1);
+          }
+        }
+      }
+      where += (where.empty() ? "" : ".") + key + index;
+    }
+  }
+  if (where.empty()) return message;
+  return message + " (line " + std::to_string(LineOf(text, where)) + ")";
 }
 
 }  // namespace footfall::detail

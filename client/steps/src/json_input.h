@@ -74,4 +74,16 @@ bool FindUnknownKey(const nlohmann::json& j, const std::set<std::string>& known,
 // "unknown field 'KEY' (known fields: a, b, c)", with the known fields in sorted order.
 std::string UnknownFieldMessage(const std::string& key, const std::set<std::string>& known);
 
+// The 1-based line of `text` (valid JSON) where the value at `where` starts ("tracks[2].keys[5]
+// .position": field names and array indices from the root object), or, when there is no such
+// value (a missing field), where the nearest enclosing value that exists starts.
+size_t LineOf(const std::string& text, const std::string& where);
+
+// `message` (an error about `text`, read from `source`) with " (line N)" added: the line of the
+// field it names first, as "SOURCE: [WITHIN: ]'field'..." (within: a path such as
+// "characters[1]" the field lies in), or of `within` itself when it names none. Unchanged when
+// it names neither.
+std::string WithLine(const std::string& text, const std::string& source, std::string message,
+                     const std::string& within = "");
+
 }  // namespace footfall::detail

@@ -1,6 +1,7 @@
 #include "footfall/steps/scene.h"
 
 #include <algorithm>
+#include <cstring>
 #include <set>
 #include <sstream>
 #include <unordered_map>
@@ -20,17 +21,26 @@ Status ParseScene(const std::string& text, const std::string& source, const std:
   detail::JsonDocument document;
   nlohmann::json& j = document.value;
   if (!detail::ParseJsonText(text, source, &document, error, kMaxDepth)) return Status::kParseError;
+  // Errors name the line of the field they are about (of the entry, for an entry's own).
   auto fail = [&](Status status, const std::string& what) {
-    *error = source + ": " + what;
+    *error = detail::WithLine(text, source, source + ": " + what);
     return status;
   };
   if (!j.is_object()) return fail(Status::kParseError, "not a JSON object (expected a scene file)");
+  // The format first: a character or walk file given as a scene was refused for a field of
+  // its own ("unknown field 'align_to_normal'").
+  if (!j.contains("format") || j["format"] != "footfall-scene") {
+    std::string found = j.contains("format") ? j["format"].dump() : "no 'format'";
+    if (j.contains("format") && j["format"] == "footfall-character")
+      found += ": a character file (give it with --character)";
+    else if (j.contains("format") && j["format"] == "footfall-walk")
+      found += ": a walk file, which footfall generate writes";
+    return fail(Status::kParseError, "'format': expected \"footfall-scene\", found " + found);
+  }
   static const std::set<std::string> kKnown = {"format", "version", "comment", "characters"};
   std::string unknown;
   if (detail::FindUnknownKey(j, kKnown, &unknown))
     return fail(Status::kParseError, detail::UnknownFieldMessage(unknown, kKnown));
-  if (!j.contains("format") || j["format"] != "footfall-scene")
-    return fail(Status::kParseError, "'format' must be \"footfall-scene\"");
   if (!j.contains("version") || !detail::IsInteger(j["version"], kSceneFormatVersion))
     return fail(Status::kParseError, "'version' must be " + std::to_string(kSceneFormatVersion));
   if (j.contains("comment") && !j["comment"].is_string())
@@ -46,14 +56,16 @@ Status ParseScene(const std::string& text, const std::string& source, const std:
     const std::string where = source + ": characters[" + std::to_string(i) + "]";
     const nlohmann::json& entry = j["characters"][i];
     if (!entry.is_object()) {
-      *error = where + ": expected an object";
+      *error = detail::WithLine(text, source, where + ": expected an object",
+                                "characters[" + std::to_string(i) + "]");
       return Status::kParseError;
     }
     SceneCharacter c;
     std::string name;
     if (entry.contains("name")) {
       if (!entry["name"].is_string() || entry["name"].get<std::string>().empty()) {
-        *error = where + ": 'name' must be a non-empty string";
+        *error = detail::WithLine(text, source, where + ": 'name' must be a non-empty string",
+                                  "characters[" + std::to_string(i) + "]");
         return Status::kParseError;
       }
       name = entry["name"].get<std::string>();
@@ -69,14 +81,28 @@ Status ParseScene(const std::string& text, const std::string& source, const std:
     const Status read =
         detail::ReadGenerateRequest(entry, where, folder, {"fps"}, {"name"}, &c.character,
                                     &c.options, &c.character_file, error);
-    if (read != Status::kOk) return read;
+    if (read != Status::kOk) {
+      // (Not one from the character file the entry names: that says its own file and line.)
+      const std::string own = where + ": ";
+      const std::string rest =
+          error->compare(0, own.size(), own) == 0 ? error->substr(own.size()) : std::string();
+      for (const char* lead : {"'", "unknown field", "missing field", "give exactly"}) {
+        if (rest.compare(0, std::strlen(lead), lead) == 0) {
+          *error = detail::WithLine(text, source, *error, "characters[" + std::to_string(i) + "]");
+          break;
+        }
+      }
+      return read;
+    }
     c.has_start_frame = entry.contains("start_frame");
     c.has_up = entry.contains("up");
     c.name = name;
     if (name.empty()) {
       // Named after its character, with '/' (which names a crowd's characters) as '_': a
       // character named "x/c" was "x/c1", crowd "x"'s first character.
-      c.name = c.character.name + std::to_string(i + 1);
+      // (An inline character without a name is "character".)
+      c.name = (c.character.name.empty() ? std::string("character") : c.character.name) +
+               std::to_string(i + 1);
       std::replace(c.name.begin(), c.name.end(), '/', '_');
     }
     if (!names.insert(c.name).second) {

@@ -18,78 +18,6 @@ namespace {
 
 using nlohmann::json;
 
-// The 1-based line of `text` (valid JSON) where the value at `where` starts ("tracks[2].keys[5]
-// .position": field names and array indices from the root object), or, when there is no such
-// value (a missing field), where the nearest enclosing value that exists starts.
-size_t LineOf(const std::string& text, const std::string& where) {
-  // `where` as steps: a field name, or an array index written "[i]".
-  std::vector<std::string> steps;
-  for (size_t i = 0; i < where.size();) {
-    if (where[i] == '.') {
-      ++i;
-    } else if (where[i] == '[') {
-      const size_t end = where.find(']', i);
-      steps.push_back(where.substr(i, end - i + 1));
-      i = end == std::string::npos ? where.size() : end + 1;
-    } else {
-      const size_t end = where.find_first_of(".[", i);
-      steps.push_back(where.substr(i, end - i));
-      i = end == std::string::npos ? where.size() : end;
-    }
-  }
-  // The containers open around the scan: each one's step to the value being read.
-  struct Level {
-    bool object;
-    bool expect_key;
-    std::string step;  // the field name, or "[i]"
-    size_t index;
-  };
-  std::vector<Level> levels;
-  size_t line = 1, best_line = 1, best_depth = 0;
-  // A value starts at the current path: the deepest one along `where` is remembered.
-  auto value_starts = [&]() {
-    size_t depth = 0;
-    while (depth < levels.size() && depth < steps.size() && levels[depth].step == steps[depth])
-      ++depth;
-    if (depth == levels.size() && depth >= best_depth) {
-      best_depth = depth, best_line = line;
-      return depth == steps.size();
-    }
-    return false;
-  };
-  for (size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (c == '\n') {
-      ++line;
-    } else if (c == '"') {
-      const size_t begin = i + 1;
-      for (++i; i < text.size() && text[i] != '"'; ++i)
-        if (text[i] == '\\') ++i;
-      if (!levels.empty() && levels.back().object && levels.back().expect_key) {
-        levels.back().step = text.substr(begin, i - begin);  // (as written: escapes kept)
-        levels.back().expect_key = false;
-      } else if (value_starts()) {
-        return best_line;
-      }
-    } else if (c == ',') {
-      if (!levels.empty() && levels.back().object)
-        levels.back().expect_key = true;
-      else if (!levels.empty())
-        levels.back().step = "[" + std::to_string(++levels.back().index) + "]";
-    } else if (c == '{' || c == '[') {
-      if (value_starts()) return best_line;
-      levels.push_back({c == '{', c == '{', c == '{' ? "" : "[0]", 0});
-    } else if (c == '}' || c == ']') {
-      if (!levels.empty()) levels.pop_back();
-    } else if (c == '-' || (c >= '0' && c <= '9') || c == 't' || c == 'f' || c == 'n') {
-      if (value_starts()) return best_line;
-      // The rest of the number or literal (the text holds no NUL: ParseJsonText refuses it).
-      while (i + 1 < text.size() && std::strchr(",]} \t\r\n", text[i + 1]) == nullptr) ++i;
-    }
-  }
-  return best_line;
-}
-
 struct Reader {
   std::string source;
   std::string error;
@@ -394,7 +322,7 @@ Status ParseWalk(const std::string& text, const std::string& source, Walk* out, 
   }
   if (!r.error.empty()) {
     // Where it stands in the file, for an editor: the path alone left a long file to count.
-    *error = r.error + " (line " + std::to_string(LineOf(text, r.where)) + ")";
+    *error = r.error + " (line " + std::to_string(detail::LineOf(text, r.where)) + ")";
     return Status::kParseError;
   }
   *out = std::move(walk);
