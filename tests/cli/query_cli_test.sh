@@ -227,6 +227,18 @@ check "make: a ramp within range written" [ -s "$work/made.pts" ]
 err=$( (ulimit -v 2000000; timeout 20 "$footfall" terrain make rocks --size 300 --spacing 0.1 -o "$work/made.pts") 2>&1)
 check "make beyond memory: exit 1" [ $? -eq 1 ]
 check "make beyond memory: message" grep -qxF "footfall terrain make: rocks: these sizes at --spacing 0.1 give about 9006001 samples: making them needs about 4.5 GB, more than the 2.05 GB of memory this process may use (raise --spacing or give smaller sizes)" <<< "$err"
+# Rocks whose relief adds surface the plan's estimate leaves out (3.7 times the samples at
+# --amplitude 5) are refused by the sampler's own count, held to what memory holds (they passed
+# the estimate and ended in a bare "out of memory").
+err=$( (ulimit -v 1000000; timeout 60 "$footfall" terrain make rocks --size 40 --spacing 0.05 --amplitude 5 -o "$work/made.pts") 2>&1)
+check "relief beyond memory: exit 1" [ $? -eq 1 ]
+check "relief beyond memory: message" grep -qE "^footfall terrain make: rocks: separation 0.05 would give about [0-9]+ samples \(limit [0-9]+\); choose a separation of at least 0\.0[0-9]+ \(the limit is what the 1.02 GB of memory this process may use holds, at about 500 bytes a sample\)$" <<< "$err"
+# A side whose ratio to the spacing rounds just below a whole number keeps its last row (7 /
+# 0.07 is 99.99999999999999: 100 x 100 samples over 6.93 m).
+for kind in flat hills; do
+  "$footfall" terrain make $kind --size 7 --spacing 0.07 -o "$work/side.pts" > "$work/side.out"
+  check "make $kind --size 7 --spacing 0.07: 101 x 101 samples" grep -qxF "wrote 10201 samples to $work/side.pts" "$work/side.out"
+done
 
 # A low soft limit on descriptors is raised to the hard one (at the limit libtirpc closes the
 # least recently active connections, an idle client's among them).

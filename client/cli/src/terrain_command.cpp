@@ -184,6 +184,16 @@ constexpr double kMeshBytesPerSample = 500;
 // About how many samples `make` would write, in double so that no flag can overflow it (areas
 // in units of spacing^2, measured per side: a 1e300 sphere at --spacing 1e300 was inf * 0,
 // "about -nan samples").
+// Lattice points along a side `size` long at `spacing`: both ends. A ratio a rounding below a
+// whole number counts as it (7 / 0.07 is 99.99999999999999: the last row and column went).
+int SamplesAlong(double size, double spacing) {
+  const double steps = size / spacing;
+  const double whole = std::round(steps);
+  return static_cast<int>(
+             std::fabs(steps - whole) <= 1e-9 * std::max(1.0, whole) ? whole : std::floor(steps)) +
+         1;
+}
+
 double EstimateSamples(const MakeFlags& f) {
   const std::string& k = f.kind;
   if (k == "stairs") {
@@ -289,29 +299,42 @@ int RunMake(const MakeFlags& f) {
     return 1;
   }
   std::string why;  // the mesh sampler's, for blocks, ramp and rocks
+  // The estimate above is the ground's plan area: relief adds surface (rocks 5 high: 3.7 times
+  // the samples), which the mesh sampler counts from the mesh itself before sampling. It is
+  // held to what memory holds too, not only to kMaxMadeSamples (it ended in a bare "out of
+  // memory").
+  size_t most = static_cast<size_t>(kMaxMadeSamples);
+  const double memory = UsableMemoryBytes();
+  const bool memory_binds = memory > 0 && memory / kMeshBytesPerSample < kMaxMadeSamples;
+  if (memory_binds) most = std::max<size_t>(1, static_cast<size_t>(memory / kMeshBytesPerSample));
   if (k == "stairs") {
     samples = MakeStairs(f.steps, f.rise, f.run, f.width, f.spacing);
   } else if (k == "blocks") {
-    samples = MakeBlocks(f.size, f.size, f.max_height, f.spacing, f.seed, &why);
+    samples = MakeBlocks(f.size, f.size, f.max_height, f.spacing, f.seed, &why, most);
   } else if (k == "ramp") {
-    samples = MakeRamps(f.slopes, f.length, f.width, f.spacing, &why);
+    samples = MakeRamps(f.slopes, f.length, f.width, f.spacing, &why, most);
   } else if (k == "rocks") {
-    samples = MakeRocks(f.size, f.amplitude, f.spacing, f.seed, &why);
+    samples = MakeRocks(f.size, f.amplitude, f.spacing, f.seed, &why, most);
   } else if (k == "sphere") {
     // Fibonacci lattice with about one sample per spacing^2 of surface (the estimate: no inf /
     // inf cast to int for a sphere as large as its spacing).
     samples = MakeSphere(static_cast<int>(estimate) + 1, {0, f.radius, 0}, f.radius);
   } else if (k == "flat") {
-    samples = MakeFlat(static_cast<int>(f.size / f.spacing) + 1, f.spacing, 0);
+    samples = MakeFlat(SamplesAlong(f.size, f.spacing), f.spacing, 0);
   } else if (k == "hills") {
-    const int n = static_cast<int>(f.size / f.spacing) + 1;
+    const int n = SamplesAlong(f.size, f.spacing);
     samples = MakeHills(n, f.spacing, f.amplitude, f.seed);
   }
   std::string error;
   if (samples.size() == 0) {
     // The sampler's reason, when it refused (rocks 10 km high: "no samples" said nothing).
     std::cerr << "footfall terrain make: " << k << ": "
-              << (why.empty() ? "the parameters give no samples" : why) << '\n';
+              << (why.empty() ? "the parameters give no samples" : why);
+    if (memory_binds && why.find("limit") != std::string::npos)
+      std::cerr << std::setprecision(3) << " (the limit is what the " << memory / 1e9
+                << " GB of memory this process may use holds, at about " << kMeshBytesPerSample
+                << " bytes a sample)";
+    std::cerr << '\n';
     return 1;
   }
   for (const Vec3& p : samples.points) {

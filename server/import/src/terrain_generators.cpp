@@ -151,9 +151,10 @@ RawSamples MakeRamp(int nx, int nz, double spacing, double slope_deg) {
 namespace {
 
 RawSamples Sample(const TriangleMesh& mesh, double spacing, bool smooth, uint64_t seed,
-                  std::string* error) {
+                  size_t max_samples, std::string* error) {
   MeshSampleOptions options;
   options.separation = spacing;
+  options.max_samples = max_samples;
   options.smooth_normals = smooth;
   options.seed = seed;
   RawSamples s;
@@ -164,17 +165,17 @@ RawSamples Sample(const TriangleMesh& mesh, double spacing, bool smooth, uint64_
 }  // namespace
 
 RawSamples MakeBlocks(int nx, int nz, int max_height, double spacing, uint64_t seed,
-                      std::string* error) {
-  return Sample(MakeBlocksMesh(nx, nz, max_height, seed), spacing, false, seed, error);
+                      std::string* error, size_t max_samples) {
+  return Sample(MakeBlocksMesh(nx, nz, max_height, seed), spacing, false, seed, max_samples, error);
 }
 
 RawSamples MakeRamps(const std::vector<double>& slopes_deg, double length, double width,
-                     double spacing, std::string* error) {
-  return Sample(MakeRampsMesh(slopes_deg, length, width), spacing, false, 1, error);
+                     double spacing, std::string* error, size_t max_samples) {
+  return Sample(MakeRampsMesh(slopes_deg, length, width), spacing, false, 1, max_samples, error);
 }
 
 RawSamples MakeRocks(double size, double amplitude, double spacing, uint64_t seed,
-                     std::string* error) {
+                     std::string* error, size_t max_samples) {
   const int n = std::max(1, static_cast<int>(std::ceil(size / std::min(spacing, 0.25))));
   const TriangleMesh mesh = MakeRocksMesh(n, size / n, amplitude, seed);
   // Rocks reaching beyond the grid's range are refused before they are sampled: sampling
@@ -189,7 +190,7 @@ RawSamples MakeRocks(double size, double amplitude, double spacing, uint64_t see
     if (error) *error = m.str();
     return {};
   }
-  return Sample(mesh, spacing, true, seed, error);
+  return Sample(mesh, spacing, true, seed, max_samples, error);
 }
 
 }  // namespace footfall

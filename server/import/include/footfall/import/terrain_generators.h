@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "footfall/import/mesh_sampler.h"
 #include "footfall/terrain/samples.h"
 
 namespace footfall {
@@ -45,12 +46,16 @@ RawSamples MakeRamp(int nx, int nz, double spacing, double slope_deg);
 // landings (flat normals), rocky noise over a square `size` wu wide (smooth normals). Empty when
 // the sampler refuses (too many samples for its area, non-finite vertices), or rocks that reach
 // beyond kMaxCoordinate (refused before sampling): *error, when given,
-// then says why.
+// then says why. The sampler's estimate refuses more than `max_samples` samples before any is
+// made (as MeshSampleOptions::max_samples).
 RawSamples MakeBlocks(int nx, int nz, int max_height, double spacing, uint64_t seed,
-                      std::string* error = nullptr);
+                      std::string* error = nullptr,
+                      size_t max_samples = MeshSampleOptions{}.max_samples);
 RawSamples MakeRamps(const std::vector<double>& slopes_deg, double length, double width,
-                     double spacing, std::string* error = nullptr);
+                     double spacing, std::string* error = nullptr,
+                     size_t max_samples = MeshSampleOptions{}.max_samples);
 RawSamples MakeRocks(double size, double amplitude, double spacing, uint64_t seed,
-                     std::string* error = nullptr);
+                     std::string* error = nullptr,
+                     size_t max_samples = MeshSampleOptions{}.max_samples);
 
 }  // namespace footfall
