@@ -107,4 +107,14 @@ check "no server: says so" grep -qi "footfall bench: .*$server" <<< "$err"
 err=$( (ulimit -v 2000000; timeout 20 "$footfall" bench --terrain "$hills" --queries 16777216) 2>&1 >/dev/null)
 check "--queries beyond memory: exit 1" [ $? -eq 1 ]
 check "--queries beyond memory: message" grep -qxF "footfall bench: --queries 16777216 needs about 2.68 GB for its queries, more than the 2.05 GB of memory this process may use (give fewer)" <<< "$err"
+
+# Queries the engine refuses are counted and said: on samples 1e15 apart the default step
+# (two cells) puts most ideal points beyond the query range (they were timed as answers).
+printf '5e14 5e14 5e14 0 1 0\n-5e14 -5e14 -5e14 0 1 0\n' > "$work/far.pts"
+err=$("$footfall" bench --terrain "$work/far.pts" --queries 1000 --min-time 0.01 2>&1 >/dev/null)
+check "refused queries: said" grep -qE "^footfall bench: note: of the 1000 queries, 0 snap and [1-9][0-9]* next queries are refused as invalid" <<< "$err"
+out=$("$footfall" bench --terrain "$work/far.pts" --queries 1000 --min-time 0.01 --json 2>/dev/null)
+check "refused queries: in the JSON" python3 -c "import json, sys; j = json.loads(sys.argv[1]); assert j['refused_snap_queries'] == 0 and j['refused_next_queries'] > 0" "$out"
+err=$("$footfall" bench --terrain "$hills" --queries 1000 --min-time 0.01 2>&1 >/dev/null)
+check "no refused queries: no note" bash -c '! grep -q "refused" <<< "$1"' _ "$err"
 finish
