@@ -433,7 +433,17 @@ int WriteOutputs(const GenerateFlags& flags, const LoadedTerrain& terrain, const
   int code = 0;
   std::string error;
   OutputFileSet outputs;
-  for (const std::string& out : flags.out) {
+  // glTF first: its model is built whole, checked against the memory free then, and writing
+  // JSON or MEL on several threads leaves the allocator's per-thread pools counted as used
+  // (a glTF given after a .json was refused where one given before it was written).
+  std::vector<std::string> order;
+  for (const bool gltf : {true, false}) {
+    for (const std::string& out : flags.out) {
+      const std::string ext = FileExtension(out);
+      if ((ext == "gltf" || ext == "glb") == gltf) order.push_back(out);
+    }
+  }
+  for (const std::string& out : order) {
     if (out == kStandardOutput) continue;  // after the files (below)
     const std::string ext = FileExtension(out);
     Status written;
