@@ -220,7 +220,26 @@ TEST_CASE("ReadAscGrid: a NODATA_value of NaN leaves out the NaN cells", "[impor
                               "ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\n"
                               "cellsize nan\n1 1\n"),
                     &map, &error) == Status::kParseError);
-  CHECK(Contains(error, "cell.asc:5: header 'cellsize' needs a number on its line"));
+  CHECK(Contains(error, "cell.asc:5: header 'cellsize': 'nan' is not a finite number"));
+  // Said as what it is (each was "needs a number on its line", "truncated" or "more values"
+  // than shown).
+  CHECK(ReadAscGrid(dir.Write("inf.asc",
+                              "ncols 3\nnrows 1\ncellsize 1\nNODATA_value 1.#INF\n"
+                              "1 2 3\n"),
+                    &map, &error) == Status::kParseError);
+  CHECK(Contains(error,
+                 "inf.asc:4: header 'NODATA_value': '1.#INF' is not a finite number "
+                 "(Microsoft C's NaN or infinity) (NODATA_value may be a number or NaN)"));
+  CHECK(ReadAscGrid(dir.Write("commas.asc", "ncols 4\nnrows 2\ncellsize 1\n1,2,3,4\n5,6,7,8\n"),
+                    &map, &error) == Status::kParseError);
+  CHECK(Contains(error,
+                 "commas.asc:4: value '1,2,3,4' is not a finite number (values are "
+                 "separated by spaces or tabs, not commas)"));
+  CHECK(ReadAscGrid(dir.Write("eof.asc", "ncols 2\nnrows 1\ncellsize 1\n1 2\n\x1a"), &map,
+                    &error) == Status::kParseError);
+  CHECK(Contains(error,
+                 "eof.asc:5: more than the 2 values the header declares: '?' (bytes 1A) follows "
+                 "them"));
 }
 
 TEST_CASE("ReadAscGrid: a bad first value is named as a value", "[import][heightmap]") {

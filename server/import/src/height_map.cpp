@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -90,6 +91,32 @@ class TokenReader {
 bool IsNanText(const std::string& token) {
   const std::string t = Lower(token);
   return t == "nan" || t == "-nan" || t == "+nan" || IsMicrosoftNaN(token);
+}
+
+// " (bytes 1A)" for a short token holding bytes that do not show (control bytes, a no-break
+// space, a DOS end-of-file mark), else "".
+std::string HexBytes(const std::string& token) {
+  const bool hidden = std::any_of(token.begin(), token.end(), [](char c) {
+    const unsigned char b = static_cast<unsigned char>(c);
+    return b < 0x20 || b >= 0x7f;
+  });
+  if (!hidden || token.size() > 8) return "";
+  std::string out = " (bytes";
+  char hex[4];
+  for (const char c : token) {
+    std::snprintf(hex, sizeof hex, " %02X", static_cast<unsigned char>(c));
+    out += hex;
+  }
+  return out + ")";
+}
+
+// "value 'T' is not a finite number", with what it looks like: Microsoft C's NaN or infinity,
+// or values separated by commas.
+std::string NotAValue(const std::string& token) {
+  return "value '" + ShownText(token) + "' is not a finite number" + NotFiniteNote(token) +
+         (token.find(',') != std::string::npos
+              ? " (values are separated by spaces or tabs, not commas)"
+              : "");
 }
 
 // Whether an ASCII grid's token is meant as a value, not a header key: it starts like a number
@@ -373,9 +400,17 @@ Status ParseAscHeader(const std::string& path, TokenReader* reader, bool cell_si
     const bool nan_nodata = value_on_line && Lower(key) == "nodata_value" && IsNanText(value);
     if (nan_nodata) {
       number = NAN;
-    } else if (!value_on_line || !ParseFiniteDecimal(value, &number)) {
+    } else if (!value_on_line) {
       return Fail(path + ":" + std::to_string(line),
                   "header '" + ShownText(key) + "' needs a number on its line", error);
+    } else if (!ParseFiniteDecimal(value, &number)) {
+      // (Said to need a number, with one there: "NODATA_value 1.#INF".)
+      return Fail(
+          path + ":" + std::to_string(line),
+          "header '" + ShownText(key) + "': '" + ShownText(value) + "' is not a finite number" +
+              NotFiniteNote(value) +
+              (Lower(key) == "nodata_value" ? " (NODATA_value may be a number or NaN)" : ""),
+          error);
     }
     // One value a line: more after it ("cellsize 1 7 8") were read as the grid's first row.
     TokenReader after = *reader;
@@ -514,6 +549,16 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error,
   }
   size_t last_line;
   const size_t present = CountValues(reader, cells, &last_line);
+  if (static_cast<double>(present) < cells) {
+    // Fewer values than declared because some are not values: the first is named (rows of
+    // "1,2,3,4" were said to be truncated).
+    TokenReader scan = reader;
+    for (size_t i = 0; i < present && scan.Next(&value); ++i) {
+      double v;
+      if (!(h.nodata_is_nan && IsNanText(value)) && !ParseFiniteDecimal(value, &v))
+        return Fail(path + ":" + std::to_string(scan.line()), NotAValue(value), error);
+    }
+  }
   status = CheckGridSize(path, path + ":" + std::to_string(h.size_line), cells, AscDeclared(h),
                          present, last_line, error);
   if (status != Status::kOk) return status;
@@ -535,11 +580,8 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error,
       out->heights[i] = 0, out->valid[i] = 0;
       continue;
     }
-    if (!ParseFiniteDecimal(value, &height)) {
-      return Fail(path + ":" + std::to_string(reader.line()),
-                  "value '" + ShownText(value) + "' is not a finite number" + NotFiniteNote(value),
-                  error);
-    }
+    if (!ParseFiniteDecimal(value, &height))
+      return Fail(path + ":" + std::to_string(reader.line()), NotAValue(value), error);
     out->heights[i] = height;
     out->valid[i] = !(h.has_nodata && height == h.nodata);
     if (out->valid[i] && std::fabs(height) > terrain::kMaxCoordinate) {
@@ -551,8 +593,12 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error,
   }
   if (reader.Next(&value)) {
     if (value[0] == '#') return CommentInGrid(path, reader.line(), error);
+    // The first one past them named: an invisible byte (a DOS end-of-file mark, a NUL, a
+    // no-break space) read as a value left the user counting the values shown.
     return Fail(path + ":" + std::to_string(reader.line()),
-                "more than the " + std::to_string(total) + " values the header declares", error);
+                "more than the " + std::to_string(total) + " values the header declares: '" +
+                    ShownText(value) + "'" + HexBytes(value) + " follows them",
+                error);
   }
   return Status::kOk;
 }
