@@ -87,6 +87,16 @@ TEST_CASE("Scene and character field errors name the field's line", "[steps][sce
   CHECK(SceneError(R"({"format": "footfall-scene", "version": 1, "characters": [
     {"character_file": "biped.json"},
     3]})") == "s.json: characters[1]: expected an object (line 3)");
+  // A character given in the entry: the line of its field in the scene file (its object was
+  // read again from one line, and every error said "(line 1)").
+  CHECK_THAT(SceneError(R"({"format": "footfall-scene", "version": 1, "characters": [
+    {"character": {"format": "footfall-character", "version": 1,
+       "feet": [{"name": "L", "rest": [0.1, 0, 0]}, {"name": "R", "rest": [-0.1, 0, 0]}],
+       "gait": [["L"], ["R"]], "step_length": 0.5, "step_height": 0.1, "body_height": 1,
+       "frames_per_step": 10, "align_to_normal": false,
+       "reach": -1}}]})"),
+             Catch::StartsWith("s.json: characters[0] character: 'reach'") &&
+                 Catch::EndsWith(" (line 6)"));
   // A character file's own line, whichever reads it.
   Character c;
   std::string error;

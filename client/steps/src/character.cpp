@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "character_read.h"
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/shown_text.h"
 #include "json_input.h"
@@ -110,11 +111,18 @@ struct Reader {
 
 Status ParseCharacter(const std::string& text, const std::string& source, Character* out,
                       std::string* error) {
+  detail::JsonDocument document;
+  if (!detail::ParseJsonText(text, source, &document, error)) return Status::kParseError;
+  const Status status = detail::ReadCharacter(document.value, source, out, error);
+  if (status != Status::kOk) *error = detail::WithLine(text, source, *error);  // the field's line
+  return status;
+}
+
+namespace detail {
+
+Status ReadCharacter(const json& j, const std::string& source, Character* out, std::string* error) {
   Reader r;
   r.source = source;
-  detail::JsonDocument document;
-  json& j = document.value;
-  if (!detail::ParseJsonText(text, source, &document, error)) return Status::kParseError;
   if (!j.is_object()) {
     *error = source + ": not a JSON object (expected a footfall character file)";
     return Status::kParseError;
@@ -296,12 +304,14 @@ Status ParseCharacter(const std::string& text, const std::string& source, Charac
     }
   }
   if (r.status != Status::kOk) {
-    *error = detail::WithLine(text, source, r.error);  // the field's line
+    *error = r.error;
     return r.status;
   }
   *out = std::move(c);
   return Status::kOk;
 }
+
+}  // namespace detail
 
 Vec3 RestCentroid(const Character& c) {
   Vec3 sum;

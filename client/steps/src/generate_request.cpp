@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "character_read.h"
 #include "footfall/terrain/shown_text.h"
 #include "json_input.h"
 #include "request_fields.h"
@@ -100,7 +101,7 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
       return Status::kParseError;
     }
     if (character_file) character_file->clear();
-    s = ParseCharacter(j["character"].dump(), source + " character", character, error);
+    s = ReadCharacter(j["character"], source + " character", character, error);
   } else {
     if (!j["character_file"].is_string() || j["character_file"].get<std::string>().empty() ||
         j["character_file"].get<std::string>().find('\0') != std::string::npos) {

@@ -367,13 +367,14 @@ size_t LineOf(const std::string& text, const std::string& where) {
 }
 
 std::string WithLine(const std::string& text, const std::string& source, std::string message,
-                     const std::string& within) {
+                     const std::string& within, const std::string& within_text) {
   // The field a message names first, right after the source and any "characters[i]: "
   // ("'feet'[2]: ...", "characters[1]: 'start': ..."), with its index when it has one.
   size_t at = message.compare(0, source.size() + 2, source + ": ") == 0 ? source.size() + 2 : 0;
   std::string where = within;
-  if (!within.empty() && message.compare(at, within.size() + 2, within + ": ") == 0)
-    at += within.size() + 2;
+  const std::string& said = within_text.empty() ? within : within_text;
+  if (!said.empty() && message.compare(at, said.size() + 2, said + ": ") == 0)
+    at += said.size() + 2;
   for (const char* lead : {"unknown field ", "missing field "}) {
     if (message.compare(at, std::strlen(lead), lead) == 0) at += std::strlen(lead);
   }

@@ -81,9 +81,9 @@ size_t LineOf(const std::string& text, const std::string& where);
 
 // `message` (an error about `text`, read from `source`) with " (line N)" added: the line of the
 // field it names first, as "SOURCE: [WITHIN: ]'field'..." (within: a path such as
-// "characters[1]" the field lies in), or of `within` itself when it names none. Unchanged when
-// it names neither.
+// "characters[1]" the field lies in, said in the message as `within_text` when that is given),
+// or of `within` itself when it names none. Unchanged when it names neither.
 std::string WithLine(const std::string& text, const std::string& source, std::string message,
-                     const std::string& within = "");
+                     const std::string& within = "", const std::string& within_text = "");
 
 }  // namespace footfall::detail

@@ -83,12 +83,19 @@ Status ParseScene(const std::string& text, const std::string& source, const std:
                                     &c.options, &c.character_file, error);
     if (read != Status::kOk) {
       // (Not one from the character file the entry names: that says its own file and line.)
-      const std::string own = where + ": ";
+      const std::string entry_path = "characters[" + std::to_string(i) + "]";
+      const std::string own = where + ": ", inline_character = where + " character: ";
+      if (error->compare(0, inline_character.size(), inline_character) == 0) {
+        // The entry's own "character" object: its field's line in this file.
+        *error = detail::WithLine(text, source, *error, entry_path + ".character",
+                                  entry_path + " character");
+        return read;
+      }
       const std::string rest =
           error->compare(0, own.size(), own) == 0 ? error->substr(own.size()) : std::string();
       for (const char* lead : {"'", "unknown field", "missing field", "give exactly"}) {
         if (rest.compare(0, std::strlen(lead), lead) == 0) {
-          *error = detail::WithLine(text, source, *error, "characters[" + std::to_string(i) + "]");
+          *error = detail::WithLine(text, source, *error, entry_path);
           break;
         }
       }
