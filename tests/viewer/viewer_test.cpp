@@ -369,6 +369,24 @@ TEST_CASE("queries and the camera follow --up", "[viewer][up]") {
   CHECK(c["eye"][2].get<double>() > c["target"][2].get<double>());
 }
 
+TEST_CASE("a --camera straight along the up is tilted, and said", "[viewer][up]") {
+  // (The eye moved without a word: straight down onto a Z-up terrain.)
+  const std::string dir = test::TempDir();
+  test::WriteFile(dir + "/z.pts", ZUpHills());
+  RunResult r = View({"--terrain", dir + "/z.pts", "--up", "z", "--camera", "20 -20 30 20 -20 0",
+                      "--size", "160x100", "--screenshot", dir + "/c.png"});
+  CHECK(r.exit_code == 0);
+  CHECK_THAT(r.err, Catch::Contains("note: --camera looks within a degree of straight along the "
+                                    "up; the eye is tilted to 89 degrees about the target"));
+  // Looking down at 45 degrees: kept, and nothing said; a leading '+' read as --query reads it.
+  r = View({"--terrain", dir + "/z.pts", "--up", "z", "--camera", "+20 -40 +20 20 -20 0", "--size",
+            "160x100", "--screenshot", dir + "/c.png", "--dump-state", dir + "/c.json"});
+  CHECK(r.exit_code == 0);
+  CHECK_THAT(r.err, !Catch::Contains("--camera"));
+  CHECK(json::parse(test::ReadFile(dir + "/c.json"))["camera"]["eye"] ==
+        json::array({20.0, -40.0, 20.0}));
+}
+
 TEST_CASE("a height map stood up along --up-axis is seen standing on it", "[viewer][up]") {
   const std::string dir = test::TempDir();
   test::WriteFile(dir + "/g.asc",
@@ -1015,6 +1033,11 @@ TEST_CASE("a walk without keys is pointed out", "[viewer][walk]") {
   const RunResult r = View({"--walk", dir + "/empty.json", "--screenshot", dir + "/x.png"});
   CHECK(r.exit_code == 0);  // the overlay is still drawn
   CHECK_THAT(r.err, Catch::Contains("note: " + dir + "/empty.json has no keys: no walk to draw"));
+  // Nor a range it does not have ("--frame 5 is outside the walk's 0-0").
+  const RunResult framed =
+      View({"--walk", dir + "/empty.json", "--frame", "5", "--screenshot", dir + "/y.png"});
+  CHECK(framed.exit_code == 0);
+  CHECK_THAT(framed.err, Catch::Contains("has no keys") && !Catch::Contains("outside the walk"));
 }
 
 TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][errors]") {

@@ -64,7 +64,7 @@ void OrbitCamera::Frame(const glm::dvec3& lo, const glm::dvec3& hi, double min_r
   eye_ += shift;
 }
 
-void OrbitCamera::LookAt(const glm::dvec3& eye, const glm::dvec3& target) {
+bool OrbitCamera::LookAt(const glm::dvec3& eye, const glm::dvec3& target) {
   target_ = target;
   double length = 0;
   const glm::dvec3 d = UnitAndLength(eye - target, &length);
@@ -74,9 +74,10 @@ void OrbitCamera::LookAt(const glm::dvec3& eye, const glm::dvec3& target) {
   yaw_ = std::atan2(d.x, d.z);
   if (pitch_ == pitch) {
     eye_ = eye;
-  } else {
-    PlaceEye();
+    return true;
   }
+  PlaceEye();
+  return false;
 }
 
 void OrbitCamera::Orbit(double yaw_delta, double pitch_delta) {

@@ -34,6 +34,8 @@ bool ParseNumbers(const std::string& text, size_t count, std::vector<double>* ou
   out->clear();
   for (std::string t; in >> t;) {
     double v = 0;
+    // A leading '+' as --query and --up take it ("+7": from_chars reads no sign).
+    if (t.size() > 1 && t[0] == '+' && t[1] != '-' && t[1] != '+') t.erase(0, 1);
     const auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
     if (ec != std::errc() || ptr != t.data() + t.size() || !std::isfinite(v)) return false;
     out->push_back(v);

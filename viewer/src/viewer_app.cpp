@@ -664,10 +664,18 @@ int RunViewer(const ViewerOptions& options) {
         "--camera: the eye and the target are too near each other to be told apart this far "
         "from the scene's centre; move the target farther from the eye",
         2);
+  // An orbit camera keeps its up: a view straight along it is tilted, and said (the eye moved
+  // without a word; straight down onto a Z-up DEM is a view people ask for).
+  if (options.has_camera && !OrbitCamera().LookAt(app.scene.ToRenderDouble(options.eye),
+                                                  app.scene.ToRenderDouble(options.target))) {
+    std::cerr << "footfall-view: note: --camera looks within a degree of straight along the up; "
+                 "the eye is tilted to 89 degrees about the target (the view keeps --up up)\n";
+  }
   app.view.color = options.height_colors ? ColorMode::kHeight : ColorMode::kNormal;
   app.view.show_cells = options.show_cells;
   app.SetFrame(options.has_frame ? options.frame : app.scene.first_frame());
-  if (options.has_frame && app.scene.has_walk() &&
+  // (Not for a walk without keys, which is said already: its "range" was 0-0.)
+  if (options.has_frame && app.scene.has_walk() && app.scene.has_walk_keys() &&
       (options.frame < app.scene.first_frame() || options.frame > app.scene.last_frame())) {
     std::cerr << "footfall-view: note: --frame " << ExactFrameText(options.frame)
               << " is outside the walk's " << ExactFrameText(app.scene.first_frame()) << "-"

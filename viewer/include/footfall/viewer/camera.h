@@ -30,8 +30,8 @@ class OrbitCamera {
              double top_band = 0, double bottom_band = 0);
   // Places the eye and the target (render space). eye != target. The eye is kept as given
   // unless the view is within a degree of vertical, which is tilted to 89 degrees about the
-  // target.
-  void LookAt(const glm::dvec3& eye, const glm::dvec3& target);
+  // target: then returns false.
+  bool LookAt(const glm::dvec3& eye, const glm::dvec3& target);
 
   // Turns around the target. [Units: radians] Pitch stays within (-89, 89) degrees.
   void Orbit(double yaw_delta, double pitch_delta);

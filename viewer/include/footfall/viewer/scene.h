@@ -73,6 +73,7 @@ class Scene {
 
   bool has_terrain() const { return !terrain_path_.empty(); }
   bool has_walk() const { return !walk_path_.empty(); }
+  bool has_walk_keys() const { return has_walk_keys_; }
   // Whether anything was loaded (a terrain, queries or a walk), not only received live.
   bool has_loaded() const { return has_bounds_; }
   const TerrainGrid& grid() const { return grid_; }
