@@ -5,6 +5,7 @@
  * the round before: every call must return (an error code with a
  * reason, or its answer), never abort the host. Sessions that cannot be opened say why through
  * ffc_last_error(NULL). Arguments: FLAG_FILE CHARACTER_FILE */
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -65,6 +66,28 @@ int main(int argc, char** argv) {
   Check(ffc_open_rpc("127.0.0.1", 0, 1.0) == NULL, "ffc_open_rpc refuses port 0");
   Check(strcmp(ffc_last_error(NULL), "no session") == 0,
         "ffc_last_error(NULL) after a refused open is no longer out of memory");
+
+  /* A count no memory holds while memory has run out: refused with its reason (making the
+   * reason's text threw out of the call, and the host aborted). */
+  {
+    ffc_session* s = ffc_open_embedded();
+    uint32_t terrain = 0;
+    Check(s != NULL && ffc_load_samples(s, samples, 400, "flat", &terrain) == FF_C_OK,
+          "a session and a terrain with memory");
+    ffc_foothold answer;
+    const double point[3] = {1, 0.5, 1};
+    Fail(0);
+    const int32_t huge = ffc_snap(s, terrain, point, SIZE_MAX, &answer);
+    const int32_t huge_next = ffc_next(s, terrain, point, SIZE_MAX, 0, &answer);
+    const char* why = ffc_last_error(s);
+    Fail(-1);
+    Check(huge == FF_C_LIMIT_EXCEEDED && huge_next == FF_C_LIMIT_EXCEEDED,
+          "a count beyond memory is FF_C_LIMIT_EXCEEDED while memory has run out");
+    /* (Every allocation failing, the call may run out before it sizes its arrays.) */
+    Check(strstr(why, "too many items for memory") != NULL || strstr(why, "out of memory") != NULL,
+          "and says why");
+    ffc_close(s);
+  }
 
   int answered = 0, refused = 0;
   for (int round = 0; round < 120; ++round) {

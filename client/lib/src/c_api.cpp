@@ -30,7 +30,9 @@ struct ffc_session {
   // Guards `error` alone, so ffc_last_error answers at once while another thread's call (a load
   // of minutes) holds `mutex`.
   mutable std::mutex error_mutex;
-  std::string error;            // written through SetError
+  std::string error;  // written through SetError
+  // A fixed reason, set where memory has run out (SetFixedError), and cleared by SetError.
+  const char* fixed_error = nullptr;
   int32_t walk_stop = FF_C_OK;  // why the last walk stopped early (ffc_walk_stop)
 };
 
@@ -77,6 +79,15 @@ std::string OneLine(const std::string& text) {
 void SetError(ffc_session* s, std::string text) {
   std::lock_guard<std::mutex> lock(s->error_mutex);
   s->error = std::move(text);
+  s->fixed_error = nullptr;
+}
+
+// SetError without allocating, for the handlers of running out of memory: making the reason's
+// string could throw there, out of an extern "C" function, and abort the host.
+void SetFixedError(ffc_session* s, const char* text) noexcept {
+  std::lock_guard<std::mutex> lock(s->error_mutex);
+  s->error.clear();
+  s->fixed_error = text;
 }
 
 int32_t Result(ffc_session* s, Status status) {
@@ -104,16 +115,20 @@ int32_t Guard(ffc_session* s, Fn&& fn) {
   try {
     return fn();
   } catch (const std::bad_alloc&) {
-    SetError(s, "out of memory");
+    SetFixedError(s, "out of memory");
     return FF_C_LIMIT_EXCEEDED;
   } catch (const std::length_error&) {
-    SetError(s, "too many items for memory");
+    SetFixedError(s, "too many items for memory");
     return FF_C_LIMIT_EXCEEDED;
   } catch (const std::exception& e) {
-    SetError(s, std::string("internal error: ") + e.what());
+    try {
+      SetError(s, std::string("internal error: ") + e.what());
+    } catch (...) {
+      SetFixedError(s, "internal error");
+    }
     return FF_C_INTERNAL_ERROR;
   } catch (...) {
-    SetError(s, "internal error");
+    SetFixedError(s, "internal error");
     return FF_C_INTERNAL_ERROR;
   }
 }
@@ -192,7 +207,7 @@ int32_t Generate(ffc_session* s, uint32_t terrain, const char* request_json, cha
     char* note_copy = notes ? MallocCopy(note_text) : nullptr;
     if (!copy || (notes && !note_copy)) {
       std::free(copy), std::free(note_copy);
-      SetError(s, "out of memory");
+      SetFixedError(s, "out of memory");
       return FF_C_LIMIT_EXCEEDED;
     }
     *walk_json = copy;
@@ -261,6 +276,7 @@ const char* ffc_last_error(const ffc_session* session) {
     std::string error;
     {
       std::lock_guard<std::mutex> lock(session->error_mutex);
+      if (session->fixed_error) return session->fixed_error;
       error = session->error;
     }
     copy = OneLine(error);
