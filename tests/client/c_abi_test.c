@@ -677,6 +677,12 @@ static void TestRpc(const char* character_path) {
         "");
   Check(ffc_open_rpc("[::1", 7407, 1) == NULL, "ffc_open_rpc refuses an unclosed bracket", "");
   Check(ffc_open_rpc("a:b", 7407, 1) == NULL, "ffc_open_rpc refuses colons in a name", "");
+  /* Brackets around anything but an IPv6 address ("[]" opened a session with an empty host). */
+  Check(ffc_open_rpc("[]", 7407, 1) == NULL, "ffc_open_rpc refuses empty brackets", "");
+  Check(ffc_open_rpc("[localhost]", 7407, 1) == NULL, "ffc_open_rpc refuses a bracketed name", "");
+  s = ffc_open_rpc("[::1]", 7407, 1);
+  Check(s != NULL, "ffc_open_rpc takes an IPv6 address in brackets", "");
+  ffc_close(s);
 
   if (!Check(port > 0, "a closed loopback port", "socket, bind or getsockname failed")) return;
   snprintf(port_text, sizeof port_text, "%d", port);

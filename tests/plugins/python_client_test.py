@@ -152,6 +152,38 @@ class EmbeddedTest(unittest.TestCase):
                 ff.Session.rpc("127.0.0.1", 9, timeout)
             self.assertIn("timeout", e.exception.message)
 
+    def test_an_open_that_runs_out_of_memory_says_so(self):
+        # ffc_open_* returned NULL for want of memory: the package said the host was bad, or
+        # "internal_error", where the library says it ran out of memory.
+        script = (
+            "import os, sys\n"
+            "import footfall_client as ff\n"
+            "from footfall_client.library import load_library\n"
+            "load_library()  # its static constructors before memory runs out\n"
+            "flag = sys.argv[1]\n"
+            "for open_ in (lambda: ff.Session.rpc('127.0.0.1', 7407), ff.Session.embedded):\n"
+            "    with open(flag, 'w') as f:\n"
+            "        f.write('0\\n')\n"
+            "    try:\n"
+            "        open_()\n"
+            "        print('opened')\n"
+            "    except ff.FootfallError as e:\n"
+            "        print(e.status_name, '|', e.message)\n"
+            "    finally:\n"
+            "        os.unlink(flag)\n")
+        with tempfile.TemporaryDirectory() as tmp:
+            env = dict(os.environ, LD_PRELOAD=os.environ["FOOTFALL_FAILING_NEW"],
+                       FOOTFALL_FAIL_NEW_WHILE=os.path.join(tmp, "flag"),
+                       FOOTFALL_FAIL_NEW_EVERY="1")
+            run = subprocess.run([sys.executable, "-c", script, os.path.join(tmp, "flag")],
+                                 env=env, capture_output=True, text=True, timeout=60)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        lines = run.stdout.splitlines()
+        self.assertEqual(len(lines), 2, run.stdout)
+        for line in lines:
+            self.assertTrue(line.startswith("limit_exceeded | ") and "out of memory" in line,
+                            line)
+
     def test_closed_session_raises_instead_of_crashing(self):
         self.s.close()
         with self.assertRaises(ff.FootfallError) as e:

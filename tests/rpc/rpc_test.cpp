@@ -2345,6 +2345,31 @@ TEST_CASE("clients report a dead server and recover after a restart", "[rpc][rob
     REQUIRE(back.status == Status::kOk);
     RequireSame(back, before);
   }
+  SECTION("an unload after a failed call reaches footfalld once it answers again") {
+    // (A failed call dropped the connection, and unloads and closes then asked no one: the
+    // terrain stayed an orphan for --orphan-timeout.)
+    kill(server->pid(), SIGSTOP);
+    CHECK(rpc->Snap(t, Vec3{5, 1, 5}).status == Status::kUnavailable);
+    kill(server->pid(), SIGCONT);
+    CHECK(rpc->Unload(t) == Status::kOk);
+    CHECK(WaitFor([&] { return server->Log().find("unloaded terrain") != std::string::npos; }));
+  }
+  SECTION("a close after a restart whose footfalld does not answer waits the close timeout") {
+    // (It reconnected and waited the session's whole call timeout, 20 s here, before the close
+    // timeout of 2 s applied.)
+    auto patient = Connect(port, 20);
+    TerrainHandle p = 0;
+    REQUIRE(patient->LoadSamples(terrain, "patient", &p) == Status::kOk);
+    server->Kill();
+    server = std::make_unique<ServerProcess>(port);
+    kill(server->pid(), SIGSTOP);
+    const auto start = std::chrono::steady_clock::now();
+    patient.reset();
+    const double took =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    kill(server->pid(), SIGCONT);
+    CHECK(took < 8);
+  }
   SECTION("nothing listening") {
     auto nobody = Connect(1, 1);  // port 1: refused at once
     TerrainHandle h = 0;

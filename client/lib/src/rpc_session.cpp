@@ -72,8 +72,9 @@ class RpcSession final : public TerrainSession {
     std::signal(SIGPIPE, SIG_IGN);
   }
   ~RpcSession() override {
-    if (options_.unload_on_close && client_ && ReconnectIfClosed()) {
-      SetCallTimeout(client_, std::min(options_.call_timeout_s, kCloseTimeout));
+    bool loaded = false;
+    for (const auto& entry : terrains_) loaded |= entry.second.loaded;
+    if (options_.unload_on_close && loaded && ConnectForUnload(kCloseTimeout)) {
       for (const auto& entry : terrains_)
         if (entry.second.loaded && UnloadOnServer(entry.second) != RPC_SUCCESS) break;  // orphans
     }
@@ -142,8 +143,10 @@ class RpcSession final : public TerrainSession {
     if (it == terrains_.end()) return Unknown(terrain);
     // Best effort; through a new connection when footfalld closed the idle one (its terrains
     // are orphans then, which any connection may unload).
-    if (it->second.loaded && client_ && ReconnectIfClosed())
+    if (it->second.loaded && ConnectForUnload(options_.call_timeout_s)) {
       Call(UnloadOnServer(it->second), "unload");
+      if (client_) SetCallTimeout(client_, options_.call_timeout_s);
+    }
     terrains_.erase(it);
     return Status::kOk;
   }
@@ -509,12 +512,19 @@ class RpcSession final : public TerrainSession {
     }
   }
 
-  // Replaces a connection footfalld closed while it was idle, quietly (last_error() is kept).
-  // False when there is no connection to call on.
-  bool ReconnectIfClosed() {
-    if (!client_ || !ClosedByServer()) return client_ != nullptr;
+  // A connection to unload on, each connection attempt and call bounded by `limit_s`, quietly
+  // (last_error() is kept): the one there, replaced when footfalld closed it, or a new one after
+  // an earlier call failed (footfalld may be back; an unload that asked no one left its
+  // terrain an orphan for --orphan-timeout). The call timeout stays at `limit_s`.
+  bool ConnectForUnload(double limit_s) {
     const std::string kept = last_error_;
+    const RpcOptions saved = options_;
+    options_.call_timeout_s = std::min(options_.call_timeout_s, limit_s);
+    options_.connect_timeout_s = std::min(options_.connect_timeout_s, limit_s);
+    // (A new footfalld that does not answer held a close for the whole call timeout.)
     const bool connected = EnsureConnected() == Status::kOk;
+    if (connected) SetCallTimeout(client_, options_.call_timeout_s);
+    options_ = saved;
     last_error_ = kept;
     return connected;
   }

@@ -42,8 +42,12 @@ bool IsIpv6Address(const std::string& text) {
 
 bool ParseHost(const std::string& text, std::string* host) {
   std::string bare = text;
-  if (bare.size() >= 2 && bare.front() == '[' && bare.back() == ']')
+  if (bare.size() >= 2 && bare.front() == '[' && bare.back() == ']') {
     bare = bare.substr(1, bare.size() - 2);
+    // Brackets hold an IPv6 address, nothing else ("[]" was an empty host, which every call
+    // then failed to resolve).
+    if (!IsIpv6Address(bare)) return false;
+  }
   // Brackets left over, or colons in what is not an IPv6 address ("[::1" was host "[:" at port
   // 1, named "[[:]:1" when it could not be resolved; "127.0.0.1:7407" a host of that name).
   if (bare.find_first_of("[]") != std::string::npos ||

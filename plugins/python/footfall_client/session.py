@@ -23,7 +23,7 @@ STATUS_NAMES = {
     8: "unavailable",
     9: "internal_error",
 }
-OK, NO_FOOTHOLD, INVALID_ARGUMENT, UNKNOWN_TERRAIN, UNAVAILABLE = 0, 1, 2, 3, 8
+OK, NO_FOOTHOLD, INVALID_ARGUMENT, UNKNOWN_TERRAIN, LIMIT_EXCEEDED, UNAVAILABLE = 0, 1, 2, 3, 4, 8
 
 
 class FootfallError(Exception):
@@ -41,6 +41,15 @@ class FootfallError(Exception):
         # Rebuilt from the same arguments, so the error crosses pickling (a multiprocessing
         # pool's worker raising it): Exception's default passes only the text.
         return (type(self), (self.status, self.message, self.call))
+
+
+def _raise_if_out_of_memory(lib, call):
+    """Raises FootfallError 'limit_exceeded' when the last ffc_open_* on this thread ran out of
+    memory (the library says so through ffc_last_error(NULL)): it was reported as a bad host."""
+    why = lib.lib.ffc_last_error(None)
+    why = why.decode("utf-8", "replace") if why else ""
+    if "out of memory" in why:
+        raise FootfallError(LIMIT_EXCEEDED, why, call)
 
 
 class WalkStopped(FootfallError):
@@ -186,6 +195,7 @@ class Session:
                                 "or less: the default)" % (timeout,), "ffc_open_rpc")
         handle = lib.lib.ffc_open_rpc((host or "").encode("utf-8", "replace"), port, timeout)
         if not handle:  # (the other arguments are checked above)
+            _raise_if_out_of_memory(lib, "ffc_open_rpc")
             raise FootfallError(INVALID_ARGUMENT, "host %r: expected a host name or an IPv4 or "
                                 "IPv6 address ([::1] or ::1), without a port (the port is "
                                 "given apart)" % (host,), "ffc_open_rpc")
@@ -197,6 +207,7 @@ class Session:
         lib = load_library(library)
         handle = lib.lib.ffc_open_embedded()
         if not handle:
+            _raise_if_out_of_memory(lib, "ffc_open_embedded")
             raise FootfallError(INTERNAL_ERROR, "cannot open the embedded engine", "ffc_open_embedded")
         return cls(handle, lib, "embedded")
 

@@ -60,13 +60,15 @@ ffc_session* ffc_open_embedded(void);
  * host NULL means 127.0.0.1; timeout_s <= 0 means 10 s per call. A host name is looked up
  * within that timeout (a lookup that does not answer fails the call FF_C_UNAVAILABLE); a
  * literal IPv4 or IPv6 address needs no lookup; an IPv6 address may be in brackets ("[::1]").
- * NULL only on bad arguments: a host holding a port ("127.0.0.1:7407") or stray brackets, a
+ * NULL only on bad arguments: a host holding a port ("127.0.0.1:7407"), stray brackets or
+ * brackets around anything but an IPv6 address ("[]"), a
  * port outside 1-65535, a timeout above 1e6 s, infinite or NaN, or one above 0 but below
  * 0.001 s (as footfall's --timeout: no call could be answered in it); or when memory runs out
  * (ffc_last_error(NULL) then says so, on this thread). */
 ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s);
-/* Frees the session and its terrains (an RPC session unloads them from footfalld while it is
- * connected, waiting at most 2 s per terrain): the pointer is invalid afterwards (closing it
+/* Frees the session and its terrains (an RPC session unloads them from footfalld, connecting
+ * again if a call failed or footfalld closed the connection, the connection and each unload
+ * waiting at most 2 s): the pointer is invalid afterwards (closing it
  * twice, or while another thread is in a call on it, is undefined). NULL is ignored. */
 void ffc_close(ffc_session* session);
 /* The reason for the session's last failed call (from any thread), as a copy that stays valid
@@ -95,8 +97,8 @@ int32_t ffc_load_server_file(ffc_session* s, const char* path, double separation
  * character). */
 int32_t ffc_load_samples(ffc_session* s, const double* samples, size_t count, const char* name,
                          uint32_t* terrain);
-/* Forgets the terrain; an RPC session asks footfalld to unload it (best effort: FF_C_OK also
- * when footfalld does not answer). */
+/* Forgets the terrain; an RPC session asks footfalld to unload it, connecting again if a call
+ * failed (best effort: FF_C_OK also when footfalld does not answer). */
 int32_t ffc_unload(ffc_session* s, uint32_t terrain);
 /* Sample count and world bounds (min xyz, max xyz) of a terrain; samples and bounds may each be
  * NULL. */

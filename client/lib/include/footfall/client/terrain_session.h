@@ -113,10 +113,10 @@ struct RpcOptions {
   // (its queue of loads and upload grids is full: FF_UNAVAILABLE), waiting 0.05 s, then twice as
   // long each time up to 1 s, between tries; past it the call fails kUnavailable, saying so.
   double busy_timeout_s = 120;
-  // Destroying the session unloads its terrains from footfalld (best effort, while connected;
-  // each call waits at most 2 s). False leaves them to footfalld as orphans, which any client
-  // may query until --orphan-timeout passes without a query (a loader that exits while others
-  // query its terrains).
+  // Destroying the session unloads its terrains from footfalld (best effort, connecting again
+  // if a call failed; the connection and each call wait at most 2 s). False leaves them to
+  // footfalld as orphans, which any client may query until --orphan-timeout passes without a query
+  // (a loader that exits while others query its terrains).
   bool unload_on_close = true;
 };
 
@@ -129,7 +129,8 @@ struct RpcOptions {
 std::unique_ptr<TerrainSession> MakeRpcSession(const RpcOptions& options);
 
 // Parses a host without its port: a name, an IPv4 address, or an IPv6 address bare or in
-// brackets ("[::1]" gives "::1"). False for stray brackets or a port ("127.0.0.1:7407").
+// brackets ("[::1]" gives "::1"). False for stray brackets, brackets around anything but an
+// IPv6 address ("[]", "[localhost]"), or a port ("127.0.0.1:7407").
 bool ParseHost(const std::string& text, std::string* host);
 
 // Parses "HOST:PORT" (or ":PORT", "PORT", "[IPV6]:PORT", or a bare IPv6 address at the default
