@@ -487,6 +487,34 @@ class BlenderAddonTest(unittest.TestCase):
         for t in targets:
             self.assertIn(t.parent, centres)
 
+    def test_3a_new_rigs_go_into_the_active_collection(self):
+        # (They went into the scene's own collection, wherever the animator was working.)
+        layer = bpy.context.view_layer
+        rigs = bpy.data.collections.new("rigs")
+        bpy.context.scene.collection.children.link(rigs)
+        saved = layer.active_layer_collection
+        layer.active_layer_collection = layer.layer_collection.children["rigs"]
+        try:
+            result = bpy.ops.footfall.character_setup(
+                character_file=os.path.join(CHARACTERS, "quadruped.json"), mode="CREATE",
+                name="collected")
+            self.assertEqual(result, {"FINISHED"})
+            made = [o for o in bpy.data.objects if o.name.startswith("collected_")]
+            self.assertTrue(made)
+            for obj in made:
+                self.assertEqual([c.name for c in obj.users_collection], ["rigs"], obj.name)
+            # An excluded one is passed over for the scene's own.
+            layer.layer_collection.children["rigs"].exclude = True
+            layer.active_layer_collection = layer.layer_collection.children["rigs"]
+            self.assertEqual(self.ops._new_objects_collection(bpy.context),
+                             bpy.context.scene.collection)
+        finally:
+            layer.layer_collection.children["rigs"].exclude = False
+            layer.active_layer_collection = saved
+            for obj in [o for o in bpy.data.objects if o.name.startswith("collected_")]:
+                bpy.data.objects.remove(obj)
+            bpy.data.collections.remove(rigs)
+
     def test_3b_bad_character_or_walk_is_a_report_and_makes_nothing(self):
         # A pair naming a missing foot raised KeyError through the operator after the body and
         # the feet were made; a walk whose key has two coordinates raised IndexError.
@@ -1116,7 +1144,7 @@ class BlenderAddonTest(unittest.TestCase):
             self.assertIn(walk["stopped"], str(error))
             self.assertIn("(no_foothold)", str(error))
             kept = sum(len(t["keys"]) for t in walk["tracks"])
-            self.assertIn("; %d keys made before it were kept" % kept, str(error))
+            self.assertIn("; the %d keys made up to frame " % kept, str(error))
             self.assertTrue(reports[-1].startswith("Error: footfall: "), reports)
             # Its position is footfall's too: a note before it says how to read it.
             self.assertRegex(walk["stopped"], r"\(-?[0-9.]+, -?[0-9.]+, -?[0-9.]+\)")
@@ -1414,6 +1442,61 @@ class BlenderAddonTest(unittest.TestCase):
             bpy.data.objects.remove(path)
             bpy.data.objects.remove(hook)
             bpy.data.curves.remove(data)
+
+    def test_7f1b_a_path_its_modifiers_draw_as_two_lines_is_refused(self):
+        # A Mirror drew the path as two lines in a V; the walk went out along one and came back
+        # across the gap along the other.
+        data = bpy.data.curves.new("mirrored_path", "CURVE")
+        data.dimensions = "3D"
+        spline = data.splines.new("POLY")
+        spline.points.add(1)
+        for p, co in zip(spline.points, [(0.5, 0.0, 0.0), (2.0, 2.0, 0.0)]):
+            p.co = co + (1.0,)
+        path = bpy.data.objects.new("mirrored_path", data)
+        bpy.context.scene.collection.objects.link(path)
+        path.modifiers.new("Mirror", "MIRROR")
+        try:
+            bpy.context.view_layer.update()
+            with self.assertRaises(ValueError) as e:
+                self.ops.curve_points(bpy.context, path)
+            self.assertIn("is drawn as 2 separate lines by its modifiers (Mirror)", str(e.exception))
+            path.modifiers.clear()
+            self.assertEqual(len(self.ops.curve_points(bpy.context, path)), 2)
+        finally:
+            bpy.data.objects.remove(path)
+            bpy.data.curves.remove(data)
+
+    def test_7f3_targets_whose_keys_would_not_act_or_not_be_saved_are_refused(self):
+        # A driver on a target's own location beat its keys (the body stood 0.5 m off its
+        # walk), and keys on an object linked from another file were lost on saving.
+        import footfall_blender.keying as keying
+        target = bpy.data.objects.new("driven_target", None)
+        bpy.context.scene.collection.objects.link(target)
+        try:
+            driver = target.driver_add("location", 2)
+            driver.driver.expression = "0.5"
+            with self.assertRaises(ValueError) as e:
+                keying.check_parents([target])
+            self.assertIn("driven_target has a driver on its location[2]", str(e.exception))
+            driver.mute = True
+            keying.check_parents([target])  # a muted driver does not act
+            target.driver_remove("location", 2)
+            # Linked from a library file written here.
+            path = os.path.join(ARGS.work_dir, "library_%d.blend" % os.getpid())
+            bpy.data.libraries.write(path, {target})
+            with bpy.data.libraries.load(path, link=True) as (source, linked):
+                linked.objects = ["driven_target"]
+            foreign = linked.objects[0]
+            self.assertIsNotNone(foreign.library)
+            with self.assertRaises(ValueError) as e:
+                keying.check_parents([foreign])
+            self.assertIn("is linked from", str(e.exception))
+            self.assertIn("make a library override", str(e.exception))
+            library = foreign.library
+            bpy.data.objects.remove(foreign)
+            bpy.data.libraries.remove(library)
+        finally:
+            bpy.data.objects.remove(target)
 
     def test_7f2_a_filled_2d_path_is_its_outline_and_a_deleted_one_is_a_report(self):
         # A closed 2D curve with a fill was walked along its fill's inner edges (186 waypoints,
@@ -1940,6 +2023,9 @@ class BlenderAddonTest(unittest.TestCase):
         scene.rig, scene.steps = rig, 10
         self.select([rig], rig)  # the rig of the active object is keyed
         server = self.server
+        # A walk of 10 steps first: the one cut short removes its keys past the new ones, and
+        # says so (it said the keys were "kept").
+        self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
 
         def kill_after_second_chunk(op, done):
             if done == 4:
@@ -1952,6 +2038,8 @@ class BlenderAddonTest(unittest.TestCase):
             self.ops.chunk_hook = None
         self.assertIn("unavailable", str(e.exception))
         self.assertIn("kept", str(e.exception))
+        self.assertRegex(str(e.exception), r"the previous walk's keys after frame [0-9.]+ are "
+                                           r"removed \(Edit > Undo brings them back\)")
         # Blender is still here; the keys of the first 4 steps stay, exactly.
         server.restart()
         partial, _ = self.cli_walk(rig, 4, "biped_4")

@@ -45,13 +45,41 @@ def own_constraint(obj):
     return None
 
 
+def linked(obj):
+    """Why obj's keys would not be saved (None when they would): an object linked from another
+    file, not overridden, takes keys in this session, which Blender does not save (a walk keyed
+    onto linked feet was gone on reopening)."""
+    if obj.library is None:
+        return None
+    return ("%s is linked from %s, whose objects Blender does not save keys on: make a library "
+            "override of it first (Object > Library Override > Make)"
+            % (obj.name, bpy.path.abspath(obj.library.filepath)))
+
+
+def own_driver(obj):
+    """Why a driver on obj's own location or rotation keeps the walk's keys from acting (None
+    when none does): a driven channel ignores its keys (the body stood 0.5 m off its walk)."""
+    ad = obj.animation_data
+    if ad is None:
+        return None
+    paths = ("location", "rotation_euler", "rotation_quaternion", "rotation_axis_angle")
+    for fc in ad.drivers:
+        if fc.data_path in paths and not fc.mute:
+            return ("%s has a driver on its %s[%d], which overrides the walk's keys there: remove "
+                    "or mute the driver, or drive a parent of it instead"
+                    % (obj.name, fc.data_path, fc.array_index))
+    return None
+
+
 def check_parents(objects):
-    """Raises ValueError naming the first of `objects` (None ones skipped) whose parent relation
-    cannot be keyed exactly (see unsupported_parent), or whose own constraints move it
-    (own_constraint), or two of them that share one action (Duplicate Linked, Alt+D, shares
-    it: both would play every key of both, one mixed track)."""
+    """Raises ValueError naming the first of `objects` (None ones skipped) whose keys would not
+    be saved (linked), whose parent relation cannot be keyed exactly (see unsupported_parent),
+    whose own constraints or drivers move it (own_constraint, own_driver), or two of them that
+    share one action (Duplicate Linked, Alt+D, shares it: both would play every key of both,
+    one mixed track)."""
     for obj in objects:
-        why = (unsupported_parent(obj) or own_constraint(obj)) if obj is not None else None
+        why = ((linked(obj) or unsupported_parent(obj) or own_constraint(obj) or own_driver(obj))
+               if obj is not None else None)
         if why:
             raise ValueError(why)
     owner = {}

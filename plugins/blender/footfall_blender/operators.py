@@ -232,6 +232,10 @@ def _add_triangles(source, matrix, points, tris, scale):
     `matrix` to `points` (footfall's frame, in metres: `scale` metres a Blender unit) and
     `tris`, wound counter-clockwise when `matrix` mirrors. An object with no mesh (an empty,
     a light) adds nothing."""
+    # (Only objects with geometry: asked of an empty, to_mesh printed "Error: Object does not
+    # have geometry data" to the console before it raised.)
+    if source.type not in ("MESH", "CURVE", "SURFACE", "META", "FONT"):
+        return
     try:
         mesh = source.to_mesh()
     except RuntimeError:
@@ -355,11 +359,23 @@ def object_name(base, suffix):
     return base + suffix
 
 
+def _new_objects_collection(context):
+    """Where new objects go, as Blender's own Add menu puts them: the active collection, unless
+    it is excluded from the view layer or not editable here (linked from a library); else the
+    scene's own collection. (They all went into the scene's collection.)"""
+    layer = context.view_layer.active_layer_collection if context.view_layer else None
+    collection = layer.collection if layer is not None else None
+    if collection is None or layer.exclude or collection.library is not None or \
+            collection.override_library is not None:
+        return context.scene.collection
+    return collection
+
+
 def _empty(context, name, display="PLAIN_AXES", size=0.2, parent=None):
     obj = bpy.data.objects.new(name, None)
     obj.empty_display_type = display
     obj.empty_display_size = size
-    context.scene.collection.objects.link(obj)
+    _new_objects_collection(context).objects.link(obj)
     if parent is not None:
         obj.parent = parent
     return obj
@@ -665,33 +681,43 @@ def curve_points(context, obj):
         evaluated = line.evaluated_get(context.evaluated_depsgraph_get())
         mesh = evaluated.to_mesh()
         try:
-            pts = [obj.matrix_world @ mesh.vertices[i].co for i in _edge_chain(mesh)] \
-                if mesh else []
+            chain, pieces = _edge_chain(mesh) if mesh else ([], 0)
+            pts = [obj.matrix_world @ mesh.vertices[i].co for i in chain]
         finally:
             evaluated.to_mesh_clear()
     finally:
         bpy.data.objects.remove(line)
         bpy.data.curves.remove(data)
+    if pieces > 1:
+        # (A Mirror or an Array drew two lines, and the walk went out along one and back
+        # across the gap along the other.)
+        raise ValueError("path curve %s is drawn as %d separate lines by its modifiers (%s), and "
+                         "one line is expected (the walk would jump from one to the next): "
+                         "remove or change the modifier, or apply it and separate the line to "
+                         "follow" % (obj.name, pieces,
+                                     ", ".join(m.name for m in obj.modifiers) or "none"))
     if len(pts) < 2:
         raise ValueError("path %s has fewer than 2 points" % obj.name)
     return pts
 
 
 def _edge_chain(mesh):
-    """The vertex indices of a curve's mesh along its edges (one spline's): a cyclic
-    spline's closing edge brings its first vertex back at its end (the vertices alone lost it,
-    and a closed path ended a segment short of its start). Vertices on no edge (a one-point
-    spline) come in their place."""
-    chain, on_edge = [], set()
+    """The vertex indices of a curve's mesh along its edges (one spline's), and how many
+    separate lines they make (a modifier may copy the line): a cyclic spline's closing edge
+    brings its first vertex back at its end (the vertices alone lost it, and a closed path ended
+    a segment short of its start). Vertices on no edge (a one-point spline) come in their
+    place."""
+    chain, on_edge, pieces = [], set(), 0
     for e in mesh.edges:
         a, b = e.vertices
         if not chain or chain[-1] != a:
             chain.append(a)
+            pieces += 1
         chain.append(b)
         on_edge.update((a, b))
     if not on_edge:
-        return list(range(len(mesh.vertices)))
-    return chain
+        return list(range(len(mesh.vertices))), 1
+    return chain, pieces
 
 
 def in_scene(scene, obj):
@@ -785,6 +811,10 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
         keyed = 0
         walk_text = None
         notes = []  # the last walk's
+        # Where the previous walk ended (None: unknown, an older rig's), for the failure report.
+        before = rig_obj.footfall_rig
+        previous_end = before.walk_end if before.walk_end_known else None
+        last_frame = None
         try:
             # Parents the keys cannot be computed in, before anything is keyed.
             keying.check_parents(list(feet.values()) + [body])
@@ -850,7 +880,15 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
             if walk_text is None:  # nothing generated: the rig's keys are as they were
                 return _fail(self, "%s; the rig's keys are unchanged" % _error_text(e))
             report_notes(self, notes, _error_text(e))  # before: the status bar shows the error
-            self.report({"ERROR"}, "%s; %d keys made before it were kept" % (_error_text(e), keyed))
+            # Said too: the previous walk's keys after the new ones were removed (they were
+            # said to be "kept"), which Undo brings back.
+            gone = ""
+            if last_frame is not None and (previous_end is None or previous_end > last_frame):
+                gone = ("; the previous walk's keys after frame %g are removed (Edit > Undo "
+                        "brings them back)" % last_frame)
+            self.report({"ERROR"}, "%s; the %d keys made up to frame %s were kept%s"
+                        % (_error_text(e), keyed,
+                           "%g" % last_frame if last_frame is not None else "?", gone))
             return {"FINISHED"} if keyed else {"CANCELLED"}
         finally:
             if walk_text is not None:
