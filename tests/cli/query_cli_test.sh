@@ -78,6 +78,12 @@ check "CR-only line ends: CRLF read" grep -q '"op":"snap","found":true,"index":1
 printf '# queries\rsnap 1 0 1\r' | "$footfall" query --terrain "$work/flat.pts" > "$work/cr.jsonl"
 check "CR-only line ends after a comment: exit 1" [ $? -eq 1 ]
 check "CR-only line ends after a comment: said" grep -q '"line":1,"message":"carriage return within the line' "$work/cr.jsonl"
+# A query beyond the query range says how that range is measured: per axis from the terrain's
+# centre (it said "farther than 1e15 from the terrain" of a point 7e14 from a sample).
+printf '0 0 0 0 1 0\n1 0 0 0 1 0\n2 0 0 0 1 0\n3 0 0 0 1 0\n5e14 0 0 0 1 0\n' > "$work/far.pts"
+printf 'snap 1.2e15 0 0\nnext 0 0 0 1.2e15 0 0\n' | "$footfall" query --terrain "$work/far.pts" > "$work/far.jsonl"
+check "beyond the query range: said from the centre" grep -qF '{"op":"error","line":1,"message":"snap: invalid query (a coordinate more than 1e15 from the terrain'"'"'s centre)"}' <(sed -n 1p "$work/far.jsonl")
+check "an ideal point beyond it: said" grep -qF 'invalid query (a zero direction, one too long to square, or a foot or ideal point' <(sed -n 2p "$work/far.jsonl")
 # A byte that is not UTF-8 in a line: that line's error (the byte replaced), and the run goes on
 # (the JSON writer threw, and no later line was answered).
 printf 'snap \xff 0 0\nsnap 2 0 2\n' | "$footfall" query --terrain "$work/flat.pts" > "$work/utf8.jsonl"

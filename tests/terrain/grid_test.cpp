@@ -263,6 +263,22 @@ TEST_CASE("TerrainGrid answers exactly as brute force", "[terrain][grid]") {
     CHECK(rounding >= 1e-300);
     CHECK(rounding <= 3e-300);
   }
+  SECTION("with an outlier a trillion units away, queries stay local") {
+    // The cells' pad was sized by every sample's bounds: one outlier 1e12 away padded each
+    // cell by a thousand units, and every query scanned every cell (slower than brute force).
+    RawSamples s = MakeHeightField(60, 60, 0.5, 2, 11);
+    s.push_back({1e12, 1e12, 1e12}, {0, 1, 0});
+    const TerrainGrid g = Build(s);
+    CheckAgainstBruteForce(g, 2000, 14);
+    QueryTrace trace;
+    const Foothold near = g.Snap({15, 1, 15}, &trace);
+    REQUIRE(near.status == Status::kOk);
+    INFO("cells scanned " << trace.cells.size() << " of " << g.stats().occupied_cells);
+    CHECK(trace.cells.size() <= 27);
+    QueryTrace next_trace;
+    g.Next({{15, 1, 15}, {1, 0, 0}}, 0, &next_trace);
+    CHECK(next_trace.cells.size() <= 64);
+  }
   SECTION("with a few far outliers where a fixed-stride subsample would pick them all") {
     // A 1e-4 lattice near 1e5 with strays at the origin: kept in the grid's box, they moved
     // its centre 5e4 away, whose float offsets (spacing 0.004) merged the lattice. Strays one

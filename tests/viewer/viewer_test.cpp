@@ -1158,8 +1158,9 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
           {"--terrain", kTerrain, "--query", "snap 0 0 1", "--query", step, "--screenshot", shot});
       CHECK(r.exit_code == 2);
       CHECK_THAT(r.err, Catch::Contains("--query \"" + std::string(step) +
-                                        "\": next: invalid query (a direction too small or too "
-                                        "large, or points farther than 1e15 from the terrain)"));
+                                        "\": next: invalid query (a zero direction, one too "
+                                        "long to square, or a foot or ideal point with a "
+                                        "coordinate more than 1e15 from the terrain's centre)"));
     }
     test::WriteFile(dir + "/far.json",
                     "{\"format\": \"footfall-walk\", \"version\": 1, \"fps\": 24, \"tracks\": "

@@ -21,9 +21,13 @@ bool ParseFiniteNumber(const std::string& token, double* value) {
 }
 
 std::string InvalidQueryReason(QueryOp op) {
-  return op == QueryOp::kNext ? "invalid query (a direction too small or too large, or points "
-                                "farther than 1e15 from the terrain)"
-                              : "invalid query (a point farther than 1e15 from the terrain)";
+  // (It said "farther than 1e15 from the terrain" of a point 7e14 from its nearest sample, and
+  // "a direction too small", which is never refused: the range is per axis, from the grid's
+  // centre.)
+  return op == QueryOp::kNext
+             ? "invalid query (a zero direction, one too long to square, or a foot or ideal point "
+               "with a coordinate more than 1e15 from the terrain's centre)"
+             : "invalid query (a coordinate more than 1e15 from the terrain's centre)";
 }
 
 const char* QueryOpName(QueryOp op) {

@@ -303,9 +303,14 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
   g.cells_ = cells;
   g.avx2_ = options.use_avx2 && CpuHasAvx2();
   // Cell boxes are padded so that rounding can never prune a sample: in cell assignment
-  // (relative to the grid's extent) and in distances (relative to the query's, added per query).
-  g.pad_ = 1e-9 * (h + (g.bounds_hi_[0] - g.bounds_lo_[0]) + (g.bounds_hi_[1] - g.bounds_lo_[1]) +
-                   (g.bounds_hi_[2] - g.bounds_lo_[2]));
+  // (relative to the coordinates the cells span) and in distances (relative to the query's,
+  // added per query). Samples beyond the cells' box are in the outer cells, whose boxes reach
+  // them exactly (CellLo, CellHi): the pad is not sized by them. (Sized by all the samples'
+  // bounds, one outlier 1e12 away padded every cell by a thousand units, and every query
+  // scanned every cell: slower than brute force.)
+  double span = h;
+  for (int a = 0; a < 3; ++a) span += std::fabs(g.grid_lo_[a]) + g.dims_[a] * h;
+  g.pad_ = 1e-9 * span;
 
   // 5. Counting sort of samples by cell, stable in source index (so ties scan in index order).
   std::vector<uint32_t> cell_of(n);

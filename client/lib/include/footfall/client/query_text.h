@@ -39,8 +39,8 @@ std::string WithoutComment(const std::string& line);
 bool ParseQueryText(const std::string& text, QueryText* out, std::string* error);
 
 // Why the engine answers a query of `op` kInvalidArgument, as `footfall query` and
-// `footfall-view --query` report it: "invalid query (a point farther than 1e15 from the
-// terrain)", or for next the direction's length too.
+// `footfall-view --query` report it: "invalid query (a coordinate more than 1e15 from the
+// terrain's centre)", or for next a zero direction or one too long to square too.
 std::string InvalidQueryReason(QueryOp op);
 
 // "next 1 0 2 0.5 0 0": the query in the syntax ParseQueryText reads, each number in the
