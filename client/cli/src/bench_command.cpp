@@ -378,7 +378,7 @@ int RunBench(const BenchFlags& flags) {
   if (refused_snaps + refused_nexts > 0) {
     std::cerr << who << "note: of the " << n << " queries, " << refused_snaps << " snap and "
               << refused_nexts << " next queries are refused as invalid (points or ideal points "
-              << "beyond the query range, 1e15 from the terrain: steps of " << step
+              << "with a coordinate more than 1e15 from the terrain's centre: steps of " << step
               << "); their figures time the refusal (give a smaller --step)\n";
   }
   return 0;

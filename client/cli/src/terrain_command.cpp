@@ -181,9 +181,6 @@ constexpr double kMaxMadeSamples = 20000000;
 constexpr double kBytesPerSample = 96;
 constexpr double kMeshBytesPerSample = 500;
 
-// About how many samples `make` would write, in double so that no flag can overflow it (areas
-// in units of spacing^2, measured per side: a 1e300 sphere at --spacing 1e300 was inf * 0,
-// "about -nan samples").
 // Lattice points along a side `size` long at `spacing`: both ends. A ratio a rounding below a
 // whole number counts as it (7 / 0.07 is 99.99999999999999: the last row and column went).
 int SamplesAlong(double size, double spacing) {
@@ -194,6 +191,9 @@ int SamplesAlong(double size, double spacing) {
          1;
 }
 
+// About how many samples `make` would write, in double so that no flag can overflow it (areas
+// in units of spacing^2, measured per side: a 1e300 sphere at --spacing 1e300 was inf * 0,
+// "about -nan samples").
 double EstimateSamples(const MakeFlags& f) {
   const std::string& k = f.kind;
   if (k == "stairs") {
