@@ -152,6 +152,37 @@ TEST_CASE("ReadMesh: bad meshes give clear errors", "[import][mesh]") {
     CHECK(Read(dir.Write("empty.obj", ""), &mesh, &error) == Status::kParseError);
     CHECK(Contains(error, "empty.obj: the file is empty"));
   }
+  SECTION("no face left, each said why") {
+    // A square with a square hole, bridged through its own corners: said to be "degenerate
+    // (zero area)", with an area of 12.
+    const std::string keyhole =
+        "v 0 0 0\nv 4 0 0\nv 4 0 4\nv 0 0 4\nv 1 0 1\nv 1 0 3\nv 3 0 3\nv 3 0 1\n"
+        "f 1 2 3 4 1 5 6 7 8 5\n";
+    CHECK(Read(dir.Write("keyhole.obj", keyhole), &mesh, &error) == Status::kParseError);
+    CHECK(Contains(error,
+                   "keyhole.obj: no face is left: 1 with a vertex used twice (a polygon "
+                   "with a hole bridged through its own corners"));
+    CHECK(Read(dir.Write("line.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"), &mesh, &error) ==
+          Status::kParseError);
+    CHECK(Contains(error, "line.obj: no face is left: 1 of no area (degenerate)"));
+  }
+  SECTION("lines ended by CR alone, in every text format") {
+    // OBJ and OFF said so; PLY said "expected the header line 'ply'" and ASCII STL "no closing
+    // 'endsolid'".
+    const std::string ply =
+        "ply\rformat ascii 1.0\relement vertex 3\rproperty float x\rproperty float y\r"
+        "property float z\relement face 1\rproperty list uchar int vertex_indices\r"
+        "end_header\r0 0 0\r1 0 0\r0 0 1\r3 0 1 2\r";
+    const std::string stl =
+        "solid t\rfacet normal 0 1 0\router loop\rvertex 0 0 0\rvertex 1 0 0\r"
+        "vertex 0 0 1\rendloop\rendfacet\rendsolid t\r";
+    for (const auto& [name, text] :
+         {std::make_pair("cr.ply", ply), std::make_pair("cr.stl", stl)}) {
+      INFO(name);
+      CHECK(Read(dir.Write(name, text), &mesh, &error) == Status::kParseError);
+      CHECK(Contains(error, "lines end in CR alone (classic Mac OS)"));
+    }
+  }
   SECTION("UTF-16 text") {
     // A UTF-16 OBJ read as "no vertices: the mesh is empty".
     const std::string obj(

@@ -30,7 +30,11 @@ std::vector<CLI::Option*> AddLoadFlags(CLI::App* command, TerrainLoadOptions* lo
           ->add_option("--seed", load->seed,
                        "Seed of the mesh sampler, a whole number from 0 to 2^64 - 1 (default 1)")
           ->transform(Seed()),
-      command->add_option("--up-axis", load->up_axis, "Height maps: up axis x, y or z")
+      command
+          ->add_option("--up-axis", load->up_axis,
+                       "Up axis x, y or z: height maps go up along it, and open meshes are turned "
+                       "to face up "
+                       "along it")
           ->check(CLI::IsMember({'x', 'y', 'z'})),
       command
           ->add_option("--cell-size", load->cell_size,

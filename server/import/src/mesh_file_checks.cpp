@@ -497,6 +497,10 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
                   "starts with a UTF-8 byte order mark before 'ply', which PLY readers do not "
                   "take: save it without the mark",
                   error);
+    // Lines ended by CR alone (classic Mac OS): the first line reads "ply\rformat ...".
+    if (line.compare(0, 4, "ply\r") == 0 && line.size() > 4)
+      return Fail(path, "lines end in CR alone (classic Mac OS): convert them to LF or CR LF",
+                  error);
     return Fail(At(path, 1), "expected the header line 'ply'", error);
   }
   number = 1;
@@ -993,7 +997,11 @@ Status ParseStlFile(const std::string& path, ParsedMesh* out, std::string* error
                     " bytes",
                 error);
   }
-  // ASCII STL: finite vertices, three to a facet's loop, and a closing 'endsolid'.
+  // ASCII STL: finite vertices, three to a facet's loop, and a closing 'endsolid'. Lines ended
+  // by CR alone are said as such (read as one line, they ended in "no closing 'endsolid'").
+  const Status start = CheckTextStart(path, error);
+  if (start != Status::kOk) return start;
+  in.clear();
   in.seekg(0);
   std::string line;
   bool closed = false;

@@ -126,6 +126,7 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
   // the other way); corners at the same position count as the same.
   const std::vector<uint32_t> id = CoincidentVertexIds(parsed.vertices);
   std::vector<char> used(faces, 1);
+  size_t repeated = 0, listed_again = 0;  // faces left out, for the message when none is left
   std::vector<uint32_t> sorted;
   std::vector<std::pair<uint64_t, uint32_t>> keyed;  // (hash of the sorted corners, face)
   auto sorted_corners = [&](size_t f, std::vector<uint32_t>* out_corners) {
@@ -140,6 +141,7 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
     std::sort(sorted.begin(), sorted.end());
     if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
       used[f] = 0;
+      ++repeated;
       continue;
     }
     sorted_corners(f, &sorted);
@@ -159,6 +161,7 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
         sorted_corners(keyed[b].second, &other);
         if (other == sorted) {
           used[keyed[a].second] = 0;
+          ++listed_again;
           break;
         }
       }
@@ -303,7 +306,23 @@ Status ReadMesh(const std::string& path, TriangleMesh* out, std::string* error,
     report->turned_faces = turned;
   }
   if (out->triangles.empty()) {
-    if (error) *error = path + ": every face is degenerate (zero area)";
+    // Why each face went (a polygon with a hole joined by a bridge that reuses its corners was
+    // said to be "degenerate (zero area)").
+    if (error) {
+      std::string why = path + ": no face is left:";
+      const size_t no_area = faces - repeated - listed_again;
+      const char* sep = "";
+      if (repeated) {
+        why += " " + std::to_string(repeated) +
+               " with a vertex used twice (a polygon with a hole bridged through its own "
+               "corners: give the bridge's corners vertices of their own, or triangulate it)";
+        sep = ",";
+      }
+      if (listed_again)
+        why += sep + (" " + std::to_string(listed_again)) + " listed again", sep = ",";
+      if (no_area) why += sep + (" " + std::to_string(no_area)) + " of no area (degenerate)";
+      *error = why;
+    }
     return Status::kParseError;
   }
   return Status::kOk;
