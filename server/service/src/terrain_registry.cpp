@@ -298,8 +298,7 @@ Status TerrainRegistry::AddGrid(const std::string& name, TerrainGrid grid, uint6
   if (status != Status::kOk) return status;
   // Refused before any orphan is freed for it (the budget counts orphans as room).
   const size_t samples = grid.stats().samples;
-  const uint64_t kept = TotalSamples() - OrphanSamples();
-  if (samples > limits_.max_total_samples || kept > limits_.max_total_samples - samples) {
+  if (!FitsWithoutOrphans(samples)) {
     *message = "'" + name + "': " + std::to_string(samples) + " samples do not fit in " + Budget();
     return Status::kLimitExceeded;
   }
@@ -650,9 +649,14 @@ uint64_t TerrainRegistry::OrphanSamples() const {
   return total;
 }
 
-bool TerrainRegistry::MakeRoomForSamples(uint64_t samples) {
+bool TerrainRegistry::FitsWithoutOrphans(uint64_t samples) const {
   const uint64_t most = limits_.max_total_samples, kept = TotalSamples() - OrphanSamples();
-  if (samples > most || kept > most - samples) return false;
+  return samples <= most && kept <= most - samples;
+}
+
+bool TerrainRegistry::MakeRoomForSamples(uint64_t samples) {
+  const uint64_t most = limits_.max_total_samples;
+  if (!FitsWithoutOrphans(samples)) return false;
   while (TotalSamples() > most - samples && EvictOldestOrphan()) {
   }
   return TotalSamples() <= most - samples;

@@ -169,6 +169,8 @@ class TerrainRegistry {
   // first. Frees none when they would not fit with every orphan gone: a request refused
   // anyway cost other clients their orphans.
   bool MakeRoomForSamples(uint64_t samples);
+  // Whether `samples` more would fit in the budget once every orphan were freed.
+  bool FitsWithoutOrphans(uint64_t samples) const;
   uint64_t OrphanSamples() const;  // samples of orphaned terrains
   Status Add(const std::string& name, RawSamples samples, uint64_t owner, uint32_t* handle,
              std::string* message);
