@@ -750,6 +750,16 @@ TEST_CASE("ReadMesh: binary PLY list counts and vertex indices are whole numbers
   CHECK(Read(dir.Write("index.ply", ply("float", "float", 3, 1.5f)), &mesh, &error) ==
         Status::kParseError);
   CHECK(Contains(error, "index.ply: face 1: vertex index 1.5 is not an index below 3"));
+  // A face of no vertices, alone in its file, was refused as truncated data (the size check
+  // counted three indices a face).
+  std::string empty =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float "
+      "y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const float v[9] = {0, 0, 0, 1, 0, 0, 1, 0, 1};
+  empty.append(reinterpret_cast<const char*>(v), sizeof v);
+  empty.push_back('\0');
+  CHECK(Read(dir.Write("empty.ply", empty), &mesh, &error) == Status::kParseError);
+  CHECK(Contains(error, "empty.ply: face 1 has 0 vertices, expected 3 or more"));
 }
 
 TEST_CASE("ReadMesh: OBJ face corners are v or v/vt or v//vn or v/vt/vn", "[import][mesh]") {

@@ -508,7 +508,8 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
     std::string name;
     long long count = 0;
     long long fixed_bytes = 0;             // fixed-size properties
-    long long list_min_bytes = 0;          // list properties, counting 3 items per face list
+    long long list_min_bytes = 0;          // list properties: their counts alone (a face with
+                                           // fewer than 3 items is told so as it is read)
     std::vector<std::string> properties;   // names, in order
     std::vector<bool> lists;               // whether each is a list
     std::vector<std::string> types;        // each one's type (lists: their items')
@@ -603,7 +604,7 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
                   "' is a list, which footfall's PLY reader does not read on vertices: remove it",
               error);
         }
-        e.list_min_bytes += count_size + (e.name == "face" ? 3 * item_size : 0);
+        e.list_min_bytes += count_size;
         e.properties.push_back(t[4]), e.lists.push_back(true);
         e.types.push_back(t[3]), e.count_types.push_back(t[2]);
       } else {
