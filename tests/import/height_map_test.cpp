@@ -235,6 +235,11 @@ TEST_CASE("ReadAscGrid: a NODATA_value of NaN leaves out the NaN cells", "[impor
   CHECK(Contains(error,
                  "commas.asc:4: value '1,2,3,4' is not a finite number (values are "
                  "separated by spaces or tabs, not commas)"));
+  CHECK(ReadAscGrid(dir.Write("decimal.asc", "ncols 2\nnrows 1\ncellsize 0,5\n1 2\n"), &map,
+                    &error) == Status::kParseError);
+  CHECK(Contains(error,
+                 "decimal.asc:3: header 'cellsize': '0,5' is not a finite number (a "
+                 "decimal comma: write a decimal point, as in 1.5)"));
   CHECK(ReadAscGrid(dir.Write("eof.asc", "ncols 2\nnrows 1\ncellsize 1\n1 2\n\x1a"), &map,
                     &error) == Status::kParseError);
   CHECK(Contains(error,

@@ -272,6 +272,11 @@ TEST_CASE("ReadMesh: bad meshes give clear errors", "[import][mesh]") {
     CHECK(Read(dir.Write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"), &mesh, &error) ==
           Status::kParseError);
     CHECK(Contains(error, "nan.obj:2: vertex coordinate 'nan' is not a finite number"));
+    CHECK(Read(dir.Write("comma.obj", "v 0 0 0\nv 1,5 0 0\nv 0 1 0\nf 1 2 3\n"), &mesh, &error) ==
+          Status::kParseError);
+    CHECK(Contains(error,
+                   "comma.obj:2: vertex coordinate '1,5' is not a finite number (a "
+                   "decimal comma: write a decimal point, as in 1.5)"));
     CHECK(Read(dir.Write("nan.off", "OFF\n3 1 0\n0 0 0\n1 inf 0\n0 1 0\n3 0 1 2\n"), &mesh,
                &error) == Status::kParseError);
     CHECK(Contains(error, "nan.off:4:"));

@@ -95,6 +95,15 @@ TEST_CASE("ReadPointStream rejects bad lines with file and line", "[terrain][poi
     CHECK(error == "t.pts:3: column 3: 'abc' is not a number (expected x y z nx ny nz)");
     CHECK(Read("0 0 1.5x 0 1 0\n", &s, &error) == Status::kParseError);
     CHECK(error.find("t.pts:1: column 3") == 0);
+    // A decimal comma (a European locale's export) or values separated by commas are named.
+    CHECK(Read("0 -0,25 1 0 1 0\n", &s, &error) == Status::kParseError);
+    CHECK(error ==
+          "t.pts:1: column 2: '-0,25' is not a number (a decimal comma: write a decimal point, "
+          "as in 1.5) (expected x y z nx ny nz)");
+    CHECK(Read("0,1,2,0,1,0\n", &s, &error) == Status::kParseError);
+    CHECK(error ==
+          "t.pts:1: column 1: '0,1,2,0,1,0' is not a number (values are separated by "
+          "spaces or tabs, not commas) (expected x y z nx ny nz)");
     // Control characters from the file reach no terminal: ESC and the C1 CSI (U+009B) as '?';
     // other UTF-8 stays.
     CHECK(Read("0 0 \x1b[31mA\xc2\x9b"

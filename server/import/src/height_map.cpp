@@ -111,12 +111,10 @@ std::string HexBytes(const std::string& token) {
 }
 
 // "value 'T' is not a finite number", with what it looks like: Microsoft C's NaN or infinity,
-// or values separated by commas.
+// a decimal comma, or values separated by commas.
 std::string NotAValue(const std::string& token) {
   return "value '" + ShownText(token) + "' is not a finite number" + NotFiniteNote(token) +
-         (token.find(',') != std::string::npos
-              ? " (values are separated by spaces or tabs, not commas)"
-              : "");
+         CommaNote(token);
 }
 
 // Whether an ASCII grid's token is meant as a value, not a header key: it starts like a number
@@ -408,7 +406,7 @@ Status ParseAscHeader(const std::string& path, TokenReader* reader, bool cell_si
       return Fail(
           path + ":" + std::to_string(line),
           "header '" + ShownText(key) + "': '" + ShownText(value) + "' is not a finite number" +
-              NotFiniteNote(value) +
+              NotFiniteNote(value) + CommaNote(value) +
               (Lower(key) == "nodata_value" ? " (NODATA_value may be a number or NaN)" : ""),
           error);
     }

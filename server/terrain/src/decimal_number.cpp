@@ -123,6 +123,17 @@ std::string NotFiniteNote(std::string_view token) {
   return IsMicrosoftNonFinite(token) ? " (Microsoft C's NaN or infinity)" : "";
 }
 
+std::string CommaNote(std::string_view token) {
+  const size_t comma = token.find(',');
+  if (comma == std::string_view::npos) return "";
+  std::string point(token);
+  point[comma] = '.';
+  double value = 0;
+  return point.find(',') == std::string::npos && ParseFiniteDecimal(point, &value)
+             ? " (a decimal comma: write a decimal point, as in 1.5)"
+             : " (values are separated by spaces or tabs, not commas)";
+}
+
 size_t CommentStart(std::string_view line) {
   for (size_t at = line.find('#'); at != std::string_view::npos; at = line.find('#', at + 1)) {
     const size_t begin = line.find_last_of(" \t\r\n\f\v", at);

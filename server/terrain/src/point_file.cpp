@@ -116,7 +116,7 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
         if (read == DecimalRead::kNotANumber) {
           return Fail(name, line_no,
                       "column " + std::to_string(count + 1) + ": '" + ShownText(token) +
-                          "' is not a number (expected x y z nx ny nz)",
+                          "' is not a number" + CommaNote(token) + " (expected x y z nx ny nz)",
                       out, error);
         }
         if (!std::isfinite(value)) {

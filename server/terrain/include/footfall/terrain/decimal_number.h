@@ -40,6 +40,10 @@ bool IsMicrosoftNonFinite(std::string_view token);
 bool IsMicrosoftNaN(std::string_view token);
 // " (Microsoft C's NaN or infinity)" for such a token, else "": for "is not a finite number".
 std::string NotFiniteNote(std::string_view token);
+// For a token holding a comma: " (a decimal comma: write a decimal point, as in 1.5)" when it
+// reads as a number written with one ("1,5", "-0,25e3"), else " (values are separated by
+// spaces or tabs, not commas)"; "" for a token without a comma. For "is not a number".
+std::string CommaNote(std::string_view token);
 // Where the '#' comment of `line` starts (npos for none): at its first '#' but those inside a
 // token IsMicrosoftNonFinite accepts.
 size_t CommentStart(std::string_view line);
