@@ -136,6 +136,19 @@ file(WRITE "${WORK}/down.obj" "v 0 0 0\nv 10 0 0\nv 10 0 10\nv 0 0 10\nf 1 2 3 4
 expect(EXIT_ZERO "down.obj: the 2 triangles of its open parts faced down: 2 triangles turned over"
        generate --terrain "${WORK}/down.obj" --separation 0.5 --character
        "${SOURCE_DIR}/data/characters/biped.json" --steps 2 --out "${WORK}/down.json")
+# Faces left out are said by convert and generate (convert said nothing of them, nor of faces
+# turned over), and by generate both at a --separation and resampling for the character.
+file(WRITE "${WORK}/left_out.obj"
+     "v 0 0 0\nv 10 0 0\nv 10 0 10\nv 0 0 10\nv 20 0 0\nf 1 4 3 2\nf 1 1 2\nf 1 2 5\n")
+expect(EXIT_ZERO "left_out.obj: 2 of 3 faces left out (a vertex used twice, a face listed again, or no area)"
+       terrain convert "${WORK}/left_out.obj" --separation 0.5 -o "${WORK}/left_out.pts")
+expect(EXIT_ZERO "down.obj: the 2 triangles of its open parts faced down: 2 triangles turned over"
+       terrain convert "${WORK}/down.obj" --separation 0.5 -o "${WORK}/down.pts")
+foreach(separation "--separation;0.5" "--seed;1")
+  expect(EXIT_ZERO "left_out.obj: 2 of 3 faces left out"
+         generate --terrain "${WORK}/left_out.obj" ${separation} --character
+         "${SOURCE_DIR}/data/characters/biped.json" --steps 2 --out "${WORK}/left_out.json")
+endforeach()
 # One face wound against the others is counted in the singular.
 string(REPLACE "f 1 4 3 2\n" "f 2 3 4 1\n" one_turned "${cube}")
 file(WRITE "${WORK}/one_turned.obj" "${one_turned}")

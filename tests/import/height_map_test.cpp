@@ -573,4 +573,22 @@ TEST_CASE("ReadAscGrid: lines ended by CR alone are counted as lines", "[import]
   CHECK(map.heights == std::vector<double>{1, 2, 3, 4});
 }
 
+TEST_CASE("DescribeSkippedFaces: a phrase for faces left out, by format", "[import][heightmap]") {
+  TerrainLoadReport report;
+  report.format = "mesh";
+  report.faces = 3;
+  CHECK(DescribeSkippedFaces(report).empty());
+  report.skipped_faces = 2;
+  CHECK(DescribeSkippedFaces(report) ==
+        "2 of 3 faces left out (a vertex used twice, a face listed again, or no area)");
+  report.format = "heightmap";
+  report.skipped_faces = 1;
+  CHECK(DescribeSkippedFaces(report) ==
+        "1 triangle of the grid left out, too thin for its length (check --height-scale and "
+        "--cell-size)");
+  report.skipped_faces = 4;
+  CHECK(DescribeSkippedFaces(report).rfind("4 triangles of the grid left out, too thin for their",
+                                           0) == 0);
+}
+
 }  // namespace footfall

@@ -187,8 +187,8 @@ std::string Box(const Vec3& lo, const Vec3& hi) {
 // Says on stderr how the terrain was resampled for the character, when not at its own spacing.
 void ReportResampling(const std::string& path, const Character& character, const WalkTerrain& t) {
   const TerrainLoadReport& r = t.report;
-  const std::string turned = DescribeTurnover(r);
-  if (!turned.empty()) std::cerr << "footfall generate: " << path << ": " << turned << '\n';
+  for (const std::string& note : {DescribeSkippedFaces(r), DescribeTurnover(r)})
+    if (!note.empty()) std::cerr << "footfall generate: " << path << ": " << note << '\n';
   if (!t.cropped && r.separation == r.file_separation) return;
   std::ostringstream o;
   o.precision(4);
@@ -365,12 +365,13 @@ bool LoadWalkTerrain(const GenerateFlags& flags, const Character& character,
     terrain_flags.load.max_samples = std::min(terrain_flags.load.max_samples, kMaxWalkSamples);
   }
   if (OpenTerrain(terrain_flags, &t->session, &t->handle, error) != Status::kOk) return false;
-  // A mesh read here at --separation: faces turned over are said, as when it is resampled for
-  // the character.
+  // A mesh read here at --separation: faces left out or turned over are said, as when it is
+  // resampled for the character.
   if (!terrain_flags.terrain.empty()) {
-    const std::string turned = DescribeTurnover(t->session->last_file_report());
-    if (!turned.empty())
-      std::cerr << "footfall generate: " << terrain_flags.terrain << ": " << turned << '\n';
+    const TerrainLoadReport& r = t->session->last_file_report();
+    for (const std::string& note : {DescribeSkippedFaces(r), DescribeTurnover(r)})
+      if (!note.empty())
+        std::cerr << "footfall generate: " << terrain_flags.terrain << ": " << note << '\n';
   }
   // footfalld resampled a mesh or height map itself: say how, as a local file's resampling is
   // reported.

@@ -112,6 +112,10 @@ int RunConvert(const ConvertFlags& flags) {
   std::cout << "wrote " << SampleCount(samples.size()) << " to " << flags.output;
   if (report.separation > 0) std::cout << " (separation " << report.separation << ")";
   std::cout << '\n';
+  // What the resampling changed of the surface, as generate says it.
+  for (const std::string& note : {DescribeSkippedFaces(report), DescribeTurnover(report)})
+    if (!note.empty())
+      std::cerr << "footfall terrain convert: " << flags.input << ": " << note << '\n';
   // Coarser than the character's steps want, to stay within a walk's samples: said, as
   // generate says it.
   const std::string coarser = flags.character.empty() || report.format == "points"

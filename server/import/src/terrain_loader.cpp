@@ -255,6 +255,18 @@ std::string DescribeTurnover(const TerrainLoadReport& report) {
   return text;
 }
 
+std::string DescribeSkippedFaces(const TerrainLoadReport& report) {
+  const size_t n = report.skipped_faces;
+  if (n == 0) return "";
+  if (report.format == "heightmap") {
+    return std::to_string(n) + (n == 1 ? " triangle" : " triangles") +
+           " of the grid left out, too thin for " + (n == 1 ? "its" : "their") +
+           " length (check --height-scale and --cell-size)";
+  }
+  return std::to_string(n) + " of " + std::to_string(report.faces) +
+         " faces left out (a vertex used twice, a face listed again, or no area)";
+}
+
 Status LoadTerrain(const std::string& path, const TerrainLoadOptions& options, RawSamples* out,
                    std::string* error, TerrainLoadReport* report) {
   out->clear();

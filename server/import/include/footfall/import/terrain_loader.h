@@ -77,6 +77,10 @@ constexpr uint64_t kSamplingBytesPerSample = 1000;
 // turned over"; faces wound against their neighbours are counted in the file's faces, the rest
 // in the triangles they were cut into), or "" when nothing was.
 std::string DescribeTurnover(const TerrainLoadReport& report);
+// What a load left out of the surface, in a phrase ("2 of 3 faces left out (a vertex used
+// twice, a face listed again, or no area)"; for height maps the grid's triangles too thin for
+// their length), or "" when nothing was.
+std::string DescribeSkippedFaces(const TerrainLoadReport& report);
 
 // kInvalidArgument, with "PATH: a cell size or height scale ... applies to height maps (.asc
 // .pgm) only, not to a point file" (or a mesh), when `options` give a height map's frame for a
