@@ -307,6 +307,11 @@ if(NOT kept MATCHES "\"step_length\"" OR NOT kept_pts MATCHES "\"step_length\"")
 endif()
 file(WRITE "${WORK}/one.pts" "0 0 0 0 1 0\n")
 expect(EXIT_ZERO "wrote 1 sample to" terrain convert "${WORK}/one.pts" -o "${WORK}/one-out.pts")
+# Samples at one point have no spacing (it read "about 1"); two apart have one.
+expect(EXIT_ZERO "sample spacing: none (a single sample)" terrain info "${WORK}/one.pts")
+file(WRITE "${WORK}/same.pts" "1 2 3 0 1 0\n1 2 3 0 0 1\n")
+expect(EXIT_ZERO "sample spacing: none (every sample at one point)" terrain info "${WORK}/same.pts")
+expect(EXIT_ZERO "sample spacing: about " terrain info "${WORK}/two.pts")
 expect(EXIT_NONZERO "two.pts: --character applies to meshes and height maps, which are resampled for it; a point file is used as it is (leave --character out)"
        terrain convert "${WORK}/two.pts" --character "${SOURCE_DIR}/data/characters/biped.json" -o "${WORK}/two-c.pts")
 foreach(command "terrain;info" "query;--terrain")

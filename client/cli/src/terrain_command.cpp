@@ -162,9 +162,15 @@ int RunInfo(const InfoFlags& flags) {
             << " (of the samples)\n"
             << "grid: " << g.cells[0] << " x " << g.cells[1] << " x " << g.cells[2] << " cells of "
             << g.cell_size << ", " << g.occupied_cells << " occupied, " << g.bytes << " bytes\n"
-            << "sample spacing: about " << g.spacing
-            << " (between neighbouring samples, taking them as a surface)\n"
-            << "stored within: " << g.max_rounding
+            << "sample spacing: ";
+  // Samples all at one point have no neighbours to be apart from (it read "about 1").
+  if (report.bounds_min == report.bounds_max)
+    std::cout << "none (" << (report.samples == 1 ? "a single sample" : "every sample at one point")
+              << ")\n";
+  else
+    std::cout << "about " << g.spacing
+              << " (between neighbouring samples, taking them as a surface)\n";
+  std::cout << "stored within: " << g.max_rounding
             << " of the given coordinates (float offsets from the centre of the bulk)\n";
   // (A full disk lost the description with exit 0.)
   if (!std::cout.flush()) {
