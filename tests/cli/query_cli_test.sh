@@ -25,6 +25,16 @@ check "unknown terrain command: named" grep -qF "footfall terrain: unknown comma
 "$footfall" -v > /dev/null 2> "$work/err.txt"
 check "an option before any command: exit 1" [ $? -eq 1 ]
 check "an option before any command: named" grep -qF "footfall: unknown option '-v' where a command is expected: query, terrain, generate, bench" "$work/err.txt"
+# An option missing its value is told so: CLI11 took the next option as the value ("--out
+# --steps" wrote a walk to a file named --steps, and the step count was lost).
+"$footfall" terrain make flat -o --size 2 > /dev/null 2> "$work/err.txt"
+check "-o followed by an option: exit 1" [ $? -eq 1 ]
+check "-o followed by an option: told" grep -qxF "footfall terrain make: -o needs a value, found the option --size (footfall terrain make --help)" "$work/err.txt"
+check "-o followed by an option: no file written" [ ! -e ./--size ]
+"$footfall" query --tolerance --terrain "$work/flat.pts" < /dev/null > /dev/null 2> "$work/err.txt"
+check "--tolerance followed by an option: told" grep -qF "footfall query: --tolerance needs a value, found the option --terrain" "$work/err.txt"
+echo "snap 0 0 0" | "$footfall" query --terrain "$work/flat.pts" --tolerance=1 > /dev/null 2> "$work/err.txt"
+check "--tolerance=1: taken" [ $? -eq 0 ]
 # --version prints the version and exits 0, as a script checking which footfall it runs expects.
 out=$("$footfall" --version 2> "$work/err.txt")
 check "--version: exit 0" [ $? -eq 0 ]

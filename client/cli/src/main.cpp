@@ -52,6 +52,38 @@ std::string CommandHint(const CLI::App& root, int argc, char** argv) {
   return path + ": a command is required: " + names(at) + " (" + path + " --help)";
 }
 
+// An option that takes a value followed by another option instead ("--terrain --character
+// c.json"): "footfall generate: --terrain needs a value, found the option --character"; else "".
+// CLI11 takes the next word as the value whatever it is, so "--out --steps" wrote a file named
+// "--steps" and the flag was lost. The command words must be valid (CommandHint is "").
+std::string MissingValueHint(const CLI::App& root, int argc, char** argv) {
+  const CLI::App* at = &root;
+  std::string path = "footfall";
+  int i = 1;
+  for (; i < argc && !at->get_subcommands({}).empty(); ++i) {
+    for (const CLI::App* command : at->get_subcommands({}))
+      if (command->check_name(argv[i])) at = command;
+    path += " " + at->get_name();
+  }
+  // An option's own name as written (not "--name=value", not a negative number).
+  auto option = [&](const std::string& word) -> const CLI::Option* {
+    if (word.size() < 2 || word[0] != '-' || word.find('=') != std::string::npos) return nullptr;
+    return at->get_option_no_throw(word);
+  };
+  for (; i + 1 < argc; ++i) {
+    const std::string word = argv[i];
+    if (word == "--") break;  // the rest are arguments, whatever they look like
+    const CLI::Option* taking = option(word);
+    if (!taking || taking->get_items_expected_min() == 0) continue;
+    const std::string next = argv[i + 1];
+    if (option(next) || next == "-h" || next == "--help")
+      return path + ": " + word + " needs a value, found the option " + next + " (" + path +
+             " --help)";
+    i += taking->get_items_expected_min();  // its values are not options to check
+  }
+  return "";
+}
+
 // The command line's work; its exit status.
 int Run(int argc, char** argv) {
   // No output file may take descriptor 1 or 2; non-blocking streams are waited for, not failed.
@@ -79,7 +111,8 @@ int Run(int argc, char** argv) {
   }
   // No command, or a word that names none: say which there are (CLI11 only says that one is
   // required).
-  const std::string hint = CommandHint(app, argc, argv);
+  std::string hint = CommandHint(app, argc, argv);
+  if (hint.empty()) hint = MissingValueHint(app, argc, argv);
   if (!hint.empty()) {
     std::cerr << hint << '\n';
     return 1;
