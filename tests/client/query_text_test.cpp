@@ -68,6 +68,10 @@ TEST_CASE("malformed query lines say what was expected", "[client][query_text]")
       {"snap 0,,0 0", kNoneBefore},
       {"snap 0, ,0 0", kNoneBefore},
       {",snap 0 0 0", kNoneBefore},
+      // A comma after the command word has no number before it either (it was taken).
+      {"snap ,1,2,3", kNoneBefore},
+      {"snap,1,2,3", kNoneBefore},
+      {"next ,0,0,0,1,0,0", kNoneBefore},
       {"snap 0 0 0,",
        "a comma with no number after it (expected numbers separated by spaces or "
        "single commas)"},

@@ -46,14 +46,15 @@ std::string WithoutComment(const std::string& line) { return line.substr(0, Comm
 
 bool ParseQueryText(const std::string& text, QueryText* out, std::string* error) {
   // Words are separated by white space, numbers also by commas ("next 1,0,2 0, 0, 1"); a comma
-  // with no number on one side (",,", a comma first or last) is refused: ",," read as one comma
-  // dropped a number.
+  // with no number on one side (",,", a comma first, right after the command, or last) is
+  // refused: ",," read as one comma dropped a number.
   std::vector<std::string> tokens;
   bool comma_pending = false;
   for (size_t i = 0; i < text.size();) {
     const char c = text[i];
     if (c == ',') {
-      if (tokens.empty() || comma_pending) {
+      // The first word is the command: a comma after it has no number before it either.
+      if (tokens.size() <= 1 || comma_pending) {
         *error =
             "a comma with no number before it (expected numbers separated by spaces or "
             "single commas)";
