@@ -120,6 +120,12 @@ for command in "--version" "terrain info $hills" \
   check "footfall $command > /dev/full: said" grep -Eq "cannot write (standard output|to stdout)" "$work/err.txt"
 done
 
+for flag in --version --help; do
+  "$footfalld" $flag > /dev/full 2> "$work/err.txt"
+  check "footfalld $flag > /dev/full: exit 1" [ $? -eq 1 ]
+  check "footfalld $flag > /dev/full: said" grep -q "footfalld: cannot write standard output" "$work/err.txt"
+done
+
 # 7b. ... and so does a standard output closed at start (it went to /dev/null, exit 0).
 echo "snap 10 0 10" | "$footfall" query --terrain "$hills" >&- 2> "$work/err.txt"
 check "footfall query >&-: exit 1" [ $? -eq 1 ]

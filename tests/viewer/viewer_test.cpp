@@ -1283,6 +1283,15 @@ TEST_CASE("bad inputs give a clear message and a non-zero exit", "[viewer][error
     CHECK(r.exit_code == 1);
     CHECK_THAT(r.err, Catch::Contains("cannot open a display"));
   }
+  SECTION("--version and --help that cannot be written") {
+    // They exited 0 with nothing written.
+    for (const char* flag : {"--version", "--help"}) {
+      const RunResult r =
+          Run({"/bin/sh", "-c", std::string(kView) + " " + flag + " > /dev/full"}, {}, kTimeout);
+      CHECK(r.exit_code == 1);
+      CHECK_THAT(r.err, Catch::Contains("footfall-view: cannot write standard output"));
+    }
+  }
   std::ifstream none(shot);
   CHECK_FALSE(none.good());  // no failed run leaves a screenshot
 }

@@ -1,9 +1,11 @@
 // footfall-view: the debug viewer of terrains, queries, walks and live servers.
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <iostream>
 #include <new>
@@ -98,7 +100,16 @@ int View(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;  // a refused flag: 2, as for --size and --camera
+    errno = 0;  // what the write of the text sets, not an earlier call's
+    if (app.exit(e) != 0) return 2;  // a refused flag: 2, as for --size and --camera
+    // --help or --version: exit 0 only when its text was written (a full disk gave exit 0).
+    if (!std::cout.flush()) {
+      const int why = errno;
+      std::cerr << "footfall-view: cannot write standard output"
+                << (why ? std::string(": ") + std::strerror(why) : std::string()) << '\n';
+      return 1;
+    }
+    return 0;
   }
   // (Without --live it was ignored: the screenshot was taken at once.)
   if (live_wait_opt->count() > 0 && !o.live) {
