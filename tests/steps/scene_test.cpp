@@ -84,6 +84,12 @@ TEST_CASE("Scene and character field errors name the field's line", "[steps][sce
   std::string fixed = scene;
   fixed.replace(fixed.find("strat"), 5, "start");
   CHECK(SceneError(fixed) == "s.json: characters[2]: 'path[1]': expected [x, y, z] (line 7)");
+  // A waypoint beyond the reach of queries too (the generator's message named no file, field
+  // or line, and counted waypoints from 1).
+  fixed.replace(fixed.find("[2, 0]"), 6, "[2, 0, -3e15]");
+  CHECK(SceneError(fixed) ==
+        "s.json: characters[2]: 'path[1]': (2, 0, -3e+15) has a coordinate beyond +-1e+15 (the "
+        "reach of terrain queries) (line 7)");
   CHECK(SceneError(R"({"format": "footfall-scene", "version": 1, "characters": [
     {"character_file": "biped.json"},
     3]})") == "s.json: characters[1]: expected an object (line 3)");

@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "character_read.h"
+#include "footfall/steps/generator.h"
 #include "footfall/terrain/shown_text.h"
 #include "json_input.h"
 #include "request_fields.h"
@@ -188,6 +190,16 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
       Vec3 p;
       const std::string key = "path[" + std::to_string(i) + "]";
       ok = ReadVec(j["path"][i], source, key.c_str(), &p, error);
+      // Named here, with its field and line (the generator's check names neither).
+      if (ok &&
+          std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) > kMaxWaypointCoordinate) {
+        std::ostringstream m;
+        m << source << ": '" << key << "': (" << p.x << ", " << p.y << ", " << p.z
+          << ") has a coordinate beyond +-" << kMaxWaypointCoordinate
+          << " (the reach of terrain queries)";
+        *error = m.str();
+        ok = false;
+      }
       o.path.push_back(p);
     }
   }

@@ -441,15 +441,13 @@ Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Charac
     *error = m.str();
     return Status::kInvalidArgument;
   }
-  // Waypoints within twice the terrain's coordinate range (the reach of its queries): farther,
-  // squared distances to them overflow and the heading turned away from the goal.
-  constexpr double kMaxWaypoint = 2 * terrain::kMaxCoordinate;
   for (size_t i = 0; i < options.path.size(); ++i) {
     const Vec3& p = options.path[i];
-    if (!IsFinite(p) || std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) > kMaxWaypoint) {
+    if (!IsFinite(p) ||
+        std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) > kMaxWaypointCoordinate) {
       Text m;
       m << "path waypoint " << i + 1 << " (" << p.x << ", " << p.y << ", " << p.z
-        << ") is not a finite point with each coordinate within +-" << kMaxWaypoint
+        << ") is not a finite point with each coordinate within +-" << kMaxWaypointCoordinate
         << " (the reach of terrain queries)";
       *error = m.str();
       return Status::kInvalidArgument;

@@ -15,6 +15,7 @@
 #include "footfall/client/terrain_session.h"
 #include "footfall/steps/character.h"
 #include "footfall/steps/walk.h"
+#include "footfall/terrain/samples.h"
 
 namespace footfall {
 
@@ -40,6 +41,10 @@ constexpr int kStartSearchSteps = 12;
 // plugins): a frame of 1e300 put every key on one frame.
 constexpr double kMaxStartFrame = 1e9;
 constexpr double kMaxFps = 1e6;
+// Bound of each coordinate of GenerateOptions::path: twice the terrain's coordinate range (the
+// reach of its queries); farther, squared distances to a waypoint overflow and the heading
+// turned away from the goal.
+constexpr double kMaxWaypointCoordinate = 2 * terrain::kMaxCoordinate;
 
 // How the generator's messages refer to the inputs that gave the start, heading, up and steps: the
 // command line's flags by default; a scene names its file and field ("s.json: characters[0]:
