@@ -2,6 +2,7 @@
 // gimbal lock, and unwrapping picks the equivalent triple nearest the previous key.
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include <catch2/catch.hpp>
 
@@ -90,6 +91,57 @@ TEST_CASE("ClosestEulerXyzDegrees unwraps toward the previous key", "[export][eu
     CHECK(e.y == Approx(100));
     CHECK(e.z == Approx(180));
     CHECK(AbsDot(FromEulerXyz(e), FromEulerXyz({0, 80, 0})) == Approx(1).margin(1e-9));
+  }
+}
+
+TEST_CASE("At gimbal lock the turn is split as the neighbouring key splits it", "[export][euler]") {
+  // A Z-up body facing -Y is at lock in ZXY (x = 90): its first key was (90, 0, 0), the next
+  // after a turn (60, 90, 90), and Maya's per-angle interpolation leaned the body up to 10
+  // degrees between them.
+  const Quat z_up = AxisAngle({1, 0, 0}, 90);
+  SECTION("ClosestEulerZxyDegrees keeps the rotation and nears the previous key") {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> angle(-400, 400);
+    for (double x : {90.0, -90.0}) {
+      for (int i = 0; i < 200; ++i) {
+        const Vec3 locked = QuatToEulerZxyDegrees(FromEulerZxy({x, angle(rng), angle(rng)}));
+        REQUIRE(std::abs(locked.x) == Approx(90));
+        const Vec3 previous{x, angle(rng), angle(rng)};
+        const Vec3 e = ClosestEulerZxyDegrees(locked, previous);
+        CHECK(AbsDot(FromEulerZxy(e), FromEulerZxy(locked)) == Approx(1).margin(1e-9));
+        // No other split of the turn, nor whole turns added, comes nearer.
+        const double s = x > 0 ? 1 : -1;
+        const double d = std::abs(e.y - previous.y) + std::abs(e.z - previous.z);
+        for (double t = -360; t <= 360; t += 7.5) {
+          for (int wy = -2; wy <= 2; ++wy) {
+            const double y = locked.y + s * t + 360 * wy;
+            for (int wz = -2; wz <= 2; ++wz) {
+              const double z = locked.z + t + 360 * wz;
+              CHECK(d <= std::abs(y - previous.y) + std::abs(z - previous.z) + 1e-9);
+            }
+          }
+        }
+      }
+    }
+  }
+  SECTION("ContinuousEulerZxyDegrees: keys at lock before the first that is not") {
+    const Quat facing_minus_y = Multiply(AxisAngle({0, 0, 1}, 180), z_up);
+    const Quat turned = Multiply(AxisAngle({0, 0, 1}, 150), z_up);
+    const std::vector<Vec3> e = ContinuousEulerZxyDegrees({facing_minus_y, facing_minus_y, turned});
+    REQUIRE(e.size() == 3);
+    REQUIRE(std::abs(e[0].x) == Approx(90));
+    REQUIRE(std::abs(e[2].x) != Approx(90));
+    for (size_t k = 0; k < 3; ++k)
+      CHECK(AbsDot(FromEulerZxy(e[k]), k < 2 ? facing_minus_y : turned) == Approx(1).margin(1e-9));
+    // Halfway between the keys, Maya's angles give a body turning about Z alone: it stays up.
+    const Vec3 mid{(e[1].x + e[2].x) / 2, (e[1].y + e[2].y) / 2, (e[1].z + e[2].z) / 2};
+    const Quat q = FromEulerZxy(mid);
+    // The body's up (+Y) in the world: 1 - 2(x^2 + z^2) etc. of the rotation's second column.
+    const Vec3 up{2 * (q.x * q.y - q.z * q.w), 1 - 2 * (q.x * q.x + q.z * q.z),
+                  2 * (q.y * q.z + q.x * q.w)};
+    CHECK(up.z == Approx(1).margin(1e-9));
+    CHECK(e[0].y == Approx(e[1].y));
+    CHECK(e[0].z == Approx(e[1].z));
   }
 }
 

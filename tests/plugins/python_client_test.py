@@ -1037,6 +1037,42 @@ class RotationTest(unittest.TestCase):
         self._assert_same_matrix(self._matrix_of_euler(e, "zxy"),
                                  self._matrix_of_euler((80.0, 0.0, 0.0), "zxy"), str(e))
 
+    def test_gimbal_lock_split_nearest_the_neighbour(self):
+        # A Z-up body facing -Y is at lock in ZXY: its first keys were (90, 0, 0), the next
+        # after a turn (60, 90, 90), and Maya's per-angle interpolation leaned the body up to 10
+        # degrees between them. Every rotate order keeps the rotation at lock and nears the
+        # neighbouring key.
+        rng = __import__("random").Random(3)
+        for order in ff.rotation.ROTATE_ORDERS:
+            i, j, k = ("xyz".index(a) for a in order)
+            for middle in (90.0, -90.0):
+                for _ in range(50):
+                    e = [0.0, 0.0, 0.0]
+                    e[i], e[j], e[k] = rng.uniform(-300, 300), middle, rng.uniform(-300, 300)
+                    previous = [0.0, 0.0, 0.0]
+                    previous[i], previous[j], previous[k] = (rng.uniform(-300, 300), middle,
+                                                             rng.uniform(-300, 300))
+                    got = ff.rotation.closest_euler_in_order(e, previous, order)
+                    self._assert_same_matrix(self._matrix_of_euler(got, order),
+                                             self._matrix_of_euler(e, order), order)
+                    d = abs(got[i] - previous[i]) + abs(got[k] - previous[k])
+                    s = (1.0 if (j - i) % 3 == 1 else -1.0) * (1.0 if middle > 0 else -1.0)
+                    for t in range(-360, 361, 15):
+                        for wi in (-360, 0, 360):
+                            for wk in (-360, 0, 360):
+                                other = (abs(e[i] + t + wi - previous[i]) +
+                                         abs(e[k] + s * t + wk - previous[k]))
+                                self.assertLessEqual(d, other + 1e-9, msg=order)
+        # The first keys at lock split their turn as the first key that is not.
+        facing_minus_y = ff.rotation.quat_from_frame((0.0, 0.0, 1.0), (0.0, -1.0, 0.0))
+        turned = ff.rotation.quat_from_frame((0.0, 0.0, 1.0), (0.5, -math.sqrt(0.75), 0.0))
+        e = ff.rotation.continuous_eulers([facing_minus_y, facing_minus_y, turned], 2)
+        self.assertAlmostEqual(abs(e[0][0]), 90.0)
+        self.assertNotAlmostEqual(abs(e[2][0]), 90.0)
+        for n in (0, 1):  # y and z as the turned key's: the turn is in x alone
+            self.assertAlmostEqual(e[n][1], e[2][1], places=6)
+            self.assertAlmostEqual(e[n][2], e[2][2], places=6)
+
     def test_keys_match_the_mel_export(self):
         cli = os.environ.get("FOOTFALL_CLI") or os.path.join(REPO, "build", "client", "cli",
                                                                "footfall")
@@ -1058,12 +1094,8 @@ class RotationTest(unittest.TestCase):
             keyed.setdefault(float(m.group(1)), {})[m.group(2)] = float(m.group(3))
         body = [t for t in walk["tracks"] if t["kind"] == "body"][0]
         self.assertGreater(len(body["keys"]), 20)
-        previous = None
-        for key in body["keys"]:
-            euler = ff.rotation.quat_to_euler_zxy(key["rotation"])
-            if previous is not None:
-                euler = ff.rotation.closest_euler_zxy(euler, previous)
-            previous = euler
+        eulers = ff.rotation.continuous_eulers([key["rotation"] for key in body["keys"]], "zxy")
+        for key, euler in zip(body["keys"], eulers):
             want = keyed[float(key["frame"])]
             for axis, value in zip("XYZ", euler):
                 self.assertAlmostEqual(value, want[axis], places=9)

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "walk_prep.h"
 
@@ -22,6 +23,21 @@ Vec3 UnwrapAll(const Vec3& euler, const Vec3& target) {
 
 double L1(const Vec3& a, const Vec3& b) {
   return std::abs(a.x - b.x) + std::abs(a.y - b.y) + std::abs(a.z - b.z);
+}
+
+// Whether a middle angle (degrees, as converted) is at gimbal lock, +-90.
+bool AtLock(double middle) { return std::abs(std::abs(middle) - 90) < 1e-9; }
+
+// At gimbal lock the first and last angles turn about one axis: in a cyclic order (XYZ, ZXY)
+// with the middle angle +90, first + t and last + t give the same rotation for any t (with -90,
+// first + t and last - t). Sets the (first, last) of that family nearest (first_to, last_to):
+// t halfway between the shifts each would need alone.
+void NearestAtLock(double middle, double* first, double* last, double first_to, double last_to) {
+  const double s = middle > 0 ? 1 : -1;
+  // The shifts taken within half a turn of each other: halfway along the shorter arc.
+  const double to_first = first_to - *first;
+  const double t = 0.5 * (to_first + Unwrap(s * (last_to - *last), to_first));
+  *first += t, *last += s * t;
 }
 
 }  // namespace
@@ -52,6 +68,11 @@ Vec3 QuatToEulerXyzDegrees(const Quat& q_in) {
 }
 
 Vec3 ClosestEulerXyzDegrees(const Vec3& euler, const Vec3& previous) {
+  if (AtLock(euler.y)) {  // X first, Z last
+    Vec3 e = euler;
+    NearestAtLock(e.y, &e.x, &e.z, previous.x, previous.z);
+    return UnwrapAll(e, previous);
+  }
   const Vec3 direct = UnwrapAll(euler, previous);
   const Vec3 alternative = UnwrapAll({euler.x + 180.0, 180.0 - euler.y, euler.z + 180.0}, previous);
   return L1(alternative, previous) < L1(direct, previous) ? alternative : direct;
@@ -86,9 +107,28 @@ Vec3 QuatToEulerZxyDegrees(const Quat& q_in) {
 }
 
 Vec3 ClosestEulerZxyDegrees(const Vec3& euler, const Vec3& previous) {
+  if (AtLock(euler.x)) {  // Z first, Y last
+    Vec3 e = euler;
+    NearestAtLock(e.x, &e.z, &e.y, previous.z, previous.y);
+    return UnwrapAll(e, previous);
+  }
   const Vec3 direct = UnwrapAll(euler, previous);
   const Vec3 alternative = UnwrapAll({180.0 - euler.x, euler.y + 180.0, euler.z + 180.0}, previous);
   return L1(alternative, previous) < L1(direct, previous) ? alternative : direct;
+}
+
+std::vector<Vec3> ContinuousEulerZxyDegrees(const std::vector<Quat>& rotations) {
+  std::vector<Vec3> out(rotations.size());
+  for (size_t k = 0; k < rotations.size(); ++k) out[k] = QuatToEulerZxyDegrees(rotations[k]);
+  // Keys at gimbal lock before the first that is not take its angles, nearest first: their
+  // split of the turn between Z and Y is free, and all in Y swung the body between them and it.
+  size_t first = 0;
+  while (first < out.size() && AtLock(out[first].x)) ++first;
+  if (first == out.size()) first = 0;
+  for (size_t k = first; k-- > 0;) out[k] = ClosestEulerZxyDegrees(out[k], out[k + 1]);
+  for (size_t k = first + 1; k < out.size(); ++k)
+    out[k] = ClosestEulerZxyDegrees(out[k], out[k - 1]);
+  return out;
 }
 
 }  // namespace footfall

@@ -281,12 +281,10 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
     if (!increasing) orders[t] = walk_export::KeyOrder(track);
     const size_t count = increasing ? track.keys.size() : orders[t].size();
     if (track.kind == TrackKind::kBody) {
-      eulers[t].reserve(count);
-      for (size_t k = 0; k < count; ++k) {
-        Vec3 euler = QuatToEulerZxyDegrees(track.Rotation(increasing ? k : orders[t][k]));
-        if (k > 0) euler = ClosestEulerZxyDegrees(euler, eulers[t].back());
-        eulers[t].push_back(euler);
-      }
+      std::vector<Quat> rotations(count);
+      for (size_t k = 0; k < count; ++k)
+        rotations[k] = track.Rotation(increasing ? k : orders[t][k]);
+      eulers[t] = ContinuousEulerZxyDegrees(rotations);
     }
     size_t first = 0;
     do {

@@ -328,17 +328,15 @@ def key_walk(walk, feet, body, from_frame=None):
                 order = int(mc.getAttr(node + ".rotateOrder"))
             else:
                 mc.setAttr(node + ".rotateOrder", 2)
-        previous = None
-        for key in track.get("keys", []):
+        keys = track.get("keys", [])
+        # Euler degrees in the body's rotate order (ZXY: R = Ry * Rx * Rz, as the MEL export
+        # keys them), each nearest its neighbour's, keyed or not.
+        rotated = [n for n, key in enumerate(keys) if is_body and "rotation" in key]
+        eulers = dict(zip(rotated, ffc.rotation.continuous_eulers(
+            [keys[n]["rotation"] for n in rotated], order)))
+        for n, key in enumerate(keys):
             frame = key["frame"]
-            euler = None
-            if is_body and "rotation" in key:
-                # Euler degrees in the body's rotate order (ZXY: R = Ry * Rx * Rz, as the MEL
-                # export keys them), unwrapped from the previous key, keyed or not.
-                euler = ffc.rotation.quat_to_euler(key["rotation"], order)
-                if previous is not None:
-                    euler = ffc.rotation.closest_euler_in_order(euler, previous, order)
-                previous = euler
+            euler = eulers.get(n)
             if from_frame is not None and frame < from_frame:
                 continue
             # Linear in and out tangents, as the MEL and glTF exports (the user's default

@@ -82,7 +82,8 @@ def quat_to_euler(q, order):
 
 def closest_euler_in_order(euler, previous, order):
     """As closest_euler, for angles in rotate order `order` (quat_to_euler): the other solution
-    is (first + 180, 180 - middle, last + 180)."""
+    is (first + 180, 180 - middle, last + 180); at gimbal lock (middle +-90) the turn is split
+    between the first and last angles as near `previous` as it goes."""
     if not isinstance(order, str):
         order = ROTATE_ORDERS[int(order)]
     i, j, k = ("xyz".index(a) for a in order)
@@ -93,10 +94,42 @@ def closest_euler_in_order(euler, previous, order):
     def l1(e):
         return sum(abs(e[n] - previous[n]) for n in range(3))
 
+    if _at_lock(euler[j]):
+        # The first and last angles turn about one axis: first + t and last + s * t give the
+        # same rotation for any t. t halfway between the shifts each would need alone, taken
+        # within half a turn of each other (the shorter arc).
+        s = (1.0 if (j - i) % 3 == 1 else -1.0) * (1.0 if euler[j] > 0 else -1.0)
+        to_first = previous[i] - euler[i]
+        t = 0.5 * (to_first + _unwrap(s * (previous[k] - euler[k]), to_first))
+        locked = list(euler)
+        locked[i], locked[k] = euler[i] + t, euler[k] + s * t
+        return unwrap_all(locked)
     other = list(euler)
     other[i], other[j], other[k] = euler[i] + 180.0, 180.0 - euler[j], euler[k] + 180.0
     direct, alternative = unwrap_all(euler), unwrap_all(other)
     return alternative if l1(alternative) < l1(direct) else direct
+
+
+def _at_lock(middle):
+    return abs(abs(middle) - 90.0) < 1e-9
+
+
+def continuous_eulers(quats, order):
+    """Keys' rotations (x, y, z, w) as Euler degrees in rotate order `order`, each the triple
+    closest to its neighbour's (closest_euler_in_order), so that per-angle interpolation between
+    keys turns the short way. Keys at gimbal lock before the first key that is not split their
+    turn as that key does (a Z-up body facing +-Y leaned up to 10 degrees between its first
+    keys and the next ones otherwise), as client/export/src/euler.cpp does for the MEL export."""
+    if not isinstance(order, str):
+        order = ROTATE_ORDERS[int(order)]
+    j = "xyz".index(order[1])
+    out = [quat_to_euler(q, order) for q in quats]
+    first = next((n for n, e in enumerate(out) if not _at_lock(e[j])), 0)
+    for n in range(first - 1, -1, -1):
+        out[n] = closest_euler_in_order(out[n], out[n + 1], order)
+    for n in range(first + 1, len(out)):
+        out[n] = closest_euler_in_order(out[n], out[n - 1], order)
+    return out
 
 
 def quat_from_frame(up, forward):

@@ -1,6 +1,8 @@
 // Quaternion to Euler angle conversion for DCC tools that key rotations as Euler angles (Maya).
 #pragma once
 
+#include <vector>
+
 #include "footfall/steps/walk.h"
 #include "footfall/terrain/vec3.h"
 
@@ -14,7 +16,8 @@ Vec3 QuatToEulerXyzDegrees(const Quat& q);
 
 // The Euler triple equivalent to `euler` (degrees, XYZ order) that is closest to `previous`:
 // adds multiples of 360 per angle and also tries the alternative solution (x+180, 180-y, z+180),
-// so keyed rotations do not spin the long way round between keys.
+// so keyed rotations do not spin the long way round between keys. At gimbal lock (y = +-90)
+// the turn is split between x and z as near `previous` as it goes.
 Vec3 ClosestEulerXyzDegrees(const Vec3& euler, const Vec3& previous);
 
 // Euler angles in degrees for Maya's rotate order ZXY: rotating by z about the Z axis, then x
@@ -27,7 +30,14 @@ Vec3 QuatToEulerZxyDegrees(const Quat& q);
 
 // The Euler triple equivalent to `euler` (degrees, ZXY order) that is closest to `previous`:
 // adds multiples of 360 per angle and also tries the alternative solution (180-x, y+180, z+180),
-// so keyed rotations do not spin the long way round between keys.
+// so keyed rotations do not spin the long way round between keys. At gimbal lock (x = +-90)
+// the turn is split between z and y as near `previous` as it goes.
 Vec3 ClosestEulerZxyDegrees(const Vec3& euler, const Vec3& previous);
+
+// Keys' rotations as ZXY Euler degrees, each the triple closest to its neighbour's, so that
+// Maya's per-angle interpolation between keys turns the short way: keys at gimbal lock before
+// the first key that is not split their turn as that key does (a Z-up body facing +-Y, then
+// turning, leaned up to 10 degrees between its keys when its first key had the turn all in y).
+std::vector<Vec3> ContinuousEulerZxyDegrees(const std::vector<Quat>& rotations);
 
 }  // namespace footfall
