@@ -464,12 +464,18 @@ TEST_CASE("WriteMel writes names that are not UTF-8 with U+FFFD", "[export][mel]
   std::remove(path.c_str());
 }
 
-TEST_CASE("WriteMel keeps comments to one line and names Maya's second and millisecond units",
-          "[export][mel]") {
+TEST_CASE(
+    "WriteMel keeps comments to one line and names Maya's second, millisecond, minute and hour "
+    "units",
+    "[export][mel]") {
   Walk walk = test::BipedWalk();
   walk.tracks[0].name = "L\\";  // a backslash ending a comment line could join the next to it
   walk.stopped = "a\x1b[2J reason\\";
-  for (const auto& [fps, unit] : {std::pair<double, std::string>{1, "sec"}, {1000, "millisec"}}) {
+  // (A frame a minute, Maya's "min", warned that Maya had no unit for it.)
+  for (const auto& [fps, unit] : {std::pair<double, std::string>{1, "sec"},
+                                  {1000, "millisec"},
+                                  {1.0 / 60, "min"},
+                                  {1.0 / 3600, "hour"}}) {
     walk.fps = fps;
     const std::string path = WriteAndKeep(walk, "units.mel");
     CHECK(ParseMel(path).time_unit == unit);

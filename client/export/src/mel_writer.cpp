@@ -158,6 +158,10 @@ std::string MayaTimeUnit(double fps) {
   for (const Named& named : kNamed) {
     if (std::abs(fps - named.fps) < 1e-3) return named.unit;
   }
+  // A frame a minute or an hour: near to a millionth of the rate (1e-3 would take every rate
+  // below 0.001 for an hour).
+  if (std::abs(fps * 60 - 1) < 1e-6) return "min";
+  if (std::abs(fps * 3600 - 1) < 1e-6) return "hour";
   // Whole rates Maya accepts as "<n>fps" (90 from Maya 2020, the others from 2017).
   static const int kWhole[] = {2,   3,   4,   5,    6,    8,    10,   12,   16,    20,   40,  75,
                                80,  90,  100, 120,  125,  150,  200,  240,  250,   300,  375, 400,
