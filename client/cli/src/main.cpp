@@ -65,10 +65,14 @@ std::string MissingValueHint(const CLI::App& root, int argc, char** argv) {
       if (command->check_name(argv[i])) at = command;
     path += " " + at->get_name();
   }
-  // An option's own name as written (not "--name=value", not a negative number).
+  // An option's own name as written (not "--name=value", not a negative number). (Not
+  // get_option_no_throw: it is noexcept, and memory running out in it ended the process.)
+  const std::vector<const CLI::Option*> options = at->get_options();
   auto option = [&](const std::string& word) -> const CLI::Option* {
     if (word.size() < 2 || word[0] != '-' || word.find('=') != std::string::npos) return nullptr;
-    return at->get_option_no_throw(word);
+    for (const CLI::Option* o : options)
+      if (o->check_name(word)) return o;
+    return nullptr;
   };
   for (; i + 1 < argc; ++i) {
     const std::string word = argv[i];
