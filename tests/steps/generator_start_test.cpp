@@ -400,6 +400,32 @@ TEST_CASE("A step_length longer than the reach allows is said once in the walk's
   }
 }
 
+TEST_CASE("A reach that leaves little room walks on level ground, shorter as it tightens",
+          "[steps][generator]") {
+  // A trotting quadruped whose reach leaves its feet a few centimetres of travel: each step's
+  // own reach check counted only that foot's share of the body's move, so a hind foot's long
+  // step carried the body away from the other hind foot; every group waited on another, and
+  // the walk stopped at step 2 without a foot moving (at reach 0.60 and 0.61, not 0.62).
+  Character c = LoadShipped("quadruped");
+  Terrain t = LoadTerrain(MakeFlat(321, 0.025, 0), 0.025);  // 8 x 8 m
+  const GenerateOptions o = StartOptions({4, 0, 4}, 20);
+  double previous = 0;
+  for (const double reach : {0.6, 0.61, 0.62, 0.65}) {
+    INFO("reach " << reach);
+    c.reach = reach;
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    CHECK(w.stopped.empty());
+    CheckWalk(t, c, o, w);
+    const WalkTrack& body = *TracksOf(w, "").back();
+    REQUIRE(body.kind == TrackKind::kBody);
+    const double travelled = Distance(body.keys.back().position, body.keys.front().position);
+    CHECK(travelled > 1);
+    CHECK(travelled >= previous);  // more room, farther
+    previous = travelled;
+  }
+}
+
 TEST_CASE("GenerateWalk takes a null error string", "[steps][generator]") {
   // Bad options with no error string to fill dereferenced it (a crash).
   Terrain t = LoadTerrain(MakeFlat(41, 0.25, 0), 0.25);

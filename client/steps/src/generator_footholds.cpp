@@ -266,6 +266,10 @@ Status Generator::QueryFootholds(std::string* error) {
         mv.ideal = a.foot[mv.foot] + v, mv.step = v;
       }
     });
+    Parallel(walkers_.size(), [&](size_t wb, size_t we) {
+      for (size_t i = wb; i < we; ++i)
+        KeepPlantedInReach(walkers_[i] * per_agent, (walkers_[i] + 1) * per_agent);
+    });
     queries_.clear();
     for (size_t m : pending_) {
       if (moves[m].done || moves[m].failed) continue;  // a step in place; nothing to aim at
@@ -407,6 +411,57 @@ void Generator::Fail(Move& mv) {
   if (mv.attempts > 1)
     mv.reason += " (" + std::to_string(mv.attempts - 1) +
                  " more tries, shorter, longer or aimed down, refused too)";
+}
+
+void Generator::KeepPlantedInReach(size_t m, size_t e) {
+  const Agent& a = agents_[moves_[m].agent];
+  // Only where a hold would end the walk (every other group waited in a row): elsewhere the
+  // group waits and the planted foot's own group steps on, as the gait has it.
+  if (a.waits + 1 < static_cast<int>(c_.gait.size())) return;
+  const std::vector<int>& slot = move_of_foot_[group_];  // foot -> its move's offset, or -1
+  const double feet = static_cast<double>(c_.feet.size());
+  // The feet's ground moves by every foot's displacement over the number of feet: the footholds
+  // found so far, and the steps still to be asked (without their aim down: where they land).
+  Vec3 found, asked;
+  bool any = false;
+  for (size_t i = m; i < e; ++i) {
+    const Move& mv = moves_[i];
+    if (mv.failed) continue;
+    if (mv.done) {
+      found += mv.end - a.foot[mv.foot];
+    } else {
+      asked += mv.step + a.up * (mv.attempt.drop * c_.max_rise);
+      any = true;
+    }
+  }
+  if (!any) return;
+  auto body = [&](double scale) {
+    return a.ground + (found + asked * scale) / feet + a.body_up * c_.body_height;
+  };
+  auto planted_in_reach = [&](double scale, bool* some) {
+    const Vec3 b = body(scale), now = body(0);
+    for (size_t f = 0; f < c_.feet.size(); ++f) {
+      if (slot[f] >= 0 || Distance(a.foot[f], now) > c_.reach) continue;  // moving, or no help
+      *some = true;
+      if (Distance(a.foot[f], b) > c_.reach) return false;
+    }
+    return true;
+  };
+  bool some = false;
+  double scale = 1;
+  for (int shrink = 0; shrink < 256 && !planted_in_reach(scale, &some); ++shrink) scale *= 0.75;
+  if (scale == 1 || !some) return;
+  for (size_t i = m; i < e; ++i) {
+    Move& mv = moves_[i];
+    if (mv.failed || mv.done) continue;
+    const Vec3 down = a.up * (mv.attempt.drop * c_.max_rise);
+    const Vec3 v = (mv.step + down) * scale;
+    if (Length(v) < kInPlace * c_.step_length && mv.attempt.drop == 0) {
+      mv.done = true, mv.end = a.foot[mv.foot], mv.end_normal = a.foot_normal[mv.foot];
+      continue;
+    }
+    mv.step = v - down, mv.ideal = a.foot[mv.foot] + mv.step;
+  }
 }
 
 void Generator::CheckReach(size_t m, size_t e) {

@@ -290,6 +290,13 @@ class Generator {
   // the footholds beyond reach of the body they lead to, or all of them when a planted foot
   // would be left beyond reach.
   void CheckReach(size_t m, size_t e);
+  // 7 (end). For one character whose moves are moves_[m, e), when every other group has
+  // waited in a row (a hold now would end the walk): shortens the steps still to be asked, all
+  // alike, until the body they move together leaves no planted foot beyond reach (one that is
+  // within it now). Each step's own check counts only its own share of the body's move: a hind
+  // foot's long step carried the body away from the other hind foot, and every group waited on
+  // another until the walk stopped on level ground.
+  void KeepPlantedInReach(size_t m, size_t e);
   // Whether a refusal (a gap or not) becomes mv's reason (see Move::reason).
   static bool KeepsReason(const Move& mv, bool gap) {
     return mv.reason.empty() || (mv.reason_is_gap && !gap);
