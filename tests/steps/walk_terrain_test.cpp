@@ -163,6 +163,44 @@ TEST_CASE("PrepareWalkTerrain: a path walked to its end widens the box along it"
                            o, &prepared, &error) == Status::kInvalidArgument);
 }
 
+TEST_CASE("PrepareWalkTerrain: a path spans the whole surface along up, whatever its heights",
+          "[steps][terrain]") {
+  // Waypoints given at y = 0 over ground 500 m up that climbs between them: the box ran from
+  // the waypoints' heights to the start's, and the walk stopped at its top as at a cliff where
+  // the bank rose above it.
+  const Character c = LoadShipped("hexapod");
+  const std::string path = std::string(std::getenv("TMPDIR") ? std::getenv("TMPDIR") : "/tmp") +
+                           "/footfall_bank_" + std::to_string(::getpid()) + ".asc";
+  {
+    std::ofstream out(path);
+    out << "ncols 40\nnrows 20\nxllcorner 0\nyllcorner 0\ncellsize 0.5\n";
+    for (int r = 0; r < 20; ++r) {
+      for (int col = 0; col < 40; ++col) out << 500 + 0.15 * col << ' ';  // up 6 m along x
+      out << '\n';
+    }
+  }
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {2, 0, 5};
+  o.path = {{18, 0, 5}};
+  WalkTerrain prepared;
+  std::string error;
+  const Status status = PrepareWalkTerrain(path, TerrainLoadOptions{}, c, o, &prepared, &error);
+  std::remove(path.c_str());
+  INFO(error);
+  REQUIRE(status == Status::kOk);
+  REQUIRE(prepared.cropped);  // across up: the path's box
+  CHECK(prepared.region_min.y <= 500);
+  CHECK(prepared.region_max.y >= 500 + 0.15 * 39);
+  Terrain t = LoadTerrain(prepared.samples, prepared.report.separation);
+  GenerateOptions walk = o;
+  walk.start = prepared.start;
+  const Walk w = Generate(t, c, walk);
+  INFO(w.stopped);
+  CHECK(w.stopped.empty());
+  CHECK(BodyKeys(w) > 20);
+}
+
 TEST_CASE("PrepareWalkTerrain: a start that may move keeps its search area in the box",
           "[steps][terrain]") {
   const Character c = LoadShipped("hexapod");

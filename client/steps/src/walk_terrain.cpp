@@ -120,6 +120,21 @@ Status PrepareWalkTerrain(const std::string& path, const TerrainLoadOptions& loa
   }
   out->region_min = lo - Vec3{widen, widen, widen};
   out->region_max = hi + Vec3{widen, widen, widen};
+  // Along a path, the ground the walk follows may climb or fall any height between waypoints
+  // (given at y = 0 over a DEM 540 m up, the box stopped 2 m below a bank the path crosses, and
+  // the walk stopped at its edge as at a cliff): the box spans the whole surface along up.
+  if (!out->region_is_bound) {
+    auto along = [](Vec3& v, int axis) -> double& {
+      return axis == 0 ? v.x : axis == 1 ? v.y : v.z;
+    };
+    Vec3 u = up;
+    for (int axis = 0; axis < 3; ++axis) {
+      if (std::fabs(along(u, axis)) < 1e-12) continue;
+      along(out->region_min, axis) = std::min(along(out->region_min, axis), along(mesh_lo, axis));
+      along(out->region_max, axis) = std::max(along(out->region_max, axis), along(mesh_hi, axis));
+    }
+  }
+
   out->cropped = mesh_lo.x < out->region_min.x || mesh_lo.y < out->region_min.y ||
                  mesh_lo.z < out->region_min.z || mesh_hi.x > out->region_max.x ||
                  mesh_hi.y > out->region_max.y || mesh_hi.z > out->region_max.z;
