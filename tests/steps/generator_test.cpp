@@ -119,6 +119,28 @@ TEST_CASE("Walks up and down stairs", "[steps][generator]") {
   }
 }
 
+TEST_CASE("A biped climbs risers exactly max_rise high", "[steps][generator]") {
+  // Samples are stored in float: a 0.4 riser measured 0.40000001 and the biped (max_rise 0.4)
+  // stopped at its foot as at a cliff.
+  const Character c = LoadShipped("biped");
+  REQUIRE(c.max_rise == 0.4);
+  const double spacing = 0.025;
+  Terrain t = LoadTerrain(MakeStairs(5, c.max_rise, 0.5, 1.5, spacing), spacing);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {0.75, 0, 0.1};
+  o.steps = 10;
+  const Walk w = Generate(t, c, o);
+  CheckWalk(t, c, o, w);
+  double highest = 0;
+  for (const WalkTrack& track : w.tracks)
+    for (const WalkKey& k : track.keys)
+      if (track.kind == TrackKind::kFoot && k.phase == KeyPhase::kEnd)
+        highest = std::max(highest, k.position.y);
+  INFO(w.stopped);
+  CHECK(highest == Approx(4 * c.max_rise));  // the top tread
+}
+
 TEST_CASE("A multiped's body climbing stairs taller than itself stays out of their noses",
           "[steps][generator]") {
   // The octopod (4 cm body, reach 32 cm) up 18 cm stairs: with feet on two treads its body,

@@ -332,7 +332,8 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
   }
   const bool found = h.status == Status::kOk && progress >= 0.5;
   const double rise = found ? Dot(h.point - foot, a.up) : 0;
-  if (found && std::fabs(rise) <= c_.max_rise && Dot(h.normal, a.up) >= cos_max_slope_) {
+  const double rise_limit = c_.max_rise * (1 + kRiseRounding);
+  if (found && std::fabs(rise) <= rise_limit && Dot(h.normal, a.up) >= cos_max_slope_) {
     if (KeepsSide(mv, h.point, h.normal)) mv.done = true;
     return;
   }
@@ -358,7 +359,7 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
           << " apart, too far for this character: resample it at a separation of "
           << kSeparationPerStep * c_.step_length;
     }
-  } else if (std::fabs(rise) > c_.max_rise) {
+  } else if (std::fabs(rise) > rise_limit) {
     why << "the foothold at " << Point(h.point) << (rise > 0 ? " rises " : " drops ")
         << Beyond(std::fabs(rise), c_.max_rise) << ", more than max_rise "
         << NumberText(c_.max_rise) << " (a cliff)";

@@ -114,6 +114,9 @@ inline constexpr double kFloorUpDeg = 60;
 inline constexpr double kMinPairGap = 0.5;
 // A step shorter than this fraction of step_length is a step in place: no foothold query.
 inline constexpr double kInPlace = 0.02;
+// A foothold rises or drops up to max_rise times (1 + this): samples are stored in float, so a
+// riser modelled exactly max_rise high measured 0.40000001 of 0.4 and was refused as a cliff.
+inline constexpr double kRiseRounding = 1e-6;
 // Move::query of a move not asked this round.
 inline constexpr size_t kNoQuery = ~size_t{0};
 // Per-character loops split across threads only from this many items (a hand-over costs
