@@ -680,6 +680,26 @@ static void TestRpc(const char* character_path) {
   /* Brackets around anything but an IPv6 address ("[]" opened a session with an empty host). */
   Check(ffc_open_rpc("[]", 7407, 1) == NULL, "ffc_open_rpc refuses empty brackets", "");
   Check(ffc_open_rpc("[localhost]", 7407, 1) == NULL, "ffc_open_rpc refuses a bracketed name", "");
+  /* Each refusal says which argument was wrong (it was "no session" alone). */
+  {
+    const struct {
+      const char* host;
+      int port;
+      double timeout_s;
+      const char* said;
+    } refused[] = {{NULL, 0, 1, "the port is outside 1-65535"},
+                   {NULL, 7407, NAN, "the timeout is NaN, infinite or above 1e6 s"},
+                   {NULL, 7407, 1e-9, "the timeout is below 0.001 s"},
+                   {"127.0.0.1:7407", 7407, 1, "the host is no host name or IP address"}};
+    for (size_t i = 0; i < sizeof refused / sizeof refused[0]; ++i) {
+      Check(ffc_open_rpc(refused[i].host, refused[i].port, refused[i].timeout_s) == NULL,
+            "ffc_open_rpc refuses it", "%s", refused[i].said);
+      Check(strncmp(ffc_last_error(NULL), "no session (ffc_open_rpc: ", 26) == 0 &&
+                strstr(ffc_last_error(NULL), refused[i].said) != NULL,
+            "ffc_last_error(NULL) says why ffc_open_rpc refused", "expected '%s', got '%s'",
+            refused[i].said, ffc_last_error(NULL));
+    }
+  }
   s = ffc_open_rpc("[::1]", 7407, 1);
   Check(s != NULL, "ffc_open_rpc takes an IPv6 address in brackets", "");
   ffc_close(s);

@@ -227,49 +227,58 @@ extern "C" {
 
 int ffc_abi_version(void) { return FFC_ABI_VERSION; }
 
-// Whether the last ffc_open_* on this thread ran out of memory (said by ffc_last_error(NULL)).
-static thread_local bool t_open_ran_out = false;
+// Why the last ffc_open_* on this thread returned NULL (ffc_last_error(NULL) says it), or NULL
+// when it did not. Fixed texts: the reason for running out of memory allocates nothing.
+static thread_local const char* t_open_refused = nullptr;
 
 ffc_session* ffc_open_embedded(void) {
   std::signal(SIGPIPE, SIG_IGN);
-  t_open_ran_out = false;
+  t_open_refused = nullptr;
   try {
     auto s = std::make_unique<ffc_session>();  // freed if the session cannot be made
     s->session = footfall::MakeEmbeddedSession();
     return s.release();
   } catch (...) {
-    t_open_ran_out = true;
+    t_open_refused = "no session (the last ffc_open_* on this thread ran out of memory)";
     return nullptr;
   }
 }
 
 ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s) {
   std::signal(SIGPIPE, SIG_IGN);
-  t_open_ran_out = false;  // (a refusal below is no want of memory)
-  if (port < 1 || port > 65535) return nullptr;
+  t_open_refused = nullptr;
+  auto refuse = [](const char* why) {
+    t_open_refused = why;
+    return nullptr;
+  };
+  if (port < 1 || port > 65535)
+    return refuse("no session (ffc_open_rpc: the port is outside 1-65535)");
   // NaN, infinite either way, beyond any bound, or too short for any call to be answered.
-  if (!std::isfinite(timeout_s) || timeout_s > kMaxTimeout) return nullptr;
-  if (timeout_s > 0 && timeout_s < kMinTimeout) return nullptr;
+  if (!std::isfinite(timeout_s) || timeout_s > kMaxTimeout)
+    return refuse("no session (ffc_open_rpc: the timeout is NaN, infinite or above 1e6 s)");
+  if (timeout_s > 0 && timeout_s < kMinTimeout)
+    return refuse(
+        "no session (ffc_open_rpc: the timeout is below 0.001 s, too short for any call)");
   try {
     footfall::RpcOptions options;
-    if (host && *host && !footfall::ParseHost(host, &options.host)) return nullptr;
+    if (host && *host && !footfall::ParseHost(host, &options.host))
+      return refuse(
+          "no session (ffc_open_rpc: the host is no host name or IP address: a port in it, or "
+          "brackets around anything but an IPv6 address)");
     options.port = port;
     if (timeout_s > 0) options.call_timeout_s = timeout_s;
     auto s = std::make_unique<ffc_session>();
     s->session = footfall::MakeRpcSession(options);
     return s.release();
   } catch (...) {
-    t_open_ran_out = true;
-    return nullptr;
+    return refuse("no session (the last ffc_open_* on this thread ran out of memory)");
   }
 }
 
 void ffc_close(ffc_session* session) { delete session; }
 
 const char* ffc_last_error(const ffc_session* session) {
-  if (!session)
-    return t_open_ran_out ? "no session (the last ffc_open_* on this thread ran out of memory)"
-                          : "no session";
+  if (!session) return t_open_refused ? t_open_refused : "no session";
   // The calling thread's copy: another thread's call may replace the session's meanwhile.
   thread_local std::string copy;
   try {

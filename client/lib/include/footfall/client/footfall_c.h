@@ -63,8 +63,9 @@ ffc_session* ffc_open_embedded(void);
  * NULL only on bad arguments: a host holding a port ("127.0.0.1:7407"), stray brackets or
  * brackets around anything but an IPv6 address ("[]"), a
  * port outside 1-65535, a timeout above 1e6 s, infinite or NaN, or one above 0 but below
- * 0.001 s (as footfall's --timeout: no call could be answered in it); or when memory runs out
- * (ffc_last_error(NULL) then says so, on this thread). */
+ * 0.001 s (as footfall's --timeout: no call could be answered in it); or when memory runs out.
+ * ffc_last_error(NULL) then says which, on this thread ("no session (ffc_open_rpc: the port is
+ * outside 1-65535)"). */
 ffc_session* ffc_open_rpc(const char* host, int port, double timeout_s);
 /* Frees the session and its terrains (an RPC session unloads them from footfalld, connecting
  * again if a call failed or footfalld closed the connection, the connection and each unload
