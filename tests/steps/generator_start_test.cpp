@@ -420,10 +420,67 @@ TEST_CASE("A reach that leaves little room walks on level ground, shorter as it 
     const WalkTrack& body = *TracksOf(w, "").back();
     REQUIRE(body.kind == TrackKind::kBody);
     const double travelled = Distance(body.keys.back().position, body.keys.front().position);
-    CHECK(travelled > 1);
+    CHECK(travelled > 0.2);
     CHECK(travelled >= previous);  // more room, farther
     previous = travelled;
   }
+}
+
+TEST_CASE("A group's steps are held within reach together, at full length where they fit",
+          "[steps][generator]") {
+  // Each step was held within reach of the body moved by its own share of the step alone: the
+  // other feet of its group move the body too, so steps were cut that fit whole (a hopping
+  // quadruped's front feet hopped 0.3 of 0.4 every fourth hop; a trot at step_length 0.6 took
+  // 0.45 every other step), and a biped near its limit, cut by a quarter at its first step,
+  // walked a third short all the way.
+  Terrain t = LoadTerrain(MakeFlat(601, 0.05, 0), 0.05);  // 30 x 30 m
+  const GenerateOptions o = StartOptions({15, 0, 5}, 16);
+  // The foot travel of each step after the first two of every foot, and the walk's notes.
+  auto steps = [&](const Character& c, std::vector<double>* lengths) {
+    const Walk w = Generate(t, c, o);
+    INFO(w.stopped);
+    CHECK(w.stopped.empty());
+    CheckWalk(t, c, o, w);
+    lengths->clear();
+    for (const WalkTrack& track : w.tracks) {
+      if (track.kind != TrackKind::kFoot) continue;
+      std::vector<Vec3> ends;
+      for (const WalkKey& k : track.keys)
+        if (k.phase == KeyPhase::kEnd) ends.push_back(k.position);
+      for (size_t i = 3; i < ends.size(); ++i) lengths->push_back(Distance(ends[i], ends[i - 1]));
+    }
+    REQUIRE(lengths->size() >= 8);
+    return w.notes;
+  };
+  std::vector<double> lengths;
+  Character hopper = LoadShipped("quadruped");
+  hopper.gait = {{0, 1, 2, 3}};
+  steps(hopper, &lengths);
+  for (const double l : lengths) CHECK(l == Approx(hopper.step_length).margin(0.051));
+  Character trot = LoadShipped("quadruped");
+  trot.step_length = 0.6;
+  CHECK(steps(trot, &lengths).empty());  // within what reach lets a foot travel
+  for (const double l : lengths) CHECK(l == Approx(0.6).margin(0.051));
+  Character biped = LoadShipped("biped");
+  biped.step_length = 2.8;  // reach 1.2 lets a foot travel about 2.89
+  steps(biped, &lengths);
+  for (const double l : lengths) CHECK(l > 2.6);
+}
+
+TEST_CASE("A slope_step_scale far below 1 still climbs a slope", "[steps][generator]") {
+  // A step under 2% of step_length was a step in place: with slope_step_scale 0.019 every step
+  // up a ramp past the threshold was one, and the walk a dead end at the ramp's foot.
+  Character c = LoadShipped("biped");
+  c.slope_step_scale = 0.019;
+  const double spacing = 0.005;
+  Terrain t = LoadTerrain(MakeRamp(160, 300, spacing, 25), spacing);
+  GenerateOptions o = StartOptions({0.4, 0.1 * std::sin(25 * 3.14159265358979 / 180),
+                                    0.1 * std::cos(25 * 3.14159265358979 / 180)},
+                                   40);
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CHECK(w.stopped.empty());
+  CheckWalk(t, c, o, w);
 }
 
 TEST_CASE("GenerateWalk takes a null error string", "[steps][generator]") {

@@ -165,7 +165,6 @@ void Generator::Steer(Agent& a, int group) const {
 }
 
 Status Generator::QueryFootholds(std::string* error) {
-  const size_t feet = c_.feet.size();
   std::vector<Move>& moves = moves_;
   const size_t per_agent = walking_.empty() ? 0 : moves.size() / walking_.size();
   const size_t locators = pairs_of_group_[group_].size();
@@ -243,7 +242,9 @@ Status Generator::QueryFootholds(std::string* error) {
           const double side = rest_[mv.foot].x > rest_[mate_[mv.foot]].x ? 1.0 : -1.0;
           v += Left(a) * (side * 0.25 * gap_);
         }
-        if (Length(v) < kInPlace * c_.step_length) {
+        // (A step of under 2% of what this one may be, not of step_length: a slope_step_scale
+        // below 0.02 made every step up a slope a step in place, and the walk a dead end.)
+        if (Length(v) < kInPlace * std::min(c_.step_length, max_len)) {
           if (mv.attempt.drop > 0) {
             Fail(mv);  // nothing ahead to aim down at
           } else {
@@ -251,24 +252,12 @@ Status Generator::QueryFootholds(std::string* error) {
           }
           continue;
         }
-        // No target beyond reach of the body where the step will put it (the feet's centroid
-        // moves by this foot's displacement over the number of feet). Up to 256 shortenings by
-        // a quarter (1e-32 of the step): the longest step_length a character file may give,
-        // 1e9, against any reach down to 1e-23 (eight left steps over about 60 times the reach
-        // beyond it, 64 those of a step_length of 1e9).
-        for (int shrink = 0; shrink < 256; ++shrink) {
-          const Vec3 ground = a.ground + v / static_cast<double>(feet);
-          const Vec3 body = ground + a.body_up * c_.body_height;
-          if (Distance(a.foot[mv.foot] + v, body) <= c_.reach) break;
-          v = v * 0.75;
-        }
-        v -= a.up * (mv.attempt.drop * c_.max_rise);  // the last retries aim down
-        mv.ideal = a.foot[mv.foot] + v, mv.step = v;
+        mv.step = v;  // aimed down, and held within reach, by FitInReach
       }
     });
     Parallel(walkers_.size(), [&](size_t wb, size_t we) {
       for (size_t i = wb; i < we; ++i)
-        KeepPlantedInReach(walkers_[i] * per_agent, (walkers_[i] + 1) * per_agent);
+        FitInReach(walkers_[i] * per_agent, (walkers_[i] + 1) * per_agent);
     });
     queries_.clear();
     for (size_t m : pending_) {
@@ -414,54 +403,76 @@ void Generator::Fail(Move& mv) {
                  " more tries, shorter, longer or aimed down, refused too)";
 }
 
-void Generator::KeepPlantedInReach(size_t m, size_t e) {
+void Generator::FitInReach(size_t m, size_t e) {
   const Agent& a = agents_[moves_[m].agent];
-  // Only where a hold would end the walk (every other group waited in a row): elsewhere the
-  // group waits and the planted foot's own group steps on, as the gait has it.
-  if (a.waits + 1 < static_cast<int>(c_.gait.size())) return;
   const std::vector<int>& slot = move_of_foot_[group_];  // foot -> its move's offset, or -1
   const double feet = static_cast<double>(c_.feet.size());
+  // A shorter retry shortens the step that fits (a step past reach, shortened first and then
+  // fitted, aimed where the first try had, and was refused as often).
+  auto shorter = [](const Move& mv) { return std::min(1.0, mv.attempt.scale); };
   // The feet's ground moves by every foot's displacement over the number of feet: the footholds
-  // found so far, and the steps still to be asked (without their aim down: where they land).
+  // found so far, and the steps still to be asked, scaled by s.
   Vec3 found, asked;
   bool any = false;
   for (size_t i = m; i < e; ++i) {
-    const Move& mv = moves_[i];
+    Move& mv = moves_[i];
     if (mv.failed) continue;
     if (mv.done) {
       found += mv.end - a.foot[mv.foot];
     } else {
-      asked += mv.step + a.up * (mv.attempt.drop * c_.max_rise);
-      any = true;
+      mv.step = mv.step / shorter(mv);
+      asked += mv.step, any = true;
     }
   }
   if (!any) return;
-  auto body = [&](double scale) {
-    return a.ground + (found + asked * scale) / feet + a.body_up * c_.body_height;
+  auto body = [&](double s) {
+    return a.ground + (found + asked * s) / feet + a.body_up * c_.body_height;
   };
-  auto planted_in_reach = [&](double scale, bool* some) {
-    const Vec3 b = body(scale), now = body(0);
-    for (size_t f = 0; f < c_.feet.size(); ++f) {
-      if (slot[f] >= 0 || Distance(a.foot[f], now) > c_.reach) continue;  // moving, or no help
-      *some = true;
-      if (Distance(a.foot[f], b) > c_.reach) return false;
+  // Planted feet count only where a hold would end the walk (every other group waited in a
+  // row): elsewhere the group waits and the planted foot's own group steps on, as the gait has
+  // it. Feet already beyond reach before the step do not count: no step brings them back.
+  const bool planted = a.waits + 1 >= static_cast<int>(c_.gait.size());
+  // Aimed half a sample spacing inside the reach, or half the room the foot has now if less:
+  // the foothold is the sample nearest the aim, and one aimed right at the reach lay past it
+  // as often as not (the shorter retries then took 0.6 of the step).
+  const Vec3 now = body(0);
+  auto within = [&](const Vec3& foot, const Vec3& step, const Vec3& b) {
+    const double before = Distance(foot, now);
+    const double margin = std::min(0.25 * gap_, 0.5 * (c_.reach - before));
+    return before > c_.reach || Distance(foot + step, b) <= c_.reach - margin;
+  };
+  auto fits = [&](double s) {
+    const Vec3 b = body(s);
+    for (size_t i = m; i < e; ++i) {
+      const Move& mv = moves_[i];
+      if (!mv.failed && !mv.done && !within(a.foot[mv.foot], mv.step * s, b)) return false;
     }
+    for (size_t f = 0; planted && f < c_.feet.size(); ++f)
+      if (slot[f] < 0 && !within(a.foot[f], Vec3{}, b)) return false;
     return true;
   };
-  bool some = false;
-  double scale = 1;
-  for (int shrink = 0; shrink < 256 && !planted_in_reach(scale, &some); ++shrink) scale *= 0.75;
-  if (scale == 1 || !some) return;
+  // Up to 256 shortenings by a quarter (1e-32 of the step: the longest step_length a character
+  // file may give, 1e9, against any reach down to 1e-23), then the longest that fits found
+  // between the last two (a cut by a quarter alone kept a biped's steps near its reach a
+  // quarter short for the whole walk).
+  double s = 1;
+  if (!fits(1)) {
+    int shrink = 0;
+    while (shrink < 256 && !fits(s)) s *= 0.75, ++shrink;
+    if (fits(s)) {
+      double hi = s / 0.75;
+      for (int it = 0; it < 24; ++it) {
+        const double mid = 0.5 * (s + hi);
+        (fits(mid) ? s : hi) = mid;
+      }
+    }
+  }
   for (size_t i = m; i < e; ++i) {
     Move& mv = moves_[i];
     if (mv.failed || mv.done) continue;
-    const Vec3 down = a.up * (mv.attempt.drop * c_.max_rise);
-    const Vec3 v = (mv.step + down) * scale;
-    if (Length(v) < kInPlace * c_.step_length && mv.attempt.drop == 0) {
-      mv.done = true, mv.end = a.foot[mv.foot], mv.end_normal = a.foot_normal[mv.foot];
-      continue;
-    }
-    mv.step = v - down, mv.ideal = a.foot[mv.foot] + mv.step;
+    mv.step = mv.step * (s * shorter(mv)) -
+              a.up * (mv.attempt.drop * c_.max_rise);  // the last retries aim down
+    mv.ideal = a.foot[mv.foot] + mv.step;
   }
 }
 

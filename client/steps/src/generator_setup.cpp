@@ -521,18 +521,22 @@ Status Generator::FindStart(const Vec3& start, bool may_move, Foothold* first, s
 
 double Generator::LongestStepInReach() const {
   // Walking straight, each foot lands d = L (G - 1) / (2G) ahead of its rest relative to the
-  // body and lifts d behind it. 7 checks a step toward that landing against where the foot's
-  // own share of it (1/n of it) takes the body: the foot ends r.z - d + L (1 - 1/n) ahead,
-  // r.z + k L, within reach of a body body_height above the feet's ground.
+  // body and lifts d behind it. 7 checks a step toward that landing against where its group's
+  // steps take the body (g/n of it, for g feet of n in the group): the foot ends
+  // r.z - d + L (1 - g/n) ahead, r.z + k L, within reach of a body body_height above the
+  // feet's ground.
   const double groups = static_cast<double>(c_.gait.size());
   const double feet = static_cast<double>(c_.feet.size());
-  const double k = (1 - 1 / feet) - (groups - 1) / (2 * groups);
   double longest = std::numeric_limits<double>::infinity();
-  if (!(k > 0)) return longest;
-  for (const Vec3& r : rest_) {
-    const double up = c_.body_height - r.y;
-    const double along2 = c_.reach * c_.reach - r.x * r.x - up * up;
-    longest = std::min(longest, along2 > 0 ? (std::sqrt(along2) - r.z) / k : 0.0);
+  for (const std::vector<int>& group : c_.gait) {
+    const double k = (1 - static_cast<double>(group.size()) / feet) - (groups - 1) / (2 * groups);
+    if (!(k > 0)) continue;  // the body moves with the foot: no step takes it out of reach
+    for (int f : group) {
+      const Vec3& r = rest_[f];
+      const double up = c_.body_height - r.y;
+      const double along2 = c_.reach * c_.reach - r.x * r.x - up * up;
+      longest = std::min(longest, along2 > 0 ? (std::sqrt(along2) - r.z) / k : 0.0);
+    }
   }
   return std::max(longest, 0.0);
 }

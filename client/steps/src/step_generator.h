@@ -293,13 +293,15 @@ class Generator {
   // the footholds beyond reach of the body they lead to, or all of them when a planted foot
   // would be left beyond reach.
   void CheckReach(size_t m, size_t e);
-  // 7 (end). For one character whose moves are moves_[m, e), when every other group has
-  // waited in a row (a hold now would end the walk): shortens the steps still to be asked, all
-  // alike, until the body they move together leaves no planted foot beyond reach (one that is
-  // within it now). Each step's own check counts only its own share of the body's move: a hind
-  // foot's long step carried the body away from the other hind foot, and every group waited on
-  // another until the walk stopped on level ground.
-  void KeepPlantedInReach(size_t m, size_t e);
+  // 7 (end). For one character whose moves are moves_[m, e), once each step still to be asked
+  // has its vector: shortens those steps, all alike, to the longest that keeps each of their
+  // feet within reach of the body the group's steps move together (and, when every other group
+  // has waited in a row, so that a hold now would end the walk, each planted foot too), then
+  // aims the last retries down. A foot already beyond reach before the step does not count.
+  // (Each step was held to reach against the body moved by its own share alone: steps of a
+  // group, whose other feet move the body too, were cut that needed no cut, and a hind foot's
+  // long step carried the body away from the other hind foot.)
+  void FitInReach(size_t m, size_t e);
   // Whether a refusal (a gap or not) becomes mv's reason (see Move::reason).
   static bool KeepsReason(const Move& mv, bool gap) {
     return mv.reason.empty() || (mv.reason_is_gap && !gap);
