@@ -100,7 +100,7 @@ int View(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    errno = 0;  // what the write of the text sets, not an earlier call's
+    errno = 0;                       // what the write of the text sets, not an earlier call's
     if (app.exit(e) != 0) return 2;  // a refused flag: 2, as for --size and --camera
     // --help or --version: exit 0 only when its text was written (a full disk gave exit 0).
     if (!std::cout.flush()) {
