@@ -494,6 +494,20 @@ TEST_CASE("Height maps: a grid too large is refused from its header, before the 
                    "wide.asc:2: the header declares 400000000 values (20000 rows of "
                    "20000), more than the 100000000 cells a height map may have"));
   }
+  // A small grid followed by gigabytes (of NUL bytes here): refused from its size too (it was
+  // read whole, 2 x its size in memory, before "more values than the header declares").
+  for (const std::string& header :
+       {std::string("ncols 2\nnrows 2\ncellsize 1\n1 2\n3 4\n"),
+        std::string("P2\n2 2\n255\n1 2 3 4\n"), std::string("P5\n2 2\n255\n\x01\x02\x03\x04")}) {
+    const std::string path = dir.Write(header[0] == 'P' ? "tail.pgm" : "tail.asc", header);
+    std::filesystem::resize_file(path, header.size() + kBytes);
+    INFO(header);
+    CHECK((header[0] == 'P' ? ReadPgm(path, &map, &error) : ReadAscGrid(path, &map, &error)) ==
+          Status::kParseError);
+    CHECK(Contains(error, ": 3221225"));
+    CHECK(Contains(error, "bytes, far more than "));
+    CHECK(Contains(error, "data past the grid (check the header's size)"));
+  }
   CHECK(PeakResidentBytes() - peak_before < (long{256} << 20));
 }
 

@@ -151,6 +151,27 @@ constexpr size_t kHeadBytes = 65536;
 // within kHeadBytes, byte order mark removed): a header declaring a grid too large is refused
 // before the file is read (a 3 GB image took 29 s and 6 GB to be refused). Out of memory is
 // kLimitExceeded naming the file.
+// The most bytes a text height map's value takes with its white space, for CheckFileSize: a
+// double written in full ("-1.2345678901234567e+300") is 24, columns padded wide a few more.
+constexpr double kMostBytesPerTextValue = 64;
+
+// kParseError, naming `path`, when a file of `size` bytes is far larger than its header's
+// `declared` grid of `values` values could be at `most_per_value` bytes each (text values and
+// their white space; binary pixels exactly), with a megabyte to spare: data past the grid,
+// refused before it is read whole (a 2 x 2 grid followed by 3 GB took 30 s and 6 GB).
+Status CheckFileSize(const std::string& path, double size, double values, double most_per_value,
+                     const std::string& declared, std::string* error) {
+  const double most = values * most_per_value + 1048576;
+  if (size <= most) return Status::kOk;
+  std::ostringstream m;
+  m.precision(15);
+  m << size << " bytes, far more than " << declared << " needs (at most " << most
+    << " bytes: " << most_per_value << (most_per_value == 1 ? " byte" : " bytes")
+    << " a value, and a "
+    << "megabyte to spare): data past the grid (check the header's size)";
+  return Fail(path, m.str(), error);
+}
+
 template <typename StartsOk, typename HeadOk>
 Status ReadWhole(const std::string& path, std::string* text, std::string* error,
                  const StartsOk& starts_ok, const char* expected, const HeadOk& head_ok) {
@@ -186,7 +207,7 @@ Status ReadWhole(const std::string& path, std::string* text, std::string* error,
     const size_t last_space = head.find_last_of(" \t\r\n");  // no word cut in two
     if (last_space != std::string::npos) head.resize(last_space + 1);
     if (head.compare(0, 3, "\xEF\xBB\xBF") == 0) head.erase(0, 3);
-    const Status status = head_ok(head);
+    const Status status = head_ok(head, static_cast<double>(size));
     if (status != Status::kOk) return status;
     in.clear();
     in.seekg(0);
@@ -519,15 +540,18 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error,
     return !word.empty() && std::isalpha(static_cast<unsigned char>(word[0])) != 0;
   };
   // The header alone first: a grid too large is refused before the file is read whole.
-  auto header_ok = [&](const std::string& head) {
+  auto header_ok = [&](const std::string& head, double size) {
     TokenReader reader(head, false);
     AscHeader h;
     bool ended = false;
-    const Status status = ParseAscHeader(path, &reader, cell_size_given, &h, error, &ended);
+    Status status = ParseAscHeader(path, &reader, cell_size_given, &h, error, &ended);
     if (ended) return Status::kOk;  // a header longer than the head: judged whole
     if (status != Status::kOk) return status;
-    return CheckGridSize(path, path + ":" + std::to_string(h.size_line), h.ncols * h.nrows,
-                         AscDeclared(h), kMaxHeightMapCells + 1, 0, error);
+    status = CheckGridSize(path, path + ":" + std::to_string(h.size_line), h.ncols * h.nrows,
+                           AscDeclared(h), kMaxHeightMapCells + 1, 0, error);
+    if (status != Status::kOk) return status;
+    return CheckFileSize(path, size, h.ncols * h.nrows, kMostBytesPerTextValue, AscDeclared(h),
+                         error);
   };
   Status status = ReadWhole(path, &text, error, header_word,
                             "the grid header's first key ('ncols N')", header_ok);
@@ -643,15 +667,20 @@ Status ReadPgm(const std::string& path, HeightMap* out, std::string* error) {
   };
   // The header alone first: an image too large is refused before the file is read whole (a
   // header the head does not hold whole is judged once it is).
-  auto header_ok = [&](const std::string& head) {
+  auto header_ok = [&](const std::string& head, double size) {
     TokenReader reader(head, true);
     std::string magic;
     double fields[3];
     size_t size_line = 1;
     if (ParsePgmHeader(path, &reader, &magic, fields, &size_line, nullptr) != Status::kOk)
       return Status::kOk;
-    return CheckGridSize(path, path + ":" + std::to_string(size_line), fields[0] * fields[1],
-                         PgmDeclared(magic, fields), kMaxHeightMapCells + 1, 0, error);
+    const Status status =
+        CheckGridSize(path, path + ":" + std::to_string(size_line), fields[0] * fields[1],
+                      PgmDeclared(magic, fields), kMaxHeightMapCells + 1, 0, error);
+    if (status != Status::kOk) return status;
+    const double per_value = magic == "P5" ? (fields[2] < 256 ? 1 : 2) : kMostBytesPerTextValue;
+    return CheckFileSize(path, size, fields[0] * fields[1], per_value, PgmDeclared(magic, fields),
+                         error);
   };
   Status status = ReadWhole(path, &text, error, magic_word,
                             "the PGM magic 'P5' (binary) or 'P2' (ASCII)", header_ok);
