@@ -321,7 +321,8 @@ Vec3 RestCentroid(const Character& c) {
 
 Status LoadCharacter(const std::string& path, Character* out, std::string* error) {
   std::string text;
-  const Status status = detail::ReadJsonFile(path, "character file", &text, error);
+  const Status status =
+      detail::ReadJsonFile(path, "character file", &text, error, detail::kMaxCharacterFileBytes);
   if (status != Status::kOk) return status;
   const Status parsed = ParseCharacter(text, path, out, error);
   // Without a name, the file's: messages said "resampled for  at ...", and scene characters

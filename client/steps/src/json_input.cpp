@@ -261,7 +261,7 @@ std::string UnknownFieldMessage(const std::string& key, const std::set<std::stri
 }
 
 Status ReadJsonFile(const std::string& path, const char* what, std::string* text,
-                    std::string* error) {
+                    std::string* error, uint64_t max_bytes) {
   const Status status = CheckInputFile(path, what, error);
   if (status != Status::kOk) return status;
   errno = 0;
@@ -274,19 +274,41 @@ Status ReadJsonFile(const std::string& path, const char* what, std::string* text
     return Status::kIoError;
   }
   // Read straight into the string (through a stringstream the text stood twice in memory).
+  // A file whose end cannot be sought (those of /proc) has no size to read ahead: it is read
+  // to its end all the same (it read as empty).
   in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
+  const std::streamoff size = std::max<std::streamoff>(0, in.tellg());
+  in.clear();
   in.seekg(0, std::ios::beg);
+  auto too_large = [&](uint64_t bytes) {
+    *error = path + ": " + std::to_string(bytes) + " bytes, more than the " +
+             std::to_string(max_bytes >> 20) + " MB a " + what + " may have";
+    return Status::kLimitExceeded;
+  };
+  if (max_bytes > 0 && static_cast<uint64_t>(size) > max_bytes) return too_large(size);
   text->clear();
-  if (size > 0) {
-    text->resize(static_cast<size_t>(size));
-    in.read(text->data(), size);
-    text->resize(static_cast<size_t>(in.gcount()));
+  try {
+    if (size > 0) {
+      text->resize(static_cast<size_t>(size));
+      in.read(text->data(), size);
+      text->resize(static_cast<size_t>(in.gcount()));
+    }
+    // A file that grew while it was read: the rest too.
+    char buffer[65536];
+    while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
+      text->append(buffer, static_cast<size_t>(in.gcount()));
+      if (max_bytes > 0 && text->size() > max_bytes) {
+        const uint64_t bytes = text->size();
+        std::string().swap(*text);
+        return too_large(bytes);
+      }
+    }
+  } catch (const std::bad_alloc&) {
+    std::string().swap(*text);
+    *error = path + ": out of memory reading the " + std::string(what) + " (" +
+             std::to_string(size) + " bytes)";
+    return Status::kLimitExceeded;
   }
-  // A file that grew while it was read: the rest too.
-  char buffer[65536];
-  while (in.read(buffer, sizeof buffer) || in.gcount() > 0)
-    text->append(buffer, static_cast<size_t>(in.gcount()));
   if (in.bad()) {
     *error = path + ": cannot read " + what;
     return Status::kIoError;

@@ -54,10 +54,18 @@ using JsonFilter =
 bool ParseJsonText(const std::string& text, const std::string& source, JsonDocument* out,
                    std::string* error, int max_depth = 0, const JsonFilter& filter = nullptr);
 
+// The largest character and scene files read [Units: bytes]: a character is a few kilobytes,
+// a scene of thousands of inline characters some megabytes (a 3 GB file was read whole, into
+// 3 GB of memory, before its first byte was refused).
+constexpr uint64_t kMaxCharacterFileBytes = uint64_t{16} << 20;
+constexpr uint64_t kMaxSceneFileBytes = uint64_t{256} << 20;
+
 // Reads the whole of the file at `path` into *text, after CheckInputFile (a regular file);
-// `what` names it in errors ("character file": "PATH: cannot open character file").
+// `what` names it in errors ("character file": "PATH: cannot open character file"). A file of
+// more than `max_bytes` (0: no bound) is kLimitExceeded before it is read, and one memory does
+// not hold kLimitExceeded naming it.
 Status ReadJsonFile(const std::string& path, const char* what, std::string* text,
-                    std::string* error);
+                    std::string* error, uint64_t max_bytes = 0);
 
 // When `name` holds a control character (a byte below 0x20, or 0x7f: NUL, newline, escape...),
 // which no exporter or DCC can keep in a name: "a name without control characters (byte 0xNN

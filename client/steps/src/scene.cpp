@@ -127,7 +127,8 @@ Status ParseScene(const std::string& text, const std::string& source, const std:
 
 Status LoadScene(const std::string& path, std::vector<SceneCharacter>* out, std::string* error) {
   std::string text;
-  const Status status = detail::ReadJsonFile(path, "scene file", &text, error);
+  const Status status =
+      detail::ReadJsonFile(path, "scene file", &text, error, detail::kMaxSceneFileBytes);
   if (status != Status::kOk) return status;
   const size_t slash = path.rfind('/');
   const std::string folder = slash == std::string::npos ? "."
