@@ -11,6 +11,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -19,6 +21,7 @@
 
 #include "footfall/client/footfall_c.h"
 #include "footfall/import/terrain_generators.h"
+#include "footfall/steps/scene.h"
 #include "footfall/steps/walk_json.h"
 #include "walk_checks.h"
 
@@ -170,6 +173,30 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
   CHECK(ParseCharacter("\xEF\xBB\xBF" + Biped(), "b.json", &c, &error) == Status::kOk);
   CHECK(LoadCharacter("/nonexistent/c.json", &c, &error) == Status::kIoError);
   CHECK_THAT(error, Catch::Contains("/nonexistent/c.json: cannot open"));
+}
+
+TEST_CASE(
+    "Character and scene files too large are refused before they are read, and /proc "
+    "files are read whole",
+    "[steps][character]") {
+  // A 3 GB file took 3 GB and 14 s to be refused at its first byte; a file of /proc (whose end
+  // cannot be sought) was read as empty.
+  const std::string dir =
+      std::filesystem::temp_directory_path() / ("footfall-large-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = dir + "/large.json";
+  { std::ofstream(path) << "{\"format\": \"footfall-character\""; }
+  std::filesystem::resize_file(path, (uint64_t{16} << 20) + 1);  // sparse
+  Character c;
+  std::string error;
+  CHECK(LoadCharacter(path, &c, &error) == Status::kLimitExceeded);
+  CHECK(error == path + ": 16777217 bytes, more than the 16 MB a character file may have");
+  std::vector<SceneCharacter> scene;
+  CHECK(LoadScene(path, &scene, &error) != Status::kLimitExceeded);  // a scene may be larger
+  std::filesystem::remove_all(dir);
+  CHECK(LoadCharacter("/proc/self/status", &c, &error) == Status::kParseError);
+  CHECK_THAT(error, Catch::StartsWith("/proc/self/status:1:1: malformed JSON") &&
+                        !Catch::Contains("unexpected end of input"));
 }
 
 TEST_CASE("A character file that exists but cannot be opened is named with the reason",
