@@ -35,6 +35,16 @@ check "-o followed by an option: no file written" [ ! -e ./--size ]
 check "--tolerance followed by an option: told" grep -qF "footfall query: --tolerance needs a value, found the option --terrain" "$work/err.txt"
 echo "snap 0 0 0" | "$footfall" query --terrain "$work/flat.pts" --tolerance=1 > /dev/null 2> "$work/err.txt"
 check "--tolerance=1: taken" [ $? -eq 0 ]
+# A word written as an option that is none is named (a file "-flat.pts" was "input is
+# required"); after '--' it is a file name; a negative number and --name=value are values.
+cp "$work/flat.pts" "$work/-flat.pts"
+(cd "$work" && "$footfall" terrain info -flat.pts) > /dev/null 2> "$work/err.txt"
+check "file name starting with '-': exit 1" [ $? -eq 1 ]
+check "file name starting with '-': told" grep -qxF "footfall terrain info: unknown option '-flat.pts' (footfall terrain info --help lists them; a file whose name starts with '-' goes after '--')" "$work/err.txt"
+(cd "$work" && "$footfall" terrain info -- -flat.pts) > /dev/null
+check "file name starting with '-' after '--': read" [ $? -eq 0 ]
+echo "next 0 0 0 1 0 0" | "$footfall" query --terrain="$work/flat.pts" --tolerance=-1 > /dev/null 2> "$work/err.txt"
+check "--tolerance=-1: refused as a value" grep -qF -- "--tolerance: '-1' is not a finite number >= 0" "$work/err.txt"
 # --version prints the version and exits 0, as a script checking which footfall it runs expects.
 out=$("$footfall" --version 2> "$work/err.txt")
 check "--version: exit 0" [ $? -eq 0 ]

@@ -1,4 +1,5 @@
 // footfall: footstep placement on uneven terrain, from the command line.
+#include <cctype>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
@@ -53,7 +54,8 @@ std::string CommandHint(const CLI::App& root, int argc, char** argv) {
 }
 
 // An option that takes a value followed by another option instead ("--terrain --character
-// c.json"): "footfall generate: --terrain needs a value, found the option --character"; else "".
+// c.json"): "footfall generate: --terrain needs a value, found the option --character", or a
+// word written as an option that is none of the command's; else "".
 // CLI11 takes the next word as the value whatever it is, so "--out --steps" wrote a file named
 // "--steps" and the flag was lost. The command words must be valid (CommandHint is "").
 std::string MissingValueHint(const CLI::App& root, int argc, char** argv) {
@@ -74,15 +76,30 @@ std::string MissingValueHint(const CLI::App& root, int argc, char** argv) {
       if (o->check_name(word)) return o;
     return nullptr;
   };
-  for (; i + 1 < argc; ++i) {
+  // A word that is no option of the command though written as one: not a negative number, a
+  // short option with its value joined ("-ofile"), nor "--name=value" of a known name.
+  auto unknown = [&](const std::string& word) {
+    if (word.size() < 2 || word[0] != '-' || word == "-h" || word == "--help") return false;
+    if (std::isdigit(static_cast<unsigned char>(word[1])) || word[1] == '.') return false;
+    if (word[1] != '-' && option(word.substr(0, 2))) return false;
+    const size_t equals = word.find('=');
+    return !(word[1] == '-' && equals != std::string::npos && option(word.substr(0, equals)));
+  };
+  for (; i < argc; ++i) {
     const std::string word = argv[i];
     if (word == "--") break;  // the rest are arguments, whatever they look like
     const CLI::Option* taking = option(word);
+    // (A file named "-dash.pts" was "input is required".)
+    if (!taking && unknown(word))
+      return path + ": unknown option '" + word + "' (" + path +
+             " --help lists them; a file whose name starts with '-' goes after '--')";
     if (!taking || taking->get_items_expected_min() == 0) continue;
-    const std::string next = argv[i + 1];
-    if (option(next) || next == "-h" || next == "--help")
-      return path + ": " + word + " needs a value, found the option " + next + " (" + path +
-             " --help)";
+    if (i + 1 < argc) {
+      const std::string next = argv[i + 1];
+      if (option(next) || next == "-h" || next == "--help")
+        return path + ": " + word + " needs a value, found the option " + next + " (" + path +
+               " --help)";
+    }
     i += taking->get_items_expected_min();  // its values are not options to check
   }
   return "";
