@@ -95,6 +95,11 @@ TEST_CASE("ReadPointStream rejects bad lines with file and line", "[terrain][poi
     CHECK(error == "t.pts:3: column 3: 'abc' is not a number (expected x y z nx ny nz)");
     CHECK(Read("0 0 1.5x 0 1 0\n", &s, &error) == Status::kParseError);
     CHECK(error.find("t.pts:1: column 3") == 0);
+    // Bytes that do not show are shown as bytes too: a NUL is no question mark.
+    CHECK(Read(std::string("0 0 a\0b 0 1 0\n", 14), &s, &error) == Status::kParseError);
+    CHECK(error ==
+          "t.pts:1: column 3: 'a?b' (bytes 61 00 62) is not a number (expected x y z nx "
+          "ny nz)");
     // A decimal comma (a European locale's export) or values separated by commas are named.
     CHECK(Read("0 -0,25 1 0 1 0\n", &s, &error) == Status::kParseError);
     CHECK(error ==

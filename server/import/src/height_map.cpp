@@ -93,23 +93,6 @@ bool IsNanText(const std::string& token) {
   return t == "nan" || t == "-nan" || t == "+nan" || IsMicrosoftNaN(token);
 }
 
-// " (bytes 1A)" for a short token holding bytes that do not show (control bytes, a no-break
-// space, a DOS end-of-file mark), else "".
-std::string HexBytes(const std::string& token) {
-  const bool hidden = std::any_of(token.begin(), token.end(), [](char c) {
-    const unsigned char b = static_cast<unsigned char>(c);
-    return b < 0x20 || b >= 0x7f;
-  });
-  if (!hidden || token.size() > 8) return "";
-  std::string out = " (bytes";
-  char hex[4];
-  for (const char c : token) {
-    std::snprintf(hex, sizeof hex, " %02X", static_cast<unsigned char>(c));
-    out += hex;
-  }
-  return out + ")";
-}
-
 // "value 'T' is not a finite number", with what it looks like: Microsoft C's NaN or infinity,
 // a decimal comma, or values separated by commas.
 std::string NotAValue(const std::string& token) {
@@ -619,7 +602,7 @@ Status ReadAscGrid(const std::string& path, HeightMap* out, std::string* error,
     // no-break space) read as a value left the user counting the values shown.
     return Fail(path + ":" + std::to_string(reader.line()),
                 "more than the " + std::to_string(total) + " values the header declares: '" +
-                    ShownText(value) + "'" + HexBytes(value) + " follows them",
+                    ShownText(value) + "'" + HiddenBytesNote(value) + " follows them",
                 error);
   }
   return Status::kOk;

@@ -128,8 +128,8 @@ Status CheckCoordinate(const std::string& where, const std::string& token, doubl
   double value = 0;
   if (!ParseFiniteDecimal(token, &value))
     return Fail(where,
-                "vertex coordinate '" + ShownText(token) + "' is not a finite number" +
-                    NotFiniteNote(token) + CommaNote(token),
+                "vertex coordinate '" + ShownText(token) + "'" + HiddenBytesNote(token) +
+                    " is not a finite number" + NotFiniteNote(token) + CommaNote(token),
                 error);
   *value_out = value;
   if (std::fabs(value) > terrain::kMaxCoordinate) {
@@ -688,7 +688,8 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
     auto not_a_number = [&](const Element& e, size_t p, const std::string& token) {
       return Fail(At(path, number),
                   ShownText(e.name) + " property '" + ShownText(e.properties[p]) + "': '" +
-                      ShownText(token) + "' is not a number" + CommaNote(token),
+                      ShownText(token) + "'" + HiddenBytesNote(token) + " is not a number" +
+                      CommaNote(token),
                   error);
     };
     long long found = 0;

@@ -115,8 +115,9 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
         }
         if (read == DecimalRead::kNotANumber) {
           return Fail(name, line_no,
-                      "column " + std::to_string(count + 1) + ": '" + ShownText(token) +
-                          "' is not a number" + CommaNote(token) + " (expected x y z nx ny nz)",
+                      "column " + std::to_string(count + 1) + ": '" + ShownText(token) + "'" +
+                          HiddenBytesNote(token) + " is not a number" + CommaNote(token) +
+                          " (expected x y z nx ny nz)",
                       out, error);
         }
         if (!std::isfinite(value)) {

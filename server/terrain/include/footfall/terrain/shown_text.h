@@ -29,6 +29,23 @@ inline std::string ShownText(std::string_view text) {
   return out;
 }
 
+// " (bytes 1A)" for a token of at most 8 bytes holding bytes that do not show as themselves in
+// ShownText or on a terminal (control bytes, a NUL, a no-break space, a DOS end-of-file mark),
+// else "": a NUL shown as '?' read as the question mark it is not.
+inline std::string HiddenBytesNote(std::string_view token) {
+  bool hidden = false;
+  for (const char c : token)
+    hidden |= static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f;
+  if (!hidden || token.size() > 8) return "";
+  static const char kDigits[] = "0123456789ABCDEF";
+  std::string out = " (bytes";
+  for (const char c : token) {
+    const unsigned char b = static_cast<unsigned char>(c);
+    out += ' ', out += kDigits[b >> 4], out += kDigits[b & 15];
+  }
+  return out + ")";
+}
+
 // The length of the well-formed UTF-8 sequence at `text[at]` (RFC 3629: no overlong forms, no
 // surrogates, nothing past U+10FFFF), or 0 when the bytes there are not one (or `at` is past the
 // end).
