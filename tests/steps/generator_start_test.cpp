@@ -467,6 +467,24 @@ TEST_CASE("A group's steps are held within reach together, at full length where 
   for (const double l : lengths) CHECK(l > 2.6);
 }
 
+TEST_CASE("A stop for reach says when the feet's room is narrower than the samples' spacing",
+          "[steps][generator]") {
+  // A hexapod with 1 cm of room within reach on a 2.5 cm grid: no sample lay within its room,
+  // and the walk stopped at its first step saying only "beyond reach".
+  Character c = LoadShipped("hexapod");
+  double rest = 0;
+  for (const FootSpec& f : c.feet)
+    rest = std::max(rest, std::hypot(f.rest.x, c.body_height - f.rest.y, f.rest.z));
+  c.reach = rest + 0.012;
+  Terrain t = LoadTerrain(MakeFlat(161, 0.025, 0), 0.025);  // 4 x 4 m
+  const Walk w = Generate(t, c, StartOptions({2, 0, 1}, 30));
+  REQUIRE_FALSE(w.stopped.empty());
+  CHECK_THAT(w.stopped, Catch::Contains("beyond reach") &&
+                            Catch::Contains("of room within it, less than the terrain's samples "
+                                            "lie apart (about 0.025") &&
+                            Catch::Contains("raise reach, or resample the terrain finer"));
+}
+
 TEST_CASE("A slope_step_scale far below 1 still climbs a slope", "[steps][generator]") {
   // A step under 2% of step_length was a step in place: with slope_step_scale 0.019 every step
   // up a ramp past the threshold was one, and the walk a dead end at the ramp's foot.

@@ -500,6 +500,16 @@ void Generator::CheckReach(size_t m, size_t e) {
       Text why(3);
       why << "the foothold at " << Point(moves[i].end) << " is " << Beyond(dist, c_.reach)
           << " from the body, beyond reach " << NumberText(c_.reach);
+      // Room within reach narrower than the samples' spacing: no sample may lie within it (a
+      // hexapod with 1 cm of room on a 2.5 cm grid stopped at its first step, saying only this).
+      const double spacing = 0.5 * gap_;
+      const double room =
+          c_.reach - Distance(a.foot[moves[i].foot], a.ground + a.body_up * c_.body_height);
+      if (room > 0 && room < spacing) {
+        why << "; the foot had " << room << " of room within it, less than the terrain's "
+            << "samples lie apart (about " << spacing << "): raise reach, or resample the terrain "
+            << "finer";
+      }
       moves[i].done = false;
       if (KeepsReason(moves[i], false)) moves[i].reason = why.str(), moves[i].reason_is_gap = false;
     }
