@@ -102,14 +102,8 @@ int View(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     errno = 0;                       // what the write of the text sets, not an earlier call's
     if (app.exit(e) != 0) return 2;  // a refused flag: 2, as for --size and --camera
-    // --help or --version: exit 0 only when its text was written (a full disk gave exit 0).
-    if (!std::cout.flush()) {
-      const int why = errno;
-      std::cerr << "footfall-view: cannot write standard output"
-                << (why ? std::string(": ") + std::strerror(why) : std::string()) << '\n';
-      return 1;
-    }
-    return 0;
+    // --help or --version: exit 0 only when its text was written.
+    return footfall::FlushStandardOutput("footfall-view") ? 0 : 1;
   }
   // (Without --live it was ignored: the screenshot was taken at once.)
   if (live_wait_opt->count() > 0 && !o.live) {

@@ -457,9 +457,9 @@ void Generator::FitInReach(size_t m, size_t e) {
   // quarter short for the whole walk).
   double s = 1;
   if (!fits(1)) {
-    int shrink = 0;
-    while (shrink < 256 && !fits(s)) s *= 0.75, ++shrink;
-    if (fits(s)) {
+    bool fitted = false;
+    for (int shrink = 0; !(fitted = fits(s)) && shrink < 256; ++shrink) s *= 0.75;
+    if (fitted) {
       double hi = s / 0.75;
       for (int it = 0; it < 24; ++it) {
         const double mid = 0.5 * (s + hi);

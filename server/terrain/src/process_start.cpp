@@ -9,6 +9,8 @@
 #include <cerrno>
 #include <chrono>
 #include <cstdint>
+#include <cstring>
+#include <iostream>
 
 namespace footfall {
 
@@ -65,6 +67,14 @@ size_t WriteWaiting(int fd, const char* data, size_t size, int first_wait_ms, in
     break;
   }
   return done;
+}
+
+bool FlushStandardOutput(const char* program) {
+  if (std::cout.flush()) return true;
+  const int why = errno;
+  std::cerr << program << ": cannot write standard output"
+            << (why ? std::string(": ") + std::strerror(why) : std::string()) << '\n';
+  return false;
 }
 
 bool SignalIgnored(int signal_number) {

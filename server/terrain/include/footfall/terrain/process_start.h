@@ -22,6 +22,11 @@ int OpenClosedStandardStreams();
 size_t WriteWaiting(int fd, const char* data, size_t size, int first_wait_ms, int rest_wait_ms,
                     int* error);
 
+// Flushes std::cout: true when everything written to it reached its file; else false, after
+// "PROGRAM: cannot write standard output: REASON" on stderr (REASON from errno, which the caller
+// sets to 0 before writing: a full disk gave exit 0 with nothing written).
+bool FlushStandardOutput(const char* program);
+
 // Whether `signal_number` is ignored (SIG_IGN) now: a program that installs a handler leaves one
 // ignored when it started so (under nohup, or as a script's background job).
 bool SignalIgnored(int signal_number);
