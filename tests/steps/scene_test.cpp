@@ -305,6 +305,45 @@ TEST_CASE("A scene's walk holds every character's tracks under its name", "[step
   CHECK(scene.stopped == "bugs: step 3 of c2: no foothold (and 1 more stopped)");
 }
 
+TEST_CASE("A scene's engine failures are said in the scene's order, before terrain stops",
+          "[steps][scene]") {
+  // (Each failure went to the front: the last character's was said first.)
+  auto failed_walk = [](const std::string& reason) {
+    Walk w;
+    w.tracks.resize(1);
+    w.tracks[0].name = "L";
+    w.stopped = reason;
+    w.stops = {reason};
+    w.session_failed = true;
+    w.failed_stops = 1;
+    return w;
+  };
+  Walk stopped;
+  stopped.tracks.resize(1);
+  stopped.tracks[0].name = "L";
+  stopped.stopped = "step 2: a cliff";
+  stopped.stops = {"step 2: a cliff"};
+  Walk crowd;  // a crowd whose two members the engine failed, after one stopped at the terrain
+  crowd.tracks.resize(1);
+  crowd.tracks[0].name = "L1", crowd.tracks[0].character = "c1";
+  crowd.stops = {"c1: footfalld died", "c2: footfalld died", "step 1 of c3: a cliff"};
+  crowd.stopped = crowd.stops.front();
+  crowd.session_failed = true;
+  crowd.failed_stops = 2;
+  Walk scene;
+  AddToSceneWalk("cliff", std::move(stopped), &scene);
+  AddToSceneWalk("first", failed_walk("footfalld died"), &scene);
+  AddToSceneWalk("crowd", std::move(crowd), &scene);
+  AddToSceneWalk("last", failed_walk("footfalld died"), &scene);
+  CHECK(scene.session_failed);
+  CHECK(scene.failed_stops == 4);
+  CHECK(scene.stops ==
+        std::vector<std::string>{"first: footfalld died", "crowd: c1: footfalld died",
+                                 "crowd: c2: footfalld died", "last: footfalld died",
+                                 "cliff: step 2: a cliff", "crowd: step 1 of c3: a cliff"});
+  CHECK(scene.stopped == "first: footfalld died (and 5 more stopped)");
+}
+
 TEST_CASE("Scene characters started on top of each other are said in notes", "[steps][scene]") {
   // Two characters given one start walked as one without a word (a crowd keeps its own apart).
   const Character biped = LoadShipped("biped");

@@ -210,6 +210,8 @@ Status Generator::Run(std::string* error) {
     return x->failed != y->failed ? x->failed : x->stopped_step < y->stopped_step;
   });
   walk_.session_failed = !stopped.empty() && stopped[0]->failed;
+  walk_.failed_stops = static_cast<size_t>(
+      std::count_if(stopped.begin(), stopped.end(), [](const Agent* a) { return a->failed; }));
   walk_.stops.clear();
   for (const Agent* a : stopped) walk_.stops.push_back(a->stopped);
   if (!stopped.empty()) walk_.stopped = stopped[0]->stopped;

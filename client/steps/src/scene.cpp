@@ -157,13 +157,16 @@ void AddToSceneWalk(const std::string& name, Walk&& walk, Walk* scene) {
   std::vector<std::string> stops;
   for (const std::string& stop : walk.stops) stops.push_back(name + ": " + stop);
   if (walk.stops.empty() && !walk.stopped.empty()) stops.push_back(name + ": " + walk.stopped);
-  // A failure of the engine goes before the terrain's stops (the first of a walk's stops is its
-  // failure when it has one).
-  if (walk.session_failed && !stops.empty()) {
-    scene->stops.insert(scene->stops.begin(), stops.front());
-    stops.erase(stops.begin());
-  }
-  scene->stops.insert(scene->stops.end(), stops.begin(), stops.end());
+  // The engine's failures go before the terrain's stops, after those of the characters added
+  // before (a walk's stops begin with its failures), so the first failure said is the scene's
+  // first character's.
+  const size_t failed =
+      std::min(stops.size(), std::max(walk.failed_stops, walk.session_failed ? size_t{1} : 0));
+  scene->stops.insert(scene->stops.begin() + static_cast<std::ptrdiff_t>(scene->failed_stops),
+                      stops.begin(), stops.begin() + static_cast<std::ptrdiff_t>(failed));
+  scene->stops.insert(scene->stops.end(), stops.begin() + static_cast<std::ptrdiff_t>(failed),
+                      stops.end());
+  scene->failed_stops += failed;
   scene->session_failed |= walk.session_failed;
   for (const std::string& note : walk.notes) scene->notes.push_back(name + ": " + note);
   SetSceneStopped(scene);

@@ -93,6 +93,8 @@ struct Walk {
   // answering after the first step), not at the terrain: stopped and stops then begin with
   // that failure (not written to files).
   bool session_failed = false;
+  // How many of stops, from the front, are the engine's failures (one per character it failed).
+  size_t failed_stops = 0;
 };
 
 const char* PhaseName(KeyPhase phase);  // "start", "mid", "end" or ""
