@@ -282,6 +282,15 @@ check "glTF beyond memory: the JSON written" [ -s "$work/oom.json" ]
 # file, and the cut file replaced the good one with exit 0. Whatever the machine's memory makes
 # of it, the file is whole, or refused and the previous one kept.
 "$footfall" terrain make flat --size 20 --spacing 0.05 -o "$work/flat20.pts" > /dev/null
+# One name for the file to write in every command: `terrain make` and `convert` take --out as
+# `generate` does, and `generate` takes -o as they do.
+"$footfall" terrain make flat --size 20 --spacing 0.05 --out "$work/flat20-out.pts" > /dev/null
+check "terrain make --out writes what -o does" cmp -s "$work/flat20.pts" "$work/flat20-out.pts"
+"$footfall" terrain convert "$work/flat20.pts" --out "$work/flat20-convert.pts" > /dev/null
+check "terrain convert --out writes the file" [ -s "$work/flat20-convert.pts" ]
+"$footfall" generate --terrain "$work/flat20.pts" --character "$chars/biped.json" --steps 2 \
+  -o "$work/short-o.json" 2> /dev/null
+check "generate -o writes the walk" [ -s "$work/short-o.json" ]
 python3 - "$work/centipede.json" <<'PY'
 import json, sys
 feet = [{"name": "%s%d" % (s, i), "rest": [0.06 if s == "L" else -0.06, 0, 0.3 - 0.03 * i]}

@@ -383,7 +383,7 @@ void AddTerrainCommand(CLI::App& app, int* exit_code) {
       "convert", "Resample a mesh or height map (or copy a point file) into a point file");
   c->add_option("input", convert->input, "Terrain file (.obj .ply .off .stl .asc .pgm .pts)")
       ->required();
-  c->add_option("-o,--output", convert->output, "Point file to write (.pts .xyz .txt)")
+  c->add_option("-o,--output,--out", convert->output, "Point file to write (.pts .xyz .txt)")
       ->required()
       ->check(kPointFileOutput);
   AddLoadFlags(c, &convert->load);
@@ -406,7 +406,7 @@ void AddTerrainCommand(CLI::App& app, int* exit_code) {
   m->add_option("kind", make->kind, "stairs, blocks, ramp, rocks, sphere, flat or hills")
       ->required()
       ->check(CLI::IsMember({"stairs", "blocks", "ramp", "rocks", "sphere", "flat", "hills"}));
-  m->add_option("-o,--output", make->output, "Point file to write (.pts .xyz .txt)")
+  m->add_option("-o,--output,--out", make->output, "Point file to write (.pts .xyz .txt)")
       ->required()
       ->check(kPointFileOutput);
   m->add_option("--spacing", make->spacing, "Distance between samples")
