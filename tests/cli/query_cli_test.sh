@@ -42,6 +42,14 @@ cp "$work/flat.pts" "$work/-flat.pts"
 check "file name starting with '-': exit 1" [ $? -eq 1 ]
 check "file name starting with '-': told" grep -qxF "footfall terrain info: unknown option '-flat.pts' (footfall terrain info --help lists them; a file whose name starts with '-' goes after '--')" "$work/err.txt"
 (cd "$work" && "$footfall" terrain info -- -flat.pts) > /dev/null
+# A misspelt option is named with the one it was most likely meant to be.
+"$footfall" generate --terrain "$work/flat.pts" --setps 3 > /dev/null 2> "$work/err.txt"
+check "misspelt option: exit 1" [ $? -eq 1 ]
+check "misspelt option: the near one suggested" grep -qF "footfall generate: unknown option '--setps': did you mean --steps? (" "$work/err.txt"
+"$footfall" terrain make flat --outptu "$work/x.pts" > /dev/null 2> "$work/err.txt"
+check "misspelt option of terrain make: suggested" grep -qF "unknown option '--outptu': did you mean --output?" "$work/err.txt"
+"$footfall" generate --terrain "$work/flat.pts" --xyz 3 > /dev/null 2> "$work/err.txt"
+check "an option near none: no suggestion" grep -qF "unknown option '--xyz' (footfall generate --help" "$work/err.txt"
 check "file name starting with '-' after '--': read" [ $? -eq 0 ]
 echo "next 0 0 0 1 0 0" | "$footfall" query --terrain="$work/flat.pts" --tolerance=-1 > /dev/null 2> "$work/err.txt"
 check "--tolerance=-1: refused as a value" grep -qF -- "--tolerance: '-1' is not a finite number >= 0" "$work/err.txt"

@@ -1,4 +1,5 @@
 // footfall: footstep placement on uneven terrain, from the command line.
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <csignal>
@@ -53,6 +54,42 @@ std::string CommandHint(const CLI::App& root, int argc, char** argv) {
   return path + ": a command is required: " + names(at) + " (" + path + " --help)";
 }
 
+// The number of single-character edits (insertions, deletions, substitutions) between a and b.
+size_t EditDistance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1] ? 1 : 0)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// The long option of `options` that `word` ("--setps", "-steps", "--sep") was most likely meant
+// to be, as "--steps"; "" when none is near. Near: at most two edits away (one for names of
+// four letters or fewer), or a name the word begins, of three letters or more.
+std::string NearestOptionName(const std::vector<const CLI::Option*>& options,
+                              const std::string& word) {
+  const std::string written = word.substr(word.find_first_not_of('-'));
+  std::string best;
+  size_t best_distance = 3;
+  for (const CLI::Option* o : options) {
+    for (const std::string& name : o->get_lnames()) {
+      size_t distance = EditDistance(written, name);
+      if (name.size() <= 4 && distance > 1) continue;
+      if (written.size() >= 3 && name.compare(0, written.size(), written) == 0)
+        distance = std::min<size_t>(distance, 2);
+      if (distance < best_distance) best = "--" + name, best_distance = distance;
+    }
+  }
+  return best;
+}
+
 // An option that takes a value followed by another option instead ("--terrain --character
 // c.json"): "footfall generate: --terrain needs a value, found the option --character", or a
 // word written as an option that is none of the command's; else "".
@@ -90,9 +127,12 @@ std::string MissingValueHint(const CLI::App& root, int argc, char** argv) {
     if (word == "--") break;  // the rest are arguments, whatever they look like
     const CLI::Option* taking = option(word);
     // (A file named "-dash.pts" was "input is required".)
-    if (!taking && unknown(word))
-      return path + ": unknown option '" + word + "' (" + path +
+    if (!taking && unknown(word)) {
+      const std::string meant = NearestOptionName(options, word);
+      return path + ": unknown option '" + word + "'" +
+             (meant.empty() ? "" : ": did you mean " + meant + "?") + " (" + path +
              " --help lists them; a file whose name starts with '-' goes after '--')";
+    }
     if (!taking || taking->get_items_expected_min() == 0) continue;
     if (i + 1 < argc) {
       const std::string next = argv[i + 1];
