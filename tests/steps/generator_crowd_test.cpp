@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -156,6 +157,42 @@ TEST_CASE("Crowd places closer than the terrain's samples are left out for their
     CHECK_THAT(stop, Catch::EndsWith("apart): left out of the walk"));
     CHECK_THAT(stop, !Catch::Contains("runs off the terrain"));
   }
+}
+
+TEST_CASE("Crowd members pushed onto the terrain's edge plant no foot on another's sample",
+          "[steps][generator][crowd]") {
+  // 1,000 hexapods on 12 m of rocks: the grid runs far off the terrain, and places pushed onto
+  // its edge snapped just over half a spacing from others' starts, so both kept walking with a
+  // foot each on one sample (three samples shared). The member pushed farther is left out.
+  const Character c = LoadShipped("hexapod");
+  const RawSamples ground = MakeRocks(12, 0.4, 0.025, 3);
+  Terrain t = LoadTerrain(ground, 0.025);
+  const Walk w = Generate(t, c, CrowdOptions({6, 1, 6}, 1, 1000, 2 * c.reach));
+  std::map<std::pair<uint32_t, int>, std::string> owner;  // (x, z) in mm -> member
+  std::map<std::string, int> members;
+  size_t shared = 0;
+  for (const WalkTrack& track : w.tracks) {
+    if (track.kind != TrackKind::kFoot) continue;
+    ++members[track.character];
+    const Vec3& p = track.keys.front().position;
+    const auto at = std::make_pair(static_cast<uint32_t>(std::lround(p.x * 1000 + 1e6)),
+                                   static_cast<int>(std::lround(p.z * 1000)));
+    const auto [it, added] = owner.emplace(at, track.character);
+    if (!added && it->second != track.character) {
+      ++shared;
+      UNSCOPED_INFO(track.character << " and " << it->second << " share a sample at " << p.x << ", "
+                                    << p.z);
+    }
+  }
+  CHECK(shared == 0);
+  CHECK(members.size() > 400);  // the members on the terrain kept
+  bool said = false;
+  for (const std::string& stop : w.stops)
+    said |= stop.find("stands on the sample a foot of c") != std::string::npos &&
+            stop.find(
+                "the grid runs off the terrain, or over a drop, there): left out of the "
+                "walk") != std::string::npos;
+  CHECK(said);
 }
 
 TEST_CASE("A crowd of insects on bumpy ground stands on a grid across world up",

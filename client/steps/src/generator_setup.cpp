@@ -247,6 +247,43 @@ Status Generator::Setup(std::string* error) {
     a.walking = false, a.left_out = true;
     a.stopped = m.str(), a.stopped_step = 1;
   }
+  // A foot planted on the sample another character's foot stands on, where their starts were
+  // pushed together (onto the terrain's edge: a quarter nearer than their places on the grid,
+  // beyond what the samples' spacing explains): the one pushed farther is left out (a foot
+  // each on one sample, at the edge of rocks). Neighbours on coarse samples keep sharing one.
+  std::unordered_map<uint32_t, int> foot_owner;  // sample index -> the character standing on it
+  std::vector<int> by_push(static_cast<size_t>(n));
+  std::vector<double> push(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) by_push[i] = i, push[i] = Distance(places[i], snapped_start[i]);
+  std::stable_sort(by_push.begin(), by_push.end(), [&](int a, int b) { return push[a] < push[b]; });
+  for (int i : by_push) {
+    Agent& a = agents_[i];
+    if (a.left_out) continue;
+    const Foothold* planted = &answers_[static_cast<size_t>(i) * feet];
+    int other = -1;
+    size_t foot = 0;
+    // (A character stopped at its start keeps its keys, and its feet their samples.)
+    for (size_t f = 0; f < feet && other < 0 && a.walking; ++f) {
+      if (planted[f].status != Status::kOk) continue;
+      const auto it = foot_owner.find(planted[f].index);
+      if (it == foot_owner.end()) continue;
+      const int j = it->second;
+      if (Distance(snapped_start[i], snapped_start[j]) <
+          0.75 * Distance(places[i], places[j]) - gap_)
+        other = j, foot = f;
+    }
+    if (other < 0) {
+      for (size_t f = 0; f < feet; ++f)
+        if (planted[f].status == Status::kOk) foot_owner.emplace(planted[f].index, i);
+      continue;
+    }
+    Text m;
+    m << "step 1 of " << a.id << ": its foot " << c_.feet[foot].name << ", at "
+      << Point(planted[foot].point) << ", stands on the sample a foot of " << agents_[other].id
+      << " does (" << crowded_why(push[i]) << "): left out of the walk";
+    a.walking = false, a.left_out = true;
+    a.stopped = m.str(), a.stopped_step = 1;
+  }
   // 5 (set-up). How far each waypoint lies from the terrain (one batch of snaps), for Reached.
   const size_t waypoints = o_.path.size();
   if (waypoints > 0) {
