@@ -43,6 +43,11 @@ check "embedded report" check_report embedded "$work/embedded.json" ""
 "$footfall" bench --terrain "$hills" --queries 3000 --batch 1000 --min-time 0.02 > "$work/text"
 check "text report names the backend" grep -q '^backend: embedded$' "$work/text"
 check "text report has a line per figure" [ "$(grep -c 'ns/query' "$work/text")" -eq 8 ]
+# Ratios keep three significant digits: against brute force on a large terrain, three
+# decimals read x0.000.
+ratios=$(grep -o '(x[^)]*)' "$work/text" | tr -d '(x)')
+check "text report gives ratios" [ -n "$ratios" ]
+check "no ratio reads zero" awk '$1 + 0 <= 0 { bad = 1 } END { exit bad }' <<< "$ratios"
 
 # 2. Over RPC against a real footfalld: the embedded engine is the batches' baseline.
 start_server "$footfalld"

@@ -371,8 +371,10 @@ int RunBench(const BenchFlags& flags) {
     std::cout << "  " << std::left << std::setw(40) << f.name << std::right << std::fixed
               << std::setprecision(0) << std::setw(10) << f.ns << " ns/query";
     if (f.base_ns > 0)
-      std::cout << "   " << f.base << " " << f.base_ns << " ns (x" << std::setprecision(3)
-                << f.ns / f.base_ns << ")";
+      // (Three significant digits: against brute force on a large terrain, three decimals
+      // read x0.000.)
+      std::cout << "   " << f.base << " " << f.base_ns << " ns (x" << std::defaultfloat
+                << std::setprecision(3) << f.ns / f.base_ns << ")";
     std::cout << std::defaultfloat << '\n';
   }
   if (refused_snaps + refused_nexts > 0) {
