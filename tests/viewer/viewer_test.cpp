@@ -880,6 +880,43 @@ TEST_CASE("live: a query on another terrain of footfalld is drawn untraced, with
   CHECK_THAT(viewer->Err(), Catch::Contains("were asked on another terrain of the server"));
 }
 
+TEST_CASE("live: a screenshot frames the live queries it waited for beside the terrain",
+          "[viewer][live]") {
+  // A query on another terrain of the server, 500 m from the viewer's: the camera framed the
+  // viewer's terrain alone, and the answer it waited for was out of the picture ("visible":
+  // false), though F frames it in the window.
+  const std::string dir = test::TempDir();
+  const LocalServer server(dir);
+  INFO("footfalld stderr: " << server.child.Err());
+  REQUIRE_FALSE(server.port.empty());
+  const std::string far = dir + "/far.pts";
+  {
+    std::ofstream out(far);
+    for (int k = 0; k < 20; ++k)
+      for (int i = 0; i < 20; ++i) out << 500 + 0.1 * i << " 0 " << 500 + 0.1 * k << " 0 1 0\n";
+  }
+  const std::unique_ptr<test::Child> viewer = FollowLive(server.address, dir, "320x200");
+  INFO("viewer stderr: " << viewer->Err());
+  for (const std::string& terrain : {far, std::string(kTerrain)}) {
+    const RunResult client =
+        Run({FOOTFALL_CLI, "query", "--terrain", terrain, "--server", server.address}, {}, kTimeout,
+            "snap 501 0 501\n");
+    INFO("footfall query: " << client.out << client.err);
+    REQUIRE(client.exit_code == 0);
+  }
+  int code = -1;
+  REQUIRE(viewer->Wait(kTimeout, &code));
+  REQUIRE(code == 0);
+  const json state = json::parse(test::ReadFile(dir + "/state.json"));
+  const json& queries = state["live"]["queries"];
+  REQUIRE(queries.size() == 2);
+  CHECK(queries[0]["other_terrain"] == true);
+  for (const json& q : queries) {
+    INFO(q.dump());
+    CHECK(q["visible"] == true);
+  }
+}
+
 namespace {
 
 // What a viewer with nothing loaded drew once `footfall query --terrain terrain` had sent

@@ -495,6 +495,11 @@ struct App {
       }
     }
     PullLive();
+    // The queries waited for are in the picture: framed with the rest, as F frames them (the
+    // camera framed the terrain alone: a query beside it, or on another terrain of the
+    // server, was left out), unless --camera places it.
+    if (live && options.live_wait > 0 && !options.has_camera)
+      FrameAll(options.width, options.height);
     Render(options.width, options.height);
     // The screenshot and the state dump replace their files together, once both are written:
     // a dump that failed left a new picture beside the old dump.
