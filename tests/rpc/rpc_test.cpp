@@ -1978,6 +1978,23 @@ TEST_CASE("footfalld listens on IPv6 addresses and logs them in brackets", "[rpc
                         Catch::Contains("cannot listen on [::1]:7407: "));
     CHECK_THAT(log, !Catch::Contains("cannot resolve"));
   }
+  SECTION(
+      "a bare IPv6 address and port, and an address alone, read as footfall --server reads "
+      "them") {
+    // ("::1:PORT" was an address that does not resolve, "::1:4811" the address ::1:4811 at
+    // port 7407, and "0.0.0.0" a bad port.)
+    for (const std::string listen : {"::1:7409", "0.0.0.0", "localhost"}) {
+      const auto [status, log] = run(listen);
+      INFO(listen << ": " << log);
+      CHECK(status != 2);
+      CHECK_THAT(log, !Catch::Contains("cannot resolve"));
+      if (listen.front() == ':')
+        CHECK_THAT(log, Catch::Contains("listening on [::1]:7409 ") ||
+                            Catch::Contains("cannot listen on [::1]:7409: "));
+      else
+        CHECK_THAT(log, Catch::Contains(":7407"));
+    }
+  }
   SECTION("a wildcard address is said to listen on every interface") {
     // ("0:0" listened on 0.0.0.0 with the log saying "listening on 0:PORT" alone.)
     for (const char* wildcard : {"0:0", "0.0.0.0:0", "[::]:0"}) {

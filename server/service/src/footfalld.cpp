@@ -1,5 +1,7 @@
 // footfalld: the footfall terrain query server (ONC RPC over TCP).
+#include <arpa/inet.h>
 #include <fcntl.h>
+#include <netinet/in.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
@@ -37,10 +39,19 @@ void OnStopSignal(int) {
   if (g_server) g_server->Stop();
 }
 
-// "ADDR:PORT", ":PORT" or "PORT"; an IPv6 address in brackets ("[::1]:7407", "[::1]") or bare
-// ("::1", with more than one colon), which takes the default port 7407.
+bool IsIpv6Address(const std::string& text) {
+  in6_addr address;
+  return inet_pton(AF_INET6, text.c_str(), &address) == 1;
+}
+
+// "ADDR:PORT", ":PORT", "PORT" or "ADDR" (the default port 7407); an IPv6 address in brackets
+// ("[::1]:7407", "[::1]") or bare, as `footfall --server` reads it: "::1" takes the default
+// port, "::1:7408" is ::1 at port 7408 (what precedes the last colon is an address).
+// ("::1:48113" was refused as an address that does not resolve, "::1:4811" listened on the
+// address ::1:4811, and "0.0.0.0" was taken for a port.)
 bool ParseListen(const std::string& text, std::string* host, int* port) {
   std::string h, p;
+  const size_t colon = text.rfind(':');
   if (!text.empty() && text.front() == '[') {
     const size_t close = text.find(']');
     if (close == std::string::npos || close == 1) return false;
@@ -54,12 +65,21 @@ bool ParseListen(const std::string& text, std::string* host, int* port) {
       return false;
     }
   } else if (std::count(text.begin(), text.end(), ':') > 1) {
-    h = text;  // a bare IPv6 address: its last group is no port
-    p = "7407";
+    if (IsIpv6Address(text) && !IsIpv6Address(text.substr(0, colon))) {
+      h = text, p = "7407";  // a bare IPv6 address: its last group is no port
+    } else {
+      h = text.substr(0, colon), p = text.substr(colon + 1);
+      if (!IsIpv6Address(h)) return false;
+    }
+  } else if (colon != std::string::npos) {
+    h = text.substr(0, colon), p = text.substr(colon + 1);
+  } else if (!text.empty() && std::all_of(text.begin(), text.end(),
+                                          [](unsigned char c) { return c >= '0' && c <= '9'; })) {
+    p = text;
   } else {
-    const size_t colon = text.rfind(':');
-    h = colon == std::string::npos ? "" : text.substr(0, colon);
-    p = colon == std::string::npos ? text : text.substr(colon + 1);
+    h = text, p = "7407";  // an address alone
+    if (std::any_of(h.begin(), h.end(), [](unsigned char c) { return std::isspace(c); }))
+      return false;
   }
   // Digits alone: strtol would also take a leading space or sign (": 80", ":+80").
   if (p.empty() || p.size() > 5 ||
