@@ -18,7 +18,7 @@ RawSamples MakeHeightField(int nx, int nz, double spacing, double amplitude, uin
 // The same noise in world units, one noise unit every kHillsUnit: hills whose relief is the
 // same whatever the spacing they are sampled at (n x n samples from the origin). MakeHills at
 // a spacing of kHillsUnit is MakeHeightField's field.
-constexpr double kHillsUnit = 0.25;
+constexpr double kHillsUnit = 1.0;
 RawSamples MakeHills(int n, double spacing, double amplitude, uint64_t seed);
 
 // Samples spread evenly over a sphere (Fibonacci lattice), normals pointing outwards.
