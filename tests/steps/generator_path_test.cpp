@@ -528,3 +528,76 @@ TEST_CASE("A path walk without a step count that arrives on its last step has ar
   }
   CHECK(arrived_last >= 1);  // one goal is reached by the last step exactly
 }
+
+namespace {
+
+// Ground along +z sampled `s` apart, `width` wide from x = 0: level at y = height(z), its
+// normals from the slope height'(z) (numerically).
+template <typename Height>
+RawSamples GroundAlongZ(double s, double width, double length, const Height& height) {
+  RawSamples g;
+  for (double z = 0; z <= length + 1e-9; z += s) {
+    const double slope = (height(z + 1e-4) - height(z - 1e-4)) / 2e-4;
+    for (double x = 0; x <= width + 1e-9; x += s)
+      g.points.push_back({x, height(z), z}), g.normals.push_back(Normalize(Vec3{0, 1, -slope}));
+  }
+  return g;
+}
+
+}  // namespace
+
+TEST_CASE("A 2D goal is neared across the world up, whatever a multiped's up leans",
+          "[steps][generator]") {
+  // A hexapod up a 45-degree ramp onto a plateau 30 m long, its goal at y = -5 (off the
+  // terrain). Its distance was measured across its own up: on the ramp, leaning toward the
+  // goal, 0.7 of the level distance; 100 steps on the plateau could not beat it, and the walk
+  // stopped with "no way to the path's goal" while it came nearer at every step.
+  const Character c = LoadShipped("hexapod");
+  const double s = 0.03;
+  auto height = [](double z) { return std::clamp(z - 1.0, 0.0, 0.5); };
+  Terrain t = LoadTerrain(GroundAlongZ(s, 0.9, 32, height), s);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {0.45, 0, 0.4};
+  o.path = {{0.45, -5, 31.5}};
+  o.steps = 3000;
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CHECK(w.stopped.empty());
+  const Vec3 end = Body(w).keys.back().position;
+  CHECK(std::hypot(end.x - 0.45, end.z - 31.5) <= c.step_length);
+}
+
+TEST_CASE("A multiped walks a straight 2D path straight across a side slope",
+          "[steps][generator]") {
+  // A hexapod along +z across a slope rising 30 degrees toward +x, its goal given at y = 0
+  // (off the slope, as a 2D path is). The level offset to the goal was laid onto the ground
+  // along the hexapod's tilted up, which turns it toward the contour seen from above: on made
+  // hills it walked up to 33 degrees off a straight path and 1.8 m aside of it. Laid along the
+  // world up, it keeps to the line.
+  const Character c = LoadShipped("hexapod");
+  const double s = 0.03, rise = std::tan(30 * kPi / 180);
+  RawSamples g;
+  for (double z = 0; z <= 12 + 1e-9; z += s)
+    for (double x = 0; x <= 4 + 1e-9; x += s)
+      g.points.push_back({x, rise * x, z}), g.normals.push_back(Normalize(Vec3{-rise, 1, 0}));
+  Terrain t = LoadTerrain(g, s);
+  for (const double goal_x : {1.0, 3.5}) {  // along the contour, and 2.5 m uphill across it
+    GenerateOptions o;
+    o.has_start = true;
+    o.start = {1.0, rise * 1.0, 0.5};
+    o.heading = {goal_x - 1.0, 0, 11};
+    o.path = {{goal_x, 0, 11.5}};
+    o.steps = 1000;
+    const Walk w = Generate(t, c, o);
+    INFO("goal x " << goal_x << ": " << w.stopped);
+    CHECK(w.stopped.empty());
+    CheckWalk(t, c, o, w);
+    double aside = 0;  // the body's farthest from the straight line to the goal, seen from above
+    for (const WalkKey& k : Body(w).keys) {
+      const double along = (k.position.z - 0.5) / 11;
+      aside = std::max(aside, std::fabs(k.position.x - (1.0 + along * (goal_x - 1.0))));
+    }
+    CHECK(aside < 0.15);  // (0.25 across it, before)
+  }
+}

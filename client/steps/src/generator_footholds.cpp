@@ -40,22 +40,34 @@ bool Generator::OnTerrain(const Agent& a, size_t i) const {
   return a.path_off[i] <= 0.5 * Radius(a, i);
 }
 
+bool Generator::OnFloor(const Agent& a) const {
+  return Dot(a.up, world_up_) >= std::cos(Radians(kFloorUpDeg));
+}
+
 Vec3 Generator::ToPathPoint(const Agent& a, const Vec3& p, bool on_terrain) const {
   Vec3 to = p - a.ground;
-  if (!on_terrain && Dot(a.up, world_up_) >= std::cos(Radians(kFloorUpDeg)))
-    to -= world_up_ * Dot(to, world_up_);
+  if (!on_terrain && OnFloor(a)) to -= world_up_ * Dot(to, world_up_);
   return to;
+}
+
+Vec3 Generator::OnGround(const Agent& a, const Vec3& to, bool on_terrain) const {
+  if (on_terrain || !OnFloor(a)) return ProjectOnPlane(to, a.up);
+  return to - world_up_ * (Dot(to, a.up) / Dot(world_up_, a.up));  // (the dot is >= 0.5)
 }
 
 double Generator::Remaining(const Agent& a, size_t i) const {
   const Vec3 to = ToWaypoint(a, i);
-  return OnTerrain(a, i) ? Length(to) : Length(ProjectOnPlane(to, a.up));
+  if (OnTerrain(a, i) || OnFloor(a)) return Length(to);  // (on a floor, `to` is level)
+  return Length(ProjectOnPlane(to, a.up));
 }
 
 bool Generator::Reached(const Agent& a, size_t i) const {
   const Vec3 to = ToWaypoint(a, i);
   const double along = Dot(to, a.up), radius = Radius(a, i);
-  if (Length2(to - a.up * along) > radius * radius) return false;
+  // Off the terrain, on a floor, `to` is level already: measured as it is, not shortened
+  // across a's up as the ground tilts (Remaining).
+  const Vec3 across = !OnTerrain(a, i) && OnFloor(a) ? to : to - a.up * along;
+  if (Length2(across) > radius * radius) return false;
   // On the terrain: no farther below the ground than the radius, nor above it than the radius
   // over the body's height (the feet's centroid lies inside a convex nose or ridge they stand
   // around: an octopod on the Spot mesh's nose came within 2 cm of its goal with its body,
@@ -128,7 +140,7 @@ void Generator::Steer(Agent& a, int group) const {
     a.walking = false;  // arrived: not an early stop
     return;
   }
-  const Vec3 to = ProjectOnPlane(ToWaypoint(a, a.waypoint), a.up);
+  const Vec3 to = OnGround(a, ToWaypoint(a, a.waypoint), OnTerrain(a, a.waypoint));
   a.stride = 1;
   // A waypoint on the terrain straight above or below (the far side of a sphere): any way on
   // along the ground leads toward it, so the heading is kept until it lies farther aside.

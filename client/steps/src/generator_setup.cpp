@@ -646,7 +646,7 @@ void Generator::Orient(Agent& a, const Foothold& ground, const Vec3& up0, const 
   // drawn from where the character stands) counts as reached on the first step, so it gives no
   // direction. (Before the waypoints' distances from the terrain are known: taken as off it.)
   for (size_t i = 0; i < a.path.size(); ++i) {
-    const Vec3 to = ProjectOnPlane(ToPathPoint(a, a.path[i], false), a.up);
+    const Vec3 to = OnGround(a, ToPathPoint(a, a.path[i], false), false);
     if (Length(to) > Radius(a, i)) {
       a.forward = Normalize(to);
       return;
@@ -654,7 +654,7 @@ void Generator::Orient(Agent& a, const Foothold& ground, const Vec3& up0, const 
   }
   // Every waypoint within its radius: toward the first that is off the start at all.
   for (const Vec3& p : a.path) {
-    const Vec3 to = ProjectOnPlane(ToPathPoint(a, p, false), a.up);
+    const Vec3 to = OnGround(a, ToPathPoint(a, p, false), false);
     if (Length2(to) > 1e-18) {
       a.forward = Normalize(to);
       return;

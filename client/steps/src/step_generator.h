@@ -363,7 +363,7 @@ class Generator {
     return next == a.path.size();
   }
   // How far a's waypoint i still is, as Reached measures it: in 3D when it lies on the terrain,
-  // else along the ground.
+  // else along the ground (level on a floor: across the world up, whatever a's up leans).
   double Remaining(const Agent& a, size_t i) const;
   // How far a's path goes on from where it stands: to its waypoint, then leg after leg to the
   // goal. [Units: wu]
@@ -378,6 +378,15 @@ class Generator {
   // multipeds too, whose up leans with the ground (on a 15-degree slope a goal 5 m up was
   // reached a metre past it). On walls and ceilings the height is along a's up.
   Vec3 ToPathPoint(const Agent& a, const Vec3& p, bool on_terrain) const;
+  // Whether a stands on ground facing the world up (within kFloorUpDeg of it): path heights
+  // are then taken along the world up.
+  bool OnFloor(const Agent& a) const;
+  // `to`, an offset from ToPathPoint (to a waypoint `on_terrain` or not), laid onto a's
+  // ground (the plane across a.up), to steer by. For a waypoint off the terrain while a stands
+  // on a floor (OnFloor), whose `to` is level, straight along the world up, so that seen from
+  // above it points where the waypoint lies (laid along a's up, it turned toward the contour on
+  // a side slope: multipeds walked a 2D path up to 33 degrees off its line); else along a's up.
+  Vec3 OnGround(const Agent& a, const Vec3& to, bool on_terrain) const;
   Vec3 ToWaypoint(const Agent& a, size_t i) const {
     return ToPathPoint(a, a.path[i], OnTerrain(a, i));
   }
