@@ -1453,7 +1453,7 @@ TEST_CASE("a walk far from frame 0 is shown at its own frames with whole numbers
   bool shown = false;
   for (const json& line : state["hud"]) {
     const std::string text = line["text"];
-    shown |= text.find("frame 1000000010.5 of 1000000001-1000000025 at 24 fps") == 0;
+    shown |= text.find("frame 1000000010.5 of 1000000001 to 1000000025 at 24 fps") == 0;
   }
   CHECK(shown);
   // A frame outside the walk is noted in the walk's own numbers.
@@ -1461,13 +1461,13 @@ TEST_CASE("a walk far from frame 0 is shown at its own frames with whole numbers
                                   "64x64", "--screenshot", dir + "/shot.png"});
   CHECK(outside.exit_code == 0);
   CHECK_THAT(outside.err, Catch::Contains("--frame -3000000000 is outside the walk's "
-                                          "1000000001-1000000025; showing 1000000001"));
+                                          "1000000001 to 1000000025; showing 1000000001"));
   // A fractional frame just outside is quoted as given, not rounded into the range.
   const RunResult just_outside = View({"--walk", dir + "/walk.json", "--frame", "1000000000.9999",
                                        "--size", "64x64", "--screenshot", dir + "/shot.png"});
   CHECK(just_outside.exit_code == 0);
   CHECK_THAT(just_outside.err, Catch::Contains("--frame 1000000000.9999 is outside the walk's "
-                                               "1000000001-1000000025; showing 1000000001"));
+                                               "1000000001 to 1000000025; showing 1000000001"));
   CHECK(viewer::ExactFrameText(0.0001) == "0.0001");
   CHECK(viewer::ExactFrameText(12.25) == "12.25");
   CHECK(viewer::ExactFrameText(-3e9) == "-3000000000");

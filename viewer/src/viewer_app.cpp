@@ -280,7 +280,7 @@ struct App {
     std::vector<std::string> frame_lines;
     if (scene.has_walk()) {
       std::ostringstream f;
-      f << "frame " << FrameText(view.frame) << " of " << FrameText(scene.first_frame()) << "-"
+      f << "frame " << FrameText(view.frame) << " of " << FrameText(scene.first_frame()) << " to "
         << FrameText(scene.last_frame()) << " at " << scene.walk().fps << " fps"
         << (playing ? "  (playing)" : "");
       if (!scene.walk().stopped.empty()) f << "   stopped: " << scene.walk().stopped;
@@ -683,7 +683,7 @@ int RunViewer(const ViewerOptions& options) {
   if (options.has_frame && app.scene.has_walk() && app.scene.has_walk_keys() &&
       (options.frame < app.scene.first_frame() || options.frame > app.scene.last_frame())) {
     std::cerr << "footfall-view: note: --frame " << ExactFrameText(options.frame)
-              << " is outside the walk's " << ExactFrameText(app.scene.first_frame()) << "-"
+              << " is outside the walk's " << ExactFrameText(app.scene.first_frame()) << " to "
               << ExactFrameText(app.scene.last_frame()) << "; showing "
               << ExactFrameText(app.view.frame) << '\n';
   }
