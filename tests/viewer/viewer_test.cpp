@@ -849,35 +849,49 @@ TEST_CASE("live: the viewer shows a query another client sends to footfalld", "[
   CHECK(CountColorNear(image, pixel, 4, kChosen) >= 40);
 }
 
-TEST_CASE("live: a query on another terrain of footfalld is drawn untraced, with a note",
-          "[viewer][live]") {
-  // (Traced on the viewer's terrain, it showed that terrain's cells and candidates beside the
-  // other terrain's answer, without a word.)
+namespace {
+
+// What a viewer with --terrain hills, following a footfalld, drew once `footfall query
+// --terrain T` had sent `query` for each T of `terrains` in turn: its --dump-state and stderr.
+struct LiveRun {
+  json state;
+  std::string viewer_err;
+};
+LiveRun FollowQueriesOn(const std::vector<std::string>& terrains, const std::string& query) {
   const std::string dir = test::TempDir();
   const LocalServer server(dir);
   INFO("footfalld stderr: " << server.child.Err());
   REQUIRE_FALSE(server.port.empty());
-  const std::string& address = server.address;
-  const std::unique_ptr<test::Child> viewer = FollowLive(address, dir, "320x200");
+  const std::unique_ptr<test::Child> viewer = FollowLive(server.address, dir, "320x200");
   INFO("viewer stderr: " << viewer->Err());
-  const std::string stairs = std::string(FOOTFALL_DATA_DIR) + "/terrain/stairs.pts";
-  for (const std::string& terrain : {stairs, kTerrain}) {
-    const RunResult client = Run({FOOTFALL_CLI, "query", "--terrain", terrain, "--server", address},
-                                 {}, kTimeout, "snap 1 0.5 1\n");
+  for (const std::string& terrain : terrains) {
+    const RunResult client =
+        Run({FOOTFALL_CLI, "query", "--terrain", terrain, "--server", server.address}, {}, kTimeout,
+            query);
     INFO("footfall query: " << client.out << client.err);
     REQUIRE(client.exit_code == 0);
   }
   int code = -1;
   REQUIRE(viewer->Wait(kTimeout, &code));
   REQUIRE(code == 0);
-  const json state = json::parse(test::ReadFile(dir + "/state.json"));
-  const json& queries = state["live"]["queries"];
+  return {json::parse(test::ReadFile(dir + "/state.json")), viewer->Err()};
+}
+
+}  // namespace
+
+TEST_CASE("live: a query on another terrain of footfalld is drawn untraced, with a note",
+          "[viewer][live]") {
+  // (Traced on the viewer's terrain, it showed that terrain's cells and candidates beside the
+  // other terrain's answer, without a word.)
+  const std::string stairs = std::string(FOOTFALL_DATA_DIR) + "/terrain/stairs.pts";
+  const LiveRun run = FollowQueriesOn({stairs, kTerrain}, "snap 1 0.5 1\n");
+  const json& queries = run.state["live"]["queries"];
   REQUIRE(queries.size() == 2);
   CHECK(queries[0]["other_terrain"] == true);  // the stairs'
   CHECK(queries[0]["traced"] == false);
   CHECK(queries[1]["other_terrain"] == false);  // the viewer's own terrain's
   CHECK(queries[1]["traced"] == true);
-  CHECK_THAT(viewer->Err(), Catch::Contains("were asked on another terrain of the server"));
+  CHECK_THAT(run.viewer_err, Catch::Contains("were asked on another terrain of the server"));
 }
 
 TEST_CASE("live: a screenshot frames the live queries it waited for beside the terrain",
@@ -885,30 +899,14 @@ TEST_CASE("live: a screenshot frames the live queries it waited for beside the t
   // A query on another terrain of the server, 500 m from the viewer's: the camera framed the
   // viewer's terrain alone, and the answer it waited for was out of the picture ("visible":
   // false), though F frames it in the window.
-  const std::string dir = test::TempDir();
-  const LocalServer server(dir);
-  INFO("footfalld stderr: " << server.child.Err());
-  REQUIRE_FALSE(server.port.empty());
-  const std::string far = dir + "/far.pts";
+  const std::string far = test::TempDir() + "/far.pts";
   {
     std::ofstream out(far);
     for (int k = 0; k < 20; ++k)
       for (int i = 0; i < 20; ++i) out << 500 + 0.1 * i << " 0 " << 500 + 0.1 * k << " 0 1 0\n";
   }
-  const std::unique_ptr<test::Child> viewer = FollowLive(server.address, dir, "320x200");
-  INFO("viewer stderr: " << viewer->Err());
-  for (const std::string& terrain : {far, std::string(kTerrain)}) {
-    const RunResult client =
-        Run({FOOTFALL_CLI, "query", "--terrain", terrain, "--server", server.address}, {}, kTimeout,
-            "snap 501 0 501\n");
-    INFO("footfall query: " << client.out << client.err);
-    REQUIRE(client.exit_code == 0);
-  }
-  int code = -1;
-  REQUIRE(viewer->Wait(kTimeout, &code));
-  REQUIRE(code == 0);
-  const json state = json::parse(test::ReadFile(dir + "/state.json"));
-  const json& queries = state["live"]["queries"];
+  const LiveRun run = FollowQueriesOn({far, kTerrain}, "snap 501 0 501\n");
+  const json& queries = run.state["live"]["queries"];
   REQUIRE(queries.size() == 2);
   CHECK(queries[0]["other_terrain"] == true);
   for (const json& q : queries) {
