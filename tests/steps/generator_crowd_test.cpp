@@ -130,12 +130,37 @@ TEST_CASE("Crowd places that snap onto another character's start are left out",
   REQUIRE(w.stops.size() == 5);
   for (const std::string& stop : w.stops) {
     CHECK_THAT(stop, Catch::Contains("its place on the crowd's grid"));
-    CHECK_THAT(stop, Catch::Contains("(its place lies ") &&
-                         Catch::Contains(" from the ground it snaps to: the grid runs off the "
-                                         "terrain, or over a drop, there): left out"));
+    CHECK_THAT(stop, Catch::Contains("(its place snaps ") &&
+                         Catch::Contains(" across the ground: the grid runs off the terrain, or "
+                                         "over a drop, there): left out"));
     // The distance to the other start, said as a distance ("within 0.25 of" read as a bound).
     CHECK_THAT(stop, Catch::Matches(".*, only [0-9.e+-]+ from c[0-9]+'s start .*"));
   }
+}
+
+TEST_CASE("A crowd member left out on coarse hills is told of the samples, not of an edge",
+          "[steps][generator][crowd]") {
+  // Bipeds 0.4 apart on the bundled hills (samples 0.25 apart): members 1.35 m inside the
+  // terrain, whose feet took their neighbours' samples, were said to stand where "the grid
+  // runs off the terrain": measured from the place to the ground, 0.1 of snapping onto the
+  // lattice and the hill's rise passed for an edge.
+  const Character c = LoadShipped("biped");
+  Terrain t = LoadTerrain(LoadShippedTerrain("hills"), 0.25);
+  const Walk w = Generate(t, c, CrowdOptions({0.75, 0, 5}, 2, 36, 0.4));
+  size_t inside = 0;
+  for (const std::string& stop : w.stops) {
+    INFO(stop);
+    const size_t at = stop.find("its place on the crowd's grid, (");
+    const size_t around = stop.find("its feet, around (");
+    const size_t open = at != std::string::npos ? at + 32 : around + 18;
+    if (at == std::string::npos && around == std::string::npos) continue;
+    const double x = std::stod(stop.substr(open));
+    if (x < 1) continue;  // a place within a metre of the edge at x = 0
+    ++inside;
+    CHECK_THAT(stop, !Catch::Contains("runs off the terrain"));
+    CHECK_THAT(stop, Catch::Contains("are coarse for the crowd's spacing, 0.4"));
+  }
+  CHECK(inside > 0);
 }
 
 TEST_CASE("Crowd places closer than the terrain's samples are left out for their spacing",

@@ -117,19 +117,28 @@ Status Generator::Setup(std::string* error) {
   // edge: a character starting within half the spacing of another stays out (CrowdedStarts).
   const std::vector<int> crowded = CrowdedStarts(points_.data(), answers_.data(), n, 0.5 * spacing);
   std::vector<Vec3> snapped_start(n);
-  for (int i = 0; i < n; ++i) snapped_start[i] = answers_[i].point;
+  // How far each place snapped across the ground (off its normal): a place off the terrain's
+  // edge snaps across it; one above or below the ground (a grid over hills) along its normal,
+  // give or take the samples' spacing.
+  std::vector<double> snapped_across(n);
+  for (int i = 0; i < n; ++i) {
+    snapped_start[i] = answers_[i].point;
+    snapped_across[i] = Length(ProjectOnPlane(points_[i] - answers_[i].point, answers_[i].normal));
+  }
   // Why places snap together: a grid finer than the terrain's samples (its neighbours snap onto
   // one sample anywhere), samples coarse for the spacing, or a place off the terrain or over a
   // drop (it snaps onto the edge another snaps onto). (Every case but the first was said as
   // "the grid runs off the terrain there", for places well inside it too.)
   const double sample_gap = 0.5 * gap_;
-  auto crowded_why = [&](double place_to_ground) {
+  // (Measured from the place to the ground it snapped to, places 0.1 above coarse samples on
+  // hills, 1.35 m inside the terrain, were said to be off its edge.)
+  auto crowded_why = [&](int i) {
     Text why(3);
     if (spacing < sample_gap) {
       why << "the crowd's spacing, " << spacing << ", is finer than the terrain's samples, "
           << "about " << sample_gap << " apart";
-    } else if (place_to_ground > 0.25 * spacing) {
-      why << "its place lies " << place_to_ground << " from the ground it snaps to: the grid "
+    } else if (snapped_across[i] > 0.25 * spacing + sample_gap) {
+      why << "its place snaps " << snapped_across[i] << " across the ground: the grid "
           << "runs off the terrain, or over a drop, there";
     } else {
       why << "the terrain's samples, about " << sample_gap << " apart, are coarse for the "
@@ -220,8 +229,7 @@ Status Generator::Setup(std::string* error) {
       m << "step 1 of " << a.id << ": its place on the crowd's grid, "
         << Point(first.point + offsets[i]) << ", snaps to " << Point(snapped_start[i]) << ", only "
         << Distance(snapped_start[i], snapped_start[crowded[i]]) << " from " << other.id
-        << "'s start (" << crowded_why(Distance(first.point + offsets[i], snapped_start[i]))
-        << "): left out of the walk";
+        << "'s start (" << crowded_why(i) << "): left out of the walk";
       a.walking = false, a.left_out = true;
       a.stopped = m.str(), a.stopped_step = 1;
     }
@@ -242,8 +250,7 @@ Status Generator::Setup(std::string* error) {
     if (stacked[i] < 0 || a.left_out) continue;
     Text m;
     m << "step 1 of " << a.id << ": its feet, around " << Point(a.ground) << ", stand where "
-      << agents_[stacked[i]].id << "'s do (" << crowded_why(Distance(places[i], snapped_start[i]))
-      << "): left out of the walk";
+      << agents_[stacked[i]].id << "'s do (" << crowded_why(i) << "): left out of the walk";
     a.walking = false, a.left_out = true;
     a.stopped = m.str(), a.stopped_step = 1;
   }
@@ -280,7 +287,7 @@ Status Generator::Setup(std::string* error) {
     Text m;
     m << "step 1 of " << a.id << ": its foot " << c_.feet[foot].name << ", at "
       << Point(planted[foot].point) << ", stands on the sample a foot of " << agents_[other].id
-      << " does (" << crowded_why(push[i]) << "): left out of the walk";
+      << " does (" << crowded_why(i) << "): left out of the walk";
     a.walking = false, a.left_out = true;
     a.stopped = m.str(), a.stopped_step = 1;
   }
