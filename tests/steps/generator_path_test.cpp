@@ -601,3 +601,25 @@ TEST_CASE("A multiped walks a straight 2D path straight across a side slope",
     CHECK(aside < 0.15);  // (0.25 across it, before)
   }
 }
+
+TEST_CASE("A slow-turning biped turns on the spot to a corner it cannot circle in samples",
+          "[steps][generator]") {
+  // A biped turning 1 degree a step on ground sampled every 5 cm, its path turning 90 degrees:
+  // the circle through the corner asked for strides of a centimetre, which the feet walked as
+  // steps in place or a whole sample on, and the body circled the goal 0.6 m off for 370 steps
+  // until the walk stopped with "no way". It turns on the spot instead until the goal is ahead.
+  Character c = LoadShipped("biped");
+  c.max_turn_deg = 1;
+  Terrain t = LoadTerrain(MakeFlat(401, 0.05, 0), 0.05);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {10, 0, 10};
+  o.path = {{10, 0, 13}, {13, 0, 13}};
+  o.steps = 2000;
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CHECK(w.stopped.empty());
+  CheckWalk(t, c, o, w);
+  const Vec3 end = Body(w).keys.back().position;
+  CHECK(std::hypot(end.x - 13, end.z - 13) <= 0.5 * c.step_length + 1e-9);
+}
