@@ -623,3 +623,26 @@ TEST_CASE("A slow-turning biped turns on the spot to a corner it cannot circle i
   const Vec3 end = Body(w).keys.back().position;
   CHECK(std::hypot(end.x - 13, end.z - 13) <= 0.5 * c.step_length + 1e-9);
 }
+
+TEST_CASE("A 2D goal below a steep ramp is neared as seen from above", "[steps][generator]") {
+  // A hexapod down a 65-degree ramp 300 m up, its goal at y = 0 past the ramp's foot. On ground
+  // steeper than a floor the goal is measured across the hexapod's up, where the 300 m of
+  // height outweighs the way walked: coming 2.4 m nearer seen from above, it was stopped for
+  // "no way to the path's goal".
+  const Character c = LoadShipped("hexapod");
+  const double s = 0.025;
+  RawSamples ramp = MakeRamps({65, 30}, 3, 1.5, s);
+  for (Vec3& p : ramp.points) p.y += 300;
+  Terrain t = LoadTerrain(ramp, s);
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = {0.75, 0, 10.5};
+  o.path = {{0.75, 0, 1}};
+  o.steps = 1000;
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CHECK(w.stopped.empty());
+  CheckWalk(t, c, o, w);
+  const Vec3 end = Body(w).keys.back().position;
+  CHECK(std::hypot(end.x - 0.75, end.z - 1) <= c.step_length);
+}

@@ -152,6 +152,7 @@ struct Agent {
   // has no way there.
   size_t nearest_waypoint = SIZE_MAX;
   double nearest = 0;
+  double nearest_level = 0;  // the same seen from above: across the world up
   int nearest_step = 0;
   // This step's stride, as a share of a full one (Steer): below 1 while the waypoint lies inside
   // the circle the body turns on at full stride, 0 to turn on the spot.
