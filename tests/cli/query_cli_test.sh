@@ -50,6 +50,18 @@ check "misspelt option: the near one suggested" grep -qF "footfall generate: unk
 check "misspelt option of terrain make: suggested" grep -qF "unknown option '--outptu': did you mean --output?" "$work/err.txt"
 "$footfall" generate --terrain "$work/flat.pts" --xyz 3 > /dev/null 2> "$work/err.txt"
 check "an option near none: no suggestion" grep -qF "unknown option '--xyz' (footfall generate --help" "$work/err.txt"
+# generate takes no file arguments: no hint of '--' for file names starting with '-'.
+check "generate: no '--' hint" grep -qxF "footfall generate: unknown option '--xyz' (footfall generate --help lists them)" "$work/err.txt"
+# A long option written with one dash was a one-letter option with the rest as its value
+# ("-out w.json" wrote a file "ut"), and "-o=w.json" wrote a file "=w.json".
+(cd "$work" && "$footfall" generate --terrain flat.pts -out w.json) > /dev/null 2> "$work/err.txt"
+check "-out: exit 1" [ $? -eq 1 ]
+check "-out: told as --out" grep -qF "footfall generate: unknown option '-out': did you mean --out?" "$work/err.txt"
+check "-out: no file 'ut' written" [ ! -e "$work/ut" ]
+(cd "$work" && "$footfall" terrain make flat -o=eq.pts) > /dev/null 2> "$work/err.txt"
+check "-o=FILE: exit 1" [ $? -eq 1 ]
+check "-o=FILE: told" grep -qF "footfall terrain make: '-o=eq.pts' would give -o the value '=eq.pts': write -o eq.pts" "$work/err.txt"
+check "-o=FILE: no file '=eq.pts' written" [ ! -e "$work/=eq.pts" ]
 check "file name starting with '-' after '--': read" [ $? -eq 0 ]
 echo "next 0 0 0 1 0 0" | "$footfall" query --terrain="$work/flat.pts" --tolerance=-1 > /dev/null 2> "$work/err.txt"
 check "--tolerance=-1: refused as a value" grep -qF -- "--tolerance: '-1' is not a finite number >= 0" "$work/err.txt"

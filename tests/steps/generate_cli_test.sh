@@ -291,6 +291,9 @@ check "terrain convert --out writes the file" [ -s "$work/flat20-convert.pts" ]
 "$footfall" generate --terrain "$work/flat20.pts" --character "$chars/biped.json" --steps 2 \
   -o "$work/short-o.json" 2> /dev/null
 check "generate -o writes the walk" [ -s "$work/short-o.json" ]
+"$footfall" generate --terrain "$work/flat20.pts" --character "$chars/biped.json" --steps 2 \
+  --output "$work/short-output.json" 2> /dev/null
+check "generate --output writes the walk" [ -s "$work/short-output.json" ]
 python3 - "$work/centipede.json" <<'PY'
 import json, sys
 feet = [{"name": "%s%d" % (s, i), "rest": [0.06 if s == "L" else -0.06, 0, 0.3 - 0.03 * i]}

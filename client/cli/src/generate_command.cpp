@@ -810,7 +810,7 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
       ->transform(WholeRange(1, 256));
   cmd->add_flag("--progress", flags->progress,
                 "Show a progress bar on stderr (shown anyway for long runs on a terminal)");
-  cmd->add_option("-o,--out", flags->out,
+  cmd->add_option("-o,--out,--output", flags->out,
                   "Output file: .json, .gltf, .glb or .mel (repeatable); .pts: the terrain's "
                   "samples the walk was placed on (as resampled for the character), for "
                   "footfall-view or a plugin; -: the walk JSON on standard output")

@@ -118,20 +118,35 @@ std::string MissingValueHint(const CLI::App& root, int argc, char** argv) {
   auto unknown = [&](const std::string& word) {
     if (word.size() < 2 || word[0] != '-' || word == "-h" || word == "--help") return false;
     if (std::isdigit(static_cast<unsigned char>(word[1])) || word[1] == '.') return false;
+    // A long option written with one dash ("-out walk.json" was -o with the value "ut").
+    if (word[1] != '-' && word.size() > 2 && option("-" + word.substr(0, word.find('='))))
+      return true;
     if (word[1] != '-' && option(word.substr(0, 2))) return false;
     const size_t equals = word.find('=');
     return !(word[1] == '-' && equals != std::string::npos && option(word.substr(0, equals)));
   };
+  // Whether the command takes arguments that are not options (files): a name starting with
+  // '-' then goes after '--'.
+  const bool positionals = std::any_of(options.begin(), options.end(),
+                                       [](const CLI::Option* o) { return !o->nonpositional(); });
+  const std::string listed =
+      " (" + path + " --help lists them" +
+      (positionals ? "; a file whose name starts with '-' goes after '--')" : ")");
   for (; i < argc; ++i) {
     const std::string word = argv[i];
     if (word == "--") break;  // the rest are arguments, whatever they look like
+    // "-o=walk.json": CLI11 takes "=walk.json" as the value, and wrote a file of that name.
+    if (word.size() > 2 && word[0] == '-' && word[1] != '-' && word[2] == '=' &&
+        option(word.substr(0, 2)))
+      return path + ": '" + word + "' would give " + word.substr(0, 2) + " the value '" +
+             word.substr(2) + "': write " + word.substr(0, 2) + " " + word.substr(3) +
+             " (a space, not '=', after a one-letter option)";
     const CLI::Option* taking = option(word);
     // (A file named "-dash.pts" was "input is required".)
     if (!taking && unknown(word)) {
       const std::string meant = NearestOptionName(options, word);
       return path + ": unknown option '" + word + "'" +
-             (meant.empty() ? "" : ": did you mean " + meant + "?") + " (" + path +
-             " --help lists them; a file whose name starts with '-' goes after '--')";
+             (meant.empty() ? "" : ": did you mean " + meant + "?") + listed;
     }
     if (!taking || taking->get_items_expected_min() == 0) continue;
     if (i + 1 < argc) {
