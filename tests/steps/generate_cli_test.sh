@@ -98,6 +98,21 @@ check "scene: every character walks as it would alone" scene_check "$work/scene-
   --out "$work/scene.mel" --out "$work/scene.gltf" --out "$work/scene.pts" 2> /dev/null
 check "scene: MEL, glTF and the terrain written" [ -s "$work/scene.mel" -a -s "$work/scene.gltf" -a -s "$work/scene.pts" ]
 check "scene: a MEL group per character" [ "$(grep -c '^$footfall_groups\[' "$work/scene.mel")" -eq 6 ]
+# A character that stops after a crowd's 25 stops is named on stderr: the list of 20 stops was
+# the scene's, and a biped stopped at the terrain's edge went unnamed.
+"$footfall" terrain make flat --size 40 --spacing 0.25 -o "$work/flat40c.pts" > /dev/null
+cat > "$work/scene/hidden.json" <<JSON
+{"format": "footfall-scene", "version": 1, "characters": [
+ {"name": "herd", "character_file": "biped.json", "start": [20, 0, 3], "heading": [0, 0, -1],
+  "steps": 20, "crowd": 25, "crowd_spacing": 1.5},
+ {"name": "loner", "character_file": "biped.json", "start": [35, 0, 37], "steps": 20}]}
+JSON
+"$footfall" generate --terrain "$work/flat40c.pts" --scene "$work/scene/hidden.json" \
+  --out "$work/hidden.json" 2> "$work/hidden.err"
+check "scene stops: exit 2" [ $? -eq 2 ]
+check "scene stops: more than 20 listed from the crowd" [ "$(grep -c '^  herd: ' "$work/hidden.err")" -eq 20 ]
+check "scene stops: the character after the crowd named" grep -q '^  loner: step ' "$work/hidden.err"
+check "scene stops: the rest counted" grep -q '^  \.\.\. and [0-9]* more$' "$work/hidden.err"
 # A scene character walking off the cliff: exit 2, its stop named, every character's keys kept.
 cat > "$work/scene/cliff.json" <<JSON
 {"format": "footfall-scene", "version": 1,

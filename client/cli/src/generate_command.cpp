@@ -506,8 +506,11 @@ int WriteOutputs(const GenerateFlags& flags, const LoadedTerrain& terrain, const
 }
 
 // Says on stderr what is worth knowing of a finished walk: path walks short of their goals, and
-// why the walk stopped early (every character's reason, up to a screenful). True if it stopped.
-bool ReportWalkEnd(const Walk& walk, const LoadedTerrain& terrain) {
+// why the walk stopped early (every character's reason, up to a screenful; of a scene, with
+// `scene_names` its characters' names, the first reason of each of them beyond that too: a
+// biped stopped after a crowd of 25 went unnamed). True if it stopped.
+bool ReportWalkEnd(const Walk& walk, const LoadedTerrain& terrain,
+                   const std::vector<std::string>& scene_names = {}) {
   constexpr size_t kMaxNotes = 20;
   for (size_t i = 0; i < walk.notes.size() && i < kMaxNotes; ++i)
     std::cerr << "footfall generate: note: " << walk.notes[i] << '\n';
@@ -521,10 +524,24 @@ bool ReportWalkEnd(const Walk& walk, const LoadedTerrain& terrain) {
                  "its failure are written; exit status 1\n";
   constexpr size_t kMaxListed = 20;
   if (walk.stops.size() > 1) {
-    for (size_t i = 0; i < walk.stops.size() && i < kMaxListed; ++i)
-      std::cerr << "  " << walk.stops[i] << '\n';
-    if (walk.stops.size() > kMaxListed)
-      std::cerr << "  ... and " << walk.stops.size() - kMaxListed << " more\n";
+    std::vector<bool> listed(walk.stops.size());
+    for (size_t i = 0; i < walk.stops.size() && i < kMaxListed; ++i) listed[i] = true;
+    for (const std::string& name : scene_names) {
+      const std::string prefix = name + ": ";
+      for (size_t i = 0; i < walk.stops.size(); ++i) {
+        if (walk.stops[i].compare(0, prefix.size(), prefix) != 0) continue;
+        listed[i] = true;
+        break;
+      }
+    }
+    size_t more = 0;
+    for (size_t i = 0; i < walk.stops.size(); ++i) {
+      if (listed[i])
+        std::cerr << "  " << walk.stops[i] << '\n';
+      else
+        ++more;
+    }
+    if (more > 0) std::cerr << "  ... and " << more << " more\n";
   }
   const WalkTerrain& prepared = terrain.prepared;
   if (terrain.resampled && prepared.cropped && !prepared.region_is_bound) {
@@ -680,7 +697,7 @@ int RunScene(const GenerateFlags& flags) {
     for (const auto& [name, error] : failures)
       std::cerr << "footfall generate: " << name << ": " << error << '\n';
     if (!walk.tracks.empty()) {
-      ReportWalkEnd(walk, LoadedTerrain{});  // the others' notes and stops
+      ReportWalkEnd(walk, LoadedTerrain{}, names);  // the others' notes and stops
       std::cerr << "footfall generate: the walks of the " << walked
                 << (walked == 1 ? " character that walked are" : " characters that walked are")
                 << " written\n";
@@ -690,7 +707,7 @@ int RunScene(const GenerateFlags& flags) {
     return 1;
   }
   const int written = WriteOutputs(flags, shared, walk);
-  const bool stopped = ReportWalkEnd(walk, LoadedTerrain{});
+  const bool stopped = ReportWalkEnd(walk, LoadedTerrain{}, names);
   return written != 0 ? written : walk.session_failed ? 1 : stopped ? 2 : 0;
 }
 
