@@ -646,3 +646,29 @@ TEST_CASE("A 2D goal below a steep ramp is neared as seen from above", "[steps][
   const Vec3 end = Body(w).keys.back().position;
   CHECK(std::hypot(end.x - 0.75, end.z - 1) <= c.step_length);
 }
+
+TEST_CASE("A multiped walks straight to a goal on far hilly ground", "[steps][generator]") {
+  // A quadruped across hills to a goal 22 m off on the ground. The goal's direction, laid onto
+  // the quadruped's ground along its up, turned toward the contour wherever the ground between
+  // leaned: its track bowed 1 m off the line (on the Kootenai DEM a hexapod's bowed 1.3 m).
+  // Seen from above, it keeps to it.
+  const Character c = LoadShipped("quadruped");
+  const int n = 241;  // 24 m at 0.1
+  const RawSamples hills = MakeHills(n, 0.1, 1.0, 2);
+  Terrain t = LoadTerrain(hills, 0.1);
+  const Vec3 from = hills.points[10 * n + 120], to = hills.points[230 * n + 120];
+  REQUIRE(from.x == Approx(12));
+  REQUIRE(to.z == Approx(23));
+  GenerateOptions o;
+  o.has_start = true;
+  o.start = from;
+  o.path = {to};
+  o.steps = 1000;
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CHECK(w.stopped.empty());
+  CheckWalk(t, c, o, w);
+  double aside = 0;  // seen from above, from the line x = 12
+  for (const WalkKey& k : Body(w).keys) aside = std::max(aside, std::fabs(k.position.x - 12));
+  CHECK(aside < 0.5);
+}

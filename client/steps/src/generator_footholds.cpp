@@ -61,7 +61,11 @@ Vec3 Generator::ToPathPoint(const Agent& a, const Vec3& p, bool on_terrain) cons
 }
 
 Vec3 Generator::OnGround(const Agent& a, const Vec3& to, bool on_terrain) const {
-  if (on_terrain || !OnFloor(a)) return ProjectOnPlane(to, a.up);
+  // (Laid along the world up also near a waypoint on the terrain, an octopod going round the
+  // foot of a stair's riser to a goal there took a way that stopped at the riser.)
+  const bool level = !on_terrain || (std::fabs(Dot(to, world_up_)) <= 0.5 * Length(to) &&
+                                     Length(to) > 10 * c_.step_length);
+  if (!level || !OnFloor(a)) return ProjectOnPlane(to, a.up);
   return to - world_up_ * (Dot(to, a.up) / Dot(world_up_, a.up));  // (the dot is >= 0.5)
 }
 

@@ -383,10 +383,14 @@ class Generator {
   // are then taken along the world up.
   bool OnFloor(const Agent& a) const;
   // `to`, an offset from ToPathPoint (to a waypoint `on_terrain` or not), laid onto a's
-  // ground (the plane across a.up), to steer by. For a waypoint off the terrain while a stands
-  // on a floor (OnFloor), whose `to` is level, straight along the world up, so that seen from
-  // above it points where the waypoint lies (laid along a's up, it turned toward the contour on
-  // a side slope: multipeds walked a 2D path up to 33 degrees off its line); else along a's up.
+  // ground (the plane across a.up), to steer by. While a stands on a floor (OnFloor), straight
+  // along the world up, so that seen from above it points where the waypoint lies (laid along
+  // a's up, it turned toward the contour wherever the ground leaned: multipeds walked a 2D path
+  // up to 33 degrees off its line, and bowed 1.3 m off a 32 m line to a goal on a DEM), for a
+  // waypoint off the terrain (a level `to`) or one on it farther than 10 steps and within 30
+  // degrees of the level. Else, near a waypoint on the terrain (the foot of a riser) or steeply
+  // above or below (the far side of a sphere, reached around the surface), and on walls and
+  // ceilings, along a's up.
   Vec3 OnGround(const Agent& a, const Vec3& to, bool on_terrain) const;
   Vec3 ToWaypoint(const Agent& a, size_t i) const {
     return ToPathPoint(a, a.path[i], OnTerrain(a, i));
