@@ -309,6 +309,12 @@ check "generate -o writes the walk" [ -s "$work/short-o.json" ]
 "$footfall" generate --terrain "$work/flat20.pts" --character "$chars/biped.json" --steps 2 \
   --output "$work/short-output.json" 2> /dev/null
 check "generate --output writes the walk" [ -s "$work/short-output.json" ]
+# A start beyond the reach of terrain queries is refused before the terrain is read (1e155 on
+# a mesh was "no samples").
+"$footfall" generate --terrain "$work/flat20.pts" --character "$chars/biped.json" \
+  --start 1e155,0,0 --out "$work/far-start.json" 2> "$work/far-start.err"
+check "start out of reach: exit 1" [ $? -eq 1 ]
+check "start out of reach: said" grep -qxF "footfall generate: the start (--start) is too far from the terrain to snap (queries reach 1e15 from it)" "$work/far-start.err"
 python3 - "$work/centipede.json" <<'PY'
 import json, sys
 feet = [{"name": "%s%d" % (s, i), "rest": [0.06 if s == "L" else -0.06, 0, 0.3 - 0.03 * i]}
@@ -529,7 +535,7 @@ bad scene-zero-heading "biped1: $work/bad-scene.json: characters[0]: 'heading' m
 scene_with '"up": [0, 0, 0]'
 bad scene-zero-up "biped1: $work/bad-scene.json: characters[0]: 'up' must be a non-zero finite vector" --terrain "$hills" --scene "$work/bad-scene.json" --out "$work/x.json"
 scene_with '"start": [1e300, 0, 0]'
-bad scene-far-start "biped1: $work/bad-scene.json: characters[0]: 'start' is too far from the terrain to snap" --terrain "$hills" --scene "$work/bad-scene.json" --out "$work/x.json"
+bad scene-far-start "$work/bad-scene.json: characters[0]: 'start' is too far from the terrain to snap (queries reach 1e15 from it) (line " --terrain "$hills" --scene "$work/bad-scene.json" --out "$work/x.json"
 # Numbers: finite, within readable bounds, one check for every float flag.
 bad fps-tiny "--fps: '1e-300' is not a finite number from 0.001 to 1e+06" --terrain "$hills" --character "$chars/biped.json" --fps 1e-300 --out "$work/x.json"
 bad start-frame "--start-frame: '-1e300' is not a finite number from -1e+09 to 1e+09" --terrain "$hills" --character "$chars/biped.json" --start-frame -1e300 --out "$work/x.json"

@@ -90,6 +90,11 @@ TEST_CASE("Scene and character field errors name the field's line", "[steps][sce
   CHECK(SceneError(fixed) ==
         "s.json: characters[2]: 'path[1]': (2, 0, -3e+15) has a coordinate beyond +-1e+15 (the "
         "reach of terrain queries) (line 7)");
+  // A start too (past 1.3e154 a mesh resampled around it was "no samples").
+  fixed.replace(fixed.find("[1, 0, 1]"), 9, "[1e155, 0, 1]");
+  CHECK(SceneError(fixed) ==
+        "s.json: characters[1]: 'start' is too far from the terrain to snap (queries reach 1e15 "
+        "from it) (line 4)");
   CHECK(SceneError(R"({"format": "footfall-scene", "version": 1, "characters": [
     {"character_file": "biped.json"},
     3]})") == "s.json: characters[1]: expected an object (line 3)");

@@ -224,6 +224,13 @@ bool ReadOptions(const GenerateFlags& flags, GenerateOptions* options, std::stri
   if (!flags.start.empty()) {
     if (!ParseVec(flags.start, "--start", &options->start, error)) return false;
     options->has_start = true;
+    // Before the terrain is resampled around it (a start of 1e155 was "no samples").
+    if (!WithinQueryReach(options->start)) {
+      *error =
+          "the start (--start) is too far from the terrain to snap (queries reach 1e15 from "
+          "it)";
+      return false;
+    }
   }
   if (!flags.heading.empty() &&
       !ParseDirection(flags.heading, "--heading", &options->heading, error))

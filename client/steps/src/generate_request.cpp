@@ -120,8 +120,14 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
   }
   if (s != Status::kOk) return s;
   bool ok = true;
-  if (ok && j.contains("start"))
+  if (ok && j.contains("start")) {
     ok = ReadVec(j["start"], source, "start", &o.start, error), o.has_start = true;
+    if (ok && !WithinQueryReach(o.start)) {
+      *error =
+          source + ": 'start' is too far from the terrain to snap (queries reach 1e15 from it)";
+      ok = false;
+    }
+  }
   if (ok && j.contains("heading")) ok = ReadVec(j["heading"], source, "heading", &o.heading, error);
   if (ok && j.contains("up")) ok = ReadVec(j["up"], source, "up", &o.up, error);
   // The bounds of `footfall generate`'s flags.

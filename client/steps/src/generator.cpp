@@ -435,6 +435,12 @@ Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Charac
         Subject(given.names.heading, "--heading", "heading") + " must be a non-zero finite vector";
     return Status::kInvalidArgument;
   }
+  if (!WithinQueryReach(options.start)) {
+    *error =
+        (given.names.start == "--start" ? std::string("the start (--start)") : given.names.start) +
+        " is too far from the terrain to snap (queries reach 1e15 from it)";
+    return Status::kInvalidArgument;
+  }
   if (!IsFinite(options.start) || !(std::fabs(options.start_frame) <= kMaxStartFrame) ||
       !(options.fps > 0) || !(options.fps <= kMaxFps)) {
     Text m;

@@ -8,6 +8,8 @@
 // calls.
 #pragma once
 
+#include <cmath>
+
 #include <functional>
 #include <string>
 #include <vector>
@@ -41,10 +43,16 @@ constexpr int kStartSearchSteps = 12;
 // plugins): a frame of 1e300 put every key on one frame.
 constexpr double kMaxStartFrame = 1e9;
 constexpr double kMaxFps = 1e6;
-// Bound of each coordinate of GenerateOptions::path: twice the terrain's coordinate range (the
-// reach of its queries); farther, squared distances to a waypoint overflow and the heading
-// turned away from the goal.
+// Bound of each coordinate of GenerateOptions::path and start: twice the terrain's coordinate
+// range (the reach of its queries); farther, squared distances to a waypoint overflow and the
+// heading turned away from the goal, and a start of 1e155 was "no samples".
 constexpr double kMaxWaypointCoordinate = 2 * terrain::kMaxCoordinate;
+
+// Whether every coordinate of p is within +-kMaxWaypointCoordinate (false for NaN).
+inline bool WithinQueryReach(const Vec3& p) {
+  return std::fabs(p.x) <= kMaxWaypointCoordinate && std::fabs(p.y) <= kMaxWaypointCoordinate &&
+         std::fabs(p.z) <= kMaxWaypointCoordinate;
+}
 
 // How the generator's messages refer to the inputs that gave the start, heading, up and steps: the
 // command line's flags by default; a scene names its file and field ("s.json: characters[0]:
