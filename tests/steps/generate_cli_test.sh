@@ -444,6 +444,18 @@ x, y, z = next(t for t in w["tracks"] if t["kind"] == "body")["keys"][0]["positi
 sys.exit(not (math.hypot(x - 8, z - 8) < step and y > 537))' "$work/$name-embedded.json" "$chars/$c.json"
     done
   done
+  # A scene on the DEM resamples it for each character, saying so: with --progress each such
+  # line is a line of its own (they were written after the bar's "25%").
+  cat > "$work/scene/dem-scene.json" <<JSON
+{"format": "footfall-scene", "version": 1, "characters": [
+ {"character_file": "biped.json", "start": [10, 0, 10], "steps": 2},
+ {"character_file": "$chars/quadruped.json", "start": [20, 0, 10], "steps": 2}]}
+JSON
+  "$footfall" generate --terrain "$dem" --scene "$work/scene/dem-scene.json" --progress \
+    --out "$work/dem-scene.json" 2> "$work/dem-scene.err"
+  check "dem scene with --progress: exit 0" [ $? -eq 0 ]
+  check "dem scene with --progress: two resampling lines" [ "$(grep -c 'resampled for' "$work/dem-scene.err")" -eq 2 ]
+  check "dem scene with --progress: each on a line of its own" [ "$(grep -c '^footfall generate: .* resampled for' "$work/dem-scene.err")" -eq 2 ]
   err=$("$footfall" terrain convert "$dem" --character "$chars/quadruped.json" --separation 1 -o "$work/x.pts" 2>&1)
   check "convert --character --separation: exit 1" [ $? -eq 1 ]
   check "convert --character --separation: message" grep -qF "give --separation or --character, not both" <<< "$err"

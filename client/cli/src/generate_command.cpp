@@ -129,15 +129,19 @@ class ProgressBar {
     const int percent = total > 0 ? static_cast<int>(100.0 * done / total) : 100;
     std::cerr << "\r[" << std::string(filled, '#') << std::string(width - filled, '.') << "] "
               << std::setw(3) << percent << '%' << std::flush;
-    shown_ = true;
+    open_ = true;
   }
-  void Finish() {
-    if (shown_) std::cerr << '\n';
+  // Ends the bar's line, so that a message written now has a line of its own (the bar is drawn
+  // again below it at its next update).
+  void Break() {
+    if (open_) std::cerr << '\n';
+    open_ = false;
   }
+  void Finish() { Break(); }
 
  private:
   std::chrono::steady_clock::time_point last_{};
-  bool shown_ = false;
+  bool open_ = false;  // the bar is drawn and its line not ended
 };
 
 // One bar for a scene's characters, walked one after the other or at once: the mean of their
@@ -152,6 +156,10 @@ class SceneProgress {
     for (double s : shares_) sum += s;
     constexpr int kScale = 1000;
     bar_.Update(static_cast<int>(sum / static_cast<double>(shares_.size()) * kScale), kScale);
+  }
+  void Break() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    bar_.Break();
   }
   void Finish() { bar_.Finish(); }
 
@@ -641,6 +649,7 @@ int RunScene(const GenerateFlags& flags) {
       walks.resize(scene.size());
       for (size_t i = 0; i < scene.size(); ++i) {
         LoadedTerrain own;
+        progress.Break();  // (the resampling's message was written after the bar's "25%")
         if (!LoadWalkTerrain(flags, scene[i].character, &options[i], &own, &error)) {
           walks[i].walked = true, walks[i].status = Status::kInvalidArgument;
           walks[i].error = error;
