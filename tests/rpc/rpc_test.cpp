@@ -2011,7 +2011,7 @@ TEST_CASE("footfalld listens on IPv6 addresses and logs them in brackets", "[rpc
   }
   SECTION("malformed addresses and ports are refused") {
     for (const char* bad : {"[::1", "[]:7", "[::1]x", "[::1]:", "[::1]:70000", "127.0.0.1: 0",
-                            "127.0.0.1:+0", " 0", "[::1]: 0"}) {
+                            "127.0.0.1:+0", " 0", "[::1]: 0", "", "::1:x"}) {
       const auto [status, log] = run(bad);
       INFO(bad << ": " << log);
       CHECK(status == 2);

@@ -50,6 +50,7 @@ bool IsIpv6Address(const std::string& text) {
 // ("::1:48113" was refused as an address that does not resolve, "::1:4811" listened on the
 // address ::1:4811, and "0.0.0.0" was taken for a port.)
 bool ParseListen(const std::string& text, std::string* host, int* port) {
+  if (text.empty()) return false;
   std::string h, p;
   const size_t colon = text.rfind(':');
   if (!text.empty() && text.front() == '[') {
