@@ -131,8 +131,8 @@ TEST_CASE("Crowd places that snap onto another character's start are left out",
   for (const std::string& stop : w.stops) {
     CHECK_THAT(stop, Catch::Contains("its place on the crowd's grid"));
     CHECK_THAT(stop, Catch::Contains("(its place snaps ") &&
-                         Catch::Contains(" across the ground: the grid runs off the terrain, or "
-                                         "over a drop, there): left out"));
+                         Catch::Contains(" sideways: the grid runs off the terrain, or over a "
+                                         "drop, there): left out"));
     // The distance to the other start, said as a distance ("within 0.25 of" read as a bound).
     CHECK_THAT(stop, Catch::Matches(".*, only [0-9.e+-]+ from c[0-9]+'s start .*"));
   }
@@ -161,6 +161,25 @@ TEST_CASE("A crowd member left out on coarse hills is told of the samples, not o
     CHECK_THAT(stop, Catch::Contains("are coarse for the crowd's spacing, 0.4"));
   }
   CHECK(inside > 0);
+}
+
+TEST_CASE("A crowd member whose place hangs over a drop beside blocks is told so",
+          "[steps][generator][crowd]") {
+  // Hexapods on piles of blocks: places hanging a metre up beside a pile snap sideways onto its
+  // face, along the face's normal. Measured across the normal alone, as over hills, they were
+  // blamed on samples coarse for the spacing, and told to widen it.
+  const Character c = LoadShipped("hexapod");
+  Terrain t = LoadTerrain(MakeBlocks(8, 8, 3, 0.05, 3), 0.05);
+  const Walk w = Generate(t, c, CrowdOptions({2, 3, 2}, 4, 49, 2 * c.reach));
+  size_t left_out = 0;
+  for (const std::string& stop : w.stops) {
+    if (stop.find("left out") == std::string::npos) continue;
+    ++left_out;
+    INFO(stop);
+    CHECK_THAT(stop, Catch::Contains("the grid runs off the terrain, or over a drop, there"));
+    CHECK_THAT(stop, !Catch::Contains("are coarse for the crowd's spacing"));
+  }
+  CHECK(left_out > 0);
 }
 
 TEST_CASE("Crowd places closer than the terrain's samples are left out for their spacing",

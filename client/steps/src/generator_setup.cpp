@@ -117,13 +117,18 @@ Status Generator::Setup(std::string* error) {
   // edge: a character starting within half the spacing of another stays out (CrowdedStarts).
   const std::vector<int> crowded = CrowdedStarts(points_.data(), answers_.data(), n, 0.5 * spacing);
   std::vector<Vec3> snapped_start(n);
-  // How far each place snapped across the ground (off its normal): a place off the terrain's
-  // edge snaps across it; one above or below the ground (a grid over hills) along its normal,
-  // give or take the samples' spacing.
+  // How far each place snapped sideways: onto ground facing the grid's up, across that ground
+  // (off its normal): a place off the terrain's edge snaps across it, one above or
+  // below it (a grid over hills) along its normal, give or take the samples' spacing. Onto a
+  // wall (a place over a drop beside a block) the whole way.
   std::vector<double> snapped_across(n);
   for (int i = 0; i < n; ++i) {
-    snapped_start[i] = answers_[i].point;
-    snapped_across[i] = Length(ProjectOnPlane(points_[i] - answers_[i].point, answers_[i].normal));
+    const Foothold& h = answers_[i];
+    snapped_start[i] = h.point;
+    const Vec3 moved = points_[i] - h.point;
+    snapped_across[i] = Dot(h.normal, grid_up) >= std::cos(Radians(kFloorUpDeg))
+                            ? Length(ProjectOnPlane(moved, h.normal))
+                            : Length(moved);
   }
   // Why places snap together: a grid finer than the terrain's samples (its neighbours snap onto
   // one sample anywhere), samples coarse for the spacing, or a place off the terrain or over a
@@ -138,7 +143,7 @@ Status Generator::Setup(std::string* error) {
       why << "the crowd's spacing, " << spacing << ", is finer than the terrain's samples, "
           << "about " << sample_gap << " apart";
     } else if (snapped_across[i] > 0.25 * spacing + sample_gap) {
-      why << "its place snaps " << snapped_across[i] << " across the ground: the grid "
+      why << "its place snaps " << snapped_across[i] << " sideways: the grid "
           << "runs off the terrain, or over a drop, there";
     } else {
       why << "the terrain's samples, about " << sample_gap << " apart, are coarse for the "
