@@ -208,8 +208,15 @@ TEST_CASE("A generate request's start heading up and steps are named by its fiel
   CHECK(error_of("\"heading\": [0, 0, 0]") ==
         "request: 'heading' must be a non-zero finite vector");
   CHECK(error_of("\"up\": [0, 0, 0]") == "request: 'up' must be a non-zero finite vector");
-  CHECK(error_of("\"start\": [1e300, 0, 0]") ==
-        "request: 'start' is too far from the terrain to snap (queries reach 1e15 from it)");
+  {  // a start beyond the queries' reach is refused as the request is read
+    Character c;
+    GenerateOptions o;
+    std::string error;
+    CHECK(ParseGenerateRequest("{\"character\": " + biped + ", \"start\": [1e300, 0, 0]}", &c, &o,
+                               &error) == Status::kParseError);
+    CHECK_THAT(error, Catch::StartsWith("request: 'start' is too far from the terrain to snap "
+                                        "(queries reach 1e15 from it)"));
+  }
   // A path walk short of its goal after the steps asked names the request's 'steps' (it said
   // "--steps").
   Character c;
