@@ -120,6 +120,12 @@ GenerateOptions StartOptions(const Vec3& start, int steps) {
   return o;
 }
 
+GenerateOptions PathOptions(const Vec3& start, const std::vector<Vec3>& path, int steps) {
+  GenerateOptions o = StartOptions(start, steps);
+  o.path = path;
+  return o;
+}
+
 // A flat square `side` wide at y = 0, sampled at a tenth of c's step, loaded.
 Terrain FlatFor(const Character& c, double side) {
   const double spacing = c.step_length / 10;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <catch2/catch.hpp>
 
@@ -72,6 +73,9 @@ Walk CheckedWalkOnFlat(const Character& c, int steps);
 
 // One character starting at `start`, walking `steps` steps.
 GenerateOptions StartOptions(const Vec3& start, int steps);
+
+// One character starting at `start`, following `path`, for at most `steps` steps.
+GenerateOptions PathOptions(const Vec3& start, const std::vector<Vec3>& path, int steps);
 
 // A flat square `side` wide at y = 0, sampled at a tenth of c's step, loaded.
 Terrain FlatFor(const Character& c, double side);
