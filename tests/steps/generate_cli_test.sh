@@ -145,6 +145,22 @@ assert walk['stopped'].endswith('(and 1 more stopped)'), walk['stopped']
 " "$work/scene-failed-embedded.json"
 check "scene failure: said" grep -q '^footfall generate: upward: the heading' "$work/scene-failed-embedded.err"
 check "scene failure: the others' stops said" grep -q '^footfall generate: stopped early: faller: step [0-9]*: foot' "$work/scene-failed-embedded.err"
+# Failures listed up to 20, then counted (footfalld dying mid-scene failed each character not
+# yet walked: 5,584 lines of one reason).
+python3 - "$work/scene/upward25.json" <<'PY'
+import json, sys
+characters = [{"name": "first", "character_file": "biped.json", "start": [10, 0, 10], "steps": 2}]
+characters += [{"name": "up%d" % i, "character_file": "biped.json", "heading": [0, 1, 0],
+                "steps": 2} for i in range(25)]
+json.dump({"format": "footfall-scene", "version": 1, "characters": characters},
+          open(sys.argv[1], "w"))
+PY
+"$footfall" generate --terrain "$hills" --scene "$work/scene/upward25.json" \
+  --out "$work/upward25.json" 2> "$work/upward25.err"
+check "25 failures: exit 1" [ $? -eq 1 ]
+check "25 failures: 20 said" [ "$(grep -c '^footfall generate: up[0-9]*: the heading' "$work/upward25.err")" -eq 20 ]
+check "25 failures: the rest counted" grep -qx 'footfall generate: \.\.\. and 5 more characters did not walk' "$work/upward25.err"
+check "25 failures: the one that walked written" grep -q '"character":"first"' "$work/upward25.json"
 # A scene character whose walk memory cannot hold: said, exit 1, not an abort. (Its steps are
 # a path's, only a bound: given steps would be refused up front, in 8. below.)
 printf '{"format": "footfall-scene", "version": 1, "characters": [{"character_file": "biped.json", "steps": 5}, {"character_file": "hexapod.json", "crowd": 300000, "path": [[30, 0, 30]], "crowd_spacing": 0.01}]}' > "$work/scene/huge.json"
