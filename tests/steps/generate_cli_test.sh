@@ -325,6 +325,11 @@ check "generate -o writes the walk" [ -s "$work/short-o.json" ]
 "$footfall" generate --terrain "$work/flat20.pts" --character "$chars/biped.json" --steps 2 \
   --output "$work/short-output.json" 2> /dev/null
 check "generate --output writes the walk" [ -s "$work/short-output.json" ]
+# --heading with --path is not used for one character (the path gives the direction): said.
+"$footfall" generate --terrain "$work/flat20.pts" --character "$chars/biped.json" --start 10,0,10 \
+  --heading 0,1,0 --path 10,0,14 --out "$work/heading-path.json" 2> "$work/heading-path.err"
+check "heading with path: exit 0" [ $? -eq 0 ]
+check "heading with path: said unused" grep -qxF "footfall generate: note: --heading is not used with --path: the character starts facing its first waypoint" "$work/heading-path.err"
 # A start beyond the reach of terrain queries is refused before the terrain is read (1e155 on
 # a mesh was "no samples").
 "$footfall" generate --terrain "$work/flat20.pts" --character "$chars/biped.json" \

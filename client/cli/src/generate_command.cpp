@@ -758,6 +758,10 @@ int RunGenerate(const GenerateFlags& flags) {
     std::cerr << "footfall generate: " << error << '\n';
     return 1;
   }
+  // (A heading given with a path was dropped without a word; a crowd's grid still turns by it.)
+  if (!flags.heading.empty() && !options.path.empty() && options.crowd <= 1)
+    std::cerr << "footfall generate: note: --heading is not used with --path: the character "
+                 "starts facing its first waypoint\n";
   ProgressBar bar;
   ShowProgress(flags, &bar, &options);
   Walk walk;
