@@ -107,9 +107,11 @@ cat > "$work/scene/hidden.json" <<JSON
   "steps": 20, "crowd": 25, "crowd_spacing": 1.5},
  {"name": "loner", "character_file": "biped.json", "start": [35, 0, 37], "steps": 20}]}
 JSON
-"$footfall" generate --terrain "$work/flat40c.pts" --scene "$work/scene/hidden.json" \
-  --out "$work/hidden.json" 2> "$work/hidden.err"
-check "scene stops: exit 2" [ $? -eq 2 ]
+scene_run() {  # scene_run NAME TERRAIN SCENE EXIT: the walk in $work/NAME.json, stderr NAME.err
+  "$footfall" generate --terrain "$2" --scene "$3" --out "$work/$1.json" 2> "$work/$1.err"
+  check "$1: exit $4" [ $? -eq "$4" ]
+}
+scene_run hidden "$work/flat40c.pts" "$work/scene/hidden.json" 2
 check "scene stops: more than 20 listed from the crowd" [ "$(grep -c '^  herd: ' "$work/hidden.err")" -eq 20 ]
 check "scene stops: the character after the crowd named" grep -q '^  loner: step ' "$work/hidden.err"
 check "scene stops: the rest counted" grep -q '^  \.\.\. and [0-9]* more$' "$work/hidden.err"
@@ -155,9 +157,7 @@ characters += [{"name": "up%d" % i, "character_file": "biped.json", "heading": [
 json.dump({"format": "footfall-scene", "version": 1, "characters": characters},
           open(sys.argv[1], "w"))
 PY
-"$footfall" generate --terrain "$hills" --scene "$work/scene/upward25.json" \
-  --out "$work/upward25.json" 2> "$work/upward25.err"
-check "25 failures: exit 1" [ $? -eq 1 ]
+scene_run upward25 "$hills" "$work/scene/upward25.json" 1
 check "25 failures: 20 said" [ "$(grep -c '^footfall generate: up[0-9]*: the heading' "$work/upward25.err")" -eq 20 ]
 check "25 failures: the rest counted" grep -qx 'footfall generate: \.\.\. and 5 more characters did not walk' "$work/upward25.err"
 check "25 failures: the one that walked written" grep -q '"character":"first"' "$work/upward25.json"

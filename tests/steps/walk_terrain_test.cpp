@@ -16,6 +16,7 @@
 #include <catch2/catch.hpp>
 
 #include "footfall/steps/character.h"
+#include "generator_fixtures.h"
 #include "walk_checks.h"
 
 using namespace footfall;
@@ -57,6 +58,12 @@ WalkTerrain Prepared(const BumpyAsc& asc, const Character& c, const GenerateOpti
   return prepared;
 }
 
+// `o` walking from the start `prepared` found for it.
+GenerateOptions FromPreparedStart(GenerateOptions o, const WalkTerrain& prepared) {
+  o.start = prepared.start;
+  return o;
+}
+
 size_t BodyKeys(const Walk& w) {
   for (const WalkTrack& t : w.tracks)
     if (t.kind == TrackKind::kBody) return t.keys.size();
@@ -93,8 +100,7 @@ TEST_CASE("PrepareWalkTerrain: a height map coarser than the steps is walked aft
     CHECK(prepared.region_max.x - prepared.region_min.x < 0.75 * 80 * cell);
 
     Terrain t = LoadTerrain(prepared.samples, prepared.report.separation);
-    GenerateOptions walk = o;
-    walk.start = prepared.start;
+    const GenerateOptions walk = FromPreparedStart(o, prepared);
     const Walk w = Generate(t, c, walk);
     INFO(w.stopped);
     CHECK(w.stopped.empty());
@@ -144,10 +150,7 @@ TEST_CASE("PrepareWalkTerrain: a path walked to its end widens the box along it"
           "[steps][terrain]") {
   const Character c = LoadShipped("hexapod");
   const BumpyAsc asc(100, 0.5, "path");
-  GenerateOptions o;
-  o.has_start = true;
-  o.start = {5, 1, 5};
-  o.path = {{30, 0, 5}, {30, 0, 40}};
+  const GenerateOptions o = PathOptions({5, 1, 5}, {{30, 0, 5}, {30, 0, 40}}, -1);
   WalkTerrain prepared = Prepared(asc, c, o);
   std::string error;
   CHECK_FALSE(prepared.region_is_bound);
@@ -179,10 +182,7 @@ TEST_CASE("PrepareWalkTerrain: a path spans the whole surface along up, whatever
       out << '\n';
     }
   }
-  GenerateOptions o;
-  o.has_start = true;
-  o.start = {2, 0, 5};
-  o.path = {{18, 0, 5}};
+  const GenerateOptions o = PathOptions({2, 0, 5}, {{18, 0, 5}}, -1);
   WalkTerrain prepared;
   std::string error;
   const Status status = PrepareWalkTerrain(path, TerrainLoadOptions{}, c, o, &prepared, &error);
@@ -193,9 +193,7 @@ TEST_CASE("PrepareWalkTerrain: a path spans the whole surface along up, whatever
   CHECK(prepared.region_min.y <= 500);
   CHECK(prepared.region_max.y >= 500 + 0.15 * 39);
   Terrain t = LoadTerrain(prepared.samples, prepared.report.separation);
-  GenerateOptions walk = o;
-  walk.start = prepared.start;
-  const Walk w = Generate(t, c, walk);
+  const Walk w = Generate(t, c, FromPreparedStart(o, prepared));
   INFO(w.stopped);
   CHECK(w.stopped.empty());
   CHECK(BodyKeys(w) > 20);
@@ -364,10 +362,7 @@ TEST_CASE("PrepareWalkTerrain: a surface too large to resample finely enough is 
   Character c = LoadShipped("hexapod");
   c.step_length = 0.03;
   const BumpyAsc asc(100, 1, "large");
-  GenerateOptions o;
-  o.has_start = true;
-  o.start = {10, 0, 10};
-  o.path = {{90, 0, 90}};
+  GenerateOptions o = PathOptions({10, 0, 10}, {{90, 0, 90}}, -1);
   WalkTerrain prepared;
   std::string error;
   CHECK(PrepareWalkTerrain(asc.path, TerrainLoadOptions{}, c, o, &prepared, &error) ==
