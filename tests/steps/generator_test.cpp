@@ -591,6 +591,57 @@ TEST_CASE("A biped climbs steep stairs without taking the next nose for an overh
   }
 }
 
+TEST_CASE("A biped going down stairs at a slant steps down them, its feet kept apart",
+          "[steps][generator]") {
+  // Its central locator, placed lead/2 above the pair's rest, snapped back onto the nose of the
+  // tread its feet stood on (nearer than the tread below): heading down at 45 degrees to the
+  // treads or less, a biped walked along that nose for every step it was given, its feet
+  // crossing. The locator now lands on the ground below where it was placed. Point stairs, and
+  // a resampled stair mesh (samples spread unevenly, both faces' normals at its noses).
+  const Character c = LoadShipped("biped");
+  const int steps = 12;
+  const double rise = 0.18, run = 0.3, spacing = 0.03;
+  RawSamples mesh;
+  MeshSampleOptions mo;
+  mo.separation = spacing;
+  mo.smooth_normals = false;
+  REQUIRE(SampleMesh(MakeStairsMesh(steps, rise, run, 8), mo, &mesh, nullptr) == Status::kOk);
+  for (const bool resampled : {false, true}) {
+    Terrain t = resampled ? LoadTerrain(mesh, spacing * 2 / 3)
+                          : LoadTerrain(MakeStairs(steps, rise, run, 8, spacing), spacing);
+    const double first_top = resampled ? rise : 0, top = first_top + (steps - 1) * rise;
+    for (const double deg : {20.0, 30.0, 45.0, 60.0}) {
+      GenerateOptions o = StartOptions({2, top, run * steps - 0.1}, 12);
+      const double a = deg * kPi / 180;
+      o.heading = {std::cos(a), 0, -std::sin(a)};
+      const Walk w = Generate(t, c, o);
+      INFO((resampled ? "mesh " : "points ") << deg << " deg: " << w.stopped);
+      CheckWalk(t, c, o, w);
+      CHECK(w.stopped.empty());
+      CHECK(Body(w).keys.back().position.y < Body(w).keys.front().position.y - 2.5 * rise);
+      auto depth = [&](const Vec3& p) { return FlightDepth(p, steps, rise, run, first_top); };
+      CHECK(DeepestSwing(w, depth) <= spacing);
+      // The feet's gap across the heading after each touch-down: never under a quarter of
+      // their rest gap (0.24), let alone crossed.
+      std::vector<std::pair<double, std::pair<int, Vec3>>> ends;
+      for (const WalkTrack& track : w.tracks)
+        for (const WalkKey& k : track.keys)
+          if (track.kind == TrackKind::kFoot && k.phase != KeyPhase::kMid)
+            ends.push_back({k.frame, {track.name == "L" ? 0 : 1, k.position}});
+      std::stable_sort(ends.begin(), ends.end(),
+                       [](const auto& x, const auto& y) { return x.first < y.first; });
+      const Vec3 left{o.heading.z, 0, -o.heading.x};
+      Vec3 at[2] = {ends.front().second.second, ends.front().second.second};
+      double least = 1;
+      for (size_t i = 0; i < ends.size(); ++i) {
+        at[ends[i].second.first] = ends[i].second.second;
+        if (i >= 2) least = std::min(least, Dot(at[0] - at[1], left));
+      }
+      CHECK(least >= 0.25 * 0.24);
+    }
+  }
+}
+
 TEST_CASE("An upright body walks on under a roof above it, neither stopped nor raised toward it",
           "[steps][generator]") {
   // A roof 1.6 m up modelled as one face (samples facing up only) over a biped 0.95 m tall:

@@ -337,8 +337,9 @@ Status Generator::Step(int k, std::string* error) {
     }
   });
   answers_.resize(points_.size());
-  const Status s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()),
-                         "snap locators", error);
+  Status s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()),
+                   "snap locators", error);
+  if (s == Status::kOk && !c_.align_to_normal) s = LandLocators(error);
   if (s != Status::kOk) return s;
   // 6 (end) and 7-8 in QueryFootholds; 9 (only the feet whose foothold was accepted) and 10-11
   // in ClearArcs. A foot whose arc cannot clear asks for its next foothold: its character goes

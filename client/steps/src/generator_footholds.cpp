@@ -195,6 +195,54 @@ void Generator::Steer(Agent& a, int group) const {
   a.forward = best_forward, a.stride = best_stride;
 }
 
+Status Generator::LandLocators(std::string* error) {
+  const size_t locators = pairs_of_group_[group_].size();
+  const double spacing = 0.5 * gap_;
+  // Down from the place's rest height to lead/2 below it (a locator landing farther from its
+  // place than `lead` would be taken as hanging over a gap), a point every sample spacing.
+  const int per_line = std::clamp(static_cast<int>(std::ceil(0.5 * lead_ / spacing)), 1, 16);
+  const double drop = 0.5 * lead_ / per_line;
+  land_points_.clear(), land_locator_.clear();
+  for (size_t l = 0; l < points_.size(); ++l) {
+    const Agent& a = agents_[walking_[l / locators]];
+    // Snapped back toward the body and aside of its line by more than a sample spacing: on
+    // ground reaching out over lower ground ahead, or under it.
+    const Vec3 aside = ProjectOnPlane(answers_[l].point - points_[l], a.up);
+    if (Length(aside) <= spacing || Dot(aside, a.forward) >= 0) continue;
+    land_locator_.push_back(l);
+    for (int j = 0; j <= per_line; ++j)
+      land_points_.push_back(points_[l] - a.up * (0.5 * lead_ + drop * j));
+  }
+  if (land_points_.empty()) return Status::kOk;
+  land_answers_.resize(land_points_.size());
+  const Status s =
+      Check(session_.Snap(terrain_, land_points_.data(), land_points_.size(), land_answers_.data()),
+            "snap locators", error);
+  if (s != Status::kOk) return s;
+  const size_t line = static_cast<size_t>(per_line) + 1;
+  for (size_t i = 0; i < land_locator_.size(); ++i) {
+    const size_t l = land_locator_[i];
+    const Agent& a = agents_[walking_[l / locators]];
+    const Vec3& placed = points_[l];
+    const double rest_height = Dot(placed, a.up) - 0.5 * lead_;
+    const double snapped_height = Dot(answers_[l].point, a.up);
+    for (size_t j = i * line; j < (i + 1) * line; ++j) {
+      const Foothold& h = land_answers_[j];
+      // Near the line (as ground straight below is: within 1.5 spacings, for samples spread
+      // unevenly), facing the up, lower than the snapped locator by a sample spacing and not
+      // above the place's rest height by more (ground rising ahead is the snap's to find).
+      if (h.status != Status::kOk || Dot(h.normal, a.up) < cos_max_slope_) continue;
+      if (Length(ProjectOnPlane(h.point - land_points_[j], a.up)) > 0.75 * gap_) continue;
+      const double height = Dot(h.point, a.up);
+      if (height > snapped_height - spacing || height > rest_height + spacing) continue;
+      if (Distance(h.point, placed) > lead_) break;
+      answers_[l] = h;
+      break;
+    }
+  }
+  return Status::kOk;
+}
+
 Status Generator::QueryFootholds(std::string* error) {
   std::vector<Move>& moves = moves_;
   const size_t per_agent = walking_.empty() ? 0 : moves.size() / walking_.size();

@@ -280,6 +280,12 @@ class Generator {
   static std::vector<int> CrowdedStarts(const Vec3* places, const Foothold* starts, int n,
                                         double apart);
   Status Step(int k, std::string* error);
+  // 6 (bipeds). A central locator snapped back toward the body onto higher ground (the nose of
+  // the tread the feet stand on, when the place lies over the tread below) takes the ground
+  // found below its place instead: points down the line along the up through it are snapped
+  // (one batch), and the highest whose sample lies on that line, lower ground facing the up,
+  // replaces the locator's snap in answers_.
+  Status LandLocators(std::string* error);
   Status QueryFootholds(std::string* error);
   // Accepts the answer h to mv's foothold query, or records why it is refused.
   void Judge(Move& mv, const Foothold& h) const;
@@ -508,6 +514,9 @@ class Generator {
   // stay the same from step to step (no refill on resize).
   std::vector<Vec3> points_, arc_points_;  // setup and locators; arc check points
   std::vector<size_t> arc_first_;          // per pending move: its first arc check point
+  std::vector<Vec3> land_points_;          // LandLocators: points down the lines
+  std::vector<Foothold> land_answers_;
+  std::vector<size_t> land_locator_;  // per line: the locator (index into points_) it is for
   std::vector<StepQuery> queries_;
   std::vector<Foothold> answers_, next_answers_, arc_answers_;
   // Bodies to key (KeyBodies): (agent, frame); per walking character the frame its body is due
