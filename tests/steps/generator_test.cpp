@@ -610,7 +610,7 @@ TEST_CASE("A biped going down stairs at a slant steps down them, its feet kept a
     Terrain t = resampled ? LoadTerrain(mesh, spacing * 2 / 3)
                           : LoadTerrain(MakeStairs(steps, rise, run, 8, spacing), spacing);
     const double first_top = resampled ? rise : 0, top = first_top + (steps - 1) * rise;
-    for (const double deg : {20.0, 30.0, 45.0, 60.0}) {
+    for (const double deg : {20.0, 30.0, 45.0, 60.0, 90.0}) {
       GenerateOptions o = StartOptions({2, top, run * steps - 0.1}, 12);
       const double a = deg * kPi / 180;
       o.heading = {std::cos(a), 0, -std::sin(a)};
@@ -618,11 +618,14 @@ TEST_CASE("A biped going down stairs at a slant steps down them, its feet kept a
       INFO((resampled ? "mesh " : "points ") << deg << " deg: " << w.stopped);
       CheckWalk(t, c, o, w);
       CHECK(w.stopped.empty());
-      CHECK(Body(w).keys.back().position.y < Body(w).keys.front().position.y - 2.5 * rise);
       auto depth = [&](const Vec3& p) { return FlightDepth(p, steps, rise, run, first_top); };
       CHECK(DeepestSwing(w, depth) <= spacing);
+      // 2.5 treads down or more in 12 steps.
+      CHECK(Body(w).keys.back().position.y < Body(w).keys.front().position.y - 2.5 * rise);
       // The feet's gap across the heading after each touch-down: never under a quarter of
-      // their rest gap (0.24), let alone crossed.
+      // their rest gap (0.24), let alone crossed; the feet never more than a tread apart in
+      // height (straight down, the next tread's nose is still the foothold, not the tread
+      // after it below the place), and no foot climbing back up.
       std::vector<std::pair<double, std::pair<int, Vec3>>> ends;
       for (const WalkTrack& track : w.tracks)
         for (const WalkKey& k : track.keys)
@@ -632,12 +635,18 @@ TEST_CASE("A biped going down stairs at a slant steps down them, its feet kept a
                        [](const auto& x, const auto& y) { return x.first < y.first; });
       const Vec3 left{o.heading.z, 0, -o.heading.x};
       Vec3 at[2] = {ends.front().second.second, ends.front().second.second};
-      double least = 1;
+      double least = 1, apart = 0, climbed = 0;
       for (size_t i = 0; i < ends.size(); ++i) {
-        at[ends[i].second.first] = ends[i].second.second;
-        if (i >= 2) least = std::min(least, Dot(at[0] - at[1], left));
+        const int f = ends[i].second.first;
+        climbed = std::max(climbed, ends[i].second.second.y - at[f].y);
+        at[f] = ends[i].second.second;
+        if (i < 2) continue;
+        least = std::min(least, Dot(at[0] - at[1], left));
+        apart = std::max(apart, std::fabs(at[0].y - at[1].y));
       }
       CHECK(least >= 0.25 * 0.24);
+      CHECK(apart <= rise + 0.01);
+      CHECK(climbed <= 0.01);
     }
   }
 }

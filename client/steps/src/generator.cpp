@@ -339,6 +339,7 @@ Status Generator::Step(int k, std::string* error) {
   answers_.resize(points_.size());
   Status s = Check(session_.Snap(terrain_, points_.data(), points_.size(), answers_.data()),
                    "snap locators", error);
+  landed_.assign(points_.size(), 0);
   if (s == Status::kOk && !c_.align_to_normal) s = LandLocators(error);
   if (s != Status::kOk) return s;
   // 6 (end) and 7-8 in QueryFootholds; 9 (only the feet whose foothold was accepted) and 10-11

@@ -198,20 +198,29 @@ void Generator::Steer(Agent& a, int group) const {
 Status Generator::LandLocators(std::string* error) {
   const size_t locators = pairs_of_group_[group_].size();
   const double spacing = 0.5 * gap_;
-  // Down from the place's rest height to lead/2 below it (a locator landing farther from its
-  // place than `lead` would be taken as hanging over a gap), a point every sample spacing.
-  const int per_line = std::clamp(static_cast<int>(std::ceil(0.5 * lead_ / spacing)), 1, 16);
-  const double drop = 0.5 * lead_ / per_line;
+  // Lines along the up at kLandLines points from the snap to the place (the last through the
+  // place), each probed down from the place's rest height to max_rise below it, a point every
+  // sample spacing (at most 33).
+  const int per_line = std::clamp(static_cast<int>(std::ceil(c_.max_rise / spacing)), 1, 32);
+  const size_t line = static_cast<size_t>(per_line) + 1, lines = kLandLines * line;
+  const double drop = c_.max_rise / per_line;
   land_points_.clear(), land_locator_.clear();
   for (size_t l = 0; l < points_.size(); ++l) {
     const Agent& a = agents_[walking_[l / locators]];
-    // Snapped back toward the body and aside of its line by more than a sample spacing: on
-    // ground reaching out over lower ground ahead, or under it.
+    // Snapped back toward the body, aside of that line by more than a sample spacing, onto
+    // ground no lower than the place's rest height (less a spacing): on ground reaching out
+    // over lower ground ahead (the nose of the tread the feet stand on), or under it. (Snapped
+    // back onto lower ground, a step down is found: the next nose down a flight.)
     const Vec3 aside = ProjectOnPlane(answers_[l].point - points_[l], a.up);
     if (Length(aside) <= spacing || Dot(aside, a.forward) >= 0) continue;
+    const double rest_height = Dot(points_[l], a.up) - 0.5 * lead_;
+    if (Dot(answers_[l].point, a.up) < rest_height - spacing) continue;
     land_locator_.push_back(l);
-    for (int j = 0; j <= per_line; ++j)
-      land_points_.push_back(points_[l] - a.up * (0.5 * lead_ + drop * j));
+    for (int q = 1; q <= kLandLines; ++q) {
+      const Vec3 top =
+          points_[l] + aside * (1 - static_cast<double>(q) / kLandLines) - a.up * (0.5 * lead_);
+      for (int j = 0; j <= per_line; ++j) land_points_.push_back(top - a.up * (drop * j));
+    }
   }
   if (land_points_.empty()) return Status::kOk;
   land_answers_.resize(land_points_.size());
@@ -219,25 +228,41 @@ Status Generator::LandLocators(std::string* error) {
       Check(session_.Snap(terrain_, land_points_.data(), land_points_.size(), land_answers_.data()),
             "snap locators", error);
   if (s != Status::kOk) return s;
-  const size_t line = static_cast<size_t>(per_line) + 1;
   for (size_t i = 0; i < land_locator_.size(); ++i) {
     const size_t l = land_locator_[i];
     const Agent& a = agents_[walking_[l / locators]];
     const Vec3& placed = points_[l];
     const double rest_height = Dot(placed, a.up) - 0.5 * lead_;
     const double snapped_height = Dot(answers_[l].point, a.up);
-    for (size_t j = i * line; j < (i + 1) * line; ++j) {
-      const Foothold& h = land_answers_[j];
-      // Near the line (as ground straight below is: within 1.5 spacings, for samples spread
-      // unevenly), facing the up, lower than the snapped locator by a sample spacing and not
-      // above the place's rest height by more (ground rising ahead is the snap's to find).
-      if (h.status != Status::kOk || Dot(h.normal, a.up) < cos_max_slope_) continue;
-      if (Length(ProjectOnPlane(h.point - land_points_[j], a.up)) > 0.75 * gap_) continue;
-      const double height = Dot(h.point, a.up);
-      if (height > snapped_height - spacing || height > rest_height + spacing) continue;
-      if (Distance(h.point, placed) > lead_) break;
-      answers_[l] = h;
-      break;
+    // Each line's ground: the first probe's sample straight below it, near the line (within
+    // 1.5 spacings, for samples spread unevenly), not above it, facing the up; lower than the
+    // snapped locator by a spacing and not above the rest height by more (ground rising ahead
+    // is the snap's to find).
+    const Foothold* ground[kLandLines] = {};
+    double highest = -std::numeric_limits<double>::infinity();
+    for (int q = 0; q < kLandLines; ++q) {
+      for (size_t j = i * lines + q * line; j < i * lines + (q + 1) * line; ++j) {
+        const Foothold& h = land_answers_[j];
+        if (h.status != Status::kOk || Dot(h.normal, a.up) < cos_max_slope_) continue;
+        const Vec3 off = h.point - land_points_[j];
+        if (Length(ProjectOnPlane(off, a.up)) > 0.75 * gap_ || Dot(off, a.up) > 0.5 * spacing)
+          continue;
+        const double height = Dot(h.point, a.up);
+        if (height > snapped_height - spacing || height > rest_height + spacing) continue;
+        ground[q] = &h;
+        highest = std::max(highest, height);
+        break;
+      }
+    }
+    // Over lower ground (the place over a tread below, not inside the step the snap lies on
+    // the riser of), the first ground down from the snap (the next tread, not the one after
+    // it where the place lies beyond a shallow tread), as near the place as it reaches.
+    if (!ground[kLandLines - 1]) continue;
+    for (int q = kLandLines - 1; q >= 0; --q) {
+      if (ground[q] && Dot(ground[q]->point, a.up) >= highest - spacing) {
+        answers_[l] = *ground[q], landed_[l] = 1;
+        break;
+      }
     }
   }
   return Status::kOk;
@@ -264,12 +289,13 @@ Status Generator::QueryFootholds(std::string* error) {
         if (round == 0) {
           // 6 (end). A locator that snapped farther than `lead` from where it was placed hangs
           // over a gap or a cliff: it keeps its place (the body's frame), so the foothold query
-          // looks over the void. Round 0 holds every move, and answers_ the locator snaps.
+          // looks over the void; one landed on the ground below its place (LandLocators) does
+          // not. Round 0 holds every move, and answers_ the locator snaps.
           const size_t m = pending_[i];
           const size_t l = (m / per_agent) * locators + slot[m % per_agent];
           const Foothold& h = answers_[l];
           const Vec3& placed = points_[l];
-          if (Distance(h.point, placed) <= lead_) {
+          if (landed_[l] || Distance(h.point, placed) <= lead_) {
             locator_[m] = h.point, locator_normal_[m] = h.normal;
             // On a face past max_slope_deg it keeps its place across the heading (a wall beside
             // it drew the feet sideways into the wall), and on a face across the heading (a wall

@@ -46,6 +46,9 @@ inline constexpr Attempt kAttempts[kMaxAttempts] = {{1.0, 0},   {0.6, 0},   {1.3
                                                     {1.0, 0.5}, {0.6, 0.5}, {0.3, 0.5}};
 // A foothold is looked for within this fraction of step_length of where the foot aims.
 inline constexpr double kFootholdTolerance = 0.5;
+// A biped's locator snapped back onto its feet's nose looks for the ground below along this
+// many lines, evenly from the snap to its place (LandLocators).
+inline constexpr int kLandLines = 4;
 inline constexpr int kMaxRaises = 8;    // swing arc raises before giving up
 inline constexpr double kRaise = 0.5;   // raise per round, in step heights
 inline constexpr double kSlide = 0.25;  // slide per round toward a blocked half's end (of the way)
@@ -280,11 +283,11 @@ class Generator {
   static std::vector<int> CrowdedStarts(const Vec3* places, const Foothold* starts, int n,
                                         double apart);
   Status Step(int k, std::string* error);
-  // 6 (bipeds). A central locator snapped back toward the body onto higher ground (the nose of
-  // the tread the feet stand on, when the place lies over the tread below) takes the ground
-  // found below its place instead: points down the line along the up through it are snapped
-  // (one batch), and the highest whose sample lies on that line, lower ground facing the up,
-  // replaces the locator's snap in answers_.
+  // 6 (bipeds). A central locator snapped back toward the body onto ground no lower than the
+  // feet's (the nose of the tread they stand on, the place over the tread below) takes the
+  // first ground down from it instead: points down kLandLines lines along the up, from the
+  // snap to the place, are snapped (one batch); of the ground found straight below them, the
+  // highest, as near the place as it reaches, replaces the snap in answers_.
   Status LandLocators(std::string* error);
   Status QueryFootholds(std::string* error);
   // Accepts the answer h to mv's foothold query, or records why it is refused.
@@ -516,7 +519,8 @@ class Generator {
   std::vector<size_t> arc_first_;          // per pending move: its first arc check point
   std::vector<Vec3> land_points_;          // LandLocators: points down the lines
   std::vector<Foothold> land_answers_;
-  std::vector<size_t> land_locator_;  // per line: the locator (index into points_) it is for
+  std::vector<size_t> land_locator_;  // per locator probed: its index into points_
+  std::vector<char> landed_;          // per locator: 1 when LandLocators replaced its snap
   std::vector<StepQuery> queries_;
   std::vector<Foothold> answers_, next_answers_, arc_answers_;
   // Bodies to key (KeyBodies): (agent, frame); per walking character the frame its body is due
