@@ -42,6 +42,10 @@ both octopod-floor 0 --terrain "$work/floor.pts" --character "$chars/octopod.jso
   --start 1.2,0,0.6 --start-frame 101
 both biped-cliff 2 --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
   --steps 100
+# A crowd of bipeds going down wide stairs at a slant (the locators landing below their places).
+"$footfall" terrain make stairs --width 8 --steps 12 --spacing 0.03 -o "$work/stairs.pts" > /dev/null
+both biped-stairs-crowd 0 --terrain "$work/stairs.pts" --character "$chars/biped.json" --steps 10 \
+  --crowd 4 --crowd-spacing 1.2 --start 3,1.98,3.4 --heading 1,0,-0.7
 "$footfall" generate --terrain "$work/floor.pts" --character "$chars/hexapod.json" --steps 12 \
   --crowd 9 --crowd-spacing 0.6 --start 1.2,0,0.8 --threads 1 --out "$work/hexapod-crowd-1.json" 2> /dev/null
 check "crowd: --threads 1 gives the same walk" cmp -s "$work/hexapod-crowd-1.json" "$work/hexapod-crowd-embedded.json"
