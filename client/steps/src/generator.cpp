@@ -314,7 +314,8 @@ Status Generator::Step(int k, std::string* error) {
   }
   // 6. Central locators: one per foot pair stepping now, `lead` ahead of the pair's rest centre
   //    in the body frame and lead/2 above it (so that at a wall ahead the locator snaps onto the
-  //    wall, not into the corner), snapped to the terrain (one batch for every character).
+  //    wall, not into the corner), snapped to the terrain (one batch for every character). A
+  //    biped's locator snapped back onto its feet's nose lands on the ground below (LandLocators).
   if (walking_.empty()) return Status::kOk;
   const std::vector<int>& stepping = c_.gait[group_];
   const std::vector<int>& pairs = pairs_of_group_[group_];
