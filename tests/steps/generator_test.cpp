@@ -591,6 +591,39 @@ TEST_CASE("A biped climbs steep stairs without taking the next nose for an overh
   }
 }
 
+namespace {
+
+// A biped's feet (L and R) after each touch-down but the first two: the least gap between them
+// across `heading` (left of it on the world up, L's side positive), the most they lie apart in
+// height, and the most a foot's touch-down rose above its lift-off.
+struct BipedStance {
+  double least_gap = 1, most_apart = 0, most_climbed = 0;
+};
+
+BipedStance Stance(const Walk& w, const Vec3& heading) {
+  std::vector<std::pair<double, std::pair<int, Vec3>>> ends;
+  for (const WalkTrack& track : w.tracks)
+    for (const WalkKey& k : track.keys)
+      if (track.kind == TrackKind::kFoot && k.phase != KeyPhase::kMid)
+        ends.push_back({k.frame, {track.name == "L" ? 0 : 1, k.position}});
+  std::stable_sort(ends.begin(), ends.end(),
+                   [](const auto& x, const auto& y) { return x.first < y.first; });
+  const Vec3 left{heading.z, 0, -heading.x};
+  Vec3 at[2] = {ends.front().second.second, ends.front().second.second};
+  BipedStance out;
+  for (size_t i = 0; i < ends.size(); ++i) {
+    const int f = ends[i].second.first;
+    out.most_climbed = std::max(out.most_climbed, ends[i].second.second.y - at[f].y);
+    at[f] = ends[i].second.second;
+    if (i < 2) continue;
+    out.least_gap = std::min(out.least_gap, Dot(at[0] - at[1], left));
+    out.most_apart = std::max(out.most_apart, std::fabs(at[0].y - at[1].y));
+  }
+  return out;
+}
+
+}  // namespace
+
 TEST_CASE("A biped going down stairs at a slant steps down them, its feet kept apart",
           "[steps][generator]") {
   // Its central locator, placed lead/2 above the pair's rest, snapped back onto the nose of the
@@ -626,27 +659,39 @@ TEST_CASE("A biped going down stairs at a slant steps down them, its feet kept a
       // their rest gap (0.24), let alone crossed; the feet never more than a tread apart in
       // height (straight down, the next tread's nose is still the foothold, not the tread
       // after it below the place), and no foot climbing back up.
-      std::vector<std::pair<double, std::pair<int, Vec3>>> ends;
-      for (const WalkTrack& track : w.tracks)
-        for (const WalkKey& k : track.keys)
-          if (track.kind == TrackKind::kFoot && k.phase != KeyPhase::kMid)
-            ends.push_back({k.frame, {track.name == "L" ? 0 : 1, k.position}});
-      std::stable_sort(ends.begin(), ends.end(),
-                       [](const auto& x, const auto& y) { return x.first < y.first; });
-      const Vec3 left{o.heading.z, 0, -o.heading.x};
-      Vec3 at[2] = {ends.front().second.second, ends.front().second.second};
-      double least = 1, apart = 0, climbed = 0;
-      for (size_t i = 0; i < ends.size(); ++i) {
-        const int f = ends[i].second.first;
-        climbed = std::max(climbed, ends[i].second.second.y - at[f].y);
-        at[f] = ends[i].second.second;
-        if (i < 2) continue;
-        least = std::min(least, Dot(at[0] - at[1], left));
-        apart = std::max(apart, std::fabs(at[0].y - at[1].y));
-      }
-      CHECK(least >= 0.25 * 0.24);
-      CHECK(apart <= rise + 0.01);
-      CHECK(climbed <= 0.01);
+      const BipedStance stance = Stance(w, o.heading);
+      CHECK(stance.least_gap >= 0.25 * 0.24);
+      CHECK(stance.most_apart <= rise + 0.01);
+      CHECK(stance.most_climbed <= 0.01);
+    }
+  }
+}
+
+TEST_CASE("A biped climbing stairs at a slant keeps its feet apart", "[steps][generator]") {
+  // Climbing at 15 degrees to the treads or less, its central locator snapped onto the next
+  // tread's nose, uphill of the heading, and drew the downhill foot's target across the other
+  // foot: the feet crossed at every step (18 of 180 walks up made stairs). A foothold lined up
+  // with its mate is now asked again aimed outward, to three quarters of the rest gap.
+  const Character c = LoadShipped("biped");
+  const int steps = 12;
+  struct Flight {
+    double rise, run, spacing, deg;
+  };
+  for (const Flight& f : {Flight{0.15, 0.3, 0.06, 12}, Flight{0.25, 0.3, 0.06, 12},
+                          Flight{0.2, 0.35, 0.05, 10}, Flight{0.2, 0.3, 0.03, 5}}) {
+    Terrain t = LoadTerrain(MakeStairs(steps, f.rise, f.run, 10, f.spacing), f.spacing);
+    for (const double side : {1.0, -1.0}) {
+      GenerateOptions o = StartOptions({side > 0 ? 1.0 : 9.0, f.rise, 1.5 * f.run}, 12);
+      const double a = f.deg * kPi / 180;
+      o.heading = {side * std::cos(a), 0, std::sin(a)};
+      const Walk w = Generate(t, c, o);
+      INFO(f.rise << " x " << f.run << " every " << f.spacing << " at " << f.deg << " deg, "
+                  << (side > 0 ? "+x: " : "-x: ") << w.stopped);
+      CheckWalk(t, c, o, w);
+      CHECK(w.stopped.empty());
+      auto depth = [&](const Vec3& p) { return FlightDepth(p, steps, f.rise, f.run, 0); };
+      CHECK(DeepestSwing(w, depth) <= f.spacing);
+      CHECK(Stance(w, o.heading).least_gap >= 0.25 * 0.24);
     }
   }
 }

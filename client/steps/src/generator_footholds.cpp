@@ -13,6 +13,23 @@
 namespace footfall::steps_detail {
 namespace {
 
+// The least outward shift of a lined-up foot's retry, as a share of gap_ (twice the sample
+// spacing): half a spacing, toward the sample on the foot's own side.
+constexpr double kNearestOutward = 0.25;
+// The gap from its mate, as a share of their rest gap, that a lined-up foot's retry aims at
+// (the rest gap itself pushed the downhill foot of a biped turning on stairs over the nose it
+// walked along more often, and made more steps two treads down: 56 walks of 600 against 53).
+constexpr double kOutwardGoal = 0.75;
+
+// A lined-up foot's outward retry aimed farther than `least` that was refused or did no
+// better: asked again `least` outward (true), at the sample on the foot's own side.
+bool NearerOutward(Move& mv, double least) {
+  if (mv.outward <= least) return false;
+  mv.outward = least;
+  --mv.attempts;  // the same attempt again
+  return true;
+}
+
 // The distance from p to the box [lo, hi] (0 inside).
 double BoxDistance(const Vec3& p, const Vec3& lo, const Vec3& hi) {
   const Vec3 out{std::max({lo.x - p.x, 0.0, p.x - hi.x}), std::max({lo.y - p.y, 0.0, p.y - hi.y}),
@@ -21,6 +38,12 @@ double BoxDistance(const Vec3& p, const Vec3& lo, const Vec3& hi) {
 }
 
 }  // namespace
+
+void Reopen(Move& mv) {
+  if (mv.outward_kept) --mv.attempts;  // (a lined-up foothold's arc may clear, or it be in reach)
+  mv.outward = mv.outward_kept ? -1 : 0;
+  mv.lined_up = mv.outward_kept = false;
+}
 
 bool Generator::Nearing(Agent& a, int k) const {
   if (a.path.empty()) return true;
@@ -342,10 +365,10 @@ Status Generator::QueryFootholds(std::string* error) {
           v = v * (max_len / Length(v));
         v = v * mv.attempt.scale;  // retries step shorter or longer
         // A foothold lined up with its pair's other foot is asked again with the step aimed
-        // outward by half the samples' spacing, toward the sample on the foot's own side.
-        if (mv.outward) {
+        // outward, toward the foot's own side (KeepsSide says how far).
+        if (mv.outward > 0) {
           const double side = rest_[mv.foot].x > rest_[mate_[mv.foot]].x ? 1.0 : -1.0;
-          v += Left(a) * (side * 0.25 * gap_);
+          v += Left(a) * (side * mv.outward);
         }
         // (A step of under 2% of what this one may be, not of step_length: a slope_step_scale
         // below 0.02 made every step up a slope a step in place, and the walk a dead end.)
@@ -431,7 +454,10 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
     if (KeepsSide(mv, h.point, h.normal)) mv.done = true;
     return;
   }
-  if (mv.lined_up) {  // the outward retry was refused: the lined-up foothold it tried to better
+  if (mv.lined_up) {  // the outward retry was refused
+    // Aimed farther than half a sample spacing (off the edge of a terrain the feet walk along),
+    // it is asked again half a spacing outward; else the lined-up foothold it tried to better.
+    if (NearerOutward(mv, kNearestOutward * gap_)) return;
     mv.done = true, mv.end = mv.lined_up_point, mv.end_normal = mv.lined_up_normal;
     return;
   }
@@ -476,19 +502,25 @@ double Generator::GapToMate(const Move& mv, const Vec3& p) const {
 bool Generator::KeepsSide(Move& mv, const Vec3& p, const Vec3& normal) const {
   const double gap = GapToMate(mv, p);
   if (mv.lined_up) {  // the outward retry: the better of the two
-    if (std::fabs(gap - 1) >= std::fabs(mv.lined_up_gap - 1))
-      mv.end = mv.lined_up_point, mv.end_normal = mv.lined_up_normal;
-    else
-      mv.end = p, mv.end_normal = normal;
+    if (std::fabs(gap - 1) < std::fabs(mv.lined_up_gap - 1)) {
+      mv.end = p, mv.end_normal = normal, mv.outward_kept = true;
+      return true;
+    }
+    if (NearerOutward(mv, kNearestOutward * gap_)) return false;
+    mv.end = mv.lined_up_point, mv.end_normal = mv.lined_up_normal;
     return true;
   }
   mv.end = p, mv.end_normal = normal;
-  // Lined up: under half the rest gap, with samples at least a quarter of it apart (nearer
-  // samples would have given a foothold on the foot's own side).
-  if (gap >= kMinPairGap || mv.outward) return true;
+  // Lined up: under half the rest gap. The retry is aimed to three quarters of the rest gap
+  // (the target itself was lined up: its locator caught on a stair's nose beside the heading,
+  // as climbing stairs at 15 degrees to the treads, where a biped's downhill foot crossed the
+  // other; or a sharp turn cut on the targets, not the footholds), and at least half a sample
+  // spacing, at the sample on the foot's own side (on the bundled hills' 25 cm lattice a
+  // biped's feet took one column of samples on a diagonal).
+  if (gap >= kMinPairGap || mv.outward != 0) return true;
   const double rest_gap = std::fabs(rest_[mv.foot].x - rest_[mate_[mv.foot]].x);
-  if (0.5 * gap_ < 0.25 * rest_gap) return true;
-  mv.outward = true, mv.lined_up = true, mv.lined_up_gap = gap;
+  mv.outward = std::max(kNearestOutward * gap_, (kOutwardGoal - gap) * rest_gap);
+  mv.lined_up = true, mv.lined_up_gap = gap;
   mv.lined_up_point = p, mv.lined_up_normal = normal;
   --mv.attempts;  // the same attempt again, aimed outward
   return false;
@@ -616,6 +648,7 @@ void Generator::CheckReach(size_t m, size_t e) {
             << "finer";
       }
       moves[i].done = false;
+      Reopen(moves[i]);
       if (KeepsReason(moves[i], false)) moves[i].reason = why.str(), moves[i].reason_is_gap = false;
     }
   }
@@ -629,6 +662,7 @@ void Generator::CheckReach(size_t m, size_t e) {
     for (size_t i = m; i < e; ++i) {
       if (!moves[i].done) continue;
       moves[i].done = false, moves[i].held_by_planted = true;
+      Reopen(moves[i]);
       if (KeepsReason(moves[i], false)) moves[i].reason = why.str(), moves[i].reason_is_gap = false;
     }
     break;

@@ -131,6 +131,7 @@ Status Generator::ClearArcs(int k, std::string* error) {
               mv.reason = why.str(), mv.reason_is_gap = false;
             }
             mv.done = false;
+            Reopen(mv);
             if (mv.attempts >= kMaxAttempts) {
               Fail(mv);
             } else {

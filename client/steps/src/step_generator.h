@@ -195,14 +195,22 @@ struct Move {
   Vec3 ideal;               // the last query's ideal point
   Vec3 step;                // the last query's step vector
   size_t query = kNoQuery;  // index of this round's foothold answer, or kNoQuery
-  // A foothold accepted but lined up with (or across) its pair's other foot, samples lying
-  // about as far apart as the feet: the query is asked again aimed outward (`outward`), and
-  // this one (`lined_up`, its gap as a share of the rest gap) is kept unless that does better.
-  bool outward = false;
+  // A foothold accepted but lined up with (or across) its pair's other foot: the query is
+  // asked again aimed outward by `outward` across the heading (0: not asked; below 0: not
+  // again in this try, whose outward foothold's arc could not clear), and this one
+  // (`lined_up`, its gap as a share of the rest gap) is kept unless that does better
+  // (`outward_kept`).
+  double outward = 0;
   bool lined_up = false;
+  bool outward_kept = false;
   double lined_up_gap = 0;
   Vec3 lined_up_point, lined_up_normal;
 };
+
+// mv's accepted foothold refused after all (beyond reach, or its arc cannot clear): a foothold
+// its outward retry found gives way to the lined-up one it bettered, asked again in the same try
+// without aiming outward; any other starts its next try afresh.
+void Reopen(Move& mv);
 
 class Generator {
  public:
