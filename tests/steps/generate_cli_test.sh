@@ -668,6 +668,9 @@ kill -9 "$server_pid"; wait "$server_pid" 2>/dev/null; server_pid=""
 wait "$walk_pid"
 check "server dies mid-walk: exit 1" [ $? -eq 1 ]
 check "server dies mid-walk: said" grep -qF "footfall generate: footfalld failed mid-walk (not the terrain): the keys up to its failure are written; exit status 1" "$work/died.err"
+# (Its bar was filled to 100% as the failure stopped every character.)
+check "server dies mid-walk: the progress bar left short of 100%" bash -c \
+  'tr "\r" "\n" < "$1" | grep -E "\] +[0-9]+%" | tail -1 | grep -qvF "100%"' _ "$work/died.err"
 check "server dies mid-walk: the keys so far written, the failed call their stop" python3 -c '
 import json, sys
 w = json.load(open(sys.argv[1]))

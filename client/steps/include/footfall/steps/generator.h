@@ -109,7 +109,9 @@ struct GenerateOptions {
   int characters_per_pass = 0;
   // Called as the walk advances with (work done, total work), in steps times passes; may be
   // empty. Called from the generating thread and, for crowds walked in passes, from the batch
-  // threads too, one call at a time: it must not assume the caller's thread.
+  // threads too, one call at a time: it must not assume the caller's thread. Work reaches the
+  // total when every character arrived, stopped or walked its steps; a pass cut short by its
+  // session failing (Walk::session_failed) leaves its steps left undone.
   std::function<void(int, int)> progress;
 };
 
