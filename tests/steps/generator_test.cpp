@@ -696,6 +696,35 @@ TEST_CASE("A biped climbing stairs at a slant keeps its feet apart", "[steps][ge
   }
 }
 
+TEST_CASE(
+    "A biped walking along a flight steps down off a nose, its swing hooked out over the "
+    "tread below",
+    "[steps][generator]") {
+  // Turned onto a tread by its path, a biped straddling a riser walks along the flight, one
+  // foot just behind a nose. Its step down lands at the foot of that riser: every arc there
+  // dropped past the nose, and raising the mid key never cleared it (the walk stopped, "the
+  // foothold ... leans 90 deg": the riser, the best reason among the refused tries). The mid
+  // key now hooks out from the riser over the tread below.
+  const Character c = LoadShipped("biped");
+  const int steps = 14;
+  const double rise = 0.2, run = 0.25, spacing = 0.02;
+  Terrain t = LoadTerrain(MakeStairs(steps, rise, run, 10, spacing), spacing);
+  const Vec3 top{5, (steps - 1) * rise, 3.4};
+  for (const auto& path : {std::vector<Vec3>{{5, 1.2, 1.5}, {1, 1.2, 1.5}},
+                           std::vector<Vec3>{{8, 1.8, 2.4}, {1, 1.8, 2.4}}}) {
+    const GenerateOptions o = PathOptions({path[0].x, top.y, top.z}, path, 80);
+    const Walk w = Generate(t, c, o);
+    INFO("along z = " << path[1].z << ": " << w.stopped);
+    CheckWalk(t, c, o, w);
+    CHECK(w.stopped.empty());
+    auto depth = [&](const Vec3& p) { return FlightDepth(p, steps, rise, run, 0); };
+    CHECK(DeepestSwing(w, depth) <= spacing);
+    // At the goal, seen from above (within the last waypoint's half step).
+    const Vec3 end = Body(w).keys.back().position;
+    CHECK(std::hypot(end.x - path[1].x, end.z - path[1].z) <= 0.5 * c.step_length + 0.1);
+  }
+}
+
 TEST_CASE("An upright body walks on under a roof above it, neither stopped nor raised toward it",
           "[steps][generator]") {
   // A roof 1.6 m up modelled as one face (samples facing up only) over a biped 0.95 m tall:

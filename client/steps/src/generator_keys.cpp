@@ -28,15 +28,21 @@ double Clearance(const Vec3& p, const Foothold& h, double gap, const Vec3& up) {
   return std::max(height, Length(v) - gap);
 }
 
+// True when the foothold `foot` stands against h's face: in front of its plane, nearer than
+// `near`, on ground unlike it (a toe at a riser).
+bool StandsAgainst(const Foothold& h, const Vec3& foot, const Vec3& foot_normal, double near) {
+  const double kept = Dot(foot - h.point, h.normal);
+  return Dot(h.normal, foot_normal) < kAlikeCos && kept >= 0 && kept <= near;
+}
+
 // The clearance an arc point must keep from h, its nearest sample: `nominal`, or, when the
 // foothold `foot` at that end of the arc stands against h's face (in front of its plane, nearer
 // than `near`, on ground unlike it: a toe at a riser), no more than half of what the foot itself
 // keeps from that plane.
 double ClearanceNeeded(double nominal, const Foothold& h, const Vec3& foot, const Vec3& foot_normal,
                        double near) {
-  const double kept = Dot(foot - h.point, h.normal);
-  if (Dot(h.normal, foot_normal) >= kAlikeCos || kept < 0 || kept > near) return nominal;
-  return std::min(nominal, 0.5 * kept);
+  if (!StandsAgainst(h, foot, foot_normal, near)) return nominal;
+  return std::min(nominal, 0.5 * Dot(foot - h.point, h.normal));
 }
 
 }  // namespace
@@ -68,6 +74,7 @@ Status Generator::ClearArcs(int k, std::string* error) {
         if (round == 0) {
           mv.mid_normal = NormalizeOr(a.foot_normal[mv.foot] + mv.end_normal, a.up);
           mv.mid = (start + mv.end) * 0.5 + mv.mid_normal * c_.step_height;
+          mv.hooks = 0;
         }
         const double half = std::max(Distance(start, mv.mid), Distance(mv.mid, mv.end));
         arc_first_[i + 1] = ArcChecks(2 * half, gap_);
@@ -105,6 +112,8 @@ Status Generator::ClearArcs(int k, std::string* error) {
           const Agent& a = agents_[mv.agent];
           bool low[2] = {false, false};   // a check point too low in the first, second half
           bool wall[2] = {false, false};  // ... beside a face unlike that half's foothold
+          // The face that half's foothold stands against, if any point of the half is near it.
+          Vec3 face[2] = {Vec3{}, Vec3{}};
           const size_t first = arc_first_[i], checks = arc_first_[i + 1] - first;
           for (size_t j = 0; j < checks; ++j) {
             const Foothold& h = arc_answers_[first + j];
@@ -112,15 +121,32 @@ Status Generator::ClearArcs(int k, std::string* error) {
             if (h.status != Status::kOk) continue;
             const int half = s > 0.5;
             const double nominal = c_.step_height * (1 - std::fabs(2 * s - 1));
+            const Vec3& foot = half ? mv.end : a.foot[mv.foot];
+            const Vec3& foot_normal = half ? mv.end_normal : a.foot_normal[mv.foot];
             const double need =
-                ClearanceNeeded(kClearanceFraction * nominal, h, half ? mv.end : a.foot[mv.foot],
-                                half ? mv.end_normal : a.foot_normal[mv.foot], c_.step_height);
+                ClearanceNeeded(kClearanceFraction * nominal, h, foot, foot_normal, c_.step_height);
+            if (StandsAgainst(h, foot, foot_normal, c_.step_height)) face[half] = h.normal;
             if (Clearance(arc_points_[first + j], h, gap_, a.up) < need) {
               low[half] = true;
               wall[half] |= need < kClearanceFraction * nominal;
             }
           }
           if (!low[0] && !low[1]) continue;
+          // Raised all it may be, one half still low by its foothold standing against a face
+          // (a foot landing at a riser's foot from the nose above it drops past that nose): the
+          // mid key hooks out from the face over that foothold, up to kMaxHooks times higher.
+          const int hook = low[0] ? 0 : 1;
+          if (round + 1 >= kMaxRaises && low[hook] != low[1 - hook] && mv.hooks < kMaxHooks &&
+              Length2(face[hook]) > 0) {
+            const Vec3& at = hook == 0 ? a.foot[mv.foot] : mv.end;
+            const Vec3& other = hook == 0 ? mv.end : a.foot[mv.foot];
+            const double height = std::max(0.0, Dot(other - at, mv.mid_normal)) +
+                                  0.5 * c_.step_height * (++mv.hooks + 1);
+            const Vec3 out = NormalizeOr(ProjectOnPlane(face[hook], mv.mid_normal), Vec3{});
+            mv.mid = at + mv.mid_normal * height + out * (kHookOut * height);
+            verdict_[i] = 1, raised_[g] = 1;
+            continue;
+          }
           if (round + 1 >= kMaxRaises) {
             // The foot asks for another foothold (its next try), or gives up after the last.
             if (KeepsReason(mv, false)) {

@@ -49,9 +49,11 @@ inline constexpr double kFootholdTolerance = 0.5;
 // A biped's locator snapped back onto its feet's nose looks for the ground below along this
 // many lines, evenly from the snap to its place (LandLocators).
 inline constexpr int kLandLines = 4;
-inline constexpr int kMaxRaises = 8;    // swing arc raises before giving up
-inline constexpr double kRaise = 0.5;   // raise per round, in step heights
-inline constexpr double kSlide = 0.25;  // slide per round toward a blocked half's end (of the way)
+inline constexpr int kMaxRaises = 8;     // swing arc raises before giving up
+inline constexpr double kRaise = 0.5;    // raise per round, in step heights
+inline constexpr double kSlide = 0.25;   // slide per round toward a blocked half's end (of the way)
+inline constexpr int kMaxHooks = 3;      // swing arcs hooked out from a face, after the raises
+inline constexpr double kHookOut = 0.5;  // a hooked mid key's distance out, per height above
 inline constexpr double kAlikeCos = 0.7071;  // footholds whose normals are within 45 deg face alike
 // A body key keeps at least this fraction of body_height from the terrain (measured as arcs
 // are, from its nearest sample); nearer, it is raised along its up, in up to kBodyRounds rounds
@@ -192,6 +194,7 @@ struct Move {
   bool held_by_planted = false;
   Vec3 end, end_normal;  // the accepted foothold
   Vec3 mid, mid_normal;
+  int hooks = 0;            // times the arc's mid key hooked out from a face (ClearArcs)
   Vec3 ideal;               // the last query's ideal point
   Vec3 step;                // the last query's step vector
   size_t query = kNoQuery;  // index of this round's foothold answer, or kNoQuery
