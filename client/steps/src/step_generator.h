@@ -200,7 +200,7 @@ struct Move {
   size_t query = kNoQuery;  // index of this round's foothold answer, or kNoQuery
   // A foothold accepted but lined up with (or across) its pair's other foot: the query is
   // asked again aimed outward by `outward` across the heading (0: not asked; below 0: not
-  // again in this try, whose outward foothold's arc could not clear), and this one
+  // again in this try, whose outward foothold was refused after all: Reopen), and this one
   // (`lined_up`, its gap as a share of the rest gap) is kept unless that does better
   // (`outward_kept`).
   double outward = 0;
