@@ -667,11 +667,15 @@ TEST_CASE("A biped going down stairs at a slant steps down them, its feet kept a
   }
 }
 
-TEST_CASE("A biped climbing stairs at a slant keeps its feet apart", "[steps][generator]") {
+TEST_CASE("A biped climbing stairs at a slant keeps its feet apart and its heading",
+          "[steps][generator]") {
   // Climbing at 15 degrees to the treads or less, its central locator snapped onto the next
   // tread's nose, uphill of the heading, and drew the downhill foot's target across the other
   // foot: the feet crossed at every step (18 of 180 walks up made stairs). A foothold lined up
-  // with its mate is now asked again aimed outward, to three quarters of the rest gap.
+  // with its mate is now asked again aimed outward, to three quarters of the rest gap. The
+  // body climbed a tread a step whatever its heading, its way bending up the flight (12
+  // degrees to the treads walked at 21 to 27): the locator now keeps its place across the
+  // heading, at the height of the nose it snapped to.
   const Character c = LoadShipped("biped");
   const int steps = 12;
   struct Flight {
@@ -692,6 +696,11 @@ TEST_CASE("A biped climbing stairs at a slant keeps its feet apart", "[steps][ge
       auto depth = [&](const Vec3& p) { return FlightDepth(p, steps, f.rise, f.run, 0); };
       CHECK(DeepestSwing(w, depth) <= f.spacing);
       CHECK(Stance(w, o.heading).least_gap >= 0.25 * 0.24);
+      // The way walked, seen from above, within 5 degrees of the heading (it went 6 to 16 off).
+      const Vec3 way = Body(w).keys.back().position - Body(w).keys.front().position;
+      const double off_deg = std::atan2(way.z, std::fabs(way.x)) * 180 / kPi - f.deg;
+      CHECK(std::fabs(off_deg) <= 5);
+      CHECK(std::hypot(way.x, way.z) >= 2.5);
     }
   }
 }

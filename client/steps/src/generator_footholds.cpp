@@ -218,6 +218,21 @@ void Generator::Steer(Agent& a, int group) const {
   a.forward = best_forward, a.stride = best_stride;
 }
 
+bool Generator::ClimbedAside(const Foothold& h, const Vec3& placed, const Agent& a, double lean,
+                             double off) const {
+  // Climbing stairs at a slant, the place lies over the tread the feet stand on, nearer the
+  // nose of the next one up beside the heading: a biped took a tread a step whatever its
+  // heading, its way bending up the flight (12 degrees to the treads walked at 24). Onto ground
+  // leaning little across the heading, above the rest height (lead/2 below the place) by more
+  // than a sample spacing, aside of the place by more than a spacing and along the heading by
+  // no more than half that (or a spacing: the samples' lattice).
+  const double spacing = 0.5 * gap_;
+  const double along = std::fabs(Dot(h.point - placed, a.forward));
+  return lean < kFlatLean && std::fabs(off) > spacing &&
+         along <= std::max(0.5 * std::fabs(off), spacing) &&
+         Dot(h.point - placed, a.up) > spacing - 0.5 * lead_;
+}
+
 Status Generator::LandLocators(std::string* error) {
   const size_t locators = pairs_of_group_[group_].size();
   const double spacing = 0.5 * gap_;
@@ -335,13 +350,17 @@ Status Generator::QueryFootholds(std::string* error) {
               // heading, it slid toward the high side by up to lead/4 (a biped crossing a
               // 25-degree slope climbed 2 m in 10): it slides back along the ground to where
               // it was placed across the heading. (Not past what the lean explains: an edge
-              // beside it. Multipeds' up is the ground's normal: they slide along it.)
+              // beside it. Multipeds' up is the ground's normal: they slide along it.) One that
+              // climbed onto the next tread up beside the heading keeps its height but its place
+              // across the heading (ClimbedAside).
               const Vec3 across = ProjectOnPlane(left, h.normal);
               const double lean = std::fabs(Dot(h.normal, left));
               const double off = Dot(h.point - placed, left);
               const double keep = Dot(across, left);  // 1 - lean^2
               if (keep > 0.25 && std::fabs(off) <= 0.5 * lead_ * lean + 0.5 * gap_)
                 locator_[m] -= across * (off / keep);
+              else if (ClimbedAside(h, placed, a, lean, off))
+                locator_[m] -= left * off;
             }
           } else {
             locator_[m] = placed - a.up * (0.5 * lead_), locator_normal_[m] = a.up;

@@ -49,6 +49,9 @@ inline constexpr double kFootholdTolerance = 0.5;
 // A biped's locator snapped back onto its feet's nose looks for the ground below along this
 // many lines, evenly from the snap to its place (LandLocators).
 inline constexpr int kLandLines = 4;
+// Ground leaning less than this (the sine of its normal's angle across the heading) is taken as
+// flat by ClimbedAside: a tread, not a slope the locator slides along.
+inline constexpr double kFlatLean = 0.1;
 inline constexpr int kMaxRaises = 8;     // swing arc raises before giving up
 inline constexpr double kRaise = 0.5;    // raise per round, in step heights
 inline constexpr double kSlide = 0.25;   // slide per round toward a blocked half's end (of the way)
@@ -300,6 +303,12 @@ class Generator {
   // snap to the place, are snapped (one batch); of the ground found straight below them, the
   // highest, as near the place as it reaches, replaces the snap in answers_.
   Status LandLocators(std::string* error);
+  // True when a biped's locator placed at `placed` snapped (h) onto a tread higher than its
+  // rest, aside of its place across a's heading (by `off`, on ground leaning `lean` across it)
+  // and little along it: the next tread's nose beside the heading. It then keeps its place
+  // across the heading.
+  bool ClimbedAside(const Foothold& h, const Vec3& placed, const Agent& a, double lean,
+                    double off) const;
   Status QueryFootholds(std::string* error);
   // Accepts the answer h to mv's foothold query, or records why it is refused.
   void Judge(Move& mv, const Foothold& h) const;
