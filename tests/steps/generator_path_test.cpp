@@ -269,7 +269,7 @@ TEST_CASE("Feet on ground sampled about as far apart as they stand keep to their
   // The main job's biped (feet 0.2 m apart) on the bundled hills' 0.25 m lattice: walking along
   // a column of samples both feet took it, and on the diagonal leg a foot often took a sample
   // across the other's (34 of 130 body keys). Each foothold lined up so is asked again aimed
-  // outward by half the spacing.
+  // outward (to three quarters of the rest gap, and at least half the spacing).
   const Character c = LoadShipped("biped");
   const double spacing = 0.25;
   Terrain t = LoadTerrain(MakeFlat(121, spacing, 0), spacing);
@@ -286,6 +286,17 @@ TEST_CASE("Feet on ground sampled about as far apart as they stand keep to their
     CheckWalk(t, c, o, w);
     CHECK(LeastPairGap(c, w) > 0.25);
   }
+  // Along the bundled hills' edge (x = 40), the right foot on its last column: the left foot's
+  // retry, aimed to three quarters of the rest gap outward, lies off the terrain, and the
+  // sample it found crossed the other foot (four times in 16 steps) until such a retry is asked
+  // once more half a spacing outward.
+  Terrain hills = LoadTerrain(LoadShippedTerrain("hills"), 0.25);
+  GenerateOptions o = StartOptions({40, 0, 9.75}, 16);
+  o.heading = {0.68005, 0, 0.73317};
+  const Walk w = Generate(hills, c, o);
+  INFO("along the hills' edge: " << w.stopped);
+  CheckWalk(hills, c, o, w);
+  CHECK(LeastPairGap(c, w) >= -0.01);
 }
 
 TEST_CASE("A foot with no foothold while its character turns on the spot keeps its place",
