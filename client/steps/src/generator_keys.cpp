@@ -36,13 +36,10 @@ bool StandsAgainst(const Foothold& h, const Vec3& foot, const Vec3& foot_normal,
 }
 
 // The clearance an arc point must keep from h, its nearest sample: `nominal`, or, when the
-// foothold `foot` at that end of the arc stands against h's face (in front of its plane, nearer
-// than `near`, on ground unlike it: a toe at a riser), no more than half of what the foot itself
-// keeps from that plane.
-double ClearanceNeeded(double nominal, const Foothold& h, const Vec3& foot, const Vec3& foot_normal,
-                       double near) {
-  if (!StandsAgainst(h, foot, foot_normal, near)) return nominal;
-  return std::min(nominal, 0.5 * Dot(foot - h.point, h.normal));
+// arc's foothold `foot` there stands against h's face (`against`: StandsAgainst), no more than
+// half of what the foot itself keeps from that plane.
+double ClearanceNeeded(double nominal, const Foothold& h, const Vec3& foot, bool against) {
+  return against ? std::min(nominal, 0.5 * Dot(foot - h.point, h.normal)) : nominal;
 }
 
 }  // namespace
@@ -123,9 +120,9 @@ Status Generator::ClearArcs(int k, std::string* error) {
             const double nominal = c_.step_height * (1 - std::fabs(2 * s - 1));
             const Vec3& foot = half ? mv.end : a.foot[mv.foot];
             const Vec3& foot_normal = half ? mv.end_normal : a.foot_normal[mv.foot];
-            const double need =
-                ClearanceNeeded(kClearanceFraction * nominal, h, foot, foot_normal, c_.step_height);
-            if (StandsAgainst(h, foot, foot_normal, c_.step_height)) face[half] = h.normal;
+            const bool against = StandsAgainst(h, foot, foot_normal, c_.step_height);
+            const double need = ClearanceNeeded(kClearanceFraction * nominal, h, foot, against);
+            if (against) face[half] = h.normal;
             if (Clearance(arc_points_[first + j], h, gap_, a.up) < need) {
               low[half] = true;
               wall[half] |= need < kClearanceFraction * nominal;
