@@ -15,8 +15,10 @@ import ctypes
 import json
 import math
 import os
+import random
 import signal
 import socket
+import struct
 import subprocess
 import sys
 import tempfile
@@ -268,6 +270,24 @@ class BlenderAddonTest(unittest.TestCase):
         self.assertEqual(scene.sample_count, self._count)
         self.assertGreater(scene.sample_count, 200 * 200)
         self.assertEqual(scene.terrain_name, "terrain")
+
+    def test_1a_terrain_setup_sends_the_pure_python_samples(self):
+        # The add-on resamples with numpy in Blender: the samples Terrain Setup sent (and saved
+        # in test_1) are the pure-Python loops' for the same mesh, every double to the bit.
+        self.assertIsNotNone(self.ops.sampling._numpy, "the add-on's sampling lacks numpy")
+        terrain = bpy.data.objects["terrain"]
+        scene = bpy.context.scene
+        separation = scene.footfall.separation * self.ops.unit_scale(scene)
+        points, tris = self.ops.mesh_triangles(bpy.context, terrain)
+        normals = ff.sampling.corner_normals(points, tris, pure=True)
+        want = ff.sampling.sample_triangles(points, tris, separation, corner_normals=normals,
+                                            pure=True)
+        path = os.path.join(ARGS.work_dir, "terrain_pure.pts")
+        ff.sampling.write_point_file(path, want)
+        with open(self.pts) as sent, open(path) as pure:
+            self.assertEqual(sent.readlines()[1:], pure.readlines()[1:])  # (repr: every bit)
+        self.assertEqual(packed(self.ops.mesh_samples(bpy.context, terrain, separation)),
+                         packed(want))
 
     def test_1b_instances_on_the_terrain_mesh_are_sampled(self):
         # A Geometry Nodes modifier's instances (a box put on a point of the ground by Instance
@@ -2389,8 +2409,217 @@ class BlenderAddonTest(unittest.TestCase):
         self.assertEqual(len(bpy.data.objects), 0)
 
 
+# -- the resampling with numpy against the pure-Python loops ----------------------------------
+
+def packed(rows):
+    """Each value's bits (struct-packed doubles), per row: None rows stay None. Raises for a
+    value that is not exactly a float."""
+    out = []
+    for row in rows:
+        if row is None:
+            out.append(None)
+            continue
+        values = [v for part in row for v in (part if isinstance(part, tuple) else (part,))]
+        for v in values:
+            if type(v) is not float:
+                raise AssertionError("%r in %r is a %s, not a float" % (v, row, type(v).__name__))
+        out.append(struct.pack("<%dd" % len(values), *values))
+    return out
+
+
+def outcome(fn, *args, **kwargs):
+    """fn's result as packed bits, or its error's type and message."""
+    try:
+        result = fn(*args, **kwargs)
+    except Exception as e:  # compared, not hidden: the other path must raise the same
+        return (type(e).__name__, str(e))
+    return ("ok", None if result is None else packed(result))
+
+
+def grid(n, spacing, offset=0.0, wave=0.3):
+    pts = [(offset + i * spacing, wave * math.sin(0.9 * i * spacing) * math.cos(0.7 * j * spacing),
+            offset + j * spacing) for j in range(n) for i in range(n)]
+    tris = []
+    for j in range(n - 1):
+        for i in range(n - 1):
+            a = j * n + i
+            tris += [(a, a + n, a + 1), (a + 1, a + n, a + n + 1)]
+    return pts, tris
+
+
+def box(size=1.0, offset=(0.0, 0.0, 0.0)):
+    """A closed box (creases of 90 degrees), wound outward."""
+    pts = [(offset[0] + x * size, offset[1] + y * size, offset[2] + z * size)
+           for x in (0.0, 1.0) for y in (0.0, 1.0) for z in (0.0, 1.0)]
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    return pts, [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))]
+
+
+def stairs(steps=5, rise=0.17, run=0.28, width=1.2):
+    """A flight of stairs (treads and risers sharing their edges), up along +z."""
+    profile = []
+    for s in range(steps):
+        profile += [(s * rise, s * run), ((s + 1) * rise, s * run)]
+    profile.append((steps * rise, steps * run))
+    pts = [(x, y, z) for y, z in profile for x in (0.0, width)]
+    tris = []
+    for p in range(len(profile) - 1):
+        a = 2 * p
+        tris += [(a, a + 2, a + 1), (a + 1, a + 2, a + 3)]
+    return pts, tris
+
+
+def tilted_plane(n=6):
+    """A flat grid on a plane leaning every way: its triangles' normals agree but for their
+    last bits, which decide whether a crease angle of 0 keeps each neighbour."""
+    pts = [(i * 0.37, 0.21 * i + 0.43 * j, j * 0.29) for j in range(n) for i in range(n)]
+    return pts, grid(n, 1.0)[1]
+
+
+def random_mesh(seed):
+    """Random triangles over shared vertices, some zero-area or naming a vertex twice, at
+    varied scales and offsets."""
+    r = random.Random(seed)
+    n = r.randint(3, 40)
+    scale = r.choice([1.0, 1e-3, 10.0, 250.0])
+    offset = r.choice([0.0, -3.5, 1e5])
+    pts = [tuple(offset + r.uniform(-1.0, 1.0) * scale for _ in range(3)) for _ in range(n)]
+    if seed % 4 == 0:  # coordinates of few digits: lattice points of neighbours coincide
+        pts = [tuple(round(v, 1) for v in p) for p in pts]
+    tris = [tuple(r.randrange(n) for _ in range(3)) for _ in range(r.randint(1, 30))]
+    tris.append((0, 0, 1))  # a vertex twice
+    pts.append(pts[1])  # the same point twice, and a triangle through both copies
+    tris.append((1, n, 2))
+    mid = tuple((a + b) / 2 for a, b in zip(pts[0], pts[2]))
+    pts.append(mid)  # on the segment from 0 to 2: a zero-area triangle
+    tris.append((0, n + 1, 2))
+    return pts, tris, scale
+
+
+class SamplingNumpyTest(unittest.TestCase):
+    """Blender's Python has numpy (Debian's python3-numpy): the add-on's resampling runs
+    through sampling_numpy, which must give the pure-Python loops' samples bit for bit."""
+
+    def test_numpy_is_used(self):
+        import numpy  # noqa: F401 (Blender's Python must have it)
+        self.assertTrue(ff.sampling.USE_NUMPY)
+        self.assertIsNotNone(ff.sampling._numpy)
+
+    def assert_same(self, label, fn, *args, **kwargs):
+        want = outcome(fn, *args, pure=True, **kwargs)
+        got = outcome(fn, *args, **kwargs)
+        self.assertEqual(got[0], want[0], "%s: %s against %s" % (label, got, want))
+        self.assertEqual(got, want, label)
+        return want
+
+    def assert_numpy_path(self, label, fn):
+        """fn (a call of sampling_numpy) answers: no quiet fall back to the pure path."""
+        try:
+            return fn()
+        except ff.sampling._numpy.Unsupported:
+            self.fail("%s: sampling_numpy refused arguments it should take" % label)
+
+    def assert_all_modes(self, label, pts, tris, separations, max_samples=ff.sampling.MAX_SAMPLES):
+        np_ = ff.sampling._numpy
+        for crease in (60.0, 0.0, 180.0):
+            self.assert_same("%s corner normals %g" % (label, crease), ff.sampling.corner_normals,
+                             pts, tris, crease)
+        self.assert_numpy_path(label, lambda: np_.corner_normals(pts, tris, 0.5))
+        corners = ff.sampling.corner_normals(pts, tris, pure=True)
+        some_none = list(corners)
+        for t in range(0, len(some_none), 3):
+            some_none[t] = None
+        vertex = [(math.sin(i), math.cos(i), 0.5) for i in range(len(pts))]
+        # Opposite normals at two corners: their mean at the midpoint is zero (the face's).
+        vertex[tris[0][0]], vertex[tris[0][1]] = (0.0, 0.0, 1.0), (0.0, 0.0, -1.0)
+        vertex[tris[-1][2]] = (0.0, 0.0, 0.0)
+        for separation in separations:
+            what = "%s at %g" % (label, separation)
+            self.assert_same(what + " count", ff.sampling.check_sample_count, pts, tris,
+                             separation, max_samples)
+            for name, kwargs in (("face", {}), ("corner normals", {"corner_normals": corners}),
+                                 ("corner normals with None", {"corner_normals": some_none}),
+                                 ("vertex normals", {"vertex_normals": vertex})):
+                result = self.assert_same("%s %s" % (what, name), ff.sampling.sample_triangles,
+                                          pts, tris, separation, max_samples=max_samples,
+                                          **kwargs)
+                if result[0] == "ok":
+                    self.assert_numpy_path(what, lambda: np_.sample_triangles(
+                        pts, tris, separation, kwargs.get("vertex_normals"),
+                        kwargs.get("corner_normals")))
+
+    def test_random_triangles_sharing_vertices(self):
+        for seed in range(16):
+            pts, tris, scale = random_mesh(seed)
+            self.assert_all_modes("random mesh %d" % seed, pts, tris,
+                                  [scale * f for f in (0.12, 0.5, 5.0)])
+
+    def test_creases_of_a_box_and_stairs(self):
+        self.assert_all_modes("box", *box(), [0.07, 0.25, 3.0])
+        self.assert_all_modes("far box", *box(2.0, (1e5, -1e5, 3e5)), [0.05, 10.0])
+        self.assert_all_modes("stairs", *stairs(), [0.02, 0.1, 1.0])
+        self.assert_all_modes("tilted plane", *tilted_plane(), [0.1, 0.5])
+
+    def test_wavy_grids_near_and_far(self):
+        self.assert_all_modes("grid", *grid(15, 0.5), [0.06, 0.2, 0.7])
+        self.assert_all_modes("far grid", *grid(10, 0.5, offset=1e5), [0.05, 2.0])
+
+    def test_count_errors_are_the_same(self):
+        inf, nan = float("inf"), float("nan")
+        for pts, separation in (
+                ([(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0), (inf, 0.0, 0.0)], 0.1),
+                ([(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, nan, 1.0), (2.0, 0.0, 0.0)], 0.1),
+                ([(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0), (nan, 0.0, 0.0)], 0.1),
+                ([(1e308, 0.0, 0.0), (-1e308, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, 1.0, 0.0)], 0.1),
+                ([(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, 1.0, 0.0)], 1e-300),
+                ([(0.0, 0.0, 0.0), (10.0, 0.0, 0.0), (0.0, 0.0, 10.0), (10.0, 0.0, 10.0)],
+                 0.001)):
+            tris = [(0, 1, 2), (1, 3, 2), (0, 1, 3)]
+            for fn in (ff.sampling.check_sample_count, ff.sampling.sample_triangles):
+                got = self.assert_same("%s %r" % (fn.__name__, pts), fn, pts, tris, separation)
+                self.assertEqual(got[0], "ValueError", pts)
+        # Too many samples, first passed at a later triangle of a mesh, for a small limit.
+        pts, tris = grid(20, 0.5)
+        for limit in (10, 400, 1000, 4000):
+            got = self.assert_same("limit %d" % limit, ff.sampling.sample_triangles, pts, tris,
+                                   0.1, max_samples=limit)
+            self.assertEqual(got[0], "ValueError")
+            self.assertIn("more than %d samples" % limit, got[1])
+        self.assertIsNone(ff.sampling._numpy.count_problem(pts, tris, 0.1, 10 ** 6))
+        # A count that reaches the limit exactly passes: 4 vertices and two triangles of
+        # lattice size 2 (1.5 samples each on their edges) make 7.
+        square = [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0), (1.0, 0.0, 1.0)]
+        for limit in (6, 7, 8, 6.5, 7.0):
+            self.assert_same("square limit %r" % limit, ff.sampling.sample_triangles, square,
+                             [(0, 2, 1), (1, 2, 3)], 0.8, max_samples=limit)
+        what, t = self.assert_numpy_path("limit", lambda: ff.sampling._numpy.count_problem(
+            pts, tris, 0.1, 4000))
+        self.assertEqual(what, "too many")  # at triangle t, as the pure-Python loop counts:
+        ff.sampling.check_sample_count(pts, tris[:t], 0.1, 4000, pure=True)
+        with self.assertRaises(ValueError):
+            ff.sampling.check_sample_count(pts, tris[:t + 1], 0.1, 4000, pure=True)
+
+    def test_arguments_numpy_cannot_take_exactly_go_the_pure_way(self):
+        # Integer coordinates (exact integer arithmetic in pure Python), large ones included.
+        for scale in (1, 3000, 10 ** 12):
+            pts = [(0, 0, 0), (2 * scale, 0, 0), (0, 1, 2 * scale), (scale, 3, scale)]
+            tris = [(0, 2, 1), (1, 2, 3)]
+            self.assert_same("ints x%d" % scale, ff.sampling.sample_triangles, pts, tris,
+                             0.7 * scale)
+            self.assert_same("ints x%d" % scale, ff.sampling.corner_normals, pts, tris)
+        pts, tris = box()
+        # A separation so small that a key overflows, and indices out of range or negative.
+        self.assert_same("tiny separation", ff.sampling.sample_triangles, [(1e300, 0.0, 0.0),
+                         (1e300, 1e-290, 0.0), (1e300, 0.0, 1e-290)], [(0, 1, 2)], 1e-295)
+        for bad in ([(0, 1, 99)], [(0, 1, -1)], [(0, 1, 2.0)], [(0, 1)]):
+            self.assert_same("triangles %r" % bad, ff.sampling.sample_triangles, pts, bad, 0.3)
+            self.assert_same("triangles %r" % bad, ff.sampling.corner_normals, pts, bad)
+
+
 def main():
-    suite = unittest.defaultTestLoader.loadTestsFromTestCase(BlenderAddonTest)
+    loader = unittest.defaultTestLoader
+    suite = unittest.TestSuite([loader.loadTestsFromTestCase(BlenderAddonTest),
+                                loader.loadTestsFromTestCase(SamplingNumpyTest)])
     result = unittest.TextTestRunner(verbosity=2, stream=sys.stdout).run(suite)
     failed = len(result.failures) + len(result.errors)
     skipped = len(result.skipped)
