@@ -255,6 +255,33 @@ class SharedLogicTest(unittest.TestCase):
         for s in ff.sampling.sample_triangles(pts, tris, 0.25, up):
             self.assertEqual(s[3:], (0.0, 1.0, 0.0))
 
+    def test_flattened_rows_are_the_same_numbers_and_errors_on_the_fast_path(self):
+        # Session's _flat takes lists of tuples of floats (sample_triangles' samples), flat
+        # lists and buffers of doubles without its loop over the numbers; an iterator of the
+        # same rows still takes the loop: both give the same doubles, or the same error.
+        from array import array
+        from footfall_client.session import _flat
+
+        def flat(rows, width=6):
+            try:
+                return ("ok", _flat(rows, width, "samples").tobytes())
+            except ff.FootfallError as e:
+                return (e.status_name, e.message)
+
+        rows = [(0.1 * i, -0.0, 1e300, float(i), 2, -3) for i in range(50)]
+        doubles = array("d", [v for row in rows for v in row])
+        cases = [rows, tuple(rows), [list(row) for row in rows], list(doubles), [], [1, 2],
+                 [(1.0, 2.0, 3.0)], [(1.0,) * 6, (1.0,) * 5], [(1.0,) * 5 + ("2.5",)],
+                 [(1.0,) * 5 + (True,)], [(1.0,) * 5 + (10 ** 400,)], [(1.0,) * 5 + (None,)],
+                 [(1.0,) * 6, 7.0, 8.0, 9.0, 1.0, 2.0, 3.0], list(doubles)[:-1]]
+        for rows_ in cases:
+            self.assertEqual(flat(rows_), flat(iter(rows_)), rows_[:2])
+        self.assertEqual(flat(doubles), flat(iter(rows)))
+        self.assertEqual(flat(memoryview(doubles).cast("B").cast("d", (50, 6))), flat(rows))
+        self.assertEqual(flat(doubles[:-1]), flat(iter(doubles[:-1])))
+        self.assertEqual(flat(b"\x00" * 48), flat(iter(b"\x00" * 48)))
+        self.assertEqual(flat(rows, 3)[0], "invalid_argument")
+
     def test_separation_must_be_positive(self):
         with self.assertRaises(ValueError):
             ff.sampling.sample_triangles([(0, 0, 0)] * 3, [(0, 1, 2)], 0)

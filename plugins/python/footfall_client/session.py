@@ -2,6 +2,7 @@
 
 import ctypes
 import functools
+import itertools
 import json
 import os
 import threading
@@ -83,8 +84,53 @@ def _path_bytes(path, function):
     return encoded
 
 
+def _flat_fast(rows, width):
+    """_flat's array('d') without a Python step per number, for the shapes callers pass: an
+    object with the buffer protocol holding native doubles (array('d'), a numpy float64 array:
+    flat, or `width` columns), a list or tuple of floats and ints, or a list or tuple of
+    `width`-tuples (or lists) of floats and ints, as sampling.sample_triangles returns. The same
+    numbers as float() of each. None for anything else, or anything wrong: _flat's loop then
+    takes it, with its errors."""
+    try:
+        view = memoryview(rows)
+    except TypeError:
+        view = None
+    if view is not None:
+        with view:
+            if (view.format in ("d", "@d") and view.c_contiguous
+                    and (view.ndim == 1 or (view.ndim == 2 and view.shape[1] == width))
+                    and view.nbytes % (8 * width) == 0):
+                flat = array("d")
+                flat.frombytes(view.cast("B"))
+                return flat
+        return None
+    if type(rows) not in (list, tuple):
+        return None
+    # Only exact floats and ints: array('d') reads a float subclass's value where float()
+    # calls its __float__, and refuses the strings float() parses.
+    numbers = {float, int}
+    kinds = set(map(type, rows))
+    if kinds <= numbers:
+        items = rows
+    elif kinds <= {tuple, list} and set(map(len, rows)) == {width}:
+        if not set(map(type, itertools.chain.from_iterable(rows))) <= numbers:
+            return None
+        items = itertools.chain.from_iterable(rows)
+    else:
+        return None
+    try:
+        flat = array("d", items)
+    except OverflowError:  # (an int beyond a double)
+        return None
+    return flat if len(flat) % width == 0 else None
+
+
 def _flat(rows, width, what):
-    """rows: a sequence of `width`-tuples, or an already flat sequence of floats -> array('d')."""
+    """rows: a sequence of `width`-tuples, or an already flat sequence of floats -> array('d').
+    FootfallError 'invalid_argument' when they are not numbers in rows of `width`."""
+    flat = _flat_fast(rows, width)
+    if flat is not None:
+        return flat
     flat = array("d")
     try:
         for row in rows:
