@@ -2564,6 +2564,21 @@ class SamplingNumpyTest(unittest.TestCase):
         self.assert_all_modes("grid", *grid(15, 0.5), [0.06, 0.2, 0.7])
         self.assert_all_modes("far grid", *grid(10, 0.5, offset=1e5), [0.05, 2.0])
 
+    def test_blocks_of_any_size_give_the_same_samples(self):
+        # sampling_numpy works a block of lattice points (or corner pairs) at a time: blocks
+        # of a few points, cutting lattices and a vertex's neighbours apart, change nothing.
+        np_ = ff.sampling._numpy
+        saved = np_._BLOCK
+        try:
+            for block in (1, 7, 50):
+                np_._BLOCK = block
+                self.assert_all_modes("grid in blocks of %d" % block, *grid(6, 0.5), [0.2, 0.7])
+                pts, tris, scale = random_mesh(3)
+                self.assert_all_modes("random mesh in blocks of %d" % block, pts, tris,
+                                      [0.5 * scale])
+        finally:
+            np_._BLOCK = saved
+
     def test_count_errors_are_the_same(self):
         inf, nan = float("inf"), float("nan")
         for pts, separation in (

@@ -214,9 +214,14 @@ def corner_normals(points, triangles, cos_crease):
         kept_corners = np.flatnonzero(np.repeat(~degenerate, 3))
         sx, sy, sz = (np.zeros(3 * m) for _ in range(3))
         degree = start[1:] - start[:-1]
-        per_block = max(1, _BLOCK // max(1, int(degree.max())))
-        for lo in range(0, len(kept_corners), per_block):
-            cs = kept_corners[lo:lo + per_block]
+        pairs = degree[corners[kept_corners]]  # per corner
+        ends = np.cumsum(pairs)
+        lo = 0
+        while lo < len(kept_corners):
+            # About _BLOCK pairs (a corner's all in one block, however many).
+            hi = max(lo + 1, int(np.searchsorted(ends, ends[lo] - pairs[lo] + _BLOCK, "right")))
+            cs = kept_corners[lo:hi]
+            lo = hi
             v = corners[cs]
             counts = degree[v]
             pair_corner = np.repeat(cs, counts)
@@ -226,15 +231,17 @@ def corner_normals(points, triangles, cos_crease):
             t = pair_corner // 3
             dot = cx[u] * fx[t] + cy[u] * fy[t] + cz[u] * fz[t]
             take = (lengths[u] > 0) & (dot >= cos_crease * lengths[u])
-            pair_corner, u = pair_corner[take], u[take]
+            pair_corner, u = pair_corner[take] - cs[0], u[take]
             # bincount adds its weights one after the other in index order, from 0.0, as the
-            # pure-Python loop adds each neighbour's normal to its sum.
+            # pure-Python loop adds each neighbour's normal to its sum (each corner's sum is
+            # made in one block: adding it to the 0.0 before leaves it as it is).
+            span = slice(cs[0], cs[-1] + 1)
             for s, n in ((sx, cx), (sy, cy), (sz, cz)):
-                s += np.bincount(pair_corner, weights=n[u], minlength=3 * m)
+                s[span] += np.bincount(pair_corner, weights=n[u], minlength=cs[-1] + 1 - cs[0])
         nx, ny, nz, none = _unit(sx, sy, sz)
         face = np.repeat(np.stack((fx, fy, fz), axis=1), 3, axis=0)
         out = np.where(none[:, None], face, np.stack((nx, ny, nz), axis=1))
-    rows = list(map(tuple, out.tolist()))
+    rows = list(struct.iter_unpack("3d", np.ascontiguousarray(out)))  # (tuples of floats)
     result = list(zip(rows[0::3], rows[1::3], rows[2::3]))
     for t in np.flatnonzero(degenerate).tolist():
         result[t] = None
@@ -352,9 +359,11 @@ def _samples(keep, first, tri, k, a, b, c, face, normals):
     i = np.empty(len(keep), np.int64)
     j = np.empty(len(keep), np.int64)
     for size in np.unique(kk).tolist():
-        li, lj = _lattice(size)
+        rows = np.arange(size + 1, 0, -1)  # row i of the lattice holds size + 1 - i points
+        starts = np.cumsum(rows) - rows
         sel = np.flatnonzero(kk == size)
-        i[sel], j[sel] = li[index[sel]], lj[index[sel]]
+        i[sel] = np.searchsorted(starts, index[sel], "right") - 1
+        j[sel] = index[sel] - starts[i[sel]]
     out = np.empty((len(keep), 6))
     out[:, 0], out[:, 1], out[:, 2] = _interpolate(i, j, kk, a[t], b[t], c[t])
     for d in range(3):
