@@ -2579,6 +2579,18 @@ class SamplingNumpyTest(unittest.TestCase):
         finally:
             np_._BLOCK = saved
 
+    def test_keys_whose_hashes_collide_are_told_apart(self):
+        # Duplicates are found by sorting a hash of each key; keys of equal hashes that differ
+        # (every key, with a hash of 0) are sorted by the keys themselves.
+        np_ = ff.sampling._numpy
+        saved = np_._mix
+        try:
+            np_._mix = lambda bits: bits * 0
+            self.assert_all_modes("grid, hashes all 0", *grid(8, 0.5), [0.1, 0.7])
+            self.assert_all_modes("box, hashes all 0", *box(), [0.25])
+        finally:
+            np_._mix = saved
+
     def test_count_errors_are_the_same(self):
         inf, nan = float("inf"), float("nan")
         for pts, separation in (
