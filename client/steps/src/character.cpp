@@ -144,6 +144,7 @@ Status ReadCharacter(const json& j, const std::string& source, Character* out, s
                                                "max_rise",
                                                "reach",
                                                "max_turn_deg",
+                                               "foot_length",
                                                "comment"};
   static const std::set<std::string> kKnownFoot = {"name", "rest", "comment"};
   // Another format's file (a scene, a walk) is named by its format, not by the first of its
@@ -264,7 +265,8 @@ Status ReadCharacter(const json& j, const std::string& source, Character* out, s
         r.Number(j, "slope_step_scale", false, &c.slope_step_scale) &&
         r.Number(j, "max_slope_deg", false, &c.max_slope_deg) &&
         r.Number(j, "max_rise", false, &c.max_rise) && r.Number(j, "reach", true, &c.reach) &&
-        r.Number(j, "max_turn_deg", false, &c.max_turn_deg);
+        r.Number(j, "max_turn_deg", false, &c.max_turn_deg) &&
+        r.Number(j, "foot_length", false, &c.foot_length);
   }
   if (r.status == Status::kOk) {
     if (!j.contains("align_to_normal") || !j["align_to_normal"].is_boolean())
@@ -288,7 +290,8 @@ Status ReadCharacter(const json& j, const std::string& source, Character* out, s
         r.Range(c.max_slope_deg, 0, 180, true, true, "max_slope_deg") &&
         r.Range(c.max_rise, 0, kMaxLength, true, false, "max_rise") &&
         r.Range(c.reach, 0, kMaxLength, true, false, "reach") &&
-        r.Range(c.max_turn_deg, 0, 180, true, false, "max_turn_deg");
+        r.Range(c.max_turn_deg, 0, 180, true, false, "max_turn_deg") &&
+        r.Range(c.foot_length, 0, kMaxLength, false, false, "foot_length");
   }
   if (r.status == Status::kOk) {
     const Vec3 centroid = RestCentroid(c);

@@ -40,9 +40,11 @@ double BoxDistance(const Vec3& p, const Vec3& lo, const Vec3& hi) {
 }  // namespace
 
 void Reopen(Move& mv) {
-  if (mv.outward_kept) --mv.attempts;  // (a lined-up foothold's arc may clear, or it be in reach)
+  // (A lined-up foothold's arc may clear, or it be in reach; so may the foothold as found.)
+  if (mv.outward_kept || mv.sole == 2) --mv.attempts;
   mv.outward = mv.outward_kept ? -1 : 0;
   mv.lined_up = mv.outward_kept = false;
+  mv.sole = mv.sole == 2 || mv.sole < 0 ? -1 : 0;
 }
 
 bool Generator::Nearing(Agent& a, int k) const {
@@ -393,7 +395,7 @@ Status Generator::QueryFootholds(std::string* error) {
         // below 0.02 made every step up a slope a step in place, and the walk a dead end.)
         if (Length(v) < kInPlace * std::min(c_.step_length, max_len)) {
           if (mv.attempt.drop > 0) {
-            Fail(mv);  // nothing ahead to aim down at
+            if (!StandAtEdge(mv)) Fail(mv);  // nothing ahead to aim down at
           } else {
             mv.done = true, mv.end = a.foot[mv.foot], mv.end_normal = a.foot_normal[mv.foot];
           }
@@ -422,6 +424,9 @@ Status Generator::QueryFootholds(std::string* error) {
     if (s != Status::kOk) return s;
     // Per character (its moves are contiguous): accept or refuse each answered foot, then the
     // reach limit on the body where the accepted footholds put it; feet beyond it retry.
+    // (With soles to fit, the reach is checked once they are: FitSoles queries in between.)
+    const bool soles = c_.foot_length > 0;
+    all_done_.assign(soles ? walkers_.size() : 0, 0);
     Parallel(walkers_.size(), [&](size_t wb, size_t we) {
       for (size_t i = wb; i < we; ++i) {
         const size_t m = walkers_[i] * per_agent, e = m + per_agent;
@@ -429,13 +434,25 @@ Status Generator::QueryFootholds(std::string* error) {
         for (size_t j = m; j < e; ++j) {
           if (moves[j].query != kNoQuery) {
             Judge(moves[j], next_answers_[moves[j].query]), moves[j].query = kNoQuery;
-            if (!moves[j].done && moves[j].attempts >= kMaxAttempts) KeepPlace(moves[j]);
+            if (!moves[j].done && moves[j].attempts >= kMaxAttempts && !StandAtEdge(moves[j]))
+              KeepPlace(moves[j]);
           }
           all_done &= moves[j].done;
         }
-        if (all_done) CheckReach(m, e);
+        if (soles)
+          all_done_[i] = all_done;
+        else if (all_done)
+          CheckReach(m, e);
       }
     });
+    if (soles) {
+      const Status fitted = FitSoles(error);
+      if (fitted != Status::kOk) return fitted;
+      Parallel(walkers_.size(), [&](size_t wb, size_t we) {
+        for (size_t i = wb; i < we; ++i)
+          if (all_done_[i]) CheckReach(walkers_[i] * per_agent, (walkers_[i] + 1) * per_agent);
+      });
+    }
     pending_.clear();
     for (size_t w : walkers_) {
       for (size_t m = w * per_agent; m < (w + 1) * per_agent; ++m) {
@@ -543,6 +560,13 @@ bool Generator::KeepsSide(Move& mv, const Vec3& p, const Vec3& normal) const {
   mv.lined_up_point = p, mv.lined_up_normal = normal;
   --mv.attempts;  // the same attempt again, aimed outward
   return false;
+}
+
+bool Generator::StandAtEdge(Move& mv) {
+  if (!mv.at_edge) return false;
+  mv.done = true, mv.at_edge = false, mv.sole = 1;
+  mv.end = mv.edge_point, mv.end_normal = mv.edge_normal;
+  return true;
 }
 
 void Generator::KeepPlace(Move& mv) const {

@@ -44,6 +44,11 @@ struct Attempt {
 inline constexpr int kMaxAttempts = 7;
 inline constexpr Attempt kAttempts[kMaxAttempts] = {{1.0, 0},   {0.6, 0},   {1.35, 0}, {0.3, 0},
                                                     {1.0, 0.5}, {0.6, 0.5}, {0.3, 0.5}};
+// The first of the tries aimed down (a full step).
+inline constexpr int kFirstDownAttempt = 4;
+static_assert(kAttempts[kFirstDownAttempt].scale == 1 && kAttempts[kFirstDownAttempt].drop > 0 &&
+                  kAttempts[kFirstDownAttempt - 1].drop == 0,
+              "the first try aimed down");
 // A foothold is looked for within this fraction of step_length of where the foot aims.
 inline constexpr double kFootholdTolerance = 0.5;
 // A biped's locator snapped back onto its feet's nose looks for the ground below along this
@@ -211,11 +216,21 @@ struct Move {
   bool outward_kept = false;
   double lined_up_gap = 0;
   Vec3 lined_up_point, lined_up_normal;
+  // Sole fitting (8, end; a character with a foot_length): 0 not yet checked, 1 checked, 2
+  // moved along its ground so that the sole fits, -1 once a moved foothold was refused after
+  // all (arc, reach): this step's tries then keep their footholds as found.
+  int sole = 0;
+  // A foothold at the edge of the ground the foot stands on, its toe over the drop (FitSoles):
+  // the foot tries stepping down past it first, and stands there only if every such try is
+  // refused (Generator::StandAtEdge).
+  bool at_edge = false;
+  Vec3 edge_point, edge_normal;
 };
 
 // mv's accepted foothold refused after all (beyond reach, or its arc cannot clear): a foothold
-// its outward retry found gives way to the lined-up one it bettered, asked again in the same try
-// without aiming outward; any other starts its next try afresh.
+// its outward retry found gives way to the lined-up one it bettered, and one moved for its sole
+// (FitSoles) to the foothold as found, each asked again in the same try (without aiming
+// outward, without moving it); any other starts its next try afresh.
 void Reopen(Move& mv);
 
 class Generator {
@@ -312,6 +327,14 @@ class Generator {
   Status QueryFootholds(std::string* error);
   // Accepts the answer h to mv's foothold query, or records why it is refused.
   void Judge(Move& mv, const Foothold& h) const;
+  // 8 (end). For the characters whose moves all have a foothold (all_done_), when the character
+  // has a foot_length: each foothold whose sole, along the heading on its ground, has no ground
+  // of its own under its heel or toe (past a stair's nose, into a riser) moves back or forward
+  // along that ground by eighths of the sole, up to half of it, to the nearest place where it
+  // has (two batches of snaps); kept as found where none fits or would be refused, and at a
+  // wall's foot. A foothold at the edge of the ground the foot stands on, its toe over the drop,
+  // is asked again aimed down (the first of the aimed-down tries) and kept for StandAtEdge.
+  Status FitSoles(std::string* error);
   // The gap across the heading between the foothold p of mv's foot and its mate (mate_), as a
   // share of their rest gap (1 as at rest, below 0 crossed); 1 for a foot without a mate.
   double GapToMate(const Move& mv, const Vec3& p) const;
@@ -336,6 +359,9 @@ class Generator {
   static bool KeepsReason(const Move& mv, bool gap) {
     return mv.reason.empty() || (mv.reason_is_gap && !gap);
   }
+  // 8 (end). A foot whose tries to step down past the edge it had reached (Move::at_edge) were
+  // all refused stands at that edge (true).
+  static bool StandAtEdge(Move& mv);
   // 8 (end). A foot refused every foothold toward a target behind it along the heading (a hind
   // foot standing at a terrain's back edge, ahead of its rest), or while its character turns at
   // a short stride (a foot on a stair's nose turning on the spot), keeps its place: a step in
@@ -542,6 +568,14 @@ class Generator {
   std::vector<size_t> land_locator_;  // per locator probed: its index into points_
   std::vector<char> landed_;          // per locator: 1 when LandLocators replaced its snap
   std::vector<StepQuery> queries_;
+  std::vector<char> all_done_;  // per walker of a round: every move has a foothold (CheckReach)
+  // FitSoles: the moves checked (and their walkers), the ways each may move, and the first of
+  // each one's candidates' snap points (centre, heel, toe; after the heel, toe and raised toe of
+  // every move checked, in the first batch).
+  std::vector<size_t> sole_moves_, sole_walker_, sole_first_;  // (sole_walker_: in walkers_)
+  std::vector<int> sole_ways_;  // (0: its sole fits, or it stays as found)
+  std::vector<Vec3> sole_points_;
+  std::vector<Foothold> sole_answers_;
   std::vector<Foothold> answers_, next_answers_, arc_answers_;
   // Bodies to key (KeyBodies): (agent, frame); per walking character the frame its body is due
   // at this step (NaN: none).

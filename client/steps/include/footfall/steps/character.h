@@ -53,6 +53,10 @@ struct Character {
   double reach = 1.2;
   // The heading turns by at most this much per step when following a path. [Limit: (0, 180]]
   double max_turn_deg = 30;
+  // The length of each foot's sole along the heading, its foothold at the middle: a foothold
+  // whose heel or toe would stand past a stair's nose or in a riser moves along its tread until
+  // the sole fits (README, "The algorithm", step 8). 0: point feet. [Units: wu] [Limit: >= 0]
+  double foot_length = 0;
 };
 
 // Parses a character file's text. `source` names it in errors ("FILE: field: what was

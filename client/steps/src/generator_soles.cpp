@@ -1,0 +1,179 @@
+// The step generator's sole fitting (8, end): for a character with a foot_length, a foothold
+// whose sole would hang past a stair's nose or stand in a riser moves along its tread.
+#include "step_generator.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace footfall::steps_detail {
+namespace {
+
+// Candidate places of a foothold whose sole misses ground: moved by 1/8, 2/8 ... of the sole.
+constexpr int kSoleShifts = 4;
+// Snap points per foothold checked: its heel, its toe, and its toe raised by max_rise.
+constexpr size_t kPerFoothold = 3;
+// Snap points per candidate: its centre, heel and toe.
+constexpr size_t kPerCandidate = 3;
+
+// Whether a sole's end at `q`, whose nearest sample is h, stands on ground like the foothold's
+// (normal `normal`): a sample within `near` of it facing alike. Past a stair's nose the nearest
+// sample is the nose's edge, farther than that; inside a riser it is the riser, facing across.
+bool SoleOnGround(const Vec3& q, const Foothold& h, const Vec3& normal, double near) {
+  return h.status == Status::kOk && Distance(h.point, q) <= near &&
+         Dot(h.normal, normal) >= kAlikeCos;
+}
+
+// The sole's direction at a foothold facing `normal`: the heading along its ground, or no
+// direction (zero) for ground facing along the heading.
+Vec3 SoleForward(const Vec3& forward, const Vec3& normal) {
+  const Vec3 f = ProjectOnPlane(forward, normal);
+  return Length2(f) >= 0.25 ? Normalize(f) : Vec3{};
+}
+
+// Which ways a foothold may move for its sole, from whether its heel and toe stand on ground:
+// forward (1) when only the heel misses, back (2) when only the toe does, both (3) when both
+// miss (a tread shorter than the sole, a narrow ledge), none (0) when the sole fits.
+int SoleWays(bool heel_on, bool toe_on) { return (heel_on ? 0 : 1) | (toe_on ? 0 : 2); }
+int SoleWayCount(int ways) { return (ways & 1) + (ways >> 1); }
+
+}  // namespace
+
+Status Generator::FitSoles(std::string* error) {
+  const size_t per_agent = walking_.empty() ? 0 : moves_.size() / walking_.size();
+  const double half = 0.5 * c_.foot_length;
+  const double near = 0.5 * gap_;  // the samples' spacing: the farthest ground under a point
+  sole_moves_.clear(), sole_walker_.clear();
+  for (size_t i = 0; i < walkers_.size(); ++i) {
+    if (!all_done_[i]) continue;
+    for (size_t m = walkers_[i] * per_agent; m < (walkers_[i] + 1) * per_agent; ++m) {
+      Move& mv = moves_[m];
+      if (!mv.done || mv.failed || mv.sole != 0) continue;
+      // A step down past an edge nearer the other foot across the heading than the lined-up
+      // limit, and nearer than the edge, gives way to the edge (on stairs walked at 30 to 60
+      // degrees to the treads, feet crossed).
+      if (mv.at_edge && GapToMate(mv, mv.end) < std::min(kMinPairGap, GapToMate(mv, mv.edge_point)))
+        StandAtEdge(mv);
+      mv.sole = 1;
+      const Agent& a = agents_[mv.agent];
+      if (mv.end != a.foot[mv.foot] && Length2(SoleForward(a.forward, mv.end_normal)) > 0)
+        sole_moves_.push_back(m), sole_walker_.push_back(i);
+    }
+  }
+  if (sole_moves_.empty()) return Status::kOk;
+  // Heel and toe of each foothold, and the toe raised by max_rise along the feet's up: one
+  // batch.
+  const size_t n = sole_moves_.size();
+  sole_points_.resize(kPerFoothold * n);
+  Parallel(n, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      const Move& mv = moves_[sole_moves_[i]];
+      const Agent& a = agents_[mv.agent];
+      const Vec3 f = SoleForward(a.forward, mv.end_normal);
+      Vec3* p = &sole_points_[kPerFoothold * i];
+      p[0] = mv.end - f * half, p[1] = mv.end + f * half, p[2] = p[1] + a.up * c_.max_rise;
+    }
+  });
+  sole_answers_.resize(sole_points_.size());
+  Status s =
+      Check(session_.Snap(terrain_, sole_points_.data(), sole_points_.size(), sole_answers_.data()),
+            "snap sole", error);
+  if (s != Status::kOk) return s;
+  // The footholds whose sole misses ground, each with its candidates: the foothold moved the
+  // ways its ends ask, nearest first (forward before back at the same distance).
+  sole_ways_.assign(n, 0);
+  sole_first_.assign(n + 1, 0);
+  for (size_t i = 0; i < n; ++i) {
+    Move& mv = moves_[sole_moves_[i]];
+    const Vec3& normal = mv.end_normal;
+    const Vec3* p = &sole_points_[kPerFoothold * i];
+    const Foothold* h = &sole_answers_[kPerFoothold * i];
+    const Foothold& toe = h[1];
+    sole_ways_[i] =
+        SoleWays(SoleOnGround(p[0], h[0], normal, near), SoleOnGround(p[1], toe, normal, near));
+    // A toe whose ground max_rise above it is a face across the foothold's (not the next tread)
+    // is at a wall, not a riser: the foot stands at the wall's foot as found (its next step
+    // finds the wall; kept back from it, a biped stood before a wall step after step instead of
+    // stopping there).
+    if ((sole_ways_[i] & 2) && h[2].status == Status::kOk && Dot(h[2].normal, normal) < kAlikeCos)
+      sole_ways_[i] &= 1;
+    // A foot stepping to the edge of the ground it stands on (level with it, on a step not
+    // aimed up: a riser ahead draws the target up), its toe over the drop beyond (its nearest
+    // sample that edge's or the drop's face, and not behind it; a riser ahead faces against
+    // the sole), stands there. Unless its other foot stands higher (it would step two treads
+    // below it), it tries stepping down past the edge first, its whole step aimed down, and
+    // stands at the edge only if that is refused (StandAtEdge). (Moved back from the edge, it
+    // found the same edge at its next step, short down steep stairs, and shuffled to it: two
+    // steps a tread.)
+    const Agent& a = agents_[mv.agent];
+    const Vec3 f = SoleForward(a.forward, normal);
+    if (sole_ways_[i] == 2 && toe.status == Status::kOk && Dot(mv.step, a.up) <= 0 &&
+        Dot(toe.normal, f) >= -0.25 && Dot(p[1] - toe.point, toe.normal) >= -0.25 * near &&
+        std::fabs(Dot(mv.end - a.foot[mv.foot], a.up)) <= near) {
+      sole_ways_[i] = 0;
+      const int mate = mate_[mv.foot];
+      if (mv.attempts <= kFirstDownAttempt &&
+          (mate < 0 || Dot(a.foot[mate] - mv.end, a.up) <= near)) {
+        mv.at_edge = true, mv.edge_point = mv.end, mv.edge_normal = mv.end_normal;
+        mv.done = false, mv.sole = 0, mv.attempts = kFirstDownAttempt;
+        all_done_[sole_walker_[i]] = 0;
+      }
+    }
+    sole_first_[i + 1] = sole_first_[i] + kPerCandidate * kSoleShifts * SoleWayCount(sole_ways_[i]);
+  }
+  if (sole_first_[n] == 0) return Status::kOk;
+  // The candidates' centres, heels and toes: one batch.
+  sole_points_.resize(sole_first_[n]);
+  Parallel(n, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      if (sole_ways_[i] == 0) continue;
+      const Move& mv = moves_[sole_moves_[i]];
+      const Vec3 f = SoleForward(agents_[mv.agent].forward, mv.end_normal);
+      size_t at = sole_first_[i];
+      for (int k = 1; k <= kSoleShifts; ++k) {
+        const double shift = c_.foot_length * k / (2.0 * kSoleShifts);
+        for (int way = 1; way <= 2; ++way) {
+          if (!(sole_ways_[i] & way)) continue;
+          const Vec3 centre = mv.end + f * (way == 1 ? shift : -shift);
+          sole_points_[at++] = centre, sole_points_[at++] = centre - f * half;
+          sole_points_[at++] = centre + f * half;
+        }
+      }
+    }
+  });
+  sole_answers_.resize(sole_points_.size());
+  s = Check(session_.Snap(terrain_, sole_points_.data(), sole_points_.size(), sole_answers_.data()),
+            "snap sole", error);
+  if (s != Status::kOk) return s;
+  // The nearest candidate whose centre snaps onto ground like the foothold's, with ground under
+  // its heel and toe, that Judge would accept as it did the foothold (rise, slope, no nearer
+  // its mate across the heading than the lined-up limit or than the foothold), and that keeps
+  // at least half the foothold's way along the sole from where the foot stands (a sample aside
+  // is no step). (Judge's progress, half the step aimed, refused most places back from a nose
+  // that a step aimed down past it had reached.)
+  const double rise_limit = c_.max_rise * (1 + kRiseRounding);
+  Parallel(n, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      Move& mv = moves_[sole_moves_[i]];
+      const Agent& a = agents_[mv.agent];
+      for (size_t at = sole_first_[i]; at < sole_first_[i + 1]; at += kPerCandidate) {
+        const Foothold& h = sole_answers_[at];
+        if (!SoleOnGround(sole_points_[at], h, mv.end_normal, near) ||
+            !SoleOnGround(sole_points_[at + 1], sole_answers_[at + 1], mv.end_normal, near) ||
+            !SoleOnGround(sole_points_[at + 2], sole_answers_[at + 2], mv.end_normal, near))
+          continue;
+        const Vec3 f = SoleForward(a.forward, mv.end_normal);
+        const Vec3& foot = a.foot[mv.foot];
+        if (Dot(h.point - foot, f) < 0.5 * Dot(mv.end - foot, f) ||
+            std::fabs(Dot(h.point - foot, a.up)) > rise_limit ||
+            Dot(h.normal, a.up) < cos_max_slope_ ||
+            GapToMate(mv, h.point) < std::min(kMinPairGap, GapToMate(mv, mv.end)))
+          continue;
+        mv.end = h.point, mv.end_normal = h.normal, mv.sole = 2;
+        break;
+      }
+    }
+  });
+  return Status::kOk;
+}
+
+}  // namespace footfall::steps_detail

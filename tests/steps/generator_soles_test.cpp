@@ -1,0 +1,138 @@
+// Soles: a character with a foot_length sets each foot's sole on the tread it stands on.
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "footfall/import/terrain_generators.h"
+#include "generator_fixtures.h"
+#include "walk_checks.h"
+
+using namespace footfall;
+using namespace footfall::test;
+
+namespace {
+
+struct SoleCount {
+  int fit = 0, touchdowns = 0;
+};
+
+// Counts the touch-downs of w (its end keys that moved the foot) whose sole, `length` long along
+// the unit horizontal `heading` with its foothold at the middle, lies over the foothold's own
+// tread within `slack` of that tread's ends, on a flight along +z (tread k at height k * rise,
+// from z = k * run to (k + 1) * run; `treads` of them).
+SoleCount SolesOnTreads(const Walk& w, const Vec3& heading, double length, double rise,
+                        double run, int treads, double slack) {
+  SoleCount n;
+  for (const WalkTrack& t : w.tracks) {
+    if (t.kind != TrackKind::kFoot) continue;
+    for (size_t i = 0; i + 2 < t.keys.size(); ++i) {
+      if (t.keys[i].phase != KeyPhase::kStart) continue;
+      const Vec3& p = t.keys[i + 2].position;
+      if (Distance(p, t.keys[i].position) == 0) continue;  // a step in place
+      const int k = static_cast<int>(std::lround(p.y / rise));
+      const double lo = k * run - slack, hi = (k + 1) * run + slack;
+      const double heel = p.z - 0.5 * length * heading.z, toe = p.z + 0.5 * length * heading.z;
+      ++n.touchdowns;
+      // (The top tread has no riser beyond it: its far end is the terrain's.)
+      n.fit += std::min(heel, toe) >= lo && (std::max(heel, toe) <= hi || k == treads - 1);
+    }
+  }
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("A biped with a foot length sets its soles on the treads, up and down stairs",
+          "[steps][generator][soles]") {
+  // A foothold is the sample nearest the step's aim: on stairs the biped stood its feet on the
+  // nose going down (the sole's front half over the drop, 16 of 17 touch-downs on 18 x 30 cm
+  // stairs) and at the riser's foot going up (its toe in the riser, 7 of 13). With a
+  // foot_length, each foothold moves along its tread until heel and toe have ground.
+  const Character shipped = LoadShipped("biped");
+  REQUIRE(shipped.foot_length > 0);
+  Character point = shipped;
+  point.foot_length = 0;
+  struct Flight {
+    double rise, run, spacing, deg;
+  };
+  const int treads = 20;
+  SoleCount with, without;
+  for (const Flight& f : {Flight{0.18, 0.3, 0.03, 0}, Flight{0.15, 0.35, 0.05, 0},
+                          Flight{0.2, 0.28, 0.02, 0}, Flight{0.12, 0.4, 0.04, 20},
+                          Flight{0.17, 0.32, 0.04, 30}}) {
+    Terrain t = LoadTerrain(MakeStairs(treads, f.rise, f.run, 6, f.spacing), f.spacing);
+    for (const bool up : {true, false}) {
+      const int from = up ? 1 : treads - 2;
+      GenerateOptions o = StartOptions({3, from * f.rise, (from + 0.5) * f.run}, 10);
+      const double a = f.deg * 3.14159265358979 / 180;
+      const Vec3 heading{std::sin(a), 0, (up ? 1 : -1) * std::cos(a)};
+      o.heading = heading;
+      const Walk w = Generate(t, shipped, o);
+      INFO(f.rise << " x " << f.run << " every " << f.spacing << " at " << f.deg << " deg, "
+                  << (up ? "up: " : "down: ") << w.stopped);
+      CheckWalk(t, shipped, o, w);
+      CHECK(w.stopped.empty());
+      const SoleCount n =
+          SolesOnTreads(w, heading, shipped.foot_length, f.rise, f.run, treads, f.spacing);
+      CHECK(n.touchdowns >= 8);
+      CHECK(n.fit >= n.touchdowns - 1);
+      with.fit += n.fit, with.touchdowns += n.touchdowns;
+      const Walk v = Generate(t, point, o);
+      const SoleCount m =
+          SolesOnTreads(v, heading, shipped.foot_length, f.rise, f.run, treads, f.spacing);
+      without.fit += m.fit, without.touchdowns += m.touchdowns;
+    }
+  }
+  INFO(with.fit << " of " << with.touchdowns << " soles on their treads, point feet "
+                << without.fit << " of " << without.touchdowns);
+  CHECK(with.fit > without.fit + with.touchdowns / 4);
+}
+
+TEST_CASE("A biped with a foot length steps down steep stairs a tread at a time",
+          "[steps][generator][soles]") {
+  // Down risers as tall as the treads are deep, its short steps found the nose of the tread it
+  // stood on: moved back from that edge, the foot found the same edge at its next step and
+  // shuffled to it, two steps a tread. A foot stepping to the edge of its own tread now steps
+  // down past it first.
+  const Character c = LoadShipped("biped");
+  const int treads = 16;
+  for (const double deg : {0.0, 15.0}) {
+    const double rise = 0.3, run = 0.3, spacing = 0.04;
+    Terrain t = LoadTerrain(MakeStairs(treads, rise, run, 6, spacing), spacing);
+    const int from = treads - 2;
+    GenerateOptions o = StartOptions({3, from * rise, (from + 0.5) * run}, 12);
+    const double a = deg * 3.14159265358979 / 180;
+    o.heading = {std::sin(a), 0, -std::cos(a)};
+    const Walk w = Generate(t, c, o);
+    INFO(deg << " deg: " << w.stopped);
+    CheckWalk(t, c, o, w);
+    CHECK(w.stopped.empty());
+    const auto& body = Body(w).keys;
+    CHECK(body.front().position.y - body.back().position.y >= 5 * rise - 1e-6);
+    const SoleCount n = SolesOnTreads(w, o.heading, c.foot_length, rise, run, treads, spacing);
+    CHECK(n.fit >= n.touchdowns - 2);
+  }
+}
+
+TEST_CASE("A biped's soles change nothing on ground that has room for them",
+          "[steps][generator][soles]") {
+  // On flat ground and the bundled hills every sole has ground under heel and toe: the walk is
+  // the point-footed one.
+  const Character shipped = LoadShipped("biped");
+  Character point = shipped;
+  point.foot_length = 0;
+  Terrain flat = LoadTerrain(MakeFlat(201, 0.05, 0), 0.05);
+  Terrain hills = LoadTerrain(LoadShippedTerrain("hills"), 0.25);
+  for (Terrain* t : {&flat, &hills}) {
+    GenerateOptions o = StartOptions(t == &flat ? Vec3{3, 0, 1} : Vec3{12, 0, 8}, 12);
+    o.heading = {0.3, 0, 1};
+    const Walk w = Generate(*t, shipped, o), v = Generate(*t, point, o);
+    CheckWalk(*t, shipped, o, w);
+    REQUIRE(w.tracks.size() == v.tracks.size());
+    for (size_t i = 0; i < w.tracks.size(); ++i) {
+      REQUIRE(w.tracks[i].keys.size() == v.tracks[i].keys.size());
+      for (size_t j = 0; j < w.tracks[i].keys.size(); ++j)
+        CHECK(w.tracks[i].keys[j].position == v.tracks[i].keys[j].position);
+    }
+  }
+}
