@@ -24,6 +24,7 @@ import sys
 import tempfile
 import time
 import unittest
+from array import array
 
 import addon_utils
 import bpy
@@ -51,6 +52,15 @@ def to_ff(v):
 
 def from_ff(v):
     return (v[0], -v[2], v[1])
+
+
+def sample_rows(flat):
+    """The add-on's samples (mesh_samples: one array('d'), 6 doubles a sample) as a list of
+    (x, y, z, nx, ny, nz) tuples."""
+    if not (isinstance(flat, array) and flat.typecode == "d" and len(flat) % 6 == 0):
+        raise AssertionError("expected an array('d') of whole samples, got a %s of %d"
+                             % (type(flat).__name__, len(flat)))
+    return list(zip(*[iter(flat)] * 6))
 
 
 def csv(v):
@@ -286,7 +296,8 @@ class BlenderAddonTest(unittest.TestCase):
         ff.sampling.write_point_file(path, want)
         with open(self.pts) as sent, open(path) as pure:
             self.assertEqual(sent.readlines()[1:], pure.readlines()[1:])  # (repr: every bit)
-        self.assertEqual(packed(self.ops.mesh_samples(bpy.context, terrain, separation)),
+        self.assertEqual(packed(sample_rows(self.ops.mesh_samples(bpy.context, terrain,
+                                                                  separation))),
                          packed(want))
 
     def test_1b_instances_on_the_terrain_mesh_are_sampled(self):
@@ -315,12 +326,12 @@ class BlenderAddonTest(unittest.TestCase):
         ground.modifiers.new("box", "NODES").node_group = tree
         try:
             bpy.context.view_layer.update()
-            instanced = self.ops.mesh_samples(bpy.context, ground, 0.1)
+            instanced = sample_rows(self.ops.mesh_samples(bpy.context, ground, 0.1))
             realize = nodes.new("GeometryNodeRealizeInstances")
             links.new(join.outputs[0], realize.inputs[0])
             links.new(realize.outputs[0], outputs.inputs[0])
             bpy.context.view_layer.update()
-            realized = self.ops.mesh_samples(bpy.context, ground, 0.1)
+            realized = sample_rows(self.ops.mesh_samples(bpy.context, ground, 0.1))
             self.assertEqual(len(instanced), len(realized))
             self.assertAlmostEqual(max(s[1] for s in instanced), 1.0, delta=1e-6)  # the box top
         finally:
@@ -339,10 +350,10 @@ class BlenderAddonTest(unittest.TestCase):
         plane.instance_type = "FACES"
         try:
             bpy.context.view_layer.update()
-            shown = self.ops.mesh_samples(bpy.context, plane, 0.1)
+            shown = sample_rows(self.ops.mesh_samples(bpy.context, plane, 0.1))
             plane.show_instancer_for_viewport = False
             bpy.context.view_layer.update()
-            hidden = self.ops.mesh_samples(bpy.context, plane, 0.1)
+            hidden = sample_rows(self.ops.mesh_samples(bpy.context, plane, 0.1))
             self.assertGreater(len(hidden), 0)  # the box
             self.assertLess(len(hidden), 0.6 * len(shown))
             # Nothing on the plane outside the box's footprint (footfall x = Blender x).
@@ -381,14 +392,14 @@ class BlenderAddonTest(unittest.TestCase):
             bpy.context.view_layer.update()
             reference.matrix_world = instance.matrix_world @ ground.matrix_world
             bpy.context.view_layer.update()
-            want = sorted(self.ops.mesh_samples(bpy.context, reference, 0.2))
+            want = sorted(sample_rows(self.ops.mesh_samples(bpy.context, reference, 0.2)))
             self.select([instance], instance)
             scene.terrain_source, scene.separation = "MESH", 0.2
             out = os.path.join(ARGS.work_dir, "set_instance.pts")
             self.assertEqual(bpy.ops.footfall.terrain_setup(save_points=out), {"FINISHED"})
             self.assertEqual(scene.sample_count, len(want))
             self.assertEqual(scene.terrain_name, instance.name)
-            got = sorted(self.ops.mesh_samples(bpy.context, instance, 0.2))
+            got = sorted(sample_rows(self.ops.mesh_samples(bpy.context, instance, 0.2)))
             self.assertEqual(len(got), len(want))
             for g, w in zip(got, want):
                 for a, b in zip(g, w):
@@ -2428,12 +2439,29 @@ def packed(rows):
 
 
 def outcome(fn, *args, **kwargs):
-    """fn's result as packed bits, or its error's type and message."""
+    """fn's result as packed bits (a flat array: "flat" and its doubles' bits), or its error's
+    type and message."""
     try:
         result = fn(*args, **kwargs)
     except Exception as e:  # compared, not hidden: the other path must raise the same
         return (type(e).__name__, str(e))
+    if isinstance(result, array):
+        return ("flat", packed_flat(result))
     return ("ok", None if result is None else packed(result))
+
+
+def packed_flat(flat):
+    """The bits of a flat array('d') of samples, as packed() of its rows joined; raises for
+    anything but an array('d') of whole samples."""
+    if type(flat) is not array or flat.typecode != "d" or len(flat) % 6:
+        raise AssertionError("expected an array('d') of whole samples, got %r" % (flat,))
+    return struct.pack("<%dd" % len(flat), *flat)
+
+
+def as_flat(result):
+    """sample_triangles' outcome as sample_triangles_flat's: its rows' bits joined, or the same
+    error."""
+    return ("flat", b"".join(result[1])) if result[0] == "ok" else result
 
 
 def grid(n, spacing, offset=0.0, wave=0.3):
@@ -2543,10 +2571,20 @@ class SamplingNumpyTest(unittest.TestCase):
                 result = self.assert_same("%s %s" % (what, name), ff.sampling.sample_triangles,
                                           pts, tris, separation, max_samples=max_samples,
                                           **kwargs)
+                # The flat array, on both paths: the tuples' doubles in their order, bit for
+                # bit, or the same error.
+                flat = self.assert_same("%s %s flat" % (what, name),
+                                        ff.sampling.sample_triangles_flat, pts, tris, separation,
+                                        max_samples=max_samples, **kwargs)
+                self.assertEqual(flat, as_flat(result), "%s %s flat" % (what, name))
                 if result[0] == "ok":
                     self.assert_numpy_path(what, lambda: np_.sample_triangles(
                         pts, tris, separation, kwargs.get("vertex_normals"),
                         kwargs.get("corner_normals")))
+                    self.assertEqual(packed_flat(self.assert_numpy_path(
+                        what, lambda: np_.sample_triangles_flat(
+                            pts, tris, separation, kwargs.get("vertex_normals"),
+                            kwargs.get("corner_normals")))), flat[1], what)
 
     def test_random_triangles_sharing_vertices(self):
         for seed in range(16):
@@ -2605,6 +2643,11 @@ class SamplingNumpyTest(unittest.TestCase):
             for fn in (ff.sampling.check_sample_count, ff.sampling.sample_triangles):
                 got = self.assert_same("%s %r" % (fn.__name__, pts), fn, pts, tris, separation)
                 self.assertEqual(got[0], "ValueError", pts)
+            # (The flat samples' limit is numpy's own unless given: given, the same errors.)
+            self.assertEqual(self.assert_same("flat %r" % (pts,),
+                                              ff.sampling.sample_triangles_flat, pts, tris,
+                                              separation, max_samples=ff.sampling.MAX_SAMPLES),
+                             got)
         # Too many samples, first passed at a later triangle of a mesh, for a small limit.
         pts, tris = grid(20, 0.5)
         for limit in (10, 400, 1000, 4000):
@@ -2612,6 +2655,9 @@ class SamplingNumpyTest(unittest.TestCase):
                                    0.1, max_samples=limit)
             self.assertEqual(got[0], "ValueError")
             self.assertIn("more than %d samples" % limit, got[1])
+            self.assertEqual(self.assert_same("flat limit %d" % limit,
+                                              ff.sampling.sample_triangles_flat, pts, tris, 0.1,
+                                              max_samples=limit), got)
         self.assertIsNone(ff.sampling._numpy.count_problem(pts, tris, 0.1, 10 ** 6))
         # A count that reaches the limit exactly passes: 4 vertices and two triangles of
         # lattice size 2 (1.5 samples each on their edges) make 7.
@@ -2631,16 +2677,98 @@ class SamplingNumpyTest(unittest.TestCase):
         for scale in (1, 3000, 10 ** 12):
             pts = [(0, 0, 0), (2 * scale, 0, 0), (0, 1, 2 * scale), (scale, 3, scale)]
             tris = [(0, 2, 1), (1, 2, 3)]
-            self.assert_same("ints x%d" % scale, ff.sampling.sample_triangles, pts, tris,
-                             0.7 * scale)
+            want = self.assert_same("ints x%d" % scale, ff.sampling.sample_triangles, pts, tris,
+                                    0.7 * scale)
+            self.assertEqual(self.assert_same("ints x%d flat" % scale,
+                                              ff.sampling.sample_triangles_flat, pts, tris,
+                                              0.7 * scale), as_flat(want))
             self.assert_same("ints x%d" % scale, ff.sampling.corner_normals, pts, tris)
         pts, tris = box()
         # A separation so small that a key overflows, and indices out of range or negative.
         self.assert_same("tiny separation", ff.sampling.sample_triangles, [(1e300, 0.0, 0.0),
                          (1e300, 1e-290, 0.0), (1e300, 0.0, 1e-290)], [(0, 1, 2)], 1e-295)
         for bad in ([(0, 1, 99)], [(0, 1, -1)], [(0, 1, 2.0)], [(0, 1)]):
-            self.assert_same("triangles %r" % bad, ff.sampling.sample_triangles, pts, bad, 0.3)
+            want = self.assert_same("triangles %r" % bad, ff.sampling.sample_triangles, pts, bad,
+                                    0.3)
+            self.assertEqual(self.assert_same("triangles %r flat" % bad,
+                                              ff.sampling.sample_triangles_flat, pts, bad, 0.3),
+                             as_flat(want))
             self.assert_same("triangles %r" % bad, ff.sampling.corner_normals, pts, bad)
+
+    def test_flat_samples_limit_is_numpys_and_the_loops_keep_theirs(self):
+        # sample_triangles_flat holds to MAX_FLAT_SAMPLES where numpy samples (no tuple a
+        # sample), and to MAX_SAMPLES in the pure-Python loops, numpy's fallback included.
+        self.assertTrue(ff.sampling.USE_NUMPY)  # (no numpy: this fails, it is not skipped)
+        self.assertEqual(ff.sampling.flat_sample_limit(), ff.sampling.MAX_FLAT_SAMPLES)
+        self.assertEqual(ff.sampling.flat_sample_limit(pure=True), ff.sampling.MAX_SAMPLES)
+        self.assertGreater(ff.sampling.MAX_FLAT_SAMPLES, ff.sampling.MAX_SAMPLES)
+        # A 3000-unit square at 2.45: about 3 million samples, between the two limits.
+        tris = [(0, 2, 1), (1, 2, 3)]
+        square = [(0.0, 0.0, 0.0), (3000.0, 0.0, 0.0), (0.0, 0.0, 3000.0), (3000.0, 0.0, 3000.0)]
+        ff.sampling.check_sample_count(square, tris, 2.45, ff.sampling.flat_sample_limit())
+        with self.assertRaises(ValueError) as e:
+            ff.sampling.check_sample_count(square, tris, 2.45)
+        self.assertIn("more than %d samples" % ff.sampling.MAX_SAMPLES, str(e.exception))
+        with self.assertRaises(ValueError) as e:  # (refused before sampling: quick)
+            ff.sampling.sample_triangles_flat(square, tris, 2.45, pure=True)
+        self.assertIn("more than %d samples" % ff.sampling.MAX_SAMPLES, str(e.exception))
+        # Integer corners past 2048 are numpy's Unsupported: the loops' limit, not numpy's.
+        ints = [tuple(int(v) for v in p) for p in square]
+        with self.assertRaises(ValueError) as e:
+            ff.sampling.sample_triangles_flat(ints, tris, 2.45)
+        self.assertIn("more than %d samples" % ff.sampling.MAX_SAMPLES, str(e.exception))
+        with self.assertRaises(ValueError) as e:
+            ff.sampling.sample_triangles_flat(square, tris, 1.0)  # about 18 million
+        self.assertIn("more than %d samples" % ff.sampling.MAX_FLAT_SAMPLES, str(e.exception))
+
+    def test_point_files_of_flat_samples_are_the_tuples_text(self):
+        # write_point_file of the flat array (numpy's or the loops') writes the bytes it writes
+        # for sample_triangles' tuples; a float64 numpy array of 6 columns too.
+        import numpy
+        meshes = [("grid", grid(12, 0.5), 0.13), ("box", box(), 0.3),
+                  ("stairs", stairs(), 0.07), ("far grid", grid(6, 0.5, offset=1e5), 0.4)]
+        pts, tris, scale = random_mesh(5)
+        meshes.append(("random mesh", (pts, tris), 0.3 * scale))
+        for label, (pts, tris), separation in meshes:
+            normals = ff.sampling.corner_normals(pts, tris)
+            tuples = ff.sampling.sample_triangles(pts, tris, separation, corner_normals=normals,
+                                                  pure=True)
+            self.assertTrue(tuples, label)
+            texts = []
+            for samples in (tuples,
+                            ff.sampling.sample_triangles_flat(pts, tris, separation,
+                                                              corner_normals=normals),
+                            ff.sampling.sample_triangles_flat(pts, tris, separation,
+                                                              corner_normals=normals, pure=True),
+                            numpy.array(tuples)):
+                path = os.path.join(ARGS.work_dir, "flat_text.pts")
+                ff.sampling.write_point_file(path, samples, "a comment")
+                with open(path, "rb") as f:
+                    texts.append(f.read())
+            self.assertEqual(texts[0].count(b"\n"), len(tuples) + 1, label)
+            for i, text in enumerate(texts[1:], 1):
+                self.assertEqual(text, texts[0], "%s: writing %d" % (label, i))
+        with self.assertRaises(ValueError) as e:
+            ff.sampling.write_point_file(os.path.join(ARGS.work_dir, "never.pts"),
+                                         array("d", range(7)))
+        self.assertIn("7 numbers", str(e.exception))
+        self.assertFalse(os.path.exists(os.path.join(ARGS.work_dir, "never.pts")))
+
+    def test_flat_samples_load_the_tuples_terrain(self):
+        # Session.load_samples takes numpy's flat array as it is: the same terrain as the
+        # tuples' (count, bounds, and every snap answer at the samples and between them).
+        pts, tris = grid(15, 0.5)
+        normals = ff.sampling.corner_normals(pts, tris)
+        tuples = ff.sampling.sample_triangles(pts, tris, 0.11, corner_normals=normals)
+        flat = ff.sampling.sample_triangles_flat(pts, tris, 0.11, corner_normals=normals)
+        probe = [(x + 0.013, y + 0.2, z - 0.021) for x, y, z, *_ in tuples[::5]]
+        with ff.Session.embedded() as s:
+            a, b = s.load_samples(tuples, "tuples"), s.load_samples(flat, "flat")
+            self.assertEqual(s.info(a), s.info(b))
+            self.assertEqual(s.info(b)[0], len(flat) // 6)
+            self.assertEqual(s.snap(a, probe), s.snap(b, probe))
+            self.assertEqual(s.normal(a, probe), s.normal(b, probe))
+        flat.append(0.0)  # (the array was lent to the call, not kept: it still grows)
 
 
 def main():

@@ -29,6 +29,56 @@ HILLS = os.path.join(REPO, "data", "terrain", "hills.pts")
 CHARACTERS = os.environ.get("FOOTFALL_CHARACTERS") or os.path.join(REPO, "data", "characters")
 
 
+def sample_rows(flat):
+    """Flat samples (sampling.sample_triangles_flat's array('d'), 6 doubles a sample) as a list
+    of (x, y, z, nx, ny, nz) tuples; AssertionError for anything else."""
+    from array import array
+    if not (type(flat) is array and flat.typecode == "d" and len(flat) % 6 == 0):
+        raise AssertionError("expected an array('d') of whole samples, got a %s"
+                             % type(flat).__name__)
+    return list(zip(*[iter(flat)] * 6))
+
+
+def packed_rows(rows):
+    """The samples' doubles, struct-packed in order (their bits); only floats."""
+    import struct
+    values = [v for row in rows for v in row]
+    for v in values:
+        if type(v) is not float:
+            raise AssertionError("%r is a %s, not a float" % (v, type(v).__name__))
+    return struct.pack("<%dd" % len(values), *values)
+
+
+def sampling_meshes():
+    """(name, points, triangles, separations) of meshes for the resampling's tests: a waved
+    grid, a closed box (90 degree creases), stairs, and triangles sharing a vertex with a
+    zero-area one, a repeated vertex and integer coordinates."""
+    n, spacing = 9, 0.5
+    wavy = [(i * spacing, 0.3 * math.sin(0.9 * i * spacing) * math.cos(0.7 * j * spacing),
+             j * spacing) for j in range(n) for i in range(n)]
+    grid_tris = []
+    for j in range(n - 1):
+        for i in range(n - 1):
+            a = j * n + i
+            grid_tris += [(a, a + n, a + 1), (a + 1, a + n, a + n + 1)]
+    corners = [(x, y, z) for x in (0.0, 1.0) for y in (0.0, 1.0) for z in (0.0, 1.0)]
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    box_tris = [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))]
+    profile = []
+    for k in range(4):
+        profile += [(k * 0.17, k * 0.28), ((k + 1) * 0.17, k * 0.28)]
+    profile.append((4 * 0.17, 4 * 0.28))
+    stairs = [(x, y, z) for y, z in profile for x in (0.0, 1.2)]
+    stairs_tris = []
+    for k in range(len(profile) - 1):
+        a = 2 * k
+        stairs_tris += [(a, a + 2, a + 1), (a + 1, a + 2, a + 3)]
+    odd = [(0, 0, 0), (2, 0, 0), (0, 1, 2), (1, 3, 1), (1.0, 0.0, 0.0), (0.5, 0.25, 1.0)]
+    odd_tris = [(0, 2, 1), (1, 2, 3), (0, 4, 1), (0, 0, 3), (0, 5, 2)]
+    return [("wavy grid", wavy, grid_tris, (0.09, 0.6)), ("box", corners, box_tris, (0.23, 2.0)),
+            ("stairs", stairs, stairs_tris, (0.05, 0.4)), ("odd", odd, odd_tris, (0.3, 0.7))]
+
+
 def flat_grid(n=21, spacing=0.5, height=0.0):
     """n x n samples on the plane y = height, normal +Y, as 6-tuples."""
     return [(i * spacing, height, j * spacing, 0.0, 1.0, 0.0) for i in range(n) for j in range(n)]
@@ -281,6 +331,109 @@ class SharedLogicTest(unittest.TestCase):
         self.assertEqual(flat(doubles[:-1]), flat(iter(doubles[:-1])))
         self.assertEqual(flat(b"\x00" * 48), flat(iter(b"\x00" * 48)))
         self.assertEqual(flat(rows, 3)[0], "invalid_argument")
+
+    def test_flat_samples_are_the_tuples_doubles(self):
+        # sample_triangles_flat (what both plugins send) holds sample_triangles' doubles in
+        # their order, bit for bit, with every kind of normal, and raises its errors.
+        from array import array
+        for name, pts, tris, separations in sampling_meshes():
+            corners = ff.sampling.corner_normals(pts, tris, pure=True)
+            some_none = [None if t % 3 == 0 else c for t, c in enumerate(corners)]
+            vertex = [(math.sin(i), math.cos(i), 0.5) for i in range(len(pts))]
+            for separation in separations:
+                for normals, kwargs in (("face", {}), ("corner", {"corner_normals": corners}),
+                                        ("some None", {"corner_normals": some_none}),
+                                        ("vertex", {"vertex_normals": vertex})):
+                    label = "%s at %g, %s normals" % (name, separation, normals)
+                    tuples = ff.sampling.sample_triangles(pts, tris, separation, pure=True,
+                                                          **kwargs)
+                    self.assertGreater(len(tuples), 3, label)
+                    for pure in (True, False):  # (the loops here without numpy: the same)
+                        flat = ff.sampling.sample_triangles_flat(pts, tris, separation,
+                                                                 pure=pure, **kwargs)
+                        self.assertIs(type(flat), array, label)
+                        self.assertEqual(flat.typecode, "d", label)
+                        self.assertEqual(len(flat), 6 * len(tuples), label)
+                        self.assertEqual(packed_rows(sample_rows(flat)), packed_rows(tuples),
+                                         label)
+        pts = [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0)]
+        for args, message in (((pts, [(0, 1, 2)], 0), "separation must be > 0"),
+                              ((pts, [(0, 1, 2)], 1e-4), "would make more than 2000000"),
+                              (([(float("nan"), 0, 0)] + pts[1:], [(0, 1, 2)], 0.1),
+                               "triangle 0")):
+            with self.assertRaises(ValueError) as e:
+                ff.sampling.sample_triangles_flat(*args, pure=True)
+            self.assertIn(message, str(e.exception))
+        with self.assertRaises(ValueError) as e:
+            ff.sampling.sample_triangles_flat(pts, [(0, 1, 2)], 0.1, max_samples=5)
+        self.assertIn("would make more than 5 samples", str(e.exception))
+        with self.assertRaises(IndexError):
+            ff.sampling.sample_triangles_flat(pts, [(0, 1, 7)], 0.1, pure=True)
+        # The pure-Python loops keep their limit, for the flat samples too.
+        self.assertEqual(ff.sampling.flat_sample_limit(pure=True), ff.sampling.MAX_SAMPLES)
+        if not ff.sampling.USE_NUMPY:
+            self.assertEqual(ff.sampling.flat_sample_limit(), ff.sampling.MAX_SAMPLES)
+
+    def test_point_files_of_flat_samples_are_the_tuples_text(self):
+        # write_point_file writes the same bytes for the flat array as for the tuples (repr of
+        # each double, spaced, a line a sample), and refuses a part of a sample before writing.
+        from array import array
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "t.pts")
+            for name, pts, tris, separations in sampling_meshes():
+                normals = ff.sampling.corner_normals(pts, tris)
+                tuples = ff.sampling.sample_triangles(pts, tris, separations[0],
+                                                      corner_normals=normals)
+                flat = ff.sampling.sample_triangles_flat(pts, tris, separations[0],
+                                                         corner_normals=normals)
+                texts = []
+                for samples in (tuples, flat, memoryview(flat)):
+                    ff.sampling.write_point_file(path, samples, "from " + name)
+                    with open(path, "rb") as f:
+                        texts.append(f.read())
+                self.assertEqual(texts[0].count(b"\n"), len(tuples) + 1, name)
+                self.assertEqual(texts[1], texts[0], name)
+                self.assertEqual(texts[2], texts[0], name)
+            # Doubles whose repr takes every digit, an exponent, or a sign of zero.
+            odd = [(0.1 + 0.2, -0.0, 1e-300, 1.7976931348623157e308, 5e-324, -2.5),
+                   (1.0 / 3.0, 2.0 ** 60, -1e22, 123456789.123456789, 0.0, 1.0)]
+            ff.sampling.write_point_file(path, odd)
+            with open(path, "rb") as f:
+                want = f.read()
+            ff.sampling.write_point_file(path, array("d", [v for row in odd for v in row]))
+            with open(path, "rb") as f:
+                self.assertEqual(f.read(), want)
+            never = os.path.join(tmp, "never.pts")
+            with self.assertRaises(ValueError) as e:
+                ff.sampling.write_point_file(never, array("d", [0.0] * 13))
+            self.assertIn("13 numbers", str(e.exception))
+            self.assertFalse(os.path.exists(never))
+
+    def test_flat_samples_load_the_tuples_terrain(self):
+        # Session.load_samples takes the flat array as it is (no copy, no loop over the
+        # numbers): the same terrain as the tuples' (count, bounds, every snap and normal).
+        from footfall_client.session import _flat
+        for name, pts, tris, separations in sampling_meshes():
+            normals = ff.sampling.corner_normals(pts, tris)
+            tuples = ff.sampling.sample_triangles(pts, tris, separations[0],
+                                                  corner_normals=normals)
+            flat = ff.sampling.sample_triangles_flat(pts, tris, separations[0],
+                                                     corner_normals=normals)
+            self.assertIs(_flat(flat, 6, "samples"), flat)
+            probe = [(x + 0.013, y + 0.2, z - 0.021) for x, y, z, *_ in tuples[::3]]
+            probe += [(x, y, z) for x, y, z, *_ in tuples[1::4]]
+            with ff.Session.embedded() as s:
+                a, b = s.load_samples(tuples, "tuples"), s.load_samples(flat, "flat")
+                self.assertEqual(s.info(b), s.info(a), name)
+                self.assertEqual(s.info(b)[0], len(flat) // 6, name)
+                self.assertEqual(s.snap(b, probe), s.snap(a, probe), name)
+                self.assertEqual(s.normal(b, probe), s.normal(a, probe), name)
+            flat.append(0.0)  # (lent to the call, not kept: the array still grows)
+        with ff.Session.embedded() as s:
+            from array import array
+            with self.assertRaises(ff.FootfallError) as e:
+                s.load_samples(array("d", [0.0] * 7))
+            self.assertIn("7 numbers is not a multiple of 6", e.exception.message)
 
     def test_separation_must_be_positive(self):
         with self.assertRaises(ValueError):
@@ -1219,7 +1372,8 @@ class MayaKeyWalkTest(unittest.TestCase):
     def test_a_mirrored_mesh_keeps_its_normals_up(self):
         # A terrain mesh under a negative scale had its triangles wound the other way in world
         # space, so every sample's normal pointed down (Maya shows it the right way up).
-        samples = self._mesh_samples([(0, 0, 0), (0, 0, 1), (-1, 0, 0)], -1.0, 0.25)  # mirrored
+        samples = sample_rows(self._mesh_samples([(0, 0, 0), (0, 0, 1), (-1, 0, 0)], -1.0,
+                                                 0.25))  # mirrored
         self.assertGreater(len(samples), 3)
         for sample in samples:
             self.assertAlmostEqual(sample[4], 1.0, places=9)  # the normal's Y: up
@@ -1228,9 +1382,9 @@ class MayaKeyWalkTest(unittest.TestCase):
         # MFnMesh gives points in centimetres (Maya's internal unit) whatever the scene's
         # unit, while xform places the character in the scene's: in a metre scene the terrain
         # was sent 100 times too large (and sampled at a separation taken as centimetres).
-        cm = self._mesh_samples([(0, 0, 0), (0, 0, 200), (200, 0, 0)], 1.0, 50.0)
-        m = self._mesh_samples([(0, 0, 0), (0, 0, 200), (200, 0, 0)], 1.0, 0.5,
-                               to_ui=lambda v: v / 100.0)
+        cm = sample_rows(self._mesh_samples([(0, 0, 0), (0, 0, 200), (200, 0, 0)], 1.0, 50.0))
+        m = sample_rows(self._mesh_samples([(0, 0, 0), (0, 0, 200), (200, 0, 0)], 1.0, 0.5,
+                                           to_ui=lambda v: v / 100.0))
         self.assertEqual(len(m), len(cm))
         for a, b in zip(m, cm):
             for i in range(3):

@@ -273,7 +273,8 @@ def mesh_triangles(context, obj):
 
 def mesh_samples(context, obj, separation):
     """The evaluated mesh of `obj` (and its instances, see mesh_triangles) resampled at
-    `separation` [metres], in footfall's frame (metres)."""
+    `separation` [metres], in footfall's frame (metres): an array('d') of x y z nx ny nz per
+    sample (sampling.sample_triangles_flat; len // 6 samples), sent and saved as it is."""
     points, tris = mesh_triangles(context, obj)
     if not tris:
         raise ValueError("%s has no faces to walk on: select a mesh, or an object that makes "
@@ -281,9 +282,10 @@ def mesh_samples(context, obj, separation):
                          % obj.name)
     # Normals from the geometry, as `footfall generate` samples a mesh file (smooth, sharp at
     # edges past the crease angle), whatever the viewport's shading.
-    sampling.check_sample_count(points, tris, separation)  # before the slow corner normals
+    # (Refused as sample_triangles_flat will, before the slow corner normals.)
+    sampling.check_sample_count(points, tris, separation, sampling.flat_sample_limit())
     normals = sampling.corner_normals(points, tris)
-    return sampling.sample_triangles(points, tris, separation, corner_normals=normals)
+    return sampling.sample_triangles_flat(points, tris, separation, corner_normals=normals)
 
 
 class FOOTFALL_OT_terrain_setup(bpy.types.Operator):

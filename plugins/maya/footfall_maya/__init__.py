@@ -100,10 +100,12 @@ def _mesh_samples(mesh, separation):
     # the normals face as Maya shows them (they pointed into the ground).
     order = (0, 2, 1) if dag.inclusiveMatrix().det3x3() < 0 else (0, 1, 2)
     tris = [tuple(verts[i + k] for k in order) for i in range(0, len(verts), 3)]
-    # Normals from the geometry, as `footfall generate` samples a mesh file.
-    ffc.sampling.check_sample_count(points, tris, separation)  # before the slow corner normals
+    # Normals from the geometry, as `footfall generate` samples a mesh file. The samples: one
+    # array('d') of x y z nx ny nz each (len // 6 of them), sent as it is. (Refused as
+    # sample_triangles_flat will, before the slow corner normals.)
+    ffc.sampling.check_sample_count(points, tris, separation, ffc.sampling.flat_sample_limit())
     normals = ffc.sampling.corner_normals(points, tris)
-    return ffc.sampling.sample_triangles(points, tris, separation, corner_normals=normals)
+    return ffc.sampling.sample_triangles_flat(points, tris, separation, corner_normals=normals)
 
 
 def _require_y_up():

@@ -15,6 +15,7 @@ Only numpy; nothing here imports bpy or maya.
 import itertools
 import operator
 import struct
+from array import array
 
 import numpy as np
 
@@ -288,6 +289,18 @@ def sample_triangles(points, triangles, separation, vertex_normals, corner_norma
     (x, y, z, nx, ny, nz) tuples of floats it returns. Unsupported for arguments it cannot
     answer for exactly, or when pure Python would raise (a key it could not round to an
     integer)."""
+    return _sample(points, triangles, separation, vertex_normals, corner_normals, False)
+
+
+def sample_triangles_flat(points, triangles, separation, vertex_normals, corner_normals):
+    """sample_triangles' samples as one array('d') of x y z nx ny nz each, in the same order,
+    the same doubles, made with no Python object a sample: each block of samples is written
+    into the array's memory as numpy makes it. The same Unsupported."""
+    return _sample(points, triangles, separation, vertex_normals, corner_normals, True)
+
+
+def _sample(points, triangles, separation, vertex_normals, corner_normals, flat):
+    """sample_triangles (flat false: a list of tuples) or sample_triangles_flat (an array)."""
     sep = _separation(separation)
     quantum = separation * 1e-4  # (as pure Python computes it: int * float included)
     P = _points(points)
@@ -306,7 +319,7 @@ def sample_triangles(points, triangles, separation, vertex_normals, corner_norma
         k = np.maximum(np.ceil(longest / sep - 1e-9), 1.0)
         tri = np.flatnonzero(valid)  # the triangles sampled, in order
         if not len(tri):
-            return []
+            return array("d") if flat else []
         k = k[tri].astype(np.int64)
         size = (k + 1) * (k + 2) // 2  # lattice points per triangle
         first = np.cumsum(size) - size  # of each triangle's lattice in the candidates
@@ -338,6 +351,17 @@ def sample_triangles(points, triangles, separation, vertex_normals, corner_norma
             normals = (N[T[:, 0]], N[T[:, 1]], N[T[:, 2]], np.ones(m, bool))
         else:
             normals = None
+        if flat:
+            # The array at its final size (zeros by repetition: no temporary), written through
+            # a numpy view of its memory; the view is dropped before the array is returned, so
+            # the caller may resize it.
+            out = array("d", (0.0,)) * (6 * len(keep))
+            view = np.frombuffer(out, np.float64).reshape(len(keep), 6)
+            for lo in range(0, len(keep), _BLOCK):
+                _samples(keep[lo:lo + _BLOCK], first, tri, k, a, b, c, (fx, fy, fz), normals,
+                         view[lo:lo + _BLOCK])
+            del view
+            return out
         out = []
         for lo in range(0, len(keep), _BLOCK):
             # struct makes each row's tuple of floats straight from the doubles (tolist() and
@@ -347,11 +371,12 @@ def sample_triangles(points, triangles, separation, vertex_normals, corner_norma
     return out
 
 
-def _samples(keep, first, tri, k, a, b, c, face, normals):
+def _samples(keep, first, tri, k, a, b, c, face, normals, out=None):
     """The (len(keep), 6) samples of the candidates `keep` (indices into the lattices of the
     triangles `tri`, each of size k, starting at `first`): each one's lattice point and
     weights again, its position and its normal (face's, or interpolated from `normals`:
-    per triangle its corners' normals and whether to interpolate, or None)."""
+    per triangle its corners' normals and whether to interpolate, or None). Written into
+    `out` (a (len(keep), 6) float64 array) when given, else into a new array."""
     where = np.searchsorted(first, keep, side="right") - 1
     t = tri[where]
     kk = k[where]
@@ -364,7 +389,8 @@ def _samples(keep, first, tri, k, a, b, c, face, normals):
         sel = np.flatnonzero(kk == size)
         i[sel] = np.searchsorted(starts, index[sel], "right") - 1
         j[sel] = index[sel] - starts[i[sel]]
-    out = np.empty((len(keep), 6))
+    if out is None:
+        out = np.empty((len(keep), 6))
     out[:, 0], out[:, 1], out[:, 2] = _interpolate(i, j, kk, a[t], b[t], c[t])
     for d in range(3):
         out[:, 3 + d] = face[d][t]

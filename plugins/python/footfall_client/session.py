@@ -90,7 +90,10 @@ def _flat_fast(rows, width):
     flat, or `width` columns), a list or tuple of floats and ints, or a list or tuple of
     `width`-tuples (or lists) of floats and ints, as sampling.sample_triangles returns. The same
     numbers as float() of each. None for anything else, or anything wrong: _flat's loop then
-    takes it, with its errors."""
+    takes it, with its errors. An array('d') (sampling.sample_triangles_flat's samples) is
+    given back as it is, not copied: the C library only reads it, during the call."""
+    if type(rows) is array and rows.typecode == "d":
+        return rows if len(rows) % width == 0 else None
     try:
         view = memoryview(rows)
     except TypeError:
@@ -334,8 +337,9 @@ class Session:
 
     @_one_call_at_a_time
     def load_samples(self, samples, name="samples"):
-        """Loads samples (x, y, z, nx, ny, nz) given as 6-tuples or one flat sequence; returns
-        the terrain id."""
+        """Loads samples (x, y, z, nx, ny, nz) given as 6-tuples or one flat sequence (an
+        array('d') as sampling.sample_triangles_flat returns is sent as it is, with no copy);
+        returns the terrain id."""
         h = self._handle("ffc_load_samples")
         flat = _flat(samples, 6, "samples")
         out = ctypes.c_uint32()
