@@ -53,9 +53,9 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
   CHECK(c.gait.size() == 2);
   CHECK(c.frames_per_step == 10);
   CHECK(c.max_slope_deg == 50);  // default
-  CHECK(c.foot_length == 0);      // default: point feet
-  REQUIRE(ParseCharacter(Biped("\"reach\": 1.1", "\"reach\": 1.1, \"foot_length\": 0.25"),
-                         "b.json", &c, &error) == Status::kOk);
+  CHECK(c.foot_length == 0);     // default: point feet
+  REQUIRE(ParseCharacter(Biped("\"reach\": 1.1", "\"reach\": 1.1, \"foot_length\": 0.25"), "b.json",
+                         &c, &error) == Status::kOk);
   CHECK(c.foot_length == 0.25);
   // A version written 1.0 is the version 1, as frames_per_step 10.0 is 10.
   CHECK(ParseCharacter(Biped("\"version\": 1", "\"version\": 1.0"), "b.json", &c, &error) ==
@@ -67,8 +67,7 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
        "b.json: 'step_length' = -1 is out of range"},
       {{"\"reach\": 1.1", "\"reach\": 1.1, \"foot_length\": -0.1"},
        "b.json: 'foot_length' = -0.1 is out of range [0, 1e+09]"},
-      {{"\"reach\": 1.1", "\"reach\": 1.1, \"foot_length\": \"long\""},
-       "b.json: 'foot_length'"},
+      {{"\"reach\": 1.1", "\"reach\": 1.1, \"foot_length\": \"long\""}, "b.json: 'foot_length'"},
       {{"[[\"L\"], [\"R\"]]", "[[\"L\"], [\"X\"]]"}, "b.json: 'gait'[1]: no foot named 'X'"},
       {{"[[\"L\"], [\"R\"]]", "[[\"L\"]]"},
        "b.json: 'gait': foot 'R' is in none of them (list every foot once)"},

@@ -20,8 +20,8 @@ struct SoleCount {
 // the unit horizontal `heading` with its foothold at the middle, lies over the foothold's own
 // tread within `slack` of that tread's ends, on a flight along +z (tread k at height k * rise,
 // from z = k * run to (k + 1) * run; `treads` of them).
-SoleCount SolesOnTreads(const Walk& w, const Vec3& heading, double length, double rise,
-                        double run, int treads, double slack) {
+SoleCount SolesOnTreads(const Walk& w, const Vec3& heading, double length, double rise, double run,
+                        int treads, double slack) {
   SoleCount n;
   for (const WalkTrack& t : w.tracks) {
     if (t.kind != TrackKind::kFoot) continue;
@@ -57,9 +57,9 @@ TEST_CASE("A biped with a foot length sets its soles on the treads, up and down 
   };
   const int treads = 20;
   SoleCount with, without;
-  for (const Flight& f : {Flight{0.18, 0.3, 0.03, 0}, Flight{0.15, 0.35, 0.05, 0},
-                          Flight{0.2, 0.28, 0.02, 0}, Flight{0.12, 0.4, 0.04, 20},
-                          Flight{0.17, 0.32, 0.04, 30}}) {
+  for (const Flight& f :
+       {Flight{0.18, 0.3, 0.03, 0}, Flight{0.15, 0.35, 0.05, 0}, Flight{0.2, 0.28, 0.02, 0},
+        Flight{0.12, 0.4, 0.04, 20}, Flight{0.17, 0.32, 0.04, 30}}) {
     Terrain t = LoadTerrain(MakeStairs(treads, f.rise, f.run, 6, f.spacing), f.spacing);
     for (const bool up : {true, false}) {
       const int from = up ? 1 : treads - 2;
@@ -83,8 +83,8 @@ TEST_CASE("A biped with a foot length sets its soles on the treads, up and down 
       without.fit += m.fit, without.touchdowns += m.touchdowns;
     }
   }
-  INFO(with.fit << " of " << with.touchdowns << " soles on their treads, point feet "
-                << without.fit << " of " << without.touchdowns);
+  INFO(with.fit << " of " << with.touchdowns << " soles on their treads, point feet " << without.fit
+                << " of " << without.touchdowns);
   CHECK(with.fit > without.fit + with.touchdowns / 4);
 }
 
