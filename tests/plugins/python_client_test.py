@@ -151,6 +151,14 @@ class EmbeddedTest(unittest.TestCase):
         with self.assertRaises(ff.FootfallError) as e:
             self.s.load_file("/tmp/no\x00pe.pts")
         self.assertIn("NUL", e.exception.message)
+        # An upload's name, or a JSON text, cut short at a NUL by the C library: refused whole.
+        with self.assertRaises(ff.FootfallError) as e:
+            self.s.load_samples([(0, 0, 0, 0, 1, 0)], "ground\x00 (copy)")
+        self.assertIn("NUL", e.exception.message)
+        self.assertEqual(e.exception.status_name, "invalid_argument")
+        with self.assertRaises(ff.FootfallError) as e:
+            self.s.check_character('{"format": "footfall-character"}\x00 trailing')
+        self.assertIn("NUL byte at offset 32", e.exception.message)
         folder = tempfile.mkdtemp()
         try:
             fifo = os.path.join(folder, "out.pts")

@@ -172,6 +172,9 @@ def _number(value, what, function):
 def _json_text(value, what, function):
     """A dict (or JSON text) as UTF-8 JSON bytes, or FootfallError naming `what`."""
     if isinstance(value, str):
+        if "\0" in value:  # C would read the text cut short at the NUL, and blame what is left
+            raise FootfallError(INVALID_ARGUMENT, "%s: the JSON text holds a NUL byte at offset "
+                                "%d" % (what, value.index("\0")), function)
         return value.encode("utf-8", "replace")
     if not isinstance(value, dict):
         raise FootfallError(INVALID_ARGUMENT, "%s: expected a dict or JSON text, got %s"
@@ -341,10 +344,14 @@ class Session:
         array('d') as sampling.sample_triangles_flat returns is sent as it is, with no copy);
         returns the terrain id."""
         h = self._handle("ffc_load_samples")
+        name = str(name)
+        if "\0" in name:  # C would read it cut short at the NUL: another name in the log
+            raise FootfallError(INVALID_ARGUMENT, "name %r: holds a NUL byte" % (name,),
+                                "ffc_load_samples")
         flat = _flat(samples, 6, "samples")
         out = ctypes.c_uint32()
         self._check(self._lib.lib.ffc_load_samples(h, _pointer(flat), len(flat) // 6,
-                                                   str(name).encode("utf-8", "replace"),
+                                                   name.encode("utf-8", "replace"),
                                                    ctypes.byref(out)),
                     "ffc_load_samples")
         return out.value
