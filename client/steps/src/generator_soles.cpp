@@ -10,6 +10,12 @@ namespace {
 
 // Candidate places of a foothold whose sole misses ground: moved by 1/8, 2/8 ... of the sole.
 constexpr int kSoleShifts = 4;
+// A toe's nearest face turned against the sole by no more than this cosine (about 15 degrees
+// from square to it: a tread's edge, or the face of the drop beyond it) does not stand ahead of
+// the toe as a riser does; a toe no more than this share of the spacing behind that face's
+// plane is not in it.
+constexpr double kSquareToSole = 0.25;
+constexpr double kBehind = 0.25;
 // Snap points per foothold checked: its heel, its toe, and its toe raised by max_rise.
 constexpr size_t kPerFoothold = 3;
 // Snap points per candidate: its centre, heel and toe.
@@ -107,7 +113,8 @@ Status Generator::FitSoles(std::string* error) {
     const Agent& a = agents_[mv.agent];
     const Vec3 f = SoleForward(a.forward, normal);
     if (sole_ways_[i] == 2 && toe.status == Status::kOk && Dot(mv.step, a.up) <= 0 &&
-        Dot(toe.normal, f) >= -0.25 && Dot(p[1] - toe.point, toe.normal) >= -0.25 * near &&
+        Dot(toe.normal, f) >= -kSquareToSole &&
+        Dot(p[1] - toe.point, toe.normal) >= -kBehind * near &&
         std::fabs(Dot(mv.end - a.foot[mv.foot], a.up)) <= near) {
       sole_ways_[i] = 0;
       const int mate = mate_[mv.foot];
@@ -155,15 +162,16 @@ Status Generator::FitSoles(std::string* error) {
     for (size_t i = b; i < e; ++i) {
       Move& mv = moves_[sole_moves_[i]];
       const Agent& a = agents_[mv.agent];
+      const Vec3 f = SoleForward(a.forward, mv.end_normal);
+      const Vec3& foot = a.foot[mv.foot];
+      const double way = Dot(mv.end - foot, f);
       for (size_t at = sole_first_[i]; at < sole_first_[i + 1]; at += kPerCandidate) {
         const Foothold& h = sole_answers_[at];
         if (!SoleOnGround(sole_points_[at], h, mv.end_normal, near) ||
             !SoleOnGround(sole_points_[at + 1], sole_answers_[at + 1], mv.end_normal, near) ||
             !SoleOnGround(sole_points_[at + 2], sole_answers_[at + 2], mv.end_normal, near))
           continue;
-        const Vec3 f = SoleForward(a.forward, mv.end_normal);
-        const Vec3& foot = a.foot[mv.foot];
-        if (Dot(h.point - foot, f) < 0.5 * Dot(mv.end - foot, f) ||
+        if (Dot(h.point - foot, f) < 0.5 * way ||
             std::fabs(Dot(h.point - foot, a.up)) > rise_limit ||
             Dot(h.normal, a.up) < cos_max_slope_ ||
             GapToMate(mv, h.point) < std::min(kMinPairGap, GapToMate(mv, mv.end)))
