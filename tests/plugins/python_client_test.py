@@ -79,6 +79,17 @@ def sampling_meshes():
             ("stairs", stairs, stairs_tris, (0.05, 0.4)), ("odd", odd, odd_tris, (0.3, 0.7))]
 
 
+def tuples_and_flat_samples():
+    """(name, sample_triangles' tuples, sample_triangles_flat's array) of each of
+    sampling_meshes() at its first separation, with corner normals."""
+    for name, pts, tris, separations in sampling_meshes():
+        normals = ff.sampling.corner_normals(pts, tris)
+        yield (name,
+               ff.sampling.sample_triangles(pts, tris, separations[0], corner_normals=normals),
+               ff.sampling.sample_triangles_flat(pts, tris, separations[0],
+                                                 corner_normals=normals))
+
+
 def flat_grid(n=21, spacing=0.5, height=0.0):
     """n x n samples on the plane y = height, normal +Y, as 6-tuples."""
     return [(i * spacing, height, j * spacing, 0.0, 1.0, 0.0) for i in range(n) for j in range(n)]
@@ -388,12 +399,7 @@ class SharedLogicTest(unittest.TestCase):
         from array import array
         with tempfile.TemporaryDirectory() as tmp:
             path = os.path.join(tmp, "t.pts")
-            for name, pts, tris, separations in sampling_meshes():
-                normals = ff.sampling.corner_normals(pts, tris)
-                tuples = ff.sampling.sample_triangles(pts, tris, separations[0],
-                                                      corner_normals=normals)
-                flat = ff.sampling.sample_triangles_flat(pts, tris, separations[0],
-                                                         corner_normals=normals)
+            for name, tuples, flat in tuples_and_flat_samples():
                 texts = []
                 for samples in (tuples, flat, memoryview(flat)):
                     ff.sampling.write_point_file(path, samples, "from " + name)
@@ -421,12 +427,7 @@ class SharedLogicTest(unittest.TestCase):
         # Session.load_samples takes the flat array as it is (no copy, no loop over the
         # numbers): the same terrain as the tuples' (count, bounds, every snap and normal).
         from footfall_client.session import _flat
-        for name, pts, tris, separations in sampling_meshes():
-            normals = ff.sampling.corner_normals(pts, tris)
-            tuples = ff.sampling.sample_triangles(pts, tris, separations[0],
-                                                  corner_normals=normals)
-            flat = ff.sampling.sample_triangles_flat(pts, tris, separations[0],
-                                                     corner_normals=normals)
+        for name, tuples, flat in tuples_and_flat_samples():
             self.assertIs(_flat(flat, 6, "samples"), flat)
             probe = [(x + 0.013, y + 0.2, z - 0.021) for x, y, z, *_ in tuples[::3]]
             probe += [(x, y, z) for x, y, z, *_ in tuples[1::4]]
