@@ -40,7 +40,63 @@ SoleCount SolesOnTreads(const Walk& w, const Vec3& heading, double length, doubl
   return n;
 }
 
+// Whether the sole of each foot where w starts (its first key) lies over that foot's tread,
+// as SolesOnTreads counts a touch-down: the number that do, of `feet`.
+int StartSolesOnTreads(const Walk& w, const Vec3& heading, double length, double rise, double run,
+                       int treads, double slack, int* feet) {
+  int fit = 0;
+  *feet = 0;
+  for (const WalkTrack& t : w.tracks) {
+    if (t.kind != TrackKind::kFoot || t.keys.empty()) continue;
+    const Vec3& p = t.keys.front().position;
+    const int k = static_cast<int>(std::lround(p.y / rise));
+    const double lo = k * run - slack, hi = (k + 1) * run + slack;
+    const double heel = p.z - 0.5 * length * heading.z, toe = p.z + 0.5 * length * heading.z;
+    ++*feet;
+    fit += (std::min(heel, toe) >= lo || k == 0) && (std::max(heel, toe) <= hi || k == treads - 1);
+  }
+  return fit;
+}
+
 }  // namespace
+
+TEST_CASE("A biped with a foot length starts with its soles on the treads, and off the risers",
+          "[steps][generator][soles]") {
+  // The feet stood where their rests snapped: a start near a nose hung a heel or a toe over
+  // the drop, and a start near a riser's foot snapped a foot onto the riser, where the walk
+  // stopped at once (a foot cannot stand on ground leaning 90 degrees: at 20 degrees to the
+  // treads, every start in the last tenth of the tread).
+  const Character shipped = LoadShipped("biped");
+  Character point = shipped;
+  point.foot_length = 0;
+  const int treads = 12;
+  const double rise = 0.18, run = 0.3, spacing = 0.03;
+  Terrain t = LoadTerrain(MakeStairs(treads, rise, run, 6, spacing), spacing);
+  int fit = 0, feet = 0, point_fit = 0;
+  for (const double deg : {0.0, 20.0, 180.0}) {
+    const double a = deg * 3.14159265358979 / 180;
+    const Vec3 heading{std::sin(a), 0, std::cos(a)};
+    for (int i = 0; i < 10; ++i) {
+      const int k = 5;
+      GenerateOptions o = StartOptions({3, k * rise + 0.02, (k + (i + 0.5) / 10) * run}, 2);
+      o.heading = heading;
+      const Walk w = Generate(t, shipped, o);
+      INFO(deg << " deg, start " << i << ": " << w.stopped);
+      CheckWalk(t, shipped, o, w);
+      CHECK(w.stopped.empty());
+      int n = 0;
+      fit += StartSolesOnTreads(w, heading, shipped.foot_length, rise, run, treads, spacing, &n);
+      feet += n;
+      const Walk v = Generate(t, point, o);
+      point_fit +=
+          StartSolesOnTreads(v, heading, shipped.foot_length, rise, run, treads, spacing, &n);
+    }
+  }
+  INFO(fit << " of " << feet << " start soles on their treads, point feet " << point_fit);
+  CHECK(feet == 60);
+  CHECK(fit >= feet - 2);
+  CHECK(point_fit < feet - 15);
+}
 
 TEST_CASE("A biped with a foot length sets its soles on the treads, up and down stairs",
           "[steps][generator][soles]") {

@@ -208,7 +208,7 @@ Status Generator::Setup(std::string* error) {
       walk_.tracks.push_back(std::move(t));
     }
   }
-  // 3. Snap the feet at their rest positions around each start.
+  // 3. Snap the feet at their rest positions around each start (soles fitted: FitStartSoles).
   points_.resize(n * feet);
   for (int i = 0; i < n; ++i)
     for (size_t f = 0; f < feet; ++f) points_[i * feet + f] = Place(agents_[i], rest_[f]);
@@ -220,6 +220,8 @@ Status Generator::Setup(std::string* error) {
                          error);
   if (s == Status::kOk)
     s = SeparateSharedFeet(points_.data(), answers_.data(), points_.size(), feet, error);
+  if (s == Status::kOk)
+    s = FitStartSoles(answers_.data(), answers_.size(), feet, agents_.data(), error);
   if (s != Status::kOk) return s;
   // 4. The body at the feet's centroid, raised by body_height along its up (multipeds: BodyUp;
   //    the feet's frame from their averaged normal). (Keyed at the start of their pass.)
@@ -372,14 +374,27 @@ std::vector<int> Generator::CrowdedStarts(const Vec3* places, const Foothold* st
 Status Generator::SnapFeetFacingUp(const Vec3* places, Foothold* feet, size_t total, size_t count,
                                    const Agent* agents, std::string* error) {
   if (count == 0) return Status::kOk;
-  auto faces_away = [&](size_t f) {
-    return feet[f].status == Status::kOk && Dot(feet[f].normal, agents[f / count].up) < 0;
-  };
+  // The way a foot snaps again, and the least dot of the ground it takes with its up: lifted
+  // along the up from a face turned away (ground facing the up), or, for an upright character,
+  // out from a face too steep to stand on (a riser its rest lies against: ground within
+  // max_slope_deg of the up).
   std::vector<size_t> turned;
-  std::vector<double> lift;
+  std::vector<Vec3> way;
+  std::vector<double> lift, least;
   for (size_t f = 0; f < total; ++f) {
-    if (!faces_away(f)) continue;
-    turned.push_back(f);
+    if (feet[f].status != Status::kOk) continue;
+    const Vec3& up = agents[f / count].up;
+    const double along = Dot(feet[f].normal, up);
+    Vec3 out;
+    double need = 0;
+    if (along < 0) {
+      out = up;
+    } else if (!c_.align_to_normal && along < cos_max_slope_) {
+      out = NormalizeOr(ProjectOnPlane(feet[f].normal, up), Vec3{});
+      need = cos_max_slope_;
+    }
+    if (Length2(out) == 0) continue;
+    turned.push_back(f), way.push_back(out), least.push_back(need);
     lift.push_back(std::max(2 * Distance(places[f], feet[f].point), gap_ / 2));
   }
   std::vector<Vec3> lifted;
@@ -387,7 +402,7 @@ Status Generator::SnapFeetFacingUp(const Vec3* places, Foothold* feet, size_t to
   while (!turned.empty()) {
     lifted.clear();
     for (size_t i = 0; i < turned.size(); ++i)
-      lifted.push_back(places[turned[i]] + agents[turned[i] / count].up * lift[i]);
+      lifted.push_back(places[turned[i]] + way[i] * lift[i]);
     again.assign(lifted.size(), Foothold{});
     const Status s = Check(session_.Snap(terrain_, lifted.data(), lifted.size(), again.data()),
                            "snap feet", error);
@@ -395,16 +410,18 @@ Status Generator::SnapFeetFacingUp(const Vec3* places, Foothold* feet, size_t to
     size_t kept = 0;
     for (size_t i = 0; i < turned.size(); ++i) {
       const size_t f = turned[i];
-      if (again[i].status == Status::kOk && Dot(again[i].normal, agents[f / count].up) > 0 &&
+      const double along = Dot(again[i].normal, agents[f / count].up);
+      if (again[i].status == Status::kOk && along > 0 && along >= least[i] &&
           Distance(places[f], again[i].point) <= c_.reach) {
         feet[f] = again[i];
         continue;
       }
       // None within reach (or no lift to double): as it snapped.
       if (!(lift[i] > 0) || 2 * lift[i] > c_.reach) continue;
-      turned[kept] = f, lift[kept] = 2 * lift[i], ++kept;
+      turned[kept] = f, way[kept] = way[i], least[kept] = least[i], lift[kept] = 2 * lift[i];
+      ++kept;
     }
-    turned.resize(kept), lift.resize(kept);
+    turned.resize(kept), way.resize(kept), least.resize(kept), lift.resize(kept);
   }
   return Status::kOk;
 }

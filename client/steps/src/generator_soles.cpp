@@ -1,5 +1,6 @@
-// The step generator's sole fitting (8, end): for a character with a foot_length, a foothold
-// whose sole would hang past a stair's nose or stand in a riser moves along its tread.
+// The step generator's sole fitting (3 and 8, end): for a character with a foot_length, a foot
+// at the start or a foothold whose sole would hang past a stair's nose or stand in a riser
+// moves along its tread.
 #include "step_generator.h"
 
 #include <algorithm>
@@ -41,6 +42,32 @@ Vec3 SoleForward(const Vec3& forward, const Vec3& normal) {
 // miss (a tread shorter than the sole, a narrow ledge), none (0) when the sole fits.
 int SoleWays(bool heel_on, bool toe_on) { return (heel_on ? 0 : 1) | (toe_on ? 0 : 2); }
 int SoleWayCount(int ways) { return (ways & 1) + (ways >> 1); }
+
+// The places a foot at `end` may move to for its sole (direction f), the ways `ways` asks
+// (SoleWays): shifted by 1/8 .. 4/8 of the sole, nearest first (forward before back at the
+// same distance), each as its centre, heel and toe. Writes kPerCandidate points a place to
+// `out`; returns the points written.
+size_t SoleCandidates(const Vec3& end, const Vec3& f, int ways, double foot_length, Vec3* out) {
+  const double half = 0.5 * foot_length;
+  size_t at = 0;
+  for (int k = 1; k <= kSoleShifts; ++k) {
+    const double shift = foot_length * k / (2.0 * kSoleShifts);
+    for (int way = 1; way <= 2; ++way) {
+      if (!(ways & way)) continue;
+      const Vec3 centre = end + f * (way == 1 ? shift : -shift);
+      out[at++] = centre, out[at++] = centre - f * half, out[at++] = centre + f * half;
+    }
+  }
+  return at;
+}
+
+// Whether a candidate place (its centre, heel and toe `p`, their nearest samples `h`) stands
+// on ground like `normal` under all three.
+bool CandidateOnGround(const Vec3* p, const Foothold* h, const Vec3& normal, double near) {
+  for (size_t j = 0; j < kPerCandidate; ++j)
+    if (!SoleOnGround(p[j], h[j], normal, near)) return false;
+  return true;
+}
 
 }  // namespace
 
@@ -135,16 +162,7 @@ Status Generator::FitSoles(std::string* error) {
       if (sole_ways_[i] == 0) continue;
       const Move& mv = moves_[sole_moves_[i]];
       const Vec3 f = SoleForward(agents_[mv.agent].forward, mv.end_normal);
-      size_t at = sole_first_[i];
-      for (int k = 1; k <= kSoleShifts; ++k) {
-        const double shift = c_.foot_length * k / (2.0 * kSoleShifts);
-        for (int way = 1; way <= 2; ++way) {
-          if (!(sole_ways_[i] & way)) continue;
-          const Vec3 centre = mv.end + f * (way == 1 ? shift : -shift);
-          sole_points_[at++] = centre, sole_points_[at++] = centre - f * half;
-          sole_points_[at++] = centre + f * half;
-        }
-      }
+      SoleCandidates(mv.end, f, sole_ways_[i], c_.foot_length, &sole_points_[sole_first_[i]]);
     }
   });
   sole_answers_.resize(sole_points_.size());
@@ -167,9 +185,7 @@ Status Generator::FitSoles(std::string* error) {
       const double way = Dot(mv.end - foot, f);
       for (size_t at = sole_first_[i]; at < sole_first_[i + 1]; at += kPerCandidate) {
         const Foothold& h = sole_answers_[at];
-        if (!SoleOnGround(sole_points_[at], h, mv.end_normal, near) ||
-            !SoleOnGround(sole_points_[at + 1], sole_answers_[at + 1], mv.end_normal, near) ||
-            !SoleOnGround(sole_points_[at + 2], sole_answers_[at + 2], mv.end_normal, near))
+        if (!CandidateOnGround(&sole_points_[at], &sole_answers_[at], mv.end_normal, near))
           continue;
         if (Dot(h.point - foot, f) < 0.5 * way ||
             std::fabs(Dot(h.point - foot, a.up)) > rise_limit ||
@@ -181,6 +197,61 @@ Status Generator::FitSoles(std::string* error) {
       }
     }
   });
+  return Status::kOk;
+}
+
+Status Generator::FitStartSoles(Foothold* feet, size_t total, size_t count, const Agent* agents,
+                                std::string* error) {
+  if (!(c_.foot_length > 0) || count == 0) return Status::kOk;
+  const double half = 0.5 * c_.foot_length;
+  const double near = 0.5 * gap_;
+  // The heel and toe of every foot with a direction on its ground: one batch.
+  std::vector<size_t> checked;
+  std::vector<Vec3> forward, points;
+  for (size_t f = 0; f < total; ++f) {
+    if (feet[f].status != Status::kOk) continue;
+    const Vec3 fwd = SoleForward(agents[f / count].forward, feet[f].normal);
+    if (Length2(fwd) == 0) continue;
+    checked.push_back(f), forward.push_back(fwd);
+    points.push_back(feet[f].point - fwd * half), points.push_back(feet[f].point + fwd * half);
+  }
+  std::vector<Foothold> answers(points.size());
+  Status s = Check(session_.Snap(terrain_, points.data(), points.size(), answers.data()),
+                   "snap sole", error);
+  if (s != Status::kOk || checked.empty()) return s;
+  // The candidates of the feet whose sole misses ground: one more batch.
+  std::vector<size_t> first(checked.size() + 1, 0);
+  std::vector<int> ways(checked.size());
+  for (size_t i = 0; i < checked.size(); ++i) {
+    const Vec3& normal = feet[checked[i]].normal;
+    ways[i] = SoleWays(SoleOnGround(points[2 * i], answers[2 * i], normal, near),
+                       SoleOnGround(points[2 * i + 1], answers[2 * i + 1], normal, near));
+    first[i + 1] = first[i] + kPerCandidate * kSoleShifts * SoleWayCount(ways[i]);
+  }
+  if (first.back() == 0) return Status::kOk;
+  points.resize(first.back());
+  for (size_t i = 0; i < checked.size(); ++i)
+    if (ways[i] != 0)
+      SoleCandidates(feet[checked[i]].point, forward[i], ways[i], c_.foot_length,
+                     &points[first[i]]);
+  answers.assign(points.size(), Foothold{});
+  s = Check(session_.Snap(terrain_, points.data(), points.size(), answers.data()), "snap sole",
+            error);
+  if (s != Status::kOk) return s;
+  // The nearest candidate with ground like the foot's under its centre, heel and toe, on a
+  // sample no other foot of its character stands on.
+  for (size_t i = 0; i < checked.size(); ++i) {
+    const size_t f = checked[i], c = f - f % count;
+    for (size_t at = first[i]; at < first[i + 1]; at += kPerCandidate) {
+      const Foothold& h = answers[at];
+      if (!CandidateOnGround(&points[at], &answers[at], feet[f].normal, near)) continue;
+      bool taken = false;
+      for (size_t g = c; g < c + count; ++g) taken |= g != f && feet[g].index == h.index;
+      if (taken) continue;
+      feet[f] = h;
+      break;
+    }
+  }
   return Status::kOk;
 }
 

@@ -297,12 +297,23 @@ class Generator {
   //    feet, `count` a character, `feet` their snaps, updated.
   Status SeparateSharedFeet(const Vec3* places, Foothold* feet, size_t total, size_t count,
                             std::string* error);
+  // 3. A character with a foot_length: each foot whose sole, along its character's heading
+  //    on its ground, has no ground of its own under its heel or toe (past a stair's nose,
+  //    into a riser) moves back or forward by eighths of the sole, up to half of it, to the
+  //    nearest place where it has, on a sample no other foot of its character has (two
+  //    batches of snaps); it stays where none fits. `feet`, `total`, `count` as for
+  //    SeparateSharedFeet; `agents` the characters in order.
+  Status FitStartSoles(Foothold* feet, size_t total, size_t count, const Agent* agents,
+                       std::string* error);
   // 3. Feet whose nearest sample faces away from their character's up: on the inside of a
   //    pipe (a concave surface) the rests laid on the start's tangent plane fall outside the
   //    inner face, nearer a thin wall's outer face, where the character then hung upside down.
   //    Each snaps again from its rest lifted along the up, twice as far each time up to `reach`,
-  //    and takes the first sample facing the up. `places`, `total`, `count` and `feet` as for
-  //    SeparateSharedFeet; `agents` the characters in order.
+  //    and takes the first sample facing the up. So does an upright character's foot whose
+  //    sample leans more than max_slope_deg (a riser its rest lies against, where the walk
+  //    stopped at once), moved out along that face across the up instead, taking the first
+  //    sample it may stand on. `places`, `total`, `count` and `feet` as for SeparateSharedFeet;
+  //    `agents` the characters in order.
   Status SnapFeetFacingUp(const Vec3* places, Foothold* feet, size_t total, size_t count,
                           const Agent* agents, std::string* error);
   // For each of the n crowd starts (places on the grid, and their snaps), another start nearer
