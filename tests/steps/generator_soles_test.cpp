@@ -96,6 +96,18 @@ TEST_CASE("A biped with a foot length starts with its soles on the treads, and o
   CHECK(feet == 60);
   CHECK(fit >= feet - 2);
   CHECK(point_fit < feet - 15);
+  // A stance straddling a riser on coarse samples: one rest lies under the tread above, and
+  // the foot off the riser took its mate's sample; moved off it again from the far side of its
+  // rest, it went back onto the riser, and the walk stopped at once. The two feet now share
+  // the sample and walk.
+  Terrain coarse = LoadTerrain(MakeStairs(12, 0.35, 0.25, 10, 0.08), 0.08);
+  GenerateOptions o = StartOptions({9, 2.1, 1.625}, 8);
+  o.heading = {-0.96268, 0, -0.270643};
+  const Walk w = Generate(coarse, shipped, o);
+  INFO(w.stopped);
+  CheckWalk(coarse, shipped, o, w);
+  CHECK(w.stopped.empty());
+  for (const WalkTrack& t : w.tracks) CHECK(t.keys.front().normal.y > 0.99);
 }
 
 TEST_CASE("A biped with a foot length sets its soles on the treads, up and down stairs",

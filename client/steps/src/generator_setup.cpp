@@ -460,7 +460,8 @@ Status Generator::SeparateSharedFeet(const Vec3* places, Foothold* feet, size_t 
     const size_t f = movers[i], c = f - f % count;
     const Foothold& h = again[i];
     if (h.status != Status::kOk ||
-        Distance(places[f], h.point) > Distance(places[f], feet[f].point) + gap_)
+        Distance(places[f], h.point) > Distance(places[f], feet[f].point) + gap_ ||
+        (!c_.align_to_normal && Dot(h.normal, world_up_) < cos_max_slope_))
       continue;
     bool taken = false;
     for (size_t g = c; g < c + count; ++g) taken |= g != f && feet[g].index == h.index;

@@ -292,8 +292,9 @@ class Generator {
   // 3. Feet of one character that snapped onto one sample (a terrain coarser than the stance,
   //    the start on a sample between two rests): each but the one nearest it snaps again from
   //    the far side of its rest, and takes that sample when no other foot has it and it lies
-  //    within a sample spacing as near its rest. (On a beam narrower than the stance the far
-  //    side gives the same sample: they share it.) `places` are the rest positions of `total`
+  //    within a sample spacing as near its rest, and, for an upright character, one it may
+  //    stand on (not a riser beyond the rest). (On a beam narrower than the stance the far side
+  //    gives the same sample: they share it.) `places` are the rest positions of `total`
   //    feet, `count` a character, `feet` their snaps, updated.
   Status SeparateSharedFeet(const Vec3* places, Foothold* feet, size_t total, size_t count,
                             std::string* error);
