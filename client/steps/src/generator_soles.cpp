@@ -45,9 +45,8 @@ int SoleWayCount(int ways) { return (ways & 1) + (ways >> 1); }
 
 // The places a foot at `end` may move to for its sole (direction f), the ways `ways` asks
 // (SoleWays): shifted by 1/8 .. 4/8 of the sole, nearest first (forward before back at the
-// same distance), each as its centre, heel and toe. Writes kPerCandidate points a place to
-// `out`; returns the points written.
-size_t SoleCandidates(const Vec3& end, const Vec3& f, int ways, double foot_length, Vec3* out) {
+// same distance), each as its centre, heel and toe: kPerCandidate points a place, to `out`.
+void SoleCandidates(const Vec3& end, const Vec3& f, int ways, double foot_length, Vec3* out) {
   const double half = 0.5 * foot_length;
   size_t at = 0;
   for (int k = 1; k <= kSoleShifts; ++k) {
@@ -58,7 +57,6 @@ size_t SoleCandidates(const Vec3& end, const Vec3& f, int ways, double foot_leng
       out[at++] = centre, out[at++] = centre - f * half, out[at++] = centre + f * half;
     }
   }
-  return at;
 }
 
 // Whether a candidate place (its centre, heel and toe `p`, their nearest samples `h`) stands
@@ -215,10 +213,11 @@ Status Generator::FitStartSoles(Foothold* feet, size_t total, size_t count, cons
     checked.push_back(f), forward.push_back(fwd);
     points.push_back(feet[f].point - fwd * half), points.push_back(feet[f].point + fwd * half);
   }
+  if (checked.empty()) return Status::kOk;
   std::vector<Foothold> answers(points.size());
   Status s = Check(session_.Snap(terrain_, points.data(), points.size(), answers.data()),
                    "snap sole", error);
-  if (s != Status::kOk || checked.empty()) return s;
+  if (s != Status::kOk) return s;
   // The candidates of the feet whose sole misses ground: one more batch.
   std::vector<size_t> first(checked.size() + 1, 0);
   std::vector<int> ways(checked.size());
@@ -246,7 +245,8 @@ Status Generator::FitStartSoles(Foothold* feet, size_t total, size_t count, cons
       const Foothold& h = answers[at];
       if (!CandidateOnGround(&points[at], &answers[at], feet[f].normal, near)) continue;
       bool taken = false;
-      for (size_t g = c; g < c + count; ++g) taken |= g != f && feet[g].index == h.index;
+      for (size_t g = c; g < c + count; ++g)
+        taken |= g != f && feet[g].status == Status::kOk && feet[g].index == h.index;
       if (taken) continue;
       feet[f] = h;
       break;
