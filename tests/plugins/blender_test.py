@@ -2236,6 +2236,19 @@ class BlenderAddonTest(unittest.TestCase):
         height = (body.matrix_world.translation - rig.matrix_world.translation).length * scale
         self.assertAlmostEqual(height, 0.95, delta=1e-4)
         settings.steps, settings.start_frame = 6, 1
+        # The panel's lengths are in scene units and reach footfall in metres; 0 keeps the
+        # character file's.
+        file_foot = ff.character.parse(rig.footfall_rig.character_json).get("foot_length")
+        self.assertEqual(
+            self.ops.walk_request(bpy.context, rig, 6, 1)["character"].get("foot_length"),
+            file_foot)
+        settings.foot_length = 0.3 / scale
+        try:
+            self.assertAlmostEqual(
+                self.ops.walk_request(bpy.context, rig, 6, 1)["character"]["foot_length"], 0.3,
+                delta=1e-6)
+        finally:
+            settings.foot_length = 0.0
         with bpy.context.temp_override(active_object=rig):
             self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
         mw = rig.matrix_world

@@ -555,9 +555,12 @@ class SharedLogicTest(unittest.TestCase):
         self.assertEqual(ff.character.pairs(data), [("L_R", ["L", "R"]), ("T", ["T"])])
         data["pairs"] = [["L"], ["R", "T"]]
         self.assertEqual(ff.character.pairs(data), [("L", ["L"]), ("R_T", ["R", "T"])])
-        out = ff.character.with_overrides(data, step_length=0.8, step_height=0, frames_per_step=9)
-        self.assertEqual((out["step_length"], out["frames_per_step"]), (0.8, 9))
+        out = ff.character.with_overrides(data, step_length=0.8, step_height=0, frames_per_step=9,
+                                          foot_length=0.25)
+        self.assertEqual((out["step_length"], out["frames_per_step"], out["foot_length"]),
+                         (0.8, 9, 0.25))
         self.assertNotIn("step_height", out)
+        self.assertNotIn("foot_length", ff.character.with_overrides(data, foot_length=0))
         self.assertEqual(data["step_length"], 0.6)
         with self.assertRaises(ff.FootfallError) as e:
             ff.character.parse('{"feet": [{"name": "L"}]}', "bad.json")

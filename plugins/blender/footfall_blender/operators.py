@@ -639,6 +639,7 @@ def walk_request(context, rig_obj, steps, start_frame):
     data = character.parse(rig.character_json, rig.character_path or rig_obj.name)
     data = character.with_overrides(data, step_length=settings.step_length * scale,
                                     step_height=settings.step_height * scale,
+                                    foot_length=settings.foot_length * scale,
                                     frames_per_step=settings.frames_per_step)
     mw = rig_obj.matrix_world
     request = {"character": data,

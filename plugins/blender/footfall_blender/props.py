@@ -92,6 +92,9 @@ class FootfallScene(bpy.types.PropertyGroup):
                                description="0: the character file's value")
     step_height: FloatProperty(name="Step height", default=0.0, min=0.0, unit="LENGTH",
                                description="0: the character file's value")
+    foot_length: FloatProperty(name="Foot length", default=0.0, min=0.0, unit="LENGTH",
+                               description="The sole's length along the heading, fitted onto "
+                                           "stair treads; 0: the character file's value")
     path: PointerProperty(type=bpy.types.Object, name="Path",
                           poll=lambda self, obj: obj.type == "CURVE",
                           description="Optional curve the walk follows")

@@ -61,7 +61,8 @@ class FOOTFALL_PT_walk(_Panel, bpy.types.Panel):
     def draw(self, context):
         s = context.scene.footfall
         col = self.layout.column()
-        for name in ("steps", "start_frame", "frames_per_step", "step_length", "step_height", "path"):
+        for name in ("steps", "start_frame", "frames_per_step", "step_length", "step_height",
+                     "foot_length", "path"):
             col.prop(s, name)
         col.operator("footfall.generate_walk")
         col.operator("footfall.import_walk")

@@ -356,7 +356,7 @@ def key_walk(walk, feet, body, from_frame=None):
 
 @_guard
 def generate_walk(rig, steps=8, start_frame=1, frames_per_step=0, step_length=0.0,
-                  step_height=0.0, path=None, chunk_steps=0):
+                  step_height=0.0, path=None, chunk_steps=0, foot_length=0.0):
     """Generates `steps` steps for `rig` and keys them; keys made before a failure stay (the
     error says how many). One undo chunk; progress in the main progress bar. The walk's notes
     are shown as warnings."""
@@ -364,7 +364,7 @@ def generate_walk(rig, steps=8, start_frame=1, frames_per_step=0, step_length=0.
     _scene_terrain_key()  # (no terrain: before anything else)
     data, feet, body = _rig_targets(rig)
     data = character.with_overrides(data, step_length=step_length, step_height=step_height,
-                                    frames_per_step=frames_per_step)
+                                    frames_per_step=frames_per_step, foot_length=foot_length)
     start = mc.xform(rig, q=True, ws=True, t=True)
     m = mc.xform(rig, q=True, ws=True, m=True)
     request = {"character": data, "start": start, "heading": [m[8], m[9], m[10]],
@@ -566,6 +566,7 @@ def show():
     fps = mc.intFieldGrp(label="Frames per step (0: file)", value1=0)
     length = mc.floatFieldGrp(label="Step length (0: file)", value1=0)
     height = mc.floatFieldGrp(label="Step height (0: file)", value1=0)
+    foot = mc.floatFieldGrp(label="Foot length (0: file)", value1=0)
     curve = mc.textFieldGrp(label="Path curve")
 
     @_guard  # (attributeQuery raises on a selected component)
@@ -580,7 +581,8 @@ def show():
                       mc.intFieldGrp(fps, q=True, value1=True),
                       mc.floatFieldGrp(length, q=True, value1=True),
                       mc.floatFieldGrp(height, q=True, value1=True),
-                      mc.textFieldGrp(curve, q=True, text=True) or None)
+                      mc.textFieldGrp(curve, q=True, text=True) or None,
+                      foot_length=mc.floatFieldGrp(foot, q=True, value1=True))
     mc.button(label="Generate Walk", command=generate)
     mc.setParent("..")
     mc.showWindow(WINDOW)

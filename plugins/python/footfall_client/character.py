@@ -12,7 +12,7 @@ from .session import INVALID_ARGUMENT, FootfallError
 
 # Walk settings a panel can override: panel name -> character file key.
 OVERRIDES = {"step_length": "step_length", "step_height": "step_height",
-             "frames_per_step": "frames_per_step"}
+             "frames_per_step": "frames_per_step", "foot_length": "foot_length"}
 
 
 def read_text(path, what="file"):
