@@ -505,3 +505,32 @@ TEST_CASE("WriteWalk dispatches on the file extension", "[export]") {
   }
   CHECK(IsWalkExportPath("a/b.Mel"));
 }
+
+TEST_CASE("WriteGltf keys the feet's rotations when asked, each foot on its ground",
+          "[export][gltf]") {
+  const Walk walk = test::TiltedFootWalk();
+  const std::string path = test::ScratchPath("feet.gltf");
+  std::string error;
+  REQUIRE(WriteGltf(walk, path, &error) == Status::kOk);
+  CHECK(Channels(Load(path, false))["L"].count("rotation") == 0);  // not unless asked
+  GltfOptions options;
+  options.foot_rotations = true;
+  REQUIRE(WriteGltf(walk, path, options, &error) == Status::kOk);
+  auto channels = Channels(Load(path, false));
+  REQUIRE(channels["L"].count("rotation") == 1);
+  const Channel& rotation = channels["L"]["rotation"];
+  CHECK(rotation.times == channels["L"]["translation"].times);
+  const std::vector<test::FootAxes> axes = test::TiltedFootAxes();
+  REQUIRE(rotation.values.size() == 4 * axes.size());
+  for (size_t i = 0; i < axes.size(); ++i) {
+    const float* v = &rotation.values[4 * i];
+    const Quat q{v[0], v[1], v[2], v[3]};
+    CHECK(std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3]) ==
+          Approx(1).margin(1e-6));
+    const Vec3 up = test::Rotated(q, {0, 1, 0}), forward = test::Rotated(q, {0, 0, 1});
+    INFO("key " << i);
+    CHECK(Distance(up, axes[i].up) < 1e-6);
+    CHECK(Distance(forward, axes[i].forward) < 1e-6);
+  }
+  std::remove(path.c_str());
+}

@@ -134,17 +134,8 @@ Vec3 RotateEulerZxy(const Vec3& euler_deg, const Vec3& v) {
   return {cy * b.x + sy * b.z, b.y, -sy * b.x + cy * b.z};
 }
 
-// `v` rotated by `q` (any non-zero length).
-Vec3 RotateQuat(const Quat& q_in, const Vec3& v) {
-  const double n = std::sqrt(q_in.x * q_in.x + q_in.y * q_in.y + q_in.z * q_in.z + q_in.w * q_in.w);
-  const double x = q_in.x / n, y = q_in.y / n, z = q_in.z / n, w = q_in.w / n;
-  const Vec3 t{2 * (y * v.z - z * v.y), 2 * (z * v.x - x * v.z), 2 * (x * v.y - y * v.x)};
-  return {v.x + w * t.x + y * t.z - z * t.y, v.y + w * t.y + z * t.x - x * t.z,
-          v.z + w * t.z + x * t.y - y * t.x};
-}
-
-// The body locator's Euler keys (rotateX/Y/Z) in key order.
-std::vector<Vec3> BodyEuler(const MelScript& script, const std::string& locator) {
+// A locator's Euler keys (rotateX/Y/Z) in key order.
+std::vector<Vec3> LocatorEuler(const MelScript& script, const std::string& locator) {
   const auto& keys = script.keys.at(locator);
   std::vector<Vec3> euler;
   for (size_t i = 0; i < keys.at("rotateX").size(); ++i) {
@@ -160,7 +151,7 @@ void CheckReproduces(const std::vector<Vec3>& euler, const std::vector<Quat>& ro
   for (size_t i = 0; i < euler.size(); ++i) {
     for (const Vec3& axis : {Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}}) {
       const Vec3 got = RotateEulerZxy(euler[i], axis);
-      const Vec3 want = RotateQuat(rotations[i], axis);
+      const Vec3 want = test::Rotated(rotations[i], axis);
       INFO("key " << i << " axis " << axis.x << axis.y << axis.z);
       CHECK(got.x == Approx(want.x).margin(1e-9));
       CHECK(got.y == Approx(want.y).margin(1e-9));
@@ -216,7 +207,7 @@ TEST_CASE("WriteMel keys a locator per track", "[export][mel]") {
     const auto& body = script.keys.at("body");
     REQUIRE(body.size() == 6);
     for (const auto& entry : body) CHECK(entry.second.size() == 5);
-    const std::vector<Vec3> eulers = BodyEuler(script, "body");
+    const std::vector<Vec3> eulers = LocatorEuler(script, "body");
     CheckReproduces(eulers, {walk.tracks[2].rotations.begin(), walk.tracks[2].rotations.end()});
     const double yaw[] = {0, 60, 150, 170, 190};
     for (size_t i = 0; i < 5; ++i) {
@@ -329,9 +320,9 @@ TEST_CASE("WriteMel keys bodies in rotate order ZXY, smooth at every heading", "
   const MelScript script = ParseMel(path);
   CHECK(script.rotate_order.at("turning") == 2);
   CHECK(script.rotate_order.at("tumbling") == 2);
-  const std::vector<Vec3> turning_euler = BodyEuler(script, "turning");
+  const std::vector<Vec3> turning_euler = LocatorEuler(script, "turning");
   CheckReproduces(turning_euler, {turning.rotations.begin(), turning.rotations.end()});
-  CheckReproduces(BodyEuler(script, "tumbling"),
+  CheckReproduces(LocatorEuler(script, "tumbling"),
                   {tumbling.rotations.begin(), tumbling.rotations.end()});
   // A 2 degree turn moves no channel by more than a few degrees (XYZ swung them by ~80).
   for (size_t i = 1; i < turning_euler.size(); ++i) {
@@ -527,4 +518,30 @@ TEST_CASE("WriteMel reports bad walks and unwritable paths", "[export][mel]") {
   walk.tracks[2].rotations[0].w = INFINITY;
   CHECK(WriteMel(walk, test::ScratchPath("bad.mel"), &error) == Status::kInvalidArgument);
   CHECK_THAT(error, Catch::Contains("track 2 'body' key 0 has a non-finite rotation"));
+}
+
+TEST_CASE("WriteMel keys the feet's rotations when asked, each foot on its ground",
+          "[export][mel]") {
+  const Walk walk = test::TiltedFootWalk();
+  const std::string path = test::ScratchPath("feet.mel");
+  std::string error;
+  REQUIRE(WriteMel(walk, path, &error) == Status::kOk);
+  MelScript script = ParseMel(path);
+  CHECK(script.rotate_order.count("L") == 0);  // not unless asked
+  CHECK(script.keys.at("L").count("rotateY") == 0);
+  MelOptions options;
+  options.foot_rotations = true;
+  REQUIRE(WriteMel(walk, path, options, &error) == Status::kOk);
+  script = ParseMel(path);
+  CHECK(script.rotate_order.at("L") == 2);  // zxy, as bodies
+  const std::vector<Vec3> euler = LocatorEuler(script, "L");
+  const std::vector<test::FootAxes> axes = test::TiltedFootAxes();
+  REQUIRE(euler.size() == axes.size());
+  for (size_t i = 0; i < axes.size(); ++i) {
+    INFO("key " << i);
+    CHECK(Distance(RotateEulerZxy(euler[i], {0, 1, 0}), axes[i].up) < 1e-9);
+    CHECK(Distance(RotateEulerZxy(euler[i], {0, 0, 1}), axes[i].forward) < 1e-9);
+    if (i > 0) CHECK(std::abs(euler[i].y - euler[i - 1].y) < 180);
+  }
+  std::remove(path.c_str());
 }

@@ -71,6 +71,45 @@ Walk BipedWalk() {
   return walk;
 }
 
+Vec3 Rotated(const Quat& q_in, const Vec3& v) {
+  const double n = std::sqrt(q_in.x * q_in.x + q_in.y * q_in.y + q_in.z * q_in.z + q_in.w * q_in.w);
+  const double x = q_in.x / n, y = q_in.y / n, z = q_in.z / n, w = q_in.w / n;
+  const Vec3 t{2 * (y * v.z - z * v.y), 2 * (z * v.x - x * v.z), 2 * (x * v.y - y * v.x)};
+  return {v.x + w * t.x + y * t.z - z * t.y, v.y + w * t.y + z * t.x - x * t.z,
+          v.z + w * t.z + x * t.y - y * t.x};
+}
+
+Walk TiltedFootWalk() {
+  Walk walk;
+  walk.fps = 24;
+  WalkTrack left = Track("L", "", TrackKind::kFoot);
+  left.keys = {FootKey(1, KeyPhase::kStart, {0, 0, 0}), FootKey(7, KeyPhase::kMid, {0, 0.2, 0.3}),
+               FootKey(13, KeyPhase::kEnd, {0.1, 0, 0.6}),
+               FootKey(19, KeyPhase::kMid, {0.4, 0.2, 0.6}),
+               FootKey(25, KeyPhase::kEnd, {0.7, 0, 0.6})};
+  const Vec3 normals[] = {{0, 1, 0}, {0, 1, 0}, {0.6, 0.8, 0}, {0, 0, 0}, {0, -2, 0}};
+  for (size_t k = 0; k < left.keys.size(); ++k) left.keys[k].normal = normals[k];
+  WalkTrack body = Track("body", "", TrackKind::kBody);
+  const Quat q90 = YawQuat(90);
+  AddBodyKey(&body, 1, {0, 0.9, 0}, YawQuat(0));
+  AddBodyKey(&body, 13, {0, 0.9, 0.5}, {-q90.x, -q90.y, -q90.z, -q90.w});
+  AddBodyKey(&body, 25, {0.5, 0.9, 0.6}, q90);
+  walk.tracks = {left, body};
+  return walk;
+}
+
+std::vector<FootAxes> TiltedFootAxes() {
+  const double h = std::sqrt(0.5);
+  // Frame 1: facing +Z. Frame 7: halfway through the body's turn, facing 45 degrees. Frame 13:
+  // facing +X, tilted onto (0.6, 0.8, 0) about Z, so its forward dips to (0.8, -0.6, 0). Frame
+  // 19: no normal, the body's frame. Frame 25: upside down, half a turn about its left (-Z).
+  return {{{0, 1, 0}, {0, 0, 1}},
+          {{0, 1, 0}, {h, 0, h}},
+          {{0.6, 0.8, 0}, {0.8, -0.6, 0}},
+          {{0, 1, 0}, {1, 0, 0}},
+          {{0, -1, 0}, {-1, 0, 0}}};
+}
+
 Walk CrowdWalk() {
   Walk walk;
   walk.fps = 30;

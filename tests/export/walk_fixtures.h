@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "footfall/steps/walk.h"
 
@@ -30,6 +31,19 @@ Walk LongCrowdWalk(int extra);
 // moved by (500000.0004, 120.0007, -300000.0009) plus 1.3 mm * its index along (1, 1, -1), so
 // keys differ by millimetres that a float at 5e5 (a step of 1/32) cannot hold.
 Walk FarWalk();
+
+// fps 24. A body (keys at frames 1, 13 and 25 turning 0, 90 and 90 degrees about +Y, the
+// 90-degree one with its sign flipped) and one foot "L" whose keys (frames 1, 7, 13, 19, 25)
+// have the normals (0, 1, 0), (0, 1, 0), (0.6, 0.8, 0), zero and (0, -2, 0). Each foot key
+// oriented as the exports' foot_rotations key it has the up and forward of TiltedFootAxes.
+Walk TiltedFootWalk();
+struct FootAxes {
+  Vec3 up, forward;  // unit, world space
+};
+std::vector<FootAxes> TiltedFootAxes();
+
+// `v` rotated by `q` (any non-zero length).
+Vec3 Rotated(const Quat& q, const Vec3& v);
 
 // A scratch file path unique to this process: <tmp>/footfall_export_<pid>_<name>.
 std::string ScratchPath(const std::string& name);

@@ -3,7 +3,8 @@
 // Usage: export_samples DIR
 // Creates DIR if needed and writes walk.gltf, walk.glb, crowd.gltf, crowd.glb, empty.gltf,
 // far.gltf and far.glb (the biped at UTM-like coordinates: tracks under a root origin node),
-// walk.mel, crowd.mel and broken.gltf: walk.gltf with its samplers switched to CUBICSPLINE
+// walk_feet.gltf and crowd_feet.glb (with the feet's rotations), walk.mel, crowd.mel and
+// broken.gltf: walk.gltf with its samplers switched to CUBICSPLINE
 // without the tangents that needs, which a working validator must reject.
 #include <cstdio>
 #include <filesystem>
@@ -34,13 +35,19 @@ int main(int argc, char** argv) {
   const struct {
     const footfall::Walk* walk;
     const char* file;
-  } samples[] = {{&biped, "walk.gltf"}, {&biped, "walk.glb"},   {&crowd, "crowd.gltf"},
-                 {&crowd, "crowd.glb"}, {&empty, "empty.gltf"}, {&far, "far.gltf"},
-                 {&far, "far.glb"},     {&biped, "walk.mel"},   {&crowd, "crowd.mel"}};
+    bool foot_rotations;
+  } samples[] = {{&biped, "walk.gltf", false},     {&biped, "walk.glb", false},
+                 {&crowd, "crowd.gltf", false},    {&crowd, "crowd.glb", false},
+                 {&empty, "empty.gltf", false},    {&far, "far.gltf", false},
+                 {&far, "far.glb", false},         {&biped, "walk_feet.gltf", true},
+                 {&crowd, "crowd_feet.glb", true}, {&biped, "walk.mel", false},
+                 {&crowd, "crowd.mel", false}};
   for (const auto& sample : samples) {
     const std::string path = dir + "/" + sample.file;
     std::string error;
-    if (footfall::WriteWalk(*sample.walk, path, &error) != footfall::Status::kOk) {
+    footfall::WalkExportOptions options;
+    options.foot_rotations = sample.foot_rotations;
+    if (footfall::WriteWalk(*sample.walk, path, options, &error) != footfall::Status::kOk) {
       std::fprintf(stderr, "export_samples: %s\n", error.c_str());
       return 1;
     }

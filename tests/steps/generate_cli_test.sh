@@ -397,6 +397,15 @@ check "unwritable output: exit 1" [ $? -eq 1 ]
 check "unwritable output: named before generating" grep -qF -- "--out $work/no/such/dir/walk.json: cannot open '$work/no/such/dir/walk.json' for writing: No such file or directory" "$work/early-bad.err"
 check "unwritable output: nothing generated" bash -c "! grep -q 'stopped early' '$work/early-bad.err' && [ ! -e '$work/early-ok.json' ]"
 check "formats: MEL keys the feet" grep -q 'setKeyframe' "$work/all.mel"
+# --foot-rotations keys the feet's rotations too in glTF and MEL (the exporters' tests check
+# their values); without it only bodies turn. The JSON is the same either way.
+"$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
+  --steps 100 --foot-rotations --out "$work/turned.json" --out "$work/turned.gltf" \
+  --out "$work/turned.mel" 2>/dev/null
+check "foot rotations: exit 2 for the stopped walk" [ $? -eq 2 ]
+check "foot rotations: the JSON unchanged" cmp -s "$work/all.json" "$work/turned.json"
+check "foot rotations: MEL turns 3 locators, not 1" [ "$(grep -c 'rotateOrder' "$work/turned.mel")" -eq 3 -a "$(grep -c 'rotateOrder' "$work/all.mel")" -eq 1 ]
+check "foot rotations: glTF has 3 rotation channels, not 1" [ "$(grep -o '"path": *"rotation"' "$work/turned.gltf" | wc -l)" -eq 3 -a "$(grep -o '"path": *"rotation"' "$work/all.gltf" | wc -l)" -eq 1 ]
 # At UTM-like coordinates glTF's floats would move keys visibly: the writer puts the tracks under
 # a root origin node, so nothing is lost and there is no warning; none near the origin either.
 awk '{ printf "%.3f %s %.3f %s %s %s\n", $1 + 500000, $2, $3 + 4000000, $4, $5, $6 }' "$work/floor.pts" > "$work/utm.pts"

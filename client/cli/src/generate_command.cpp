@@ -51,6 +51,7 @@ struct GenerateFlags {
   int crowd = 1;
   double crowd_spacing = 0;
   bool progress = false;
+  bool foot_rotations = false;
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::vector<std::string> out;
 };
@@ -108,10 +109,11 @@ bool WriteWalkJsonToStandardOutput(const Walk& walk, std::string* error) {
 }
 
 // Writes one output, chosen by its extension.
-Status WriteOutput(const Walk& walk, const std::string& path, std::string* error) {
+Status WriteOutput(const Walk& walk, const std::string& path, const WalkExportOptions& options,
+                   std::string* error) {
   const std::string ext = FileExtension(path);
   if (ext == "json") return WriteWalkJson(walk, path, error);
-  if (IsWalkExportPath(path)) return WriteWalk(walk, path, error);
+  if (IsWalkExportPath(path)) return WriteWalk(walk, path, options, error);
   *error = path + ": unsupported output extension (expected .json, .gltf, .glb or .mel)";
   return Status::kInvalidArgument;
 }
@@ -446,6 +448,8 @@ std::string OutOfMemoryMessage(const GenerateFlags& flags, const GenerateOptions
 // their names together, once all are written (OutputFileSet): Ctrl-C while they are written
 // leaves the older files, never a mix. Returns 1 if any failed, else 0.
 int WriteOutputs(const GenerateFlags& flags, const LoadedTerrain& terrain, const Walk& walk) {
+  WalkExportOptions exports;
+  exports.foot_rotations = flags.foot_rotations;
   int code = 0;
   std::string error;
   OutputFileSet outputs;
@@ -468,7 +472,7 @@ int WriteOutputs(const GenerateFlags& flags, const LoadedTerrain& terrain, const
                     ? WriteWalkTerrain(terrain.flags,
                                        terrain.resampled ? &terrain.prepared.samples : nullptr, out,
                                        &error)
-                    : WriteOutput(walk, out, &error);
+                    : WriteOutput(walk, out, exports, &error);
     } catch (const std::bad_alloc&) {
       error =
           "out of memory writing it (the outputs before it are written; the walk JSON "
@@ -853,6 +857,9 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
       ->transform(WholeRange(1, 256));
   cmd->add_flag("--progress", flags->progress,
                 "Show a progress bar on stderr (shown anyway for long runs on a terminal)");
+  cmd->add_flag("--foot-rotations", flags->foot_rotations,
+                "Key the feet's rotations too in .gltf, .glb and .mel outputs: each foot on its "
+                "ground, facing its body's heading (the JSON has each key's normal)");
   cmd->add_option("-o,--out,--output", flags->out,
                   "Output file: .json, .gltf, .glb or .mel (repeatable); .pts: the terrain's "
                   "samples the walk was placed on (as resampled for the character), for "

@@ -150,10 +150,14 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
   // refused first. Measured peaks: about 9 KB a track (its accessors, views and their JSON),
   // and the buffer twice over for .glb (its streams, then the buffer), five times as base64 text
   // for .gltf.
+  // Which tracks are keyed with rotations: bodies, and feet when asked.
+  auto rotated = [&options](const WalkTrack& track) {
+    return track.kind == TrackKind::kBody || options.foot_rotations;
+  };
   double buffer_bytes = 0;
   for (const WalkTrack& track : walk.tracks)
-    buffer_bytes += static_cast<double>(track.keys.size()) *
-                    (track.kind == TrackKind::kBody ? 4 + 12 + 16 : 4 + 12);
+    buffer_bytes +=
+        static_cast<double>(track.keys.size()) * (rotated(track) ? 4 + 12 + 16 : 4 + 12);
   constexpr double kGlbBytesPerTrack = 2048, kGlbHeaderBytes = 28;
   const double glb_bytes =
       buffer_bytes + kGlbBytesPerTrack * static_cast<double>(walk.tracks.size()) + kGlbHeaderBytes;
@@ -198,23 +202,23 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
   {
     // Sized for every key (keys sharing a frame are dropped): grown a track at a time, the
     // streams were copied over and over.
-    size_t keys = 0, body_keys = 0;
+    size_t keys = 0, rotated_keys = 0;
     for (const WalkTrack& track : walk.tracks)
-      keys += track.keys.size(),
-          body_keys += track.kind == TrackKind::kBody ? track.keys.size() : 0;
+      keys += track.keys.size(), rotated_keys += rotated(track) ? track.keys.size() : 0;
     streams.times.reserve(keys);
     streams.vec3.reserve(3 * keys);
-    streams.vec4.reserve(4 * body_keys);
+    streams.vec4.reserve(4 * rotated_keys);
   }
   std::vector<PendingAccessor> pending;
   tinygltf::Animation animation;
   animation.name = "walk";
   tinygltf::Scene scene;
   scene.name = "walk";
+  walk_export::FootOrientation feet(walk);
 
   for (size_t t = 0; t < walk.tracks.size(); ++t) {
     const WalkTrack& track = walk.tracks[t];
-    const bool body = track.kind == TrackKind::kBody;
+    const bool body = track.kind == TrackKind::kBody, turns = rotated(track);
     tinygltf::Node node;
     node.name = names[t];
     node.extras = NodeExtras(track);
@@ -228,14 +232,17 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
       std::vector<float> translations;
       std::vector<float> rotations;
       translations.reserve(count * 3);
+      const std::vector<Quat> foot_rotations =
+          turns && !body ? feet.Rotations(t) : std::vector<Quat>{};
       Quat previous;
       for (size_t i = 0; i < count; ++i) {
         const Vec3 stored = StoredFloats(track.keys[samples.keys[i]].position, origin);
         translations.insert(translations.end(),
                             {static_cast<float>(stored.x), static_cast<float>(stored.y),
                              static_cast<float>(stored.z)});
-        if (body) {
-          Quat q = walk_export::Normalized(track.Rotation(samples.keys[i]));
+        if (turns) {
+          Quat q = body ? walk_export::Normalized(track.Rotation(samples.keys[i]))
+                        : foot_rotations[samples.keys[i]];
           // q and -q are the same rotation; keep neighbours in one hemisphere so that
           // interpolation takes the short way.
           if (i > 0 &&
@@ -248,7 +255,7 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
         }
       }
       node.translation = {translations[0], translations[1], translations[2]};
-      if (body) node.rotation = {rotations[0], rotations[1], rotations[2], rotations[3]};
+      if (turns) node.rotation = {rotations[0], rotations[1], rotations[2], rotations[3]};
 
       const int input =
           AddAccessor(&pending, &streams, kTimes, samples.times, TINYGLTF_TYPE_SCALAR, count);
@@ -272,7 +279,7 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
       };
       add_channel(AddAccessor(&pending, &streams, kVec3, translations, TINYGLTF_TYPE_VEC3, count),
                   "translation");
-      if (body) {
+      if (turns) {
         add_channel(AddAccessor(&pending, &streams, kVec4, rotations, TINYGLTF_TYPE_VEC4, count),
                     "rotation");
       }

@@ -178,6 +178,11 @@ constexpr char kRootName[] = "footfall_walk";
 }  // namespace
 
 Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
+  return WriteMel(walk, path, MelOptions{}, error);
+}
+
+Status WriteMel(const Walk& walk, const std::string& path, const MelOptions& options,
+                std::string* error) {
   Status status = walk_export::CheckWalk(walk, error);
   if (status != Status::kOk) return status;
 
@@ -277,6 +282,11 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
   std::vector<Run> runs;
   std::vector<std::vector<size_t>> orders(walk.tracks.size());
   std::vector<std::vector<Vec3>> eulers(walk.tracks.size());
+  walk_export::FootOrientation feet(walk);
+  // Which tracks are keyed with rotations: bodies, and feet when asked.
+  auto rotated = [&](const WalkTrack& track) {
+    return track.kind == TrackKind::kBody || options.foot_rotations;
+  };
   for (size_t t = 0; t < walk.tracks.size(); ++t) {
     const WalkTrack& track = walk.tracks[t];
     bool increasing = true;
@@ -284,10 +294,14 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
       increasing = track.keys[k - 1].frame < track.keys[k].frame;
     if (!increasing) orders[t] = walk_export::KeyOrder(track);
     const size_t count = increasing ? track.keys.size() : orders[t].size();
-    if (track.kind == TrackKind::kBody) {
+    if (rotated(track)) {
+      const bool body = track.kind == TrackKind::kBody;
+      const std::vector<Quat> foot = body ? std::vector<Quat>{} : feet.Rotations(t);
       std::vector<Quat> rotations(count);
-      for (size_t k = 0; k < count; ++k)
-        rotations[k] = track.Rotation(increasing ? k : orders[t][k]);
+      for (size_t k = 0; k < count; ++k) {
+        const size_t key = increasing ? k : orders[t][k];
+        rotations[k] = body ? track.Rotation(key) : foot[key];
+      }
       eulers[t] = ContinuousEulerZxyDegrees(rotations);
     }
     size_t first = 0;
@@ -307,7 +321,7 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
     // planted foot drift between its equal end and start keys).
     static const char* kLinear = " -itt linear -ott linear";
     const WalkTrack& track = walk.tracks[t];
-    const bool body = track.kind == TrackKind::kBody;
+    const bool body = track.kind == TrackKind::kBody, turns = rotated(track);
     if (runs[r].first == 0) {
       const std::string qualified = walk_export::QualifiedTrackName(track, t);
       mel += "// track " + std::to_string(t) + ": " + (body ? "body " : "foot ") +
@@ -324,10 +338,11 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
       mel += "addAttr -longName \"footfallKind\" -dataType \"string\" $footfall_node[0];\n";
       mel += "setAttr -type \"string\" ($footfall_node[0] + \".footfallKind\") " +
              MelString(body ? "body" : "foot") + ";\n";
-      // Bodies turn in rotate order ZXY (enum 2): heading about Y is applied last, so an
-      // upright body is never at gimbal lock whatever its heading (in XYZ, heading +-X is: a
-      // small turn there swung each channel by tens of degrees).
-      if (body) mel += "setAttr ($footfall_node[0] + \".rotateOrder\") 2;\n";
+      // Bodies (and feet keyed with rotations) turn in rotate order ZXY (enum 2): heading
+      // about Y is applied last, so an upright body is never at gimbal lock whatever its
+      // heading (in XYZ, heading +-X is: a small turn there swung each channel by tens of
+      // degrees).
+      if (turns) mel += "setAttr ($footfall_node[0] + \".rotateOrder\") 2;\n";
     }
     std::string time;
     for (size_t k = runs[r].first; k < runs[r].end; ++k) {
@@ -347,7 +362,7 @@ Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
       };
       const double translate[] = {key.position.x, key.position.y, key.position.z};
       for (int axis = 0; axis < 3; ++axis) key_line("translate", kAxes[axis], translate[axis]);
-      if (body) {
+      if (turns) {
         const Vec3& euler = eulers[t][k];
         const double rotate[] = {euler.x, euler.y, euler.z};
         for (int axis = 0; axis < 3; ++axis) key_line("rotate", kAxes[axis], rotate[axis]);

@@ -22,6 +22,21 @@ double MaxAbs(const Quat& q) {
   return std::max({std::fabs(q.x), std::fabs(q.y), std::fabs(q.z), std::fabs(q.w)});
 }
 
+// The rotation a then b: b * a.
+Quat Then(const Quat& a, const Quat& b) {
+  return {b.w * a.x + a.w * b.x + (b.y * a.z - b.z * a.y),
+          b.w * a.y + a.w * b.y + (b.z * a.x - b.x * a.z),
+          b.w * a.z + a.w * b.z + (b.x * a.y - b.y * a.x),
+          b.w * a.w - (b.x * a.x + b.y * a.y + b.z * a.z)};
+}
+
+// v turned by the unit quaternion q.
+Vec3 Turned(const Quat& q, const Vec3& v) {
+  const Vec3 u{q.x, q.y, q.z};
+  const Vec3 t = Cross(u, v) * 2.0;
+  return v + t * q.w + Cross(u, t);
+}
+
 }  // namespace
 
 void SetError(std::string* error, const std::string& message) {
@@ -162,6 +177,63 @@ Quat Normalized(const Quat& q) {
   const Quat s{q.x / m, q.y / m, q.z / m, q.w / m};
   const double n = std::sqrt(Norm2(s));
   return {s.x / n, s.y / n, s.z / n, s.w / n};
+}
+
+FootOrientation::FootOrientation(const Walk& walk) : walk_(walk) {
+  for (size_t t = 0; t < walk.tracks.size(); ++t)
+    if (walk.tracks[t].kind == TrackKind::kBody) body_of_.emplace(walk.tracks[t].character, t);
+}
+
+Quat FootOrientation::BodyAt(size_t body, double frame) {
+  const WalkTrack& track = walk_.tracks[body];
+  auto found = order_.find(body);
+  if (found == order_.end()) found = order_.emplace(body, KeyOrder(track)).first;
+  const std::vector<size_t>& order = found->second;
+  if (order.empty()) return Quat{};
+  const auto at = std::lower_bound(order.begin(), order.end(), frame,
+                                   [&](size_t k, double f) { return track.keys[k].frame < f; });
+  if (at == order.begin()) return Normalized(track.Rotation(order.front()));
+  if (at == order.end()) return Normalized(track.Rotation(order.back()));
+  const Quat b = Normalized(track.Rotation(*at));
+  if (track.keys[*at].frame == frame) return b;
+  const Quat a = Normalized(track.Rotation(*(at - 1)));
+  const double fa = track.keys[*(at - 1)].frame, fb = track.keys[*at].frame;
+  const double t = (frame - fa) / (fb - fa);
+  const double sign = a.x * b.x + a.y * b.y + a.z * b.z + a.w * b.w < 0 ? -1.0 : 1.0;
+  const double u = 1 - t, v = sign * t;
+  return Normalized({a.x * u + b.x * v, a.y * u + b.y * v, a.z * u + b.z * v, a.w * u + b.w * v});
+}
+
+std::vector<Quat> FootOrientation::Rotations(size_t track) {
+  const WalkTrack& foot = walk_.tracks[track];
+  const auto body = body_of_.find(foot.character);
+  std::vector<Quat> out(foot.keys.size());
+  for (size_t k = 0; k < foot.keys.size(); ++k) {
+    const WalkKey& key = foot.keys[k];
+    const Quat q = body == body_of_.end() ? Quat{} : BodyAt(body->second, key.frame);
+    // (Scaled by its largest component first: no square overflows or underflows.)
+    const double m =
+        std::max({std::fabs(key.normal.x), std::fabs(key.normal.y), std::fabs(key.normal.z)});
+    if (!std::isfinite(m) || !(m > 0)) {
+      out[k] = q;
+      continue;
+    }
+    const Vec3 n = Normalize(key.normal / m);
+    const Vec3 up = Turned(q, Vec3{0, 1, 0});
+    const double d = Dot(up, n);
+    // The shortest rotation taking up onto n; half a turn about the body's left when n is
+    // opposite (no shortest one).
+    Quat tilt;
+    if (d < -1 + 1e-12) {
+      const Vec3 left = Turned(q, Vec3{1, 0, 0});
+      tilt = {left.x, left.y, left.z, 0};
+    } else {
+      const Vec3 c = Cross(up, n);
+      tilt = Normalized({c.x, c.y, c.z, 1 + d});
+    }
+    out[k] = Normalized(Then(q, tilt));
+  }
+  return out;
 }
 
 }  // namespace walk_export

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "footfall/steps/walk.h"
@@ -41,6 +42,27 @@ std::string ValidUtf8(const std::string& text);
 
 // q / |q|; q must be finite and non-zero (CheckWalk).
 Quat Normalized(const Quat& q);
+
+// The orientations the exports key on foot tracks when asked to (GltfOptions, MelOptions):
+// each foot key turned as its character's body is at the key's frame, then tilted by the
+// shortest rotation that takes the body's up onto the key's normal, so that the foot lies on
+// its ground (the swing's mid key on the averaged normal) facing the body's heading.
+class FootOrientation {
+ public:
+  // `walk` must pass CheckWalk and outlive this.
+  explicit FootOrientation(const Walk& walk);
+  // One unit quaternion per key of foot track `track`, in track order. The body's rotation
+  // between its keys is interpolated (normalised linear, the short way), held before its first
+  // key and after its last; a character without a body track turns as the identity. A key
+  // whose normal is zero or not finite is not tilted.
+  std::vector<Quat> Rotations(size_t track);
+
+ private:
+  Quat BodyAt(size_t body, double frame);
+  const Walk& walk_;
+  std::unordered_map<std::string, size_t> body_of_;        // character -> its first body track
+  std::unordered_map<size_t, std::vector<size_t>> order_;  // body track -> KeyOrder
+};
 
 }  // namespace walk_export
 }  // namespace footfall

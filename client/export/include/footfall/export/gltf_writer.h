@@ -29,6 +29,10 @@ struct GltfOptions {
   // larger (its buffer and about 2 KB of JSON a track) is refused, naming .gltf, which has no
   // such limit.
   double max_glb_bytes = 4294967295.0;
+  // true: foot nodes are keyed with rotations too, each foot on its ground facing its body's
+  // heading (the body's rotation at the key's frame, tilted by the shortest rotation that takes
+  // the body's up onto the key's normal). false: feet have translation channels only.
+  bool foot_rotations = false;
 };
 
 // [Units: wu] [Limit: > 0] Beyond this |coordinate| a walk's glTF gets a root origin node: below
@@ -56,13 +60,15 @@ Vec3 GltfOrigin(const Walk& walk);
 //   world position is the root's translation (double) + the child's key (float).
 //   Names and the stop reason are written as valid UTF-8, as in the walk JSON: a byte that
 //   belongs to no well-formed UTF-8 sequence becomes U+FFFD.
-//   Each node's rest translation (and rotation for bodies) is its first key.
-// - Channels: feet animate translation; bodies translation and rotation (normalised
-//   quaternions). Times in seconds = frame / fps. glTF needs strictly increasing times: keys are
-//   ordered by frame (stable) and of several keys on the same frame only the last one is kept;
-//   distinct frames whose times are the same float (a start frame far from 0 at a high fps) are
-//   refused (kInvalidArgument), as merging them would lose keys. Positions are floats too,
-//   relative to the origin node if any: a walk spanning kilometres still moves (MaxFloatRounding).
+//   Each node's rest translation (and rotation for bodies, and feet with foot_rotations) is
+//   its first key.
+// - Channels: feet animate translation (and rotation with GltfOptions::foot_rotations); bodies
+//   translation and rotation (normalised quaternions). Times in seconds = frame / fps. glTF needs
+//   strictly increasing times: keys are ordered by frame (stable) and of several keys on the same
+//   frame only the last one is kept; distinct frames whose times are the same float (a start frame
+//   far from 0 at a high fps) are refused (kInvalidArgument), as merging them would lose keys.
+//   Positions are floats too, relative to the origin node if any: a walk spanning kilometres still
+//   moves (MaxFloatRounding).
 // - Node extras hold {"kind", "character", "track"}; the animation's extras hold {"fps"} and
 //   {"stopped"} when the walk stopped early. World units are written unchanged (glTF metres).
 // Returns kInvalidArgument (with `*error` set) for fps <= 0, a negative frame, NaN/Inf values or

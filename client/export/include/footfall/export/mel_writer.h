@@ -17,9 +17,10 @@ namespace footfall {
 // 2. creates a root transform "footfall_walk" and, for crowd walks, one transform per character
 //    under it;
 // 3. per track, creates a locator (`spaceLocator -n`), parents it, and keys translateX/Y/Z at
-//    every key frame (bodies also rotateX/Y/Z, in rotate order ZXY so that heading is rotateY
-//    alone and an upright body is never at gimbal lock: the quaternion as Euler ZXY degrees,
-//    unwrapped so consecutive keys take the shortest turn). Frames are written as they are in the
+//    every key frame (bodies, and feet with MelOptions::foot_rotations, also rotateX/Y/Z, in
+//    rotate order ZXY so that heading is rotateY alone and an upright body is never at gimbal
+//    lock: the quaternion as Euler ZXY degrees, unwrapped so consecutive keys take the shortest
+//    turn). Frames are written as they are in the
 //    walk. Every key has linear in and out tangents, as the glTF export's LINEAR samplers.
 // Frames and values are MEL decimals without exponent, with the fewest digits that read back as
 // the same double (a walk in tiny or huge units keeps full precision).
@@ -32,5 +33,16 @@ namespace footfall {
 // values or a zero quaternion; kIoError naming `path` when the file cannot be written. `error` may
 // be null.
 Status WriteMel(const Walk& walk, const std::string& path, std::string* error);
+
+struct MelOptions {
+  // true: foot locators are keyed with rotations too (rotateX/Y/Z in rotate order ZXY, as
+  // bodies), each foot on its ground facing its body's heading, as GltfOptions::foot_rotations
+  // turns glTF's foot nodes.
+  bool foot_rotations = false;
+};
+
+// As above, with `options`.
+Status WriteMel(const Walk& walk, const std::string& path, const MelOptions& options,
+                std::string* error);
 
 }  // namespace footfall

@@ -14,6 +14,15 @@ namespace footfall {
 // extensions. `error` may be null.
 Status WriteWalk(const Walk& walk, const std::string& path, std::string* error);
 
+struct WalkExportOptions {
+  // Feet keyed with rotations too (GltfOptions::foot_rotations, MelOptions::foot_rotations).
+  bool foot_rotations = false;
+};
+
+// As above, with `options`.
+Status WriteWalk(const Walk& walk, const std::string& path, const WalkExportOptions& options,
+                 std::string* error);
+
 // True when WriteWalk knows the extension of `path`.
 bool IsWalkExportPath(const std::string& path);
 
