@@ -60,11 +60,13 @@ void SoleCandidates(const Vec3& end, const Vec3& f, int ways, double foot_length
 }
 
 // Whether a candidate place (its centre, heel and toe `p`, their nearest samples `h`) stands
-// on ground like `normal` under all three.
+// on ground like `normal` under all three. The foot lands on the centre's sample, not on the
+// centre: its heel and toe move with it, so theirs must have ground within `near` less that
+// offset (a sole fitted up to the slack then hung past a nose by up to half a spacing more).
 bool CandidateOnGround(const Vec3* p, const Foothold* h, const Vec3& normal, double near) {
-  for (size_t j = 0; j < kPerCandidate; ++j)
-    if (!SoleOnGround(p[j], h[j], normal, near)) return false;
-  return true;
+  if (!SoleOnGround(p[0], h[0], normal, near)) return false;
+  const double slack = near - Distance(h[0].point, p[0]);
+  return SoleOnGround(p[1], h[1], normal, slack) && SoleOnGround(p[2], h[2], normal, slack);
 }
 
 }  // namespace
