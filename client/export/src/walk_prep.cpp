@@ -30,13 +30,6 @@ Quat Then(const Quat& a, const Quat& b) {
           b.w * a.w - (b.x * a.x + b.y * a.y + b.z * a.z)};
 }
 
-// v turned by the unit quaternion q.
-Vec3 Turned(const Quat& q, const Vec3& v) {
-  const Vec3 u{q.x, q.y, q.z};
-  const Vec3 t = Cross(u, v) * 2.0;
-  return v + t * q.w + Cross(u, t);
-}
-
 }  // namespace
 
 void SetError(std::string* error, const std::string& message) {
@@ -219,13 +212,13 @@ std::vector<Quat> FootOrientation::Rotations(size_t track) {
       continue;
     }
     const Vec3 n = Normalize(key.normal / m);
-    const Vec3 up = Turned(q, Vec3{0, 1, 0});
+    const Vec3 up = Rotate(q, Vec3{0, 1, 0});
     const double d = Dot(up, n);
     // The shortest rotation taking up onto n; half a turn about the body's left when n is
     // opposite (no shortest one).
     Quat tilt;
     if (d < -1 + 1e-12) {
-      const Vec3 left = Turned(q, Vec3{1, 0, 0});
+      const Vec3 left = Rotate(q, Vec3{1, 0, 0});
       tilt = {left.x, left.y, left.z, 0};
     } else {
       const Vec3 c = Cross(up, n);

@@ -143,11 +143,4 @@ inline Quat QuatFromBasis(const Vec3& x, const Vec3& y, const Vec3& z) {
   return q;
 }
 
-// v rotated by the unit quaternion q.
-inline Vec3 Rotate(const Quat& q, const Vec3& v) {
-  const Vec3 u{q.x, q.y, q.z};
-  const Vec3 t = Cross(u, v) * 2;
-  return v + t * q.w + Cross(u, t);
-}
-
 }  // namespace footfall::steps_detail

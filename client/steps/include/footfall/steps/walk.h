@@ -17,6 +17,13 @@ struct Quat {
   double x = 0, y = 0, z = 0, w = 1;
 };
 
+// v rotated by the unit quaternion q.
+inline Vec3 Rotate(const Quat& q, const Vec3& v) {
+  const Vec3 u{q.x, q.y, q.z};
+  const Vec3 t = Cross(u, v) * 2;
+  return v + t * q.w + Cross(u, t);
+}
+
 // Where a foot key sits in its step: lift-off, top of the swing arc, touch-down. Body keys
 // have no phase.
 enum class KeyPhase : uint8_t { kNone, kStart, kMid, kEnd };
