@@ -21,6 +21,8 @@
 
 #include "footfall/client/footfall_c.h"
 #include "footfall/import/terrain_generators.h"
+#include "footfall/steps/foot_rotations.h"
+#include "footfall/steps/generate_request.h"
 #include "footfall/steps/scene.h"
 #include "footfall/steps/walk_json.h"
 #include "walk_checks.h"
@@ -269,6 +271,15 @@ TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]")
        "tracks[0].keys[1].frame: frames must increase"},
       {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"b","kind":"body","keys":[{"frame":1,"position":[0,0,0],"rotation":[0,0,0,0]}]}]})",
        "w.json: tracks[0].keys[0].rotation: expected a non-zero quaternion"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","keys":[{"frame":1,"phase":"end","position":[0,0,0],"rotation":[0,0,0,0]}]}]})",
+       "w.json: tracks[0].keys[0].rotation: expected a non-zero quaternion"},
+      // A foot track's rotations are on all its keys or on none.
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","keys":[{"frame":1,"phase":"end","position":[0,0,0]},{"frame":2,"phase":"start","position":[0,0,0],"rotation":[0,0,0,1]}]}]})",
+       "w.json: tracks[0].keys[1].rotation: expected a rotation on every key of a foot track or on "
+       "none (the first key has none)"},
+      {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","keys":[{"frame":1,"phase":"end","position":[0,0,0],"rotation":[0,0,0,1]},{"frame":2,"phase":"start","position":[0,0,0]}]}]})",
+       "w.json: tracks[0].keys[1]: expected a rotation on every key of a foot track or on none "
+       "(the first key has one)"},
       {R"({"format":5,"version":1,"fps":24,"tracks":[]})",
        "w.json: format: must be a string, found number"},
       {R"({"format":"footfall-walk","version":1,"fps":24,"stopped":7,"tracks":[]})",
@@ -293,7 +304,7 @@ TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]")
        "w.json: tracks[0]: unknown field 'key'"},
       {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","keys":[{"frame":1,"phase":"end","position":[0,0,0],"normals":[0,0,1]}]}]})",
        "w.json: tracks[0].keys[0]: unknown field 'normals' (known fields: comment, "
-       "frame, normal, phase, position)"},
+       "frame, normal, phase, position, rotation)"},
       {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"b","kind":"body","keys":[{"frame":1,"position":[0,0,0],"phase":"end"}]}]})",
        "w.json: tracks[0].keys[0]: unknown field 'phase' (known fields: comment, frame, "
        "position, rotation)"},
@@ -323,6 +334,81 @@ TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]")
     CHECK(ParseWalkJson(input, "w.json", &back, &error) == Status::kParseError);
     CHECK_THAT(error, Catch::Contains(message));
   }
+}
+
+TEST_CASE("Foot rotations: asked for, the walk and its JSON carry each foot key's orientation",
+          "[steps][walk_json][foot_rotations]") {
+  const Character c = LoadShipped("hexapod");
+  Terrain t = LoadTerrain(MakeHeightField(150, 150, 0.012, 0.01, 3), 0.012);
+  GenerateOptions o;
+  o.steps = 6, o.crowd = 2, o.crowd_spacing = 0.6;
+  const Walk plain = Generate(t, c, o);
+  o.foot_rotations = true;
+  const Walk turned = Generate(t, c, o);
+  REQUIRE(turned.tracks.size() == plain.tracks.size());
+  FootOrientation orientation(plain);
+  size_t feet = 0;
+  for (size_t i = 0; i < turned.tracks.size(); ++i) {
+    const WalkTrack& track = turned.tracks[i];
+    INFO(track.character << "/" << track.name);
+    CHECK(track.keys.size() == plain.tracks[i].keys.size());
+    if (track.kind == TrackKind::kBody) {
+      CHECK(std::equal(track.rotations.begin(), track.rotations.end(),
+                       plain.tracks[i].rotations.begin(), plain.tracks[i].rotations.end(),
+                       [](const Quat& a, const Quat& b) {
+                         return a.x == b.x && a.y == b.y && a.z == b.z && a.w == b.w;
+                       }));
+      continue;
+    }
+    CHECK(plain.tracks[i].rotations.empty());
+    REQUIRE(track.rotations.size() == track.keys.size());
+    const std::vector<Quat> expected = orientation.Rotations(i);
+    for (size_t k = 0; k < track.keys.size(); ++k, ++feet) {
+      const Quat& q = track.rotations[k];
+      CHECK(q.x == expected[k].x);
+      CHECK(q.w == expected[k].w);
+      // The foot's up stands on the key's normal.
+      CHECK(Dot(Rotate(q, Vec3{0, 1, 0}), Normalize(track.keys[k].normal)) > 1 - 1e-9);
+    }
+  }
+  CHECK(feet > 50);
+  // Written as "rotation" on every foot key, read back exactly; without them, none.
+  const std::string text = WalkToJson(turned);
+  Walk back;
+  std::string error;
+  REQUIRE(ParseWalkJson(text, "w.json", &back, &error) == Status::kOk);
+  CHECK(WalkToJson(back) == text);
+  CHECK(back.tracks[0].rotations.size() == back.tracks[0].keys.size());
+  const auto count = [](const std::string& s, const std::string& what) {
+    size_t n = 0;
+    for (size_t at = s.find(what); at != std::string::npos; at = s.find(what, at + 1)) ++n;
+    return n;
+  };
+  CHECK(count(text, "\"rotation\"") == count(text, "\"frame\""));
+  const std::string plain_text = WalkToJson(plain);
+  CHECK(count(plain_text, "\"rotation\"") < count(plain_text, "\"frame\"") / 5);
+  // AddFootRotations on the plain walk gives the same.
+  Walk added = plain;
+  AddFootRotations(&added);
+  CHECK(WalkToJson(added) == text);
+  // A request asks for them with "foot_rotations": true; anything but a boolean is refused,
+  // and a scene's characters take it from the whole walk, not each.
+  Character rc;
+  GenerateOptions ro;
+  const std::string file = std::string(FOOTFALL_SOURCE_DIR) + "/data/characters/biped.json";
+  REQUIRE(ParseGenerateRequest(R"({"character_file": ")" + file + R"(", "foot_rotations": true})",
+                               &rc, &ro, &error) == Status::kOk);
+  CHECK(ro.foot_rotations);
+  CHECK(ParseGenerateRequest(R"({"character_file": ")" + file + R"(", "foot_rotations": 1})", &rc,
+                             &ro, &error) == Status::kParseError);
+  CHECK(error == "request: 'foot_rotations': expected true or false");
+  std::vector<SceneCharacter> scene;
+  const Status read = ParseScene(
+      R"({"format": "footfall-scene", "version": 1, "characters": [{"character_file": ")" + file +
+          R"(", "foot_rotations": true}]})",
+      "s.json", "", &scene, &error);
+  CHECK(read != Status::kOk);
+  CHECK_THAT(error, Catch::Contains("unknown field 'foot_rotations'"));
 }
 
 TEST_CASE("ffc_generate gives the walk GenerateWalk gives", "[steps][c_api]") {

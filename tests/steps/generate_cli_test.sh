@@ -398,12 +398,30 @@ check "unwritable output: named before generating" grep -qF -- "--out $work/no/s
 check "unwritable output: nothing generated" bash -c "! grep -q 'stopped early' '$work/early-bad.err' && [ ! -e '$work/early-ok.json' ]"
 check "formats: MEL keys the feet" grep -q 'setKeyframe' "$work/all.mel"
 # --foot-rotations keys the feet's rotations too in glTF and MEL (the exporters' tests check
-# their values); without it only bodies turn. The JSON is the same either way.
+# their values); without it only bodies turn. The JSON gives each foot key its rotation, which
+# stands the foot's up on the key's normal, and is otherwise the same.
 "$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
   --steps 100 --foot-rotations --out "$work/turned.json" --out "$work/turned.gltf" \
   --out "$work/turned.mel" 2>/dev/null
 check "foot rotations: exit 2 for the stopped walk" [ $? -eq 2 ]
-check "foot rotations: the JSON unchanged" cmp -s "$work/all.json" "$work/turned.json"
+check "foot rotations: the JSON has them, and is otherwise unchanged" python3 - "$work/all.json" "$work/turned.json" <<'PY'
+import json, math, sys
+plain, turned = (json.load(open(p)) for p in sys.argv[1:])
+feet = 0
+for track in turned["tracks"]:
+    for key in track["keys"]:
+        if track["kind"] != "foot":
+            continue
+        x, y, z, w = key.pop("rotation")
+        assert abs(math.sqrt(x * x + y * y + z * z + w * w) - 1) < 1e-9, key
+        # (0, 1, 0) turned by the quaternion, against the key's normal.
+        up = (2 * (x * y - w * z), 1 - 2 * (x * x + z * z), 2 * (y * z + w * x))
+        n = key["normal"]
+        length = math.sqrt(sum(c * c for c in n))
+        assert sum(u * c / length for u, c in zip(up, n)) > 1 - 1e-9, (key, up)
+        feet += 1
+assert feet > 10 and turned == plain, feet
+PY
 check "foot rotations: MEL turns 3 locators, not 1" [ "$(grep -c 'rotateOrder' "$work/turned.mel")" -eq 3 -a "$(grep -c 'rotateOrder' "$work/all.mel")" -eq 1 ]
 check "foot rotations: glTF has 3 rotation channels, not 1" [ "$(grep -o '"path": *"rotation"' "$work/turned.gltf" | wc -l)" -eq 3 -a "$(grep -o '"path": *"rotation"' "$work/all.gltf" | wc -l)" -eq 1 ]
 # At UTM-like coordinates glTF's floats would move keys visibly: the writer puts the tracks under

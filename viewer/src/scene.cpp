@@ -40,15 +40,6 @@ void Grow(const Vec3& p, Vec3* lo, Vec3* hi, bool* any) {
   hi->x = std::max(hi->x, p.x), hi->y = std::max(hi->y, p.y), hi->z = std::max(hi->z, p.z);
 }
 
-// q as a unit quaternion, scaled by its largest component first: squaring components of 1e300
-// overflowed to a length of infinity, and the rotation became zero. q is non-zero and finite.
-Quat Normalized(const Quat& q) {
-  const double m = std::max({std::fabs(q.x), std::fabs(q.y), std::fabs(q.z), std::fabs(q.w)});
-  const Quat s{q.x / m, q.y / m, q.z / m, q.w / m};
-  const double n = std::sqrt(s.x * s.x + s.y * s.y + s.z * s.z + s.w * s.w);
-  return {s.x / n, s.y / n, s.z / n, s.w / n};
-}
-
 // The radius of the ring drawn around a next query's ideal point. [Units: wu]
 double RingRadius(const QueryView& q) {
   return q.trace.radius > 0     ? q.trace.radius

@@ -25,6 +25,7 @@
 #include "footfall/export/gltf_writer.h"
 #include "footfall/export/walk_writer.h"
 #include "footfall/import/terrain_loader.h"
+#include "footfall/steps/foot_rotations.h"
 #include "footfall/steps/generator.h"
 #include "footfall/steps/scene.h"
 #include "footfall/steps/walk_json.h"
@@ -443,6 +444,22 @@ std::string OutOfMemoryMessage(const GenerateFlags& flags, const GenerateOptions
   return m.str();
 }
 
+// --foot-rotations: gives the walk's feet their orientations, which the walk JSON then carries
+// (the glTF and MEL writers key the same ones). Memory running out keeps the walk as it was,
+// its JSON without them, and says so.
+void AddFootRotationsIfAsked(const GenerateFlags& flags, Walk* walk) {
+  if (!flags.foot_rotations) return;
+  try {
+    AddFootRotations(walk);
+  } catch (const std::bad_alloc&) {
+    for (WalkTrack& t : walk->tracks)
+      if (t.kind == TrackKind::kFoot)
+        t.rotations = std::pmr::vector<Quat>(t.rotations.get_allocator());
+    std::cerr << "footfall generate: warning: out of memory giving the feet their rotations: the "
+                 "walk JSON is written without them (glTF and MEL still key them)\n";
+  }
+}
+
 // Writes every --out, each on its own: one that fails is said (and an older file of its name
 // said to be left as it was) and the others are still written. They replace older files of
 // their names together, once all are written (OutputFileSet): Ctrl-C while they are written
@@ -706,6 +723,7 @@ int RunScene(const GenerateFlags& flags) {
     ++walked;
   }
   walk.notes.insert(walk.notes.end(), overlapping.begin(), overlapping.end());
+  AddFootRotationsIfAsked(flags, &walk);
   if (walks.empty() && failures.empty()) {
     std::cerr << "footfall generate: out of memory setting out the scene's walks; nothing was "
                  "written (give fewer characters, crowds or steps)\n";
@@ -795,6 +813,7 @@ int RunGenerate(const GenerateFlags& flags) {
                  "the character starts (a waypoint counts as reached within half a step along "
                  "the ground, whatever its height above it)\n";
   }
+  AddFootRotationsIfAsked(flags, &walk);
   const int code = WriteOutputs(flags, terrain, walk);
   const bool stopped = ReportWalkEnd(walk, terrain);
   // An output not written, or footfalld failing mid-walk, is an error before a stop.
@@ -858,8 +877,9 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
   cmd->add_flag("--progress", flags->progress,
                 "Show a progress bar on stderr (shown anyway for long runs on a terminal)");
   cmd->add_flag("--foot-rotations", flags->foot_rotations,
-                "Key the feet's rotations too in .gltf, .glb and .mel outputs: each foot on its "
-                "ground, facing its body's heading (the JSON has each key's normal)");
+                "Key the feet's rotations too: each foot on its ground, facing its body's "
+                "heading (.gltf, .glb and .mel outputs key them; the .json gives each foot key a "
+                "rotation)");
   cmd->add_option("-o,--out,--output", flags->out,
                   "Output file: .json, .gltf, .glb or .mel (repeatable); .pts: the terrain's "
                   "samples the walk was placed on (as resampled for the character), for "

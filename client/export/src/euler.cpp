@@ -43,7 +43,7 @@ void NearestAtLock(double middle, double* first, double* last, double first_to, 
 }  // namespace
 
 Vec3 QuatToEulerXyzDegrees(const Quat& q_in) {
-  const Quat q = walk_export::Normalized(q_in);
+  const Quat q = Normalized(q_in);
   const double x = q.x, y = q.y, z = q.z, w = q.w;
   // Rotation matrix entries (column vectors) needed for R = Rz(c) * Ry(b) * Rx(a).
   const double m00 = 1 - 2 * (y * y + z * z);
@@ -79,7 +79,7 @@ Vec3 ClosestEulerXyzDegrees(const Vec3& euler, const Vec3& previous) {
 }
 
 Vec3 QuatToEulerZxyDegrees(const Quat& q_in) {
-  const Quat q = walk_export::Normalized(q_in);
+  const Quat q = Normalized(q_in);
   const double x = q.x, y = q.y, z = q.z, w = q.w;
   // Rotation matrix entries (column vectors) needed for R = Ry(b) * Rx(a) * Rz(c):
   // m12 = -sin a; m02, m22 = sin b cos a, cos b cos a; m10, m11 = cos a sin c, cos a cos c.

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "file_output.h"
+#include "footfall/steps/foot_rotations.h"
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/output_file.h"
@@ -49,7 +50,7 @@ struct Samples {
 
 Status TrackSamples(const WalkTrack& track, size_t track_index, double fps, Samples* samples,
                     std::string* error) {
-  for (size_t index : walk_export::KeyOrder(track)) {
+  for (size_t index : KeyOrder(track)) {
     const WalkKey& key = track.keys[index];
     if (key.frame < 0) {
       std::ostringstream message;
@@ -214,7 +215,7 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
   animation.name = "walk";
   tinygltf::Scene scene;
   scene.name = "walk";
-  walk_export::FootOrientation feet(walk);
+  FootOrientation feet(walk);
 
   for (size_t t = 0; t < walk.tracks.size(); ++t) {
     const WalkTrack& track = walk.tracks[t];
@@ -241,8 +242,8 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
                             {static_cast<float>(stored.x), static_cast<float>(stored.y),
                              static_cast<float>(stored.z)});
         if (turns) {
-          Quat q = body ? walk_export::Normalized(track.Rotation(samples.keys[i]))
-                        : foot_rotations[samples.keys[i]];
+          Quat q =
+              body ? Normalized(track.Rotation(samples.keys[i])) : foot_rotations[samples.keys[i]];
           // q and -q are the same rotation; keep neighbours in one hemisphere so that
           // interpolation takes the short way.
           if (i > 0 &&

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "footfall/export/euler.h"
+#include "footfall/steps/foot_rotations.h"
 #include "footfall/terrain/ordered_text.h"
 #include "footfall/terrain/output_file.h"
 #include "footfall/version.h"
@@ -282,7 +283,7 @@ Status WriteMel(const Walk& walk, const std::string& path, const MelOptions& opt
   std::vector<Run> runs;
   std::vector<std::vector<size_t>> orders(walk.tracks.size());
   std::vector<std::vector<Vec3>> eulers(walk.tracks.size());
-  walk_export::FootOrientation feet(walk);
+  FootOrientation feet(walk);
   // Which tracks are keyed with rotations: bodies, and feet when asked.
   auto rotated = [&](const WalkTrack& track) {
     return track.kind == TrackKind::kBody || options.foot_rotations;
@@ -292,7 +293,7 @@ Status WriteMel(const Walk& walk, const std::string& path, const MelOptions& opt
     bool increasing = true;
     for (size_t k = 1; k < track.keys.size() && increasing; ++k)
       increasing = track.keys[k - 1].frame < track.keys[k].frame;
-    if (!increasing) orders[t] = walk_export::KeyOrder(track);
+    if (!increasing) orders[t] = KeyOrder(track);
     const size_t count = increasing ? track.keys.size() : orders[t].size();
     if (rotated(track)) {
       const bool body = track.kind == TrackKind::kBody;

@@ -72,9 +72,9 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
     return Status::kParseError;
   }
   static const std::set<std::string> kKnown = {
-      "character", "character_file", "start",        "heading",
-      "path",      "steps",          "start_frame",  "up",
-      "fps",       "crowd",          "crowd_spacing"};
+      "character", "character_file", "start",         "heading",
+      "path",      "steps",          "start_frame",   "up",
+      "fps",       "crowd",          "crowd_spacing", "foot_rotations"};
   for (auto it = j.begin(); it != j.end(); ++it) {
     if (read_by_caller.count(it.key())) continue;
     if (!kKnown.count(it.key()) || refused.count(it.key())) {
@@ -151,6 +151,13 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
       *error = source + ": 'crowd_spacing': expected a number from 0 (the default) to 1e+06";
       ok = false;
     }
+  }
+  if (ok && j.contains("foot_rotations")) {
+    ok = j["foot_rotations"].is_boolean();
+    if (ok)
+      o.foot_rotations = j["foot_rotations"].get<bool>();
+    else
+      *error = source + ": 'foot_rotations': expected true or false";
   }
   for (const char* key : {"steps", "crowd"}) {
     if (!ok || !j.contains(key)) continue;

@@ -10,6 +10,8 @@
 #include <mutex>
 #include <sstream>
 
+#include "footfall/steps/foot_rotations.h"
+
 namespace footfall::steps_detail {
 
 std::string Point(const Vec3& p) {
@@ -486,6 +488,7 @@ Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Charac
   Generator g(session, terrain, character, options, &agents, &walk);
   const Status s = g.Run(error);
   if (s != Status::kOk) return s;
+  if (options.foot_rotations) AddFootRotations(&walk);
   *out = std::move(walk);
   return Status::kOk;
 }

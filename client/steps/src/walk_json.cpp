@@ -43,13 +43,20 @@ void String(std::string& out, const std::string& s) {
   out += json(s).dump(-1, ' ', false, json::error_handler_t::replace);  // never throws
 }
 
+void Rotation(std::string& out, const Quat& q) {
+  out += ",\"rotation\":[";
+  Number(out, q.x), out += ',', Number(out, q.y), out += ',';
+  Number(out, q.z), out += ',', Number(out, q.w);
+  out += ']';
+}
+
 const char* KindName(TrackKind kind) { return kind == TrackKind::kFoot ? "foot" : "body"; }
 
 // Which keys of `track` are written, in order: all of them when their frames increase (every
 // generated walk), else ascending frames (stable) with only the last of the keys sharing a frame,
 // as the glTF and MEL exporters key them, so that the file reads back. `order` is left empty for
 // the first case.
-void KeyOrder(const WalkTrack& track, std::vector<size_t>* order) {
+void WrittenOrder(const WalkTrack& track, std::vector<size_t>* order) {
   order->clear();
   const auto& keys = track.keys;
   bool increasing = true;
@@ -58,17 +65,7 @@ void KeyOrder(const WalkTrack& track, std::vector<size_t>* order) {
   // A NaN frame (written as null, refused on reading) has no place in any order.
   const bool finite = std::all_of(keys.begin(), keys.end(),
                                   [](const WalkKey& k) { return std::isfinite(k.frame); });
-  if (increasing || !finite) return;
-  std::vector<size_t> sorted(keys.size());
-  for (size_t i = 0; i < sorted.size(); ++i) sorted[i] = i;
-  std::stable_sort(sorted.begin(), sorted.end(),
-                   [&keys](size_t a, size_t b) { return keys[a].frame < keys[b].frame; });
-  for (size_t index : sorted) {
-    if (!order->empty() && keys[order->back()].frame == keys[index].frame)
-      order->back() = index;  // same frame: the later key wins
-    else
-      order->push_back(index);
-  }
+  if (!increasing && finite) *order = KeyOrder(track);
 }
 
 }  // namespace
@@ -90,6 +87,8 @@ void AppendRun(const Walk& walk, const KeyRun& run, const std::vector<size_t>& o
                std::string& out) {
   const WalkTrack& t = walk.tracks[run.track];
   const size_t count = order.empty() ? t.keys.size() : order.size();
+  // A foot track's orientations, when it carries one per key (AddFootRotations).
+  const bool rotated = t.kind == TrackKind::kFoot && t.rotations.size() == t.keys.size();
   if (run.first == 0) {
     out += run.track ? ",\n" : "\n";
     out += "{\"name\":";
@@ -112,14 +111,11 @@ void AppendRun(const Walk& walk, const KeyRun& run, const std::vector<size_t>& o
       Vector(out, k.position);
       out += ",\"normal\":";
       Vector(out, k.normal);
+      if (rotated) Rotation(out, t.rotations[ki]);
     } else {
       out += ",\"position\":";
       Vector(out, k.position);
-      out += ",\"rotation\":[";
-      const Quat q = t.Rotation(ki);
-      Number(out, q.x), out += ',', Number(out, q.y), out += ',';
-      Number(out, q.z), out += ',', Number(out, q.w);
-      out += ']';
+      Rotation(out, t.Rotation(ki));
     }
     out += '}';
   }
@@ -135,7 +131,7 @@ bool EmitWalkJson(const Walk& walk, const std::function<bool(std::string_view)>&
   std::vector<KeyRun> runs;
   size_t keys = 0;
   for (size_t ti = 0; ti < walk.tracks.size(); ++ti) {
-    KeyOrder(walk.tracks[ti], &orders[ti]);
+    WrittenOrder(walk.tracks[ti], &orders[ti]);
     const size_t count = orders[ti].empty() ? walk.tracks[ti].keys.size() : orders[ti].size();
     keys += count;
     size_t first = 0;

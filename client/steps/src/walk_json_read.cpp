@@ -84,7 +84,8 @@ bool ReadKey(Reader& r, const json& k, const std::string& kw, WalkTrack* track) 
     r.Fail(kw, "expected an object with frame and position");
     return false;
   }
-  static const std::set<std::string> kFootKey = {"frame", "phase", "position", "normal", "comment"};
+  static const std::set<std::string> kFootKey = {"frame",  "phase",    "position",
+                                                 "normal", "rotation", "comment"};
   static const std::set<std::string> kBodyKey = {"frame", "position", "rotation", "comment"};
   if (!r.Known(k, kw, track->kind == TrackKind::kFoot ? kFootKey : kBodyKey)) return false;
   if (!r.Finite(k["frame"], kw + ".frame", &key.frame)) return false;
@@ -114,6 +115,23 @@ bool ReadKey(Reader& r, const json& k, const std::string& kw, WalkTrack* track) 
         r.Fail(kw + ".normal", "expected a non-zero normal [nx, ny, nz]");
         return false;
       }
+    }
+    // A foot's orientations (AddFootRotations) are on every key of its track or on none.
+    const bool rotated = k.contains("rotation");
+    if (!track->keys.empty() && rotated != (track->rotations.size() == track->keys.size())) {
+      r.Fail(rotated ? kw + ".rotation" : kw,
+             "expected a rotation on every key of a foot track or on none (the first key has " +
+                 std::string(track->rotations.empty() ? "none" : "one") + ")");
+      return false;
+    }
+    if (rotated) {
+      double q[4];
+      if (!r.Array(k["rotation"], 4, kw + ".rotation", q)) return false;
+      if (std::max({std::fabs(q[0]), std::fabs(q[1]), std::fabs(q[2]), std::fabs(q[3])}) == 0) {
+        r.Fail(kw + ".rotation", "expected a non-zero quaternion [qx, qy, qz, qw]");
+        return false;
+      }
+      track->rotations.push_back({q[0], q[1], q[2], q[3]});
     }
   } else {
     double q[4] = {0, 0, 0, 1};

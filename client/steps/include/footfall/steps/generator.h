@@ -95,6 +95,9 @@ struct GenerateOptions {
   // character id "c1".."cN".
   int crowd = 1;
   double crowd_spacing = 0;
+  // Foot tracks also carry each key's orientation (AddFootRotations, foot_rotations.h), which
+  // the walk JSON then writes.
+  bool foot_rotations = false;
   // Threads for the generator's own work on large crowds: in process, passes walked in parallel,
   // one per thread; otherwise the per-character work between batches (the session splits its
   // batches by itself). The walk is the same whatever the count. [Limit: >= 1]

@@ -24,6 +24,10 @@ inline Vec3 Rotate(const Quat& q, const Vec3& v) {
   return v + t * q.w + Cross(u, t);
 }
 
+// q / |q| (scaled by its largest component first, so that no square overflows or
+// underflows); the identity when q is zero or not finite.
+Quat Normalized(const Quat& q);
+
 // Where a foot key sits in its step: lift-off, top of the swing arc, touch-down. Body keys
 // have no phase.
 enum class KeyPhase : uint8_t { kNone, kStart, kMid, kEnd };
@@ -72,8 +76,8 @@ struct WalkTrack {
   // default heap. Declared before the keys: destroyed after them.
   KeyMemory memory;
   std::pmr::vector<WalkKey> keys;  // ascending frames
-  // Body tracks: the body's world orientation at each key (rotations[i] at keys[i]). Empty for
-  // feet.
+  // Body tracks: the body's world orientation at each key (rotations[i] at keys[i]). Foot
+  // tracks: empty, or each key's orientation once given (AddFootRotations, foot_rotations.h).
   std::pmr::vector<Quat> rotations;
 
   // The orientation at keys[i]: rotations[i], or the identity where there is none.
@@ -103,6 +107,10 @@ struct Walk {
   // How many of stops, from the front, are the engine's failures (one per character it failed).
   size_t failed_stops = 0;
 };
+
+// Indices into track.keys in ascending frame order (stable); of keys sharing a frame only the
+// last (in track order) is listed. Keys whose frame is not finite are left out.
+std::vector<size_t> KeyOrder(const WalkTrack& track);
 
 const char* PhaseName(KeyPhase phase);  // "start", "mid", "end" or ""
 

@@ -3,6 +3,7 @@
 //   {"format": "footfall-walk", "version": 1, "fps": 24, "stopped": "",
 //    "tracks": [{"name": "L1", "kind": "foot", "keys": [{"frame": 1, "phase": "start",
 //                "position": [x, y, z], "normal": [nx, ny, nz]}, ...]},
+//               (foot keys given their orientations, AddFootRotations, add "rotation"),
 //               {"name": "body", "kind": "body", "keys": [{"frame": 1, "position": [x, y, z],
 //                "rotation": [qx, qy, qz, qw]}, ...]}]}
 // Crowd tracks add "character": "c1". Numbers are written so they read back exactly.
