@@ -212,23 +212,25 @@ class BlenderAddonTest(unittest.TestCase):
             type(self)._tree, type(self)._count = tree, len(pts)
         return type(self)._tree
 
-    def cli_walk(self, rig, steps, name):
+    def cli_walk(self, rig, steps, name, *flags):
         out = os.path.join(ARGS.work_dir, name + ".json")
         mw = rig.matrix_world
         run_cli("generate", "--terrain", self.pts, "--character", rig.footfall_rig.character_path,
                 "--start", csv(to_ff(mw.translation)),
                 "--heading", csv(to_ff(mw.to_3x3() @ Vector((0, -1, 0)))),
                 "--steps", steps, "--start-frame", bpy.context.scene.footfall.start_frame,
-                "--server", "127.0.0.1:%d" % self.server.port, "--out", out)
+                "--server", "127.0.0.1:%d" % self.server.port, "--out", out, *flags)
         with open(out) as f:
             return json.load(f), out
 
     def assert_keys_equal_walk(self, walk, feet, body, scale=1.0):
-        """The objects' keys are exactly the walk's tracks (frames, positions, rotations), in
-        a scene of Unit Scale `scale` (positions divided by it)."""
+        """The objects' keys are exactly the walk's tracks (frames, positions, rotations: the
+        body's, and the feet's where the walk has them), in a scene of Unit Scale `scale`
+        (positions divided by it)."""
         for track in walk["tracks"]:
             is_body = track["kind"] == "body"
             obj = body if is_body else feet[track["name"]]
+            rotated = all("rotation" in k for k in track["keys"])
             keys = fcurve_keys(obj, "location", 3)
             frames = sorted({k["frame"] for k in track["keys"]})
             self.assertEqual(sorted(keys), [float(f) for f in frames], track["name"])
@@ -238,7 +240,7 @@ class BlenderAddonTest(unittest.TestCase):
                 for g, w in zip(got, want):
                     self.assertAlmostEqual(g, w, delta=TOL * max(1.0, abs(w)),
                                            msg="%s frame %s" % (track["name"], k["frame"]))
-            if is_body:
+            if rotated:
                 rots = body_rotation_keys(obj)
                 for k in track["keys"]:
                     x, y, z, w = k["rotation"]
@@ -246,8 +248,8 @@ class BlenderAddonTest(unittest.TestCase):
                     got = rots[float(k["frame"])]
                     same = all(abs(g - v) < TOL for g, v in zip(got, want))
                     flipped = all(abs(g + v) < TOL for g, v in zip(got, want))
-                    self.assertTrue(same or flipped, "body rotation at %s: %s vs %s"
-                                    % (k["frame"], got, want))
+                    self.assertTrue(same or flipped, "%s rotation at %s: %s vs %s"
+                                    % (track["name"], k["frame"], got, want))
 
     def assert_feet_on_terrain(self, walk):
         tree = self.samples_tree()
@@ -726,11 +728,11 @@ class BlenderAddonTest(unittest.TestCase):
                     depsgraph = bpy.context.evaluated_depsgraph_get()
                     mw = obj.evaluated_get(depsgraph).matrix_world
                     worst = max(worst, (mw.translation - Vector(from_ff(k["position"]))).length)
-                    if is_body:
+                    if "rotation" in k:
                         x, y, z, w = k["rotation"]
                         got = mw.to_quaternion()
                         self.assertGreater(abs(got.dot(Quaternion((w, x, -z, y)))), 1 - tol,
-                                           "body rotation at %s" % k["frame"])
+                                           "%s rotation at %s" % (track["name"], k["frame"]))
         finally:
             scene.frame_set(frame)
         self.assertLess(worst, tol)
@@ -2277,6 +2279,68 @@ class BlenderAddonTest(unittest.TestCase):
                 for t in expected["tracks"] if t["kind"] == "foot"}
         self.assert_keys_equal_walk(expected, feet, bpy.data.objects["units_walk_gltf_body"],
                                     scale)
+
+    def test_9x1_foot_rotations_key_each_target_on_its_ground(self):
+        # Foot rotations on: each IK target is keyed turned as the walk's glTF and MEL key the
+        # feet (--foot-rotations), standing on its ground; off again, the walk's rotation keys
+        # on the targets go, and the user's own after the walk stay.
+        rig, feet, body = rig_feet_body("biped_rig")
+        settings = bpy.context.scene.footfall
+        settings.rig, settings.steps, settings.start_frame = rig, 6, 1
+        self.select([rig], rig)
+        clear_animation(list(feet.values()) + [body])
+        foot = feet["L"]
+        foot.rotation_mode = "XYZ"
+        own = foot.rotation_euler.copy()
+        foot.rotation_euler = Euler((0.1, 0.2, 0.3))
+        foot.keyframe_insert("rotation_euler", frame=500)
+        foot.rotation_euler = own
+        self.assertNotIn("foot_rotations", self.ops.walk_request(bpy.context, rig, 6, 1))
+        settings.foot_rotations = True
+        try:
+            self.assertIs(self.ops.walk_request(bpy.context, rig, 6, 1)["foot_rotations"], True)
+            self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
+        finally:
+            settings.foot_rotations = False
+        expected, out = self.cli_walk(rig, 6, "turned_cli", "--foot-rotations")
+        got = json.loads(bpy.data.texts["footfall_walk.json"].as_string())
+        self.assertEqual(got, expected)  # the command line's walk, rotations and all
+        foot_keys = [k for t in got["tracks"] if t["kind"] == "foot" for k in t["keys"]]
+        self.assertTrue(foot_keys and all("rotation" in k for k in foot_keys))
+        self.assertTrue(rig.footfall_rig.walk_turned_feet)
+        self.assert_keys_equal_walk(expected, feet, body)
+        self.assert_world_at_key_frames(expected, feet, body)
+        for k in foot_keys:  # each target's up (its local Z in Blender) on the key's normal
+            x, y, z, w = k["rotation"]
+            up = Quaternion((w, x, -z, y)) @ Vector((0, 0, 1))
+            self.assertGreater(up.dot(Vector(from_ff(k["normal"])).normalized()), 1 - 1e-6)
+        self.assertIn(500.0, body_rotation_keys(foot))
+        # Off: the walk's foot rotation keys go (the targets keep the orientation they have),
+        # the user's key after the walk stays.
+        self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
+        self.assertFalse(rig.footfall_rig.walk_turned_feet)
+        plain, _ = self.cli_walk(rig, 6, "unturned_cli")
+        self.assertEqual(json.loads(bpy.data.texts["footfall_walk.json"].as_string()), plain)
+        self.assert_keys_equal_walk(plain, feet, body)
+        for obj in feet.values():
+            self.assertEqual(sorted(body_rotation_keys(obj)), [500.0] if obj == foot else [],
+                             obj.name)
+        # Imported onto new empties, from the JSON and from the glTF: turned the same.
+        gltf = out[:-5] + ".gltf"
+        run_cli("generate", "--terrain", self.pts, "--character", rig.footfall_rig.character_path,
+                "--start", csv(to_ff(rig.matrix_world.translation)),
+                "--heading", csv(to_ff(rig.matrix_world.to_3x3() @ Vector((0, -1, 0)))),
+                "--steps", 6, "--foot-rotations", "--out", gltf)
+        settings.rig = None
+        for path, prefix in ((out, "turned_cli_"), (gltf, "turned_cli_")):
+            with bpy.context.temp_override(active_object=None):
+                self.assertEqual(bpy.ops.footfall.import_walk(filepath=path), {"FINISHED"})
+            made = {t["name"]: bpy.data.objects[prefix + t["name"]]
+                    for t in expected["tracks"] if t["kind"] == "foot"}
+            self.assert_keys_equal_walk(expected, made, bpy.data.objects[prefix + "body"])
+            for obj in list(made.values()) + [bpy.data.objects[prefix + "body"]]:
+                bpy.data.objects.remove(obj)
+        settings.rig = rig
 
     def test_9y_a_deleted_scenes_terrains_are_unloaded(self):
         # Terrains were unloaded only when a file was loaded: a deleted scene's stayed loaded on

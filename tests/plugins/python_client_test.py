@@ -669,6 +669,17 @@ class SharedLogicTest(unittest.TestCase):
                    {"frame": 1, "position": [0, 0, 0], "rotation": [0, 0, 1]}]}]},
                 "expected \"rotation\""),
                ([], "expected footfall walk JSON")]
+        # A foot's rotations (foot rotations asked for) are on all its keys or on none.
+        turned = {"frame": 1, "position": [0, 0, 0], "rotation": [0, 0, 0, 1]}
+        ff.character.check_walk({"tracks": [{"name": "L", "keys": [turned, dict(turned,
+                                                                                 frame=2)]}]})
+        bad += [({"tracks": [{"name": "L", "keys": [{"frame": 1, "position": [0, 0, 0]},
+                                                    dict(turned, frame=2)]}]},
+                 "tracks[0].keys[1]: expected a rotation on every key of a foot track or on none "
+                 "(the first key has none)"),
+                ({"tracks": [{"name": "L", "keys": [turned, {"frame": 2,
+                                                             "position": [0, 0, 0]}]}]},
+                 "(the first key has one)")]
         # Integers beyond a double, as JSON allows them (math.isfinite raised OverflowError,
         # which Blender's Import showed as a traceback).
         huge = 10 ** 400
@@ -1793,6 +1804,71 @@ class MayaKeyWalkTest(unittest.TestCase):
                 for a, b in zip(euler, previous):
                     self.assertLess(abs(a - b), 3.0, msg="%s after %s" % (euler, previous))
             previous = euler
+
+    def test_foot_rotations_turn_the_handles_in_rotate_order_zxy(self):
+        # A walk generated with foot rotations: each handle whose every key has one is keyed
+        # turned, in ZXY as the body (and as the MEL export's --foot-rotations); a handle
+        # without them keeps its own rotation.
+        def tilted(deg):
+            h = math.radians(deg) / 2
+            return (math.sin(h), 0.0, 0.0, math.cos(h))
+        turned = [{"frame": 1 + i, "phase": "end", "position": [0.1, 0.0, 0.1 * i],
+                   "normal": [0.0, 1.0, 0.0], "rotation": tilted(5 * i)} for i in range(4)]
+        plain = [{"frame": 1 + i, "phase": "end", "position": [-0.1, 0.0, 0.1 * i],
+                  "normal": [0.0, 1.0, 0.0]} for i in range(4)]
+        walk = {"tracks": [{"name": "L", "kind": "foot", "keys": turned},
+                           {"name": "R", "kind": "foot", "keys": plain}]}
+        calls = self._key_walk(walk, {"L": "footL", "R": "footR"}, None)
+        self.assertEqual([c for c in calls if c[0] == "setAttr"],
+                         [("setAttr", ("footL.rotateOrder", 2), {})])
+        rotations = [c for c in calls if c[0] == "xform" and "ro" in c[2]]
+        self.assertEqual([c[1] for c in rotations], [("footL",)] * len(turned))
+        self.assertEqual(len([c for c in calls if c[0] == "setKeyframe" and
+                              c[2].get("attribute") == "rotate"]), len(turned))
+        for key, call in zip(turned, rotations):
+            got = RotationTest._matrix_of_euler(call[2]["ro"], "zxy")
+            want = RotationTest._matrix_of_quat(key["rotation"])
+            for i in range(3):
+                for j in range(3):
+                    self.assertAlmostEqual(got[i][j], want[i][j], places=9)
+
+    def test_generate_walk_asks_for_foot_rotations(self):
+        requests = []
+
+        class FakeSession:
+            def generate_json_with_notes(self, terrain, request):
+                requests.append(dict(request))
+                keys = [{"frame": 1, "phase": "end", "position": [0.0, 0.0, 0.0],
+                         "normal": [0.0, 1.0, 0.0], "rotation": [0.0, 0.0, 0.0, 1.0]}]
+                return 0, json.dumps({"tracks": [{"name": "L", "kind": "foot",
+                                                  "keys": keys}]}), None, []
+        with open(os.path.join(CHARACTERS, "biped.json")) as f:
+            attributes = {"footfallCharacter": f.read(), "footfallFoot0": None}
+        calls = []
+        cmds = types.ModuleType("maya.cmds")
+        cmds.currentUnit = lambda *args, **kwargs: "deg"
+        for name in ("setKeyframe", "cutKey", "undoInfo", "warning", "confirmDialog", "addAttr"):
+            setattr(cmds, name, lambda *args, _name=name, **kwargs:
+                    calls.append((_name, args, kwargs)))
+        cmds.setAttr = lambda plug, *values, **kwargs: calls.append(("setAttr", (plug,) + values,
+                                                                      kwargs))
+        cmds.getAttr = lambda plug, **kwargs: attributes.get(plug.split(".")[1])
+        cmds.attributeQuery = lambda attr, node, exists: attr in attributes
+        cmds.listConnections = lambda plug, **kwargs: [plug.split(".")[1] + "_handle"]
+        cmds.fileInfo = lambda *args, **kwargs: ["scene-1"]
+        cmds.xform = lambda *args, **kwargs: (
+            [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1] if kwargs.get("m")
+            else [0.0, 0.0, 0.0]) if kwargs.get("q") else calls.append(("xform", args, kwargs))
+        with self._footfall_maya(cmds) as footfall_maya:
+            footfall_maya._session = lambda: FakeSession()
+            footfall_maya._connection = types.SimpleNamespace(
+                terrain=lambda name: 1, has_terrain=lambda name: name == "scene-1")
+            footfall_maya.generate_walk("biped_rig", 2, 1)
+            footfall_maya.generate_walk("biped_rig", 2, 1, foot_rotations=True)
+        self.assertNotIn("foot_rotations", requests[0])
+        self.assertIs(requests[-1]["foot_rotations"], True)
+        # The handle is keyed turned (the walk's foot keys have rotations).
+        self.assertIn(("setAttr", ("footfallFoot0_handle.rotateOrder", 2), {}), calls)
 
     def test_rotations_are_keyed_in_the_scenes_angle_unit(self):
         # xform takes the scene's angle unit: in a scene set to radians, degrees turned the

@@ -335,16 +335,17 @@ def action_frame(obj, frame):
     return frame
 
 
-def clear_keys(objects, from_frame, body=None, to_frame=None):
+def clear_keys(objects, from_frame, body=None, to_frame=None, turned=()):
     """Removes location keys at frames from from_frame to to_frame (None: on to the end) from
-    `objects`, and the rotation keys of `body` (one of them) in the path of its rotation
-    mode. A curve left without keys is removed, but for one with modifiers, kept for the keys
-    to come."""
+    `objects`, and the rotation keys of `body` (one of them) and of the objects in `turned`
+    (feet whose rotations a walk keys) in the path of its rotation mode. A curve left without
+    keys is removed, but for one with modifiers, kept for the keys to come."""
     for obj in objects:
         action = obj.animation_data.action if obj and obj.animation_data else None
         if action is None:
             continue
-        paths = ("location", rotation_path(obj)) if obj == body else ("location",)
+        rotated = obj == body or obj in turned
+        paths = ("location", rotation_path(obj)) if rotated else ("location",)
         first = action_frame(obj, from_frame)
         last = None if to_frame is None else action_frame(obj, to_frame)
         for fc in list(action.fcurves):
@@ -447,13 +448,20 @@ def _key_channel(obj, path, values, frames):
     setattr(obj, path, values[-1])
 
 
-def _worlds(is_body, keys, orientation, scale):
-    """The world matrices of a track's keys: the body's positions and rotations, a foot's
-    positions in `orientation`; positions (metres) divided by `scale` (metres a unit)."""
+def turns(is_body, keys):
+    """True when a track's keys key its object's rotation: a body's, and a foot's whose every
+    key has one (a walk generated with foot rotations)."""
+    return is_body or (bool(keys) and all("rotation" in key for key in keys))
+
+
+def _worlds(rotated, keys, orientation, scale):
+    """The world matrices of a track's keys: positions and, for a track that turns its object
+    (`rotated`), rotations, else positions in `orientation`; positions (metres) divided by
+    `scale` (metres a unit)."""
     worlds = []
     for key in keys:
         loc = Vector(from_ff(key["position"], scale))
-        if is_body and "rotation" in key:
+        if rotated and "rotation" in key:
             rot = Quaternion(quat_from_ff(key["rotation"]))
             world = Matrix.Translation(loc) @ rot.to_matrix().to_4x4()
         else:
@@ -464,8 +472,9 @@ def _worlds(is_body, keys, orientation, scale):
 
 
 def key_walk(walk, feet, body, from_frame=None):
-    """Keys every track of `walk`: feet {foot name: object} get location keys, `body` gets
-    location and rotation keys (world orientation of the walk) in its rotation mode. Tracks
+    """Keys every track of `walk`: feet {foot name: object} get location keys (and rotation
+    keys when each of their keys has a rotation: Foot rotations), `body` gets location and
+    rotation keys (world orientation of the walk) in its rotation mode. Tracks
     without an object are skipped; with `from_frame`, so are keys before it (keyed already: a
     longer walk generated again keeps the keys of its first steps). Keys are world positions:
     an object under an animated parent is keyed in its parent's space at each key's frame (the
@@ -484,8 +493,9 @@ def key_walk(walk, feet, body, from_frame=None):
                 frames.pop(), keys.pop()
             frames.append(frame)
             keys.append(key)
-        if frames:  # a foot keeps its orientation (read at this frame)
-            tracks.append((obj, is_body, frames, keys, obj.matrix_world.normalized()))
+        if frames:  # a foot keeps its orientation (read at this frame) unless keyed
+            tracks.append((obj, turns(is_body, keys), frames, keys,
+                           obj.matrix_world.normalized()))
     # An object under another keyed object (a foot under the body) is keyed in its space, so
     # after it, in groups by the number of keyed objects above (the scene stepped once through
     # each group's frames). The keys an object above sets from `from_frame` on bend its curve
@@ -504,7 +514,7 @@ def key_walk(walk, feet, body, from_frame=None):
     try:
         for depth in sorted(groups):
             jobs = []
-            for obj, is_body, frames, keys, orientation in groups[depth]:
+            for obj, rotated, frames, keys, orientation in groups[depth]:
                 start = from_frame
                 for a in above[obj]:
                     if changed.get(a) is not None and start is not None:
@@ -512,14 +522,14 @@ def key_walk(walk, feet, body, from_frame=None):
                 first = 0 if start is None else bisect.bisect_left(frames, start)
                 if first == len(frames):
                     continue
-                jobs.append((obj, is_body, frames[first:], keys[first:], orientation,
+                jobs.append((obj, rotated, frames[first:], keys[first:], orientation,
                              start is not None and start < from_frame))
             spaces.read([(job[0], job[2]) for job in jobs])
-            for obj, is_body, frames, keys, orientation, again in jobs:
-                worlds = _worlds(is_body, keys, orientation, scale)
+            for obj, rotated, frames, keys, orientation, again in jobs:
+                worlds = _worlds(rotated, keys, orientation, scale)
                 before = _curves(obj) if obj in below else None
                 if again:  # keys from where the objects above changed
-                    clear_keys([obj], frames[0], to_frame=frames[-1])
+                    clear_keys([obj], frames[0], obj if rotated else None, frames[-1])
                 # Less its delta transform, which Blender adds to the keyed location and
                 # turns the keyed rotation by (a 0.5 m Delta Location floated every foot key).
                 delta_location = obj.delta_location.copy()
@@ -529,10 +539,10 @@ def key_walk(walk, feet, body, from_frame=None):
                     l, r, _ = (inverse @ world).decompose()
                     locations.append(tuple(l - delta_location))
                     rotations.append(undelta @ r)
-                if is_body:
+                if rotated:
                     path, values = _rotation_values(obj, rotations, frames[0])
                 _key_channel(obj, "location", locations, frames)
-                if is_body:
+                if rotated:
                     _key_channel(obj, path, values, frames)
                 spaces.forget(obj)
                 if obj in below:

@@ -647,6 +647,8 @@ def walk_request(context, rig_obj, steps, start_frame):
                "heading": list(to_ff(mw.to_3x3() @ Vector((0, -1, 0)))),
                "steps": int(steps), "start_frame": int(start_frame),
                "fps": context.scene.render.fps / context.scene.render.fps_base}
+    if settings.foot_rotations:
+        request["foot_rotations"] = True
     if settings.path is not None:
         if not in_scene(context.scene, settings.path):
             raise ValueError("the path curve %s is no longer in the scene: pick another path, or "
@@ -853,18 +855,24 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
                     walk_last = max(frames) if frames else settings.start_frame
                     rig = rig_obj.footfall_rig
                     objects = list(feet.values()) + [body]
+                    # The feet's rotation keys go where this walk keys them (Foot rotations)
+                    # and where the previous walk did; otherwise they are the user's.
+                    turned = set(feet.values()) if settings.foot_rotations else set()
                     if walk_text is None:
                         # The previous walk's keys (up to its end, or on to the last key for a
                         # rig of an older version).
                         keying.clear_keys(objects, settings.start_frame, body,
-                                          rig.walk_end if rig.walk_end_known else None)
+                                          rig.walk_end if rig.walk_end_known else None,
+                                          turned | (set(feet.values()) if rig.walk_turned_feet
+                                                    else set()))
                     # Keys within this walk's frames so far go as it is keyed there; the user's
                     # keys after both walks stay (the walk's end is its last key, not its start
                     # plus Steps: a path walk that reached its goal early removed the user's
                     # later keys).
                     keying.clear_keys(objects, settings.start_frame if last_frame is None
-                                      else last_frame + 1e-3, body, walk_last)
+                                      else last_frame + 1e-3, body, walk_last, turned)
                     rig.walk_end_known, rig.walk_end = True, walk_last
+                    rig.walk_turned_feet = bool(settings.foot_rotations)
                     keying.key_walk(walk, feet, body, from_frame=last_frame)
                     last_frame = walk_last if frames else last_frame
                     keyed = sum(len(t.get("keys", [])) for t in walk.get("tracks", [])
@@ -958,13 +966,23 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
             for part, feet, body, rig_obj in sets:
                 frames = [k["frame"] for t in part["tracks"] for k in t.get("keys", [])]
                 first = min(frames, default=0)
-                keying.clear_keys(list(feet.values()) + [body], first, body)
+                # Feet the walk turns (it was generated with foot rotations), and on a rig
+                # those its last walk turned: their rotation keys go too.
+                turned = {feet[t["name"]] for t in part["tracks"] if t.get("name") in feet and
+                          t.get("kind", "foot") == "foot" and
+                          keying.turns(False, t.get("keys", []))}
+                previous = set()
+                if rig_obj is not None and rig_obj.footfall_rig.walk_turned_feet:
+                    previous = set(feet.values())
+                keying.clear_keys(list(feet.values()) + [body], first, body,
+                                  turned=turned | previous)
                 count += keying.key_walk(part, feet, body)
                 if rig_obj is not None and frames:
                     # The rig's walk now ends here (its keys after `first` are gone): a later
                     # Generate Walk replaces them up to here.
                     rig = rig_obj.footfall_rig
                     rig.walk_end_known, rig.walk_end = True, max(frames)
+                    rig.walk_turned_feet = bool(turned)
         except (ffc.FootfallError, OSError, ValueError, KeyError, TypeError) as e:
             why = e.message if isinstance(e, ffc.FootfallError) else e
             return _fail(self, "footfall: cannot import %s: %s" % (path, why))
@@ -1053,9 +1071,6 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
             name = str(obj.get("track") or obj.name.split(".")[0])
             kind = str(obj.get("kind") or ("body" if ("rotation_quaternion", 0) in curves
                                            else "foot"))
-            if kind == "foot":
-                for key in keys:
-                    key.pop("rotation", None)
             track = {"name": name, "kind": kind, "keys": keys}
             if obj.get("character"):  # a crowd's: imported per character, as from JSON
                 track["character"] = str(obj.get("character"))

@@ -60,6 +60,9 @@ class FootfallRig(bpy.types.PropertyGroup):
     # user set after both are kept.
     walk_end_known: BoolProperty(default=False)
     walk_end: FloatProperty(default=0.0)
+    # Its last walk keyed the IK targets' rotations (Foot rotations): a walk again replaces
+    # them, with or without.
+    walk_turned_feet: BoolProperty(default=False)
 
 
 class FootfallScene(bpy.types.PropertyGroup):
@@ -95,6 +98,10 @@ class FootfallScene(bpy.types.PropertyGroup):
     foot_length: FloatProperty(name="Foot length", default=0.0, min=0.0, unit="LENGTH",
                                description="The sole's length along the heading, fitted onto "
                                            "stair treads; 0: the character file's value")
+    foot_rotations: BoolProperty(name="Foot rotations", default=False,
+                                 description="Key each IK target's rotation too: on its ground, "
+                                             "facing the body's heading (off: locations only, "
+                                             "and their own rotations are left alone)")
     path: PointerProperty(type=bpy.types.Object, name="Path",
                           poll=lambda self, obj: obj.type == "CURVE",
                           description="Optional curve the walk follows")

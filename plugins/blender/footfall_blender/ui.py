@@ -62,7 +62,7 @@ class FOOTFALL_PT_walk(_Panel, bpy.types.Panel):
         s = context.scene.footfall
         col = self.layout.column()
         for name in ("steps", "start_frame", "frames_per_step", "step_length", "step_height",
-                     "foot_length", "path"):
+                     "foot_length", "foot_rotations", "path"):
             col.prop(s, name)
         col.operator("footfall.generate_walk")
         col.operator("footfall.import_walk")

@@ -312,7 +312,9 @@ def _rig_targets(rig):
 
 def key_walk(walk, feet, body, from_frame=None):
     """Keys the walk (footfall JSON dict) on the IK handles and body, as the seed's tool did;
-    with `from_frame`, only its keys from that frame on (those before are keyed already)."""
+    with `from_frame`, only its keys from that frame on (those before are keyed already). The
+    body is keyed turned, and so is a handle whose every key has a rotation (a walk generated
+    with foot rotations)."""
     count = 0
     to_ui_angle = _ui_angles()
     for track in walk.get("tracks", []):
@@ -320,9 +322,11 @@ def key_walk(walk, feet, body, from_frame=None):
         node = body if is_body else feet.get(track.get("name"))
         if not node:
             continue
+        keys = track.get("keys", [])
+        turns = is_body or (bool(keys) and all("rotation" in key for key in keys))
         order = 2
-        if is_body:
-            # A body with rotation keys of its own keeps its rotate order, the walk keyed in it
+        if turns:
+            # A node with rotation keys of its own keeps its rotate order, the walk keyed in it
             # (setting another reinterpreted those keys: a pose keyed before the walk turned).
             # Any other turns in ZXY, as the MEL export: heading is rotateY alone, so a body
             # heading +-X is not at gimbal lock (in Maya's default XYZ it is).
@@ -330,10 +334,9 @@ def key_walk(walk, feet, body, from_frame=None):
                 order = int(mc.getAttr(node + ".rotateOrder"))
             else:
                 mc.setAttr(node + ".rotateOrder", 2)
-        keys = track.get("keys", [])
-        # Euler degrees in the body's rotate order (ZXY: R = Ry * Rx * Rz, as the MEL export
+        # Euler degrees in the node's rotate order (ZXY: R = Ry * Rx * Rz, as the MEL export
         # keys them), each nearest its neighbour's, keyed or not.
-        rotated = [n for n, key in enumerate(keys) if is_body and "rotation" in key]
+        rotated = [n for n, key in enumerate(keys) if turns and "rotation" in key]
         eulers = dict(zip(rotated, ffc.rotation.continuous_eulers(
             [keys[n]["rotation"] for n in rotated], order)))
         for n, key in enumerate(keys):
@@ -356,10 +359,12 @@ def key_walk(walk, feet, body, from_frame=None):
 
 @_guard
 def generate_walk(rig, steps=8, start_frame=1, frames_per_step=0, step_length=0.0,
-                  step_height=0.0, path=None, chunk_steps=0, foot_length=0.0):
+                  step_height=0.0, path=None, chunk_steps=0, foot_length=0.0,
+                  foot_rotations=False):
     """Generates `steps` steps for `rig` and keys them; keys made before a failure stay (the
-    error says how many). One undo chunk; progress in the main progress bar. The walk's notes
-    are shown as warnings."""
+    error says how many). `foot_rotations`: the IK handles are keyed turned too, each foot on
+    its ground facing the body's heading (as the MEL export's --foot-rotations). One undo
+    chunk; progress in the main progress bar. The walk's notes are shown as warnings."""
     _require_y_up()
     _scene_terrain_key()  # (no terrain: before anything else)
     data, feet, body = _rig_targets(rig)
@@ -371,6 +376,8 @@ def generate_walk(rig, steps=8, start_frame=1, frames_per_step=0, step_length=0.
                "start_frame": start_frame}
     if path:
         request["path"] = _curve_points(path)
+    if foot_rotations:
+        request["foot_rotations"] = True
     chunk = chunk_steps or max(1, int(math.ceil(steps / 10.0)))
     s = _session()
     terrain = _scene_terrain()
@@ -567,6 +574,7 @@ def show():
     length = mc.floatFieldGrp(label="Step length (0: file)", value1=0)
     height = mc.floatFieldGrp(label="Step height (0: file)", value1=0)
     foot = mc.floatFieldGrp(label="Foot length (0: file)", value1=0)
+    turned = mc.checkBoxGrp(label="Foot rotations", value1=False)
     curve = mc.textFieldGrp(label="Path curve")
 
     @_guard  # (attributeQuery raises on a selected component)
@@ -582,7 +590,8 @@ def show():
                       mc.floatFieldGrp(length, q=True, value1=True),
                       mc.floatFieldGrp(height, q=True, value1=True),
                       mc.textFieldGrp(curve, q=True, text=True) or None,
-                      foot_length=mc.floatFieldGrp(foot, q=True, value1=True))
+                      foot_length=mc.floatFieldGrp(foot, q=True, value1=True),
+                      foot_rotations=bool(mc.checkBoxGrp(turned, q=True, value1=True)))
     mc.button(label="Generate Walk", command=generate)
     mc.setParent("..")
     mc.showWindow(WINDOW)

@@ -237,7 +237,7 @@ def check_walk(walk, name="walk"):
     """Raises ValueError naming the first problem of a footfall walk dict (JSON format
     "footfall-walk", as read from a file), before a plugin keys or creates anything: tracks
     with a name and a kind, keys with a finite frame, a position of three finite numbers and,
-    where given, a rotation of four."""
+    where given, a rotation of four (a foot's on all its keys or on none)."""
     if not isinstance(walk, dict) or not isinstance(walk.get("tracks"), list):
         raise ValueError("%s: expected footfall walk JSON with a \"tracks\" list" % name)
 
@@ -264,6 +264,13 @@ def check_walk(walk, name="walk"):
                                       not any(key["rotation"])):
                 raise ValueError("%s: expected \"rotation\": [x, y, z, w] (finite numbers, not "
                                  "all zero)" % at)
+            # A foot's rotations (a walk generated with foot rotations) are on all its keys or
+            # on none, as footfall's reader takes them.
+            if track.get("kind", "foot") == "foot" and k > 0 and \
+                    ("rotation" in key) != ("rotation" in keys[0]):
+                raise ValueError("%s: expected a rotation on every key of a foot track or on none "
+                                 "(the first key has %s)"
+                                 % (at, "one" if "rotation" in keys[0] else "none"))
 
 
 def rig_tracks(walk, feet, has_body, name="walk"):
