@@ -1,5 +1,5 @@
 // The walk as JSON, footfall's canonical interchange (read by the viewer and the Blender
-// plugin). Format "footfall-walk", version 1, documented in client/steps/README.md:
+// plugin). Format "footfall-walk", version 1, documented in the top-level README ("Walk JSON"):
 //   {"format": "footfall-walk", "version": 1, "fps": 24, "stopped": "",
 //    "tracks": [{"name": "L1", "kind": "foot", "keys": [{"frame": 1, "phase": "start",
 //                "position": [x, y, z], "normal": [nx, ny, nz]}, ...]},
