@@ -102,6 +102,20 @@ check "scene: every character walks as it would alone" scene_check "$work/scene-
   --out "$work/scene.mel" --out "$work/scene.gltf" --out "$work/scene.pts" 2> /dev/null
 check "scene: MEL, glTF and the terrain written" [ -s "$work/scene.mel" -a -s "$work/scene.gltf" -a -s "$work/scene.pts" ]
 check "scene: a MEL group per character" [ "$(grep -c '^$footfall_groups\[' "$work/scene.mel")" -eq 6 ]
+# --foot-rotations applies to the whole scene: every foot key of every character is turned, and
+# the rest of the walk is the same.
+"$footfall" generate --terrain "$work/floor.pts" --scene "$work/scene/scene.json" --foot-rotations \
+  --out "$work/scene-turned.json" 2> /dev/null
+check "scene: --foot-rotations turns every foot key, nothing else changes" python3 - "$work/scene-embedded.json" "$work/scene-turned.json" <<'PY'
+import json, sys
+plain, turned = (json.load(open(p)) for p in sys.argv[1:])
+feet = [t for t in turned["tracks"] if t["kind"] == "foot"]
+assert len({t.get("character") for t in feet}) > 2 and all("rotation" in k for t in feet for k in t["keys"])
+for t in feet:
+    for k in t["keys"]:
+        del k["rotation"]
+assert turned == plain
+PY
 # A character that stops after a crowd's 25 stops is named on stderr: the list of 20 stops was
 # the scene's, and a biped stopped at the terrain's edge went unnamed.
 "$footfall" terrain make flat --size 40 --spacing 0.25 -o "$work/flat40c.pts" > /dev/null
