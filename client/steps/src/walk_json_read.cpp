@@ -76,6 +76,20 @@ struct Reader {
   }
 };
 
+// Reads the "rotation" of key object `k` (at `kw`; the identity when it has none) onto the end
+// of track->rotations; false, with r's error, when it is not four numbers, not all zero.
+bool ReadRotation(Reader& r, const json& k, const std::string& kw, WalkTrack* track) {
+  double q[4] = {0, 0, 0, 1};
+  if (k.contains("rotation") && !r.Array(k["rotation"], 4, kw + ".rotation", q)) return false;
+  // Any non-zero length (1e-10 or 1e300 components alike): readers normalise it.
+  if (std::max({std::fabs(q[0]), std::fabs(q[1]), std::fabs(q[2]), std::fabs(q[3])}) == 0) {
+    r.Fail(kw + ".rotation", "expected a non-zero quaternion [qx, qy, qz, qw]");
+    return false;
+  }
+  track->rotations.push_back({q[0], q[1], q[2], q[3]});
+  return true;
+}
+
 // Reads key object `k` (at `kw`, for messages) onto the end of `track`, whose kind says which
 // fields it has; false, with r's error, when it is refused.
 bool ReadKey(Reader& r, const json& k, const std::string& kw, WalkTrack* track) {
@@ -124,24 +138,9 @@ bool ReadKey(Reader& r, const json& k, const std::string& kw, WalkTrack* track) 
                  std::string(track->rotations.empty() ? "none" : "one") + ")");
       return false;
     }
-    if (rotated) {
-      double q[4];
-      if (!r.Array(k["rotation"], 4, kw + ".rotation", q)) return false;
-      if (std::max({std::fabs(q[0]), std::fabs(q[1]), std::fabs(q[2]), std::fabs(q[3])}) == 0) {
-        r.Fail(kw + ".rotation", "expected a non-zero quaternion [qx, qy, qz, qw]");
-        return false;
-      }
-      track->rotations.push_back({q[0], q[1], q[2], q[3]});
-    }
-  } else {
-    double q[4] = {0, 0, 0, 1};
-    if (k.contains("rotation") && !r.Array(k["rotation"], 4, kw + ".rotation", q)) return false;
-    // Any non-zero length (1e-10 or 1e300 components alike): readers normalise it.
-    if (std::max({std::fabs(q[0]), std::fabs(q[1]), std::fabs(q[2]), std::fabs(q[3])}) == 0) {
-      r.Fail(kw + ".rotation", "expected a non-zero quaternion [qx, qy, qz, qw]");
-      return false;
-    }
-    track->rotations.push_back({q[0], q[1], q[2], q[3]});
+    if (rotated && !ReadRotation(r, k, kw, track)) return false;
+  } else if (!ReadRotation(r, k, kw, track)) {
+    return false;
   }
   track->keys.push_back(key);
   return true;
