@@ -687,6 +687,66 @@ TEST_CASE("screenshot of a walk shows the feet where the JSON puts them at that 
   }
 }
 
+TEST_CASE("a foot that carries rotations is posed with them, one without has none",
+          "[viewer][walk]") {
+  // (--foot-rotations walks: the feet's orientations were read and then not shown.)
+  const std::string dir = test::TempDir();
+  const double s = std::sqrt(0.5);
+  test::WriteFile(dir + "/turned.json", R"({"format": "footfall-walk", "version": 1, "fps": 24,
+    "tracks": [
+    {"name": "L", "kind": "foot", "keys": [
+      {"frame": 1, "phase": "end", "position": [0, 0, 0], "normal": [0, 1, 0],
+       "rotation": [0, 0, 0, 1]},
+      {"frame": 11, "phase": "end", "position": [0, 0, 1], "normal": [0, 1, 0],
+       "rotation": [0, 1, 0, 1]}]},
+    {"name": "R", "kind": "foot", "keys": [
+      {"frame": 1, "phase": "end", "position": [1, 0, 0], "normal": [0, 1, 0]}]}]})");
+  struct Case {
+    int frame;
+    double y, w;  // the foot's rotation: a turn about Y
+  };
+  const double quarter = std::sin(M_PI / 8), quarter_w = std::cos(M_PI / 8);
+  for (const Case& c : {Case{1, 0, 1}, Case{6, quarter, quarter_w}, Case{11, s, s}}) {
+    INFO("frame " << c.frame);
+    const RunResult r =
+        View({"--walk", dir + "/turned.json", "--frame", std::to_string(c.frame), "--size",
+              "160x100", "--screenshot", dir + "/turned.png", "--dump-state", dir + "/state.json"});
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    const json state = json::parse(test::ReadFile(dir + "/state.json"));
+    const json& feet = state["walk"]["tracks"];
+    REQUIRE(feet[0]["rotation"].size() == 4);
+    CHECK(feet[0]["rotation"][0].get<double>() == Approx(0).margin(1e-12));
+    CHECK(feet[0]["rotation"][1].get<double>() == Approx(c.y).margin(1e-12));
+    CHECK(feet[0]["rotation"][3].get<double>() == Approx(c.w).margin(1e-12));
+    CHECK_FALSE(feet[1].contains("rotation"));
+  }
+  // Drawn: the foot's forward is a line from it (close up, beside its normal), which the same
+  // walk without rotations lacks.
+  std::string plain = test::ReadFile(dir + "/turned.json");
+  for (const char* q : {R"(,
+       "rotation": [0, 0, 0, 1])",
+                        R"(,
+       "rotation": [0, 1, 0, 1])"})
+    plain.erase(plain.find(q), std::string(q).size());
+  // (The same file, the overlay showing its path: turned first, then plain.)
+  Image shots[2];
+  for (int i = 0; i < 2; ++i) {
+    if (i == 1) test::WriteFile(dir + "/turned.json", plain);
+    const RunResult r =
+        View({"--walk", dir + "/turned.json", "--frame", "1", "--size", "320x240", "--camera",
+              "0.06 0.08 -0.06 0 0 0.01", "--screenshot", dir + "/close.png"});
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    shots[i] = ReadPng(dir + "/close.png");
+  }
+  REQUIRE(shots[0].rgb.size() == shots[1].rgb.size());
+  int differ = 0;
+  for (int y = 0; y < shots[0].height; ++y)
+    for (int x = 0; x < shots[0].width; ++x) differ += shots[0].At(x, y) != shots[1].At(x, y);
+  CHECK(differ >= 30);
+}
+
 TEST_CASE("a walk's rotations with huge components are drawn as unit quaternions",
           "[viewer][walk]") {
   // (Squaring 1e300 overflowed: the rotation was normalised to zero, and the body drawn

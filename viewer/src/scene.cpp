@@ -428,6 +428,10 @@ void Scene::DrawWalk(const ViewState& view, DrawList* on_top) const {
     const TrackPose pose = PoseAt(track, view.frame);
     const glm::vec3 p = ToRender(pose.position);
     on_top->Line(p, p + ToRenderDirection(pose.normal) * (unit * 6), color);
+    // A foot that carries its orientation (--foot-rotations): its forward, dimmed.
+    if (track.rotations.size() == keys.size())
+      on_top->Line(p, p + ToRenderDirection(Rotate(pose.rotation, Vec3{0, 0, 1})) * (unit * 6),
+                   dim);
     on_top->Point(p, color, 16);
   }
 }
@@ -550,7 +554,8 @@ void Scene::Describe(const ViewState& view, const OrbitCamera& camera, int width
       j.Value(c.r), j.Value(c.g), j.Value(c.b);
       j.End();
       j.Key("swinging").Value(pose.swinging);
-    } else {
+    }
+    if (t.kind == TrackKind::kBody || t.rotations.size() == t.keys.size()) {
       const Quat& q = pose.rotation;
       j.Key("rotation").BeginArray();
       j.Value(q.x), j.Value(q.y), j.Value(q.z), j.Value(q.w);

@@ -53,7 +53,10 @@ TrackPose PoseAt(const WalkTrack& track, double frame) {
                           keys.begin() - 1);
   const WalkKey& a = keys[i];
   const WalkKey& b = keys[i + 1];
+  const double span = b.frame - a.frame;
+  const double t = span > 0 ? (frame - a.frame) / span : 1.0;
   TrackPose pose;
+  pose.rotation = Slerp(track.Rotation(i), track.Rotation(i + 1), t);
   if (track.kind == TrackKind::kFoot) {
     // A swing's lift-off, mid and touch-down keys around `frame` make its arc.
     size_t s = keys.size();
@@ -66,21 +69,18 @@ TrackPose PoseAt(const WalkTrack& track, double frame) {
       const WalkKey& k0 = keys[s];
       const WalkKey& km = keys[s + 1];
       const WalkKey& k1 = keys[s + 2];
-      const double span = k1.frame - k0.frame;
-      const double t = span > 0 ? (frame - k0.frame) / span : 1.0;
-      pose.position = ArcPoint(k0.position, km.position, k1.position, t);
-      const Vec3 n = Lerp(k0.normal, k1.normal, t);
+      const double swing = k1.frame - k0.frame;
+      const double u = swing > 0 ? (frame - k0.frame) / swing : 1.0;
+      pose.position = ArcPoint(k0.position, km.position, k1.position, u);
+      const Vec3 n = Lerp(k0.normal, k1.normal, u);
       pose.normal = Length2(n) > 0 ? Normalize(n) : k0.normal;
       pose.swinging = true;
       return pose;
     }
   }
-  const double span = b.frame - a.frame;
-  const double t = span > 0 ? (frame - a.frame) / span : 1.0;
   pose.position = Lerp(a.position, b.position, t);
   const Vec3 n = Lerp(a.normal, b.normal, t);
   pose.normal = Length2(n) > 0 ? Normalize(n) : a.normal;
-  pose.rotation = Slerp(track.Rotation(i), track.Rotation(i + 1), t);
   pose.swinging = a.phase == KeyPhase::kMid;  // (a lift-off with its mid key is an arc above)
   return pose;
 }

@@ -10,15 +10,16 @@ namespace footfall::viewer {
 struct TrackPose {
   Vec3 position;  // world space
   Vec3 normal{0, 1, 0};
-  Quat rotation;          // body tracks
+  Quat rotation;          // body tracks, and feet that carry rotations (AddFootRotations)
   bool swinging = false;  // feet: between a start and an end key
 };
 
 // The pose of `track` at `frame` (animation frames, may be fractional). A swing from a start
 // key through a mid key to an end key follows the quadratic arc through those three points;
-// elsewhere positions are interpolated linearly (a planted foot keeps its place) and body
-// rotations spherically. Before the first key and after the last the track holds still.
-// The track must have at least one key.
+// elsewhere positions are interpolated linearly (a planted foot keeps its place). Rotations
+// (bodies', and feet's that have them) are interpolated spherically between neighbouring keys.
+// Before the first key and after the last the track holds still. The track must have at least one
+// key.
 TrackPose PoseAt(const WalkTrack& track, double frame);
 
 // A point of the quadratic arc through start (t = 0), mid (t = 0.5) and end (t = 1).
