@@ -1847,11 +1847,16 @@ class MayaKeyWalkTest(unittest.TestCase):
         calls = []
         cmds = types.ModuleType("maya.cmds")
         cmds.currentUnit = lambda *args, **kwargs: "deg"
-        for name in ("setKeyframe", "cutKey", "undoInfo", "warning", "confirmDialog", "addAttr"):
+        for name in ("setKeyframe", "cutKey", "undoInfo", "warning", "confirmDialog"):
             setattr(cmds, name, lambda *args, _name=name, **kwargs:
                     calls.append((_name, args, kwargs)))
-        cmds.setAttr = lambda plug, *values, **kwargs: calls.append(("setAttr", (plug,) + values,
-                                                                      kwargs))
+
+        def set_attr(plug, *values, **kwargs):
+            calls.append(("setAttr", (plug,) + values, kwargs))
+            if plug.startswith("biped_rig."):
+                attributes[plug.split(".")[1]] = values[0]
+        cmds.setAttr = set_attr
+        cmds.addAttr = lambda node, longName, **kwargs: attributes.setdefault(longName, 0)  # noqa: N803
         cmds.getAttr = lambda plug, **kwargs: attributes.get(plug.split(".")[1])
         cmds.attributeQuery = lambda attr, node, exists: attr in attributes
         cmds.listConnections = lambda plug, **kwargs: [plug.split(".")[1] + "_handle"]
@@ -1863,12 +1868,25 @@ class MayaKeyWalkTest(unittest.TestCase):
             footfall_maya._session = lambda: FakeSession()
             footfall_maya._connection = types.SimpleNamespace(
                 terrain=lambda name: 1, has_terrain=lambda name: name == "scene-1")
-            footfall_maya.generate_walk("biped_rig", 2, 1)
-            footfall_maya.generate_walk("biped_rig", 2, 1, foot_rotations=True)
+            rotate_cuts = []
+            for turn in (False, True, False):
+                del calls[:]
+                footfall_maya.generate_walk("biped_rig", 2, 1, foot_rotations=turn)
+                rotate_cuts.append([sorted(c[1][0]) for c in calls
+                                    if c[0] == "cutKey" and c[2]["attribute"] == "rotate"])
+                if turn:
+                    # The handle is keyed turned (the walk's foot keys have rotations).
+                    self.assertIn(("setAttr", ("footfallFoot0_handle.rotateOrder", 2), {}),
+                                  calls)
         self.assertNotIn("foot_rotations", requests[0])
-        self.assertIs(requests[-1]["foot_rotations"], True)
-        # The handle is keyed turned (the walk's foot keys have rotations).
-        self.assertIn(("setAttr", ("footfallFoot0_handle.rotateOrder", 2), {}), calls)
+        self.assertIs(requests[2]["foot_rotations"], True)
+        # Rotate keys are cut on the body, and on the handles only where this walk or the one
+        # before turned them: an animator's own handle rotations stay otherwise.
+        body = ["footfallBody_handle"]
+        both = body + ["footfallFoot0_handle", "footfallFoot_R_handle"]
+        self.assertEqual(rotate_cuts[0], [body, body])
+        self.assertEqual(rotate_cuts[1], [both, both])
+        self.assertEqual(rotate_cuts[2], [both, body])
 
     def test_rotations_are_keyed_in_the_scenes_angle_unit(self):
         # xform takes the scene's angle unit: in a scene set to radians, degrees turned the

@@ -30,6 +30,7 @@ RIG_ATTR = "footfallCharacter"   # string attribute on the rig group: the charac
 # Double attribute on the rig group: the last frame its walk keyed (Generate Walk or Import);
 # NO_WALK before any. A rig without it (an older version's) has an unknown end.
 WALK_END_ATTR = "footfallWalkEnd"
+TURNED_FEET_ATTR = "footfallWalkTurnedFeet"  # its last walk keyed the handles' rotate
 NO_WALK = -1e9
 WINDOW = "footfallWindow"
 
@@ -289,11 +290,27 @@ def _set_walk_end(rig, frame):
     mc.setAttr(rig + "." + WALK_END_ATTR, float(frame))
 
 
-def _cut(nodes, first, last):
-    """Removes the nodes' translate and rotate keys from frame `first` to `last` (none when
-    `last` is before `first`)."""
+def _turned_feet(rig):
+    """Whether the rig's last walk keyed its IK handles' rotate (Foot rotations)."""
+    return bool(mc.attributeQuery(TURNED_FEET_ATTR, node=rig, exists=True) and
+                mc.getAttr(rig + "." + TURNED_FEET_ATTR))
+
+
+def _set_turned_feet(rig, turned):
+    if not mc.attributeQuery(TURNED_FEET_ATTR, node=rig, exists=True):
+        mc.addAttr(rig, longName=TURNED_FEET_ATTR, attributeType="bool")
+    mc.setAttr(rig + "." + TURNED_FEET_ATTR, bool(turned))
+
+
+def _cut(nodes, first, last, turned):
+    """Removes the nodes' translate keys from frame `first` to `last` (none when `last` is
+    before `first`), and the rotate keys of those in `turned` (the body, and the handles a walk
+    turns or turned): a handle's own rotate keys are the user's otherwise."""
     if nodes and last >= first:
-        mc.cutKey(nodes, time=(first, last), attribute=["translate", "rotate"], clear=True)
+        mc.cutKey(nodes, time=(first, last), attribute="translate", clear=True)
+        rotated = [n for n in nodes if n in turned]
+        if rotated:
+            mc.cutKey(rotated, time=(first, last), attribute="rotate", clear=True)
 
 
 def _rig_targets(rig):
@@ -392,6 +409,7 @@ def generate_walk(rig, steps=8, start_frame=1, frames_per_step=0, step_length=0.
         done = 0
         last_frame = None
         nodes = [n for n in list(feet.values()) + [body] if n]
+        turned = {body} | (set(feet.values()) if foot_rotations else set())
         while done < steps:
             done = min(steps, done + chunk)
             request["steps"] = done
@@ -405,12 +423,15 @@ def generate_walk(rig, steps=8, start_frame=1, frames_per_step=0, step_length=0.
                     # The previous walk goes once this one has keys (a refused request keeps
                     # it), up to its end (on to the last key for a rig of an older version):
                     # the user's keys after both walks stay (they were all cut).
+                    # The handles' rotate keys go where the previous walk turned them.
                     old_end = _walk_end(rig)
-                    _cut(nodes, start_frame, 1e9 if old_end is None else old_end)
+                    _cut(nodes, start_frame, 1e9 if old_end is None else old_end,
+                         turned | (set(feet.values()) if _turned_feet(rig) else set()))
                 # Keys within this walk's frames go as it is keyed there.
                 _cut(nodes, start_frame if last_frame is None else last_frame + 1e-3,
-                     walk_last)
+                     walk_last, turned)
                 _set_walk_end(rig, walk_last)
+                _set_turned_feet(rig, foot_rotations)
                 # Each call gives the walk so far: only its new keys are set.
                 key_walk(walk, feet, body, from_frame=last_frame)
                 keyed = sum(len(t.get("keys", [])) for t in walk.get("tracks", [])
@@ -471,6 +492,7 @@ def import_walk(path, rig=None):
         feet = {n: feet[n] for n in keyed}
         body = body if keys_body else None
         sets = [(walk, feet, body)]
+        previously_turned = _turned_feet(rig)
     mc.undoInfo(openChunk=True, chunkName="footfall import walk")
     try:
         if rig:
@@ -492,7 +514,15 @@ def import_walk(path, rig=None):
             first = min((k["frame"] for t in part["tracks"] for k in t.get("keys", [])),
                         default=0)
             nodes = [n for n in list(feet.values()) + [body] if n]
-            mc.cutKey(nodes, time=(first, 1e9), attribute=["translate", "rotate"], clear=True)
+            # Handles the walk turns (generated with foot rotations), and on a rig those its
+            # last walk turned, lose their rotate keys too.
+            turning = {feet[t["name"]] for t in part["tracks"]
+                       if t.get("kind", "foot") == "foot" and t.get("name") in feet and
+                       t.get("keys") and all("rotation" in k for k in t["keys"])}
+            previous = set(feet.values()) if rig and previously_turned else set()
+            _cut(nodes, first, 1e9, {body} | turning | previous)
+            if rig:
+                _set_turned_feet(rig, bool(turning))
             count += key_walk(part, feet, body)
     finally:
         mc.undoInfo(closeChunk=True)
