@@ -88,6 +88,14 @@ std::vector<std::string> WrapText(std::string text, const std::string& separator
   return lines;
 }
 
+// s.str(), or std::bad_alloc when s ran out of memory while it was written: a stream keeps what
+// it had and sets its badbit, and the overlay showed its help line cut short ("drag: orbit
+// r") in a picture that was otherwise whole.
+std::string Written(const std::ostringstream& s) {
+  if (s.bad()) throw std::bad_alloc();
+  return s.str();
+}
+
 // Polls footfalld on its own thread so a slow or vanished server never stalls drawing.
 class LiveFollower {
  public:
@@ -215,7 +223,7 @@ struct App {
       << (view.show_cells ? "on" : "off") << ")";
     if (scene.has_walk()) s << "   space: play   left/right: frame   Home/End: first/last";
     s << "   Esc: quit";
-    return s.str();
+    return Written(s);
   }
 
   std::string InfoText() {
@@ -228,7 +236,7 @@ struct App {
         << live->status() << ")   ";
     }
     if (scene.has_walk()) s << "walk " << options.walk;
-    return s.str();
+    return Written(s);
   }
 
   // Draws one frame into the bound framebuffer.
@@ -284,7 +292,7 @@ struct App {
         << FrameText(scene.last_frame()) << " at " << scene.walk().fps << " fps"
         << (playing ? "  (playing)" : "");
       if (!scene.walk().stopped.empty()) f << "   stopped: " << scene.walk().stopped;
-      frame_lines = WrapText(f.str(), "   ", scale, static_cast<float>(width) - 2 * kTimelineX);
+      frame_lines = WrapText(Written(f), "   ", scale, static_cast<float>(width) - 2 * kTimelineX);
     }
     const bool tight = static_cast<float>(info.size() + lines.size() + frame_lines.size()) * line +
                            20 + (scene.has_walk() ? kTimelineHeight : 0) >
