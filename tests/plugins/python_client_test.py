@@ -1334,6 +1334,43 @@ class MayaKeyWalkTest(unittest.TestCase):
                 if module is not None:
                     sys.modules[name] = module
 
+    @staticmethod
+    def _rig_cmds(attributes, calls):
+        """A stand-in for maya.cmds enough for generate_walk on a rig: the key, cut and setAttr
+        commands append (name, args, kwargs) to `calls`; setAttr and addAttr keep values in
+        `attributes`, by attribute name; a rig attribute's connection is "<attribute>_handle";
+        the scene's terrain is "scene-1"."""
+        cmds = types.ModuleType("maya.cmds")
+        cmds.currentUnit = lambda *args, **kwargs: "deg"
+        for name in ("setKeyframe", "cutKey", "undoInfo", "warning", "confirmDialog"):
+            setattr(cmds, name, lambda *args, _name=name, **kwargs:
+                    calls.append((_name, args, kwargs)))
+
+        def set_attr(plug, *values, **kwargs):
+            calls.append(("setAttr", (plug,) + values, kwargs))
+            attributes[plug.split(".")[1]] = values[0]
+
+        def add_attr(node, longName, **kwargs):  # noqa: N803 (Maya's name)
+            attributes.setdefault(longName, 0.0)
+        cmds.setAttr, cmds.addAttr = set_attr, add_attr
+        cmds.getAttr = lambda plug, **kwargs: attributes[plug.split(".")[1]]
+        cmds.attributeQuery = lambda attr, node, exists: attr in attributes
+        cmds.listConnections = lambda plug, **kwargs: [plug.split(".")[1] + "_handle"]
+        cmds.fileInfo = lambda *args, **kwargs: ["scene-1"]
+        cmds.xform = lambda *args, **kwargs: (
+            [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1] if kwargs.get("m")
+            else [0.0, 0.0, 0.0]) if kwargs.get("q") else calls.append(("xform", args, kwargs))
+        return cmds
+
+    @contextlib.contextmanager
+    def _generating(self, cmds, session):
+        """footfall_maya over `cmds`, its session `session` and its scene's terrain loaded."""
+        with self._footfall_maya(cmds) as footfall_maya:
+            footfall_maya._session = lambda: session
+            footfall_maya._connection = types.SimpleNamespace(
+                terrain=lambda name: 1, has_terrain=lambda name: name == "scene-1")
+            yield footfall_maya
+
     def _key_walk(self, walk, feet, body, keyed_order=None, angle_unit="deg"):
         """The calls key_walk makes; with `keyed_order`, every node has rotation keys and that
         rotateOrder; `angle_unit`: the scene's ("deg" or "rad")."""
@@ -1591,29 +1628,8 @@ class MayaKeyWalkTest(unittest.TestCase):
 
         def run(attributes, steps):
             calls = []
-            cmds = types.ModuleType("maya.cmds")
-            cmds.currentUnit = lambda *args, **kwargs: "deg"
-            for name in ("setKeyframe", "cutKey", "undoInfo", "warning", "confirmDialog"):
-                setattr(cmds, name, lambda *args, _name=name, **kwargs:
-                        calls.append((_name, args, kwargs)))
-
-            def set_attr(plug, *values, **kwargs):
-                attributes[plug.split(".")[1]] = values[0]
-
-            def add_attr(node, longName, **kwargs):  # noqa: N803 (Maya's name)
-                attributes.setdefault(longName, 0.0)
-            cmds.setAttr, cmds.addAttr = set_attr, add_attr
-            cmds.getAttr = lambda plug, **kwargs: attributes[plug.split(".")[1]]
-            cmds.attributeQuery = lambda attr, node, exists: attr in attributes
-            cmds.listConnections = lambda plug, **kwargs: [plug.split(".")[1] + "_handle"]
-            cmds.fileInfo = lambda *args, **kwargs: ["scene-1"]
-            cmds.xform = lambda *args, **kwargs: (
-                [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1] if kwargs.get("m")
-                else [0.0, 0.0, 0.0]) if kwargs.get("q") else None
-            with self._footfall_maya(cmds) as footfall_maya:
-                footfall_maya._session = lambda: FakeSession()
-                footfall_maya._connection = types.SimpleNamespace(
-                    terrain=lambda name: 1, has_terrain=lambda name: name == "scene-1")
+            with self._generating(self._rig_cmds(attributes, calls),
+                                  FakeSession()) as footfall_maya:
                 self.assertEqual(footfall_maya.generate_walk("biped_rig", steps, 1, chunk_steps=3),
                                  steps)
             return [c[2]["time"] for c in calls if c[0] == "cutKey"]
@@ -1845,29 +1861,7 @@ class MayaKeyWalkTest(unittest.TestCase):
         with open(os.path.join(CHARACTERS, "biped.json")) as f:
             attributes = {"footfallCharacter": f.read(), "footfallFoot0": None}
         calls = []
-        cmds = types.ModuleType("maya.cmds")
-        cmds.currentUnit = lambda *args, **kwargs: "deg"
-        for name in ("setKeyframe", "cutKey", "undoInfo", "warning", "confirmDialog"):
-            setattr(cmds, name, lambda *args, _name=name, **kwargs:
-                    calls.append((_name, args, kwargs)))
-
-        def set_attr(plug, *values, **kwargs):
-            calls.append(("setAttr", (plug,) + values, kwargs))
-            if plug.startswith("biped_rig."):
-                attributes[plug.split(".")[1]] = values[0]
-        cmds.setAttr = set_attr
-        cmds.addAttr = lambda node, longName, **kwargs: attributes.setdefault(longName, 0)  # noqa: N803
-        cmds.getAttr = lambda plug, **kwargs: attributes.get(plug.split(".")[1])
-        cmds.attributeQuery = lambda attr, node, exists: attr in attributes
-        cmds.listConnections = lambda plug, **kwargs: [plug.split(".")[1] + "_handle"]
-        cmds.fileInfo = lambda *args, **kwargs: ["scene-1"]
-        cmds.xform = lambda *args, **kwargs: (
-            [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1] if kwargs.get("m")
-            else [0.0, 0.0, 0.0]) if kwargs.get("q") else calls.append(("xform", args, kwargs))
-        with self._footfall_maya(cmds) as footfall_maya:
-            footfall_maya._session = lambda: FakeSession()
-            footfall_maya._connection = types.SimpleNamespace(
-                terrain=lambda name: 1, has_terrain=lambda name: name == "scene-1")
+        with self._generating(self._rig_cmds(attributes, calls), FakeSession()) as footfall_maya:
             rotate_cuts = []
             for turn in (False, True, False):
                 del calls[:]
