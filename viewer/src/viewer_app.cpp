@@ -15,13 +15,13 @@
 #include <iostream>
 #include <mutex>
 #include <new>
-#include <sstream>
 #include <thread>
 
 #include "footfall/client/recent_queries.h"
 #include "footfall/steps/walk_json.h"
 #include "footfall/terrain/ascii.h"
 #include "footfall/terrain/output_file.h"
+#include "footfall/terrain/text_stream.h"
 #include "footfall/viewer/png_writer.h"
 #include "footfall/viewer/renderer.h"
 #include "footfall/viewer/scene.h"
@@ -86,14 +86,6 @@ std::vector<std::string> WrapText(std::string text, const std::string& separator
   }
   if (!line.empty() || lines.empty()) lines.push_back(line);
   return lines;
-}
-
-// s.str(), or std::bad_alloc when s ran out of memory while it was written: a stream keeps what
-// it had and sets its badbit, and the overlay showed its help line cut short ("drag: orbit
-// r") in a picture that was otherwise whole.
-std::string Written(const std::ostringstream& s) {
-  if (s.bad()) throw std::bad_alloc();
-  return s.str();
 }
 
 // Polls footfalld on its own thread so a slow or vanished server never stalls drawing.
@@ -217,17 +209,17 @@ struct App {
   }
 
   std::string HelpText() const {
-    std::ostringstream s;
+    TextStream s;
     s << "drag: orbit   right-drag: pan   wheel: zoom   F: frame all   C: colour ("
       << (view.color == ColorMode::kNormal ? "normal" : "height") << ")   G: cells ("
       << (view.show_cells ? "on" : "off") << ")";
     if (scene.has_walk()) s << "   space: play   left/right: frame   Home/End: first/last";
     s << "   Esc: quit";
-    return Written(s);
+    return s.str();
   }
 
   std::string InfoText() {
-    std::ostringstream s;
+    TextStream s;
     if (scene.has_terrain())
       s << "terrain " << options.terrain << " (" << scene.grid().size() << " samples)   ";
     if (!scene.queries().empty()) s << "queries " << scene.queries().size() << "   ";
@@ -236,7 +228,7 @@ struct App {
         << live->status() << ")   ";
     }
     if (scene.has_walk()) s << "walk " << options.walk;
-    return Written(s);
+    return s.str();
   }
 
   // Draws one frame into the bound framebuffer.
@@ -287,12 +279,12 @@ struct App {
     constexpr float kTimelineX = 10, kTimelineHeight = 20;
     std::vector<std::string> frame_lines;
     if (scene.has_walk()) {
-      std::ostringstream f;
+      TextStream f;
       f << "frame " << FrameText(view.frame) << " of " << FrameText(scene.first_frame()) << " to "
         << FrameText(scene.last_frame()) << " at " << scene.walk().fps << " fps"
         << (playing ? "  (playing)" : "");
       if (!scene.walk().stopped.empty()) f << "   stopped: " << scene.walk().stopped;
-      frame_lines = WrapText(Written(f), "   ", scale, static_cast<float>(width) - 2 * kTimelineX);
+      frame_lines = WrapText(f.str(), "   ", scale, static_cast<float>(width) - 2 * kTimelineX);
     }
     const bool tight = static_cast<float>(info.size() + lines.size() + frame_lines.size()) * line +
                            20 + (scene.has_walk() ? kTimelineHeight : 0) >

@@ -35,6 +35,7 @@
 #include "footfall/terrain/output_file.h"
 #include "footfall/terrain/point_file.h"
 #include "footfall/terrain/shown_text.h"
+#include "footfall/terrain/text_stream.h"
 #include "standard_streams.h"
 #include "terrain_flags.h"
 
@@ -188,7 +189,7 @@ bool ResamplesForCharacter(const TerrainFlags& flags) {
 }
 
 std::string Box(const Vec3& lo, const Vec3& hi) {
-  std::ostringstream o;
+  TextStream o;
   o.precision(4);
   o << "(" << lo.x << ", " << lo.y << ", " << lo.z << ") to (" << hi.x << ", " << hi.y << ", "
     << hi.z << ")";
@@ -201,7 +202,7 @@ void ReportResampling(const std::string& path, const Character& character, const
   for (const std::string& note : {DescribeSkippedFaces(r), DescribeTurnover(r)})
     if (!note.empty()) std::cerr << "footfall generate: " << path << ": " << note << '\n';
   if (!t.cropped && r.separation == r.file_separation) return;
-  std::ostringstream o;
+  TextStream o;
   o.precision(4);
   o << "footfall generate: " << path << " resampled for " << character.name
     << " at a separation of " << r.separation << " (its own spacing " << r.file_separation
@@ -298,7 +299,7 @@ bool CheckOutputs(const GenerateFlags& flags, const std::vector<std::string>& in
     // characters are checked each (RunScene): --start-frame is only the default of those that
     // give none.
     if ((ext == "gltf" || ext == "glb") && flags.start_frame < 0 && flags.scene.empty()) {
-      std::ostringstream m;
+      TextStream m;
       m << "--out " << out << ": glTF animation times must be >= 0, and --start-frame is "
         << flags.start_frame << "; start at frame 0 or later, or write .json or .mel only";
       *error = m.str();
@@ -419,7 +420,7 @@ double EstimateKeys(double crowd, double steps, const Character& character) {
 bool CheckKeyMemory(double keys, const std::string& what, std::string* error) {
   const double memory = UsableMemoryBytes();
   if (!(memory > 0) || keys * kBytesPerKey <= memory) return true;
-  std::ostringstream m;
+  TextStream m;
   m.precision(3);
   m << what << " make about " << keys << " keys, " << keys * kBytesPerKey / 1e9
     << " GB, more than the " << memory / 1e9
@@ -434,7 +435,7 @@ std::string OutOfMemoryMessage(const GenerateFlags& flags, const GenerateOptions
                                const Character& character) {
   const double steps = flags.steps < 0 ? kMaxPathSteps : flags.steps;
   const double keys = EstimateKeys(flags.crowd, steps, character);
-  std::ostringstream m;
+  TextStream m;
   m.precision(3);
   const bool capped = flags.steps < 0 && !options.path.empty();
   m << "out of memory generating " << flags.crowd

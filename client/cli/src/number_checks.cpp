@@ -1,16 +1,16 @@
 #include "footfall/cli/number_checks.h"
 
-#include <sstream>
 #include <string>
 
 #include "footfall/client/query_text.h"
 #include "footfall/terrain/decimal_number.h"
+#include "footfall/terrain/text_stream.h"
 
 namespace footfall::cli {
 namespace {
 
 std::string Text(double v) {
-  std::ostringstream out;
+  TextStream out;
   out << v;
   return out.str();
 }

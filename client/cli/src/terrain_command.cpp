@@ -24,6 +24,7 @@
 #include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/output_file.h"
 #include "footfall/terrain/point_file.h"
+#include "footfall/terrain/text_stream.h"
 #include "standard_streams.h"
 #include "terrain_flags.h"
 
@@ -64,7 +65,7 @@ struct MakeFlags {
 
 // Enough digits to tell apart samples a millimetre apart a thousand kilometres out.
 std::string Format(const Vec3& v) {
-  std::ostringstream out;
+  TextStream out;
   out << std::setprecision(12) << "(" << v.x << ", " << v.y << ", " << v.z << ")";
   return out.str();
 }
@@ -261,7 +262,7 @@ int OutOfRange(const std::string& kind, double m) {
 
 // `x` with 3 significant digits ("4e+24"), for counts far beyond any limit.
 std::string Format3(double x) {
-  std::ostringstream o;
+  TextStream o;
   o << std::setprecision(3) << x;
   return o.str();
 }
@@ -271,7 +272,7 @@ int RunMake(const MakeFlags& f) {
   const std::string& k = f.kind;
   const double estimate = EstimateSamples(f);
   if (!(estimate <= kMaxMadeSamples)) {
-    std::ostringstream m;
+    TextStream m;
     m << "footfall terrain make: " << k << ": these sizes at --spacing " << f.spacing << " give "
       << (estimate < 1e15           ? "about " + std::to_string(std::llround(estimate))
           : std::isfinite(estimate) ? "about " + Format3(estimate)
@@ -283,7 +284,7 @@ int RunMake(const MakeFlags& f) {
   }
   const double cells = EstimateMeshCells(f);
   if (!(cells <= kMaxMadeSamples)) {
-    std::ostringstream m;
+    TextStream m;
     m << "footfall terrain make: " << k << ": these sizes give a mesh of about "
       << (cells < 1e15 ? std::to_string(std::llround(cells)) : Format3(cells))
       << " cells to sample ("

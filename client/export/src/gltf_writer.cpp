@@ -9,7 +9,6 @@
 #include <cstring>
 #include <exception>
 #include <ostream>
-#include <sstream>
 #include <streambuf>
 #include <vector>
 
@@ -18,6 +17,7 @@
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/output_file.h"
+#include "footfall/terrain/text_stream.h"
 #include "footfall/version.h"
 #include "walk_prep.h"
 
@@ -53,7 +53,7 @@ Status TrackSamples(const WalkTrack& track, size_t track_index, double fps, Samp
   for (size_t index : KeyOrder(track)) {
     const WalkKey& key = track.keys[index];
     if (key.frame < 0) {
-      std::ostringstream message;
+      TextStream message;
       message << "glTF animation times must be >= 0 but track " << track_index << " '"
               << walk_export::QualifiedTrackName(track, track_index) << "' key " << index
               << " is at frame " << key.frame << "; start the walk at frame 0 or later";
@@ -65,7 +65,7 @@ Status TrackSamples(const WalkTrack& track, size_t track_index, double fps, Samp
       const WalkKey& before = track.keys[samples->keys.back()];
       if (before.frame != key.frame) {
         // Distinct frames that float seconds cannot tell apart: merging them would lose keys.
-        std::ostringstream message;
+        TextStream message;
         message.precision(10);
         message << "glTF times are float seconds, and frames " << before.frame << " and "
                 << key.frame << " of track " << track_index << " '"
@@ -163,7 +163,7 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
   const double glb_bytes =
       buffer_bytes + kGlbBytesPerTrack * static_cast<double>(walk.tracks.size()) + kGlbHeaderBytes;
   if (options.binary && glb_bytes > options.max_glb_bytes) {
-    std::ostringstream m;
+    TextStream m;
     m.precision(3);
     m << "the walk takes about " << glb_bytes / 1e9 << " GB as .glb, whose lengths are 32-bit: it "
       << "holds at most " << options.max_glb_bytes / 1e9
@@ -175,7 +175,7 @@ Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& o
                         9e3 * static_cast<double>(walk.tracks.size()) + 64e6;
   const double available = AvailableMemoryBytes();
   if (available > 0 && needed > available) {
-    std::ostringstream m;
+    TextStream m;
     m.precision(3);
     m << "writing the walk as glTF needs about " << needed / 1e9 << " GB, more than the "
       << available / 1e9

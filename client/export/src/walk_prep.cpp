@@ -1,10 +1,10 @@
 #include "walk_prep.h"
+#include "footfall/terrain/text_stream.h"
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <set>
-#include <sstream>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -28,7 +28,7 @@ void SetError(std::string* error, const std::string& message) {
 
 Status CheckWalk(const Walk& walk, std::string* error) {
   if (!std::isfinite(walk.fps) || walk.fps <= 0) {
-    std::ostringstream message;
+    TextStream message;
     message << "walk fps must be finite and > 0, got " << walk.fps;
     SetError(error, message.str());
     return Status::kInvalidArgument;
@@ -38,7 +38,7 @@ Status CheckWalk(const Walk& walk, std::string* error) {
     // Bodies have one rotation per key; feet none, or one per key (AddFootRotations).
     const bool rotated = track.kind == TrackKind::kBody || !track.rotations.empty();
     if (rotated && track.rotations.size() != track.keys.size()) {
-      std::ostringstream message;
+      TextStream message;
       message << "track " << t << " '" << QualifiedTrackName(track, t) << "' has "
               << track.rotations.size() << " rotations for " << track.keys.size()
               << " keys (expected one per key)";
@@ -58,7 +58,7 @@ Status CheckWalk(const Walk& walk, std::string* error) {
         what = "a zero rotation quaternion";
       }
       if (what != nullptr) {
-        std::ostringstream message;
+        TextStream message;
         message << "track " << t << " '" << QualifiedTrackName(track, t) << "' key " << k << " has "
                 << what;
         SetError(error, message.str());

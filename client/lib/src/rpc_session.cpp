@@ -14,13 +14,13 @@
 #include <csignal>
 #include <cstring>
 #include <map>
-#include <sstream>
 #include <thread>
 
 #include "footfall.h"
 #include "footfall/client/terrain_session.h"
 #include "footfall/rpc/batch_xdr.h"
 #include "footfall/terrain/shown_text.h"
+#include "footfall/terrain/text_stream.h"
 #include "handle_counter.h"
 #include "rpc_connect.h"
 
@@ -437,7 +437,7 @@ class RpcSession final : public TerrainSession {
       const std::string message = reply.value.message ? reply.value.message : "";
       if (reply.value.status == FF_UNAVAILABLE) {
         if (std::chrono::steady_clock::now() + std::chrono::duration<double>(pause_s) > give_up) {
-          std::ostringstream text;
+          TextStream text;
           text << what << ": footfalld at " << Address() << " stayed busy for "
                << options_.busy_timeout_s << " s (RpcOptions::busy_timeout_s): " << message;
           return Fail(Status::kUnavailable, text.str());
@@ -477,7 +477,7 @@ class RpcSession final : public TerrainSession {
     std::string reason = CallFailureText(status);
     if (status == RPC_TIMEDOUT) {
       // Loading a large terrain (a mesh resampled finely) can take longer than a query.
-      std::ostringstream hint;
+      TextStream hint;
       hint << " (no answer within the call timeout of "
            << (waited_s < 0 ? options_.call_timeout_s : waited_s)
            << " s: a busy or hung server, or a terrain that takes longer to load; a longer "

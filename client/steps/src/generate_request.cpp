@@ -3,13 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "character_read.h"
 #include "footfall/steps/generator.h"
 #include "footfall/terrain/shown_text.h"
+#include "footfall/terrain/text_stream.h"
 #include "json_input.h"
 #include "request_fields.h"
 
@@ -206,7 +206,7 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
       // Named here, with its field and line (the generator's check names neither).
       if (ok &&
           std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) > kMaxWaypointCoordinate) {
-        std::ostringstream m;
+        TextStream m;
         m << source << ": '" << key << "': (" << p.x << ", " << p.y << ", " << p.z
           << ") has a coordinate beyond +-" << kMaxWaypointCoordinate
           << " (the reach of terrain queries)";

@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <cstring>
 #include <set>
-#include <sstream>
 #include <unordered_map>
 
 #include <nlohmann/json.hpp>
 
 #include "footfall/terrain/shown_text.h"
+#include "footfall/terrain/text_stream.h"
 #include "json_input.h"
 #include "request_fields.h"
 
@@ -234,7 +234,7 @@ std::vector<std::string> OverlappingStartNotes(const std::vector<std::string>& n
   };
   std::vector<std::string> notes;
   for (const auto& [a, b] : named) {
-    std::ostringstream note;
+    TextStream note;
     note.precision(3);
     note << name(starts[a]) << " and " << name(starts[b]) << " start "
          << Distance(starts[a].at, starts[b].at)

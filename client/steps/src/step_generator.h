@@ -12,28 +12,20 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
-#include <locale>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "footfall/steps/generator.h"
 #include "footfall/terrain/batch_pool.h"
+#include "footfall/terrain/text_stream.h"
 #include "frame_math.h"
 
 namespace footfall::steps_detail {
 
-// A text stream in the classic "C" locale, with `precision` significant digits: stop reasons and
-// notes (written into walk files) read the same whatever global C++ locale a host process set.
-class Text : public std::ostringstream {
- public:
-  explicit Text(int precision = 6) {
-    imbue(std::locale::classic());
-    this->precision(precision);
-  }
-};
+// Stop reasons and notes (written into walk files): the "C" locale, never cut short.
+using Text = TextStream;
 
 // Foothold queries per foot and step, in turn: the step vector scaled (shorter, then longer:
 // over a stair's riser, then shorter still), then aimed down by `drop` times max_rise along the

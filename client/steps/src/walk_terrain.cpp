@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
+#include "footfall/terrain/text_stream.h"
 #include "frame_math.h"
 #include "step_generator.h"
 
@@ -63,7 +63,7 @@ Status TooCoarse(const std::string& path, const Character& c, const WalkTerrain&
 
 std::string CoarserThanStepsNote(const TerrainLoadReport& report, double wanted) {
   if (!(report.separation > 1.0001 * std::min(wanted, report.file_separation))) return "";
-  std::ostringstream o;
+  TextStream o;
   o.precision(4);
   o << "not finer than " << report.separation << " (" << report.separation / wanted
     << " times a quarter of the step): the surface would need more samples than the "

@@ -9,7 +9,6 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
-#include <sstream>
 #include <string_view>
 #include <tuple>
 #include <utility>
@@ -21,6 +20,7 @@
 #include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/samples.h"
 #include "footfall/terrain/shown_text.h"
+#include "footfall/terrain/text_stream.h"
 
 namespace footfall {
 namespace {
@@ -37,7 +37,7 @@ std::string Lower(std::string s) {
 
 // A number as people write it: "5e+14", "0.25".
 std::string Number(double v) {
-  std::ostringstream out;
+  TextStream out;
   out << v;
   return out.str();
 }
@@ -146,7 +146,7 @@ Status CheckFileSize(const std::string& path, double size, double values, double
                      const std::string& declared, std::string* error) {
   const double most = values * most_per_value + 1048576;
   if (size <= most) return Status::kOk;
-  std::ostringstream m;
+  TextStream m;
   m.precision(15);
   m << size << " bytes, far more than " << declared << " needs (at most " << most
     << " bytes: " << most_per_value << (most_per_value == 1 ? " byte" : " bytes")
@@ -221,7 +221,7 @@ Status ReadWhole(const std::string& path, std::string* text, std::string* error,
 // the conversion to an integer overflowed to -9223372036854775808).
 std::string Count(double n) {
   if (std::fabs(n) < 1e18) return std::to_string(static_cast<long long>(n));
-  std::ostringstream out;
+  TextStream out;
   out << n;
   return out.str();
 }
@@ -260,7 +260,7 @@ Status CheckGridSize(const std::string& path, const std::string& header, double 
   constexpr double kBytesPerCell = 130;
   const double memory = UsableMemoryBytes();
   if (memory > 0 && cells * kBytesPerCell > memory) {
-    std::ostringstream m;
+    TextStream m;
     m.precision(3);
     m << "the header declares " << declared << ": reading it needs about "
       << cells * kBytesPerCell / 1e9 << " GB, more than the " << memory / 1e9

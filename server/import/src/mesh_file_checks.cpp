@@ -21,6 +21,7 @@
 #include "footfall/terrain/input_file.h"
 #include "footfall/terrain/samples.h"
 #include "footfall/terrain/shown_text.h"
+#include "footfall/terrain/text_stream.h"
 
 namespace footfall::detail {
 namespace {
@@ -133,7 +134,7 @@ Status CheckCoordinate(const std::string& where, const std::string& token, doubl
                 error);
   *value_out = value;
   if (std::fabs(value) > terrain::kMaxCoordinate) {
-    std::ostringstream m;
+    TextStream m;
     m << "vertex coordinate " << ShownText(token)
       << " is out of range (expected |coordinate| <= " << terrain::kMaxCoordinate << ")";
     return Fail(where, m.str(), error);
@@ -845,7 +846,7 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
         double n = 0;
         if (!values.Next(e.count_types[p], &n)) return truncated(e, r);
         if (!(n >= 0 && n == std::floor(n))) {  // a float count: the rest of the data misread
-          std::ostringstream m;
+          TextStream m;
           m << ShownText(e.name) << " " << r + 1 << ": list '" << ShownText(name) << "' count " << n
             << " is not a whole number >= 0";
           return Fail(path, m.str(), error);
@@ -863,7 +864,7 @@ Status ParsePlyFile(const std::string& path, ParsedMesh* out, std::string* error
           if (!values.Next(e.types[p], &v)) return truncated(e, r);
           if (indices && !(v >= (strips ? -1 : 0) && v < static_cast<double>(vertices) &&
                            v == std::floor(v))) {
-            std::ostringstream m;
+            TextStream m;
             m << ShownText(e.name) << " " << r + 1 << ": vertex index ";
             if (std::fabs(v) < 1e18 && v == std::floor(v))
               m << static_cast<long long>(v);

@@ -7,7 +7,6 @@
 #include <cstring>
 #include <fstream>
 #include <mutex>
-#include <sstream>
 #include <utility>
 #include <vector>
 
@@ -17,6 +16,7 @@
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/input_file.h"
 #include "footfall/terrain/samples.h"
+#include "footfall/terrain/text_stream.h"
 #include "mesh_file_checks.h"
 
 namespace footfall {
@@ -49,9 +49,9 @@ class CapturedOpenMeshMessages {
     static std::mutex mutex;
     return mutex;
   }
-  static std::ostringstream& Buffer() {
-    static std::ostringstream* const buffer = [] {
-      auto* b = new std::ostringstream;  // never freed: OpenMesh's streams write to it to the end
+  static TextStream& Buffer() {
+    static TextStream* const buffer = [] {
+      auto* b = new TextStream;  // never freed: OpenMesh's streams write to it to the end
       ::omerr().disconnect(std::cerr), ::omlog().disconnect(std::clog);
       ::omout().disconnect(std::cout);
       ::omerr().connect(*b), ::omlog().connect(*b), ::omout().connect(*b);

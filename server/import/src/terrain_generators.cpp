@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "footfall/import/mesh_generators.h"
 #include "footfall/import/mesh_sampler.h"
 #include "footfall/terrain/samples.h"
+#include "footfall/terrain/text_stream.h"
 
 namespace footfall {
 namespace {
@@ -184,7 +184,7 @@ RawSamples MakeRocks(double size, double amplitude, double spacing, uint64_t see
   for (const Vec3& v : mesh.vertices)
     reach = std::max({reach, std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)});
   if (!(reach <= terrain::kMaxCoordinate)) {
-    std::ostringstream m;
+    TextStream m;
     m << "the parameters give coordinates beyond " << terrain::kMaxCoordinate << " (" << reach
       << "), out of the grid's range";
     if (error) *error = m.str();

@@ -14,7 +14,6 @@
 #include <mutex>
 #include <new>
 #include <set>
-#include <sstream>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -25,6 +24,7 @@
 #include "footfall/rpc/batch_xdr.h"
 #include "footfall/terrain/batch_pool.h"
 #include "footfall/terrain/shown_text.h"
+#include "footfall/terrain/text_stream.h"
 #include "read_gate.h"
 #include "reserve_ahead.h"
 #include "service_log.h"
@@ -226,7 +226,7 @@ void LogEvicted() {
 // (TerrainLoadOptions::finest_default, a character's quarter step), that limit; else "".
 std::string ResampledText(const PendingLoad* load) {
   if (!load || load->upload || !(load->report.separation > 0)) return "";
-  std::ostringstream text;
+  TextStream text;
   text.precision(4);
   const TerrainLoadOptions& o = load->options;
   text << " at separation " << load->report.separation;

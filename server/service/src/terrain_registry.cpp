@@ -2,6 +2,7 @@
 
 #include "footfall/service/pinned_file.h"
 #include "footfall/terrain/large_memory.h"
+#include "footfall/terrain/text_stream.h"
 
 #include <fcntl.h>
 #include <limits.h>
@@ -14,7 +15,6 @@
 #include <cstring>
 #include <new>
 #include <random>
-#include <sstream>
 #include <vector>
 
 namespace footfall {
@@ -487,7 +487,7 @@ std::string Dropped(uint32_t upload) {
 std::string TerrainRegistry::NoUpload(uint32_t upload, uint64_t owner) const {
   for (const auto& [id, by] : expired_ids_) {
     if (id == upload && by == owner) {
-      std::ostringstream text;
+      TextStream text;
       text << "upload " << upload << " was dropped: no samples for " << limits_.upload_idle_s
            << " s (--upload-timeout); begin it again";
       return text.str();

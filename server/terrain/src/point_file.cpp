@@ -10,7 +10,6 @@
 #include <fstream>
 #include <istream>
 #include <new>
-#include <sstream>
 #include <string_view>
 
 #include "footfall/terrain/decimal_number.h"
@@ -18,6 +17,7 @@
 #include "footfall/terrain/ordered_text.h"
 #include "footfall/terrain/output_file.h"
 #include "footfall/terrain/shown_text.h"
+#include "footfall/terrain/text_stream.h"
 
 namespace footfall {
 namespace {
@@ -127,7 +127,7 @@ Status ReadPointStream(std::istream& in, const std::string& name, RawSamples* ou
                       out, error);
         }
         if (count < 3 && std::fabs(value) > terrain::kMaxCoordinate) {
-          std::ostringstream m;
+          TextStream m;
           m << "column " << count + 1 << ": " << ShownText(token) << " is out of range (expected |"
             << "xyz"[count] << "| <= " << terrain::kMaxCoordinate << ")";
           return Fail(name, line_no, m.str(), out, error);
