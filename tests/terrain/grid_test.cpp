@@ -571,6 +571,33 @@ TEST_CASE("TerrainGrid reports its samples' spacing whatever its cells hold", "[
   CHECK(Build(RawSamples{}).stats().spacing == 0);
 }
 
+TEST_CASE("TerrainGrid reports the spacing of a few samples sample to sample", "[terrain][grid]") {
+  // Too few samples to fill the cells the spacing is measured on: two samples 1 m apart read
+  // 0.07, the size of the cells that stopped growing.
+  auto lattice = [](int nx, int nz, double step, const Vec3& at) {
+    RawSamples s;
+    for (int i = 0; i < nx; ++i)
+      for (int k = 0; k < nz; ++k) s.push_back(at + Vec3{i * step, 0, k * step}, {0, 1, 0});
+    return s;
+  };
+  CHECK(Build(lattice(2, 1, 1.0, {})).stats().spacing == Approx(1.0));
+  CHECK(Build(lattice(3, 3, 0.5, {})).stats().spacing == Approx(0.5));
+  CHECK(Build(lattice(3, 13, 0.25, {1e5, -3, 1e5})).stats().spacing == Approx(0.25));  // 39
+  // A sample given twice is measured to its nearest other place, not to its copy.
+  RawSamples twice = lattice(4, 1, 2.0, {});
+  twice.push_back({0, 0, 0}, {0, 1, 0});
+  CHECK(Build(twice).stats().spacing == Approx(2.0));
+  // One place holds them all: no distance to measure; a spacing all the same (callers size
+  // their checks by it).
+  RawSamples one_place = lattice(1, 1, 1.0, {3, 4, 5});
+  one_place.push_back({3, 4, 5}, {0, 1, 0});
+  CHECK(Build(one_place).stats().spacing > 0);
+  // From kDirectSpacingSamples on, as a surface (the lattice of 40 within 10% of its step).
+  const double forty = Build(lattice(4, 10, 0.25, {})).stats().spacing;
+  CHECK(forty > 0.225);
+  CHECK(forty < 0.275);
+}
+
 TEST_CASE("TerrainGrid reports the same spacing however its terrain is turned", "[terrain][grid]") {
   // Occupied cells alone counted a leaning surface as sparser: the same hills turned 37 degrees
   // read 8 to 15% wider apart, and walks (whose swing arcs are checked by the spacing) differed.

@@ -170,7 +170,9 @@ int RunInfo(const InfoFlags& flags) {
               << ")\n";
   else
     std::cout << "about " << g.spacing
-              << " (between neighbouring samples, taking them as a surface)\n";
+              << (report.samples < kDirectSpacingSamples
+                      ? " (the median distance from a sample to its nearest)\n"
+                      : " (between neighbouring samples, taking them as a surface)\n");
   std::cout << "stored within: " << g.max_rounding
             << " of the given coordinates (float offsets from the centre of the bulk)\n";
   // (A full disk lost the description with exit 0.)

@@ -20,6 +20,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // GridStats::spacing is measured on cells grown to hold about this many samples each, whatever
 // the query cells hold: callers size their checks by it (the step generator's swing arcs).
 constexpr double kSpacingSamplesPerCell = 20;
+// Fewer samples than kDirectSpacingSamples cannot fill such cells (two samples 1 m apart read a
+// spacing of 0.07, the size of the cells they stopped growing at).
+static_assert(kDirectSpacingSamples >= 2 * kSpacingSamplesPerCell, "too few to fill the cells");
 
 // Total cells for a cell size h over local extents e, saturating in double.
 double CellCount(const double e[3], double h) {
@@ -143,6 +146,29 @@ size_t CountOccupiedCells(const std::vector<float>& local, const double lo[3], c
     if (!occupied[cell]) occupied[cell] = true, ++count;
   }
   return count;
+}
+
+// The median, over the samples of `local` (x, y, z per sample) that have another at a different
+// place, of the distance to the nearest such one; 0 when every sample is at one place. Compares
+// every pair: for the few samples below kDirectSpacingSamples.
+double MedianNearestDistance(const std::vector<float>& local) {
+  const size_t n = local.size() / 3;
+  std::vector<double> nearest;
+  nearest.reserve(n);
+  for (size_t i = 0; i < n; ++i) {
+    double best = kInf;
+    for (size_t j = 0; j < n; ++j) {
+      const double d = std::hypot(static_cast<double>(local[3 * j]) - local[3 * i],
+                                  static_cast<double>(local[3 * j + 1]) - local[3 * i + 1],
+                                  static_cast<double>(local[3 * j + 2]) - local[3 * i + 2]);
+      if (d > 0) best = std::min(best, d);
+    }
+    if (best < kInf) nearest.push_back(best);
+  }
+  if (nearest.empty()) return 0;
+  const auto middle = nearest.begin() + static_cast<std::ptrdiff_t>(nearest.size() / 2);
+  std::nth_element(nearest.begin(), middle, nearest.end());
+  return *middle;
 }
 
 // Cells of side h over local extents e that hold samples, and in *crossing how many more cells
@@ -387,6 +413,10 @@ Status TerrainGrid::Build(const RawSamples& samples, const GridOptions& options,
   st.spacing = n > 0 ? spacing_h * std::sqrt(static_cast<double>(spacing_occupied) /
                                              (static_cast<double>(n) * crossing))
                      : 0;
+  if (n >= 2 && n < kDirectSpacingSamples) {
+    const double direct = MedianNearestDistance(local);
+    if (direct > 0) st.spacing = direct;
+  }
   st.bytes = bytes;
   st.max_rounding = std::max(std::sqrt(rounding2), tiny_rounding);
   const double* o = g.origin_;

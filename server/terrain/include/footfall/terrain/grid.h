@@ -56,6 +56,9 @@ struct QueryTrace {
   std::vector<uint32_t> candidates;        // next: samples that met the candidate conditions
 };
 
+// Below this many samples, GridStats::spacing is measured sample to sample (see there).
+inline constexpr size_t kDirectSpacingSamples = 40;
+
 struct GridStats {
   size_t samples = 0;
   uint32_t cells[3] = {0, 0, 0};  // grid dimensions in x, y, z
@@ -66,7 +69,9 @@ struct GridStats {
   // 20 samples per occupied cell (not the query cells: it does not change with
   // GridOptions::samples_per_cell), less the extra cells a surface crosses where it leans
   // across the axes, so that it stays within a per cent or two however the terrain is turned
-  // (it read up to 15% wider on ground turned 37 degrees). 0 for no samples.
+  // (it read up to 15% wider on ground turned 37 degrees). Fewer than kDirectSpacingSamples,
+  // too few to fill such cells, give instead the median distance from a sample to its nearest
+  // other one at a different place. 0 for no samples.
   double spacing = 0;
   size_t bytes = 0;             // the grid's single allocation
   Vec3 bounds_min, bounds_max;  // world-space bounds of all samples
