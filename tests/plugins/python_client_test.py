@@ -1438,6 +1438,53 @@ class MayaKeyWalkTest(unittest.TestCase):
         for sample in samples:
             self.assertAlmostEqual(sample[4], 1.0, places=9)  # the normal's Y: up
 
+    def test_character_setup_notes_a_scene_not_in_metres(self):
+        # The plugin takes one scene unit as one of footfall's, and character files give
+        # metres: in Maya's default centimetre scene the shipped biped stood 0.95 cm tall,
+        # without a word.
+        warnings = []
+        om = types.ModuleType("maya.api.OpenMaya")
+        om.MGlobal = types.SimpleNamespace(displayWarning=warnings.append)
+        api = types.ModuleType("maya.api")
+        api.OpenMaya = om
+        hold = types.SimpleNamespace(ok=True, point=(0.0, 0.0, 0.0), normal=(0.0, 1.0, 0.0))
+        session = types.SimpleNamespace(check_character=lambda data, path: None,
+                                        snap=lambda terrain, points: [hold for _ in points])
+        saved = {name: sys.modules.pop(name, None) for name in ("maya.api", "maya.api.OpenMaya")}
+        sys.modules.update({"maya.api": api, "maya.api.OpenMaya": om})
+        try:
+            for unit, noted in (("cm", True), ("in", True), ("m", False)):
+                made = []
+                cmds = types.ModuleType("maya.cmds")
+                # Every other command is recorded, and answers None.
+                cmds.__getattr__ = lambda name: (
+                    lambda *args, _name=name, **kwargs: made.append(_name))
+                cmds.currentUnit = lambda unit=unit, **kwargs: (
+                    unit if kwargs.get("linear") else "deg")
+                cmds.upAxis = lambda *args, **kwargs: "y"
+                cmds.fileInfo = lambda *args, **kwargs: ["scene-1"]
+                cmds.group = lambda **kwargs: "biped_rig"
+                cmds.spaceLocator = lambda name: [name]
+                cmds.parent = lambda node, parent: [node]
+                del warnings[:]
+                with self._generating(cmds, session) as footfall_maya:
+                    sys.modules["maya"].api = api
+                    rig = footfall_maya.character_setup(os.path.join(CHARACTERS, "biped.json"))
+                self.assertEqual(rig, "biped_rig", (unit, made))  # set up all the same
+                self.assertIn("xform", made)
+                if noted:
+                    self.assertEqual(len(warnings), 1, unit)
+                    self.assertIn("lengths are in this scene's unit, %s: the character's body "
+                                  "height 0.95 is 0.95 %s here" % (unit, unit), warnings[0])
+                    self.assertIn("Working Units > Linear to meter", warnings[0])
+                else:
+                    self.assertEqual(warnings, [])
+        finally:
+            for name, module in saved.items():
+                sys.modules.pop(name, None)
+                if module is not None:
+                    sys.modules[name] = module
+
     def test_a_mesh_is_sampled_in_the_scenes_linear_unit(self):
         # MFnMesh gives points in centimetres (Maya's internal unit) whatever the scene's
         # unit, while xform places the character in the scene's: in a metre scene the terrain

@@ -195,6 +195,19 @@ def _ui_angles():
     return math.radians if mc.currentUnit(query=True, angle=True) == "rad" else float
 
 
+def _unit_note(data):
+    """A note for a scene whose linear unit is not the metre, or None: the plugin takes one
+    scene unit as one of footfall's, and character files give metres (in Maya's default
+    centimetre scene the shipped biped stood 0.95 cm tall, without a word)."""
+    unit = str(mc.currentUnit(query=True, linear=True))
+    if unit in ("m", "meter"):
+        return None
+    return ("lengths are in this scene's unit, %s: the character's body height %g is %g %s "
+            "here; for a character file in metres (as the shipped ones), set Preferences > "
+            "Settings > Working Units > Linear to meter" % (unit, character.body_height(data),
+                                                             character.body_height(data), unit))
+
+
 def _orient(node, up, forward):
     """Turns `node` (world space) so that its Y is `up` and its Z `forward` across it."""
     euler = ffc.rotation.quat_to_euler_xyz(ffc.rotation.quat_from_frame(up, forward))
@@ -266,6 +279,7 @@ def character_setup(character_file, name=None, ik_handles=None, body=None):
                          t=[p[i] + forward[i] * step / 2 for i in range(3)])
     finally:
         mc.undoInfo(closeChunk=True)
+    _show_notes([note for note in (_unit_note(data),) if note])
     return rig
 
 
