@@ -1121,6 +1121,48 @@ TEST_CASE("a walk drawn on a terrain it was not made on is pointed out", "[viewe
   CHECK_THAT(r.err, Catch::Contains("the walk was made on another terrain?"));
 }
 
+TEST_CASE("framing on the walk (--frame-walk) shows it large on a large terrain",
+          "[viewer][camera]") {
+  // A walk 2 m long on a 40 m floor was a few pixels across the picture: F framed everything.
+  const std::string dir = test::TempDir();
+  test::WriteFile(dir + "/walk.json", WalkJson());
+  std::string floor;
+  for (int k = 0; k <= 80; ++k) {
+    for (int i = 0; i <= 80; ++i)
+      floor += std::to_string(-17 + i * 0.5) + " 0 " + std::to_string(-19 + k * 0.5) + " 0 1 0\n";
+  }
+  test::WriteFile(dir + "/floor.pts", floor);
+  // The distance in pixels between the feet at frame 1, (2, 0, 2) and (2, 0, 0), framed as
+  // `how` says.
+  auto feet_apart = [&](const std::vector<std::string>& how) {
+    std::vector<std::string> args = {
+        "--terrain",    dir + "/floor.pts", "--walk",       dir + "/walk.json", "--size", "640x400",
+        "--screenshot", dir + "/shot.png",  "--dump-state", dir + "/state.json"};
+    args.insert(args.end(), how.begin(), how.end());
+    const RunResult r = View(args);
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    const json state = json::parse(test::ReadFile(dir + "/state.json"));
+    const json& tracks = state["walk"]["tracks"];
+    CHECK(tracks[0]["visible"] == true);
+    CHECK(tracks[1]["visible"] == true);
+    const glm::vec2 l1(tracks[0]["pixel"][0].get<float>(), tracks[0]["pixel"][1].get<float>());
+    const glm::vec2 r1(tracks[1]["pixel"][0].get<float>(), tracks[1]["pixel"][1].get<float>());
+    return glm::length(l1 - r1);
+  };
+  const float all = feet_apart({}), walk = feet_apart({"--frame-walk"});
+  INFO("feet " << all << " px apart framing everything, " << walk << " framing the walk");
+  CHECK(walk > 4 * all);
+  CHECK(walk < 400);  // the whole walk in the picture
+  // A camera given wins; without a walk there is nothing to frame.
+  CHECK(feet_apart({"--frame-walk", "--camera", "3 6 7 3 0 1"}) ==
+        Approx(feet_apart({"--camera", "3 6 7 3 0 1"})));
+  const RunResult none =
+      View({"--terrain", dir + "/floor.pts", "--frame-walk", "--screenshot", dir + "/shot.png"});
+  CHECK(none.exit_code == 2);
+  CHECK_THAT(none.err, Catch::Contains("--frame-walk needs --walk"));
+}
+
 TEST_CASE("a walk without keys is pointed out", "[viewer][walk]") {
   const std::string dir = test::TempDir();
   test::WriteFile(dir + "/empty.json",

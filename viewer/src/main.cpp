@@ -54,7 +54,8 @@ int View(int argc, char** argv) {
   CLI::App app{
       "footfall-view: draws terrain samples, queries (foot, direction, cells, candidates, chosen "
       "sample), walks and the queries of a live footfalld. Keys: drag orbit, right-drag pan, "
-      "wheel zoom, F frame all, C colour, G grid cells, space play, left/right frame, Home/End "
+      "wheel zoom, F frame all, W frame the walk, C colour, G grid cells, space play, left/right "
+      "frame, Home/End "
       "first/last frame, Esc or Q quit."};
   app.set_version_flag("--version", "footfall-view " FOOTFALL_VERSION,
                        "Print footfall-view's version and exit");
@@ -94,6 +95,9 @@ int View(int argc, char** argv) {
       app.add_option("--up", up,
                      "The world axis shown up: x, y, z, -x, -y, -z or a vector along one (0,0,1); "
                      "default --up-axis when given, else y");
+  app.add_flag("--frame-walk", o.frame_walk,
+               "Frame the walk at the start (as the W key does), not everything (F); a walk on "
+               "a large terrain is otherwise small in the picture");
   app.add_option("--camera", camera,
                  "Camera \"EX EY EZ TX TY TZ\": eye and target in world space, within +-1e15 "
                  "(--up up, 45 degree vertical field of view); default frames everything");
@@ -109,6 +113,10 @@ int View(int argc, char** argv) {
   if (live_wait_opt->count() > 0 && !o.live) {
     std::cerr << "footfall-view: --live-wait needs --live (it waits for queries the --server "
                  "answers)\n";
+    return 2;
+  }
+  if (o.frame_walk && o.walk.empty()) {
+    std::cerr << "footfall-view: --frame-walk needs --walk (it frames the walk's keys)\n";
     return 2;
   }
   if (!size.empty()) {

@@ -284,6 +284,17 @@ void Scene::FrameBounds(const ViewState& view, glm::dvec3* lo, glm::dvec3* hi) c
   *lo -= glm::dvec3(margin), *hi += glm::dvec3(margin);
 }
 
+bool Scene::WalkFrameBounds(glm::dvec3* lo, glm::dvec3* hi) const {
+  if (!has_walk_keys_) return false;
+  const RenderBox box = ToRenderBox(walk_lo_, walk_hi_);
+  // Room for the feet's points and crosses; the longer markers (the body's axes, 8 units of a
+  // coarse terrain's spacing: 4 m on 50 cm samples) may reach out of the picture, which shows
+  // the walk.
+  const double margin = 2 * MarkerUnit();
+  *lo = box.lo - glm::dvec3(margin), *hi = box.hi + glm::dvec3(margin);
+  return true;
+}
+
 std::vector<RenderBox> Scene::DrawnBoxes() const {
   std::vector<RenderBox> boxes;
   // Room for markers drawn around points (normals and body axes up to 8 sample spacings long,

@@ -193,13 +193,28 @@ struct App {
                  (hud_top + 4) / height, (hud_bottom + 4) / height);
   }
 
-  // Frames everything, or looks as --camera says.
+  // Frames the walk's keys (the terrain around them too, as it is drawn), or everything when
+  // the walk has none.
+  void FrameWalk(int width, int height) {
+    width = std::max(width, 1), height = std::max(height, 1);
+    glm::dvec3 lo, hi;
+    if (!scene.WalkFrameBounds(&lo, &hi)) return FrameAll(width, height);
+    DrawList layout;
+    DrawOverlay(width, height, &layout);  // measures the bands
+    camera.Frame(lo, hi, scene.MinFrameRadius(), static_cast<double>(width) / height,
+                 (hud_top + 4) / height, (hud_bottom + 4) / height);
+  }
+
+  // Frames everything (the walk with --frame-walk), or looks as --camera says.
   void PlaceCamera(int width, int height) {
     frame_width = width, frame_height = height;
     // With nothing loaded, the live queries are the scene: framed as they arrive, until the
     // camera is moved.
     follow_live = live && !scene.has_loaded() && !options.has_camera;
-    FrameAll(width, height);
+    if (options.frame_walk)
+      FrameWalk(width, height);
+    else
+      FrameAll(width, height);
     if (options.has_camera)
       camera.LookAt(scene.ToRenderDouble(options.eye), scene.ToRenderDouble(options.target));
   }
@@ -213,7 +228,8 @@ struct App {
     s << "drag: orbit   right-drag: pan   wheel: zoom   F: frame all   C: colour ("
       << (view.color == ColorMode::kNormal ? "normal" : "height") << ")   G: cells ("
       << (view.show_cells ? "on" : "off") << ")";
-    if (scene.has_walk()) s << "   space: play   left/right: frame   Home/End: first/last";
+    if (scene.has_walk())
+      s << "   W: frame walk   space: play   left/right: frame   Home/End: first/last";
     s << "   Esc: quit";
     return s.str();
   }
@@ -382,6 +398,13 @@ struct App {
         glfwGetFramebufferSize(w, &width, &height);
         app->frame_width = width, app->frame_height = height;
         app->FrameAll(width, height);
+        break;
+      }
+      case GLFW_KEY_W: {
+        int width = 0, height = 0;
+        glfwGetFramebufferSize(w, &width, &height);
+        app->frame_width = width, app->frame_height = height;
+        app->FrameWalk(width, height);
         break;
       }
       case GLFW_KEY_C:

@@ -102,6 +102,9 @@ class Scene {
   // queries received, the candidate rings, arrows, cells and markers around them: what the
   // camera frames.
   void FrameBounds(const ViewState& view, glm::dvec3* lo, glm::dvec3* hi) const;
+  // The render-space bounds of the walk's keys, with room for the feet's markers: what the
+  // camera frames to show the walk alone. False, and nothing set, when the walk has no keys.
+  bool WalkFrameBounds(glm::dvec3* lo, glm::dvec3* hi) const;
   // The render-space boxes of what is drawn, one for the terrain (its cells), one for the walk
   // and one per query and live query, each with room for the markers around it (rings,
   // normals, cells): the camera keeps them between its clip planes.

@@ -29,8 +29,9 @@ struct ViewerOptions {
   bool height_colors = false;
   bool show_cells = false;
   bool has_camera = false;
-  Vec3 eye, target;  // world space, with has_camera
-  ViewUp up;         // the world axis shown up (the camera's up)
+  bool frame_walk = false;  // frame the walk's keys at the start, not everything (W)
+  Vec3 eye, target;         // world space, with has_camera
+  ViewUp up;                // the world axis shown up (the camera's up)
 };
 
 // Runs the viewer. Prints errors as "footfall-view: ..." on stderr and returns the exit code:
