@@ -55,8 +55,7 @@ int View(int argc, char** argv) {
       "footfall-view: draws terrain samples, queries (foot, direction, cells, candidates, chosen "
       "sample), walks and the queries of a live footfalld. Keys: drag orbit, right-drag pan, "
       "wheel zoom, F frame all, W frame the walk, C colour, G grid cells, space play, left/right "
-      "frame, Home/End "
-      "first/last frame, Esc or Q quit."};
+      "frame, Home/End first/last frame, Esc or Q quit."};
   app.set_version_flag("--version", "footfall-view " FOOTFALL_VERSION,
                        "Print footfall-view's version and exit");
   std::string size, camera, up;

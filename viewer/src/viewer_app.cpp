@@ -193,12 +193,14 @@ struct App {
                  (hud_top + 4) / height, (hud_bottom + 4) / height);
   }
 
-  // Frames the walk's keys (the terrain around them too, as it is drawn), or everything when
-  // the walk has none.
+  // Frames the walk's keys alone, or everything when the walk has none.
   void FrameWalk(int width, int height) {
     width = std::max(width, 1), height = std::max(height, 1);
     glm::dvec3 lo, hi;
-    if (!scene.WalkFrameBounds(&lo, &hi)) return FrameAll(width, height);
+    if (!scene.WalkFrameBounds(&lo, &hi)) {
+      FrameAll(width, height);
+      return;
+    }
     DrawList layout;
     DrawOverlay(width, height, &layout);  // measures the bands
     camera.Frame(lo, hi, scene.MinFrameRadius(), static_cast<double>(width) / height,
