@@ -747,6 +747,45 @@ TEST_CASE("a foot that carries rotations is posed with them, one without has non
   CHECK(differ >= 30);
 }
 
+TEST_CASE("soles (--foot-length) are drawn at each foot's pose and at its footholds",
+          "[viewer][walk]") {
+  // WalkJson's body faces +Z: at frame 1, L1 stands at (2, 0, 2) with its sole from z 1.6 to
+  // 2.4 (0.8 long) and x 2 -+ 0.133 (a third as wide); its next foothold is (4, 0, 2).
+  const std::string dir = test::TempDir();
+  test::WriteFile(dir + "/walk.json", WalkJson());
+  const glm::dvec3 eye(3, 6, 7), target(3, 0, 1);
+  const glm::ivec3 left(255, 80, 40), dim_left(167, 80, 60);  // L1, and its dimmed colour
+  auto shot = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args = {
+        "--walk",       dir + "/walk.json", "--frame",      "1",
+        "--camera",     "3 6 7 3 0 1",      "--size",       "640x480",
+        "--screenshot", dir + "/sole.png",  "--dump-state", dir + "/state.json"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const RunResult r = View(args);
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    return ReadPng(dir + "/sole.png");
+  };
+  const double side = 2 + 0.8 / 6;
+  const glm::vec2 sole_edge = Project(eye, target, 640, 480, {side, 0, 2.25});
+  const glm::vec2 footprint_edge = Project(eye, target, 640, 480, {4 + 0.8 / 6, 0, 2.25});
+  INFO("sole edge at " << sole_edge.x << "," << sole_edge.y << ", footprint edge at "
+                       << footprint_edge.x << "," << footprint_edge.y);
+  const Image plain = shot({});
+  CHECK(CountColorNear(plain, sole_edge, 2, left) == 0);
+  CHECK(CountColorNear(plain, footprint_edge, 2, dim_left) == 0);
+  const Image soles = shot({"--foot-length", "0.8"});
+  CHECK(CountColorNear(soles, sole_edge, 2, left) > 0);
+  CHECK(CountColorNear(soles, footprint_edge, 2, dim_left) > 0);
+  // Feet without rotations of their own are turned as --foot-rotations turns them.
+  const json state = json::parse(test::ReadFile(dir + "/state.json"));
+  REQUIRE(state["walk"]["tracks"][0].contains("rotation"));
+  CHECK(state["walk"]["tracks"][0]["rotation"][3].get<double>() == Approx(1));
+  const RunResult none = View({"--foot-length", "0.2", "--screenshot", dir + "/sole.png"});
+  CHECK(none.exit_code == 2);
+  CHECK_THAT(none.err, Catch::Contains("--foot-length needs --walk"));
+}
+
 TEST_CASE("a walk's rotations with huge components are drawn as unit quaternions",
           "[viewer][walk]") {
   // (Squaring 1e300 overflowed: the rotation was normalised to zero, and the body drawn

@@ -94,6 +94,10 @@ int View(int argc, char** argv) {
       app.add_option("--up", up,
                      "The world axis shown up: x, y, z, -x, -y, -z or a vector along one (0,0,1); "
                      "default --up-axis when given, else y");
+  app.add_option("--foot-length", o.sole_length,
+                 "Draw each foot's sole this long (world units; a character's foot_length), at "
+                 "its pose and dimmed at its footholds, turned as --foot-rotations turns feet")
+      ->check(footfall::cli::FiniteRange(0, 1e9));
   app.add_flag("--frame-walk", o.frame_walk,
                "Frame the walk at the start (as the W key does), not everything (F); a walk on "
                "a large terrain is otherwise small in the picture");
@@ -112,6 +116,10 @@ int View(int argc, char** argv) {
   if (live_wait_opt->count() > 0 && !o.live) {
     std::cerr << "footfall-view: --live-wait needs --live (it waits for queries the --server "
                  "answers)\n";
+    return 2;
+  }
+  if (o.sole_length > 0 && o.walk.empty()) {
+    std::cerr << "footfall-view: --foot-length needs --walk (it draws the walk's feet)\n";
     return 2;
   }
   if (o.frame_walk && o.walk.empty()) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "footfall/steps/foot_rotations.h"
 #include "footfall/steps/walk_json.h"
 #include "footfall/viewer/walk_pose.h"
 
@@ -153,6 +154,20 @@ Status Scene::LoadWalk(const std::string& path, std::string* error) {
     }
   }
   return Status::kOk;
+}
+
+void Scene::SetSoleLength(double length) {
+  sole_length_ = length;
+  if (!(length > 0)) return;
+  AddFootRotations(&walk_);  // (a track's own rotations are kept)
+  // The soles reach half their length past the feet's keys: framed and kept between the clip
+  // planes with them.
+  if (!has_walk_keys_) return;
+  const Vec3 reach{0.5 * length, 0.5 * length, 0.5 * length};
+  for (const Vec3& corner : {walk_lo_ - reach, walk_hi_ + reach}) {
+    Grow(corner, &lo_, &hi_, &has_bounds_);
+    Grow(corner, &walk_lo_, &walk_hi_, &has_walk_keys_);
+  }
 }
 
 size_t Scene::PlantedKeysOffTerrain(double limit, size_t* planted) const {
@@ -419,6 +434,19 @@ void Scene::DrawWalk(const ViewState& view, DrawList* on_top) const {
     const Rgba dim{static_cast<uint8_t>(color.r / 2 + 40), static_cast<uint8_t>(color.g / 2 + 40),
                    static_cast<uint8_t>(color.b / 2 + 40), 255};
     const auto& keys = track.keys;
+    const bool turned = track.rotations.size() == keys.size();
+    // The sole's outline about the foot at `at`, turned by `q`.
+    auto sole = [&](const Vec3& at, const Quat& q, const Rgba& c) {
+      const Vec3 forward = Rotate(q, Vec3{0, 0, 1}) * (0.5 * sole_length_);
+      const Vec3 side = Rotate(q, Vec3{1, 0, 0}) * (sole_length_ / 6);
+      const glm::vec3 corners[4] = {ToRender(at + forward + side), ToRender(at + forward - side),
+                                    ToRender(at - forward - side), ToRender(at - forward + side)};
+      for (int i = 0; i < 4; ++i) on_top->Line(corners[i], corners[(i + 1) % 4], c);
+    };
+    if (sole_length_ > 0 && turned) {
+      for (size_t i = 0; i < keys.size(); ++i)
+        if (keys[i].phase != KeyPhase::kMid) sole(keys[i].position, track.rotations[i], dim);
+    }
     for (size_t i = 0; i < keys.size(); ++i) {
       const WalkKey& k = keys[i];
       if (k.phase == KeyPhase::kEnd || k.phase == KeyPhase::kStart || k.phase == KeyPhase::kNone)
@@ -440,9 +468,10 @@ void Scene::DrawWalk(const ViewState& view, DrawList* on_top) const {
     const glm::vec3 p = ToRender(pose.position);
     on_top->Line(p, p + ToRenderDirection(pose.normal) * (unit * 6), color);
     // A foot that carries its orientation (--foot-rotations): its forward, dimmed.
-    if (track.rotations.size() == keys.size())
+    if (turned)
       on_top->Line(p, p + ToRenderDirection(Rotate(pose.rotation, Vec3{0, 0, 1})) * (unit * 6),
                    dim);
+    if (sole_length_ > 0 && turned) sole(pose.position, pose.rotation, color);
     on_top->Point(p, color, 16);
   }
 }

@@ -663,6 +663,7 @@ int RunViewer(const ViewerOptions& options) {
   }
   if (!options.walk.empty() && app.scene.LoadWalk(options.walk, &error) != Status::kOk)
     return Fail(error);
+  app.scene.SetSoleLength(options.sole_length);
   if (!options.walk.empty()) {
     // A walk of no keys (no tracks, or tracks without keys) draws nothing: say so rather than
     // leave an empty picture unexplained.

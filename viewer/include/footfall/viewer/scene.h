@@ -56,6 +56,11 @@ class Scene {
   // Reads a footfall-walk JSON file (footfall/steps/walk_json.h); body rotations are
   // normalised for drawing.
   Status LoadWalk(const std::string& path, std::string* error);
+  // Draws each foot's sole, `length` long along its forward and a third as wide, centred on
+  // the foot: at its pose, and dimmed at every planted key (its footprints). Feet whose walk
+  // carries no rotations are turned as `footfall generate --foot-rotations` turns them
+  // (AddFootRotations). 0 (the default): no soles. Call after LoadWalk. [Units: wu]
+  void SetSoleLength(double length);
   // How many of the walk's planted foot keys (start and end) lie farther than `limit` from
   // every terrain sample, of *planted: a walk made on another terrain shows as many. 0 without
   // a terrain or a walk.
@@ -149,6 +154,7 @@ class Scene {
   size_t live_received_ = 0;
   size_t live_other_terrain_ = 0;
   Walk walk_;
+  double sole_length_ = 0;  // SetSoleLength
   double first_frame_ = 0, last_frame_ = 0;
   Vec3 origin_;
   ViewUp up_;
