@@ -395,18 +395,15 @@ struct App {
       case GLFW_KEY_Q:
         glfwSetWindowShouldClose(w, GLFW_TRUE);
         break;
-      case GLFW_KEY_F: {
+      case GLFW_KEY_F:    // frame all
+      case GLFW_KEY_W: {  // frame the walk
         int width = 0, height = 0;
         glfwGetFramebufferSize(w, &width, &height);
         app->frame_width = width, app->frame_height = height;
-        app->FrameAll(width, height);
-        break;
-      }
-      case GLFW_KEY_W: {
-        int width = 0, height = 0;
-        glfwGetFramebufferSize(w, &width, &height);
-        app->frame_width = width, app->frame_height = height;
-        app->FrameWalk(width, height);
+        if (key == GLFW_KEY_W)
+          app->FrameWalk(width, height);
+        else
+          app->FrameAll(width, height);
         break;
       }
       case GLFW_KEY_C:
