@@ -247,6 +247,63 @@ TEST_CASE("ParseWalkJson says on which line the value it refuses stands", "[expo
   }
 }
 
+TEST_CASE("A foot track's foot_length is written, read back and checked", "[export][walk_json]") {
+  Walk walk = test::BipedWalk();  // tracks L, R, body
+  walk.tracks[0].foot_length = 0.22;
+  walk.tracks[1].foot_length = 1.0 / 3;  // the shortest text that reads back as the double
+  const std::string text = WalkToJson(walk);
+  CHECK(text.find("\"name\":\"L\",\"kind\":\"foot\",\"foot_length\":0.22,\"keys\"") !=
+        std::string::npos);
+  Walk back;
+  std::string error;
+  REQUIRE(ParseWalkJson(text, "w.json", &back, &error) == Status::kOk);
+  CHECK(back.tracks[0].foot_length == 0.22);
+  CHECK(back.tracks[1].foot_length == 1.0 / 3);
+  CHECK(back.tracks[2].foot_length == 0);
+  CHECK(WalkToJson(back) == text);
+
+  // Point feet (0) write none, as walks did before.
+  walk.tracks[0].foot_length = 0;
+  const std::string point = WalkToJson(walk);
+  CHECK(point.find("\"name\":\"L\",\"kind\":\"foot\",\"keys\"") != std::string::npos);
+  CHECK(point.find("foot_length", point.find("\"name\":\"R\"")) != std::string::npos);
+  CHECK(point.find("foot_length") > point.find("\"name\":\"R\""));
+
+  auto refuse = [&text](const std::string& replaced, const std::string& by) {
+    std::string bad = text;
+    const size_t at = bad.find(replaced);
+    REQUIRE(at != std::string::npos);
+    bad.replace(at, replaced.size(), by);
+    Walk w;
+    std::string message;
+    CHECK(ParseWalkJson(bad, "w.json", &w, &message) == Status::kParseError);
+    return message;
+  };
+  const std::string l = "\"foot_length\":0.22";
+  CHECK(refuse(l, "\"foot_length\":-0.1") ==
+        "w.json: tracks[0].foot_length: expected a length in [0, 1e9] (the character's "
+        "foot_length) (line 2)");
+  CHECK(refuse(l, "\"foot_length\":2e9").find("expected a length in [0, 1e9]") !=
+        std::string::npos);
+  CHECK(refuse(l, "\"foot_length\":\"long\"") ==
+        "w.json: tracks[0].foot_length: expected a finite number (line 2)");
+  CHECK(refuse("\"kind\":\"body\"", "\"kind\":\"body\",\"foot_length\":0.2")
+            .find("tracks[2].foot_length: only a foot track has a foot_length") !=
+        std::string::npos);
+  // Read the same as the keys are parsed and as a whole document, and in another tool's
+  // order of fields (sorted: foot_length and keys before kind).
+  Walk whole;
+  REQUIRE(detail::ParseWalkJsonWhole(text, "w.json", &whole, &error) == Status::kOk);
+  CHECK(whole.tracks[0].foot_length == 0.22);
+  const std::string sorted = nlohmann::json::parse(text).dump(2);
+  REQUIRE(sorted.find("\"foot_length\"") < sorted.find("\"kind\""));
+  Walk resorted;
+  REQUIRE(ParseWalkJson(sorted, "w.json", &resorted, &error) == Status::kOk);
+  CHECK(resorted.tracks[0].foot_length == 0.22);
+  CHECK(resorted.tracks[1].foot_length == 1.0 / 3);
+  CHECK(WalkToJson(resorted) == text);
+}
+
 namespace {
 
 // The first difference between two walks read from JSON ("" when they are the same).
@@ -257,8 +314,9 @@ std::string WalkDifference(const Walk& a, const Walk& b) {
     const WalkTrack& x = a.tracks[t];
     const WalkTrack& y = b.tracks[t];
     const std::string at = "track " + std::to_string(t) + ": ";
-    if (x.name != y.name || x.character != y.character || x.kind != y.kind)
-      return at + "name, character or kind";
+    if (x.name != y.name || x.character != y.character || x.kind != y.kind ||
+        x.foot_length != y.foot_length)
+      return at + "name, character, kind or foot_length";
     if (x.keys.size() != y.keys.size() || x.rotations.size() != y.rotations.size())
       return at + "key count";
     for (size_t k = 0; k < x.keys.size(); ++k) {

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "footfall/import/terrain_generators.h"
+#include "footfall/steps/walk_json.h"
 #include "generator_fixtures.h"
 #include "walk_checks.h"
 
@@ -201,6 +202,31 @@ TEST_CASE("A biped's soles change nothing on ground that has room for them",
       REQUIRE(w.tracks[i].keys.size() == v.tracks[i].keys.size());
       for (size_t j = 0; j < w.tracks[i].keys.size(); ++j)
         CHECK(w.tracks[i].keys[j].position == v.tracks[i].keys[j].position);
+    }
+  }
+}
+
+TEST_CASE("A walk's foot tracks carry their character's foot length", "[steps][generator][soles]") {
+  // (For the viewer, which draws each sole as long as its track says.)
+  const Character shipped = LoadShipped("biped");
+  REQUIRE(shipped.foot_length > 0);
+  Character point = shipped;
+  point.foot_length = 0;
+  Terrain flat = LoadTerrain(MakeFlat(201, 0.05, 0), 0.05);
+  const GenerateOptions one = StartOptions(Vec3{3, 0, 1}, 2);
+  const GenerateOptions crowd = CrowdOptions(Vec3{5, 0, 3}, 2, 3, 1.0);
+  for (const GenerateOptions* o : {&one, &crowd}) {
+    for (const Character* c : {&shipped, static_cast<const Character*>(&point)}) {
+      const Walk w = Generate(flat, *c, *o);
+      size_t feet = 0;
+      for (const WalkTrack& t : w.tracks) {
+        INFO(t.character << " " << t.name);
+        CHECK(t.foot_length == (t.kind == TrackKind::kFoot ? c->foot_length : 0));
+        feet += t.kind == TrackKind::kFoot;
+      }
+      CHECK(feet == c->feet.size() * (o == &crowd ? 3 : 1));
+      const std::string text = WalkToJson(w);
+      CHECK((text.find("\"foot_length\":0.22,") != std::string::npos) == (c == &shipped));
     }
   }
 }

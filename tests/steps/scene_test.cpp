@@ -283,7 +283,7 @@ TEST_CASE("LoadScene reads character files beside the scene file", "[steps][scen
 TEST_CASE("A scene's walk holds every character's tracks under its name", "[steps][scene]") {
   Walk one;
   one.tracks.resize(2);
-  one.tracks[0].name = "L";
+  one.tracks[0].name = "L", one.tracks[0].foot_length = 0.22;
   one.tracks[1].name = "body", one.tracks[1].kind = TrackKind::kBody;
   Walk crowd;
   crowd.tracks.resize(2);
@@ -298,6 +298,7 @@ TEST_CASE("A scene's walk holds every character's tracks under its name", "[step
   AddToSceneWalk("bugs", std::move(crowd), &scene);
   REQUIRE(scene.tracks.size() == 4);
   CHECK(scene.tracks[0].character == "walker");
+  CHECK(scene.tracks[0].foot_length == 0.22);  // the sole the viewer draws goes along
   CHECK(scene.tracks[1].character == "walker");
   CHECK(scene.tracks[2].character == "bugs/c1");
   CHECK(scene.tracks[3].character == "bugs/c2");

@@ -747,8 +747,10 @@ TEST_CASE("a foot that carries rotations is posed with them, one without has non
   CHECK(differ >= 30);
 }
 
-TEST_CASE("soles (--foot-length) are drawn at each foot's pose and at its footholds",
-          "[viewer][walk]") {
+TEST_CASE(
+    "soles (the walk's foot_length, --foot-length) are drawn at each foot's pose and at "
+    "its footholds",
+    "[viewer][walk]") {
   // WalkJson's body faces +Z: at frame 1, L1 stands at (2, 0, 2) with its sole from z 1.6 to
   // 2.4 (0.8 long) and x 2 -+ 0.133 (a third as wide); its next foothold is (4, 0, 2).
   const std::string dir = test::TempDir();
@@ -781,6 +783,31 @@ TEST_CASE("soles (--foot-length) are drawn at each foot's pose and at its footho
   const json state = json::parse(test::ReadFile(dir + "/state.json"));
   REQUIRE(state["walk"]["tracks"][0].contains("rotation"));
   CHECK(state["walk"]["tracks"][0]["rotation"][3].get<double>() == Approx(1));
+
+  // A walk whose foot tracks carry their foot_length (as footfall generate writes a character
+  // with one) draws those soles unasked; --foot-length 0 draws none, and a length given
+  // replaces the walk's.
+  std::string own = WalkJson();
+  own.replace(own.find(R"("kind": "foot")"), 14, R"("kind": "foot", "foot_length": 0.8)");
+  test::WriteFile(dir + "/walk.json", own);
+  // (--dump-state gives each foot's sole_length where a sole is drawn: here L1's alone.)
+  auto sole_lengths = [&dir]() {
+    const json tracks = json::parse(test::ReadFile(dir + "/state.json"))["walk"]["tracks"];
+    return std::vector<double>{tracks[0].value("sole_length", 0.0),
+                               tracks[1].value("sole_length", 0.0)};
+  };
+  const Image walk_soles = shot({});
+  CHECK(CountColorNear(walk_soles, sole_edge, 2, left) > 0);
+  CHECK(CountColorNear(walk_soles, footprint_edge, 2, dim_left) > 0);
+  CHECK(sole_lengths() == std::vector<double>{0.8, 0});
+  const Image off = shot({"--foot-length", "0"});
+  CHECK(CountColorNear(off, sole_edge, 2, left) == 0);
+  CHECK(CountColorNear(off, footprint_edge, 2, dim_left) == 0);
+  CHECK(sole_lengths() == std::vector<double>{0, 0});
+  const Image shorter = shot({"--foot-length", "0.2"});
+  CHECK(CountColorNear(shorter, sole_edge, 2, left) == 0);
+  CHECK(CountColorNear(shorter, footprint_edge, 2, dim_left) == 0);
+  CHECK(sole_lengths() == std::vector<double>{0.2, 0.2});
   const RunResult none = View({"--foot-length", "0.2", "--screenshot", dir + "/sole.png"});
   CHECK(none.exit_code == 2);
   CHECK_THAT(none.err, Catch::Contains("--foot-length needs --walk"));

@@ -94,10 +94,12 @@ int View(int argc, char** argv) {
       app.add_option("--up", up,
                      "The world axis shown up: x, y, z, -x, -y, -z or a vector along one (0,0,1); "
                      "default --up-axis when given, else y");
-  app.add_option("--foot-length", o.sole_length,
-                 "Draw each foot's sole this long (world units; a character's foot_length), at "
-                 "its pose and dimmed at its footholds, turned as --foot-rotations turns feet")
-      ->check(footfall::cli::FiniteRange(0, 1e9));
+  auto* foot_length_opt =
+      app.add_option("--foot-length", o.sole_length,
+                     "Draw each foot's sole this long (world units; 0: none), at its pose and "
+                     "dimmed at its footholds, turned as --foot-rotations turns feet; default: "
+                     "the walk's own foot_length (a character's), where it has one")
+          ->check(footfall::cli::FiniteRange(0, 1e9));
   app.add_flag("--frame-walk", o.frame_walk,
                "Frame the walk at the start (as the W key does), not everything (F); a walk on "
                "a large terrain is otherwise small in the picture");
@@ -118,7 +120,7 @@ int View(int argc, char** argv) {
                  "answers)\n";
     return 2;
   }
-  if (o.sole_length > 0 && o.walk.empty()) {
+  if (foot_length_opt->count() > 0 && o.walk.empty()) {
     std::cerr << "footfall-view: --foot-length needs --walk (it draws the walk's feet)\n";
     return 2;
   }

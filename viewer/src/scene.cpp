@@ -153,17 +153,32 @@ Status Scene::LoadWalk(const std::string& path, std::string* error) {
       Grow(k.position, &walk_lo_, &walk_hi_, &has_walk_keys_);
     }
   }
+  sole_reach_ = 0;
+  FitSoles();
   return Status::kOk;
 }
 
 void Scene::SetSoleLength(double length) {
   sole_length_ = length;
-  if (!(length > 0)) return;
+  FitSoles();
+}
+
+double Scene::SoleLength(const WalkTrack& track) const {
+  if (track.kind != TrackKind::kFoot) return 0;
+  return sole_length_ >= 0 ? sole_length_ : track.foot_length;
+}
+
+void Scene::FitSoles() {
+  double longest = 0;
+  for (const WalkTrack& t : walk_.tracks) longest = std::max(longest, SoleLength(t));
+  if (!(longest > 0)) return;
   AddFootRotations(&walk_);  // (a track's own rotations are kept)
   // The soles reach half their length past the feet's keys: framed and kept between the clip
-  // planes with them.
-  if (!has_walk_keys_) return;
-  const Vec3 reach{0.5 * length, 0.5 * length, 0.5 * length};
+  // planes with them. (Grown by what the bounds lack: a second call does not grow them twice.)
+  if (!has_walk_keys_ || !(0.5 * longest > sole_reach_)) return;
+  const double grow = 0.5 * longest - sole_reach_;
+  sole_reach_ = 0.5 * longest;
+  const Vec3 reach{grow, grow, grow};
   for (const Vec3& corner : {walk_lo_ - reach, walk_hi_ + reach}) {
     Grow(corner, &lo_, &hi_, &has_bounds_);
     Grow(corner, &walk_lo_, &walk_hi_, &has_walk_keys_);
@@ -436,14 +451,15 @@ void Scene::DrawWalk(const ViewState& view, DrawList* on_top) const {
     const auto& keys = track.keys;
     const bool turned = track.rotations.size() == keys.size();
     // The sole's outline about the foot at `at`, turned by `q`.
+    const double sole_length = SoleLength(track);
     auto sole = [&](const Vec3& at, const Quat& q, const Rgba& c) {
-      const Vec3 forward = Rotate(q, Vec3{0, 0, 1}) * (0.5 * sole_length_);
-      const Vec3 side = Rotate(q, Vec3{1, 0, 0}) * (sole_length_ / 6);
+      const Vec3 forward = Rotate(q, Vec3{0, 0, 1}) * (0.5 * sole_length);
+      const Vec3 side = Rotate(q, Vec3{1, 0, 0}) * (sole_length / 6);
       const glm::vec3 corners[4] = {ToRender(at + forward + side), ToRender(at + forward - side),
                                     ToRender(at - forward - side), ToRender(at - forward + side)};
       for (int i = 0; i < 4; ++i) on_top->Line(corners[i], corners[(i + 1) % 4], c);
     };
-    if (sole_length_ > 0 && turned) {
+    if (sole_length > 0 && turned) {
       for (size_t i = 0; i < keys.size(); ++i)
         if (keys[i].phase != KeyPhase::kMid) sole(keys[i].position, track.rotations[i], dim);
     }
@@ -471,7 +487,7 @@ void Scene::DrawWalk(const ViewState& view, DrawList* on_top) const {
     if (turned)
       on_top->Line(p, p + ToRenderDirection(Rotate(pose.rotation, Vec3{0, 0, 1})) * (unit * 6),
                    dim);
-    if (sole_length_ > 0 && turned) sole(pose.position, pose.rotation, color);
+    if (sole_length > 0 && turned) sole(pose.position, pose.rotation, color);
     on_top->Point(p, color, 16);
   }
 }
@@ -594,6 +610,9 @@ void Scene::Describe(const ViewState& view, const OrbitCamera& camera, int width
       j.Value(c.r), j.Value(c.g), j.Value(c.b);
       j.End();
       j.Key("swinging").Value(pose.swinging);
+      // The sole drawn about it (SetSoleLength), when one is.
+      if (SoleLength(t) > 0 && t.rotations.size() == t.keys.size())
+        j.Key("sole_length").Value(SoleLength(t));
     }
     if (t.kind == TrackKind::kBody || t.rotations.size() == t.keys.size()) {
       const Quat& q = pose.rotation;

@@ -205,6 +205,7 @@ Status Generator::Setup(std::string* error) {
                   std::pmr::vector<Quat>(arena.get())};
       t.keys.reserve(body ? body_keys : foot_keys);
       if (body) t.rotations.reserve(body_keys);
+      if (!body) t.foot_length = c_.foot_length;
       walk_.tracks.push_back(std::move(t));
     }
   }

@@ -96,7 +96,12 @@ void AppendRun(const Walk& walk, const KeyRun& run, const std::vector<size_t>& o
     if (!t.character.empty()) out += ",\"character\":", String(out, t.character);
     out += ",\"kind\":\"";
     out += KindName(t.kind);
-    out += "\",\"keys\":[";
+    out += '"';
+    if (t.kind == TrackKind::kFoot && t.foot_length > 0) {
+      out += ",\"foot_length\":";
+      Number(out, t.foot_length);
+    }
+    out += ",\"keys\":[";
   }
   for (size_t i = run.first; i < run.end; ++i) {
     const size_t ki = order.empty() ? i : order[i];

@@ -296,7 +296,7 @@ Status ParseWalk(const std::string& text, const std::string& source, Walk* out, 
         r.Fail(tw, "expected {\"name\": STRING, \"kind\": \"foot\"|\"body\", \"keys\": [...]}");
         break;
       }
-      if (!r.Known(t, tw, {"name", "kind", "character", "keys", "comment"})) break;
+      if (!r.Known(t, tw, {"name", "kind", "character", "foot_length", "keys", "comment"})) break;
       track.name = t["name"].get<std::string>();
       if (!detail::ControlCharacterIn(track.name).empty()) {
         r.Fail(tw + ".name", detail::ControlCharacterIn(track.name));
@@ -322,6 +322,18 @@ Status ParseWalk(const std::string& text, const std::string& source, Walk* out, 
       else {
         r.Fail(tw + ".kind", "expected \"foot\" or \"body\"");
         break;
+      }
+      if (t.contains("foot_length")) {
+        const std::string at = tw + ".foot_length";
+        if (track.kind != TrackKind::kFoot) {
+          r.Fail(at, "only a foot track has a foot_length");
+          break;
+        }
+        if (!r.Finite(t["foot_length"], at, &track.foot_length)) break;
+        if (!(track.foot_length >= 0 && track.foot_length <= kMaxFootLength)) {
+          r.Fail(at, "expected a length in [0, 1e9] (the character's foot_length)");
+          break;
+        }
       }
       if (!t.contains("keys") || !t["keys"].is_array()) {
         r.Fail(tw + ".keys", "expected an array");

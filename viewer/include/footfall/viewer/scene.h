@@ -56,10 +56,12 @@ class Scene {
   // Reads a footfall-walk JSON file (footfall/steps/walk_json.h); body rotations are
   // normalised for drawing.
   Status LoadWalk(const std::string& path, std::string* error);
-  // Draws each foot's sole, `length` long along its forward and a third as wide, centred on
-  // the foot: at its pose, and dimmed at every planted key (its footprints). Feet whose walk
+  // Each foot's sole is drawn its track's foot_length long (the walk's own; none where it is
+  // 0) along its forward and a third as wide, centred on the foot: at its pose, and dimmed at
+  // every planted key (its footprints). SetSoleLength(length) draws every foot's sole `length`
+  // long instead (0: none); a negative length goes back to the walk's own. Feet whose walk
   // carries no rotations are turned as `footfall generate --foot-rotations` turns them
-  // (AddFootRotations). 0 (the default): no soles. Call after LoadWalk. [Units: wu]
+  // (AddFootRotations). [Units: wu]
   void SetSoleLength(double length);
   // How many of the walk's planted foot keys (start and end) lie farther than `limit` from
   // every terrain sample, of *planted: a walk made on another terrain shows as many. 0 without
@@ -141,6 +143,11 @@ class Scene {
  private:
   void DrawQuery(const QueryView& q, bool latest, DrawList* depth_tested, DrawList* on_top) const;
   void DrawWalk(const ViewState& view, DrawList* on_top) const;
+  // The length a foot track's sole is drawn (SetSoleLength). [Units: wu]
+  double SoleLength(const WalkTrack& track) const;
+  // Turns the feet (AddFootRotations) and grows the walk's bounds by half the longest sole,
+  // once some sole is drawn.
+  void FitSoles();
   // The world-space box of a query's points, its arrow, cells and candidate ring.
   void QueryBounds(const QueryView& q, Vec3* lo, Vec3* hi) const;
   // Grows the drawn bounds by QueryBounds(q).
@@ -154,7 +161,8 @@ class Scene {
   size_t live_received_ = 0;
   size_t live_other_terrain_ = 0;
   Walk walk_;
-  double sole_length_ = 0;  // SetSoleLength
+  double sole_length_ = -1;  // SetSoleLength (negative: each track's foot_length)
+  double sole_reach_ = 0;    // how far the walk's bounds were grown for soles (FitSoles)
   double first_frame_ = 0, last_frame_ = 0;
   Vec3 origin_;
   ViewUp up_;

@@ -30,7 +30,8 @@ struct ViewerOptions {
   bool show_cells = false;
   bool has_camera = false;
   bool frame_walk = false;  // frame the walk's keys at the start, not everything (W)
-  double sole_length = 0;   // [Units: wu] draw the feet's soles this long (0: none)
+  double sole_length = -1;  // [Units: wu] draw the feet's soles this long (0: none;
+                            // negative: each foot track's foot_length, as the walk has it)
   Vec3 eye, target;         // world space, with has_camera
   ViewUp up;                // the world axis shown up (the camera's up)
 };

@@ -79,6 +79,9 @@ struct WalkTrack {
   // Body tracks: the body's world orientation at each key (rotations[i] at keys[i]). Foot
   // tracks: empty, or each key's orientation once given (AddFootRotations, foot_rotations.h).
   std::pmr::vector<Quat> rotations;
+  // Foot tracks: the length of the foot's sole (its character's foot_length), for drawing it;
+  // 0 for point feet, for body tracks, and when not known. [Units: wu]
+  double foot_length = 0;
 
   // The orientation at keys[i]: rotations[i], or the identity where there is none.
   Quat Rotation(size_t i) const { return i < rotations.size() ? rotations[i] : Quat{}; }

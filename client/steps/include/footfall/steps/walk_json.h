@@ -41,14 +41,17 @@ Status WriteWalkJson(const Walk& walk, const std::string& path, std::string* err
 // and what a walk adds above them.
 constexpr double kMaxKeyCoordinate = 1e15;
 
+// A foot track's foot_length lies in [0, this], as a character's does.
+constexpr double kMaxFootLength = 1e9;
+
 // Parses walk JSON. `source` names it in errors: "SOURCE:LINE:COLUMN: malformed JSON: ..." for
 // text that is not JSON, "SOURCE: tracks[2].keys[5].position: expected an array of 3 numbers
 // (line 8)" for a wrong structure: the line (1-based) where that value starts, or, for a missing
 // field, where the object without it starts. Frames must increase along each track, positions
-// lie within +-kMaxKeyCoordinate, foot normals must be non-zero vectors and body rotations
-// non-zero quaternions (both finite, read as written, not normalised). kParseError for
-// malformed or unsupported input. Keys are read as they are parsed: the text and the walk are
-// all it holds.
+// lie within +-kMaxKeyCoordinate, a foot track's foot_length within [0, kMaxFootLength], foot
+// normals must be non-zero vectors and body rotations non-zero quaternions (both finite, read as
+// written, not normalised). kParseError for malformed or unsupported input. Keys are read as they
+// are parsed: the text and the walk are all it holds.
 Status ParseWalkJson(const std::string& text, const std::string& source, Walk* out,
                      std::string* error);
 
