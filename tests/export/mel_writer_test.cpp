@@ -38,8 +38,11 @@ struct MelScript {
   std::map<std::string, std::map<std::string, std::vector<MelKey>>> keys;  // loc -> attr
   std::vector<std::string> warnings;
   int braces = 0;
-  std::string angle_unit;       // set by the script, before any rotation key
-  bool angle_restored = false;  // the user's angle unit put back, after every key
+  std::string angle_unit;        // set by the script, before any rotation key
+  bool angle_restored = false;   // the user's angle unit put back, after every key
+  std::string linear_unit;       // set by the script (MelOptions::linear_unit), before any key
+  bool linear_restored = false;  // the user's linear unit put back, after every key
+  bool translate_before_linear = false;  // a translate key before the linear unit was set
 };
 
 // Every setKeyframe line must match `key`: keys carry linear tangents, as glTF's LINEAR samplers,
@@ -64,8 +67,11 @@ MelScript ParseMel(const std::string& path) {
       R"re(^setKeyframe -t (-?[0-9.]+) -at (translate[XYZ]|rotate[XYZ]) -v (-?[0-9.]+) -itt linear -ott linear \$footfall_node\[0\];$)re");
   static const std::regex angle_query(
       R"re(^string \$footfall_angle_unit = `currentUnit -query -angle`;$)re");
+  static const std::regex linear_query(
+      R"re(^string \$footfall_linear_unit = `currentUnit -query -linear`;$)re");
+  static const std::regex linear_set(R"re(^currentUnit -linear "(\w+)";$)re");
   MelScript script;
-  bool angle_queried = false;
+  bool angle_queried = false, linear_queried = false;
   std::string line, current;
   std::smatch m;
   while (std::getline(in, line)) {
@@ -79,6 +85,17 @@ MelScript ParseMel(const std::string& path) {
     } else if (line == "currentUnit -angle $footfall_angle_unit;") {
       REQUIRE(script.angle_unit == "deg");
       script.angle_restored = true;
+    } else if (std::regex_match(line, m, linear_query)) {
+      linear_queried = true;
+    } else if (std::regex_match(line, m, linear_set)) {
+      REQUIRE(linear_queried);
+      REQUIRE(script.keys.empty());
+      script.linear_unit = m[1];
+    } else if (line == "currentUnit -linear $footfall_linear_unit;") {
+      REQUIRE(!script.linear_unit.empty());
+      script.linear_restored = true;
+    } else if (line.rfind("currentUnit -linear", 0) == 0) {
+      FAIL("unexpected currentUnit line: " << line);
     } else if (std::regex_match(line, m, unit)) {
       script.time_unit = m[1];
     } else if (std::regex_match(line, m, playback)) {
@@ -104,7 +121,10 @@ MelScript ParseMel(const std::string& path) {
     } else if (std::regex_match(line, m, key)) {
       REQUIRE(!current.empty());
       REQUIRE(!script.angle_restored);
+      REQUIRE(!script.linear_restored);
       if (m[2].str().rfind("rotate", 0) == 0) REQUIRE(script.angle_unit == "deg");
+      if (m[2].str().rfind("translate", 0) == 0 && script.linear_unit.empty())
+        script.translate_before_linear = true;
       script.keys[current][m[2]].push_back({std::stod(m[1]), std::stod(m[3])});
     } else if (line.rfind("warning ", 0) == 0) {
       script.warnings.push_back(line);
@@ -113,6 +133,15 @@ MelScript ParseMel(const std::string& path) {
     }
   }
   return script;
+}
+
+// The whole text of the file at `path`.
+std::string FileText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  REQUIRE(in.good());
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
 }
 
 std::string WriteAndKeep(const Walk& walk, const std::string& name) {
@@ -225,6 +254,59 @@ TEST_CASE("WriteMel keys a locator per track", "[export][mel]") {
     }
   }
   std::remove(path.c_str());
+}
+
+TEST_CASE("WriteMel keys lengths in the walk's linear unit when it is named", "[export][mel]") {
+  // Maya reads setKeyframe values in the scene's linear unit (centimetres by default): a walk in
+  // metres was keyed 100 times small. Named, the unit is set while keying and the user's put
+  // back, as for angles; the keys are the same numbers.
+  const Walk walk = test::BipedWalk();
+  const std::string plain_path = WriteAndKeep(walk, "scene_unit.mel");
+  const MelScript plain = ParseMel(plain_path);
+  CHECK(plain.linear_unit.empty());
+  CHECK_FALSE(plain.linear_restored);
+  CHECK(FileText(plain_path).find("// Lengths are keyed in the scene's linear unit") !=
+        std::string::npos);
+  for (const std::string unit : {"m", "cm", "mm", "km", "in", "ft", "yd", "mi"}) {
+    INFO(unit);
+    CHECK(IsMayaLinearUnit(unit));
+    MelOptions options;
+    options.linear_unit = unit;
+    const std::string path = test::ScratchPath("unit_" + unit + ".mel");
+    std::string error;
+    REQUIRE(WriteMel(walk, path, options, &error) == Status::kOk);
+    const MelScript named = ParseMel(path);
+    CHECK(named.linear_unit == unit);
+    CHECK(named.linear_restored);
+    CHECK_FALSE(named.translate_before_linear);
+    CHECK(named.braces == 0);
+    CHECK(named.keys.size() == plain.keys.size());
+    for (const auto& [locator, attrs] : plain.keys) {
+      for (const auto& [attr, keys] : attrs) {
+        const auto& other = named.keys.at(locator).at(attr);
+        REQUIRE(other.size() == keys.size());
+        for (size_t i = 0; i < keys.size(); ++i) {
+          CHECK(other[i].frame == keys[i].frame);
+          CHECK(other[i].value == keys[i].value);
+        }
+      }
+    }
+    CHECK(FileText(path).find("// Lengths are in " + unit + " and keyed so") != std::string::npos);
+    std::remove(path.c_str());
+  }
+  for (const std::string bad : {"furlong", "M", "meter", " m", "m\"; quit -f; \""}) {
+    INFO(bad);
+    CHECK_FALSE(IsMayaLinearUnit(bad));
+    MelOptions options;
+    options.linear_unit = bad;
+    const std::string path = test::ScratchPath("unit_bad.mel");
+    std::string error;
+    CHECK(WriteMel(walk, path, options, &error) == Status::kInvalidArgument);
+    CHECK(error.rfind("unknown Maya linear unit '", 0) == 0);
+    CHECK(error.find("(expected mm, cm, m, km, in, ft, yd or mi)") != std::string::npos);
+    CHECK_FALSE(std::ifstream(path).good());
+  }
+  std::remove(plain_path.c_str());
 }
 
 TEST_CASE("WriteMel writes frames and values that read back exactly, without exponents",

@@ -438,6 +438,26 @@ assert feet > 10 and turned == plain, feet
 PY
 check "foot rotations: MEL turns 3 locators, not 1" [ "$(grep -c 'rotateOrder' "$work/turned.mel")" -eq 3 -a "$(grep -c 'rotateOrder' "$work/all.mel")" -eq 1 ]
 check "foot rotations: glTF has 3 rotation channels, not 1" [ "$(grep -o '"path": *"rotation"' "$work/turned.gltf" | wc -l)" -eq 3 -a "$(grep -o '"path": *"rotation"' "$work/all.gltf" | wc -l)" -eq 1 ]
+# --mel-unit m: the MEL keys the same numbers with the scene's linear unit set to metres while it
+# keys (Maya converts), the user's put back after; a unit Maya does not know, or no .mel to
+# apply it to, is refused before anything is written.
+"$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
+  --steps 100 --mel-unit m --out "$work/metres.mel" 2>/dev/null
+check "--mel-unit: exit 2 for the stopped walk" [ $? -eq 2 ]
+check "--mel-unit: the unit set, after the user's is kept" grep -qx 'currentUnit -linear "m";' "$work/metres.mel"
+check "--mel-unit: the user's unit put back" grep -qx 'currentUnit -linear $footfall_linear_unit;' "$work/metres.mel"
+check "--mel-unit: the same keys" cmp -s <(grep setKeyframe "$work/all.mel") <(grep setKeyframe "$work/metres.mel")
+check "--mel-unit: none without it" bash -c "! grep -q 'currentUnit -linear' '$work/all.mel'"
+"$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
+  --steps 2 --mel-unit furlong --out "$work/furlong.mel" 2> "$work/furlong.err"
+check "--mel-unit furlong: exit 1" [ $? -eq 1 ]
+check "--mel-unit furlong: the units named" grep -qF -- "--mel-unit: expected mm, cm, m, km, in, ft, yd or mi" "$work/furlong.err"
+check "--mel-unit furlong: nothing written" [ ! -e "$work/furlong.mel" ]
+"$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
+  --steps 2 --mel-unit cm --out "$work/no-mel.json" 2> "$work/no-mel.err"
+check "--mel-unit without a .mel: exit 1" [ $? -eq 1 ]
+check "--mel-unit without a .mel: said" grep -qF -- "--mel-unit cm names the unit of .mel outputs, and no --out is a .mel file" "$work/no-mel.err"
+check "--mel-unit without a .mel: nothing written" [ ! -e "$work/no-mel.json" ]
 # At UTM-like coordinates glTF's floats would move keys visibly: the writer puts the tracks under
 # a root origin node, so nothing is lost and there is no warning; none near the origin either.
 awk '{ printf "%.3f %s %.3f %s %s %s\n", $1 + 500000, $2, $3 + 4000000, $4, $5, $6 }' "$work/floor.pts" > "$work/utm.pts"

@@ -23,6 +23,7 @@
 #include "footfall/cli/number_checks.h"
 #include "footfall/client/query_text.h"
 #include "footfall/export/gltf_writer.h"
+#include "footfall/export/mel_writer.h"
 #include "footfall/export/walk_writer.h"
 #include "footfall/import/terrain_loader.h"
 #include "footfall/steps/foot_rotations.h"
@@ -54,6 +55,7 @@ struct GenerateFlags {
   double crowd_spacing = 0;
   bool progress = false;
   bool foot_rotations = false;
+  std::string mel_unit;  // the walk's linear unit in .mel outputs ("": the scene's)
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::vector<std::string> out;
 };
@@ -333,6 +335,14 @@ bool CheckOutputs(const GenerateFlags& flags, const std::vector<std::string>& in
       }
     }
   }
+  // (Without a .mel it would change nothing, unseen.)
+  if (!flags.mel_unit.empty() &&
+      std::none_of(flags.out.begin(), flags.out.end(),
+                   [](const std::string& out) { return FileExtension(out) == "mel"; })) {
+    *error = "--mel-unit " + flags.mel_unit +
+             " names the unit of .mel outputs, and no --out is a .mel file";
+    return false;
+  }
   return true;
 }
 
@@ -468,6 +478,7 @@ void AddFootRotationsIfAsked(const GenerateFlags& flags, Walk* walk) {
 int WriteOutputs(const GenerateFlags& flags, const LoadedTerrain& terrain, const Walk& walk) {
   WalkExportOptions exports;
   exports.foot_rotations = flags.foot_rotations;
+  exports.mel_linear_unit = flags.mel_unit;
   int code = 0;
   std::string error;
   OutputFileSet outputs;
@@ -881,6 +892,17 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
                 "Key the feet's rotations too: each foot on its ground, facing its body's "
                 "heading (.gltf, .glb and .mel outputs key them; the .json gives each foot key a "
                 "rotation)");
+  cmd->add_option("--mel-unit", flags->mel_unit,
+                  "The linear unit the walk's lengths are in (m for the shipped characters): "
+                  ".mel outputs key them so in any Maya scene (Maya converts; a centimetre "
+                  "scene gets 100 units a metre) and put the user's unit back; default: keyed in "
+                  "the scene's unit, one walk unit to one scene unit")
+      ->check(CLI::Validator(
+          [](const std::string& unit) {
+            return IsMayaLinearUnit(unit) ? std::string()
+                                          : std::string("expected ") + MayaLinearUnits();
+          },
+          "UNIT"));
   cmd->add_option("-o,--out,--output", flags->out,
                   "Output file: .json, .gltf, .glb or .mel (repeatable); .pts: the terrain's "
                   "samples the walk was placed on (as resampled for the character), for "

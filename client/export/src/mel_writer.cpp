@@ -14,6 +14,7 @@
 #include "footfall/steps/foot_rotations.h"
 #include "footfall/terrain/ordered_text.h"
 #include "footfall/terrain/output_file.h"
+#include "footfall/terrain/shown_text.h"
 #include "footfall/version.h"
 #include "walk_prep.h"
 
@@ -178,6 +179,14 @@ constexpr char kRootName[] = "footfall_walk";
 
 }  // namespace
 
+bool IsMayaLinearUnit(const std::string& unit) {
+  for (const char* known : {"mm", "cm", "m", "km", "in", "ft", "yd", "mi"})
+    if (unit == known) return true;
+  return false;
+}
+
+const char* MayaLinearUnits() { return "mm, cm, m, km, in, ft, yd or mi"; }
+
 Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
   return WriteMel(walk, path, MelOptions{}, error);
 }
@@ -186,6 +195,13 @@ Status WriteMel(const Walk& walk, const std::string& path, const MelOptions& opt
                 std::string* error) {
   Status status = walk_export::CheckWalk(walk, error);
   if (status != Status::kOk) return status;
+  const std::string& linear = options.linear_unit;
+  if (!linear.empty() && !IsMayaLinearUnit(linear)) {
+    if (error)
+      *error = "unknown Maya linear unit '" + ShownText(linear) + "' (expected " +
+               MayaLinearUnits() + ")";
+    return Status::kInvalidArgument;
+  }
 
   // Group names (one per crowd character, in order of appearance) and locator names, all
   // unique in the file and none the root group's name (Maya would rename one of the two).
@@ -227,9 +243,10 @@ Status WriteMel(const Walk& walk, const std::string& path, const MelOptions& opt
     }
   }
 
-  // The script's end: the user's angle unit back, the walk's root selected.
-  static const char* kTail =
-      "currentUnit -angle $footfall_angle_unit;\nselect -replace $footfall_root;\n}\n";
+  // The script's end: the user's angle (and linear) unit back, the walk's root selected.
+  const std::string tail = std::string("currentUnit -angle $footfall_angle_unit;\n") +
+                           (linear.empty() ? "" : "currentUnit -linear $footfall_linear_unit;\n") +
+                           "select -replace $footfall_root;\n}\n";
   // The script's head: time unit, playback range, the root and the characters' groups.
   std::string head;
   {
@@ -240,6 +257,10 @@ Status WriteMel(const Walk& walk, const std::string& path, const MelOptions& opt
     mel +=
         "// In Maya: source this file (File > Source Script); one keyed locator per foot IK "
         "target and body.\n";
+    mel += linear.empty() ? "// Lengths are keyed in the scene's linear unit: one walk unit to one "
+                            "scene unit (footfall generate --mel-unit names the walk's).\n"
+                          : "// Lengths are in " + linear +
+                                " and keyed so whatever the scene's linear unit.\n";
     if (!walk.stopped.empty())
       mel += "// The walk stopped early: " + CommentText(walk.stopped) + "\n";
     mel += "{\n";
@@ -258,6 +279,12 @@ Status WriteMel(const Walk& walk, const std::string& path, const MelOptions& opt
     // as the Maya plugin sends the scene's terrain.
     mel += "string $footfall_angle_unit = `currentUnit -query -angle`;\n";
     mel += "currentUnit -angle \"deg\";\n";
+    // Lengths in the walk's unit when it is named (MelOptions::linear_unit): Maya converts them
+    // to the scene's, whose unit is put back at the end.
+    if (!linear.empty()) {
+      mel += "string $footfall_linear_unit = `currentUnit -query -linear`;\n";
+      mel += "currentUnit -linear " + MelString(linear) + ";\n";
+    }
     if (first_frame <= last_frame) {
       mel += "playbackOptions -minTime " + Number(first_frame) + " -maxTime " + Number(last_frame) +
              " -animationStartTime " + Number(first_frame) + " -animationEndTime " +
@@ -369,14 +396,14 @@ Status WriteMel(const Walk& walk, const std::string& path, const MelOptions& opt
         for (int axis = 0; axis < 3; ++axis) key_line("rotate", kAxes[axis], rotate[axis]);
       }
     }
-    if (r + 1 == runs.size()) mel += kTail;
+    if (r + 1 == runs.size()) mel += tail;
   };
   std::string message;
   const Status written = ReplaceFile(
       path,
       [&](std::FILE* file) {
         if (runs.empty()) {  // no tracks: the head and the end
-          const std::string all = head + kTail;
+          const std::string all = head + tail;
           return std::fwrite(all.data(), 1, all.size(), file) == all.size();
         }
         return FormatInOrder(runs.size(), 0, format, [file](std::string_view text) {

@@ -28,6 +28,7 @@ Status WriteWalk(const Walk& walk, const std::string& path, const WalkExportOpti
   if (ext == "mel") {
     MelOptions mel;
     mel.foot_rotations = options.foot_rotations;
+    mel.linear_unit = options.mel_linear_unit;
     return WriteMel(walk, path, mel, error);
   }
   const std::string what = ext.empty() ? "no extension" : "unknown extension '." + ext + "'";

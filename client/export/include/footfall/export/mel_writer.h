@@ -30,8 +30,8 @@ namespace footfall {
 // well-formed UTF-8 sequence becomes U+FFFD, as in the walk JSON). The script uses the names Maya
 // returns, so it still works when the scene already holds nodes of the same names. Keys on the same
 // frame: the last one wins. Returns kInvalidArgument (with `*error` set) for fps <= 0, NaN/Inf
-// values or a zero quaternion; kIoError naming `path` when the file cannot be written. `error` may
-// be null.
+// values, a zero quaternion or a linear unit Maya does not know (MelOptions::linear_unit); kIoError
+// naming `path` when the file cannot be written. `error` may be null.
 Status WriteMel(const Walk& walk, const std::string& path, std::string* error);
 
 struct MelOptions {
@@ -39,7 +39,20 @@ struct MelOptions {
   // bodies), each foot on its ground facing its body's heading, as GltfOptions::foot_rotations
   // turns glTF's foot nodes.
   bool foot_rotations = false;
+  // The Maya linear unit the walk's lengths are in (IsMayaLinearUnit: "m" for the shipped
+  // characters), or "" (the default) for the scene's. Given, the script sets the scene's
+  // linear unit to it while it keys and puts the user's back after, as it does for angles:
+  // Maya converts, so a walk in metres sourced into a centimetre scene keeps its size (100
+  // scene units a metre) where it was otherwise keyed one walk unit to one scene unit.
+  std::string linear_unit;
 };
+
+// Whether `unit` is one of the linear units Maya's `currentUnit -linear` takes by their short
+// names: mm, cm, m, km, in, ft, yd, mi.
+bool IsMayaLinearUnit(const std::string& unit);
+
+// The units IsMayaLinearUnit takes, for messages: "mm, cm, m, km, in, ft, yd or mi".
+const char* MayaLinearUnits();
 
 // As above, with `options`.
 Status WriteMel(const Walk& walk, const std::string& path, const MelOptions& options,
