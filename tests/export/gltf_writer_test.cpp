@@ -98,7 +98,8 @@ void CheckPositions(const Channel& channel, const WalkTrack& track, const std::v
 }  // namespace
 
 TEST_CASE("WriteGltf writes a node per track with keyed channels", "[export][gltf]") {
-  const Walk walk = test::BipedWalk();
+  Walk walk = test::BipedWalk();
+  walk.tracks[0].foot_length = 0.25;  // L's sole; R has point feet
   const bool binary = GENERATE(false, true);
   const std::string path = test::ScratchPath(binary ? "biped.glb" : "biped.gltf");
   std::string error;
@@ -122,6 +123,10 @@ TEST_CASE("WriteGltf writes a node per track with keyed channels", "[export][glt
   CHECK(model.nodes[2].name == "body");
   CHECK(model.nodes[2].extras.Get("kind").Get<std::string>() == "body");
   CHECK(model.nodes[0].extras.Get("kind").Get<std::string>() == "foot");
+  // A foot's foot_length where the walk has one (as the walk JSON), none for point feet.
+  CHECK(model.nodes[0].extras.Get("foot_length").GetNumberAsDouble() == 0.25);
+  CHECK_FALSE(model.nodes[1].extras.Has("foot_length"));
+  CHECK_FALSE(model.nodes[2].extras.Has("foot_length"));
   REQUIRE(model.scenes.size() == 1);
   CHECK(model.defaultScene == 0);
   CHECK(model.scenes[0].nodes == std::vector<int>{0, 1, 2});

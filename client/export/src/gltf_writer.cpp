@@ -90,6 +90,9 @@ tinygltf::Value NodeExtras(const WalkTrack& track) {
   extras["kind"] = tinygltf::Value(std::string(track.kind == TrackKind::kBody ? "body" : "foot"));
   extras["character"] = tinygltf::Value(walk_export::ValidUtf8(track.character));
   extras["track"] = tinygltf::Value(walk_export::ValidUtf8(track.name));
+  // A foot's sole, as the walk JSON carries it (a custom property once imported).
+  if (track.kind == TrackKind::kFoot && track.foot_length > 0)
+    extras["foot_length"] = tinygltf::Value(track.foot_length);
   return tinygltf::Value(std::move(extras));
 }
 
