@@ -438,6 +438,42 @@ assert feet > 10 and turned == plain, feet
 PY
 check "foot rotations: MEL turns 3 locators, not 1" [ "$(grep -c 'rotateOrder' "$work/turned.mel")" -eq 3 -a "$(grep -c 'rotateOrder' "$work/all.mel")" -eq 1 ]
 check "foot rotations: glTF has 3 rotation channels, not 1" [ "$(grep -o '"path": *"rotation"' "$work/turned.gltf" | wc -l)" -eq 3 -a "$(grep -o '"path": *"rotation"' "$work/all.gltf" | wc -l)" -eq 1 ]
+# The character file's walk settings given as flags walk as a character file with those values
+# does, byte for byte (the plugins' panels override the same four); out of range, or with a
+# scene, they are refused.
+python3 - "$chars/biped.json" "$work/biped-set.json" "$work/biped-point.json" <<'PY'
+import json, sys
+c = json.load(open(sys.argv[1]))
+c.update(step_length=0.45, step_height=0.2, frames_per_step=16, foot_length=0.3)
+json.dump(c, open(sys.argv[2], "w"))
+c["foot_length"] = 0
+json.dump(c, open(sys.argv[3], "w"))
+PY
+"$footfall" generate --terrain "$hills" --character "$chars/biped.json" --start 12,0,8 --steps 6 \
+  --step-length 0.45 --step-height 0.2 --frames-per-step 16 --foot-length 0.3 --out "$work/flags-set.json" 2>/dev/null
+check "walk settings as flags: exit 0" [ $? -eq 0 ]
+"$footfall" generate --terrain "$hills" --character "$work/biped-set.json" --start 12,0,8 --steps 6 \
+  --out "$work/file-set.json" 2>/dev/null
+check "walk settings as flags: the walk of a file with those settings" cmp -s "$work/flags-set.json" "$work/file-set.json"
+"$footfall" generate --terrain "$hills" --character "$chars/biped.json" --start 12,0,8 --steps 6 \
+  --out "$work/file-own.json" 2>/dev/null
+check "walk settings as flags: not the file's own walk" bash -c "! cmp -s '$work/flags-set.json' '$work/file-own.json'"
+"$footfall" generate --terrain "$hills" --character "$work/biped-set.json" --start 12,0,8 --steps 6 \
+  --foot-length 0 --out "$work/flags-point.json" 2>/dev/null
+"$footfall" generate --terrain "$hills" --character "$work/biped-point.json" --start 12,0,8 --steps 6 \
+  --out "$work/file-point.json" 2>/dev/null
+check "--foot-length 0: point feet" cmp -s "$work/flags-point.json" "$work/file-point.json"
+check "--foot-length 0: no foot_length written" bash -c "! grep -q foot_length '$work/flags-point.json'"
+for bad in "--step-length 0" "--step-height -1" "--frames-per-step 1" "--frames-per-step 2.5" "--foot-length -0.1" "--step-length nan"; do
+  # shellcheck disable=SC2086
+  "$footfall" generate --terrain "$hills" --character "$chars/biped.json" $bad --out "$work/bad-setting.json" 2> "$work/bad-setting.err"
+  check "$bad: exit 1" [ $? -eq 1 ]
+  check "$bad: the flag named" grep -qF -- "${bad%% *}: " "$work/bad-setting.err"
+  check "$bad: nothing written" [ ! -e "$work/bad-setting.json" ]
+done
+"$footfall" generate --terrain "$hills" --scene "$work/none.json" --foot-length 0.2 --out "$work/bad-setting.json" 2> "$work/bad-setting.err"
+check "--foot-length with --scene: exit 1" [ $? -eq 1 ]
+check "--foot-length with --scene: said" grep -qF -- "--scene excludes --foot-length" "$work/bad-setting.err"
 # --mel-unit m: the MEL keys the same numbers with the scene's linear unit set to metres while it
 # keys (Maya converts), the user's put back after; a unit Maya does not know, or no .mel to
 # apply it to, is refused before anything is written.

@@ -56,6 +56,9 @@ struct GenerateFlags {
   bool progress = false;
   bool foot_rotations = false;
   std::string mel_unit;  // the walk's linear unit in .mel outputs ("": the scene's)
+  // The character file's walk settings replaced (negative: the file's own).
+  double step_length = -1, step_height = -1, foot_length = -1;
+  int frames_per_step = -1;
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::vector<std::string> out;
 };
@@ -343,6 +346,18 @@ bool CheckOutputs(const GenerateFlags& flags, const std::vector<std::string>& in
              " names the unit of .mel outputs, and no --out is a .mel file";
     return false;
   }
+  return true;
+}
+
+// Loads --character, with the walk settings given as flags (--step-length, --step-height,
+// --frames-per-step, --foot-length, each checked against the character file's range as it was
+// read) in place of the file's. False with the loader's message.
+bool LoadCharacterWithFlags(const GenerateFlags& flags, Character* c, std::string* error) {
+  if (LoadCharacter(flags.character, c, error) != Status::kOk) return false;
+  if (flags.step_length > 0) c->step_length = flags.step_length;
+  if (flags.step_height > 0) c->step_height = flags.step_height;
+  if (flags.frames_per_step > 0) c->frames_per_step = flags.frames_per_step;
+  if (flags.foot_length >= 0) c->foot_length = flags.foot_length;
   return true;
 }
 
@@ -781,7 +796,7 @@ int RunGenerate(const GenerateFlags& flags) {
   // Flags first, so a typo fails before the terrain loads.
   if (!ReadOptions(flags, &options, &error) ||
       !CheckOutputs(flags, {flags.terrain.terrain, flags.character}, &error) ||
-      LoadCharacter(flags.character, &character, &error) != Status::kOk ||
+      !LoadCharacterWithFlags(flags, &character, &error) ||
       (flags.steps >= 0 &&
        !CheckKeyMemory(EstimateKeys(flags.crowd, flags.steps, character),
                        std::to_string(flags.crowd) +
@@ -868,6 +883,27 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
                       "Steps per character, one gait group each (default 8; with --path, until "
                       "the goal)")
           ->transform(WholeUpTo(1000000));
+  // The character file's walk settings, as the plugins' panels override them (the ranges are
+  // the character file's).
+  CLI::Option* step_length =
+      cmd->add_option("--step-length", flags->step_length,
+                      "Distance a foot travels in a step, in place of the character file's "
+                      "step_length")
+          ->check(FiniteAboveUpTo(0, 1e9));
+  CLI::Option* step_height =
+      cmd->add_option("--step-height", flags->step_height,
+                      "Swing arc height, in place of the character file's step_height")
+          ->check(FiniteAboveUpTo(0, 1e9));
+  CLI::Option* frames_per_step =
+      cmd->add_option("--frames-per-step", flags->frames_per_step,
+                      "Frames from lift-off to touch-down, in place of the character file's "
+                      "frames_per_step")
+          ->transform(WholeRange(2, 1000000));
+  CLI::Option* foot_length =
+      cmd->add_option("--foot-length", flags->foot_length,
+                      "Length of each foot's sole (0: point feet), in place of the character "
+                      "file's foot_length")
+          ->check(FiniteRange(0, 1e9));
   cmd->add_option("--start-frame", flags->start_frame, "Frame of the first keys (default 1)")
       ->check(FiniteRange(-kMaxStartFrame, kMaxStartFrame));
   cmd->add_option("--fps", flags->fps, "Frames per second of the walk (default 24)")
@@ -908,7 +944,9 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
                   "samples the walk was placed on (as resampled for the character), for "
                   "footfall-view or a plugin; -: the walk JSON on standard output")
       ->required();
-  for (CLI::Option* o : {start, heading, path_opt, steps, crowd, crowd_spacing}) scene->excludes(o);
+  for (CLI::Option* o : {start, heading, path_opt, steps, crowd, crowd_spacing, step_length,
+                         step_height, frames_per_step, foot_length})
+    scene->excludes(o);
   cmd->footer(
       "Exit status: 0 when every step was generated, 2 when the walk stopped early (at a cliff, "
       "a gap, a wall too steep; the outputs then hold every key up to that step), 1 on errors "
