@@ -276,7 +276,7 @@ Status WriteMel(const Walk& walk, const std::string& path, const MelOptions& opt
     // setKeyframe values are in the scene's units: rotations are keyed in degrees whatever the
     // user's angle unit (a scene in radians turned bodies 57.3 times too far), which is put back
     // at the end. Lengths stay in the scene's linear unit, one footfall unit to one scene unit,
-    // as the Maya plugin sends the scene's terrain.
+    // as the Maya plugin sends the scene's terrain, unless the walk's unit is named (below).
     mel += "string $footfall_angle_unit = `currentUnit -query -angle`;\n";
     mel += "currentUnit -angle \"deg\";\n";
     // Lengths in the walk's unit when it is named (MelOptions::linear_unit): Maya converts them
