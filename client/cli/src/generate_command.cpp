@@ -884,25 +884,22 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
                       "the goal)")
           ->transform(WholeUpTo(1000000));
   // The character file's walk settings, as the plugins' panels override them (the ranges are
-  // the character file's).
+  // the character file's): --step-length replaces step_length, and so on.
+  auto setting = [cmd](const std::string& flag, auto* value, const std::string& what) {
+    std::string field = flag.substr(2);
+    std::replace(field.begin(), field.end(), '-', '_');
+    return cmd->add_option(flag, *value, what + ", in place of the character file's " + field);
+  };
   CLI::Option* step_length =
-      cmd->add_option("--step-length", flags->step_length,
-                      "Distance a foot travels in a step, in place of the character file's "
-                      "step_length")
+      setting("--step-length", &flags->step_length, "Distance a foot travels in a step")
           ->check(FiniteAboveUpTo(0, 1e9));
-  CLI::Option* step_height =
-      cmd->add_option("--step-height", flags->step_height,
-                      "Swing arc height, in place of the character file's step_height")
-          ->check(FiniteAboveUpTo(0, 1e9));
+  CLI::Option* step_height = setting("--step-height", &flags->step_height, "Swing arc height")
+                                 ->check(FiniteAboveUpTo(0, 1e9));
   CLI::Option* frames_per_step =
-      cmd->add_option("--frames-per-step", flags->frames_per_step,
-                      "Frames from lift-off to touch-down, in place of the character file's "
-                      "frames_per_step")
+      setting("--frames-per-step", &flags->frames_per_step, "Frames from lift-off to touch-down")
           ->transform(WholeRange(2, 1000000));
   CLI::Option* foot_length =
-      cmd->add_option("--foot-length", flags->foot_length,
-                      "Length of each foot's sole (0: point feet), in place of the character "
-                      "file's foot_length")
+      setting("--foot-length", &flags->foot_length, "Length of each foot's sole (0: point feet)")
           ->check(FiniteRange(0, 1e9));
   cmd->add_option("--start-frame", flags->start_frame, "Frame of the first keys (default 1)")
       ->check(FiniteRange(-kMaxStartFrame, kMaxStartFrame));
