@@ -376,9 +376,9 @@ Status Generator::SnapFeetFacingUp(const Vec3* places, Foothold* feet, size_t to
                                    const Agent* agents, std::string* error) {
   if (count == 0) return Status::kOk;
   // The way a foot snaps again, and the least dot of the ground it takes with its up: lifted
-  // along the up from a face turned away (ground facing the up), or, for an upright character,
-  // out from a face too steep to stand on (a riser its rest lies against: ground within
-  // max_slope_deg of the up).
+  // along the up from a face turned away (ground facing the up), or out from a face too steep
+  // to stand on (a riser its rest lies against: ground within max_slope_deg of the up; for a
+  // multiped, the start's normal).
   std::vector<size_t> turned;
   std::vector<Vec3> way;
   std::vector<double> lift, least;
@@ -390,7 +390,7 @@ Status Generator::SnapFeetFacingUp(const Vec3* places, Foothold* feet, size_t to
     double need = 0;
     if (along < 0) {
       out = up;
-    } else if (!c_.align_to_normal && along < cos_max_slope_) {
+    } else if (along < cos_max_slope_) {
       out = NormalizeOr(ProjectOnPlane(feet[f].normal, up), Vec3{});
       need = cos_max_slope_;
     }

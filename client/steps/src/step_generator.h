@@ -302,11 +302,11 @@ class Generator {
   //    pipe (a concave surface) the rests laid on the start's tangent plane fall outside the
   //    inner face, nearer a thin wall's outer face, where the character then hung upside down.
   //    Each snaps again from its rest lifted along the up, twice as far each time up to `reach`,
-  //    and takes the first sample facing the up. So does an upright character's foot whose
-  //    sample leans more than max_slope_deg (a riser its rest lies against, where the walk
-  //    stopped at once), moved out along that face across the up instead, taking the first
-  //    sample it may stand on. `places`, `total`, `count` and `feet` as for SeparateSharedFeet;
-  //    `agents` the characters in order.
+  //    and takes the first sample facing the up. So does a foot whose sample leans more than
+  //    max_slope_deg from the up (a riser its rest lies against, where the walk stopped at
+  //    once; a multiped's up is the start's normal), moved out along that face across the up
+  //    instead, taking the first sample it may stand on. `places`, `total`, `count` and `feet` as
+  //    for SeparateSharedFeet; `agents` the characters in order.
   Status SnapFeetFacingUp(const Vec3* places, Foothold* feet, size_t total, size_t count,
                           const Agent* agents, std::string* error);
   // For each of the n crowd starts (places on the grid, and their snaps), another start nearer
