@@ -211,9 +211,10 @@ check "bad scene file: fps not listed" sh -c "! grep -q 'known fields: .*fps' '$
 both biped-blocks 0 --terrain "$src/data/terrain/blocks.pts" --character "$chars/biped.json" --steps 2
 both quadruped-blocks 0 --terrain "$src/data/terrain/blocks.pts" --character "$chars/quadruped.json" --steps 8
 # A crowd member whose place snaps onto a block's side, where the heading runs along its up:
-# the heading is judged at the crowd's start, and that member walks as far as it can (the
-# whole crowd was refused, nothing written, with advice to change a heading that was fine).
-both hexapod-blocks-crowd 2 --terrain "$src/data/terrain/blocks.pts" --character "$chars/hexapod.json" \
+# the heading is judged at the crowd's start, and that member walks on that side (the whole
+# crowd was refused, nothing written, with advice to change a heading that was fine; then the
+# member stopped at step 3, until the tries aimed down by a whole max_rise).
+both hexapod-blocks-crowd 0 --terrain "$src/data/terrain/blocks.pts" --character "$chars/hexapod.json" \
   --steps 3 --crowd 3
 check "crowd with a member on a block's side: every member keyed" python3 -c "
 import json, sys

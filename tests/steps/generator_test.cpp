@@ -1076,7 +1076,7 @@ TEST_CASE("A cliff stops the walk with the step, the position and the keys so fa
     CHECK_THAT(w.stopped, Catch::Contains("cliff"));
     // The first refusal (the step as meant), then how many other tries failed too.
     CHECK_THAT(w.stopped,
-               Catch::Contains("(6 more tries, shorter, longer or aimed down, refused too)"));
+               Catch::Contains("(8 more tries, shorter, longer or aimed down, refused too)"));
     CHECK_THAT(w.stopped, Catch::Contains("keys up to step " + std::to_string(done) + " kept"));
     // Samples a tenth of a step apart are fine enough: no advice to resample.
     CHECK_THAT(w.stopped, !Catch::Contains("resample"));
@@ -1117,4 +1117,33 @@ TEST_CASE("A multiped with its feet in a line walks up a ramp (no plane to fit: 
   // The body's up is the ramp's normal (every foot on the same plane, normals alike).
   const Vec3 ramp_normal{0, std::cos(slope), -std::sin(slope)};
   for (const Quat& q : Body(w).rotations) CHECK(Dot(BodyUp(q), ramp_normal) > 0.999);
+}
+
+TEST_CASE("A quadruped walks straight down stairs steeper than half its max_rise reaches",
+          "[steps][generator]") {
+  // Its feet's up is the treads' normal, so each target hangs at the stance's height: on 20 cm
+  // rises and 25 cm treads the front feet aimed 20 cm over the next tread, and the tries aimed
+  // down by half of max_rise (17.5 cm) found nothing within the tolerance: it stopped at its
+  // first step. The last tries aim down by the whole max_rise.
+  const Character quadruped = LoadShipped("quadruped");
+  const int treads = 20;
+  const double rise = 0.2, run = 0.25;
+  REQUIRE(rise > 0.5 * quadruped.max_rise);
+  REQUIRE(rise <= quadruped.max_rise);
+  Terrain t = LoadTerrain(MakeStairs(treads, rise, run, 6, 0.03), 0.03);
+  const int from = treads - 2;
+  GenerateOptions o = StartOptions({3, from * rise, (from + 0.5) * run}, 8);
+  o.heading = {0, 0, -1};
+  const Walk w = Generate(t, quadruped, o);
+  INFO(w.stopped);
+  CheckWalk(t, quadruped, o, w);
+  CHECK(w.stopped.empty());
+  // Every foot went down: its last key at least two treads below its first (samples are
+  // stored in single precision).
+  for (const WalkTrack& track : w.tracks) {
+    if (track.kind != TrackKind::kFoot) continue;
+    INFO(track.name);
+    REQUIRE(track.keys.size() > 2);
+    CHECK(track.keys.back().position.y <= track.keys.front().position.y - 2 * rise + 1e-5);
+  }
 }

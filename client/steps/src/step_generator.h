@@ -33,9 +33,10 @@ using Text = TextStream;
 struct Attempt {
   double scale, drop;
 };
-inline constexpr int kMaxAttempts = 7;
-inline constexpr Attempt kAttempts[kMaxAttempts] = {{1.0, 0},   {0.6, 0},   {1.35, 0}, {0.3, 0},
-                                                    {1.0, 0.5}, {0.6, 0.5}, {0.3, 0.5}};
+inline constexpr int kMaxAttempts = 9;
+inline constexpr Attempt kAttempts[kMaxAttempts] = {{1.0, 0},   {0.6, 0},   {1.35, 0},
+                                                    {0.3, 0},   {1.0, 0.5}, {0.6, 0.5},
+                                                    {0.3, 0.5}, {1.0, 1.0}, {0.6, 1.0}};
 // The first of the tries aimed down (a full step).
 inline constexpr int kFirstDownAttempt = 4;
 static_assert(kAttempts[kFirstDownAttempt].scale == 1 && kAttempts[kFirstDownAttempt].drop > 0 &&
