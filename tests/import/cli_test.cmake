@@ -279,6 +279,16 @@ execute_process(COMMAND "${FOOTFALL}" terrain convert "${WORK}/square.obj" --cha
 if(NOT rc EQUAL 0 OR NOT out MATCHES "separation 0\\.17" OR NOT err STREQUAL "")
   message(FATAL_ERROR "convert --character within the limit: exit ${rc}, '${out}' '${err}'")
 endif()
+# --scale scales the character as generate's does: twice the biped, twice the separation.
+execute_process(COMMAND "${FOOTFALL}" terrain convert "${WORK}/square.obj" --character
+                "${SOURCE_DIR}/data/characters/biped.json" --scale 2 -o "${WORK}/square.pts"
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "separation 0\\.35" OR NOT err STREQUAL "")
+  message(FATAL_ERROR "convert --character --scale 2: exit ${rc}, '${out}' '${err}'")
+endif()
+expect(EXIT_NONZERO "--scale: '0' is not a finite number from 1e-06 to 1e+06"
+       terrain convert "${WORK}/square.obj" --character "${SOURCE_DIR}/data/characters/biped.json"
+       --scale 0 -o "${WORK}/square.pts")
 # convert never writes over its input; --separation with a point file is refused, not ignored.
 file(WRITE "${WORK}/two.pts" "# surveyed\n0 0 0 0 1 0\n1 0 0 0 1 0\n")
 expect(EXIT_NONZERO "two.pts: the output is the input file"

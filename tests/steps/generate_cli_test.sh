@@ -475,6 +475,60 @@ done
 "$footfall" generate --terrain "$hills" --scene "$work/none.json" --foot-length 0.2 --out "$work/bad-setting.json" 2> "$work/bad-setting.err"
 check "--foot-length with --scene: exit 1" [ $? -eq 1 ]
 check "--foot-length with --scene: said" grep -qF -- "--scene excludes --foot-length" "$work/bad-setting.err"
+# --scale 100: the biped (a file in metres) on the hills in centimetres walks its walk on the
+# hills in metres, 100 times larger (to 1e-6 of its size); the walk settings' flags after it are
+# in the terrain's units; unscaled, a note says which scale fits; out of range, or with a scene,
+# it is refused before anything is written.
+awk '/^#/ || NF == 0 { next } { printf "%.10g %.10g %.10g %s %s %s\n", $1 * 100, $2 * 100, $3 * 100, $4, $5, $6 }' "$hills" > "$work/hills-cm.pts"
+"$footfall" generate --terrain "$work/hills-cm.pts" --character "$chars/biped.json" --scale 100 \
+  --start 1200,0,800 --steps 6 --out "$work/scaled.json" 2> "$work/scaled.err"
+check "--scale 100: exit 0" [ $? -eq 0 ]
+check "--scale 100: nothing said" [ ! -s "$work/scaled.err" ]
+"$footfall" generate --terrain "$work/hills-cm.pts" --character "$chars/biped.json" --scale 100 \
+  --start 1200,0,800 --steps 6 --step-length 45 --step-height 20 --frames-per-step 16 \
+  --foot-length 30 --out "$work/scaled-set.json" 2>/dev/null
+check "--scale 100 with the walk settings' flags: exit 0" [ $? -eq 0 ]
+scaled_like() {  # scaled_like METRES.json CENTIMETRES.json: the second is the first times 100
+  python3 - "$1" "$2" <<'PY'
+import json, sys
+a, b = (json.load(open(p)) for p in sys.argv[1:3])
+assert [t["name"] for t in a["tracks"]] == [t["name"] for t in b["tracks"]]
+for ta, tb in zip(a["tracks"], b["tracks"]):
+    assert abs(ta.get("foot_length", 0) * 100 - tb.get("foot_length", 0)) <= 1e-9
+    assert len(ta["keys"]) == len(tb["keys"]), ta["name"]
+    for ka, kb in zip(ta["keys"], tb["keys"]):
+        assert ka["frame"] == kb["frame"] and ka.get("phase") == kb.get("phase")
+        for x, y in zip(ka["position"], kb["position"]):
+            assert abs(x * 100 - y) <= 1e-6 * max(1.0, abs(y)), (ta["name"], ka, kb)
+PY
+}
+check "--scale 100: the walk in metres, 100 times larger" scaled_like "$work/file-own.json" "$work/scaled.json"
+check "--scale 100: --step-length 45 and the others in centimetres" scaled_like "$work/flags-set.json" "$work/scaled-set.json"
+"$footfall" generate --terrain "$work/hills-cm.pts" --character "$chars/biped.json" \
+  --start 1200,0,800 --steps 6 --out "$work/unscaled.json" 2> "$work/unscaled.err"
+check "no --scale on a terrain in centimetres: the scale that fits said" grep -qF -- "(--scale; 100 from metres to centimetres)" "$work/unscaled.err"
+for bad in "--scale 0" "--scale 2e6" "--scale nan" "--scale -1"; do
+  # shellcheck disable=SC2086
+  "$footfall" generate --terrain "$hills" --character "$chars/biped.json" $bad --out "$work/bad-scale.json" 2> "$work/bad-scale.err"
+  check "$bad: exit 1" [ $? -eq 1 ]
+  check "$bad: the flag named" grep -qF -- "--scale: " "$work/bad-scale.err"
+  check "$bad: nothing written" [ ! -e "$work/bad-scale.json" ]
+done
+python3 - "$chars/biped.json" "$work/biped-long-reach.json" <<'PY'
+import json, sys
+c = json.load(open(sys.argv[1]))
+c["reach"] = 2000
+json.dump(c, open(sys.argv[2], "w"))
+PY
+"$footfall" generate --terrain "$hills" --character "$work/biped-long-reach.json" --scale 1e6 --out "$work/bad-scale.json" 2> "$work/bad-scale.err"
+check "--scale past a character's lengths: exit 1" [ $? -eq 1 ]
+check "--scale past a character's lengths: the file and the length named" grep -qF -- "--scale: $work/biped-long-reach.json: scale 1e+06 makes 'reach' 2e+09, out of a character's range" "$work/bad-scale.err"
+check "--scale past a character's lengths: nothing written" [ ! -e "$work/bad-scale.json" ]
+"$footfall" generate --terrain "$hills" --scene "$work/none.json" --scale 2 --out "$work/bad-scale.json" 2> "$work/bad-scale.err"
+check "--scale with --scene: said" grep -qF -- "--scene excludes --scale" "$work/bad-scale.err"
+"$footfall" terrain convert "$hills" --scale 2 -o "$work/bad-scale.pts" 2> "$work/bad-scale.err"
+check "terrain convert --scale without --character: exit 1" [ $? -eq 1 ]
+check "terrain convert --scale without --character: said" grep -qF -- "--scale requires --character" "$work/bad-scale.err"
 # --mel-unit m: the MEL keys the same numbers with the scene's linear unit set to metres while it
 # keys (Maya converts), the user's put back after; a unit Maya does not know, or no .mel to
 # apply it to, is refused before anything is written.

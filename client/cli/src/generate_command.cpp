@@ -56,7 +56,9 @@ struct GenerateFlags {
   bool progress = false;
   bool foot_rotations = false;
   std::string mel_unit;  // the walk's linear unit in .mel outputs ("": the scene's)
-  // The character file's walk settings replaced (negative: the file's own).
+  double scale = 1;      // the character's lengths multiplied (ScaleCharacter)
+  // The character file's walk settings replaced (negative: the file's own), in the terrain's
+  // units (not scaled).
   double step_length = -1, step_height = -1, foot_length = -1;
   int frames_per_step = -1;
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -354,6 +356,10 @@ bool CheckOutputs(const GenerateFlags& flags, const std::vector<std::string>& in
 // read) in place of the file's. False with the loader's message.
 bool LoadCharacterWithFlags(const GenerateFlags& flags, Character* c, std::string* error) {
   if (LoadCharacter(flags.character, c, error) != Status::kOk) return false;
+  if (flags.scale != 1 && ScaleCharacter(flags.scale, c, error) != Status::kOk) {
+    *error = "--scale: " + flags.character + ": " + *error;
+    return false;
+  }
   if (flags.step_length > 0) c->step_length = flags.step_length;
   if (flags.step_height > 0) c->step_height = flags.step_height;
   if (flags.frames_per_step > 0) c->frames_per_step = flags.frames_per_step;
@@ -883,8 +889,15 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
                       "Steps per character, one gait group each (default 8; with --path, until "
                       "the goal)")
           ->transform(WholeUpTo(1000000));
+  CLI::Option* scale =
+      cmd->add_option("--scale", flags->scale,
+                      "Multiply the character's lengths (its feet's rests, step length and "
+                      "height, body height, max_rise, reach, foot length) by this: 100 walks a "
+                      "character file in metres on a terrain in centimetres (default 1)")
+          ->check(FiniteRange(kMinCharacterScale, kMaxCharacterScale));
   // The character file's walk settings, as the plugins' panels override them (the ranges are
-  // the character file's): --step-length replaces step_length, and so on.
+  // the character file's): --step-length replaces step_length, and so on, in the terrain's
+  // units (after --scale).
   auto setting = [cmd](const std::string& flag, auto* value, const std::string& what) {
     std::string field = flag.substr(2);
     std::replace(field.begin(), field.end(), '-', '_');
@@ -941,7 +954,7 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
                   "samples the walk was placed on (as resampled for the character), for "
                   "footfall-view or a plugin; -: the walk JSON on standard output")
       ->required();
-  for (CLI::Option* o : {start, heading, path_opt, steps, crowd, crowd_spacing, step_length,
+  for (CLI::Option* o : {start, heading, path_opt, steps, crowd, crowd_spacing, scale, step_length,
                          step_height, frames_per_step, foot_length})
     scene->excludes(o);
   cmd->footer(

@@ -37,6 +37,7 @@ std::string SampleCount(size_t n) { return std::to_string(n) + (n == 1 ? " sampl
 struct ConvertFlags {
   std::string input, output;
   std::string character;  // resample for this character's steps (walk_terrain.h)
+  double scale = 1;       // the character's lengths multiplied (generate's --scale)
   TerrainLoadOptions load;
 };
 
@@ -86,8 +87,12 @@ int RunConvert(const ConvertFlags& flags) {
               ": --character applies to meshes and height maps, which are resampled for it; a "
               "point file is used as it is (leave --character out)";
     } else if (LoadCharacter(flags.character, &character, &error) == Status::kOk) {
-      load.finest_default = kSeparationPerStep * character.step_length;
-      load.max_samples = std::min(load.max_samples, kMaxWalkSamples);
+      if (flags.scale != 1 && ScaleCharacter(flags.scale, &character, &error) != Status::kOk) {
+        error = "--scale: " + flags.character + ": " + error;
+      } else {
+        load.finest_default = kSeparationPerStep * character.step_length;
+        load.max_samples = std::min(load.max_samples, kMaxWalkSamples);
+      }
     }
     if (!error.empty()) {
       std::cerr << "footfall terrain convert: " << error << '\n';
@@ -390,10 +395,16 @@ void AddTerrainCommand(CLI::App& app, int* exit_code) {
       ->required()
       ->check(kPointFileOutput);
   AddLoadFlags(c, &convert->load);
-  c->add_option("--character", convert->character,
-                "Meshes and height maps: resample as finely as footfall generate does for this "
-                "character (a quarter of its step, at most 2,000,000 samples); not with "
-                "--separation");
+  CLI::Option* character =
+      c->add_option("--character", convert->character,
+                    "Meshes and height maps: resample as finely as footfall generate does for this "
+                    "character (a quarter of its step, at most 2,000,000 samples); not with "
+                    "--separation");
+  c->add_option("--scale", convert->scale,
+                "The character's lengths multiplied, as footfall generate --scale takes them "
+                "(with --character)")
+      ->check(FiniteRange(kMinCharacterScale, kMaxCharacterScale))
+      ->needs(character);  // (by name, CLI11 looks it up in a noexcept function)
   c->callback([convert, exit_code] { *exit_code = RunConvert(*convert); });
 
   auto info = std::make_shared<InfoFlags>();

@@ -322,6 +322,57 @@ Vec3 RestCentroid(const Character& c) {
   return c.feet.empty() ? sum : sum / static_cast<double>(c.feet.size());
 }
 
+Status ScaleCharacter(double scale, Character* c, std::string* error) {
+  if (!(scale >= kMinCharacterScale && scale <= kMaxCharacterScale)) {
+    *error = "scale " + NumberText(scale) + " is out of range [" + NumberText(kMinCharacterScale) +
+             ", " + NumberText(kMaxCharacterScale) + "]";
+    return Status::kInvalidArgument;
+  }
+  Character scaled = *c;
+  for (FootSpec& f : scaled.feet) f.rest = f.rest * scale;
+  struct ScaledLength {
+    const char* key;
+    double* value;
+    bool positive;  // must stay above 0 (else at least 0)
+  };
+  const ScaledLength lengths[] = {{"step_length", &scaled.step_length, true},
+                                  {"step_height", &scaled.step_height, true},
+                                  {"body_height", &scaled.body_height, false},
+                                  {"max_rise", &scaled.max_rise, true},
+                                  {"reach", &scaled.reach, true},
+                                  {"foot_length", &scaled.foot_length, false}};
+  for (const ScaledLength& l : lengths) {
+    *l.value *= scale;
+    if (!(*l.value <= kMaxLength) || (l.positive && !(*l.value > 0))) {
+      *error = "scale " + NumberText(scale) + " makes '" + l.key + "' " + NumberText(*l.value) +
+               ", out of a character's range " + (l.positive ? "(0" : "[0") + ", " +
+               NumberText(kMaxLength) + "]";
+      return Status::kInvalidArgument;
+    }
+  }
+  for (const FootSpec& f : scaled.feet) {
+    const double largest =
+        std::max({std::fabs(f.rest.x), std::fabs(f.rest.y), std::fabs(f.rest.z)});
+    if (!(largest <= kMaxLength)) {
+      *error = "scale " + NumberText(scale) + " puts the rest of foot '" + f.name + "' " +
+               NumberText(largest) + " from the body, out of a character's range [-" +
+               NumberText(kMaxLength) + ", " + NumberText(kMaxLength) + "]";
+      return Status::kInvalidArgument;
+    }
+  }
+  // Rounded, a rest just inside the reach may land on it.
+  const Vec3 centroid = RestCentroid(scaled);
+  for (const FootSpec& f : scaled.feet) {
+    if (!(Length(f.rest - centroid + Vec3{0, -scaled.body_height, 0}) < scaled.reach)) {
+      *error = "scale " + NumberText(scale) + " puts the rest of foot '" + f.name +
+               "' at the character's reach, " + NumberText(scaled.reach);
+      return Status::kInvalidArgument;
+    }
+  }
+  *c = std::move(scaled);
+  return Status::kOk;
+}
+
 Status LoadCharacter(const std::string& path, Character* out, std::string* error) {
   std::string text;
   const Status status =

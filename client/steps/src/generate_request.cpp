@@ -72,9 +72,9 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
     return Status::kParseError;
   }
   static const std::set<std::string> kKnown = {
-      "character", "character_file", "start",         "heading",
-      "path",      "steps",          "start_frame",   "up",
-      "fps",       "crowd",          "crowd_spacing", "foot_rotations"};
+      "character",     "character_file", "start", "heading", "path",
+      "steps",         "start_frame",    "up",    "fps",     "crowd",
+      "crowd_spacing", "foot_rotations", "scale"};
   for (auto it = j.begin(); it != j.end(); ++it) {
     if (read_by_caller.count(it.key())) continue;
     if (!kKnown.count(it.key()) || refused.count(it.key())) {
@@ -92,6 +92,7 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
   o.names.up = source + ": 'up'";
   o.names.steps = source + ": 'steps'";
   o.names.crowd_spacing = source + ": 'crowd_spacing'";
+  o.names.scale = source + ": 'scale'";
   Status s;
   if (j.contains("character") == j.contains("character_file")) {
     *error = source + ": give exactly one of 'character' (an object) or 'character_file' (a path)";
@@ -119,6 +120,14 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
     if (s != Status::kOk && !folder.empty()) *error = source + ": " + *error;
   }
   if (s != Status::kOk) return s;
+  if (j.contains("scale")) {
+    double scale = 1;
+    if (!ReadNumber(j["scale"], source, "scale", &scale, error)) return Status::kParseError;
+    if (ScaleCharacter(scale, character, error) != Status::kOk) {
+      *error = source + ": 'scale': " + *error;
+      return Status::kInvalidArgument;
+    }
+  }
   bool ok = true;
   if (ok && j.contains("start")) {
     ok = ReadVec(j["start"], source, "start", &o.start, error), o.has_start = true;

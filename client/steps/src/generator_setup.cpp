@@ -88,6 +88,7 @@ Status Generator::Setup(std::string* error) {
     setup_notes_.push_back(m.str());
   }
   AddCharacterShapeNotes();
+  AddUnitsNote(g);
   // 2. The start frame: up (terrain normal for multipeds, world up for bipeds) and the heading
   //    projected onto the plane perpendicular to it. Crowds stand on a grid in that plane, or,
   //    on ground within 45 degrees of world up, across world up: one bump's normal tilted a
@@ -655,6 +656,27 @@ void Generator::AddCharacterShapeNotes() {
          "positions)";
     setup_notes_.push_back(m.str());
   }
+}
+
+void Generator::AddUnitsNote(const GridStats& g) {
+  const Vec3 size = g.bounds_max - g.bounds_min;
+  const double across = std::max({size.x, size.y, size.z});
+  Text m(3);
+  if (g.spacing > kUnitsNoteSpacingSteps * c_.step_length) {
+    m << "the terrain's samples lie about " << g.spacing << " apart, more than "
+      << kUnitsNoteSpacingSteps << " of this character's steps (step_length " << c_.step_length
+      << "): a terrain in smaller units than the character (centimetres against metres) wants "
+         "the character scaled to it ("
+      << o_.names.scale << "; 100 from metres to centimetres)";
+  } else if (across > 0 && across < c_.reach) {
+    m << "the terrain is " << across << " across, less than this character's reach " << c_.reach
+      << ": a character in smaller units than the terrain (centimetres against metres) wants "
+         "scaling to it ("
+      << o_.names.scale << "; 0.01 from centimetres to metres)";
+  } else {
+    return;
+  }
+  setup_notes_.push_back(m.str());
 }
 
 double Generator::MidKeyDistance() const {

@@ -111,6 +111,9 @@ inline constexpr double kOffGroundRestShare = 0.5;
 // Two feet resting closer than this share of the reach are worth a note (they plant on the
 // same samples).
 inline constexpr double kNearRestsShare = 0.1;
+// Terrain samples farther apart than this many step lengths, or a terrain smaller across than
+// the reach, are worth a note: most likely the terrain and the character are in different units.
+inline constexpr double kUnitsNoteSpacingSteps = 4;
 // Steer: a turn is tried at its whole and then in kTurnShares - 1 smaller shares, and the
 // largest that keeps every pair's feet at least kMinPairGap of their rest gap apart is taken.
 inline constexpr int kTurnShares = 8;
@@ -272,6 +275,9 @@ class Generator {
   // Setup's notes on a character file that walks badly without a word: mid keys out of reach,
   // rests off the ground plane (a Z-up rig), feet resting nearly together.
   void AddCharacterShapeNotes();
+  // Setup's note on a terrain whose size or sample spacing is far off the character's step (most
+  // likely centimetres against metres: GenerateInputNames::scale).
+  void AddUnitsNote(const GridStats& g);
   // 2. The heading at a start whose up is up0: GenerateOptions::heading projected across it.
   Vec3 StartHeading(const Vec3& up0) const {
     return TangentForward(o_.heading, AnyPerpendicular(world_up_), world_up_, up0);

@@ -73,4 +73,16 @@ Vec3 RestCentroid(const Character& c);
 // Reads and parses a character file. kIoError when it cannot be read.
 Status LoadCharacter(const std::string& path, Character* out, std::string* error);
 
+// The range of ScaleCharacter's scale.
+constexpr double kMinCharacterScale = 1e-6;
+constexpr double kMaxCharacterScale = 1e6;
+
+// Multiplies every length of `c` by `scale`: its feet's rests, step_length, step_height,
+// body_height, max_rise, reach and foot_length (angles, frames and the gait stay). The same
+// character on a terrain in other units (100: a character file in metres on a terrain in
+// centimetres), or bigger or smaller. kInvalidArgument, naming the field, when `scale` is
+// outside [kMinCharacterScale, kMaxCharacterScale] or a length would leave the range a character
+// file allows; `c` is then unchanged.
+Status ScaleCharacter(double scale, Character* c, std::string* error);
+
 }  // namespace footfall

@@ -62,6 +62,7 @@ struct GenerateInputNames {
   std::string up = "--up";
   std::string steps = "--steps";
   std::string crowd_spacing = "--crowd-spacing";
+  std::string scale = "--scale";  // the character's scale (ScaleCharacter), named in notes
 };
 
 struct GenerateOptions {

@@ -3,7 +3,8 @@
 //   {"format": "footfall-scene", "version": 1, "comment": "...",
 //    "characters": [{"name": "spider", "character_file": "octopod.json", "start": [x, y, z],
 //                    "heading": [x, y, z], "path": [[x, y, z], ...], "steps": N,
-//                    "start_frame": F, "up": [x, y, z], "crowd": N, "crowd_spacing": D}, ...]}
+//                    "start_frame": F, "up": [x, y, z], "crowd": N, "crowd_spacing": D,
+//                    "scale": S}, ...]}
 // Each character takes the fields of a generate request (generate_request.h) but "fps" and
 // "foot_rotations", which are the whole walk's; "name" names its tracks (default: its character's
 // name and its place in the list, "biped1"); a relative character_file is read from the scene
