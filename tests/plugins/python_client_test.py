@@ -566,6 +566,39 @@ class SharedLogicTest(unittest.TestCase):
             ff.character.parse('{"feet": [{"name": "L"}]}', "bad.json")
         self.assertIn("bad.json: feet[0]", e.exception.message)
 
+    def test_a_character_scaled_here_walks_as_the_generator_scales_it(self):
+        # The Maya plugin scales a character file in metres to the scene's unit itself: the same
+        # lengths as a request's "scale" (ScaleCharacter), so the same walk, byte for byte.
+        data = ff.character.load(os.path.join(CHARACTERS, "quadruped.json"))
+        del data["max_rise"]  # the generator's default, scaled too
+        self.assertEqual(ff.character.scaled(data, 100.0)["max_rise"], 35.0)
+        self.assertEqual(ff.character.unit_scale("m", "cm"), 100.0)
+        self.assertEqual(ff.character.unit_scale("centimeter", "m"), 0.01)
+        self.assertAlmostEqual(ff.character.unit_scale("ft", "in"), 12.0, places=12)
+        with self.assertRaises(ValueError) as e:
+            ff.character.unit_scale("furlong", "m")
+        self.assertIn("unknown linear unit 'furlong'", str(e.exception))
+        for bad in (0, -1.0, float("nan"), float("inf"), "2", True):
+            with self.assertRaises(ValueError):
+                ff.character.scaled(data, bad)
+        flat = [(x * 4.0, 0.0, z * 4.0, 0.0, 1.0, 0.0) for z in range(201) for x in range(201)]
+        with ff.Session.embedded() as s:
+            t = s.load_samples(flat, "flat-cm")
+            request = {"start": [400.0, 0.0, 400.0], "steps": 6}
+            here = s.generate(t, dict(request, character=ff.character.scaled(data, 100.0)))
+            there = s.generate(t, dict(request, character=data, scale=100.0))
+            # Unscaled, the metres character stops at once, and a note says which scale fits.
+            with self.assertRaises(ff.WalkStopped) as e:
+                s.generate(t, dict(request, character=data))
+        self.assertEqual(json.dumps(here), json.dumps(there))
+        self.assertTrue(any(n.endswith("(request: 'scale'; 100 from metres to centimetres)")
+                            for n in e.exception.notes), e.exception.notes)
+        self.assertEqual(here["stopped"], "")
+        body = [tr for tr in here["tracks"] if tr["kind"] == "body"][0]
+        self.assertAlmostEqual(body["keys"][0]["position"][1], data["body_height"] * 100.0,
+                               places=6)
+        self.assertNotIn("max_rise", data)  # the character given is left as it was
+
     def test_character_files_the_plugins_cannot_rig_are_refused_before_anything_is_made(self):
         # Each of these escaped from Blender's Character Setup as a Python traceback
         # (KeyError, ZeroDivisionError, IndexError), after half the rig was made.
@@ -1438,52 +1471,63 @@ class MayaKeyWalkTest(unittest.TestCase):
         for sample in samples:
             self.assertAlmostEqual(sample[4], 1.0, places=9)  # the normal's Y: up
 
-    def test_character_setup_notes_a_scene_not_in_metres(self):
-        # The plugin takes one scene unit as one of footfall's, and character files give
-        # metres: in Maya's default centimetre scene the shipped biped stood 0.95 cm tall,
-        # without a word.
-        warnings = []
-        om = types.ModuleType("maya.api.OpenMaya")
-        om.MGlobal = types.SimpleNamespace(displayWarning=warnings.append)
-        api = types.ModuleType("maya.api")
-        api.OpenMaya = om
-        hold = types.SimpleNamespace(ok=True, point=(0.0, 0.0, 0.0), normal=(0.0, 1.0, 0.0))
-        session = types.SimpleNamespace(check_character=lambda data, path: None,
-                                        snap=lambda terrain, points: [hold for _ in points])
-        saved = {name: sys.modules.pop(name, None) for name in ("maya.api", "maya.api.OpenMaya")}
-        sys.modules.update({"maya.api": api, "maya.api.OpenMaya": om})
-        try:
-            for unit, noted in (("cm", True), ("in", True), ("m", False)):
-                made = []
-                cmds = types.ModuleType("maya.cmds")
-                # Every other command is recorded, and answers None.
-                cmds.__getattr__ = lambda name: (
-                    lambda *args, _name=name, **kwargs: made.append(_name))
-                cmds.currentUnit = lambda unit=unit, **kwargs: (
-                    unit if kwargs.get("linear") else "deg")
-                cmds.upAxis = lambda *args, **kwargs: "y"
-                cmds.fileInfo = lambda *args, **kwargs: ["scene-1"]
-                cmds.group = lambda **kwargs: "biped_rig"
-                cmds.spaceLocator = lambda name: [name]
-                cmds.parent = lambda node, parent: [node]
-                del warnings[:]
-                with self._generating(cmds, session) as footfall_maya:
-                    sys.modules["maya"].api = api
-                    rig = footfall_maya.character_setup(os.path.join(CHARACTERS, "biped.json"))
-                self.assertEqual(rig, "biped_rig", (unit, made))  # set up all the same
-                self.assertIn("xform", made)
-                if noted:
-                    self.assertEqual(len(warnings), 1, unit)
-                    self.assertIn("lengths are in this scene's unit, %s: the character's body "
-                                  "height 0.95 is 0.95 %s here" % (unit, unit), warnings[0])
-                    self.assertIn("Working Units > Linear to meter", warnings[0])
-                else:
-                    self.assertEqual(warnings, [])
-        finally:
-            for name, module in saved.items():
-                sys.modules.pop(name, None)
-                if module is not None:
-                    sys.modules[name] = module
+    def test_character_setup_scales_the_character_to_the_scenes_unit(self):
+        # Character files give metres and Maya's default scene is in centimetres: the shipped
+        # biped stood 0.95 cm tall there. The rig now keeps the character scaled to the scene's
+        # unit, and places its body, feet and targets so; a file in the scene's unit is not.
+        checked = []
+        session = types.SimpleNamespace(  # flat ground at y = 0
+            check_character=lambda data, path: checked.append(data),
+            snap=lambda terrain, points: [types.SimpleNamespace(
+                ok=True, point=(p[0], 0.0, p[2]), normal=(0.0, 1.0, 0.0)) for p in points])
+        biped = json.load(open(os.path.join(CHARACTERS, "biped.json")))
+        for scene_unit, file_unit, scale in (("cm", "m", 100.0), ("in", "m", 1 / 0.0254),
+                                             ("m", "m", 1.0), ("cm", "cm", 1.0),
+                                             ("m", "mm", 0.001)):
+            calls = []
+            cmds = types.ModuleType("maya.cmds")
+            # Every other command is recorded, and answers None.
+            cmds.__getattr__ = lambda name: (
+                lambda *args, _name=name, **kwargs: calls.append((_name, args, kwargs)))
+            cmds.currentUnit = lambda unit=scene_unit, **kwargs: (
+                unit if kwargs.get("linear") else "deg")
+            cmds.upAxis = lambda *args, **kwargs: "y"
+            cmds.fileInfo = lambda *args, **kwargs: ["scene-1"]
+            cmds.group = lambda **kwargs: "biped_rig"
+            cmds.spaceLocator = lambda name: [name]
+            cmds.parent = lambda node, parent: [node]
+            del checked[:]
+            with self._generating(cmds, session) as footfall_maya:
+                rig = footfall_maya.character_setup(os.path.join(CHARACTERS, "biped.json"),
+                                                    character_unit=file_unit)
+            what = (scene_unit, file_unit)
+            self.assertEqual(rig, "biped_rig", what)
+            placed = {args[0]: kwargs["t"] for name, args, kwargs in calls
+                      if name == "xform" and "t" in kwargs}
+            self.assertAlmostEqual(placed["biped_body"][1], 0.95 * scale, places=9, msg=what)
+            rests = dict(footfall_maya.character.rest_positions(biped))
+            for foot, rest in rests.items():
+                for i in (0, 2):
+                    self.assertAlmostEqual(abs(placed["biped_%s" % foot][i]),
+                                           abs(rest[i]) * scale, places=9, msg=what)
+                # Its target half a (scaled) step ahead of it.
+                self.assertAlmostEqual(placed["biped_%s_target" % foot][2],
+                                       placed["biped_%s" % foot][2] + 0.35 * scale, places=9,
+                                       msg=what)
+            kept = [args for name, args, kwargs in calls
+                    if name == "setAttr" and args[0] == "biped_rig.footfallCharacter"]
+            self.assertEqual(len(kept), 1, what)
+            data = json.loads(kept[0][1])
+            self.assertEqual(checked, [data])  # checked as it is kept
+            self.assertAlmostEqual(data["step_length"], 0.7 * scale, places=9, msg=what)
+            self.assertAlmostEqual(data["reach"], biped["reach"] * scale, places=9, msg=what)
+            said = [kwargs.get("amg", "") for name, args, kwargs in calls
+                    if name == "inViewMessage"]
+            if scale == 1:
+                self.assertEqual(said, [], what)
+            else:
+                self.assertEqual(said, ["footfall: biped scaled from %s to this scene's %s "
+                                        "(x %g)" % (file_unit, scene_unit, scale)], what)
 
     def test_a_mesh_is_sampled_in_the_scenes_linear_unit(self):
         # MFnMesh gives points in centimetres (Maya's internal unit) whatever the scene's
@@ -1525,6 +1569,17 @@ class MayaKeyWalkTest(unittest.TestCase):
             fields[name] = dict(kwargs)
             return name
         cmds.textFieldButtonGrp = text_field_button_grp
+        menus = {}  # option menu -> its items' labels, the first chosen (Maya's default)
+
+        def option_menu_grp(*args, **kwargs):
+            if kwargs.get("q"):
+                return menus[args[0]][0]
+            name = "menu%d" % len(menus)
+            menus[name] = []
+            fields[name] = dict(kwargs, items=menus[name])
+            return name
+        cmds.optionMenuGrp = option_menu_grp
+        cmds.menuItem = lambda label: menus[sorted(menus)[-1]].append(label)
         return cmds
 
     def test_the_windows_file_buttons_pick_files(self):
@@ -1536,7 +1591,11 @@ class MayaKeyWalkTest(unittest.TestCase):
         with self._footfall_maya(cmds) as footfall_maya:
             footfall_maya.show()
             by_label = {f["label"]: f for f in fields.values()}
-            self.assertEqual(sorted(by_label), ["Character file", "Point file"])
+            self.assertEqual(sorted(by_label), ["Character file", "Character file unit",
+                                                "Point file"])
+            # Metres first: the shipped character files'.
+            self.assertEqual(by_label["Character file unit"]["items"][:2], ["m", "cm"])
+            del by_label["Character file unit"]
             for label, chosen in (("Point file", "/data/hills.obj"),
                                   ("Character file", "/data/biped.json")):
                 field = by_label[label]
@@ -1575,7 +1634,8 @@ class MayaKeyWalkTest(unittest.TestCase):
             by_label["Character file"]["text"] = os.path.join(CHARACTERS, "biped.json")
             made = []
             footfall_maya.character_setup = (
-                lambda path, ik_handles=None, body=None: made.append((ik_handles, body)))
+                lambda path, ik_handles=None, body=None, character_unit=None:
+                made.append((ik_handles, body)) or self.assertEqual(character_unit, "m"))
             setup = [kw["command"] for name, _, kw in calls
                      if name == "button" and kw.get("label", "").startswith("Set Up")]
             self.assertEqual(len(setup), 1)

@@ -195,17 +195,9 @@ def _ui_angles():
     return math.radians if mc.currentUnit(query=True, angle=True) == "rad" else float
 
 
-def _unit_note(data):
-    """A note for a scene whose linear unit is not the metre, or None: the plugin takes one
-    scene unit as one of footfall's, and character files give metres (in Maya's default
-    centimetre scene the shipped biped stood 0.95 cm tall, without a word)."""
-    unit = str(mc.currentUnit(query=True, linear=True))
-    if unit in ("m", "meter"):
-        return None
-    return ("lengths are in this scene's unit, %s: the character's body height %g is %g %s "
-            "here; for a character file in metres (as the shipped ones), set Preferences > "
-            "Settings > Working Units > Linear to meter" % (unit, character.body_height(data),
-                                                             character.body_height(data), unit))
+def _scene_linear_unit():
+    """The scene's linear unit, as Maya names it short ("cm")."""
+    return str(mc.currentUnit(query=True, linear=True))
 
 
 def _orient(node, up, forward):
@@ -216,15 +208,19 @@ def _orient(node, up, forward):
 
 
 @_guard
-def character_setup(character_file, name=None, ik_handles=None, body=None):
+def character_setup(character_file, name=None, ik_handles=None, body=None, character_unit="m"):
     """Sets up a character at the origin facing +Z (or at `body`, facing as it does): foot IK
     handles given as {foot name: handle} (created as locators when None), target locators half
     a step ahead of each foot under a central locator per foot pair, aligned to the terrain
-    normal. Checks the file as the generator reads it, and snaps everything, before anything is
-    made; one undo chunk."""
+    normal. The character file's lengths are in `character_unit` (metres, as the shipped
+    files), scaled to the scene's linear unit (100 times in Maya's default centimetres); the rig
+    keeps the character so scaled, and Generate Walk walks it. Checks the file as the generator
+    reads it, and snaps everything, before anything is made; one undo chunk."""
     _require_y_up()
     _scene_terrain_key()  # (no terrain: before anything else)
-    data = character.load(character_file)
+    scene_unit = _scene_linear_unit()
+    scale = character.unit_scale(character_unit, scene_unit)
+    data = character.scaled(character.load(character_file), scale)
     s = _session()
     s.check_character(data, character_file)
     feet = character.rest_positions(data, character_file)
@@ -279,7 +275,9 @@ def character_setup(character_file, name=None, ik_handles=None, body=None):
                          t=[p[i] + forward[i] * step / 2 for i in range(3)])
     finally:
         mc.undoInfo(closeChunk=True)
-    _show_notes([note for note in (_unit_note(data),) if note])
+    if scale != 1:
+        mc.inViewMessage(amg="footfall: %s scaled from %s to this scene's %s (x %g)"
+                         % (name, character_unit, scene_unit, scale), pos="topCenter", fade=True)
     return rig
 
 
@@ -549,6 +547,8 @@ def import_walk(path, rig=None):
 TERRAIN_FILTER = ("Terrains (*.pts *.xyz *.txt *.obj *.ply *.off *.stl *.asc *.pgm);;"
                   "All files (*.*)")
 CHARACTER_FILTER = "Characters (*.json);;All files (*.*)"
+# The Character file unit menu's choices, the first the default (Maya's short names).
+CHARACTER_UNITS = ("m", "cm", "mm", "in", "ft", "yd", "km", "mi")
 
 
 def _browse_button(field, caption, file_filter):
@@ -596,6 +596,10 @@ def show():
     mc.frameLayout(label="Character Setup", collapsable=True)
     cfile = mc.textFieldButtonGrp(label="Character file", buttonLabel="...")
     _browse_button(cfile, "footfall character file", CHARACTER_FILTER)
+    # The unit the character file's lengths are in: metres for the shipped ones.
+    cunit = mc.optionMenuGrp(label="Character file unit")
+    for unit in CHARACTER_UNITS:
+        mc.menuItem(label=unit)
 
     @_guard
     def setup(*_):
@@ -607,7 +611,8 @@ def show():
         # alone became the body and foot both; a body selected alone was ignored).
         bodies = [s for s in sel if s not in handles.values()]
         character_setup(mc.textFieldButtonGrp(cfile, q=True, text=True),
-                        ik_handles=handles or None, body=bodies[0] if bodies else None)
+                        ik_handles=handles or None, body=bodies[0] if bodies else None,
+                        character_unit=mc.optionMenuGrp(cunit, q=True, value=True))
     mc.button(label="Set Up (select body and/or IK handles, or nothing)", command=setup)
     mc.setParent("..")
 

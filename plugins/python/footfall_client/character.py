@@ -222,6 +222,54 @@ def with_overrides(data, **values):
     return out
 
 
+# The lengths of a character file (ScaleCharacter, character.h, multiplies the same ones),
+# beside its feet's rests.
+LENGTHS = ("step_length", "step_height", "body_height", "max_rise", "reach", "foot_length")
+
+# Metres in one of each linear unit a DCC may work in (Maya's short and long names).
+METRES_PER_UNIT = {"mm": 0.001, "millimeter": 0.001, "cm": 0.01, "centimeter": 0.01,
+                   "m": 1.0, "meter": 1.0, "km": 1000.0, "kilometer": 1000.0,
+                   "in": 0.0254, "inch": 0.0254, "ft": 0.3048, "foot": 0.3048,
+                   "yd": 0.9144, "yard": 0.9144, "mi": 1609.344, "mile": 1609.344}
+
+
+def unit_scale(from_unit, to_unit):
+    """How many `to_unit` make one `from_unit` (100 from "m" to "cm"); ValueError naming the
+    unit for one not in METRES_PER_UNIT."""
+    for unit in (from_unit, to_unit):
+        if unit not in METRES_PER_UNIT:
+            raise ValueError("unknown linear unit %r (expected one of %s)"
+                             % (unit, ", ".join(sorted(METRES_PER_UNIT))))
+    return METRES_PER_UNIT[from_unit] / METRES_PER_UNIT[to_unit]
+
+
+def scaled(data, factor):
+    """A copy of the character `data` with every length multiplied by `factor` (its feet's
+    rests and LENGTHS; angles, frames and the gait stay), as `footfall generate --scale` and a
+    request's "scale" scale it: a character file in metres in a centimetre scene. Lengths the
+    file leaves out keep the generator's defaults, scaled too where they are lengths (max_rise);
+    ValueError for a factor that is not a finite number above 0."""
+    if not _finite_number(factor) or factor <= 0:
+        raise ValueError("a character's scale must be a finite number above 0, not %r"
+                         % (factor,))
+    out = json.loads(json.dumps(data))
+    if factor == 1:
+        return out
+    for foot in out.get("feet", []):
+        if isinstance(foot, dict) and isinstance(foot.get("rest"), list):
+            foot["rest"] = [v * factor if _finite_number(v) else v for v in foot["rest"]]
+    for key in LENGTHS:
+        if _finite_number(out.get(key)):
+            out[key] = out[key] * factor
+    if "max_rise" not in out:
+        out["max_rise"] = DEFAULT_MAX_RISE * factor
+    return out
+
+
+# The generator's max_rise for a character file without one (character.h).
+DEFAULT_MAX_RISE = 0.35
+
+
 def _finite_number(value):
     """Whether a JSON value is a finite number a double holds (an integer of 400 digits, which
     JSON allows, is not: math.isfinite raised OverflowError on it)."""
