@@ -539,3 +539,58 @@ TEST_CASE("WriteGltf keys the feet's rotations when asked, each foot on its grou
   }
   std::remove(path.c_str());
 }
+
+TEST_CASE("WriteGltf converts a walk in another linear unit to metres", "[export][gltf]") {
+  // glTF's unit is the metre: a walk in centimetres (a character scaled onto a terrain in
+  // centimetres) was read 100 times too large by Blender and Unreal.
+  Walk walk = test::FarWalk();
+  walk.tracks[0].foot_length = 25;
+  const std::string metres_path = test::ScratchPath("far_m.glb");
+  const std::string cm_path = test::ScratchPath("far_cm.glb");
+  std::string error;
+  GltfOptions metres;
+  metres.binary = true;
+  REQUIRE(WriteGltf(walk, metres_path, metres, &error) == Status::kOk);
+  GltfOptions cm = metres;
+  cm.linear_unit = "cm";
+  REQUIRE(WriteGltf(walk, cm_path, cm, &error) == Status::kOk);
+  const tinygltf::Model a = Load(metres_path, true), b = Load(cm_path, true);
+  REQUIRE(a.nodes.size() == b.nodes.size());
+  // The far walk (5e5 cm is 5 km) still has its origin node, in metres.
+  const std::vector<double>& origin = b.nodes.back().translation;
+  REQUIRE(origin.size() == 3);
+  CHECK(origin == std::vector<double>{5000, 0, -3000});
+  CHECK(b.nodes[0].extras.Get("foot_length").GetNumberAsDouble() == 0.25);
+  auto ca = Channels(a), cb = Channels(b);
+  const std::vector<double>& far_origin = a.nodes.back().translation;
+  for (const char* node : {"L", "R", "body"}) {
+    INFO(node);
+    const Channel &ta = ca[node]["translation"], &tb = cb[node]["translation"];
+    CHECK(ta.times == tb.times);
+    REQUIRE(ta.values.size() == tb.values.size());
+    for (size_t i = 0; i < ta.values.size(); ++i) {
+      const size_t axis = i % 3;
+      const double world_cm = far_origin[axis] + ta.values[i];
+      const double world_m = origin[axis] + tb.values[i];
+      CHECK(world_m == Approx(world_cm / 100).margin(1e-6));
+    }
+    // Rotations are the same.
+    CHECK(ca[node].count("rotation") == cb[node].count("rotation"));
+    if (ca[node].count("rotation"))
+      CHECK(ca[node]["rotation"].values == cb[node]["rotation"].values);
+  }
+  // "m" is the same file as none; an unknown unit is refused, naming the units known.
+  GltfOptions m = metres;
+  m.linear_unit = "m";
+  const std::string m_path = test::ScratchPath("far_named_m.glb");
+  REQUIRE(WriteGltf(walk, m_path, m, &error) == Status::kOk);
+  CHECK(ReadBytes(m_path) == ReadBytes(metres_path));
+  GltfOptions furlong = metres;
+  furlong.linear_unit = "furlong";
+  const std::string bad_path = test::ScratchPath("far_furlong.glb");
+  CHECK(WriteGltf(walk, bad_path, furlong, &error) == Status::kInvalidArgument);
+  CHECK_THAT(error, Catch::Contains("unknown linear unit 'furlong' (expected mm, cm, m, km, in, "
+                                    "ft, yd or mi)"));
+  CHECK_FALSE(std::ifstream(bad_path).good());
+  for (const std::string& path : {metres_path, cm_path, m_path}) std::remove(path.c_str());
+}

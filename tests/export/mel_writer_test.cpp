@@ -13,6 +13,7 @@
 #include <catch2/catch.hpp>
 
 #include "footfall/export/euler.h"
+#include "footfall/export/linear_units.h"
 #include "footfall/export/mel_writer.h"
 #include "walk_fixtures.h"
 
@@ -269,7 +270,7 @@ TEST_CASE("WriteMel keys lengths in the walk's linear unit when it is named", "[
         std::string::npos);
   for (const std::string unit : {"m", "cm", "mm", "km", "in", "ft", "yd", "mi"}) {
     INFO(unit);
-    CHECK(IsMayaLinearUnit(unit));
+    CHECK(MetresPerLinearUnit(unit) > 0);
     MelOptions options;
     options.linear_unit = unit;
     const std::string path = test::ScratchPath("unit_" + unit + ".mel");
@@ -296,7 +297,7 @@ TEST_CASE("WriteMel keys lengths in the walk's linear unit when it is named", "[
   }
   for (const std::string bad : {"furlong", "M", "meter", " m", "m\"; quit -f; \""}) {
     INFO(bad);
-    CHECK_FALSE(IsMayaLinearUnit(bad));
+    CHECK(MetresPerLinearUnit(bad) == 0);
     MelOptions options;
     options.linear_unit = bad;
     const std::string path = test::ScratchPath("unit_bad.mel");

@@ -3,7 +3,8 @@
 // Usage: export_samples DIR
 // Creates DIR if needed and writes walk.gltf, walk.glb, crowd.gltf, crowd.glb, empty.gltf,
 // far.gltf and far.glb (the biped at UTM-like coordinates: tracks under a root origin node),
-// walk_feet.gltf and crowd_feet.glb (with the feet's rotations), walk.mel, crowd.mel and
+// walk_feet.gltf and crowd_feet.glb (with the feet's rotations), far_cm.glb (the far walk taken
+// as centimetres, written in metres), walk.mel, crowd.mel and
 // broken.gltf: walk.gltf with its samplers switched to CUBICSPLINE
 // without the tangents that needs, which a working validator must reject.
 #include <cstdio>
@@ -36,17 +37,19 @@ int main(int argc, char** argv) {
     const footfall::Walk* walk;
     const char* file;
     bool foot_rotations;
-  } samples[] = {{&biped, "walk.gltf", false},     {&biped, "walk.glb", false},
-                 {&crowd, "crowd.gltf", false},    {&crowd, "crowd.glb", false},
-                 {&empty, "empty.gltf", false},    {&far, "far.gltf", false},
-                 {&far, "far.glb", false},         {&biped, "walk_feet.gltf", true},
-                 {&crowd, "crowd_feet.glb", true}, {&biped, "walk.mel", false},
-                 {&crowd, "crowd.mel", false}};
+    const char* gltf_unit;  // the walk's linear unit, converted to metres ("": none)
+  } samples[] = {{&biped, "walk.gltf", false, ""},     {&biped, "walk.glb", false, ""},
+                 {&crowd, "crowd.gltf", false, ""},    {&crowd, "crowd.glb", false, ""},
+                 {&empty, "empty.gltf", false, ""},    {&far, "far.gltf", false, ""},
+                 {&far, "far.glb", false, ""},         {&biped, "walk_feet.gltf", true, ""},
+                 {&crowd, "crowd_feet.glb", true, ""}, {&far, "far_cm.glb", true, "cm"},
+                 {&biped, "walk.mel", false, ""},      {&crowd, "crowd.mel", false, ""}};
   for (const auto& sample : samples) {
     const std::string path = dir + "/" + sample.file;
     std::string error;
     footfall::WalkExportOptions options;
     options.foot_rotations = sample.foot_rotations;
+    options.gltf_linear_unit = sample.gltf_unit;
     if (footfall::WriteWalk(*sample.walk, path, options, &error) != footfall::Status::kOk) {
       std::fprintf(stderr, "export_samples: %s\n", error.c_str());
       return 1;

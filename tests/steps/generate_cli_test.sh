@@ -529,6 +529,30 @@ check "--scale with --scene: said" grep -qF -- "--scene excludes --scale" "$work
 "$footfall" terrain convert "$hills" --scale 2 -o "$work/bad-scale.pts" 2> "$work/bad-scale.err"
 check "terrain convert --scale without --character: exit 1" [ $? -eq 1 ]
 check "terrain convert --scale without --character: said" grep -qF -- "--scale requires --character" "$work/bad-scale.err"
+# --gltf-unit cm: the walk in centimetres is written in metres, glTF's unit: its nodes where the
+# walk in metres puts them; without a glTF output, or for a unit it does not know, refused.
+"$footfall" generate --terrain "$work/hills-cm.pts" --character "$chars/biped.json" --scale 100 \
+  --start 1200,0,800 --steps 6 --gltf-unit cm --out "$work/scaled.gltf" 2>/dev/null
+check "--gltf-unit cm: exit 0" [ $? -eq 0 ]
+"$footfall" generate --terrain "$hills" --character "$chars/biped.json" --start 12,0,8 --steps 6 \
+  --out "$work/metres.gltf" 2>/dev/null
+check "--gltf-unit cm: the nodes of the walk in metres" python3 - "$work/metres.gltf" "$work/scaled.gltf" <<'PY'
+import json, sys
+a, b = (json.load(open(p))["nodes"] for p in sys.argv[1:3])
+assert [n["name"] for n in a] == [n["name"] for n in b]
+for na, nb in zip(a, b):
+    for x, y in zip(na["translation"], nb["translation"]):
+        assert abs(x - y) <= 1e-5 * max(1.0, abs(x)), (na, nb)
+PY
+"$footfall" generate --terrain "$hills" --character "$chars/biped.json" --steps 2 --gltf-unit cm \
+  --out "$work/no-gltf.json" 2> "$work/no-gltf.err"
+check "--gltf-unit without a glTF output: exit 1" [ $? -eq 1 ]
+check "--gltf-unit without a glTF output: said" grep -qF -- "--gltf-unit cm names the unit of .gltf and .glb outputs, and no --out is one" "$work/no-gltf.err"
+check "--gltf-unit without a glTF output: nothing written" [ ! -e "$work/no-gltf.json" ]
+"$footfall" generate --terrain "$hills" --character "$chars/biped.json" --steps 2 --gltf-unit furlong \
+  --out "$work/furlong.gltf" 2> "$work/furlong-gltf.err"
+check "--gltf-unit furlong: exit 1" [ $? -eq 1 ]
+check "--gltf-unit furlong: the units known" grep -qF -- "expected mm, cm, m, km, in, ft, yd or mi" "$work/furlong-gltf.err"
 # --mel-unit m: the MEL keys the same numbers with the scene's linear unit set to metres while it
 # keys (Maya converts), the user's put back after; a unit Maya does not know, or no .mel to
 # apply it to, is refused before anything is written.

@@ -23,6 +23,7 @@
 #include "footfall/cli/number_checks.h"
 #include "footfall/client/query_text.h"
 #include "footfall/export/gltf_writer.h"
+#include "footfall/export/linear_units.h"
 #include "footfall/export/mel_writer.h"
 #include "footfall/export/walk_writer.h"
 #include "footfall/import/terrain_loader.h"
@@ -55,8 +56,9 @@ struct GenerateFlags {
   double crowd_spacing = 0;
   bool progress = false;
   bool foot_rotations = false;
-  std::string mel_unit;  // the walk's linear unit in .mel outputs ("": the scene's)
-  double scale = 1;      // the character's lengths multiplied (ScaleCharacter)
+  std::string mel_unit;   // the walk's linear unit in .mel outputs ("": the scene's)
+  std::string gltf_unit;  // the walk's linear unit, converted to metres in glTF ("": metres)
+  double scale = 1;       // the character's lengths multiplied (ScaleCharacter)
   // The character file's walk settings replaced (negative: the file's own), in the terrain's
   // units (not scaled).
   double step_length = -1, step_height = -1, foot_length = -1;
@@ -348,6 +350,14 @@ bool CheckOutputs(const GenerateFlags& flags, const std::vector<std::string>& in
              " names the unit of .mel outputs, and no --out is a .mel file";
     return false;
   }
+  if (!flags.gltf_unit.empty() &&
+      std::none_of(flags.out.begin(), flags.out.end(), [](const std::string& out) {
+        return FileExtension(out) == "gltf" || FileExtension(out) == "glb";
+      })) {
+    *error = "--gltf-unit " + flags.gltf_unit +
+             " names the unit of .gltf and .glb outputs, and no --out is one";
+    return false;
+  }
   return true;
 }
 
@@ -500,6 +510,7 @@ int WriteOutputs(const GenerateFlags& flags, const LoadedTerrain& terrain, const
   WalkExportOptions exports;
   exports.foot_rotations = flags.foot_rotations;
   exports.mel_linear_unit = flags.mel_unit;
+  exports.gltf_linear_unit = flags.gltf_unit;
   int code = 0;
   std::string error;
   OutputFileSet outputs;
@@ -938,17 +949,24 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
                 "Key the feet's rotations too: each foot on its ground, facing its body's "
                 "heading (.gltf, .glb and .mel outputs key them; the .json gives each foot key a "
                 "rotation)");
+  const CLI::Validator linear_unit(
+      [](const std::string& unit) {
+        return MetresPerLinearUnit(unit) > 0 ? std::string()
+                                             : std::string("expected ") + LinearUnitNames();
+      },
+      "UNIT");
+  cmd->add_option("--gltf-unit", flags->gltf_unit,
+                  "The linear unit the walk's lengths are in (cm for a terrain in centimetres): "
+                  ".gltf and .glb outputs convert them to metres, glTF's unit, so that Blender, "
+                  "Unreal and other readers show the walk at its size (default: written as "
+                  "they are, taken as metres)")
+      ->check(linear_unit);
   cmd->add_option("--mel-unit", flags->mel_unit,
                   "The linear unit the walk's lengths are in (m for the shipped characters): "
                   ".mel outputs key them so in any Maya scene (Maya converts; a centimetre "
                   "scene gets 100 units a metre) and put the user's unit back; default: keyed in "
                   "the scene's unit, one walk unit to one scene unit")
-      ->check(CLI::Validator(
-          [](const std::string& unit) {
-            return IsMayaLinearUnit(unit) ? std::string()
-                                          : std::string("expected ") + MayaLinearUnits();
-          },
-          "UNIT"));
+      ->check(linear_unit);
   cmd->add_option("-o,--out,--output", flags->out,
                   "Output file: .json, .gltf, .glb or .mel (repeatable); .pts: the terrain's "
                   "samples the walk was placed on (as resampled for the character), for "

@@ -8,15 +8,18 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <new>
 #include <ostream>
 #include <streambuf>
 #include <vector>
 
 #include "file_output.h"
+#include "footfall/export/linear_units.h"
 #include "footfall/steps/foot_rotations.h"
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/output_file.h"
+#include "footfall/terrain/shown_text.h"
 #include "footfall/terrain/text_stream.h"
 #include "footfall/version.h"
 #include "walk_prep.h"
@@ -145,8 +148,40 @@ Vec3 StoredFloats(const Vec3& p, const Vec3& origin) {
 
 }  // namespace
 
+namespace {
+
+// `walk` with its lengths (positions, foot lengths) multiplied by `factor`.
+Walk ScaledWalk(const Walk& walk, double factor) {
+  Walk out = walk;
+  for (WalkTrack& track : out.tracks) {
+    track.foot_length *= factor;
+    for (WalkKey& key : track.keys) key.position = key.position * factor;
+  }
+  return out;
+}
+
+}  // namespace
+
 Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& options,
                  std::string* error) {
+  if (!options.linear_unit.empty() && options.linear_unit != "m") {
+    const double metres = MetresPerLinearUnit(options.linear_unit);
+    if (!(metres > 0)) {
+      SetError(error, "cannot write glTF '" + path + "': unknown linear unit '" +
+                          ShownText(options.linear_unit) + "' (expected " + LinearUnitNames() +
+                          ")");
+      return Status::kInvalidArgument;
+    }
+    GltfOptions in_metres = options;
+    in_metres.linear_unit.clear();
+    try {
+      return WriteGltf(ScaledWalk(walk, metres), path, in_metres, error);
+    } catch (const std::bad_alloc&) {
+      SetError(error,
+               "cannot write glTF '" + path + "': out of memory converting the walk to metres");
+      return Status::kLimitExceeded;
+    }
+  }
   Status status = walk_export::CheckWalk(walk, error);
   if (status != Status::kOk) return status;
   // tinygltf serialises in functions that may not throw: running out of memory there aborts the

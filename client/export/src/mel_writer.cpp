@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "footfall/export/euler.h"
+#include "footfall/export/linear_units.h"
 #include "footfall/steps/foot_rotations.h"
 #include "footfall/terrain/ordered_text.h"
 #include "footfall/terrain/output_file.h"
@@ -179,14 +180,6 @@ constexpr char kRootName[] = "footfall_walk";
 
 }  // namespace
 
-bool IsMayaLinearUnit(const std::string& unit) {
-  for (const char* known : {"mm", "cm", "m", "km", "in", "ft", "yd", "mi"})
-    if (unit == known) return true;
-  return false;
-}
-
-const char* MayaLinearUnits() { return "mm, cm, m, km, in, ft, yd or mi"; }
-
 Status WriteMel(const Walk& walk, const std::string& path, std::string* error) {
   return WriteMel(walk, path, MelOptions{}, error);
 }
@@ -196,10 +189,10 @@ Status WriteMel(const Walk& walk, const std::string& path, const MelOptions& opt
   Status status = walk_export::CheckWalk(walk, error);
   if (status != Status::kOk) return status;
   const std::string& linear = options.linear_unit;
-  if (!linear.empty() && !IsMayaLinearUnit(linear)) {
+  if (!linear.empty() && !(MetresPerLinearUnit(linear) > 0)) {
     if (error)
       *error = "unknown Maya linear unit '" + ShownText(linear) + "' (expected " +
-               MayaLinearUnits() + ")";
+               LinearUnitNames() + ")";
     return Status::kInvalidArgument;
   }
 

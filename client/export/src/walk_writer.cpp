@@ -23,6 +23,7 @@ Status WriteWalk(const Walk& walk, const std::string& path, const WalkExportOpti
     GltfOptions gltf;
     gltf.binary = ext == "glb";
     gltf.foot_rotations = options.foot_rotations;
+    gltf.linear_unit = options.gltf_linear_unit;
     return WriteGltf(walk, path, gltf, error);
   }
   if (ext == "mel") {

@@ -39,20 +39,13 @@ struct MelOptions {
   // bodies), each foot on its ground facing its body's heading, as GltfOptions::foot_rotations
   // turns glTF's foot nodes.
   bool foot_rotations = false;
-  // The Maya linear unit the walk's lengths are in (IsMayaLinearUnit: "m" for the shipped
+  // The Maya linear unit the walk's lengths are in (linear_units.h: "m" for the shipped
   // characters), or "" (the default) for the scene's. Given, the script sets the scene's
   // linear unit to it while it keys and puts the user's back after, as it does for angles:
   // Maya converts, so a walk in metres sourced into a centimetre scene keeps its size (100
   // scene units a metre) where it was otherwise keyed one walk unit to one scene unit.
   std::string linear_unit;
 };
-
-// Whether `unit` is one of the linear units Maya's `currentUnit -linear` takes by their short
-// names: mm, cm, m, km, in, ft, yd, mi.
-bool IsMayaLinearUnit(const std::string& unit);
-
-// The units IsMayaLinearUnit takes, for messages: "mm, cm, m, km, in, ft, yd or mi".
-const char* MayaLinearUnits();
 
 // As above, with `options`.
 Status WriteMel(const Walk& walk, const std::string& path, const MelOptions& options,

@@ -19,6 +19,9 @@ struct WalkExportOptions {
   bool foot_rotations = false;
   // .mel: the walk's linear unit (MelOptions::linear_unit); "" for the scene's.
   std::string mel_linear_unit;
+  // .gltf, .glb: the walk's linear unit (GltfOptions::linear_unit), converted to metres; "" or
+  // "m" for none.
+  std::string gltf_linear_unit;
 };
 
 // As above, with `options`.
