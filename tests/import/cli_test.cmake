@@ -363,6 +363,19 @@ endif()
 string(ASCII 27 escape)
 file(WRITE "${WORK}/esc.asc" "ncols 2\nnrows 2\ncellsize 1\n1 2\n3 ${escape}]0x\n")
 expect(EXIT_NONZERO "esc.asc:5: value '?]0x' is not a finite number" terrain info "${WORK}/esc.asc")
+# A height map far steeper than ground (cells 1 apart under heights in tens: a .pgm of an SRTM
+# tile in metres) is said, naming --cell-size; with a cell size that fits, it is not. Loaded all
+# the same (exit 0).
+file(WRITE "${WORK}/steep.pgm" "P2\n3 3\n90\n0 40 80\n10 50 90\n0 40 80\n")
+expect(EXIT_ZERO "steep.pgm: its surface is 41.2 times the area it covers (slopes of about 88.6 degrees on average, steeper than ground): its cells, 1 apart, are likely not in its heights' unit"
+       terrain info "${WORK}/steep.pgm")
+expect(EXIT_ZERO "give --cell-size in the heights' unit, or --height-scale" terrain info "${WORK}/steep.pgm")
+execute_process(COMMAND "${FOOTFALL}" terrain info "${WORK}/steep.pgm" --cell-size 90
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT err STREQUAL "" OR NOT out MATCHES "surface over area covered: 1\\.")
+  message(FATAL_ERROR "steep.pgm with --cell-size 90: exit ${rc}, '${out}' '${err}'")
+endif()
+expect(EXIT_ZERO "steep.pgm: its surface is" terrain convert "${WORK}/steep.pgm" -o "${WORK}/steep.pts")
 file(WRITE "${WORK}/more.pgm" "P2\n2 2\n9\n1 2\n3 4 5\n")
 expect(EXIT_NONZERO "more.pgm:5: more than the 4 grey levels the header declares"
        terrain info "${WORK}/more.pgm")

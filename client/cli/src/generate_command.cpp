@@ -208,7 +208,8 @@ std::string Box(const Vec3& lo, const Vec3& hi) {
 // Says on stderr how the terrain was resampled for the character, when not at its own spacing.
 void ReportResampling(const std::string& path, const Character& character, const WalkTerrain& t) {
   const TerrainLoadReport& r = t.report;
-  for (const std::string& note : {DescribeSkippedFaces(r), DescribeTurnover(r)})
+  for (const std::string& note :
+       {DescribeSkippedFaces(r), DescribeTurnover(r), DescribeSteepHeightMap(r)})
     if (!note.empty()) std::cerr << "footfall generate: " << path << ": " << note << '\n';
   if (!t.cropped && r.separation == r.file_separation) return;
   TextStream o;
@@ -429,7 +430,8 @@ bool LoadWalkTerrain(const GenerateFlags& flags, const Character& character,
   // resampled for the character.
   if (!terrain_flags.terrain.empty()) {
     const TerrainLoadReport& r = t->session->last_file_report();
-    for (const std::string& note : {DescribeSkippedFaces(r), DescribeTurnover(r)})
+    for (const std::string& note :
+         {DescribeSkippedFaces(r), DescribeTurnover(r), DescribeSteepHeightMap(r)})
       if (!note.empty())
         std::cerr << "footfall generate: " << terrain_flags.terrain << ": " << note << '\n';
   }

@@ -119,7 +119,8 @@ int RunConvert(const ConvertFlags& flags) {
   if (report.separation > 0) std::cout << " (separation " << report.separation << ")";
   std::cout << '\n';
   // What the resampling changed of the surface, as generate says it.
-  for (const std::string& note : {DescribeSkippedFaces(report), DescribeTurnover(report)})
+  for (const std::string& note :
+       {DescribeSkippedFaces(report), DescribeTurnover(report), DescribeSteepHeightMap(report)})
     if (!note.empty())
       std::cerr << "footfall terrain convert: " << flags.input << ": " << note << '\n';
   // Coarser than the character's steps want, to stay within a walk's samples: said, as
@@ -158,7 +159,11 @@ int RunInfo(const InfoFlags& flags) {
   } else if (report.format == "heightmap") {
     std::cout << "cells with data: " << report.vertices << '\n'
               << "nodata cells: " << report.nodata_cells << '\n'
-              << "triangles: " << report.faces << '\n';
+              << "triangles: " << report.faces << '\n'
+              << "surface over area covered: " << report.surface_ratio << " (1 when flat)\n";
+    if (!DescribeSteepHeightMap(report).empty())
+      std::cerr << "footfall terrain info: " << flags.input << ": "
+                << DescribeSteepHeightMap(report) << '\n';
   }
   if (report.format != "points") {
     std::cout << "area: " << report.area << '\n' << "separation: " << report.separation << '\n';

@@ -15,6 +15,7 @@
 #include "footfall/terrain/input_file.h"
 #include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/point_file.h"
+#include "footfall/terrain/text_stream.h"
 
 namespace footfall {
 
@@ -133,6 +134,10 @@ Status ReadTerrainMesh(const std::string& path, const TerrainLoadOptions& option
     report->skipped_faces = RemoveDegenerateTriangles(mesh);
     report->faces = mesh->triangles.size();
     report->file_separation = frame.cell_size;
+    // Each triangle of the grid covers half a cell.
+    const double covered =
+        0.5 * static_cast<double>(report->faces) * frame.cell_size * frame.cell_size;
+    if (covered > 0) report->surface_ratio = SurfaceArea(*mesh) / covered;
     if (mesh->triangles.empty() && report->skipped_faces > 0) {
       if (error)
         *error = path + ": all " + std::to_string(report->skipped_faces) +
@@ -265,6 +270,17 @@ std::string DescribeSkippedFaces(const TerrainLoadReport& report) {
   }
   return std::to_string(n) + " of " + std::to_string(report.faces) +
          " faces left out (a vertex used twice, a face listed again, or no area)";
+}
+
+std::string DescribeSteepHeightMap(const TerrainLoadReport& report) {
+  if (report.format != "heightmap" || !(report.surface_ratio > kSteepHeightMapRatio)) return "";
+  TextStream m(3);
+  m << "its surface is " << report.surface_ratio << " times the area it covers (slopes of about "
+    << std::acos(1 / report.surface_ratio) * 180 / 3.14159265358979323846
+    << " degrees on average, steeper than ground): its cells, " << report.file_separation
+    << " apart, are likely not in its heights' unit (a .pgm's cells are 1 apart, an SRTM grid's "
+       "3 arc-seconds about 90 m): give --cell-size in the heights' unit, or --height-scale";
+  return m.str();
 }
 
 Status LoadTerrain(const std::string& path, const TerrainLoadOptions& options, RawSamples* out,

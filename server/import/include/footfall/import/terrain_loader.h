@@ -59,7 +59,11 @@ struct TerrainLoadReport {
   // along up_axis (TurnOutward).
   size_t rewound_faces = 0;
   MeshTurnover turnover;
-  size_t nodata_cells = 0;      // height maps: cells left out
+  size_t nodata_cells = 0;  // height maps: cells left out
+  // Height maps: the surface's area over the area it covers (1 when flat; the secant of the
+  // mean slope, area-weighted). Far above 1, the cells are most likely not in the heights'
+  // unit (DescribeSteepHeightMap).
+  double surface_ratio = 0;
   double area = 0;              // [Units: wu^2] meshes and height maps
   double separation = 0;        // [Units: wu] the separation used (meshes and height maps)
   double file_separation = 0;   // [Units: wu] the file's own default: mean edge / cell size
@@ -81,6 +85,12 @@ std::string DescribeTurnover(const TerrainLoadReport& report);
 // twice, a face listed again, or no area)"; for height maps the grid's triangles too thin for
 // their length), or "" when nothing was.
 std::string DescribeSkippedFaces(const TerrainLoadReport& report);
+
+// A height map steeper than ground (TerrainLoadReport::surface_ratio above
+// kSteepHeightMapRatio, slopes of 70 degrees on average) in a phrase naming --cell-size and
+// --height-scale, or "" for any other terrain.
+std::string DescribeSteepHeightMap(const TerrainLoadReport& report);
+constexpr double kSteepHeightMapRatio = 3;
 
 // kInvalidArgument, with "PATH: a cell size or height scale ... applies to height maps (.asc
 // .pgm) only, not to a point file" (or a mesh), when `options` give a height map's frame for a
