@@ -175,6 +175,10 @@ expect(EXIT_NONZERO "cut.off: truncated: header declares 2 faces, found 1"
 # A grid far narrower than its heights are tall (cells in degrees) is told about --cell-size.
 file(WRITE "${WORK}/degrees.asc" "ncols 3\nnrows 3\nxllcorner -105\nyllcorner 40\ncellsize 0.0001\n0 1000 0\n1000 0 1000\n0 1000 0\n")
 expect(EXIT_NONZERO "give --cell-size in the heights' units" terrain info "${WORK}/degrees.asc")
+# So is generate, which resamples it finer for a character and finds its triangles thin.
+expect(EXIT_NONZERO "if its cells are in degrees, as a geographic grid's, give --cell-size"
+       generate --terrain "${WORK}/degrees.asc" --character "${SOURCE_DIR}/data/characters/biped.json"
+       --out "${WORK}/degrees.json")
 # terrain make: every number finite, and a cap on the samples before anything is allocated.
 expect(EXIT_NONZERO "--amplitude: 'nan' is not a finite number"
        terrain make hills --amplitude nan -o "${WORK}/x.pts")

@@ -197,12 +197,7 @@ Status ResampleTerrainMesh(const std::string& path, const TriangleMesh& mesh,
     why += " (the limit is what this process's memory holds while sampling: " +
            std::to_string(static_cast<long long>(memory / (1 << 20))) + " MB)";
   if (status != Status::kOk) {
-    if (status == Status::kLimitExceeded && report->format == "heightmap" &&
-        why.find("long and thin") != std::string::npos) {
-      why +=
-          " (a height map's cells are thin when its heights are far larger than its cell "
-          "size: check --height-scale and --cell-size)";
-    } else if (status == Status::kLimitExceeded && report->format == "heightmap") {
+    if (status == Status::kLimitExceeded && report->format == "heightmap") {
       // A grid far narrower than its heights are tall: most likely cells in degrees (a
       // geographic grid) under heights in metres, whose separation advice makes a spike.
       const int up = options.up_axis == 'x' ? 0 : options.up_axis == 'z' ? 2 : 1;
@@ -220,11 +215,17 @@ Status ResampleTerrainMesh(const std::string& path, const TriangleMesh& mesh,
         const auto end = std::to_chars(text, text + sizeof text, x, std::chars_format::general, 3);
         return std::string(text, end.ptr);
       };
+      const bool thin = why.find("long and thin") != std::string::npos;
+      if (thin)
+        why +=
+            " (a height map's cells are thin when its heights are far larger than its cell "
+            "size: check --height-scale and --cell-size";
       if (tall > 10 * across)
-        why += " (but the grid is " + shown(across) + " across under heights spanning " +
-               shown(tall) +
+        why += std::string(thin ? "; the" : " (but the") + " grid is " + shown(across) +
+               " across under heights spanning " + shown(tall) +
                ": if its cells are in degrees, as a geographic grid's, give --cell-size in the "
-               "heights' units, for example metres)";
+               "heights' units, for example metres";
+      if (thin || tall > 10 * across) why += ")";
     }
     if (error) *error = path + ": " + why;
     return status;
