@@ -520,6 +520,42 @@ class BlenderAddonTest(unittest.TestCase):
         for t in targets:
             self.assertIn(t.parent, centres)
 
+    def test_3aa_a_character_file_in_centimetres_is_set_up_at_its_size(self):
+        # The add-on took character files for metres: one in centimetres stood 100 times too
+        # tall. Its unit, given on the operator or in the panel, scales it to metres.
+        metres = ff.character.load(os.path.join(CHARACTERS, "biped.json"))
+        cm_file = os.path.join(ARGS.work_dir, "biped_cm.json")
+        with open(cm_file, "w") as f:
+            json.dump(ff.character.scaled(metres, 100.0), f)
+        settings = bpy.context.scene.footfall
+        bpy.context.scene.cursor.location = (0.5, 2.5, 0.0)
+        try:
+            for name, given, panel in (("cm_op", "cm", "m"), ("cm_panel", "", "cm")):
+                settings.character_unit = panel
+                with bpy.context.temp_override(active_object=None):
+                    self.assertEqual(bpy.ops.footfall.character_setup(
+                        character_file=cm_file, mode="CREATE", name=name,
+                        character_unit=given), {"FINISHED"})
+                rig = bpy.data.objects[name + "_rig"]
+                kept = ff.character.parse(rig.footfall_rig.character_json)
+                self.assertAlmostEqual(kept["step_length"], metres["step_length"], places=9)
+                self.assertAlmostEqual(kept["reach"], metres["reach"], places=9)
+                body = rig.footfall_rig.body
+                height = (body.matrix_world.translation - rig.matrix_world.translation).length
+                self.assertAlmostEqual(height, 0.95, delta=1e-4, msg=name)
+            # An unknown unit is a report, and makes nothing.
+            settings.character_unit = "m"
+            before = len(bpy.data.objects)
+            with self.assertRaises(RuntimeError) as e:
+                bpy.ops.footfall.character_setup(character_file=cm_file, mode="CREATE",
+                                                 name="furlong", character_unit="furlong")
+            self.assertIn("unknown linear unit 'furlong'", str(e.exception))
+            self.assertEqual(len(bpy.data.objects), before)
+        finally:
+            settings.character_unit = "m"
+            for obj in [o for o in bpy.data.objects if o.name.startswith(("cm_op", "cm_panel"))]:
+                bpy.data.objects.remove(obj)
+
     def test_3a_new_rigs_go_into_the_active_collection(self):
         # (They went into the scene's own collection, wherever the animator was working.)
         layer = bpy.context.view_layer

@@ -419,6 +419,10 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
         ("PICK", "Pick selected", "Use the active object as body and selected objects named "
                                   "after the feet as IK targets")], default="CREATE")
     name: StringProperty(name="Name", default="", description="Rig name (default: the file's)")
+    # Empty: the panel's (the scene's Character file unit).
+    character_unit: StringProperty(name="Character file unit", default="",
+                                   description="The unit the character file's lengths are in "
+                                               "(m, cm, mm, in, ft, yd, km or mi)")
 
     def execute(self, context):
         try:
@@ -427,7 +431,11 @@ class FOOTFALL_OT_character_setup(bpy.types.Operator):
             path = self.character_file or context.scene.footfall.character_file
             if not path:
                 raise ValueError("choose a character file (Character Setup > Character file)")
-            data = character.load(bpy.path.abspath(path))
+            # The rig keeps the character in metres, footfall's unit here (as the scene's
+            # lengths are sent, times the Unit Scale).
+            unit = self.character_unit or context.scene.footfall.character_unit
+            data = character.scaled(character.load(bpy.path.abspath(path)),
+                                    character.unit_scale(unit, "m"))
             s = session(context)
             # As the generator reads it, before anything is made (a file it refuses made a
             # whole rig, and the error came only at Generate Walk).

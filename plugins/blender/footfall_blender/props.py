@@ -85,6 +85,14 @@ class FootfallScene(bpy.types.PropertyGroup):
     character_file: StringProperty(name="Character file", subtype="FILE_PATH",
                                    description="The character file (JSON) Character Setup "
                                                "reads")
+    # The unit the character file's lengths are in (footfall_client.character.METRES_PER_UNIT):
+    # Character Setup keeps the character in metres on the rig.
+    character_unit: EnumProperty(
+        name="Character file unit", default="m",
+        items=[(u, u, "The character file's lengths are in %s" % u)
+               for u in ("m", "cm", "mm", "in", "ft", "yd", "km", "mi")],
+        description="The unit the character file's lengths are in (metres for the shipped "
+                    "characters)")
     rig: PointerProperty(type=bpy.types.Object, name="Rig",
                          poll=lambda self, obj: obj.footfall_rig.is_rig)
     steps: IntProperty(name="Steps", default=8, min=1, max=100000)

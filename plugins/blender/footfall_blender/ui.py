@@ -38,6 +38,7 @@ class FOOTFALL_PT_character(_Panel, bpy.types.Panel):
         s = context.scene.footfall
         col = self.layout.column()
         col.prop(s, "character_file")
+        col.prop(s, "character_unit")
         op = col.operator("footfall.character_setup", text="Create Empties at Cursor")
         op.mode = "CREATE"
         op = col.operator("footfall.character_setup", text="Use Selected (active = body)")
