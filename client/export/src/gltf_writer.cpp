@@ -146,10 +146,6 @@ Vec3 StoredFloats(const Vec3& p, const Vec3& origin) {
           static_cast<float>(p.z - origin.z)};
 }
 
-}  // namespace
-
-namespace {
-
 // `walk` with its lengths (positions, foot lengths) multiplied by `factor`.
 Walk ScaledWalk(const Walk& walk, double factor) {
   Walk out = walk;

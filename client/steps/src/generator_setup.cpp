@@ -665,13 +665,13 @@ void Generator::AddUnitsNote(const GridStats& g) {
   if (g.spacing > kUnitsNoteSpacingSteps * c_.step_length) {
     m << "the terrain's samples lie about " << g.spacing << " apart, more than "
       << kUnitsNoteSpacingSteps << " of this character's steps (step_length " << c_.step_length
-      << "): a terrain in smaller units than the character (centimetres against metres) wants "
-         "the character scaled to it ("
+      << "): if the terrain is in smaller units than the character (centimetres against "
+         "metres), scale the character to it ("
       << o_.names.scale << "; 100 from metres to centimetres)";
   } else if (across > 0 && across < c_.reach) {
     m << "the terrain is " << across << " across, less than this character's reach " << c_.reach
-      << ": a character in smaller units than the terrain (centimetres against metres) wants "
-         "scaling to it ("
+      << ": if the character is in smaller units than the terrain (centimetres against "
+         "metres), scale it to the terrain ("
       << o_.names.scale << "; 0.01 from centimetres to metres)";
   } else {
     return;
