@@ -540,7 +540,7 @@ TEST_CASE("WriteGltf keys the feet's rotations when asked, each foot on its grou
   std::remove(path.c_str());
 }
 
-TEST_CASE("WriteGltf converts a walk in another linear unit to metres", "[export][gltf]") {
+TEST_CASE("WriteGltf converts a walk in another unit to metres", "[export][gltf]") {
   // glTF's unit is the metre: a walk in centimetres (a character scaled onto a terrain in
   // centimetres) was read 100 times too large by Blender and Unreal.
   Walk walk = test::FarWalk();
@@ -551,9 +551,9 @@ TEST_CASE("WriteGltf converts a walk in another linear unit to metres", "[export
   GltfOptions metres;
   metres.binary = true;
   REQUIRE(WriteGltf(walk, metres_path, metres, &error) == Status::kOk);
-  GltfOptions cm = metres;
-  cm.linear_unit = "cm";
-  REQUIRE(WriteGltf(walk, cm_path, cm, &error) == Status::kOk);
+  Walk in_cm = walk;
+  in_cm.unit = "cm";
+  REQUIRE(WriteGltf(in_cm, cm_path, metres, &error) == Status::kOk);
   const tinygltf::Model a = Load(metres_path, true), b = Load(cm_path, true);
   REQUIRE(a.nodes.size() == b.nodes.size());
   // The far walk (5e5 cm is 5 km) still has its origin node, in metres.
@@ -580,17 +580,17 @@ TEST_CASE("WriteGltf converts a walk in another linear unit to metres", "[export
       CHECK(ca[node]["rotation"].values == cb[node]["rotation"].values);
   }
   // "m" is the same file as none; an unknown unit is refused, naming the units known.
-  GltfOptions m = metres;
-  m.linear_unit = "m";
+  Walk in_m = walk;
+  in_m.unit = "m";
   const std::string m_path = test::ScratchPath("far_named_m.glb");
-  REQUIRE(WriteGltf(walk, m_path, m, &error) == Status::kOk);
+  REQUIRE(WriteGltf(in_m, m_path, metres, &error) == Status::kOk);
   CHECK(ReadBytes(m_path) == ReadBytes(metres_path));
-  GltfOptions furlong = metres;
-  furlong.linear_unit = "furlong";
+  Walk in_furlongs = walk;
+  in_furlongs.unit = "furlong";
   const std::string bad_path = test::ScratchPath("far_furlong.glb");
-  CHECK(WriteGltf(walk, bad_path, furlong, &error) == Status::kInvalidArgument);
-  CHECK_THAT(error, Catch::Contains("unknown linear unit 'furlong' (expected mm, cm, m, km, in, "
-                                    "ft, yd or mi)"));
+  CHECK(WriteGltf(in_furlongs, bad_path, metres, &error) == Status::kInvalidArgument);
+  CHECK_THAT(error, Catch::Contains("the walk's unit 'furlong' is none of mm, cm, m, km, in, ft, "
+                                    "yd or mi"));
   CHECK_FALSE(std::ifstream(bad_path).good());
   for (const std::string& path : {metres_path, cm_path, m_path}) std::remove(path.c_str());
 }

@@ -13,8 +13,8 @@
 #include <catch2/catch.hpp>
 
 #include "footfall/export/euler.h"
-#include "footfall/export/linear_units.h"
 #include "footfall/export/mel_writer.h"
+#include "footfall/steps/linear_units.h"
 #include "walk_fixtures.h"
 
 using namespace footfall;
@@ -39,10 +39,10 @@ struct MelScript {
   std::map<std::string, std::map<std::string, std::vector<MelKey>>> keys;  // loc -> attr
   std::vector<std::string> warnings;
   int braces = 0;
-  std::string angle_unit;        // set by the script, before any rotation key
-  bool angle_restored = false;   // the user's angle unit put back, after every key
-  std::string linear_unit;       // set by the script (MelOptions::linear_unit), before any key
-  bool linear_restored = false;  // the user's linear unit put back, after every key
+  std::string angle_unit;                // set by the script, before any rotation key
+  bool angle_restored = false;           // the user's angle unit put back, after every key
+  std::string linear_unit;               // set by the script (Walk::unit), before any key
+  bool linear_restored = false;          // the user's linear unit put back, after every key
   bool translate_before_linear = false;  // a translate key before the linear unit was set
 };
 
@@ -257,11 +257,11 @@ TEST_CASE("WriteMel keys a locator per track", "[export][mel]") {
   std::remove(path.c_str());
 }
 
-TEST_CASE("WriteMel keys lengths in the walk's linear unit when it is named", "[export][mel]") {
+TEST_CASE("WriteMel keys lengths in the walk's unit when it has one", "[export][mel]") {
   // Maya reads setKeyframe values in the scene's linear unit (centimetres by default): a walk in
-  // metres was keyed 100 times small. Named, the unit is set while keying and the user's put
+  // metres was keyed 100 times small. With a unit, it is set while keying and the user's put
   // back, as for angles; the keys are the same numbers.
-  const Walk walk = test::BipedWalk();
+  Walk walk = test::BipedWalk();
   const std::string plain_path = WriteAndKeep(walk, "scene_unit.mel");
   const MelScript plain = ParseMel(plain_path);
   CHECK(plain.linear_unit.empty());
@@ -271,11 +271,10 @@ TEST_CASE("WriteMel keys lengths in the walk's linear unit when it is named", "[
   for (const std::string unit : {"m", "cm", "mm", "km", "in", "ft", "yd", "mi"}) {
     INFO(unit);
     CHECK(MetresPerLinearUnit(unit) > 0);
-    MelOptions options;
-    options.linear_unit = unit;
+    walk.unit = unit;
     const std::string path = test::ScratchPath("unit_" + unit + ".mel");
     std::string error;
-    REQUIRE(WriteMel(walk, path, options, &error) == Status::kOk);
+    REQUIRE(WriteMel(walk, path, &error) == Status::kOk);
     const MelScript named = ParseMel(path);
     CHECK(named.linear_unit == unit);
     CHECK(named.linear_restored);
@@ -298,13 +297,13 @@ TEST_CASE("WriteMel keys lengths in the walk's linear unit when it is named", "[
   for (const std::string bad : {"furlong", "M", "meter", " m", "m\"; quit -f; \""}) {
     INFO(bad);
     CHECK(MetresPerLinearUnit(bad) == 0);
-    MelOptions options;
-    options.linear_unit = bad;
+    walk.unit = bad;
     const std::string path = test::ScratchPath("unit_bad.mel");
     std::string error;
-    CHECK(WriteMel(walk, path, options, &error) == Status::kInvalidArgument);
-    CHECK(error.rfind("unknown Maya linear unit '", 0) == 0);
-    CHECK(error.find("(expected mm, cm, m, km, in, ft, yd or mi)") != std::string::npos);
+    CHECK(WriteMel(walk, path, &error) == Status::kInvalidArgument);
+    CHECK(error.rfind("the walk's unit '", 0) == 0);
+    CHECK(error.find("is none of Maya's linear units (mm, cm, m, km, in, ft, yd or mi)") !=
+          std::string::npos);
     CHECK_FALSE(std::ifstream(path).good());
   }
   std::remove(plain_path.c_str());

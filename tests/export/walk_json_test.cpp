@@ -304,6 +304,34 @@ TEST_CASE("A foot track's foot_length is written, read back and checked", "[expo
   CHECK(WalkToJson(resorted) == text);
 }
 
+TEST_CASE("A walk's unit is written, read back and checked", "[export][walk_json]") {
+  Walk walk = test::BipedWalk();
+  const std::string without = WalkToJson(walk);
+  CHECK(without.find("unit") == std::string::npos);  // as walks were before
+  walk.unit = "cm";
+  const std::string text = WalkToJson(walk);
+  CHECK(text.rfind("{\"format\":\"footfall-walk\",\"version\":1,\"fps\":24,\"unit\":\"cm\",", 0) ==
+        0);
+  Walk back;
+  std::string error;
+  REQUIRE(ParseWalkJson(text, "w.json", &back, &error) == Status::kOk);
+  CHECK(back.unit == "cm");
+  CHECK(WalkToJson(back) == text);
+  Walk whole;
+  REQUIRE(detail::ParseWalkJsonWhole(text, "w.json", &whole, &error) == Status::kOk);
+  CHECK(whole.unit == "cm");
+  REQUIRE(ParseWalkJson(without, "w.json", &back, &error) == Status::kOk);
+  CHECK(back.unit.empty());
+  for (const char* bad : {"\"furlong\"", "\"CM\"", "100", "\"\""}) {
+    INFO(bad);
+    std::string refused = text;
+    refused.replace(refused.find("\"cm\""), 4, bad);
+    Walk w;
+    CHECK(ParseWalkJson(refused, "w.json", &w, &error) == Status::kParseError);
+    CHECK(error == "w.json: unit: expected one of mm, cm, m, km, in, ft, yd or mi (line 1)");
+  }
+}
+
 namespace {
 
 // The first difference between two walks read from JSON ("" when they are the same).

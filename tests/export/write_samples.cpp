@@ -32,24 +32,24 @@ int main(int argc, char** argv) {
   const footfall::Walk biped = footfall::test::BipedWalk();
   const footfall::Walk crowd = footfall::test::CrowdWalk();
   const footfall::Walk far = footfall::test::FarWalk();
+  footfall::Walk far_cm = far;
+  far_cm.unit = "cm";
   const footfall::Walk empty;
   const struct {
     const footfall::Walk* walk;
     const char* file;
     bool foot_rotations;
-    const char* gltf_unit;  // the walk's linear unit, converted to metres ("": none)
-  } samples[] = {{&biped, "walk.gltf", false, ""},     {&biped, "walk.glb", false, ""},
-                 {&crowd, "crowd.gltf", false, ""},    {&crowd, "crowd.glb", false, ""},
-                 {&empty, "empty.gltf", false, ""},    {&far, "far.gltf", false, ""},
-                 {&far, "far.glb", false, ""},         {&biped, "walk_feet.gltf", true, ""},
-                 {&crowd, "crowd_feet.glb", true, ""}, {&far, "far_cm.glb", true, "cm"},
-                 {&biped, "walk.mel", false, ""},      {&crowd, "crowd.mel", false, ""}};
+  } samples[] = {{&biped, "walk.gltf", false},     {&biped, "walk.glb", false},
+                 {&crowd, "crowd.gltf", false},    {&crowd, "crowd.glb", false},
+                 {&empty, "empty.gltf", false},    {&far, "far.gltf", false},
+                 {&far, "far.glb", false},         {&biped, "walk_feet.gltf", true},
+                 {&crowd, "crowd_feet.glb", true}, {&far_cm, "far_cm.glb", true},
+                 {&biped, "walk.mel", false},      {&crowd, "crowd.mel", false}};
   for (const auto& sample : samples) {
     const std::string path = dir + "/" + sample.file;
     std::string error;
     footfall::WalkExportOptions options;
     options.foot_rotations = sample.foot_rotations;
-    options.gltf_linear_unit = sample.gltf_unit;
     if (footfall::WriteWalk(*sample.walk, path, options, &error) != footfall::Status::kOk) {
       std::fprintf(stderr, "export_samples: %s\n", error.c_str());
       return 1;

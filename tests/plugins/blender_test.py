@@ -1239,6 +1239,23 @@ class BlenderAddonTest(unittest.TestCase):
         with self.assertRaises(RuntimeError) as e:
             bpy.ops.footfall.import_walk(filepath=os.path.join(ARGS.work_dir, "none.json"))
         self.assertIn("cannot import", str(e.exception))
+        # A walk that says its unit (footfall generate --unit cm) is keyed at its size: the
+        # same keys as the walk in metres (it was taken for metres, 100 times too large).
+        in_cm = dict(walk, unit="cm", tracks=[
+            dict(t, keys=[dict(k, position=[v * 100 for v in k["position"]]) for k in t["keys"]])
+            for t in walk["tracks"]])
+        cm_path = os.path.join(ARGS.work_dir, "hexapod_cm.json")
+        with open(cm_path, "w") as f:
+            json.dump(in_cm, f)
+        self.assertEqual(bpy.ops.footfall.import_walk(filepath=cm_path), {"FINISHED"})
+        feet = {t["name"]: bpy.data.objects["hexapod_cm_" + t["name"]]
+                for t in walk["tracks"] if t["kind"] == "foot"}
+        self.assert_keys_equal_walk(walk, feet, bpy.data.objects["hexapod_cm_body"])
+        with open(cm_path, "w") as f:
+            json.dump(dict(in_cm, unit="furlong"), f)
+        with self.assertRaises(RuntimeError) as e:
+            bpy.ops.footfall.import_walk(filepath=cm_path)
+        self.assertIn("unit: expected one of mm, cm, m, km, in, ft, yd, mi", str(e.exception))
 
     def test_7b_failures_keep_what_the_user_has(self):
         rig = bpy.data.objects["biped_rig"]

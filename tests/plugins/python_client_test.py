@@ -1854,6 +1854,52 @@ class MayaKeyWalkTest(unittest.TestCase):
             os.unlink(path)
             os.rmdir(folder)
 
+    def test_import_keys_a_walk_that_says_its_unit_in_the_scenes(self):
+        # footfall generate --unit m writes "unit": "m": in Maya's default centimetre scene its
+        # keys go in 100 times larger; a walk without a unit is keyed as it is.
+        calls = []
+        cmds = types.ModuleType("maya.cmds")
+        cmds.currentUnit = lambda *args, **kwargs: "cm" if kwargs.get("linear") else "deg"
+        for name in ("setAttr", "addAttr", "setKeyframe", "cutKey", "undoInfo", "warning",
+                     "confirmDialog"):
+            setattr(cmds, name, lambda *args, _name=name, **kwargs: None)
+        cmds.xform = lambda *args, **kwargs: calls.append(kwargs.get("t"))
+        cmds.spaceLocator = lambda name: [name]
+        walk = {"format": "footfall-walk", "version": 1, "fps": 24,
+                "tracks": [{"name": "L", "kind": "foot", "foot_length": 0.25,
+                            "keys": [{"frame": f, "position": [0.5, 0, 0.1 * f]}
+                                     for f in (1, 2, 3)]}]}
+        folder = tempfile.mkdtemp()
+        path = os.path.join(folder, "walk.json")
+        try:
+            with self._footfall_maya(cmds) as footfall_maya:
+                for unit, factor in ((None, 1.0), ("m", 100.0), ("cm", 1.0), ("in", 2.54)):
+                    with open(path, "w") as f:
+                        json.dump(dict(walk, unit=unit) if unit else walk, f)
+                    del calls[:]
+                    self.assertEqual(footfall_maya.import_walk(path), 3, unit)
+                    keyed = [t for t in calls if t is not None]
+                    self.assertEqual(len(keyed), 3, unit)
+                    for f, t in zip((1, 2, 3), keyed):
+                        for got, want in zip(t, (0.5 * factor, 0.0, 0.1 * f * factor)):
+                            self.assertAlmostEqual(got, want, places=9, msg=unit)
+                with open(path, "w") as f:
+                    json.dump(dict(walk, unit="furlong"), f)
+                warnings = []
+                cmds.warning = warnings.append
+                self.assertIsNone(footfall_maya.import_walk(path))
+                self.assertEqual(len(warnings), 1)
+                self.assertIn("unit: expected one of mm, cm, m, km, in, ft, yd, mi", warnings[0])
+        finally:
+            os.unlink(path)
+            os.rmdir(folder)
+        # walk_in_unit itself: the walk given is left as it was.
+        in_m = dict(walk, unit="m")
+        in_mm = ff.character.walk_in_unit(in_m, "mm")
+        self.assertEqual(in_mm["unit"], "mm")
+        self.assertAlmostEqual(in_mm["tracks"][0]["foot_length"], 250.0, places=9)
+        self.assertEqual(in_m["tracks"][0]["keys"][0]["position"], [0.5, 0, 0.1])
+
     def test_rotations_of_any_length_are_turned_as_unit_quaternions(self):
         # The walk reader keeps rotations as written (non-zero); the viewer and exporters scale
         # them to unit length. Blender keyed [0, 2, 0, 2] as 49 degrees (its matrices take the

@@ -299,7 +299,7 @@ TEST_CASE("Walk JSON reads back exactly what was written", "[steps][walk_json]")
       // the default, unseen); a comment is text.
       {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[],"frame_rate":30})",
        "w.json: unknown field 'frame_rate' (known fields: comment, format, fps, "
-       "stopped, tracks, version)"},
+       "stopped, tracks, unit, version)"},
       {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","key":[]}]})",
        "w.json: tracks[0]: unknown field 'key'"},
       {R"({"format":"footfall-walk","version":1,"fps":24,"tracks":[{"name":"L","kind":"foot","keys":[{"frame":1,"phase":"end","position":[0,0,0],"normals":[0,0,1]}]}]})",

@@ -529,14 +529,17 @@ check "--scale with --scene: said" grep -qF -- "--scene excludes --scale" "$work
 "$footfall" terrain convert "$hills" --scale 2 -o "$work/bad-scale.pts" 2> "$work/bad-scale.err"
 check "terrain convert --scale without --character: exit 1" [ $? -eq 1 ]
 check "terrain convert --scale without --character: said" grep -qF -- "--scale requires --character" "$work/bad-scale.err"
-# --gltf-unit cm: the walk in centimetres is written in metres, glTF's unit: its nodes where the
-# walk in metres puts them; without a glTF output, or for a unit it does not know, refused.
+# --unit cm: the walk JSON says it; the glTF of the walk in centimetres is written in metres,
+# its nodes where the walk in metres puts them; a unit it does not know is refused.
 "$footfall" generate --terrain "$work/hills-cm.pts" --character "$chars/biped.json" --scale 100 \
-  --start 1200,0,800 --steps 6 --gltf-unit cm --out "$work/scaled.gltf" 2>/dev/null
-check "--gltf-unit cm: exit 0" [ $? -eq 0 ]
+  --start 1200,0,800 --steps 6 --unit cm --out "$work/scaled.gltf" --out "$work/scaled-unit.json" 2>/dev/null
+check "--unit cm: exit 0" [ $? -eq 0 ]
+check "--unit cm: said in the walk JSON" grep -q '^{"format":"footfall-walk","version":1,"fps":24,"unit":"cm",' "$work/scaled-unit.json"
+check "--unit cm: the walk's keys as without it" cmp -s <(tail -n +2 "$work/scaled.json") <(tail -n +2 "$work/scaled-unit.json")
+check "no --unit: no unit in the walk JSON" bash -c "! grep -q '\"unit\"' '$work/scaled.json'"
 "$footfall" generate --terrain "$hills" --character "$chars/biped.json" --start 12,0,8 --steps 6 \
   --out "$work/metres.gltf" 2>/dev/null
-check "--gltf-unit cm: the nodes of the walk in metres" python3 - "$work/metres.gltf" "$work/scaled.gltf" <<'PY'
+check "--unit cm: the glTF's nodes those of the walk in metres" python3 - "$work/metres.gltf" "$work/scaled.gltf" <<'PY'
 import json, sys
 a, b = (json.load(open(p))["nodes"] for p in sys.argv[1:3])
 assert [n["name"] for n in a] == [n["name"] for n in b]
@@ -544,35 +547,21 @@ for na, nb in zip(a, b):
     for x, y in zip(na["translation"], nb["translation"]):
         assert abs(x - y) <= 1e-5 * max(1.0, abs(x)), (na, nb)
 PY
-"$footfall" generate --terrain "$hills" --character "$chars/biped.json" --steps 2 --gltf-unit cm \
-  --out "$work/no-gltf.json" 2> "$work/no-gltf.err"
-check "--gltf-unit without a glTF output: exit 1" [ $? -eq 1 ]
-check "--gltf-unit without a glTF output: said" grep -qF -- "--gltf-unit cm names the unit of .gltf and .glb outputs, and no --out is one" "$work/no-gltf.err"
-check "--gltf-unit without a glTF output: nothing written" [ ! -e "$work/no-gltf.json" ]
-"$footfall" generate --terrain "$hills" --character "$chars/biped.json" --steps 2 --gltf-unit furlong \
-  --out "$work/furlong.gltf" 2> "$work/furlong-gltf.err"
-check "--gltf-unit furlong: exit 1" [ $? -eq 1 ]
-check "--gltf-unit furlong: the units known" grep -qF -- "expected mm, cm, m, km, in, ft, yd or mi" "$work/furlong-gltf.err"
-# --mel-unit m: the MEL keys the same numbers with the scene's linear unit set to metres while it
-# keys (Maya converts), the user's put back after; a unit Maya does not know, or no .mel to
-# apply it to, is refused before anything is written.
+# --unit m: the MEL keys the same numbers with the scene's linear unit set to metres while it
+# keys (Maya converts), the user's put back after; a unit Maya does not know is refused before
+# anything is written.
 "$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
-  --steps 100 --mel-unit m --out "$work/metres.mel" 2>/dev/null
-check "--mel-unit: exit 2 for the stopped walk" [ $? -eq 2 ]
-check "--mel-unit: the unit set, after the user's is kept" grep -qx 'currentUnit -linear "m";' "$work/metres.mel"
-check "--mel-unit: the user's unit put back" grep -qx 'currentUnit -linear $footfall_linear_unit;' "$work/metres.mel"
-check "--mel-unit: the same keys" cmp -s <(grep setKeyframe "$work/all.mel") <(grep setKeyframe "$work/metres.mel")
-check "--mel-unit: none without it" bash -c "! grep -q 'currentUnit -linear' '$work/all.mel'"
+  --steps 100 --unit m --out "$work/metres.mel" 2>/dev/null
+check "--unit m: exit 2 for the stopped walk" [ $? -eq 2 ]
+check "--unit m: the unit set, after the user's is kept" grep -qx 'currentUnit -linear "m";' "$work/metres.mel"
+check "--unit m: the user's unit put back" grep -qx 'currentUnit -linear $footfall_linear_unit;' "$work/metres.mel"
+check "--unit m: the same keys" cmp -s <(grep setKeyframe "$work/all.mel") <(grep setKeyframe "$work/metres.mel")
+check "no --unit: no unit set" bash -c "! grep -q 'currentUnit -linear' '$work/all.mel'"
 "$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
-  --steps 2 --mel-unit furlong --out "$work/furlong.mel" 2> "$work/furlong.err"
-check "--mel-unit furlong: exit 1" [ $? -eq 1 ]
-check "--mel-unit furlong: the units named" grep -qF -- "--mel-unit: expected mm, cm, m, km, in, ft, yd or mi" "$work/furlong.err"
-check "--mel-unit furlong: nothing written" [ ! -e "$work/furlong.mel" ]
-"$footfall" generate --terrain "$work/cliff.pts" --character "$chars/biped.json" --start 2.5,0,2 \
-  --steps 2 --mel-unit cm --out "$work/no-mel.json" 2> "$work/no-mel.err"
-check "--mel-unit without a .mel: exit 1" [ $? -eq 1 ]
-check "--mel-unit without a .mel: said" grep -qF -- "--mel-unit cm names the unit of .mel outputs, and no --out is a .mel file" "$work/no-mel.err"
-check "--mel-unit without a .mel: nothing written" [ ! -e "$work/no-mel.json" ]
+  --steps 2 --unit furlong --out "$work/furlong.mel" --out "$work/furlong.json" 2> "$work/furlong.err"
+check "--unit furlong: exit 1" [ $? -eq 1 ]
+check "--unit furlong: the units named" grep -qF -- "--unit: expected mm, cm, m, km, in, ft, yd or mi" "$work/furlong.err"
+check "--unit furlong: nothing written" [ ! -e "$work/furlong.mel" -a ! -e "$work/furlong.json" ]
 # At UTM-like coordinates glTF's floats would move keys visibly: the writer puts the tracks under
 # a root origin node, so nothing is lost and there is no warning; none near the origin either.
 awk '{ printf "%.3f %s %.3f %s %s %s\n", $1 + 500000, $2, $3 + 4000000, $4, $5, $6 }' "$work/floor.pts" > "$work/utm.pts"

@@ -23,12 +23,12 @@
 #include "footfall/cli/number_checks.h"
 #include "footfall/client/query_text.h"
 #include "footfall/export/gltf_writer.h"
-#include "footfall/export/linear_units.h"
 #include "footfall/export/mel_writer.h"
 #include "footfall/export/walk_writer.h"
 #include "footfall/import/terrain_loader.h"
 #include "footfall/steps/foot_rotations.h"
 #include "footfall/steps/generator.h"
+#include "footfall/steps/linear_units.h"
 #include "footfall/steps/scene.h"
 #include "footfall/steps/walk_json.h"
 #include "footfall/steps/walk_terrain.h"
@@ -56,9 +56,8 @@ struct GenerateFlags {
   double crowd_spacing = 0;
   bool progress = false;
   bool foot_rotations = false;
-  std::string mel_unit;   // the walk's linear unit in .mel outputs ("": the scene's)
-  std::string gltf_unit;  // the walk's linear unit, converted to metres in glTF ("": metres)
-  double scale = 1;       // the character's lengths multiplied (ScaleCharacter)
+  std::string unit;  // the walk's linear unit (Walk::unit; "": not said)
+  double scale = 1;  // the character's lengths multiplied (ScaleCharacter)
   // The character file's walk settings replaced (negative: the file's own), in the terrain's
   // units (not scaled).
   double step_length = -1, step_height = -1, foot_length = -1;
@@ -343,22 +342,6 @@ bool CheckOutputs(const GenerateFlags& flags, const std::vector<std::string>& in
       }
     }
   }
-  // (Without a .mel it would change nothing, unseen.)
-  if (!flags.mel_unit.empty() &&
-      std::none_of(flags.out.begin(), flags.out.end(),
-                   [](const std::string& out) { return FileExtension(out) == "mel"; })) {
-    *error = "--mel-unit " + flags.mel_unit +
-             " names the unit of .mel outputs, and no --out is a .mel file";
-    return false;
-  }
-  if (!flags.gltf_unit.empty() &&
-      std::none_of(flags.out.begin(), flags.out.end(), [](const std::string& out) {
-        return FileExtension(out) == "gltf" || FileExtension(out) == "glb";
-      })) {
-    *error = "--gltf-unit " + flags.gltf_unit +
-             " names the unit of .gltf and .glb outputs, and no --out is one";
-    return false;
-  }
   return true;
 }
 
@@ -507,12 +490,12 @@ void AddFootRotationsIfAsked(const GenerateFlags& flags, Walk* walk) {
 // Writes every --out, each on its own: one that fails is said (and an older file of its name
 // said to be left as it was) and the others are still written. They replace older files of
 // their names together, once all are written (OutputFileSet): Ctrl-C while they are written
-// leaves the older files, never a mix. Returns 1 if any failed, else 0.
-int WriteOutputs(const GenerateFlags& flags, const LoadedTerrain& terrain, const Walk& walk) {
+// leaves the older files, never a mix. The walk is given its unit (--unit) first. Returns 1 if
+// any failed, else 0.
+int WriteOutputs(const GenerateFlags& flags, const LoadedTerrain& terrain, Walk& walk) {
+  walk.unit = flags.unit;
   WalkExportOptions exports;
   exports.foot_rotations = flags.foot_rotations;
-  exports.mel_linear_unit = flags.mel_unit;
-  exports.gltf_linear_unit = flags.gltf_unit;
   int code = 0;
   std::string error;
   OutputFileSet outputs;
@@ -951,24 +934,18 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
                 "Key the feet's rotations too: each foot on its ground, facing its body's "
                 "heading (.gltf, .glb and .mel outputs key them; the .json gives each foot key a "
                 "rotation)");
-  const CLI::Validator linear_unit(
-      [](const std::string& unit) {
-        return MetresPerLinearUnit(unit) > 0 ? std::string()
-                                             : std::string("expected ") + LinearUnitNames();
-      },
-      "UNIT");
-  cmd->add_option("--gltf-unit", flags->gltf_unit,
-                  "The linear unit the walk's lengths are in (cm for a terrain in centimetres): "
-                  ".gltf and .glb outputs convert them to metres, glTF's unit, so that Blender, "
-                  "Unreal and other readers show the walk at its size (default: written as "
-                  "they are, taken as metres)")
-      ->check(linear_unit);
-  cmd->add_option("--mel-unit", flags->mel_unit,
-                  "The linear unit the walk's lengths are in (m for the shipped characters): "
-                  ".mel outputs key them so in any Maya scene (Maya converts; a centimetre "
-                  "scene gets 100 units a metre) and put the user's unit back; default: keyed in "
-                  "the scene's unit, one walk unit to one scene unit")
-      ->check(linear_unit);
+  cmd->add_option("--unit", flags->unit,
+                  "The linear unit of the terrain, and so of the walk (cm for a terrain in "
+                  "centimetres): the walk JSON says it, .gltf and .glb outputs convert the walk "
+                  "to metres, glTF's unit, and .mel outputs key it with Maya's unit set to it "
+                  "(the user's put back after), so the walk keeps its size wherever it goes; "
+                  "default: not said, one walk unit to one unit of the scene it goes to")
+      ->check(CLI::Validator(
+          [](const std::string& unit) {
+            return MetresPerLinearUnit(unit) > 0 ? std::string()
+                                                 : std::string("expected ") + LinearUnitNames();
+          },
+          "UNIT"));
   cmd->add_option("-o,--out,--output", flags->out,
                   "Output file: .json, .gltf, .glb or .mel (repeatable); .pts: the terrain's "
                   "samples the walk was placed on (as resampled for the character), for "

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "file_output.h"
-#include "footfall/export/linear_units.h"
 #include "footfall/steps/foot_rotations.h"
+#include "footfall/steps/linear_units.h"
 #include "footfall/terrain/file_extension.h"
 #include "footfall/terrain/large_memory.h"
 #include "footfall/terrain/output_file.h"
@@ -146,7 +146,7 @@ Vec3 StoredFloats(const Vec3& p, const Vec3& origin) {
           static_cast<float>(p.z - origin.z)};
 }
 
-// `walk` with its lengths (positions, foot lengths) multiplied by `factor`.
+// `walk` with its lengths (positions, foot lengths) multiplied by `factor` (its unit as it was).
 Walk ScaledWalk(const Walk& walk, double factor) {
   Walk out = walk;
   for (WalkTrack& track : out.tracks) {
@@ -160,18 +160,17 @@ Walk ScaledWalk(const Walk& walk, double factor) {
 
 Status WriteGltf(const Walk& walk, const std::string& path, const GltfOptions& options,
                  std::string* error) {
-  if (!options.linear_unit.empty() && options.linear_unit != "m") {
-    const double metres = MetresPerLinearUnit(options.linear_unit);
+  if (!walk.unit.empty() && walk.unit != "m") {
+    const double metres = MetresPerLinearUnit(walk.unit);
     if (!(metres > 0)) {
-      SetError(error, "cannot write glTF '" + path + "': unknown linear unit '" +
-                          ShownText(options.linear_unit) + "' (expected " + LinearUnitNames() +
-                          ")");
+      SetError(error, "cannot write glTF '" + path + "': the walk's unit '" + ShownText(walk.unit) +
+                          "' is none of " + LinearUnitNames());
       return Status::kInvalidArgument;
     }
-    GltfOptions in_metres = options;
-    in_metres.linear_unit.clear();
     try {
-      return WriteGltf(ScaledWalk(walk, metres), path, in_metres, error);
+      Walk in_metres = ScaledWalk(walk, metres);
+      in_metres.unit = "m";
+      return WriteGltf(in_metres, path, options, error);
     } catch (const std::bad_alloc&) {
       SetError(error,
                "cannot write glTF '" + path + "': out of memory converting the walk to metres");

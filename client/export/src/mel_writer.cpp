@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "footfall/export/euler.h"
-#include "footfall/export/linear_units.h"
 #include "footfall/steps/foot_rotations.h"
+#include "footfall/steps/linear_units.h"
 #include "footfall/terrain/ordered_text.h"
 #include "footfall/terrain/output_file.h"
 #include "footfall/terrain/shown_text.h"
@@ -188,10 +188,10 @@ Status WriteMel(const Walk& walk, const std::string& path, const MelOptions& opt
                 std::string* error) {
   Status status = walk_export::CheckWalk(walk, error);
   if (status != Status::kOk) return status;
-  const std::string& linear = options.linear_unit;
+  const std::string& linear = walk.unit;
   if (!linear.empty() && !(MetresPerLinearUnit(linear) > 0)) {
     if (error)
-      *error = "unknown Maya linear unit '" + ShownText(linear) + "' (expected " +
+      *error = "the walk's unit '" + ShownText(linear) + "' is none of Maya's linear units (" +
                LinearUnitNames() + ")";
     return Status::kInvalidArgument;
   }
@@ -251,7 +251,7 @@ Status WriteMel(const Walk& walk, const std::string& path, const MelOptions& opt
         "// In Maya: source this file (File > Source Script); one keyed locator per foot IK "
         "target and body.\n";
     mel += linear.empty() ? "// Lengths are keyed in the scene's linear unit: one walk unit to one "
-                            "scene unit (footfall generate --mel-unit names the walk's).\n"
+                            "scene unit (footfall generate --unit names the walk's).\n"
                           : "// Lengths are in " + linear +
                                 " and keyed so whatever the scene's linear unit.\n";
     if (!walk.stopped.empty())
@@ -272,7 +272,7 @@ Status WriteMel(const Walk& walk, const std::string& path, const MelOptions& opt
     // as the Maya plugin sends the scene's terrain, unless the walk's unit is named (below).
     mel += "string $footfall_angle_unit = `currentUnit -query -angle`;\n";
     mel += "currentUnit -angle \"deg\";\n";
-    // Lengths in the walk's unit when it is named (MelOptions::linear_unit): Maya converts them
+    // Lengths in the walk's unit when it has one (Walk::unit): Maya converts them
     // to the scene's, whose unit is put back at the end.
     if (!linear.empty()) {
       mel += "string $footfall_linear_unit = `currentUnit -query -linear`;\n";

@@ -23,13 +23,11 @@ Status WriteWalk(const Walk& walk, const std::string& path, const WalkExportOpti
     GltfOptions gltf;
     gltf.binary = ext == "glb";
     gltf.foot_rotations = options.foot_rotations;
-    gltf.linear_unit = options.gltf_linear_unit;
     return WriteGltf(walk, path, gltf, error);
   }
   if (ext == "mel") {
     MelOptions mel;
     mel.foot_rotations = options.foot_rotations;
-    mel.linear_unit = options.mel_linear_unit;
     return WriteMel(walk, path, mel, error);
   }
   const std::string what = ext.empty() ? "no extension" : "unknown extension '." + ext + "'";

@@ -151,6 +151,10 @@ bool EmitWalkJson(const Walk& walk, const std::function<bool(std::string_view)>&
   out += std::to_string(kWalkFormatVersion);
   out += ",\"fps\":";
   Number(out, walk.fps);
+  if (!walk.unit.empty()) {
+    out += ",\"unit\":";
+    String(out, walk.unit);
+  }
   out += ",\"stopped\":";
   String(out, walk.stopped);
   out += ",\"tracks\":[";

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "footfall/steps/linear_units.h"
 #include "footfall/steps/walk_json.h"
 #include "json_input.h"
 
@@ -278,14 +279,18 @@ Status ParseWalk(const std::string& text, const std::string& source, Walk* out, 
     r.Fail("fps", "expected a positive number");
   } else if (!(walk.fps > 0)) {
     r.Fail("fps", "expected a positive number");
+  } else if (j.contains("unit") &&
+             !(j["unit"].is_string() && MetresPerLinearUnit(j["unit"].get<std::string>()) > 0)) {
+    r.Fail("unit", std::string("expected one of ") + LinearUnitNames());
   } else if (j.contains("stopped") && !j["stopped"].is_string()) {
     r.Fail("stopped", "expected a string");
   } else if (!j.contains("tracks") || !j["tracks"].is_array()) {
     r.Fail("tracks", "expected an array");
   } else {
-    r.Known(j, "", {"format", "version", "fps", "stopped", "tracks", "comment"});
+    r.Known(j, "", {"format", "version", "fps", "unit", "stopped", "tracks", "comment"});
   }
   if (r.error.empty()) {
+    walk.unit = j.value("unit", std::string());
     walk.stopped = j.value("stopped", std::string());
     const json& tracks = j["tracks"];
     for (size_t ti = 0; ti < tracks.size() && r.error.empty(); ++ti) {

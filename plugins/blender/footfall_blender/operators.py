@@ -941,6 +941,9 @@ class FOOTFALL_OT_import_walk(bpy.types.Operator, ImportHelper):
             else:
                 walk = character.read_json(path, "walk file")
             character.check_walk(walk, path)  # before anything is made
+            # In metres, footfall's unit here (a walk generated with --unit cm was keyed 100
+            # times too large).
+            walk = character.walk_in_unit(walk, "m")
             keying.check_frames(walk)
             # (A walk whose tracks had no keys made their empties, or cleared the rig's keys from
             # frame 0 on, and then reported that it had no keys.)

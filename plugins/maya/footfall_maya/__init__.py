@@ -490,6 +490,9 @@ def import_walk(path, rig=None):
     back one key)."""
     walk = ffc.character.read_json(path, "walk file")
     ffc.character.check_walk(walk, path)  # before any locator is made
+    # A walk that says its unit (footfall generate --unit) in the scene's; one that does not is
+    # keyed as it is, one walk unit to one scene unit.
+    walk = ffc.character.walk_in_unit(walk, _scene_linear_unit())
     # (Tracks without keys made their locators, or cut the rig's keys from frame 0 on.)
     if not any(t.get("keys") for t in walk["tracks"]):
         raise ValueError("%s has no keys" % path)

@@ -266,6 +266,9 @@ def scaled(data, factor):
     return out
 
 
+# The units a walk JSON's "unit" may name (footfall/steps/linear_units.h; Maya's short names).
+WALK_UNITS = ("mm", "cm", "m", "km", "in", "ft", "yd", "mi")
+
 # The generator's max_rise for a character file without one (character.h).
 DEFAULT_MAX_RISE = 0.35
 
@@ -288,6 +291,8 @@ def check_walk(walk, name="walk"):
     where given, a rotation of four (a foot's on all its keys or on none)."""
     if not isinstance(walk, dict) or not isinstance(walk.get("tracks"), list):
         raise ValueError("%s: expected footfall walk JSON with a \"tracks\" list" % name)
+    if "unit" in walk and walk["unit"] not in WALK_UNITS:
+        raise ValueError("%s: unit: expected one of %s" % (name, ", ".join(WALK_UNITS)))
 
     def finite(values, count):
         return (isinstance(values, list) and len(values) == count and
@@ -319,6 +324,28 @@ def check_walk(walk, name="walk"):
                 raise ValueError("%s: expected a rotation on every key of a foot track or on none "
                                  "(the first key has %s)"
                                  % (at, "one" if "rotation" in keys[0] else "none"))
+
+
+def walk_in_unit(walk, unit):
+    """The walk `walk` (checked by check_walk) with its lengths in `unit` (a METRES_PER_UNIT
+    name): its positions and foot lengths converted from the walk's "unit", and "unit" set to
+    `unit`. A walk without a "unit" (footfall generate without --unit) is returned as it is, one
+    walk unit to one of `unit`."""
+    if "unit" not in walk:
+        return walk
+    factor = unit_scale(walk["unit"], unit)
+    out = dict(walk, unit=unit)
+    if factor == 1:
+        return out
+    out["tracks"] = []
+    for track in walk["tracks"]:
+        track = dict(track)
+        if _finite_number(track.get("foot_length")):
+            track["foot_length"] = track["foot_length"] * factor
+        track["keys"] = [dict(key, position=[v * factor for v in key["position"]])
+                         for key in track.get("keys", [])]
+        out["tracks"].append(track)
+    return out
 
 
 def rig_tracks(walk, feet, has_body, name="walk"):

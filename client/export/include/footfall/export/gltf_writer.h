@@ -33,11 +33,6 @@ struct GltfOptions {
   // heading (the body's rotation at the key's frame, tilted by the shortest rotation that takes
   // the body's up onto the key's normal). false: feet have translation channels only.
   bool foot_rotations = false;
-  // The linear unit the walk's lengths are in (linear_units.h): "" or "m" writes them as they
-  // are, as glTF's metres; another is converted to metres (keys, the origin node, the feet's
-  // foot_length), so a walk in centimetres keeps its size in a reader that takes glTF as glTF
-  // is (Blender, Unreal).
-  std::string linear_unit;
 };
 
 // [Units: wu] [Limit: > 0] Beyond this |coordinate| a walk's glTF gets a root origin node: below
@@ -75,8 +70,10 @@ Vec3 GltfOrigin(const Walk& walk);
 //   Positions are floats too, relative to the origin node if any: a walk spanning kilometres still
 //   moves (MaxFloatRounding).
 // - Node extras hold {"kind", "character", "track"}; the animation's extras hold {"fps"} and
-//   {"stopped"} when the walk stopped early. World units are written unchanged (glTF metres),
-//   unless GltfOptions::linear_unit names another unit, converted to metres.
+//   {"stopped"} when the walk stopped early. Lengths are written as they are (taken as glTF's
+//   metres), unless the walk's unit (Walk::unit) is another: then they are converted to metres
+//   (keys, the origin node, the feet's foot_length), so a walk in centimetres keeps its size in
+//   a reader that takes glTF as glTF is (Blender, Unreal).
 // Returns kInvalidArgument (with `*error` set) for an unknown linear unit, fps <= 0, a negative
 // frame, NaN/Inf values or a zero quaternion; kLimitExceeded when writing it would need more memory
 // than the process has free (AvailableMemoryBytes); kIoError naming `path` when the file cannot be

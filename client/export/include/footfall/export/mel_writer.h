@@ -22,6 +22,11 @@ namespace footfall {
 //    lock: the quaternion as Euler ZXY degrees, unwrapped so consecutive keys take the shortest
 //    turn). Frames are written as they are in the
 //    walk. Every key has linear in and out tangents, as the glTF export's LINEAR samplers.
+//    A walk with a unit (Walk::unit: "m" for the shipped characters on a terrain in metres)
+//    is keyed with the scene's linear unit set to it, the user's put back after, as for
+//    angles: Maya converts, so a walk in metres sourced into a centimetre scene keeps its size
+//    (100 scene units a metre). A walk without one is keyed in the scene's unit, one walk unit
+//    to one scene unit.
 // Frames and values are MEL decimals without exponent, with the fewest digits that read back as
 // the same double (a walk in tiny or huge units keeps full precision).
 // Node names are sanitised to Maya names ([A-Za-z_][A-Za-z0-9_]*; other characters become '_')
@@ -30,7 +35,7 @@ namespace footfall {
 // well-formed UTF-8 sequence becomes U+FFFD, as in the walk JSON). The script uses the names Maya
 // returns, so it still works when the scene already holds nodes of the same names. Keys on the same
 // frame: the last one wins. Returns kInvalidArgument (with `*error` set) for fps <= 0, NaN/Inf
-// values, a zero quaternion or a linear unit Maya does not know (MelOptions::linear_unit); kIoError
+// values, a zero quaternion or a walk unit Maya does not know (Walk::unit); kIoError
 // naming `path` when the file cannot be written. `error` may be null.
 Status WriteMel(const Walk& walk, const std::string& path, std::string* error);
 
@@ -39,12 +44,6 @@ struct MelOptions {
   // bodies), each foot on its ground facing its body's heading, as GltfOptions::foot_rotations
   // turns glTF's foot nodes.
   bool foot_rotations = false;
-  // The Maya linear unit the walk's lengths are in (linear_units.h: "m" for the shipped
-  // characters), or "" (the default) for the scene's. Given, the script sets the scene's
-  // linear unit to it while it keys and puts the user's back after, as it does for angles:
-  // Maya converts, so a walk in metres sourced into a centimetre scene keeps its size (100
-  // scene units a metre) where it was otherwise keyed one walk unit to one scene unit.
-  std::string linear_unit;
 };
 
 // As above, with `options`.

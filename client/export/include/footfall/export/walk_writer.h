@@ -17,11 +17,6 @@ Status WriteWalk(const Walk& walk, const std::string& path, std::string* error);
 struct WalkExportOptions {
   // Feet keyed with rotations too (GltfOptions::foot_rotations, MelOptions::foot_rotations).
   bool foot_rotations = false;
-  // .mel: the walk's linear unit (MelOptions::linear_unit); "" for the scene's.
-  std::string mel_linear_unit;
-  // .gltf, .glb: the walk's linear unit (GltfOptions::linear_unit), converted to metres; "" or
-  // "m" for none.
-  std::string gltf_linear_unit;
 };
 
 // As above, with `options`.

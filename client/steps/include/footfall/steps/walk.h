@@ -89,6 +89,11 @@ struct WalkTrack {
 
 struct Walk {
   double fps = 24;
+  // The linear unit of the walk's lengths, as linear_units.h names them ("cm"), when it is known;
+  // "" when it is not (one walk unit is then one unit of wherever it goes). The glTF export
+  // converts a walk with a unit to metres, the MEL export keys it in that unit, and the walk
+  // JSON carries it.
+  std::string unit;
   std::vector<WalkTrack> tracks;
   // Empty when every requested step was generated; otherwise why the walk stopped early (for
   // example at a cliff: the step and position). The keys up to that point are kept. A crowd's

@@ -6,7 +6,8 @@
 //               (foot keys given their orientations, AddFootRotations, add "rotation"),
 //               {"name": "body", "kind": "body", "keys": [{"frame": 1, "position": [x, y, z],
 //                "rotation": [qx, qy, qz, qw]}, ...]}]}
-// Crowd tracks add "character": "c1". Numbers are written so they read back exactly.
+// Crowd tracks add "character": "c1"; a walk whose unit is known adds "unit": "cm" after "fps"
+// (Walk::unit). Numbers are written so they read back exactly.
 #pragma once
 
 #include <functional>

@@ -1,4 +1,4 @@
-#include "footfall/export/linear_units.h"
+#include "footfall/steps/linear_units.h"
 
 namespace footfall {
 

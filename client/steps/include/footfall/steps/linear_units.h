@@ -1,6 +1,6 @@
-// Linear units a walk's lengths may be in, named as Maya's `currentUnit -linear` names them
-// (mm, cm, m, km, in, ft, yd, mi): the MEL export sets Maya's unit to one, the glTF export
-// converts from one to metres.
+// Linear units a walk's lengths may be in (Walk::unit), named as Maya's `currentUnit -linear`
+// names them (mm, cm, m, km, in, ft, yd, mi): the MEL export sets Maya's unit to one, the glTF
+// export converts from one to metres.
 #pragma once
 
 #include <string>
