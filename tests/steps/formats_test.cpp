@@ -471,6 +471,20 @@ TEST_CASE("ffc_generate gives the walk GenerateWalk gives", "[steps][c_api]") {
   CHECK(ffc_walk_stop(s) == FF_C_OK);
   ffc_free_string(json);
   CHECK(ffc_walk_stop(nullptr) == FF_C_INVALID_ARGUMENT);
+  // A request's unit (--unit) is its walk's, said in the JSON; one it does not know is refused.
+  const std::string in_metres =
+      R"({"character_file": ")" + file + R"(", "start": [5, 0, 5], "steps": 2, "unit": "m"})";
+  REQUIRE(ffc_generate(s, terrain, in_metres.c_str(), &json) == FF_C_OK);
+  CHECK_THAT(std::string(json),
+             Catch::StartsWith(R"({"format":"footfall-walk","version":1,"fps":24,"unit":"m",)"));
+  ffc_free_string(json);
+  json = nullptr;
+  const std::string in_furlongs =
+      R"({"character_file": ")" + file + R"(", "start": [5, 0, 5], "steps": 2, "unit": "furlong"})";
+  CHECK(ffc_generate(s, terrain, in_furlongs.c_str(), &json) == FF_C_PARSE_ERROR);
+  CHECK_THAT(ffc_last_error(s),
+             Catch::Contains("request: 'unit': expected one of mm, cm, m, km, in, ft, yd or mi"));
+  CHECK(json == nullptr);
   ffc_close(s);
 }
 

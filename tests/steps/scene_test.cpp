@@ -195,6 +195,9 @@ TEST_CASE("Scene file errors name the file the character and the field", "[steps
   // The walk has one frame rate: --fps.
   CHECK_THAT(SceneError(Scene(R"({"character_file": "biped.json", "fps": 30})")),
              Catch::Contains("characters[0]: unknown field 'fps'"));
+  // And one unit: --unit.
+  CHECK_THAT(SceneError(Scene(R"({"character_file": "biped.json", "unit": "cm"})")),
+             Catch::Contains("characters[0]: unknown field 'unit'"));
   CHECK_THAT(SceneError(Scene(R"({"character_file": "biped.json", "crowd": 0})")),
              Catch::Contains("characters[0]: 'crowd': out of range"));
   // An empty path was taken for none (the command line refuses --path "").

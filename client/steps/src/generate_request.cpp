@@ -8,6 +8,7 @@
 
 #include "character_read.h"
 #include "footfall/steps/generator.h"
+#include "footfall/steps/linear_units.h"
 #include "footfall/terrain/shown_text.h"
 #include "footfall/terrain/text_stream.h"
 #include "json_input.h"
@@ -74,7 +75,7 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
   static const std::set<std::string> kKnown = {
       "character",     "character_file", "start", "heading", "path",
       "steps",         "start_frame",    "up",    "fps",     "crowd",
-      "crowd_spacing", "foot_rotations", "scale"};
+      "crowd_spacing", "foot_rotations", "scale", "unit"};
   for (auto it = j.begin(); it != j.end(); ++it) {
     if (read_by_caller.count(it.key())) continue;
     if (!kKnown.count(it.key()) || refused.count(it.key())) {
@@ -160,6 +161,13 @@ Status ReadGenerateRequest(const json& j, const std::string& source, const std::
       *error = source + ": 'crowd_spacing': expected a number from 0 (the default) to 1e+06";
       ok = false;
     }
+  }
+  if (ok && j.contains("unit")) {
+    ok = j["unit"].is_string() && MetresPerLinearUnit(j["unit"].get<std::string>()) > 0;
+    if (ok)
+      o.unit = j["unit"].get<std::string>();
+    else
+      *error = source + ": 'unit': expected one of " + LinearUnitNames();
   }
   if (ok && j.contains("foot_rotations")) {
     ok = j["foot_rotations"].is_boolean();

@@ -11,6 +11,8 @@
 #include <sstream>
 
 #include "footfall/steps/foot_rotations.h"
+#include "footfall/steps/linear_units.h"
+#include "footfall/terrain/shown_text.h"
 
 namespace footfall::steps_detail {
 
@@ -482,8 +484,13 @@ Status GenerateWalk(TerrainSession& session, TerrainHandle terrain, const Charac
     *error = "the character has no feet or no gait";
     return Status::kInvalidArgument;
   }
+  if (!options.unit.empty() && !(MetresPerLinearUnit(options.unit) > 0)) {
+    *error = "unit '" + ShownText(options.unit) + "' is none of " + LinearUnitNames();
+    return Status::kInvalidArgument;
+  }
   Walk walk;
   walk.fps = options.fps;
+  walk.unit = options.unit;
   std::vector<Agent> agents;
   Generator g(session, terrain, character, options, &agents, &walk);
   const Status s = g.Run(error);

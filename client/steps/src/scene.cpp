@@ -77,10 +77,11 @@ Status ParseScene(const std::string& text, const std::string& source, const std:
         return Status::kInvalidArgument;
       }
     }
-    // "fps" and "foot_rotations" are the whole walk's (--fps, --foot-rotations).
+    // "fps", "foot_rotations" and "unit" are the whole walk's (--fps, --foot-rotations,
+    // --unit).
     const Status read =
-        detail::ReadGenerateRequest(entry, where, folder, {"fps", "foot_rotations"}, {"name"},
-                                    &c.character, &c.options, &c.character_file, error);
+        detail::ReadGenerateRequest(entry, where, folder, {"fps", "foot_rotations", "unit"},
+                                    {"name"}, &c.character, &c.options, &c.character_file, error);
     if (read != Status::kOk) {
       // (Not one from the character file the entry names: that says its own file and line.)
       const std::string entry_path = "characters[" + std::to_string(i) + "]";

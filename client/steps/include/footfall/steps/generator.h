@@ -89,6 +89,9 @@ struct GenerateOptions {
   int steps = -1;
   double start_frame = 1;  // frame of the first keys
   double fps = 24;         // frames per second of the walk [Limit: > 0]
+  // The walk's linear unit (Walk::unit, linear_units.h), or "" for none said. The walk carries
+  // it; the generator's lengths are the terrain's and the character's whatever it is.
+  std::string unit;
   // World up for bipeds (characters with align_to_normal false). Non-zero; normalised.
   Vec3 up{0, 1, 0};
   // Crowd: this many characters on a square grid around `start` (spacing `crowd_spacing`, or

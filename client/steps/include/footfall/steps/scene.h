@@ -5,10 +5,10 @@
 //                    "heading": [x, y, z], "path": [[x, y, z], ...], "steps": N,
 //                    "start_frame": F, "up": [x, y, z], "crowd": N, "crowd_spacing": D,
 //                    "scale": S}, ...]}
-// Each character takes the fields of a generate request (generate_request.h) but "fps" and
-// "foot_rotations", which are the whole walk's; "name" names its tracks (default: its character's
-// name and its place in the list, "biped1"); a relative character_file is read from the scene
-// file's folder.
+// Each character takes the fields of a generate request (generate_request.h) but "fps",
+// "foot_rotations" and "unit", which are the whole walk's; "name" names its tracks (default: its
+// character's name and its place in the list, "biped1"); a relative character_file is read from the
+// scene file's folder.
 #pragma once
 
 #include <string>
