@@ -219,7 +219,7 @@ class BlenderAddonTest(unittest.TestCase):
                 "--start", csv(to_ff(mw.translation)),
                 "--heading", csv(to_ff(mw.to_3x3() @ Vector((0, -1, 0)))),
                 "--steps", steps, "--start-frame", bpy.context.scene.footfall.start_frame,
-                "--server", "127.0.0.1:%d" % self.server.port, "--out", out, *flags)
+                "--server", "127.0.0.1:%d" % self.server.port, "--unit", "m", "--out", out, *flags)
         with open(out) as f:
             return json.load(f), out
 
@@ -2311,7 +2311,8 @@ class BlenderAddonTest(unittest.TestCase):
         run_cli("generate", "--terrain", self.pts, "--character", character_file,
                 "--start", csv([c * scale for c in to_ff(mw.translation)]),
                 "--heading", csv(to_ff(mw.to_3x3() @ Vector((0, -1, 0)))),
-                "--steps", 6, "--start-frame", 1, "--out", out, "--out", out[:-5] + "_gltf.gltf")
+                "--steps", 6, "--start-frame", 1, "--unit", "m", "--out", out,
+                "--out", out[:-5] + "_gltf.gltf")
         with open(out) as f:
             expected = json.load(f)
         got = json.loads(bpy.data.texts["footfall_walk.json"].as_string())

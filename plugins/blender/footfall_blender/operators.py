@@ -640,7 +640,8 @@ def adopt(root, root_world, adopted):
 
 def walk_request(context, rig_obj, steps, start_frame):
     """The ffc_generate request for the rig and the scene's walk settings, and the character.
-    Lengths in metres: the scene's (points, the step overrides) times its Unit Scale."""
+    Lengths in metres: the scene's (points, the step overrides) times its Unit Scale; the walk
+    says so ("unit": "m")."""
     settings = context.scene.footfall
     scale = unit_scale(context.scene)
     rig = rig_obj.footfall_rig
@@ -654,7 +655,10 @@ def walk_request(context, rig_obj, steps, start_frame):
                "start": list(to_ff(mw.translation, scale)),
                "heading": list(to_ff(mw.to_3x3() @ Vector((0, -1, 0)))),
                "steps": int(steps), "start_frame": int(start_frame),
-               "fps": context.scene.render.fps / context.scene.render.fps_base}
+               "fps": context.scene.render.fps / context.scene.render.fps_base,
+               # The walk's lengths are metres (the scene's times its Unit Scale): its JSON says
+               # so, and Maya's Import Walk, or anything else reading it, keeps its size.
+               "unit": "m"}
     if settings.foot_rotations:
         request["foot_rotations"] = True
     if settings.path is not None:
