@@ -18,6 +18,12 @@ namespace {
 // [Units: wu] The largest length a character file may give (rests, step, heights, reach).
 constexpr double kMaxLength = 1e9;
 
+// [Units: wu] How far foot f's rest lies from the body standing over the rests' `centroid`,
+// which `reach` must exceed.
+double RestFromBody(const Character& c, const FootSpec& f, const Vec3& centroid) {
+  return Length(f.rest - centroid + Vec3{0, -c.body_height, 0});
+}
+
 using nlohmann::json;
 
 // Collects the first error while reading fields; every reader returns false once it fails.
@@ -296,7 +302,7 @@ Status ReadCharacter(const json& j, const std::string& source, Character* out, s
   if (r.status == Status::kOk) {
     const Vec3 centroid = RestCentroid(c);
     for (const FootSpec& f : c.feet) {
-      const double rest = Length(f.rest - centroid + Vec3{0, -c.body_height, 0});
+      const double rest = RestFromBody(c, f, centroid);
       if (rest >= c.reach) {
         r.Fail(Status::kInvalidArgument, "'reach' = " + NumberText(c.reach) +
                                              " must exceed the distance from the body to the "
@@ -363,7 +369,7 @@ Status ScaleCharacter(double scale, Character* c, std::string* error) {
   // Rounded, a rest just inside the reach may land on it.
   const Vec3 centroid = RestCentroid(scaled);
   for (const FootSpec& f : scaled.feet) {
-    if (!(Length(f.rest - centroid + Vec3{0, -scaled.body_height, 0}) < scaled.reach)) {
+    if (!(RestFromBody(scaled, f, centroid) < scaled.reach)) {
       *error = "scale " + NumberText(scale) + " puts the rest of foot '" + f.name +
                "' at the character's reach, " + NumberText(scaled.reach);
       return Status::kInvalidArgument;
