@@ -572,6 +572,34 @@ TEST_CASE("An upright body stops before a slab lower than it, its legs never thr
   }
 }
 
+TEST_CASE("A biped climbs stairs steeper than its stride, a tread every two steps",
+          "[steps][generator]") {
+  // Risers of 26 to 32 cm on treads of 20 to 26 cm: the central locator, placed half a step
+  // ahead and lead/2 up, snapped onto the riser of the tread after next (out of max_rise's
+  // reach), and the feet shuffled along each tread (four steps a tread), or the start stopped
+  // with "no room for the body". It now lands on the tread before that riser: each foot climbs
+  // one tread a step.
+  const Character c = LoadShipped("biped");
+  const int treads = 8;
+  const double spacing = 0.03;
+  for (const auto& [rise, run] : std::vector<std::pair<double, double>>{
+           {0.3, 0.25}, {0.32, 0.2}, {0.28, 0.24}, {0.26, 0.26}}) {
+    Terrain t = LoadTerrain(MakeStairs(treads, rise, run, 2, spacing), spacing);
+    GenerateOptions o = StartOptions({1, 0, 0.1}, 2 * (treads - 1) + 2);
+    o.heading = {0, 0, 1};
+    const Walk w = Generate(t, c, o);
+    INFO(rise << " x " << run << ": " << w.stopped);
+    CheckWalk(t, c, o, w);
+    CHECK_THAT(w.stopped, !Catch::Contains("no room"));
+    double highest = 0;
+    for (const WalkTrack& track : w.tracks)
+      for (const WalkKey& k : track.keys)
+        if (track.kind == TrackKind::kFoot && k.phase == KeyPhase::kEnd)
+          highest = std::max(highest, k.position.y);
+    CHECK(highest == Approx((treads - 1) * rise));  // the top tread
+  }
+}
+
 TEST_CASE("A biped climbs steep stairs without taking the next nose for an overhang",
           "[steps][generator]") {
   // 19 cm risers, 26 cm treads, sampled every 3 cm: with both feet on a tread just before its

@@ -346,6 +346,7 @@ Status Generator::Step(int k, std::string* error) {
                    "snap locators", error);
   landed_.assign(points_.size(), 0);
   if (s == Status::kOk && !c_.align_to_normal) s = LandLocators(error);
+  if (s == Status::kOk && !c_.align_to_normal) s = ClimbLocators(error);
   if (s != Status::kOk) return s;
   // 6 (end) and 7-8 in QueryFootholds; 9 (only the feet whose foothold was accepted) and 10-11
   // in ClearArcs. A foot whose arc cannot clear asks for its next foothold: its character goes

@@ -308,6 +308,70 @@ Status Generator::LandLocators(std::string* error) {
   return Status::kOk;
 }
 
+Status Generator::ClimbLocators(std::string* error) {
+  const size_t locators = pairs_of_group_[group_].size();
+  const double spacing = 0.5 * gap_;
+  const double depth = std::max(kClimbDepth * c_.foot_length, spacing);
+  land_points_.clear(), land_locator_.clear(), land_first_.assign(1, 0);
+  // Points a line: from `from` to `to` along the up, a point every sample spacing (at most
+  // kMaxClimbPoints), the first one spacing from `from`.
+  auto line = [&](const Vec3& from, double to, const Vec3& up) {
+    const double span = to - Dot(from, up);
+    const int count =
+        std::clamp(static_cast<int>(std::ceil(std::fabs(span) / spacing)), 1, kMaxClimbPoints);
+    for (int j = 1; j <= count; ++j) land_points_.push_back(from + up * (span * j / count));
+    land_first_.push_back(land_points_.size());
+  };
+  for (size_t l = 0; l < points_.size(); ++l) {
+    const Foothold& h = answers_[l];
+    if (landed_[l] || h.status != Status::kOk) continue;
+    const Agent& a = agents_[walking_[l / locators]];
+    // A riser ahead: too steep to stand on, facing back along the heading more than across it
+    // (a wall beside the body keeps its place, as QueryFootholds has it).
+    if (Dot(h.normal, a.up) >= cos_max_slope_ ||
+        -Dot(h.normal, a.forward) <= std::fabs(Dot(h.normal, Left(a))))
+      continue;
+    const double rest_height = Dot(points_[l], a.up) - 0.5 * lead_;
+    const double snapped_height = Dot(h.point, a.up);
+    const double top = rest_height + c_.max_rise + spacing;
+    if (top <= snapped_height) continue;
+    // Two lines: up inside the riser to max_rise above the rest height (its top), and down
+    // before it to the rest height (the tread at its foot, when higher).
+    land_locator_.push_back(l);
+    line(h.point + a.forward * depth, top, a.up);
+    line(h.point - a.forward * depth + a.up * spacing, rest_height - spacing, a.up);
+  }
+  if (land_points_.empty()) return Status::kOk;
+  land_answers_.resize(land_points_.size());
+  const Status s =
+      Check(session_.Snap(terrain_, land_points_.data(), land_points_.size(), land_answers_.data()),
+            "snap locators", error);
+  if (s != Status::kOk) return s;
+  for (size_t i = 0; i < land_locator_.size(); ++i) {
+    const size_t l = land_locator_[i];
+    const Agent& a = agents_[walking_[l / locators]];
+    const double snapped_height = Dot(answers_[l].point, a.up);
+    const double rest_height = Dot(points_[l], a.up) - 0.5 * lead_;
+    // The first ground straight over a point of the lines (within 1.5 spacings of it across
+    // the up), facing the up: above the riser's snap on top of it, else before it, not above
+    // the snap and above the rest height by more than a spacing (a tread up; a wall standing
+    // on the feet's own ground stays where it snapped, for the step to be refused on it).
+    for (size_t j = land_first_[2 * i]; j < land_first_[2 * i + 2]; ++j) {
+      const Foothold& h = land_answers_[j];
+      const bool on_top = j < land_first_[2 * i + 1];
+      const double height = Dot(h.point, a.up);
+      if (h.status != Status::kOk || Dot(h.normal, a.up) < cos_max_slope_ ||
+          (on_top ? height <= snapped_height + 0.5 * spacing
+                  : height > snapped_height + 0.5 * spacing || height <= rest_height + spacing) ||
+          Length(ProjectOnPlane(h.point - land_points_[j], a.up)) > 0.75 * gap_)
+        continue;
+      answers_[l] = h, landed_[l] = 1;
+      break;
+    }
+  }
+  return Status::kOk;
+}
+
 Status Generator::QueryFootholds(std::string* error) {
   std::vector<Move>& moves = moves_;
   const size_t per_agent = walking_.empty() ? 0 : moves.size() / walking_.size();

@@ -47,6 +47,10 @@ inline constexpr double kFootholdTolerance = 0.5;
 // A biped's locator snapped back onto its feet's nose looks for the ground below along this
 // many lines, evenly from the snap to its place (LandLocators).
 inline constexpr int kLandLines = 4;
+// A biped's locator on a riser ahead looks for the tread above (below) along a line this share
+// of foot_length behind (before) the riser's face (ClimbLocators).
+inline constexpr double kClimbDepth = 0.5;
+inline constexpr int kMaxClimbPoints = 32;  // points up that line, at most
 // Ground leaning less than this (the sine of its normal's angle across the heading) is taken as
 // flat by ClimbedAside: a tread, not a slope the locator slides along.
 inline constexpr double kFlatLean = 0.1;
@@ -329,6 +333,14 @@ class Generator {
   // snap to the place, are snapped (one batch); of the ground found straight below them, the
   // highest, as near the place as it reaches, replaces the snap in answers_.
   Status LandLocators(std::string* error);
+  // 6 (bipeds). A central locator snapped onto a face past max_slope_deg facing back along the
+  // heading (a riser taller than lead/2 ahead: stairs steeper than the character's stride)
+  // takes the ground on top of it instead, when that lies no more than max_rise above the
+  // place's rest height, else the tread at its foot, when that lies above the rest height:
+  // points up a line inside the face and down a line before it (kClimbDepth sole lengths, or a
+  // sample spacing, from it) are snapped (one batch), and the first ground found straight over
+  // a point replaces the snap in answers_.
+  Status ClimbLocators(std::string* error);
   // True when a biped's locator placed at `placed` snapped (h) onto a tread higher than its
   // rest, aside of its place across a's heading (by `off`, on ground leaning `lean` across it)
   // and little along it: the next tread's nose beside the heading. It then keeps its place
@@ -577,7 +589,8 @@ class Generator {
   std::vector<Vec3> land_points_;          // LandLocators: points down the lines
   std::vector<Foothold> land_answers_;
   std::vector<size_t> land_locator_;  // per locator probed: its index into points_
-  std::vector<char> landed_;          // per locator: 1 when LandLocators replaced its snap
+  std::vector<size_t> land_first_;    // ClimbLocators: each probed locator's first point
+  std::vector<char> landed_;          // per locator: 1 when Land/ClimbLocators replaced its snap
   std::vector<StepQuery> queries_;
   std::vector<char> all_done_;  // per walker of a round: every move has a foothold (CheckReach)
   // FitSoles: the moves checked (and their walkers), the ways each may move, and the first of
