@@ -695,6 +695,39 @@ TEST_CASE("A biped going down stairs at a slant steps down them, its feet kept a
   }
 }
 
+TEST_CASE("A biped goes down stairs with risers near its max_rise at a slant",
+          "[steps][generator]") {
+  // Risers of 30 to 38 cm (max_rise 40), 45 to 60 degrees to the treads: the place lay over a
+  // tread more than max_rise below, so the central locator, snapped back onto the nose the feet
+  // stood on, did not land on the tread between (no ground below the place), and the biped
+  // walked along the top tread for every step it was given. A place in the air down to the
+  // ground found below the other lines now lands there.
+  const Character c = LoadShipped("biped");
+  const int treads = 8;
+  const double spacing = 0.03;
+  for (const auto& [rise, run] :
+       std::vector<std::pair<double, double>>{{0.38, 0.3}, {0.32, 0.2}, {0.3, 0.25}}) {
+    Terrain t = LoadTerrain(MakeStairs(treads, rise, run, 8, spacing), spacing);
+    for (const double deg : {50.0, 60.0}) {
+      GenerateOptions o = StartOptions({2, (treads - 1) * rise, run * treads - 0.15}, 24);
+      const double a = deg * kPi / 180;
+      o.heading = {std::cos(a), 0, -std::sin(a)};
+      const Walk w = Generate(t, c, o);
+      INFO(rise << " x " << run << " at " << deg << " deg: " << w.stopped);
+      CheckWalk(t, c, o, w);
+      double lowest = (treads - 1) * rise;
+      for (const WalkTrack& track : w.tracks)
+        for (const WalkKey& k : track.keys)
+          if (track.kind == TrackKind::kFoot && k.phase == KeyPhase::kEnd)
+            lowest = std::min(lowest, k.position.y);
+      CHECK(lowest <= rise + 1e-6);  // down to the first tread above the ground, or the ground
+      const BipedStance stance = Stance(w, o.heading);
+      CHECK(stance.least_gap >= 0.25 * 0.24);
+      CHECK(stance.most_climbed <= 0.01);
+    }
+  }
+}
+
 TEST_CASE("A biped climbing stairs at a slant keeps its feet apart and its heading",
           "[steps][generator]") {
   // Climbing at 15 degrees to the treads or less, its central locator snapped onto the next

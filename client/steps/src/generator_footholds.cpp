@@ -296,8 +296,22 @@ Status Generator::LandLocators(std::string* error) {
     }
     // Over lower ground (the place over a tread below, not inside the step the snap lies on
     // the riser of), the first ground down from the snap (the next tread, not the one after
-    // it where the place lies beyond a shallow tread), as near the place as it reaches.
-    if (!ground[kLandLines - 1]) continue;
+    // it where the place lies beyond a shallow tread), as near the place as it reaches. The
+    // place's line without ground is over lower ground still when each of its points down to a
+    // spacing above that ground lies in front of the face nearest it, not behind it by more than
+    // a quarter spacing (in the air over a tread more than max_rise below: a biped heading down
+    // 30 to 38 cm risers at 40 to 60 degrees to the treads walked along the top tread).
+    if (!ground[kLandLines - 1]) {
+      bool in_air = false;  // and at least one point checked
+      for (size_t j = i * lines + (kLandLines - 1) * line; j < (i + 1) * lines; ++j) {
+        const Foothold& h = land_answers_[j];
+        if (Dot(land_points_[j], a.up) < highest + spacing) break;
+        in_air =
+            h.status == Status::kOk && Dot(land_points_[j] - h.point, h.normal) > -0.25 * spacing;
+        if (!in_air) break;
+      }
+      if (!in_air) continue;
+    }
     for (int q = kLandLines - 1; q >= 0; --q) {
       if (ground[q] && Dot(ground[q]->point, a.up) >= highest - spacing) {
         answers_[l] = *ground[q], landed_[l] = 1;

@@ -331,7 +331,8 @@ class Generator {
   // feet's (the nose of the tread they stand on, the place over the tread below) takes the
   // first ground down from it instead: points down kLandLines lines along the up, from the
   // snap to the place, are snapped (one batch); of the ground found straight below them, the
-  // highest, as near the place as it reaches, replaces the snap in answers_.
+  // highest, as near the place as it reaches, replaces the snap in answers_, when the place's
+  // line has ground too or is in the air down to it (over a tread more than max_rise below).
   Status LandLocators(std::string* error);
   // 6 (bipeds). A central locator snapped onto a face past max_slope_deg facing back along the
   // heading (a riser taller than lead/2 ahead: stairs steeper than the character's stride)
