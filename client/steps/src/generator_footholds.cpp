@@ -235,6 +235,13 @@ bool Generator::ClimbedAside(const Foothold& h, const Vec3& placed, const Agent&
          Dot(h.point - placed, a.up) > spacing - 0.5 * lead_;
 }
 
+Status Generator::SnapLandPoints(std::string* error) {
+  land_answers_.resize(land_points_.size());
+  return Check(
+      session_.Snap(terrain_, land_points_.data(), land_points_.size(), land_answers_.data()),
+      "snap locators", error);
+}
+
 Status Generator::LandLocators(std::string* error) {
   const size_t locators = pairs_of_group_[group_].size();
   const double spacing = 0.5 * gap_;
@@ -263,11 +270,7 @@ Status Generator::LandLocators(std::string* error) {
     }
   }
   if (land_points_.empty()) return Status::kOk;
-  land_answers_.resize(land_points_.size());
-  const Status s =
-      Check(session_.Snap(terrain_, land_points_.data(), land_points_.size(), land_answers_.data()),
-            "snap locators", error);
-  if (s != Status::kOk) return s;
+  if (const Status s = SnapLandPoints(error); s != Status::kOk) return s;
   for (size_t i = 0; i < land_locator_.size(); ++i) {
     const size_t l = land_locator_[i];
     const Agent& a = agents_[walking_[l / locators]];
@@ -356,11 +359,7 @@ Status Generator::ClimbLocators(std::string* error) {
     line(h.point - a.forward * depth + a.up * spacing, rest_height - spacing, a.up);
   }
   if (land_points_.empty()) return Status::kOk;
-  land_answers_.resize(land_points_.size());
-  const Status s =
-      Check(session_.Snap(terrain_, land_points_.data(), land_points_.size(), land_answers_.data()),
-            "snap locators", error);
-  if (s != Status::kOk) return s;
+  if (const Status s = SnapLandPoints(error); s != Status::kOk) return s;
   for (size_t i = 0; i < land_locator_.size(); ++i) {
     const size_t l = land_locator_[i];
     const Agent& a = agents_[walking_[l / locators]];

@@ -334,6 +334,8 @@ class Generator {
   // highest, as near the place as it reaches, replaces the snap in answers_, when the place's
   // line has ground too or is in the air down to it (over a tread more than max_rise below).
   Status LandLocators(std::string* error);
+  // Snaps land_points_ into land_answers_ (one batch), for Land/ClimbLocators.
+  Status SnapLandPoints(std::string* error);
   // 6 (bipeds). A central locator snapped onto a face past max_slope_deg facing back along the
   // heading (a riser taller than lead/2 ahead: stairs steeper than the character's stride)
   // takes the ground on top of it instead, when that lies no more than max_rise above the
