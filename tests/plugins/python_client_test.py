@@ -11,6 +11,7 @@ import json
 import math
 import os
 import pickle
+import re
 import signal
 import subprocess
 import sys
@@ -1853,6 +1854,26 @@ class MayaKeyWalkTest(unittest.TestCase):
         finally:
             os.unlink(path)
             os.rmdir(folder)
+
+    def test_the_unit_lists_are_the_command_lines(self):
+        # The walk units were listed in four places (the library, this package, the Maya and
+        # Blender menus); the menus now take UNIT_MENU, and this package's lists must name
+        # what `footfall generate --unit` accepts, in its order.
+        cli = os.environ.get("FOOTFALL_CLI") or os.path.join(REPO, "build", "client", "cli",
+                                                               "footfall")
+        run = subprocess.run([cli, "generate", "--terrain", HILLS, "--character",
+                              os.path.join(CHARACTERS, "biped.json"), "--unit", "furlong",
+                              "--out", os.path.join(tempfile.gettempdir(), "never.json")],
+                             capture_output=True, text=True)
+        self.assertNotEqual(run.returncode, 0)
+        listed = re.search(r"--unit: expected (.*)", run.stderr)
+        self.assertIsNotNone(listed, run.stderr)
+        names = re.split(r", | or ", listed.group(1).strip())
+        self.assertEqual(tuple(names), ff.character.WALK_UNITS)
+        self.assertEqual(sorted(ff.character.UNIT_MENU), sorted(ff.character.WALK_UNITS))
+        self.assertEqual(ff.character.UNIT_MENU[0], "m")
+        for unit in ff.character.WALK_UNITS:
+            self.assertIn(unit, ff.character.METRES_PER_UNIT)
 
     def test_import_keys_a_walk_that_says_its_unit_in_the_scenes(self):
         # footfall generate --unit m writes "unit": "m": in Maya's default centimetre scene its

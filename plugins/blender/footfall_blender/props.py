@@ -4,6 +4,11 @@ import bpy
 from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty,
                        IntProperty, PointerProperty, StringProperty)
 
+try:  # inside the add-on zip
+    from . import footfall_client as ffc
+except ImportError:  # the source tree: plugins/python on sys.path
+    import footfall_client as ffc
+
 ADDON = __package__
 
 
@@ -85,12 +90,12 @@ class FootfallScene(bpy.types.PropertyGroup):
     character_file: StringProperty(name="Character file", subtype="FILE_PATH",
                                    description="The character file (JSON) Character Setup "
                                                "reads")
-    # The unit the character file's lengths are in (footfall_client.character.METRES_PER_UNIT):
+    # The unit the character file's lengths are in (footfall_client.character.UNIT_MENU):
     # Character Setup keeps the character in metres on the rig.
     character_unit: EnumProperty(
         name="Character file unit", default="m",
         items=[(u, u, "The character file's lengths are in %s" % u)
-               for u in ("m", "cm", "mm", "in", "ft", "yd", "km", "mi")],
+               for u in ffc.character.UNIT_MENU],
         description="The unit the character file's lengths are in (metres for the shipped "
                     "characters)")
     rig: PointerProperty(type=bpy.types.Object, name="Rig",

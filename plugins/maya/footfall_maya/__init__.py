@@ -551,7 +551,7 @@ TERRAIN_FILTER = ("Terrains (*.pts *.xyz *.txt *.obj *.ply *.off *.stl *.asc *.p
                   "All files (*.*)")
 CHARACTER_FILTER = "Characters (*.json);;All files (*.*)"
 # The Character file unit menu's choices, the first the default (Maya's short names).
-CHARACTER_UNITS = ("m", "cm", "mm", "in", "ft", "yd", "km", "mi")
+CHARACTER_UNITS = ffc.character.UNIT_MENU
 
 
 def _browse_button(field, caption, file_filter):

@@ -266,8 +266,12 @@ def scaled(data, factor):
     return out
 
 
-# The units a walk JSON's "unit" may name (footfall/steps/linear_units.h; Maya's short names).
+# The units a walk JSON's "unit" may name (footfall/steps/linear_units.h; Maya's short names),
+# in the order `footfall generate --unit` lists them.
 WALK_UNITS = ("mm", "cm", "m", "km", "in", "ft", "yd", "mi")
+# The same units in the order the plugins' "Character file unit" menus list them: metres, the
+# shipped characters' unit and the default, first.
+UNIT_MENU = ("m", "cm", "mm", "in", "ft", "yd", "km", "mi")
 
 # The generator's max_rise for a character file without one (character.h).
 DEFAULT_MAX_RISE = 0.35
