@@ -59,6 +59,11 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
   REQUIRE(ParseCharacter(Biped("\"reach\": 1.1", "\"reach\": 1.1, \"foot_length\": 0.25"), "b.json",
                          &c, &error) == Status::kOk);
   CHECK(c.foot_length == 0.25);
+  CHECK(c.foot_width == 0);  // default: no width
+  REQUIRE(ParseCharacter(
+              Biped("\"reach\": 1.1", "\"reach\": 1.1, \"foot_length\": 0.25, \"foot_width\": 0.1"),
+              "b.json", &c, &error) == Status::kOk);
+  CHECK(c.foot_width == 0.1);
   // A version written 1.0 is the version 1, as frames_per_step 10.0 is 10.
   CHECK(ParseCharacter(Biped("\"version\": 1", "\"version\": 1.0"), "b.json", &c, &error) ==
         Status::kOk);
@@ -70,6 +75,10 @@ TEST_CASE("Character files parse, and bad ones are named", "[steps][character]")
       {{"\"reach\": 1.1", "\"reach\": 1.1, \"foot_length\": -0.1"},
        "b.json: 'foot_length' = -0.1 is out of range [0, 1e+09]"},
       {{"\"reach\": 1.1", "\"reach\": 1.1, \"foot_length\": \"long\""}, "b.json: 'foot_length'"},
+      {{"\"reach\": 1.1", "\"reach\": 1.1, \"foot_length\": 0.2, \"foot_width\": -0.1"},
+       "b.json: 'foot_width' = -0.1 is out of range [0, 1e+09]"},
+      {{"\"reach\": 1.1", "\"reach\": 1.1, \"foot_width\": 0.1"},
+       "b.json: 'foot_width': needs a 'foot_length' above 0"},
       {{"[[\"L\"], [\"R\"]]", "[[\"L\"], [\"X\"]]"}, "b.json: 'gait'[1]: no foot named 'X'"},
       {{"[[\"L\"], [\"R\"]]", "[[\"L\"]]"},
        "b.json: 'gait': foot 'R' is in none of them (list every foot once)"},

@@ -445,13 +445,15 @@ check "foot rotations: glTF has 3 rotation channels, not 1" [ "$(grep -o '"path"
 python3 - "$chars/biped.json" "$work/biped-set.json" "$work/biped-point.json" <<'PY'
 import json, sys
 c = json.load(open(sys.argv[1]))
-c.update(step_length=0.45, step_height=0.2, frames_per_step=16, foot_length=0.3)
+c.update(step_length=0.45, step_height=0.2, frames_per_step=16, foot_length=0.3, foot_width=0.12)
 json.dump(c, open(sys.argv[2], "w"))
 c["foot_length"] = 0
+c.pop("foot_width")  # point feet have no width
 json.dump(c, open(sys.argv[3], "w"))
 PY
 "$footfall" generate --terrain "$hills" --character "$chars/biped.json" --start 12,0,8 --steps 6 \
-  --step-length 0.45 --step-height 0.2 --frames-per-step 16 --foot-length 0.3 --out "$work/flags-set.json" 2>/dev/null
+  --step-length 0.45 --step-height 0.2 --frames-per-step 16 --foot-length 0.3 --foot-width 0.12 \
+  --out "$work/flags-set.json" 2>/dev/null
 check "walk settings as flags: exit 0" [ $? -eq 0 ]
 "$footfall" generate --terrain "$hills" --character "$work/biped-set.json" --start 12,0,8 --steps 6 \
   --out "$work/file-set.json" 2>/dev/null
@@ -465,7 +467,13 @@ check "walk settings as flags: not the file's own walk" bash -c "! cmp -s '$work
   --out "$work/file-point.json" 2>/dev/null
 check "--foot-length 0: point feet" cmp -s "$work/flags-point.json" "$work/file-point.json"
 check "--foot-length 0: no foot_length written" bash -c "! grep -q foot_length '$work/flags-point.json'"
-for bad in "--step-length 0" "--step-height -1" "--frames-per-step 1" "--frames-per-step 2.5" "--foot-length -0.1" "--step-length nan"; do
+# A width needs a length: refused with point feet, named.
+"$footfall" generate --terrain "$hills" --character "$chars/biped.json" --foot-length 0 --foot-width 0.1 \
+  --out "$work/bad-width.json" 2> "$work/bad-width.err"
+check "--foot-width without a foot length: exit 1" [ $? -eq 1 ]
+check "--foot-width without a foot length: named" grep -q -- "--foot-width: 0.1 needs a foot length above 0" "$work/bad-width.err"
+check "--foot-width without a foot length: no walk written" [ ! -e "$work/bad-width.json" ]
+for bad in "--step-length 0" "--step-height -1" "--frames-per-step 1" "--frames-per-step 2.5" "--foot-length -0.1" "--foot-width -0.1" "--step-length nan"; do
   # shellcheck disable=SC2086
   "$footfall" generate --terrain "$hills" --character "$chars/biped.json" $bad --out "$work/bad-setting.json" 2> "$work/bad-setting.err"
   check "$bad: exit 1" [ $? -eq 1 ]

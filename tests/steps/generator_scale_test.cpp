@@ -85,6 +85,7 @@ TEST_CASE("ScaleCharacter multiplies every length and nothing else", "[steps][ch
     INFO(name);
     Character c = LoadShipped(name);
     c.foot_length = 0.2;
+    c.foot_width = 0.08;
     Character s = c;
     std::string error;
     REQUIRE(ScaleCharacter(100, &s, &error) == Status::kOk);
@@ -99,6 +100,7 @@ TEST_CASE("ScaleCharacter multiplies every length and nothing else", "[steps][ch
     CHECK(s.max_rise == c.max_rise * 100);
     CHECK(s.reach == c.reach * 100);
     CHECK(s.foot_length == c.foot_length * 100);
+    CHECK(s.foot_width == c.foot_width * 100);
     // Angles, frames and the gait stay.
     CHECK(s.frames_per_step == c.frames_per_step);
     CHECK(s.slope_threshold_deg == c.slope_threshold_deg);

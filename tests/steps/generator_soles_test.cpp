@@ -206,6 +206,51 @@ TEST_CASE("A biped's soles change nothing on ground that has room for them",
   }
 }
 
+TEST_CASE("A biped with a foot width keeps its soles off a side edge",
+          "[steps][generator][soles]") {
+  // Ground ending at x = 2 beside a biped walking along +z, its left foot 1 cm inside the edge:
+  // without a width the sole hung half over the drop. With one, every foot (at the start and
+  // at each touch-down) stands where both sides of its sole have ground of their own; on the
+  // open ground the walk is the one without a width.
+  Character wide = LoadShipped("biped");
+  REQUIRE(wide.foot_width > 0);
+  Character narrow = wide;
+  narrow.foot_width = 0;
+  const double s = 0.03;
+  RawSamples ground;
+  for (int i = 0; i * s <= 2 + 1e-9; ++i)
+    for (int k = 0; k * s <= 8 + 1e-9; ++k) ground.push_back({i * s, 0, k * s}, {0, 1, 0});
+  Terrain t = LoadTerrain(ground, s);
+  const double edge = (static_cast<int>((2 + 1e-9) / s)) * s;  // the last column of samples
+  const double half = 0.5 * wide.foot_width;
+  for (const double x : {edge - 0.12 - 0.01, 1.0}) {
+    GenerateOptions o = StartOptions({x, 0, 0.5}, 8);
+    o.heading = {0, 0, 1};
+    const Walk w = Generate(t, wide, o), v = Generate(t, narrow, o);
+    INFO("start x " << x << ": " << w.stopped);
+    CheckWalk(t, wide, o, w);
+    CHECK(w.stopped.empty());
+    double widest = 0, widest_narrow = 0;
+    for (const Walk* walk : {&w, &v})
+      for (const WalkTrack& tr : walk->tracks)
+        if (tr.kind == TrackKind::kFoot)
+          for (const WalkKey& k : tr.keys)
+            if (k.phase != KeyPhase::kMid)
+              (walk == &w ? widest : widest_narrow) =
+                  std::max(walk == &w ? widest : widest_narrow, k.position.x + half);
+    if (x > 1.5) {                      // beside the edge
+      CHECK(widest_narrow > edge + s);  // hangs past the edge by more than a spacing
+      CHECK(widest <= edge + s);        // ground within a spacing under the side
+    } else {
+      CHECK(widest == widest_narrow);
+      REQUIRE(w.tracks.size() == v.tracks.size());
+      for (size_t i = 0; i < w.tracks.size(); ++i)
+        for (size_t j = 0; j < w.tracks[i].keys.size() && j < v.tracks[i].keys.size(); ++j)
+          CHECK(w.tracks[i].keys[j].position == v.tracks[i].keys[j].position);
+    }
+  }
+}
+
 TEST_CASE("A walk's foot tracks carry their character's foot length", "[steps][generator][soles]") {
   // (For the viewer, which draws each sole as long as its track says.)
   const Character shipped = LoadShipped("biped");

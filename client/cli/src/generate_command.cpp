@@ -60,7 +60,7 @@ struct GenerateFlags {
   double scale = 1;  // the character's lengths multiplied (ScaleCharacter)
   // The character file's walk settings replaced (negative: the file's own), in the terrain's
   // units (not scaled).
-  double step_length = -1, step_height = -1, foot_length = -1;
+  double step_length = -1, step_height = -1, foot_length = -1, foot_width = -1;
   int frames_per_step = -1;
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::vector<std::string> out;
@@ -346,8 +346,8 @@ bool CheckOutputs(const GenerateFlags& flags, const std::vector<std::string>& in
 }
 
 // Loads --character, with the walk settings given as flags (--step-length, --step-height,
-// --frames-per-step, --foot-length, each checked against the character file's range as it was
-// read) in place of the file's. False with the loader's message.
+// --frames-per-step, --foot-length, --foot-width, each checked against the character file's range
+// as it was read) in place of the file's. False with the loader's message.
 bool LoadCharacterWithFlags(const GenerateFlags& flags, Character* c, std::string* error) {
   if (LoadCharacter(flags.character, c, error) != Status::kOk) return false;
   if (flags.scale != 1 && ScaleCharacter(flags.scale, c, error) != Status::kOk) {
@@ -358,6 +358,15 @@ bool LoadCharacterWithFlags(const GenerateFlags& flags, Character* c, std::strin
   if (flags.step_height > 0) c->step_height = flags.step_height;
   if (flags.frames_per_step > 0) c->frames_per_step = flags.frames_per_step;
   if (flags.foot_length >= 0) c->foot_length = flags.foot_length;
+  if (flags.foot_width >= 0) c->foot_width = flags.foot_width;
+  // Point feet have no width: --foot-length 0 takes the file's width away too.
+  if (flags.foot_length == 0 && flags.foot_width < 0) c->foot_width = 0;
+  if (c->foot_width > 0 && !(c->foot_length > 0)) {
+    *error = "--foot-width: " + NumberText(c->foot_width) +
+             " needs a foot length above 0 (--foot-length, or the character file's "
+             "'foot_length')";
+    return false;
+  }
   return true;
 }
 
@@ -910,6 +919,9 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
   CLI::Option* foot_length =
       setting("--foot-length", &flags->foot_length, "Length of each foot's sole (0: point feet)")
           ->check(FiniteRange(0, 1e9));
+  CLI::Option* foot_width = setting("--foot-width", &flags->foot_width,
+                                    "Width of each foot's sole (0: none; needs a foot length)")
+                                ->check(FiniteRange(0, 1e9));
   cmd->add_option("--start-frame", flags->start_frame, "Frame of the first keys (default 1)")
       ->check(FiniteRange(-kMaxStartFrame, kMaxStartFrame));
   cmd->add_option("--fps", flags->fps, "Frames per second of the walk (default 24)")
@@ -952,7 +964,7 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
                   "footfall-view or a plugin; -: the walk JSON on standard output")
       ->required();
   for (CLI::Option* o : {start, heading, path_opt, steps, crowd, crowd_spacing, scale, step_length,
-                         step_height, frames_per_step, foot_length})
+                         step_height, frames_per_step, foot_length, foot_width})
     scene->excludes(o);
   cmd->footer(
       "Exit status: 0 when every step was generated, 2 when the walk stopped early (at a cliff, "

@@ -151,6 +151,7 @@ Status ReadCharacter(const json& j, const std::string& source, Character* out, s
                                                "reach",
                                                "max_turn_deg",
                                                "foot_length",
+                                               "foot_width",
                                                "comment"};
   static const std::set<std::string> kKnownFoot = {"name", "rest", "comment"};
   // Another format's file (a scene, a walk) is named by its format, not by the first of its
@@ -272,7 +273,8 @@ Status ReadCharacter(const json& j, const std::string& source, Character* out, s
         r.Number(j, "max_slope_deg", false, &c.max_slope_deg) &&
         r.Number(j, "max_rise", false, &c.max_rise) && r.Number(j, "reach", true, &c.reach) &&
         r.Number(j, "max_turn_deg", false, &c.max_turn_deg) &&
-        r.Number(j, "foot_length", false, &c.foot_length);
+        r.Number(j, "foot_length", false, &c.foot_length) &&
+        r.Number(j, "foot_width", false, &c.foot_width);
   }
   if (r.status == Status::kOk) {
     if (!j.contains("align_to_normal") || !j["align_to_normal"].is_boolean())
@@ -297,7 +299,11 @@ Status ReadCharacter(const json& j, const std::string& source, Character* out, s
         r.Range(c.max_rise, 0, kMaxLength, true, false, "max_rise") &&
         r.Range(c.reach, 0, kMaxLength, true, false, "reach") &&
         r.Range(c.max_turn_deg, 0, 180, true, false, "max_turn_deg") &&
-        r.Range(c.foot_length, 0, kMaxLength, false, false, "foot_length");
+        r.Range(c.foot_length, 0, kMaxLength, false, false, "foot_length") &&
+        r.Range(c.foot_width, 0, kMaxLength, false, false, "foot_width");
+    if (r.status == Status::kOk && c.foot_width > 0 && !(c.foot_length > 0))
+      r.Fail(Status::kInvalidArgument,
+             "'foot_width': needs a 'foot_length' above 0 (a sole has both, or neither)");
   }
   if (r.status == Status::kOk) {
     const Vec3 centroid = RestCentroid(c);
@@ -346,7 +352,8 @@ Status ScaleCharacter(double scale, Character* c, std::string* error) {
                                   {"body_height", &scaled.body_height, false},
                                   {"max_rise", &scaled.max_rise, true},
                                   {"reach", &scaled.reach, true},
-                                  {"foot_length", &scaled.foot_length, false}};
+                                  {"foot_length", &scaled.foot_length, false},
+                                  {"foot_width", &scaled.foot_width, false}};
   for (const ScaledLength& l : lengths) {
     *l.value *= scale;
     if (!(*l.value <= kMaxLength) || (l.positive && !(*l.value > 0))) {

@@ -21,6 +21,8 @@ constexpr double kBehind = 0.25;
 constexpr size_t kPerFoothold = 3;
 // Snap points per candidate: its centre, heel and toe.
 constexpr size_t kPerCandidate = 3;
+// Snap points per candidate across the sole (FitSoleWidths): its centre, heel, toe and sides.
+constexpr size_t kPerWideCandidate = 5;
 
 // Whether a sole's end at `q`, whose nearest sample is h, stands on ground like the foothold's
 // (normal `normal`): a sample within `near` of it facing alike. Past a stair's nose the nearest
@@ -67,6 +69,15 @@ bool CandidateOnGround(const Vec3* p, const Foothold* h, const Vec3& normal, dou
   if (!SoleOnGround(p[0], h[0], normal, near)) return false;
   const double slack = near - Distance(h[0].point, p[0]);
   return SoleOnGround(p[1], h[1], normal, slack) && SoleOnGround(p[2], h[2], normal, slack);
+}
+
+// Whether a foot of foot f's character (`count` feet from a multiple of count) other than f
+// stands on sample `index`.
+bool TakenByOther(const Foothold* feet, size_t f, size_t count, uint32_t index) {
+  const size_t c = f - f % count;
+  for (size_t g = c; g < c + count; ++g)
+    if (g != f && feet[g].status == Status::kOk && feet[g].index == index) return true;
+  return false;
 }
 
 }  // namespace
@@ -154,7 +165,7 @@ Status Generator::FitSoles(std::string* error) {
     }
     sole_first_[i + 1] = sole_first_[i] + kPerCandidate * kSoleShifts * SoleWayCount(sole_ways_[i]);
   }
-  if (sole_first_[n] == 0) return Status::kOk;
+  if (sole_first_[n] == 0) return FitMoveSoleWidths(error);
   // The candidates' centres, heels and toes: one batch.
   sole_points_.resize(sole_first_[n]);
   Parallel(n, [&](size_t b, size_t e) {
@@ -175,28 +186,126 @@ Status Generator::FitSoles(std::string* error) {
   // at least half the foothold's way along the sole from where the foot stands (a sample aside
   // is no step). (Judge's progress, half the step aimed, refused most places back from a nose
   // that a step aimed down past it had reached.)
-  const double rise_limit = c_.max_rise * (1 + kRiseRounding);
   Parallel(n, [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       Move& mv = moves_[sole_moves_[i]];
-      const Agent& a = agents_[mv.agent];
-      const Vec3 f = SoleForward(a.forward, mv.end_normal);
-      const Vec3& foot = a.foot[mv.foot];
-      const double way = Dot(mv.end - foot, f);
+      const Vec3 f = SoleForward(agents_[mv.agent].forward, mv.end_normal);
+      const double way = Dot(mv.end - agents_[mv.agent].foot[mv.foot], f);
       for (size_t at = sole_first_[i]; at < sole_first_[i + 1]; at += kPerCandidate) {
         const Foothold& h = sole_answers_[at];
-        if (!CandidateOnGround(&sole_points_[at], &sole_answers_[at], mv.end_normal, near))
-          continue;
-        if (Dot(h.point - foot, f) < 0.5 * way ||
-            std::fabs(Dot(h.point - foot, a.up)) > rise_limit ||
-            Dot(h.normal, a.up) < cos_max_slope_ ||
-            GapToMate(mv, h.point) < std::min(kMinPairGap, GapToMate(mv, mv.end)))
+        if (!CandidateOnGround(&sole_points_[at], &sole_answers_[at], mv.end_normal, near) ||
+            !KeepsSoleShift(mv, h, f, way))
           continue;
         mv.end = h.point, mv.end_normal = h.normal, mv.sole = 2;
         break;
       }
     }
   });
+  return FitMoveSoleWidths(error);
+}
+
+bool Generator::KeepsSoleShift(const Move& mv, const Foothold& h, const Vec3& f, double way) const {
+  const Agent& a = agents_[mv.agent];
+  const Vec3& foot = a.foot[mv.foot];
+  return Dot(h.point - foot, f) >= 0.5 * way &&
+         std::fabs(Dot(h.point - foot, a.up)) <= c_.max_rise * (1 + kRiseRounding) &&
+         Dot(h.normal, a.up) >= cos_max_slope_ &&
+         GapToMate(mv, h.point) >= std::min(kMinPairGap, GapToMate(mv, mv.end));
+}
+
+Status Generator::FitMoveSoleWidths(std::string* error) {
+  if (!(c_.foot_width > 0)) return Status::kOk;
+  // The footholds FitSoles checked that stand (not asked again aimed down).
+  std::vector<size_t> fitted;
+  std::vector<Foothold> holds;
+  std::vector<Vec3> forward;
+  std::vector<double> way;
+  for (size_t m : sole_moves_) {
+    const Move& mv = moves_[m];
+    if (!mv.done || mv.failed) continue;
+    const Vec3 f = SoleForward(agents_[mv.agent].forward, mv.end_normal);
+    if (Length2(f) == 0) continue;
+    Foothold h;
+    h.status = Status::kOk, h.point = mv.end, h.normal = mv.end_normal;
+    fitted.push_back(m), holds.push_back(h), forward.push_back(f);
+    way.push_back(Dot(mv.end - agents_[mv.agent].foot[mv.foot], f));
+  }
+  if (fitted.empty()) return Status::kOk;
+  const Status s = FitSoleWidths(
+      &holds, forward,
+      [&](size_t i, const Foothold& h) {
+        return KeepsSoleShift(moves_[fitted[i]], h, forward[i], way[i]);
+      },
+      error);
+  if (s != Status::kOk) return s;
+  for (size_t i = 0; i < fitted.size(); ++i) {
+    Move& mv = moves_[fitted[i]];
+    if (holds[i].point == mv.end) continue;
+    mv.end = holds[i].point, mv.end_normal = holds[i].normal, mv.sole = 2;
+  }
+  return Status::kOk;
+}
+
+Status Generator::FitSoleWidths(std::vector<Foothold>* holds, const std::vector<Vec3>& forward,
+                                const std::function<bool(size_t, const Foothold&)>& keeps,
+                                std::string* error) {
+  const size_t n = holds->size();
+  const double half_length = 0.5 * c_.foot_length, half_width = 0.5 * c_.foot_width;
+  const double near = 0.5 * gap_;
+  // Each sole's sides at its middle: one batch.
+  std::vector<Vec3> left(n), points(2 * n);
+  for (size_t i = 0; i < n; ++i) {
+    const Foothold& h = (*holds)[i];
+    left[i] = Normalize(Cross(h.normal, forward[i]));
+    points[2 * i] = h.point + left[i] * half_width,
+               points[2 * i + 1] = h.point - left[i] * half_width;
+  }
+  std::vector<Foothold> answers(points.size());
+  Status s = Check(session_.Snap(terrain_, points.data(), points.size(), answers.data()),
+                   "snap sole", error);
+  if (s != Status::kOk) return s;
+  // The soles with one side off the ground: their candidates moved toward the other side,
+  // nearest first, each as its centre, heel, toe and sides.
+  std::vector<size_t> first(n + 1, 0);
+  std::vector<double> toward(n, 0);  // +1: toward the left, -1: the right, 0: fits or stays
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3& normal = (*holds)[i].normal;
+    const bool left_on = SoleOnGround(points[2 * i], answers[2 * i], normal, near);
+    const bool right_on = SoleOnGround(points[2 * i + 1], answers[2 * i + 1], normal, near);
+    if (left_on != right_on) toward[i] = left_on ? 1 : -1;
+    first[i + 1] = first[i] + (toward[i] != 0 ? kPerWideCandidate * kSoleShifts : 0);
+  }
+  if (first[n] == 0) return Status::kOk;
+  points.resize(first[n]);
+  for (size_t i = 0; i < n; ++i) {
+    if (toward[i] == 0) continue;
+    const Vec3 &f = forward[i], &l = left[i];
+    Vec3* out = &points[first[i]];
+    for (int k = 1; k <= kSoleShifts; ++k) {
+      const Vec3 centre =
+          (*holds)[i].point + l * (toward[i] * c_.foot_width * k / (2.0 * kSoleShifts));
+      *out++ = centre, *out++ = centre - f * half_length, *out++ = centre + f * half_length;
+      *out++ = centre + l * half_width, *out++ = centre - l * half_width;
+    }
+  }
+  answers.assign(points.size(), Foothold{});
+  s = Check(session_.Snap(terrain_, points.data(), points.size(), answers.data()), "snap sole",
+            error);
+  if (s != Status::kOk) return s;
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 normal = (*holds)[i].normal;
+    for (size_t at = first[i]; at < first[i + 1]; at += kPerWideCandidate) {
+      const Foothold& h = answers[at];
+      if (!SoleOnGround(points[at], h, normal, near)) continue;
+      const double slack = near - Distance(h.point, points[at]);
+      bool on = true;
+      for (size_t q = at + 1; on && q < at + kPerWideCandidate; ++q)
+        on = SoleOnGround(points[q], answers[q], normal, slack);
+      if (!on || !keeps(i, h)) continue;
+      (*holds)[i] = h;
+      break;
+    }
+  }
   return Status::kOk;
 }
 
@@ -229,7 +338,7 @@ Status Generator::FitStartSoles(Foothold* feet, size_t total, size_t count, cons
                        SoleOnGround(points[2 * i + 1], answers[2 * i + 1], normal, near));
     first[i + 1] = first[i] + kPerCandidate * kSoleShifts * SoleWayCount(ways[i]);
   }
-  if (first.back() == 0) return Status::kOk;
+  if (first.back() == 0) return FitStartSoleWidths(feet, count, checked, forward, error);
   points.resize(first.back());
   for (size_t i = 0; i < checked.size(); ++i)
     if (ways[i] != 0)
@@ -242,18 +351,31 @@ Status Generator::FitStartSoles(Foothold* feet, size_t total, size_t count, cons
   // The nearest candidate with ground like the foot's under its centre, heel and toe, on a
   // sample no other foot of its character stands on.
   for (size_t i = 0; i < checked.size(); ++i) {
-    const size_t f = checked[i], c = f - f % count;
+    const size_t f = checked[i];
     for (size_t at = first[i]; at < first[i + 1]; at += kPerCandidate) {
       const Foothold& h = answers[at];
       if (!CandidateOnGround(&points[at], &answers[at], feet[f].normal, near)) continue;
-      bool taken = false;
-      for (size_t g = c; g < c + count; ++g)
-        taken |= g != f && feet[g].status == Status::kOk && feet[g].index == h.index;
-      if (taken) continue;
+      if (TakenByOther(feet, f, count, h.index)) continue;
       feet[f] = h;
       break;
     }
   }
+  return FitStartSoleWidths(feet, count, checked, forward, error);
+}
+
+Status Generator::FitStartSoleWidths(Foothold* feet, size_t count,
+                                     const std::vector<size_t>& checked,
+                                     const std::vector<Vec3>& forward, std::string* error) {
+  if (!(c_.foot_width > 0) || checked.empty()) return Status::kOk;
+  std::vector<Foothold> holds(checked.size());
+  for (size_t i = 0; i < checked.size(); ++i) holds[i] = feet[checked[i]];
+  // On a sample no other foot of its character stands on.
+  const Status s = FitSoleWidths(
+      &holds, forward,
+      [&](size_t i, const Foothold& h) { return !TakenByOther(feet, checked[i], count, h.index); },
+      error);
+  if (s != Status::kOk) return s;
+  for (size_t i = 0; i < checked.size(); ++i) feet[checked[i]] = holds[i];
   return Status::kOk;
 }
 

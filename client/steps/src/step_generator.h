@@ -309,6 +309,10 @@ class Generator {
   //    SeparateSharedFeet; `agents` the characters in order.
   Status FitStartSoles(Foothold* feet, size_t total, size_t count, const Agent* agents,
                        std::string* error);
+  // FitSoleWidths on the start feet FitStartSoles checked (`checked`, their soles' directions
+  // `forward`), each onto a sample no other foot of its character stands on.
+  Status FitStartSoleWidths(Foothold* feet, size_t count, const std::vector<size_t>& checked,
+                            const std::vector<Vec3>& forward, std::string* error);
   // 3. Feet whose nearest sample faces away from their character's up: on the inside of a
   //    pipe (a concave surface) the rests laid on the start's tangent plane fall outside the
   //    inner face, nearer a thin wall's outer face, where the character then hung upside down.
@@ -361,6 +365,22 @@ class Generator {
   // wall's foot. A foothold at the edge of the ground the foot stands on, its toe over the drop,
   // is asked again aimed down (the first of the aimed-down tries) and kept for StandAtEdge.
   Status FitSoles(std::string* error);
+  // 3 and 8 (end). A character with a foot_width: each foothold `holds[i]` (its sole's
+  // direction forward[i], non-zero) with no ground of its own under one side of its sole
+  // (across the sole at its middle: a side edge) moves toward its other side by eighths of
+  // the width, up to half of it, to the nearest place with ground under its centre, heel, toe
+  // and both sides that keeps(i, place) accepts (two batches of snaps); it stays where none
+  // fits (ground narrower than the sole).
+  Status FitSoleWidths(std::vector<Foothold>* holds, const std::vector<Vec3>& forward,
+                       const std::function<bool(size_t, const Foothold&)>& keeps,
+                       std::string* error);
+  // Whether FitSoles may move mv's foothold to h: Judge would accept it as it did the foothold
+  // (rise, slope, no nearer its mate across the heading than the lined-up limit or than the
+  // foothold), and it keeps at least half the foothold's way `way` along the sole direction f
+  // from where the foot stands.
+  bool KeepsSoleShift(const Move& mv, const Foothold& h, const Vec3& f, double way) const;
+  // FitSoleWidths on the footholds FitSoles checked that stand.
+  Status FitMoveSoleWidths(std::string* error);
   // The gap across the heading between the foothold p of mv's foot and its mate (mate_), as a
   // share of their rest gap (1 as at rest, below 0 crossed); 1 for a foot without a mate.
   double GapToMate(const Move& mv, const Vec3& p) const;

@@ -224,7 +224,8 @@ def with_overrides(data, **values):
 
 # The lengths of a character file (ScaleCharacter, character.h, multiplies the same ones),
 # beside its feet's rests.
-LENGTHS = ("step_length", "step_height", "body_height", "max_rise", "reach", "foot_length")
+LENGTHS = ("step_length", "step_height", "body_height", "max_rise", "reach", "foot_length",
+           "foot_width")
 
 # Metres in one of each linear unit a DCC may work in (Maya's short and long names).
 METRES_PER_UNIT = {"mm": 0.001, "millimeter": 0.001, "cm": 0.01, "centimeter": 0.01,

@@ -57,6 +57,11 @@ struct Character {
   // whose heel or toe would stand past a stair's nose or in a riser moves along its tread until
   // the sole fits (README, "The algorithm", step 8). 0: point feet. [Units: wu] [Limit: >= 0]
   double foot_length = 0;
+  // The width of each foot's sole across the heading, its foothold at the middle: a foothold
+  // whose sole would hang over a side edge (the end of a tread beside the heading, a beam's
+  // edge) moves across until it fits. Needs a foot_length. 0: no width. [Units: wu]
+  // [Limit: >= 0]
+  double foot_width = 0;
 };
 
 // Parses a character file's text. `source` names it in errors ("FILE: field: what was
@@ -78,8 +83,8 @@ constexpr double kMinCharacterScale = 1e-6;
 constexpr double kMaxCharacterScale = 1e6;
 
 // Multiplies every length of `c` by `scale`: its feet's rests, step_length, step_height,
-// body_height, max_rise, reach and foot_length (angles, frames and the gait stay). The same
-// character on a terrain in other units (100: a character file in metres on a terrain in
+// body_height, max_rise, reach, foot_length and foot_width (angles, frames and the gait stay). The
+// same character on a terrain in other units (100: a character file in metres on a terrain in
 // centimetres), or bigger or smaller. kInvalidArgument, naming the field, when `scale` is
 // outside [kMinCharacterScale, kMaxCharacterScale] or a length would leave the range a character
 // file allows; `c` is then unchanged.
