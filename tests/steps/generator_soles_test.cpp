@@ -251,6 +251,42 @@ TEST_CASE("A biped with a foot width keeps its soles off a side edge",
   }
 }
 
+TEST_CASE("A biped with a foot width walks a beam narrower than its stance with both soles on it",
+          "[steps][generator][soles]") {
+  // A beam 24 cm wide (9 columns of 3 cm samples), the biped's feet 24 cm apart at rest: each
+  // sole's outer side hung 5 cm off the beam. Both feet now step in until it has ground.
+  Character wide = LoadShipped("biped");
+  Character narrow = wide;
+  narrow.foot_width = 0;
+  const double s = 0.03, x0 = 1, x1 = 1 + 8 * s;
+  RawSamples beam;
+  for (int i = 0; i <= 8; ++i)
+    for (int k = 0; k <= 200; ++k) beam.push_back({x0 + i * s, 1, k * s}, {0, 1, 0});
+  Terrain t = LoadTerrain(beam, s);
+  GenerateOptions o = StartOptions({0.5 * (x0 + x1), 1, 0.3}, 8);
+  o.heading = {0, 0, 1};
+  const double half = 0.5 * wide.foot_width;
+  for (const Character* c : {&wide, &narrow}) {
+    const Walk w = Generate(t, *c, o);
+    INFO((c == &wide ? "with a width: " : "without: ") << w.stopped);
+    CheckWalk(t, *c, o, w);
+    CHECK(w.stopped.empty());
+    double overhang = 0;  // the most a sole's side lies past the beam's samples
+    int keys = 0;
+    for (const WalkTrack& tr : w.tracks)
+      if (tr.kind == TrackKind::kFoot)
+        for (const WalkKey& k : tr.keys)
+          if (k.phase != KeyPhase::kMid)
+            ++keys, overhang =
+                        std::max({overhang, x0 - (k.position.x - half), k.position.x + half - x1});
+    CHECK(keys >= 9);
+    if (c == &wide)
+      CHECK(overhang <= s);  // ground within a spacing under each side
+    else
+      CHECK(overhang > s);
+  }
+}
+
 TEST_CASE("A walk's foot tracks carry their character's foot length", "[steps][generator][soles]") {
   // (For the viewer, which draws each sole as long as its track says.)
   const Character shipped = LoadShipped("biped");

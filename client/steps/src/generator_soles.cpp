@@ -21,8 +21,8 @@ constexpr double kBehind = 0.25;
 constexpr size_t kPerFoothold = 3;
 // Snap points per candidate: its centre, heel and toe.
 constexpr size_t kPerCandidate = 3;
-// Snap points per candidate across the sole (FitSoleWidths): its centre, heel, toe and sides.
-constexpr size_t kPerWideCandidate = 5;
+// Snap points per sole checked around a sample (FitSoleWidths): its heel, toe and sides.
+constexpr size_t kPerSole = 4;
 
 // Whether a sole's end at `q`, whose nearest sample is h, stands on ground like the foothold's
 // (normal `normal`): a sample within `near` of it facing alike. Past a stair's nose the nearest
@@ -250,59 +250,76 @@ Status Generator::FitSoleWidths(std::vector<Foothold>* holds, const std::vector<
                                 const std::function<bool(size_t, const Foothold&)>& keeps,
                                 std::string* error) {
   const size_t n = holds->size();
-  const double half_length = 0.5 * c_.foot_length, half_width = 0.5 * c_.foot_width;
   const double near = 0.5 * gap_;
+  // The sole's heel, toe and sides around a middle at p (`left` across it): kPerSole points.
+  auto sole = [&](const Vec3& p, const Vec3& f, const Vec3& left, Vec3* out) {
+    out[0] = p - f * (0.5 * c_.foot_length), out[1] = p + f * (0.5 * c_.foot_length);
+    out[2] = p + left * (0.5 * c_.foot_width), out[3] = p - left * (0.5 * c_.foot_width);
+  };
   // Each sole's sides at its middle: one batch.
   std::vector<Vec3> left(n), points(2 * n);
   for (size_t i = 0; i < n; ++i) {
     const Foothold& h = (*holds)[i];
     left[i] = Normalize(Cross(h.normal, forward[i]));
-    points[2 * i] = h.point + left[i] * half_width,
-               points[2 * i + 1] = h.point - left[i] * half_width;
+    points[2 * i] = h.point + left[i] * (0.5 * c_.foot_width);
+    points[2 * i + 1] = h.point - left[i] * (0.5 * c_.foot_width);
   }
   std::vector<Foothold> answers(points.size());
   Status s = Check(session_.Snap(terrain_, points.data(), points.size(), answers.data()),
                    "snap sole", error);
   if (s != Status::kOk) return s;
-  // The soles with one side off the ground: their candidates moved toward the other side,
-  // nearest first, each as its centre, heel, toe and sides.
-  std::vector<size_t> first(n + 1, 0);
+  // The soles with one side off the ground: their places moved toward the other side, nearest
+  // first (one batch).
   std::vector<double> toward(n, 0);  // +1: toward the left, -1: the right, 0: fits or stays
+  std::vector<size_t> moved;
   for (size_t i = 0; i < n; ++i) {
     const Vec3& normal = (*holds)[i].normal;
     const bool left_on = SoleOnGround(points[2 * i], answers[2 * i], normal, near);
     const bool right_on = SoleOnGround(points[2 * i + 1], answers[2 * i + 1], normal, near);
-    if (left_on != right_on) toward[i] = left_on ? 1 : -1;
-    first[i + 1] = first[i] + (toward[i] != 0 ? kPerWideCandidate * kSoleShifts : 0);
+    if (left_on != right_on) toward[i] = left_on ? 1 : -1, moved.push_back(i);
   }
-  if (first[n] == 0) return Status::kOk;
-  points.resize(first[n]);
-  for (size_t i = 0; i < n; ++i) {
-    if (toward[i] == 0) continue;
-    const Vec3 &f = forward[i], &l = left[i];
-    Vec3* out = &points[first[i]];
-    for (int k = 1; k <= kSoleShifts; ++k) {
-      const Vec3 centre =
-          (*holds)[i].point + l * (toward[i] * c_.foot_width * k / (2.0 * kSoleShifts));
-      *out++ = centre, *out++ = centre - f * half_length, *out++ = centre + f * half_length;
-      *out++ = centre + l * half_width, *out++ = centre - l * half_width;
+  if (moved.empty()) return Status::kOk;
+  std::vector<Vec3> places;
+  for (size_t i : moved)
+    for (int k = 1; k <= kSoleShifts; ++k)
+      places.push_back((*holds)[i].point +
+                       left[i] * (toward[i] * c_.foot_width * k / (2.0 * kSoleShifts)));
+  std::vector<Foothold> landed(places.size());
+  s = Check(session_.Snap(terrain_, places.data(), places.size(), landed.data()), "snap sole",
+            error);
+  if (s != Status::kOk) return s;
+  // The sole around each sample a place lands on (the foot stands on the sample, not the
+  // place), for the places on ground like the foothold's that keeps accepts: one batch.
+  std::vector<size_t> first(places.size() + 1, 0);
+  points.clear();
+  for (size_t m = 0; m < moved.size(); ++m) {
+    const size_t i = moved[m];
+    for (int k = 0; k < kSoleShifts; ++k) {
+      const size_t at = m * kSoleShifts + k;
+      const Foothold& h = landed[at];
+      if (SoleOnGround(places[at], h, (*holds)[i].normal, near) && keeps(i, h)) {
+        points.resize(points.size() + kPerSole);
+        sole(h.point, forward[i], left[i], &points[points.size() - kPerSole]);
+      }
+      first[at + 1] = points.size();
     }
   }
+  if (points.empty()) return Status::kOk;
   answers.assign(points.size(), Foothold{});
   s = Check(session_.Snap(terrain_, points.data(), points.size(), answers.data()), "snap sole",
             error);
   if (s != Status::kOk) return s;
-  for (size_t i = 0; i < n; ++i) {
+  for (size_t m = 0; m < moved.size(); ++m) {
+    const size_t i = moved[m];
     const Vec3 normal = (*holds)[i].normal;
-    for (size_t at = first[i]; at < first[i + 1]; at += kPerWideCandidate) {
-      const Foothold& h = answers[at];
-      if (!SoleOnGround(points[at], h, normal, near)) continue;
-      const double slack = near - Distance(h.point, points[at]);
+    for (int k = 0; k < kSoleShifts; ++k) {
+      const size_t at = m * kSoleShifts + k;
+      if (first[at + 1] == first[at]) continue;  // off the ground, or refused
       bool on = true;
-      for (size_t q = at + 1; on && q < at + kPerWideCandidate; ++q)
-        on = SoleOnGround(points[q], answers[q], normal, slack);
-      if (!on || !keeps(i, h)) continue;
-      (*holds)[i] = h;
+      for (size_t q = first[at]; on && q < first[at + 1]; ++q)
+        on = SoleOnGround(points[q], answers[q], normal, near);
+      if (!on) continue;
+      (*holds)[i] = landed[at];
       break;
     }
   }

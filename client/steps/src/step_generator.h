@@ -368,9 +368,9 @@ class Generator {
   // 3 and 8 (end). A character with a foot_width: each foothold `holds[i]` (its sole's
   // direction forward[i], non-zero) with no ground of its own under one side of its sole
   // (across the sole at its middle: a side edge) moves toward its other side by eighths of
-  // the width, up to half of it, to the nearest place with ground under its centre, heel, toe
-  // and both sides that keeps(i, place) accepts (two batches of snaps); it stays where none
-  // fits (ground narrower than the sole).
+  // the width, up to half of it, to the nearest place whose sample keeps(i, sample) accepts
+  // with ground under the heel, toe and both sides of a sole around that sample (three batches
+  // of snaps); it stays where none fits (ground narrower than the sole).
   Status FitSoleWidths(std::vector<Foothold>* holds, const std::vector<Vec3>& forward,
                        const std::function<bool(size_t, const Foothold&)>& keeps,
                        std::string* error);
