@@ -82,6 +82,13 @@ bool TakenByOther(const Foothold* feet, size_t f, size_t count, uint32_t index) 
 
 }  // namespace
 
+Status Generator::SnapSole(const std::vector<Vec3>& points, std::vector<Foothold>* answers,
+                           std::string* error) {
+  answers->assign(points.size(), Foothold{});
+  return Check(session_.Snap(terrain_, points.data(), points.size(), answers->data()), "snap sole",
+               error);
+}
+
 Status Generator::FitSoles(std::string* error) {
   const size_t per_agent = walking_.empty() ? 0 : moves_.size() / walking_.size();
   const double half = 0.5 * c_.foot_length;
@@ -117,10 +124,7 @@ Status Generator::FitSoles(std::string* error) {
       p[0] = mv.end - f * half, p[1] = mv.end + f * half, p[2] = p[1] + a.up * c_.max_rise;
     }
   });
-  sole_answers_.resize(sole_points_.size());
-  Status s =
-      Check(session_.Snap(terrain_, sole_points_.data(), sole_points_.size(), sole_answers_.data()),
-            "snap sole", error);
+  Status s = SnapSole(sole_points_, &sole_answers_, error);
   if (s != Status::kOk) return s;
   // The footholds whose sole misses ground, each with its candidates: the foothold moved the
   // ways its ends ask, nearest first (forward before back at the same distance).
@@ -176,9 +180,7 @@ Status Generator::FitSoles(std::string* error) {
       SoleCandidates(mv.end, f, sole_ways_[i], c_.foot_length, &sole_points_[sole_first_[i]]);
     }
   });
-  sole_answers_.resize(sole_points_.size());
-  s = Check(session_.Snap(terrain_, sole_points_.data(), sole_points_.size(), sole_answers_.data()),
-            "snap sole", error);
+  s = SnapSole(sole_points_, &sole_answers_, error);
   if (s != Status::kOk) return s;
   // The nearest candidate whose centre snaps onto ground like the foothold's, with ground under
   // its heel and toe, that Judge would accept as it did the foothold (rise, slope, no nearer
@@ -264,9 +266,8 @@ Status Generator::FitSoleWidths(std::vector<Foothold>* holds, const std::vector<
     points[2 * i] = h.point + left[i] * (0.5 * c_.foot_width);
     points[2 * i + 1] = h.point - left[i] * (0.5 * c_.foot_width);
   }
-  std::vector<Foothold> answers(points.size());
-  Status s = Check(session_.Snap(terrain_, points.data(), points.size(), answers.data()),
-                   "snap sole", error);
+  std::vector<Foothold> answers;
+  Status s = SnapSole(points, &answers, error);
   if (s != Status::kOk) return s;
   // The soles with one side off the ground: their places moved toward the other side, nearest
   // first (one batch).
@@ -284,9 +285,8 @@ Status Generator::FitSoleWidths(std::vector<Foothold>* holds, const std::vector<
     for (int k = 1; k <= kSoleShifts; ++k)
       places.push_back((*holds)[i].point +
                        left[i] * (toward[i] * c_.foot_width * k / (2.0 * kSoleShifts)));
-  std::vector<Foothold> landed(places.size());
-  s = Check(session_.Snap(terrain_, places.data(), places.size(), landed.data()), "snap sole",
-            error);
+  std::vector<Foothold> landed;
+  s = SnapSole(places, &landed, error);
   if (s != Status::kOk) return s;
   // The sole around each sample a place lands on (the foot stands on the sample, not the
   // place), for the places on ground like the foothold's that keeps accepts: one batch.
@@ -305,9 +305,7 @@ Status Generator::FitSoleWidths(std::vector<Foothold>* holds, const std::vector<
     }
   }
   if (points.empty()) return Status::kOk;
-  answers.assign(points.size(), Foothold{});
-  s = Check(session_.Snap(terrain_, points.data(), points.size(), answers.data()), "snap sole",
-            error);
+  s = SnapSole(points, &answers, error);
   if (s != Status::kOk) return s;
   for (size_t m = 0; m < moved.size(); ++m) {
     const size_t i = moved[m];
@@ -342,9 +340,8 @@ Status Generator::FitStartSoles(Foothold* feet, size_t total, size_t count, cons
     points.push_back(feet[f].point - fwd * half), points.push_back(feet[f].point + fwd * half);
   }
   if (checked.empty()) return Status::kOk;
-  std::vector<Foothold> answers(points.size());
-  Status s = Check(session_.Snap(terrain_, points.data(), points.size(), answers.data()),
-                   "snap sole", error);
+  std::vector<Foothold> answers;
+  Status s = SnapSole(points, &answers, error);
   if (s != Status::kOk) return s;
   // The candidates of the feet whose sole misses ground: one more batch.
   std::vector<size_t> first(checked.size() + 1, 0);
@@ -361,9 +358,7 @@ Status Generator::FitStartSoles(Foothold* feet, size_t total, size_t count, cons
     if (ways[i] != 0)
       SoleCandidates(feet[checked[i]].point, forward[i], ways[i], c_.foot_length,
                      &points[first[i]]);
-  answers.assign(points.size(), Foothold{});
-  s = Check(session_.Snap(terrain_, points.data(), points.size(), answers.data()), "snap sole",
-            error);
+  s = SnapSole(points, &answers, error);
   if (s != Status::kOk) return s;
   // The nearest candidate with ground like the foot's under its centre, heel and toe, on a
   // sample no other foot of its character stands on.

@@ -365,6 +365,9 @@ class Generator {
   // wall's foot. A foothold at the edge of the ground the foot stands on, its toe over the drop,
   // is asked again aimed down (the first of the aimed-down tries) and kept for StandAtEdge.
   Status FitSoles(std::string* error);
+  // Snaps `points` into `answers` (one batch), for the sole fits.
+  Status SnapSole(const std::vector<Vec3>& points, std::vector<Foothold>* answers,
+                  std::string* error);
   // 3 and 8 (end). A character with a foot_width: each foothold `holds[i]` (its sole's
   // direction forward[i], non-zero) with no ground of its own under one side of its sole
   // (across the sole at its middle: a side edge) moves toward its other side by eighths of
