@@ -100,6 +100,7 @@ void CheckPositions(const Channel& channel, const WalkTrack& track, const std::v
 TEST_CASE("WriteGltf writes a node per track with keyed channels", "[export][gltf]") {
   Walk walk = test::BipedWalk();
   walk.tracks[0].foot_length = 0.25;  // L's sole; R has point feet
+  walk.tracks[0].foot_width = 0.1;
   const bool binary = GENERATE(false, true);
   const std::string path = test::ScratchPath(binary ? "biped.glb" : "biped.gltf");
   std::string error;
@@ -126,6 +127,8 @@ TEST_CASE("WriteGltf writes a node per track with keyed channels", "[export][glt
   // A foot's foot_length where the walk has one (as the walk JSON), none for point feet.
   CHECK(model.nodes[0].extras.Get("foot_length").GetNumberAsDouble() == 0.25);
   CHECK_FALSE(model.nodes[1].extras.Has("foot_length"));
+  CHECK(model.nodes[0].extras.Get("foot_width").GetNumberAsDouble() == 0.1);
+  CHECK_FALSE(model.nodes[1].extras.Has("foot_width"));
   CHECK_FALSE(model.nodes[2].extras.Has("foot_length"));
   REQUIRE(model.scenes.size() == 1);
   CHECK(model.defaultScene == 0);
@@ -544,7 +547,7 @@ TEST_CASE("WriteGltf converts a walk in another unit to metres", "[export][gltf]
   // glTF's unit is the metre: a walk in centimetres (a character scaled onto a terrain in
   // centimetres) was read 100 times too large by Blender and Unreal.
   Walk walk = test::FarWalk();
-  walk.tracks[0].foot_length = 25;
+  walk.tracks[0].foot_length = 25, walk.tracks[0].foot_width = 10;
   const std::string metres_path = test::ScratchPath("far_m.glb");
   const std::string cm_path = test::ScratchPath("far_cm.glb");
   std::string error;
@@ -561,6 +564,7 @@ TEST_CASE("WriteGltf converts a walk in another unit to metres", "[export][gltf]
   REQUIRE(origin.size() == 3);
   CHECK(origin == std::vector<double>{5000, 0, -3000});
   CHECK(b.nodes[0].extras.Get("foot_length").GetNumberAsDouble() == 0.25);
+  CHECK(b.nodes[0].extras.Get("foot_width").GetNumberAsDouble() == Approx(0.1).epsilon(1e-12));
   auto ca = Channels(a), cb = Channels(b);
   const std::vector<double>& far_origin = a.nodes.back().translation;
   for (const char* node : {"L", "R", "body"}) {

@@ -247,6 +247,42 @@ TEST_CASE("ParseWalkJson says on which line the value it refuses stands", "[expo
   }
 }
 
+TEST_CASE("A foot track's foot_width is written after its foot_length, read back and checked",
+          "[export][walk_json]") {
+  Walk walk = test::BipedWalk();  // tracks L, R, body
+  walk.tracks[0].foot_length = 0.22, walk.tracks[0].foot_width = 0.1;
+  const std::string text = WalkToJson(walk);
+  CHECK(text.find("\"name\":\"L\",\"kind\":\"foot\",\"foot_length\":0.22,\"foot_width\":0.1,"
+                  "\"keys\"") != std::string::npos);
+  CHECK(text.find("foot_width", text.find("\"name\":\"R\"")) == std::string::npos);
+  Walk back, whole;
+  std::string error;
+  REQUIRE(ParseWalkJson(text, "w.json", &back, &error) == Status::kOk);
+  CHECK(back.tracks[0].foot_width == 0.1);
+  CHECK(back.tracks[1].foot_width == 0);
+  CHECK(WalkToJson(back) == text);
+  REQUIRE(detail::ParseWalkJsonWhole(text, "w.json", &whole, &error) == Status::kOk);
+  CHECK(whole.tracks[0].foot_width == 0.1);
+  auto refuse = [&text](const std::string& replaced, const std::string& by) {
+    std::string bad = text;
+    const size_t at = bad.find(replaced);
+    REQUIRE(at != std::string::npos);
+    bad.replace(at, replaced.size(), by);
+    Walk w;
+    std::string message;
+    CHECK(ParseWalkJson(bad, "w.json", &w, &message) == Status::kParseError);
+    return message;
+  };
+  const std::string w = "\"foot_width\":0.1";
+  CHECK(refuse(w, "\"foot_width\":-0.1") ==
+        "w.json: tracks[0].foot_width: expected a length in [0, 1e9] (the character's "
+        "foot_width) (line 2)");
+  CHECK(refuse(w, "\"foot_width\":null") ==
+        "w.json: tracks[0].foot_width: expected a finite number (line 2)");
+  CHECK(refuse("\"kind\":\"body\"", "\"kind\":\"body\",\"foot_width\":0.2")
+            .find("tracks[2].foot_width: only a foot track has a foot_width") != std::string::npos);
+}
+
 TEST_CASE("A foot track's foot_length is written, read back and checked", "[export][walk_json]") {
   Walk walk = test::BipedWalk();  // tracks L, R, body
   walk.tracks[0].foot_length = 0.22;
@@ -343,8 +379,8 @@ std::string WalkDifference(const Walk& a, const Walk& b) {
     const WalkTrack& y = b.tracks[t];
     const std::string at = "track " + std::to_string(t) + ": ";
     if (x.name != y.name || x.character != y.character || x.kind != y.kind ||
-        x.foot_length != y.foot_length)
-      return at + "name, character, kind or foot_length";
+        x.foot_length != y.foot_length || x.foot_width != y.foot_width)
+      return at + "name, character, kind, foot_length or foot_width";
     if (x.keys.size() != y.keys.size() || x.rotations.size() != y.rotations.size())
       return at + "key count";
     for (size_t k = 0; k < x.keys.size(); ++k) {

@@ -1887,7 +1887,7 @@ class MayaKeyWalkTest(unittest.TestCase):
         cmds.xform = lambda *args, **kwargs: calls.append(kwargs.get("t"))
         cmds.spaceLocator = lambda name: [name]
         walk = {"format": "footfall-walk", "version": 1, "fps": 24,
-                "tracks": [{"name": "L", "kind": "foot", "foot_length": 0.25,
+                "tracks": [{"name": "L", "kind": "foot", "foot_length": 0.25, "foot_width": 0.1,
                             "keys": [{"frame": f, "position": [0.5, 0, 0.1 * f]}
                                      for f in (1, 2, 3)]}]}
         folder = tempfile.mkdtemp()
@@ -1919,6 +1919,7 @@ class MayaKeyWalkTest(unittest.TestCase):
         in_mm = ff.character.walk_in_unit(in_m, "mm")
         self.assertEqual(in_mm["unit"], "mm")
         self.assertAlmostEqual(in_mm["tracks"][0]["foot_length"], 250.0, places=9)
+        self.assertAlmostEqual(in_mm["tracks"][0]["foot_width"], 100.0, places=9)
         self.assertEqual(in_m["tracks"][0]["keys"][0]["position"], [0.5, 0, 0.1])
 
     def test_rotations_of_any_length_are_turned_as_unit_quaternions(self):

@@ -303,11 +303,14 @@ TEST_CASE("A walk's foot tracks carry their character's foot length", "[steps][g
       for (const WalkTrack& t : w.tracks) {
         INFO(t.character << " " << t.name);
         CHECK(t.foot_length == (t.kind == TrackKind::kFoot ? c->foot_length : 0));
+        CHECK(t.foot_width ==
+              (t.kind == TrackKind::kFoot && c->foot_length > 0 ? c->foot_width : 0));
         feet += t.kind == TrackKind::kFoot;
       }
       CHECK(feet == c->feet.size() * (o == &crowd ? 3 : 1));
       const std::string text = WalkToJson(w);
       CHECK((text.find("\"foot_length\":0.22,") != std::string::npos) == (c == &shipped));
+      CHECK((text.find("\"foot_width\":0.1,") != std::string::npos) == (c == &shipped));
     }
   }
 }

@@ -808,6 +808,19 @@ TEST_CASE(
   CHECK(CountColorNear(shorter, sole_edge, 2, left) == 0);
   CHECK(CountColorNear(shorter, footprint_edge, 2, dim_left) == 0);
   CHECK(sole_lengths() == std::vector<double>{0.2, 0.2});
+  // A track's foot_width gives its sole's width (a third of the length without one).
+  std::string wide = WalkJson();
+  wide.replace(wide.find(R"("kind": "foot")"), 14,
+               R"("kind": "foot", "foot_length": 0.8, "foot_width": 0.5)");
+  test::WriteFile(dir + "/walk.json", wide);
+  const glm::vec2 wide_edge = Project(eye, target, 640, 480, {2 + 0.25, 0, 2.25});
+  const Image wide_soles = shot({});
+  CHECK(CountColorNear(wide_soles, wide_edge, 2, left) > 0);
+  CHECK(CountColorNear(wide_soles, sole_edge, 2, left) == 0);
+  CHECK(CountColorNear(walk_soles, wide_edge, 2, left) == 0);
+  const json wide_state = json::parse(test::ReadFile(dir + "/state.json"))["walk"]["tracks"][0];
+  CHECK(wide_state.value("sole_width", 0.0) == 0.5);
+  test::WriteFile(dir + "/walk.json", own);
   const RunResult none = View({"--foot-length", "0.2", "--screenshot", dir + "/sole.png"});
   CHECK(none.exit_code == 2);
   CHECK_THAT(none.err, Catch::Contains("--foot-length needs --walk"));

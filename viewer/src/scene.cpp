@@ -450,11 +450,13 @@ void Scene::DrawWalk(const ViewState& view, DrawList* on_top) const {
                    static_cast<uint8_t>(color.b / 2 + 40), 255};
     const auto& keys = track.keys;
     const bool turned = track.rotations.size() == keys.size();
-    // The sole's outline about the foot at `at`, turned by `q`.
+    // The sole's outline about the foot at `at`, turned by `q`: its track's foot_width wide, or
+    // a third of its length where the track has none.
     const double sole_length = SoleLength(track);
+    const double sole_width = track.foot_width > 0 ? track.foot_width : sole_length / 3;
     auto sole = [&](const Vec3& at, const Quat& q, const Rgba& c) {
       const Vec3 forward = Rotate(q, Vec3{0, 0, 1}) * (0.5 * sole_length);
-      const Vec3 side = Rotate(q, Vec3{1, 0, 0}) * (sole_length / 6);
+      const Vec3 side = Rotate(q, Vec3{1, 0, 0}) * (0.5 * sole_width);
       const glm::vec3 corners[4] = {ToRender(at + forward + side), ToRender(at + forward - side),
                                     ToRender(at - forward - side), ToRender(at - forward + side)};
       for (int i = 0; i < 4; ++i) on_top->Line(corners[i], corners[(i + 1) % 4], c);
@@ -611,8 +613,10 @@ void Scene::Describe(const ViewState& view, const OrbitCamera& camera, int width
       j.End();
       j.Key("swinging").Value(pose.swinging);
       // The sole drawn about it (SetSoleLength), when one is.
-      if (SoleLength(t) > 0 && t.rotations.size() == t.keys.size())
+      if (SoleLength(t) > 0 && t.rotations.size() == t.keys.size()) {
         j.Key("sole_length").Value(SoleLength(t));
+        j.Key("sole_width").Value(t.foot_width > 0 ? t.foot_width : SoleLength(t) / 3);
+      }
     }
     if (t.kind == TrackKind::kBody || t.rotations.size() == t.keys.size()) {
       const Quat& q = pose.rotation;

@@ -96,6 +96,8 @@ tinygltf::Value NodeExtras(const WalkTrack& track) {
   // A foot's sole, as the walk JSON carries it (a custom property once imported).
   if (track.kind == TrackKind::kFoot && track.foot_length > 0)
     extras["foot_length"] = tinygltf::Value(track.foot_length);
+  if (track.kind == TrackKind::kFoot && track.foot_width > 0)
+    extras["foot_width"] = tinygltf::Value(track.foot_width);
   return tinygltf::Value(std::move(extras));
 }
 
@@ -146,11 +148,12 @@ Vec3 StoredFloats(const Vec3& p, const Vec3& origin) {
           static_cast<float>(p.z - origin.z)};
 }
 
-// `walk` with its lengths (positions, foot lengths) multiplied by `factor` (its unit as it was).
+// `walk` with its lengths (positions, foot lengths and widths) multiplied by `factor` (its unit as
+// it was).
 Walk ScaledWalk(const Walk& walk, double factor) {
   Walk out = walk;
   for (WalkTrack& track : out.tracks) {
-    track.foot_length *= factor;
+    track.foot_length *= factor, track.foot_width *= factor;
     for (WalkKey& key : track.keys) key.position = key.position * factor;
   }
   return out;

@@ -206,7 +206,8 @@ Status Generator::Setup(std::string* error) {
                   std::pmr::vector<Quat>(arena.get())};
       t.keys.reserve(body ? body_keys : foot_keys);
       if (body) t.rotations.reserve(body_keys);
-      if (!body) t.foot_length = c_.foot_length;
+      if (!body)
+        t.foot_length = c_.foot_length, t.foot_width = c_.foot_length > 0 ? c_.foot_width : 0;
       walk_.tracks.push_back(std::move(t));
     }
   }

@@ -101,6 +101,10 @@ void AppendRun(const Walk& walk, const KeyRun& run, const std::vector<size_t>& o
       out += ",\"foot_length\":";
       Number(out, t.foot_length);
     }
+    if (t.kind == TrackKind::kFoot && t.foot_width > 0) {
+      out += ",\"foot_width\":";
+      Number(out, t.foot_width);
+    }
     out += ",\"keys\":[";
   }
   for (size_t i = run.first; i < run.end; ++i) {

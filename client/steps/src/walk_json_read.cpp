@@ -301,7 +301,9 @@ Status ParseWalk(const std::string& text, const std::string& source, Walk* out, 
         r.Fail(tw, "expected {\"name\": STRING, \"kind\": \"foot\"|\"body\", \"keys\": [...]}");
         break;
       }
-      if (!r.Known(t, tw, {"name", "kind", "character", "foot_length", "keys", "comment"})) break;
+      if (!r.Known(t, tw,
+                   {"name", "kind", "character", "foot_length", "foot_width", "keys", "comment"}))
+        break;
       track.name = t["name"].get<std::string>();
       if (!detail::ControlCharacterIn(track.name).empty()) {
         r.Fail(tw + ".name", detail::ControlCharacterIn(track.name));
@@ -328,18 +330,22 @@ Status ParseWalk(const std::string& text, const std::string& source, Walk* out, 
         r.Fail(tw + ".kind", "expected \"foot\" or \"body\"");
         break;
       }
-      if (t.contains("foot_length")) {
-        const std::string at = tw + ".foot_length";
-        if (track.kind != TrackKind::kFoot) {
-          r.Fail(at, "only a foot track has a foot_length");
-          break;
-        }
-        if (!r.Finite(t["foot_length"], at, &track.foot_length)) break;
-        if (!(track.foot_length >= 0 && track.foot_length <= kMaxFootLength)) {
-          r.Fail(at, "expected a length in [0, 1e9] (the character's foot_length)");
-          break;
-        }
+      // The sole (a foot track's foot_length and foot_width).
+      bool sole_read = true;
+      for (const auto& [field, value] :
+           {std::pair<const char*, double*>{"foot_length", &track.foot_length},
+            {"foot_width", &track.foot_width}}) {
+        if (!sole_read || !t.contains(field)) continue;
+        const std::string at = tw + "." + field;
+        if (track.kind != TrackKind::kFoot)
+          sole_read = r.Fail(at, std::string("only a foot track has a ") + field);
+        else if (!r.Finite(t[field], at, value))
+          sole_read = false;
+        else if (!(*value >= 0 && *value <= kMaxFootLength))
+          sole_read = r.Fail(
+              at, std::string("expected a length in [0, 1e9] (the character's ") + field + ")");
       }
+      if (!sole_read) break;
       if (!t.contains("keys") || !t["keys"].is_array()) {
         r.Fail(tw + ".keys", "expected an array");
         break;

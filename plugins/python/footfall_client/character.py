@@ -333,7 +333,7 @@ def check_walk(walk, name="walk"):
 
 def walk_in_unit(walk, unit):
     """The walk `walk` (checked by check_walk) with its lengths in `unit` (a METRES_PER_UNIT
-    name): its positions and foot lengths converted from the walk's "unit", and "unit" set to
+    name): its positions and foot lengths and widths converted from the walk's "unit", and "unit" set to
     `unit`. A walk without a "unit" (footfall generate without --unit) is returned as it is, one
     walk unit to one of `unit`."""
     if "unit" not in walk:
@@ -345,8 +345,9 @@ def walk_in_unit(walk, unit):
     out["tracks"] = []
     for track in walk["tracks"]:
         track = dict(track)
-        if _finite_number(track.get("foot_length")):
-            track["foot_length"] = track["foot_length"] * factor
+        for key in ("foot_length", "foot_width"):
+            if _finite_number(track.get(key)):
+                track[key] = track[key] * factor
         track["keys"] = [dict(key, position=[v * factor for v in key["position"]])
                          for key in track.get("keys", [])]
         out["tracks"].append(track)

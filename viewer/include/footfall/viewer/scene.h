@@ -57,7 +57,8 @@ class Scene {
   // normalised for drawing.
   Status LoadWalk(const std::string& path, std::string* error);
   // Each foot's sole is drawn its track's foot_length long (the walk's own; none where it is
-  // 0) along its forward and a third as wide, centred on the foot: at its pose, and dimmed at
+  // 0) along its forward and its track's foot_width wide (a third of its length where the track
+  // has none), centred on the foot: at its pose, and dimmed at
   // every planted key (its footprints). SetSoleLength(length) draws every foot's sole `length`
   // long instead (0: none); a negative length goes back to the walk's own. Feet whose walk
   // carries no rotations are turned as `footfall generate --foot-rotations` turns them

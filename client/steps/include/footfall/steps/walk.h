@@ -82,6 +82,9 @@ struct WalkTrack {
   // Foot tracks: the length of the foot's sole (its character's foot_length), for drawing it;
   // 0 for point feet, for body tracks, and when not known. [Units: wu]
   double foot_length = 0;
+  // Foot tracks: the width of the foot's sole (its character's foot_width), for drawing it; 0
+  // for none, for body tracks, and when not known. [Units: wu]
+  double foot_width = 0;
 
   // The orientation at keys[i]: rotations[i], or the identity where there is none.
   Quat Rotation(size_t i) const { return i < rotations.size() ? rotations[i] : Quat{}; }
