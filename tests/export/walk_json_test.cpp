@@ -247,6 +247,23 @@ TEST_CASE("ParseWalkJson says on which line the value it refuses stands", "[expo
   }
 }
 
+namespace {
+
+// The message ParseWalkJson refuses `text` with once its first `replaced` is replaced by `by`.
+std::string RefusedEdit(const std::string& text, const std::string& replaced,
+                        const std::string& by) {
+  std::string bad = text;
+  const size_t at = bad.find(replaced);
+  REQUIRE(at != std::string::npos);
+  bad.replace(at, replaced.size(), by);
+  Walk w;
+  std::string message;
+  CHECK(ParseWalkJson(bad, "w.json", &w, &message) == Status::kParseError);
+  return message;
+}
+
+}  // namespace
+
 TEST_CASE("A foot track's foot_width is written after its foot_length, read back and checked",
           "[export][walk_json]") {
   Walk walk = test::BipedWalk();  // tracks L, R, body
@@ -263,23 +280,13 @@ TEST_CASE("A foot track's foot_width is written after its foot_length, read back
   CHECK(WalkToJson(back) == text);
   REQUIRE(detail::ParseWalkJsonWhole(text, "w.json", &whole, &error) == Status::kOk);
   CHECK(whole.tracks[0].foot_width == 0.1);
-  auto refuse = [&text](const std::string& replaced, const std::string& by) {
-    std::string bad = text;
-    const size_t at = bad.find(replaced);
-    REQUIRE(at != std::string::npos);
-    bad.replace(at, replaced.size(), by);
-    Walk w;
-    std::string message;
-    CHECK(ParseWalkJson(bad, "w.json", &w, &message) == Status::kParseError);
-    return message;
-  };
   const std::string w = "\"foot_width\":0.1";
-  CHECK(refuse(w, "\"foot_width\":-0.1") ==
+  CHECK(RefusedEdit(text, w, "\"foot_width\":-0.1") ==
         "w.json: tracks[0].foot_width: expected a length in [0, 1e9] (the character's "
         "foot_width) (line 2)");
-  CHECK(refuse(w, "\"foot_width\":null") ==
+  CHECK(RefusedEdit(text, w, "\"foot_width\":null") ==
         "w.json: tracks[0].foot_width: expected a finite number (line 2)");
-  CHECK(refuse("\"kind\":\"body\"", "\"kind\":\"body\",\"foot_width\":0.2")
+  CHECK(RefusedEdit(text, "\"kind\":\"body\"", "\"kind\":\"body\",\"foot_width\":0.2")
             .find("tracks[2].foot_width: only a foot track has a foot_width") != std::string::npos);
 }
 
@@ -305,25 +312,15 @@ TEST_CASE("A foot track's foot_length is written, read back and checked", "[expo
   CHECK(point.find("foot_length", point.find("\"name\":\"R\"")) != std::string::npos);
   CHECK(point.find("foot_length") > point.find("\"name\":\"R\""));
 
-  auto refuse = [&text](const std::string& replaced, const std::string& by) {
-    std::string bad = text;
-    const size_t at = bad.find(replaced);
-    REQUIRE(at != std::string::npos);
-    bad.replace(at, replaced.size(), by);
-    Walk w;
-    std::string message;
-    CHECK(ParseWalkJson(bad, "w.json", &w, &message) == Status::kParseError);
-    return message;
-  };
   const std::string l = "\"foot_length\":0.22";
-  CHECK(refuse(l, "\"foot_length\":-0.1") ==
+  CHECK(RefusedEdit(text, l, "\"foot_length\":-0.1") ==
         "w.json: tracks[0].foot_length: expected a length in [0, 1e9] (the character's "
         "foot_length) (line 2)");
-  CHECK(refuse(l, "\"foot_length\":2e9").find("expected a length in [0, 1e9]") !=
+  CHECK(RefusedEdit(text, l, "\"foot_length\":2e9").find("expected a length in [0, 1e9]") !=
         std::string::npos);
-  CHECK(refuse(l, "\"foot_length\":\"long\"") ==
+  CHECK(RefusedEdit(text, l, "\"foot_length\":\"long\"") ==
         "w.json: tracks[0].foot_length: expected a finite number (line 2)");
-  CHECK(refuse("\"kind\":\"body\"", "\"kind\":\"body\",\"foot_length\":0.2")
+  CHECK(RefusedEdit(text, "\"kind\":\"body\"", "\"kind\":\"body\",\"foot_length\":0.2")
             .find("tracks[2].foot_length: only a foot track has a foot_length") !=
         std::string::npos);
   // Read the same as the keys are parsed and as a whole document, and in another tool's
