@@ -1875,6 +1875,41 @@ class MayaKeyWalkTest(unittest.TestCase):
         for unit in ff.character.WALK_UNITS:
             self.assertIn(unit, ff.character.METRES_PER_UNIT)
 
+    def test_the_unit_factors_are_the_command_lines(self):
+        # The factors are written twice too (linear_units.cpp and METRES_PER_UNIT). A walk
+        # made with --unit U says its lengths in U in its JSON and in metres in its glTF (the
+        # foot nodes' extras): walk_in_unit(json, "m") must give the glTF's numbers.
+        cli = os.environ.get("FOOTFALL_CLI") or os.path.join(REPO, "build", "client", "cli",
+                                                               "footfall")
+        folder = tempfile.mkdtemp()
+        try:
+            for unit in ff.character.WALK_UNITS:
+                walk_path = os.path.join(folder, unit + ".json")
+                gltf_path = os.path.join(folder, unit + ".gltf")
+                run = subprocess.run([cli, "generate", "--terrain", HILLS, "--character",
+                                      os.path.join(CHARACTERS, "biped.json"), "--steps", "1",
+                                      "--unit", unit, "--out", walk_path, "--out", gltf_path],
+                                     capture_output=True, text=True)
+                self.assertEqual(run.returncode, 0, run.stderr)
+                with open(walk_path) as f:
+                    in_metres = ff.character.walk_in_unit(json.load(f), "m")
+                with open(gltf_path) as f:
+                    nodes = json.load(f)["nodes"]
+                gltf_lengths = {(n["extras"]["track"], key): n["extras"][key]
+                                for n in nodes if "extras" in n and "track" in n["extras"]
+                                for key in ("foot_length", "foot_width") if key in n["extras"]}
+                json_lengths = {(t["name"], key): t[key] for t in in_metres["tracks"]
+                                for key in ("foot_length", "foot_width") if key in t}
+                self.assertEqual(len(json_lengths), 4, unit)  # the biped's two feet
+                self.assertEqual(sorted(gltf_lengths), sorted(json_lengths), unit)
+                for name, length in json_lengths.items():
+                    self.assertAlmostEqual(gltf_lengths[name] / length, 1.0, places=12,
+                                           msg="%s %s" % (unit, name))
+        finally:
+            for name in os.listdir(folder):
+                os.unlink(os.path.join(folder, name))
+            os.rmdir(folder)
+
     def test_import_keys_a_walk_that_says_its_unit_in_the_scenes(self):
         # footfall generate --unit m writes "unit": "m": in Maya's default centimetre scene its
         # keys go in 100 times larger; a walk without a unit is keyed as it is.
