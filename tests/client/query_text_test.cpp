@@ -98,7 +98,12 @@ TEST_CASE("malformed query lines say what was expected", "[client][query_text]")
       {"snap 1 2 " + std::string(100000, '7') + "x",
        "snap: argument 3 '77777777777777777777777777777777... (100001 bytes)' is not a finite "
        "number"},
-      {std::string("snap 1 a\x01 3"), "snap: argument 2 'a?' is not a finite number"},
+      // ... with the bytes a '?' stands for (or that do not show, a byte-order mark).
+      {std::string("snap 1 a\x01 3"), "snap: argument 2 'a?' (bytes 61 01) is not a finite number"},
+      {std::string("snap 1 2 3\x7f"), "snap: argument 3 '3?' (bytes 33 7F) is not a finite number"},
+      {"\xef\xbb\xbfsnap 1 2 3",
+       "unknown command '\xef\xbb\xbfsnap' (bytes EF BB BF 73 6E 61 70) (expected snap X Y Z, "
+       "normal X Y Z or next X Y Z DX DY DZ)"},
   };
   for (const auto& [text, message] : bad) {
     INFO("'" << text << "'");

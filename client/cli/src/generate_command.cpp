@@ -74,14 +74,16 @@ bool ParseVec(const std::string& text, const std::string& flag, Vec3* out, std::
   while (std::getline(in, token, ',')) {
     double x;
     if (!ParseFiniteNumber(token, &x)) {
-      *error = flag + " '" + text + "': '" + token + "' is not a finite number (expected X,Y,Z)";
+      *error = flag + " '" + ShownText(text) + "': '" + ShownText(token) + "'" +
+               HiddenBytesNote(token) + " is not a finite number (expected X,Y,Z)";
       return false;
     }
     v.push_back(x);
   }
   if (v.size() != 3 ||
       (!text.empty() && text.back() == ',')) {  // getline drops a last, empty field
-    *error = flag + " '" + text + "': expected X,Y,Z (three numbers separated by commas)";
+    *error =
+        flag + " '" + ShownText(text) + "': expected X,Y,Z (three numbers separated by commas)";
     return false;
   }
   *out = {v[0], v[1], v[2]};

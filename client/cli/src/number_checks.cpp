@@ -4,6 +4,7 @@
 
 #include "footfall/client/query_text.h"
 #include "footfall/terrain/decimal_number.h"
+#include "footfall/terrain/shown_text.h"
 #include "footfall/terrain/text_stream.h"
 
 namespace footfall::cli {
@@ -21,7 +22,8 @@ CLI::Validator Make(const std::string& expected, Ok ok) {
   return CLI::Validator(
       [expected, ok](std::string& input) -> std::string {
         double x;
-        if (!ParseFiniteNumber(input, &x) || !ok(x)) return "'" + input + "' is not " + expected;
+        if (!ParseFiniteNumber(input, &x) || !ok(x))
+          return "'" + ShownText(input) + "'" + HiddenBytesNote(input) + " is not " + expected;
         return "";
       },
       expected);

@@ -90,7 +90,8 @@ bool ParseQueryText(const std::string& text, QueryText* out, std::string* error)
   } else if (op == "next") {
     query.op = QueryOp::kNext, want = 6;
   } else {
-    *error = "unknown command '" + ShownText(op) + "' (expected " + kForms + ")";
+    *error = "unknown command '" + ShownText(op) + "'" + HiddenBytesNote(op) + " (expected " +
+             kForms + ")";
     return false;
   }
   if (tokens.size() - 1 != want) {
@@ -101,8 +102,9 @@ bool ParseQueryText(const std::string& text, QueryText* out, std::string* error)
   double v[6] = {0, 0, 0, 0, 0, 0};
   for (size_t i = 0; i < want; ++i) {
     if (!ParseFiniteNumber(tokens[i + 1], &v[i])) {
-      *error = op + ": argument " + std::to_string(i + 1) + " '" + ShownText(tokens[i + 1]) +
-               "' is not a finite number" + NotFiniteNote(tokens[i + 1]);
+      *error = op + ": argument " + std::to_string(i + 1) + " '" + ShownText(tokens[i + 1]) + "'" +
+               HiddenBytesNote(tokens[i + 1]) + " is not a finite number" +
+               NotFiniteNote(tokens[i + 1]);
       return false;
     }
   }
