@@ -609,6 +609,7 @@ if [ -f "$dem" ]; then
   check "dem --separation 1: stopped early (exit 2)" [ $? -eq 2 ]
   check "dem --separation 1: not resampled for the character" bash -c "! grep -q 'resampled for' '$work/dem-own.err'"
   check "dem --separation 1: advice to resample at a quarter step" grep -q "too far for this character: resample it at a separation of 0.03" "$work/dem-own.err"
+  check "dem --separation 1: how to resample" grep -qF "(a mesh or height map: --separation; a point file is used as it is: sample its surface that finely)" "$work/dem-own.err"
   # Where the terrain simply ends (a goal far off it), no advice to resample.
   "$footfall" generate --terrain "$hills" --character "$chars/biped.json" --start 8,0,8 \
     --path "8,0,12 100,0,100" --out "$work/off-edge.json" 2> "$work/off-edge.err"
@@ -731,7 +732,7 @@ bad steps-fraction "--steps: '1.5' is not a whole number from 0 to 1000000" --te
 bad crowd-fraction "--crowd: '1.5' is not a whole number from 1 to 1000000" --terrain "$hills" --character "$chars/biped.json" --crowd 1.5 --out "$work/x.json"
 bad crowd-0 "--crowd: '0' is not a whole number from 1 to 1000000" --terrain "$hills" --character "$chars/biped.json" --crowd 0 --out "$work/x.json"
 bad threads-fraction "--threads: '2.5' is not a whole number from 1 to 256" --terrain "$hills" --character "$chars/biped.json" --threads 2.5 --out "$work/x.json"
-bad heading-up-flag "it gives no clear direction on the ground; give a heading along the ground with --heading" --terrain "$hills" --character "$chars/biped.json" --heading 0,1,0 --out "$work/x.json"
+bad heading-up-flag "it gives no clear direction on the ground; give a heading along the ground (--heading)" --terrain "$hills" --character "$chars/biped.json" --heading 0,1,0 --out "$work/x.json"
 # A scene's character: its start, heading and up named by the scene file and field (--scene
 # refuses those flags).
 scene_with() {  # scene_with FIELDS: a scene of one biped with these extra fields
@@ -739,7 +740,7 @@ scene_with() {  # scene_with FIELDS: a scene of one biped with these extra field
     "$chars/biped.json" "$1" > "$work/bad-scene.json"
 }
 scene_with '"heading": [0, 1, 0]'
-bad scene-heading-up "biped1: the heading (0.0000, 1.0000, 0.0000) is along the up (0.0000, 1.0000, 0.0000) where the character starts (within 10 deg of it): it gives no clear direction on the ground; give a heading along the ground with $work/bad-scene.json: characters[0]: 'heading'" --terrain "$hills" --scene "$work/bad-scene.json" --out "$work/x.json"
+bad scene-heading-up "biped1: the heading (0.0000, 1.0000, 0.0000) is along the up (0.0000, 1.0000, 0.0000) where the character starts (within 10 deg of it): it gives no clear direction on the ground; give a heading along the ground ($work/bad-scene.json: characters[0]: 'heading')" --terrain "$hills" --scene "$work/bad-scene.json" --out "$work/x.json"
 scene_with '"heading": [0, 0, 0]'
 bad scene-zero-heading "biped1: $work/bad-scene.json: characters[0]: 'heading' must be a non-zero finite vector" --terrain "$hills" --scene "$work/bad-scene.json" --out "$work/x.json"
 scene_with '"up": [0, 0, 0]'

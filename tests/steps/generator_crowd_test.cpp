@@ -203,6 +203,29 @@ TEST_CASE("Crowd places closer than the terrain's samples are left out for their
   }
 }
 
+TEST_CASE("Crowd members on a terrain of one point are told so, not of a spacing",
+          "[steps][generator][crowd]") {
+  // One sample, or several at one place: the grid's spacing is no measure there (it read
+  // "the terrain's samples, about 1 apart, are coarse for the crowd's spacing").
+  const Character c = LoadShipped("quadruped");
+  for (const int copies : {1, 3}) {
+    INFO(copies << " samples");
+    RawSamples point;
+    for (int i = 0; i < copies; ++i) point.push_back({0, 0, 0}, {0, 1, 0});
+    Terrain t = LoadTerrain(point, 0.1);
+    const Walk w = Generate(t, c, CrowdOptions({0, 0, 0}, 2, 2, 2 * c.reach));
+    size_t left_out = 0;
+    for (const std::string& stop : w.stops) {
+      if (stop.find("left out") == std::string::npos) continue;
+      ++left_out;
+      CHECK_THAT(stop, Catch::Contains("(the terrain is a single point, onto which every place "
+                                       "snaps): left out of the walk"));
+      CHECK_THAT(stop, !Catch::Contains("apart"));
+    }
+    CHECK(left_out == 1);
+  }
+}
+
 TEST_CASE("Crowd members pushed onto the terrain's edge plant no foot on another's sample",
           "[steps][generator][crowd]") {
   // 1,000 hexapods on 12 m of rocks: the grid runs far off the terrain, and places pushed onto

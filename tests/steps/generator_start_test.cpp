@@ -204,7 +204,7 @@ TEST_CASE("A generate request's start heading up and steps are named by its fiel
     return error;
   };
   CHECK(error_of("\"heading\": [0, 1, 0]")
-            .find("give a heading along the ground with request: 'heading'") != std::string::npos);
+            .find("give a heading along the ground (request: 'heading')") != std::string::npos);
   CHECK(error_of("\"heading\": [0, 0, 0]") ==
         "request: 'heading' must be a non-zero finite vector");
   CHECK(error_of("\"up\": [0, 0, 0]") == "request: 'up' must be a non-zero finite vector");

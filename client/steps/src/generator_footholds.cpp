@@ -590,7 +590,9 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
         kSeparationPerStep * c_.step_length < 0.8 * spacing) {
       why << "; the terrain's samples lie about " << spacing
           << " apart, too far for this character: resample it at a separation of "
-          << kSeparationPerStep * c_.step_length;
+          << kSeparationPerStep * c_.step_length
+          << " (a mesh or height map: --separation; a point file is used as it is: sample its "
+             "surface that finely)";
     }
   } else if (std::fabs(rise) > rise_limit) {
     why << "the foothold at " << Point(h.point) << (rise > 0 ? " rises " : " drops ")

@@ -140,7 +140,9 @@ Status Generator::Setup(std::string* error) {
   // hills, 1.35 m inside the terrain, were said to be off its edge.)
   auto crowded_why = [&](int i) {
     Text why(3);
-    if (spacing < sample_gap) {
+    if (bounds_min_ == bounds_max_) {  // one sample, or all at one point: no spacing to blame
+      why << "the terrain is a single point, onto which every place snaps";
+    } else if (spacing < sample_gap) {
       why << "the crowd's spacing, " << spacing << ", is finer than the terrain's samples, "
           << "about " << sample_gap << " apart";
     } else if (snapped_across[i] > 0.25 * spacing + sample_gap) {
@@ -183,8 +185,8 @@ Status Generator::Setup(std::string* error) {
       m << "the heading " << Point(o_.heading) << " is along the up " << Point(up)
         << " where the character starts (within " << kMinDegreesFromUp
         << " deg of it): it gives no clear direction on the ground; give a heading along the "
-           "ground with "
-        << o_.names.heading;
+           "ground ("
+        << o_.names.heading << ")";
       *error = m.str();
       return Status::kInvalidArgument;
     }
