@@ -65,6 +65,8 @@ check "-o=FILE: no file '=eq.pts' written" [ ! -e "$work/=eq.pts" ]
 check "file name starting with '-' after '--': read" [ $? -eq 0 ]
 echo "next 0 0 0 1 0 0" | "$footfall" query --terrain="$work/flat.pts" --tolerance=-1 > /dev/null 2> "$work/err.txt"
 check "--tolerance=-1: refused as a value" grep -qF -- "--tolerance: '-1' is not a finite number >= 0" "$work/err.txt"
+echo "snap 0 0 0" | "$footfall" query --terrain="$work/flat.pts" --tolerance=$'1\x01' > /dev/null 2> "$work/err.txt"
+check "--tolerance with a control byte: its bytes shown" grep -qF -- "--tolerance: '1?' (bytes 31 01) is not a finite number >= 0" "$work/err.txt"
 # --version prints the version and exits 0, as a script checking which footfall it runs expects.
 out=$("$footfall" --version 2> "$work/err.txt")
 check "--version: exit 0" [ $? -eq 0 ]

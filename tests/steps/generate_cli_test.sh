@@ -676,6 +676,7 @@ bad() {  # bad NAME EXPECTED_MESSAGE ARGS...: exit 1
 bad start "--start '1,2': expected X,Y,Z" --terrain "$hills" --character "$chars/biped.json" --start 1,2 --out "$work/x.json"
 bad start-comma "--start '8,0,12,': expected X,Y,Z" --terrain "$hills" --character "$chars/biped.json" --start 8,0,12, --out "$work/x.json"
 bad heading "--heading 'a,0,1': 'a' is not a finite number" --terrain "$hills" --character "$chars/biped.json" --heading a,0,1 --out "$work/x.json"
+bad heading-bytes "--heading '1,0?,1': '0?' (bytes 30 01) is not a finite number" --terrain "$hills" --character "$chars/biped.json" --heading $'1,0\x01,1' --out "$work/x.json"
 bad path "--path '3,4': expected X,Y,Z" --terrain "$hills" --character "$chars/biped.json" --path "1,0,1 3,4" --out "$work/x.json"
 bad path-spaces "each waypoint X,Y,Z without spaces" --terrain "$hills" --character "$chars/biped.json" --path "20, 0, 25" --out "$work/x.json"
 bad extension "unsupported output extension" --terrain "$hills" --character "$chars/biped.json" --out "$work/x.csv"
