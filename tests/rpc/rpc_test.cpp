@@ -1746,6 +1746,26 @@ TEST_CASE("misbehaving clients leave others served and memory flat", "[rpc][robu
     RequireServed(server.port());
     for (int fd : held) close(fd);
   }
+  SECTION("half-sent requests announcing a record up to and past the size limit") {
+    // A record mark alone, announcing 262,145 to 270,336 bytes (past the transport's buffer,
+    // within the old record limit), sent and no more: libtirpc grew its buffer and then spun
+    // on the connection, serving no one else, until the sender went away.
+    std::vector<int> held;
+    for (const uint32_t length : {FF_MAX_REQUEST_BYTES - 4u, FF_MAX_REQUEST_BYTES + 0u,
+                                  FF_MAX_REQUEST_BYTES + 1u, FF_MAX_REQUEST_BYTES + 4096u,
+                                  FF_MAX_REQUEST_BYTES + 8192u, FF_MAX_REQUEST_BYTES + 8193u}) {
+      for (const bool last : {true, false}) {
+        INFO("announced " << length << " bytes, last fragment " << last);
+        const int fd = RawConnect(server.port());
+        std::vector<unsigned char> mark;
+        Put32(&mark, (last ? 0x80000000u : 0) | length);
+        SendSome(fd, mark);
+        held.push_back(fd);
+        RequireServed(server.port());
+      }
+    }
+    for (int fd : held) close(fd);
+  }
   SECTION("clients that never read their replies") {
     // Full snap batches on the real terrain: 64 large replies nobody reads, per client.
     std::vector<unsigned char> batch;

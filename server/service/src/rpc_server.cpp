@@ -172,10 +172,13 @@ bool RpcServer::Start(std::string* error) {
   mallopt(M_MMAP_THRESHOLD, FF_MAX_REQUEST_BYTES);
   // Non-blocking transports with a bounded record size: a half-sent request cannot stall the
   // loop (ReadGate holds back clients that never read). Must be set before the transport is
-  // created.
-  int max_record = FF_MAX_REQUEST_BYTES + 8192;
+  // created. The record limit is the receive buffer itself (libtirpc caps it at 256 KiB,
+  // FF_MAX_REQUEST_BYTES): a fragment announced past the buffer but within a larger limit made
+  // libtirpc grow the buffer, after which it took the half-received record for one still
+  // holding requests and read it again and again, serving no one else, until the rest came.
+  int max_record = FF_MAX_REQUEST_BYTES;
   rpc_control(RPC_SVC_CONNMAXREC_SET, &max_record);
-  SVCXPRT* transport = svc_vc_create(listen_fd_, FF_MAX_REQUEST_BYTES, FF_MAX_REQUEST_BYTES + 8192);
+  SVCXPRT* transport = svc_vc_create(listen_fd_, FF_MAX_REQUEST_BYTES, FF_MAX_REQUEST_BYTES);
   if (!transport) {
     *error = "cannot create the RPC transport";
     return false;
