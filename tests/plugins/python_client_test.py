@@ -792,6 +792,26 @@ class RpcTest(unittest.TestCase):
             thread.join()
         self.assertEqual(crossed, [])
 
+    def test_a_terrain_name_given_as_bytes_is_sent_as_its_bytes(self):
+        # str(b"ridge") named the terrain "b'ridge'" in footfalld's log.
+        samples = [(0.0, 0.0, 0.0, 0.0, 1.0, 0.0), (1.0, 0.0, 0.0, 0.0, 1.0, 0.0)]
+        for name, logged in ((b"ridge", "'ridge'"), (bytearray(b"caf\xc3\xa9"), "'caf\u00e9'"),
+                             ("stairs", "'stairs'")):
+            self.s.load_samples(samples, name=name)
+            deadline = time.time() + 5
+            while logged not in self._log() and time.time() < deadline:
+                time.sleep(0.05)
+            self.assertIn("loaded terrain", self._log())
+            self.assertIn(logged, self._log())
+            self.assertNotIn("b'", self._log())
+        with self.assertRaises(ff.FootfallError):
+            self.s.load_samples(samples, name=b"a\0b")
+
+    def _log(self):
+        with open(self.server.log_path or os.path.join(self.server._dir, "footfalld.log"),
+                  encoding="utf-8", errors="replace") as f:
+            return f.read()
+
     def test_a_local_server_on_ipv6_loopback(self):
         # LocalServer(host="::1") passed --listen ::1:0, which footfalld refuses: it never
         # started.

@@ -342,16 +342,20 @@ class Session:
     def load_samples(self, samples, name="samples"):
         """Loads samples (x, y, z, nx, ny, nz) given as 6-tuples or one flat sequence (an
         array('d') as sampling.sample_triangles_flat returns is sent as it is, with no copy);
-        returns the terrain id."""
+        returns the terrain id. The name is text (sent as UTF-8) or bytes (sent as they are:
+        footfalld's log shows bytes that are not UTF-8 escaped); anything else as str() gives
+        it."""
         h = self._handle("ffc_load_samples")
-        name = str(name)
-        if "\0" in name:  # C would read it cut short at the NUL: another name in the log
+        if isinstance(name, (bytes, bytearray)):
+            encoded = bytes(name)  # (str() gave "b'...'", the repr, as the name)
+        else:
+            encoded = str(name).encode("utf-8", "replace")
+        if b"\0" in encoded:  # C would read it cut short at the NUL: another name in the log
             raise FootfallError(INVALID_ARGUMENT, "name %r: holds a NUL byte" % (name,),
                                 "ffc_load_samples")
         flat = _flat(samples, 6, "samples")
         out = ctypes.c_uint32()
-        self._check(self._lib.lib.ffc_load_samples(h, _pointer(flat), len(flat) // 6,
-                                                   name.encode("utf-8", "replace"),
+        self._check(self._lib.lib.ffc_load_samples(h, _pointer(flat), len(flat) // 6, encoded,
                                                    ctypes.byref(out)),
                     "ffc_load_samples")
         return out.value
