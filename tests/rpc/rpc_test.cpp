@@ -505,6 +505,7 @@ TEST_CASE("A batch past --batch-time-limit lets other clients in and is complete
     RequireSame(got[i], expected[i]);
   }
   CHECK_THAT(server.Log(), Catch::Contains("past its time limit (0.05 s)"));
+  CHECK_THAT(server.Log(), Catch::Contains("to be asked again (client 127.0.0.1:"));
 
   // A client that never said it asks again (FF_ASK_AGAIN, as the library does) gets batches in
   // parts too: a raw client held every other for a whole batch (20 s and more).

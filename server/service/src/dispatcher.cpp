@@ -516,9 +516,11 @@ constexpr double kLimitCheckS = 0.002;
 
 // Answers queries [0, n) of a batch into g_storage.answers on the batch threads; `answer(b, e)`
 // fills answers [b, e). Queries taken after `limit_s` seconds are answered kLimitExceeded, to be
-// asked again (the first always is answered: every call makes progress). True if any was.
+// asked again (the first always is answered: every call makes progress). True if any was; the
+// log line saying so names the client `peer`.
 template <typename Fn>
-bool RunBatch(size_t n, BatchReplyView<Foothold>* r, double limit_s, Fn&& answer) {
+bool RunBatch(size_t n, BatchReplyView<Foothold>* r, double limit_s, const std::string& peer,
+              Fn&& answer) {
   Foothold* answers = g_storage.answers.data();
   using Clock = std::chrono::steady_clock;
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
@@ -559,7 +561,8 @@ bool RunBatch(size_t n, BatchReplyView<Foothold>* r, double limit_s, Fn&& answer
                (limit_s < g_state->batch_time_limit_s ? ", --batch-time-limit shared with other "
                                                         "connections sending costly batches"
                                                       : "") +
-               "): " + std::to_string(late.load()) + " answered limit_exceeded, to be asked again");
+               "): " + std::to_string(late.load()) +
+               " answered limit_exceeded, to be asked again (client " + peer + ")");
   r->status = FF_OK;
   r->count = r->capacity = static_cast<u_int>(n);
   r->results = answers;
@@ -567,8 +570,8 @@ bool RunBatch(size_t n, BatchReplyView<Foothold>* r, double limit_s, Fn&& answer
 }
 
 // A snap or normal batch, answered within `limit_s` seconds (RunBatch). True if cut.
-bool PointBatch(const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r, int op,
-                double limit_s) {
+bool PointBatch(const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r, int op, double limit_s,
+                const std::string& peer) {
   const LoadedTerrain* t = g_state->registry.Use(a.terrain);
   if (!t) {
     LogUnknownTerrain(op == FF_OP_SNAP ? "snap batch" : "normal batch", a.terrain);
@@ -577,7 +580,7 @@ bool PointBatch(const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r, int 
   }
   const size_t n = a.count;
   const Vec3* points = a.points;
-  const bool cut = RunBatch(n, r, limit_s, [&](size_t b, size_t e, Foothold* out) {
+  const bool cut = RunBatch(n, r, limit_s, peer, [&](size_t b, size_t e, Foothold* out) {
     t->grid.SnapBatch(points + b, e - b, out + b);
   });
   for (size_t i = 0; i < n && i < kRecordPerBatch; ++i)
@@ -586,7 +589,8 @@ bool PointBatch(const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r, int 
 }
 
 // A next batch, answered within `limit_s` seconds (RunBatch). True if cut.
-bool NextBatch(const NextBatchView<StepQuery>& a, BatchReplyView<Foothold>* r, double limit_s) {
+bool NextBatch(const NextBatchView<StepQuery>& a, BatchReplyView<Foothold>* r, double limit_s,
+               const std::string& peer) {
   const LoadedTerrain* t = g_state->registry.Use(a.terrain);
   if (!t) {
     LogUnknownTerrain("next batch", a.terrain);
@@ -600,7 +604,7 @@ bool NextBatch(const NextBatchView<StepQuery>& a, BatchReplyView<Foothold>* r, d
   const size_t n = a.count;
   const StepQuery* steps = a.queries;
   const double tolerance = a.tolerance;
-  const bool cut = RunBatch(n, r, limit_s, [&](size_t b, size_t e, Foothold* out) {
+  const bool cut = RunBatch(n, r, limit_s, peer, [&](size_t b, size_t e, Foothold* out) {
     t->grid.NextBatch(steps + b, e - b, tolerance, out + b);
   });
   for (size_t i = 0; i < n && i < kRecordPerBatch; ++i)
@@ -805,7 +809,8 @@ void DispatchRequest(svc_req* request, SVCXPRT* transport) {
           AsXdrProc(XdrBatchReplyView<Foothold>),
           request->rq_proc == FF_SNAP_BATCH ? "snap batch" : "normal batch",
           [op, transport](const PointBatchView<Vec3>& a, BatchReplyView<Foothold>* r) {
-            if (PointBatch(a, r, op, BatchSliceSeconds(transport))) NoteBatchCut(transport);
+            if (PointBatch(a, r, op, BatchSliceSeconds(transport), ConnectionOf(transport).shown))
+              NoteBatchCut(transport);
           });
     }
     case FF_NEXT_BATCH: {
@@ -816,7 +821,8 @@ void DispatchRequest(svc_req* request, SVCXPRT* transport) {
           transport, AsXdrProc(XdrNextBatchView<StepQuery>), args,
           AsXdrProc(XdrBatchReplyView<Foothold>), "next batch",
           [transport](const NextBatchView<StepQuery>& a, BatchReplyView<Foothold>* r) {
-            if (NextBatch(a, r, BatchSliceSeconds(transport))) NoteBatchCut(transport);
+            if (NextBatch(a, r, BatchSliceSeconds(transport), ConnectionOf(transport).shown))
+              NoteBatchCut(transport);
           });
     }
     case FF_ASK_AGAIN: {
