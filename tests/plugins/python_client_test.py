@@ -725,6 +725,23 @@ class SharedLogicTest(unittest.TestCase):
                                          '[{"frame": 1, "position": [0, 0, 0], "rotation": '
                                          '[0, 0, 0, 1%s]}]}]}' % ("0" * 400)),
                  "expected \"rotation\"")]
+        # As footfall's reader takes them (the viewer refused these; Import keyed them, the
+        # second of two keys at one frame over the first): a later format version, two keys
+        # at one frame, a bad phase or frame rate.
+        foot = good["tracks"][0]
+        key = foot["keys"][0]
+        bad += [(dict(good, version=2), "w.json: version: expected 1"),
+                (dict(good, format="footfall-scene"), "format: expected \"footfall-walk\""),
+                (dict(good, fps=0), "fps: expected a positive number"),
+                (dict(good, fps="24"), "fps: expected a positive number"),
+                ({"tracks": [dict(foot, keys=[key, dict(key)])]},
+                 "tracks[0].keys[1].frame: frames must increase along a track (1 after 1)"),
+                ({"tracks": [dict(foot, keys=[dict(key, frame=2), key])]},
+                 "frames must increase along a track (1 after 2)"),
+                ({"tracks": [dict(foot, keys=[dict(key, phase="lift")])]},
+                 "tracks[0].keys[0].phase: expected \"start\", \"mid\" or \"end\"")]
+        ff.character.check_walk(dict(good, format="footfall-walk", version=1, fps=30.0))
+        ff.character.check_walk({"tracks": [dict(foot, keys=[dict(key, phase="end")])]})
         for walk, message in bad:
             with self.assertRaises(ValueError, msg=str(walk)) as e:
                 ff.character.check_walk(walk, "w.json")

@@ -292,10 +292,21 @@ def _finite_number(value):
 def check_walk(walk, name="walk"):
     """Raises ValueError naming the first problem of a footfall walk dict (JSON format
     "footfall-walk", as read from a file), before a plugin keys or creates anything: tracks
-    with a name and a kind, keys with a finite frame, a position of three finite numbers and,
-    where given, a rotation of four (a foot's on all its keys or on none)."""
+    with a name and a kind, keys with a finite frame, increasing along each track, a position
+    of three finite numbers and, where given, a rotation of four (a foot's on all its keys or
+    on none) and a phase. The header's fields, where given, as footfall's reader takes them:
+    "format" "footfall-walk", "version" 1 (a later format is refused, not misread), "fps" a
+    positive number. A walk of tracks alone (as read back from a glTF, or written by hand) is
+    taken: the plugins key frames and positions, not phases or frame rates."""
     if not isinstance(walk, dict) or not isinstance(walk.get("tracks"), list):
         raise ValueError("%s: expected footfall walk JSON with a \"tracks\" list" % name)
+    if "format" in walk and walk["format"] != "footfall-walk":
+        raise ValueError("%s: format: expected \"footfall-walk\"" % name)
+    if "version" in walk and (not _finite_number(walk["version"]) or walk["version"] != 1):
+        raise ValueError("%s: version: expected 1 (a walk of another format version: update "
+                         "footfall)" % name)
+    if "fps" in walk and (not _finite_number(walk["fps"]) or not walk["fps"] > 0):
+        raise ValueError("%s: fps: expected a positive number" % name)
     if "unit" in walk and walk["unit"] not in WALK_UNITS:
         raise ValueError("%s: unit: expected one of %s" % (name, ", ".join(WALK_UNITS)))
 
@@ -316,6 +327,12 @@ def check_walk(walk, name="walk"):
             at = "%s.keys[%d]" % (where, k)
             if not isinstance(key, dict) or not finite([key.get("frame")], 1):
                 raise ValueError("%s: expected a finite \"frame\"" % at)
+            # (Two keys at one frame: one was keyed over the other, with no word.)
+            if k > 0 and not key["frame"] > keys[k - 1]["frame"]:
+                raise ValueError("%s.frame: frames must increase along a track (%.15g after "
+                                 "%.15g)" % (at, key["frame"], keys[k - 1]["frame"]))
+            if "phase" in key and key["phase"] not in ("start", "mid", "end"):
+                raise ValueError("%s.phase: expected \"start\", \"mid\" or \"end\"" % at)
             if not finite(key.get("position"), 3):
                 raise ValueError("%s: expected \"position\": [x, y, z] (finite numbers)" % at)
             if "rotation" in key and (not finite(key["rotation"], 4) or
