@@ -1857,15 +1857,50 @@ class BlenderAddonTest(unittest.TestCase):
         try:
             body.keyframe_insert("location", frame=user_frame)
             feet["L"].keyframe_insert("location", frame=user_frame)
-            self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
+            result, error, reports = run_reporting(bpy.ops.footfall.generate_walk)
+            self.assertEqual(result, {"FINISHED"}, (error, reports))
             walk = json.loads(bpy.data.texts["footfall_walk.json"].as_string())
             last = max(k["frame"] for t in walk["tracks"] for k in t["keys"])
             self.assertLess(last, user_frame - 50)  # the goal was reached early
+            # The steps walked are reported, not the 40 asked.
+            walked = len([t for t in walk["tracks"] if t["kind"] == "body"][0]["keys"]) - 1
+            self.assertLess(walked, 20)
+            self.assertIn("Info: footfall: %d steps (the path's goal reached; 40 asked), "
+                          % walked, "\n".join(reports))
             for obj in (body, feet["L"]):
                 frames = [kp.co[0] for fc in obj.animation_data.action.fcurves
                           if fc.data_path == "location" for kp in fc.keyframe_points]
                 self.assertIn(float(user_frame), frames, obj.name)
             self.assertEqual(rig.footfall_rig.walk_end, last)
+        finally:
+            settings.path = None
+            bpy.data.objects.remove(path)
+            bpy.data.curves.remove(data)
+
+    def test_8c1_a_path_curve_of_one_point_is_a_goal(self):
+        # A one-point curve was refused ("fewer than 2 points"); the command line takes one
+        # waypoint as the goal.
+        rig, feet, body, settings = self.biped_walk_setup(40)
+        start = body.matrix_world.translation.copy()
+        data = bpy.data.curves.new("goal_path", "CURVE")
+        data.dimensions = "3D"
+        spline = data.splines.new("POLY")
+        goal = (start.x, start.y + 2.0, start.z)
+        spline.points[0].co = goal + (1.0,)
+        path = bpy.data.objects.new("goal_path", data)
+        bpy.context.scene.collection.objects.link(path)
+        settings.path = path
+        try:
+            bpy.context.view_layer.update()
+            self.assertEqual(len(self.ops.walk_request(bpy.context, rig, 4, 1)["path"]), 1)
+            result, error, reports = run_reporting(bpy.ops.footfall.generate_walk)
+            self.assertEqual(result, {"FINISHED"}, (error, reports))
+            walk = json.loads(bpy.data.texts["footfall_walk.json"].as_string())
+            body_keys = [t for t in walk["tracks"] if t["kind"] == "body"][0]["keys"]
+            self.assertGreater(len(body_keys), 2)
+            # The body ends within a step of the goal, across the ground.
+            end = Vector(from_ff(body_keys[-1]["position"]))
+            self.assertLess((end - Vector(goal)).xy.length, 0.8)
         finally:
             settings.path = None
             bpy.data.objects.remove(path)

@@ -713,8 +713,9 @@ def curve_points(context, obj):
                          "remove or change the modifier, or apply it and separate the line to "
                          "follow" % (obj.name, pieces,
                                      ", ".join(m.name for m in obj.modifiers) or "none"))
-    if len(pts) < 2:
-        raise ValueError("path %s has fewer than 2 points" % obj.name)
+    # One point is a goal, as `footfall generate --path X,Y,Z` takes it (it was refused).
+    if not pts:
+        raise ValueError("path curve %s has no points" % obj.name)
     return pts
 
 
@@ -826,6 +827,7 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
         chunk = self.chunk_steps or max(1, int(math.ceil(total / 10.0)))
         wm = context.window_manager
         keyed = 0
+        walked = 0
         walk_text = None
         notes = []  # the last walk's
         # Where the previous walk ended (None: unknown, an older rig's), for the failure report.
@@ -891,6 +893,9 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
                                 if (t.get("kind") == "body" and body) or t.get("name") in feet)
                     walk_text = walk_text_new
                     stopped = walk.get("stopped")
+                    # A body key a step, and one at the start.
+                    walked = max((len(t.get("keys", [])) for t in walk.get("tracks", [])
+                                  if t.get("kind") == "body"), default=1) - 1
                 else:
                     stopped = None
                 if status != 0 or stopped:
@@ -899,6 +904,8 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
                 wm.progress_update(done)
                 if chunk_hook is not None:
                     chunk_hook(self, done)
+                if walked < done:
+                    break  # a path's goal reached: more steps asked would give the same walk
         except (ffc.FootfallError, ValueError, OSError) as e:
             if walk_text is None:  # nothing generated: the rig's keys are as they were
                 return _fail(self, "%s; the rig's keys are unchanged" % _error_text(e))
@@ -921,7 +928,10 @@ class FOOTFALL_OT_generate_walk(bpy.types.Operator):
             except Exception:
                 pass
             _status(context, None)
-        self.report({"INFO"}, "footfall: %d steps, %d keys on %s" % (total, keyed, rig_obj.name))
+        # The steps walked (a path walk that reached its goal early was said to walk them all).
+        self.report({"INFO"}, "footfall: %d steps%s, %d keys on %s"
+                    % (walked, " (the path's goal reached; %d asked)" % total
+                       if walked < total else "", keyed, rig_obj.name))
         report_notes(self, notes)  # after: the status bar shows the last report
         return {"FINISHED"}
 
