@@ -424,6 +424,18 @@ class BlenderAddonTest(unittest.TestCase):
             self.assertIn("footfall_test_plain_empty has no faces to walk on: select a mesh",
                           str(e.exception))
             self.assertEqual((scene.terrain_key, scene.sample_count), (key, count))
+            # Faces of no area (scaled to 0 on an axis): a report naming the object (it was
+            # "blender: no samples").
+            bpy.ops.mesh.primitive_plane_add(size=4.0, location=(60.0, 0.0, 0.0))
+            flat = bpy.context.active_object
+            made.append(flat)
+            flat.scale = (0.0, 1.0, 1.0)
+            bpy.context.view_layer.update()
+            self.select([flat], flat)
+            with self.assertRaises(RuntimeError) as e:
+                bpy.ops.footfall.terrain_setup()
+            self.assertIn("%s has faces of no area to walk on" % flat.name, str(e.exception))
+            self.assertEqual((scene.terrain_key, scene.sample_count), (key, count))
         finally:
             curves = [o.data for o in made if o.type == "CURVE"]
             for obj in made:

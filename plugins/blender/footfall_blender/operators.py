@@ -285,7 +285,12 @@ def mesh_samples(context, obj, separation):
     # (Refused as sample_triangles_flat will, before the slow corner normals.)
     sampling.check_sample_count(points, tris, separation, sampling.flat_sample_limit())
     normals = sampling.corner_normals(points, tris)
-    return sampling.sample_triangles_flat(points, tris, separation, corner_normals=normals)
+    samples = sampling.sample_triangles_flat(points, tris, separation, corner_normals=normals)
+    # (It was sent, and refused as "blender: no samples", naming no object.)
+    if not samples:
+        raise ValueError("%s has faces of no area to walk on (a scale of 0 on an axis?)"
+                         % obj.name)
+    return samples
 
 
 class FOOTFALL_OT_terrain_setup(bpy.types.Operator):
