@@ -264,6 +264,25 @@ class EmbeddedTest(unittest.TestCase):
 class SharedLogicTest(unittest.TestCase):
     """The pure-Python parts both plugins use: mesh resampling and character files."""
 
+    def test_a_biped_on_a_wall_is_told_in_the_scene_s_terms(self):
+        # The generator advises giving the request's "up", which the plugins never set (their
+        # scene's up is footfall's): said in Blender and Maya as advice their users can follow.
+        wall = [(0.0, 0.1 * i, 0.1 * j, 1.0, 0.0, 0.0) for i in range(41) for j in range(41)]
+        with ff.Session.embedded() as s:
+            terrain = s.load_samples(wall, "wall")
+            request = {"character": ff.character.load(os.path.join(CHARACTERS, "biped.json")),
+                       "steps": 4}
+            status, _, message, _ = s.generate_json_with_notes(terrain, request)
+        self.assertNotEqual(status, 0)
+        self.assertIn("; if the terrain's up is not (0.0000, 1.0000, 0.0000), give the world up "
+                      "with request: 'up' (X up: [1, 0, 0])", message)
+        said = ff.character.in_scene_terms(message, "Z")
+        self.assertNotIn("request: 'up'", said)
+        self.assertIn("ground leans 90 deg, more than max_slope_deg 45; a biped stands upright "
+                      "along the scene's Z axis: turn the terrain so that its ground faces +Z; "
+                      "walk stopped", said)
+        self.assertEqual(ff.character.in_scene_terms("step 2: a cliff", "Y"), "step 2: a cliff")
+
     def test_errors_survive_pickling(self):
         # A multiprocessing pool sends a worker's exception back pickled: one that cannot be
         # rebuilt kills the pool's result thread and the caller waits forever.

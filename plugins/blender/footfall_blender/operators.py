@@ -189,7 +189,7 @@ def _fail(op, message):
 
 def _error_text(e):
     if isinstance(e, ffc.FootfallError):
-        return "footfall: %s (%s)" % (e.message, e.status_name)
+        return "footfall: %s (%s)" % (character.in_scene_terms(e.message, "Z"), e.status_name)
     return "footfall: %s" % e
 
 

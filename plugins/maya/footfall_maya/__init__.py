@@ -73,7 +73,7 @@ def _guard(fn):
         try:
             return fn(*args, **kwargs)
         except ffc.FootfallError as e:
-            _error("%s (%s)" % (e.message, e.status_name))
+            _error("%s (%s)" % (ffc.character.in_scene_terms(e.message, "Y"), e.status_name))
         except (ValueError, OSError, RuntimeError) as e:
             _error(str(e))
         except Exception as e:  # anything else is a bug: reported, never a traceback into Maya

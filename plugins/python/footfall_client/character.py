@@ -388,3 +388,17 @@ def rig_tracks(walk, feet, has_body, name="walk"):
                          "another character's walk; import it with no rig active, onto new "
                          "objects" % (name, ", ".join(foreign), ", ".join(feet) or "none"))
     return walk_feet, body
+
+
+# The generator's advice to a biped on ground across its up names the request's "up" field
+# (generator_setup.cpp), which the plugins never set: the scene's up axis is footfall's up.
+_UP_ADVICE = re.compile(r"; if the terrain's up is not \([^()]*\), give the world up with "
+                        r"request: 'up' \([^()]*\)")
+
+
+def in_scene_terms(message, scene_up):
+    """`message` (a generate failure's) with advice a plugin's user cannot follow, to give the
+    request's "up", said as they can: the scene's up axis `scene_up` ("Z" in Blender, "Y" in
+    Maya) is a biped's up, so its ground must face that way."""
+    return _UP_ADVICE.sub("; a biped stands upright along the scene's %s axis: turn the terrain "
+                          "so that its ground faces +%s" % (scene_up, scene_up), message)
