@@ -50,9 +50,11 @@ class Connection:
         if not hung and self.session.ping():
             return self.session
         if hung and not start_local:
+            # (Or something else answers there, not in ONC RPC: an HTTP server's reply reads as
+            # a record a gigabyte long, waited for until the timeout.)
             raise FootfallError(UNAVAILABLE, "footfalld at %s:%d does not answer within %g s: it "
-                                "is there, but busy or hung (%s)" % (target + (timeout, reason)),
-                                "connect")
+                                "is there, but busy or hung, or the port is another program's "
+                                "(%s)" % (target + (timeout, reason)), "connect")
         if not start_local:
             raise FootfallError(UNAVAILABLE, "no footfalld answers at %s:%d: start one there or "
                                 "allow starting a local footfalld" % target, "connect")
