@@ -1043,6 +1043,39 @@ class ConnectionTest(unittest.TestCase):
         self.c.shutdown()
         self.server.stop()
 
+    def test_a_port_held_by_another_program_is_said_to_be_maybe_not_footfalld(self):
+        # An HTTP server's answer reads as a record a gigabyte long: the call waits its timeout.
+        import socket
+        import threading
+        listener = socket.socket()
+        listener.bind(("127.0.0.1", 0))
+        listener.listen(4)
+        port = listener.getsockname()[1]
+        accepted = []
+
+        def answer():
+            try:
+                while True:
+                    conn, _ = listener.accept()
+                    accepted.append(conn)
+                    conn.recv(4096)
+                    conn.sendall(b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\n\r\n")
+            except OSError:
+                pass  # the listener closed: the test is over
+        thread = threading.Thread(target=answer, daemon=True)
+        thread.start()
+        try:
+            with self.assertRaises(ff.FootfallError) as e:
+                self.c.get("127.0.0.1", port, start_local=False, timeout=0.5)
+        finally:
+            listener.close()
+            for conn in accepted:
+                conn.close()
+        self.assertGreater(len(accepted), 0)
+        self.assertIn("footfalld at 127.0.0.1:%d does not answer within 0.5 s: it is there, but "
+                      "busy or hung, or the port is another program's" % port,
+                      e.exception.message)
+
     def test_changed_preferences_leave_the_private_server(self):
         # Once a local footfalld was started, every later call went to it, whatever server the
         # preferences named from then on.
