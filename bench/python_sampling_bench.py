@@ -112,7 +112,8 @@ def written(path, samples, runs):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--n", type=int, default=100, help="vertices along each side")
     ap.add_argument("--spacing", type=float, default=0.5, help="between vertices")
     ap.add_argument("--separation", type=float, default=0.1, help="between samples")

@@ -14,7 +14,7 @@ if [ "$(id -u)" -eq 0 ]; then
   as_user=(setpriv --reuid=65534 --regid=65534 --clear-groups)
 fi
 chmod 755 "$work"
-mkdir -p "$work/root/locked" "$work/run"
+mkdir -p "$work/root/locked" "$work/root/inner" "$work/run"
 chmod 777 "$work/run"
 # Run from a copy that nobody may execute wherever the build lies (under /root, say).
 cp "$footfalld" "$work/run/footfalld"
@@ -58,5 +58,11 @@ chmod 700 "$work/root"
 err=$(timeout 20 "${as_user[@]}" "$footfalld" --listen 127.0.0.1:0 --no-rpcbind --data-root "$work/root" 2>&1)
 check "unsearchable root: exit 2" [ $? -eq 2 ]
 check "unsearchable root: said" grep -qF "footfalld: --data-root $work/root: this user (uid $(id -u "${as_user[@]:+nobody}")) may not search it (Permission denied), so no load could succeed" <<< "$err"
+# A root inside a folder its user may not search: it is there, not "no such folder".
+err=$(timeout 20 "${as_user[@]}" "$footfalld" --listen 127.0.0.1:0 --no-rpcbind --data-root "$work/root/inner" 2>&1)
+check "root behind an unsearchable folder: exit 2" [ $? -eq 2 ]
+check "root behind an unsearchable folder: said" grep -qF -- "--data-root: '$work/root/inner': cannot be reached (Permission denied)" <<< "$err"
+err=$(timeout 20 "${as_user[@]}" "$footfalld" --listen 127.0.0.1:0 --no-rpcbind --data-root "$work/no/such" 2>&1)
+check "missing root: said" grep -qF -- "--data-root: '$work/no/such': no such folder (No such file or directory)" <<< "$err"
 chmod -R u+rwx "$work/root"
 finish

@@ -899,7 +899,8 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
   CLI::Option* scale =
       cmd->add_option("--scale", flags->scale,
                       "Multiply the character's lengths (its feet's rests, step length and "
-                      "height, body height, max_rise, reach, foot length) by this: 100 walks a "
+                      "height, body height, max_rise, reach, foot length and width) by this: 100 "
+                      "walks a "
                       "character file in metres on a terrain in centimetres (default 1)")
           ->check(FiniteRange(kMinCharacterScale, kMaxCharacterScale));
   // The character file's walk settings, as the plugins' panels override them (the ranges are

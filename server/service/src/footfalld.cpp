@@ -142,8 +142,14 @@ CLI::Validator ExistingFolder() {
   return CLI::Validator(
       [](std::string& input) -> std::string {
         struct stat st;
-        if (stat(input.c_str(), &st) != 0)
-          return "'" + input + "': no such folder (" + std::strerror(errno) + ")";
+        if (stat(input.c_str(), &st) != 0) {
+          // (A folder behind one that may not be searched is there: "no such folder" was
+          // said of it too.)
+          const int err = errno;
+          return "'" + input + "': " +
+                 (err == ENOENT || err == ENOTDIR ? "no such folder" : "cannot be reached") + " (" +
+                 std::strerror(err) + ")";
+        }
         return S_ISDIR(st.st_mode) ? std::string() : "'" + input + "' is not a folder";
       },
       "DIR");

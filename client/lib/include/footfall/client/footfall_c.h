@@ -124,9 +124,10 @@ int32_t ffc_next(ffc_session* s, uint32_t terrain, const double* steps, size_t c
  * request_json: {"character": {...character file object...} or "character_file": PATH,
  *                "start": [x,y,z], "heading": [x,y,z], "path": [[x,y,z],...], "steps": N,
  *                "start_frame": F, "up": [x,y,z], "fps": F, "crowd": N, "crowd_spacing": D,
- *                "foot_rotations": true|false}
+ *                "foot_rotations": true|false, "scale": S, "unit": UNIT}
  * (keys as the command's flags; steps 0 to 1e6, crowd 1 to 1e6, crowd_spacing 0 for the
- * default; foot_rotations: each foot key of the walk JSON also has its "rotation"; nesting
+ * default; foot_rotations: each foot key of the walk JSON also has its "rotation"; scale as
+ * --scale, the character's lengths multiplied; unit as --unit, the walk's linear unit; nesting
  * deeper than 32 levels is refused; the character file must be a regular file).
  * On FF_C_OK and on a walk that stopped early, *walk_json receives the walk as footfall's JSON
  * (release it with ffc_free_string); a walk that stopped early returns FF_C_NO_FOOTHOLD,
