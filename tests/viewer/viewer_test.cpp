@@ -572,6 +572,30 @@ TEST_CASE("a window too small for the overlay still shows the terrain", "[viewer
   }
 }
 
+TEST_CASE("markers shrink in a tiny window and leave the terrain in view", "[viewer][walk]") {
+  // Markers of a fixed pixel size covered a 7 x 3 screenshot whole, and most of 60 x 40.
+  const std::string dir = test::TempDir();
+  test::WriteFile(dir + "/walk.json", WalkJson());
+  for (const std::string size : {"60x40", "24x24"}) {
+    INFO(size);
+    const RunResult bare =
+        View({"--terrain", kTerrain, "--size", size, "--screenshot", dir + "/bare.png"});
+    REQUIRE(bare.exit_code == 0);
+    const RunResult walk = View({"--terrain", kTerrain, "--walk", dir + "/walk.json", "--frame",
+                                 "13", "--size", size, "--screenshot", dir + "/walk.png"});
+    INFO(walk.err);
+    REQUIRE(walk.exit_code == 0);
+    const Image a = ReadPng(dir + "/bare.png"), b = ReadPng(dir + "/walk.png");
+    REQUIRE((a.width == b.width && a.height == b.height));
+    int changed = 0;
+    for (int y = 0; y < a.height; ++y)
+      for (int x = 0; x < a.width; ++x) changed += !Near(a.At(x, y), b.At(x, y), 3);
+    INFO(changed << " of " << a.width * a.height << " pixels changed by the walk");
+    CHECK(changed > 0);                            // the walk is drawn
+    CHECK(changed < a.width * a.height * 3 / 10);  // and leaves most of the terrain
+  }
+}
+
 TEST_CASE("scenes a few centimetres across are framed to their size", "[viewer][camera]") {
   // (Framing took a radius of at least 0.5 m: a terrain or a walk of 4 cm was a dot.)
   const std::string dir = test::TempDir();

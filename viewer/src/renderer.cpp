@@ -18,11 +18,12 @@ layout(location = 1) in vec4 a_color;
 layout(location = 2) in float a_size;
 uniform mat4 u_mvp;
 uniform float u_point_scale;
+uniform float u_pixel_scale;
 out vec4 v_color;
 void main() {
   gl_Position = u_mvp * vec4(a_position, 1.0);
   v_color = a_color;
-  gl_PointSize = a_size > 0.0 ? a_size
+  gl_PointSize = a_size > 0.0 ? max(a_size * u_pixel_scale, 1.0)
                               : clamp(-a_size * u_point_scale / max(gl_Position.w, 1e-30), 1.0, 64.0);
 }
 )";
@@ -49,7 +50,10 @@ bool Compile(GLuint shader, const char* source, std::string* error) {
 
 struct Renderer::Gl {
   GLuint program = 0, vao = 0, stream = 0, terrain = 0;
-  GLint mvp = -1, point_scale = -1;
+  GLint mvp = -1, point_scale = -1, pixel_scale = -1;
+  // Sizes given in pixels (markers) times this: 1 in a view of kFullMarkerPixels and more
+  // across, less in a smaller one, where full-size markers covered the scene.
+  float marker_scale = 1;
   GLsizei terrain_count = 0;
 
   ~Gl() {
@@ -85,6 +89,7 @@ struct Renderer::Gl {
     glUseProgram(program);
     glUniformMatrix4fv(mvp, 1, GL_FALSE, glm::value_ptr(mvp_matrix));
     glUniform1f(point_scale, scale);
+    glUniform1f(pixel_scale, marker_scale);
   }
 };
 
@@ -115,6 +120,7 @@ bool Renderer::Init(std::string* error) {
   }
   gl_->mvp = glGetUniformLocation(gl_->program, "u_mvp");
   gl_->point_scale = glGetUniformLocation(gl_->program, "u_point_scale");
+  gl_->pixel_scale = glGetUniformLocation(gl_->program, "u_pixel_scale");
   glGenVertexArrays(1, &gl_->vao);
   glGenBuffers(1, &gl_->stream);
   glGenBuffers(1, &gl_->terrain);
@@ -130,6 +136,9 @@ void Renderer::SetTerrain(const std::vector<DrawVertex>& points) {
 }
 
 void Renderer::Begin(int width, int height, Rgba background) {
+  constexpr float kFullMarkerPixels = 320;
+  gl_->marker_scale =
+      std::min(1.0f, static_cast<float>(std::min(width, height)) / kFullMarkerPixels);
   glViewport(0, 0, width, height);
   glClearColor(background.r / 255.0f, background.g / 255.0f, background.b / 255.0f, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);

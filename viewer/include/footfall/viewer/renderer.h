@@ -26,7 +26,8 @@ class Renderer {
   // Keeps `points` (render space) in a static buffer drawn by DrawTerrain.
   void SetTerrain(const std::vector<DrawVertex>& points);
 
-  // Clears the bound framebuffer's width x height viewport to `background`.
+  // Clears the bound framebuffer's width x height viewport to `background`. Sizes given in
+  // pixels (markers) are drawn smaller in a view under 320 pixels across, in proportion.
   void Begin(int width, int height, Rgba background);
   // Draws the static terrain points, depth tested.
   void DrawTerrain(const glm::mat4& view_projection, float point_scale);
