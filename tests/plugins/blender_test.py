@@ -1451,8 +1451,8 @@ class BlenderAddonTest(unittest.TestCase):
         self.assertIs(settings.rig, rig)  # (the Rig field still refers to it)
         with self.assertRaises(RuntimeError) as e:
             bpy.ops.footfall.generate_walk()
-        self.assertIn("the rig doomed_rig is no longer in the scene: run Character Setup",
-                      str(e.exception))
+        self.assertIn("the rig doomed_rig is not in this scene (deleted from it, or another "
+                      "scene's): run Character Setup here", str(e.exception))
         for obj in list(feet.values()) + [body]:
             self.assertEqual(fcurve_keys(obj, "location", 3), {}, obj.name)
         settings.rig = None
@@ -1620,7 +1620,8 @@ class BlenderAddonTest(unittest.TestCase):
             bpy.ops.object.delete()
             with self.assertRaises(ValueError) as e:
                 self.ops.walk_request(bpy.context, rig, 4, 1)
-            self.assertIn("is no longer in the scene", str(e.exception))
+            self.assertIn("is not in this scene (deleted from it, or another scene's)",
+                          str(e.exception))
         finally:
             settings.path = None
 

@@ -668,8 +668,9 @@ def walk_request(context, rig_obj, steps, start_frame):
         request["foot_rotations"] = True
     if settings.path is not None:
         if not in_scene(context.scene, settings.path):
-            raise ValueError("the path curve %s is no longer in the scene: pick another path, or "
-                             "clear the Path field" % settings.path.name)
+            raise ValueError("the path curve %s is not in this scene (deleted from it, or "
+                             "another scene's): pick another path, or clear the Path field"
+                             % settings.path.name)
         request["path"] = [list(to_ff(p, scale)) for p in curve_points(context, settings.path)]
     return request
 
@@ -803,8 +804,9 @@ def walk_rig(context):
     if rig_obj is None or not rig_obj.footfall_rig.is_rig:
         raise ValueError("no rig: select one, or run Character Setup first")
     if not in_scene(context.scene, rig_obj):
-        raise ValueError("the rig %s is no longer in the scene: run Character Setup"
-                         % rig_obj.name)
+        # (Said "no longer in the scene" of a rig of another scene too, which never was.)
+        raise ValueError("the rig %s is not in this scene (deleted from it, or another "
+                         "scene's): run Character Setup here" % rig_obj.name)
     return rig_obj
 
 
