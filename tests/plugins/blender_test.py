@@ -1851,21 +1851,27 @@ class BlenderAddonTest(unittest.TestCase):
         self.assertEqual(bpy.ops.footfall.generate_walk(), {"FINISHED"})
         self.assert_keys_equal_walk(self.cli_walk(rig, 4, "biped_4_after_import")[0], feet, body)
 
+    def path_curve(self, name, points):
+        """A poly curve through `points` (Blender world), linked to the scene and set as the
+        Path: (object, curve data), for the caller to remove."""
+        data = bpy.data.curves.new(name, "CURVE")
+        data.dimensions = "3D"
+        spline = data.splines.new("POLY")
+        spline.points.add(len(points) - 1)
+        for point, co in zip(spline.points, points):
+            point.co = tuple(co) + (1.0,)
+        path = bpy.data.objects.new(name, data)
+        bpy.context.scene.collection.objects.link(path)
+        bpy.context.scene.footfall.path = path
+        return path, data
+
     def test_8c_keys_after_a_walk_that_ends_early_stay(self):
         # A path walk that reaches its goal long before Steps end: its end was taken as the
         # start plus Steps, and the user's keys up to there were removed (and that end kept for
         # the next walk).
         rig, feet, body, settings = self.biped_walk_setup(40)
         start = body.matrix_world.translation.copy()
-        data = bpy.data.curves.new("short_path", "CURVE")
-        data.dimensions = "3D"
-        spline = data.splines.new("POLY")
-        spline.points.add(1)
-        spline.points[0].co = (start.x, start.y, start.z, 1.0)
-        spline.points[1].co = (start.x, start.y + 2.0, start.z, 1.0)
-        path = bpy.data.objects.new("short_path", data)
-        bpy.context.scene.collection.objects.link(path)
-        settings.path = path
+        path, data = self.path_curve("short_path", [start, start + Vector((0.0, 2.0, 0.0))])
         user_frame = 400
         try:
             body.keyframe_insert("location", frame=user_frame)
@@ -1894,15 +1900,8 @@ class BlenderAddonTest(unittest.TestCase):
         # A one-point curve was refused ("fewer than 2 points"); the command line takes one
         # waypoint as the goal.
         rig, feet, body, settings = self.biped_walk_setup(40)
-        start = body.matrix_world.translation.copy()
-        data = bpy.data.curves.new("goal_path", "CURVE")
-        data.dimensions = "3D"
-        spline = data.splines.new("POLY")
-        goal = (start.x, start.y + 2.0, start.z)
-        spline.points[0].co = goal + (1.0,)
-        path = bpy.data.objects.new("goal_path", data)
-        bpy.context.scene.collection.objects.link(path)
-        settings.path = path
+        goal = body.matrix_world.translation + Vector((0.0, 2.0, 0.0))
+        path, data = self.path_curve("goal_path", [goal])
         try:
             bpy.context.view_layer.update()
             self.assertEqual(len(self.ops.walk_request(bpy.context, rig, 4, 1)["path"]), 1)
@@ -1913,7 +1912,7 @@ class BlenderAddonTest(unittest.TestCase):
             self.assertGreater(len(body_keys), 2)
             # The body ends within a step of the goal, across the ground.
             end = Vector(from_ff(body_keys[-1]["position"]))
-            self.assertLess((end - Vector(goal)).xy.length, 0.8)
+            self.assertLess((end - goal).xy.length, 0.8)
         finally:
             settings.path = None
             bpy.data.objects.remove(path)
