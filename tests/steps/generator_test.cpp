@@ -3,6 +3,7 @@
 // the invariants of walk_checks.h.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -417,6 +418,36 @@ TEST_CASE("A goal off the terrain is reached across the ground whatever its heig
       CHECK(across <= 0.5 * c.step_length / std::cos(rad) + 1e-9);
     }
   }
+}
+
+TEST_CASE("A trotting quadruped's body does not rock from side to side over curved ground",
+          "[steps][generator]") {
+  // The plane fitted to a diagonal gait's feet leans one way after one pair steps and the
+  // other way after the next on curved ground: down a sphere the body rolled 8 to 10 degrees
+  // each step, the other way each time. The body's up is the fit over the gait's cycle.
+  const Character c = LoadShipped("quadruped");
+  const double radius = 3, spacing = 0.04;
+  const int count = static_cast<int>(4 * kPi * radius * radius / (spacing * spacing));
+  Terrain t = LoadTerrain(MakeSphere(count, {0, 0, 0}, radius), spacing);
+  const GenerateOptions o = StartOptions({0, 2 * radius, 0}, 30);
+  const Walk w = Generate(t, c, o);
+  INFO(w.stopped);
+  CheckWalk(t, c, o, w);
+  const auto& turns = Body(w).rotations;
+  REQUIRE(turns.size() > 20);
+  int flips = 0;
+  double most = 0, before = 0;
+  for (size_t i = 1; i < turns.size(); ++i) {
+    // The roll from one key to the next: the new up along the old left.
+    const Vec3 left = Rotate(turns[i - 1], {1, 0, 0});
+    const double roll = std::asin(std::clamp(Dot(BodyUp(turns[i]), left), -1.0, 1.0)) * 180 / kPi;
+    most = std::max(most, std::fabs(roll));
+    if (std::fabs(roll) > 1.5 && std::fabs(before) > 1.5 && roll * before < 0) ++flips;
+    before = roll;
+  }
+  INFO(flips << " rolls the other way from the key before; the largest " << most << " deg");
+  CHECK(flips <= 2);
+  CHECK(most < 5);
 }
 
 TEST_CASE("A goal on the far side of a sphere is walked to, not reached where the walk starts",

@@ -72,6 +72,10 @@ Vec3 Generator::BodyUp(const Vec3& feet_up, const std::vector<Vec3>& feet) const
   return FittedPlaneNormal(feet.data(), feet.size(), feet_up);
 }
 
+Vec3 Generator::GaitCycleUp(const Vec3& before, const Vec3& after) {
+  return Dot(before, after) > 0 ? NormalizeOr(before + after, after) : after;
+}
+
 class Generator::Progress {
  public:
   // `total` units of work, reported scaled down to fit an int.

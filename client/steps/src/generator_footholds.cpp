@@ -751,7 +751,7 @@ void Generator::CheckReach(size_t m, size_t e) {
     after_normals[f] = moving ? moves[m + slot[f]].end_normal : a.foot_normal[f];
     centroid += after[f];
   }
-  const Vec3 up = BodyUp(FeetUp(a.up, after, after_normals), after);
+  const Vec3 up = GaitCycleUp(a.fitted_up, BodyUp(FeetUp(a.up, after, after_normals), after));
   const Vec3 body = centroid / static_cast<double>(feet) + up * c_.body_height;
   for (size_t i = m; i < e; ++i) {
     const double dist = Distance(moves[i].end, body);

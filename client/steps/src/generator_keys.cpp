@@ -274,7 +274,9 @@ void Generator::Finish(size_t w, int k) {
   a.ground = centroid / static_cast<double>(a.foot.size());
   const Vec3 old_up = a.up;
   a.up = FeetUp(a.up, a.foot, a.foot_normal);
-  a.body_up = BodyUp(a.up, a.foot);
+  const Vec3 fitted = BodyUp(a.up, a.foot);
+  a.body_up = GaitCycleUp(a.fitted_up, fitted);
+  a.fitted_up = fitted;
   a.forward = TangentForward(a.forward, a.forward, old_up, a.up);
   body_frame_[w] = f1;  // keyed by KeyBodies at the end of the step
 }

@@ -728,7 +728,7 @@ std::string Generator::Plant(Agent& a, const Foothold* feet) const {
   }
   const Vec3 old_up = a.up;
   a.up = AveragedUp(a.up, a.foot_normal);
-  a.body_up = BodyUp(a.up, a.foot);
+  a.body_up = a.fitted_up = BodyUp(a.up, a.foot);
   a.forward = TangentForward(a.forward, a.forward, old_up, a.up);
   a.ground = centroid / static_cast<double>(n);
   for (size_t f = 0; f < n; ++f) {

@@ -152,7 +152,8 @@ struct Agent {
   bool left_out = false;                // a crowd's character starting on another: no tracks
   Vec3 ground;                          // the body's ground point: centroid of the planted feet
   Vec3 up;                              // the up of the feet's frame (FeetUp)
-  Vec3 body_up;                         // the body's up (BodyUp)
+  Vec3 body_up;                         // the body's up (GaitCycleUp)
+  Vec3 fitted_up;                       // BodyUp of the feet as they stand
   Vec3 forward;                         // the body's heading, unit, perpendicular to up
   std::vector<Vec3> foot, foot_normal;  // planted feet
   std::vector<Vec3> path;
@@ -519,6 +520,13 @@ class Generator {
   // not a tread's or a riser's), on the side of `feet_up`, which it falls back to for feet in a
   // line or a plane leaning more than 60 degrees from it.
   Vec3 BodyUp(const Vec3& feet_up, const std::vector<Vec3>& feet) const;
+  // The body's up after a step: halfway between the plane fitted to the feet before it
+  // (`before`) and after it (`after`), as long as they lie within 90 degrees of each other,
+  // else `after`. A diagonal gait's feet, fitted one phase at a time on curved ground, lean
+  // the plane to one side and then the other: a trotting quadruped's body rocked 8 to 10
+  // degrees each step down a sphere or over a ramp's change of slope, where the fits of two
+  // phases in a row lean as much either way.
+  static Vec3 GaitCycleUp(const Vec3& before, const Vec3& after);
   void KeyFoot(const Agent& a, int foot, double frame, KeyPhase phase, const Vec3& p,
                const Vec3& n);
   // Keys a's body at `frame`, `raise` above its place along its up.
