@@ -39,6 +39,34 @@ TEST_CASE("Any heading, not only +Z", "[steps][generator]") {
   CHECK(Dot(BodyForward(Body(w).rotations.back()), want) > 0.999);
 }
 
+TEST_CASE("A biped heading across a cliff's edge stops there, not crabbing along it",
+          "[steps][generator]") {
+  // Heading at 30 to 60 degrees to the edge of a flat terrain (8 m, 4 cm samples), the biped
+  // reached the edge and walked along it, facing the drop, its feet closing in on each other.
+  const Character c = LoadShipped("biped");
+  Terrain t = LoadTerrain(MakeFlat(200, 0.04, 0), 0.04);
+  for (const double degrees : {30.0, 45.0, 60.0}) {
+    INFO(degrees << " degrees to the edge at z = 7.96");
+    const double r = degrees * kPi / 180;
+    GenerateOptions o = StartOptions({2, 0, 6}, 24);
+    o.heading = {std::cos(r), 0, std::sin(r)};
+    const Walk walk = Generate(t, c, o);
+    CheckWalk(t, c, o, walk);
+    CHECK_THAT(walk.stopped, Catch::Contains("the terrain ends"));
+    // Every step of the body goes the way it faces (within the 40 degrees a foothold may lie
+    // aside of its step).
+    const auto& keys = Body(walk).keys;
+    const auto& turns = Body(walk).rotations;
+    REQUIRE(keys.size() > 3);
+    for (size_t i = 1; i < keys.size(); ++i) {
+      const Vec3 moved = keys[i].position - keys[i - 1].position;
+      if (Length(moved) < 0.02) continue;
+      INFO("body key " << i << " moved " << Length(moved));
+      CHECK(Dot(Normalize(moved), BodyForward(turns[i])) > std::cos(45 * kPi / 180));
+    }
+  }
+}
+
 TEST_CASE("The heading follows a path with a 90-degree turn", "[steps][generator]") {
   for (const std::string& name : ShippedCharacters()) {
     const Character c = LoadShipped(name);

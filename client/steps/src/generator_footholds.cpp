@@ -440,6 +440,14 @@ Status Generator::QueryFootholds(std::string* error) {
                 locator_[m] -= across * (off / keep);
               else if (ClimbedAside(h, placed, a, lean, off))
                 locator_[m] -= left * off;
+              else if (lean < kFlatLean && std::fabs(off) > gap_ &&
+                       std::fabs(Dot(h.point - placed, a.up) + 0.5 * lead_) <= 0.5 * gap_)
+                // Snapped aside across level ground, by more than two spacings, at the
+                // height the place stands over: no ground under the place, beyond the edge
+                // of the ground beside it. It keeps its place, as over a gap (kept on the
+                // edge, it drew the feet of a biped heading at 25 to 60 degrees to a cliff's
+                // edge along it, crabbing, their stance closing to a third).
+                locator_[m] = placed - a.up * (0.5 * lead_), locator_normal_[m] = a.up;
             }
           } else {
             locator_[m] = placed - a.up * (0.5 * lead_), locator_normal_[m] = a.up;
@@ -555,12 +563,22 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
   // A step aimed down is judged on the progress it was aimed to make.
   const Vec3 intended = mv.step + a.up * (mv.attempt.drop * c_.max_rise);
   double progress = 1;
+  bool sideways = false;
   if (h.status == Status::kOk) {
     const Vec3 along = ProjectOnPlane(intended, h.normal);
-    if (Length2(along) >= 0.25 * Length2(intended))
-      progress = Dot(h.point - foot, along) / Length2(along);
+    if (Length2(along) >= 0.25 * Length2(intended)) {
+      const Vec3 moved = ProjectOnPlane(h.point - foot, h.normal);
+      progress = Dot(moved, along) / Length2(along);
+      // An upright character's, nor heading more than kMaxSidewaysDeg off the step: along a
+      // cliff's edge at 45 degrees to the step, a foothold made just half the progress, and a
+      // biped heading at that angle to the edge crabbed along it. (Multipeds turning on the
+      // spot or along beams and blocks take footholds farther aside.)
+      const Vec3 across = moved - along * progress;
+      sideways = !c_.align_to_normal &&
+                 Length(across) > std::tan(Radians(kMaxSidewaysDeg)) * progress * Length(along);
+    }
   }
-  const bool found = h.status == Status::kOk && progress >= 0.5;
+  const bool found = h.status == Status::kOk && progress >= 0.5 && !sideways;
   const double rise = found ? Dot(h.point - foot, a.up) : 0;
   const double rise_limit = c_.max_rise * (1 + kRiseRounding);
   if (found && std::fabs(rise) <= rise_limit && Dot(h.normal, a.up) >= cos_max_slope_) {
@@ -579,14 +597,19 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
   if (!found) {
     // Past the terrain's bounds by more than the radius, no sample can be a foothold.
     const double radius = kFootholdTolerance * c_.step_length;
-    const bool beyond = BoxDistance(mv.ideal, bounds_min_, bounds_max_) > radius;
-    why << "no foothold within " << radius << " of " << Point(mv.ideal)
-        << (beyond ? " (the terrain ends, or rises as a wall at its bounds, before it)"
+    // (One aside of the step: past the bounds at all, where the nearest lies on their edge.)
+    const bool aside = sideways && progress >= 0.5;
+    const bool beyond = BoxDistance(mv.ideal, bounds_min_, bounds_max_) > (aside ? 0 : radius);
+    why << "no foothold within " << radius << " of " << Point(mv.ideal);
+    // The nearest lay aside of the step, along the edge of the ground beyond which it aims.
+    if (sideways && progress >= 0.5)
+      why << " ahead (the nearest, " << Point(h.point) << ", lies aside)";
+    why << (beyond ? " (the terrain ends, or rises as a wall at its bounds, before it)"
                    : " (a gap or a cliff)");
     // Samples spread wider than half that radius leave gaps everywhere: say so, unless the
     // terrain simply ends there or resampling would not bring them closer.
     const double spacing = 0.5 * gap_;
-    if (!beyond && spacing > 0.5 * kFootholdTolerance * c_.step_length &&
+    if (!beyond && !aside && spacing > 0.5 * kFootholdTolerance * c_.step_length &&
         kSeparationPerStep * c_.step_length < 0.8 * spacing) {
       why << "; the terrain's samples lie about " << spacing
           << " apart, too far for this character: resample it at a separation of "

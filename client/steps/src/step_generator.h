@@ -124,6 +124,9 @@ inline constexpr int kTurnShares = 8;
 // Ground whose up lies within this many degrees of the world up is a floor for path walks:
 // waypoints off the terrain are aimed at across it, their height along the world up ignored.
 inline constexpr double kFloorUpDeg = 60;
+// [Units: deg] How far off its step's direction, along its ground, a foothold may lie
+// (Generator::Judge).
+inline constexpr double kMaxSidewaysDeg = 40;
 inline constexpr double kMinPairGap = 0.5;
 // A step shorter than this fraction of step_length is a step in place: no foothold query.
 inline constexpr double kInPlace = 0.02;
