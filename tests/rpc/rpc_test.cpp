@@ -2610,6 +2610,36 @@ TEST_CASE("a client loading and unloading in a loop cannot flood footfalld's log
   CHECK(lines <= 100 + 10 * (elapsed + 2));
 }
 
+TEST_CASE("clients that load and close in a loop cannot flood footfalld's log",
+          "[rpc][robustness]") {
+  // Each closed connection's terrain wrote an "orphaned" line, and each freed orphan another,
+  // without a budget: a client loading and closing in a loop wrote megabytes a second. They
+  // have a budget of their own, as the load lines' (100 at once, 10 a second).
+  ServerProcess server(0, {"--no-rpcbind", "--orphan-timeout", "1"});
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < 300; ++i) {
+    auto rpc = ConnectLeavingOrphans(server.port());
+    TerrainHandle t = 0;
+    REQUIRE(rpc->LoadSamples(MakeFlat(2, 1, 0), "tiny", &t) == Status::kOk);
+  }  // each connection closed with its terrain loaded: an orphan, freed a second later
+  CHECK(WaitFor([&] {
+    return server.Log().find(
+               " lines (orphaned, freed and dropped terrains and uploads) not "
+               "written in the last ") != std::string::npos;
+  }));
+  RequireServed(server.port());
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // the orphans freed
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::string log = server.Log();
+  size_t lines = 0;
+  for (const char* what : {" orphaned: ", "footfalld: freed orphaned terrain "})
+    for (size_t at = log.find(what); at != std::string::npos; at = log.find(what, at + 1)) ++lines;
+  INFO(lines << " orphaned and freed lines in " << elapsed << " s");
+  CHECK(lines >= 100);
+  CHECK(lines <= 100 + 10 * (elapsed + 2));
+}
+
 TEST_CASE("a client sending costly batches cannot flood footfalld's log", "[rpc][robustness]") {
   // Every batch cut at --batch-time-limit wrote a line: far snaps, sent again and again, wrote
   // about 100 lines a second. They share the error lines' budget: 100 at once, 10 a second.

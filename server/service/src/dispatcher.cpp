@@ -91,12 +91,13 @@ void DropClient(const Connection& connection,
                 const char* how = "the connection that loaded it closed") {
   std::vector<std::string> uploads;
   for (const uint32_t handle : g_state->registry.DropClient(connection.id, &uploads))
-    Log("terrain " + std::to_string(handle) + " orphaned: " + how + "; it is freed after " +
-        SecondsText(g_state->registry.limits().orphan_idle_s) + " without queries");
+    LogLifeLimited("terrain " + std::to_string(handle) + " orphaned: " + how +
+                   "; it is freed after " + SecondsText(g_state->registry.limits().orphan_idle_s) +
+                   " without queries");
   for (const std::string& upload : uploads)
-    Log(upload +
-        " dropped: the connection that began it closed before it finished; its "
-        "samples are freed");
+    LogLifeLimited(upload +
+                   " dropped: the connection that began it closed before it finished; its "
+                   "samples are freed");
 }
 
 // [Units: s] How long a batch of the connection of `transport` may take before its remaining
@@ -208,15 +209,16 @@ bool_t XdrLoadOptionsArgs(XDR* xdrs, LoadOptionsArgs* a) {
 // Logs the uploads the registry dropped for receiving no samples for --upload-timeout.
 void LogExpiredUploads() {
   for (const std::string& upload : g_state->registry.TakeExpiredUploads())
-    Log(upload + " dropped: no samples for " +
-        SecondsText(g_state->registry.limits().upload_idle_s) +
-        " (--upload-timeout); its samples are freed and its client must upload again");
+    LogLifeLimited(upload + " dropped: no samples for " +
+                   SecondsText(g_state->registry.limits().upload_idle_s) +
+                   " (--upload-timeout); its samples are freed and its client must upload again");
 }
 
 // Logs the orphans the registry freed early to make room for a new terrain or upload.
 void LogEvicted() {
   for (const uint32_t handle : g_state->registry.TakeEvicted())
-    Log("freed orphaned terrain " + std::to_string(handle) +
+    LogLifeLimited(
+        "freed orphaned terrain " + std::to_string(handle) +
         " early, to make room for a new one (at the terrain limit or the sample budget, the "
         "least recently queried orphan goes)");
 }
@@ -286,8 +288,9 @@ void CancelAbandonedLoads() {
     SendHeldReply(ticket, reinterpret_cast<xdrproc_t>(xdr_ff_load_reply), nullptr);
     g_state->registry.DropLoad(withdrawn.get());
     it = g_load_tickets.erase(it);  // before the log line, which may run out of memory
-    Log(std::string(withdrawn->upload ? "upload" : "load of") + " '" + withdrawn->relative_path +
-        "' cancelled: its connection closed while it waited its turn");
+    LogLifeLimited(std::string(withdrawn->upload ? "upload" : "load of") + " '" +
+                   withdrawn->relative_path +
+                   "' cancelled: its connection closed while it waited its turn");
   }
 }
 
@@ -967,8 +970,8 @@ void AnswerLoad(PendingLoad* load, uint64_t ticket, uint32_t* handle) {
   if (!HeldReplyOpen(ticket)) {
     SendHeldReply(ticket, FF_XDR(ff_load_reply), nullptr);  // releases the ticket
     g_state->registry.DropLoad(load);
-    Log(std::string(load->upload ? "upload" : "load of") + " '" + load->relative_path +
-        "' dropped: its connection closed before it finished");
+    LogLifeLimited(std::string(load->upload ? "upload" : "load of") + " '" + load->relative_path +
+                   "' dropped: its connection closed before it finished");
     return;
   }
   ff_load_reply r{};
@@ -1020,8 +1023,8 @@ void ExpireIdle() {
   g_state->registry.ExpireUploads();
   LogExpiredUploads();
   for (const uint32_t handle : g_state->registry.ExpireOrphans())
-    Log("freed orphaned terrain " + std::to_string(handle) + " after " +
-        SecondsText(g_state->registry.limits().orphan_idle_s) + " without queries");
+    LogLifeLimited("freed orphaned terrain " + std::to_string(handle) + " after " +
+                   SecondsText(g_state->registry.limits().orphan_idle_s) + " without queries");
 }
 
 namespace {

@@ -64,6 +64,7 @@ struct LineBudget {
 };
 LineBudget g_error_lines{"errors, batches past their time limit"};
 LineBudget g_load_lines{"loads and unloads"};
+LineBudget g_life_lines{"orphaned, freed and dropped terrains and uploads"};
 
 // True when a line of `budget` may be written now; false counts it as unwritten.
 bool TakeLine(LineBudget& budget) {
@@ -148,8 +149,12 @@ void LogLoadLimited(const std::string& line) {
   if (TakeLine(g_load_lines)) std::fprintf(stderr, "footfalld: %s\n", EscapeControl(line).c_str());
 }
 
+void LogLifeLimited(const std::string& line) {
+  if (TakeLine(g_life_lines)) std::fprintf(stderr, "footfalld: %s\n", EscapeControl(line).c_str());
+}
+
 void ReportUnwrittenErrors() {
-  for (LineBudget* budget : {&g_error_lines, &g_load_lines}) {
+  for (LineBudget* budget : {&g_error_lines, &g_load_lines, &g_life_lines}) {
     std::lock_guard<std::mutex> lock(budget->mutex);
     if (budget->unwritten == 0) continue;
     const double seconds =

@@ -40,6 +40,11 @@ void LogLimited(const std::string& line);
 // second; many loads in a row must not use up the error lines' budget).
 void LogLoadLimited(const std::string& line);
 
+// Writes a line of a terrain's or an upload's end that a client going away causes ("orphaned",
+// "freed orphaned terrain", an upload or a load "dropped" or "cancelled") within a budget of its
+// own, as LogLimited's (a client loading and closing in a loop wrote megabytes a second).
+void LogLifeLimited(const std::string& line);
+
 // Says in one line how many rate-limited lines were not written since the first of them, if
 // any. Call about once a second.
 void ReportUnwrittenErrors();
