@@ -602,8 +602,7 @@ void Generator::Judge(Move& mv, const Foothold& h) const {
     const bool beyond = BoxDistance(mv.ideal, bounds_min_, bounds_max_) > (aside ? 0 : radius);
     why << "no foothold within " << radius << " of " << Point(mv.ideal);
     // The nearest lay aside of the step, along the edge of the ground beyond which it aims.
-    if (sideways && progress >= 0.5)
-      why << " ahead (the nearest, " << Point(h.point) << ", lies aside)";
+    if (aside) why << " ahead (the nearest, " << Point(h.point) << ", lies aside)";
     why << (beyond ? " (the terrain ends, or rises as a wall at its bounds, before it)"
                    : " (a gap or a cliff)");
     // Samples spread wider than half that radius leave gaps everywhere: say so, unless the
