@@ -603,6 +603,63 @@ TEST_CASE("Connections sending costly batches share --batch-time-limit so others
                                            "sending costly batches"));
 }
 
+TEST_CASE("A connection whose batch was cut waits while the clients ready meanwhile are served",
+          "[rpc][robustness]") {
+  // A costly connection's next batch, in with a ping sent during its cut batch, was served first
+  // whenever its socket's number was the lower: the ping waited two time limits, not one. Here
+  // the costly connection is the first, and sends its next batch before the ping.
+  ServerProcess server(0, {"--no-rpcbind", "--threads", "1", "--batch-time-limit", "0.25"});
+  auto loader = Connect(server.port(), 60);
+  TerrainHandle t = 0;
+  REQUIRE(loader->LoadSamples(MakeFlat(300, 0.1, 0), "flat", &t) == Status::kOk);
+  std::vector<unsigned char> args;
+  Put32(&args, OnlyServerTerrain(server.port()));
+  const std::vector<ff_vec3> far = FarSnaps();
+  Put32(&args, static_cast<uint32_t>(far.size()));
+  for (const ff_vec3& p : far) PutDouble(&args, p.x), PutDouble(&args, p.y), PutDouble(&args, p.z);
+  const int costly = RawConnect(server.port());  // the lower socket number
+  const int pinger = RawConnect(server.port());
+  auto send_all = [](int fd, const std::vector<unsigned char>& bytes) {
+    for (size_t sent = 0; sent < bytes.size();) {
+      const ssize_t n = send(fd, bytes.data() + sent, bytes.size() - sent, MSG_NOSIGNAL);
+      REQUIRE(n > 0);
+      sent += static_cast<size_t>(n);
+    }
+  };
+  std::vector<unsigned char> two = CallRecord(1, FF_SNAP_BATCH, args);
+  const std::vector<unsigned char> next = CallRecord(2, FF_SNAP_BATCH, args);
+  two.insert(two.end(), next.begin(), next.end());
+  send_all(costly, two);
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the first batch under way
+  send_all(pinger, CallRecord(3, FF_NULL, {}));
+  // Whole reply records, in the order they arrive.
+  std::vector<std::string> order;
+  std::vector<unsigned char> buffer;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (order.size() < 3 && std::chrono::steady_clock::now() < deadline) {
+    pollfd fds[2] = {{costly, POLLIN, 0}, {pinger, POLLIN, 0}};
+    REQUIRE(poll(fds, 2, 1000) >= 0);
+    for (const pollfd& p : fds) {
+      if (!(p.revents & POLLIN)) continue;
+      bool last = false;
+      while (!last) {
+        unsigned char mark[4];
+        REQUIRE(recv(p.fd, mark, 4, MSG_WAITALL) == 4);
+        last = (mark[0] & 0x80) != 0;
+        const size_t length = (static_cast<size_t>(mark[0] & 0x7f) << 24) |
+                              (static_cast<size_t>(mark[1]) << 16) |
+                              (static_cast<size_t>(mark[2]) << 8) | mark[3];
+        buffer.resize(length);
+        REQUIRE(recv(p.fd, buffer.data(), length, MSG_WAITALL) == static_cast<ssize_t>(length));
+      }
+      order.push_back(p.fd == costly ? "batch" : "ping");
+    }
+  }
+  close(costly);
+  close(pinger);
+  CHECK(order == std::vector<std::string>{"batch", "ping", "batch"});
+}
+
 TEST_CASE("A batch of costly queries keeps to --batch-time-limit within a few milliseconds",
           "[rpc][robustness]") {
   // Snaps from 1e10 above flat ground of 640,000 samples: each compares them all, milliseconds

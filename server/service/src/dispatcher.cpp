@@ -115,10 +115,14 @@ double BatchSliceSeconds(SVCXPRT* transport) {
   return g_state->batch_time_limit_s / costly;
 }
 
+// The sockets whose batches were cut at their time limit in this turn (ServeCutLast).
+std::vector<int> g_cut_this_turn;
+
 // Notes that a batch of the connection of `transport` was cut at its time limit.
 void NoteBatchCut(SVCXPRT* transport) {
   const auto it = g_state->connections.find(transport->xp_fd);
   if (it != g_state->connections.end()) it->second.last_cut = std::chrono::steady_clock::now();
+  g_cut_this_turn.push_back(transport->xp_fd);
 }
 
 // The connection a request came on, registered on its first request.
@@ -1015,6 +1019,14 @@ void FinishLoads() {
     }
   }
   g_finished_loads.clear();  // (keeps its room for the next turn)
+}
+
+void ServeCutLast(std::vector<pollfd>* ready) {
+  if (g_cut_this_turn.empty()) return;
+  std::stable_partition(ready->begin(), ready->end(), [](const pollfd& p) {
+    return std::find(g_cut_this_turn.begin(), g_cut_this_turn.end(), p.fd) == g_cut_this_turn.end();
+  });
+  g_cut_this_turn.clear();
 }
 
 void ExpireIdle() {

@@ -1,6 +1,7 @@
 // The RPC dispatcher of footfalld (internal to footfall::service).
 #pragma once
 
+#include <poll.h>
 #include <rpc/rpc.h>
 
 #include <chrono>
@@ -8,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "footfall/service/terrain_registry.h"
 #include "load_queue.h"
@@ -65,6 +67,13 @@ void ReapConnections();
 // Replies to the server-side loads that have finished (LoadQueue::wake_fd() is readable),
 // adding their terrains. A load whose connection closed meanwhile is dropped, with a log line.
 void FinishLoads();
+
+// Moves the sockets of connections whose batch was cut at its time limit since the last call
+// to the end of `ready` (the sockets a turn serves, in order), so that the clients waiting
+// meanwhile are served before their next request; then forgets them. (svc_getreq_poll serves
+// in the order given, which was the sockets' numbers: a client connected after a costly one
+// waited two time limits whenever the costly one's next batch came in with its request.)
+void ServeCutLast(std::vector<pollfd>* ready);
 
 // Drops idle uploads and frees orphaned terrains left unqueried past their grace period, with a
 // log line each. Call about once a second.

@@ -291,6 +291,7 @@ void RpcServer::Run() {
       // svc_getreq_poll serves the first `count` entries with revents set, reading a request
       // from each: hand it only those whose reply fits.
       gate.Collect(fds, &readable);
+      ServeCutLast(&readable);
       if (!readable.empty()) {
         g_partial->Before(readable, listen_fd_);
         svc_getreq_poll(readable.data(), static_cast<int>(readable.size()));
