@@ -22,6 +22,7 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <initializer_list>
 #include <random>
 #include <sstream>
 #include <string>
@@ -2632,6 +2633,18 @@ TEST_CASE("an unknown terrain is said alike by every session, whatever the count
   }
 }
 
+namespace {
+
+// How many times the strings `whats` occur in `log`, together.
+size_t Occurrences(const std::string& log, std::initializer_list<const char*> whats) {
+  size_t count = 0;
+  for (const char* what : whats)
+    for (size_t at = log.find(what); at != std::string::npos; at = log.find(what, at + 1)) ++count;
+  return count;
+}
+
+}  // namespace
+
 TEST_CASE("a client loading and unloading in a loop cannot flood footfalld's log",
           "[rpc][robustness]") {
   // Each load and unload wrote a line: a tiny terrain loaded and unloaded in a loop wrote
@@ -2658,10 +2671,8 @@ TEST_CASE("a client loading and unloading in a loop cannot flood footfalld's log
            std::string::npos;
   }));
   CHECK(WaitFor([&] { return server.Log().find("error: snap") != std::string::npos; }));
-  const std::string log = server.Log();
-  size_t lines = 0;
-  for (const char* what : {"footfalld: loaded terrain ", "footfalld: unloaded terrain "})
-    for (size_t at = log.find(what); at != std::string::npos; at = log.find(what, at + 1)) ++lines;
+  const size_t lines =
+      Occurrences(server.Log(), {"footfalld: loaded terrain ", "footfalld: unloaded terrain "});
   INFO(lines << " load and unload lines in " << elapsed << " s");
   CHECK(lines >= 100);
   CHECK(lines <= 100 + 10 * (elapsed + 2));
@@ -2688,10 +2699,8 @@ TEST_CASE("clients that load and close in a loop cannot flood footfalld's log",
   std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // the orphans freed
   const double elapsed =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const std::string log = server.Log();
-  size_t lines = 0;
-  for (const char* what : {" orphaned: ", "footfalld: freed orphaned terrain "})
-    for (size_t at = log.find(what); at != std::string::npos; at = log.find(what, at + 1)) ++lines;
+  const size_t lines =
+      Occurrences(server.Log(), {" orphaned: ", "footfalld: freed orphaned terrain "});
   INFO(lines << " orphaned and freed lines in " << elapsed << " s");
   CHECK(lines >= 100);
   CHECK(lines <= 100 + 10 * (elapsed + 2));
